@@ -1,0 +1,34 @@
+"""symstab: symbolic derivation and verification of haptic-rendering stability.
+
+symstab re-derives, from the plant and the virtual environment, the stability
+boundary of a 1-DOF haptic device with a zero-order hold, a constant loop
+delay of ``d`` samples and a virtual mass-spring-damper (Mashayekhi et al.,
+IEEE Trans. Haptics, 2025), and checks the paper's printed equations against
+it.
+
+The modules follow the data flow: :mod:`~symstab.model` (symbols, plant,
+environment) -> :mod:`~symstab.discretize` (ZOH pulse transfer function) ->
+:mod:`~symstab.loop` (characteristic polynomial) ->
+:mod:`~symstab.unit_circle` -> :mod:`~symstab.boundary` (alpha(theta),
+beta(theta), C-coefficients) -> :mod:`~symstab.limits`,
+:mod:`~symstab.theta_max`; :mod:`~symstab.identity` is the exact equality
+checker and :mod:`~symstab.derive` writes everything out.
+"""
+
+from .boundary import boundary, coefficients
+from .discretize import dimensionless_pulse_transfer_function, pulse_transfer_function
+from .identity import IdentityResult, assert_identity, check_identity
+from .limits import small_theta_limits
+from .loop import characteristic_polynomial
+from .model import dimensionless_values
+from .theta_max import closed_form_d0, newton_form_gamma0, theta_max, theta_max_newton
+from .unit_circle import unit_circle_split
+
+__all__ = [
+    "boundary", "coefficients",
+    "pulse_transfer_function", "dimensionless_pulse_transfer_function",
+    "IdentityResult", "check_identity", "assert_identity",
+    "small_theta_limits", "characteristic_polynomial", "dimensionless_values",
+    "closed_form_d0", "newton_form_gamma0", "theta_max", "theta_max_newton",
+    "unit_circle_split",
+]

@@ -1,0 +1,80 @@
+"""Input validation, in one place, for every public entry point.
+
+Wrong kinds raise :class:`TypeError`; wrong values raise :class:`ValueError`
+whose message names the parameter and the allowed range.
+"""
+
+import math
+import numbers
+
+__all__ = ["check_real", "check_delay", "check_delay_samples"]
+
+
+def _describe_range(low, high, low_open, high_open):
+    if low is None and high is None:
+        return "a finite real number"
+    parts = []
+    if low is not None:
+        parts.append(f"{'>' if low_open else '>='} {low:g}")
+    if high is not None:
+        parts.append(f"{'<' if high_open else '<='} {high:g}")
+    return "a finite real number " + " and ".join(parts)
+
+
+def check_real(name, value, *, low=None, high=None, low_open=False, high_open=False):
+    """Return ``value`` as a float after checking it is finite and in range.
+
+    Raises
+    ------
+    TypeError
+        If ``value`` is not a real number (bool and complex included).
+    ValueError
+        If ``value`` is NaN, infinite or outside the range.
+    """
+    if isinstance(value, bool) or not isinstance(value, numbers.Real):
+        raise TypeError(f"{name} must be a real number, got {type(value).__name__}")
+    x = float(value)
+    allowed = _describe_range(low, high, low_open, high_open)
+    bad = not math.isfinite(x)
+    if low is not None:
+        bad = bad or x < low or (low_open and x == low)
+    if high is not None:
+        bad = bad or x > high or (high_open and x == high)
+    if bad:
+        raise ValueError(f"{name} must be {allowed}, got {value!r}")
+    return x
+
+
+def check_delay(d, *, name="d"):
+    """Return the loop delay ``d`` (in samples) as an ``int``.
+
+    ``d`` must be a non-negative integer; an integral float such as ``3.0``
+    is accepted, ``2.5`` is not.
+    """
+    if isinstance(d, bool) or not isinstance(d, numbers.Real):
+        raise TypeError(f"delay {name} must be a non-negative integer, got {type(d).__name__}")
+    if isinstance(d, numbers.Integral):
+        k = int(d)
+    else:
+        x = float(d)
+        if not (math.isfinite(x) and x.is_integer()):
+            raise ValueError(f"delay {name} must be a non-negative integer, got {d!r}")
+        k = int(x)
+    if k < 0:
+        raise ValueError(f"delay {name} must be a non-negative integer, got {d!r}")
+    return k
+
+
+def check_delay_samples(ratio, *, name="Td / T", rtol=1e-9):
+    """Return a delay ratio such as ``Td / T`` as an ``int``.
+
+    The ratio of two floats is rarely an exact integer (40e-3 / 1e-3 is
+    40.00000000000001), so a relative tolerance ``rtol`` is allowed.
+    """
+    x = check_real(name, ratio, low=0.0)
+    k = round(x)
+    if abs(x - k) > rtol * max(1.0, abs(x)):
+        raise ValueError(
+            f"{name} must be a non-negative whole number of samples, got {ratio!r}"
+        )
+    return int(k)

@@ -1,0 +1,94 @@
+"""Where every boundary arc starts: the small-theta Taylor limits.
+
+The numerators and the denominator of alpha(theta), beta(theta) are expanded
+in powers of theta with the delay ``d`` symbolic.  Near theta = 0::
+
+    alpha(theta) = a2 theta**2 + O(theta**4)
+    beta(theta)  = -delta + b2 theta**2 + O(theta**4)
+
+so every arc starts at (beta, alpha) = (-delta, 0), and it enters
+``alpha > 0`` exactly when ``a2 > 0``.
+"""
+
+import dataclasses
+import functools
+
+import sympy as sp
+
+from . import model
+from .boundary import boundary
+
+__all__ = ["SmallThetaLimits", "small_theta_limits"]
+
+
+@dataclasses.dataclass(frozen=True)
+class SmallThetaLimits:
+    """The Taylor limits of the boundary at theta -> 0.
+
+    Attributes
+    ----------
+    alpha_limit, beta_limit : sympy.Expr
+        Limits of alpha and beta as theta -> 0+.
+    alpha_theta2, beta_theta2 : sympy.Expr
+        Coefficients of theta**2 in alpha(theta) and beta(theta).
+    start_slope : sympy.Expr
+        d alpha / d beta at the starting point (``alpha_theta2 / beta_theta2``).
+    alpha_sign_condition : sympy.Expr
+        A relational that holds exactly when alpha > 0 for small theta > 0
+        (``alpha_theta2 > 0`` with the positive factors removed).
+    """
+
+    alpha_limit: sp.Expr
+    beta_limit: sp.Expr
+    alpha_theta2: sp.Expr
+    beta_theta2: sp.Expr
+    start_slope: sp.Expr
+    alpha_sign_condition: sp.Basic
+
+
+def _series_coefficients(expr, order):
+    """Return the Taylor coefficients of ``expr`` in theta up to ``order``."""
+    series = sp.expand(sp.series(expr, model.theta, 0, order + 1).removeO())
+    return [sp.factor(series.coeff(model.theta, k)) for k in range(order + 1)]
+
+
+def _quotient_series(num, den, order):
+    """Coefficients of num/den in theta, given both as coefficient lists."""
+    lead = next(k for k, c in enumerate(den) if c != 0)
+    x = sp.Symbol("x")
+    n = sp.Add(*[c * x**k for k, c in enumerate(num)])
+    dd = sp.Add(*[c * x**k for k, c in enumerate(den)])
+    q = sp.series(n / dd, x, 0, order + 1 - lead).removeO()
+    return [sp.factor(sp.expand(q).coeff(x, k)) for k in range(order + 1 - lead)]
+
+
+@functools.lru_cache(maxsize=None)
+def small_theta_limits():
+    """Derive the limits and leading terms of the boundary at theta = 0.
+
+    Returns
+    -------
+    SmallThetaLimits
+    """
+    bd = boundary()
+    order = 5
+    den = _series_coefficients(bd.denominator, order)
+    alpha = _quotient_series(_series_coefficients(bd.alpha_numerator, order), den, 3)
+    beta = _quotient_series(_series_coefficients(bd.beta_numerator, order), den, 3)
+    a2 = sp.factor(alpha[2])
+    # Remove factors that are positive on the model's domain (delta > 0,
+    # Gamma = exp(delta) > 1 so Gamma - 1 > 0 and squares).
+    sign_factor = sp.S.One
+    for factor, power in sp.factor_list(a2)[1]:
+        if not (factor.is_positive or factor == model.Gamma - 1 or power % 2 == 0):
+            sign_factor *= factor**power
+    coeff, _ = sp.factor_list(a2)
+    condition = sp.Gt(sp.sign(coeff) * sign_factor, 0)
+    return SmallThetaLimits(
+        alpha_limit=alpha[0],
+        beta_limit=beta[0],
+        alpha_theta2=a2,
+        beta_theta2=sp.factor(beta[2]),
+        start_slope=sp.factor(a2 / beta[2]),
+        alpha_sign_condition=condition,
+    )
