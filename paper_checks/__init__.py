@@ -1,0 +1,1 @@
+"""Checks of the printed paper against the :mod:`symstab` derivation."""
