@@ -1,0 +1,312 @@
+"""Shared oracles, fixtures and assertion helpers for the symstab tests.
+
+The oracles here do not go through symstab's derivation:
+
+* the printed eqs. (1), (2) and (4) of the paper (believed correct), evaluated
+  with mpmath -- :func:`eq4_pulse_transfer_function`, :func:`loop_gain_parts`,
+  :func:`first_principles_boundary_point`, :func:`first_principles_theta_max`;
+* python-control -- :func:`python_control_closed_loop`.
+
+Helpers that *do* evaluate symstab objects at high precision
+(:func:`loop_coefficients_mp`, :func:`chi_mp`) are here so that every test
+evaluates them the same way: always with mpmath numbers, never Python floats.
+"""
+
+import functools
+import os
+import pathlib
+import re
+import subprocess
+import sys
+
+import mpmath
+import numpy as np
+import pytest
+import sympy as sp
+
+from symstab import model
+from symstab.boundary import boundary
+from symstab.loop import characteristic_polynomial
+
+REPO = pathlib.Path(__file__).resolve().parents[1]
+
+# The paper's device (Section IV-A): T = 1 ms, m = 0.0128 kg m^2, b = 0.0324 N m s/rad.
+PAPER_M = 0.0128
+PAPER_B = 0.0324
+PAPER_T = 1e-3
+#: delta = b T / m of the paper's device (Table I): 0.00253125.
+PAPER_DELTA = PAPER_B * PAPER_T / PAPER_M
+
+
+# --------------------------------------------------------------------------
+# Assertion helpers
+# --------------------------------------------------------------------------
+
+def relative_error(actual, expected):
+    """|actual - expected| / |expected| (absolute error when expected == 0)."""
+    expected_abs = abs(expected)
+    err = abs(actual - expected)
+    return err / expected_abs if expected_abs != 0 else err
+
+
+def assert_rel_close(actual, expected, rtol, label=""):
+    """Assert ``actual`` equals ``expected`` to relative tolerance ``rtol``."""
+    err = relative_error(actual, expected)
+    assert err <= rtol, (
+        f"{label}: got {mpmath.nstr(actual, 20)}, expected {mpmath.nstr(expected, 20)}; "
+        f"relative error {mpmath.nstr(err, 3)} > {mpmath.nstr(rtol, 3)}")
+
+
+def assert_message_names(excinfo, name):
+    """Assert an exception message names ``name`` as a whole word."""
+    message = str(excinfo.value)
+    assert re.search(rf"(?<![\w]){re.escape(name)}(?![\w])", message), (
+        f"message does not name {name!r}: {message!r}")
+
+
+# --------------------------------------------------------------------------
+# First-principles oracle: the paper's eqs. (1), (2), (4)
+# --------------------------------------------------------------------------
+
+def eq4_pulse_transfer_function(z, m, b, T, exp=sp.exp):
+    """Z[ZOH G(s)] as printed in the paper's eq. (4) (line 171 of the text).
+
+    ``((e^{-bT/m} - 1 + bT/m) z + 1 - (1 + bT/m) e^{-bT/m})
+    / ((z - 1) b^2/m (z - e^{-bT/m}))``.
+    Pass ``exp=mpmath.exp`` for numbers.
+    """
+    e = exp(-b * T / m)
+    return (((e - 1 + b * T / m) * z + 1 - (1 + b * T / m) * e)
+            / ((z - 1) * b**2 / m * (z - e)))
+
+
+def eq1_virtual_environment(z, K_w, B_w, M_w, T):
+    """VE(z) as printed in the paper's eq. (1)."""
+    return K_w + B_w * (z - 1) / (T * z) + M_w * (z - 1) ** 2 / (T**2 * z**2)
+
+
+def loop_gain_parts(z, d, delta):
+    """``(A, B, C)`` with eq. (2)'s Delta(z) = 1 + alpha A + beta B + gamma C.
+
+    Eq. (2) with eqs. (1) and (4) in Table I's variables: the loop is
+    invariant under the scaling of Table I, so m = T = 1, b = delta,
+    K_w = alpha, B_w = beta, M_w = gamma.
+    """
+    one = mpmath.mpf(1)
+    base = z ** (-d) * eq4_pulse_transfer_function(z, one, delta, one, exp=mpmath.exp)
+    return base, base * (z - 1) / z, base * (z - 1) ** 2 / z**2
+
+
+def delta_of_z(z, *, alpha, beta, gamma, d, delta):
+    """Eq. (2): Delta(z) = 1 + VE(z) z^-d Z[ZOH G] in Table I's variables."""
+    A, B, C = loop_gain_parts(z, d, delta)
+    return 1 + alpha * A + beta * B + gamma * C
+
+
+def first_principles_boundary_point(theta, gamma, d, delta):
+    """(alpha, beta) with Delta(exp(j theta)) = 0, by Cramer's rule on Re and Im."""
+    theta, gamma, delta = mpmath.mpf(theta), mpmath.mpf(gamma), mpmath.mpf(delta)
+    A, B, C = loop_gain_parts(mpmath.expj(theta), d, delta)
+    R = -(1 + gamma * C)
+    det = A.real * B.imag - A.imag * B.real
+    return ((R.real * B.imag - R.imag * B.real) / det,
+            (A.real * R.imag - A.imag * R.real) / det)
+
+
+def first_principles_alpha(theta, gamma, d, delta):
+    return first_principles_boundary_point(theta, gamma, d, delta)[0]
+
+
+def first_principles_theta_max(gamma, d, delta, *, dps=40, n=None):
+    """First theta in (0, pi) where the first-principles alpha(theta) turns negative.
+
+    A fine scan (spacing well below a quarter period of sin(d theta)) finds the
+    first sign change; mpmath refines it on alpha itself, which is O(1), so the
+    stopping rule |alpha| < eps is a tight one.  Returns None if alpha < 0 at the
+    first grid point or never changes sign.
+    """
+    with mpmath.workdps(dps):
+        f = lambda t: first_principles_alpha(t, gamma, d, delta)  # noqa: E731
+        n = n or max(1000, 32 * (d + 1))
+        prev_t, prev = None, None
+        for k in range(1, n):
+            t = mpmath.pi * k / n
+            value = f(t)
+            if prev is None and value < 0:
+                return None
+            if prev is not None and prev > 0 > value:
+                return mpmath.findroot(f, (prev_t, t), solver="anderson")
+            prev_t, prev = t, value
+        return None
+
+
+# --------------------------------------------------------------------------
+# symstab objects at high precision
+# --------------------------------------------------------------------------
+
+def mpf_args(*values):
+    return tuple(mpmath.mpf(v) for v in values)
+
+
+@functools.lru_cache(maxsize=None)
+def _coefficient_function(d):
+    args = (model.alpha, model.beta, model.gamma, model.delta, model.Gamma)
+    return sp.lambdify(args, characteristic_polynomial().coeffs(d), modules="mpmath")
+
+
+def loop_coefficients_mp(*, alpha, beta, gamma, d, delta):
+    """``characteristic_polynomial().coeffs(d)`` at a point, in mpmath (current dps)."""
+    a, b, g, dl = mpf_args(alpha, beta, gamma, delta)
+    return _coefficient_function(d)(a, b, g, dl, mpmath.exp(dl))
+
+
+def chi_mp(z, coeffs):
+    """Return ``(chi(z), sum |c_k| |z|^k)`` for coefficients highest first."""
+    value, size = mpmath.mpf(0), mpmath.mpf(0)
+    for c in coeffs:
+        value = value * z + c
+        size = size * abs(z) + abs(c)
+    return value, size
+
+
+@functools.lru_cache(maxsize=None)
+def boundary_functions():
+    """mpmath functions alpha(theta, gamma, d, delta, Gamma), beta(...) of boundary()."""
+    bd = boundary()
+    args = (model.theta, model.gamma, model.d, model.delta, model.Gamma)
+    return (sp.lambdify(args, bd.alpha, modules="mpmath"),
+            sp.lambdify(args, bd.beta, modules="mpmath"))
+
+
+def boundary_point_mp(theta, gamma, d, delta):
+    """(alpha, beta) of symstab's boundary() at a point, in mpmath (current dps)."""
+    fa, fb = boundary_functions()
+    t, g, dl = mpf_args(theta, gamma, delta)
+    return fa(t, g, d, dl, mpmath.exp(dl)), fb(t, g, d, dl, mpmath.exp(dl))
+
+
+# --------------------------------------------------------------------------
+# python-control oracle
+# --------------------------------------------------------------------------
+
+def python_control_closed_loop(*, alpha, beta, gamma, d, delta, m, T):
+    """Closed loop of Fig. 2 built with python-control from physical values.
+
+    G(s) = 1/(m s^2 + b s) discretised with a ZOH by ``control.c2d``; VE(z)
+    of eq. (1); a delay of ``d`` samples; negative feedback, so the poles are
+    the roots of 1 + G(z) VE(z) z^-d (eq. (2)).
+    """
+    import control
+
+    b = delta * m / T
+    K_w, B_w, M_w = alpha * m / T**2, beta * m / T, gamma * m
+    G = control.c2d(control.tf([1], [m, b, 0]), T, "zoh")
+    z = control.tf([1, 0], [1], T)
+    VE = eq1_virtual_environment(z, K_w, B_w, M_w, T)
+    delay = control.tf([1], [1] + [0] * d, T)
+    return control.feedback(G, VE * delay)
+
+
+def random_loop_points(seed, n, *, delta_range=(1e-4, 1.0)):
+    """Seeded random parameter points, physical and dimensionless.
+
+    delta log-uniform in ``delta_range``, d in 0..12, gamma in [-0.9, 2.5],
+    alpha in [-1, 5], beta in [-2, 3]; m log-uniform in [0.005, 0.5] and T
+    log-uniform in [0.25, 4] ms (haptic devices; far outside, python-control's
+    own polynomial arithmetic loses digits once K_w = alpha m / T^2 ~ 1e9).
+    """
+    rng = np.random.default_rng(seed)
+    lo, hi = np.log10(delta_range[0]), np.log10(delta_range[1])
+    points = []
+    for _ in range(n):
+        points.append(dict(
+            delta=float(10 ** rng.uniform(lo, hi)),
+            d=int(rng.integers(0, 13)),
+            gamma=float(rng.uniform(-0.9, 2.5)),
+            alpha=float(rng.uniform(-1.0, 5.0)),
+            beta=float(rng.uniform(-2.0, 3.0)),
+            m=float(10 ** rng.uniform(np.log10(0.005), np.log10(0.5))),
+            T=float(10 ** rng.uniform(np.log10(2.5e-4), np.log10(4e-3))),
+        ))
+    return points
+
+
+def dimensionless(point):
+    return {k: point[k] for k in ("alpha", "beta", "gamma", "d", "delta")}
+
+
+# --------------------------------------------------------------------------
+# Fixtures
+# --------------------------------------------------------------------------
+
+@pytest.fixture(scope="session")
+def loop():
+    return characteristic_polynomial()
+
+
+@pytest.fixture(scope="session")
+def bd():
+    return boundary()
+
+
+@pytest.fixture(scope="session")
+def derivation():
+    """derivation_steps(), built once (about 6 s)."""
+    from symstab.derive import derivation_steps
+
+    return derivation_steps()
+
+
+@pytest.fixture(scope="session")
+def rendered_files(derivation):
+    from symstab.derive import render
+
+    return render(derivation)
+
+
+#: The file hand-edited for the drift tests, and the edit.
+EDITED_FILE = "04_boundary.tex"
+EDIT = "% a hand edit\n"
+
+
+def run_symstab(*args, env_extra=None, cwd=None, timeout=300):
+    """Run ``python -m symstab ...`` in a subprocess (no shell)."""
+    env = dict(os.environ)
+    env.update(env_extra or {})
+    return subprocess.run([sys.executable, "-m", "symstab", *args], capture_output=True,
+                          text=True, env=env, cwd=cwd, timeout=timeout)
+
+
+@pytest.fixture(scope="session")
+def derive_subprocess_runs(tmp_path_factory, rendered_files):
+    """Three ``symstab derive`` subprocesses, run concurrently.
+
+    ``seed1`` and ``seed2`` write a fresh derivation under PYTHONHASHSEED=1
+    and 2; ``check_edited`` runs ``--check`` on a copy of the in-process
+    derivation in which :data:`EDITED_FILE` was edited by hand.
+
+    Returns ``{name: (CompletedProcess-like tuple (returncode, stdout, stderr), out_dir)}``.
+    """
+    base = tmp_path_factory.mktemp("derive_runs")
+    edited = base / "edited"
+    edited.mkdir()
+    for name, text in rendered_files.items():
+        (edited / name).write_text(text, encoding="utf-8", newline="\n")
+    with open(edited / EDITED_FILE, "a", encoding="utf-8", newline="\n") as fh:
+        fh.write(EDIT)
+    jobs = {
+        "seed1": (["derive", "--out", str(base / "seed1")], "1", base / "seed1"),
+        "seed2": (["derive", "--out", str(base / "seed2")], "2", base / "seed2"),
+        "check_edited": (["derive", "--out", str(edited), "--check"], "3", edited),
+    }
+    procs = {}
+    for name, (args, seed, _) in jobs.items():
+        env = dict(os.environ, PYTHONHASHSEED=seed)
+        procs[name] = subprocess.Popen([sys.executable, "-m", "symstab", *args], cwd=base,
+                                       env=env, stdout=subprocess.PIPE,
+                                       stderr=subprocess.PIPE, text=True)
+    out = {}
+    for name, proc in procs.items():
+        stdout, stderr = proc.communicate(timeout=600)
+        out[name] = ((proc.returncode, stdout, stderr), jobs[name][2])
+    return out

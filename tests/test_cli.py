@@ -1,0 +1,73 @@
+"""Tests of the ``symstab`` command line, run as ``python -m symstab``."""
+
+import pytest
+
+from symstab import cli
+
+from conftest import EDITED_FILE, run_symstab
+
+
+def _assert_one_line_error(result, *needles):
+    assert result.returncode == 2
+    assert "Traceback" not in result.stderr
+    lines = result.stderr.strip().splitlines()
+    assert len(lines) == 1, result.stderr
+    assert lines[0].startswith("symstab: error:")
+    for needle in needles:
+        assert needle in lines[0]
+
+
+def test_derive_out_pointing_to_a_file_exits_2(tmp_path):
+    target = tmp_path / "not_a_dir.txt"
+    target.write_text("keep me\n")
+    result = run_symstab("derive", "--out", str(target), cwd=tmp_path)
+    _assert_one_line_error(result, "--out", str(target))
+    assert target.read_text() == "keep me\n"
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["not_a_dir.txt"]
+
+
+@pytest.mark.parametrize("args, needle", [
+    (["derive", "--bogus"], "--bogus"),
+    (["--bogus"], "error"),      # argparse reports the missing command first
+    (["frobnicate"], "frobnicate"),
+    ([], "required"),
+])
+def test_bad_command_line_exits_2_with_one_line(tmp_path, args, needle):
+    result = run_symstab(*args, cwd=tmp_path)
+    _assert_one_line_error(result, needle)
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_help_exits_0(tmp_path):
+    result = run_symstab("derive", "--help", cwd=tmp_path)
+    assert result.returncode == 0 and "--check" in result.stdout
+
+
+def test_check_exits_1_and_names_only_the_edited_file(derive_subprocess_runs):
+    (returncode, stdout, stderr), out_dir = derive_subprocess_runs["check_edited"]
+    assert returncode == 1, stderr
+    assert "Traceback" not in stderr
+    named = [line for line in stdout.splitlines() if line.startswith("drift:")]
+    assert len(named) == 1
+    assert str(out_dir / EDITED_FILE) in named[0]
+    assert "symstab derive" in named[0]
+
+
+def test_derive_writes_into_out(derive_subprocess_runs, rendered_files):
+    (returncode, stdout, _), out_dir = derive_subprocess_runs["seed1"]
+    assert returncode == 0
+    assert f"wrote {len(rendered_files)} files to {out_dir}" in stdout
+
+
+def test_check_exits_0_on_fresh_output(tmp_path, rendered_files, capsys):
+    from symstab import derive
+
+    derive.write(tmp_path, rendered_files)
+    assert cli.main(["derive", "--out", str(tmp_path), "--check"]) == 0
+    assert "match a fresh derivation" in capsys.readouterr().out
+
+
+def test_check_on_missing_directory_exits_1(tmp_path, capsys):
+    assert cli.main(["derive", "--out", str(tmp_path / "absent"), "--check"]) == 1
+    assert capsys.readouterr().out.count("drift:") >= 2
+    assert not (tmp_path / "absent").exists()

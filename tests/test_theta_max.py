@@ -1,0 +1,187 @@
+"""Tests of symstab.theta_max: where a boundary arc ends.
+
+Oracle: the first positive root of alpha(theta) solved from eq. (2) with
+eqs. (1) and (4) (conftest.first_principles_theta_max), at 40 digits.
+"""
+
+import math
+
+import mpmath
+import pytest
+import sympy as sp
+
+from symstab import model
+from symstab.theta_max import closed_form_d0, theta_max, theta_max_newton
+
+from conftest import (
+    PAPER_DELTA, assert_message_names, assert_rel_close, first_principles_alpha,
+    first_principles_theta_max,
+)
+
+#: (gamma, d, delta) with an arc that ends before pi.
+ARCS = [(0.0, 0, PAPER_DELTA), (-0.5, 0, PAPER_DELTA), (0.0, 5, PAPER_DELTA),
+        (-0.75, 10, PAPER_DELTA), (1.0, 1, PAPER_DELTA), (0.4, 3, 0.05), (-0.3, 12, 0.8),
+        (2.2, 7, 1e-3), (0.0, 40, PAPER_DELTA)]
+
+
+@pytest.mark.parametrize("gamma, d, delta", ARCS)
+def test_theta_max_is_a_root_of_alpha(gamma, d, delta):
+    """alpha changes sign across theta_max within a relative 1e-9 bracket."""
+    top = theta_max(gamma=gamma, d=d, delta=delta)
+    with mpmath.workdps(40):
+        top = mpmath.mpf(top)
+        assert first_principles_alpha(top * (1 - mpmath.mpf(1e-9)), gamma, d, delta) > 0
+        assert first_principles_alpha(top * (1 + mpmath.mpf(1e-9)), gamma, d, delta) < 0
+
+
+@pytest.mark.parametrize("gamma, d, delta", ARCS)
+def test_theta_max_is_the_first_root(gamma, d, delta):
+    """alpha > 0 on a fine grid of (0, theta_max)."""
+    top = theta_max(gamma=gamma, d=d, delta=delta)
+    with mpmath.workdps(40):
+        for k in range(1, 200):
+            t = mpmath.mpf(top) * k / 200
+            assert first_principles_alpha(t, gamma, d, delta) > 0, t
+
+
+@pytest.mark.parametrize("gamma, d, delta", [(0.0, 0, PAPER_DELTA), (0.0, 5, PAPER_DELTA),
+                                             (0.4, 3, 0.05), (-0.3, 12, 0.8)])
+def test_theta_max_to_double_precision(gamma, d, delta):
+    reference = first_principles_theta_max(gamma, d, delta)
+    assert_rel_close(theta_max(gamma=gamma, d=d, delta=delta), reference, 1e-13, "theta_max")
+
+
+@pytest.mark.parametrize("gamma, d, delta", [(-0.9, 0, PAPER_DELTA), (2.0, 1, PAPER_DELTA),
+                                             (1.0, 1, PAPER_DELTA)])
+def test_theta_max_to_double_precision_with_virtual_mass(gamma, d, delta):
+    reference = first_principles_theta_max(gamma, d, delta)
+    assert_rel_close(theta_max(gamma=gamma, d=d, delta=delta), reference, 1e-13, "theta_max")
+
+
+def test_theta_max_of_paper_device_is_1_5725():
+    """Section IV-C: theta_max = 1.5725 rad for gamma = 0, d = 0 (printed to 4 decimals)."""
+    assert round(theta_max(gamma=0.0, d=0, delta=PAPER_DELTA), 4) == 1.5725
+
+
+@pytest.mark.parametrize("d", [0, 3])
+@pytest.mark.parametrize("gamma", [-1.5, -3.0, -10.0])
+def test_theta_max_is_nan_when_no_arc_enters_alpha_positive(gamma, d):
+    assert math.isnan(theta_max(gamma=gamma, d=d, delta=PAPER_DELTA))
+    with mpmath.workdps(40):  # the oracle agrees: alpha < 0 just after 0
+        assert first_principles_alpha(mpmath.mpf("1e-4"), gamma, d, PAPER_DELTA) < 0
+
+
+def test_theta_max_of_a_short_arc():
+    gamma = -1 - PAPER_DELTA + 1e-6
+    reference = first_principles_theta_max(gamma, 0, PAPER_DELTA, n=4000)
+    assert reference is not None and reference < math.pi / 400
+    assert_rel_close(theta_max(gamma=gamma, d=0, delta=PAPER_DELTA), reference, 1e-9, "theta_max")
+
+
+# The d = 0 closed form ---------------------------------------------------
+
+def _closed_form_mp(gamma, delta):
+    f = sp.lambdify((model.gamma, model.delta, model.Gamma), closed_form_d0().theta_max,
+                    modules="mpmath")
+    dl = mpmath.mpf(delta)
+    return f(mpmath.mpf(gamma), dl, mpmath.exp(dl))
+
+
+def _printed_eq8(gamma, delta):
+    """Eqs. (8)-(10) as printed."""
+    G = mpmath.exp(delta)
+    A = gamma * ((1 - G) ** 2 - delta * (G**2 - 1) + G * delta**2) + G * delta**2 * (1 - G + delta)
+    u = -(1 - G) ** 2 * delta**2 * (gamma + 1 + delta) / (2 * A)
+    return 2 * mpmath.atan(mpmath.sqrt(u / (2 - u)))
+
+
+D0_GAMMAS = [-0.85, -0.5, 0.0, 0.5, 1.0, 1.5, 2.1]
+
+
+@pytest.mark.parametrize("gamma", D0_GAMMAS)
+def test_closed_form_d0_equals_theta_max(gamma):
+    # rtol 1e-9, not 1e-15: see test_theta_max_to_double_precision_with_virtual_mass.
+    with mpmath.workdps(40):
+        closed = _closed_form_mp(gamma, PAPER_DELTA)
+    assert_rel_close(theta_max(gamma=gamma, d=0, delta=PAPER_DELTA), closed, 1e-9, "theta_max")
+
+
+@pytest.mark.parametrize("gamma, delta", [(g, PAPER_DELTA) for g in (-0.85, 0.0, 2.1)]
+                         + [(-0.5, 0.1), (1.0, 0.7)])
+def test_closed_form_d0_is_the_root_of_eq2(gamma, delta):
+    with mpmath.workdps(40):
+        closed = _closed_form_mp(gamma, delta)
+        assert_rel_close(closed, first_principles_theta_max(gamma, 0, delta), mpmath.mpf(10) ** -25,
+                         "closed form")
+
+
+@pytest.mark.parametrize("gamma", D0_GAMMAS)
+def test_closed_form_d0_equals_printed_eqs_8_to_10(gamma):
+    with mpmath.workdps(40):
+        dl = mpmath.mpf(PAPER_DELTA)
+        assert_rel_close(_closed_form_mp(gamma, dl), _printed_eq8(mpmath.mpf(gamma), dl),
+                         mpmath.mpf(10) ** -30, "eq. (8)")
+
+
+def test_printed_eq15_gamma0_matches_eq2():
+    """Eq. (15) (gamma = 0, d = 0) against the first-principles root."""
+    with mpmath.workdps(40):
+        dl = mpmath.mpf(PAPER_DELTA)
+        G = mpmath.exp(dl)
+        x = (G - 1) ** 2 * (1 + dl)
+        printed = 2 * mpmath.atan(mpmath.sqrt(x / (4 * G * (G - 1 - dl) - x)))
+        assert_rel_close(printed, first_principles_theta_max(0, 0, dl), mpmath.mpf(10) ** -25, "eq. (15)")
+
+
+# The gamma = 0 Newton form ------------------------------------------------
+
+#: (d, observed relative error bound) for the paper's delta; the Newton step is
+#: an approximation whose error grows with d: observed 1.8e-6 (d=0),
+#: 1.1e-4 (d=5), 1.4e-3 (d=20), 5.3e-3 (d=40).
+NEWTON = [(0, 5e-6), (1, 3e-5), (2, 1e-4), (5, 3e-4), (10, 1e-3), (20, 4e-3), (40, 1.5e-2)]
+
+
+@pytest.mark.parametrize("d, rtol", NEWTON)
+def test_newton_form_is_close_to_exact_for_gamma0(d, rtol):
+    reference = first_principles_theta_max(0, d, PAPER_DELTA)
+    assert_rel_close(theta_max_newton(d=d, delta=PAPER_DELTA), reference, rtol, "Newton")
+
+
+def test_newton_form_error_grows_with_d():
+    errors = [abs(theta_max_newton(d=d, delta=PAPER_DELTA) - theta_max(gamma=0.0, d=d, delta=PAPER_DELTA))
+              / theta_max(gamma=0.0, d=d, delta=PAPER_DELTA) for d in (0, 2, 10, 40)]
+    assert errors == sorted(errors)
+
+
+# Input checks -------------------------------------------------------------
+
+_GOOD = dict(gamma=0.0, d=0, delta=PAPER_DELTA)
+
+
+@pytest.mark.parametrize("name, value", [
+    ("gamma", math.nan), ("gamma", math.inf), ("d", -1), ("d", 2.5), ("delta", 0.0),
+    ("delta", -1e-3), ("delta", math.nan),
+])
+def test_theta_max_rejects_bad_values_naming_them(name, value):
+    with pytest.raises(ValueError) as excinfo:
+        theta_max(**{**_GOOD, name: value})
+    assert_message_names(excinfo, name)
+
+
+@pytest.mark.parametrize("name, value", [("d", -1), ("d", 2.5), ("delta", 0.0), ("delta", math.inf)])
+def test_theta_max_newton_rejects_bad_values_naming_them(name, value):
+    kwargs = {"d": 0, "delta": PAPER_DELTA, name: value}
+    with pytest.raises(ValueError) as excinfo:
+        theta_max_newton(**kwargs)
+    assert_message_names(excinfo, name)
+
+
+@pytest.mark.parametrize("name, value", [("gamma", "0"), ("d", None), ("delta", True)])
+def test_theta_max_rejects_wrong_kinds(name, value):
+    with pytest.raises(TypeError):
+        theta_max(**{**_GOOD, name: value})
+
+
+def test_theta_max_is_keyword_only():
+    with pytest.raises(TypeError):
+        theta_max(0.0, 0, PAPER_DELTA)

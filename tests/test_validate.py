@@ -1,0 +1,114 @@
+"""Tests of symstab._validate: one place for kind and range checks."""
+
+import fractions
+import math
+
+import numpy as np
+import pytest
+
+from symstab._validate import check_delay, check_delay_samples, check_real
+
+from conftest import assert_message_names
+
+
+# check_real ---------------------------------------------------------------
+
+@pytest.mark.parametrize("value, expected", [
+    (0, 0.0), (3, 3.0), (-2.5, -2.5), (np.float64(1.25), 1.25), (np.int32(7), 7.0),
+    (fractions.Fraction(1, 4), 0.25), (1e300, 1e300),
+])
+def test_check_real_accepts_finite_reals_and_returns_float(value, expected):
+    result = check_real("x", value)
+    assert type(result) is float
+    assert result == expected
+
+
+@pytest.mark.parametrize("value", ["1.0", None, 1 + 0j, [1.0], True, False, np.bool_(True)])
+def test_check_real_rejects_non_reals_with_type_error(value):
+    with pytest.raises(TypeError) as excinfo:
+        check_real("kappa", value)
+    assert_message_names(excinfo, "kappa")
+
+
+@pytest.mark.parametrize("value", [math.nan, math.inf, -math.inf, np.float64("nan")])
+def test_check_real_rejects_non_finite_with_value_error(value):
+    with pytest.raises(ValueError) as excinfo:
+        check_real("kappa", value)
+    assert_message_names(excinfo, "kappa")
+
+
+@pytest.mark.parametrize("value, bounds, ok", [
+    (0.0, dict(low=0.0), True),
+    (0.0, dict(low=0.0, low_open=True), False),
+    (-1e-300, dict(low=0.0), False),
+    (1.0, dict(high=1.0), True),
+    (1.0, dict(high=1.0, high_open=True), False),
+    (2.0, dict(low=-1.0, high=1.0), False),
+    (0.5, dict(low=-1.0, high=1.0, low_open=True, high_open=True), True),
+])
+def test_check_real_enforces_range(value, bounds, ok):
+    if ok:
+        assert check_real("x", value, **bounds) == value
+    else:
+        with pytest.raises(ValueError, match=r"x must be a finite real number"):
+            check_real("x", value, **bounds)
+
+
+def test_check_real_message_states_allowed_range():
+    with pytest.raises(ValueError) as excinfo:
+        check_real("m", -1.0, low=0.0, low_open=True)
+    assert "> 0" in str(excinfo.value) and "-1.0" in str(excinfo.value)
+
+
+def test_check_real_huge_integer_raises_value_error():
+    with pytest.raises(ValueError):
+        check_real("m", 10**400)
+
+
+# check_delay --------------------------------------------------------------
+
+@pytest.mark.parametrize("d, expected", [
+    (0, 0), (3, 3), (3.0, 3), (np.int64(12), 12), (np.float64(40.0), 40), (10**6, 10**6),
+])
+def test_check_delay_accepts_non_negative_integers(d, expected):
+    result = check_delay(d)
+    assert type(result) is int and result == expected
+
+
+@pytest.mark.parametrize("d", [-1, -3.0, 2.5, math.nan, math.inf, fractions.Fraction(5, 2)])
+def test_check_delay_rejects_bad_values_naming_d(d):
+    with pytest.raises(ValueError) as excinfo:
+        check_delay(d)
+    assert_message_names(excinfo, "d")
+    assert "non-negative integer" in str(excinfo.value)
+
+
+@pytest.mark.parametrize("d", ["3", None, True, 2j])
+def test_check_delay_rejects_non_numbers_with_type_error(d):
+    with pytest.raises(TypeError):
+        check_delay(d)
+
+
+def test_check_delay_uses_given_name():
+    with pytest.raises(ValueError) as excinfo:
+        check_delay(-2, name="lag")
+    assert_message_names(excinfo, "lag")
+
+
+# check_delay_samples ----------------------------------------------------
+
+@pytest.mark.parametrize("Td, T, expected", [
+    (40e-3, 1e-3, 40),      # 40.00000000000001 in floating point
+    (0.0, 1e-3, 0),
+    (3e-4, 1e-4, 3),        # 2.9999999999999996
+    (0.7, 0.1, 7),          # 6.999999999999999
+])
+def test_check_delay_samples_rounds_float_ratios(Td, T, expected):
+    assert check_delay_samples(Td / T) == expected
+
+
+@pytest.mark.parametrize("ratio", [1.5, 40.001, -1.0, math.nan, math.inf])
+def test_check_delay_samples_rejects_non_whole_ratios(ratio):
+    with pytest.raises(ValueError) as excinfo:
+        check_delay_samples(ratio)
+    assert "Td / T" in str(excinfo.value)
