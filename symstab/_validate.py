@@ -33,7 +33,10 @@ def check_real(name, value, *, low=None, high=None, low_open=False, high_open=Fa
     """
     if isinstance(value, bool) or not isinstance(value, numbers.Real):
         raise TypeError(f"{name} must be a real number, got {type(value).__name__}")
-    x = float(value)
+    try:
+        x = float(value)
+    except OverflowError:
+        x = math.inf
     allowed = _describe_range(low, high, low_open, high_open)
     bad = not math.isfinite(x)
     if low is not None:

@@ -193,11 +193,16 @@ def write(out_dir, files):
 
 
 def check(out_dir, files):
-    """Return the names of files in ``out_dir`` that differ from ``files``."""
+    """Return the paths in ``out_dir`` that differ from ``files`` or are extra."""
     out = pathlib.Path(out_dir)
     stale = []
     for name, text in sorted(files.items()):
         path = out / name
         if not path.is_file() or path.read_text(encoding="utf-8") != text:
             stale.append(str(path))
+    # A file a former step wrote but no step writes any more is drift too.
+    if out.is_dir():
+        for path in sorted(out.glob("[0-9][0-9]_*")):
+            if path.suffix in (".json", ".tex") and path.name not in files:
+                stale.append(str(path))
     return stale

@@ -53,6 +53,10 @@ E = sp.Symbol("E")
 _TRIG = (sp.sin, sp.cos, sp.tan, sp.cot, sp.sec, sp.csc)
 
 
+class _exp_atom(sp.Function):
+    """exp(x) as an opaque generator that SymPy does not simplify."""
+
+
 class UnsupportedExpression(ValueError):
     """The expression is outside the class the exact checker can decide."""
 
@@ -110,6 +114,11 @@ def exponential_form(expr, *, theta=model.theta, d=model.d, delta=model.delta,
             k = sp.expand(arg / delta)
             if k.is_Rational:
                 return Gamma**k
+            # exp(c x) -> X**c with one generator X per x, so that exp(x) and
+            # exp(-x) are seen as reciprocals (SymPy would fold X**-1 back).
+            coeff, rest = arg.as_coeff_Mul()
+            if coeff.is_Rational:
+                return _exp_atom(rest) ** coeff
             return sp.exp(rec(arg))
         if e.is_Atom:
             return e
@@ -131,6 +140,10 @@ def conjugate_on_circle(expr):
 
 def _rational_difference(lhs, rhs):
     """Return ``lhs - rhs`` as an element of a rational function field."""
+    # A float stands for its exact binary value; replace it before any
+    # arithmetic, which would round 5/2 - 1e-20 back to the float 2.5.
+    lhs, rhs = (sp.sympify(x) for x in (lhs, rhs))
+    lhs, rhs = (x.xreplace({f: sp.Rational(f) for f in x.atoms(sp.Float)}) for x in (lhs, rhs))
     diff = exponential_form(lhs) - exponential_form(rhs)
     # Opaque subexpressions (sqrt of a parameter, atan, ...) become free
     # generators: an identity with them free holds under any value they take.

@@ -16,6 +16,7 @@ them for a concrete delay.
 import dataclasses
 import functools
 
+import mpmath
 import numpy as np
 import sympy as sp
 
@@ -89,14 +90,18 @@ class LoopPolynomial:
 
     @functools.cached_property
     def _numeric(self):
-        args = (model.alpha, model.beta, model.gamma, model.delta, model.Gamma)
-        return (sp.lambdify(args, self.delayed.all_coeffs(), modules="numpy"),
-                sp.lambdify(args, self.direct.all_coeffs(), modules="numpy"))
+        args = (model.alpha, model.beta, model.gamma, model.delta)
+        sub = {model.Gamma: sp.exp(model.delta)}
+        return (sp.lambdify(args, [c.subs(sub) for c in self.delayed.all_coeffs()], modules="mpmath"),
+                sp.lambdify(args, [c.subs(sub) for c in self.direct.all_coeffs()], modules="mpmath"))
 
     def numeric_coeffs(self, *, alpha, beta, gamma, d, delta):
         """Return the coefficients (floats, highest first) at a parameter point.
 
-        ``Gamma`` is evaluated as ``exp(delta)``.
+        The coefficients are evaluated at 30 digits with ``Gamma = exp(delta)``
+        and rounded once: expanded forms such as ``Gamma delta - Gamma + 1``
+        (about ``delta**2 / 2``) would lose ``log10(1 / delta**2)`` digits in
+        floating point.
 
         Raises
         ------
@@ -104,13 +109,14 @@ class LoopPolynomial:
             If a parameter is not finite, ``delta <= 0`` or ``d`` is not a
             non-negative integer.
         """
-        values = (check_real("alpha", alpha), check_real("beta", beta),
-                  check_real("gamma", gamma), check_real("delta", delta, low=0.0, low_open=True))
+        values = [mpmath.mpf(x) for x in (
+            check_real("alpha", alpha), check_real("beta", beta), check_real("gamma", gamma),
+            check_real("delta", delta, low=0.0, low_open=True))]
         d = check_delay(d)
-        Gamma = np.exp(values[3])
         delayed_f, direct_f = self._numeric
-        delayed = np.array(delayed_f(*values, Gamma), dtype=float)
-        direct = np.array(direct_f(*values, Gamma), dtype=float)
+        with mpmath.workdps(30):
+            delayed = [float(x) for x in delayed_f(*values)]
+            direct = [float(x) for x in direct_f(*values)]
         out = np.zeros(d + len(delayed))
         out[: len(delayed)] += delayed
         out[len(out) - len(direct):] += direct

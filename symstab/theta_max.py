@@ -117,7 +117,9 @@ def newton_form_gamma0():
     re_F, im_F = sp.expand((F + Fc) / 2), sp.expand((F - Fc) / (2 * sp.I))
     sin_t = (w**2 - w**-2) / (2 * sp.I)
     cos_t = (w**2 + w**-2) / 2
-    A_S = sp.factor(trig_form(sp.cancel(2 * re_F / sin_t)))
+    # Collected in delta (A_S = delta B + ...), which also keeps the form
+    # that srepr round-trips (factor() would give Mul(-2, Add(...))).
+    A_S = sp.collect(sp.expand(trig_form(sp.cancel(2 * re_F / sin_t))), model.delta, sp.factor)
     A_D = sp.factor(trig_form(sp.cancel(-2 * im_F - 2 * re_F * cos_t / sin_t)))
     form = A_S * sp.sin((d + 1) * theta) + A_D * sp.sin(d * theta)
     theta0 = sp.pi / (2 * (d + 1))
@@ -163,7 +165,8 @@ def theta_max(*, gamma, d, delta, dps=30):
     float
         theta_max in (0, pi]; ``pi`` when alpha does not return to zero
         before theta = pi, and ``nan`` when alpha < 0 just after theta = 0
-        (no arc enters alpha > 0; see :mod:`symstab.limits`).
+        (no arc enters alpha > 0; see :mod:`symstab.limits`), or when the
+        arc is shorter than ``1e-10 pi / n`` for the scan's ``n`` points.
 
     Examples
     --------
@@ -172,14 +175,19 @@ def theta_max(*, gamma, d, delta, dps=30):
     """
     gamma, d, delta = _check(gamma, d, delta)
     f = alpha_numerator_function()
-    with mpmath.workdps(dps):
-        g = lambda t: f(t, gamma, d, delta)  # noqa: E731
+    # N_alpha ~ theta**3 near 0 out of terms of size 1: the extra digits keep
+    # its sign right down to the first grid point, pi/n * 1e-10.
+    with mpmath.workdps(dps + 40):
+        g_, d_ = mpmath.mpf(gamma), mpmath.mpf(delta)
+        g = lambda t: f(t, g_, d, d_)  # noqa: E731
         n = max(400, 16 * (d + 1))
-        grid = [mpmath.pi * k / n for k in range(1, n + 1)]
+        step = mpmath.pi / n
+        short = [step * mpmath.mpf(10) ** (-k / mpmath.mpf(4)) for k in range(40, 0, -1)]
+        grid = short + [step * k for k in range(1, n + 1)]
         values = [g(t) for t in grid]
-        if values[0] < 0:
+        if values[0] <= 0:
             return float("nan")
-        for k in range(1, n):
+        for k in range(1, len(grid)):
             if values[k] == 0:
                 return float(grid[k])
             if values[k] < 0 < values[k - 1]:
