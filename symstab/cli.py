@@ -13,6 +13,8 @@ __all__ = ["main"]
 
 #: Where ``symstab derive`` writes without ``--out``.
 DEFAULT_DERIVATIONS = pathlib.Path("derivations") / "generated"
+#: Where ``symstab audit`` writes its report without ``--report``.
+DEFAULT_REPORT = pathlib.Path("paper_checks") / "REPORT.md"
 
 
 class _Parser(argparse.ArgumentParser):
@@ -45,6 +47,33 @@ def _cmd_derive(args):
     return 0
 
 
+def _cmd_audit(args):
+    try:
+        from paper_checks import audit
+    except ImportError as exc:  # pragma: no cover - packaging problem
+        raise ValueError(f"the paper_checks package is not installed ({exc})") from exc
+    from .derive import write
+
+    start = time.perf_counter()
+
+    def progress(n, total, cid):
+        print(f"[{n:3d}/{total}] {cid}", file=sys.stderr, flush=True)
+
+    findings = audit.run_audit(progress=progress if args.verbose else None)
+    outputs = {pathlib.Path(args.report): audit.render_report(findings)}
+    if args.json:
+        outputs[pathlib.Path(args.json)] = audit.to_json(findings)
+    for path, text in outputs.items():
+        write(path.parent if str(path.parent) else ".", {path.name: text})
+    counts = {}
+    for f in findings:
+        counts[f.verdict] = counts.get(f.verdict, 0) + 1
+    summary = ", ".join(f"{counts[v]} {v}" for v in audit.VERDICTS if v in counts)
+    print(f"audited {len(findings)} checks: {summary}; wrote "
+          f"{', '.join(str(p) for p in outputs)} ({time.perf_counter() - start:.0f} s)")
+    return 0
+
+
 def build_parser():
     """Return the argument parser of the ``symstab`` command."""
     parser = _Parser(prog="symstab", description=(
@@ -57,6 +86,12 @@ def build_parser():
     p.add_argument("--check", action="store_true",
                    help="compare the files in --out with a fresh derivation; exit 1 on drift")
     p.set_defaults(func=_cmd_derive)
+    p = sub.add_parser("audit", help="check every equation and claim of the paper; write REPORT.md")
+    p.add_argument("--report", default=str(DEFAULT_REPORT),
+                   help=f"Markdown report (default: {DEFAULT_REPORT})")
+    p.add_argument("--json", metavar="PATH", help="also write the verdicts as JSON")
+    p.add_argument("-v", "--verbose", action="store_true", help="print each check as it runs")
+    p.set_defaults(func=_cmd_audit)
     return parser
 
 

@@ -1,0 +1,329 @@
+"""The paper's numeric and qualitative claims, reproduced from the derivation.
+
+Numbers are compared at the paper's own precision: a value is reproduced
+when the derived number, rounded to the digits the paper prints, equals the
+printed number.  Stability of a region is decided by counting characteristic
+roots outside the unit circle (:mod:`paper_checks.regions`), not by the
+"right-sided / left-sided" shape of a curve.
+"""
+
+import decimal
+import functools
+
+from symstab import model
+from symstab.evaluate import alpha_max_on_arc, arc_end, boundary_point
+from symstab.limits import small_theta_limits
+from symstab.stability import stable_alpha_intervals
+from symstab.theta_max import theta_max
+
+from . import regions
+from ._common import DEVICE_DELTA, show
+from .audit import Outcome, check
+
+#: The paper's device (Section VI).
+M, B, T = 0.0128, 0.0324, 1e-3
+#: Td = 40 ms in samples.
+D_EXPERIMENT = 40
+
+
+def rounds_to(value, printed):
+    """True when ``value`` rounded to the digits of the string ``printed`` equals it."""
+    places = decimal.Decimal(printed).as_tuple().exponent
+    rounded = decimal.Decimal(repr(float(value))).quantize(decimal.Decimal(1).scaleb(places),
+                                                           rounding=decimal.ROUND_HALF_EVEN)
+    return rounded == decimal.Decimal(printed)
+
+
+def _number(derived, printed, what):
+    if rounds_to(derived, printed):
+        return Outcome("confirmed", f"derived {what} = {derived:.6g}, which rounds to the printed {printed}")
+    return Outcome("not-reproduced", f"derived {what} = {derived:.6g}; printed {printed}")
+
+
+@functools.lru_cache(maxsize=None)
+def _classify(gamma, d):
+    return regions.classify(gamma, d, DEVICE_DELTA)
+
+
+def _top_of_stable_interval(beta, gamma, d=0, **kw):
+    intervals = stable_alpha_intervals(beta=beta, gamma=gamma, d=d, delta=DEVICE_DELTA, **kw)
+    return intervals
+
+
+@check("claim:theta_max_1.5725", kind="claim", where="Sec. IV-C, line 252",
+       claim="theta_max = 1.5725 rad for d = 0, gamma = 0 (paper's device)")
+def theta_max_value():
+    return _number(theta_max(gamma=0.0, d=0, delta=DEVICE_DELTA), "1.5725", "theta_max")
+
+
+@check("claim:alpha_max_gamma0", kind="claim", where="Sec. V, lines 304-306 (circle 1 of Fig. 7)",
+       claim="alpha_max = 0.6896 at beta = 0.8206 (gamma = 0, d = 0)")
+def alpha_max_gamma0():
+    t, a, b = alpha_max_on_arc(gamma=0.0, d=0, delta=DEVICE_DELTA)
+    alpha_ok, beta_ok = rounds_to(a, "0.6896"), rounds_to(b, "0.8206")
+    verdict = "confirmed" if alpha_ok and beta_ok else "not-reproduced"
+    return Outcome(verdict,
+                   f"the highest point of the arc is alpha = {a:.6f} at beta = {b:.4f} (theta = {t:.4f}); "
+                   f"printed 0.6896 at 0.8206. The alpha is flat there: the arc passes beta = 0.8206 at "
+                   f"alpha = {float(_alpha_on_arc_at_beta(0.8206)):.6f}, so the printed point lies on the "
+                   f"boundary but is not its maximum")
+
+
+def _alpha_on_arc_at_beta(beta):
+    import mpmath
+    f = lambda t: boundary_point(t, gamma=0.0, d=0, delta=DEVICE_DELTA)[1] - beta  # noqa: E731
+    t = mpmath.findroot(f, (0.9, 1.3), solver="anderson")
+    return boundary_point(t, gamma=0.0, d=0, delta=DEVICE_DELTA)[0]
+
+
+def _stable_alpha_top(beta, gamma, printed, what):
+    intervals = _top_of_stable_interval(beta, gamma)
+    if not intervals:
+        return Outcome("not-reproduced", f"no stable alpha at beta = {beta}, gamma = {gamma} (root count)")
+    lo, hi = intervals[-1]
+    outcome = _number(hi, printed, what)
+    return Outcome(outcome.verdict, outcome.evidence + f" (stable alpha interval ({lo:.4g}, {hi:.6g}) "
+                   f"at beta = {beta}, gamma = {gamma}, d = 0, by root counting)")
+
+
+@check("claim:alpha_beta0_gamma0", kind="claim", where="Sec. V, line 306",
+       claim="alpha = 0.005 at beta = 0, gamma = 0, d = 0")
+def alpha_beta0_gamma0():
+    return _stable_alpha_top(0.0, 0.0, "0.005", "largest stable alpha")
+
+
+@check("claim:alpha_beta0_gamma1", kind="claim", where="Sec. V, line 306 (circle 2 of Fig. 7)",
+       claim="alpha = 2 at beta = 0, gamma = 1, d = 0")
+def alpha_beta0_gamma1():
+    return _stable_alpha_top(0.0, 1.0, "2", "largest stable alpha")
+
+
+@check("claim:alpha_beta-1_gamma1.5", kind="claim", where="Sec. V, line 308 (circle 3 of Fig. 7)",
+       claim="alpha ~ 3 at beta = -1, gamma = 1.5, d = 0")
+def alpha_beta_m1_gamma15():
+    return _stable_alpha_top(-1.0, 1.5, "3", "largest stable alpha")
+
+
+@check("claim:alpha_max_gamma2", kind="claim", where="Sec. V, line 310 (circle 4 of Fig. 7)",
+       claim="alpha_max ~ 4 at beta = -2, gamma = 2, d = 0")
+def alpha_max_gamma2():
+    r = _classify(2.0, 0)
+    ok = r.stable_exists and rounds_to(r.region_alpha_max, "4") and rounds_to(r.region_beta_at_alpha_max, "-2")
+    return Outcome("confirmed" if ok else "not-reproduced",
+                   f"largest stable alpha {r.region_alpha_max:.4f} at beta = {r.region_beta_at_alpha_max:.4f} "
+                   f"(root counting; a sliver of area {r.region_area:.3g}); the arc's top is "
+                   f"{r.arc_alpha_max:.4f} at beta = {r.arc_beta_at_alpha_max:.4f}")
+
+
+@check("claim:fold_5.8", kind="claim", where="Abstract; Sec. V, line 310; Sec. VIII, line 512",
+       claim="virtual mass raises alpha_max about 5.8-fold at d = 0 (4 / 0.6896)")
+def fold():
+    a0 = alpha_max_on_arc(gamma=0.0, d=0, delta=DEVICE_DELTA)[1]
+    a2 = _classify(2.0, 0).region_alpha_max
+    return _number(a2 / a0, "5.8", f"ratio {a2:.4f} / {a0:.4f}")
+
+
+@check("claim:beta_min", kind="claim", where="Sec. V, line 268; Sec. IV, line 262; Sec. VIII, line 508",
+       claim="beta_min = -bT/m = -0.00253 for every d and gamma")
+def beta_min():
+    lim = small_theta_limits().beta_limit
+    if lim != -model.delta:
+        return Outcome("not-reproduced", f"derived start beta = {show(lim)}")
+    return Outcome("confirmed", f"every arc starts at beta = {show(lim)} (Taylor limit with symbolic d, "
+                   f"gamma); for the device -delta = {-DEVICE_DELTA:.6g}, which rounds to -0.00253")
+
+
+@check("claim:beta_max_2", kind="claim", where="Sec. IV-C, line 252; Sec. V, lines 268, 339",
+       claim="beta_max = 2, reached at d = 0, gamma = 0, and the largest over d and gamma")
+def beta_max():
+    _, b00 = arc_end(gamma=0.0, d=0, delta=DEVICE_DELTA)
+    others = {(g, d): arc_end(gamma=g, d=d, delta=DEVICE_DELTA)[1]
+              for g, d in ((-0.25, 0), (0.5, 0), (0.0, 1), (0.5, 1), (0.0, 5))}
+    largest = max(others.values())
+    ok = rounds_to(b00, "2") and largest < b00
+    return Outcome("confirmed" if ok else "not-reproduced",
+                   f"arc end beta = {b00:.6f} at d = 0, gamma = 0 (rounds to 2); at (gamma, d) = "
+                   + ", ".join(f"({g:g}, {d}): {v:.4f}" for (g, d), v in others.items()))
+
+
+@check("claim:no_region_gamma_le_-1", kind="claim", where="Sec. V, lines 264-266; Sec. VII, line 463",
+       claim="no stable region for gamma <= -1")
+def no_region():
+    lim = small_theta_limits()
+    cases = [(g, d) for d in (0, 10) for g in (-1.0, -1.001)]
+    found = {c: _classify(*c) for c in cases}
+    stable = [c for c, r in found.items() if r.stable_exists]
+    if not stable:
+        return Outcome("confirmed", "no stable point at gamma = -1, -1.001 (d = 0, 10)")
+    return Outcome("not-reproduced",
+                   f"alpha > 0 along the start of the arc iff {show(lim.alpha_sign_condition)}, i.e. "
+                   f"gamma > -1 - (d+1) delta = {-1 - DEVICE_DELTA:.6f} (d = 0), {-1 - 11 * DEVICE_DELTA:.6f} "
+                   f"(d = 10); root counting finds stable points at "
+                   + ", ".join(f"gamma = {g:g}, d = {d} (alpha up to {found[(g, d)].region_alpha_max:.2g})"
+                               for g, d in stable)
+                   + ". The region for gamma <= -1 is tiny but not empty")
+
+
+@check("claim:max_gamma_2_d0", kind="claim", where="Abstract; Sec. VII, line 465",
+       claim="the maximum renderable gamma is 2, at d = 0")
+def max_gamma():
+    r_in, r_out = _classify(2.0, 0), _classify(2.01, 0)
+    ok = r_in.stable_exists and not r_out.stable_exists
+    return Outcome("confirmed" if ok else "not-reproduced",
+                   f"stable points exist at gamma = 2 ({r_in.n_stable} samples) and none at gamma = 2.01 "
+                   f"(root counting), so the largest renderable gamma at d = 0 lies in [2, 2.01): "
+                   f"slightly above 2, which rounds to the printed 2")
+
+
+@check("claim:gamma2_is_boundary", kind="claim", where="Sec. V, lines 296-298, 327 (Figs. 7, 8(a))",
+       claim="at gamma = 2, d = 0 the curve is a straight line: the boundary case B with no stable area")
+def gamma2_boundary():
+    r = _classify(2.0, 0)
+    if not r.stable_exists:
+        return Outcome("confirmed", "no stable point at gamma = 2, d = 0")
+    lo_hi = _top_of_stable_interval(-1.0, 2.0, alpha_low=1.9, alpha_high=2.1, n=400)
+    return Outcome("not-reproduced",
+                   f"the gamma = 2 arc is a thin loop (start direction {r.start.side}, end beta "
+                   f"{r.arc_beta_end:.6f}) enclosing a stable sliver of area {r.region_area:.3g}; "
+                   f"at beta = -1 the stable alpha interval is {lo_hi} (root counting)")
+
+
+def _figure_claim(cases):
+    disagreements, rows = [], []
+    for claim in cases:
+        r = _classify(claim.gamma, claim.d)
+        agree = regions.compare(claim, r)
+        rows.append(f"gamma={claim.gamma:g}: {'S' if r.stable_exists else 'U'}")
+        if agree is not True:
+            disagreements.append(f"gamma = {claim.gamma:g}, d = {claim.d}: paper {claim.claim}, root "
+                                 f"count {'stable region' if r.stable_exists else 'no stable point'}")
+    summary = "root counting: " + ", ".join(rows)
+    if disagreements:
+        return Outcome("not-reproduced", summary + ". Disagreements: " + "; ".join(disagreements))
+    return Outcome("confirmed", summary + "; every curve agrees with the paper's verdict")
+
+
+def _register_figure(figure, d, where, text):
+    cases = [c for c in regions.FIGURE_CASES if c.figure.startswith(figure) and c.d == d]
+    check(f"claim:fig{figure}_d{d}", kind="claim", where=where, claim=text)(
+        lambda: _figure_claim(cases))
+
+
+for _d in (0, 1, 5, 10):
+    _register_figure("6", _d, "Sec. V, lines 264-266 (Fig. 6)",
+                     f"d = {_d}: the regions of gamma = 0, -0.25, -0.5, -0.75 are stable")
+_register_figure("8", 0, "Sec. V, lines 325-327 (Fig. 8(a))",
+                 "d = 0: gamma < 2 stable, gamma = 2 boundary, gamma = 2.2 unstable")
+_register_figure("8", 1, "Sec. V, line 331 (Fig. 8(b))",
+                 "d = 1: gamma = 1.5, 2 unstable; all others (0, 0.5, 1, 2.2) stable")
+_register_figure("8", 5, "Sec. V, line 333 (Fig. 8(c))", "d = 5: gamma = 0, 0.5, 1 stable; 1.5, 2, 2.2 unstable")
+_register_figure("8", 10, "Sec. V, line 333 (Fig. 8(d))", "d = 10: gamma = 0, 0.5, 1 stable; 1.5, 2, 2.2 unstable")
+
+
+@check("claim:sided_rule", kind="claim", where="Sec. V, lines 287-298, 329",
+       claim="right-sided curves bound stable regions, left-sided curves unstable ones")
+def sided_rule():
+    wrong = []
+    for claim in regions.FIGURE_CASES:
+        r = _classify(claim.gamma, claim.d)
+        predicted = r.start.side == "right"
+        if predicted != r.stable_exists:
+            wrong.append(f"(gamma {claim.gamma:g}, d {claim.d}: starts {r.start.side}, "
+                         f"{'stable' if r.stable_exists else 'unstable'})")
+    if not wrong:
+        return Outcome("confirmed", "the starting direction predicts the root count for every curve")
+    return Outcome("not-reproduced",
+                   f"reading 'sided' as the arc's starting direction at (-delta, 0), it mispredicts "
+                   f"{len(wrong)} of {len(regions.FIGURE_CASES)} curves: " + ", ".join(wrong[:6])
+                   + ("..." if len(wrong) > 6 else "")
+                   + "; symstab decides stability by counting roots outside the unit circle instead")
+
+
+@check("claim:min_stiffness_fig7", kind="claim", where="Sec. V, line 319 (circles 5, 6 of Fig. 7)",
+       claim="gamma = 1.5, beta = -0.5, d = 0: stability needs a nonzero minimum alpha")
+def min_stiffness():
+    intervals = _top_of_stable_interval(-0.5, 1.5)
+    if intervals and intervals[0][0] > 1e-6:
+        lo, hi = intervals[0]
+        return Outcome("confirmed", f"stable alpha interval ({lo:.4f}, {hi:.4f}) by root counting: "
+                       f"circle 6 at alpha = {lo:.4f}, circle 5 at {hi:.4f}")
+    return Outcome("not-reproduced", f"stable alpha intervals {intervals}")
+
+
+def _kmax(gamma):
+    r = _classify(gamma, D_EXPERIMENT)
+    return r.region_alpha_max * M / T**2, r
+
+
+@check("claim:kmax_theory_gamma0", kind="claim", where="Sec. VII, line 457",
+       claim="theoretical K_max = 4.94 N m/rad (gamma = 0, T = 1 ms, Td = 40 ms)")
+def kmax0():
+    k, r = _kmax(0.0)
+    out = _number(k, "4.94", "K_max (N m/rad)")
+    return Outcome(out.verdict, out.evidence + f" (alpha_max = {r.region_alpha_max:.6g} at beta = "
+                   f"{r.region_beta_at_alpha_max:.4g}, root counting; K = alpha m / T^2)")
+
+
+@check("claim:kmax_theory_gamma1", kind="claim", where="Sec. VII, line 457",
+       claim="theoretical K_max = 20.35 N m/rad (gamma = 1, T = 1 ms, Td = 40 ms)")
+def kmax1():
+    k, r = _kmax(1.0)
+    out = _number(k, "20.35", "K_max (N m/rad)")
+    return Outcome(out.verdict, out.evidence + f" (largest stable alpha found {r.region_alpha_max:.6g} at "
+                   f"beta = {r.region_beta_at_alpha_max:.4g}; the arc's top, an upper bound, is "
+                   f"K = {r.arc_alpha_max * M / T**2:.4g}; the stable set is a thin band needing a minimum "
+                   f"stiffness)")
+
+
+@check("claim:increase_412", kind="claim", where="Sec. VII, line 457; Abstract ('4.1 times')",
+       claim="virtual mass gamma = 1 raises the theoretical K_max by 412 % (4.1-fold) at Td = 40 ms")
+def increase():
+    k0, _ = _kmax(0.0)
+    k1, _ = _kmax(1.0)
+    out = _number(100 * k1 / k0, "412", "ratio K_max(1)/K_max(0) in %")
+    return Outcome(out.verdict, out.evidence + " (the paper's 412 % is the ratio 20.35/4.94, not an "
+                   "increase of 412 %)")
+
+
+def _experimental(text, theory):
+    return Outcome("not-checkable", f"experimental result ({text}); theory: {theory}")
+
+
+@check("claim:exp_kmax_gamma0", kind="claim", where="Sec. VII, line 457",
+       claim="measured K_max = 4.3 N m/rad (gamma = 0, high gains)")
+def exp_k0():
+    return _experimental("measured on the device", f"K_max = {_kmax(0.0)[0]:.3f} N m/rad")
+
+
+@check("claim:exp_kmax_gamma1", kind="claim", where="Sec. VII, line 457",
+       claim="measured K_max = 15 N m/rad (gamma = 1, high gains)")
+def exp_k1():
+    return _experimental("measured on the device", f"K_max = {_kmax(1.0)[0]:.3f} N m/rad")
+
+
+@check("claim:exp_increase_349", kind="claim", where="Sec. VII, line 457; Abstract ('3.5')",
+       claim="measured increase 349 % (15 / 4.3)")
+def exp_inc():
+    return _experimental("measured on the device",
+                         f"ratio {100 * _kmax(1.0)[0] / _kmax(0.0)[0]:.0f} %")
+
+
+def _window(B_w, text):
+    beta = B_w * T / M
+    intervals = stable_alpha_intervals(beta=beta, gamma=1.0, d=D_EXPERIMENT, delta=DEVICE_DELTA,
+                                       alpha_low=0.0, alpha_high=3e-3, n=600)
+    k = ", ".join(f"{lo * M / T**2:.2f} < K_w < {hi * M / T**2:.2f}" for lo, hi in intervals) or "none"
+    return _experimental(text, f"at B_w = {B_w} N m s/rad, M_w = m, Td = 40 ms the linear model is "
+                         f"stable for {k} N m/rad (root counting)")
+
+
+@check("claim:exp_window_hg", kind="claim", where="Fig. 10(d) caption, line 391; Sec. VII, line 451",
+       claim="high gains, B_w = 0.45, M_w = m: stable for 5 < K_w < 15")
+def exp_window_hg():
+    return _window(0.45, "measured window with the PI current loop, quantization and filter")
+
+
+@check("claim:exp_window_lg", kind="claim", where="Fig. 10(d) caption, line 391; Sec. VII, line 451",
+       claim="low gains, B_w = 0.60, M_w = m: stable for 5 < K_w < 11")
+def exp_window_lg():
+    return _window(0.60, "measured window with the PI current loop, quantization and filter")

@@ -1,0 +1,239 @@
+"""The audit of the paper: every printed equation and claim has a row, and
+every verdict is pinned, so a change in any verdict (a regression or a fix)
+fails here and shows up in review.
+
+The audit runs once, through the command line, into a temporary folder.
+"""
+
+import json
+import subprocess
+import sys
+
+import pytest
+
+from paper_checks import audit, claims, printed
+
+#: The verdicts as reviewed against the mathematics; update only with a reason.
+EXPECTED_VERDICTS = {
+    'eq1': 'confirmed',
+    'eq3': 'confirmed',
+    'eq4': 'confirmed',
+    'eq2': 'confirmed',
+    'eq5': 'erratum',
+    'eq6': 'confirmed',
+    'eq16': 'not-checkable',
+    'eq17': 'not-checkable',
+    'eq7.alpha': 'confirmed',
+    'eq7.beta': 'erratum',
+    'eq11.alpha': 'confirmed',
+    'eq11.beta': 'confirmed',
+    'eq14.alpha': 'confirmed',
+    'eq14.beta': 'confirmed',
+    'eq18': 'erratum',
+    'eq19': 'erratum',
+    'eq20': 'confirmed',
+    'eq21': 'confirmed',
+    'eq22': 'confirmed',
+    'eq23': 'confirmed',
+    'eq24': 'confirmed',
+    'eq25': 'confirmed',
+    'eq26': 'confirmed',
+    'eq27': 'confirmed',
+    'eq28': 'confirmed',
+    'eq29': 'confirmed',
+    'eq30': 'confirmed',
+    'eq31': 'confirmed',
+    'eq32': 'confirmed',
+    'eq33': 'confirmed',
+    'eq34': 'confirmed',
+    'eq8': 'confirmed',
+    'eq47': 'confirmed',
+    'eq15': 'confirmed',
+    'eq9': 'confirmed',
+    'eq46': 'confirmed',
+    'eq10': 'confirmed',
+    'eq44': 'confirmed',
+    'eq45': 'confirmed',
+    'eq36': 'confirmed',
+    'eq43': 'confirmed',
+    'eq37.lhs': 'confirmed',
+    'eq37.rhs': 'confirmed',
+    'eq38.lhs': 'confirmed',
+    'eq38.rhs': 'confirmed',
+    'eq39.lhs': 'confirmed',
+    'eq39.rhs': 'confirmed',
+    'eq40.lhs': 'confirmed',
+    'eq40.rhs': 'confirmed',
+    'eq41.lhs': 'confirmed',
+    'eq41.rhs': 'confirmed',
+    'eq42.rhs': 'confirmed',
+    'eq35.s_h': 'not-checkable',
+    'eq35.c_h': 'not-checkable',
+    'eq35.c': 'not-checkable',
+    'eq42.lhs': 'not-checkable',
+    'eq50.sh': 'not-checkable',
+    'eq50.ch': 'not-checkable',
+    'eq50.s': 'not-checkable',
+    'eq50.c': 'not-checkable',
+    'eq50.Gamma': 'confirmed',
+    'eq48': 'confirmed',
+    'eq49': 'confirmed',
+    'eq13.A_S': 'confirmed',
+    'eq51': 'confirmed',
+    'eq13.A_D': 'confirmed',
+    'eq52': 'confirmed',
+    'eq53': 'confirmed',
+    'eq13.theta0': 'confirmed',
+    'eq56': 'confirmed',
+    'eq54': 'confirmed',
+    'eq55': 'confirmed',
+    'eq57.sin': 'confirmed',
+    'eq57.cos': 'confirmed',
+    'eq59': 'confirmed',
+    'eq60': 'erratum',
+    'eq61': 'confirmed',
+    'eq62': 'confirmed',
+    'eq12': 'approximation',
+    'eq58': 'approximation',
+    'eq63': 'approximation',
+    'eq64.K1': 'erratum',
+    'eq64.K2': 'confirmed',
+    'eq64.K3': 'confirmed',
+    'eq64.K4': 'confirmed',
+    'eq65.C1': 'approximation',
+    'eq65.C2': 'approximation',
+    'eq65.C3': 'approximation',
+    'eq65.C4': 'approximation',
+    'eq65.C5': 'approximation',
+    'eq65.C6': 'approximation',
+    'eq65.C7': 'approximation',
+    'eq65.C8': 'approximation',
+    'eq65.C9': 'approximation',
+    'eq65.C10': 'approximation',
+    'eq65.C11': 'approximation',
+    'eq66': 'confirmed',
+    'eq69': 'erratum',
+    'eq67': 'approximation',
+    'eq68': 'erratum',
+    'eq70': 'confirmed',
+    'claim:theta_max_1.5725': 'confirmed',
+    'claim:alpha_max_gamma0': 'not-reproduced',
+    'claim:alpha_beta0_gamma0': 'confirmed',
+    'claim:alpha_beta0_gamma1': 'confirmed',
+    'claim:alpha_beta-1_gamma1.5': 'confirmed',
+    'claim:alpha_max_gamma2': 'confirmed',
+    'claim:fold_5.8': 'confirmed',
+    'claim:beta_min': 'confirmed',
+    'claim:beta_max_2': 'confirmed',
+    'claim:no_region_gamma_le_-1': 'not-reproduced',
+    'claim:max_gamma_2_d0': 'confirmed',
+    'claim:gamma2_is_boundary': 'not-reproduced',
+    'claim:fig6_d0': 'confirmed',
+    'claim:fig6_d1': 'confirmed',
+    'claim:fig6_d5': 'confirmed',
+    'claim:fig6_d10': 'confirmed',
+    'claim:fig8_d0': 'not-reproduced',
+    'claim:fig8_d1': 'not-reproduced',
+    'claim:fig8_d5': 'confirmed',
+    'claim:fig8_d10': 'confirmed',
+    'claim:sided_rule': 'not-reproduced',
+    'claim:min_stiffness_fig7': 'confirmed',
+    'claim:kmax_theory_gamma0': 'not-reproduced',
+    'claim:kmax_theory_gamma1': 'not-reproduced',
+    'claim:increase_412': 'not-reproduced',
+    'claim:exp_kmax_gamma0': 'not-checkable',
+    'claim:exp_kmax_gamma1': 'not-checkable',
+    'claim:exp_increase_349': 'not-checkable',
+    'claim:exp_window_hg': 'not-checkable',
+    'claim:exp_window_lg': 'not-checkable',
+}
+
+
+@pytest.fixture(scope="module")
+def audit_run(tmp_path_factory):
+    out = tmp_path_factory.mktemp("audit")
+    report, js = out / "REPORT.md", out / "audit.json"
+    proc = subprocess.run([sys.executable, "-m", "symstab", "audit", "--report", str(report),
+                           "--json", str(js)], capture_output=True, text=True, timeout=900)
+    return proc, report, js
+
+
+def test_audit_exits_zero_and_writes_both_files(audit_run):
+    proc, report, js = audit_run
+    assert proc.returncode == 0, proc.stderr
+    assert report.is_file() and js.is_file()
+    assert "audited" in proc.stdout
+
+
+def test_every_verdict_is_pinned(audit_run):
+    _, _, js = audit_run
+    rows = json.loads(js.read_text())
+    got = {r["id"]: r["verdict"] for r in rows}
+    assert got == EXPECTED_VERDICTS
+
+
+def test_json_rows_have_the_documented_fields(audit_run):
+    _, _, js = audit_run
+    for row in json.loads(js.read_text()):
+        assert set(row) == {"id", "kind", "verdict", "detail"}
+        assert row["kind"] == ("claim" if row["id"].startswith("claim:") else "equation")
+        assert row["verdict"] in audit.VERDICTS
+        assert row["detail"].strip()
+
+
+def test_report_counts_match_the_rows(audit_run):
+    _, report, js = audit_run
+    rows = json.loads(js.read_text())
+    text = report.read_text()
+    for verdict in audit.VERDICTS:
+        n = sum(r["verdict"] == verdict for r in rows)
+        assert f"| {verdict} | {n} |" in text
+    for row in rows:
+        assert f"| {row['id']} |" in text
+
+
+def test_every_printed_equation_has_a_check():
+    assert set(printed.PRINTED) <= set(audit.registered())
+
+
+@pytest.mark.parametrize("cid", [
+    "claim:theta_max_1.5725", "claim:alpha_max_gamma0", "claim:alpha_beta0_gamma0",
+    "claim:alpha_beta0_gamma1", "claim:alpha_beta-1_gamma1.5", "claim:alpha_max_gamma2",
+    "claim:fold_5.8", "claim:beta_min", "claim:beta_max_2", "claim:no_region_gamma_le_-1",
+    "claim:max_gamma_2_d0", "claim:min_stiffness_fig7", "claim:kmax_theory_gamma0",
+    "claim:kmax_theory_gamma1", "claim:increase_412", "claim:exp_kmax_gamma0",
+    "claim:exp_kmax_gamma1", "claim:exp_increase_349", "claim:exp_window_hg",
+    "claim:fig8_d0", "claim:fig8_d1", "claim:fig8_d5", "claim:fig8_d10", "claim:fig6_d0",
+])
+def test_the_issue_s_claims_are_audited(cid):
+    assert cid in audit.registered()
+
+
+def test_an_erratum_needs_a_corrected_form():
+    with pytest.raises(ValueError, match="corrected"):
+        audit.Outcome("erratum", "wrong")
+    with pytest.raises(ValueError, match="verdict"):
+        audit.Outcome("plausible", "no such verdict")
+
+
+def test_check_ids_follow_the_naming_rule():
+    with pytest.raises(ValueError):
+        audit.check("claim:x", kind="equation", where="", claim="")
+    with pytest.raises(ValueError):
+        audit.check("eq1", kind="claim", where="", claim="")
+
+
+@pytest.mark.parametrize("value, printed_text, expected", [
+    (1.57248, "1.5725", True), (0.68967, "0.6896", False), (2.0034, "2", True),
+    (4.95884, "4.94", False), (0.0050646, "0.005", True), (-0.00253125, "-0.00253", True),
+])
+def test_rounds_to_is_rounding_at_the_printed_digits(value, printed_text, expected):
+    assert claims.rounds_to(value, printed_text) is expected
+
+
+def test_report_rendering_is_deterministic():
+    rows = [audit.Finding("eq1", "equation", "eq. (1)", "x | y", "confirmed", "proved"),
+            audit.Finding("claim:a", "claim", "Sec. I", "n = 1", "not-reproduced", "n = 2")]
+    first = audit.render_report(rows)
+    assert first == audit.render_report(rows)
+    assert "x \\| y" in first and "| not-reproduced | 1 |" in first
