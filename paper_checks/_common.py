@@ -2,7 +2,6 @@
 
 import sympy as sp
 
-from symstab import model
 from symstab.identity import check_identity
 
 from .audit import Outcome
@@ -57,8 +56,11 @@ def compare(printed_expr, derived_expr, *, corrected=None, corrected_note="",
     which is itself proved equal to the derivation.
     """
     result = prove(printed_expr, derived_expr)
-    if result.equal is True or (result.equal is None and result.max_rel_diff < 1e-30):
+    if result.equal is True:
         return Outcome("confirmed", f"equals {derived_name}: {_evidence(result)}")
+    if result.equal is None and result.max_rel_diff < 1e-30:
+        return Outcome("confirmed", f"equals {derived_name} numerically only (not proved exactly): "
+                       f"{_evidence(result)}")
     fixed = derived_expr if corrected is None else corrected
     fixed_result = prove(fixed, derived_expr)
     if fixed_result.equal is not True:

@@ -19,6 +19,7 @@ from symstab.theta_max import theta_max
 from . import regions
 from ._common import DEVICE_DELTA, show
 from .audit import Outcome, check
+from .eq_limits import gamma_threshold
 
 #: The paper's device (Section VI).
 M, B, T = 0.0128, 0.0324, 1e-3
@@ -45,7 +46,7 @@ def _classify(gamma, d):
     return regions.classify(gamma, d, DEVICE_DELTA)
 
 
-def _top_of_stable_interval(beta, gamma, d=0, **kw):
+def _stable_intervals(beta, gamma, d=0, **kw):
     intervals = stable_alpha_intervals(beta=beta, gamma=gamma, d=d, delta=DEVICE_DELTA, **kw)
     return intervals
 
@@ -77,7 +78,7 @@ def _alpha_on_arc_at_beta(beta):
 
 
 def _stable_alpha_top(beta, gamma, printed, what):
-    intervals = _top_of_stable_interval(beta, gamma)
+    intervals = _stable_intervals(beta, gamma)
     if not intervals:
         return Outcome("not-reproduced", f"no stable alpha at beta = {beta}, gamma = {gamma} (root count)")
     lo, hi = intervals[-1]
@@ -155,9 +156,11 @@ def no_region():
     stable = [c for c, r in found.items() if r.stable_exists]
     if not stable:
         return Outcome("confirmed", "no stable point at gamma = -1, -1.001 (d = 0, 10)")
+    threshold = gamma_threshold()
+    at = {dd: float(threshold.subs({model.d: dd, model.delta: DEVICE_DELTA})) for dd in (0, 10)}
     return Outcome("not-reproduced",
                    f"alpha > 0 along the start of the arc iff {show(lim.alpha_sign_condition)}, i.e. "
-                   f"gamma > -1 - (d+1) delta = {-1 - DEVICE_DELTA:.6f} (d = 0), {-1 - 11 * DEVICE_DELTA:.6f} "
+                   f"gamma > {show(threshold)} = {at[0]:.6f} (d = 0), {at[10]:.6f} "
                    f"(d = 10); root counting finds stable points at "
                    + ", ".join(f"gamma = {g:g}, d = {d} (alpha up to {found[(g, d)].region_alpha_max:.2g})"
                                for g, d in stable)
@@ -169,10 +172,13 @@ def no_region():
 def max_gamma():
     r_in, r_out = _classify(2.0, 0), _classify(2.01, 0)
     ok = r_in.stable_exists and not r_out.stable_exists
-    return Outcome("confirmed" if ok else "not-reproduced",
+    if not ok:
+        return Outcome("not-reproduced", f"stable points at gamma = 2: {r_in.stable_exists}; at gamma = "
+                       f"2.01: {r_out.stable_exists} (root counting)")
+    return Outcome("confirmed",
                    f"stable points exist at gamma = 2 ({r_in.n_stable} samples) and none at gamma = 2.01 "
-                   f"(root counting), so the largest renderable gamma at d = 0 lies in [2, 2.01): "
-                   f"slightly above 2, which rounds to the printed 2")
+                   f"(root counting), so the largest renderable gamma at d = 0 lies in [2, 2.01), "
+                   f"which rounds to the printed 2")
 
 
 @check("claim:gamma2_is_boundary", kind="claim", where="Sec. V, lines 296-298, 327 (Figs. 7, 8(a))",
@@ -181,7 +187,7 @@ def gamma2_boundary():
     r = _classify(2.0, 0)
     if not r.stable_exists:
         return Outcome("confirmed", "no stable point at gamma = 2, d = 0")
-    lo_hi = _top_of_stable_interval(-1.0, 2.0, alpha_low=1.9, alpha_high=2.1, n=400)
+    lo_hi = _stable_intervals(-1.0, 2.0, alpha_low=1.9, alpha_high=2.1, n=400)
     return Outcome("not-reproduced",
                    f"the gamma = 2 arc is a thin loop (start direction {r.start.side}, end beta "
                    f"{r.arc_beta_end:.6f}) enclosing a stable sliver of area {r.region_area:.3g}; "
@@ -242,7 +248,7 @@ def sided_rule():
 @check("claim:min_stiffness_fig7", kind="claim", where="Sec. V, line 319 (circles 5, 6 of Fig. 7)",
        claim="gamma = 1.5, beta = -0.5, d = 0: stability needs a nonzero minimum alpha")
 def min_stiffness():
-    intervals = _top_of_stable_interval(-0.5, 1.5)
+    intervals = _stable_intervals(-0.5, 1.5)
     if intervals and intervals[0][0] > 1e-6:
         lo, hi = intervals[0]
         return Outcome("confirmed", f"stable alpha interval ({lo:.4f}, {hi:.4f}) by root counting: "
@@ -281,8 +287,8 @@ def increase():
     k0, _ = _kmax(0.0)
     k1, _ = _kmax(1.0)
     out = _number(100 * k1 / k0, "412", "ratio K_max(1)/K_max(0) in %")
-    return Outcome(out.verdict, out.evidence + " (the paper's 412 % is the ratio 20.35/4.94, not an "
-                   "increase of 412 %)")
+    return Outcome(out.verdict, out.evidence + " (412 % is read as the ratio of the two K_max, as the "
+                   "paper's '4.1 times' in the abstract says)")
 
 
 def _experimental(text, theory):

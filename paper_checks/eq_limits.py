@@ -16,7 +16,7 @@ from symstab.boundary import boundary, coefficients
 from symstab.evaluate import boundary_point
 from symstab.limits import small_theta_limits
 
-from ._common import DEVICE_DELTA, compare, prove, show, where, with_printed_coefficients
+from ._common import DEVICE_DELTA, compare, show, where, with_printed_coefficients
 from .audit import Outcome, check
 from .eq_boundary import BETA_CORRECTED
 from .printed import Delta, const, eta, printed, xi
@@ -125,14 +125,26 @@ def eq67():
 def eq68():
     lim = small_theta_limits()
     if lim.alpha_limit != 0:
-        raise AssertionError("derived limit of alpha is not 0")
+        return Outcome("erratum", f"the derived limit is {show(lim.alpha_limit)}",
+                       corrected=f"lim alpha = {show(lim.alpha_limit)}")
+    threshold = gamma_threshold()
+    if threshold is None:
+        return Outcome("confirmed", f"alpha = ({show(lim.alpha_theta2)}) theta^2 + ..., positive for all "
+                       f"gamma, d")
     return Outcome(
         "erratum",
         f"the limit is 0, but alpha = ({show(lim.alpha_theta2)}) theta^2 + O(theta^4) (Taylor series of "
         f"the derived alpha with symbolic d), so alpha approaches 0 from above only when "
-        f"{show(lim.alpha_sign_condition)}; the argument of lines 828-830 assumes every term of (67) "
-        f"positive, which fails for gamma < -1 - (d+1) delta",
+        f"{show(lim.alpha_sign_condition)}, i.e. gamma > {show(threshold)}; the argument of (67) takes "
+        f"every term positive, which fails below that gamma",
         corrected=f"lim alpha = 0, from above iff {show(lim.alpha_sign_condition)}")
+
+
+def gamma_threshold():
+    """The gamma below which alpha < 0 next to theta = 0 (None if there is none)."""
+    lim = small_theta_limits()
+    roots = sp.solve(lim.alpha_theta2, model.gamma)
+    return sp.factor(roots[0]) if len(roots) == 1 else None
 
 
 @check("eq70", kind="equation", where=where("eq70"), claim="lim_{theta->0} beta = -delta")

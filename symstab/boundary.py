@@ -35,7 +35,7 @@ import functools
 import sympy as sp
 
 from . import model
-from .identity import E, conjugate_on_circle, exponential_form, trig_form, w
+from .identity import conjugate_on_circle, exponential_form, trig_form, w
 from .discretize import dimensionless_pulse_transfer_function
 from .unit_circle import unit_circle_split
 

@@ -59,7 +59,11 @@ def _cmd_audit(args):
     def progress(n, total, cid):
         print(f"[{n:3d}/{total}] {cid}", file=sys.stderr, flush=True)
 
-    findings = audit.run_audit(progress=progress if args.verbose else None)
+    try:
+        findings = audit.run_audit(progress=progress if args.verbose else None)
+    except (AssertionError, RuntimeError, ArithmeticError) as exc:
+        print(f"symstab: audit failed inside a check: {type(exc).__name__}: {exc}", file=sys.stderr)
+        return 1
     outputs = {pathlib.Path(args.report): audit.render_report(findings)}
     if args.json:
         outputs[pathlib.Path(args.json)] = audit.to_json(findings)
