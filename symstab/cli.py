@@ -13,6 +13,8 @@ __all__ = ["main"]
 
 #: Where ``symstab derive`` writes without ``--out``.
 DEFAULT_DERIVATIONS = pathlib.Path("derivations") / "generated"
+#: Where ``symstab derive`` writes the generated kernels without ``--codegen-out``.
+DEFAULT_CODEGEN = pathlib.Path("symstab") / "_generated"
 #: Where ``symstab audit`` writes its report without ``--report``.
 DEFAULT_REPORT = pathlib.Path("paper_checks") / "REPORT.md"
 
@@ -23,27 +25,35 @@ class _Parser(argparse.ArgumentParser):
 
 
 def _cmd_derive(args):
-    from . import derive
+    from . import codegen, derive
 
     start = time.perf_counter()
-    out = pathlib.Path(args.out)
-    if out.exists() and not out.is_dir():
-        raise ValueError(f"--out must be a directory, got file {out}")
+    out, code_out = pathlib.Path(args.out), pathlib.Path(args.codegen_out)
+    for flag, path in (("--out", out), ("--codegen-out", code_out)):
+        if path.exists() and not path.is_dir():
+            raise ValueError(f"{flag} must be a directory, got file {path}")
     print("deriving: ZOH, characteristic polynomial, unit circle, boundary, limits, "
-          "theta_max, proofs ...", file=sys.stderr)
-    files = derive.render(derive.derivation_steps())
+          "theta_max, proofs, code generation ...", file=sys.stderr)
+    outputs = [(out, derive.render(derive.derivation_steps()), derive.OWNED),
+               (code_out, codegen.generated_files(), codegen.OWNED)]
     if args.check:
-        stale = derive.check(out, files)
+        command = "symstab derive"
+        if out != DEFAULT_DERIVATIONS:
+            command += f" --out {out}"
+        if code_out != DEFAULT_CODEGEN:
+            command += f" --codegen-out {code_out}"
+        stale = [path for folder, files, owned in outputs
+                 for path in derive.check(folder, files, owned=owned)]
         for path in stale:
-            print(f"drift: {path} differs from a fresh derivation; run `symstab derive"
-                  f"{'' if out == DEFAULT_DERIVATIONS else ' --out ' + str(out)}`")
+            print(f"drift: {path} differs from a fresh derivation; run `{command}`")
         if stale:
             return 1
-        print(f"{len(files)} files in {out} match a fresh derivation "
-              f"({time.perf_counter() - start:.1f} s)")
+        print(f"{sum(len(files) for _, files, _ in outputs)} files in {out} and {code_out} "
+              f"match a fresh derivation ({time.perf_counter() - start:.1f} s)")
         return 0
-    written = derive.write(out, files)
-    print(f"wrote {len(written)} files to {out} ({time.perf_counter() - start:.1f} s)")
+    written = [derive.write(folder, files) for folder, files, _ in outputs]
+    print(f"wrote {len(written[0])} files to {out} and {len(written[1])} to {code_out} "
+          f"({time.perf_counter() - start:.1f} s)")
     return 0
 
 
@@ -87,8 +97,10 @@ def build_parser():
     p = sub.add_parser("derive", help="regenerate every derived object as LaTeX and srepr JSON")
     p.add_argument("--out", default=str(DEFAULT_DERIVATIONS),
                    help=f"output directory (default: {DEFAULT_DERIVATIONS})")
+    p.add_argument("--codegen-out", default=str(DEFAULT_CODEGEN),
+                   help=f"output directory of the generated NumPy and C kernels (default: {DEFAULT_CODEGEN})")
     p.add_argument("--check", action="store_true",
-                   help="compare the files in --out with a fresh derivation; exit 1 on drift")
+                   help="compare both output directories with a fresh run; exit 1 on drift")
     p.set_defaults(func=_cmd_derive)
     p = sub.add_parser("audit", help="check every equation and claim of the paper; write REPORT.md")
     p.add_argument("--report", default=str(DEFAULT_REPORT),

@@ -18,7 +18,7 @@ import tempfile
 
 import sympy as sp
 
-from . import model
+from . import kernel_forms, model
 from .boundary import boundary, coefficients, beta_relations
 from .discretize import dimensionless_pulse_transfer_function, pulse_transfer_function
 from .identity import check_identity
@@ -27,7 +27,7 @@ from .loop import characteristic_polynomial
 from .theta_max import closed_form_d0, newton_form_gamma0
 from .unit_circle import unit_circle_split
 
-__all__ = ["Step", "derivation_steps", "render", "write", "check", "proofs"]
+__all__ = ["Step", "derivation_steps", "render", "write", "check", "proofs", "OWNED"]
 
 
 @dataclasses.dataclass(frozen=True)
@@ -76,6 +76,8 @@ def proofs():
     for key, (lhs, rhs) in beta_relations().items():
         out.append((f"beta_monomial_{'_'.join(map(str, key))}",
                     f"coefficient of monomial {key} in N_beta", lhs, rhs))
+    # The forms the numeric kernels are generated from (symstab.codegen).
+    out += kernel_forms.proofs()
     return out
 
 
@@ -192,17 +194,25 @@ def write(out_dir, files):
     return sorted(out / name for name in files)
 
 
-def check(out_dir, files):
-    """Return the paths in ``out_dir`` that differ from ``files`` or are extra."""
+#: Glob patterns of the files :func:`render` owns in its folder (for drift).
+OWNED = ("[0-9][0-9]_*.json", "[0-9][0-9]_*.tex")
+
+
+def check(out_dir, files, *, owned=OWNED):
+    """Return the paths in ``out_dir`` that differ from ``files`` or are extra.
+
+    ``owned`` are the glob patterns of the files a generator writes in
+    ``out_dir``: one that matches and is not in ``files`` (a former step's
+    output) is drift too.
+    """
     out = pathlib.Path(out_dir)
     stale = []
     for name, text in sorted(files.items()):
         path = out / name
         if not path.is_file() or path.read_text(encoding="utf-8") != text:
             stale.append(str(path))
-    # A file a former step wrote but no step writes any more is drift too.
     if out.is_dir():
-        for path in sorted(out.glob("[0-9][0-9]_*")):
-            if path.suffix in (".json", ".tex") and path.name not in files:
-                stale.append(str(path))
+        extra = {path for pattern in owned for path in out.glob(pattern)
+                 if path.is_file() and path.name not in files}
+        stale += sorted(str(path) for path in extra)
     return stale

@@ -278,35 +278,58 @@ def run_symstab(*args, env_extra=None, cwd=None, timeout=300):
 
 
 @pytest.fixture(scope="session")
-def derive_subprocess_runs(tmp_path_factory, rendered_files):
-    """Three ``symstab derive`` subprocesses, run concurrently.
+def generated_code():
+    """codegen.generated_files(), built once."""
+    from symstab.codegen import generated_files
 
-    ``seed1`` and ``seed2`` write a fresh derivation under PYTHONHASHSEED=1
-    and 2; ``check_edited`` runs ``--check`` on a copy of the in-process
-    derivation in which :data:`EDITED_FILE` was edited by hand.
+    return generated_files()
 
-    Returns ``{name: (CompletedProcess-like tuple (returncode, stdout, stderr), out_dir)}``.
+
+#: The generated-code file hand-edited for the codegen drift test.
+EDITED_CODE_FILE = "symstab_kernels.c"
+
+
+def _copy_files(folder, files, edited=None):
+    folder.mkdir(parents=True)
+    for name, text in files.items():
+        (folder / name).write_text(text, encoding="utf-8", newline="\n")
+    if edited is not None:
+        with open(folder / edited, "a", encoding="utf-8", newline="\n") as fh:
+            fh.write("/* a hand edit */\n" if edited.endswith((".c", ".h")) else EDIT)
+
+
+@pytest.fixture(scope="session")
+def derive_subprocess_runs(tmp_path_factory, rendered_files, generated_code):
+    """Four ``symstab derive`` subprocesses, run concurrently.
+
+    ``seed1`` and ``seed2`` write a fresh derivation and fresh kernels under
+    PYTHONHASHSEED=1 and 2; ``check_edited`` runs ``--check`` on a copy of
+    the in-process output in which :data:`EDITED_FILE` was edited by hand,
+    ``check_edited_code`` on one in which :data:`EDITED_CODE_FILE` was.
+
+    Returns ``{name: (CompletedProcess-like tuple (returncode, stdout, stderr),
+    (derivations dir, code dir))}``.
     """
     base = tmp_path_factory.mktemp("derive_runs")
-    edited = base / "edited"
-    edited.mkdir()
-    for name, text in rendered_files.items():
-        (edited / name).write_text(text, encoding="utf-8", newline="\n")
-    with open(edited / EDITED_FILE, "a", encoding="utf-8", newline="\n") as fh:
-        fh.write(EDIT)
+    _copy_files(base / "edited", rendered_files, EDITED_FILE)
+    _copy_files(base / "edited_code_ok", generated_code)
+    _copy_files(base / "fresh", rendered_files)
+    _copy_files(base / "edited_code", generated_code, EDITED_CODE_FILE)
     jobs = {
-        "seed1": (["derive", "--out", str(base / "seed1")], "1", base / "seed1"),
-        "seed2": (["derive", "--out", str(base / "seed2")], "2", base / "seed2"),
-        "check_edited": (["derive", "--out", str(edited), "--check"], "3", edited),
+        "seed1": (base / "seed1", base / "seed1_code", False),
+        "seed2": (base / "seed2", base / "seed2_code", False),
+        "check_edited": (base / "edited", base / "edited_code_ok", True),
+        "check_edited_code": (base / "fresh", base / "edited_code", True),
     }
     procs = {}
-    for name, (args, seed, _) in jobs.items():
-        env = dict(os.environ, PYTHONHASHSEED=seed)
+    for seed, (name, (out, code, check)) in enumerate(jobs.items(), start=1):
+        args = ["derive", "--out", str(out), "--codegen-out", str(code)] + (["--check"] if check else [])
+        env = dict(os.environ, PYTHONHASHSEED=str(seed))
         procs[name] = subprocess.Popen([sys.executable, "-m", "symstab", *args], cwd=base,
                                        env=env, stdout=subprocess.PIPE,
                                        stderr=subprocess.PIPE, text=True)
     out = {}
     for name, proc in procs.items():
         stdout, stderr = proc.communicate(timeout=600)
-        out[name] = ((proc.returncode, stdout, stderr), jobs[name][2])
+        out[name] = ((proc.returncode, stdout, stderr), jobs[name][:2])
     return out

@@ -4,7 +4,7 @@ import pytest
 
 from symstab import cli
 
-from conftest import EDITED_FILE, run_symstab
+from conftest import EDITED_CODE_FILE, EDITED_FILE, REPO, run_symstab
 
 
 def _assert_one_line_error(result, *needles):
@@ -44,7 +44,7 @@ def test_help_exits_0(tmp_path):
 
 
 def test_check_exits_1_and_names_only_the_edited_file(derive_subprocess_runs):
-    (returncode, stdout, stderr), out_dir = derive_subprocess_runs["check_edited"]
+    (returncode, stdout, stderr), (out_dir, _) = derive_subprocess_runs["check_edited"]
     assert returncode == 1, stderr
     assert "Traceback" not in stderr
     named = [line for line in stdout.splitlines() if line.startswith("drift:")]
@@ -54,17 +54,48 @@ def test_check_exits_1_and_names_only_the_edited_file(derive_subprocess_runs):
 
 
 def test_derive_writes_into_out(derive_subprocess_runs, rendered_files):
-    (returncode, stdout, _), out_dir = derive_subprocess_runs["seed1"]
+    (returncode, stdout, _), (out_dir, code_dir) = derive_subprocess_runs["seed1"]
     assert returncode == 0
-    assert f"wrote {len(rendered_files)} files to {out_dir}" in stdout
+    assert f"wrote {len(rendered_files)} files to {out_dir} and " in stdout
+    assert f" to {code_dir} " in stdout
 
 
-def test_check_exits_0_on_fresh_output(tmp_path, rendered_files, capsys):
+def test_check_exits_1_and_names_only_the_edited_generated_file(derive_subprocess_runs):
+    (returncode, stdout, stderr), (_, code_dir) = derive_subprocess_runs["check_edited_code"]
+    assert returncode == 1, stderr
+    named = [line for line in stdout.splitlines() if line.startswith("drift:")]
+    assert len(named) == 1
+    assert str(code_dir / EDITED_CODE_FILE) in named[0]
+    assert f"--codegen-out {code_dir}" in named[0]
+
+
+def test_check_exits_0_on_fresh_output(tmp_path, rendered_files, generated_code, capsys):
     from symstab import derive
 
-    derive.write(tmp_path, rendered_files)
-    assert cli.main(["derive", "--out", str(tmp_path), "--check"]) == 0
+    derive.write(tmp_path / "derivations", rendered_files)
+    derive.write(tmp_path / "code", generated_code)
+    assert cli.main(["derive", "--out", str(tmp_path / "derivations"),
+                     "--codegen-out", str(tmp_path / "code"), "--check"]) == 0
     assert "match a fresh derivation" in capsys.readouterr().out
+
+
+def test_check_reports_a_stray_generated_file(tmp_path, rendered_files, generated_code, capsys):
+    from symstab import derive
+
+    derive.write(tmp_path / "derivations", rendered_files)
+    derive.write(tmp_path / "code", generated_code)
+    (tmp_path / "code" / "old_kernels.py").write_text("# a former kernel\n")
+    assert cli.main(["derive", "--out", str(tmp_path / "derivations"),
+                     "--codegen-out", str(tmp_path / "code"), "--check"]) == 1
+    assert "old_kernels.py" in capsys.readouterr().out
+
+
+def test_committed_kernels_match_a_fresh_generation(generated_code):
+    from symstab import derive
+
+    committed = REPO / "symstab" / "_generated"
+    stale = derive.check(committed, generated_code, owned=("*.py", "*.c", "*.h"))
+    assert stale == [], f"generated code drifted: {stale}; run `symstab derive`"
 
 
 def test_check_on_missing_directory_exits_1(tmp_path, capsys):

@@ -25,18 +25,25 @@ def test_render_is_byte_identical_on_two_calls(rendered_files):
         assert again[name].encode() == rendered_files[name].encode(), name
 
 
-def test_output_does_not_depend_on_hash_seed(derive_subprocess_runs, rendered_files):
+def test_output_does_not_depend_on_hash_seed(derive_subprocess_runs, rendered_files, generated_code):
     dirs = {}
     for name in ("seed1", "seed2"):
-        (returncode, stdout, stderr), out_dir = derive_subprocess_runs[name]
+        (returncode, stdout, stderr), (out_dir, code_dir) = derive_subprocess_runs[name]
         assert returncode == 0, stderr
         dirs[name] = out_dir
+        dirs[name + "_code"] = code_dir
     names = sorted(p.name for p in dirs["seed1"].iterdir())
     assert names == sorted(p.name for p in dirs["seed2"].iterdir()) == sorted(rendered_files)
     for name in names:
         one = (dirs["seed1"] / name).read_bytes()
         assert one == (dirs["seed2"] / name).read_bytes(), name
         assert one == rendered_files[name].encode("utf-8"), name
+    names = sorted(p.name for p in dirs["seed1_code"].iterdir())
+    assert names == sorted(p.name for p in dirs["seed2_code"].iterdir()) == sorted(generated_code)
+    for name in names:
+        one = (dirs["seed1_code"] / name).read_bytes()
+        assert one == (dirs["seed2_code"] / name).read_bytes(), name
+        assert one == generated_code[name].encode("utf-8"), name
 
 
 def test_every_step_has_json_and_tex(rendered_files):
@@ -101,11 +108,11 @@ def test_srepr_keeps_symbol_assumptions(rendered_files):
     assert symbols["delta"].is_positive
 
 
-def test_output_has_no_dates_versions_or_paths(rendered_files, derive_subprocess_runs):
+def test_output_has_no_dates_versions_or_paths(rendered_files, generated_code, derive_subprocess_runs):
     versions = {importlib.metadata.version(p) for p in ("sympy", "mpmath", "symstab")}
     versions.add(platform.python_version())
-    _, out_dir = derive_subprocess_runs["seed1"]
-    for name, text in rendered_files.items():
+    _, (out_dir, _) = derive_subprocess_runs["seed1"]
+    for name, text in {**rendered_files, **generated_code}.items():
         assert not re.search(r"\b(19|20)\d\d-\d\d-\d\d\b", text), name
         assert not re.search(r"\b\d\d:\d\d:\d\d\b", text), name
         for v in versions:
@@ -157,11 +164,12 @@ def test_proved_identities_hold_numerically():
         # scale: the sizes of the top-level terms of both sides
         terms = sp.Add(*[sp.Abs(t) for t in sp.Add.make_args(sp.sympify(lhs))
                          + sp.Add.make_args(sp.sympify(rhs))])
-        args = (model.theta, model.gamma, model.d, model.delta, model.Gamma)
+        args = (model.theta, model.gamma, model.d, model.delta, model.Gamma, model.alpha, model.beta)
         f = sp.lambdify(args, [expr, terms], modules="mpmath")
         with mpmath.workdps(40):
             for _ in range(3):
                 dl = mpmath.mpf(10 ** rng.uniform(-3, 0))
                 value, size = f(mpmath.mpf(rng.uniform(0.05, 3.0)), mpmath.mpf(rng.uniform(-0.9, 2.5)),
-                                int(rng.integers(0, 13)), dl, mpmath.exp(dl))
+                                int(rng.integers(0, 13)), dl, mpmath.exp(dl),
+                                mpmath.mpf(rng.uniform(-1, 3)), mpmath.mpf(rng.uniform(-1, 3)))
                 assert abs(value) <= mpmath.mpf(10) ** -28 * size, name

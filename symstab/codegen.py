@@ -1,0 +1,267 @@
+"""Generate the numeric kernels (NumPy and C99) from the derived expressions.
+
+The expressions come from :mod:`symstab.kernel_forms` (proved equal to the
+derivation); this module only prints them.  Following SymPy's code
+generators, the layers are separate:
+
+* :class:`Kernel` -- one entry point: its name, its argument list and its
+  outputs as SymPy expressions.  Construction fails when an expression uses a
+  symbol that is not an argument.
+* :class:`NumPyKernelPrinter`, :class:`CKernelPrinter` -- print expressions,
+  strictly: anything they cannot print raises.
+* :func:`numpy_module`, :func:`c_source`, :func:`c_header` -- lay out a file
+  (pure: they return strings); :func:`generated_files` collects them, and
+  :func:`symstab.derive.write` writes them.
+
+Every kernel goes through ``cse()`` with temporaries named ``x0, x1, ...``.
+The files carry no date or version, so they change only when the math or
+the printers change, and ``symstab derive --check`` reports any drift.
+"""
+
+import dataclasses
+import functools
+import textwrap
+
+import sympy as sp
+from sympy.printing.c import C99CodePrinter
+from sympy.printing.numpy import NumPyPrinter
+
+from . import model
+from . import kernel_forms as kf
+
+__all__ = [
+    "Kernel", "kernels", "NumPyKernelPrinter", "CKernelPrinter",
+    "numpy_module", "c_source", "c_header", "generated_files",
+    "COMMAND", "C_PREFIX", "OWNED",
+]
+
+#: The command that regenerates the files, named in their headers.
+COMMAND = "symstab derive"
+#: Glob patterns of the files the generator owns in its folder (for drift).
+OWNED = ("*.py", "*.c", "*.h")
+#: Prefix of every C symbol.
+C_PREFIX = "symstab_"
+
+
+@dataclasses.dataclass(frozen=True)
+class Kernel:
+    """One generated entry point.
+
+    Attributes
+    ----------
+    name : str
+        Function name (``symstab_`` is prepended in C).
+    args : tuple of (sympy.Symbol, str, str)
+        ``(symbol, C type, description)`` in call order; ``"int"`` marks the
+        delay.
+    outputs : tuple of (str, sympy.Expr, str)
+        ``(name, expression, description)``.
+    doc : str
+        One paragraph for the generated docstring and comment.
+    """
+
+    name: str
+    args: tuple
+    outputs: tuple
+    doc: str
+
+    def __post_init__(self):
+        allowed = {symbol for symbol, _, _ in self.args}
+        for out_name, expr, _ in self.outputs:
+            extra = sp.sympify(expr).free_symbols - allowed
+            if extra:
+                names = ", ".join(sorted(str(s) for s in extra))
+                raise ValueError(f"kernel {self.name}: output {out_name} uses {names}, "
+                                 f"which are not arguments")
+
+    def cse(self):
+        """``(replacements, reduced)`` with temporaries x0, x1, ... in order."""
+        exprs = [sp.sympify(expr) for _, expr, _ in self.outputs]
+        return sp.cse(exprs, symbols=sp.numbered_symbols("x"))
+
+
+_ARG = {
+    "theta": (model.theta, "double", "angle on the unit circle, z = exp(j theta) (rad)"),
+    "gamma": (model.gamma, "double", "gamma = M_w / m, virtual mass ratio"),
+    "d": (model.d, "int", "loop delay in samples, d >= 0"),
+    "delta": (model.delta, "double", "delta = b T / m > 0"),
+    "alpha": (model.alpha, "double", "alpha = K_w T^2 / m, dimensionless stiffness"),
+    "beta": (model.beta, "double", "beta = B_w T / m, dimensionless damping"),
+}
+
+
+@functools.lru_cache(maxsize=None)
+def kernels():
+    """Return the kernels, in file order."""
+    x = model.delta
+    alpha, beta = kf.boundary_forms()
+    delayed, direct = kf.loop_coefficient_forms()
+    names = ["z^(d+4)", "z^(d+3)", "z^(d+2)", "z^3", "z^2", "z^1", "z^0"]
+    coefficient_outputs = tuple(
+        (f"c{k}", kf.as_evaluable(expr), f"coefficient of {name}")
+        for k, (expr, name) in enumerate(zip(delayed + direct, names)))
+    return (
+        Kernel("exprel3", (_ARG["delta"],),
+               (("phi3", kf.exprel3_piecewise(x), "(exp(delta) - 1 - delta - delta^2/2) / delta^3"),),
+               "(exp(delta) - 1 - delta - delta^2/2) / delta^3 for delta > 0: a Taylor "
+               "polynomial below delta = 1/2, expm1 above."),
+        Kernel("boundary", tuple(_ARG[k] for k in ("theta", "gamma", "d", "delta")),
+               (("alpha", kf.as_evaluable(alpha), "dimensionless stiffness on the boundary"),
+                ("beta", kf.as_evaluable(beta), "dimensionless damping on the boundary")),
+               "The stability boundary alpha(theta), beta(theta): the (alpha, beta) at which "
+               "z = exp(j theta) is a root of the characteristic polynomial."),
+        Kernel("loop_coefficients", tuple(_ARG[k] for k in ("alpha", "beta", "gamma", "delta")),
+               coefficient_outputs,
+               "Coefficients of chi(z) / delta^2 = z^(d+2) (z-1) (Gamma z - 1) + V(z) (P z + Q), "
+               "highest power first: three of the delayed part (z^(d+4), z^(d+3), z^(d+2)) "
+               "and four of the direct part (z^3 .. z^0)."),
+    )
+
+
+class NumPyKernelPrinter(NumPyPrinter):
+    """NumPy printer for the kernels: exprel3 calls the generated helper."""
+
+    def __init__(self, settings=None):
+        super().__init__(dict({"strict": True}, **(settings or {})))
+
+    def _print_exprel3(self, expr):
+        return f"exprel3({self._print(expr.args[0])})"
+
+    def _print_Max(self, expr):
+        args = [self._print(a) for a in expr.args]
+        out = args[0]
+        for a in args[1:]:
+            out = f"numpy.maximum({out}, {a})"
+        return out
+
+    def _print_Piecewise(self, expr):
+        if expr.args[-1].cond is not sp.true:
+            raise NotImplementedError("a Piecewise needs a final True branch")
+        out = self._print(expr.args[-1].expr)
+        for e, c in reversed(expr.args[:-1]):
+            out = f"numpy.where({self._print(c)}, {self._print(e)}, {out})"
+        return out
+
+
+class CKernelPrinter(C99CodePrinter):
+    """C99 printer for the kernels: exprel3 calls the generated helper."""
+
+    def __init__(self, settings=None):
+        super().__init__(dict({"strict": True}, **(settings or {})))
+
+    def _print_exprel3(self, expr):
+        return f"{C_PREFIX}exprel3({self._print(expr.args[0])})"
+
+
+def _header_lines(comment, what):
+    return [f"{comment} Generated by `{COMMAND}` from symstab.kernel_forms; do not edit.",
+            f"{comment} {what}",
+            f"{comment} Every expression is proved equal to the derivation by `{COMMAND}`"
+            " (step 07_proofs).", ""]
+
+
+def _python_function(kernel, printer):
+    replacements, reduced = kernel.cse()
+    args = [str(symbol) for symbol, _, _ in kernel.args]
+    doc = textwrap.wrap(kernel.doc, 72)
+    lines = [f"def {kernel.name}({', '.join(args)}):", f'    """{doc[0]}']
+    lines += [f"    {line}" for line in doc[1:]]
+    lines += ["", "    Parameters", "    ----------"]
+    for symbol, ctype, description in kernel.args:
+        kind = "int" if ctype == "int" else "float or ndarray"
+        lines += [f"    {symbol} : {kind}", f"        {description}"]
+    lines += ["", "    Returns", "    -------"]
+    for name, _, description in kernel.outputs:
+        lines += [f"    {name} : float or ndarray", f"        {description}"]
+    lines.append('    """')
+    for symbol, expr in replacements:
+        lines.append(f"    {symbol} = {printer.doprint(expr)}")
+    results = [printer.doprint(expr) for expr in reduced]
+    if len(results) == 1:
+        lines.append(f"    return {results[0]}")
+    else:
+        lines.append("    return (")
+        lines += [f"        {r}," for r in results]
+        lines.append("    )")
+    return "\n".join(lines)
+
+
+def numpy_module():
+    """Return the text of ``symstab/_generated/kernels.py``."""
+    printer = NumPyKernelPrinter()
+    names = [k.name for k in kernels()]
+    parts = ["\n".join(_header_lines("#", "NumPy kernels, vectorised over theta, gamma, delta, "
+                                          "alpha, beta (arrays broadcast); d is an int.")),
+             '"""Generated NumPy kernels of symstab (see symstab.codegen)."""', "",
+             "import numpy", "",
+             f"__all__ = {names!r}", ""]
+    for kernel in kernels():
+        parts += ["", _python_function(kernel, printer), ""]
+    return "\n".join(parts).rstrip("\n") + "\n"
+
+
+def _c_signature(kernel):
+    params = [f"{ctype} {symbol}" for symbol, ctype, _ in kernel.args]
+    if len(kernel.outputs) == 1:
+        return f"double {C_PREFIX}{kernel.name}({', '.join(params)})"
+    params += [f"double *{name}" for name, _, _ in kernel.outputs]
+    return f"void {C_PREFIX}{kernel.name}({', '.join(params)})"
+
+
+def _c_comment(kernel):
+    lines = ["/*"] + [f" * {line}" for line in textwrap.wrap(kernel.doc, 72)] + [" *"]
+    for symbol, _, description in kernel.args:
+        lines.append(f" * {symbol}: {description}")
+    for name, _, description in kernel.outputs:
+        role = "returns" if len(kernel.outputs) == 1 else f"*{name}"
+        lines.append(f" * {role}: {description}")
+    lines.append(" */")
+    return "\n".join(lines)
+
+
+def _c_function(kernel, printer):
+    replacements, reduced = kernel.cse()
+    lines = [_c_comment(kernel), _c_signature(kernel), "{"]
+    for symbol, expr in replacements:
+        lines.append(f"    const double {symbol} = {printer.doprint(expr)};")
+    if len(reduced) == 1:
+        lines.append(f"    return {printer.doprint(reduced[0])};")
+    else:
+        for (name, _, _), expr in zip(kernel.outputs, reduced):
+            lines.append(f"    *{name} = {printer.doprint(expr)};")
+    lines.append("}")
+    return "\n".join(lines)
+
+
+def c_header():
+    """Return the text of ``symstab/_generated/symstab_kernels.h``."""
+    guard = "SYMSTAB_KERNELS_H"
+    lines = _header_lines("//", "C99 kernels; they need only <math.h> (link with -lm).")
+    lines += [f"#ifndef {guard}", f"#define {guard}", "", "#ifdef __cplusplus",
+              'extern "C" {', "#endif", ""]
+    for kernel in kernels():
+        lines += [_c_comment(kernel), _c_signature(kernel) + ";", ""]
+    lines += ["#ifdef __cplusplus", "}", "#endif", "", f"#endif /* {guard} */"]
+    return "\n".join(lines) + "\n"
+
+
+def c_source():
+    """Return the text of ``symstab/_generated/symstab_kernels.c``."""
+    printer = CKernelPrinter()
+    lines = _header_lines("//", "C99 kernels; they need only <math.h> (link with -lm).")
+    lines += ['#include <math.h>', '#include "symstab_kernels.h"', ""]
+    for kernel in kernels():
+        lines += [_c_function(kernel, printer), ""]
+    return "\n".join(lines).rstrip("\n") + "\n"
+
+
+def generated_files():
+    """Return ``{filename: text}`` for ``symstab/_generated/``."""
+    init = "\n".join(_header_lines("#", "The generated code of symstab; it imports nothing from symstab.")
+                     + ['"""Code generated by `symstab derive`; see symstab.codegen."""', ""])
+    return {
+        "__init__.py": init,
+        "kernels.py": numpy_module(),
+        "symstab_kernels.c": c_source(),
+        "symstab_kernels.h": c_header(),
+    }
