@@ -13,6 +13,14 @@ environment) -> :mod:`~symstab.discretize` (ZOH pulse transfer function) ->
 beta(theta), C-coefficients) -> :mod:`~symstab.limits`,
 :mod:`~symstab.theta_max`; :mod:`~symstab.identity` is the exact equality
 checker and :mod:`~symstab.derive` writes everything out.
+
+:mod:`~symstab.kernel_forms` rewrites the boundary and the loop polynomial in
+forms that keep their digits in floating point, :mod:`~symstab.codegen`
+prints them as NumPy and C99 kernels into ``symstab/_generated``, and the
+numeric API builds on those: :mod:`~symstab.units` (:class:`Device`),
+:mod:`~symstab.curves` (:func:`boundary_curve`), :mod:`~symstab.stability`
+(:func:`spectral_radius`, :func:`is_stable`, :func:`classify`) and
+:mod:`~symstab.region` (:func:`limits`, :func:`best_virtual_mass`).
 """
 
 from .boundary import boundary, coefficients
@@ -23,6 +31,10 @@ from .loop import characteristic_polynomial
 from .model import dimensionless_values
 from .theta_max import closed_form_d0, newton_form_gamma0, theta_max, theta_max_newton
 from .unit_circle import unit_circle_split
+from .units import PAPER_DEVICE, Device
+from .curves import BoundaryCurve, arc_end_angle, boundary_curve
+from .stability import MARGINAL, STABLE, UNSTABLE, classify, is_stable, spectral_radius
+from .region import BestVirtualMass, Limits, StabilityRegion, best_virtual_mass, limits
 
 __all__ = [
     "boundary", "coefficients",
@@ -31,4 +43,8 @@ __all__ = [
     "small_theta_limits", "characteristic_polynomial", "dimensionless_values",
     "closed_form_d0", "newton_form_gamma0", "theta_max", "theta_max_newton",
     "unit_circle_split",
+    "Device", "PAPER_DEVICE",
+    "BoundaryCurve", "arc_end_angle", "boundary_curve",
+    "STABLE", "MARGINAL", "UNSTABLE", "classify", "is_stable", "spectral_radius",
+    "StabilityRegion", "Limits", "limits", "BestVirtualMass", "best_virtual_mass",
 ]

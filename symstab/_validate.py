@@ -7,7 +7,9 @@ whose message names the parameter and the allowed range.
 import math
 import numbers
 
-__all__ = ["check_real", "check_delay", "check_delay_samples"]
+import numpy as np
+
+__all__ = ["check_real", "check_delay", "check_delay_samples", "check_array"]
 
 
 def _describe_range(low, high, low_open, high_open):
@@ -81,3 +83,26 @@ def check_delay_samples(ratio, *, name="Td / T", rtol=1e-9):
             f"{name} must be a non-negative whole number of samples, got {ratio!r}"
         )
     return int(k)
+
+
+def check_array(name, value, *, low=None, low_open=False):
+    """Return ``value`` as a float ndarray after checking every entry.
+
+    Scalars become 0-d arrays.  Booleans, complex numbers and non-numeric
+    objects raise :class:`TypeError`; NaN, infinite or out-of-range entries
+    raise :class:`ValueError` naming ``name`` and the allowed range.
+    """
+    arr = np.asarray(value)
+    if arr.dtype == bool or arr.dtype.kind not in "iuf":
+        raise TypeError(f"{name} must be a real number or an array of real numbers, "
+                        f"got {type(value).__name__} of {arr.dtype}")
+    arr = arr.astype(float)
+    bad = ~np.isfinite(arr)
+    if low is not None:
+        bad |= (arr <= low) if low_open else (arr < low)
+    if np.any(bad):
+        first = arr[bad].flat[0]
+        allowed = _describe_range(low, None, low_open, False)
+        where = "" if arr.ndim == 0 else f" (entry {int(np.flatnonzero(bad.ravel())[0])})"
+        raise ValueError(f"{name} must be {allowed}, got {float(first)!r}{where}")
+    return arr

@@ -1,0 +1,217 @@
+"""The boundary arc in floating point: theta_max and ``boundary_curve``.
+
+The generated kernel :func:`symstab._generated.kernels.boundary` evaluates
+alpha(theta), beta(theta) to about 1e-14 relative (tests/test_generated_kernels.py).
+Here it is used to find where the arc ends and to sample it:
+
+* :func:`arc_end_angle` -- theta_max, the first root of alpha(theta) in
+  (0, pi), bracketed on a grid fine enough for the delay and refined by
+  bisection to the last bit (the float counterpart of the 30-digit
+  :func:`symstab.theta_max.theta_max`);
+* :func:`boundary_curve` -- the arc from theta = 0 to theta_max on ``n``
+  points, with the other pieces of the boundary of the stable region (the
+  real-axis crossings z = 1 and z = -1, straight lines in the alpha-beta
+  plane) where they bound it.
+"""
+
+import dataclasses
+
+import numpy as np
+
+from ._generated import kernels
+from ._validate import check_delay, check_real
+
+__all__ = ["arc_end_angle", "minus_one_line", "BoundaryCurve", "Segment", "boundary_curve"]
+
+
+def _check(gamma, d, delta):
+    return (check_real("gamma", gamma), check_delay(d),
+            check_real("delta", delta, low=0.0, low_open=True))
+
+
+def scan_grid(d, *, n=None, upper=np.pi):
+    """Angles that resolve the arc: geometric near 0, then uniform up to ``upper``.
+
+    The uniform spacing is below a sixteenth of the period of ``sin(d theta)``;
+    the geometric part reaches down to ``1e-10`` of the first step, where
+    alpha ~ theta**2 may still be tiny but keeps its sign.
+    """
+    n = n or max(400, 16 * (d + 1))
+    step = upper / n
+    near_zero = step * np.logspace(-10, -0.25, 40)
+    return np.concatenate([near_zero, step * np.arange(1, n + 1)])
+
+
+def _bisect(f, lo, hi, iterations=64):
+    """Vectorised bisection for f(lo) > 0 >= f(hi) (or the reverse, per entry)."""
+    lo, hi = np.array(lo, dtype=float), np.array(hi, dtype=float)
+    sign_lo = np.sign(f(lo))
+    for _ in range(iterations):
+        mid = 0.5 * (lo + hi)
+        same = np.sign(f(mid)) == sign_lo
+        lo = np.where(same, mid, lo)
+        hi = np.where(same, hi, mid)
+        if np.all((hi - lo) <= 2 * np.spacing(np.maximum(np.abs(lo), np.abs(hi)))):
+            break
+    return 0.5 * (lo + hi)
+
+
+def arc_end_angle(*, gamma, d, delta):
+    """theta_max: the first root of alpha(theta) in (0, pi).
+
+    Parameters
+    ----------
+    gamma : float
+        ``M_w / m``.
+    d : int
+        Delay in samples, ``d >= 0``.
+    delta : float
+        ``b T / m > 0``.
+
+    Returns
+    -------
+    float
+        theta_max; ``pi`` when alpha stays positive up to pi; ``nan`` when
+        alpha < 0 just after theta = 0 (no arc enters alpha > 0).
+
+    Examples
+    --------
+    >>> round(arc_end_angle(gamma=0.0, d=0, delta=0.00253125), 4)
+    1.5725
+    """
+    gamma, d, delta = _check(gamma, d, delta)
+
+    def alpha(t):
+        return kernels.boundary(t, gamma, d, delta)[0]
+
+    grid = scan_grid(d)
+    values = alpha(grid)
+    if not values[0] > 0:
+        return float("nan")
+    negative = np.flatnonzero(values <= 0)
+    if negative.size == 0:
+        return float(np.pi)
+    k = negative[0]
+    if values[k] == 0:
+        return float(grid[k])
+    return float(_bisect(alpha, grid[k - 1], grid[k]))
+
+
+def minus_one_line(*, gamma, d, delta):
+    """The z = -1 crossing: ``alpha + 2 beta = c``; returns ``c``.
+
+    chi(-1) / delta**2 = (-1)**d 2 (Gamma + 1) + (alpha + 2 beta + 4 gamma)(Q - P),
+    with ``P - Q = delta (1/2 + (delta - 2) exprel3(delta))`` (see
+    :mod:`symstab.kernel_forms`); far away (~ 24 / delta) for small delta.
+    """
+    gamma, d, delta = _check(gamma, d, delta)
+    p_minus_q = delta * (0.5 + (delta - 2.0) * kernels.exprel3(delta))
+    gamma_big = 1.0 + float(np.expm1(delta))
+    return float((-1) ** d * 2.0 * (gamma_big + 1.0) / p_minus_q - 4.0 * gamma)
+
+
+@dataclasses.dataclass(frozen=True)
+class Segment:
+    """A straight piece of the boundary: from ``(beta0, alpha0)`` to ``(beta1, alpha1)``.
+
+    ``root`` says which real root crosses the unit circle on it: ``"z=1"``
+    (the line alpha = 0) or ``"z=-1"``.
+    """
+
+    root: str
+    beta0: float
+    alpha0: float
+    beta1: float
+    alpha1: float
+
+
+@dataclasses.dataclass(frozen=True)
+class BoundaryCurve:
+    """The boundary arc and the straight pieces that close the stable region.
+
+    Attributes
+    ----------
+    gamma, d, delta
+        The parameters.
+    theta, alpha, beta : ndarray
+        The arc from theta = 0 (alpha = 0, beta = -delta) to theta_max; empty
+        when there is no arc.
+    theta_max : float
+        End of the arc (``nan`` when there is none).
+    segments : tuple of Segment
+        The pieces of the lines z = 1 (alpha = 0) and z = -1 that bound the
+        stable region, found from the region itself
+        (:class:`symstab.region.StabilityRegion`).
+    message : str
+        Empty, or why there is no arc.
+    """
+
+    gamma: float
+    d: int
+    delta: float
+    theta: np.ndarray
+    alpha: np.ndarray
+    beta: np.ndarray
+    theta_max: float
+    segments: tuple = ()
+    message: str = ""
+
+    @property
+    def empty(self):
+        """True when there is no arc."""
+        return self.theta.size == 0
+
+
+def boundary_curve(*, gamma, d, delta, n=1000, segments=True):
+    """Sample the boundary arc from theta = 0 to theta_max.
+
+    Parameters
+    ----------
+    gamma : float
+        ``M_w / m``.
+    d : int
+        Delay in samples, ``d >= 0``.
+    delta : float
+        ``b T / m > 0``.
+    n : int
+        Number of points on the arc, ``n >= 2``.
+    segments : bool
+        Also find the straight pieces (z = +-1) that bound the stable region
+        (a stability scan; skip it when only the arc is wanted).
+
+    Returns
+    -------
+    BoundaryCurve
+
+    Raises
+    ------
+    TypeError, ValueError
+        For a non-real, non-finite or out-of-range parameter.
+
+    Examples
+    --------
+    >>> c = boundary_curve(gamma=0.0, d=0, delta=0.00253125, n=5, segments=False)
+    >>> float(c.alpha[0]), round(float(c.beta[0]), 8), round(c.theta_max, 4)
+    (0.0, -0.00253125, 1.5725)
+    """
+    gamma, d, delta = _check(gamma, d, delta)
+    if isinstance(n, bool) or not isinstance(n, (int, np.integer)) or n < 2:
+        raise ValueError(f"n must be an integer >= 2, got {n!r}")
+    t_end = arc_end_angle(gamma=gamma, d=d, delta=delta)
+    if not np.isfinite(t_end):
+        empty = np.empty(0)
+        return BoundaryCurve(gamma, d, delta, empty, empty, empty, t_end, (),
+                             "no boundary arc: alpha < 0 just after theta = 0, so the arc never "
+                             "enters alpha > 0 (1 + gamma + (d + 1) delta <= 0 or close to it)")
+    theta = np.linspace(0.0, t_end, n)
+    alpha, beta = kernels.boundary(theta, gamma, d, delta)
+    # The ends are exact: the arc starts at (-delta, 0) and ends on alpha = 0.
+    alpha[0], beta[0] = 0.0, -delta
+    if t_end < np.pi:
+        alpha[-1] = 0.0
+    pieces = ()
+    if segments:
+        from .region import StabilityRegion
+
+        pieces = StabilityRegion(gamma=gamma, d=d, delta=delta).line_segments()
+    return BoundaryCurve(gamma, d, delta, theta, alpha, beta, t_end, pieces)

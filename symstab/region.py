@@ -1,0 +1,531 @@
+"""The stable region in the (beta, alpha) plane, and what it lets a user render.
+
+For fixed ``(gamma, d, delta)`` the characteristic polynomial is affine in
+alpha and in beta, so along any vertical line ``beta = b`` (or horizontal
+line ``alpha = a``) a root can cross the unit circle only where the line
+meets
+
+* the boundary arc ``(beta(theta), alpha(theta))``, ``0 < theta < pi``
+  (a pair of complex roots on the circle), from the generated kernel;
+* the line ``alpha = 0`` (a root at z = 1);
+* the line ``alpha + 2 beta = c`` (a root at z = -1,
+  :func:`symstab.curves.minus_one_line`).
+
+Between two consecutive crossings the number of unstable roots is constant,
+so one classification per gap (:func:`symstab.stability.classify`) decides
+the whole gap: the stable intervals along a line are exact up to the
+root-finding of the crossings (bisection to the last bit), with no scan of
+alpha.  :class:`StabilityRegion` does this for many lines at once;
+:func:`limits` builds on it (alpha_max and the beta range by a k-ary search
+for the last line that still meets the region, the Z-width by integrating
+the stable length over beta), and :func:`best_virtual_mass` maximises
+alpha_max over gamma.
+"""
+
+import dataclasses
+import math
+
+import numpy as np
+
+from ._generated import kernels
+from ._validate import check_delay, check_real
+from .curves import Segment, _bisect, minus_one_line, scan_grid
+from .stability import STABLE, classify
+
+__all__ = ["StabilityRegion", "Limits", "limits", "BestVirtualMass", "best_virtual_mass"]
+
+#: Relative offset of the probes that decide whether an arc point touches
+#: the stable region (far above the 1e-12 marginal band, far below any
+#: feature of the region).
+_PROBE = 1e-6
+
+
+def _check(gamma, d, delta):
+    return (check_real("gamma", gamma), check_delay(d),
+            check_real("delta", delta, low=0.0, low_open=True))
+
+
+def _ranges(start, stop):
+    """Concatenate ``arange(start[i], stop[i])``; also return the owner i of each."""
+    counts = stop - start
+    owner = np.repeat(np.arange(len(start)), counts)
+    offsets = np.arange(counts.sum()) - np.repeat(np.cumsum(counts) - counts, counts)
+    return owner, np.repeat(start, counts) + offsets
+
+
+class StabilityRegion:
+    """The stable set of one ``(gamma, d, delta)`` in the (beta, alpha) plane.
+
+    Parameters
+    ----------
+    gamma : float
+        ``M_w / m``.
+    d : int
+        Delay in samples, ``d >= 0``.
+    delta : float
+        ``b T / m > 0``.
+
+    Examples
+    --------
+    >>> r = StabilityRegion(gamma=1.5, d=0, delta=0.00253125)
+    >>> [(round(lo, 3), round(hi, 3)) for lo, hi in r.alpha_intervals(-0.5)]
+    [(1.266, 2.232)]
+    """
+
+    def __init__(self, *, gamma, d, delta):
+        self.gamma, self.d, self.delta = _check(gamma, d, delta)
+        theta = np.concatenate([[0.0], scan_grid(self.d, upper=np.pi * (1 - 1e-9))])
+        theta = np.union1d(theta, self._extrema(theta))
+        alpha, beta = kernels.boundary(theta, self.gamma, self.d, self.delta)
+        alpha[0], beta[0] = 0.0, -self.delta
+        self._theta, self._alpha, self._beta = theta, alpha, beta
+        self.minus_one = minus_one_line(gamma=self.gamma, d=self.d, delta=self.delta)
+
+    def _extrema(self, theta):
+        """The angles of the local extrema of alpha(theta) and beta(theta).
+
+        With them among the samples, alpha and beta are monotone on every
+        segment of the sampled arc, so a line that meets a segment twice
+        (near the top of the arc, say) cannot slip through unnoticed.
+        """
+        out = []
+        values = kernels.boundary(theta, self.gamma, self.d, self.delta)
+        for index, v in enumerate(values):
+            inner = v[1:-1]
+            peak = (inner >= v[:-2]) & (inner > v[2:]) | (inner <= v[:-2]) & (inner < v[2:])
+            i = np.flatnonzero(peak & np.isfinite(inner)) + 1
+            if i.size:
+                sign = np.where(v[i] > v[i - 1], 1.0, -1.0)
+                out.append(_golden_max(lambda t, k=index, s=sign: s * kernels.boundary(
+                    t, self.gamma, self.d, self.delta)[k], theta[i - 1], theta[i + 1]))
+        return np.concatenate(out) if out else np.empty(0)
+
+    # -- crossings of the boundary with a family of lines -----------------
+
+    def _arc_point(self, theta):
+        return kernels.boundary(theta, self.gamma, self.d, self.delta)
+
+    def _arc_crossings(self, axis, values):
+        """Arc points where ``axis`` (``"beta"`` or ``"alpha"``) equals each value.
+
+        Returns ``(owner, other)``: the index into ``values`` and the other
+        coordinate of every crossing.  Each arc segment is half-open, so a
+        value met exactly at a sample is found once.
+        """
+        coord = self._beta if axis == "beta" else self._alpha
+        order = np.argsort(values)
+        sorted_values = values[order]
+        c0, c1 = coord[:-1], coord[1:]
+        rising = c1 > c0
+        start = np.where(rising, np.searchsorted(sorted_values, c0, "left"),
+                         np.searchsorted(sorted_values, c1, "right"))
+        stop = np.where(rising, np.searchsorted(sorted_values, c1, "left"),
+                        np.searchsorted(sorted_values, c0, "right"))
+        stop = np.maximum(stop, start)
+        segment, k = _ranges(start, stop)
+        if segment.size == 0:
+            return np.empty(0, dtype=int), np.empty(0)
+        target = sorted_values[k]
+        index = 1 if axis == "beta" else 0
+
+        def f(t):
+            return self._arc_point(t)[index] - target
+
+        lo, hi = self._theta[segment], self._theta[segment + 1]
+        flo = coord[segment] - target
+        exact = flo == 0
+        root = _bisect(f, lo, hi)
+        root = np.where(exact, lo, root)
+        other = self._arc_point(root)[1 - index]
+        if axis == "beta":
+            other = np.where(root == 0.0, 0.0, other)
+        else:
+            other = np.where(root == 0.0, -self.delta, other)
+        return order[k], other
+
+    def _intervals(self, axis, values):
+        """Stable intervals of the other coordinate on each line ``axis = value``."""
+        values = np.atleast_1d(np.asarray(values, dtype=float))
+        owner, cuts = self._arc_crossings(axis, values)
+        if axis == "beta":
+            lines = [(np.arange(len(values)), np.zeros(len(values))),
+                     (np.arange(len(values)), self.minus_one - 2 * values)]
+        else:
+            lines = [(np.arange(len(values)), (self.minus_one - values) / 2)]
+        owner = np.concatenate([owner] + [o for o, _ in lines])
+        cuts = np.concatenate([cuts] + [c for _, c in lines])
+        keep = np.isfinite(cuts)
+        owner, cuts = owner[keep], cuts[keep]
+        order = np.lexsort((cuts, owner))
+        owner, cuts = owner[order], cuts[order]
+        # Probes: below the first cut, between cuts, above the last one.
+        first = np.r_[True, owner[1:] != owner[:-1]]
+        last = np.r_[owner[1:] != owner[:-1], True]
+        pad = 1.0 + np.abs(cuts)
+        between = 0.5 * (cuts[:-1] + cuts[1:])
+        probe_owner = np.concatenate([owner[first], owner[:-1][~last[:-1]], owner[last]])
+        probe_at = np.concatenate([cuts[first] - pad[first], between[~last[:-1]],
+                                   cuts[last] + pad[last]])
+        probe_lo = np.concatenate([np.full(first.sum(), -np.inf), cuts[:-1][~last[:-1]], cuts[last]])
+        probe_hi = np.concatenate([cuts[first], cuts[1:][~last[:-1]], np.full(last.sum(), np.inf)])
+        line_value = values[probe_owner]
+        if axis == "beta":
+            code = classify(alpha=probe_at, beta=line_value, gamma=self.gamma, d=self.d, delta=self.delta)
+        else:
+            code = classify(alpha=line_value, beta=probe_at, gamma=self.gamma, d=self.d, delta=self.delta)
+        stable = np.atleast_1d(code) == STABLE
+        out = [[] for _ in values]
+        order = np.lexsort((probe_lo, probe_owner))
+        for i in order[stable[order]]:
+            runs = out[probe_owner[i]]
+            if runs and runs[-1][1] == probe_lo[i]:
+                runs[-1] = (runs[-1][0], float(probe_hi[i]))
+            else:
+                runs.append((float(probe_lo[i]), float(probe_hi[i])))
+        return out
+
+    def alpha_intervals(self, beta):
+        """The stable alpha intervals at damping ``beta``.
+
+        Parameters
+        ----------
+        beta : float
+            Dimensionless damping.
+
+        Returns
+        -------
+        list of (float, float)
+            Increasing, disjoint; empty when no alpha is stable.  An interval
+            that does not start at 0 shows the minimum stiffness needed.
+        """
+        return self._intervals("beta", [check_real("beta", beta)])[0]
+
+    def beta_intervals(self, alpha):
+        """The stable beta intervals at stiffness ``alpha`` (as :meth:`alpha_intervals`)."""
+        return self._intervals("alpha", [check_real("alpha", alpha)])[0]
+
+    # -- where the region is ----------------------------------------------
+
+    def _touching_arc(self):
+        """Mask of arc samples with a stable point within a relative 1e-6."""
+        a, b = self._alpha, self._beta
+        ok = np.isfinite(a) & np.isfinite(b) & (np.abs(a) < 1e6) & (np.abs(b) < 1e6)
+        a, b = a[ok], b[ok]
+        ea = _PROBE * (np.abs(a) + self.delta)
+        eb = _PROBE * (np.abs(b) + self.delta)
+        probes_a = np.concatenate([a + ea, a - ea, a, a])
+        probes_b = np.concatenate([b, b, b + eb, b - eb])
+        code = classify(alpha=probes_a, beta=probes_b, gamma=self.gamma, d=self.d, delta=self.delta)
+        touching = np.zeros(len(self._alpha), dtype=bool)
+        touching[np.flatnonzero(ok)] = np.any((np.asarray(code) == STABLE).reshape(4, -1), axis=0)
+        return touching
+
+    def _last_meeting(self, axis, inside, outside, rounds=14, fan=16):
+        """The boundary between ``inside`` (a line meeting the region) and ``outside``.
+
+        A ``fan``-ary search: each round tests ``fan`` lines at once.
+        Returns the last line found to meet the region and its intervals
+        (``None`` when no trial line met it: ``inside`` itself was the best).
+        """
+        runs_inside = None
+        for _ in range(rounds):
+            trial = np.linspace(inside, outside, fan + 2)[1:-1]
+            runs = self._intervals(axis, trial)
+            k = np.flatnonzero([bool(r) for r in runs])
+            j = k[-1] + 1 if k.size else 0
+            if j > 0:
+                inside, runs_inside = trial[j - 1], runs[j - 1]
+            outside = trial[j] if j < fan else outside
+            if abs(outside - inside) <= 4 * np.spacing(max(abs(inside), abs(outside))):
+                break
+        return inside, runs_inside
+
+    def _corners(self):
+        """beta of the points where the arc meets alpha = 0 (exact corners)."""
+        ends = self._arc_crossings("alpha", np.array([0.0]))[1]
+        return np.sort(np.concatenate([ends, [-self.delta]]))
+
+    def _beta_window(self):
+        touching = self._touching_arc()
+        if not touching.any():
+            return None
+        lo, hi = self._beta[touching].min(), self._beta[touching].max()
+        return lo, hi
+
+    def line_segments(self):
+        """The pieces of z = 1 (alpha = 0) and z = -1 that bound the stable region.
+
+        Returns
+        -------
+        tuple of :class:`symstab.curves.Segment`
+        """
+        window = self._beta_window()
+        if window is None:
+            return ()
+        lo, hi = window
+        pad = 0.05 * (hi - lo) + self.delta
+        out = []
+        # z = 1: the beta where a point just above alpha = 0 is stable.
+        betas = np.linspace(lo - pad, hi + pad, 2001)
+        eps = _PROBE * max(self._alpha[self._touching_arc()].max(), self.delta)
+        above = np.asarray(classify(alpha=eps, beta=betas, gamma=self.gamma, d=self.d,
+                                    delta=self.delta)) == STABLE
+        ends = self._corners()
+        for run in _runs(above):
+            b0, b1 = betas[run[0]], betas[run[1]]
+            # Snap to where the arc meets alpha = 0: the exact corners.
+            b0 = ends[np.argmin(np.abs(ends - b0))] if ends.size else b0
+            b1 = ends[np.argmin(np.abs(ends - b1))] if ends.size else b1
+            out.append(Segment("z=1", float(b0), 0.0, float(b1), 0.0))
+        # z = -1: alpha + 2 beta = c, stable on one side only.
+        line_alpha = self.minus_one - 2 * betas
+        e = _PROBE * (np.abs(line_alpha) + self.delta)
+        sides = [np.asarray(classify(alpha=line_alpha + s * e, beta=betas, gamma=self.gamma,
+                                     d=self.d, delta=self.delta)) == STABLE for s in (1, -1)]
+        for run in _runs(sides[0] ^ sides[1]):
+            out.append(Segment("z=-1", float(betas[run[0]]), float(line_alpha[run[0]]),
+                               float(betas[run[1]]), float(line_alpha[run[1]])))
+        return tuple(out)
+
+    def limits(self, *, n_beta=801):
+        """alpha_max, the beta range and the Z-width (see :func:`limits`)."""
+        window = self._beta_window()
+        if window is None:
+            return Limits.empty_region(self, "no stable point next to the boundary arc: "
+                                             "the stable region is empty")
+        lo, hi = window
+        pad = 0.05 * (hi - lo) + self.delta
+        for _ in range(8):
+            betas = np.linspace(lo - pad, hi + pad, n_beta)
+            runs = self._intervals("beta", betas)
+            meets = np.array([bool(r) for r in runs])
+            if not meets.any():
+                return Limits.empty_region(self, "the stable region is empty (or thinner "
+                                                 "than the scan resolves)")
+            if not (meets[0] or meets[-1]):
+                break
+            pad *= 4
+        k = np.flatnonzero(meets)
+        beta_min = self._snap(self._last_meeting("beta", betas[k[0]], betas[k[0] - 1])[0])
+        beta_max = self._snap(self._last_meeting("beta", betas[k[-1]], betas[k[-1] + 1])[0])
+        tops = [r[-1][1] for r in runs if r]
+        alpha_low = max(tops)
+        if not math.isfinite(alpha_low):
+            return Limits(self, math.inf, math.nan, beta_max, beta_min, math.inf,
+                          "the stable region is unbounded in alpha")
+        alpha_high = alpha_low + max(alpha_low, self.delta) * 1e-2
+        while self._intervals("alpha", [alpha_high])[0]:
+            alpha_high += 2 * (alpha_high - alpha_low)
+        alpha_max, at_top = self._last_meeting("alpha", alpha_low, alpha_high)
+        if at_top is None:
+            at_top = runs[int(np.argmax([r[-1][1] if r else -np.inf for r in runs]))]
+            beta_at = betas[[i for i, r in enumerate(runs) if r == at_top][0]]
+        else:
+            beta_at = 0.5 * (at_top[0][0] + at_top[-1][1])
+        # Z-width: the stable length on verticals across [beta_min, beta_max].
+        betas = np.linspace(beta_min, beta_max, n_beta)
+        lengths = np.array([sum(h - l for l, h in r) for r in self._intervals("beta", betas)])
+        z_width = float(np.trapezoid(lengths, betas)) if hasattr(np, "trapezoid") \
+            else float(np.trapz(lengths, betas))
+        return Limits(self, float(alpha_max), float(beta_at), float(beta_max), float(beta_min),
+                      z_width, "")
+
+
+    def _snap(self, beta, rtol=1e-7):
+        """Move an extreme beta onto a corner of the arc and alpha = 0 within ``rtol``.
+
+        Next to a corner the region is a wedge of height ~ (beta - corner);
+        probes there are marginal (radius within 1e-12 of 1), so the search
+        stops about 1e-9 short of the corner, which is exact.
+        """
+        corners = self._corners()
+        if corners.size:
+            near = corners[np.argmin(np.abs(corners - beta))]
+            if abs(near - beta) <= rtol * max(abs(near), self.delta):
+                return float(near)
+        return float(beta)
+
+
+def _golden_max(f, a, b, iterations=80):
+    """Vectorised golden-section search for the maximum of f on [a, b]."""
+    ratio = (math.sqrt(5) - 1) / 2
+    a, b = np.array(a, dtype=float), np.array(b, dtype=float)
+    x1, x2 = b - ratio * (b - a), a + ratio * (b - a)
+    f1, f2 = f(x1), f(x2)
+    for _ in range(iterations):
+        left = f1 < f2
+        a = np.where(left, x1, a)
+        b = np.where(left, b, x2)
+        x1, x2 = np.where(left, x2, b - ratio * (b - a)), np.where(left, a + ratio * (b - a), x1)
+        f1, f2 = np.where(left, f2, f(x1)), np.where(left, f(x2), f1)
+    return 0.5 * (a + b)
+
+
+def _runs(mask):
+    """Index pairs (first, last) of the runs of True in a 1-D mask."""
+    edges = np.diff(np.r_[0, mask.astype(np.int8), 0])
+    return list(zip(np.flatnonzero(edges == 1), np.flatnonzero(edges == -1) - 1))
+
+
+@dataclasses.dataclass(frozen=True)
+class Limits:
+    """What one ``(gamma, d, delta)`` lets a device render.
+
+    Attributes
+    ----------
+    alpha_max : float or None
+        Largest stable alpha (the renderable stiffness ``K_w T**2 / m``).
+    beta_at_alpha_max : float or None
+        The beta at which alpha_max is reached.
+    beta_max, beta_min : float or None
+        The range of beta over the stable region.
+    z_width : float
+        Area of the stable region in the (beta, alpha) plane (0 when empty).
+    message : str
+        Empty, or why the region is empty or unbounded.
+    """
+
+    region: StabilityRegion
+    alpha_max: float
+    beta_at_alpha_max: float
+    beta_max: float
+    beta_min: float
+    z_width: float
+    message: str = ""
+
+    @classmethod
+    def empty_region(cls, region, message):
+        return cls(region, None, None, None, None, 0.0, message)
+
+    @property
+    def empty(self):
+        """True when no parameter point is stable."""
+        return self.alpha_max is None
+
+    def alpha_interval(self, beta):
+        """The stable alpha intervals at ``beta``; see :meth:`StabilityRegion.alpha_intervals`."""
+        return self.region.alpha_intervals(beta)
+
+    def minimum_stiffness(self, beta):
+        """The smallest stable alpha at ``beta`` (0 unless a minimum stiffness is needed).
+
+        ``None`` when nothing is stable at ``beta``.
+        """
+        runs = self.region.alpha_intervals(beta)
+        return runs[0][0] if runs else None
+
+    def as_dict(self):
+        """The numbers, for tables and JSON."""
+        return {"gamma": self.region.gamma, "d": self.region.d, "delta": self.region.delta,
+                "alpha_max": self.alpha_max, "beta_at_alpha_max": self.beta_at_alpha_max,
+                "beta_max": self.beta_max, "beta_min": self.beta_min,
+                "z_width": self.z_width, "message": self.message}
+
+
+def limits(*, gamma, d, delta, n_beta=801):
+    """Renderable limits of one virtual mass, delay and device.
+
+    Parameters
+    ----------
+    gamma : float
+        ``M_w / m``.
+    d : int
+        Delay in samples, ``d >= 0``.
+    delta : float
+        ``b T / m > 0``.
+    n_beta : int
+        Vertical lines for the Z-width (trapezoid rule; its error is about
+        ``1 / n_beta**2`` of the width where the region's edges are smooth).
+
+    Returns
+    -------
+    Limits
+        Empty (``alpha_max is None``, ``z_width == 0``, with a message) when
+        no point is stable.
+
+    Examples
+    --------
+    >>> lim = limits(gamma=0.0, d=0, delta=0.00253125)
+    >>> round(lim.alpha_max, 4), round(lim.beta_max, 4)
+    (0.6897, 2.0034)
+    """
+    if isinstance(n_beta, bool) or not isinstance(n_beta, (int, np.integer)) or n_beta < 3:
+        raise ValueError(f"n_beta must be an integer >= 3, got {n_beta!r}")
+    return StabilityRegion(gamma=gamma, d=d, delta=delta).limits(n_beta=n_beta)
+
+
+@dataclasses.dataclass(frozen=True)
+class BestVirtualMass:
+    """The virtual mass that maximises the renderable stiffness.
+
+    Attributes
+    ----------
+    gamma, beta : float
+        The best ``M_w / m`` and the damping at which alpha_max is reached.
+    alpha_max : float
+        alpha_max at that gamma.
+    alpha_max_gamma0 : float
+        alpha_max with no virtual mass.
+    gain : float
+        ``alpha_max / alpha_max_gamma0``.
+    """
+
+    d: int
+    delta: float
+    gamma: float
+    beta: float
+    alpha_max: float
+    alpha_max_gamma0: float
+    gain: float
+
+
+def _alpha_max(gamma, d, delta):
+    lim = StabilityRegion(gamma=gamma, d=d, delta=delta).limits(n_beta=41)
+    return (-math.inf, math.nan) if lim.empty else (lim.alpha_max, lim.beta_at_alpha_max)
+
+
+def best_virtual_mass(*, d, delta, gamma_range=None, n=17):
+    """The gamma (and beta) that maximise alpha_max, and the gain over gamma = 0.
+
+    alpha_max(gamma) is scanned on ``n`` points of ``gamma_range`` (default
+    from just above ``-1 - (d + 1) delta``, below which no arc exists, to 3)
+    and the best scan point is refined by a golden-section search between
+    its neighbours.
+
+    Returns
+    -------
+    BestVirtualMass
+
+    Examples
+    --------
+    >>> best = best_virtual_mass(d=0, delta=0.00253125)
+    >>> 5 < best.gain < 6.5
+    True
+    """
+    _, d, delta = _check(0.0, d, delta)
+    if gamma_range is None:
+        gamma_range = (-1.0 - (d + 1) * delta + 1e-3, 3.0)
+    g_lo, g_hi = (check_real("gamma_range[0]", gamma_range[0]), check_real("gamma_range[1]", gamma_range[1]))
+    if not g_lo < g_hi:
+        raise ValueError(f"gamma_range must be increasing, got {gamma_range!r}")
+    gammas = np.linspace(g_lo, g_hi, n)
+    values = [_alpha_max(g, d, delta)[0] for g in gammas]
+    k = int(np.argmax(values))
+    a, b = gammas[max(k - 1, 0)], gammas[min(k + 1, n - 1)]
+    ratio = (math.sqrt(5) - 1) / 2
+    x1, x2 = b - ratio * (b - a), a + ratio * (b - a)
+    f1, f2 = _alpha_max(x1, d, delta)[0], _alpha_max(x2, d, delta)[0]
+    while b - a > 1e-6 * max(1.0, abs(a)):
+        if f1 < f2:
+            a, x1, f1 = x1, x2, f2
+            x2 = a + ratio * (b - a)
+            f2 = _alpha_max(x2, d, delta)[0]
+        else:
+            b, x2, f2 = x2, x1, f1
+            x1 = b - ratio * (b - a)
+            f1 = _alpha_max(x1, d, delta)[0]
+    best_gamma = 0.5 * (a + b)
+    alpha_best, beta_best = _alpha_max(best_gamma, d, delta)
+    alpha_zero = _alpha_max(0.0, d, delta)[0]
+    return BestVirtualMass(d, delta, float(best_gamma), float(beta_best), float(alpha_best),
+                           float(alpha_zero), float(alpha_best / alpha_zero))

@@ -1,0 +1,474 @@
+"""Tests of the generated numeric kernels in ``symstab/_generated/``.
+
+``symstab derive`` prints the float-safe forms of :mod:`symstab.kernel_forms`
+as a NumPy module (``kernels.py``) and a C99 library
+(``symstab_kernels.c`` / ``.h``).  The exact checker proves the *forms*
+equal to the derivation; these tests measure what is left, the floating-point
+evaluation of the printed code:
+
+* the C library compiles warning-free under ``-Werror`` and its header's
+  signatures are the ones the kernels are called with;
+* C and NumPy agree to 1e-12 on a few thousand seeded random points;
+* both kernels match 50-digit mpmath references -- the derivation's own
+  (unrearranged) boundary :func:`symstab.evaluate.boundary_point`, the
+  definition of ``exprel3`` and ``characteristic_polynomial().numeric_coeffs``;
+* the naive float evaluation of the derivation's C-coefficient form fails
+  the same accuracy check at small delta, so that check can fail, and the
+  rearranged forms are needed.
+
+Notes
+-----
+Errors are relative to the reference value.  The mixed measure of
+:func:`conftest.relative_error` (absolute where the reference is exactly 0)
+matters only for the loop coefficients, one of which is the constant 1 and
+one proportional to gamma (0 at gamma = 0).
+"""
+
+import ctypes
+import functools
+import math
+import re
+import shutil
+import subprocess
+
+import mpmath
+import numpy as np
+import pytest
+import sympy as sp
+
+from conftest import PAPER_DELTA, REPO, relative_error
+from symstab import model
+from symstab._generated import kernels as numpy_kernels
+from symstab.boundary import boundary
+from symstab.evaluate import boundary_point
+from symstab.theta_max import theta_max
+
+GENERATED = REPO / "symstab" / "_generated"
+C_SOURCE = GENERATED / "symstab_kernels.c"
+C_HEADER = GENERATED / "symstab_kernels.h"
+
+#: C vs NumPy: the same operations in the same order; only libm and NumPy's
+#: own sin/cos/tan/expm1 (which may be SIMD) differ by an ulp or so.
+C_VS_NUMPY_RTOL = 1e-12
+#: Kernel vs the 50-digit reference of the boundary.
+BOUNDARY_RTOL = 1e-10
+#: exprel3 from its Taylor polynomial (delta < 1/2): a Horner sum of positive
+#: terms, a couple of roundings.
+EXPREL3_SERIES_RTOL = 4e-16
+#: exprel3 from ``(expm1(x) - x - x**2/2) / x**3`` (delta >= 1/2): the
+#: subtraction cancels a factor expm1(x) / (x**3 exprel3(x)), 27 at x = 1/2,
+#: so a few-ulp evaluation carries ~27 ulp (6e-15) there; measured 4.6e-15.
+EXPREL3_CLOSED_FORM_RTOL = 1e-14
+#: Loop coefficients vs the 30-digit coefficients, relative to the largest.
+LOOP_RTOL = 1e-12
+
+
+# --------------------------------------------------------------------------
+# The C library: compile with -Werror, load with ctypes from the header
+# --------------------------------------------------------------------------
+
+_C_TYPES = {
+    "double": ctypes.c_double,
+    "int": ctypes.c_int,
+    "double *": ctypes.POINTER(ctypes.c_double),
+    "void": None,
+}
+_PROTOTYPE = re.compile(r"^(double|void) (symstab_\w+)\(([^)]*)\);$", re.MULTILINE)
+_PARAMETER = re.compile(r"\s*(double|int)\s*(\*?)\s*\w+\s*")
+
+
+def header_signatures(text):
+    """``{name: (C return type, [C parameter types])}`` of the prototypes in ``text``.
+
+    Types are spelled ``"double"``, ``"int"``, ``"double *"``, ``"void"``;
+    a parameter of any other type raises, so the wrappers never guess.
+    """
+    signatures = {}
+    for ret, name, params in _PROTOTYPE.findall(text):
+        types = []
+        for param in params.split(","):
+            m = _PARAMETER.fullmatch(param)
+            if m is None:
+                raise ValueError(f"{name}: cannot map parameter {param.strip()!r} to ctypes")
+            types.append(m[1] + (" *" if m[2] else ""))
+        signatures[name] = (ret, types)
+    return signatures
+
+
+#: What the wrappers below call; the header must declare exactly this.
+EXPECTED_SIGNATURES = {
+    "symstab_exprel3": ("double", ["double"]),
+    "symstab_boundary": ("void", ["double", "double", "int", "double"] + ["double *"] * 2),
+    "symstab_loop_coefficients": ("void", ["double"] * 4 + ["double *"] * 7),
+}
+
+
+class CKernels:
+    """Python-callable wrappers of the loaded C library (scalars only)."""
+
+    def __init__(self, lib):
+        self.lib = lib
+
+    def exprel3(self, delta):
+        return self.lib.symstab_exprel3(float(delta))
+
+    @staticmethod
+    def _outputs(n):
+        # NaN-initialised, so an output the C code forgets to write is caught.
+        return [ctypes.c_double(math.nan) for _ in range(n)]
+
+    def boundary(self, theta, gamma, d, delta):
+        out = self._outputs(2)
+        self.lib.symstab_boundary(float(theta), float(gamma), int(d), float(delta),
+                                  *(ctypes.byref(x) for x in out))
+        return tuple(x.value for x in out)
+
+    def loop_coefficients(self, alpha, beta, gamma, delta):
+        out = self._outputs(7)
+        self.lib.symstab_loop_coefficients(float(alpha), float(beta), float(gamma), float(delta),
+                                           *(ctypes.byref(x) for x in out))
+        return tuple(x.value for x in out)
+
+
+def _c_compiler():
+    for name in ("cc", "gcc"):
+        path = shutil.which(name)
+        if path:
+            return path
+    return None
+
+
+@pytest.fixture(scope="session")
+def c_kernels(tmp_path_factory):
+    """The generated C compiled with ``-Werror`` into a shared library, loaded.
+
+    A compiler warning fails every test that uses the library: the generated
+    C must be warning-free under ``-std=c99 -Wall -Wextra -pedantic``.
+    """
+    compiler = _c_compiler()
+    if compiler is None:
+        pytest.skip("no C compiler found on PATH (tried cc, gcc); the C kernels are not tested")
+    library = tmp_path_factory.mktemp("c_kernels") / "libsymstab_kernels.so"
+    command = [compiler, "-std=c99", "-O2", "-Wall", "-Wextra", "-pedantic", "-Werror",
+               "-fPIC", "-shared", f"-I{GENERATED}", str(C_SOURCE), "-o", str(library), "-lm"]
+    proc = subprocess.run(command, capture_output=True, text=True, timeout=120)
+    if proc.returncode != 0:
+        pytest.fail(f"compiling the generated C failed ({' '.join(command)}):\n"
+                    f"{proc.stdout}{proc.stderr}")
+    lib = ctypes.CDLL(str(library))
+    for name, (ret, params) in header_signatures(C_HEADER.read_text(encoding="utf-8")).items():
+        function = getattr(lib, name)
+        function.restype = _C_TYPES[ret]
+        function.argtypes = [_C_TYPES[p] for p in params]
+    return CKernels(lib)
+
+
+def test_header_declares_the_called_signatures():
+    """The header's prototypes are the ones the ctypes wrappers assume."""
+    assert header_signatures(C_HEADER.read_text(encoding="utf-8")) == EXPECTED_SIGNATURES
+
+
+def test_c_compiles_warning_free_and_exports_the_kernels(c_kernels):
+    """Compiled with -Werror (by the fixture); every declared kernel is exported."""
+    for name in EXPECTED_SIGNATURES:
+        assert hasattr(c_kernels.lib, name), name
+
+
+def test_header_parser_rejects_unknown_types():
+    """A prototype the wrappers cannot type must raise, not be guessed."""
+    with pytest.raises(ValueError, match="float"):
+        header_signatures("void symstab_f(float x);\n")
+
+
+# --------------------------------------------------------------------------
+# C vs NumPy on random points
+# --------------------------------------------------------------------------
+
+N_RANDOM = 3000
+
+
+@pytest.fixture(scope="module")
+def random_points():
+    """Seeded random points: delta log-uniform in [1e-6, 1], d in 0..200,
+    gamma in [-0.9, 3], theta in (1e-4, 3.1), alpha in [-1, 5], beta in [-2, 3]."""
+    rng = np.random.default_rng(20240607)
+    return dict(
+        delta=10 ** rng.uniform(-6.0, 0.0, N_RANDOM),
+        d=rng.integers(0, 201, N_RANDOM),
+        gamma=rng.uniform(-0.9, 3.0, N_RANDOM),
+        theta=rng.uniform(1e-4, 3.1, N_RANDOM),
+        alpha=rng.uniform(-1.0, 5.0, N_RANDOM),
+        beta=rng.uniform(-2.0, 3.0, N_RANDOM),
+    )
+
+
+def _mixed_error(actual, expected):
+    """Vectorised :func:`conftest.relative_error`: absolute only where expected == 0."""
+    actual, expected = np.broadcast_arrays(np.asarray(actual, float), np.asarray(expected, float))
+    err = np.abs(actual - expected)
+    nonzero = expected != 0
+    err[nonzero] /= np.abs(expected[nonzero])
+    return err
+
+
+def _assert_all_below(errors, rtol, points, label):
+    """Assert ``errors <= rtol`` everywhere; on failure name the worst point."""
+    k = int(np.argmax(errors))
+    where = ", ".join(f"{name}={np.asarray(v)[k]!r}" for name, v in points.items())
+    assert errors[k] <= rtol, (f"{label}: {np.count_nonzero(errors > rtol)} of {errors.size} points "
+                               f"exceed {rtol:g}; worst {errors[k]:.3g} at {where}")
+
+
+def test_c_exprel3_matches_numpy(c_kernels, random_points):
+    delta = random_points["delta"]
+    c = np.array([c_kernels.exprel3(x) for x in delta])
+    _assert_all_below(_mixed_error(c, numpy_kernels.exprel3(delta)), C_VS_NUMPY_RTOL,
+                      {"delta": delta}, "exprel3, C vs NumPy")
+
+
+def test_c_boundary_matches_numpy(c_kernels, random_points):
+    """alpha and beta agree on random points, anywhere in (0, 3.1).
+
+    The points are not restricted to the arc, so some lie near a root of
+    alpha or beta, where the relative difference of two float evaluations
+    grows as 1 / |value| (worst measured 5e-14 at |alpha| ~ 1e-4).
+    """
+    p = random_points
+    numpy_alpha = np.empty(N_RANDOM)
+    numpy_beta = np.empty(N_RANDOM)
+    for d in np.unique(p["d"]):
+        # d is a Python int in the kernel's contract: vectorise per delay.
+        m = p["d"] == d
+        numpy_alpha[m], numpy_beta[m] = numpy_kernels.boundary(p["theta"][m], p["gamma"][m],
+                                                               int(d), p["delta"][m])
+    c_alpha, c_beta = np.array([c_kernels.boundary(t, g, d, dl) for t, g, d, dl in
+                                zip(p["theta"], p["gamma"], p["d"], p["delta"])]).T
+    where = {k: p[k] for k in ("theta", "gamma", "d", "delta")}
+    _assert_all_below(_mixed_error(c_alpha, numpy_alpha), C_VS_NUMPY_RTOL, where, "alpha, C vs NumPy")
+    _assert_all_below(_mixed_error(c_beta, numpy_beta), C_VS_NUMPY_RTOL, where, "beta, C vs NumPy")
+
+
+def test_c_loop_coefficients_match_numpy(c_kernels, random_points):
+    p = random_points
+    args = [p[k] for k in ("alpha", "beta", "gamma", "delta")]
+    numpy_c = numpy_kernels.loop_coefficients(*args)
+    c_c = np.array([c_kernels.loop_coefficients(*point) for point in zip(*args)]).T
+    where = {k: p[k] for k in ("alpha", "beta", "gamma", "delta")}
+    for k in range(7):
+        # c2 is the constant 1 (a scalar in NumPy): broadcast before comparing.
+        _assert_all_below(_mixed_error(c_c[k], numpy_c[k]), C_VS_NUMPY_RTOL, where,
+                          f"c{k}, C vs NumPy")
+
+
+# --------------------------------------------------------------------------
+# The boundary against the derivation at 50 digits
+# --------------------------------------------------------------------------
+
+DELTAS = (1e-6, 1e-5, 1e-4, PAPER_DELTA, 0.03, 0.3, 0.49, 0.51, 1.0)
+DELAYS = (0, 1, 5, 40, 200)
+GAMMAS = (-0.5, 0.0, 1.0, 2.0)
+N_THETA = 6
+THETA_MIN = 1e-4
+
+
+def _grid():
+    """(delta, d, gamma) combinations of the reference grid.
+
+    theta_max costs 0.25 s at d <= 5, 0.45 s at d = 40 and 1.8 s at d = 200
+    (a scan of 16 (d+1) points at 70 digits), so the full 9 x 5 x 4 grid takes
+    100 s.  Every (delta, d) pair is kept, with the gammas rotated so that
+    every (delta, gamma) and every (d, gamma) pair still occurs: two gammas per
+    pair, one at d = 200.  About 40 s.
+    """
+    out = []
+    for i, delta in enumerate(DELTAS):
+        for j, d in enumerate(DELAYS):
+            picks = [(i + j) % 4] if d == 200 else [(i + j) % 4, (i + j + 2) % 4]
+            out += [(delta, d, GAMMAS[k]) for k in picks]
+    return out
+
+
+GRID = _grid()
+GRID_IDS = [f"delta={delta:g}-d={d}-gamma={gamma:g}" for delta, d, gamma in GRID]
+
+
+@functools.lru_cache(maxsize=None)
+def _theta_max(delta, d, gamma):
+    """theta_max, computed once per point (shared by the tests below)."""
+    return theta_max(gamma=gamma, d=d, delta=delta)
+
+
+def _arc_end_or_skip(delta, d, gamma):
+    t_end = _theta_max(delta, d, gamma)
+    if math.isnan(t_end):
+        pytest.skip("no arc: alpha < 0 just after theta = 0")
+    return t_end
+
+
+def _kernel_boundaries(c_kernels):
+    """``{name: f(theta, gamma, d, delta) -> (alpha, beta)}``, NumPy and C."""
+    return {"numpy": numpy_kernels.boundary, "C": c_kernels.boundary}
+
+
+@pytest.mark.parametrize("delta, d, gamma", GRID, ids=GRID_IDS)
+def test_boundary_matches_derivation_at_50_digits(c_kernels, delta, d, gamma):
+    """alpha and beta of both kernels to 1e-10 relative on the arc.
+
+    theta runs over a geometric grid from 1e-4 up to, but excluding,
+    theta_max: alpha(theta_max) = 0, so its relative error is unbounded for
+    any floating-point evaluation (the condition number of a function at a
+    root is infinite); the absolute error there is tested separately.
+    """
+    t_end = _arc_end_or_skip(delta, d, gamma)
+    thetas = np.geomspace(THETA_MIN, t_end, N_THETA + 1)[:-1]
+    failures = []
+    for theta in thetas:
+        ref = boundary_point(float(theta), gamma=gamma, d=d, delta=delta, dps=50)
+        for kernel, f in _kernel_boundaries(c_kernels).items():
+            for name, value, expected in zip(("alpha", "beta"), f(theta, gamma, d, delta), ref):
+                err = relative_error(mpmath.mpf(float(value)), expected)
+                if not err <= BOUNDARY_RTOL:
+                    failures.append(f"{kernel} {name} at theta={theta!r}: {float(value)!r} vs "
+                                    f"{mpmath.nstr(expected, 17)}, relative error {float(err):.3g}")
+    assert not failures, "\n".join(failures)
+
+
+@pytest.mark.parametrize("delta, d, gamma", GRID, ids=GRID_IDS)
+def test_alpha_vanishes_at_theta_max(c_kernels, delta, d, gamma):
+    """|alpha(theta_max)| <= 1e-12 max alpha on the arc, for both kernels.
+
+    At the root only the absolute error means anything; it should be about
+    1e-16 times the size of the terms of alpha, i.e. of max alpha.
+    """
+    t_end = _arc_end_or_skip(delta, d, gamma)
+    if t_end == float(mpmath.pi):
+        pytest.skip("alpha does not return to 0 before theta = pi")
+    # The peak only sets the scale: a dense grid of the kernel itself will do.
+    arc = np.linspace(0.0, t_end, 4001)[1:-1]
+    peak = float(np.max(numpy_kernels.boundary(arc, gamma, d, delta)[0]))
+    assert peak > 0
+    for kernel, f in _kernel_boundaries(c_kernels).items():
+        alpha_end = float(f(t_end, gamma, d, delta)[0])
+        assert abs(alpha_end) <= 1e-12 * peak, (
+            f"{kernel}: alpha(theta_max={t_end!r}) = {alpha_end:.3g}, max alpha on the arc {peak:.3g}")
+
+
+# --------------------------------------------------------------------------
+# exprel3 against its definition
+# --------------------------------------------------------------------------
+
+SWITCH = 0.5
+EXPREL3_POINTS = np.unique(np.concatenate([
+    np.geomspace(1e-8, 20.0, 400),
+    # Both sides of the switch from the Taylor polynomial to expm1.
+    [np.nextafter(SWITCH, 0.0), SWITCH, np.nextafter(SWITCH, 1.0)],
+    SWITCH + 1e-3 * np.arange(-20, 21),
+]))
+
+
+def _exprel3_reference(x):
+    with mpmath.workdps(50):
+        x = mpmath.mpf(float(x))
+        return (mpmath.expm1(x) - x - x**2 / 2) / x**3
+
+
+@pytest.fixture(scope="module")
+def exprel3_reference():
+    return [_exprel3_reference(x) for x in EXPREL3_POINTS]
+
+
+@pytest.mark.parametrize("kernel", ["numpy", "C"])
+def test_exprel3_matches_definition_at_50_digits(request, kernel, exprel3_reference):
+    """Series branch within 4e-16, expm1 branch within 1e-14 (see the bounds)."""
+    if kernel == "numpy":
+        values = numpy_kernels.exprel3(EXPREL3_POINTS)
+    else:
+        c = request.getfixturevalue("c_kernels")
+        values = np.array([c.exprel3(x) for x in EXPREL3_POINTS])
+    errors = np.array([float(relative_error(mpmath.mpf(float(v)), r))
+                       for v, r in zip(values, exprel3_reference)])
+    series = EXPREL3_POINTS < SWITCH
+    for mask, rtol, label in ((series, EXPREL3_SERIES_RTOL, "Taylor branch"),
+                              (~series, EXPREL3_CLOSED_FORM_RTOL, "expm1 branch")):
+        _assert_all_below(errors[mask], rtol, {"delta": EXPREL3_POINTS[mask]},
+                          f"{kernel} exprel3, {label}")
+
+
+# --------------------------------------------------------------------------
+# Loop coefficients against the 30-digit characteristic polynomial
+# --------------------------------------------------------------------------
+
+def _loop_points():
+    """A few dozen seeded points, with delta = 1e-6 and the overlapping d = 0, 1, 2."""
+    rng = np.random.default_rng(7)
+    points = []
+    for k in range(36):
+        points.append(dict(
+            alpha=float(rng.uniform(-1.0, 5.0)), beta=float(rng.uniform(-2.0, 3.0)),
+            gamma=float(rng.uniform(-0.9, 3.0)),
+            d=int(k if k < 3 else rng.integers(0, 201)),
+            delta=1e-6 if k % 4 == 0 else float(10 ** rng.uniform(-6.0, 0.0))))
+    return points
+
+
+LOOP_POINTS = _loop_points()
+
+
+def assemble(coefficients, d):
+    """Place the kernel's c0..c6 in the length-(d+5) vector, highest power first.
+
+    c0..c2 are the coefficients of z^(d+4), z^(d+3), z^(d+2); c3..c6 those of
+    z^3..z^0.  For d < 2 the two groups overlap and add.
+    """
+    out = np.zeros(d + 5)
+    out[:3] += coefficients[:3]
+    out[-4:] += coefficients[3:]
+    return out
+
+
+@pytest.mark.parametrize("kernel", ["numpy", "C"])
+@pytest.mark.parametrize("point", LOOP_POINTS,
+                         ids=[f"d={p['d']}-delta={p['delta']:.3g}" for p in LOOP_POINTS])
+def test_loop_coefficients_match_characteristic_polynomial(request, loop, kernel, point):
+    """Every coefficient of chi / delta^2 within 1e-12 of the largest one."""
+    args = [point[k] for k in ("alpha", "beta", "gamma", "delta")]
+    if kernel == "numpy":
+        values = [float(c) for c in numpy_kernels.loop_coefficients(*args)]
+    else:
+        values = request.getfixturevalue("c_kernels").loop_coefficients(*args)
+    actual = assemble(np.array(values), point["d"])
+    expected = loop.numeric_coeffs(**point) / point["delta"] ** 2
+    errors = np.abs(actual - expected) / np.max(np.abs(expected))
+    k = int(np.argmax(errors))
+    assert errors[k] <= LOOP_RTOL, (
+        f"{kernel}: coefficient {k} (of z^{point['d'] + 4 - k}) is {actual[k]!r}, expected "
+        f"{expected[k]!r}; error {errors[k]:.3g} of the largest coefficient at {point}")
+
+
+# --------------------------------------------------------------------------
+# Why the rearranged forms: the naive C-coefficient form fails the same check
+# --------------------------------------------------------------------------
+
+@functools.lru_cache(maxsize=None)
+def _naive_alpha():
+    """alpha of the derivation, Gamma -> exp(delta), evaluated in NumPy floats."""
+    args = (model.theta, model.gamma, model.d, model.delta)
+    return sp.lambdify(args, boundary().alpha.subs(model.Gamma, sp.exp(model.delta)),
+                       modules="numpy")
+
+
+@pytest.mark.parametrize("d", [0, 5, 40])
+@pytest.mark.parametrize("theta", [1e-3, 1e-2, 0.1])
+def test_naive_form_loses_digits_where_kernel_does_not(c_kernels, d, theta):
+    """At delta = 1e-6 the C-coefficient form cancels ~log10(1/delta^2) digits.
+
+    Its relative error exceeds 1e-6 (so the 1e-10 check above can fail),
+    while both kernels stay within that check's bound.
+    """
+    gamma, delta = 0.5, 1e-6
+    expected = boundary_point(theta, gamma=gamma, d=d, delta=delta, dps=50)[0]
+    naive = float(_naive_alpha()(theta, gamma, d, delta))
+    assert relative_error(mpmath.mpf(naive), expected) > 1e-6
+    for kernel, f in _kernel_boundaries(c_kernels).items():
+        value = float(f(theta, gamma, d, delta)[0])
+        assert relative_error(mpmath.mpf(value), expected) <= BOUNDARY_RTOL, kernel
