@@ -23,6 +23,7 @@ alpha_max over gamma.
 """
 
 import dataclasses
+import functools
 import math
 
 import numpy as np
@@ -115,7 +116,8 @@ class StabilityRegion:
         coord = self._beta if axis == "beta" else self._alpha
         order = np.argsort(values)
         sorted_values = values[order]
-        c0, c1 = coord[:-1], coord[1:]
+        active = np.flatnonzero(self._active_segments)
+        c0, c1 = coord[active], coord[active + 1]
         rising = c1 > c0
         start = np.where(rising, np.searchsorted(sorted_values, c0, "left"),
                          np.searchsorted(sorted_values, c1, "right"))
@@ -123,6 +125,7 @@ class StabilityRegion:
                         np.searchsorted(sorted_values, c0, "right"))
         stop = np.maximum(stop, start)
         segment, k = _ranges(start, stop)
+        segment = active[segment]
         if segment.size == 0:
             return np.empty(0, dtype=int), np.empty(0)
         target = sorted_values[k]
@@ -206,7 +209,19 @@ class StabilityRegion:
 
     # -- where the region is ----------------------------------------------
 
-    def _touching_arc(self):
+    @functools.cached_property
+    def _active_segments(self):
+        """Arc segments within two samples of one that touches the region.
+
+        Only these can bound the stable region; the rest of the arc (at large
+        d it winds around many times) only splits unstable gaps, so leaving
+        it out changes no interval and saves most of the work.
+        """
+        near = np.convolve(self._touching.astype(float), np.ones(5), mode="same") > 0
+        return near[:-1] | near[1:]
+
+    @functools.cached_property
+    def _touching(self):
         """Mask of arc samples with a stable point within a relative 1e-6."""
         a, b = self._alpha, self._beta
         ok = np.isfinite(a) & np.isfinite(b) & (np.abs(a) < 1e6) & (np.abs(b) < 1e6)
@@ -246,7 +261,7 @@ class StabilityRegion:
         return np.sort(np.concatenate([ends, [-self.delta]]))
 
     def _beta_window(self):
-        touching = self._touching_arc()
+        touching = self._touching
         if not touching.any():
             return None
         lo, hi = self._beta[touching].min(), self._beta[touching].max()
@@ -267,7 +282,7 @@ class StabilityRegion:
         out = []
         # z = 1: the beta where a point just above alpha = 0 is stable.
         betas = np.linspace(lo - pad, hi + pad, 2001)
-        eps = _PROBE * max(self._alpha[self._touching_arc()].max(), self.delta)
+        eps = _PROBE * max(self._alpha[self._touching].max(), self.delta)
         above = np.asarray(classify(alpha=eps, beta=betas, gamma=self.gamma, d=self.d,
                                     delta=self.delta)) == STABLE
         ends = self._corners()
@@ -287,49 +302,82 @@ class StabilityRegion:
                                float(betas[run[1]]), float(line_alpha[run[1]])))
         return tuple(out)
 
-    def limits(self, *, n_beta=801):
-        """alpha_max, the beta range and the Z-width (see :func:`limits`)."""
-        window = self._beta_window()
-        if window is None:
-            return Limits.empty_region(self, "no stable point next to the boundary arc: "
-                                             "the stable region is empty")
-        lo, hi = window
+    def alpha_max(self):
+        """``(alpha_max, beta at alpha_max)``, or ``None`` when the region is empty.
+
+        The highest arc sample next to the region (the arc's local maxima are
+        among the samples, refined) brackets alpha_max within a relative 1e-6;
+        a k-ary search for the last horizontal line that meets the region
+        settles it.
+        """
+        touching = self._touching
+        if not touching.any():
+            return None
+        top = self._alpha[touching].max()
+        inside = top * (1 - 2 * _PROBE) - _PROBE * self.delta
+        outside = top * (1 + 1e-9) + 1e-300
+        if not self._intervals("alpha", [inside])[0]:
+            return self._alpha_max_from_scan()
+        while self._intervals("alpha", [outside])[0]:
+            outside = inside + 4 * (outside - inside)
+            if not math.isfinite(outside):
+                return math.inf, math.nan
+        alpha_max, at_top = self._last_meeting("alpha", inside, outside)
+        at_top = at_top or self._intervals("alpha", [alpha_max])[0]
+        return float(alpha_max), float(0.5 * (at_top[0][0] + at_top[-1][1]))
+
+    def _alpha_max_from_scan(self, n_beta=801):
+        """alpha_max when no arc sample is the top: the tops of vertical lines."""
+        betas = np.linspace(*self._beta_range_bracket(n_beta)[:2], n_beta)
+        runs = self._intervals("beta", betas)
+        tops = np.array([r[-1][1] if r else -np.inf for r in runs])
+        k = int(np.argmax(tops))
+        if not np.isfinite(tops[k]):
+            return (math.inf, math.nan) if tops[k] > 0 else None
+        return float(tops[k]), float(betas[k])
+
+    def _beta_range_bracket(self, n_beta):
+        """A window of vertical lines whose first and last miss the region."""
+        lo, hi = self._beta_window()
         pad = 0.05 * (hi - lo) + self.delta
         for _ in range(8):
             betas = np.linspace(lo - pad, hi + pad, n_beta)
-            runs = self._intervals("beta", betas)
-            meets = np.array([bool(r) for r in runs])
-            if not meets.any():
-                return Limits.empty_region(self, "the stable region is empty (or thinner "
-                                                 "than the scan resolves)")
+            meets = np.array([bool(r) for r in self._intervals("beta", betas)])
             if not (meets[0] or meets[-1]):
                 break
             pad *= 4
+        return betas[0], betas[-1], betas, meets
+
+    def beta_range(self, n_beta=201):
+        """``(beta_min, beta_max)`` of the stable region, or ``None`` when it is empty."""
+        if self._beta_window() is None:
+            return None
+        _, _, betas, meets = self._beta_range_bracket(n_beta)
         k = np.flatnonzero(meets)
-        beta_min = self._snap(self._last_meeting("beta", betas[k[0]], betas[k[0] - 1])[0])
-        beta_max = self._snap(self._last_meeting("beta", betas[k[-1]], betas[k[-1] + 1])[0])
-        tops = [r[-1][1] for r in runs if r]
-        alpha_low = max(tops)
-        if not math.isfinite(alpha_low):
-            return Limits(self, math.inf, math.nan, beta_max, beta_min, math.inf,
-                          "the stable region is unbounded in alpha")
-        alpha_high = alpha_low + max(alpha_low, self.delta) * 1e-2
-        while self._intervals("alpha", [alpha_high])[0]:
-            alpha_high += 2 * (alpha_high - alpha_low)
-        alpha_max, at_top = self._last_meeting("alpha", alpha_low, alpha_high)
-        if at_top is None:
-            at_top = runs[int(np.argmax([r[-1][1] if r else -np.inf for r in runs]))]
-            beta_at = betas[[i for i, r in enumerate(runs) if r == at_top][0]]
-        else:
-            beta_at = 0.5 * (at_top[0][0] + at_top[-1][1])
-        # Z-width: the stable length on verticals across [beta_min, beta_max].
+        if k.size == 0:
+            return None
+        return (self._snap(self._last_meeting("beta", betas[k[0]], betas[k[0] - 1])[0]),
+                self._snap(self._last_meeting("beta", betas[k[-1]], betas[k[-1] + 1])[0]))
+
+    def z_width(self, beta_min, beta_max, n_beta=801):
+        """Area of the stable region: the stable length on verticals, trapezoid rule."""
         betas = np.linspace(beta_min, beta_max, n_beta)
         lengths = np.array([sum(h - l for l, h in r) for r in self._intervals("beta", betas)])
-        z_width = float(np.trapezoid(lengths, betas)) if hasattr(np, "trapezoid") \
-            else float(np.trapz(lengths, betas))
-        return Limits(self, float(alpha_max), float(beta_at), float(beta_max), float(beta_min),
-                      z_width, "")
+        return float(np.sum(0.5 * (lengths[1:] + lengths[:-1]) * np.diff(betas)))
 
+    def limits(self, *, n_beta=801):
+        """alpha_max, the beta range and the Z-width (see :func:`limits`)."""
+        beta_range = self.beta_range()
+        top = self.alpha_max() if beta_range else None
+        if top is None:
+            return Limits.empty_region(self, "no stable point next to the boundary arc: "
+                                             "the stable region is empty")
+        alpha_max, beta_at = top
+        if not math.isfinite(alpha_max):
+            return Limits(self, math.inf, math.nan, beta_range[1], beta_range[0], math.inf,
+                          "the stable region is unbounded in alpha")
+        return Limits(self, alpha_max, beta_at, beta_range[1], beta_range[0],
+                      self.z_width(*beta_range, n_beta=n_beta), "")
 
     def _snap(self, beta, rtol=1e-7):
         """Move an extreme beta onto a corner of the arc and alpha = 0 within ``rtol``.
@@ -480,8 +528,8 @@ class BestVirtualMass:
 
 
 def _alpha_max(gamma, d, delta):
-    lim = StabilityRegion(gamma=gamma, d=d, delta=delta).limits(n_beta=41)
-    return (-math.inf, math.nan) if lim.empty else (lim.alpha_max, lim.beta_at_alpha_max)
+    top = StabilityRegion(gamma=gamma, d=d, delta=delta).alpha_max()
+    return (-math.inf, math.nan) if top is None else top
 
 
 def best_virtual_mass(*, d, delta, gamma_range=None, n=17):

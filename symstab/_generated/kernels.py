@@ -23,8 +23,8 @@ def exprel3(delta):
     phi3 : float or ndarray
         (exp(delta) - 1 - delta - delta^2/2) / delta^3
     """
-    x0 = numpy.maximum(1/2, delta)
-    return numpy.where(numpy.less(delta, 1/2), delta*(delta*(delta*(delta*(delta*(delta*(delta*(delta*(delta*(delta*(delta*(delta*(delta*(delta*(delta*((1/121645100408832000)*delta + 1/6402373705728000) + 1/355687428096000) + 1/20922789888000) + 1/1307674368000) + 1/87178291200) + 1/6227020800) + 1/479001600) + 1/39916800) + 1/3628800) + 1/362880) + 1/40320) + 1/5040) + 1/720) + 1/120) + 1/24) + 1/6, (-1/2*x0**2 - x0 + numpy.expm1(x0))/x0**3)
+    x0 = numpy.maximum(1, delta)
+    return numpy.where(numpy.less(delta, 1), delta*(delta*(delta*(delta*(delta*(delta*(delta*(delta*(delta*(delta*(delta*(delta*(delta*(delta*(delta*((1/121645100408832000)*delta + 1/6402373705728000) + 1/355687428096000) + 1/20922789888000) + 1/1307674368000) + 1/87178291200) + 1/6227020800) + 1/479001600) + 1/39916800) + 1/3628800) + 1/362880) + 1/40320) + 1/5040) + 1/720) + 1/120) + 1/24) + 1/6, (-1/2*x0**2 - x0 + numpy.expm1(x0))/x0**3)
 
 
 def boundary(theta, gamma, d, delta):

@@ -14,8 +14,8 @@
  */
 double symstab_exprel3(double delta)
 {
-    const double x0 = fmax(1.0/2.0, delta);
-    return ((delta < 1.0/2.0) ? (
+    const double x0 = fmax(1, delta);
+    return ((delta < 1) ? (
    delta*(delta*(delta*(delta*(delta*(delta*(delta*(delta*(delta*(delta*(delta*(delta*(delta*(delta*(delta*((1.0/121645100408832000.0)*delta + 1.0/6402373705728000.0) + 1.0/355687428096000.0) + 1.0/20922789888000.0) + 1.0/1307674368000.0) + 1.0/87178291200.0) + 1.0/6227020800.0) + 1.0/479001600.0) + 1.0/39916800.0) + 1.0/3628800.0) + 1.0/362880.0) + 1.0/40320.0) + 1.0/5040.0) + 1.0/720.0) + 1.0/120.0) + 1.0/24.0) + 1.0/6.0
 )
 : (
