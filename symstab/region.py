@@ -31,13 +31,15 @@ import numpy as np
 from ._generated import kernels
 from ._validate import check_delay, check_real
 from .curves import Segment, _bisect, minus_one_line, scan_grid
-from .stability import STABLE, classify
+from .stability import MARGINAL, STABLE, classify
 
 __all__ = ["StabilityRegion", "Limits", "limits", "BestVirtualMass", "best_virtual_mass"]
 
 #: Relative offset of the probes that decide whether an arc point touches
-#: the stable region (far above the 1e-12 marginal band, far below any
-#: feature of the region).
+#: the stable region: far above the 1e-12 marginal band, and below the width
+#: of the thinnest regions (the gamma = 2, d = 0 sliver is 3e-5 wide; 1e-4
+#: missed its top).  It picks the arc segments to work with and seeds the
+#: searches, which then run to the last bit.
 _PROBE = 1e-6
 
 
@@ -146,8 +148,15 @@ class StabilityRegion:
             other = np.where(root == 0.0, -self.delta, other)
         return order[k], other
 
-    def _intervals(self, axis, values):
-        """Stable intervals of the other coordinate on each line ``axis = value``."""
+    def _intervals(self, axis, values, closure=False):
+        """Stable intervals of the other coordinate on each line ``axis = value``.
+
+        With ``closure``, gaps whose probe is marginal count too: next to a
+        corner or the top of the region the gap between two crossings is so
+        short that its probe lies within 1e-12 of radius 1, and the searches
+        for the extent of the region should run into the corner, not stop
+        where the classification can no longer tell.
+        """
         values = np.atleast_1d(np.asarray(values, dtype=float))
         owner, cuts = self._arc_crossings(axis, values)
         if axis == "beta":
@@ -176,7 +185,8 @@ class StabilityRegion:
             code = classify(alpha=probe_at, beta=line_value, gamma=self.gamma, d=self.d, delta=self.delta)
         else:
             code = classify(alpha=line_value, beta=probe_at, gamma=self.gamma, d=self.d, delta=self.delta)
-        stable = np.atleast_1d(code) == STABLE
+        code = np.atleast_1d(code)
+        stable = (code == STABLE) | (closure & (code == MARGINAL))
         out = [[] for _ in values]
         order = np.lexsort((probe_lo, probe_owner))
         for i in order[stable[order]]:
@@ -218,6 +228,9 @@ class StabilityRegion:
         it out changes no interval and saves most of the work.
         """
         near = np.convolve(self._touching.astype(float), np.ones(5), mode="same") > 0
+        # The arc's start (-delta, 0) is a corner of every region that
+        # reaches it, however thin the wedge there is next to it.
+        near |= self._theta < 2 * self._theta[-1] / max(400, 16 * (self.d + 1))
         return near[:-1] | near[1:]
 
     @functools.cached_property
@@ -230,7 +243,11 @@ class StabilityRegion:
         eb = _PROBE * (np.abs(b) + self.delta)
         probes_a = np.concatenate([a + ea, a - ea, a, a])
         probes_b = np.concatenate([b, b, b + eb, b - eb])
-        code = classify(alpha=probes_a, beta=probes_b, gamma=self.gamma, d=self.d, delta=self.delta)
+        # The Schur-Cohn verdicts alone: these probes sit 1e-6 from the
+        # boundary, where the eigenvalue refinement of every one would cost
+        # 20 s at d = 200, and a wrong verdict would only widen the search.
+        code = classify(alpha=probes_a, beta=probes_b, gamma=self.gamma, d=self.d,
+                        delta=self.delta, refine=False)
         touching = np.zeros(len(self._alpha), dtype=bool)
         touching[np.flatnonzero(ok)] = np.any((np.asarray(code) == STABLE).reshape(4, -1), axis=0)
         return touching
@@ -245,7 +262,7 @@ class StabilityRegion:
         runs_inside = None
         for _ in range(rounds):
             trial = np.linspace(inside, outside, fan + 2)[1:-1]
-            runs = self._intervals(axis, trial)
+            runs = self._intervals(axis, trial, closure=True)
             k = np.flatnonzero([bool(r) for r in runs])
             j = k[-1] + 1 if k.size else 0
             if j > 0:
@@ -356,8 +373,8 @@ class StabilityRegion:
         k = np.flatnonzero(meets)
         if k.size == 0:
             return None
-        return (self._snap(self._last_meeting("beta", betas[k[0]], betas[k[0] - 1])[0]),
-                self._snap(self._last_meeting("beta", betas[k[-1]], betas[k[-1] + 1])[0]))
+        return (float(self._last_meeting("beta", betas[k[0]], betas[k[0] - 1])[0]),
+                float(self._last_meeting("beta", betas[k[-1]], betas[k[-1] + 1])[0]))
 
     def z_width(self, beta_min, beta_max, n_beta=801):
         """Area of the stable region: the stable length on verticals, trapezoid rule."""
@@ -378,20 +395,6 @@ class StabilityRegion:
                           "the stable region is unbounded in alpha")
         return Limits(self, alpha_max, beta_at, beta_range[1], beta_range[0],
                       self.z_width(*beta_range, n_beta=n_beta), "")
-
-    def _snap(self, beta, rtol=1e-7):
-        """Move an extreme beta onto a corner of the arc and alpha = 0 within ``rtol``.
-
-        Next to a corner the region is a wedge of height ~ (beta - corner);
-        probes there are marginal (radius within 1e-12 of 1), so the search
-        stops about 1e-9 short of the corner, which is exact.
-        """
-        corners = self._corners()
-        if corners.size:
-            near = corners[np.argmin(np.abs(corners - beta))]
-            if abs(near - beta) <= rtol * max(abs(near), self.delta):
-                return float(near)
-        return float(beta)
 
 
 def _golden_max(f, a, b, iterations=80):

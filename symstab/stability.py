@@ -179,7 +179,7 @@ def schur_cohn(coefficients):
     return stable, margin
 
 
-def classify(*, alpha, beta, gamma, d, delta, marginal_tol=MARGINAL_TOL):
+def classify(*, alpha, beta, gamma, d, delta, marginal_tol=MARGINAL_TOL, refine=True):
     """Classify parameter points as stable, unstable or marginal.
 
     Parameters
@@ -188,6 +188,13 @@ def classify(*, alpha, beta, gamma, d, delta, marginal_tol=MARGINAL_TOL):
         As in :func:`loop_coefficients`.
     marginal_tol : float
         A spectral radius within this of 1 is :data:`MARGINAL`.
+    refine : bool
+        Decide the points whose Schur-Cohn margin is below 1e-6 by their
+        eigenvalues (the default).  With ``False`` the Schur-Cohn verdict is
+        returned as it is (only a margin of exactly 0 is marginal): faster at
+        large ``d`` near the boundary, and in the tests it never disagreed
+        with the eigenvalues where the margin was positive, but a radius
+        within ``marginal_tol`` of 1 is then not recognised.
 
     Returns
     -------
@@ -206,7 +213,9 @@ def classify(*, alpha, beta, gamma, d, delta, marginal_tol=MARGINAL_TOL):
     stable, margin = schur_cohn(c)
     out = np.where(stable, STABLE, UNSTABLE).astype(np.int8)
     close = margin < max(_SCHUR_COHN_SAFE, marginal_tol)
-    if np.any(close):
+    if not refine:
+        out[margin == 0] = MARGINAL
+    elif np.any(close):
         r = _radius(c[close])
         out[close] = np.where(np.abs(r - 1.0) <= marginal_tol, MARGINAL,
                               np.where(r < 1.0, STABLE, UNSTABLE))
