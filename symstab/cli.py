@@ -108,13 +108,19 @@ def build_parser():
     p.add_argument("--json", metavar="PATH", help="also write the verdicts as JSON")
     p.add_argument("-v", "--verbose", action="store_true", help="print each check as it runs")
     p.set_defaults(func=_cmd_audit)
+    from .cli_numeric import add_commands
+
+    add_commands(sub)
     return parser
 
 
 def main(argv=None):
     """Run the command line; return the exit status."""
     parser = build_parser()
-    args = parser.parse_args(argv)
+    try:
+        args = parser.parse_args(argv)
+    except SystemExit as exc:  # --help, or a usage error already printed
+        return exc.code
     try:
         return args.func(args)
     except (ValueError, TypeError, OSError) as exc:

@@ -1,0 +1,370 @@
+"""The numeric sub-commands of ``symstab``: boundary, limits, classify, design.
+
+Each takes the device and delay either in physical units (``--m --b --T``,
+default the paper's device, and ``--Td``) or dimensionless (``--delta --d``),
+the virtual mass as ``--Mw`` (physical) or ``--gamma``, and prints a table,
+CSV or JSON.  Physical inputs are echoed with the output and results are
+given in both unit systems.  Validation happens in the library; the caller
+(:func:`symstab.cli.main`) turns ``ValueError``/``TypeError`` into one line
+on stderr and exit status 2.
+"""
+
+import argparse
+import csv
+import dataclasses
+import io
+import json
+import math
+import sys
+
+import numpy as np
+
+__all__ = ["add_commands"]
+
+FORMATS = ("table", "csv", "json")
+
+
+@dataclasses.dataclass(frozen=True)
+class Setup:
+    """The resolved inputs of a numeric command."""
+
+    device: object  # symstab.units.Device or None (dimensionless input)
+    gamma: float
+    d: int
+    delta: float
+    units: dict
+    echo: tuple  # lines describing the inputs
+
+    @property
+    def physical(self):
+        return self.device is not None
+
+    def as_dict(self):
+        out = {"gamma": self.gamma, "d": self.d, "delta": self.delta}
+        if self.physical:
+            out.update(m=self.device.m, b=self.device.b, T=self.device.T,
+                       Td=self.device.delay(self.d), M_w=self.device.mass(self.gamma),
+                       units=self.units)
+        return out
+
+
+def _add_model_options(p):
+    g = p.add_argument_group("device and delay (physical; default: the paper's device)")
+    g.add_argument("--m", type=float, help="effective mass, kg (or kg m^2), > 0 (default 0.0128)")
+    g.add_argument("--b", type=float, help="viscous friction, N s/m (or N m s/rad), > 0 (default 0.0324)")
+    g.add_argument("--T", type=float, help="sample period, s, > 0 (default 0.001)")
+    g.add_argument("--Td", type=float, help="loop delay, s, a whole number of periods (default 0)")
+    g = p.add_argument_group("device and delay (dimensionless, instead of --m --b --T --Td)")
+    g.add_argument("--delta", type=float, help="b T / m > 0")
+    g.add_argument("--d", type=_integer, help="delay in samples, an integer >= 0 (also allowed "
+                                               "with the physical options instead of --Td)")
+    g = p.add_argument_group("virtual mass")
+    x = g.add_mutually_exclusive_group()
+    x.add_argument("--gamma", type=float, help="M_w / m (default 0)")
+    x.add_argument("--Mw", type=float, help="virtual mass, kg (or kg m^2)")
+    p.add_argument("--linear", action="store_true",
+                   help="label physical units for a linear device (N/m, N s/m, kg) "
+                        "instead of a rotary one (N m/rad, N m s/rad, kg m^2)")
+    p.add_argument("--format", choices=FORMATS, default="table", help="output format (default: table)")
+
+
+def _integer(text):
+    try:
+        value = float(text)
+    except ValueError:
+        value = math.nan
+    if not (math.isfinite(value) and value.is_integer() and value >= 0):
+        raise argparse.ArgumentTypeError(f"delay d must be a non-negative integer, got {text!r}")
+    return int(value)
+
+
+def _resolve(args):
+    """Turn the parsed options into a :class:`Setup` (raises ValueError)."""
+    from .units import PAPER_DEVICE, Device
+
+    physical = [name for name in ("m", "b", "T", "Td") if getattr(args, name) is not None]
+    if args.delta is not None:
+        if physical:
+            raise ValueError(f"--delta (dimensionless) cannot be combined with --{physical[0]} "
+                             "(physical); give one or the other")
+        if args.Mw is not None:
+            raise ValueError("--Mw needs a physical device (--m); use --gamma with --delta")
+        from ._validate import check_delay, check_real
+        delta = check_real("delta", args.delta, low=0.0, low_open=True)
+        d = check_delay(0 if args.d is None else args.d)
+        gamma = check_real("gamma", 0.0 if args.gamma is None else args.gamma)
+        echo = (f"dimensionless: delta = {delta:.6g}, d = {d}, gamma = {gamma:.6g}",)
+        return Setup(None, gamma, d, delta, {}, echo)
+    if args.Td is not None and args.d is not None:
+        raise ValueError("give the delay once: --Td (seconds) or --d (samples)")
+    device = Device(m=PAPER_DEVICE.m if args.m is None else args.m,
+                    b=PAPER_DEVICE.b if args.b is None else args.b,
+                    T=PAPER_DEVICE.T if args.T is None else args.T)
+    if args.d is not None:
+        from ._validate import check_delay
+        d = check_delay(args.d)
+    else:
+        d = device.delay_samples(0.0 if args.Td is None else args.Td)
+    gamma = device.gamma(args.Mw) if args.Mw is not None else (0.0 if args.gamma is None else args.gamma)
+    from ._validate import check_real
+    gamma = check_real("gamma", gamma)
+    units = device.units(rotary=not args.linear)
+    mass_unit = units["M_w"]
+    echo = (f"device: m = {device.m:g} {mass_unit}, b = {device.b:g} {units['B_w']}, "
+            f"T = {device.T:g} s; delay Td = {device.delay(d):g} s (d = {d}); "
+            f"virtual mass M_w = {device.mass(gamma):g} {mass_unit} (gamma = {gamma:g})",
+            f"dimensionless: delta = b T / m = {device.delta:.6g}")
+    return Setup(device, gamma, d, device.delta, units, echo)
+
+
+# --------------------------------------------------------------------------
+# Output
+
+
+def _number(x):
+    if x is None:
+        return ""
+    if isinstance(x, (int, np.integer)) and not isinstance(x, bool):
+        return str(int(x))
+    if isinstance(x, str):
+        return x
+    x = float(x)
+    return "nan" if math.isnan(x) else f"{x:.10g}"
+
+
+def _emit(setup, fmt, columns, rows, *, result=None, notes=(), out=None, json_rows=True):
+    """Print ``rows`` (tuples matching ``columns``) in ``fmt``.
+
+    ``result`` is the JSON payload besides the rows; ``notes`` are lines
+    printed after a table (and kept in JSON as "notes").
+    """
+    out = out or sys.stdout
+    if fmt == "json":
+        payload = {"inputs": setup.as_dict(), **(result or {})}
+        if rows and json_rows:
+            payload["rows"] = [dict(zip(columns, (None if isinstance(v, float) and math.isnan(v)
+                                                  else v for v in row))) for row in rows]
+        if notes:
+            payload["notes"] = list(notes)
+        json.dump(_plain(payload), out, indent=1, sort_keys=False)
+        out.write("\n")
+        return
+    if fmt == "csv":
+        for line in setup.echo:
+            print(line, file=sys.stderr)
+        for line in notes:
+            print(line, file=sys.stderr)
+        buf = io.StringIO()
+        writer = csv.writer(buf, lineterminator="\n")
+        writer.writerow(columns)
+        for row in rows:
+            writer.writerow([_number(v) for v in row])
+        out.write(buf.getvalue())
+        return
+    for line in setup.echo:
+        print(line, file=out)
+    if rows:
+        cells = [list(columns)] + [[_number(v) for v in row] for row in rows]
+        widths = [max(len(r[i]) for r in cells) for i in range(len(columns))]
+        print(file=out)
+        for k, r in enumerate(cells):
+            print("  ".join(c.rjust(w) for c, w in zip(r, widths)).rstrip(), file=out)
+            if k == 0:
+                print("  ".join("-" * w for w in widths), file=out)
+    if notes:
+        print(file=out)
+        for line in notes:
+            print(line, file=out)
+
+
+def _plain(x):
+    if isinstance(x, dict):
+        return {k: _plain(v) for k, v in x.items()}
+    if isinstance(x, (list, tuple)):
+        return [_plain(v) for v in x]
+    if isinstance(x, np.generic):
+        x = x.item()
+    if isinstance(x, float) and not math.isfinite(x):
+        return None if math.isnan(x) else ("inf" if x > 0 else "-inf")
+    return x
+
+
+def _physical_columns(setup, names):
+    """Column labels with units for K_w, B_w (physical setups only)."""
+    return [f"{n} [{setup.units[n]}]" for n in names]
+
+
+# --------------------------------------------------------------------------
+# Commands
+
+
+def _cmd_boundary(args):
+    from .curves import boundary_curve
+
+    setup = _resolve(args)
+    curve = boundary_curve(gamma=setup.gamma, d=setup.d, delta=setup.delta, n=args.n)
+    columns = ["theta [rad]", "alpha", "beta"]
+    rows = list(zip(curve.theta, curve.alpha, curve.beta))
+    if setup.physical:
+        columns += _physical_columns(setup, ["K_w", "B_w"])
+        rows = [r + (setup.device.stiffness(r[1]), setup.device.damping(r[2])) for r in rows]
+    notes = [curve.message] if curve.empty else [f"theta_max = {curve.theta_max:.15g} rad"]
+    for seg in curve.segments:
+        notes.append(f"boundary segment ({seg.root}): (beta, alpha) from ({seg.beta0:.10g}, "
+                     f"{seg.alpha0:.10g}) to ({seg.beta1:.10g}, {seg.alpha1:.10g})")
+    result = {"theta_max": curve.theta_max, "message": curve.message,
+              "segments": [dataclasses.asdict(s) for s in curve.segments]}
+    _emit(setup, args.format, columns, rows, result=result, notes=notes)
+    return 0
+
+
+def _limits_rows(setup, lim):
+    quantities = [("alpha_max", lim.alpha_max, "K_max", "K_w"),
+                  ("beta_at_alpha_max", lim.beta_at_alpha_max, "B_w at K_max", "B_w"),
+                  ("beta_max", lim.beta_max, "B_max", "B_w"),
+                  ("beta_min", lim.beta_min, "B_min", "B_w"),
+                  ("z_width", lim.z_width, "Z-width", None)]
+    rows = []
+    for name, value, label, unit in quantities:
+        row = [name, value]
+        if setup.physical:
+            dev = setup.device
+            if value is None:
+                phys = None
+            elif unit == "K_w":
+                phys = dev.stiffness(value)
+            elif unit == "B_w":
+                phys = dev.damping(value)
+            else:  # area in the (B_w, K_w) plane
+                phys = value * (dev.m / dev.T) * (dev.m / dev.T**2)
+                unit_text = f"({setup.units['B_w']})({setup.units['K_w']})"
+            row += [label, phys, setup.units[unit] if unit else unit_text]
+        rows.append(tuple(row))
+    columns = ["quantity", "value"] + (["physical", "physical value", "unit"] if setup.physical else [])
+    return columns, rows
+
+
+def _cmd_limits(args):
+    from .region import limits
+
+    setup = _resolve(args)
+    lim = limits(gamma=setup.gamma, d=setup.d, delta=setup.delta)
+    columns, rows = _limits_rows(setup, lim)
+    notes = [lim.message] if lim.message else []
+    result = {"limits": {k: v for k, v in lim.as_dict().items() if k not in ("gamma", "d", "delta")}}
+    damping = None
+    if args.beta is not None or args.Bw is not None:
+        if args.Bw is not None:
+            if not setup.physical:
+                raise ValueError("--Bw needs a physical device; use --beta with --delta")
+            damping = float(setup.device.beta(args.Bw))
+        else:
+            damping = args.beta
+        runs = [] if lim.empty else lim.alpha_interval(damping)
+        text = ", ".join(f"[{lo:.10g}, {hi:.10g}]" for lo, hi in runs) or "none"
+        notes.append(f"stable alpha at beta = {damping:.10g}: {text}")
+        if setup.physical and runs:
+            dev = setup.device
+            notes.append("stable K_w at B_w = {:.10g} {}: {}".format(
+                float(dev.damping(damping)), setup.units["B_w"],
+                ", ".join(f"[{float(dev.stiffness(lo)):.10g}, {float(dev.stiffness(hi)):.10g}]"
+                          for lo, hi in runs) + f" {setup.units['K_w']}"))
+        if runs and runs[0][0] > 0:
+            notes.append(f"a minimum stiffness is needed: alpha > {runs[0][0]:.10g}")
+        result["alpha_intervals"] = {"beta": damping, "intervals": [list(r) for r in runs]}
+    _emit(setup, args.format, columns, rows, result=result, notes=notes, json_rows=False)
+    return 0
+
+
+def _parse_list(text, name):
+    try:
+        values = [float(v) for v in text.split(",") if v.strip()]
+    except ValueError:
+        raise ValueError(f"{name} must be a comma-separated list of numbers, got {text!r}") from None
+    if not values:
+        raise ValueError(f"{name} must name at least one number")
+    return np.array(values)
+
+
+def _cmd_classify(args):
+    from .stability import MARGINAL, STABLE, classify, spectral_radius
+
+    setup = _resolve(args)
+    if (args.alpha is None) == (args.Kw is None) or (args.beta is None) == (args.Bw is None):
+        raise ValueError("give the stiffness (--alpha or --Kw) and the damping (--beta or --Bw), once each")
+    if (args.Kw is not None or args.Bw is not None) and not setup.physical:
+        raise ValueError("--Kw and --Bw need a physical device; use --alpha and --beta with --delta")
+    alpha = _parse_list(args.alpha, "--alpha") if args.alpha is not None else \
+        np.atleast_1d(setup.device.alpha(_parse_list(args.Kw, "--Kw")))
+    beta = _parse_list(args.beta, "--beta") if args.beta is not None else \
+        np.atleast_1d(setup.device.beta(_parse_list(args.Bw, "--Bw")))
+    try:
+        alpha, beta = np.broadcast_arrays(alpha, beta)
+    except ValueError:
+        raise ValueError(f"--alpha/--Kw and --beta/--Bw must have the same length or one value, "
+                         f"got {alpha.size} and {beta.size}") from None
+    kwargs = dict(alpha=alpha, beta=beta, gamma=setup.gamma, d=setup.d, delta=setup.delta)
+    code = np.atleast_1d(classify(**kwargs))
+    radius = np.atleast_1d(spectral_radius(**kwargs))
+    verdict = np.where(code == STABLE, "stable", np.where(code == MARGINAL, "marginal", "unstable"))
+    columns = ["alpha", "beta"]
+    rows = [(a, b) for a, b in zip(alpha, beta)]
+    if setup.physical:
+        columns += _physical_columns(setup, ["K_w", "B_w"])
+        rows = [r + (setup.device.stiffness(r[0]), setup.device.damping(r[1])) for r in rows]
+    columns += ["spectral radius", "verdict"]
+    rows = [r + (rad, str(v)) for r, rad, v in zip(rows, radius, verdict)]
+    _emit(setup, args.format, columns, rows)
+    return 0
+
+
+def _cmd_design(args):
+    from .region import best_virtual_mass
+
+    setup = _resolve(args)
+    print("searching gamma for the largest renderable stiffness ...", file=sys.stderr, flush=True)
+    best = best_virtual_mass(d=setup.d, delta=setup.delta)
+    rows = [("gamma (best)", best.gamma), ("beta at alpha_max", best.beta),
+            ("alpha_max", best.alpha_max), ("alpha_max at gamma = 0", best.alpha_max_gamma0),
+            ("gain", best.gain)]
+    columns = ["quantity", "value"]
+    if setup.physical:
+        dev, u = setup.device, setup.units
+        physical = [(dev.mass(best.gamma), "M_w", u["M_w"]), (dev.damping(best.beta), "B_w", u["B_w"]),
+                    (dev.stiffness(best.alpha_max), "K_max", u["K_w"]),
+                    (dev.stiffness(best.alpha_max_gamma0), "K_max (M_w = 0)", u["K_w"]),
+                    (best.gain, "gain", "")]
+        columns += ["physical", "physical value", "unit"]
+        rows = [r + (label, value, unit) for r, (value, label, unit) in zip(rows, physical)]
+    result = {"best": {k: v for k, v in dataclasses.asdict(best).items() if k not in ("d", "delta")}}
+    notes = ["the virtual mass argument --gamma/--Mw is ignored: design searches over it"] \
+        if (args.gamma is not None or args.Mw is not None) else []
+    _emit(setup, args.format, columns, rows, result=result, notes=notes, json_rows=False)
+    return 0
+
+
+def add_commands(sub):
+    """Register the numeric sub-commands on an argparse sub-parser set."""
+    p = sub.add_parser("boundary", help="the stability boundary alpha(theta), beta(theta)")
+    _add_model_options(p)
+    p.add_argument("--n", type=int, default=101, help="points on the arc (default 101)")
+    p.set_defaults(func=_cmd_boundary)
+
+    p = sub.add_parser("limits", help="alpha_max, the beta range and the Z-width")
+    _add_model_options(p)
+    x = p.add_mutually_exclusive_group()
+    x.add_argument("--beta", type=float, help="also give the stable alpha interval(s) at this beta")
+    x.add_argument("--Bw", type=float, help="also give the stable K_w interval(s) at this damping")
+    p.set_defaults(func=_cmd_limits)
+
+    p = sub.add_parser("classify", help="stable, unstable or marginal, with the spectral radius")
+    _add_model_options(p)
+    p.add_argument("--alpha", help="dimensionless stiffness(es), comma-separated")
+    p.add_argument("--beta", help="dimensionless damping(s), comma-separated")
+    p.add_argument("--Kw", help="virtual stiffness(es), comma-separated (physical)")
+    p.add_argument("--Bw", help="virtual damping(s), comma-separated (physical)")
+    p.set_defaults(func=_cmd_classify)
+
+    p = sub.add_parser("design", help="the virtual mass that maximises the renderable stiffness")
+    _add_model_options(p)
+    p.set_defaults(func=_cmd_design)

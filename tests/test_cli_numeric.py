@@ -1,0 +1,138 @@
+"""The numeric sub-commands: boundary, limits, classify, design.
+
+The numbers are checked against the library called directly and, where it
+matters, against an independent oracle (python-control's poles for
+``classify``); the rest checks what a user sees: units echoed, formats
+parseable, bad input one line and exit status 2 with nothing written.
+"""
+
+import csv
+import io
+import json
+
+import numpy as np
+import pytest
+
+import symstab
+from symstab import cli
+
+from conftest import PAPER_B, PAPER_DELTA, PAPER_M, PAPER_T, python_control_closed_loop
+
+
+def run(capsys, *args):
+    status = cli.main(list(args))
+    out, err = capsys.readouterr()
+    return status, out, err
+
+
+def test_limits_physical_echoes_units_and_matches_the_library(capsys):
+    status, out, _ = run(capsys, "limits", "--Td", "0.04", "--Mw", "0.0128", "--format", "json")
+    assert status == 0
+    data = json.loads(out)
+    assert data["inputs"]["d"] == 40 and data["inputs"]["gamma"] == pytest.approx(1.0)
+    assert data["inputs"]["units"]["K_w"] == "N m/rad"
+    lim = symstab.limits(gamma=1.0, d=40, delta=PAPER_DELTA)
+    assert data["limits"]["alpha_max"] == pytest.approx(lim.alpha_max, rel=1e-12)
+    status, out, _ = run(capsys, "limits", "--Td", "0.04", "--Mw", "0.0128")
+    assert "m = 0.0128 kg m^2" in out and "Td = 0.04 s (d = 40)" in out
+    k_max = lim.alpha_max * PAPER_M / PAPER_T**2
+    line = next(line for line in out.splitlines() if "K_max" in line)
+    assert f"{k_max:.10g}" in line and "N m/rad" in line
+
+
+def test_linear_units(capsys):
+    _, out, _ = run(capsys, "limits", "--linear", "--d", "1")
+    assert "N/m" in out and "N m/rad" not in out
+
+
+def test_limits_reports_the_minimum_stiffness(capsys):
+    status, out, _ = run(capsys, "limits", "--delta", str(PAPER_DELTA), "--gamma", "1.5",
+                         "--beta", "-0.5")
+    assert status == 0
+    (lo, hi), = symstab.StabilityRegion(gamma=1.5, d=0, delta=PAPER_DELTA).alpha_intervals(-0.5)
+    assert lo > 1.0
+    assert f"a minimum stiffness is needed: alpha > {lo:.10g}" in out
+
+
+def test_limits_of_an_empty_region_is_a_message_not_an_error(capsys):
+    status, out, err = run(capsys, "limits", "--delta", str(PAPER_DELTA), "--d", "5",
+                           "--gamma", "2.2", "--format", "json")
+    assert status == 0 and err == ""
+    data = json.loads(out)
+    assert data["limits"]["alpha_max"] is None and data["limits"]["z_width"] == 0.0
+    assert "empty" in data["notes"][0]
+
+
+def test_boundary_csv_parses_and_lies_on_the_library_curve(capsys):
+    status, out, err = run(capsys, "boundary", "--d", "10", "--n", "7", "--format", "csv")
+    assert status == 0
+    assert "Td = 0.01 s" in err  # the echo goes to stderr with CSV
+    rows = list(csv.DictReader(io.StringIO(out)))
+    assert len(rows) == 7
+    assert list(rows[0]) == ["theta [rad]", "alpha", "beta", "K_w [N m/rad]", "B_w [N m s/rad]"]
+    curve = symstab.boundary_curve(gamma=0.0, d=10, delta=PAPER_DELTA, n=7, segments=False)
+    np.testing.assert_allclose([float(r["alpha"]) for r in rows], curve.alpha, rtol=1e-9, atol=0)
+    np.testing.assert_allclose([float(r["K_w [N m/rad]"]) for r in rows],
+                               curve.alpha * PAPER_M / PAPER_T**2, rtol=1e-9, atol=0)
+
+
+def test_classify_agrees_with_python_control(capsys):
+    kw, bw = [1.0, 3.0, 10.0, 4.0], [0.2, 0.2, 0.2, 0.05]
+    status, out, _ = run(capsys, "classify", "--Td", "0.01", "--Kw", ",".join(map(str, kw)),
+                         "--Bw", ",".join(map(str, bw)), "--format", "json")
+    assert status == 0
+    rows = json.loads(out)["rows"]
+    for row, k, b in zip(rows, kw, bw):
+        alpha, beta = k * PAPER_T**2 / PAPER_M, b * PAPER_T / PAPER_M
+        poles = python_control_closed_loop(alpha=alpha, beta=beta, gamma=0.0, d=10,
+                                           delta=PAPER_DELTA, m=PAPER_M, T=PAPER_T).poles()
+        radius = float(np.max(np.abs(poles)))
+        assert row["spectral radius"] == pytest.approx(radius, rel=1e-8)
+        assert row["verdict"] == ("stable" if radius < 1 else "unstable")
+
+
+def test_design_finds_a_gain_over_no_virtual_mass(capsys):
+    status, out, err = run(capsys, "design", "--delta", str(PAPER_DELTA), "--d", "10",
+                           "--format", "json")
+    assert status == 0 and "searching" in err
+    best = json.loads(out)["best"]
+    assert best["gain"] > 1
+    assert best["alpha_max_gamma0"] == pytest.approx(
+        symstab.limits(gamma=0.0, d=10, delta=PAPER_DELTA).alpha_max, rel=1e-9)
+
+
+@pytest.mark.parametrize("args, needle", [
+    (["limits", "--m", "0"], "m must be"),
+    (["limits", "--m", "-1"], "m must be"),
+    (["limits", "--T", "0"], "T must be"),
+    (["limits", "--b", "nan"], "b must be"),
+    (["limits", "--Td", "0.0105"], "Td / T"),
+    (["limits", "--d", "2.5"], "delay d"),
+    (["limits", "--d", "-1"], "delay d"),
+    (["limits", "--gamma", "nan"], "gamma"),
+    (["limits", "--delta", "0"], "delta"),
+    (["limits", "--delta", "0.1", "--Td", "0.04"], "--delta"),
+    (["limits", "--delta", "0.1", "--Mw", "0.01"], "--Mw"),
+    (["limits", "--Td", "0.01", "--d", "10"], "--Td"),
+    (["limits", "--gamma", "1", "--Mw", "0.01"], "--Mw"),
+    (["boundary", "--n", "1"], "n must be"),
+    (["classify", "--alpha", "1"], "damping"),
+    (["classify", "--alpha", "1,x", "--beta", "0"], "--alpha"),
+    (["classify", "--alpha", "1,2", "--beta", "0,1,2"], "same length"),
+    (["classify", "--delta", "0.1", "--Kw", "1", "--beta", "0"], "--Kw"),
+    (["limits", "--format", "xml"], "--format"),
+])
+def test_bad_input_is_one_line_and_exit_2(capsys, tmp_path, monkeypatch, args, needle):
+    monkeypatch.chdir(tmp_path)
+    status, out, err = run(capsys, *args)
+    assert status == 2
+    lines = err.strip().splitlines()
+    assert len(lines) == 1 and lines[0].startswith("symstab: error:"), err
+    assert needle in lines[0]
+    assert "Traceback" not in err and out == ""
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_paper_device_is_the_default():
+    assert (PAPER_M, PAPER_B, PAPER_T) == (symstab.PAPER_DEVICE.m, symstab.PAPER_DEVICE.b,
+                                           symstab.PAPER_DEVICE.T)
