@@ -87,6 +87,12 @@ _ARG = {
     "delta": (model.delta, "double", "delta = b T / m > 0"),
     "alpha": (model.alpha, "double", "alpha = K_w T^2 / m, dimensionless stiffness"),
     "beta": (model.beta, "double", "beta = B_w T / m, dimensionless damping"),
+    "position": (kf.position, "double", "position x(k)"),
+    "velocity": (kf.velocity, "double", "velocity times T, v(k) T"),
+    "force": (kf.force, "double", "force held over the period times T^2 / m"),
+    "x_k": (kf.position_history[0], "double", "sampled position x(k)"),
+    "x_km1": (kf.position_history[1], "double", "sampled position x(k-1)"),
+    "x_km2": (kf.position_history[2], "double", "sampled position x(k-2)"),
 }
 
 
@@ -96,6 +102,9 @@ def kernels():
     x = model.delta
     alpha, beta = kf.boundary_forms()
     delayed, direct = kf.loop_coefficient_forms()
+    Phi, Gamma_u = kf.plant_step_forms()
+    state = sp.Matrix([kf.position, kf.velocity])
+    step_x, step_v = Phi * state + Gamma_u * kf.force
     names = ["z^(d+4)", "z^(d+3)", "z^(d+2)", "z^3", "z^2", "z^1", "z^0"]
     coefficient_outputs = tuple(
         (f"c{k}", kf.as_evaluable(expr), f"coefficient of {name}")
@@ -115,6 +124,24 @@ def kernels():
                "Coefficients of chi(z) / delta^2 = z^(d+2) (z-1) (Gamma z - 1) + V(z) (P z + Q), "
                "highest power first: three of the delayed part (z^(d+4), z^(d+3), z^(d+2)) "
                "and four of the direct part (z^3 .. z^0)."),
+        Kernel("plant_step_coefficients", (_ARG["delta"],),
+               (("phi01", kf.as_evaluable(Phi[0, 1]), "Phi[0,1]: position gained per unit v T"),
+                ("phi11", kf.as_evaluable(Phi[1, 1]), "Phi[1,1] = exp(-delta): velocity kept"),
+                ("gamma0", kf.as_evaluable(Gamma_u[0]), "Gamma_u[0]: position gained per unit force"),
+                ("gamma1", kf.as_evaluable(Gamma_u[1]), "Gamma_u[1]: v T gained per unit force")),
+               "The exact one-period plant step (x, v T)(k+1) = Phi (x, v T)(k) + Gamma_u "
+               "f(k) T^2/m under a held force; Phi[0,0] = 1 and Phi[1,0] = 0."),
+        Kernel("plant_step", tuple(_ARG[k] for k in ("position", "velocity", "force", "delta")),
+               (("position_next", kf.as_evaluable(step_x), "position x(k+1)"),
+                ("velocity_next", kf.as_evaluable(step_v), "v(k+1) T")),
+               "One period of the device m x'' + b x' = f under a force held constant "
+               "(zero-order hold), exactly, in Table I's units."),
+        Kernel("environment_force", tuple(_ARG[k] for k in ("x_k", "x_km1", "x_km2",
+                                                             "alpha", "beta", "gamma")),
+               (("force", kf.environment_force_form(), "force f(k) T^2 / m"),),
+               "The virtual environment's force of eq. (1) on the sampled positions: "
+               "-(alpha x(k) + beta (x(k) - x(k-1)) + gamma (x(k) - 2 x(k-1) + x(k-2))), "
+               "in units of m / T^2."),
     )
 
 

@@ -41,12 +41,15 @@ from sympy.codegen.cfunctions import expm1
 
 from . import model
 from .boundary import boundary
-from .loop import characteristic_polynomial
+from .loop import characteristic_polynomial, dimensionless_environment
+from .sampled_plant import dimensionless_step
 
 __all__ = [
     "exprel3", "EXPREL3_SWITCH", "exprel3_series", "exprel3_piecewise",
     "em1", "phi3", "pulse_numerator_parts", "boundary_forms", "loop_coefficient_forms",
-    "as_derivation", "proofs",
+    "plant_step_forms", "environment_force_form", "position_history",
+    "position", "velocity", "force",
+    "as_derivation", "as_evaluable", "proofs",
 ]
 
 #: Below this delta, :class:`exprel3` is evaluated from its Taylor series.
@@ -150,6 +153,43 @@ def loop_coefficient_forms():
         tuple(sp.collect(c, [model.alpha, model.beta, model.gamma]) for c in direct)
 
 
+@functools.lru_cache(maxsize=None)
+def plant_step_forms():
+    """The exact one-sample plant step in the float-safe form.
+
+    Returns ``(Phi, Gamma_u)`` (2x2 and 2x1 matrices) for the state
+    ``(x, v T)`` and the force ``f T**2 / m``: ``Phi = [[1, em1 / (delta
+    Gamma)], [0, 1 / Gamma]]``, ``Gamma_u = [P / Gamma, em1 / (delta Gamma)]``
+    with ``Gamma = 1 + em1`` (see :mod:`symstab.sampled_plant`).
+    """
+    P, _, _ = pulse_numerator_parts()
+    G = 1 + em1
+    ratio = em1 / (model.delta * G)
+    return sp.Matrix([[1, ratio], [0, 1 / G]]), sp.Matrix([P / G, ratio])
+
+
+#: Sampled positions x(k), x(k-1), x(k-2) as the environment sees them.
+position_history = sp.symbols("x_k x_km1 x_km2", real=True)
+#: The plant state (x, v T) and the held force f T**2 / m.
+position, velocity, force = sp.symbols("position velocity force", real=True)
+
+
+@functools.lru_cache(maxsize=None)
+def environment_force_form():
+    """The force ``f T**2 / m`` of eq. (1) on the sampled positions.
+
+    ``-T**2 VE(z) / m`` applied to the position sequence, read off the
+    derivation's environment as a polynomial in ``1 / z``.
+    """
+    q = sp.Symbol("q")
+    ve = sp.expand(dimensionless_environment().subs(model.z, 1 / q))
+    poly = sp.Poly(ve, q)
+    if poly.degree() > 2:
+        raise AssertionError(f"VE(z) reaches further back than two samples: {ve}")
+    return -sp.Add(*[sp.collect(poly.coeff_monomial(q**k), [model.alpha, model.beta, model.gamma])
+                     * position_history[k] for k in range(3)])
+
+
 def as_derivation(expr):
     """Replace :data:`em1` and :data:`phi3` by their definitions in ``Gamma, delta``."""
     dl, G = model.delta, model.Gamma
@@ -185,4 +225,12 @@ def proofs():
     for k, (form, derived) in enumerate(zip(direct, chi.direct.all_coeffs())):
         out.append((f"direct_coefficient_{k}", f"coefficient {k} of the direct part / delta^2",
                     as_derivation(form), derived / dl2))
+    step = dimensionless_step()
+    Phi, Gamma_u = plant_step_forms()
+    for (i, j) in ((0, 0), (0, 1), (1, 0), (1, 1)):
+        out.append((f"plant_step_Phi_{i}{j}", f"Phi[{i},{j}] = exp(A T)[{i},{j}] (scaled)",
+                    as_derivation(Phi[i, j]), step.Phi[i, j]))
+    for i in range(2):
+        out.append((f"plant_step_Gamma_{i}", f"Gamma_u[{i}] = (int exp(A s) ds B)[{i}] (scaled)",
+                    as_derivation(Gamma_u[i]), step.Gamma_u[i]))
     return out

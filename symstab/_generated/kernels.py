@@ -6,7 +6,7 @@
 
 import numpy
 
-__all__ = ['exprel3', 'boundary', 'loop_coefficients']
+__all__ = ['exprel3', 'boundary', 'loop_coefficients', 'plant_step_coefficients', 'plant_step', 'environment_force']
 
 
 def exprel3(delta):
@@ -124,3 +124,95 @@ def loop_coefficients(alpha, beta, gamma, delta):
         -beta*x6 + gamma*(x4 + x7 - 1/2),
         gamma*x6,
     )
+
+
+def plant_step_coefficients(delta):
+    """The exact one-period plant step (x, v T)(k+1) = Phi (x, v T)(k) +
+    Gamma_u f(k) T^2/m under a held force; Phi[0,0] = 1 and Phi[1,0] = 0.
+
+    Parameters
+    ----------
+    delta : float or ndarray
+        delta = b T / m > 0
+
+    Returns
+    -------
+    phi01 : float or ndarray
+        Phi[0,1]: position gained per unit v T
+    phi11 : float or ndarray
+        Phi[1,1] = exp(-delta): velocity kept
+    gamma0 : float or ndarray
+        Gamma_u[0]: position gained per unit force
+    gamma1 : float or ndarray
+        Gamma_u[1]: v T gained per unit force
+    """
+    x0 = numpy.expm1(delta)
+    x1 = (x0 + 1)**(-1.0)
+    x2 = x0*x1/delta
+    return (
+        x2,
+        x1,
+        x1*(-(1 - delta)*(delta*exprel3(delta) + 1/2) + 1),
+        x2,
+    )
+
+
+def plant_step(position, velocity, force, delta):
+    """One period of the device m x'' + b x' = f under a force held constant
+    (zero-order hold), exactly, in Table I's units.
+
+    Parameters
+    ----------
+    position : float or ndarray
+        position x(k)
+    velocity : float or ndarray
+        velocity times T, v(k) T
+    force : float or ndarray
+        force held over the period times T^2 / m
+    delta : float or ndarray
+        delta = b T / m > 0
+
+    Returns
+    -------
+    position_next : float or ndarray
+        position x(k+1)
+    velocity_next : float or ndarray
+        v(k+1) T
+    """
+    x0 = numpy.expm1(delta)
+    x1 = (x0 + 1)**(-1.0)
+    x2 = velocity*x1
+    x3 = x0/delta
+    x4 = force*x1
+    return (
+        position + x2*x3 + x4*(-(1 - delta)*(delta*exprel3(delta) + 1/2) + 1),
+        x2 + x3*x4,
+    )
+
+
+def environment_force(x_k, x_km1, x_km2, alpha, beta, gamma):
+    """The virtual environment's force of eq. (1) on the sampled positions:
+    -(alpha x(k) + beta (x(k) - x(k-1)) + gamma (x(k) - 2 x(k-1) + x(k-2))),
+    in units of m / T^2.
+
+    Parameters
+    ----------
+    x_k : float or ndarray
+        sampled position x(k)
+    x_km1 : float or ndarray
+        sampled position x(k-1)
+    x_km2 : float or ndarray
+        sampled position x(k-2)
+    alpha : float or ndarray
+        alpha = K_w T^2 / m, dimensionless stiffness
+    beta : float or ndarray
+        beta = B_w T / m, dimensionless damping
+    gamma : float or ndarray
+        gamma = M_w / m, virtual mass ratio
+
+    Returns
+    -------
+    force : float or ndarray
+        force f(k) T^2 / m
+    """
+    return -gamma*x_km2 - x_k*(alpha + beta + gamma) - x_km1*(-beta - 2*gamma)

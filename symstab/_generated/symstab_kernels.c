@@ -94,3 +94,64 @@ void symstab_loop_coefficients(double alpha, double beta, double gamma, double d
     *c5 = -beta*x6 + gamma*(x4 + x7 - 1.0/2.0);
     *c6 = gamma*x6;
 }
+
+/*
+ * The exact one-period plant step (x, v T)(k+1) = Phi (x, v T)(k) +
+ * Gamma_u f(k) T^2/m under a held force; Phi[0,0] = 1 and Phi[1,0] = 0.
+ *
+ * delta: delta = b T / m > 0
+ * *phi01: Phi[0,1]: position gained per unit v T
+ * *phi11: Phi[1,1] = exp(-delta): velocity kept
+ * *gamma0: Gamma_u[0]: position gained per unit force
+ * *gamma1: Gamma_u[1]: v T gained per unit force
+ */
+void symstab_plant_step_coefficients(double delta, double *phi01, double *phi11, double *gamma0, double *gamma1)
+{
+    const double x0 = expm1(delta);
+    const double x1 = 1.0/(x0 + 1);
+    const double x2 = x0*x1/delta;
+    *phi01 = x2;
+    *phi11 = x1;
+    *gamma0 = x1*(-(1 - delta)*(delta*symstab_exprel3(delta) + 1.0/2.0) + 1);
+    *gamma1 = x2;
+}
+
+/*
+ * One period of the device m x'' + b x' = f under a force held constant
+ * (zero-order hold), exactly, in Table I's units.
+ *
+ * position: position x(k)
+ * velocity: velocity times T, v(k) T
+ * force: force held over the period times T^2 / m
+ * delta: delta = b T / m > 0
+ * *position_next: position x(k+1)
+ * *velocity_next: v(k+1) T
+ */
+void symstab_plant_step(double position, double velocity, double force, double delta, double *position_next, double *velocity_next)
+{
+    const double x0 = expm1(delta);
+    const double x1 = 1.0/(x0 + 1);
+    const double x2 = velocity*x1;
+    const double x3 = x0/delta;
+    const double x4 = force*x1;
+    *position_next = position + x2*x3 + x4*(-(1 - delta)*(delta*symstab_exprel3(delta) + 1.0/2.0) + 1);
+    *velocity_next = x2 + x3*x4;
+}
+
+/*
+ * The virtual environment's force of eq. (1) on the sampled positions:
+ * -(alpha x(k) + beta (x(k) - x(k-1)) + gamma (x(k) - 2 x(k-1) + x(k-2))),
+ * in units of m / T^2.
+ *
+ * x_k: sampled position x(k)
+ * x_km1: sampled position x(k-1)
+ * x_km2: sampled position x(k-2)
+ * alpha: alpha = K_w T^2 / m, dimensionless stiffness
+ * beta: beta = B_w T / m, dimensionless damping
+ * gamma: gamma = M_w / m, virtual mass ratio
+ * returns: force f(k) T^2 / m
+ */
+double symstab_environment_force(double x_k, double x_km1, double x_km2, double alpha, double beta, double gamma)
+{
+    return -gamma*x_km2 - x_k*(alpha + beta + gamma) - x_km1*(-beta - 2*gamma);
+}

@@ -50,6 +50,46 @@ void symstab_boundary(double theta, double gamma, int d, double delta, double *a
  */
 void symstab_loop_coefficients(double alpha, double beta, double gamma, double delta, double *c0, double *c1, double *c2, double *c3, double *c4, double *c5, double *c6);
 
+/*
+ * The exact one-period plant step (x, v T)(k+1) = Phi (x, v T)(k) +
+ * Gamma_u f(k) T^2/m under a held force; Phi[0,0] = 1 and Phi[1,0] = 0.
+ *
+ * delta: delta = b T / m > 0
+ * *phi01: Phi[0,1]: position gained per unit v T
+ * *phi11: Phi[1,1] = exp(-delta): velocity kept
+ * *gamma0: Gamma_u[0]: position gained per unit force
+ * *gamma1: Gamma_u[1]: v T gained per unit force
+ */
+void symstab_plant_step_coefficients(double delta, double *phi01, double *phi11, double *gamma0, double *gamma1);
+
+/*
+ * One period of the device m x'' + b x' = f under a force held constant
+ * (zero-order hold), exactly, in Table I's units.
+ *
+ * position: position x(k)
+ * velocity: velocity times T, v(k) T
+ * force: force held over the period times T^2 / m
+ * delta: delta = b T / m > 0
+ * *position_next: position x(k+1)
+ * *velocity_next: v(k+1) T
+ */
+void symstab_plant_step(double position, double velocity, double force, double delta, double *position_next, double *velocity_next);
+
+/*
+ * The virtual environment's force of eq. (1) on the sampled positions:
+ * -(alpha x(k) + beta (x(k) - x(k-1)) + gamma (x(k) - 2 x(k-1) + x(k-2))),
+ * in units of m / T^2.
+ *
+ * x_k: sampled position x(k)
+ * x_km1: sampled position x(k-1)
+ * x_km2: sampled position x(k-2)
+ * alpha: alpha = K_w T^2 / m, dimensionless stiffness
+ * beta: beta = B_w T / m, dimensionless damping
+ * gamma: gamma = M_w / m, virtual mass ratio
+ * returns: force f(k) T^2 / m
+ */
+double symstab_environment_force(double x_k, double x_km1, double x_km2, double alpha, double beta, double gamma);
+
 #ifdef __cplusplus
 }
 #endif

@@ -1,0 +1,426 @@
+"""The sampled haptic loop in time: many parameter points at once.
+
+Every period ``T`` the position is sampled, the virtual environment of
+eq. (1) computes a force from the sampled positions
+(:func:`symstab._generated.kernels.environment_force`), the force waits
+``d`` samples, and a zero-order hold applies it to the device, whose state
+advances by the exact step derived in :mod:`symstab.sampled_plant`
+(:func:`symstab._generated.kernels.plant_step_coefficients`).  The state
+lives in Table I's units: position, ``v T``, force ``f T**2 / m``.  All
+points run together as NumPy arrays, one loop over time.
+
+Non-idealities (:class:`Nonidealities`, physical units, each off by
+default) need a :class:`symstab.units.Device`:
+
+* ``encoder_resolution`` -- the sampled position is rounded to this step;
+* ``velocity_cutoff`` -- the velocity used by the damper and mass terms is
+  the backward difference passed through a first-order low-pass filter
+  (pole ``exp(-2 pi f_c T)``, unit DC gain); the mass term differences the
+  filtered velocity;
+* ``coulomb_friction`` (with ``stiction``, the breakaway force, default
+  equal) -- integrated inside the period on ``substeps`` sub-steps: a moving
+  device feels ``-F_c sign(v)``; a sub-step that would reverse the velocity
+  ends at rest instead, and a device at rest stays there while the applied
+  force is within the stiction force;
+* ``friction_compensation`` -- the command adds ``F_c sign(v_hat)``, with
+  ``v_hat`` the (filtered) velocity estimate;
+* ``actuator_bandwidth`` -- the applied force follows the command through a
+  first-order lag of that bandwidth (integrated exactly on the sub-steps).
+
+Stability by simulation (:func:`stability_map`): the run starts from the
+position ``x0``, the history at ``x0`` and a small velocity (``v0 T = x0 /
+100`` by default: starting at rest would leave the modes of ``z = 1``
+unexcited at ``alpha = 0``, a constant position being an equilibrium there),
+with an empty delay line; a point is unstable when the
+largest ``|x|`` over the last quarter of the horizon exceeds that over the
+quarter before (the slowest mode grows), or the state overflows.  A
+decaying or bounded run is stable, including a limit cycle at the
+resolution of the encoder.  The default horizon grows with the delay; near
+the boundary the modes have ``|z|`` close to 1 and any finite horizon
+leaves a band of undecidable cells, which the tests count.
+"""
+
+import dataclasses
+import math
+import sys
+import time
+
+import numpy as np
+
+from ._generated import kernels
+from ._validate import check_array, check_delay, check_real
+
+__all__ = ["Nonidealities", "Simulation", "simulate", "StabilityMap", "stability_map",
+           "default_horizon", "PAPER_ENCODER_RESOLUTION"]
+
+#: The paper's encoder: better than 3 arc seconds after quadrature and gear
+#: train (Section VI), in rad.
+PAPER_ENCODER_RESOLUTION = math.radians(3 / 3600)
+#: |x| above this is divergence: the run stops for that point.
+_OVERFLOW = 1e100
+
+
+@dataclasses.dataclass(frozen=True)
+class Nonidealities:
+    """Departures from the ideal loop, in physical units; ``None``/False is off.
+
+    Attributes
+    ----------
+    encoder_resolution : float
+        Position quantum (m or rad), > 0.
+    velocity_cutoff : float
+        Cut-off of the velocity filter (Hz), in (0, Nyquist).
+    coulomb_friction : float
+        Coulomb friction force (N or N m), >= 0.
+    stiction : float
+        Breakaway force (N or N m), >= coulomb_friction (default: equal).
+    friction_compensation : bool
+        Add ``coulomb_friction * sign(v_hat)`` to the command.
+    actuator_bandwidth : float
+        First-order lag of the applied force (Hz), > 0.
+    substeps : int
+        Sub-steps per period for friction and the actuator lag, >= 1.
+    """
+
+    encoder_resolution: float = None
+    velocity_cutoff: float = None
+    coulomb_friction: float = None
+    stiction: float = None
+    friction_compensation: bool = False
+    actuator_bandwidth: float = None
+    substeps: int = 20
+
+    def check(self, T):
+        """Validate against the sample period ``T``; raise ValueError naming the field."""
+        if self.encoder_resolution is not None:
+            check_real("encoder_resolution", self.encoder_resolution, low=0.0, low_open=True)
+        if self.velocity_cutoff is not None:
+            check_real("velocity_cutoff", self.velocity_cutoff, low=0.0, low_open=True,
+                       high=0.5 / T, high_open=True)
+        if self.coulomb_friction is not None:
+            check_real("coulomb_friction", self.coulomb_friction, low=0.0)
+        if self.stiction is not None:
+            if self.coulomb_friction is None:
+                raise ValueError("stiction needs coulomb_friction")
+            check_real("stiction", self.stiction, low=self.coulomb_friction)
+        if self.friction_compensation and self.coulomb_friction is None:
+            raise ValueError("friction_compensation needs coulomb_friction")
+        if self.actuator_bandwidth is not None:
+            check_real("actuator_bandwidth", self.actuator_bandwidth, low=0.0, low_open=True)
+        if isinstance(self.substeps, bool) or not isinstance(self.substeps, (int, np.integer)) \
+                or self.substeps < 1:
+            raise ValueError(f"substeps must be an integer >= 1, got {self.substeps!r}")
+
+    @property
+    def ideal(self):
+        return (self.encoder_resolution is None and self.velocity_cutoff is None
+                and self.coulomb_friction is None and self.actuator_bandwidth is None)
+
+    @property
+    def needs_substeps(self):
+        """Friction and the actuator lag act inside the period; the rest on samples."""
+        return self.coulomb_friction is not None or self.actuator_bandwidth is not None
+
+
+def default_horizon(d):
+    """Periods simulated by default: long enough for the slow modes near the boundary.
+
+    ``12000 + 800 d``: on the paper's 100 x 100 grids (d in 0..10, eight
+    virtual masses) every cell that no boundary curve crosses then gets the
+    exact verdict; with ``4000 + 400 d`` six cells whose slowest mode grows
+    by 1e-4 to 5e-4 per period still looked stable.  Slower growth needs a
+    longer horizon.
+    """
+    return 12000 + 800 * check_delay(d)
+
+
+@dataclasses.dataclass(frozen=True)
+class Simulation:
+    """What a run returns.
+
+    Attributes
+    ----------
+    positions : ndarray or None
+        ``(steps + 1, *shape)`` positions (with ``record=True``).
+    amplitude : ndarray
+        ``(4, *shape)``: the largest ``|x|`` in each quarter of the run.
+    diverged : ndarray of bool
+        The state overflowed (|x| > 1e100).
+    stable : ndarray of bool
+        Not diverged, and the last quarter's amplitude does not exceed the
+        third's (see the module docstring).
+    steps : int
+    """
+
+    positions: object
+    amplitude: np.ndarray
+    diverged: np.ndarray
+    stable: np.ndarray
+    steps: int
+
+
+def _progress_printer(label, total, stream=sys.stderr, min_seconds=2.0):
+    """A callback ``(done)`` that draws a bar once a run takes longer than ``min_seconds``."""
+    start = time.perf_counter()
+    state = {"last": 0.0}
+
+    def update(done):
+        now = time.perf_counter() - start
+        if now < min_seconds or (now - state["last"] < 0.2 and done < total):
+            return
+        state["last"] = now
+        frac = done / total
+        bar = "#" * int(30 * frac)
+        eta = now / frac - now if frac > 0 else 0.0
+        stream.write(f"\r{label} [{bar:<30}] {100 * frac:5.1f}%  {now:5.1f} s, ~{eta:4.0f} s left")
+        if done >= total:
+            stream.write("\n")
+        stream.flush()
+
+    return update
+
+
+def simulate(*, alpha, beta, gamma, d, delta, steps=None, x0=1.0, v0=None, device=None,
+             nonideal=None, record=False, progress=None):
+    """Run the sampled loop for every parameter point at once.
+
+    Parameters
+    ----------
+    alpha, beta, gamma : float or array_like
+        Dimensionless stiffness, damping, virtual mass (broadcast together).
+    d : int
+        Delay in samples, ``d >= 0``.
+    delta : float
+        ``b T / m > 0``; with a ``device`` it must equal ``device.delta``
+        (pass ``None`` to take it from the device).
+    steps : int
+        Periods to simulate, >= 8 (default :func:`default_horizon`).
+    x0 : float
+        Initial position (m or rad); the sampled history starts there too.
+    v0 : float
+        Initial velocity times T (position per period); default ``x0 / 100``.
+    device : symstab.units.Device
+        Needed for the non-idealities (physical units).
+    nonideal : Nonidealities
+        Off by default.
+    record : bool
+        Keep every position (memory: ``steps`` times the points).
+    progress : callable
+        Called with the number of steps done (every 1 % or so).
+
+    Returns
+    -------
+    Simulation
+    """
+    nonideal = nonideal or Nonidealities()
+    if device is not None:
+        nonideal.check(device.T)
+        if delta is None:
+            delta = device.delta
+        elif not math.isclose(float(delta), device.delta, rel_tol=1e-12):
+            raise ValueError(f"delta must equal the device's b T / m = {device.delta!r}, got {delta!r}")
+    elif not nonideal.ideal:
+        raise ValueError("nonideal needs a device (physical units)")
+    arrays = np.broadcast_arrays(check_array("alpha", alpha), check_array("beta", beta),
+                                 check_array("gamma", gamma))
+    shape = arrays[0].shape
+    alpha, beta, gamma = (a.ravel() for a in arrays)
+    delta = check_real("delta", delta, low=0.0, low_open=True)
+    d = check_delay(d)
+    steps = default_horizon(d) if steps is None else steps
+    if isinstance(steps, bool) or not isinstance(steps, (int, np.integer)) or steps < 8:
+        raise ValueError(f"steps must be an integer >= 8, got {steps!r}")
+    x0 = check_real("x0", x0)
+    v0 = x0 / 100 if v0 is None else check_real("v0", v0)
+    run = _Loop(alpha, beta, gamma, d, delta, x0, v0, device, nonideal)
+    quarter = steps // 4
+    amplitude = np.zeros((4, alpha.size))
+    positions = np.empty((steps + 1, alpha.size)) if record else None
+    if record:
+        positions[0] = run.x
+    report = max(1, steps // 100)
+    for k in range(steps):
+        run.step()
+        q = min(k // quarter, 3)
+        np.maximum(amplitude[q], np.abs(run.x), out=amplitude[q])
+        if record:
+            positions[k + 1] = run.x
+        if progress is not None and ((k + 1) % report == 0 or k + 1 == steps):
+            progress(k + 1)
+    amplitude[:, run.diverged] = np.inf
+    floor = 4 * nonideal.encoder_resolution if nonideal.encoder_resolution else 0.0
+    stable = ~run.diverged & (amplitude[3] <= np.maximum(amplitude[2], floor))
+    return Simulation(
+        positions=None if positions is None else positions.reshape((steps + 1,) + shape),
+        amplitude=amplitude.reshape((4,) + shape),
+        diverged=run.diverged.reshape(shape), stable=stable.reshape(shape), steps=steps)
+
+
+class _Loop:
+    """The loop's state for N points; :meth:`step` advances one period."""
+
+    def __init__(self, alpha, beta, gamma, d, delta, x0, v0, device, nonideal):
+        n = alpha.size
+        self.alpha, self.beta, self.gamma, self.d = alpha, beta, gamma, d
+        self.nonideal = nonideal
+        self.x = np.full(n, x0)
+        self.v = np.full(n, v0)           # v T
+        self.history = np.zeros((2, n))   # sampled x(k-1), x(k-2): the loop starts at rest
+        self.history[:] = self._sample(self.x)
+        self.forces = np.zeros((d + 1, n))  # commands waiting in the delay line
+        self.k = 0
+        self.diverged = np.zeros(n, dtype=bool)
+        self.sub = nonideal.substeps if nonideal.needs_substeps else 1
+        phi01, phi11, g0, g1 = kernels.plant_step_coefficients(delta / self.sub)
+        self.phi01, self.phi11, self.g0, self.g1 = (float(c) for c in (phi01, phi11, g0, g1))
+        self.device = device
+        if device is not None:
+            force_scale = device.T**2 / device.m   # physical force -> f T^2 / m
+            self.coulomb = (nonideal.coulomb_friction or 0.0) * force_scale
+            self.stiction = (nonideal.stiction if nonideal.stiction is not None
+                             else (nonideal.coulomb_friction or 0.0)) * force_scale
+            self.filter_pole = (math.exp(-2 * math.pi * nonideal.velocity_cutoff * device.T)
+                                if nonideal.velocity_cutoff else None)
+            self.lag = (math.exp(-2 * math.pi * nonideal.actuator_bandwidth * device.T / self.sub)
+                        if nonideal.actuator_bandwidth else None)
+        else:
+            self.coulomb = self.stiction = 0.0
+            self.filter_pole = self.lag = None
+        self.v_hat = np.zeros(n)          # filtered velocity estimate (times T)
+        self.applied = np.zeros(n)        # actuator output
+        self.x_prev_sample = self.history[0].copy()
+
+    def _sample(self, x):
+        q = self.nonideal.encoder_resolution
+        return x if not q else q * np.round(x / q)
+
+    def _command(self, xs):
+        x1, x2 = self.history
+        if self.filter_pole is None:
+            force = kernels.environment_force(xs, x1, x2, self.alpha, self.beta, self.gamma)
+            v_est = xs - x1
+        else:
+            # K x + B v_hat + M (v_hat - v_hat_prev): the damper and mass terms
+            # see the filtered velocity (backward difference, first-order LPF).
+            a = self.filter_pole
+            v_new = a * self.v_hat + (1 - a) * (xs - x1)
+            force = -(self.alpha * xs + self.beta * v_new + self.gamma * (v_new - self.v_hat))
+            self.v_hat = v_new
+            v_est = v_new
+        if self.nonideal.friction_compensation:
+            force = force + self.coulomb * np.sign(v_est)
+        return force
+
+    def step(self):
+        xs = self._sample(self.x)
+        command = self._command(xs)
+        self.history[1] = self.history[0]
+        self.history[0] = xs
+        slot = self.k % (self.d + 1)
+        self.forces[slot] = command
+        held = self.forces[(self.k - self.d) % (self.d + 1)] if self.k >= self.d else 0.0 * command
+        self.k += 1
+        if self.sub == 1:
+            x, v = self.x, self.v
+            self.x = x + self.phi01 * v + self.g0 * held
+            self.v = self.phi11 * v + self.g1 * held
+        else:
+            self._substeps(held)
+        bad = ~(np.abs(self.x) < _OVERFLOW) | ~np.isfinite(self.v)
+        if bad.any():
+            self.diverged |= bad
+            self.x[bad] = 0.0
+            self.v[bad] = 0.0
+            self.forces[:, bad] = 0.0
+            self.history[:, bad] = 0.0
+            self.v_hat[bad] = 0.0
+            self.applied[bad] = 0.0
+
+    def _substeps(self, held):
+        n = self.sub
+        for _ in range(n):
+            if self.lag is not None:
+                self.applied = held + (self.applied - held) * self.lag
+            else:
+                self.applied = held
+            drive = self.applied
+            if self.coulomb > 0 or self.stiction > 0:
+                moving = self.v != 0
+                stuck = ~moving & (np.abs(drive) <= self.stiction)
+                direction = np.where(moving, np.sign(self.v), np.sign(drive))
+                total = drive - self.coulomb * direction
+            else:
+                stuck = np.zeros_like(self.v, dtype=bool)
+                direction = None
+                total = drive
+            # Sub-step of length T/n: velocity (v T)/n and force (f T^2/m)/n^2.
+            x_new = self.x + self.phi01 * self.v / n + self.g0 * total / n**2
+            v_new = self.phi11 * self.v + self.g1 * total / n
+            if direction is not None:
+                # A reversal within the sub-step ends at rest (friction cannot
+                # push the device backwards); a stuck device stays put.
+                reversed_ = (direction != 0) & (np.sign(v_new) == -direction) & (self.v != 0)
+                v_new = np.where(reversed_ | stuck, 0.0, v_new)
+                x_new = np.where(stuck, self.x, x_new)
+            self.x, self.v = x_new, v_new
+
+
+@dataclasses.dataclass(frozen=True)
+class StabilityMap:
+    """Stability by simulation on a grid.
+
+    Attributes
+    ----------
+    alpha, beta : ndarray
+        The 1-D grids.
+    stable : ndarray of bool
+        Shape ``(len(alpha), len(beta))``.
+    growth : ndarray
+        Last quarter's amplitude over the third's (``inf`` when diverged).
+    gamma, d, delta, steps
+        The run's parameters.
+    """
+
+    alpha: np.ndarray
+    beta: np.ndarray
+    stable: np.ndarray
+    growth: np.ndarray
+    gamma: float
+    d: int
+    delta: float
+    steps: int
+
+
+def stability_map(*, alpha, beta, gamma, d, delta, steps=None, x0=1.0, v0=None, device=None,
+                  nonideal=None, progress=None):
+    """Stable cells of an (alpha, beta) grid by simulation.
+
+    Parameters
+    ----------
+    alpha, beta : array_like
+        1-D grids.
+    gamma, d, delta, steps, x0, v0, device, nonideal
+        As in :func:`simulate`.
+    progress : callable or True
+        ``True`` draws a progress bar on stderr for runs over 2 s.
+
+    Returns
+    -------
+    StabilityMap
+    """
+    alpha = check_array("alpha", alpha)
+    beta = check_array("beta", beta)
+    if alpha.ndim != 1 or beta.ndim != 1:
+        raise ValueError("alpha and beta must be 1-D grids")
+    gamma = check_real("gamma", gamma)
+    d = check_delay(d)
+    total = default_horizon(d) if steps is None else steps
+    if progress is True:
+        progress = _progress_printer("simulating", total)
+    A, B = np.meshgrid(alpha, beta, indexing="ij")
+    run = simulate(alpha=A, beta=B, gamma=gamma, d=d, delta=delta, steps=steps, x0=x0, v0=v0,
+                   device=device, nonideal=nonideal, progress=progress)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        growth = np.where(run.diverged, np.inf, run.amplitude[3] / run.amplitude[2])
+    return StabilityMap(alpha, beta, run.stable, growth, gamma, d,
+                        float(delta if delta is not None else device.delta), run.steps)
