@@ -108,9 +108,10 @@ def build_parser():
     p.add_argument("--json", metavar="PATH", help="also write the verdicts as JSON")
     p.add_argument("-v", "--verbose", action="store_true", help="print each check as it runs")
     p.set_defaults(func=_cmd_audit)
-    from .cli_numeric import add_commands
+    from . import cli_numeric, cli_simulate
 
-    add_commands(sub)
+    cli_numeric.add_commands(sub)
+    cli_simulate.add_commands(sub)
     return parser
 
 

@@ -136,3 +136,55 @@ def test_bad_input_is_one_line_and_exit_2(capsys, tmp_path, monkeypatch, args, n
 def test_paper_device_is_the_default():
     assert (PAPER_M, PAPER_B, PAPER_T) == (symstab.PAPER_DEVICE.m, symstab.PAPER_DEVICE.b,
                                            symstab.PAPER_DEVICE.T)
+
+
+# --------------------------------------------------------------------------
+# simulate and map
+
+
+def test_simulate_writes_the_trajectory_and_agrees_with_the_radius(capsys, tmp_path):
+    out = tmp_path / "traj.csv"
+    status, text, _ = run(capsys, "simulate", "--Td", "0.01", "--Kw", "30", "--Bw", "0.5",
+                          "--steps", "3000", "--out", str(out))
+    assert status == 0
+    radius = symstab.spectral_radius(alpha=30 * PAPER_T**2 / PAPER_M, beta=0.5 * PAPER_T / PAPER_M,
+                                     gamma=0.0, d=10, delta=PAPER_DELTA)
+    assert radius < 1 and ": stable;" in text
+    data = np.loadtxt(out, delimiter=",", skiprows=1)
+    assert data.shape == (3001, 3) and data[0, 2] == 1.0
+    # The envelope's decay per period is the spectral radius (the max over a
+    # window of an oscillation is off by a phase, hence the per-period root).
+    tail = np.abs(data[-500:, 2]).max() / np.abs(data[-1000:-500, 2]).max()
+    assert tail ** (1 / 500) == pytest.approx(radius, rel=1e-3)
+
+
+def test_map_writes_npz_and_png_matching_the_exact_classification(capsys, tmp_path):
+    out = tmp_path / "m.npz"
+    status, text, _ = run(capsys, "map", "--delta", str(PAPER_DELTA), "--d", "1",
+                          "--alpha", "0.02,0.5,12", "--beta=0.05,1.2,12", "--out", str(out))
+    assert status == 0
+    with np.load(out) as f:
+        stable, alpha, beta = f["stable"], f["alpha"], f["beta"]
+    A, B = np.meshgrid(alpha, beta, indexing="ij")
+    exact = symstab.classify(alpha=A, beta=B, gamma=0.0, d=1, delta=PAPER_DELTA) == symstab.STABLE
+    assert stable.shape == (12, 12) and 0 < exact.sum() < 144
+    assert np.count_nonzero(stable != exact) <= 4  # only cells next to the boundary
+    assert (tmp_path / "m.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+
+
+@pytest.mark.parametrize("args, needle", [
+    (["simulate", "--alpha", "0.1", "--beta", "0.1", "--velocity-cutoff", "600"], "velocity_cutoff"),
+    (["simulate", "--alpha", "0.1", "--beta", "0.1", "--encoder-resolution", "-1"], "encoder_resolution"),
+    (["simulate", "--alpha", "0.1", "--beta", "0.1", "--steps", "0"], "steps"),
+    (["simulate", "--alpha", "0.1", "--beta", "0.1", "--coulomb", "0.1", "--stiction", "0.05"], "stiction"),
+    (["simulate", "--delta", "0.1", "--alpha", "0.1", "--beta", "0.1", "--paper-encoder"], "physical"),
+    (["map", "--alpha", "0,1,10", "--beta", "0,1,10", "--out", "m.txt"], "--out"),
+    (["map", "--alpha", "0,1", "--beta", "0,1,10", "--out", "m.csv"], "--alpha"),
+    (["map", "--alpha", "0,1,10", "--beta", "0,1,10", "--out", "missing/m.csv"], "folder"),
+])
+def test_simulation_bad_input_exits_2_and_writes_nothing(capsys, tmp_path, monkeypatch, args, needle):
+    monkeypatch.chdir(tmp_path)
+    status, out, err = run(capsys, *args)
+    assert status == 2, err
+    assert needle in err.strip().splitlines()[-1]
+    assert list(tmp_path.iterdir()) == []

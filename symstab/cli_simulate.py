@@ -1,0 +1,261 @@
+"""``symstab simulate`` (one point, a CSV trajectory) and ``symstab map`` (a grid).
+
+The device and delay options are those of the numeric commands
+(:mod:`symstab.cli_numeric`); the non-idealities are given in physical
+units and need the physical device options (the default device is the
+paper's).  Files are written atomically: a failed run leaves nothing behind.
+"""
+
+import io
+import os
+import pathlib
+import sys
+import tempfile
+
+import numpy as np
+
+from .cli_numeric import _add_model_options, _parse_list, _resolve
+
+__all__ = ["add_commands"]
+
+
+def _add_nonideal_options(p):
+    g = p.add_argument_group("non-idealities (physical units; each off by default)")
+    g.add_argument("--encoder-resolution", type=float, metavar="Q",
+                   help="position quantum, m or rad (the paper's: 3 arc seconds = 1.454e-5 rad)")
+    g.add_argument("--paper-encoder", action="store_true",
+                   help="use the paper's encoder resolution (3 arc seconds)")
+    g.add_argument("--velocity-cutoff", type=float, metavar="HZ",
+                   help="first-order low-pass filter on the velocity, Hz (the paper's: 50)")
+    g.add_argument("--coulomb", type=float, metavar="F", help="Coulomb friction, N or N m")
+    g.add_argument("--stiction", type=float, metavar="F", help="breakaway force (default: --coulomb)")
+    g.add_argument("--friction-compensation", action="store_true",
+                   help="add the Coulomb friction times sign(estimated velocity) to the command")
+    g.add_argument("--actuator-bandwidth", type=float, metavar="HZ", help="first-order lag, Hz")
+    g.add_argument("--substeps", type=int, default=20,
+                   help="sub-steps per period for friction and the actuator lag (default 20)")
+    p.add_argument("--steps", type=int, help="periods to simulate (default 12000 + 800 d)")
+    p.add_argument("--x0", type=float, default=None,
+                   help="initial position, m or rad (default 1; 0.01 with non-idealities)")
+
+
+def _nonideal(args, setup):
+    from .simulate import PAPER_ENCODER_RESOLUTION, Nonidealities
+
+    resolution = args.encoder_resolution
+    if args.paper_encoder:
+        if resolution is not None:
+            raise ValueError("give --encoder-resolution or --paper-encoder, not both")
+        resolution = PAPER_ENCODER_RESOLUTION
+    nonideal = Nonidealities(encoder_resolution=resolution, velocity_cutoff=args.velocity_cutoff,
+                             coulomb_friction=args.coulomb, stiction=args.stiction,
+                             friction_compensation=args.friction_compensation,
+                             actuator_bandwidth=args.actuator_bandwidth, substeps=args.substeps)
+    if not nonideal.ideal and not setup.physical:
+        raise ValueError("non-idealities are in physical units: use --m --b --T --Td (or their "
+                         "defaults), not --delta")
+    if setup.physical:
+        nonideal.check(setup.device.T)
+    x0 = args.x0 if args.x0 is not None else (1.0 if nonideal.ideal else 0.01)
+    return nonideal, x0
+
+
+def _write_atomic(path, data):
+    """Write bytes to ``path`` through a temporary file in the same folder."""
+    path = pathlib.Path(path)
+    if path.is_dir():
+        raise ValueError(f"output {path} is a directory, expected a file name")
+    folder = path.parent if str(path.parent) else pathlib.Path(".")
+    if not folder.is_dir():
+        raise ValueError(f"output folder {folder} does not exist")
+    fd, tmp = tempfile.mkstemp(dir=folder, prefix=f".{path.name}.", suffix=".tmp")
+    try:
+        with os.fdopen(fd, "wb") as fh:
+            fh.write(data)
+        os.chmod(tmp, 0o644)
+        os.replace(tmp, path)
+    except BaseException:
+        pathlib.Path(tmp).unlink(missing_ok=True)
+        raise
+
+
+def _single(text, name):
+    values = _parse_list(text, name)
+    if values.size != 1:
+        raise ValueError(f"{name} takes one value here, got {values.size}")
+    return float(values[0])
+
+
+def _point(args, setup):
+    if (args.alpha is None) == (args.Kw is None) or (args.beta is None) == (args.Bw is None):
+        raise ValueError("give the stiffness (--alpha or --Kw) and the damping (--beta or --Bw), once each")
+    if (args.Kw is not None or args.Bw is not None) and not setup.physical:
+        raise ValueError("--Kw and --Bw need a physical device; use --alpha and --beta with --delta")
+    alpha = _single(args.alpha, "--alpha") if args.alpha is not None else \
+        float(setup.device.alpha(_single(args.Kw, "--Kw")))
+    beta = _single(args.beta, "--beta") if args.beta is not None else \
+        float(setup.device.beta(_single(args.Bw, "--Bw")))
+    return alpha, beta
+
+
+def _cmd_simulate(args):
+    from .simulate import simulate
+    from .stability import spectral_radius
+
+    setup = _resolve(args)
+    alpha, beta = _point(args, setup)
+    nonideal, x0 = _nonideal(args, setup)
+    if args.out is not None and pathlib.Path(args.out).is_dir():
+        raise ValueError(f"--out {args.out} is a directory, expected a file name")
+    run = simulate(alpha=alpha, beta=beta, gamma=setup.gamma, d=setup.d,
+                   delta=None if setup.physical else setup.delta, steps=args.steps, x0=x0,
+                   device=setup.device, nonideal=nonideal, record=True)
+    for line in setup.echo:
+        print(line)
+    radius = spectral_radius(alpha=alpha, beta=beta, gamma=setup.gamma, d=setup.d, delta=setup.delta)
+    verdict = "diverged (unstable)" if run.diverged else ("stable" if run.stable else "unstable")
+    amp = run.amplitude
+    print(f"point: alpha = {alpha:.10g}, beta = {beta:.10g}"
+          + (f" (K_w = {float(setup.device.stiffness(alpha)):.10g} {setup.units['K_w']}, "
+             f"B_w = {float(setup.device.damping(beta)):.10g} {setup.units['B_w']})" if setup.physical else ""))
+    print(f"simulated {run.steps} periods from x0 = {x0:g}: {verdict}; max |x| per quarter: "
+          + ", ".join(f"{a:.4g}" for a in amp))
+    print(f"theory (ideal loop): spectral radius {radius:.12g} -> "
+          + ("stable" if radius < 1 else "unstable"))
+    if args.out is not None:
+        k = np.arange(run.steps + 1)
+        t = k * (setup.device.T if setup.physical else 1.0)
+        buf = io.StringIO()
+        buf.write("k,t [s]," + ("x [rad]" if setup.physical and not args.linear else
+                                "x [m]" if setup.physical else "x") + "\n")
+        np.savetxt(buf, np.column_stack([k, t, run.positions]), delimiter=",", fmt=["%d", "%.9g", "%.17g"])
+        _write_atomic(args.out, buf.getvalue().encode())
+        print(f"wrote the trajectory to {args.out}")
+    return 0
+
+
+def _grid(text, name):
+    parts = text.split(",")
+    if len(parts) != 3:
+        raise ValueError(f"{name} must be LOW,HIGH,N, got {text!r}")
+    try:
+        lo, hi, n = float(parts[0]), float(parts[1]), int(parts[2])
+    except ValueError:
+        raise ValueError(f"{name} must be LOW,HIGH,N with a whole N, got {text!r}") from None
+    if not (np.isfinite(lo) and np.isfinite(hi) and lo < hi and 2 <= n <= 2000):
+        raise ValueError(f"{name} must have finite LOW < HIGH and 2 <= N <= 2000, got {text!r}")
+    return np.linspace(lo, hi, n)
+
+
+def _cmd_map(args):
+    from .simulate import _progress_printer, default_horizon, stability_map
+    from .stability import STABLE, classify
+
+    setup = _resolve(args)
+    nonideal, x0 = _nonideal(args, setup)
+    if (args.alpha is None) == (args.Kw is None) or (args.beta is None) == (args.Bw is None):
+        raise ValueError("give the grids --alpha (or --Kw) and --beta (or --Bw) as LOW,HIGH,N, once each")
+    if (args.Kw is not None or args.Bw is not None) and not setup.physical:
+        raise ValueError("--Kw and --Bw need a physical device; use --alpha and --beta with --delta")
+    alpha = _grid(args.alpha, "--alpha") if args.alpha is not None else \
+        np.atleast_1d(setup.device.alpha(_grid(args.Kw, "--Kw")))
+    beta = _grid(args.beta, "--beta") if args.beta is not None else \
+        np.atleast_1d(setup.device.beta(_grid(args.Bw, "--Bw")))
+    out = pathlib.Path(args.out)
+    if out.suffix not in (".csv", ".npz"):
+        raise ValueError(f"--out must end in .csv or .npz, got {out}")
+    for line in setup.echo:
+        print(line)
+    steps = args.steps or default_horizon(setup.d)
+    result = stability_map(alpha=alpha, beta=beta, gamma=setup.gamma, d=setup.d,
+                           delta=None if setup.physical else setup.delta, steps=steps, x0=x0,
+                           device=setup.device, nonideal=nonideal,
+                           progress=_progress_printer("simulating", steps))
+    A, B = np.meshgrid(alpha, beta, indexing="ij")
+    exact = classify(alpha=A, beta=B, gamma=setup.gamma, d=setup.d, delta=setup.delta) == STABLE
+    if out.suffix == ".npz":
+        buf = io.BytesIO()
+        np.savez(buf, alpha=alpha, beta=beta, stable=result.stable, growth=result.growth,
+                 exact_stable=exact, gamma=setup.gamma, d=setup.d, delta=setup.delta, steps=steps)
+        data = buf.getvalue()
+    else:
+        buf = io.StringIO()
+        buf.write("alpha,beta,stable,exact_stable,growth\n")
+        for a, b, s, e, g in zip(A.ravel(), B.ravel(), result.stable.ravel(), exact.ravel(),
+                                 result.growth.ravel()):
+            buf.write(f"{a:.12g},{b:.12g},{int(s)},{int(e)},{g:.6g}\n")
+        data = buf.getvalue().encode()
+    png = _png(args, setup, result, exact)
+    _write_atomic(out, data)
+    written = [str(out)]
+    if png is not None:
+        png_path = out.with_suffix(".png") if args.png is None else pathlib.Path(args.png)
+        _write_atomic(png_path, png)
+        written.append(str(png_path))
+    differ = int(np.count_nonzero(result.stable != exact))
+    print(f"{int(result.stable.sum())} of {result.stable.size} cells stable by simulation "
+          f"({steps} periods); {differ} differ from the exact classification of the ideal loop")
+    print("wrote " + ", ".join(written))
+    return 0
+
+
+def _png(args, setup, result, exact):
+    """The map as PNG bytes, or None without matplotlib (or with --no-png)."""
+    if args.no_png:
+        return None
+    try:
+        import matplotlib
+        matplotlib.use("Agg")
+        import matplotlib.pyplot as plt
+    except ImportError:
+        print("matplotlib is not installed: no PNG", file=sys.stderr)
+        return None
+    from .curves import boundary_curve
+
+    from matplotlib.colors import ListedColormap
+
+    fig, ax = plt.subplots(figsize=(6, 4.5), dpi=120)
+    x, y = result.beta, result.alpha
+    ax.pcolormesh(x, y, result.stable.astype(float), shading="nearest",
+                  cmap=ListedColormap(["white", "#7fc97f"]), vmin=0, vmax=1)
+    curve = boundary_curve(gamma=setup.gamma, d=setup.d, delta=setup.delta, n=2000, segments=False)
+    if not curve.empty:
+        ax.plot(curve.beta, curve.alpha, "k-", lw=1.2, label="boundary, eq. (7)")
+    ax.set_xlim(x[0], x[-1])
+    ax.set_ylim(y[0], y[-1])
+    ax.set_xlabel(r"$\beta = B_w T / m$")
+    ax.set_ylabel(r"$\alpha = K_w T^2 / m$")
+    ax.set_title(f"stable by simulation (green); $\\gamma$ = {setup.gamma:g}, d = {setup.d}", fontsize=10)
+    if not curve.empty:
+        ax.legend(loc="upper right", fontsize=8)
+    fig.tight_layout()
+    buf = io.BytesIO()
+    fig.savefig(buf, format="png", metadata={"Software": None})
+    plt.close(fig)
+    return buf.getvalue()
+
+
+def add_commands(sub):
+    """Register ``simulate`` and ``map``."""
+    p = sub.add_parser("simulate", help="simulate one point; write its trajectory as CSV")
+    _add_model_options(p)
+    _add_nonideal_options(p)
+    p.add_argument("--alpha", help="dimensionless stiffness")
+    p.add_argument("--beta", help="dimensionless damping")
+    p.add_argument("--Kw", help="virtual stiffness (physical)")
+    p.add_argument("--Bw", help="virtual damping (physical)")
+    p.add_argument("--out", help="CSV file for the trajectory (k, t, x)")
+    p.set_defaults(func=_cmd_simulate)
+
+    p = sub.add_parser("map", help="stability of a grid by simulation; write CSV or NPZ and a PNG")
+    _add_model_options(p)
+    _add_nonideal_options(p)
+    p.add_argument("--alpha", metavar="LOW,HIGH,N", help="alpha grid (write --alpha=LOW,... "
+                                                           "when LOW is negative)")
+    p.add_argument("--beta", metavar="LOW,HIGH,N", help="beta grid (--beta=-0.01,0.3,100)")
+    p.add_argument("--Kw", metavar="LOW,HIGH,N", help="K_w grid (physical)")
+    p.add_argument("--Bw", metavar="LOW,HIGH,N", help="B_w grid (physical; --Bw=-0.1,3,100)")
+    p.add_argument("--out", required=True, help="output file, .csv or .npz")
+    p.add_argument("--png", help="PNG file (default: --out with .png)")
+    p.add_argument("--no-png", action="store_true", help="do not draw the PNG")
+    p.set_defaults(func=_cmd_map)
