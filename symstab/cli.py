@@ -88,6 +88,28 @@ def _cmd_audit(args):
     return 0
 
 
+def _cmd_reproduce(args):
+    from .reproduce import reproduce
+
+    _, drift = reproduce(args.out, workers=args.workers)
+    return 1 if drift else 0
+
+
+def _cmd_figures(args):
+    from .figures import make_figures
+
+    def progress(name, seconds):
+        print(f"{name}.png ({seconds:.1f} s)", file=sys.stderr, flush=True)
+
+    out = pathlib.Path(args.out)
+    if out.exists() and not out.is_dir():
+        raise ValueError(f"--out must be a directory, got file {out}")
+    results = make_figures(out, progress=progress)
+    for r in results:
+        print(f"{out / (r.name + '.png')}: {r.symstab}")
+    return 0
+
+
 def build_parser():
     """Return the argument parser of the ``symstab`` command."""
     parser = _Parser(prog="symstab", description=(
@@ -108,6 +130,14 @@ def build_parser():
     p.add_argument("--json", metavar="PATH", help="also write the verdicts as JSON")
     p.add_argument("-v", "--verbose", action="store_true", help="print each check as it runs")
     p.set_defaults(func=_cmd_audit)
+    p = sub.add_parser("figures", help="draw the paper's figures as PNG")
+    p.add_argument("--out", default="figures", help="output directory (default: figures)")
+    p.set_defaults(func=_cmd_figures)
+    p = sub.add_parser("reproduce", help="derive (with the drift check), audit and draw every "
+                                         "figure; write index.md")
+    p.add_argument("--out", default="reproduction", help="output directory (default: reproduction)")
+    p.add_argument("--workers", type=int, default=2, help="worker processes (default 2)")
+    p.set_defaults(func=_cmd_reproduce)
     from . import cli_numeric, cli_simulate
 
     cli_numeric.add_commands(sub)

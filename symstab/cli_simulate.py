@@ -7,10 +7,8 @@ paper's).  Files are written atomically: a failed run leaves nothing behind.
 """
 
 import io
-import os
 import pathlib
 import sys
-import tempfile
 
 import numpy as np
 
@@ -61,22 +59,16 @@ def _nonideal(args, setup):
 
 
 def _write_atomic(path, data):
-    """Write bytes to ``path`` through a temporary file in the same folder."""
+    """Write bytes to ``path`` atomically, into an existing folder only."""
+    from .derive import write_bytes
+
     path = pathlib.Path(path)
     if path.is_dir():
         raise ValueError(f"output {path} is a directory, expected a file name")
     folder = path.parent if str(path.parent) else pathlib.Path(".")
     if not folder.is_dir():
         raise ValueError(f"output folder {folder} does not exist")
-    fd, tmp = tempfile.mkstemp(dir=folder, prefix=f".{path.name}.", suffix=".tmp")
-    try:
-        with os.fdopen(fd, "wb") as fh:
-            fh.write(data)
-        os.chmod(tmp, 0o644)
-        os.replace(tmp, path)
-    except BaseException:
-        pathlib.Path(tmp).unlink(missing_ok=True)
-        raise
+    write_bytes(path, data)
 
 
 def _single(text, name):

@@ -27,7 +27,7 @@ from .loop import characteristic_polynomial
 from .theta_max import closed_form_d0, newton_form_gamma0
 from .unit_circle import unit_circle_split
 
-__all__ = ["Step", "derivation_steps", "render", "write", "check", "proofs", "OWNED"]
+__all__ = ["Step", "derivation_steps", "render", "write", "write_bytes", "check", "proofs", "OWNED"]
 
 
 @dataclasses.dataclass(frozen=True)
@@ -173,24 +173,32 @@ def render(steps):
     return files
 
 
-def write(out_dir, files):
-    """Write ``files`` into ``out_dir`` atomically, file by file.
+def write_bytes(path, data):
+    """Write ``data`` (bytes) to ``path`` atomically.
 
-    Each file is written to a temporary name in the same folder and renamed
+    The bytes go to a temporary name in the same folder, which is renamed
     into place, so a failure never leaves a half-written file.
     """
+    path = pathlib.Path(path)
+    folder = path.parent
+    folder.mkdir(parents=True, exist_ok=True)
+    fd, tmp = tempfile.mkstemp(dir=folder, prefix=f".{path.name}.", suffix=".tmp")
+    try:
+        with os.fdopen(fd, "wb") as fh:
+            fh.write(data)
+        os.chmod(tmp, 0o644)
+        os.replace(tmp, path)
+    except BaseException:
+        pathlib.Path(tmp).unlink(missing_ok=True)
+        raise
+    return path
+
+
+def write(out_dir, files):
+    """Write ``files`` (``{name: text}``) into ``out_dir`` atomically, file by file."""
     out = pathlib.Path(out_dir)
-    out.mkdir(parents=True, exist_ok=True)
     for name, text in sorted(files.items()):
-        fd, tmp = tempfile.mkstemp(dir=out, prefix=f".{name}.", suffix=".tmp")
-        try:
-            with os.fdopen(fd, "w", encoding="utf-8", newline="\n") as fh:
-                fh.write(text)
-            os.chmod(tmp, 0o644)
-            os.replace(tmp, out / name)
-        except BaseException:
-            pathlib.Path(tmp).unlink(missing_ok=True)
-            raise
+        write_bytes(out / name, text.encode("utf-8"))
     return sorted(out / name for name in files)
 
 
