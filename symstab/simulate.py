@@ -25,7 +25,9 @@ default) need a :class:`symstab.units.Device`:
 * ``friction_compensation`` -- the command adds ``F_c sign(v_hat)``, with
   ``v_hat`` the (filtered) velocity estimate;
 * ``actuator_bandwidth`` -- the applied force follows the command through a
-  first-order lag of that bandwidth (integrated exactly on the sub-steps).
+  first-order lag of that bandwidth; each sub-step drives the plant with the
+  lag's exact mean over the sub-step, held (accurate to second order in the
+  sub-step, not exact: the plant sees a constant force per sub-step).
 
 Stability by simulation (:func:`stability_map`): the run starts from the
 position ``x0``, the history at ``x0`` and a small velocity (``v0 T = x0 /
@@ -270,7 +272,8 @@ class _Loop:
         self.forces = np.zeros((d + 1, n))  # commands waiting in the delay line
         self.k = 0
         self.diverged = np.zeros(n, dtype=bool)
-        self.sub = nonideal.substeps if nonideal.needs_substeps else 1
+        self.inner = nonideal.needs_substeps
+        self.sub = nonideal.substeps if self.inner else 1
         phi01, phi11, g0, g1 = kernels.plant_step_coefficients(delta / self.sub)
         self.phi01, self.phi11, self.g0, self.g1 = (float(c) for c in (phi01, phi11, g0, g1))
         self.device = device
@@ -281,8 +284,12 @@ class _Loop:
                              else (nonideal.coulomb_friction or 0.0)) * force_scale
             self.filter_pole = (math.exp(-2 * math.pi * nonideal.velocity_cutoff * device.T)
                                 if nonideal.velocity_cutoff else None)
-            self.lag = (math.exp(-2 * math.pi * nonideal.actuator_bandwidth * device.T / self.sub)
-                        if nonideal.actuator_bandwidth else None)
+            if nonideal.actuator_bandwidth:
+                h = 2 * math.pi * nonideal.actuator_bandwidth * device.T / self.sub
+                self.lag = math.exp(-h)
+                self.lag_mean = -math.expm1(-h) / h   # mean of exp(-t) over [0, h]
+            else:
+                self.lag = None
         else:
             self.coulomb = self.stiction = 0.0
             self.filter_pole = self.lag = None
@@ -320,7 +327,7 @@ class _Loop:
         self.forces[slot] = command
         held = self.forces[(self.k - self.d) % (self.d + 1)] if self.k >= self.d else 0.0 * command
         self.k += 1
-        if self.sub == 1:
+        if not self.inner:
             x, v = self.x, self.v
             self.x = x + self.phi01 * v + self.g0 * held
             self.v = self.phi11 * v + self.g1 * held
@@ -340,10 +347,13 @@ class _Loop:
         n = self.sub
         for _ in range(n):
             if self.lag is not None:
-                self.applied = held + (self.applied - held) * self.lag
+                # The lag's exact mean over the sub-step drives the plant (the
+                # held-mean approximation is second order in 1/substeps).
+                start = self.applied
+                self.applied = held + (start - held) * self.lag
+                drive = held + (start - held) * self.lag_mean
             else:
-                self.applied = held
-            drive = self.applied
+                drive = self.applied = held
             if self.coulomb > 0 or self.stiction > 0:
                 moving = self.v != 0
                 stuck = ~moving & (np.abs(drive) <= self.stiction)

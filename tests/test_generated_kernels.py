@@ -101,6 +101,9 @@ EXPECTED_SIGNATURES = {
     "symstab_exprel3": ("double", ["double"]),
     "symstab_boundary": ("void", ["double", "double", "int", "double"] + ["double *"] * 2),
     "symstab_loop_coefficients": ("void", ["double"] * 4 + ["double *"] * 7),
+    "symstab_plant_step_coefficients": ("void", ["double"] + ["double *"] * 4),
+    "symstab_plant_step": ("void", ["double"] * 4 + ["double *"] * 2),
+    "symstab_environment_force": ("double", ["double"] * 6),
 }
 
 
@@ -474,3 +477,61 @@ def test_naive_form_loses_digits_where_kernel_does_not(c_kernels, d, theta):
     for kernel, f in _kernel_boundaries(c_kernels).items():
         value = float(f(theta, gamma, d, delta)[0])
         assert relative_error(mpmath.mpf(value), expected) <= BOUNDARY_RTOL, kernel
+
+
+# --------------------------------------------------------------------------
+# The simulator's kernels: plant step and environment force, C vs NumPy
+# --------------------------------------------------------------------------
+
+def _c_call(function, args, n_out):
+    """Call a void C kernel with NaN-initialised outputs; return them."""
+    out = [ctypes.c_double(math.nan) for _ in range(n_out)]
+    function(*(float(a) for a in args), *(ctypes.byref(x) for x in out))
+    return tuple(x.value for x in out)
+
+
+@pytest.fixture(scope="module")
+def simulator_points():
+    """Seeded: delta log-uniform in [1e-6, 5], states, forces and environments."""
+    rng = np.random.default_rng(20250101)
+    n = N_RANDOM
+    return dict(
+        delta=10 ** rng.uniform(-6.0, np.log10(5.0), n),
+        position=rng.uniform(-10.0, 10.0, n), velocity=rng.uniform(-1.0, 1.0, n),
+        force=rng.uniform(-1.0, 1.0, n),
+        x_k=rng.uniform(-5.0, 5.0, n), x_km1=rng.uniform(-5.0, 5.0, n),
+        x_km2=rng.uniform(-5.0, 5.0, n),
+        alpha=rng.uniform(-1.0, 5.0, n), beta=rng.uniform(-2.0, 3.0, n),
+        gamma=rng.uniform(-0.9, 3.0, n),
+    )
+
+
+def test_c_plant_step_coefficients_match_numpy(c_kernels, simulator_points):
+    delta = simulator_points["delta"]
+    c = np.array([_c_call(c_kernels.lib.symstab_plant_step_coefficients, (x,), 4) for x in delta]).T
+    numpy_c = numpy_kernels.plant_step_coefficients(delta)
+    for k, name in enumerate(("phi01", "phi11", "gamma0", "gamma1")):
+        _assert_all_below(_mixed_error(c[k], numpy_c[k]), C_VS_NUMPY_RTOL, {"delta": delta},
+                          f"{name}, C vs NumPy")
+
+
+def test_c_plant_step_matches_numpy(c_kernels, simulator_points):
+    p = simulator_points
+    args = [p[k] for k in ("position", "velocity", "force", "delta")]
+    c = np.array([_c_call(c_kernels.lib.symstab_plant_step, point, 2) for point in zip(*args)]).T
+    numpy_c = numpy_kernels.plant_step(*args)
+    where = {k: p[k] for k in ("position", "velocity", "force", "delta")}
+    for k, name in enumerate(("position_next", "velocity_next")):
+        _assert_all_below(_mixed_error(c[k], numpy_c[k]), C_VS_NUMPY_RTOL, where,
+                          f"{name}, C vs NumPy")
+
+
+def test_c_environment_force_matches_numpy(c_kernels, simulator_points):
+    """Same expression, same order: equal to 1e-12 relative (measured: bit for bit)."""
+    p = simulator_points
+    names = ("x_k", "x_km1", "x_km2", "alpha", "beta", "gamma")
+    args = [p[k] for k in names]
+    function = c_kernels.lib.symstab_environment_force
+    c = np.array([function(*(float(a) for a in point)) for point in zip(*args)])
+    _assert_all_below(_mixed_error(c, numpy_kernels.environment_force(*args)), C_VS_NUMPY_RTOL,
+                      {k: p[k] for k in names}, "force, C vs NumPy")
