@@ -25,7 +25,7 @@ from .region import StabilityRegion, limits
 from .simulate import PAPER_ENCODER_RESOLUTION, Nonidealities, stability_map
 from .units import PAPER_DEVICE
 
-__all__ = ["FigureResult", "FIGURES", "make_figures"]
+__all__ = ["FigureResult", "FIGURES", "make_figures", "require_matplotlib"]
 
 DELTA = PAPER_DEVICE.delta
 #: The delays of Figs. 6, 8, 11 and 12.
@@ -44,7 +44,17 @@ class FigureResult:
     symstab: str
 
 
+def require_matplotlib():
+    """Raise a one-line ValueError when matplotlib is missing (it is an extra)."""
+    try:
+        import matplotlib  # noqa: F401
+    except ImportError:
+        raise ValueError("the figures need matplotlib: pip install 'symstab[figures]' "
+                         "(or pip install matplotlib)") from None
+
+
 def _plt():
+    require_matplotlib()
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt

@@ -106,10 +106,17 @@ def reproduce(out_dir, *, workers=2, log=None):
     """
     from .derive import write, write_bytes
 
+    from .figures import require_matplotlib
+
     log = log or (lambda line: print(line, file=sys.stderr, flush=True))
     out = pathlib.Path(out_dir)
     if out.exists() and not out.is_dir():
         raise ValueError(f"--out must be a directory, got file {out}")
+    require_matplotlib()
+    try:
+        import paper_checks.audit  # noqa: F401
+    except ImportError as exc:  # pragma: no cover - packaging problem
+        raise ValueError(f"the paper_checks package is not installed ({exc})") from None
     total = time.perf_counter()
     timings = []
     log("[1/3] derive: derivation steps, proofs and generated kernels ...")
