@@ -43,16 +43,36 @@ def scan_grid(d, *, n=None, upper=np.pi):
 
 
 def _bisect(f, lo, hi, iterations=64):
-    """Vectorised bisection for f(lo) > 0 >= f(hi) (or the reverse, per entry)."""
+    """Vectorised root of ``f`` in each bracket ``[lo, hi]`` (signs differ at the ends).
+
+    The Illinois variant of regula falsi: superlinear on smooth functions (a
+    dozen evaluations where bisection needs sixty), with the bracket kept,
+    and a bisection step wherever the secant stalls.  Stops when every
+    bracket is a few ulps wide.
+    """
     lo, hi = np.array(lo, dtype=float), np.array(hi, dtype=float)
-    sign_lo = np.sign(f(lo))
+    flo, fhi = np.asarray(f(lo), dtype=float), np.asarray(f(hi), dtype=float)
+    side = np.zeros(lo.shape, dtype=np.int8)   # which end was kept last time
     for _ in range(iterations):
-        mid = 0.5 * (lo + hi)
-        same = np.sign(f(mid)) == sign_lo
-        lo = np.where(same, mid, lo)
-        hi = np.where(same, hi, mid)
-        if np.all((hi - lo) <= 2 * np.spacing(np.maximum(np.abs(lo), np.abs(hi)))):
+        width = hi - lo
+        if np.all(width <= 4 * np.spacing(np.maximum(np.abs(lo), np.abs(hi)))):
             break
+        with np.errstate(divide="ignore", invalid="ignore"):
+            x = hi - fhi * width / (fhi - flo)
+        # Bisect where the secant leaves the bracket or creeps along one side.
+        bad = ~np.isfinite(x) | (x <= lo) | (x >= hi)
+        x = np.where(bad, lo + 0.5 * width, x)
+        fx = np.asarray(f(x), dtype=float)
+        same_as_lo = np.sign(fx) == np.sign(flo)
+        # Illinois: halve the value at the end that stays, so it cannot stick.
+        fhi = np.where(same_as_lo & (side == 1), 0.5 * fhi, fhi)
+        flo = np.where(~same_as_lo & (side == -1), 0.5 * flo, flo)
+        lo, flo = np.where(same_as_lo, x, lo), np.where(same_as_lo, fx, flo)
+        hi, fhi = np.where(same_as_lo, hi, x), np.where(same_as_lo, fhi, fx)
+        side = np.where(same_as_lo, 1, -1).astype(np.int8)
+        exact = fx == 0
+        if exact.any():
+            lo, hi = np.where(exact, x, lo), np.where(exact, x, hi)
     return 0.5 * (lo + hi)
 
 
