@@ -199,6 +199,14 @@ def theta_max(*, gamma, d, delta, dps=30):
 def theta_max_newton(*, d, delta):
     """theta_max for gamma = 0 by the one-step Newton form (approximate)."""
     _, d, delta = _check(0.0, d, delta)
-    expr = newton_form_gamma0().theta_newton
-    value = expr.subs({model.d: d, model.delta: delta, model.Gamma: sp.exp(delta)})
-    return float(sp.N(value, 30))
+    # The Newton quotient cancels: evaluate at 30 digits from the exact
+    # binary value of delta (a 15-digit Float lost up to 1e-7 at d = 100).
+    with mpmath.workdps(30):
+        dl = mpmath.mpf(delta)
+        return float(_newton_function()(d, dl, mpmath.exp(dl)))
+
+
+@functools.lru_cache(maxsize=None)
+def _newton_function():
+    return sp.lambdify((model.d, model.delta, model.Gamma), newton_form_gamma0().theta_newton,
+                       modules="mpmath")
