@@ -113,7 +113,7 @@ def kernels():
         Kernel("exprel3", (_ARG["delta"],),
                (("phi3", kf.exprel3_piecewise(x), "(exp(delta) - 1 - delta - delta^2/2) / delta^3"),),
                "(exp(delta) - 1 - delta - delta^2/2) / delta^3 for delta > 0: a Taylor "
-               "polynomial below delta = 1/2, expm1 above."),
+               f"polynomial below delta = {kf.EXPREL3_SWITCH}, expm1 above."),
         Kernel("boundary", tuple(_ARG[k] for k in ("theta", "gamma", "d", "delta")),
                (("alpha", kf.as_evaluable(alpha), "dimensionless stiffness on the boundary"),
                 ("beta", kf.as_evaluable(beta), "dimensionless damping on the boundary")),

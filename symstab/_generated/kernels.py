@@ -11,7 +11,7 @@ __all__ = ['exprel3', 'boundary', 'loop_coefficients', 'plant_step_coefficients'
 
 def exprel3(delta):
     """(exp(delta) - 1 - delta - delta^2/2) / delta^3 for delta > 0: a Taylor
-    polynomial below delta = 1/2, expm1 above.
+    polynomial below delta = 1, expm1 above.
 
     Parameters
     ----------

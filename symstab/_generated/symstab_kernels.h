@@ -11,7 +11,7 @@ extern "C" {
 
 /*
  * (exp(delta) - 1 - delta - delta^2/2) / delta^3 for delta > 0: a Taylor
- * polynomial below delta = 1/2, expm1 above.
+ * polynomial below delta = 1, expm1 above.
  *
  * delta: delta = b T / m > 0
  * returns: (exp(delta) - 1 - delta - delta^2/2) / delta^3
