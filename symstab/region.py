@@ -41,6 +41,8 @@ __all__ = ["StabilityRegion", "Limits", "limits", "BestVirtualMass", "best_virtu
 #: missed its top).  It picks the arc segments to work with and seeds the
 #: searches, which then run to the last bit.
 _PROBE = 1e-6
+#: The probe distances of the touching test (relative).
+_PROBES = (_PROBE, 1e-9)
 
 
 def _check(gamma, d, delta):
@@ -235,21 +237,30 @@ class StabilityRegion:
 
     @functools.cached_property
     def _touching(self):
-        """Mask of arc samples with a stable point within a relative 1e-6."""
+        """Mask of arc samples with a stable point within a relative 1e-6 or 1e-9.
+
+        Probes on both sides in alpha and in beta, at two distances: the far
+        ones find ordinary regions, the near ones slivers thinner than the
+        far ones jump over (at the gamma where the d = 0 sliver vanishes it
+        is 2e-7 wide).
+        """
         a, b = self._alpha, self._beta
         ok = np.isfinite(a) & np.isfinite(b) & (np.abs(a) < 1e6) & (np.abs(b) < 1e6)
         a, b = a[ok], b[ok]
-        ea = _PROBE * (np.abs(a) + self.delta)
-        eb = _PROBE * (np.abs(b) + self.delta)
-        probes_a = np.concatenate([a + ea, a - ea, a, a])
-        probes_b = np.concatenate([b, b, b + eb, b - eb])
-        # The Schur-Cohn verdicts alone: these probes sit 1e-6 from the
+        probes_a, probes_b = [], []
+        for scale in _PROBES:
+            ea = scale * (np.abs(a) + self.delta)
+            eb = scale * (np.abs(b) + self.delta)
+            probes_a += [a + ea, a - ea, a, a]
+            probes_b += [b, b, b + eb, b - eb]
+        # The Schur-Cohn verdicts alone: these probes sit next to the
         # boundary, where the eigenvalue refinement of every one would cost
         # 20 s at d = 200, and a wrong verdict would only widen the search.
-        code = classify(alpha=probes_a, beta=probes_b, gamma=self.gamma, d=self.d,
-                        delta=self.delta, refine=False)
+        code = classify(alpha=np.concatenate(probes_a), beta=np.concatenate(probes_b),
+                        gamma=self.gamma, d=self.d, delta=self.delta, refine=False)
         touching = np.zeros(len(self._alpha), dtype=bool)
-        touching[np.flatnonzero(ok)] = np.any((np.asarray(code) == STABLE).reshape(4, -1), axis=0)
+        stable = (np.asarray(code) == STABLE).reshape(4 * len(_PROBES), -1)
+        touching[np.flatnonzero(ok)] = np.any(stable, axis=0)
         return touching
 
     def _last_meeting(self, axis, inside, outside, rounds=14, fan=16):
