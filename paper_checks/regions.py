@@ -37,7 +37,7 @@ import numpy as np
 import sympy as sp
 
 from symstab import model
-from symstab._validate import check_delay, check_real
+from symstab._validate import check_loop
 from symstab.boundary import boundary
 from symstab.limits import small_theta_limits
 from symstab.loop import characteristic_polynomial
@@ -60,11 +60,6 @@ DEFAULT_DELTA = model.dimensionless_values(m=0.0128, b=0.0324, T=1e-3)["delta"]
 MARGINAL_TOL = 1e-9
 
 _DPS = 30
-
-
-def _check(gamma, d, delta):
-    return (check_real("gamma", gamma), check_delay(d),
-            check_real("delta", delta, low=0.0, low_open=True))
 
 
 # --------------------------------------------------------------------------
@@ -134,7 +129,7 @@ def initial_direction(gamma, d, delta=DEFAULT_DELTA, *, straight_tol=1e-12):
     >>> initial_direction(0.0, 0).side
     'right'
     """
-    gamma, d, delta = _check(gamma, d, delta)
+    gamma, d, delta = check_loop(gamma, d, delta)
     with mpmath.workdps(_DPS):
         a0, b0, a2, b2 = (float(v) for v in _start_functions()(gamma, d, delta))
     if abs(b2) <= straight_tol:
@@ -221,7 +216,7 @@ def minus_one_line(gamma, d, delta=DEFAULT_DELTA):
     >>> round(b / a, 6)
     2.0
     """
-    gamma, d, delta = _check(gamma, d, delta)
+    gamma, d, delta = check_loop(gamma, d, delta)
     with mpmath.workdps(_DPS):
         return tuple(float(v) for v in _minus_one_function(d)(gamma, delta))
 
@@ -652,7 +647,7 @@ def classify(gamma, d, delta=DEFAULT_DELTA, *, n_beta=41, n_alpha=201, beta_marg
     (True, True, False)
     """
     started = time.perf_counter()
-    gamma, d, delta = _check(gamma, d, delta)
+    gamma, d, delta = check_loop(gamma, d, delta)
     for name, value in (("n_beta", n_beta), ("n_alpha", n_alpha)):
         if isinstance(value, bool) or not isinstance(value, int) or value < 3:
             raise ValueError(f"{name} must be an integer >= 3, got {value!r}")

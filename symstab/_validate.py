@@ -9,7 +9,7 @@ import numbers
 
 import numpy as np
 
-__all__ = ["check_real", "check_delay", "check_delay_samples", "check_array"]
+__all__ = ["check_real", "check_delay", "check_delay_samples", "check_array", "check_loop"]
 
 
 def _describe_range(low, high, low_open, high_open):
@@ -106,3 +106,13 @@ def check_array(name, value, *, low=None, low_open=False):
         where = "" if arr.ndim == 0 else f" (entry {int(np.flatnonzero(bad.ravel())[0])})"
         raise ValueError(f"{name} must be {allowed}, got {float(first)!r}{where}")
     return arr
+
+
+def check_loop(gamma, d, delta):
+    """Validate the loop parameters of a dimensionless entry point.
+
+    Returns ``(gamma, d, delta)`` as ``(float, int, float)``; ``delta`` must
+    be positive.
+    """
+    return (check_real("gamma", gamma), check_delay(d),
+            check_real("delta", delta, low=0.0, low_open=True))

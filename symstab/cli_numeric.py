@@ -286,18 +286,24 @@ def _parse_list(text, name):
     return np.array(values)
 
 
-def _cmd_classify(args):
-    from .stability import MARGINAL, STABLE, classify, spectral_radius
-
-    setup = _resolve(args)
+def stiffness_and_damping(args, setup, parse):
+    """(alpha, beta) from --alpha/--Kw and --beta/--Bw, each read by ``parse(text, flag)``."""
     if (args.alpha is None) == (args.Kw is None) or (args.beta is None) == (args.Bw is None):
         raise ValueError("give the stiffness (--alpha or --Kw) and the damping (--beta or --Bw), once each")
     if (args.Kw is not None or args.Bw is not None) and not setup.physical:
         raise ValueError("--Kw and --Bw need a physical device; use --alpha and --beta with --delta")
-    alpha = _parse_list(args.alpha, "--alpha") if args.alpha is not None else \
-        np.atleast_1d(setup.device.alpha(_parse_list(args.Kw, "--Kw")))
-    beta = _parse_list(args.beta, "--beta") if args.beta is not None else \
-        np.atleast_1d(setup.device.beta(_parse_list(args.Bw, "--Bw")))
+    alpha = parse(args.alpha, "--alpha") if args.alpha is not None else \
+        setup.device.alpha(parse(args.Kw, "--Kw"))
+    beta = parse(args.beta, "--beta") if args.beta is not None else \
+        setup.device.beta(parse(args.Bw, "--Bw"))
+    return alpha, beta
+
+
+def _cmd_classify(args):
+    from .stability import MARGINAL, STABLE, classify, spectral_radius
+
+    setup = _resolve(args)
+    alpha, beta = (np.atleast_1d(x) for x in stiffness_and_damping(args, setup, _parse_list))
     try:
         alpha, beta = np.broadcast_arrays(alpha, beta)
     except ValueError:

@@ -12,7 +12,7 @@ import sys
 
 import numpy as np
 
-from .cli_numeric import _add_model_options, _parse_list, _resolve
+from .cli_numeric import _add_model_options, _parse_list, _resolve, stiffness_and_damping
 
 __all__ = ["add_commands"]
 
@@ -79,15 +79,8 @@ def _single(text, name):
 
 
 def _point(args, setup):
-    if (args.alpha is None) == (args.Kw is None) or (args.beta is None) == (args.Bw is None):
-        raise ValueError("give the stiffness (--alpha or --Kw) and the damping (--beta or --Bw), once each")
-    if (args.Kw is not None or args.Bw is not None) and not setup.physical:
-        raise ValueError("--Kw and --Bw need a physical device; use --alpha and --beta with --delta")
-    alpha = _single(args.alpha, "--alpha") if args.alpha is not None else \
-        float(setup.device.alpha(_single(args.Kw, "--Kw")))
-    beta = _single(args.beta, "--beta") if args.beta is not None else \
-        float(setup.device.beta(_single(args.Bw, "--Bw")))
-    return alpha, beta
+    alpha, beta = stiffness_and_damping(args, setup, _single)
+    return float(alpha), float(beta)
 
 
 def _cmd_simulate(args):
@@ -145,14 +138,7 @@ def _cmd_map(args):
 
     setup = _resolve(args)
     nonideal, x0 = _nonideal(args, setup)
-    if (args.alpha is None) == (args.Kw is None) or (args.beta is None) == (args.Bw is None):
-        raise ValueError("give the grids --alpha (or --Kw) and --beta (or --Bw) as LOW,HIGH,N, once each")
-    if (args.Kw is not None or args.Bw is not None) and not setup.physical:
-        raise ValueError("--Kw and --Bw need a physical device; use --alpha and --beta with --delta")
-    alpha = _grid(args.alpha, "--alpha") if args.alpha is not None else \
-        np.atleast_1d(setup.device.alpha(_grid(args.Kw, "--Kw")))
-    beta = _grid(args.beta, "--beta") if args.beta is not None else \
-        np.atleast_1d(setup.device.beta(_grid(args.Bw, "--Bw")))
+    alpha, beta = (np.atleast_1d(x) for x in stiffness_and_damping(args, setup, _grid))
     out = pathlib.Path(args.out)
     if out.suffix not in (".csv", ".npz"):
         raise ValueError(f"--out must end in .csv or .npz, got {out}")

@@ -19,14 +19,9 @@ import dataclasses
 import numpy as np
 
 from ._generated import kernels
-from ._validate import check_delay, check_real
+from ._validate import check_loop
 
 __all__ = ["arc_end_angle", "minus_one_line", "BoundaryCurve", "Segment", "boundary_curve"]
-
-
-def _check(gamma, d, delta):
-    return (check_real("gamma", gamma), check_delay(d),
-            check_real("delta", delta, low=0.0, low_open=True))
 
 
 def scan_grid(d, *, n=None, upper=np.pi):
@@ -99,7 +94,7 @@ def arc_end_angle(*, gamma, d, delta):
     >>> round(arc_end_angle(gamma=0.0, d=0, delta=0.00253125), 4)
     1.5725
     """
-    gamma, d, delta = _check(gamma, d, delta)
+    gamma, d, delta = check_loop(gamma, d, delta)
 
     def alpha(t):
         return kernels.boundary(t, gamma, d, delta)[0]
@@ -124,7 +119,7 @@ def minus_one_line(*, gamma, d, delta):
     with ``P - Q = delta (1/2 + (delta - 2) exprel3(delta))`` (see
     :mod:`symstab.kernel_forms`); far away (~ 24 / delta) for small delta.
     """
-    gamma, d, delta = _check(gamma, d, delta)
+    gamma, d, delta = check_loop(gamma, d, delta)
     p_minus_q = delta * (0.5 + (delta - 2.0) * kernels.exprel3(delta))
     gamma_big = 1.0 + float(np.expm1(delta))
     return float((-1) ** d * 2.0 * (gamma_big + 1.0) / p_minus_q - 4.0 * gamma)
@@ -214,7 +209,7 @@ def boundary_curve(*, gamma, d, delta, n=1000, segments=True):
     >>> float(c.alpha[0]), round(float(c.beta[0]), 8), round(c.theta_max, 4)
     (0.0, -0.00253125, 1.5725)
     """
-    gamma, d, delta = _check(gamma, d, delta)
+    gamma, d, delta = check_loop(gamma, d, delta)
     if isinstance(n, bool) or not isinstance(n, (int, np.integer)) or n < 2:
         raise ValueError(f"n must be an integer >= 2, got {n!r}")
     t_end = arc_end_angle(gamma=gamma, d=d, delta=delta)

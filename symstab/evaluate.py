@@ -12,7 +12,7 @@ import mpmath
 import sympy as sp
 
 from . import model
-from ._validate import check_delay, check_real
+from ._validate import check_loop
 from .boundary import boundary
 from .theta_max import theta_max
 
@@ -31,11 +31,6 @@ def _functions():
             sp.lambdify(args, sp.diff(alpha_expr, model.theta), modules="mpmath"))
 
 
-def _check(gamma, d, delta):
-    return (check_real("gamma", gamma), check_delay(d),
-            check_real("delta", delta, low=0.0, low_open=True))
-
-
 def boundary_point(theta, *, gamma, d, delta, dps=30):
     """Return ``(alpha, beta)`` on the boundary at angle ``theta`` (mpmath).
 
@@ -48,7 +43,7 @@ def boundary_point(theta, *, gamma, d, delta, dps=30):
     dps : int
         Working precision in decimal digits.
     """
-    gamma, d, delta = _check(gamma, d, delta)
+    gamma, d, delta = check_loop(gamma, d, delta)
     values, _ = _functions()
     with mpmath.workdps(dps):
         na, nb, den = values(mpmath.mpf(theta), mpmath.mpf(gamma), d, mpmath.mpf(delta))
@@ -76,7 +71,7 @@ def alpha_max_on_arc(*, gamma, d, delta, dps=30, grid=400):
     (theta, alpha, beta) : tuple of float
         ``nan`` throughout when no arc enters alpha > 0.
     """
-    gamma, d, delta = _check(gamma, d, delta)
+    gamma, d, delta = check_loop(gamma, d, delta)
     t_end = theta_max(gamma=gamma, d=d, delta=delta, dps=dps)
     if not mpmath.isfinite(t_end):
         return (float("nan"),) * 3

@@ -29,7 +29,7 @@ import math
 import numpy as np
 
 from ._generated import kernels
-from ._validate import check_delay, check_real
+from ._validate import check_real, check_loop
 from .curves import Segment, _bisect, minus_one_line, scan_grid
 from .stability import MARGINAL, STABLE, classify
 
@@ -43,11 +43,6 @@ __all__ = ["StabilityRegion", "Limits", "limits", "BestVirtualMass", "best_virtu
 _PROBE = 1e-6
 #: The probe distances of the touching test (relative).
 _PROBES = (_PROBE, 1e-9)
-
-
-def _check(gamma, d, delta):
-    return (check_real("gamma", gamma), check_delay(d),
-            check_real("delta", delta, low=0.0, low_open=True))
 
 
 def _ranges(start, stop):
@@ -78,7 +73,7 @@ class StabilityRegion:
     """
 
     def __init__(self, *, gamma, d, delta):
-        self.gamma, self.d, self.delta = _check(gamma, d, delta)
+        self.gamma, self.d, self.delta = check_loop(gamma, d, delta)
         theta = np.concatenate([[0.0], scan_grid(self.d, upper=np.pi * (1 - 1e-9))])
         theta = np.union1d(theta, self._extrema(theta))
         alpha, beta = kernels.boundary(theta, self.gamma, self.d, self.delta)
@@ -564,7 +559,7 @@ def best_virtual_mass(*, d, delta, gamma_range=None, n=17):
     >>> 5 < best.gain < 6.5
     True
     """
-    _, d, delta = _check(0.0, d, delta)
+    _, d, delta = check_loop(0.0, d, delta)
     if gamma_range is None:
         gamma_range = (-1.0 - (d + 1) * delta + 1e-3, 3.0)
     g_lo, g_hi = (check_real("gamma_range[0]", gamma_range[0]), check_real("gamma_range[1]", gamma_range[1]))

@@ -15,7 +15,6 @@ Stages, each reported with its time:
 """
 
 import concurrent.futures
-import dataclasses
 import io
 import pathlib
 import sys

@@ -24,7 +24,7 @@ import mpmath
 import sympy as sp
 
 from . import model
-from ._validate import check_delay, check_real
+from ._validate import check_loop
 from .boundary import boundary
 from .identity import E, exponential_form, trig_form, w
 
@@ -136,11 +136,6 @@ def alpha_numerator_function():
     return sp.lambdify(args, expr, modules="mpmath")
 
 
-def _check(gamma, d, delta):
-    return (check_real("gamma", gamma), check_delay(d),
-            check_real("delta", delta, low=0.0, low_open=True))
-
-
 def theta_max(*, gamma, d, delta, dps=30):
     """Exact theta_max: the first root of alpha(theta) in (0, pi].
 
@@ -173,7 +168,7 @@ def theta_max(*, gamma, d, delta, dps=30):
     >>> round(theta_max(gamma=0.0, d=0, delta=0.0324e-3 / 0.0128), 4)
     1.5725
     """
-    gamma, d, delta = _check(gamma, d, delta)
+    gamma, d, delta = check_loop(gamma, d, delta)
     f = alpha_numerator_function()
     # N_alpha ~ theta**3 near 0 out of terms of size 1: the extra digits keep
     # its sign right down to the first grid point, pi/n * 1e-10.
@@ -198,7 +193,7 @@ def theta_max(*, gamma, d, delta, dps=30):
 
 def theta_max_newton(*, d, delta):
     """theta_max for gamma = 0 by the one-step Newton form (approximate)."""
-    _, d, delta = _check(0.0, d, delta)
+    _, d, delta = check_loop(0.0, d, delta)
     # The Newton quotient cancels: evaluate at 30 digits from the exact
     # binary value of delta (a 15-digit Float lost up to 1e-7 at d = 100).
     with mpmath.workdps(30):
