@@ -274,7 +274,7 @@ def fig7():
     for g, color in zip(gammas, _COLORS):
         curve = boundary_curve(gamma=g, d=0, delta=DELTA, n=2000, segments=False)
         lim = limits(gamma=g, d=0, delta=DELTA, n_beta=101)
-        tag = "B" if g == 2.0 else ("S" if not lim.empty else "U")
+        tag = "U" if lim.empty else ("S, a thin sliver" if lim.z_width < 0.05 else "S")
         if not curve.empty:
             ax.plot(curve.beta, curve.alpha, "-", color=color, lw=1.5, label=fr"$\gamma$ = {g:g} ({tag})")
     points = []
@@ -294,7 +294,7 @@ def fig7():
     ax.set_xlim(-2.5, 2.2)
     ax.set_ylim(0, 4.5)
     _labels(ax)
-    ax.set_title(r"Fig. 7: boundaries for $d = 0$; S stable below, U no stable point, B the $\gamma$ = 2 case")
+    ax.set_title(r"Fig. 7: boundaries for $d = 0$; S: a stable region, U: none (root counting)")
     ax.legend(fontsize=8, loc="upper right")
     text = ", ".join(f"{k}: (beta {b:.4f}, alpha {a:.4f})" for k, b, a in points)
     return FigureResult(
@@ -365,23 +365,27 @@ def _fig_limits(name, title, gammas, paper, note):
         bm = np.array([np.nan if r.empty else r.beta_max for r in rows])
         am = np.array([np.nan if r.empty else r.alpha_max for r in rows])
         zw = np.array([r.z_width for r in rows])
+        # One log axis: at d = 10 alpha_max and the Z-width are 30 and 300
+        # times smaller than beta_max and would lie flat on a linear one.
+        ax.set_yscale("log")
         ax.plot(gammas, bm, "-", color=_COLORS[0], lw=1.8, label=r"$\beta_{\max}$")
         ax.plot(gammas, am, "--", color=_COLORS[1], lw=1.8, label=r"$\alpha_{\max}$")
-        ax.plot(gammas, zw, ":", color=_COLORS[3], lw=2.2, label="Z-width (area)")
+        ax.plot(gammas, np.where(zw > 0, zw, np.nan), ":", color=_COLORS[3], lw=2.2,
+                label="Z-width (area)")
         empty = np.array([r.empty for r in rows])
         if empty.any():
             ax.fill_between(gammas, 0, 1, where=empty, color="red", alpha=0.15,
                             transform=ax.get_xaxis_transform(), label="no stable region")
         ax.set_xlabel(r"$\gamma = M_w/m$")
-        ax.set_ylabel("dimensionless")
+        ax.set_ylabel("dimensionless (log scale)")
         ax.set_title(f"d = {d}")
         ax.legend(fontsize=7)
         k = int(np.nanargmax(am))
-        last = np.flatnonzero(~empty)[-1]
-        summary.append(f"d={d}: alpha_max peaks at {am[k]:.4g} (gamma {gammas[k]:.2f}); at "
-                       f"gamma {gammas[0]:g} Z-width {zw[0]:.3g}, alpha_max {am[0]:.3g}; last gamma "
-                       f"with a region {gammas[last]:.2f} (alpha_max {am[last]:.3g}, beta_max "
-                       f"{bm[last]:.3g}, Z-width {zw[last]:.3g})")
+        edge = np.flatnonzero(~empty)[0 if gammas[0] < 0 else -1]
+        summary.append(f"d={d}: alpha_max peaks at {am[k]:.4g} (gamma {gammas[k]:.2f}); "
+                       f"{'first' if gammas[0] < 0 else 'last'} gamma of the scan with a region "
+                       f"{gammas[edge]:.2f}: alpha_max {am[edge]:.3g}, beta_max {bm[edge]:.3g}, "
+                       f"Z-width {zw[edge]:.3g}")
     fig.suptitle(title, fontsize=10)
     fig.tight_layout()
     return FigureResult(name, title, fig, paper, "; ".join(summary) + "; " + note)
