@@ -14,7 +14,7 @@ import sympy as sp
 from symstab import model
 from symstab.boundary import boundary, coefficients
 from symstab.evaluate import boundary_point
-from symstab.limits import small_theta_limits
+from symstab.small_theta import small_theta_limits
 
 from ._common import DEVICE_DELTA, compare, show, where, with_printed_coefficients
 from .audit import Outcome, check

@@ -39,7 +39,7 @@ import sympy as sp
 from symstab import model
 from symstab._validate import check_loop
 from symstab.boundary import boundary
-from symstab.limits import small_theta_limits
+from symstab.small_theta import small_theta_limits
 from symstab.loop import characteristic_polynomial
 from symstab.stability import coefficients_at, stable_alpha_intervals, unstable_root_count
 from symstab.theta_max import theta_max
@@ -80,7 +80,7 @@ class InitialDirection:
     """How the arc leaves its starting point.
 
     Near theta = 0, ``beta = beta_start + beta_theta2 theta**2`` and
-    ``alpha = alpha_theta2 theta**2`` (:mod:`symstab.limits`).
+    ``alpha = alpha_theta2 theta**2`` (:mod:`symstab.small_theta`).
 
     Attributes
     ----------
@@ -143,7 +143,7 @@ def side(gamma, d, delta=DEFAULT_DELTA):
     """Return "right", "left" or "straight": the arc's initial direction.
 
     The sign of ``beta_theta2`` in ``beta = -delta + beta_theta2 theta**2``
-    (:func:`symstab.limits.small_theta_limits`); see :func:`initial_direction`
+    (:func:`symstab.small_theta.small_theta_limits`); see :func:`initial_direction`
     for the coefficients themselves.
 
     Parameters

@@ -10,7 +10,7 @@ The modules follow the data flow: :mod:`~symstab.model` (symbols, plant,
 environment) -> :mod:`~symstab.discretize` (ZOH pulse transfer function) ->
 :mod:`~symstab.loop` (characteristic polynomial) ->
 :mod:`~symstab.unit_circle` -> :mod:`~symstab.boundary` (alpha(theta),
-beta(theta), C-coefficients) -> :mod:`~symstab.limits`,
+beta(theta), C-coefficients) -> :mod:`~symstab.small_theta`,
 :mod:`~symstab.theta_max`; :mod:`~symstab.identity` is the exact equality
 checker and :mod:`~symstab.derive` writes everything out.
 
@@ -26,7 +26,7 @@ numeric API builds on those: :mod:`~symstab.units` (:class:`Device`),
 from .boundary import boundary, coefficients
 from .discretize import dimensionless_pulse_transfer_function, pulse_transfer_function
 from .identity import IdentityResult, assert_identity, check_identity
-from .limits import small_theta_limits
+from .small_theta import small_theta_limits
 from .loop import characteristic_polynomial
 from .model import dimensionless_values
 from .theta_max import closed_form_d0, newton_form_gamma0, theta_max, theta_max_newton

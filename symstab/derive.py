@@ -22,7 +22,7 @@ from . import kernel_forms, model
 from .boundary import boundary, coefficients, beta_relations
 from .discretize import dimensionless_pulse_transfer_function, pulse_transfer_function
 from .identity import check_identity
-from .limits import small_theta_limits
+from .small_theta import small_theta_limits
 from .loop import characteristic_polynomial
 from .theta_max import closed_form_d0, newton_form_gamma0
 from .unit_circle import unit_circle_split

@@ -160,7 +160,7 @@ def theta_max(*, gamma, d, delta, dps=30):
     float
         theta_max in (0, pi]; ``pi`` when alpha does not return to zero
         before theta = pi, and ``nan`` when alpha < 0 just after theta = 0
-        (no arc enters alpha > 0; see :mod:`symstab.limits`), or when the
+        (no arc enters alpha > 0; see :mod:`symstab.small_theta`), or when the
         arc is shorter than ``1e-10 pi / n`` for the scan's ``n`` points.
 
     Examples

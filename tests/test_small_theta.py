@@ -1,4 +1,4 @@
-"""Tests of symstab.limits: the boundary near theta = 0.
+"""Tests of symstab.small_theta: the boundary near theta = 0.
 
 Oracle: alpha(theta), beta(theta) solved directly from eq. (2) with eqs. (1)
 and (4) (conftest.first_principles_boundary_point) at 80 digits and a tiny
@@ -11,7 +11,7 @@ import pytest
 import sympy as sp
 
 from symstab import model
-from symstab.limits import small_theta_limits
+from symstab.small_theta import small_theta_limits
 
 from conftest import PAPER_DELTA, assert_rel_close, first_principles_boundary_point
 
