@@ -136,7 +136,7 @@ def build_parser():
     p = sub.add_parser("reproduce", help="derive (with the drift check), audit and draw every "
                                          "figure; write index.md")
     p.add_argument("--out", default="reproduction", help="output directory (default: reproduction)")
-    p.add_argument("--workers", type=int, default=2, help="worker processes (default 2)")
+    p.add_argument("--workers", type=int, default=2, help="worker processes, >= 1 (default 2)")
     p.set_defaults(func=_cmd_reproduce)
     from . import cli_numeric, cli_simulate
 

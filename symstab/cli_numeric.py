@@ -325,26 +325,31 @@ def _cmd_classify(args):
 
 
 def _cmd_design(args):
-    from .region import best_virtual_mass
+    from .region import best_virtual_mass, limits
 
     setup = _resolve(args)
     print("searching gamma for the largest renderable stiffness ...", file=sys.stderr, flush=True)
     best = best_virtual_mass(d=setup.d, delta=setup.delta)
     rows = [("gamma (best)", best.gamma), ("beta at alpha_max", best.beta),
             ("alpha_max", best.alpha_max), ("alpha_max at gamma = 0", best.alpha_max_gamma0),
-            ("gain", best.gain)]
+            ("gain", best.gain), ("Z-width at the best gamma", best.z_width)]
     columns = ["quantity", "value"]
     if setup.physical:
         dev, u = setup.device, setup.units
+        area = dev.m**2 / dev.T**3
         physical = [(dev.mass(best.gamma), "M_w", u["M_w"]), (dev.damping(best.beta), "B_w", u["B_w"]),
                     (dev.stiffness(best.alpha_max), "K_max", u["K_w"]),
                     (dev.stiffness(best.alpha_max_gamma0), "K_max (M_w = 0)", u["K_w"]),
-                    (best.gain, "gain", "")]
+                    (best.gain, "gain", ""),
+                    (best.z_width * area, "Z-width", f"({u['B_w']})({u['K_w']})")]
         columns += ["physical", "physical value", "unit"]
         rows = [r + (label, value, unit) for r, (value, label, unit) in zip(rows, physical)]
     result = {"best": {k: v for k, v in dataclasses.asdict(best).items() if k not in ("d", "delta")}}
     notes = ["the virtual mass argument --gamma/--Mw is ignored: design searches over it"] \
         if (args.gamma is not None or args.Mw is not None) else []
+    if best.z_width < 0.05 * limits(gamma=0.0, d=setup.d, delta=setup.delta).z_width:
+        notes.append("the best gamma lies where the stable region is a thin sliver: the gain "
+                     "needs very precise tuning of the virtual mass and damping")
     _emit(setup, args.format, columns, rows, result=result, notes=notes, json_rows=False)
     return 0
 

@@ -58,16 +58,21 @@ def _nonideal(args, setup):
     return nonideal, x0
 
 
-def _write_atomic(path, data):
-    """Write bytes to ``path`` atomically, into an existing folder only."""
-    from .derive import write_bytes
-
+def _check_output(path, flag):
+    """Fail early, before any simulation, on an output path that cannot be written."""
     path = pathlib.Path(path)
     if path.is_dir():
-        raise ValueError(f"output {path} is a directory, expected a file name")
+        raise ValueError(f"{flag} {path} is a directory, expected a file name")
     folder = path.parent if str(path.parent) else pathlib.Path(".")
     if not folder.is_dir():
-        raise ValueError(f"output folder {folder} does not exist")
+        raise ValueError(f"{flag}: output folder {folder} does not exist")
+    return path
+
+
+def _write_atomic(path, data):
+    """Write bytes to ``path`` atomically (the folder was checked by :func:`_check_output`)."""
+    from .derive import write_bytes
+
     write_bytes(path, data)
 
 
@@ -85,18 +90,19 @@ def _point(args, setup):
 
 def _cmd_simulate(args):
     from .simulate import simulate
-    from .stability import spectral_radius
+    from .stability import MARGINAL, STABLE, UNSTABLE, classify, spectral_radius
 
     setup = _resolve(args)
     alpha, beta = _point(args, setup)
     nonideal, x0 = _nonideal(args, setup)
-    if args.out is not None and pathlib.Path(args.out).is_dir():
-        raise ValueError(f"--out {args.out} is a directory, expected a file name")
+    if args.out is not None:
+        _check_output(args.out, "--out")
     run = simulate(alpha=alpha, beta=beta, gamma=setup.gamma, d=setup.d,
                    delta=None if setup.physical else setup.delta, steps=args.steps, x0=x0,
                    device=setup.device, nonideal=nonideal, record=True)
     for line in setup.echo:
         print(line)
+    code = classify(alpha=alpha, beta=beta, gamma=setup.gamma, d=setup.d, delta=setup.delta)
     radius = spectral_radius(alpha=alpha, beta=beta, gamma=setup.gamma, d=setup.d, delta=setup.delta)
     verdict = "diverged (unstable)" if run.diverged else ("stable" if run.stable else "unstable")
     amp = run.amplitude
@@ -106,13 +112,14 @@ def _cmd_simulate(args):
     print(f"simulated {run.steps} periods from x0 = {x0:g}: {verdict}; max |x| per quarter: "
           + ", ".join(f"{a:.4g}" for a in amp))
     print(f"theory (ideal loop): spectral radius {radius:.12g} -> "
-          + ("stable" if radius < 1 else "unstable"))
+          + {STABLE: "stable", MARGINAL: "marginal", UNSTABLE: "unstable"}[code])
     if args.out is not None:
         k = np.arange(run.steps + 1)
         t = k * (setup.device.T if setup.physical else 1.0)
         buf = io.StringIO()
-        buf.write("k,t [s]," + ("x [rad]" if setup.physical and not args.linear else
-                                "x [m]" if setup.physical else "x") + "\n")
+        buf.write(("k,t [s]," if setup.physical else "k,t [T],")
+                  + ("x [rad]" if setup.physical and not args.linear else
+                     "x [m]" if setup.physical else "x") + "\n")
         np.savetxt(buf, np.column_stack([k, t, run.positions]), delimiter=",", fmt=["%d", "%.9g", "%.17g"])
         _write_atomic(args.out, buf.getvalue().encode())
         print(f"wrote the trajectory to {args.out}")
@@ -133,28 +140,33 @@ def _grid(text, name):
 
 
 def _cmd_map(args):
-    from .simulate import _progress_printer, default_horizon, stability_map
-    from .stability import STABLE, classify
+    from .simulate import default_horizon, progress_printer, stability_map
+    from .stability import MARGINAL, STABLE, classify
 
     setup = _resolve(args)
     nonideal, x0 = _nonideal(args, setup)
     alpha, beta = (np.atleast_1d(x) for x in stiffness_and_damping(args, setup, _grid))
-    out = pathlib.Path(args.out)
+    out = _check_output(args.out, "--out")
     if out.suffix not in (".csv", ".npz"):
         raise ValueError(f"--out must end in .csv or .npz, got {out}")
+    png_path = None
+    if not args.no_png:
+        png_path = _check_output(out.with_suffix(".png") if args.png is None else args.png, "--png")
     for line in setup.echo:
         print(line)
-    steps = args.steps or default_horizon(setup.d)
+    steps = default_horizon(setup.d) if args.steps is None else args.steps
     result = stability_map(alpha=alpha, beta=beta, gamma=setup.gamma, d=setup.d,
                            delta=None if setup.physical else setup.delta, steps=steps, x0=x0,
                            device=setup.device, nonideal=nonideal,
-                           progress=_progress_printer("simulating", steps))
+                           progress=progress_printer("simulating", steps))
     A, B = np.meshgrid(alpha, beta, indexing="ij")
-    exact = classify(alpha=A, beta=B, gamma=setup.gamma, d=setup.d, delta=setup.delta) == STABLE
+    code = classify(alpha=A, beta=B, gamma=setup.gamma, d=setup.d, delta=setup.delta)
+    exact = code == STABLE
     if out.suffix == ".npz":
         buf = io.BytesIO()
         np.savez(buf, alpha=alpha, beta=beta, stable=result.stable, growth=result.growth,
-                 exact_stable=exact, gamma=setup.gamma, d=setup.d, delta=setup.delta, steps=steps)
+                 exact_stable=exact, exact_code=code, gamma=setup.gamma, d=setup.d,
+                 delta=setup.delta, steps=steps)
         data = buf.getvalue()
     else:
         buf = io.StringIO()
@@ -163,32 +175,31 @@ def _cmd_map(args):
                                  result.growth.ravel()):
             buf.write(f"{a:.12g},{b:.12g},{int(s)},{int(e)},{g:.6g}\n")
         data = buf.getvalue().encode()
-    png = _png(args, setup, result, exact)
+    png = _png(args, setup, result, exact) if png_path is not None else None
     _write_atomic(out, data)
     written = [str(out)]
     if png is not None:
-        png_path = out.with_suffix(".png") if args.png is None else pathlib.Path(args.png)
         _write_atomic(png_path, png)
         written.append(str(png_path))
-    differ = int(np.count_nonzero(result.stable != exact))
+    decided = code != MARGINAL
+    differ = int(np.count_nonzero((result.stable != exact) & decided))
     print(f"{int(result.stable.sum())} of {result.stable.size} cells stable by simulation "
-          f"({steps} periods); {differ} differ from the exact classification of the ideal loop")
+          f"({steps} periods); {differ} of the {int(decided.sum())} cells that are not marginal "
+          f"differ from the root-counting classification of the ideal loop")
     print("wrote " + ", ".join(written))
     return 0
 
 
 def _png(args, setup, result, exact):
-    """The map as PNG bytes, or None without matplotlib (or with --no-png)."""
-    if args.no_png:
-        return None
+    """The map as PNG bytes, or None without matplotlib."""
+    from .curves import boundary_curve
+    from .figures import pyplot
+
     try:
-        import matplotlib
-        matplotlib.use("Agg")
-        import matplotlib.pyplot as plt
-    except ImportError:
+        plt = pyplot()
+    except ValueError:
         print("matplotlib is not installed: no PNG", file=sys.stderr)
         return None
-    from .curves import boundary_curve
 
     from matplotlib.colors import ListedColormap
 

@@ -25,7 +25,7 @@ from .region import StabilityRegion, limits
 from .simulate import PAPER_ENCODER_RESOLUTION, Nonidealities, stability_map
 from .units import PAPER_DEVICE
 
-__all__ = ["FigureResult", "FIGURES", "make_figures", "require_matplotlib"]
+__all__ = ["FigureResult", "FIGURES", "make_figures", "pyplot", "require_matplotlib"]
 
 DELTA = PAPER_DEVICE.delta
 #: The delays of Figs. 6, 8, 11 and 12.
@@ -53,7 +53,8 @@ def require_matplotlib():
                          "(or pip install matplotlib)") from None
 
 
-def _plt():
+def pyplot():
+    """matplotlib.pyplot with the Agg backend and the figures' style."""
     require_matplotlib()
     import matplotlib
     matplotlib.use("Agg")
@@ -82,7 +83,7 @@ def fig3():
     from . import model
     import sympy as sp
 
-    plt = _plt()
+    plt = pyplot()
     gammas = np.linspace(-1.0, 2.0, 121)
     exact = np.array([arc_end_angle(gamma=g, d=0, delta=DELTA) for g in gammas])
     form = sp.lambdify((model.gamma, model.delta, model.Gamma), closed_form_d0().theta_max, "mpmath")
@@ -113,7 +114,7 @@ def fig3():
 
 def fig4():
     """theta_max versus d, gamma = 0: exact and the Newton form (12)."""
-    plt = _plt()
+    plt = pyplot()
     import sympy as sp
     from . import model
     from .theta_max import newton_form_gamma0
@@ -144,7 +145,7 @@ def fig5():
     from . import model
     from paper_checks.printed import printed
 
-    plt = _plt()
+    plt = pyplot()
     curve = boundary_curve(gamma=0.0, d=0, delta=DELTA, n=400, segments=False)
     args = (model.theta, model.delta, model.Gamma)
     fa = sp.lambdify(args, printed("eq14.alpha").expr, "numpy")
@@ -224,7 +225,7 @@ def _overlay(ax, gammas, d, n, verdicts):
 
 def _fig_overlay(name, title, gammas, n, paper, claimed):
     """Boundaries over simulated areas; ``claimed[(gamma, d)]`` is the paper's S, U or B."""
-    plt = _plt()
+    plt = pyplot()
     fig, axes = plt.subplots(2, 2, figsize=(11, 8.5))
     verdicts = []
     for ax, d in zip(axes.ravel(), DELAYS):
@@ -238,9 +239,14 @@ def _fig_overlay(name, title, gammas, n, paper, claimed):
               for g, d, v, _ in verdicts if claimed[(g, d)] != v]
     verdict = ("every verdict agrees with the paper" if not differ
                else "differs from the paper at " + "; ".join(differ))
+    counted = {(g, d): "U" if limits(gamma=g, d=d, delta=DELTA, n_beta=21).empty else "S"
+               for g, d, _, _ in verdicts}
+    split = [f"gamma {g:g}, d {d}" for g, d, v, _ in verdicts if counted[(g, d)] != v]
+    check = ("root counting (symstab.limits) gives the same verdicts" if not split
+             else "root counting disagrees with the simulation at " + ", ".join(split))
     return FigureResult(name, title, fig, paper,
                         "simulated verdicts (S: some stable cell, U: none): " + text + "; " + verdict
-                        + ". The exact classification (root counting, REPORT.md) gives the same verdicts.")
+                        + "; " + check + ".")
 
 
 def fig6(n=100):
@@ -268,7 +274,7 @@ def fig8(n=100):
 
 def fig7():
     """Boundaries for gamma 0 .. 3 at d = 0 with the numbered points."""
-    plt = _plt()
+    plt = pyplot()
     fig, ax = plt.subplots(figsize=(7.5, 5.5))
     gammas = (0.0, 0.5, 1.0, 1.5, 2.0, 2.5, 3.0)
     for g, color in zip(gammas, _COLORS):
@@ -302,13 +308,15 @@ def fig7():
         "circles 1-6: alpha_max 0.6896 at beta 0.8206 (gamma 0); alpha 2 at beta 0, gamma 1; "
         "alpha ~3 at beta -1, gamma 1.5; alpha ~4 at beta -2, gamma 2; at beta = -0.5, gamma 1.5 "
         "the largest (5) and the smallest (6) stable alpha; gamma = 2 is a boundary case.",
-        f"circles {text}. Circle 1 is at beta 0.8279, not 0.8206; at gamma = 2 the region is a "
-        f"thin stable sliver (Z-width {lim2.z_width:.4f}), not a line.")
+        f"circles {text}. Circle 1 is at beta {lim0.beta_at_alpha_max:.4f}, not 0.8206 "
+        f"(alpha_max {lim0.alpha_max:.5f}); at gamma = 2 the region is "
+        + (f"a thin stable sliver (Z-width {lim2.z_width:.4f}), not a line." if not lim2.empty
+           else "empty."))
 
 
 def fig10(n=40):
     """Physical units at Td = 40 ms: theory and simulations, ideal and quantized + filtered."""
-    plt = _plt()
+    plt = pyplot()
     dev, d = PAPER_DEVICE, 40
     qf = Nonidealities(encoder_resolution=PAPER_ENCODER_RESOLUTION, velocity_cutoff=50.0)
     fig, axes = plt.subplots(2, 2, figsize=(11, 8.5))
@@ -349,17 +357,23 @@ def fig10(n=40):
         "fig10_physical_td40", "physical units at Td = 40 ms, M_w = -0.5m, 0, 0.5m, m", fig,
         "theory against simulations (ideal; quantization + filter; PI controller high/low gains) and "
         "experiments; PI(-), QF(+) gives a lower K_max than the theory.",
-        f"{text} (grid {n} x {n}, so K and B are resolved to one cell). The ideal simulation "
-        "fills the theory; quantization (3 arc seconds) with the 50 Hz velocity filter lowers K_max, "
-        "as the paper reports. The PI current-controller runs and the experiments are not modelled. "
-        "At M_w = m the arc of eq. (7) encloses more than the stable set, which is the band along "
-        "its upper edge (the lower edge is another part of the boundary).")
+        f"{text} (grid {n} x {n}, so K and B are resolved to one cell). "
+        + ("The ideal simulation reaches the theoretical K_max within two cells in every panel; "
+           if all(abs(ki - kt) <= 2.5 * kt / n for _, kt, ki, _, _, _ in found)
+           else "The ideal simulation falls short of the theoretical K_max by more than two cells; ")
+        + ("quantization (3 arc seconds) with the 50 Hz velocity filter lowers K_max in every panel, "
+           "as the paper reports. " if all(kq < ki for _, _, ki, kq, _, _ in found)
+           else "quantization with the 50 Hz filter does not lower K_max in every panel, unlike the "
+                "paper's report. ")
+        + "The PI current-controller runs and the experiments are not modelled. At M_w = m the arc "
+          "of eq. (7) encloses more than the stable set, which is the band along its upper edge "
+          "(the lower edge is another part of the boundary).")
 
 
 def _fig_limits(name, title, gammas, paper, note):
-    plt = _plt()
+    plt = pyplot()
     fig, axes = plt.subplots(2, 2, figsize=(11, 8.5))
-    summary = []
+    summary, facts = [], []
     for ax, d in zip(axes.ravel(), DELAYS):
         rows = [limits(gamma=g, d=d, delta=DELTA, n_beta=101) for g in gammas]
         bm = np.array([np.nan if r.empty else r.beta_max for r in rows])
@@ -382,13 +396,14 @@ def _fig_limits(name, title, gammas, paper, note):
         ax.legend(fontsize=7)
         k = int(np.nanargmax(am))
         edge = np.flatnonzero(~empty)[0 if gammas[0] < 0 else -1]
+        facts.append(dict(d=d, am=am, bm=bm, zw=zw, edge=edge, empty=empty))
         summary.append(f"d={d}: alpha_max peaks at {am[k]:.4g} (gamma {gammas[k]:.2f}); "
                        f"{'first' if gammas[0] < 0 else 'last'} gamma of the scan with a region "
                        f"{gammas[edge]:.2f}: alpha_max {am[edge]:.3g}, beta_max {bm[edge]:.3g}, "
                        f"Z-width {zw[edge]:.3g}")
     fig.suptitle(title, fontsize=10)
     fig.tight_layout()
-    return FigureResult(name, title, fig, paper, "; ".join(summary) + "; " + note)
+    return FigureResult(name, title, fig, paper, "; ".join(summary) + "; " + note(facts))
 
 
 def fig11():
@@ -397,9 +412,14 @@ def fig11():
     return _fig_limits("fig11_limits_negative_mass", "Fig. 11: limits versus gamma <= 0", gammas,
                        "beta_max, alpha_max and Z-width decrease continuously as gamma goes from 0 "
                        "to -1, where all are zero.",
-                       "all three decrease towards gamma = -1, but at gamma = -1 they are tiny, not "
-                       "zero: a region exists while gamma > -1 - (d + 1) delta (REPORT.md, "
-                       "claim:no_region_gamma_le_-1).")
+                       lambda facts: (
+                           ("all three decrease towards gamma = -1" if all(
+                               np.all(np.diff(f["am"]) > 0) and np.all(np.diff(f["zw"]) > 0)
+                               for f in facts) else "they do not all decrease monotonically")
+                           + ("; at gamma = -1 they are tiny, not zero: a region exists while "
+                              "gamma > -1 - (d + 1) delta (REPORT.md, claim:no_region_gamma_le_-1)"
+                              if all(f["zw"][0] > 0 for f in facts) else "; at gamma = -1 they are 0")
+                           + "."))
 
 
 def fig12():
@@ -409,9 +429,13 @@ def fig12():
                        "d = 0: largest gamma 2, beta_max falls from gamma 0 to 2; alpha_max and "
                        "Z-width rise, then fall; for d > 0 the Z-width reaches zero while beta_max "
                        "and alpha_max do not.",
-                       "the Z-width rises then falls to zero for every d, and where the region "
-                       "disappears beta_max and alpha_max are still nonzero, as the paper says; at "
-                       "d = 0 the region lasts slightly past gamma = 2 (a thin sliver).")
+                       lambda facts: "; ".join(
+                           f"d={f['d']}: the Z-width "
+                           + ("rises, then falls" if np.nanargmax(f["zw"]) > 0 else "falls")
+                           + (" to zero" if f["empty"][-1] else "")
+                           + ("; where the region ends beta_max and alpha_max are still nonzero"
+                              if f["bm"][f["edge"]] > 0 and f["am"][f["edge"]] > 0 else "")
+                           for f in facts) + ".")
 
 
 #: Every figure, in the paper's order.
@@ -425,7 +449,7 @@ def make_figures(out_dir, progress=None):
     """
     from .derive import write_bytes
 
-    plt = _plt()
+    plt = pyplot()
     out = pathlib.Path(out_dir)
     results = []
     for make in FIGURES:

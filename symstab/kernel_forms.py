@@ -53,8 +53,8 @@ __all__ = [
 ]
 
 #: Below this delta, :class:`exprel3` is evaluated from its Taylor series.
-#: Above it the closed form cancels by at most exp(1) / (exp(1) - 2.5), about
-#: 8, in relative terms; at 1/2 it would be about 27.
+#: Above it the closed form cancels by at most (e - 1) / (e - 2.5), about 8,
+#: in relative terms; at 1/2 it would be about 27.
 EXPREL3_SWITCH = sp.Integer(1)
 #: Terms of the series: the first neglected one, delta**17 / 20!, is below
 #: 2**-53 relative to phi3 >= 1/6 for delta < 1.

@@ -250,7 +250,9 @@ class StabilityRegion:
             probes_b += [b, b, b + eb, b - eb]
         # The Schur-Cohn verdicts alone: these probes sit next to the
         # boundary, where the eigenvalue refinement of every one would cost
-        # 20 s at d = 200, and a wrong verdict would only widen the search.
+        # 20 s at d = 200.  Where the margin is positive they never disagreed
+        # with the eigenvalues in the tests (tests/test_classify.py); a false
+        # "unstable" here would drop arc segments near the region.
         code = classify(alpha=np.concatenate(probes_a), beta=np.concatenate(probes_b),
                         gamma=self.gamma, d=self.d, delta=self.delta, refine=False)
         touching = np.zeros(len(self._alpha), dtype=bool)
@@ -297,24 +299,28 @@ class StabilityRegion:
         -------
         tuple of :class:`symstab.curves.Segment`
         """
-        window = self._beta_window()
-        if window is None:
+        extent = self.beta_range()
+        if extent is None:
             return ()
-        lo, hi = window
+        lo, hi = extent
         pad = 0.05 * (hi - lo) + self.delta
         out = []
         # z = 1: the beta where a point just above alpha = 0 is stable.
         betas = np.linspace(lo - pad, hi + pad, 2001)
+        step = betas[1] - betas[0]
         eps = _PROBE * max(self._alpha[self._touching].max(), self.delta)
         above = np.asarray(classify(alpha=eps, beta=betas, gamma=self.gamma, d=self.d,
                                     delta=self.delta)) == STABLE
-        ends = self._corners()
+        # The exact corners on alpha = 0: where the arc or the z = -1 line meets it.
+        ends = np.concatenate([self._corners(), [self.minus_one / 2]])
+
+        def snap(b):
+            near = ends[np.argmin(np.abs(ends - b))]
+            return near if abs(near - b) <= 2 * step else b
+
         for run in _runs(above):
-            b0, b1 = betas[run[0]], betas[run[1]]
-            # Snap to where the arc meets alpha = 0: the exact corners.
-            b0 = ends[np.argmin(np.abs(ends - b0))] if ends.size else b0
-            b1 = ends[np.argmin(np.abs(ends - b1))] if ends.size else b1
-            out.append(Segment("z=1", float(b0), 0.0, float(b1), 0.0))
+            out.append(Segment("z=1", float(snap(betas[run[0]])), 0.0,
+                               float(snap(betas[run[1]])), 0.0))
         # z = -1: alpha + 2 beta = c, stable on one side only.
         line_alpha = self.minus_one - 2 * betas
         e = _PROBE * (np.abs(line_alpha) + self.delta)
@@ -346,7 +352,12 @@ class StabilityRegion:
             if not math.isfinite(outside):
                 return math.inf, math.nan
         alpha_max, at_top = self._last_meeting("alpha", inside, outside)
-        at_top = at_top or self._intervals("alpha", [alpha_max])[0]
+        at_top = at_top or self._intervals("alpha", [alpha_max], closure=True)[0]
+        if not at_top:
+            return float(alpha_max), math.nan
+        # The run the search ended on touches the top: its middle is the
+        # top's beta (to within the marginal band; limits() clamps it into
+        # the beta range).
         return float(alpha_max), float(0.5 * (at_top[0][0] + at_top[-1][1]))
 
     def _alpha_max_from_scan(self, n_beta=801):
@@ -399,6 +410,7 @@ class StabilityRegion:
         if not math.isfinite(alpha_max):
             return Limits(self, math.inf, math.nan, beta_range[1], beta_range[0], math.inf,
                           "the stable region is unbounded in alpha")
+        beta_at = min(max(beta_at, beta_range[0]), beta_range[1])
         return Limits(self, alpha_max, beta_at, beta_range[1], beta_range[0],
                       self.z_width(*beta_range, n_beta=n_beta), "")
 
@@ -517,14 +529,21 @@ class BestVirtualMass:
 
     Attributes
     ----------
-    gamma, beta : float
+    gamma, beta : float or None
         The best ``M_w / m`` and the damping at which alpha_max is reached.
-    alpha_max : float
-        alpha_max at that gamma.
-    alpha_max_gamma0 : float
+    alpha_max : float or None
+        alpha_max at that gamma (a supremum of the stable region).
+    alpha_max_gamma0 : float or None
         alpha_max with no virtual mass.
-    gain : float
+    gain : float or None
         ``alpha_max / alpha_max_gamma0``.
+    z_width : float
+        Area of the stable region at the best gamma: how much room there is.
+        At d = 0 the optimum lies where the region shrinks to nothing (near
+        gamma = 2); the gain is real but needs very precise tuning, as the
+        paper says.
+    message : str
+        Empty, or why there is no result (no gamma of the range has a region).
     """
 
     d: int
@@ -534,6 +553,8 @@ class BestVirtualMass:
     alpha_max: float
     alpha_max_gamma0: float
     gain: float
+    z_width: float = 0.0
+    message: str = ""
 
 
 def _alpha_max(gamma, d, delta):
@@ -547,11 +568,18 @@ def best_virtual_mass(*, d, delta, gamma_range=None, n=17):
     alpha_max(gamma) is scanned on ``n`` points of ``gamma_range`` (default
     from just above ``-1 - (d + 1) delta``, below which no arc exists, to 3)
     and the best scan point is refined by a golden-section search between
-    its neighbours.
+    its neighbours, to 1e-6 in gamma.
 
     Returns
     -------
     BestVirtualMass
+        With ``None`` values and a message when no gamma of the range has a
+        stable region.
+
+    Raises
+    ------
+    TypeError, ValueError
+        For bad ``d``, ``delta``, ``gamma_range`` or ``n``.
 
     Examples
     --------
@@ -560,6 +588,8 @@ def best_virtual_mass(*, d, delta, gamma_range=None, n=17):
     True
     """
     _, d, delta = check_loop(0.0, d, delta)
+    if isinstance(n, bool) or not isinstance(n, (int, np.integer)) or n < 3:
+        raise ValueError(f"n must be an integer >= 3, got {n!r}")
     if gamma_range is None:
         gamma_range = (-1.0 - (d + 1) * delta + 1e-3, 3.0)
     g_lo, g_hi = (check_real("gamma_range[0]", gamma_range[0]), check_real("gamma_range[1]", gamma_range[1]))
@@ -567,6 +597,9 @@ def best_virtual_mass(*, d, delta, gamma_range=None, n=17):
         raise ValueError(f"gamma_range must be increasing, got {gamma_range!r}")
     gammas = np.linspace(g_lo, g_hi, n)
     values = [_alpha_max(g, d, delta)[0] for g in gammas]
+    if not np.isfinite(values).any():
+        return BestVirtualMass(d, delta, None, None, None, None, None, 0.0,
+                               f"no gamma in [{g_lo:g}, {g_hi:g}] has a stable region at d = {d}")
     k = int(np.argmax(values))
     a, b = gammas[max(k - 1, 0)], gammas[min(k + 1, n - 1)]
     ratio = (math.sqrt(5) - 1) / 2
@@ -581,8 +614,12 @@ def best_virtual_mass(*, d, delta, gamma_range=None, n=17):
             b, x2, f2 = x2, x1, f1
             x1 = b - ratio * (b - a)
             f1 = _alpha_max(x1, d, delta)[0]
-    best_gamma = 0.5 * (a + b)
-    alpha_best, beta_best = _alpha_max(best_gamma, d, delta)
+    # The best point seen: at the edge where the region vanishes the middle
+    # of the last bracket may already have no region.
+    candidates = [(values[k], gammas[k]), (f1, x1), (f2, x2)]
+    _, best_gamma = max(candidates)
+    region = StabilityRegion(gamma=best_gamma, d=d, delta=delta)
+    best = region.limits(n_beta=201)
     alpha_zero = _alpha_max(0.0, d, delta)[0]
-    return BestVirtualMass(d, delta, float(best_gamma), float(beta_best), float(alpha_best),
-                           float(alpha_zero), float(alpha_best / alpha_zero))
+    return BestVirtualMass(d, delta, float(best_gamma), best.beta_at_alpha_max, best.alpha_max,
+                           float(alpha_zero), float(best.alpha_max / alpha_zero), best.z_width)

@@ -16,8 +16,10 @@ Stages, each reported with its time:
 
 import concurrent.futures
 import io
+import os
 import pathlib
 import sys
+import tempfile
 import time
 
 __all__ = ["reproduce", "render_index"]
@@ -36,7 +38,7 @@ def _audit_task():
 def _figure_task(name):
     from . import figures
 
-    plt = figures._plt()
+    plt = figures.pyplot()
     start = time.perf_counter()
     result = getattr(figures, name)()
     buf = io.BytesIO()
@@ -54,13 +56,15 @@ def _derive(out, log):
     derive.write(out / "derivations", files)
     derive.write(out / "generated", code)
     package_code = pathlib.Path(__file__).parent / "_generated"
-    drift = derive.check(package_code, code, owned=codegen.OWNED)
+    drift = [f"symstab/_generated/{pathlib.Path(p).name}"
+             for p in derive.check(package_code, code, owned=codegen.OWNED)]
     checkout = pathlib.Path("derivations") / "generated"
     if checkout.is_dir():
         drift += derive.check(checkout, files)
-        where = f"{package_code} and {checkout}"
+        where = "the installed package's symstab/_generated and derivations/generated"
     else:
-        where = f"{package_code} (no derivations/generated here: not a source checkout)"
+        where = ("the installed package's symstab/_generated (no derivations/generated here: "
+                 "not a source checkout)")
     for path in drift:
         log(f"  drift: {path} differs from a fresh derivation; run `symstab derive`")
     return drift, where
@@ -99,23 +103,42 @@ def render_index(results, verdicts, drift, where):
 
 
 def reproduce(out_dir, *, workers=2, log=None):
-    """Run every stage into ``out_dir``; return the index path.
+    """Run every stage into ``out_dir``; return ``(index path, drifted files)``.
 
-    ``log(line)`` receives progress lines (default: print to stderr).
+    Everything is built in a temporary folder beside ``out_dir`` and moved
+    into it only when every stage has succeeded, so a failure leaves
+    ``out_dir`` as it was.  ``log(line)`` receives progress lines (default:
+    print to stderr).
     """
-    from .derive import write, write_bytes
-
     from .figures import require_matplotlib
 
     log = log or (lambda line: print(line, file=sys.stderr, flush=True))
     out = pathlib.Path(out_dir)
     if out.exists() and not out.is_dir():
         raise ValueError(f"--out must be a directory, got file {out}")
+    if isinstance(workers, bool) or not isinstance(workers, int) or workers < 1:
+        raise ValueError(f"workers must be an integer >= 1, got {workers!r}")
     require_matplotlib()
     try:
         import paper_checks.audit  # noqa: F401
     except ImportError as exc:  # pragma: no cover - packaging problem
         raise ValueError(f"the paper_checks package is not installed ({exc})") from None
+    parent = out.resolve().parent
+    parent.mkdir(parents=True, exist_ok=True)
+    with tempfile.TemporaryDirectory(dir=parent, prefix=f".{out.name}.") as tmp:
+        index, drift = _run(pathlib.Path(tmp), workers, log)
+        for path in sorted(pathlib.Path(tmp).rglob("*")):
+            if path.is_file():
+                target = out / path.relative_to(tmp)
+                target.parent.mkdir(parents=True, exist_ok=True)
+                os.replace(path, target)
+    log(f"reproduced into {out}: index.md, REPORT.md, figures/")
+    return out / index.name, drift
+
+
+def _run(out, workers, log):
+    from .derive import write, write_bytes
+
     total = time.perf_counter()
     timings = []
     log("[1/3] derive: derivation steps, proofs and generated kernels ...")
@@ -133,8 +156,7 @@ def reproduce(out_dir, *, workers=2, log=None):
             if future is audit_future:
                 report, as_json, verdicts = future.result()
                 write(out, {"REPORT.md": report, "audit.json": as_json})
-                log(f"      audit: {len(verdicts)} checks -> {out / 'REPORT.md'} "
-                    f"({time.perf_counter() - start:.0f} s)")
+                log(f"      audit: {len(verdicts)} checks ({time.perf_counter() - start:.0f} s)")
                 continue
             result, png, seconds = future.result()
             write_bytes(out / "figures" / f"{result.name}.png", png)
@@ -146,9 +168,7 @@ def reproduce(out_dir, *, workers=2, log=None):
 
     ordered = [results[f.__name__] for f in figures.FIGURES]
     log("[3/3] index ...")
-    timings.append(("total", time.perf_counter() - total))
     write(out, {"index.md": render_index(ordered, verdicts, drift, where)})
+    timings.append(("total", time.perf_counter() - total))
     log("timings: " + ", ".join(f"{name} {seconds:.1f} s" for name, seconds in timings))
-    log(f"reproduced into {out} in {timings[-1][1]:.0f} s: index.md, REPORT.md, "
-        f"{len(ordered)} figures")
     return out / "index.md", drift

@@ -53,7 +53,7 @@ from ._generated import kernels
 from ._validate import check_array, check_delay, check_real
 
 __all__ = ["Nonidealities", "Simulation", "simulate", "StabilityMap", "stability_map",
-           "default_horizon", "PAPER_ENCODER_RESOLUTION"]
+           "default_horizon", "progress_printer", "PAPER_ENCODER_RESOLUTION"]
 
 #: The paper's encoder: better than 3 arc seconds after quadrature and gear
 #: train (Section VI), in rad.
@@ -161,7 +161,7 @@ class Simulation:
     steps: int
 
 
-def _progress_printer(label, total, stream=sys.stderr, min_seconds=2.0):
+def progress_printer(label, total, stream=sys.stderr, min_seconds=2.0):
     """A callback ``(done)`` that draws a bar once a run takes longer than ``min_seconds``."""
     start = time.perf_counter()
     state = {"last": 0.0}
@@ -276,7 +276,6 @@ class _Loop:
         self.sub = nonideal.substeps if self.inner else 1
         phi01, phi11, g0, g1 = kernels.plant_step_coefficients(delta / self.sub)
         self.phi01, self.phi11, self.g0, self.g1 = (float(c) for c in (phi01, phi11, g0, g1))
-        self.device = device
         if device is not None:
             force_scale = device.T**2 / device.m   # physical force -> f T^2 / m
             self.coulomb = (nonideal.coulomb_friction or 0.0) * force_scale
@@ -295,7 +294,6 @@ class _Loop:
             self.filter_pole = self.lag = None
         self.v_hat = np.zeros(n)          # filtered velocity estimate (times T)
         self.applied = np.zeros(n)        # actuator output
-        self.x_prev_sample = self.history[0].copy()
 
     def _sample(self, x):
         q = self.nonideal.encoder_resolution
@@ -426,7 +424,7 @@ def stability_map(*, alpha, beta, gamma, d, delta, steps=None, x0=1.0, v0=None, 
     d = check_delay(d)
     total = default_horizon(d) if steps is None else steps
     if progress is True:
-        progress = _progress_printer("simulating", total)
+        progress = progress_printer("simulating", total)
     A, B = np.meshgrid(alpha, beta, indexing="ij")
     run = simulate(alpha=A, beta=B, gamma=gamma, d=d, delta=delta, steps=steps, x0=x0, v0=v0,
                    device=device, nonideal=nonideal, progress=progress)

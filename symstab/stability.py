@@ -1,4 +1,4 @@
-"""Stability of parameter points: spectral radius and exact classification.
+"""Stability of parameter points: spectral radius and root-counting classification.
 
 A parameter point is stable when every root of the characteristic polynomial
 chi(z) lies strictly inside the unit circle.  The vectorised functions here
@@ -302,8 +302,10 @@ def stable_alpha_intervals(*, beta, gamma, d, delta, alpha_low=-1.0, alpha_high=
 
     ``alpha`` is scanned on ``n`` points of ``[alpha_low, alpha_high]``;
     each change of stability is refined by bisection on the spectral radius
-    to ``xtol``.  (:meth:`symstab.region.StabilityRegion.alpha_intervals`
-    finds the same intervals from the boundary curves without a scan.)
+    (roots of the 30-digit coefficients) to ``xtol``.  It is slow and
+    independent of the generated kernels;
+    :meth:`symstab.region.StabilityRegion.alpha_intervals` finds the same
+    intervals from the boundary curves, fast and without a scan.
 
     Returns
     -------
@@ -311,10 +313,13 @@ def stable_alpha_intervals(*, beta, gamma, d, delta, alpha_low=-1.0, alpha_high=
         The stable intervals, in increasing order; empty when none.
     """
     def rho(a):
-        return spectral_radius(alpha=float(a), beta=beta, gamma=gamma, d=d, delta=delta) - 1.0
+        # The 30-digit coefficients and numpy's roots, not the generated
+        # kernels: the audit uses this as a reference independent of them.
+        coeffs = coefficients_at(alpha=float(a), beta=beta, gamma=gamma, d=d, delta=delta)
+        return float(np.max(np.abs(np.roots(coeffs)))) - 1.0
 
     grid = np.linspace(alpha_low, alpha_high, n)
-    stable = list(spectral_radius(alpha=grid, beta=beta, gamma=gamma, d=d, delta=delta) < 1.0)
+    stable = [rho(a) < 0 for a in grid]
     edges = []
     for k in range(1, n):
         if stable[k] != stable[k - 1]:

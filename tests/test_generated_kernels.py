@@ -535,3 +535,29 @@ def test_c_environment_force_matches_numpy(c_kernels, simulator_points):
     c = np.array([function(*(float(a) for a in point)) for point in zip(*args)])
     _assert_all_below(_mixed_error(c, numpy_kernels.environment_force(*args)), C_VS_NUMPY_RTOL,
                       {k: p[k] for k in names}, "force, C vs NumPy")
+
+
+# --------------------------------------------------------------------------
+# Dense grids, zeros of alpha and beta included
+
+
+@pytest.mark.parametrize("gamma, d, delta", [(0.0, 0, PAPER_DELTA), (1.0, 10, PAPER_DELTA),
+                                             (0.5, 200, 1e-6), (-0.5, 5, 1.0)])
+def test_boundary_on_a_dense_grid_mixed_error(gamma, d, delta):
+    """200 angles from 1e-4 to theta_max, where beta changes sign and alpha ends at 0.
+
+    At a zero of alpha or beta no floating-point evaluation is relatively
+    accurate (the condition number is infinite there: theta itself is rounded),
+    so the bound is mixed: |error| <= 1e-10 |value| + 1e-14 max|value on the arc|.
+    """
+    t_end = theta_max(gamma=gamma, d=d, delta=delta)
+    thetas = np.linspace(1e-4, t_end, 200)
+    alpha, beta = numpy_kernels.boundary(thetas, gamma, d, delta)
+    refs = [boundary_point(float(t), gamma=gamma, d=d, delta=delta, dps=50) for t in thetas]
+    ra = np.array([float(a) for a, _ in refs])
+    rb = np.array([float(b) for _, b in refs])
+    for name, got, ref in (("alpha", alpha, ra), ("beta", beta, rb)):
+        bound = 1e-10 * np.abs(ref) + 1e-14 * np.max(np.abs(ref))
+        worst = int(np.argmax(np.abs(got - ref) - bound))
+        assert np.all(np.abs(got - ref) <= bound), (
+            f"{name} at theta = {thetas[worst]!r}: {got[worst]!r} vs {ref[worst]!r}")
