@@ -260,6 +260,8 @@ def _cmd_limits(args):
             damping = float(setup.device.beta(args.Bw))
         else:
             damping = args.beta
+        from ._validate import check_real
+        damping = check_real("beta", damping)
         runs = [] if lim.empty else lim.alpha_interval(damping)
         text = ", ".join(f"[{lo:.10g}, {hi:.10g}]" for lo, hi in runs) or "none"
         notes.append(f"stable alpha at beta = {damping:.10g}: {text}")

@@ -210,7 +210,9 @@ def boundary_curve(*, gamma, d, delta, n=1000, segments=True):
     (0.0, -0.00253125, 1.5725)
     """
     gamma, d, delta = check_loop(gamma, d, delta)
-    if isinstance(n, bool) or not isinstance(n, (int, np.integer)) or n < 2:
+    if isinstance(n, bool) or not isinstance(n, (int, np.integer)):
+        raise TypeError(f"n must be an integer >= 2, got {type(n).__name__}")
+    if n < 2:
         raise ValueError(f"n must be an integer >= 2, got {n!r}")
     t_end = arc_end_angle(gamma=gamma, d=d, delta=delta)
     if not np.isfinite(t_end):

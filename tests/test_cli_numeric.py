@@ -168,7 +168,15 @@ def test_map_writes_npz_and_png_matching_the_exact_classification(capsys, tmp_pa
     A, B = np.meshgrid(alpha, beta, indexing="ij")
     exact = symstab.classify(alpha=A, beta=B, gamma=0.0, d=1, delta=PAPER_DELTA) == symstab.STABLE
     assert stable.shape == (12, 12) and 0 < exact.sum() < 144
-    assert np.count_nonzero(stable != exact) <= 4  # only cells next to the boundary
+    # Where the simulation disagrees, a neighbouring cell has the other exact
+    # verdict: the boundary passes next to it (or it is on alpha = 0, marginal).
+    code = symstab.classify(alpha=A, beta=B, gamma=0.0, d=1, delta=PAPER_DELTA)
+    padded = np.pad(exact, 1, mode="edge")
+    mixed = np.zeros_like(exact)
+    for da, db in ((0, 1), (2, 1), (1, 0), (1, 2)):
+        mixed |= padded[da:da + 12, db:db + 12] != exact
+    differ = (stable != exact) & (code != symstab.MARGINAL)
+    assert not np.any(differ & ~mixed), np.argwhere(differ & ~mixed)
     assert (tmp_path / "m.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
 
 

@@ -24,13 +24,9 @@ on 801 verticals); the 400 x 400 grid for gamma = 1.5, d = 0 agrees with
 alpha_max within 0.3 cell, with the beta range within 0.6 cell and with the
 area to 0.2 % (0.036 of the edge cells' area).
 
-Known failure (this revision): at the gamma best_virtual_mass returns for
-d = 0 (2.00333), the stable region is a sliver about 2e-7 wide in alpha, and
-it continues ~4.4e-6 in beta past where StabilityRegion stops: the
-first-principles roots give radius 1 - 4.9e-6 at (beta, alpha) =
-(-2.0100449, 4.0134240), while alpha_max = 4.0134152 (2.2e-6 relative too
-low) and beta_min = -2.0100406.  See
-test_alpha_max_at_the_best_gamma_is_the_top_of_the_region.
+The sliver at the gamma best_virtual_mass returns for d = 0 (about 2e-7 wide
+in alpha) was once missed by the region's probes (alpha_max 2.2e-6 too low);
+test_alpha_max_at_the_best_gamma_is_the_top_of_the_region guards it.
 """
 
 import functools
@@ -172,9 +168,12 @@ def test_boundary_curve_with_1e5_points():
             assert abs(c.beta[k] - b) <= 1e-10 * abs(b)
 
 
-@pytest.mark.parametrize("n", [1, 0, -3, 2.5, 10.0, "10", True, None])
-def test_boundary_curve_rejects_bad_n(n):
-    with pytest.raises(ValueError) as excinfo:
+@pytest.mark.parametrize("n, error", [(1, ValueError), (0, ValueError), (-3, ValueError),
+                                      (2.5, TypeError), (10.0, TypeError), ("10", TypeError),
+                                      (True, TypeError), (None, TypeError)])
+def test_boundary_curve_rejects_bad_n(n, error):
+    """Wrong kinds are TypeError, wrong values ValueError (the project's convention)."""
+    with pytest.raises(error) as excinfo:
         boundary_curve(gamma=0.0, d=0, delta=PAPER_DELTA, n=n, segments=False)
     assert_message_names(excinfo, "n")
 
