@@ -60,6 +60,8 @@ __all__ = ["Nonidealities", "Simulation", "simulate", "StabilityMap", "stability
 PAPER_ENCODER_RESOLUTION = math.radians(3 / 3600)
 #: |x| above this is divergence: the run stops for that point.
 _OVERFLOW = 1e100
+#: Periods between overflow checks.
+_CHECK_EVERY = 8
 
 
 @dataclasses.dataclass(frozen=True)
@@ -235,6 +237,8 @@ def simulate(*, alpha, beta, gamma, d, delta, steps=None, x0=1.0, v0=None, devic
     x0 = check_real("x0", x0)
     v0 = x0 / 100 if v0 is None else check_real("v0", v0)
     run = _Loop(alpha, beta, gamma, d, delta, x0, v0, device, nonideal)
+    # Recorded positions must never hold an overflowed value: check every period then.
+    run.check_every = 1 if record else _CHECK_EVERY
     quarter = steps // 4
     amplitude = np.zeros((4, alpha.size))
     positions = np.empty((steps + 1, alpha.size)) if record else None
@@ -242,13 +246,15 @@ def simulate(*, alpha, beta, gamma, d, delta, steps=None, x0=1.0, v0=None, devic
         positions[0] = run.x
     report = max(1, steps // 100)
     for k in range(steps):
-        run.step()
+        with np.errstate(over="ignore", invalid="ignore"):
+            run.step()
         q = min(k // quarter, 3)
         np.maximum(amplitude[q], np.abs(run.x), out=amplitude[q])
         if record:
             positions[k + 1] = run.x
         if progress is not None and ((k + 1) % report == 0 or k + 1 == steps):
             progress(k + 1)
+    run.freeze_diverged()
     amplitude[:, run.diverged] = np.inf
     floor = 4 * nonideal.encoder_resolution if nonideal.encoder_resolution else 0.0
     stable = ~run.diverged & (amplitude[3] <= np.maximum(amplitude[2], floor))
@@ -331,6 +337,14 @@ class _Loop:
             self.v = self.phi11 * v + self.g1 * held
         else:
             self._substeps(held)
+        # Overflow is checked every few periods (a third of the work per
+        # period otherwise); in between, inf and nan stay confined to their
+        # own points and are reset here.
+        if self.k % self.check_every == 0:
+            self.freeze_diverged()
+
+    def freeze_diverged(self):
+        """Mark the points whose state left [-1e100, 1e100] or is not finite; zero them."""
         bad = ~(np.abs(self.x) < _OVERFLOW) | ~np.isfinite(self.v)
         if bad.any():
             self.diverged |= bad

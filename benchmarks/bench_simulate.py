@@ -1,0 +1,87 @@
+"""Throughput of the plant simulator against a per-point scipy.signal.dlsim loop (run by hand).
+
+    python benchmarks/bench_simulate.py [--runs 5] [--dlsim-points 40]
+
+1. symstab.simulate.simulate on a 100 x 100 (alpha, beta) grid at d = 10 on
+   the paper's device, ideal loop, 8000 periods: point-steps per second
+   (median of ``--runs``).
+2. The obvious alternative, side by side in the same run: for each point of
+   a random subset of the same grid, the closed loop as a discrete
+   state-space system (companion form of the characteristic polynomial,
+   built outside the timing) simulated by ``scipy.signal.dlsim`` from an
+   initial state for the same number of periods; point-steps per second,
+   median over the subset.
+
+Prints both rates and their ratio (targets: >= 5e7 point-steps/s, >= 100x).
+"""
+
+import argparse
+import os
+import statistics
+import time
+
+import numpy as np
+import scipy.signal
+
+import symstab
+from symstab.simulate import simulate
+from symstab.stability import loop_coefficients
+
+
+def _companion(coeffs):
+    """A discrete state-space system whose poles are the roots of ``coeffs``."""
+    c = np.asarray(coeffs, dtype=float) / coeffs[0]
+    n = len(c) - 1
+    A = np.zeros((n, n))
+    A[0, :] = -c[1:]
+    A[np.arange(1, n), np.arange(n - 1)] = 1.0
+    B = np.zeros((n, 1))
+    B[0, 0] = 1.0
+    C = np.zeros((1, n))
+    C[0, -1] = 1.0
+    return A, B, C, np.zeros((1, 1))
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--runs", type=int, default=5)
+    parser.add_argument("--dlsim-points", type=int, default=40)
+    parser.add_argument("--steps", type=int, default=8000)
+    args = parser.parse_args()
+    dev, d = symstab.PAPER_DEVICE, 10
+    alpha = np.linspace(0.0, 0.025, 100)
+    beta = np.linspace(-0.01, 0.2, 100)
+    A, B = np.meshgrid(alpha, beta, indexing="ij")
+    print(f"numpy {np.__version__}, scipy {scipy.__version__}, {os.cpu_count()} CPUs; "
+          f"OPENBLAS_CORETYPE {'set' if 'OPENBLAS_CORETYPE' in os.environ else 'not set'}")
+    print(f"grid 100 x 100, d = {d}, delta = {dev.delta:.6g}, {args.steps} periods")
+
+    simulate(alpha=A, beta=B, gamma=0.0, d=d, delta=dev.delta, steps=200)  # warm-up
+    times = []
+    for _ in range(args.runs):
+        start = time.perf_counter()
+        simulate(alpha=A, beta=B, gamma=0.0, d=d, delta=dev.delta, steps=args.steps)
+        times.append(time.perf_counter() - start)
+    ours = A.size * args.steps / statistics.median(times)
+
+    rng = np.random.default_rng(0)
+    pick = rng.choice(A.size, size=args.dlsim_points, replace=False)
+    u = np.zeros(args.steps)
+    rates = []
+    for k in pick:
+        coeffs = loop_coefficients(alpha=A.flat[k], beta=B.flat[k], gamma=0.0, d=d, delta=dev.delta)
+        system = _companion(coeffs) + (1.0,)
+        x0 = np.ones(len(coeffs) - 1)
+        start = time.perf_counter()
+        scipy.signal.dlsim(system, u, x0=x0)
+        rates.append(args.steps / (time.perf_counter() - start))
+    theirs = statistics.median(rates)
+    print(f"  symstab.simulate (all points at once)   {ours:10.3g} point-steps/s "
+          f"(median {statistics.median(times):.2f} s per run)")
+    print(f"  scipy.signal.dlsim per point            {theirs:10.3g} point-steps/s "
+          f"(median over {args.dlsim_points} points)")
+    print(f"  ratio {ours / theirs:,.0f}x  (targets: >= 5e7 point-steps/s, >= 100x)")
+
+
+if __name__ == "__main__":
+    main()
