@@ -21,7 +21,8 @@ import numpy as np
 from ._generated import kernels
 from ._validate import check_loop
 
-__all__ = ["arc_end_angle", "minus_one_line", "BoundaryCurve", "Segment", "boundary_curve"]
+__all__ = ["arc_end_angle", "minus_one_line", "BoundaryCurve", "Segment", "boundary_curve",
+           "scan_grid", "bracketed_root"]
 
 
 def scan_grid(d, *, n=None, upper=np.pi):
@@ -37,7 +38,7 @@ def scan_grid(d, *, n=None, upper=np.pi):
     return np.concatenate([near_zero, step * np.arange(1, n + 1)])
 
 
-def _bisect(f, lo, hi, iterations=64):
+def bracketed_root(f, lo, hi, iterations=64):
     """Vectorised root of ``f`` in each bracket ``[lo, hi]`` (signs differ at the ends).
 
     The Illinois variant of regula falsi: superlinear on smooth functions (a
@@ -109,7 +110,7 @@ def arc_end_angle(*, gamma, d, delta):
     k = negative[0]
     if values[k] == 0:
         return float(grid[k])
-    return float(_bisect(alpha, grid[k - 1], grid[k]))
+    return float(bracketed_root(alpha, grid[k - 1], grid[k]))
 
 
 def minus_one_line(*, gamma, d, delta):

@@ -30,7 +30,7 @@ import numpy as np
 
 from ._generated import kernels
 from ._validate import check_real, check_loop
-from .curves import Segment, _bisect, minus_one_line, scan_grid
+from .curves import Segment, bracketed_root, minus_one_line, scan_grid
 from .stability import MARGINAL, STABLE, classify
 
 __all__ = ["StabilityRegion", "Limits", "limits", "BestVirtualMass", "best_virtual_mass"]
@@ -136,7 +136,7 @@ class StabilityRegion:
         lo, hi = self._theta[segment], self._theta[segment + 1]
         flo = coord[segment] - target
         exact = flo == 0
-        root = _bisect(f, lo, hi)
+        root = bracketed_root(f, lo, hi)
         root = np.where(exact, lo, root)
         other = self._arc_point(root)[1 - index]
         if axis == "beta":
