@@ -9,6 +9,8 @@ import numbers
 
 import numpy as np
 
+from ._resources import MAX_DELAY_ENV, max_delay
+
 __all__ = ["check_real", "check_delay", "check_delay_samples", "check_array", "check_loop"]
 
 
@@ -67,6 +69,10 @@ def check_delay(d, *, name="d"):
         k = int(x)
     if k < 0:
         raise ValueError(f"delay {name} must be a non-negative integer, got {d!r}")
+    limit = max_delay()
+    if k > limit:
+        raise ValueError(f"delay {name} must be an integer from 0 to {limit}, got {d!r} "
+                         f"(raise the limit with {MAX_DELAY_ENV})")
     return k
 
 
@@ -82,7 +88,7 @@ def check_delay_samples(ratio, *, name="Td / T", rtol=1e-9):
         raise ValueError(
             f"{name} must be a non-negative whole number of samples, got {ratio!r}"
         )
-    return int(k)
+    return check_delay(int(k), name=name)
 
 
 def check_array(name, value, *, low=None, low_open=False):
