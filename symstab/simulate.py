@@ -30,7 +30,7 @@ default) need a :class:`symstab.units.Device`:
   sub-step, not exact: the plant sees a constant force per sub-step).
 
 Stability by simulation (:func:`stability_map`): the run starts from the
-position ``x0``, the history at ``x0`` and a small velocity (``v0 T = x0 /
+position ``x0`` (``1e-100 <= |x0| <= 1e50``, see :func:`simulate`), the history at ``x0`` and a small velocity (``v0 T = x0 /
 100`` by default: starting at rest would leave the modes of ``z = 1``
 unexcited at ``alpha = 0``, a constant position being an equilibrium there),
 with an empty delay line; a point is unstable when the
@@ -50,7 +50,8 @@ import time
 import numpy as np
 
 from ._generated import kernels
-from ._validate import check_array, check_delay, check_real
+from ._resources import check_memory, chunk_slices
+from ._validate import check_array, check_delay, check_loop, check_real
 
 __all__ = ["Nonidealities", "Simulation", "simulate", "StabilityMap", "stability_map",
            "default_horizon", "progress_printer", "PAPER_ENCODER_RESOLUTION"]
@@ -62,6 +63,18 @@ PAPER_ENCODER_RESOLUTION = math.radians(3 / 3600)
 _OVERFLOW = 1e100
 #: Periods between overflow checks.
 _CHECK_EVERY = 8
+#: Allowed size of the initial state.  The verdict compares the largest |x|
+#: of the last two quarters and calls |x| > _OVERFLOW divergence: a start at
+#: zero never moves (0 <= 0 reads as stable), and a stable point needs room
+#: above |x0| for its transient before the overflow threshold (50 orders of
+#: magnitude), as a decaying or growing run needs room below it before
+#: subnormal numbers lose the ratio (about 200 orders down to 1e-308).
+X0_MIN = 1e-100
+X0_MAX = _OVERFLOW * 1e-50
+#: Floats held per point besides the delay line: position, velocity, two
+#: sampled positions, filter and actuator states, four amplitudes, three
+#: environment coefficients, alpha, beta, gamma and about six temporaries.
+_FLOATS_PER_POINT = 22
 
 
 @dataclasses.dataclass(frozen=True)
@@ -94,26 +107,43 @@ class Nonidealities:
     actuator_bandwidth: float = None
     substeps: int = 20
 
-    def check(self, T):
-        """Validate against the sample period ``T``; raise ValueError naming the field."""
+    def __post_init__(self):
+        # Checked at construction, so that a wrong kind never reaches a run:
+        # friction_compensation="no" would otherwise switch compensation on.
         if self.encoder_resolution is not None:
             check_real("encoder_resolution", self.encoder_resolution, low=0.0, low_open=True)
         if self.velocity_cutoff is not None:
-            check_real("velocity_cutoff", self.velocity_cutoff, low=0.0, low_open=True,
-                       high=0.5 / T, high_open=True)
+            check_real("velocity_cutoff", self.velocity_cutoff, low=0.0, low_open=True)
         if self.coulomb_friction is not None:
             check_real("coulomb_friction", self.coulomb_friction, low=0.0)
         if self.stiction is not None:
             if self.coulomb_friction is None:
                 raise ValueError("stiction needs coulomb_friction")
             check_real("stiction", self.stiction, low=self.coulomb_friction)
+        if not isinstance(self.friction_compensation, (bool, np.bool_)):
+            raise TypeError(f"friction_compensation must be True or False, "
+                            f"got {type(self.friction_compensation).__name__} "
+                            f"{self.friction_compensation!r}")
         if self.friction_compensation and self.coulomb_friction is None:
             raise ValueError("friction_compensation needs coulomb_friction")
         if self.actuator_bandwidth is not None:
             check_real("actuator_bandwidth", self.actuator_bandwidth, low=0.0, low_open=True)
-        if isinstance(self.substeps, bool) or not isinstance(self.substeps, (int, np.integer)) \
-                or self.substeps < 1:
+        if isinstance(self.substeps, (bool, np.bool_)) or \
+                not isinstance(self.substeps, (int, np.integer)):
+            raise TypeError(f"substeps must be an integer >= 1, got "
+                            f"{type(self.substeps).__name__} {self.substeps!r}")
+        if self.substeps < 1:
             raise ValueError(f"substeps must be an integer >= 1, got {self.substeps!r}")
+
+    def check(self, T):
+        """Validate against the sample period ``T``; raise ValueError naming the field.
+
+        The fields themselves are checked at construction; what depends on
+        ``T`` is the velocity filter's cut-off, below the Nyquist frequency.
+        """
+        if self.velocity_cutoff is not None:
+            check_real("velocity_cutoff", self.velocity_cutoff, low=0.0, low_open=True,
+                       high=0.5 / T, high_open=True)
 
     @property
     def ideal(self):
@@ -195,14 +225,19 @@ def simulate(*, alpha, beta, gamma, d, delta, steps=None, x0=1.0, v0=None, devic
     d : int
         Delay in samples, ``d >= 0``.
     delta : float
-        ``b T / m > 0``; with a ``device`` it must equal ``device.delta``
+        ``b T / m``; with a ``device`` it must equal ``device.delta``
         (pass ``None`` to take it from the device).
     steps : int
         Periods to simulate, >= 8 (default :func:`default_horizon`).
     x0 : float
         Initial position (m or rad); the sampled history starts there too.
+        ``1e-100 <= |x0| <= 1e50`` (:data:`X0_MIN`, :data:`X0_MAX`): the
+        verdict compares amplitudes, which a start at zero never has, and
+        calls ``|x| > 1e100`` divergence, which a stable point's transient
+        must stay below.
     v0 : float
-        Initial velocity times T (position per period); default ``x0 / 100``.
+        Initial velocity times T (position per period); default ``x0 / 100``;
+        ``|v0| <= 1e50``.
     device : symstab.units.Device
         Needed for the non-idealities (physical units).
     nonideal : Nonidealities
@@ -215,53 +250,106 @@ def simulate(*, alpha, beta, gamma, d, delta, steps=None, x0=1.0, v0=None, devic
     Returns
     -------
     Simulation
+
+    Raises
+    ------
+    TypeError, ValueError
+        For a parameter of the wrong kind or out of range (the message
+        names it), and when the run would need more memory than
+        ``SYMSTAB_MEMORY_LIMIT`` (see :mod:`symstab._resources`).  Without
+        ``record`` the points are simulated in chunks, so the working
+        memory does not grow with their number.
     """
-    nonideal = nonideal or Nonidealities()
+    from .units import Device
+
+    if nonideal is None:
+        nonideal = Nonidealities()
+    elif not isinstance(nonideal, Nonidealities):
+        raise TypeError(f"nonideal must be a symstab.simulate.Nonidealities or None, "
+                        f"got {type(nonideal).__name__}")
+    if device is not None and not isinstance(device, Device):
+        raise TypeError(f"device must be a symstab.Device or None, got {type(device).__name__}")
+    if progress is not None and not callable(progress):
+        raise TypeError(f"progress must be a callable taking the number of steps done, or None, "
+                        f"got {type(progress).__name__}")
     if device is not None:
         nonideal.check(device.T)
         if delta is None:
             delta = device.delta
-        elif not math.isclose(float(delta), device.delta, rel_tol=1e-12):
-            raise ValueError(f"delta must equal the device's b T / m = {device.delta!r}, got {delta!r}")
+        else:
+            # The loop's rule for delta lives in check_loop (gamma is checked below).
+            delta = check_loop(0.0, 0, delta)[2]
+            if not math.isclose(delta, device.delta, rel_tol=1e-12):
+                raise ValueError(f"delta must equal the device's b T / m = {device.delta!r}, "
+                                 f"got {delta!r}")
     elif not nonideal.ideal:
         raise ValueError("nonideal needs a device (physical units)")
     arrays = np.broadcast_arrays(check_array("alpha", alpha), check_array("beta", beta),
                                  check_array("gamma", gamma))
     shape = arrays[0].shape
     alpha, beta, gamma = (a.ravel() for a in arrays)
-    delta = check_real("delta", delta, low=0.0, low_open=True)
-    d = check_delay(d)
+    if delta is None:
+        raise TypeError("delta must be a real number (or None with a device), got None")
+    _, d, delta = check_loop(0.0, d, delta)
     steps = default_horizon(d) if steps is None else steps
     if isinstance(steps, bool) or not isinstance(steps, (int, np.integer)) or steps < 8:
         raise ValueError(f"steps must be an integer >= 8, got {steps!r}")
+    steps = int(steps)
     x0 = check_real("x0", x0)
-    v0 = x0 / 100 if v0 is None else check_real("v0", v0)
-    run = _Loop(alpha, beta, gamma, d, delta, x0, v0, device, nonideal)
-    # Recorded positions must never hold an overflowed value: check every period then.
-    run.check_every = 1 if record else _CHECK_EVERY
-    quarter = steps // 4
-    amplitude = np.zeros((4, alpha.size))
-    positions = np.empty((steps + 1, alpha.size)) if record else None
+    if not X0_MIN <= abs(x0) <= X0_MAX:
+        raise ValueError(f"x0 must be a finite real number with {X0_MIN:g} <= |x0| <= {X0_MAX:g} "
+                         f"(the verdict compares amplitudes and calls |x| > {_OVERFLOW:g} "
+                         f"divergence), got {x0!r}")
+    v0 = x0 / 100 if v0 is None else check_real("v0", v0, low=-X0_MAX, high=X0_MAX)
+    n_points = alpha.size
+    point_bytes = 8 * (d + 1 + _FLOATS_PER_POINT)
     if record:
-        positions[0] = run.x
+        check_memory(f"recording {steps} periods of {n_points} point(s) at d = {d}",
+                     8 * (steps + 1) * n_points + point_bytes * n_points)
+    else:
+        # The chunks bound the working set; what stays is the result.
+        check_memory(f"simulating {n_points} point(s)", 8 * 6 * n_points)
+    chunks = [slice(0, n_points)] if record else chunk_slices(n_points, point_bytes)
+    amplitude = np.zeros((4, n_points))
+    diverged = np.zeros(n_points, dtype=bool)
+    positions = np.empty((steps + 1, n_points)) if record else None
     report = max(1, steps // 100)
+    for number, part in enumerate(chunks):
+        run = _Loop(alpha[part], beta[part], gamma[part], d, delta, x0, v0, device, nonideal)
+        # Recorded positions must never hold an overflowed value: check every period then.
+        run.check_every = 1 if record else _CHECK_EVERY
+        _run(run, steps, amplitude[:, part], None if positions is None else positions[:, part],
+             progress, report, number, len(chunks))
+        diverged[part] = run.diverged
+    amplitude[:, diverged] = np.inf
+    floor = 4 * nonideal.encoder_resolution if nonideal.encoder_resolution else 0.0
+    stable = ~diverged & (amplitude[3] <= np.maximum(amplitude[2], floor))
+    return Simulation(
+        positions=None if positions is None else positions.reshape((steps + 1,) + shape),
+        amplitude=amplitude.reshape((4,) + shape),
+        diverged=diverged.reshape(shape), stable=stable.reshape(shape), steps=steps)
+
+
+def _run(run, steps, amplitude, positions, progress, report, chunk, n_chunks):
+    """Advance ``run`` ``steps`` periods, keeping the largest |x| of each quarter.
+
+    ``progress`` hears the steps done over all chunks, scaled to ``steps``.
+    """
+    quarter = steps // 4
+    if positions is not None:
+        positions[0] = run.x
+    magnitude = np.empty_like(run.x)
     for k in range(steps):
         with np.errstate(over="ignore", invalid="ignore"):
             run.step()
         q = min(k // quarter, 3)
-        np.maximum(amplitude[q], np.abs(run.x), out=amplitude[q])
-        if record:
+        np.abs(run.x, out=magnitude)
+        np.maximum(amplitude[q], magnitude, out=amplitude[q])
+        if positions is not None:
             positions[k + 1] = run.x
         if progress is not None and ((k + 1) % report == 0 or k + 1 == steps):
-            progress(k + 1)
+            progress((chunk * steps + k + 1) // n_chunks)
     run.freeze_diverged()
-    amplitude[:, run.diverged] = np.inf
-    floor = 4 * nonideal.encoder_resolution if nonideal.encoder_resolution else 0.0
-    stable = ~run.diverged & (amplitude[3] <= np.maximum(amplitude[2], floor))
-    return Simulation(
-        positions=None if positions is None else positions.reshape((steps + 1,) + shape),
-        amplitude=amplitude.reshape((4,) + shape),
-        diverged=run.diverged.reshape(shape), stable=stable.reshape(shape), steps=steps)
 
 
 class _Loop:
@@ -273,8 +361,9 @@ class _Loop:
         self.nonideal = nonideal
         self.x = np.full(n, x0)
         self.v = np.full(n, v0)           # v T
-        self.history = np.zeros((2, n))   # sampled x(k-1), x(k-2): the loop starts at rest
-        self.history[:] = self._sample(self.x)
+        # Sampled x(k-1), x(k-2): the loop starts at rest.  Two arrays, not
+        # one (2, n) array, so that the ideal step can swap them instead of copying.
+        self.history = [np.array(self._sample(self.x), dtype=float) for _ in range(2)]
         self.forces = np.zeros((d + 1, n))  # commands waiting in the delay line
         self.k = 0
         self.diverged = np.zeros(n, dtype=bool)
@@ -300,6 +389,20 @@ class _Loop:
             self.filter_pole = self.lag = None
         self.v_hat = np.zeros(n)          # filtered velocity estimate (times T)
         self.applied = np.zeros(n)        # actuator output
+        self.ideal = nonideal.ideal and not nonideal.friction_compensation
+        if self.ideal:
+            # The force of eq. (1) is linear in the three sampled positions:
+            # its coefficients, read from the generated kernel at unit
+            # positions, turn each period into a few in-place products.
+            # (A coefficient that overflows makes its point diverge at once.)
+            unit, zero = np.ones(n), np.zeros(n)
+            with np.errstate(over="ignore", invalid="ignore"):
+                self.coefficients = [
+                    np.asarray(kernels.environment_force(
+                        *(unit if j == i else zero for j in range(3)), alpha, beta, gamma),
+                        dtype=float)
+                    for i in range(3)]
+            self._scratch = np.empty(n)
 
     def _sample(self, x):
         q = self.nonideal.encoder_resolution
@@ -323,10 +426,47 @@ class _Loop:
         return force
 
     def step(self):
+        if self.ideal:
+            self._step_ideal()
+        else:
+            self._step_general()
+        # Overflow is checked every few periods (a third of the work per
+        # period otherwise); in between, inf and nan stay confined to their
+        # own points and are reset here.
+        if self.k % self.check_every == 0:
+            self.freeze_diverged()
+
+    def _step_ideal(self):
+        """One period of the ideal loop, in place: the general step's sums, in its order."""
+        x, v, tmp = self.x, self.v, self._scratch
+        c0, c1, c2 = self.coefficients
+        x1, x2 = self.history
+        command = self.forces[self.k % (self.d + 1)]
+        # Summed in the generated kernel's order, so the force is bit-identical.
+        np.multiply(c2, x2, out=command)
+        np.multiply(c0, x, out=tmp)
+        command += tmp
+        np.multiply(c1, x1, out=tmp)
+        command += tmp
+        x2[...] = x               # becomes x(k-1); the old x(k-1) becomes x(k-2)
+        self.history = [x2, x1]
+        held = self.forces[(self.k - self.d) % (self.d + 1)] if self.k >= self.d else None
+        self.k += 1
+        # x + phi01 v + g0 f and phi11 v + g1 f, summed in that order.
+        np.multiply(self.phi01, v, out=tmp)
+        x += tmp
+        v *= self.phi11
+        if held is not None:
+            np.multiply(self.g0, held, out=tmp)
+            x += tmp
+            np.multiply(self.g1, held, out=tmp)
+            v += tmp
+
+    def _step_general(self):
         xs = self._sample(self.x)
         command = self._command(xs)
-        self.history[1] = self.history[0]
-        self.history[0] = xs
+        self.history[1][...] = self.history[0]
+        self.history[0][...] = xs
         slot = self.k % (self.d + 1)
         self.forces[slot] = command
         held = self.forces[(self.k - self.d) % (self.d + 1)] if self.k >= self.d else 0.0 * command
@@ -337,11 +477,6 @@ class _Loop:
             self.v = self.phi11 * v + self.g1 * held
         else:
             self._substeps(held)
-        # Overflow is checked every few periods (a third of the work per
-        # period otherwise); in between, inf and nan stay confined to their
-        # own points and are reset here.
-        if self.k % self.check_every == 0:
-            self.freeze_diverged()
 
     def freeze_diverged(self):
         """Mark the points whose state left [-1e100, 1e100] or is not finite; zero them."""
@@ -351,7 +486,8 @@ class _Loop:
             self.x[bad] = 0.0
             self.v[bad] = 0.0
             self.forces[:, bad] = 0.0
-            self.history[:, bad] = 0.0
+            for sampled in self.history:
+                sampled[bad] = 0.0
             self.v_hat[bad] = 0.0
             self.applied[bad] = 0.0
 
@@ -429,6 +565,12 @@ def stability_map(*, alpha, beta, gamma, d, delta, steps=None, x0=1.0, v0=None, 
     Returns
     -------
     StabilityMap
+
+    Raises
+    ------
+    TypeError, ValueError
+        As :func:`simulate`; the grid is simulated in chunks, so the working
+        memory does not grow with it (only the result does).
     """
     alpha = check_array("alpha", alpha)
     beta = check_array("beta", beta)
@@ -436,6 +578,9 @@ def stability_map(*, alpha, beta, gamma, d, delta, steps=None, x0=1.0, v0=None, 
         raise ValueError("alpha and beta must be 1-D grids")
     gamma = check_real("gamma", gamma)
     d = check_delay(d)
+    if progress is not None and progress is not True and not callable(progress):
+        raise TypeError(f"progress must be True, a callable taking the number of steps done, "
+                        f"or None, got {type(progress).__name__}")
     total = default_horizon(d) if steps is None else steps
     if progress is True:
         progress = progress_printer("simulating", total)

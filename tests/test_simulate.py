@@ -389,7 +389,8 @@ def test_simulated_maps_agree_with_exact_classification():
     stable; 4 more on that row at d = 10, beta in (-delta, 0), where
     classify() says STABLE (radius 1 - 4e-12) and the simulation unstable;
     3 next to the arc with radius 1 + 3e-7 .. 1 + 1.5e-5 that the horizon
-    does not resolve.  60 s unloaded, 100 s with other jobs running.
+    does not resolve.  25 s with other jobs running (53 s before the simulator's
+    in-place ideal step).
     """
     start = time.perf_counter()
     total_crossed = total_inside = total_outside = inside_alpha0 = 0
@@ -828,3 +829,144 @@ def test_diverging_run_is_flagged_and_finite():
         sm = stability_map(alpha=[0.1, 50.0], beta=[0.5], gamma=0.0, d=0, delta=PAPER_DELTA, steps=400)
     assert sm.stable.tolist() == [[True], [False]]
     assert not np.any(np.isnan(sm.growth)) and sm.growth[1, 0] == np.inf
+
+
+# --------------------------------------------------------------------------
+# Initial state, kinds of the arguments, memory
+# --------------------------------------------------------------------------
+
+#: A stable point (radius 0.735) and an unstable one (radius 1.004), d = 0.
+STABLE_POINT = dict(alpha=0.1, beta=0.5, gamma=0.0, d=0, delta=PAPER_DELTA)
+UNSTABLE_POINT = dict(alpha=0.1, beta=-0.01, gamma=0.0, d=0, delta=PAPER_DELTA)
+
+
+def test_the_two_points_are_what_their_names_say():
+    """python-control's poles, independent of symstab: one inside, one outside the circle."""
+    for point, stable in ((STABLE_POINT, True), (UNSTABLE_POINT, False)):
+        poles = python_control_closed_loop(**point, m=PAPER_M, T=PAPER_T).poles()
+        radius = float(np.max(np.abs(poles)))
+        assert (radius < 0.99) if stable else (radius > 1.001), radius
+
+
+@pytest.mark.parametrize("x0", [0.0, -0.0, 1e-101, 1e100, -1e51, 1e300])
+def test_x0_outside_its_range_is_refused(x0):
+    """x0 = 0 never moves (every cell read stable); 1e100 starts at the divergence threshold."""
+    for run in (lambda: simulate(**STABLE_POINT, steps=100, x0=x0),
+                lambda: stability_map(alpha=[0.1], beta=[0.5], gamma=0.0, d=0, delta=PAPER_DELTA,
+                                      steps=100, x0=x0)):
+        with pytest.raises(ValueError) as excinfo:
+            run()
+        assert_message_names(excinfo, "x0")
+        assert "1e-100 <= |x0| <= 1e+50" in str(excinfo.value)
+
+
+@pytest.mark.parametrize("x0", [1e-100, -1e-100, 1e50, -1e50, 1.0])
+def test_x0_at_the_ends_of_its_range_gives_the_true_verdict(x0):
+    """The verdicts at the ends of the allowed range equal the poles' (test above)."""
+    run = simulate(alpha=[STABLE_POINT["alpha"], UNSTABLE_POINT["alpha"]],
+                   beta=[STABLE_POINT["beta"], UNSTABLE_POINT["beta"]], gamma=0.0, d=0,
+                   delta=PAPER_DELTA, steps=2000, x0=x0)
+    assert run.stable.tolist() == [True, False]
+    assert not run.diverged.any()
+
+
+@pytest.mark.parametrize("field, value", [
+    ("friction_compensation", "no"),
+    ("friction_compensation", 1),
+    ("encoder_resolution", "1e-5"),
+    ("velocity_cutoff", [50.0]),
+    ("coulomb_friction", True),
+    ("stiction", "0.1"),
+    ("actuator_bandwidth", 1j),
+    ("substeps", 2.0),
+    ("substeps", "20"),
+])
+def test_nonidealities_of_the_wrong_kind_raise_type_error(field, value):
+    fields = {"coulomb_friction": 0.01} if field in ("friction_compensation", "stiction") else {}
+    fields[field] = value
+    with pytest.raises(TypeError) as excinfo:
+        Nonidealities(**fields)
+    assert_message_names(excinfo, field)
+
+
+def test_friction_compensation_must_be_a_bool_not_a_truthy_string():
+    """"no" is truthy: it used to switch compensation on."""
+    with pytest.raises(TypeError, match="friction_compensation must be True or False"):
+        Nonidealities(coulomb_friction=0.01, friction_compensation="no")
+    assert Nonidealities(coulomb_friction=0.01, friction_compensation=np.bool_(True)).friction_compensation
+
+
+@pytest.mark.parametrize("name, change, expected", [
+    ("nonideal", dict(nonideal={"encoder_resolution": 1e-5}), "Nonidealities"),
+    ("delta", dict(delta="abc", device=PAPER_DEVICE), "delta"),
+    ("progress", dict(progress=1), "callable"),
+    ("device", dict(device="paper", delta=None), "Device"),
+])
+def test_simulate_arguments_of_the_wrong_kind_raise_type_error(name, change, expected):
+    kw = dict(alpha=0.1, beta=0.5, gamma=0.0, d=0, delta=PAPER_DELTA, steps=100)
+    kw.update(change)
+    with pytest.raises(TypeError) as excinfo:
+        simulate(**kw)
+    assert_message_names(excinfo, name)
+    assert expected in str(excinfo.value)
+
+
+def test_stability_map_progress_of_the_wrong_kind_raises_type_error():
+    with pytest.raises(TypeError) as excinfo:
+        stability_map(alpha=[0.1], beta=[0.5], gamma=0.0, d=0, delta=PAPER_DELTA, steps=100,
+                      progress=1)
+    assert_message_names(excinfo, "progress")
+
+
+def test_recording_beyond_the_memory_limit_is_refused_before_running(monkeypatch):
+    """200000 recorded periods of 10 points need 16 MB: over a 1 MiB limit, refused at once."""
+    monkeypatch.setenv("SYMSTAB_MEMORY_LIMIT", "1M")
+    start = time.perf_counter()
+    with pytest.raises(ValueError) as excinfo:
+        simulate(alpha=np.full(10, 0.1), beta=0.5, gamma=0.0, d=0, delta=PAPER_DELTA,
+                 steps=200000, record=True)
+    assert time.perf_counter() - start < 1.0, "the run started before the memory check"
+    assert "SYMSTAB_MEMORY_LIMIT" in str(excinfo.value)
+    assert "200000 periods" in str(excinfo.value)
+
+
+def _small_chunks(monkeypatch, budget):
+    from symstab import _resources
+    from symstab import simulate as module
+
+    monkeypatch.setattr(module, "chunk_slices",
+                        lambda n, size: _resources.chunk_slices(n, size, budget=budget))
+
+
+def test_chunked_map_equals_one_chunk_and_reports_progress_in_order(monkeypatch):
+    """The same verdicts and growth, bit for bit, in 7 chunks as in one."""
+    alpha, beta = np.linspace(0.0, 0.05, 21), np.linspace(-0.05, 0.3, 20)
+    kw = dict(alpha=alpha, beta=beta, gamma=0.5, d=3, delta=PAPER_DELTA, steps=600)
+    whole = stability_map(**kw)
+    _small_chunks(monkeypatch, budget=8 * (3 + 1 + 22) * 60)   # 60 points per chunk
+    seen = []
+    chunked = stability_map(**kw, progress=seen.append)
+    assert np.array_equal(whole.stable, chunked.stable)
+    assert np.array_equal(whole.growth, chunked.growth)
+    assert 0 < whole.stable.sum() < whole.stable.size
+    assert seen == sorted(seen) and seen[-1] == 600 and len(seen) > 7 * 50
+
+
+def test_chunked_map_memory_does_not_grow_with_the_working_set(monkeypatch):
+    """Peak traced memory per grid point: chunks keep it near the size of the result.
+
+    At d = 40 the working state is 63 floats (504 bytes) per point; the
+    result and the grid copies are about 15 floats (120 bytes).  In chunks of
+    256 KiB the peak stays under 200 bytes per point plus the chunk.
+    """
+    import tracemalloc
+
+    _small_chunks(monkeypatch, budget=256 * 1024)
+    alpha, beta = np.linspace(0.0, 0.01, 100), np.linspace(0.0, 0.2, 100)
+    tracemalloc.start()
+    try:
+        stability_map(alpha=alpha, beta=beta, gamma=0.0, d=40, delta=PAPER_DELTA, steps=48)
+        _, peak = tracemalloc.get_traced_memory()
+    finally:
+        tracemalloc.stop()
+    assert peak < 200 * alpha.size * beta.size + 2 * 256 * 1024, peak
