@@ -11,7 +11,8 @@ import numpy as np
 
 from ._resources import MAX_DELAY_ENV, max_delay
 
-__all__ = ["check_real", "check_delay", "check_delay_samples", "check_array", "check_loop"]
+__all__ = ["check_real", "check_delay", "check_delay_samples", "check_array", "check_delta",
+           "check_loop", "DELTA_MAX"]
 
 
 def _describe_range(low, high, low_open, high_open):
@@ -91,7 +92,7 @@ def check_delay_samples(ratio, *, name="Td / T", rtol=1e-9):
     return check_delay(int(k), name=name)
 
 
-def check_array(name, value, *, low=None, low_open=False):
+def check_array(name, value, *, low=None, low_open=False, high=None):
     """Return ``value`` as a float ndarray after checking every entry.
 
     Scalars become 0-d arrays.  Booleans, complex numbers and non-numeric
@@ -106,19 +107,34 @@ def check_array(name, value, *, low=None, low_open=False):
     bad = ~np.isfinite(arr)
     if low is not None:
         bad |= (arr <= low) if low_open else (arr < low)
+    if high is not None:
+        bad |= arr > high
     if np.any(bad):
         first = arr[bad].flat[0]
-        allowed = _describe_range(low, None, low_open, False)
+        allowed = _describe_range(low, high, low_open, False)
         where = "" if arr.ndim == 0 else f" (entry {int(np.flatnonzero(bad.ravel())[0])})"
         raise ValueError(f"{name} must be {allowed}, got {float(first)!r}{where}")
     return arr
+
+
+#: The largest delta = b T / m accepted.  The kernels are accurate to a few
+#: ulps up to here (tests/test_generated_kernels.py); far beyond it the
+#: products of the ZOH coefficients (~ 1 / delta**3) underflow.
+DELTA_MAX = 1e6
+
+
+def check_delta(delta, *, name="delta"):
+    """Return ``delta = b T / m`` as a float in ``[0, DELTA_MAX]``.
+
+    ``delta = 0`` is a frictionless (or friction-compensated) device.
+    """
+    return check_real(name, delta, low=0.0, high=DELTA_MAX)
 
 
 def check_loop(gamma, d, delta):
     """Validate the loop parameters of a dimensionless entry point.
 
     Returns ``(gamma, d, delta)`` as ``(float, int, float)``; ``delta`` must
-    be positive.
+    be in ``[0, DELTA_MAX]``.
     """
-    return (check_real("gamma", gamma), check_delay(d),
-            check_real("delta", delta, low=0.0, low_open=True))
+    return check_real("gamma", gamma), check_delay(d), check_delta(delta)

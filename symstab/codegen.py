@@ -84,7 +84,7 @@ _ARG = {
     "theta": (model.theta, "double", "angle on the unit circle, z = exp(j theta) (rad)"),
     "gamma": (model.gamma, "double", "gamma = M_w / m, virtual mass ratio"),
     "d": (model.d, "int", "loop delay in samples, d >= 0"),
-    "delta": (model.delta, "double", "delta = b T / m > 0"),
+    "delta": (model.delta, "double", "delta = b T / m >= 0"),
     "alpha": (model.alpha, "double", "alpha = K_w T^2 / m, dimensionless stiffness"),
     "beta": (model.beta, "double", "beta = B_w T / m, dimensionless damping"),
     "position": (kf.position, "double", "position x(k)"),
@@ -110,10 +110,11 @@ def kernels():
         (f"c{k}", kf.as_evaluable(expr), f"coefficient of {name}")
         for k, (expr, name) in enumerate(zip(delayed + direct, names)))
     return (
-        Kernel("exprel3", (_ARG["delta"],),
-               (("phi3", kf.exprel3_piecewise(x), "(exp(delta) - 1 - delta - delta^2/2) / delta^3"),),
-               "(exp(delta) - 1 - delta - delta^2/2) / delta^3 for delta > 0: a Taylor "
-               f"polynomial below delta = {kf.EXPREL3_SWITCH}, expm1 above."),
+        *(Kernel(f.__name__, (_ARG["delta"],),
+                 ((f.__name__, f.evaluation(x), f.formula),),
+                 f"{f.formula}: {f.__doc__[0].lower()}{f.__doc__[1:].rstrip('.')}, for delta >= 0; a Taylor "
+                 f"polynomial below delta = {f.switch}, exp(-delta) and expm1(-delta) above.")
+          for f in kf.SERIES_FUNCTIONS),
         Kernel("boundary", tuple(_ARG[k] for k in ("theta", "gamma", "d", "delta")),
                (("alpha", kf.as_evaluable(alpha), "dimensionless stiffness on the boundary"),
                 ("beta", kf.as_evaluable(beta), "dimensionless damping on the boundary")),
@@ -121,7 +122,8 @@ def kernels():
                "z = exp(j theta) is a root of the characteristic polynomial."),
         Kernel("loop_coefficients", tuple(_ARG[k] for k in ("alpha", "beta", "gamma", "delta")),
                coefficient_outputs,
-               "Coefficients of chi(z) / delta^2 = z^(d+2) (z-1) (Gamma z - 1) + V(z) (P z + Q), "
+               "Coefficients of chi(z) / (delta^2 Gamma) = z^(d+2) (z-1) (z - exp(-delta)) "
+               "+ V(z) (b1 z + b0), "
                "highest power first: three of the delayed part (z^(d+4), z^(d+3), z^(d+2)) "
                "and four of the direct part (z^3 .. z^0)."),
         Kernel("plant_step_coefficients", (_ARG["delta"],),
@@ -146,13 +148,21 @@ def kernels():
 
 
 class NumPyKernelPrinter(NumPyPrinter):
-    """NumPy printer for the kernels: exprel3 calls the generated helper."""
+    """NumPy printer for the kernels.
+
+    The series functions of :mod:`symstab.kernel_forms` print as calls of
+    their generated helpers.
+    """
 
     def __init__(self, settings=None):
         super().__init__(dict({"strict": True}, **(settings or {})))
 
-    def _print_exprel3(self, expr):
-        return f"exprel3({self._print(expr.args[0])})"
+    def _print_Function(self, expr):
+        # SymPy's printers skip subclass names of a Function's bases, so the
+        # series functions are recognised here rather than by _print_<name>.
+        if isinstance(expr, kf.SeriesFunction):
+            return f"{type(expr).__name__}({self._print(expr.args[0])})"
+        return super()._print_Function(expr)
 
     def _print_Max(self, expr):
         args = [self._print(a) for a in expr.args]
@@ -171,13 +181,15 @@ class NumPyKernelPrinter(NumPyPrinter):
 
 
 class CKernelPrinter(C99CodePrinter):
-    """C99 printer for the kernels: exprel3 calls the generated helper."""
+    """C99 printer for the kernels: series functions call their generated helpers."""
 
     def __init__(self, settings=None):
         super().__init__(dict({"strict": True}, **(settings or {})))
 
-    def _print_exprel3(self, expr):
-        return f"{C_PREFIX}exprel3({self._print(expr.args[0])})"
+    def _print_Function(self, expr):
+        if isinstance(expr, kf.SeriesFunction):
+            return f"{C_PREFIX}{type(expr).__name__}({self._print(expr.args[0])})"
+        return super()._print_Function(expr)
 
 
 def _header_lines(comment, what):
@@ -185,8 +197,8 @@ def _header_lines(comment, what):
             f"{comment} {what}",
             f"{comment} Every expression is proved equal to the derivation by `{COMMAND}`"
             " (step 07_proofs),",
-            f"{comment} except the Taylor branch of exprel3, an approximation exact to the last bit"
-            " for delta < 1.", ""]
+            f"{comment} except the Taylor branches of {', '.join(f.__name__ for f in kf.SERIES_FUNCTIONS)},",
+            f"{comment} approximations exact to the last bit below their switch.", ""]
 
 
 def _python_function(kernel, printer):

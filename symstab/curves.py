@@ -116,14 +116,17 @@ def arc_end_angle(*, gamma, d, delta):
 def minus_one_line(*, gamma, d, delta):
     """The z = -1 crossing: ``alpha + 2 beta = c``; returns ``c``.
 
-    chi(-1) / delta**2 = (-1)**d 2 (Gamma + 1) + (alpha + 2 beta + 4 gamma)(Q - P),
-    with ``P - Q = delta (1/2 + (delta - 2) exprel3(delta))`` (see
-    :mod:`symstab.kernel_forms`); far away (~ 24 / delta) for small delta.
+    chi(-1) / (delta**2 Gamma) = (-1)**d 2 (1 + exp(-delta))
+    - (alpha + 2 beta + 4 gamma) delta zoh_gap(delta) (see
+    :mod:`symstab.kernel_forms`); far away (~ 24 / delta) for small delta,
+    and at infinity (``(-1)**d inf``) for delta = 0, where z = -1 is never
+    a root.
     """
     gamma, d, delta = check_loop(gamma, d, delta)
-    p_minus_q = delta * (0.5 + (delta - 2.0) * kernels.exprel3(delta))
-    gamma_big = 1.0 + float(np.expm1(delta))
-    return float((-1) ** d * 2.0 * (gamma_big + 1.0) / p_minus_q - 4.0 * gamma)
+    if delta == 0.0:
+        return float((-1) ** d * np.inf)
+    spread = delta * float(kernels.zoh_gap(delta))
+    return float((-1) ** d * 2.0 * (1.0 + np.exp(-delta)) / spread - 4.0 * gamma)
 
 
 @dataclasses.dataclass(frozen=True)

@@ -1,37 +1,43 @@
 """Forms of the boundary and the loop polynomial that keep their digits in floats.
 
 The derivation writes everything in ``delta`` and ``Gamma = exp(delta)``.
-That is exact for proofs but poor for floating point: the pulse-transfer
-numerator ``(Gamma delta - Gamma + 1) z + (Gamma - delta - 1)`` is about
-``delta**2 / 2 (z + 1)`` out of terms of size 1, and the C-coefficient form
-of alpha(theta) loses about ``log10(1 / delta**2)`` digits.
+That is exact for proofs but poor for floating point at both ends:
 
-This module rewrites the same objects in quantities that are all of size 1
-or carry their smallness as an explicit factor:
+* small delta: the pulse-transfer numerator ``(Gamma delta - Gamma + 1) z +
+  (Gamma - delta - 1)`` is about ``delta**2 / 2 (z + 1)`` out of terms of
+  size 1, and the C-coefficient form of alpha(theta) loses about
+  ``log10(1 / delta**2)`` digits; at ``delta = 0`` it is 0 / 0;
+* large delta: ``Gamma`` overflows for delta > 709 (and its square for
+  delta > 354), though the loop is perfectly well defined there.
 
-``em1 = expm1(delta)``
-    ``Gamma - 1``, evaluated without cancellation.
-``phi3 = (exp(delta) - 1 - delta - delta**2 / 2) / delta**3``
-    :class:`exprel3`, evaluated from its Taylor series for small delta;
-    with it ``phi2 = 1/2 + delta phi3 = (Gamma - 1 - delta) / delta**2``.
-``P = (Gamma delta - Gamma + 1) / delta**2 = 1 - (1 - delta) phi2``,
-``Q = (Gamma - delta - 1) / delta**2 = phi2``
-    the pulse-transfer numerator divided by ``delta**2``, so that
-    ``chi(z) / delta**2 = z**(d+2) (z - 1) (Gamma z - 1) + V(z) (P z + Q)``;
-    ``P - Q = delta (1/2 + (delta - 2) phi3)`` without cancellation.
+This module divides the loop polynomial by ``delta**2 Gamma``, so that only
+``r = exp(-delta)`` in (0, 1] appears, and writes the pulse-transfer
+numerator with four functions of delta that are bounded, smooth on
+``[0, inf)`` and evaluated without cancellation or overflow (:class:`zoh_b1`,
+:class:`zoh_b0`, :class:`zoh_gap`, :class:`decay_mean`; a Taylor series below
+a switch, ``expm1(-delta)`` and ``exp(-delta)`` above it)::
 
-On the unit circle, with ``G = Gamma z - 1`` (whose real part is
-``em1 cos(theta) - 2 sin(theta/2)**2``), ``H = P z + Q`` and
+    b1 = (delta - 1 + r) / delta**2          -> 1/2 at 0, ~ 1/delta for large delta
+    b0 = (1 - r - delta r) / delta**2        -> 1/2 at 0, ~ 1/delta**2
+    gap = (b1 - b0) / delta                  -> 1/6 at 0, ~ 1/delta**2
+    mean = (1 - r) / delta                   -> 1 at 0,   ~ 1/delta
+
+so that ``chi(z) / (delta**2 Gamma) = z**(d+2) (z - 1) (z - r) + V(z) (b1 z + b0)``,
+finite and nonzero at ``delta = 0`` (the frictionless double integrator).
+
+On the unit circle, with ``G = z - r`` (whose real part is ``em - 2
+sin(theta/2)**2``, ``em = -expm1(-delta) = 1 - r``), ``H = b1 z + b0`` and
 ``M = G conj(H)``, Cramer's rule collapses to::
 
     alpha = 2 tan(theta/2) Im(exp(j (d+1) theta) M) / |H|**2 + 4 gamma sin(theta/2)**2
     beta  = -Re(exp(j (d+1/2) theta) M) / (cos(theta/2) |H|**2) - 4 gamma sin(theta/2)**2
 
-with ``|H|**2 = (P - Q)**2 + 4 P Q cos(theta/2)**2``.  Every form is proved
-equal to the derivation by the exact checker (:func:`proofs`), with
-``em1 = Gamma - 1`` and ``phi3`` replaced by its definition; only the
-evaluation of :class:`exprel3` itself is a numerical approximation, measured
-against mpmath in the tests.
+with ``|H|**2 = delta**2 gap**2 + 4 b1 b0 cos(theta/2)**2``.  Every form is
+proved equal to the derivation by the exact checker (:func:`proofs`), with
+the symbols replaced by their definitions in ``Gamma`` and ``delta``; so are
+the closed forms the four functions are evaluated by above their switch.
+Only their Taylor branches are numerical approximations, measured against
+mpmath in the tests.
 """
 
 import functools
@@ -45,76 +51,169 @@ from .loop import characteristic_polynomial, dimensionless_environment
 from .sampled_plant import dimensionless_step
 
 __all__ = [
-    "exprel3", "EXPREL3_SWITCH", "exprel3_series", "exprel3_piecewise",
-    "em1", "phi3", "pulse_numerator_parts", "boundary_forms", "loop_coefficient_forms",
+    "SeriesFunction", "zoh_b1", "zoh_b0", "zoh_gap", "decay_mean", "SERIES_FUNCTIONS",
+    "r", "em", "b1", "b0", "gap", "mean",
+    "boundary_forms", "loop_coefficient_forms",
     "plant_step_forms", "environment_force_form", "position_history",
     "position", "velocity", "force",
     "as_derivation", "as_evaluable", "proofs",
 ]
 
-#: Below this delta, :class:`exprel3` is evaluated from its Taylor series.
-#: Above it the closed form cancels by at most (e - 1) / (e - 2.5), about 8,
-#: in relative terms; at 1/2 it would be about 27.
-EXPREL3_SWITCH = sp.Integer(1)
-#: Terms of the series: the first neglected one, delta**17 / 20!, is below
-#: 2**-53 relative to phi3 >= 1/6 for delta < 1.
-_EXPREL3_TERMS = 17
 
+class SeriesFunction(sp.Function):
+    """A bounded function of ``delta >= 0`` evaluated by a series or a closed form.
 
-class exprel3(sp.Function):
-    """``(exp(x) - 1 - x - x**2 / 2) / x**3``, continuous at ``x = 0`` (= 1/6).
-
-    Code printers print it as a call of the generated helper of that name.
+    Subclasses give :meth:`definition` (in ``exp(-x)``, exact, used by the
+    proofs), :meth:`closed_form` (in ``expm1(-x)`` and ``exp(-x)``, used above
+    :attr:`switch`, proved equal to the definition), the Taylor coefficient
+    :meth:`coefficient` and the number of :attr:`terms` kept below the
+    switch (the first neglected term is below ``2**-53`` of the value on
+    ``[0, switch)``).  The code printers of :mod:`symstab.codegen` print a
+    call of the generated helper of the same name.
     """
 
     nargs = 1
+    #: The function, as text in ``delta`` (for generated docstrings).
+    formula = ""
+    switch = sp.Integer(1)
+    terms = 18
+
+    @staticmethod
+    def definition(x):
+        raise NotImplementedError
+
+    @staticmethod
+    def closed_form(x):
+        raise NotImplementedError
+
+    @staticmethod
+    def coefficient(k):
+        raise NotImplementedError
+
+    @classmethod
+    def series(cls, x):
+        """Horner form of the Taylor polynomial with :attr:`terms` terms."""
+        out = cls.coefficient(cls.terms - 1)
+        for k in range(cls.terms - 2, -1, -1):
+            out = cls.coefficient(k) + x * out
+        return out
+
+    @classmethod
+    def evaluation(cls, x):
+        """The evaluation rule for ``x >= 0``, as a Piecewise.
+
+        The series below :attr:`switch`, the closed form above it; the closed
+        form's argument is clipped at the switch so that a vectorised
+        evaluation of both branches never divides by zero.
+        """
+        return sp.Piecewise((cls.series(x), x < cls.switch),
+                            (cls.closed_form(sp.Max(x, cls.switch)), True))
 
     def _eval_rewrite_as_exp(self, x, **kwargs):
-        return (sp.exp(x) - 1 - x - x**2 / 2) / x**3
+        return self.definition(x)
 
 
-def exprel3_series(x):
-    """Horner form of the first terms of exprel3's Taylor series, sum x**k / (k+3)!."""
-    out = 1 / sp.factorial(_EXPREL3_TERMS + 2)
-    for k in range(_EXPREL3_TERMS - 2, -1, -1):
-        out = 1 / sp.factorial(k + 3) + x * out
-    return out
+def _em(x):
+    """``1 - exp(-x)`` without cancellation."""
+    return -expm1(-x)
 
 
-def exprel3_piecewise(x):
-    """The evaluation rule of :class:`exprel3` for ``x > 0``, as a Piecewise.
+class zoh_b1(SeriesFunction):
+    """The ZOH numerator's coefficient of z over ``delta**2 Gamma``."""
 
-    The series below :data:`EXPREL3_SWITCH`, the closed form with ``expm1``
-    above it; the closed form's argument is clipped at the switch so that a
-    vectorised evaluation of both branches never divides by zero.
-    """
-    xs = sp.Max(x, EXPREL3_SWITCH)
-    return sp.Piecewise((exprel3_series(x), x < EXPREL3_SWITCH),
-                        ((expm1(xs) - xs - xs**2 / 2) / xs**3, True))
+    formula = "(delta - 1 + exp(-delta)) / delta^2"
+    terms = 17
+
+    @staticmethod
+    def definition(x):
+        return (x - 1 + sp.exp(-x)) / x**2
+
+    @staticmethod
+    def closed_form(x):
+        return (x - _em(x)) / x**2
+
+    @staticmethod
+    def coefficient(k):
+        return sp.Integer(-1) ** k / sp.factorial(k + 2)
 
 
-#: Symbols standing for ``expm1(delta)`` and ``exprel3(delta)`` in the forms.
-em1 = sp.Symbol("em1", positive=True)
-phi3 = sp.Symbol("phi3", positive=True)
+class zoh_b0(SeriesFunction):
+    """The ZOH numerator's constant term over ``delta**2 Gamma``."""
+
+    formula = "(1 - exp(-delta) - delta exp(-delta)) / delta^2"
+    terms = 18
+
+    @staticmethod
+    def definition(x):
+        return (1 - sp.exp(-x) - x * sp.exp(-x)) / x**2
+
+    @staticmethod
+    def closed_form(x):
+        return (_em(x) - x * sp.exp(-x)) / x**2
+
+    @staticmethod
+    def coefficient(k):
+        return sp.Integer(-1) ** k * (k + 1) / sp.factorial(k + 2)
 
 
-def pulse_numerator_parts():
-    """Return ``(P, Q, P - Q)`` in ``delta`` and ``phi3``."""
-    dl = model.delta
-    phi2 = sp.Rational(1, 2) + dl * phi3
-    return 1 - (1 - dl) * phi2, phi2, dl * (sp.Rational(1, 2) + (dl - 2) * phi3)
+class zoh_gap(SeriesFunction):
+    """``(zoh_b1 - zoh_b0) / delta``, the difference of the ZOH numerator's coefficients."""
+
+    formula = "(delta (1 + exp(-delta)) - 2 (1 - exp(-delta))) / delta^3"
+    switch = sp.Integer(2)
+    terms = 22
+
+    @staticmethod
+    def definition(x):
+        return (x * (1 + sp.exp(-x)) - 2 * (1 - sp.exp(-x))) / x**3
+
+    @staticmethod
+    def closed_form(x):
+        return (x * (1 + sp.exp(-x)) - 2 * _em(x)) / x**3
+
+    @staticmethod
+    def coefficient(k):
+        return sp.Integer(-1) ** k * (k + 1) / sp.factorial(k + 3)
+
+
+class decay_mean(SeriesFunction):
+    """The mean of ``exp(-delta s)`` over ``s`` in [0, 1]."""
+
+    formula = "(1 - exp(-delta)) / delta"
+    terms = 18
+
+    @staticmethod
+    def definition(x):
+        return (1 - sp.exp(-x)) / x
+
+    @staticmethod
+    def closed_form(x):
+        return _em(x) / x
+
+    @staticmethod
+    def coefficient(k):
+        return sp.Integer(-1) ** k / sp.factorial(k + 1)
+
+
+#: The series-evaluated functions, in the order they are generated.
+SERIES_FUNCTIONS = (zoh_b1, zoh_b0, zoh_gap, decay_mean)
+
+#: Symbols of the forms: ``r = exp(-delta)``, ``em = 1 - r`` and the four
+#: functions above at ``delta``.
+r, em = sp.symbols("r em", positive=True)
+b1, b0, gap, mean = sp.symbols("b1 b0 gap mean", positive=True)
+_FUNCTION_OF = {b1: zoh_b1, b0: zoh_b0, gap: zoh_gap, mean: decay_mean}
 
 
 def _circle_parts():
     """Re/Im of M = G conj(H) and |H|**2, with z = exp(j theta)."""
     th = model.theta
-    P, Q, P_minus_Q = pulse_numerator_parts()
     c, s = sp.cos(th), sp.sin(th)
-    re_G, im_G = em1 * c - 2 * sp.sin(th / 2) ** 2, (1 + em1) * s
-    re_H, im_H = P * c + Q, P * s
+    re_G, im_G = em - 2 * sp.sin(th / 2) ** 2, s
+    re_H, im_H = b1 * c + b0, b1 * s
     re_M = re_G * re_H + im_G * im_H
     im_M = im_G * re_H - re_G * im_H
-    H2 = P_minus_Q**2 + 4 * P * Q * sp.cos(th / 2) ** 2
+    H2 = model.delta**2 * gap**2 + 4 * b1 * b0 * sp.cos(th / 2) ** 2
     return re_M, im_M, H2
 
 
@@ -122,8 +221,8 @@ def _circle_parts():
 def boundary_forms():
     """Return ``(alpha, beta)`` on the boundary in the well-conditioned form.
 
-    Expressions in ``theta, gamma, d, delta`` and the symbols :data:`em1`,
-    :data:`phi3`.
+    Expressions in ``theta, gamma, d, delta`` and the symbols :data:`em`,
+    :data:`b1`, :data:`b0`, :data:`gap`.
     """
     th, d, g = model.theta, model.d, model.gamma
     re_M, im_M, H2 = _circle_parts()
@@ -137,20 +236,21 @@ def boundary_forms():
 
 @functools.lru_cache(maxsize=None)
 def loop_coefficient_forms():
-    """Return the coefficients of ``chi(z) / delta**2``, highest power first.
+    """Return the coefficients of ``chi(z) / (delta**2 Gamma)``, highest power first.
 
-    ``(delayed, direct)``: the delayed part's coefficients of ``z**(d+4)``,
-    ``z**(d+3)``, ``z**(d+2)`` and the direct part's of ``z**3 .. z**0``,
-    in ``alpha, beta, gamma, delta`` and :data:`em1`, :data:`phi3`.
+    ``(delayed, direct)``: the delayed part ``z**(d+2) (z - 1) (z - r)``'s
+    coefficients of ``z**(d+4)``, ``z**(d+3)``, ``z**(d+2)`` and the direct
+    part ``V(z) (b1 z + b0)``'s of ``z**3 .. z**0``.  Each direct coefficient
+    is written so that no difference of two large terms is left to the
+    floats (``b0 - b1 = -delta gap``).
     """
-    z = model.z
-    P, Q, _ = pulse_numerator_parts()
-    Gamma = 1 + em1
-    V = model.alpha * z**2 + model.beta * z * (z - 1) + model.gamma * (z - 1) ** 2
-    delayed = sp.Poly(z**2 * (z - 1) * (Gamma * z - 1), z).all_coeffs()[:3]
-    direct = sp.Poly(sp.expand(V * (P * z + Q)), z).all_coeffs()
-    return tuple(sp.collect(c, [model.alpha, model.beta, model.gamma]) for c in delayed), \
-        tuple(sp.collect(c, [model.alpha, model.beta, model.gamma]) for c in direct)
+    al, be, ga, dl = model.alpha, model.beta, model.gamma, model.delta
+    delayed = (sp.Integer(1), -(1 + r), r)
+    direct = ((al + be + ga) * b1,
+              al * b0 - be * dl * gap - ga * (b1 + dl * gap),
+              -be * b0 + ga * (b1 - 2 * b0),
+              ga * b0)
+    return delayed, direct
 
 
 @functools.lru_cache(maxsize=None)
@@ -158,14 +258,11 @@ def plant_step_forms():
     """The exact one-sample plant step in the float-safe form.
 
     Returns ``(Phi, Gamma_u)`` (2x2 and 2x1 matrices) for the state
-    ``(x, v T)`` and the force ``f T**2 / m``: ``Phi = [[1, em1 / (delta
-    Gamma)], [0, 1 / Gamma]]``, ``Gamma_u = [P / Gamma, em1 / (delta Gamma)]``
-    with ``Gamma = 1 + em1`` (see :mod:`symstab.sampled_plant`).
+    ``(x, v T)`` and the force ``f T**2 / m``: ``Phi = [[1, mean], [0, r]]``,
+    ``Gamma_u = [b1, mean]`` (see :mod:`symstab.sampled_plant`); at
+    ``delta = 0`` the frictionless double integrator.
     """
-    P, _, _ = pulse_numerator_parts()
-    G = 1 + em1
-    ratio = em1 / (model.delta * G)
-    return sp.Matrix([[1, ratio], [0, 1 / G]]), sp.Matrix([P / G, ratio])
+    return sp.Matrix([[1, mean], [0, r]]), sp.Matrix([b1, mean])
 
 
 #: Sampled positions x(k), x(k-1), x(k-2) as the environment sees them.
@@ -190,15 +287,25 @@ def environment_force_form():
                      * position_history[k] for k in range(3)])
 
 
-def as_derivation(expr):
-    """Replace :data:`em1` and :data:`phi3` by their definitions in ``Gamma, delta``."""
+def _definitions():
     dl, G = model.delta, model.Gamma
-    return expr.subs({em1: G - 1, phi3: (G - 1 - dl - dl**2 / 2) / dl**3})
+    out = {r: 1 / G, em: 1 - 1 / G}
+    for symbol, function in _FUNCTION_OF.items():
+        out[symbol] = function.definition(dl).subs(sp.exp(-dl), 1 / G)
+    return out
+
+
+def as_derivation(expr):
+    """Replace the symbols of the forms by their definitions in ``Gamma, delta``."""
+    return expr.subs(_definitions())
 
 
 def as_evaluable(expr):
-    """Replace :data:`em1` and :data:`phi3` by ``expm1(delta)`` and ``exprel3(delta)``."""
-    return expr.subs({em1: expm1(model.delta), phi3: exprel3(model.delta)})
+    """Replace the symbols of the forms by ``exp(-delta)``, ``expm1`` and the series functions."""
+    dl = model.delta
+    out = {r: sp.exp(-dl), em: _em(dl)}
+    out.update({symbol: function(dl) for symbol, function in _FUNCTION_OF.items()})
+    return expr.subs(out)
 
 
 def proofs():
@@ -208,23 +315,33 @@ def proofs():
     -------
     list of (name, statement, lhs, rhs)
         Each ``lhs`` is a form of this module with :func:`as_derivation`
-        applied; ``rhs`` the derivation's object.
+        applied; ``rhs`` the derivation's object.  The closed forms by which
+        the series functions are evaluated above their switch are proved
+        equal to their definitions too.
     """
     bd = boundary()
     alpha, beta = boundary_forms()
     chi = characteristic_polynomial()
     delayed, direct = loop_coefficient_forms()
-    dl2 = model.delta**2
+    dl, G = model.delta, model.Gamma
+    scale = dl**2 * G
     out = [
         ("alpha_kernel_form", "alpha of the float-safe form = N_alpha / D", as_derivation(alpha), bd.alpha),
         ("beta_kernel_form", "beta of the float-safe form = N_beta / D", as_derivation(beta), bd.beta),
     ]
+    for function in SERIES_FUNCTIONS:
+        name = function.__name__
+        closed = function.closed_form(dl).replace(
+            lambda e: isinstance(e, expm1), lambda e: sp.exp(e.args[0]) - 1)
+        out.append((f"{name}_closed_form", f"{name}: the closed form evaluated above "
+                    f"delta = {function.switch} = its definition",
+                    closed.subs(sp.exp(-dl), 1 / G), function.definition(dl).subs(sp.exp(-dl), 1 / G)))
     for k, (form, derived) in enumerate(zip(delayed, chi.delayed.all_coeffs()[:3])):
-        out.append((f"delayed_coefficient_{k}", f"coefficient {k} of the delayed part / delta^2",
-                    as_derivation(form), derived / dl2))
+        out.append((f"delayed_coefficient_{k}", f"coefficient {k} of the delayed part / (delta^2 Gamma)",
+                    as_derivation(form), derived / scale))
     for k, (form, derived) in enumerate(zip(direct, chi.direct.all_coeffs())):
-        out.append((f"direct_coefficient_{k}", f"coefficient {k} of the direct part / delta^2",
-                    as_derivation(form), derived / dl2))
+        out.append((f"direct_coefficient_{k}", f"coefficient {k} of the direct part / (delta^2 Gamma)",
+                    as_derivation(form), derived / scale))
     step = dimensionless_step()
     Phi, Gamma_u = plant_step_forms()
     for (i, j) in ((0, 0), (0, 1), (1, 0), (1, 1)):

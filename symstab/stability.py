@@ -28,31 +28,43 @@ audit was built on.
 import numpy as np
 
 from ._generated import kernels
-from ._validate import check_array, check_delay
+from ._resources import CHUNK_BYTES, check_memory, chunk_slices
+from ._validate import DELTA_MAX, check_array, check_delay
 from .loop import characteristic_polynomial
 
 __all__ = [
-    "STABLE", "MARGINAL", "UNSTABLE", "MARGINAL_TOL",
-    "loop_coefficients", "spectral_radius", "schur_cohn", "classify", "is_stable",
+    "STABLE", "MARGINAL", "UNSTABLE",
+    "loop_coefficients", "spectral_radius", "schur_cohn", "unstable_root_counts",
+    "classify", "is_stable",
     "coefficients_at", "unstable_root_count", "stable_alpha_intervals",
 ]
 
 #: Codes returned by :func:`classify`.
 STABLE, MARGINAL, UNSTABLE = 1, 0, -1
-#: A spectral radius within this of 1 is marginal.
-MARGINAL_TOL = 1e-12
 #: Points whose Schur-Cohn margin ``min |1 - |k_j|||`` is below this are
-#: decided by eigenvalues: the reflection coefficients are not the radius, and
-#: their rounding grows with ``1 / (1 - k_j**2)``.
+#: re-decided by the certified root count: the reflection coefficients are
+#: not the radius, and their rounding grows with ``1 / (1 - k_j**2)``.
 _SCHUR_COHN_SAFE = 1e-6
-#: Largest batch of companion matrices handed to LAPACK at once (bytes).
+#: From this delay on, every point goes to the root count: it is O(d) per
+#: point where Schur-Cohn is O(d**2), and at long delays the stable points'
+#: Schur-Cohn margins fall below the safe level anyway.
+_COUNT_ALL_FROM_DELAY = 48
+#: Relative accuracy assumed of the generated coefficients, in units of
+#: 2**-53; measured at most a few (tests/test_generated_kernels.py).
+_COEFFICIENT_ULPS = 64
+_U = 2.0**-53
+#: Bisection rounds of an arc of the circle before a point is called
+#: marginal, and the most arcs of one point left open at once.
+_MAX_ROUNDS = 48
+_MAX_OPEN_ARCS = 1024
+#: Rows of companion matrices handed to LAPACK at once (bytes).
 _EIG_BATCH_BYTES = 64 * 2**20
 
 
 def _points(alpha, beta, gamma, d, delta):
     """Validate and broadcast; return (alpha, beta, gamma, delta, d, shape)."""
     arrays = [check_array("alpha", alpha), check_array("beta", beta),
-              check_array("gamma", gamma), check_array("delta", delta, low=0.0, low_open=True)]
+              check_array("gamma", gamma), check_array("delta", delta, low=0.0, high=DELTA_MAX)]
     d = check_delay(d)
     try:
         arrays = np.broadcast_arrays(*arrays)
@@ -61,20 +73,36 @@ def _points(alpha, beta, gamma, d, delta):
     return (*arrays, d, arrays[0].shape)
 
 
-def _coefficients(alpha, beta, gamma, d, delta):
-    """(..., d + 5) coefficients of chi / delta**2, highest power first."""
-    c = kernels.loop_coefficients(alpha, beta, gamma, delta)
+def _kernel_coefficients(alpha, beta, gamma, delta):
+    """The seven distinct coefficients of chi / (delta**2 Gamma), as (N,) arrays."""
+    with np.errstate(all="ignore"):
+        c = kernels.loop_coefficients(alpha, beta, gamma, delta)
     shape = np.broadcast(alpha, beta, gamma, delta).shape
-    out = np.zeros(shape + (d + 5,))
+    out = [np.broadcast_to(np.asarray(ck, dtype=float), shape).ravel() for ck in c]
+    bad = ~np.all([np.isfinite(ck) for ck in out], axis=0)
+    if np.any(bad):
+        i = int(np.flatnonzero(bad)[0])
+        names = ("alpha", "beta", "gamma", "delta")
+        values = ", ".join(f"{n} = {np.broadcast_to(v, shape).ravel()[i]!r}"
+                           for n, v in zip(names, (alpha, beta, gamma, delta)))
+        raise ValueError(f"the loop polynomial's coefficients overflow at {values}: "
+                         f"alpha, beta and gamma must be below about 1e300 in magnitude")
+    return out
+
+
+def _dense(c7, d, rows=slice(None)):
+    """(N, d + 5) coefficients, highest power first, from the seven distinct ones."""
+    n_rows = len(c7[0][rows])
+    out = np.zeros((n_rows, d + 5))
     for k in range(3):
-        out[..., k] += c[k]
+        out[:, k] += c7[k][rows]
     for k in range(4):
-        out[..., d + 1 + k] += c[3 + k]
+        out[:, d + 1 + k] += c7[3 + k][rows]
     return out
 
 
 def loop_coefficients(*, alpha, beta, gamma, d, delta):
-    """Coefficients of ``chi(z) / delta**2``, highest power first.
+    """Coefficients of ``chi(z) / (delta**2 exp(delta))``, highest power first.
 
     Parameters
     ----------
@@ -83,20 +111,24 @@ def loop_coefficients(*, alpha, beta, gamma, d, delta):
     d : int
         Delay in samples, ``d >= 0``.
     delta : float or array_like
-        ``b T / m > 0``.
+        ``b T / m``, from 0 (frictionless) to ``DELTA_MAX`` (1e6).
 
     Returns
     -------
     ndarray
-        Shape ``broadcast_shape + (d + 5,)``.
+        Shape ``broadcast_shape + (d + 5,)``; the leading coefficient is 1.
 
     Raises
     ------
     TypeError, ValueError
-        For non-real, non-finite or out-of-range parameters.
+        For non-real, non-finite or out-of-range parameters, or an array
+        that would not fit in the memory limit.
     """
-    alpha, beta, gamma, delta, d, _ = _points(alpha, beta, gamma, d, delta)
-    return _coefficients(alpha, beta, gamma, d, delta)
+    alpha, beta, gamma, delta, d, shape = _points(alpha, beta, gamma, d, delta)
+    check_memory(f"the coefficients of {int(np.prod(shape))} points at d = {d}",
+                 8 * (d + 5) * int(np.prod(shape)))
+    c7 = _kernel_coefficients(alpha, beta, gamma, delta)
+    return _dense(c7, d).reshape(shape + (d + 5,))
 
 
 def _horner(c, z):
@@ -118,9 +150,9 @@ def _polish(c, roots, steps=3):
     """
     for _ in range(steps):
         value, slope = _horner(c, roots)
-        with np.errstate(divide="ignore", invalid="ignore"):
+        with np.errstate(all="ignore"):
             trial = roots - value / slope
-        better = np.isfinite(trial) & (np.abs(_horner(c, trial)[0]) < np.abs(value))
+            better = np.isfinite(trial) & (np.abs(_horner(c, trial)[0]) < np.abs(value))
         roots = np.where(better, trial, roots)
     return roots
 
@@ -150,6 +182,13 @@ def _radius(coefficients):
 def spectral_radius(*, alpha, beta, gamma, d, delta):
     """Largest modulus of the closed-loop poles (batched eigenvalues).
 
+    The roots come from companion-matrix eigenvalues, the two largest of
+    each point polished by Newton steps on the polynomial: about 1e-14
+    where the largest root is simple, but only about the square root of
+    that (1e-8) where two roots nearly coincide.  For a verdict use
+    :func:`classify`, which is certified; this is the O(d**3) per point
+    measure of how far a point is from the boundary.
+
     Parameters are as in :func:`loop_coefficients`.
 
     Returns
@@ -164,8 +203,15 @@ def spectral_radius(*, alpha, beta, gamma, d, delta):
     True
     """
     alpha, beta, gamma, delta, d, shape = _points(alpha, beta, gamma, d, delta)
-    c = _coefficients(alpha, beta, gamma, d, delta).reshape(-1, d + 5)
-    r = _radius(c).reshape(shape)
+    n = d + 4
+    size = int(np.prod(shape))
+    # One companion matrix and its workspace must fit (LAPACK's O(n**2)).
+    check_memory(f"the spectral radius at d = {d}", 4 * 8 * n * n)
+    c7 = _kernel_coefficients(alpha, beta, gamma, delta)
+    r = np.empty(size)
+    for rows in chunk_slices(size, 8 * (d + 5)):
+        r[rows] = _radius(_dense(c7, d, rows))
+    r = r.reshape(shape)
     return float(r) if r.ndim == 0 else r
 
 
@@ -175,7 +221,8 @@ def schur_cohn(coefficients):
     For ``p(z) = p_n z**n + ... + p_0`` the reflection coefficient is
     ``k = p_0 / p_n``; every root lies in the open unit disk exactly when
     ``|k| < 1`` and the same holds for ``(p(z) - k z**n p(1/z)) / z``, of
-    degree ``n - 1``.
+    degree ``n - 1``.  In floating point the verdict is reliable only where
+    the margin is not small (:func:`classify` re-decides the others).
 
     Parameters
     ----------
@@ -195,44 +242,188 @@ def schur_cohn(coefficients):
     stable = np.ones(n_points, dtype=bool)
     margin = np.full(n_points, np.inf)
     active = np.ones(n_points, dtype=bool)
-    for _ in range(p.shape[1] - 1):
-        k = p[:, -1] / p[:, 0]
-        size = np.abs(k)
-        margin = np.where(active, np.minimum(margin, np.abs(1.0 - size)), margin)
-        failed = active & ~(size < 1.0)
-        stable &= ~failed
-        active &= ~failed
-        # One step of the recursion, normalised so that the leading
-        # coefficient stays 1 (the sizes neither overflow nor underflow);
-        # rows already decided are reset to a harmless polynomial.
-        q = p - k[:, None] * p[:, ::-1]
-        with np.errstate(divide="ignore", invalid="ignore"):
+    with np.errstate(all="ignore"):
+        for _ in range(p.shape[1] - 1):
+            k = p[:, -1] / p[:, 0]
+            size = np.abs(k)
+            margin = np.where(active, np.minimum(margin, np.abs(1.0 - size)), margin)
+            failed = active & ~(size < 1.0)
+            stable &= ~failed
+            active &= ~failed
+            # One step of the recursion, normalised so that the leading
+            # coefficient stays 1 (the sizes neither overflow nor underflow);
+            # rows already decided are reset to a harmless polynomial.
+            q = p - k[:, None] * p[:, ::-1]
             p = q[:, :-1] / q[:, :1]
-        p[~active] = 1.0
+            p[~active] = 1.0
     return stable, margin
 
 
-def classify(*, alpha, beta, gamma, d, delta, marginal_tol=MARGINAL_TOL, refine=True):
+def _circle_values(theta, d, em, r, c3, c4, c5, c6):
+    """chi(exp(j theta)) / (delta**2 Gamma), ``|z - 1|`` and ``|z - r|``.
+
+    ``chi = exp(j (d+2) theta) A + B`` with ``A = (z - 1)(z - r)`` in the
+    factored form (``cos(theta) - r = em - 2 sin(theta/2)**2`` has no
+    cancellation) and ``B = c3 z**3 + c4 z**2 + c5 z + c6``.  Rows of the
+    parameters broadcast against columns of ``theta``.
+    """
+    s_half = np.sin(0.5 * theta)
+    sin_t = np.sin(theta)
+    z_minus_1 = -2.0 * s_half**2 + 1j * sin_t
+    z_minus_r = (em - 2.0 * s_half**2) + 1j * sin_t
+    a = z_minus_1 * z_minus_r
+    z = np.exp(1j * theta)
+    b = ((c3 * z + c4) * z + c5) * z + c6
+    return np.exp(1j * ((d + 2) * theta)) * a + b, 2.0 * np.abs(s_half), np.abs(z_minus_r)
+
+
+def unstable_root_counts(*, alpha, beta, gamma, d, delta):
+    """Number of closed-loop poles outside the unit circle, certified.
+
+    The argument principle on the unit circle: with ``chi(exp(j theta)) =
+    exp(j (d+2) theta) A + B`` (:func:`_circle_values`), the number of roots
+    inside is the change of ``arg chi`` over ``theta`` in [0, pi] divided by
+    pi (the coefficients are real).  The change is summed arc by arc, and an
+    arc counts only when a bound on ``|d chi / d theta|`` over it and a
+    bound on the rounding error keep its whole image inside a disc that
+    excludes 0; other arcs are halved, up to 48 times.  The count is then
+    exact for the polynomial whose coefficients are within 64 ulps of the
+    generated kernel's (measured within a few ulps of the exact ones).  O(d)
+    per point.
+
+    Parameters are as in :func:`loop_coefficients`.
+
+    Returns
+    -------
+    int or ndarray of int
+        The number of roots with modulus > 1, or -1 where a root lies on
+        the unit circle to within rounding (a marginal point).
+
+    Examples
+    --------
+    >>> int(unstable_root_counts(alpha=3.0, beta=0.5, gamma=0.0, d=0, delta=0.0025))
+    2
+    """
+    alpha, beta, gamma, delta, d, shape = _points(alpha, beta, gamma, d, delta)
+    c7 = _kernel_coefficients(alpha, beta, gamma, delta)
+    em = np.broadcast_to(-np.expm1(-delta), shape).ravel()
+    out = _root_counts(c7, em, d)
+    out = out.reshape(shape)
+    return int(out) if out.ndim == 0 else out
+
+
+def _root_counts(c7, em, d, rows=None):
+    """Certified counts of roots outside the circle for rows of ``c7`` (-1: marginal)."""
+    if rows is None:
+        rows = np.arange(len(em))
+    n_arcs = max(64, 8 * (d + 4))
+    counts = np.empty(len(rows), dtype=np.int64)
+    per_row = 16 * (2 * n_arcs + 1) * 6
+    for part in chunk_slices(len(rows), per_row, CHUNK_BYTES):
+        counts[part] = _root_counts_chunk([c[rows[part]] for c in c7], em[rows[part]], d, n_arcs)
+    return counts
+
+
+def _root_counts_chunk(c7, em, d, n_arcs):
+    c3, c4, c5, c6 = (c[:, None] for c in c7[3:])
+    r = c7[2][:, None]
+    em = em[:, None]
+    n_rows = len(em)
+    b_sum = np.abs(c3) + np.abs(c4) + np.abs(c5) + np.abs(c6)
+    # |d B / d theta| <= sum k |b_k|.  For A = (z - 1)(z - r) the bounds are
+    # local (|dz / d theta| = 1): on an arc of half-width h around z_m,
+    # |A| <= (|z_m - 1| + h)(|z_m - r| + h), |A'| <= |z_m - 1| + |z_m - r| + 2 h.
+    b_slope = 3 * np.abs(c3) + 2 * np.abs(c4) + np.abs(c5)
+    # Rounding of chi at one angle, doubled for the bounds' own rounding:
+    # the phase (d+2) theta and the factored A carry errors relative to |A|;
+    # B those of its evaluation and of the coefficients themselves (64 ulps).
+    b_error = 2 * _U * (8 + _COEFFICIENT_ULPS) * b_sum
+    args = (d, em, r, c3, c4, c5, c6)
+
+    theta = np.linspace(0.0, np.pi, 2 * n_arcs + 1)
+    with np.errstate(all="ignore"):
+        chi, to_one, to_r = _circle_values(theta[None, :], *args)
+    row = np.repeat(np.arange(n_rows), n_arcs)
+    lo, mid, hi = (np.broadcast_to(theta[k:len(theta) - 2 + k:2], (n_rows, n_arcs)).ravel()
+                   for k in range(3))
+    chi_lo, chi_mid, chi_hi = (chi[:, k:chi.shape[1] - 2 + k:2].ravel() for k in range(3))
+    to_one, to_r = (np.broadcast_to(x[:, 1::2], (n_rows, n_arcs)).ravel() for x in (to_one, to_r))
+    change = np.zeros(n_rows)
+    undecided = np.zeros(n_rows, dtype=bool)
+    for _ in range(_MAX_ROUNDS):
+        half = 0.5 * (hi - lo)
+        a_max = (to_one + half) * (to_r + half)
+        slope = (d + 2) * a_max + to_one + to_r + 2 * half + b_slope[row, 0]
+        error = 2 * _U * (4 * np.pi * (d + 4) + 16) * a_max + b_error[row, 0]
+        ok = slope * half * (1 + 4 * _U) + error < np.abs(chi_mid)
+        with np.errstate(all="ignore"):
+            step = np.angle(chi_hi / chi_mid) - np.angle(chi_lo / chi_mid)
+        np.add.at(change, row[ok], step[ok])
+        bad = ~ok
+        # A row whose open arcs multiply has |chi| within rounding of 0 along
+        # a stretch of the circle (clustered roots on it): marginal.
+        crowded = np.bincount(row[bad], minlength=n_rows) > _MAX_OPEN_ARCS
+        undecided |= crowded
+        bad &= ~crowded[row]
+        if not bad.any():
+            break
+        # Halve the arcs that did not pass: [lo, mid] and [mid, hi].
+        row, lo, mid, hi = row[bad], lo[bad], mid[bad], hi[bad]
+        chi_lo, chi_mid, chi_hi = chi_lo[bad], chi_mid[bad], chi_hi[bad]
+        q1, q3 = 0.5 * (lo + mid), 0.5 * (mid + hi)
+        sub = (d, em[row], r[row], c3[row], c4[row], c5[row], c6[row])
+        with np.errstate(all="ignore"):
+            chi_q1, one_q1, r_q1 = _circle_values(q1[:, None], *sub)
+            chi_q3, one_q3, r_q3 = _circle_values(q3[:, None], *sub)
+        row = np.concatenate([row, row])
+        lo, hi, mid = np.concatenate([lo, mid]), np.concatenate([mid, hi]), np.concatenate([q1, q3])
+        chi_lo, chi_hi = np.concatenate([chi_lo, chi_mid]), np.concatenate([chi_mid, chi_hi])
+        chi_mid = np.concatenate([chi_q1.ravel(), chi_q3.ravel()])
+        to_one = np.concatenate([np.broadcast_to(one_q1, r_q1.shape).ravel(),
+                                 np.broadcast_to(one_q3, r_q3.shape).ravel()])
+        to_r = np.concatenate([r_q1.ravel(), r_q3.ravel()])
+        if not np.all(hi > lo):
+            undecided[np.unique(row[~(hi > lo)])] = True
+    else:
+        undecided[np.unique(row)] = True
+    inside = change / np.pi
+    whole = np.rint(inside)
+    if np.any(~undecided & (np.abs(inside - whole) > 0.25)):
+        raise AssertionError("the certified argument change is not a multiple of pi")
+    return np.where(undecided, -1, (d + 4) - whole.astype(np.int64))
+
+
+def classify(*, alpha, beta, gamma, d, delta, refine=True):
     """Classify parameter points as stable, unstable or marginal.
+
+    A fast floating-point Schur-Cohn test (:func:`schur_cohn`) decides the
+    points it decides with a margin of at least 1e-6; every other point,
+    and every point from d = 48 on, is decided by the certified root count
+    of :func:`unstable_root_counts`.  :data:`MARGINAL` means that a root lies
+    on the unit circle to within the rounding of the coefficients (a point
+    on the boundary, to about 1e-13 relative): the verdict is then not
+    certain either way.
 
     Parameters
     ----------
     alpha, beta, gamma, d, delta
         As in :func:`loop_coefficients`.
-    marginal_tol : float
-        A spectral radius within this of 1 is :data:`MARGINAL`.
     refine : bool
-        Decide the points whose Schur-Cohn margin is below 1e-6 by their
-        eigenvalues (the default).  With ``False`` the Schur-Cohn verdict is
-        returned as it is (only a margin of exactly 0 is marginal): faster at
-        large ``d`` near the boundary, and in the tests it never disagreed
-        with the eigenvalues where the margin was positive, but a radius
-        within ``marginal_tol`` of 1 is then not recognised.
+        Re-decide the points the float test does not decide safely (the
+        default).  With ``False`` the Schur-Cohn verdict is returned as it is
+        (only a margin of exactly 0 is marginal): faster where a wrong
+        verdict next to the boundary does no harm.
 
     Returns
     -------
     int or ndarray of int8
         :data:`STABLE` (1), :data:`MARGINAL` (0) or :data:`UNSTABLE` (-1).
+
+    Raises
+    ------
+    TypeError, ValueError
+        For non-real, non-finite or out-of-range parameters (``delta`` in
+        [0, 1e6], ``d`` up to ``SYMSTAB_MAX_DELAY``).
 
     Examples
     --------
@@ -242,21 +433,35 @@ def classify(*, alpha, beta, gamma, d, delta, marginal_tol=MARGINAL_TOL, refine=
     True
     """
     alpha, beta, gamma, delta, d, shape = _points(alpha, beta, gamma, d, delta)
-    c = _coefficients(alpha, beta, gamma, d, delta).reshape(-1, d + 5)
-    stable, margin = schur_cohn(c)
-    out = np.where(stable, STABLE, UNSTABLE).astype(np.int8)
-    close = margin < max(_SCHUR_COHN_SAFE, marginal_tol)
-    if not refine:
-        out[margin == 0] = MARGINAL
-    elif np.any(close):
-        r = _radius(c[close])
-        out[close] = np.where(np.abs(r - 1.0) <= marginal_tol, MARGINAL,
-                              np.where(r < 1.0, STABLE, UNSTABLE))
-    out = out.reshape(shape)
-    return int(out) if out.ndim == 0 else out
+    c7 = _kernel_coefficients(alpha, beta, gamma, delta)
+    em = np.broadcast_to(-np.expm1(-delta), shape).ravel()
+    size = len(em)
+    out = np.empty(size, dtype=np.int8)
+    if refine and d >= _COUNT_ALL_FROM_DELAY:
+        counts = _root_counts(c7, em, d)
+        out[:] = np.where(counts < 0, MARGINAL, np.where(counts == 0, STABLE, UNSTABLE))
+        return _shaped(out, shape)
+    for rows in chunk_slices(size, 8 * (d + 5) * 4):
+        stable, margin = schur_cohn(_dense(c7, d, rows))
+        part = np.where(stable, STABLE, UNSTABLE).astype(np.int8)
+        if not refine:
+            part[margin == 0] = MARGINAL
+        else:
+            close = np.flatnonzero(margin < _SCHUR_COHN_SAFE)
+            if close.size:
+                counts = _root_counts(c7, em, d, np.arange(size)[rows][close])
+                part[close] = np.where(counts < 0, MARGINAL,
+                                       np.where(counts == 0, STABLE, UNSTABLE))
+        out[rows] = part
+    return _shaped(out, shape)
 
 
-def is_stable(*, alpha, beta, gamma, d, delta, marginal_tol=MARGINAL_TOL):
+def _shaped(codes, shape):
+    codes = codes.reshape(shape)
+    return int(codes) if codes.ndim == 0 else codes
+
+
+def is_stable(*, alpha, beta, gamma, d, delta):
     """Whether each point is stable; marginal points are undecided.
 
     Returns
@@ -270,8 +475,7 @@ def is_stable(*, alpha, beta, gamma, d, delta, marginal_tol=MARGINAL_TOL):
     >>> is_stable(alpha=[0.1, 3.0], beta=0.5, gamma=0.0, d=0, delta=0.0025).tolist()
     [True, False]
     """
-    code = np.asarray(classify(alpha=alpha, beta=beta, gamma=gamma, d=d, delta=delta,
-                               marginal_tol=marginal_tol))
+    code = np.asarray(classify(alpha=alpha, beta=beta, gamma=gamma, d=d, delta=delta))
     if code.ndim == 0:
         return None if code == MARGINAL else bool(code == STABLE)
     return np.ma.MaskedArray(code == STABLE, mask=code == MARGINAL)

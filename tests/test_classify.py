@@ -389,9 +389,11 @@ BAD_INPUTS = [
     ("d", True, TypeError),
     ("d", "3", TypeError),
     ("d", 3 + 0j, TypeError),
-    ("delta", 0.0, ValueError),
     ("delta", -0.1, ValueError),
-    ("delta", [0.1, 0.0], ValueError),
+    ("delta", [0.1, -1e-300], ValueError),
+    ("delta", 1.5e6, ValueError),
+    ("d", 10**20, ValueError),
+    ("d", 1e20, ValueError),
 ]
 
 

@@ -11,7 +11,7 @@ evaluation of the printed code:
 * C and NumPy agree to 1e-12 on a few thousand seeded random points;
 * both kernels match 50-digit mpmath references -- the derivation's own
   (unrearranged) boundary :func:`symstab.evaluate.boundary_point`, the
-  definition of ``exprel3`` and ``characteristic_polynomial().numeric_coeffs``;
+  definitions of the series functions (zoh_b1, ...) and ``characteristic_polynomial().numeric_coeffs``;
 * the naive float evaluation of the derivation's C-coefficient form fails
   the same accuracy check at small delta, so that check can fail, and the
   rearranged forms are needed.
@@ -37,11 +37,12 @@ import pytest
 import sympy as sp
 
 from conftest import PAPER_DELTA, REPO, relative_error
+import symstab
 from symstab import model
 from symstab._generated import kernels as numpy_kernels
 from symstab.boundary import boundary
 from symstab.evaluate import boundary_point
-from symstab.kernel_forms import EXPREL3_SWITCH
+from symstab.kernel_forms import SERIES_FUNCTIONS
 from symstab.theta_max import theta_max
 
 GENERATED = REPO / "symstab" / "_generated"
@@ -53,13 +54,11 @@ C_HEADER = GENERATED / "symstab_kernels.h"
 C_VS_NUMPY_RTOL = 1e-12
 #: Kernel vs the 50-digit reference of the boundary.
 BOUNDARY_RTOL = 1e-10
-#: exprel3 from its Taylor polynomial (delta < 1): a Horner sum of positive
-#: terms, a couple of roundings.
-EXPREL3_SERIES_RTOL = 4e-16
-#: exprel3 from ``(expm1(x) - x - x**2/2) / x**3`` (delta >= 1): the
-#: subtraction cancels a factor expm1(x) / (x**3 exprel3(x)), about 8 at
-#: x = 1, so a few-ulp evaluation carries ~8 ulp (2e-15) there.
-EXPREL3_CLOSED_FORM_RTOL = 3e-15
+#: The series functions (zoh_b1, zoh_b0, zoh_gap, decay_mean), both branches:
+#: an alternating Horner sum dominated by its first term below the switch, a
+#: difference that cancels at most a factor of about 4 above it (measured
+#: at most 5.7 ulp, for zoh_gap just above its switch at 2).
+SERIES_FUNCTION_RTOL = 16 * 2.0**-53
 #: Loop coefficients vs the 30-digit coefficients, relative to the largest.
 LOOP_RTOL = 1e-12
 
@@ -98,7 +97,10 @@ def header_signatures(text):
 
 #: What the wrappers below call; the header must declare exactly this.
 EXPECTED_SIGNATURES = {
-    "symstab_exprel3": ("double", ["double"]),
+    "symstab_zoh_b1": ("double", ["double"]),
+    "symstab_zoh_b0": ("double", ["double"]),
+    "symstab_zoh_gap": ("double", ["double"]),
+    "symstab_decay_mean": ("double", ["double"]),
     "symstab_boundary": ("void", ["double", "double", "int", "double"] + ["double *"] * 2),
     "symstab_loop_coefficients": ("void", ["double"] * 4 + ["double *"] * 7),
     "symstab_plant_step_coefficients": ("void", ["double"] + ["double *"] * 4),
@@ -113,8 +115,8 @@ class CKernels:
     def __init__(self, lib):
         self.lib = lib
 
-    def exprel3(self, delta):
-        return self.lib.symstab_exprel3(float(delta))
+    def series_function(self, name, delta):
+        return getattr(self.lib, f"symstab_{name}")(float(delta))
 
     @staticmethod
     def _outputs(n):
@@ -223,11 +225,12 @@ def _assert_all_below(errors, rtol, points, label):
                                f"exceed {rtol:g}; worst {errors[k]:.3g} at {where}")
 
 
-def test_c_exprel3_matches_numpy(c_kernels, random_points):
-    delta = random_points["delta"]
-    c = np.array([c_kernels.exprel3(x) for x in delta])
-    _assert_all_below(_mixed_error(c, numpy_kernels.exprel3(delta)), C_VS_NUMPY_RTOL,
-                      {"delta": delta}, "exprel3, C vs NumPy")
+@pytest.mark.parametrize("name", [f.__name__ for f in SERIES_FUNCTIONS])
+def test_c_series_functions_match_numpy(c_kernels, random_points, name):
+    delta = np.concatenate([random_points["delta"], [0.0, 1.0, 2.0, 400.0, 710.0, 1e4, 1e6]])
+    c = np.array([c_kernels.series_function(name, x) for x in delta])
+    _assert_all_below(_mixed_error(c, getattr(numpy_kernels, name)(delta)), C_VS_NUMPY_RTOL,
+                      {"delta": delta}, f"{name}, C vs NumPy")
 
 
 def test_c_boundary_matches_numpy(c_kernels, random_points):
@@ -359,44 +362,44 @@ def test_alpha_vanishes_at_theta_max(c_kernels, delta, d, gamma):
 
 
 # --------------------------------------------------------------------------
-# exprel3 against its definition
+# The series functions against their definitions, delta from 0 to 1e6
 # --------------------------------------------------------------------------
 
-SWITCH = float(EXPREL3_SWITCH)
-EXPREL3_POINTS = np.unique(np.concatenate([
-    np.geomspace(1e-8, 20.0, 400),
-    # Both sides of the switch from the Taylor polynomial to expm1.
-    [np.nextafter(SWITCH, 0.0), SWITCH, np.nextafter(SWITCH, 1.0)],
-    SWITCH + 1e-3 * np.arange(-20, 21),
+SERIES_POINTS = np.unique(np.concatenate([
+    [0.0, 1e-300, 1e-20, 1e-8],
+    np.geomspace(1e-6, 1e6, 600),
+    # Both sides of the switches from the Taylor polynomial to expm1.
+    [np.nextafter(x, 0.0) for x in (1.0, 2.0)], [1.0, 2.0],
+    1.0 + 1e-3 * np.arange(-20, 21), 2.0 + 1e-3 * np.arange(-20, 21),
 ]))
 
 
-def _exprel3_reference(x):
-    with mpmath.workdps(50):
+def _series_reference(name, x):
+    """The definition at 40 digits plus the digits it cancels; the limit at 0."""
+    if x == 0.0:
+        return {"zoh_b1": mpmath.mpf(1) / 2, "zoh_b0": mpmath.mpf(1) / 2,
+                "zoh_gap": mpmath.mpf(1) / 6, "decay_mean": mpmath.mpf(1)}[name]
+    with mpmath.workdps(40 + int(3 * max(0.0, -math.log10(x)))):
         x = mpmath.mpf(float(x))
-        return (mpmath.expm1(x) - x - x**2 / 2) / x**3
-
-
-@pytest.fixture(scope="module")
-def exprel3_reference():
-    return [_exprel3_reference(x) for x in EXPREL3_POINTS]
+        e = mpmath.exp(-x)
+        return {"zoh_b1": (x - 1 + e) / x**2,
+                "zoh_b0": (1 - e - x * e) / x**2,
+                "zoh_gap": (x * (1 + e) - 2 * (1 - e)) / x**3,
+                "decay_mean": (1 - e) / x}[name]
 
 
 @pytest.mark.parametrize("kernel", ["numpy", "C"])
-def test_exprel3_matches_definition_at_50_digits(request, kernel, exprel3_reference):
-    """Series branch within 4e-16, expm1 branch within 1e-14 (see the bounds)."""
+@pytest.mark.parametrize("name", [f.__name__ for f in SERIES_FUNCTIONS])
+def test_series_functions_match_definition_from_0_to_1e6(request, kernel, name):
+    """Both branches within 16 ulp of the definition (measured at most 5.7)."""
     if kernel == "numpy":
-        values = numpy_kernels.exprel3(EXPREL3_POINTS)
+        values = getattr(numpy_kernels, name)(SERIES_POINTS)
     else:
         c = request.getfixturevalue("c_kernels")
-        values = np.array([c.exprel3(x) for x in EXPREL3_POINTS])
-    errors = np.array([float(relative_error(mpmath.mpf(float(v)), r))
-                       for v, r in zip(values, exprel3_reference)])
-    series = EXPREL3_POINTS < SWITCH
-    for mask, rtol, label in ((series, EXPREL3_SERIES_RTOL, "Taylor branch"),
-                              (~series, EXPREL3_CLOSED_FORM_RTOL, "expm1 branch")):
-        _assert_all_below(errors[mask], rtol, {"delta": EXPREL3_POINTS[mask]},
-                          f"{kernel} exprel3, {label}")
+        values = np.array([c.series_function(name, x) for x in SERIES_POINTS])
+    errors = np.array([float(relative_error(mpmath.mpf(float(v)), _series_reference(name, x)))
+                       for v, x in zip(values, SERIES_POINTS)])
+    _assert_all_below(errors, SERIES_FUNCTION_RTOL, {"delta": SERIES_POINTS}, f"{kernel} {name}")
 
 
 # --------------------------------------------------------------------------
@@ -435,14 +438,14 @@ def assemble(coefficients, d):
 @pytest.mark.parametrize("point", LOOP_POINTS,
                          ids=[f"d={p['d']}-delta={p['delta']:.3g}" for p in LOOP_POINTS])
 def test_loop_coefficients_match_characteristic_polynomial(request, loop, kernel, point):
-    """Every coefficient of chi / delta^2 within 1e-12 of the largest one."""
+    """Every coefficient of chi / (delta^2 Gamma) within 1e-12 of the largest one."""
     args = [point[k] for k in ("alpha", "beta", "gamma", "delta")]
     if kernel == "numpy":
         values = [float(c) for c in numpy_kernels.loop_coefficients(*args)]
     else:
         values = request.getfixturevalue("c_kernels").loop_coefficients(*args)
     actual = assemble(np.array(values), point["d"])
-    expected = loop.numeric_coeffs(**point) / point["delta"] ** 2
+    expected = loop.numeric_coeffs(**point) / (point["delta"] ** 2 * math.exp(point["delta"]))
     errors = np.abs(actual - expected) / np.max(np.abs(expected))
     k = int(np.argmax(errors))
     assert errors[k] <= LOOP_RTOL, (
@@ -542,7 +545,8 @@ def test_c_environment_force_matches_numpy(c_kernels, simulator_points):
 
 
 @pytest.mark.parametrize("gamma, d, delta", [(0.0, 0, PAPER_DELTA), (1.0, 10, PAPER_DELTA),
-                                             (0.5, 200, 1e-6), (-0.5, 5, 1.0)])
+                                             (0.5, 200, 1e-6), (-0.5, 5, 1.0),
+                                             (0.0, 0, 400.0), (1.0, 3, 710.0), (0.5, 10, 1e4)])
 def test_boundary_on_a_dense_grid_mixed_error(gamma, d, delta):
     """200 angles from 1e-4 to theta_max, where beta changes sign and alpha ends at 0.
 
@@ -550,7 +554,10 @@ def test_boundary_on_a_dense_grid_mixed_error(gamma, d, delta):
     accurate (the condition number is infinite there: theta itself is rounded),
     so the bound is mixed: |error| <= 1e-10 |value| + 1e-14 max|value on the arc|.
     """
-    t_end = theta_max(gamma=gamma, d=d, delta=delta)
+    # The angle range only says where to look (the 30-digit theta_max's
+    # tolerance is absolute and fails beyond delta ~ 700); the oracle is
+    # boundary_point.
+    t_end = symstab.arc_end_angle(gamma=gamma, d=d, delta=delta)
     thetas = np.linspace(1e-4, t_end, 200)
     alpha, beta = numpy_kernels.boundary(thetas, gamma, d, delta)
     refs = [boundary_point(float(t), gamma=gamma, d=d, delta=delta, dps=50) for t in thetas]
@@ -561,3 +568,72 @@ def test_boundary_on_a_dense_grid_mixed_error(gamma, d, delta):
         worst = int(np.argmax(np.abs(got - ref) - bound))
         assert np.all(np.abs(got - ref) <= bound), (
             f"{name} at theta = {thetas[worst]!r}: {got[worst]!r} vs {ref[worst]!r}")
+
+
+# --------------------------------------------------------------------------
+# delta = 0 (a frictionless device) and large delta: no overflow, no 0 / 0
+
+
+def _first_principles_coefficients(alpha, beta, gamma, d, delta, dps=60):
+    """chi(z) / (delta**2 Gamma) from eqs. (1), (2), (4) in exp(-delta), at ``dps`` digits.
+
+    ``z**(d+2) (z - 1)(z - E) + V(z) (n1 z + n0) / delta**2`` with ``E =
+    exp(-delta)``, ``n1 = E - 1 + delta``, ``n0 = 1 - (1 + delta) E``; at
+    delta = 0 the limits ``n1 / delta**2 = n0 / delta**2 = 1/2``.
+    """
+    # n1 and n0 cancel to delta**2: carry the digits they lose.
+    dps += int(3 * max(0.0, -math.log10(delta))) if delta > 0 else 0
+    with mpmath.workdps(dps):
+        a, b, g, dl = (mpmath.mpf(x) for x in (alpha, beta, gamma, delta))
+        E = mpmath.exp(-dl)
+        if dl == 0:
+            h1 = h0 = mpmath.mpf(1) / 2
+        else:
+            h1, h0 = (E - 1 + dl) / dl**2, (1 - (1 + dl) * E) / dl**2
+        v = [a + b + g, -b - 2 * g, g]
+        out = [mpmath.mpf(0)] * (d + 5)
+        for k, c in enumerate((1, -(1 + E), E)):
+            out[k] += c
+        for k, c in enumerate((v[0] * h1, v[0] * h0 + v[1] * h1, v[1] * h0 + v[2] * h1, v[2] * h0)):
+            out[d + 1 + k] += c
+        return [float(c) for c in out]
+
+
+EXTREME_DELTAS = (0.0, 1e-300, 400.0, 710.0, 1e4, 1e6)
+
+
+@pytest.mark.parametrize("delta", EXTREME_DELTAS)
+@pytest.mark.parametrize("kernel", ["numpy", "C"])
+def test_loop_coefficients_at_extreme_delta_match_first_principles(request, kernel, delta):
+    """Today's forms overflowed for delta > 709 and were 0 / 0 at delta = 0."""
+    args = (0.1, 0.5, 0.7, delta)
+    if kernel == "numpy":
+        values = [float(c) for c in numpy_kernels.loop_coefficients(*args)]
+    else:
+        values = request.getfixturevalue("c_kernels").loop_coefficients(*args)
+    actual = assemble(np.array(values), 3)
+    expected = np.array(_first_principles_coefficients(*args[:3], 3, delta))
+    assert np.all(np.isfinite(actual))
+    errors = np.abs(actual - expected) / np.max(np.abs(expected))
+    assert np.max(errors) <= LOOP_RTOL, f"{actual} vs {expected}"
+
+
+@pytest.mark.parametrize("delta, d", [(0.0, 0), (0.0, 5), (400.0, 0), (710.0, 0), (1e4, 2), (1e6, 1)])
+def test_classification_at_extreme_delta_matches_60_digit_roots(delta, d):
+    """The issue's cases (delta = 400 and 710 called empty or unstable) and delta = 0.
+
+    Points on a ray through the stable region's neighbourhood; the oracle is
+    mpmath.polyroots of the first-principles polynomial at 60 digits.
+    """
+    alphas = np.array([0.05, 0.1, 0.5, 1.0, 2.0, 4.0])
+    beta = 0.5
+    codes = symstab.classify(alpha=alphas, beta=beta, gamma=0.0, d=d, delta=delta)
+    radii = symstab.spectral_radius(alpha=alphas, beta=beta, gamma=0.0, d=d, delta=delta)
+    with mpmath.workdps(60):
+        for a, code, radius in zip(alphas, codes, radii):
+            roots = mpmath.polyroots(_first_principles_coefficients(a, beta, 0.0, d, delta),
+                                     maxsteps=200, extraprec=200)
+            exact = max(abs(r) for r in roots)
+            assert abs(exact - 1) > 1e-9, "test point too close to the boundary"
+            assert code == (symstab.STABLE if exact < 1 else symstab.UNSTABLE), (a, exact)
+            assert abs(radius - float(exact)) <= 1e-9, (a, radius, exact)

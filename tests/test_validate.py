@@ -68,7 +68,7 @@ def test_check_real_huge_integer_raises_value_error():
 # check_delay --------------------------------------------------------------
 
 @pytest.mark.parametrize("d, expected", [
-    (0, 0), (3, 3), (3.0, 3), (np.int64(12), 12), (np.float64(40.0), 40), (10**6, 10**6),
+    (0, 0), (3, 3), (3.0, 3), (np.int64(12), 12), (np.float64(40.0), 40), (10_000, 10_000),
 ])
 def test_check_delay_accepts_non_negative_integers(d, expected):
     result = check_delay(d)
@@ -112,3 +112,25 @@ def test_check_delay_samples_rejects_non_whole_ratios(ratio):
     with pytest.raises(ValueError) as excinfo:
         check_delay_samples(ratio)
     assert "Td / T" in str(excinfo.value)
+
+
+def test_check_delay_refuses_more_than_the_limit_naming_it(monkeypatch):
+    with pytest.raises(ValueError, match=r"delay d must be an integer from 0 to 10000.*SYMSTAB_MAX_DELAY"):
+        check_delay(1e20)
+    monkeypatch.setenv("SYMSTAB_MAX_DELAY", "20000")
+    assert check_delay(20_000) == 20_000
+    with pytest.raises(ValueError, match="from 0 to 20000"):
+        check_delay(20_001)
+    monkeypatch.setenv("SYMSTAB_MAX_DELAY", "lots")
+    with pytest.raises(ValueError, match="SYMSTAB_MAX_DELAY must be a positive whole number"):
+        check_delay(3)
+
+
+@pytest.mark.parametrize("value, ok", [(0.0, True), (1e6, True), (-1e-300, False), (1.0000001e6, False)])
+def test_check_delta_accepts_zero_up_to_the_limit(value, ok):
+    from symstab._validate import check_delta
+    if ok:
+        assert check_delta(value) == value
+    else:
+        with pytest.raises(ValueError, match=r"delta must be a finite real number >= 0 and <= 1e\+06"):
+            check_delta(value)
