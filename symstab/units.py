@@ -14,7 +14,7 @@ import dataclasses
 
 import numpy as np
 
-from ._validate import check_array, check_delay, check_delay_samples, check_real
+from ._validate import check_array, check_delay, check_delay_samples, check_delta, check_real
 
 __all__ = ["Device", "PAPER_DEVICE"]
 
@@ -28,14 +28,18 @@ class Device:
     m : float
         Effective mass (kg, or kg m^2 for a rotary device), ``m > 0``.
     b : float
-        Viscous friction (N s/m, or N m s/rad), ``b > 0``.
+        Viscous friction (N s/m, or N m s/rad), ``b >= 0``; 0 is a
+        frictionless (or friction-compensated) device.
     T : float
         Sample period (s), ``T > 0``.
 
     Raises
     ------
     TypeError, ValueError
-        For a non-real, non-finite or out-of-range parameter.
+        For a non-real, non-finite or out-of-range parameter, or a device
+        whose ``delta = b T / m`` is above ``DELTA_MAX`` (1e6).  A conversion
+        whose result overflows (or a nonzero one that underflows to 0)
+        raises :class:`ValueError` naming the quantity.
 
     Examples
     --------
@@ -52,8 +56,10 @@ class Device:
 
     def __post_init__(self):
         object.__setattr__(self, "m", check_real("m", self.m, low=0.0, low_open=True))
-        object.__setattr__(self, "b", check_real("b", self.b, low=0.0, low_open=True))
+        object.__setattr__(self, "b", check_real("b", self.b, low=0.0))
         object.__setattr__(self, "T", check_real("T", self.T, low=0.0, low_open=True))
+        check_delta(float(_converted("delta = b T / m", self.b, lambda: self.b * self.T / self.m)),
+                    name="delta = b T / m")
 
     @property
     def delta(self):
@@ -68,15 +74,18 @@ class Device:
 
     def alpha(self, K_w):
         """``alpha = K_w T**2 / m`` for a stiffness ``K_w`` (N/m or N m/rad)."""
-        return _as_float(check_array("K_w", K_w) * self.T**2 / self.m)
+        K_w = check_array("K_w", K_w)
+        return _as_float(_converted("alpha = K_w T^2 / m", K_w, lambda: K_w * (self.T / self.m) * self.T))
 
     def beta(self, B_w):
         """``beta = B_w T / m`` for a damping ``B_w`` (N s/m or N m s/rad)."""
-        return _as_float(check_array("B_w", B_w) * self.T / self.m)
+        B_w = check_array("B_w", B_w)
+        return _as_float(_converted("beta = B_w T / m", B_w, lambda: B_w * (self.T / self.m)))
 
     def gamma(self, M_w):
         """``gamma = M_w / m`` for a virtual mass ``M_w`` (kg or kg m^2)."""
-        return _as_float(check_array("M_w", M_w) / self.m)
+        M_w = check_array("M_w", M_w)
+        return _as_float(_converted("gamma = M_w / m", M_w, lambda: M_w / self.m))
 
     # dimensionless -> physical
     def delay(self, d):
@@ -85,15 +94,18 @@ class Device:
 
     def stiffness(self, alpha):
         """``K_w = alpha m / T**2``."""
-        return _as_float(check_array("alpha", alpha) * self.m / self.T**2)
+        alpha = check_array("alpha", alpha)
+        return _as_float(_converted("K_w = alpha m / T^2", alpha, lambda: alpha * (self.m / self.T) / self.T))
 
     def damping(self, beta):
         """``B_w = beta m / T``."""
-        return _as_float(check_array("beta", beta) * self.m / self.T)
+        beta = check_array("beta", beta)
+        return _as_float(_converted("B_w = beta m / T", beta, lambda: beta * (self.m / self.T)))
 
     def mass(self, gamma):
         """``M_w = gamma m``."""
-        return _as_float(check_array("gamma", gamma) * self.m)
+        gamma = check_array("gamma", gamma)
+        return _as_float(_converted("M_w = gamma m", gamma, lambda: gamma * self.m))
 
     def units(self, rotary=True):
         """Unit strings of ``K_w, B_w, M_w`` (rotary: N m/rad, N m s/rad, kg m^2)."""
@@ -102,11 +114,28 @@ class Device:
         return {"K_w": "N/m", "B_w": "N s/m", "M_w": "kg", "Td": "s"}
 
 
-#: The paper's device (Sections IV and VI): m = 0.0128 kg m^2,
-#: b = 0.0324 N m s/rad, T = 1 ms.
-PAPER_DEVICE = Device(m=0.0128, b=0.0324, T=1e-3)
+def _converted(what, given, compute):
+    """``compute()``, a unit conversion, or ValueError if it overflows or underflows.
+
+    ``given`` is the input it was converted from: a nonzero input whose
+    result is 0 (underflow) or whose result is not finite (overflow) cannot
+    be represented.
+    """
+    with np.errstate(all="ignore"):
+        given, result = np.asarray(given, dtype=float), np.asarray(compute(), dtype=float)
+        bad = ~np.isfinite(result) | ((result == 0) & (given != 0))
+    if np.any(bad):
+        raise ValueError(f"{what} is not representable as a float for this device "
+                         f"(m, b, T) and input: it overflows or underflows; "
+                         f"use units in which the values are nearer 1")
+    return result
 
 
 def _as_float(x):
     x = np.asarray(x, dtype=float)
     return float(x) if x.ndim == 0 else x
+
+
+#: The paper's device (Sections IV and VI): m = 0.0128 kg m^2,
+#: b = 0.0324 N m s/rad, T = 1 ms.
+PAPER_DEVICE = Device(m=0.0128, b=0.0324, T=1e-3)
