@@ -1,5 +1,7 @@
 """Helpers shared by the check modules: printed entries, proofs, wording."""
 
+import functools
+
 import sympy as sp
 
 from symstab.identity import check_identity
@@ -8,10 +10,47 @@ from .audit import Outcome
 from .printed import C, PRINTED_COEFFICIENTS, printed
 
 __all__ = ["where", "with_printed_coefficients", "prove", "compare",
-           "show", "DEVICE_DELTA"]
+           "show", "DEVICE_DELTA", "Memo"]
 
 #: delta = b T / m of the paper's device (m = 0.0128, b = 0.0324, T = 1 ms).
 DEVICE_DELTA = 0.0324 * 1e-3 / 0.0128
+
+
+class Memo:
+    """Cache of an expensive, deterministic function of hashable arguments.
+
+    Like ``functools.lru_cache``, and besides: it has a name by which a
+    worker process finds it, and its values can be computed elsewhere and
+    filled in (see :func:`paper_checks.audit.run_audit`), so that checks
+    which share a result compute it once between them.
+    """
+
+    #: Every Memo by name, for the workers.
+    registry = {}
+
+    def __init__(self, func):
+        functools.update_wrapper(self, func)
+        self.func = func
+        self.name = f"{func.__module__}.{func.__qualname__}"
+        self.values = {}
+        if self.name in Memo.registry:
+            raise ValueError(f"Memo {self.name!r} defined twice")
+        Memo.registry[self.name] = self
+
+    def compute(self, args):
+        """The value at ``args`` (a tuple), computed now; the cache is not consulted."""
+        return self.func(*args)
+
+    def __call__(self, *args):
+        if args not in self.values:
+            self.values[args] = self.compute(args)
+        return self.values[args]
+
+    @classmethod
+    def fill(cls, cached):
+        """Add ``{name: {args: value}}`` computed elsewhere to the caches."""
+        for name, values in cached.items():
+            cls.registry[name].values.update(values)
 
 
 def where(id):

@@ -20,11 +20,21 @@ A check is a function registered with :func:`check`; it returns an
 
 The check modules (``eq_*.py``, ``claims.py``) only call :mod:`symstab` and
 read :mod:`paper_checks.printed`; no formula is derived here.
+
+The checks are independent, so :func:`run_audit` runs them in worker
+processes (two by default).  A module whose checks share expensive results
+(a region classified by root counting, an exact theta_max) keeps them in
+:class:`paper_checks._common.Memo` caches and lists the calls in a
+``prefetch()`` function: those calls run first, one task each, and the
+module's checks then start with every result cached, so no result is
+computed twice and the order of the checks does not matter.
 """
 
+import concurrent.futures
 import dataclasses
 import importlib
 import json
+import sys
 
 __all__ = [
     "VERDICTS", "Outcome", "Finding", "check", "registered", "run_audit",
@@ -108,30 +118,114 @@ def registered():
     return dict(_REGISTRY)
 
 
-def run_audit(ids=None, progress=None):
-    """Run the checks (all, or those in ``ids``) and return the findings.
-
-    Parameters
-    ----------
-    ids : iterable of str, optional
-        Only these checks.
-    progress : callable, optional
-        Called with ``(index, total, id)`` before each check.
-    """
+def _selected(ids):
     checks = registered()
     if ids is not None:
         unknown = sorted(set(ids) - set(checks))
         if unknown:
             raise ValueError(f"unknown check ids: {', '.join(unknown)}")
         checks = {k: v for k, v in checks.items() if k in set(ids)}
-    findings = []
-    for n, (cid, (kind, where, claim, func)) in enumerate(checks.items(), 1):
-        if progress is not None:
-            progress(n, len(checks), cid)
-        outcome = func()
-        findings.append(Finding(cid, kind, where, claim, outcome.verdict,
-                                outcome.evidence, outcome.corrected))
-    return findings
+    return checks
+
+
+def _finding(cid, entry, outcome):
+    kind, where, claim, _ = entry
+    return Finding(cid, kind, where, claim, outcome.verdict, outcome.evidence, outcome.corrected)
+
+
+def run_audit(ids=None, progress=None, *, workers=None, executor=None):
+    """Run the checks (all, or those in ``ids``) and return the findings.
+
+    The findings are in report order however the checks were scheduled,
+    and the same whatever the number of workers.
+
+    Parameters
+    ----------
+    ids : iterable of str, optional
+        Only these checks.
+    progress : callable, optional
+        Called with ``(index, total, id)`` as each check starts (one worker)
+        or finishes (several).
+    workers : int, optional
+        Worker processes; 1 runs every check here, in order.  Default: the
+        cores, at most two (:func:`symstab.reproduce.default_workers`).
+    executor : concurrent.futures.Executor, optional
+        Run the checks in this pool (whose workers are shared with other
+        work, as in ``symstab reproduce``) instead of a new one.
+    """
+    from symstab.reproduce import default_workers, worker_pool
+
+    checks = _selected(ids)
+    if executor is not None:
+        return _run_parallel(checks, progress, executor)
+    workers = default_workers() if workers is None else workers
+    if isinstance(workers, bool) or not isinstance(workers, int) or workers < 1:
+        raise ValueError(f"workers must be an integer >= 1, got {workers!r}")
+    if workers == 1 or len(checks) < 2:
+        findings = []
+        for n, (cid, entry) in enumerate(checks.items(), 1):
+            if progress is not None:
+                progress(n, len(checks), cid)
+            findings.append(_finding(cid, entry, entry[3]()))
+        return findings
+    with worker_pool(min(workers, len(checks))) as pool:
+        return _run_parallel(checks, progress, pool)
+
+
+def _prefetch_task(name, args):
+    from ._common import Memo
+
+    registered()  # a worker forked or spawned before the check modules were imported
+    return Memo.registry[name].compute(args)
+
+
+def _check_task(cid, cached):
+    from ._common import Memo
+
+    func = registered()[cid][3]
+    Memo.fill(cached)
+    return func()
+
+
+def _run_parallel(checks, progress, executor):
+    """Run ``checks`` as tasks of ``executor``: the prefetches first, then their users."""
+    from ._common import Memo
+
+    waiting = set()    # checks of modules with a prefetch: they start when it is done
+    calls = []
+    for module in dict.fromkeys(entry[3].__module__ for entry in checks.values()):
+        prefetch = getattr(sys.modules[module], "prefetch", None)
+        if prefetch is None:
+            continue
+        waiting |= {cid for cid, entry in checks.items() if entry[3].__module__ == module}
+        calls += [(memo.name, args) for memo, args in prefetch() if (memo.name, args) not in calls]
+    pending = {executor.submit(_prefetch_task, name, args): ("prefetch", name, args)
+               for name, args in calls}
+    pending.update({executor.submit(_check_task, cid, {}): ("check", cid)
+                    for cid in checks if cid not in waiting})
+    cached, outcomes = {}, {}
+
+    def release():
+        for cid in checks:
+            if cid in waiting:
+                pending[executor.submit(_check_task, cid, cached)] = ("check", cid)
+        waiting.clear()
+
+    if not calls:
+        release()
+    while pending:
+        done, _ = concurrent.futures.wait(pending, return_when=concurrent.futures.FIRST_COMPLETED)
+        for future in done:
+            task = pending.pop(future)
+            if task[0] == "prefetch":
+                cached.setdefault(task[1], {})[task[2]] = future.result()
+                continue
+            outcomes[task[1]] = future.result()
+            if progress is not None:
+                progress(len(outcomes), len(checks), task[1])
+        if waiting and not any(t[0] == "prefetch" for t in pending.values()):
+            release()
+    return [_finding(cid, entry, outcomes[cid]) for cid, entry in checks.items()]
 
 
 def _cell(text):

@@ -8,7 +8,6 @@ roots outside the unit circle (:mod:`paper_checks.regions`), not by the
 """
 
 import decimal
-import functools
 
 from symstab import model
 from symstab.evaluate import alpha_max_on_arc, arc_end, boundary_point
@@ -18,7 +17,7 @@ from symstab.stability import stable_alpha_intervals
 from symstab.theta_max import theta_max
 
 from . import regions
-from ._common import DEVICE_DELTA, show
+from ._common import DEVICE_DELTA, Memo, show
 from .audit import Outcome, check
 from .eq_limits import gamma_threshold
 
@@ -42,7 +41,7 @@ def _number(derived, printed, what):
     return Outcome("not-reproduced", f"derived {what} = {derived:.6g}; printed {printed}")
 
 
-@functools.lru_cache(maxsize=None)
+@Memo
 def _classify(gamma, d):
     return regions.classify(gamma, d, DEVICE_DELTA)
 
@@ -257,7 +256,7 @@ def min_stiffness():
     return Outcome("not-reproduced", f"stable alpha intervals {intervals}")
 
 
-@functools.lru_cache(maxsize=None)
+@Memo
 def _kmax(gamma):
     """K_max from symstab.limits (the supremum of the stable region, to the last bit).
 
@@ -341,3 +340,11 @@ def exp_window_hg():
        claim="low gains, B_w = 0.60, M_w = m: stable for 5 < K_w < 11")
 def exp_window_lg():
     return _window(0.60, "measured window with the PI current loop, quantization and filter")
+
+
+def prefetch():
+    """The shared results of these checks, ``[(Memo, args), ...]``: computed first, in parallel."""
+    cases = {(c.gamma, c.d) for c in regions.FIGURE_CASES}
+    cases |= {(g, d) for d in (0, 10) for g in (-1.0, -1.001)} | {(2.0, 0), (2.01, 0)}
+    return ([(_kmax, (0.0,)), (_kmax, (1.0,))]
+            + [(_classify, case) for case in sorted(cases, key=lambda c: (-c[1], c[0]))])

@@ -14,7 +14,7 @@ from symstab import model
 from symstab.boundary import boundary, coefficients
 from symstab.theta_max import closed_form_d0, newton_form_gamma0, theta_max
 
-from ._common import DEVICE_DELTA, compare, prove, show, where, with_printed_coefficients
+from ._common import DEVICE_DELTA, Memo, compare, prove, show, where, with_printed_coefficients
 from .audit import Outcome, check
 from .printed import PRINTED_D0_COEFFICIENTS, printed, u, xi
 
@@ -286,6 +286,17 @@ def eq62():
 NEWTON_DELAYS = (1, 2, 3, 5, 10, 20, 40, 100, 200)
 
 
+@Memo
+def _exact_theta_max_gamma0(dd):
+    """The exact theta_max at gamma = 0 on the paper's device, shared by (12), (58), (63)."""
+    return theta_max(gamma=0.0, d=dd, delta=DEVICE_DELTA)
+
+
+def prefetch():
+    """The shared results of these checks, ``[(Memo, args), ...]``: computed first, in parallel."""
+    return [(_exact_theta_max_gamma0, (dd,)) for dd in sorted(NEWTON_DELAYS, reverse=True)]
+
+
 def _newton_error(expr, label):
     f = sp.lambdify((d, dl, Gamma), expr, modules="mpmath")
     derived = sp.lambdify((d, dl, Gamma), newton_form_gamma0().theta_newton, modules="mpmath")
@@ -295,7 +306,7 @@ def _newton_error(expr, label):
         for dd in NEWTON_DELAYS:
             approx = f(dd, delta, mpmath.exp(delta))
             step = derived(dd, delta, mpmath.exp(delta))
-            exact = theta_max(gamma=0.0, d=dd, delta=DEVICE_DELTA)
+            exact = _exact_theta_max_gamma0(dd)
             rows.append((dd, float(approx), exact, float(abs(approx - exact) / exact),
                          float(abs(approx - step) / abs(step))))
     worst = max(rows, key=lambda r: r[3])
