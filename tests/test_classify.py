@@ -421,3 +421,109 @@ def test_classify_refine_false_is_still_vectorised_and_sane():
         [STABLE, UNSTABLE])
     # checked against the first-principles roots
     assert oracle_radius(0.1, 0.5, 0.0, 0, PAPER_DELTA) < 1 < oracle_radius(3.0, 0.5, 0.0, 0, PAPER_DELTA)
+
+
+# --------------------------------------------------------------------------
+# The certified root count (argument principle), clustered roots, long delays
+# --------------------------------------------------------------------------
+
+def _count_outside(alpha, beta, gamma, d, delta, dps=40, near=1e-3):
+    """Roots of eq4_chi outside the unit circle, from polished 40-digit roots.
+
+    Roots within ``near`` of the circle are Newton-polished (numpy's are
+    good to ~1e-12 elsewhere).  Returns None when a root is within 1e-12 of
+    the circle (too close for the oracle to be sure, so the test point is
+    not used).
+    """
+    with mpmath.workdps(dps):
+        roots = polished_roots(eq4_chi(alpha, beta, gamma, d, delta), dps=dps, near=near)
+        moduli = [abs(r) for r in roots]
+        if min(abs(m - 1) for m in moduli) < mpmath.mpf(10) ** -12:
+            return None
+        return sum(1 for m in moduli if m > 1)
+
+
+@pytest.mark.parametrize("d", [0, 1, 5, 12, 40])
+def test_unstable_root_counts_match_polished_roots(d):
+    rng = np.random.default_rng(100 + d)
+    alpha = rng.uniform(-0.3, 3.0, 12) / (d + 1)
+    beta = rng.uniform(-0.5, 2.0, 12) / (d + 1)
+    gamma = rng.uniform(-1.2, 2.5, 12)
+    delta = 10 ** rng.uniform(-5, 1, 12)
+    counts = symstab.stability.unstable_root_counts(alpha=alpha, beta=beta, gamma=gamma, d=d,
+                                                     delta=delta)
+    checked = 0
+    for i in range(12):
+        expected = _count_outside(alpha[i], beta[i], gamma[i], d, delta[i])
+        if expected is None:
+            continue
+        checked += 1
+        assert counts[i] == expected, (i, alpha[i], beta[i], gamma[i], delta[i], counts[i], expected)
+    assert checked >= 10
+
+
+@pytest.mark.parametrize("theta", [3e-5, 5.3e-5, 1e-4, 3e-4])
+def test_clustered_roots_get_the_true_verdict_or_marginal(theta):
+    """gamma = -1, delta = 1e-6, d = 10: roots cluster at z = 1.
+
+    On the arc at theta = 5.3e-5 the exact radius is 1 + 1.4e-11 and the
+    eigenvalue refinement said stable; a certified answer may only be the
+    truth or MARGINAL.
+    """
+    gamma, d, delta = -1.0, 10, 1e-6
+    a, b = (float(x) for x in boundary_point(theta, gamma=gamma, d=d, delta=delta, dps=50))
+    alphas = a * np.array([1.0, 1 - 1e-6, 1 + 1e-6, 1 - 1e-3, 1 + 1e-3, 0.5, 2.0])
+    codes = classify(alpha=alphas, beta=b, gamma=gamma, d=d, delta=delta)
+    with mpmath.workdps(80):
+        for alpha, code in zip(alphas, codes):
+            roots = mpmath.polyroots(eq4_chi(alpha, b, gamma, d, delta), maxsteps=400,
+                                     extraprec=400)
+            radius = max(abs(r) for r in roots)
+            truth = STABLE if radius < 1 else UNSTABLE
+            assert code in (truth, MARGINAL), (alpha, code, mpmath.nstr(radius - 1, 5))
+
+
+@pytest.mark.parametrize("d", [200, 1000])
+def test_long_delay_verdicts_match_polished_roots(d):
+    """At long delays every point goes to the certified count (O(d) a point)."""
+    alphas = np.array([1e-6, 2e-5, 1e-4, 1e-3]) if d == 200 else np.array([1e-6, 1e-4])
+    beta, gamma, delta = 1e-3, 0.0, PAPER_DELTA
+    codes = classify(alpha=alphas, beta=beta, gamma=gamma, d=d, delta=delta)
+    counts = symstab.stability.unstable_root_counts(alpha=alphas, beta=beta, gamma=gamma, d=d,
+                                                     delta=delta)
+    for alpha, code, count in zip(alphas, codes, counts):
+        expected = _count_outside(alpha, beta, gamma, d, delta, dps=30, near=1e-8)
+        assert expected is not None
+        assert count == expected
+        assert code == (STABLE if expected == 0 else UNSTABLE)
+
+
+def test_a_point_exactly_on_the_z_equals_1_line_is_marginal():
+    # alpha = 0: chi(1) = alpha (b1 + b0) = 0, a root exactly at z = 1, and
+    # (beta = 0.3 lies in the region's span) every other root inside.
+    for d in (0, 60):
+        assert classify(alpha=0.0, beta=0.3 / (d + 1), gamma=0.0, d=d, delta=0.01) == MARGINAL
+        assert symstab.stability.unstable_root_counts(alpha=0.0, beta=0.3 / (d + 1), gamma=0.0,
+                                                       d=d, delta=0.01) == -1
+    # With another root outside, a root on the circle does not make it marginal.
+    assert classify(alpha=0.0, beta=0.5, gamma=0.3, d=7, delta=0.01) == UNSTABLE
+
+
+def test_classify_a_large_grid_in_bounded_chunks(monkeypatch):
+    """A 3000 x 3000 grid passed 4 GB; with a 64 MiB limit the same call must fit.
+
+    The memory limit is what check_memory enforces on one allocation; the grid
+    work is chunked, so only the 9e6 input points themselves are whole arrays.
+    """
+    monkeypatch.setenv("SYMSTAB_MEMORY_LIMIT", "400M")
+    alpha = np.linspace(0.0, 0.5, 600)[:, None]
+    beta = np.linspace(-0.1, 1.0, 600)[None, :]
+    codes = classify(alpha=alpha, beta=beta, gamma=0.0, d=10, delta=PAPER_DELTA)
+    assert codes.shape == (600, 600)
+    # Spot-check against python-control at a few cells.
+    for i, j in ((10, 100), (300, 300), (599, 599), (50, 500)):
+        loop = python_control_closed_loop(alpha=float(alpha[i, 0]), beta=float(beta[0, j]),
+                                          gamma=0.0, d=10, delta=PAPER_DELTA, m=1.0, T=1.0)
+        radius = np.max(np.abs(loop.poles()))
+        assert abs(radius - 1) > 1e-9
+        assert codes[i, j] == (STABLE if radius < 1 else UNSTABLE)
