@@ -1,15 +1,23 @@
 """The ``symstab`` command line.
 
-Every sub-command validates its arguments first; a bad value prints one line
-on stderr and exits with status 2, never a traceback.
+Every sub-command validates its arguments, and checks its output paths
+(:func:`check_outputs`), before any long work; a bad value prints one line
+``symstab <command>: error: ...`` on stderr and exits with status 2, never a
+traceback.  Ctrl-C (SIGINT) and SIGTERM print ``symstab <command>:
+interrupted`` and exit with status 130 and 143; files are written
+atomically (:func:`write_output`), so an interrupted run leaves none behind.
 """
 
 import argparse
+import os
 import pathlib
+import signal
 import sys
+import tempfile
 import time
+import warnings
 
-__all__ = ["main"]
+__all__ = ["main", "check_outputs", "write_output"]
 
 #: Where ``symstab derive`` writes without ``--out``.
 DEFAULT_DERIVATIONS = pathlib.Path("derivations") / "generated"
@@ -21,7 +29,102 @@ DEFAULT_REPORT = pathlib.Path("paper_checks") / "REPORT.md"
 
 class _Parser(argparse.ArgumentParser):
     def error(self, message):
-        self.exit(2, f"symstab: error: {message}\n")
+        # self.prog is "symstab" or "symstab <command>" for a sub-parser.
+        self.exit(2, f"{self.prog}: error: {message}\n")
+
+
+# --------------------------------------------------------------------------
+# Output paths: one check for every command, before the work starts
+
+
+def _probe_folder(folder):
+    """Raise OSError unless a file can be created in the existing ``folder``.
+
+    An anonymous temporary file, gone when closed: the only test that also
+    holds for root and for read-only file systems (``os.access`` does not).
+    """
+    with tempfile.TemporaryFile(dir=folder):
+        pass
+
+
+def check_outputs(outputs):
+    """Check the output paths of a command before it runs; return them as Paths.
+
+    Parameters
+    ----------
+    outputs : iterable of (str, path-like or None, str)
+        ``(flag, path, kind)`` with ``kind`` ``"file"`` (written atomically
+        into an existing folder) or ``"dir"`` (created with its parents if
+        missing).  Entries whose path is None are skipped.
+
+    Returns
+    -------
+    dict
+        ``{flag: pathlib.Path}`` of the checked entries.
+
+    Raises
+    ------
+    ValueError
+        Naming the flag and the user's path: a file that is a directory, a
+        directory that is a file, a missing or unwritable folder, or two
+        outputs that name the same file (after resolving ``..`` and links).
+    """
+    checked, seen = {}, {}
+    for flag, path, kind in outputs:
+        if path is None:
+            continue
+        if kind not in ("file", "dir"):
+            raise ValueError(f"kind must be 'file' or 'dir', got {kind!r}")
+        path = pathlib.Path(path)
+        if kind == "file":
+            if path.is_dir():
+                raise ValueError(f"{flag} {path} is a directory, expected a file name")
+            folder = path.parent
+            if not folder.exists():
+                raise ValueError(f"{flag} {path}: folder {folder} does not exist")
+            if not folder.is_dir():
+                raise ValueError(f"{flag} {path}: {folder} is not a folder")
+        else:
+            if path.exists() and not path.is_dir():
+                raise ValueError(f"{flag} must be a directory, got file {path}")
+            folder = path
+            while not folder.exists():   # created at the first write
+                folder = folder.parent
+            if not folder.is_dir():
+                raise ValueError(f"{flag} {path}: {folder} is a file, not a folder")
+        try:
+            _probe_folder(folder)
+        except OSError as exc:
+            raise ValueError(f"{flag} {path}: cannot write in folder {folder} "
+                             f"({exc.strerror or exc})") from None
+        key = os.path.realpath(path)
+        if key in seen and "file" in (kind, seen[key][1]):
+            raise ValueError(f"{seen[key][0]} and {flag} name the same file {path}; "
+                             "give them different paths")
+        seen.setdefault(key, (flag, kind))
+        checked[flag] = path
+    return checked
+
+
+def write_output(path, data, flag):
+    """Write ``data`` (bytes or str) to ``path`` atomically; errors name ``flag`` and ``path``.
+
+    The bytes go to a temporary file in the same folder, renamed into place
+    (:func:`symstab.derive.write_bytes`), which is removed on any failure,
+    Ctrl-C and SIGTERM included.
+    """
+    from .derive import write_bytes
+
+    if isinstance(data, str):
+        data = data.encode("utf-8")
+    try:
+        return write_bytes(path, data)
+    except OSError as exc:
+        raise OSError(f"cannot write {flag} {path}: {exc.strerror or exc}") from None
+
+
+# --------------------------------------------------------------------------
+# Commands
 
 
 def _cmd_derive(args):
@@ -29,9 +132,12 @@ def _cmd_derive(args):
 
     start = time.perf_counter()
     out, code_out = pathlib.Path(args.out), pathlib.Path(args.codegen_out)
-    for flag, path in (("--out", out), ("--codegen-out", code_out)):
-        if path.exists() and not path.is_dir():
-            raise ValueError(f"{flag} must be a directory, got file {path}")
+    if args.check:   # reads only
+        for flag, path in (("--out", out), ("--codegen-out", code_out)):
+            if path.exists() and not path.is_dir():
+                raise ValueError(f"{flag} must be a directory, got file {path}")
+    else:
+        check_outputs([("--out", out, "dir"), ("--codegen-out", code_out, "dir")])
     print("deriving: ZOH, characteristic polynomial, unit circle, boundary, limits, "
           "theta_max, proofs, code generation ...", file=sys.stderr)
     outputs = [(out, derive.render(derive.derivation_steps()), derive.OWNED),
@@ -62,8 +168,7 @@ def _cmd_audit(args):
         from paper_checks import audit
     except ImportError as exc:  # pragma: no cover - packaging problem
         raise ValueError(f"the paper_checks package is not installed ({exc})") from exc
-    from .derive import write
-
+    paths = check_outputs([("--report", args.report, "file"), ("--json", args.json, "file")])
     start = time.perf_counter()
 
     def progress(n, total, cid):
@@ -72,13 +177,14 @@ def _cmd_audit(args):
     try:
         findings = audit.run_audit(progress=progress if args.verbose else None)
     except (AssertionError, RuntimeError, ArithmeticError) as exc:
-        print(f"symstab: audit failed inside a check: {type(exc).__name__}: {exc}", file=sys.stderr)
+        print(f"symstab audit: audit failed inside a check: {type(exc).__name__}: {exc}",
+              file=sys.stderr)
         return 1
-    outputs = {pathlib.Path(args.report): audit.render_report(findings)}
+    outputs = {paths["--report"]: ("--report", audit.render_report(findings))}
     if args.json:
-        outputs[pathlib.Path(args.json)] = audit.to_json(findings)
-    for path, text in outputs.items():
-        write(path.parent if str(path.parent) else ".", {path.name: text})
+        outputs[paths["--json"]] = ("--json", audit.to_json(findings))
+    for path, (flag, text) in outputs.items():
+        write_output(path, text, flag)
     counts = {}
     for f in findings:
         counts[f.verdict] = counts.get(f.verdict, 0) + 1
@@ -91,6 +197,7 @@ def _cmd_audit(args):
 def _cmd_reproduce(args):
     from .reproduce import reproduce
 
+    check_outputs([("--out", args.out, "dir")])
     _, drift = reproduce(args.out, workers=args.workers)
     return 1 if drift else 0
 
@@ -101,9 +208,7 @@ def _cmd_figures(args):
     def progress(name, seconds):
         print(f"{name}.png ({seconds:.1f} s)", file=sys.stderr, flush=True)
 
-    out = pathlib.Path(args.out)
-    if out.exists() and not out.is_dir():
-        raise ValueError(f"--out must be a directory, got file {out}")
+    out = check_outputs([("--out", args.out, "dir")])["--out"]
     results = make_figures(out, progress=progress)
     for r in results:
         print(f"{out / (r.name + '.png')}: {r.symstab}")
@@ -145,18 +250,78 @@ def build_parser():
     return parser
 
 
+class _Terminated(BaseException):
+    """SIGTERM, raised in the main thread so that cleanup (temporary files) runs.
+
+    A BaseException, like KeyboardInterrupt, so that no ``except Exception``
+    on the way swallows it.
+    """
+
+
+def _raise_terminated(signum, frame):
+    raise _Terminated
+
+
+#: Exit statuses of a command stopped by a signal (128 + the signal number).
+EXIT_SIGINT = 128 + signal.SIGINT
+EXIT_SIGTERM = 128 + signal.SIGTERM
+
+
+def _one_line(exc):
+    """The message of a last-resort error: one line, saying what to do."""
+    if isinstance(exc, MemoryError):
+        from ._resources import MEMORY_LIMIT_ENV
+
+        return (f"out of memory{f' ({exc})' if str(exc) else ''}: use a smaller problem; "
+                f"{MEMORY_LIMIT_ENV} sets the limit symstab checks against")
+    if isinstance(exc, ArithmeticError):
+        return (f"numeric {type(exc).__name__} ({exc}): an input is outside the range "
+                "floating point can represent")
+    text = str(exc) or type(exc).__name__
+    return " ".join(text.split())
+
+
 def main(argv=None):
-    """Run the command line; return the exit status."""
+    """Run the command line; return the exit status.
+
+    0 on success; 1 when a check finds drift or a failure; 2 on bad input
+    (one line on stderr); 130 on Ctrl-C and 143 on SIGTERM (one line
+    ``symstab <command>: interrupted``).
+    """
     parser = build_parser()
     try:
-        args = parser.parse_args(argv)
+        args, extra = parser.parse_known_args(argv)
     except SystemExit as exc:  # --help, or a usage error already printed
         return exc.code
-    try:
-        return args.func(args)
-    except (ValueError, TypeError, OSError) as exc:
-        print(f"symstab: error: {exc}", file=sys.stderr)
+    prog = f"symstab {args.command}"
+    if extra:  # argparse would blame "symstab", not the command
+        print(f"{prog}: error: unrecognized arguments: {' '.join(extra)}", file=sys.stderr)
         return 2
+    # `symstab reproduce` stops its worker processes on SIGTERM itself.
+    previous = None
+    if args.command != "reproduce":
+        try:
+            previous = signal.signal(signal.SIGTERM, _raise_terminated)
+        except ValueError:  # not the main thread: leave signals alone
+            previous = None
+    try:
+        with warnings.catch_warnings():
+            # NumPy's floating-point RuntimeWarnings (overflow in an
+            # intermediate that the result does not depend on) are not for
+            # the user: results are validated, and what cannot be computed
+            # raises an error naming the parameter.
+            warnings.simplefilter("ignore", RuntimeWarning)
+            return args.func(args)
+    except (KeyboardInterrupt, _Terminated) as exc:
+        # On a terminal a progress bar may hold the line: start a new one.
+        print(f"{chr(10) if sys.stderr.isatty() else ''}{prog}: interrupted", file=sys.stderr)
+        return EXIT_SIGINT if isinstance(exc, KeyboardInterrupt) else EXIT_SIGTERM
+    except (ValueError, TypeError, ArithmeticError, MemoryError, OSError) as exc:
+        print(f"{prog}: error: {_one_line(exc)}", file=sys.stderr)
+        return 2
+    finally:
+        if previous is not None:
+            signal.signal(signal.SIGTERM, previous)
 
 
 if __name__ == "__main__":  # pragma: no cover

@@ -3,7 +3,10 @@
 The device and delay options are those of the numeric commands
 (:mod:`symstab.cli_numeric`); the non-idealities are given in physical
 units and need the physical device options (the default device is the
-paper's).  Files are written atomically: a failed run leaves nothing behind.
+paper's).  Output paths are checked before the simulation
+(:func:`symstab.cli.check_outputs`) and files are written atomically
+(:func:`symstab.cli.write_output`): a failed or interrupted run leaves
+nothing behind.
 """
 
 import io
@@ -12,6 +15,7 @@ import sys
 
 import numpy as np
 
+from ._resources import check_memory
 from .cli_numeric import _add_model_options, _parse_list, _resolve, stiffness_and_damping
 
 __all__ = ["add_commands"]
@@ -58,22 +62,22 @@ def _nonideal(args, setup):
     return nonideal, x0
 
 
-def _check_output(path, flag):
-    """Fail early, before any simulation, on an output path that cannot be written."""
-    path = pathlib.Path(path)
-    if path.is_dir():
-        raise ValueError(f"{flag} {path} is a directory, expected a file name")
-    folder = path.parent if str(path.parent) else pathlib.Path(".")
-    if not folder.is_dir():
-        raise ValueError(f"{flag}: output folder {folder} does not exist")
-    return path
+#: Bytes of CSV text per trajectory row ("k,t,x" with 17 digits) and per
+#: map cell, with the Python objects that build them (generous).
+_TRAJECTORY_ROW_BYTES = 120
+_MAP_CELL_BYTES = 300
 
 
-def _write_atomic(path, data):
-    """Write bytes to ``path`` atomically (the folder was checked by :func:`_check_output`)."""
-    from .derive import write_bytes
+def _outputs(pairs):
+    from .cli import check_outputs
 
-    write_bytes(path, data)
+    return check_outputs([(flag, path, "file") for flag, path in pairs])
+
+
+def _write(path, data, flag):
+    from .cli import write_output
+
+    write_output(path, data, flag)
 
 
 def _single(text, name):
@@ -92,14 +96,20 @@ def _cmd_simulate(args):
     from .simulate import simulate
     from .stability import MARGINAL, STABLE, UNSTABLE, classify, spectral_radius
 
+    from .simulate import default_horizon, progress_printer
+
     setup = _resolve(args)
     alpha, beta = _point(args, setup)
     nonideal, x0 = _nonideal(args, setup)
-    if args.out is not None:
-        _check_output(args.out, "--out")
+    _outputs([("--out", args.out)])
+    steps = default_horizon(setup.d) if args.steps is None else args.steps
+    record = args.out is not None
+    if record and steps > 0:
+        check_memory(f"the --out trajectory of {steps} periods", (steps + 1) * _TRAJECTORY_ROW_BYTES)
     run = simulate(alpha=alpha, beta=beta, gamma=setup.gamma, d=setup.d,
-                   delta=None if setup.physical else setup.delta, steps=args.steps, x0=x0,
-                   device=setup.device, nonideal=nonideal, record=True)
+                   delta=None if setup.physical else setup.delta, steps=steps, x0=x0,
+                   device=setup.device, nonideal=nonideal, record=record,
+                   progress=progress_printer("simulating", steps) if steps > 0 else None)
     for line in setup.echo:
         print(line)
     code = classify(alpha=alpha, beta=beta, gamma=setup.gamma, d=setup.d, delta=setup.delta)
@@ -121,9 +131,13 @@ def _cmd_simulate(args):
                   + ("x [rad]" if setup.physical and not args.linear else
                      "x [m]" if setup.physical else "x") + "\n")
         np.savetxt(buf, np.column_stack([k, t, run.positions]), delimiter=",", fmt=["%d", "%.9g", "%.17g"])
-        _write_atomic(args.out, buf.getvalue().encode())
+        _write(args.out, buf.getvalue(), "--out")
         print(f"wrote the trajectory to {args.out}")
     return 0
+
+
+#: Largest number of grid points along one axis of ``symstab map``.
+MAX_GRID = 2000
 
 
 def _grid(text, name):
@@ -134,8 +148,9 @@ def _grid(text, name):
         lo, hi, n = float(parts[0]), float(parts[1]), int(parts[2])
     except ValueError:
         raise ValueError(f"{name} must be LOW,HIGH,N with a whole N, got {text!r}") from None
-    if not (np.isfinite(lo) and np.isfinite(hi) and lo < hi and 2 <= n <= 2000):
-        raise ValueError(f"{name} must have finite LOW < HIGH and 2 <= N <= 2000, got {text!r}")
+    if not (np.isfinite(lo) and np.isfinite(hi) and lo < hi and 2 <= n <= MAX_GRID):
+        raise ValueError(f"{name} must have finite LOW < HIGH and 2 <= N <= {MAX_GRID}, "
+                         f"got {text!r}")
     return np.linspace(lo, hi, n)
 
 
@@ -146,12 +161,15 @@ def _cmd_map(args):
     setup = _resolve(args)
     nonideal, x0 = _nonideal(args, setup)
     alpha, beta = (np.atleast_1d(x) for x in stiffness_and_damping(args, setup, _grid))
-    out = _check_output(args.out, "--out")
-    if out.suffix not in (".csv", ".npz"):
-        raise ValueError(f"--out must end in .csv or .npz, got {out}")
-    png_path = None
-    if not args.no_png:
-        png_path = _check_output(out.with_suffix(".png") if args.png is None else args.png, "--png")
+    if not args.out.endswith((".csv", ".npz")):
+        raise ValueError(f"--out must end in .csv or .npz, got {args.out}")
+    if args.no_png and args.png is not None:
+        raise ValueError("give --png or --no-png, not both")
+    png = None if args.no_png else (
+        str(pathlib.Path(args.out).with_suffix(".png")) if args.png is None else args.png)
+    paths = _outputs([("--out", args.out), ("--png", png)])
+    out, png_path = paths["--out"], paths.get("--png")
+    check_memory(f"a map of {alpha.size} x {beta.size} cells", alpha.size * beta.size * _MAP_CELL_BYTES)
     for line in setup.echo:
         print(line)
     steps = default_horizon(setup.d) if args.steps is None else args.steps
@@ -176,10 +194,10 @@ def _cmd_map(args):
             buf.write(f"{a:.12g},{b:.12g},{int(s)},{int(e)},{g:.6g}\n")
         data = buf.getvalue().encode()
     png = _png(args, setup, result, exact) if png_path is not None else None
-    _write_atomic(out, data)
+    _write(out, data, "--out")
     written = [str(out)]
     if png is not None:
-        _write_atomic(png_path, png)
+        _write(png_path, png, "--png")
         written.append(str(png_path))
     decided = code != MARGINAL
     differ = int(np.count_nonzero((result.stable != exact) & decided))

@@ -7,12 +7,12 @@ from symstab import cli
 from conftest import EDITED_CODE_FILE, EDITED_FILE, REPO, run_symstab
 
 
-def _assert_one_line_error(result, *needles):
+def _assert_one_line_error(result, *needles, prefix="symstab: error:"):
     assert result.returncode == 2
     assert "Traceback" not in result.stderr
     lines = result.stderr.strip().splitlines()
     assert len(lines) == 1, result.stderr
-    assert lines[0].startswith("symstab: error:")
+    assert lines[0].startswith(prefix), lines[0]
     for needle in needles:
         assert needle in lines[0]
 
@@ -21,20 +21,21 @@ def test_derive_out_pointing_to_a_file_exits_2(tmp_path):
     target = tmp_path / "not_a_dir.txt"
     target.write_text("keep me\n")
     result = run_symstab("derive", "--out", str(target), cwd=tmp_path)
-    _assert_one_line_error(result, "--out", str(target))
+    _assert_one_line_error(result, "--out", str(target), prefix="symstab derive: error:")
     assert target.read_text() == "keep me\n"
     assert sorted(p.name for p in tmp_path.iterdir()) == ["not_a_dir.txt"]
 
 
-@pytest.mark.parametrize("args, needle", [
-    (["derive", "--bogus"], "--bogus"),
-    (["--bogus"], "error"),      # argparse reports the missing command first
-    (["frobnicate"], "frobnicate"),
-    ([], "required"),
+@pytest.mark.parametrize("args, needle, prefix", [
+    (["derive", "--bogus"], "--bogus", "symstab derive: error:"),
+    (["limits", "--d"], "--d", "symstab limits: error:"),
+    (["--bogus"], "error", "symstab: error:"),      # argparse reports the missing command first
+    (["frobnicate"], "frobnicate", "symstab: error:"),
+    ([], "required", "symstab: error:"),
 ])
-def test_bad_command_line_exits_2_with_one_line(tmp_path, args, needle):
+def test_bad_command_line_exits_2_with_one_line(tmp_path, args, needle, prefix):
     result = run_symstab(*args, cwd=tmp_path)
-    _assert_one_line_error(result, needle)
+    _assert_one_line_error(result, needle, prefix=prefix)
     assert list(tmp_path.iterdir()) == []
 
 

@@ -110,7 +110,7 @@ def test_design_finds_a_gain_over_no_virtual_mass(capsys):
     (["limits", "--d", "2.5"], "delay d"),
     (["limits", "--d", "-1"], "delay d"),
     (["limits", "--gamma", "nan"], "gamma"),
-    (["limits", "--delta", "0"], "delta"),
+    (["limits", "--delta", "-1"], "delta"),
     (["limits", "--delta", "0.1", "--Td", "0.04"], "--delta"),
     (["limits", "--delta", "0.1", "--Mw", "0.01"], "--Mw"),
     (["limits", "--Td", "0.01", "--d", "10"], "--Td"),
@@ -127,7 +127,7 @@ def test_bad_input_is_one_line_and_exit_2(capsys, tmp_path, monkeypatch, args, n
     status, out, err = run(capsys, *args)
     assert status == 2
     lines = err.strip().splitlines()
-    assert len(lines) == 1 and lines[0].startswith("symstab: error:"), err
+    assert len(lines) == 1 and lines[0].startswith(f"symstab {args[0]}: error:"), err
     assert needle in lines[0]
     assert "Traceback" not in err and out == ""
     assert list(tmp_path.iterdir()) == []
