@@ -50,11 +50,12 @@ import time
 import numpy as np
 
 from ._generated import kernels
-from ._resources import check_memory, chunk_slices
+from ._resources import _env_int, check_memory, chunk_slices
 from ._validate import check_array, check_delay, check_loop, check_real
 
 __all__ = ["Nonidealities", "Simulation", "simulate", "StabilityMap", "stability_map",
-           "default_horizon", "progress_printer", "PAPER_ENCODER_RESOLUTION"]
+           "default_horizon", "max_steps", "progress_printer", "PAPER_ENCODER_RESOLUTION",
+           "MAX_STEPS_ENV"]
 
 #: The paper's encoder: better than 3 arc seconds after quadrature and gear
 #: train (Section VI), in rad.
@@ -75,6 +76,12 @@ X0_MAX = _OVERFLOW * 1e-50
 #: sampled positions, filter and actuator states, four amplitudes, three
 #: environment coefficients, alpha, beta, gamma and about six temporaries.
 _FLOATS_PER_POINT = 22
+#: Environment variable: the largest ``steps`` of one run.  A period costs
+#: about 30 us for one point and 40 us for 10000 (numbers loaded with other
+#: jobs), so the default of 10 million periods is minutes, not hours; the
+#: default horizon is always allowed, whatever the limit.
+MAX_STEPS_ENV = "SYMSTAB_MAX_STEPS"
+_DEFAULT_MAX_STEPS = 10_000_000
 
 
 @dataclasses.dataclass(frozen=True)
@@ -168,6 +175,15 @@ def default_horizon(d):
     return 12000 + 800 * check_delay(d)
 
 
+def max_steps(d):
+    """The largest ``steps`` accepted at delay ``d``.
+
+    ``SYMSTAB_MAX_STEPS`` (default 10 million), or :func:`default_horizon`
+    of ``d`` when that is longer.
+    """
+    return max(_env_int(MAX_STEPS_ENV, _DEFAULT_MAX_STEPS, int), default_horizon(d))
+
+
 @dataclasses.dataclass(frozen=True)
 class Simulation:
     """What a run returns.
@@ -193,10 +209,19 @@ class Simulation:
     steps: int
 
 
-def progress_printer(label, total, stream=sys.stderr, min_seconds=2.0):
-    """A callback ``(done)`` that draws a bar once a run takes longer than ``min_seconds``."""
+def progress_printer(label, total, stream=None, min_seconds=2.0):
+    """A callback ``(done)`` that draws a bar once a run takes longer than ``min_seconds``.
+
+    The bar is drawn on ``stream`` (default ``sys.stderr``) only when it is
+    a terminal: redrawn with carriage returns, it would be noise in a log
+    file or a pipe (and a second "line" before an error message there).
+    """
+    stream = sys.stderr if stream is None else stream
     start = time.perf_counter()
     state = {"last": 0.0}
+    isatty = getattr(stream, "isatty", None)
+    if not (isatty is not None and isatty()):
+        return lambda done: None
 
     def update(done):
         now = time.perf_counter() - start
@@ -228,7 +253,8 @@ def simulate(*, alpha, beta, gamma, d, delta, steps=None, x0=1.0, v0=None, devic
         ``b T / m``; with a ``device`` it must equal ``device.delta``
         (pass ``None`` to take it from the device).
     steps : int
-        Periods to simulate, >= 8 (default :func:`default_horizon`).
+        Periods to simulate, from 8 to :func:`max_steps` (default
+        :func:`default_horizon`).
     x0 : float
         Initial position (m or rad); the sampled history starts there too.
         ``1e-100 <= |x0| <= 1e50`` (:data:`X0_MIN`, :data:`X0_MAX`): the
@@ -295,6 +321,11 @@ def simulate(*, alpha, beta, gamma, d, delta, steps=None, x0=1.0, v0=None, devic
     if isinstance(steps, bool) or not isinstance(steps, (int, np.integer)) or steps < 8:
         raise ValueError(f"steps must be an integer >= 8, got {steps!r}")
     steps = int(steps)
+    limit = max_steps(d)
+    if steps > limit:
+        raise ValueError(f"steps must be an integer from 8 to {limit}, got {steps} (about "
+                         f"{steps * 3e-5 / 3600:.2g} hours per point; raise the limit with "
+                         f"{MAX_STEPS_ENV})")
     x0 = check_real("x0", x0)
     if not X0_MIN <= abs(x0) <= X0_MAX:
         raise ValueError(f"x0 must be a finite real number with {X0_MIN:g} <= |x0| <= {X0_MAX:g} "

@@ -970,3 +970,15 @@ def test_chunked_map_memory_does_not_grow_with_the_working_set(monkeypatch):
     finally:
         tracemalloc.stop()
     assert peak < 200 * alpha.size * beta.size + 2 * 256 * 1024, peak
+
+
+def test_steps_beyond_the_limit_are_refused_naming_it(monkeypatch):
+    """steps = 1e9 ran for hours (about 30 us a period); the limit is named with its variable."""
+    with pytest.raises(ValueError) as excinfo:
+        simulate(**STABLE_POINT, steps=1_000_000_000)
+    assert_message_names(excinfo, "steps")
+    assert "10000000" in str(excinfo.value) and "SYMSTAB_MAX_STEPS" in str(excinfo.value)
+    monkeypatch.setenv("SYMSTAB_MAX_STEPS", "50")
+    with pytest.raises(ValueError, match="from 8 to 12000"):   # the default horizon at d = 0
+        simulate(**STABLE_POINT, steps=12001)
+    assert simulate(**STABLE_POINT, steps=12000).steps == 12000
