@@ -298,38 +298,88 @@ def _copy_files(folder, files, edited=None):
             fh.write("/* a hand edit */\n" if edited.endswith((".c", ".h")) else EDIT)
 
 
+def hash_seed_other_than_ours():
+    """A PYTHONHASHSEED for a subprocess that differs from this process's."""
+    ours = os.environ.get("PYTHONHASHSEED")
+    return "2" if ours == "1" else "1"
+
+
+def _main_in_process(argv):
+    """``symstab.cli.main(argv)`` here, as ``(returncode, stdout, stderr)``."""
+    import contextlib
+    import io
+
+    from symstab import cli
+
+    out, err = io.StringIO(), io.StringIO()
+    with contextlib.redirect_stdout(out), contextlib.redirect_stderr(err):
+        code = cli.main(argv)
+    return code, out.getvalue(), err.getvalue()
+
+
 @pytest.fixture(scope="session")
 def derive_subprocess_runs(tmp_path_factory, rendered_files, generated_code):
-    """Four ``symstab derive`` subprocesses, run concurrently.
+    """``symstab derive`` runs shared by the session: one subprocess, two in-process.
 
-    ``seed1`` and ``seed2`` write a fresh derivation and fresh kernels under
-    PYTHONHASHSEED=1 and 2; ``check_edited`` runs ``--check`` on a copy of
-    the in-process output in which :data:`EDITED_FILE` was edited by hand,
-    ``check_edited_code`` on one in which :data:`EDITED_CODE_FILE` was.
+    ``seed1`` is the subprocess ``python -m symstab derive`` writing a fresh
+    derivation and fresh kernels, under a PYTHONHASHSEED other than this
+    process's (:func:`hash_seed_other_than_ours`), so comparing its files
+    with the in-process ones tests that the output does not depend on the
+    hash seed.  ``check_edited`` runs ``derive --check`` (``cli.main``, in
+    this process: the proofs are cached here, a subprocess would redo them)
+    on a copy of the in-process output in which :data:`EDITED_FILE` was
+    edited by hand, ``check_edited_code`` on one in which
+    :data:`EDITED_CODE_FILE` was.
 
-    Returns ``{name: (CompletedProcess-like tuple (returncode, stdout, stderr),
-    (derivations dir, code dir))}``.
+    Returns ``{name: ((returncode, stdout, stderr), (derivations dir, code dir))}``.
     """
     base = tmp_path_factory.mktemp("derive_runs")
     _copy_files(base / "edited", rendered_files, EDITED_FILE)
     _copy_files(base / "edited_code_ok", generated_code)
     _copy_files(base / "fresh", rendered_files)
     _copy_files(base / "edited_code", generated_code, EDITED_CODE_FILE)
-    jobs = {
-        "seed1": (base / "seed1", base / "seed1_code", False),
-        "seed2": (base / "seed2", base / "seed2_code", False),
-        "check_edited": (base / "edited", base / "edited_code_ok", True),
-        "check_edited_code": (base / "fresh", base / "edited_code", True),
-    }
-    procs = {}
-    for seed, (name, (out, code, check)) in enumerate(jobs.items(), start=1):
-        args = ["derive", "--out", str(out), "--codegen-out", str(code)] + (["--check"] if check else [])
-        env = dict(os.environ, PYTHONHASHSEED=str(seed))
-        procs[name] = subprocess.Popen([sys.executable, "-m", "symstab", *args], cwd=base,
-                                       env=env, stdout=subprocess.PIPE,
-                                       stderr=subprocess.PIPE, text=True)
-    out = {}
-    for name, proc in procs.items():
-        stdout, stderr = proc.communicate(timeout=600)
-        out[name] = ((proc.returncode, stdout, stderr), jobs[name][:2])
-    return out
+    seed = hash_seed_other_than_ours()
+    out, code = base / "seed1", base / "seed1_code"
+    proc = subprocess.run([sys.executable, "-m", "symstab", "derive", "--out", str(out),
+                           "--codegen-out", str(code)], cwd=base,
+                          env=dict(os.environ, PYTHONHASHSEED=seed),
+                          capture_output=True, text=True, timeout=900)
+    runs = {"seed1": ((proc.returncode, proc.stdout, proc.stderr), (out, code))}
+    for name, (out, code) in {"check_edited": (base / "edited", base / "edited_code_ok"),
+                              "check_edited_code": (base / "fresh", base / "edited_code")}.items():
+        result = _main_in_process(["derive", "--out", str(out), "--codegen-out", str(code),
+                                   "--check"])
+        runs[name] = (result, (out, code))
+    return runs
+
+
+@pytest.fixture(scope="session")
+def audit_run(tmp_path_factory):
+    """``symstab audit --report --json`` run once per session, as a subprocess.
+
+    Returns ``(CompletedProcess, report path, json path)``.
+    """
+    out = tmp_path_factory.mktemp("audit")
+    report, js = out / "REPORT.md", out / "audit.json"
+    proc = subprocess.run([sys.executable, "-m", "symstab", "audit", "--report", str(report),
+                           "--json", str(js)], capture_output=True, text=True, timeout=900)
+    return proc, report, js
+
+
+#: Session fixtures that run a whole command, and the xdist group of their tests.
+_SHARED_RUNS = {"audit_run": "audit", "derive_subprocess_runs": "derive"}
+
+
+def pytest_collection_modifyitems(config, items):
+    """Keep the tests of one shared command run on one xdist worker; mark them slow.
+
+    A session fixture is built once per worker, so with ``-n 2 --dist
+    loadgroup`` the tests that share the audit (or the derive) subprocess go
+    to the same worker and the command runs once per session.
+    """
+    for item in items:
+        for fixture, group in _SHARED_RUNS.items():
+            if fixture in getattr(item, "fixturenames", ()):
+                item.add_marker(pytest.mark.xdist_group(group))
+                item.add_marker(pytest.mark.slow)
+                break

@@ -3,8 +3,10 @@
 import difflib
 import importlib.metadata
 import json
+import os
 import platform
 import re
+import sys
 
 import mpmath
 import numpy as np
@@ -13,7 +15,7 @@ import sympy as sp
 
 from symstab import derive, model
 
-from conftest import REPO
+from conftest import REPO, hash_seed_other_than_ours
 
 COMMITTED = REPO / "derivations" / "generated"
 
@@ -26,24 +28,37 @@ def test_render_is_byte_identical_on_two_calls(rendered_files):
 
 
 def test_output_does_not_depend_on_hash_seed(derive_subprocess_runs, rendered_files, generated_code):
-    dirs = {}
-    for name in ("seed1", "seed2"):
-        (returncode, stdout, stderr), (out_dir, code_dir) = derive_subprocess_runs[name]
-        assert returncode == 0, stderr
-        dirs[name] = out_dir
-        dirs[name + "_code"] = code_dir
-    names = sorted(p.name for p in dirs["seed1"].iterdir())
-    assert names == sorted(p.name for p in dirs["seed2"].iterdir()) == sorted(rendered_files)
-    for name in names:
-        one = (dirs["seed1"] / name).read_bytes()
-        assert one == (dirs["seed2"] / name).read_bytes(), name
-        assert one == rendered_files[name].encode("utf-8"), name
-    names = sorted(p.name for p in dirs["seed1_code"].iterdir())
-    assert names == sorted(p.name for p in dirs["seed2_code"].iterdir()) == sorted(generated_code)
-    for name in names:
-        one = (dirs["seed1_code"] / name).read_bytes()
-        assert one == (dirs["seed2_code"] / name).read_bytes(), name
-        assert one == generated_code[name].encode("utf-8"), name
+    """The subprocess ran under another PYTHONHASHSEED than this process: same bytes."""
+    ours = os.environ.get("PYTHONHASHSEED")
+    assert ours != hash_seed_other_than_ours()
+    if ours is None:   # then this process's seed is random: it differs from the child's
+        assert sys.flags.hash_randomization
+    (returncode, stdout, stderr), (out_dir, code_dir) = derive_subprocess_runs["seed1"]
+    assert returncode == 0, stderr
+    for folder, files in ((out_dir, rendered_files), (code_dir, generated_code)):
+        assert sorted(p.name for p in folder.iterdir()) == sorted(files)
+        for name in files:
+            assert (folder / name).read_bytes() == files[name].encode("utf-8"), name
+
+
+def test_a_second_derivation_reuses_the_proofs_but_a_changed_identity_is_proved(monkeypatch):
+    derive.derivation_steps()   # every proof cached
+    calls = []
+    real = derive.check_identity
+
+    def counting(lhs, rhs, **kw):
+        calls.append((lhs, rhs))
+        return real(lhs, rhs, **kw)
+
+    monkeypatch.setattr(derive, "check_identity", counting)
+    derive.derivation_steps()
+    assert calls == []
+    wrong = model.theta + 1
+    monkeypatch.setattr(derive, "proofs", lambda: [("wrong", "theta = theta + 1", model.theta, wrong)])
+    with pytest.raises(AssertionError, match="wrong"):
+        derive.derivation_steps()
+    assert calls == [(model.theta, wrong)]
+    assert (model.theta, wrong) not in derive._PROVED   # a failure is not cached
 
 
 def test_every_step_has_json_and_tex(rendered_files):

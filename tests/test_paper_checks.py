@@ -2,12 +2,12 @@
 every verdict is pinned, so a change in any verdict (a regression or a fix)
 fails here and shows up in review.
 
-The audit runs once, through the command line, into a temporary folder.
+The audit runs once per session, through the command line, into a temporary
+folder (the ``audit_run`` fixture of conftest.py).
 """
 
 import json
-import subprocess
-import sys
+import multiprocessing
 
 import pytest
 
@@ -149,15 +149,6 @@ EXPECTED_VERDICTS = {
 }
 
 
-@pytest.fixture(scope="module")
-def audit_run(tmp_path_factory):
-    out = tmp_path_factory.mktemp("audit")
-    report, js = out / "REPORT.md", out / "audit.json"
-    proc = subprocess.run([sys.executable, "-m", "symstab", "audit", "--report", str(report),
-                           "--json", str(js)], capture_output=True, text=True, timeout=900)
-    return proc, report, js
-
-
 def test_audit_exits_zero_and_writes_both_files(audit_run):
     proc, report, js = audit_run
     assert proc.returncode == 0, proc.stderr
@@ -237,3 +228,47 @@ def test_report_rendering_is_deterministic():
     first = audit.render_report(rows)
     assert first == audit.render_report(rows)
     assert "x \\| y" in first and "| not-reproduced | 1 |" in first
+
+
+@pytest.mark.skipif("fork" not in multiprocessing.get_all_start_methods(),
+                    reason="the workers must inherit the shortened NEWTON_DELAYS")
+def test_parallel_audit_gives_the_serial_findings(monkeypatch):
+    """Two workers (with the shared theta_max of eqs. (12), (58) prefetched) = one."""
+    from paper_checks import eq_theta_max
+
+    # Two delays instead of nine keep the test short; the scheduling is the same.
+    monkeypatch.setattr(eq_theta_max, "NEWTON_DELAYS", (1, 3))
+    ids = ["eq1", "eq5", "eq12", "eq58", "eq8"]   # no claim: its prefetch is 45 regions
+    seen = []
+    parallel = audit.run_audit(ids, progress=lambda n, total, cid: seen.append((n, total, cid)),
+                               workers=2)
+    assert parallel == audit.run_audit(ids, workers=1)
+    assert [f.id for f in parallel] == [cid for cid in audit.registered() if cid in ids]
+    assert sorted(cid for _, _, cid in seen) == sorted(ids)
+    assert [n for n, _, _ in seen] == list(range(1, len(ids) + 1))
+
+
+def test_memo_computes_once_and_accepts_values_computed_elsewhere():
+    from paper_checks._common import Memo
+
+    calls = []
+
+    def square(x):
+        calls.append(x)
+        return x * x
+
+    memo = Memo(square)
+    try:
+        assert memo(3) == 9 and memo(3) == 9 and calls == [3]
+        Memo.fill({memo.name: {(4,): 17}})   # as a worker receives a prefetched value
+        assert memo(4) == 17 and calls == [3]
+        with pytest.raises(ValueError, match="twice"):
+            Memo(square)
+    finally:
+        del Memo.registry[memo.name]
+
+
+@pytest.mark.parametrize("workers", [0, 1.5, True])
+def test_run_audit_rejects_a_bad_worker_count(workers):
+    with pytest.raises(ValueError, match="workers"):
+        audit.run_audit(["eq1"], workers=workers)
