@@ -15,14 +15,31 @@ Here it is used to find where the arc ends and to sample it:
 """
 
 import dataclasses
+import numbers
 
 import numpy as np
 
 from ._generated import kernels
+from ._resources import check_memory, chunk_slices
 from ._validate import check_loop
 
 __all__ = ["arc_end_angle", "minus_one_line", "BoundaryCurve", "Segment", "boundary_curve",
            "scan_grid", "bracketed_root"]
+
+
+def _check_count(name, value, low):
+    """Return an integer count ``value >= low`` as an ``int``.
+
+    The one check of every count parameter (``n``, ``n_beta``, ...): a
+    non-integer kind (bool, float, str, None) is a :class:`TypeError`, an
+    integer below ``low`` a :class:`ValueError`, both naming ``name``.
+    (Meant to move to :mod:`symstab._validate`.)
+    """
+    if isinstance(value, bool) or not isinstance(value, numbers.Integral):
+        raise TypeError(f"{name} must be an integer >= {low}, got {type(value).__name__}")
+    if value < low:
+        raise ValueError(f"{name} must be an integer >= {low}, got {value!r}")
+    return int(value)
 
 
 def scan_grid(d, *, n=None, upper=np.pi):
@@ -38,38 +55,73 @@ def scan_grid(d, *, n=None, upper=np.pi):
     return np.concatenate([near_zero, step * np.arange(1, n + 1)])
 
 
-def bracketed_root(f, lo, hi, iterations=64):
+def bracketed_root(f, lo, hi, iterations=64, *, indexed=False):
     """Vectorised root of ``f`` in each bracket ``[lo, hi]`` (signs differ at the ends).
 
     The Illinois variant of regula falsi: superlinear on smooth functions (a
     dozen evaluations where bisection needs sixty), with the bracket kept,
-    and a bisection step wherever the secant stalls.  Stops when every
-    bracket is a few ulps wide.
+    and a bisection step wherever the secant stalls.  A bracket stops when
+    it is a few ulps wide.
+
+    Parameters
+    ----------
+    f : callable
+        ``f(x)`` for arrays ``x`` of the brackets' shape; with ``indexed``,
+        ``f(x, index)`` for the brackets ``index`` (flat indices) that are
+        still open, so that each evaluation costs only what is left (poles
+        and slow brackets then no longer set the pace for all).
+    lo, hi : array_like
+        The brackets (``f`` changes sign between them).
+    iterations : int
+        Most evaluations per bracket.
+
+    Returns
+    -------
+    ndarray
+        The roots, to a few ulps.
     """
     lo, hi = np.array(lo, dtype=float), np.array(hi, dtype=float)
-    flo, fhi = np.asarray(f(lo), dtype=float), np.asarray(f(hi), dtype=float)
-    side = np.zeros(lo.shape, dtype=np.int8)   # which end was kept last time
+    shape = lo.shape
+    lo, hi = lo.ravel(), hi.ravel()
+    everything = np.arange(lo.size)
+    if indexed:
+        def g(x, index):
+            return np.asarray(f(x, index), dtype=float).ravel()
+    else:
+        def g(x, index):
+            if index.size == lo.size:
+                return np.asarray(f(x.reshape(shape)), dtype=float).ravel()
+            full = 0.5 * (lo + hi)
+            full[index] = x
+            return np.asarray(f(full.reshape(shape)), dtype=float).ravel()[index]
+    flo, fhi = g(lo, everything), g(hi, everything)
+    side = np.zeros(lo.size, dtype=np.int8)   # which end was kept last time
+    active = everything
     for _ in range(iterations):
-        width = hi - lo
-        if np.all(width <= 4 * np.spacing(np.maximum(np.abs(lo), np.abs(hi)))):
+        a, b = lo[active], hi[active]
+        open_ = (b - a) > 4 * np.spacing(np.maximum(np.abs(a), np.abs(b)))
+        active = active[open_]
+        if active.size == 0:
             break
-        with np.errstate(divide="ignore", invalid="ignore"):
-            x = hi - fhi * width / (fhi - flo)
+        a, b, fa, fb, sd = lo[active], hi[active], flo[active], fhi[active], side[active]
+        width = b - a
+        with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
+            x = b - fb * width / (fb - fa)
         # Bisect where the secant leaves the bracket or creeps along one side.
-        bad = ~np.isfinite(x) | (x <= lo) | (x >= hi)
-        x = np.where(bad, lo + 0.5 * width, x)
-        fx = np.asarray(f(x), dtype=float)
-        same_as_lo = np.sign(fx) == np.sign(flo)
+        bad = ~np.isfinite(x) | (x <= a) | (x >= b)
+        x = np.where(bad, a + 0.5 * width, x)
+        fx = g(x, active)
+        same_as_lo = np.sign(fx) == np.sign(fa)
         # Illinois: halve the value at the end that stays, so it cannot stick.
-        fhi = np.where(same_as_lo & (side == 1), 0.5 * fhi, fhi)
-        flo = np.where(~same_as_lo & (side == -1), 0.5 * flo, flo)
-        lo, flo = np.where(same_as_lo, x, lo), np.where(same_as_lo, fx, flo)
-        hi, fhi = np.where(same_as_lo, hi, x), np.where(same_as_lo, fhi, fx)
-        side = np.where(same_as_lo, 1, -1).astype(np.int8)
+        fb = np.where(same_as_lo & (sd == 1), 0.5 * fb, fb)
+        fa = np.where(~same_as_lo & (sd == -1), 0.5 * fa, fa)
         exact = fx == 0
-        if exact.any():
-            lo, hi = np.where(exact, x, lo), np.where(exact, x, hi)
-    return 0.5 * (lo + hi)
+        lo[active] = np.where(same_as_lo | exact, x, a)
+        flo[active] = np.where(same_as_lo, fx, fa)
+        hi[active] = np.where(same_as_lo & ~exact, b, x)
+        fhi[active] = np.where(same_as_lo, fb, fx)
+        side[active] = np.where(same_as_lo, 1, -1)
+    return (0.5 * (lo + hi)).reshape(shape)
 
 
 def arc_end_angle(*, gamma, d, delta):
@@ -127,6 +179,13 @@ def minus_one_line(*, gamma, d, delta):
         return float((-1) ** d * np.inf)
     spread = delta * float(kernels.zoh_gap(delta))
     return float((-1) ** d * 2.0 * (1.0 + np.exp(-delta)) / spread - 4.0 * gamma)
+
+
+#: Working set of the boundary kernel per point (tracemalloc measured 16
+#: floats per point at its peak; twice that as a margin), and the chunk it
+#: is run in.
+_KERNEL_BYTES_PER_POINT = 8 * 32
+_KERNEL_CHUNK_BYTES = 32 * 2**20
 
 
 @dataclasses.dataclass(frozen=True)
@@ -193,7 +252,9 @@ def boundary_curve(*, gamma, d, delta, n=1000, segments=True):
     delta : float
         ``b T / m > 0``.
     n : int
-        Number of points on the arc, ``n >= 2``.
+        Number of points on the arc, ``n >= 2``; about 24 bytes each are
+        kept, so ``n`` is limited by the memory limit
+        (:mod:`symstab._resources`, ``SYMSTAB_MEMORY_LIMIT``).
     segments : bool
         Also find the straight pieces (z = +-1) that bound the stable region
         (a stability scan; skip it when only the arc is wanted).
@@ -205,7 +266,8 @@ def boundary_curve(*, gamma, d, delta, n=1000, segments=True):
     Raises
     ------
     TypeError, ValueError
-        For a non-real, non-finite or out-of-range parameter.
+        For a non-real, non-finite or out-of-range parameter, and
+        ValueError for an ``n`` whose arrays would exceed the memory limit.
 
     Examples
     --------
@@ -214,10 +276,9 @@ def boundary_curve(*, gamma, d, delta, n=1000, segments=True):
     (0.0, -0.00253125, 1.5725)
     """
     gamma, d, delta = check_loop(gamma, d, delta)
-    if isinstance(n, bool) or not isinstance(n, (int, np.integer)):
-        raise TypeError(f"n must be an integer >= 2, got {type(n).__name__}")
-    if n < 2:
-        raise ValueError(f"n must be an integer >= 2, got {n!r}")
+    n = _check_count("n", n, 2)
+    # theta, alpha and beta are kept; the kernel's temporaries are chunked.
+    check_memory(f"boundary_curve with n = {n} points", 3 * 8 * n + _KERNEL_CHUNK_BYTES)
     t_end = arc_end_angle(gamma=gamma, d=d, delta=delta)
     if not np.isfinite(t_end):
         empty = np.empty(0)
@@ -225,7 +286,9 @@ def boundary_curve(*, gamma, d, delta, n=1000, segments=True):
                              "no boundary arc: alpha < 0 just after theta = 0, so the arc never "
                              "enters alpha > 0 (1 + gamma + (d + 1) delta <= 0 or close to it)")
     theta = np.linspace(0.0, t_end, n)
-    alpha, beta = kernels.boundary(theta, gamma, d, delta)
+    alpha, beta = np.empty(n), np.empty(n)
+    for part in chunk_slices(n, _KERNEL_BYTES_PER_POINT, _KERNEL_CHUNK_BYTES):
+        alpha[part], beta[part] = kernels.boundary(theta[part], gamma, d, delta)
     # The ends are exact: the arc starts at (-delta, 0) and ends on alpha = 0.
     alpha[0], beta[0] = 0.0, -delta
     if t_end < np.pi:

@@ -11,17 +11,26 @@ meets
 * the line ``alpha + 2 beta = c`` (a root at z = -1,
   :func:`symstab.curves.minus_one_line`).
 
-Between two consecutive crossings the number of unstable roots is constant,
-so one classification per gap (:func:`symstab.stability.classify`) decides
-the whole gap: the stable intervals along a line are exact up to the
-root-finding of the crossings (bisection to the last bit), with no scan of
-alpha.  :class:`StabilityRegion` does this for many lines at once;
-:func:`limits` builds on it (alpha_max and the beta range by a k-ary search
-for the last line that still meets the region, the Z-width by integrating
-the stable length over beta), and :func:`best_virtual_mass` maximises
-alpha_max over gamma.
+Between two consecutive crossings the number N of roots outside the unit
+circle is constant, and across a crossing it changes by +-2 (the arc) or +-1
+(z = +-1) with the sign of the crossing root's radial velocity; at the two
+ends of a line N is known in closed form.  So N in every gap follows by
+counting, with no classification and no probe near the boundary: the stable
+intervals along a line are the gaps with N = 0, exact up to the root-finding
+of the crossings (to the last bit, by :func:`symstab.curves.bracketed_root`),
+with no scan of alpha.  A line whose count fails its consistency check is
+decided gap by gap with :func:`symstab.stability.classify`.  The cost per
+line is O(d) kernel evaluations, not the O(d**2) of a Schur-Cohn test or the
+O(d**3) of eigenvalues, so d in the thousands stays interactive.
+
+:class:`StabilityRegion` does this for many lines at once; :func:`limits`
+builds on it (a scan of vertical lines between the arc's samples finds the
+region, then alpha_max and the beta range by a k-ary search for the last
+line that still meets it, and the Z-width by integrating the stable length
+over beta), and :func:`best_virtual_mass` maximises alpha_max over gamma.
 """
 
+import collections.abc
 import dataclasses
 import functools
 import math
@@ -29,20 +38,18 @@ import math
 import numpy as np
 
 from ._generated import kernels
+from ._resources import check_memory, chunk_slices
 from ._validate import check_real, check_loop
-from .curves import Segment, bracketed_root, minus_one_line, scan_grid
-from .stability import MARGINAL, STABLE, classify
+from .curves import Segment, _check_count, bracketed_root, minus_one_line, scan_grid
+from .stability import MARGINAL, STABLE, UNSTABLE, classify, loop_coefficients
 
 __all__ = ["StabilityRegion", "Limits", "limits", "BestVirtualMass", "best_virtual_mass"]
 
-#: Relative offset of the probes that decide whether an arc point touches
-#: the stable region: far above the 1e-12 marginal band, and below the width
-#: of the thinnest regions (the gamma = 2, d = 0 sliver is 3e-5 wide; 1e-4
-#: missed its top).  It picks the arc segments to work with and seeds the
-#: searches, which then run to the last bit.
-_PROBE = 1e-6
-#: The probe distances of the touching test (relative).
-_PROBES = (_PROBE, 1e-9)
+#: Largest number of vertical lines in the scan that finds where the region is.
+_SCAN_LINES = 512
+#: Working bytes per crossing of a line with the boundary (positions, angles,
+#: the terms of the crossing direction); crossings per line are about d + 2.
+_BYTES_PER_CROSSING = 640
 
 
 def _ranges(start, stop):
@@ -53,8 +60,87 @@ def _ranges(start, stop):
     return owner, np.repeat(start, counts) + offsets
 
 
+def _loop_basis(gamma, d, delta):
+    """chi = P(z) + alpha A(z) + beta B(z): the powers of z that occur and their
+    coefficients in P, A and B (from :func:`symstab.stability.loop_coefficients`;
+    chi is affine in alpha and beta, so three evaluations give it all)."""
+    base = loop_coefficients(alpha=0.0, beta=0.0, gamma=gamma, d=d, delta=delta)
+    d_alpha = loop_coefficients(alpha=1.0, beta=0.0, gamma=gamma, d=d, delta=delta) - base
+    d_beta = loop_coefficients(alpha=0.0, beta=1.0, gamma=gamma, d=d, delta=delta) - base
+    used = np.flatnonzero((base != 0) | (d_alpha != 0) | (d_beta != 0))
+    return (d + 4 - used).astype(float), base[used], d_alpha[used], d_beta[used]
+
+
+def _count(owner, change, low, high, n_lines):
+    """N just above each cut (sorted by line, then position), and the lines whose count fails.
+
+    ``low``/``high`` are N at the two ends of each line.  One crossing
+    whose direction was lost (``change == 0``) is filled in from the ends;
+    a line fails when more are lost, when the count from the low end does
+    not arrive at the high end's value, or when it goes below 0.
+    """
+    unknown = change == 0
+    n_unknown = np.bincount(owner, weights=unknown, minlength=n_lines)
+    known_sum = np.bincount(owner, weights=change, minlength=n_lines)
+    missing = (high - low - known_sum)[owner]
+    fill = unknown & (n_unknown[owner] == 1) & (np.abs(missing) <= 2)
+    change = np.where(fill, missing, change)
+    n_cuts = np.bincount(owner, minlength=n_lines)
+    first = np.r_[True, owner[1:] != owner[:-1]] if owner.size else np.zeros(0, dtype=bool)
+    running = np.cumsum(change)
+    offset = np.repeat(running[first] - change[first], n_cuts[n_cuts > 0])
+    above = low[owner] + running - offset
+    bad = np.zeros(n_lines, dtype=bool)
+    np.logical_or.at(bad, owner, (unknown & ~fill) | (above < 0))
+    bad |= (low < 0) | (low + np.bincount(owner, weights=change, minlength=n_lines) != high)
+    return above, bad
+
+
+@dataclasses.dataclass
+class _Crossings:
+    """Crossings of a family of lines with the boundary (parallel arrays)."""
+
+    axis: str
+    owner: np.ndarray
+    segment: np.ndarray
+    target: np.ndarray
+    theta: np.ndarray
+    other: np.ndarray
+    low: np.ndarray
+    high: np.ndarray
+    exact: np.ndarray
+    change: np.ndarray = None
+
+    _FIELDS = ("owner", "segment", "target", "theta", "other", "low", "high", "exact", "change")
+
+    def take(self, index):
+        return _Crossings(self.axis, *(None if getattr(self, f) is None else getattr(self, f)[index]
+                                       for f in self._FIELDS))
+
+    def join(self, more):
+        return _Crossings(self.axis, *(np.concatenate([getattr(self, f), getattr(more, f)])
+                                       for f in self._FIELDS[:-1]))
+
+    def alpha_beta(self):
+        """(alpha, beta) of each crossing."""
+        return (self.other, self.target) if self.axis == "beta" else (self.target, self.other)
+
+
 class StabilityRegion:
     """The stable set of one ``(gamma, d, delta)`` in the (beta, alpha) plane.
+
+    On a line ``beta = b`` (or ``alpha = a``) the number N of roots outside
+    the unit circle changes only where the line crosses the boundary: by 2
+    on the arc (a pair of roots), by 1 on z = 1 and z = -1, with the sign
+    of the radial velocity of the crossing root, ``-Re(conj(z) chi_s /
+    chi'(z))``.  At the ends of the line N is known in closed form (see
+    :meth:`_end_counts`), so N in every gap between crossings follows by
+    counting, with no classification and no probe next to the boundary; the
+    stable gaps are those with N = 0.  Each line is checked: the count from
+    one end must arrive at the other end's value and never go below 0.  A
+    line that fails the check (a crossing whose direction rounding cannot
+    tell, at a corner or a tangency) is decided gap by gap with
+    :func:`symstab.stability.classify` instead.
 
     Parameters
     ----------
@@ -76,10 +162,21 @@ class StabilityRegion:
         self.gamma, self.d, self.delta = check_loop(gamma, d, delta)
         theta = np.concatenate([[0.0], scan_grid(self.d, upper=np.pi * (1 - 1e-9))])
         theta = np.union1d(theta, self._extrema(theta))
+        poles = self._poles(theta)
+        # Samples a few ulps either side of each pole: every other segment
+        # is then monotone in alpha and in beta, so a crossing lies between
+        # its segment's ends, without root-finding.
+        theta = np.union1d(theta, np.concatenate([poles - 4 * np.spacing(poles),
+                                                  poles + 4 * np.spacing(poles)]))
         alpha, beta = kernels.boundary(theta, self.gamma, self.d, self.delta)
         alpha[0], beta[0] = 0.0, -self.delta
         self._theta, self._alpha, self._beta = theta, alpha, beta
+        finite = np.isfinite(alpha) & np.isfinite(beta)
+        segment = finite[:-1] & finite[1:]
+        segment[np.searchsorted(theta, poles) - 1] = False
+        self._segments = np.flatnonzero(segment)
         self.minus_one = minus_one_line(gamma=self.gamma, d=self.d, delta=self.delta)
+        self._basis = _loop_basis(self.gamma, self.d, self.delta)
 
     def _extrema(self, theta):
         """The angles of the local extrema of alpha(theta) and beta(theta).
@@ -100,23 +197,40 @@ class StabilityRegion:
                     t, self.gamma, self.d, self.delta)[k], theta[i - 1], theta[i + 1]))
         return np.concatenate(out) if out else np.empty(0)
 
+    def _poles(self, theta):
+        """Angles where the arc goes to infinity (alpha and beta change sign there)."""
+        beta = kernels.boundary(theta, self.gamma, self.d, self.delta)[1]
+        s = np.flatnonzero(np.isfinite(beta[:-1]) & np.isfinite(beta[1:])
+                           & (beta[:-1] * beta[1:] < 0))
+        if s.size == 0:
+            return np.empty(0)
+        root = bracketed_root(lambda t, i: kernels.boundary(t, self.gamma, self.d, self.delta)[1],
+                              theta[s], theta[s + 1], indexed=True)
+        value = np.abs(kernels.boundary(root, self.gamma, self.d, self.delta)[1])
+        pole = ~np.isfinite(value) | (value > np.maximum(np.abs(beta[s]), np.abs(beta[s + 1])))
+        return root[pole]
+
     # -- crossings of the boundary with a family of lines -----------------
 
     def _arc_point(self, theta):
         return kernels.boundary(theta, self.gamma, self.d, self.delta)
 
-    def _arc_crossings(self, axis, values):
+    def _arc_crossings(self, axis, values, precise=True):
         """Arc points where ``axis`` (``"beta"`` or ``"alpha"``) equals each value.
 
-        Returns ``(owner, other)``: the index into ``values`` and the other
-        coordinate of every crossing.  Each arc segment is half-open, so a
-        value met exactly at a sample is found once.
+        Returns a :class:`_Crossings`: for every crossing the index into
+        ``values``, its arc segment, angle and other coordinate.  Each arc
+        segment is half-open, so a value met exactly at a sample is found
+        once.  Without ``precise`` the angle and the other coordinate are
+        interpolated in the segment, and ``low``/``high`` bound the other
+        coordinate (the segments are monotone); :meth:`_refine` settles
+        those it is asked to.
         """
         coord = self._beta if axis == "beta" else self._alpha
+        other = self._alpha if axis == "beta" else self._beta
         order = np.argsort(values)
         sorted_values = values[order]
-        active = np.flatnonzero(self._active_segments)
-        c0, c1 = coord[active], coord[active + 1]
+        c0, c1 = coord[self._segments], coord[self._segments + 1]
         rising = c1 > c0
         start = np.where(rising, np.searchsorted(sorted_values, c0, "left"),
                          np.searchsorted(sorted_values, c1, "right"))
@@ -124,50 +238,187 @@ class StabilityRegion:
                         np.searchsorted(sorted_values, c0, "right"))
         stop = np.maximum(stop, start)
         segment, k = _ranges(start, stop)
-        segment = active[segment]
-        if segment.size == 0:
-            return np.empty(0, dtype=int), np.empty(0)
+        segment = self._segments[segment]
         target = sorted_values[k]
-        index = 1 if axis == "beta" else 0
+        c0, c1 = coord[segment], coord[segment + 1]
+        o0, o1 = other[segment], other[segment + 1]
+        with np.errstate(divide="ignore", invalid="ignore"):
+            frac = np.clip((target - c0) / (c1 - c0), 0.0, 1.0)
+        frac = np.where(c0 == target, 0.0, frac)
+        t0, t1 = self._theta[segment], self._theta[segment + 1]
+        found = _Crossings(axis=axis, owner=order[k], segment=segment, target=target,
+                           theta=t0 + frac * (t1 - t0), other=o0 + frac * (o1 - o0),
+                           low=np.minimum(o0, o1), high=np.maximum(o0, o1),
+                           exact=c0 == target)
+        found.other[found.exact] = o0[found.exact]
+        found.low[found.exact] = found.high[found.exact] = o0[found.exact]
+        if precise:
+            self._refine(found, np.flatnonzero(~found.exact))
+        return found
 
-        def f(t):
-            return self._arc_point(t)[index] - target
+    def _refine(self, found, which):
+        """Root-find the crossings ``which`` of ``found`` to the last bit (in place)."""
+        which = which[~found.exact[which]]
+        if which.size == 0:
+            return
+        index = 1 if found.axis == "beta" else 0
+        segment, target = found.segment[which], found.target[which]
 
-        lo, hi = self._theta[segment], self._theta[segment + 1]
-        flo = coord[segment] - target
-        exact = flo == 0
-        root = bracketed_root(f, lo, hi)
-        root = np.where(exact, lo, root)
+        def f(t, i):
+            return self._arc_point(t)[index] - target[i]
+
+        root = bracketed_root(f, self._theta[segment], self._theta[segment + 1], indexed=True)
         other = self._arc_point(root)[1 - index]
-        if axis == "beta":
-            other = np.where(root == 0.0, 0.0, other)
-        else:
-            other = np.where(root == 0.0, -self.delta, other)
-        return order[k], other
+        other = np.where(root == 0.0, 0.0 if found.axis == "beta" else -self.delta, other)
+        found.theta[which], found.other[which] = root, other
+        found.low[which] = found.high[which] = other
+        found.exact[which] = True
 
-    def _intervals(self, axis, values, closure=False):
-        """Stable intervals of the other coordinate on each line ``axis = value``.
+    def _crossing_change(self, axis, theta, alpha, beta):
+        """How N (roots outside the circle) changes across each crossing.
 
-        With ``closure``, gaps whose probe is marginal count too: next to a
-        corner or the top of the region the gap between two crossings is so
-        short that its probe lies within 1e-12 of radius 1, and the searches
-        for the extent of the region should run into the corner, not stop
-        where the classification can no longer tell.
+        Moving along the line in the increasing direction of its free
+        coordinate s (alpha on ``beta = b``, beta on ``alpha = a``), the
+        root ``z = exp(i theta)`` moves with ``dz/ds = -chi_s(z) / chi'(z)``
+        and leaves the circle where ``Re(conj(z) dz/ds) > 0``.  Returns
+        +-2 on the arc, +-1 at z = +-1, and 0 where the radial velocity is
+        lost in rounding (a tangency or a corner).
         """
-        values = np.atleast_1d(np.asarray(values, dtype=float))
-        owner, cuts = self._arc_crossings(axis, values)
+        powers, base, d_alpha, d_beta = self._basis
+        c = base + alpha[:, None] * d_alpha + beta[:, None] * d_beta
+        moving = d_alpha if axis == "beta" else d_beta
+        # z**p on the circle from the angle (no powers of a rounded z); the
+        # powers come in two runs (0..3 and d + 1..d + 4), so two exponentials
+        # and products by z give them all.
+        z = np.exp(1j * theta)
+        high = powers > 3
+        start = powers[high].min() if high.any() else 0.0
+        near = powers - np.where(high, start, 0.0)
+        z_power = np.where(high, np.exp(1j * theta * start)[:, None], 1.0)
+        for k in range(1, int(near.max()) + 1):
+            z_power = np.where(near >= k, z_power * z[:, None], z_power)
+        z_slope = np.sum(c * powers * z_power, axis=1)          # z chi'(z)
+        partial = np.sum(moving * z_power, axis=1)               # chi_s(z)
+        radial = -np.real(partial * np.conj(z_slope))
+        # Rounding: a few ulps of the largest terms, and the phases p theta
+        # carry an absolute error of about p theta ulps.
+        scale = np.sum(np.abs(c * powers), axis=1) * np.sum(np.abs(moving))
+        noise = 2e-15 * (1.0 + powers.max() * theta) * scale
+        sign = np.where(np.abs(radial) > noise, np.sign(radial), 0.0)
+        multiplicity = np.where((theta > 0) & (theta < np.pi), 2.0, 1.0)
+        return multiplicity * sign
+
+    def _cuts(self, axis, values, precise=True):
+        """Every crossing of the boundary with the lines ``axis = value``.
+
+        Returns ``(owner, position, change)`` sorted by line and position:
+        the line's index, the free coordinate of the crossing and the change
+        of N across it (:meth:`_crossing_change`).
+        """
+        cuts = self._all_cuts(axis, values, precise)
+        return cuts.owner, cuts.other, cuts.change
+
+    def _all_cuts(self, axis, values, precise):
+        """The crossings with the arc (:meth:`_arc_crossings`) and with z = +-1, sorted."""
+        found = self._arc_crossings(axis, values, precise)
+        # The arc's start (theta = 0) is the corner with z = 1, counted there.
+        found = found.take(found.theta > 0)
+        lines = np.arange(len(values))
         if axis == "beta":
-            lines = [(np.arange(len(values)), np.zeros(len(values))),
-                     (np.arange(len(values)), self.minus_one - 2 * values)]
+            extra = [(np.zeros(len(values)), 0.0), (self.minus_one - 2 * values, np.pi)]
         else:
-            lines = [(np.arange(len(values)), (self.minus_one - values) / 2)]
-        owner = np.concatenate([owner] + [o for o, _ in lines])
-        cuts = np.concatenate([cuts] + [c for _, c in lines])
-        keep = np.isfinite(cuts)
-        owner, cuts = owner[keep], cuts[keep]
-        order = np.lexsort((cuts, owner))
-        owner, cuts = owner[order], cuts[order]
-        # Probes: below the first cut, between cuts, above the last one.
+            extra = [((self.minus_one - values) / 2, np.pi)]
+        for position, theta in extra:
+            keep = np.isfinite(position)
+            n = int(keep.sum())
+            found = found.join(_Crossings(
+                axis=axis, owner=lines[keep], segment=np.full(n, -1), target=values[keep],
+                theta=np.full(n, theta), other=position[keep], low=position[keep],
+                high=position[keep], exact=np.ones(n, dtype=bool)))
+        found = found.take(np.lexsort((found.other, found.owner)))
+        found.change = self._crossing_change(axis, found.theta, *found.alpha_beta())
+        return found
+
+    def _end_counts(self, axis, values):
+        """N at the low and the high end of each line (closed form).
+
+        For |alpha| -> infinity on ``beta = b``, d + 1 roots go to infinity
+        and the other three tend to 0, 0 and ``-zoh_b0 / zoh_b1`` (inside:
+        ``0 < zoh_b0 < zoh_b1`` for delta > 0), so N = d + 1 at both ends.
+        For |beta| -> infinity on ``alpha = a``, d + 1 roots go to infinity
+        and the others tend to 0, ``-zoh_b0 / zoh_b1`` and
+        ``1 - a / beta``: N = d + 1 at the end where ``a / beta > 0`` and
+        d + 2 at the other.  On ``alpha = 0`` z = 1 is a root everywhere:
+        the line is marginal (ends ``-1``, matched by nothing).
+
+        For delta = 0, ``zoh_b0 = zoh_b1`` and the third root tends to -1
+        itself: ``z + 1 ~ -8 (-1)**d / alpha`` on a vertical line and
+        ``-4 (-1)**d / beta`` on a horizontal one (chi(-1) = 4 (-1)**d), one
+        more root outside at one end (checked against 50-digit roots).
+        """
+        n = np.full(len(values), self.d + 1)
+        even = self.d % 2 == 0
+        if axis == "beta":
+            if self.delta == 0:
+                return n + (not even), n + even
+            return n, n
+        low = np.where(values > 0, self.d + 2, self.d + 1)
+        high = np.where(values > 0, self.d + 1, self.d + 2)
+        if self.delta == 0:
+            low, high = low + (not even), high + even
+        low[values == 0] = -1
+        return low, high
+
+    def _counted_runs(self, axis, values):
+        """Stable intervals on each line by counting; ``None`` where the check fails.
+
+        The crossings start as estimates bounded by their arc segments;
+        those whose bounds overlap a neighbour's (their order is in doubt)
+        and those that end an interval with N = 0 are root-found, until
+        none is left in doubt.
+        """
+        out = [None] * len(values)
+        for part in chunk_slices(len(values), _BYTES_PER_CROSSING * (self.d + 8)):
+            chunk = values[part]
+            cuts = self._all_cuts(axis, chunk, precise=False)
+            low, high = self._end_counts(axis, chunk)
+            for _ in range(8):
+                above, bad = _count(cuts.owner, cuts.change, low, high, len(chunk))
+                # Pairs of neighbours on one line: in doubt when their bounds
+                # overlap, or when they end an interval with N = 0.
+                pair = (cuts.owner[1:] == cuts.owner[:-1]) & (
+                    (cuts.high[:-1] >= cuts.low[1:]) | (above[:-1] == 0))
+                doubt = np.zeros(len(cuts.owner), dtype=bool)
+                doubt[:-1] |= pair
+                doubt[1:] |= pair
+                doubt &= ~cuts.exact
+                if not doubt.any():
+                    break
+                which = np.flatnonzero(doubt)
+                self._refine(cuts, which)
+                cuts.change[which] = self._crossing_change(
+                    axis, cuts.theta[which], *(x[which] for x in cuts.alpha_beta()))
+                cuts = cuts.take(np.lexsort((cuts.other, cuts.owner)))
+            else:
+                bad[:] = True
+            for i in np.flatnonzero(~bad):
+                out[part.start + i] = []
+            same = np.zeros(len(cuts.owner), dtype=bool)
+            same[:-1] = cuts.owner[1:] == cuts.owner[:-1]
+            for j in np.flatnonzero((above == 0) & same):
+                runs = out[part.start + cuts.owner[j]]
+                if runs is not None and cuts.other[j + 1] > cuts.other[j]:
+                    runs.append((float(cuts.other[j]), float(cuts.other[j + 1])))
+        return out
+
+    def _classified_runs(self, axis, values, closure):
+        """Stable intervals on each line by one classification per gap (the fallback).
+
+        With ``closure``, gaps whose probe is marginal count too (the
+        searches for the extent of the region run into corners, where the
+        gaps are too short for the classification to tell).
+        """
+        owner, cuts, _ = self._cuts(axis, values)  # precise: the probes go between them
         first = np.r_[True, owner[1:] != owner[:-1]]
         last = np.r_[owner[1:] != owner[:-1], True]
         pad = 1.0 + np.abs(cuts)
@@ -194,8 +445,44 @@ class StabilityRegion:
                 runs.append((float(probe_lo[i]), float(probe_hi[i])))
         return out
 
+    def _intervals(self, axis, values, closure=False, confirm=False, fallback=True):
+        """Stable intervals of the other coordinate on each line ``axis = value``.
+
+        By counting (:meth:`_counted_runs`); lines whose count fails its
+        check, and with ``confirm`` lines where the classification of the
+        middle of a counted interval disagrees, are decided gap by gap
+        (:meth:`_classified_runs`), or left ``None`` without ``fallback``.
+        """
+        values = np.atleast_1d(np.asarray(values, dtype=float))
+        runs = self._counted_runs(axis, values)
+        if confirm:
+            owner = np.array([i for i, r in enumerate(runs) if r for _ in r], dtype=int)
+            middle = np.array([0.5 * (lo + hi) for r in runs if r for lo, hi in r])
+            if owner.size:
+                on_line = values[owner]
+                alpha, beta = (middle, on_line) if axis == "beta" else (on_line, middle)
+                # The float Schur-Cohn verdict (refine=False) is enough here:
+                # "stable" keeps the counted interval, and "unstable" only
+                # sends the line to the gap-by-gap classification, which
+                # certifies its verdicts; a wrong verdict can cost time but
+                # not change the answer.  (At large d every point has roots
+                # within 1e-6 of the circle, and certifying one costs seconds.)
+                code = np.atleast_1d(classify(alpha=alpha, beta=beta, gamma=self.gamma,
+                                              d=self.d, delta=self.delta, refine=False))
+                for i in owner[code == UNSTABLE]:
+                    runs[i] = None
+        redo = [i for i, r in enumerate(runs) if r is None]
+        if redo and fallback:
+            for i, r in zip(redo, self._classified_runs(axis, values[redo], closure)):
+                runs[i] = r
+        return runs
+
     def alpha_intervals(self, beta):
         """The stable alpha intervals at damping ``beta``.
+
+        Each interval found by counting is checked by one Schur-Cohn test
+        (:func:`symstab.stability.classify`) of its middle; a line where they
+        disagree is classified gap by gap.
 
         Parameters
         ----------
@@ -208,57 +495,43 @@ class StabilityRegion:
             Increasing, disjoint; empty when no alpha is stable.  An interval
             that does not start at 0 shows the minimum stiffness needed.
         """
-        return self._intervals("beta", [check_real("beta", beta)])[0]
+        return self._intervals("beta", [check_real("beta", beta)], confirm=True)[0]
 
     def beta_intervals(self, alpha):
         """The stable beta intervals at stiffness ``alpha`` (as :meth:`alpha_intervals`)."""
-        return self._intervals("alpha", [check_real("alpha", alpha)])[0]
+        return self._intervals("alpha", [check_real("alpha", alpha)], confirm=True)[0]
 
     # -- where the region is ----------------------------------------------
 
     @functools.cached_property
-    def _active_segments(self):
-        """Arc segments within two samples of one that touches the region.
+    def _scan(self):
+        """Vertical lines between the arc's samples, and their stable intervals.
 
-        Only these can bound the stable region; the rest of the arc (at large
-        d it winds around many times) only splits unstable gaps, so leaving
-        it out changes no interval and saves most of the work.
+        Every piece of arc that bounds the region has samples on it, so
+        lines between consecutive sample betas meet every part of the region
+        wider than the samples' spacing (down to the thinnest slivers: at
+        d = 0 every gap between samples has its line).  At large d the lines
+        are thinned to :data:`_SCAN_LINES`, keeping all those of the first
+        lobe of the arc (theta up to where alpha first falls to 0), where the
+        region lies.
         """
-        near = np.convolve(self._touching.astype(float), np.ones(5), mode="same") > 0
-        # The arc's start (-delta, 0) is a corner of every region that
-        # reaches it, however thin the wedge there is next to it.
-        near |= self._theta < 2 * self._theta[-1] / max(400, 16 * (self.d + 1))
-        return near[:-1] | near[1:]
-
-    @functools.cached_property
-    def _touching(self):
-        """Mask of arc samples with a stable point within a relative 1e-6 or 1e-9.
-
-        Probes on both sides in alpha and in beta, at two distances: the far
-        ones find ordinary regions, the near ones slivers thinner than the
-        far ones jump over (at the gamma where the d = 0 sliver vanishes it
-        is 2e-7 wide).
-        """
-        a, b = self._alpha, self._beta
-        ok = np.isfinite(a) & np.isfinite(b) & (np.abs(a) < 1e6) & (np.abs(b) < 1e6)
-        a, b = a[ok], b[ok]
-        probes_a, probes_b = [], []
-        for scale in _PROBES:
-            ea = scale * (np.abs(a) + self.delta)
-            eb = scale * (np.abs(b) + self.delta)
-            probes_a += [a + ea, a - ea, a, a]
-            probes_b += [b, b, b + eb, b - eb]
-        # The Schur-Cohn verdicts alone: these probes sit next to the
-        # boundary, where the eigenvalue refinement of every one would cost
-        # 20 s at d = 200.  Where the margin is positive they never disagreed
-        # with the eigenvalues in the tests (tests/test_classify.py); a false
-        # "unstable" here would drop arc segments near the region.
-        code = classify(alpha=np.concatenate(probes_a), beta=np.concatenate(probes_b),
-                        gamma=self.gamma, d=self.d, delta=self.delta, refine=False)
-        touching = np.zeros(len(self._alpha), dtype=bool)
-        stable = (np.asarray(code) == STABLE).reshape(4 * len(_PROBES), -1)
-        touching[np.flatnonzero(ok)] = np.any(stable, axis=0)
-        return touching
+        ok = np.isfinite(self._beta) & (np.abs(self._beta) < 1e6) & np.isfinite(self._alpha)
+        betas = np.unique(self._beta[ok])
+        if len(betas) > _SCAN_LINES:
+            negative = np.flatnonzero(self._alpha[1:] <= 0)
+            end = negative[0] + 2 if negative.size else len(self._theta)
+            lobe = np.unique(self._beta[:end][ok[:end]])
+            keep = np.linspace(0, len(betas) - 1, _SCAN_LINES - len(lobe)).astype(int)
+            betas = np.union1d(betas[keep], lobe)
+        lines = 0.5 * (betas[1:] + betas[:-1])
+        # Lines through the corner (-delta, 0), where the samples near
+        # theta = 0 crowd, meet the region on nothing wider than rounding.
+        lines = lines[np.abs(lines + self.delta) > 1e-9 * self.delta]
+        # A line that cannot be counted is left out, not classified gap by
+        # gap: the scan only has to find the region, and a neighbour does.
+        runs = self._intervals("beta", lines, fallback=False)
+        known = [i for i, r in enumerate(runs) if r is not None]
+        return lines[known], [runs[i] for i in known]
 
     def _last_meeting(self, axis, inside, outside, rounds=14, fan=16):
         """The boundary between ``inside`` (a line meeting the region) and ``outside``.
@@ -270,7 +543,16 @@ class StabilityRegion:
         runs_inside = None
         for _ in range(rounds):
             trial = np.linspace(inside, outside, fan + 2)[1:-1]
-            runs = self._intervals(axis, trial, closure=True)
+            runs = self._intervals(axis, trial, fallback=False)
+            if any(r is None for r in runs):
+                # Lines this close to a corner (within about 1e-8 relative
+                # at d = 200) cannot be counted; classifying every gap on
+                # them would cost O(d**3) for the last digits.  The extreme
+                # is then the corner, when one lies in the bracket.
+                corner = self._corners_between(axis, inside, outside)
+                if corner is not None:
+                    inside = corner
+                break
             k = np.flatnonzero([bool(r) for r in runs])
             j = k[-1] + 1 if k.size else 0
             if j > 0:
@@ -280,123 +562,156 @@ class StabilityRegion:
                 break
         return inside, runs_inside
 
+    def _missing_line(self, axis, inside, step):
+        """A line beyond ``inside`` (by multiples of ``step``) that misses the region."""
+        outside = inside + step
+        for _ in range(60):
+            if not self._intervals(axis, [outside])[0]:
+                return outside
+            step *= 4
+            outside = inside + step
+            if not math.isfinite(outside):
+                break
+        return None
+
+    def _corners_between(self, axis, inside, outside):
+        """The corner nearest to ``inside`` in ``[inside, outside]``, or None.
+
+        Corners are where the boundary pieces meet on alpha = 0: the arc's
+        start (-delta, 0), the arc's other ends and z = -1 (beta = c / 2);
+        only vertical lines (``axis == "beta"``) are snapped.
+        """
+        if axis != "beta":
+            return None
+        corners = np.concatenate([self._corners(), [self.minus_one / 2]])
+        lo, hi = min(inside, outside), max(inside, outside)
+        near = corners[(corners >= lo) & (corners <= hi)]
+        if near.size == 0:
+            return None
+        return float(near[np.argmin(np.abs(near - inside))])
+
     def _corners(self):
         """beta of the points where the arc meets alpha = 0 (exact corners)."""
-        ends = self._arc_crossings("alpha", np.array([0.0]))[1]
+        ends = self._arc_crossings("alpha", np.array([0.0])).other
         return np.sort(np.concatenate([ends, [-self.delta]]))
-
-    def _beta_window(self):
-        touching = self._touching
-        if not touching.any():
-            return None
-        lo, hi = self._beta[touching].min(), self._beta[touching].max()
-        return lo, hi
 
     def line_segments(self):
         """The pieces of z = 1 (alpha = 0) and z = -1 that bound the stable region.
+
+        Along each line the corners (where the arc or the other line meets
+        it) cut it into pieces; one vertical line through the middle of a
+        piece tells whether the region borders it.
 
         Returns
         -------
         tuple of :class:`symstab.curves.Segment`
         """
-        extent = self.beta_range()
-        if extent is None:
+        if self.beta_range() is None:
             return ()
-        lo, hi = extent
-        pad = 0.05 * (hi - lo) + self.delta
+        c = self.minus_one
         out = []
-        # z = 1: the beta where a point just above alpha = 0 is stable.
-        betas = np.linspace(lo - pad, hi + pad, 2001)
-        step = betas[1] - betas[0]
-        eps = _PROBE * max(self._alpha[self._touching].max(), self.delta)
-        above = np.asarray(classify(alpha=eps, beta=betas, gamma=self.gamma, d=self.d,
-                                    delta=self.delta)) == STABLE
-        # The exact corners on alpha = 0: where the arc or the z = -1 line meets it.
-        ends = np.concatenate([self._corners(), [self.minus_one / 2]])
-
-        def snap(b):
-            near = ends[np.argmin(np.abs(ends - b))]
-            return near if abs(near - b) <= 2 * step else b
-
-        for run in _runs(above):
-            out.append(Segment("z=1", float(snap(betas[run[0]])), 0.0,
-                               float(snap(betas[run[1]])), 0.0))
-        # z = -1: alpha + 2 beta = c, stable on one side only.
-        line_alpha = self.minus_one - 2 * betas
-        e = _PROBE * (np.abs(line_alpha) + self.delta)
-        sides = [np.asarray(classify(alpha=line_alpha + s * e, beta=betas, gamma=self.gamma,
-                                     d=self.d, delta=self.delta)) == STABLE for s in (1, -1)]
-        for run in _runs(sides[0] ^ sides[1]):
-            out.append(Segment("z=-1", float(betas[run[0]]), float(line_alpha[run[0]]),
-                               float(betas[run[1]]), float(line_alpha[run[1]])))
+        # z = 1: alpha = 0; the region borders a piece when a stable interval
+        # of the vertical line through its middle starts or ends at 0.
+        ends = self._corners()
+        if math.isfinite(c):
+            ends = np.union1d(ends, [c / 2])
+        out += self._bordering_pieces("z=1", np.unique(ends), lambda b: 0.0)
+        if math.isfinite(c):
+            # z = -1: alpha + 2 beta = c, cut where the arc crosses it and at alpha = 0.
+            ends = np.union1d(self._arc_roots(lambda a, b: a + 2 * b - c), [c / 2])
+            out += self._bordering_pieces("z=-1", ends, lambda b: c - 2 * b)
         return tuple(out)
+
+    def _bordering_pieces(self, root, ends, line_alpha):
+        """Segments of a line (alpha = line_alpha(beta)) between consecutive ``ends``
+        that border the stable region, merged where they meet."""
+        ends = ends[np.isfinite(ends)]
+        if ends.size < 2:
+            return []
+        middle = 0.5 * (ends[1:] + ends[:-1])
+        runs = self._intervals("beta", middle)
+        out = []
+        for b0, b1, bm, r in zip(ends[:-1], ends[1:], middle, runs):
+            a = line_alpha(bm)
+            if b1 > b0 and any(lo == a or hi == a for lo, hi in r):
+                if out and out[-1][1] == b0:
+                    out[-1] = (out[-1][0], b1)
+                else:
+                    out.append((b0, b1))
+        return [Segment(root, float(b0), float(line_alpha(b0)), float(b1), float(line_alpha(b1)))
+                for b0, b1 in out]
+
+    def _arc_roots(self, g):
+        """beta of the arc points where ``g(alpha, beta)`` changes sign (poles left out)."""
+        s = self._segments
+        g0 = g(self._alpha[s], self._beta[s])
+        g1 = g(self._alpha[s + 1], self._beta[s + 1])
+        change = np.sign(g0) != np.sign(g1)
+        s, g0, g1 = s[change], g0[change], g1[change]
+        if s.size == 0:
+            return np.empty(0)
+        root = bracketed_root(lambda t: g(*self._arc_point(t)), self._theta[s], self._theta[s + 1])
+        a, b = self._arc_point(root)
+        residual = np.abs(g(a, b))
+        return b[np.isfinite(residual) & (residual <= np.maximum(np.abs(g0), np.abs(g1)))]
 
     def alpha_max(self):
         """``(alpha_max, beta at alpha_max)``, or ``None`` when the region is empty.
 
-        The highest arc sample next to the region (the arc's local maxima are
-        among the samples, refined) brackets alpha_max within a relative 1e-6;
-        a k-ary search for the last horizontal line that meets the region
-        settles it.
+        The highest stable point on the scan's vertical lines brackets
+        alpha_max from below; a k-ary search for the last horizontal line
+        that meets the region settles it.
         """
-        touching = self._touching
-        if not touching.any():
+        lines, runs = self._scan
+        tops = [(r[-1][1], r[-1][0]) for r in runs if r]
+        if not tops:
             return None
-        top = self._alpha[touching].max()
-        inside = top * (1 - 2 * _PROBE) - _PROBE * self.delta
-        outside = top * (1 + 1e-9) + 1e-300
+        top, bottom = max(tops)
+        inside = top - 0.25 * (top - bottom)
         if not self._intervals("alpha", [inside])[0]:
-            return self._alpha_max_from_scan()
-        while self._intervals("alpha", [outside])[0]:
-            outside = inside + 4 * (outside - inside)
-            if not math.isfinite(outside):
-                return math.inf, math.nan
+            k = int(np.argmax([r[-1][1] if r else -np.inf for r in runs]))
+            return float(top), float(lines[k])
+        outside = self._missing_line("alpha", inside, 2 * (top - inside) + 1e-300)
+        if outside is None:
+            return math.inf, math.nan
         alpha_max, at_top = self._last_meeting("alpha", inside, outside)
         at_top = at_top or self._intervals("alpha", [alpha_max], closure=True)[0]
         if not at_top:
             return float(alpha_max), math.nan
         # The run the search ended on touches the top: its middle is the
-        # top's beta (to within the marginal band; limits() clamps it into
-        # the beta range).
+        # top's beta, a stable point (the run was counted).
         return float(alpha_max), float(0.5 * (at_top[0][0] + at_top[-1][1]))
 
-    def _alpha_max_from_scan(self, n_beta=801):
-        """alpha_max when no arc sample is the top: the tops of vertical lines."""
-        betas = np.linspace(*self._beta_range_bracket(n_beta)[:2], n_beta)
-        runs = self._intervals("beta", betas)
-        tops = np.array([r[-1][1] if r else -np.inf for r in runs])
-        k = int(np.argmax(tops))
-        if not np.isfinite(tops[k]):
-            return (math.inf, math.nan) if tops[k] > 0 else None
-        return float(tops[k]), float(betas[k])
-
-    def _beta_range_bracket(self, n_beta):
-        """A window of vertical lines whose first and last miss the region."""
-        lo, hi = self._beta_window()
-        pad = 0.05 * (hi - lo) + self.delta
-        for _ in range(8):
-            betas = np.linspace(lo - pad, hi + pad, n_beta)
-            meets = np.array([bool(r) for r in self._intervals("beta", betas)])
-            if not (meets[0] or meets[-1]):
-                break
-            pad *= 4
-        return betas[0], betas[-1], betas, meets
-
-    def beta_range(self, n_beta=201):
+    def beta_range(self):
         """``(beta_min, beta_max)`` of the stable region, or ``None`` when it is empty."""
-        if self._beta_window() is None:
-            return None
-        _, _, betas, meets = self._beta_range_bracket(n_beta)
-        k = np.flatnonzero(meets)
+        lines, runs = self._scan
+        k = np.flatnonzero([bool(r) for r in runs])
         if k.size == 0:
             return None
-        return (float(self._last_meeting("beta", betas[k[0]], betas[k[0] - 1])[0]),
-                float(self._last_meeting("beta", betas[k[-1]], betas[k[-1] + 1])[0]))
+        spacing = max(np.max(np.diff(lines)) if len(lines) > 1 else 0.0, self.delta)
+        ends = []
+        for i, toward in ((k[0], k[0] - 1), (k[-1], k[-1] + 1)):
+            if 0 <= toward < len(lines):
+                outside = lines[toward]
+            else:
+                outside = self._missing_line("beta", lines[i], (toward - i) * spacing)
+                if outside is None:
+                    outside = math.copysign(math.inf, toward - i)
+                    ends.append(outside)
+                    continue
+            ends.append(float(self._last_meeting("beta", lines[i], outside)[0]))
+        return ends[0], ends[1]
 
     def z_width(self, beta_min, beta_max, n_beta=801):
         """Area of the stable region: the stable length on verticals, trapezoid rule."""
         betas = np.linspace(beta_min, beta_max, n_beta)
-        lengths = np.array([sum(h - l for l, h in r) for r in self._intervals("beta", betas)])
+        # No boundary piece is vertical (the arc is vertical at points only,
+        # the lines z = +-1 are not), so the stable length is 0 at the two
+        # extreme betas; their lines run through corners, where counting
+        # fails.
+        lengths = np.zeros(n_beta)
+        runs = self._intervals("beta", betas[1:-1])
+        lengths[1:-1] = [sum(h - l for l, h in r) for r in runs]
         return float(np.sum(0.5 * (lengths[1:] + lengths[:-1]) * np.diff(betas)))
 
     def limits(self, *, n_beta=801):
@@ -407,10 +722,14 @@ class StabilityRegion:
             return Limits.empty_region(self, "no stable point next to the boundary arc: "
                                              "the stable region is empty")
         alpha_max, beta_at = top
-        if not math.isfinite(alpha_max):
-            return Limits(self, math.inf, math.nan, beta_range[1], beta_range[0], math.inf,
-                          "the stable region is unbounded in alpha")
-        beta_at = min(max(beta_at, beta_range[0]), beta_range[1])
+        if not (math.isfinite(alpha_max) and all(map(math.isfinite, beta_range))):
+            return Limits(self, alpha_max, math.nan, beta_range[1], beta_range[0], math.inf,
+                          "the stable region is unbounded")
+        # beta_at lies on a stable interval at alpha_max: a point of the
+        # region, so the range holds it (the searches for the extremes of
+        # beta stop a few ulps short where a corner cannot be counted).
+        if math.isfinite(beta_at):
+            beta_range = (min(beta_range[0], beta_at), max(beta_range[1], beta_at))
         return Limits(self, alpha_max, beta_at, beta_range[1], beta_range[0],
                       self.z_width(*beta_range, n_beta=n_beta), "")
 
@@ -428,12 +747,6 @@ def _golden_max(f, a, b, iterations=80):
         x1, x2 = np.where(left, x2, b - ratio * (b - a)), np.where(left, a + ratio * (b - a), x1)
         f1, f2 = np.where(left, f2, f(x1)), np.where(left, f(x2), f1)
     return 0.5 * (a + b)
-
-
-def _runs(mask):
-    """Index pairs (first, last) of the runs of True in a 1-D mask."""
-    edges = np.diff(np.r_[0, mask.astype(np.int8), 0])
-    return list(zip(np.flatnonzero(edges == 1), np.flatnonzero(edges == -1) - 1))
 
 
 @dataclasses.dataclass(frozen=True)
@@ -503,8 +816,9 @@ def limits(*, gamma, d, delta, n_beta=801):
     delta : float
         ``b T / m > 0``.
     n_beta : int
-        Vertical lines for the Z-width (trapezoid rule; its error is about
-        ``1 / n_beta**2`` of the width where the region's edges are smooth).
+        Vertical lines for the Z-width, ``n_beta >= 3`` (trapezoid rule; its
+        error is about ``1 / n_beta**2`` of the width where the region's
+        edges are smooth).
 
     Returns
     -------
@@ -518,8 +832,8 @@ def limits(*, gamma, d, delta, n_beta=801):
     >>> round(lim.alpha_max, 4), round(lim.beta_max, 4)
     (0.6897, 2.0034)
     """
-    if isinstance(n_beta, bool) or not isinstance(n_beta, (int, np.integer)) or n_beta < 3:
-        raise ValueError(f"n_beta must be an integer >= 3, got {n_beta!r}")
+    n_beta = _check_count("n_beta", n_beta, 3)
+    check_memory(f"limits with n_beta = {n_beta} vertical lines", 4 * 8 * n_beta)
     return StabilityRegion(gamma=gamma, d=d, delta=delta).limits(n_beta=n_beta)
 
 
@@ -562,6 +876,22 @@ def _alpha_max(gamma, d, delta):
     return (-math.inf, math.nan) if top is None else top
 
 
+def _check_gamma_range(gamma_range):
+    """``(low, high)``: two finite reals with ``low < high``."""
+    if isinstance(gamma_range, (str, bytes)) or not isinstance(gamma_range, collections.abc.Sequence) \
+            and not isinstance(gamma_range, np.ndarray):
+        raise TypeError(f"gamma_range must be a pair (low, high) of real numbers, "
+                        f"got {type(gamma_range).__name__}")
+    if len(gamma_range) != 2:
+        raise ValueError(f"gamma_range must be a pair (low, high) of real numbers, "
+                         f"got {len(gamma_range)} item(s): {gamma_range!r}")
+    low = check_real("gamma_range[0]", gamma_range[0])
+    high = check_real("gamma_range[1]", gamma_range[1])
+    if not low < high:
+        raise ValueError(f"gamma_range must be a pair (low, high) with low < high, got {gamma_range!r}")
+    return low, high
+
+
 def best_virtual_mass(*, d, delta, gamma_range=None, n=17):
     """The gamma (and beta) that maximise alpha_max, and the gain over gamma = 0.
 
@@ -569,6 +899,17 @@ def best_virtual_mass(*, d, delta, gamma_range=None, n=17):
     from just above ``-1 - (d + 1) delta``, below which no arc exists, to 3)
     and the best scan point is refined by a golden-section search between
     its neighbours, to 1e-6 in gamma.
+
+    Parameters
+    ----------
+    d : int
+        Delay in samples, ``d >= 0``.
+    delta : float
+        ``b T / m > 0``.
+    gamma_range : (float, float), optional
+        ``(low, high)``, finite, ``low < high``: the gammas scanned.
+    n : int
+        Points of the scan, ``n >= 3``.
 
     Returns
     -------
@@ -588,13 +929,10 @@ def best_virtual_mass(*, d, delta, gamma_range=None, n=17):
     True
     """
     _, d, delta = check_loop(0.0, d, delta)
-    if isinstance(n, bool) or not isinstance(n, (int, np.integer)) or n < 3:
-        raise ValueError(f"n must be an integer >= 3, got {n!r}")
+    n = _check_count("n", n, 3)
     if gamma_range is None:
         gamma_range = (-1.0 - (d + 1) * delta + 1e-3, 3.0)
-    g_lo, g_hi = (check_real("gamma_range[0]", gamma_range[0]), check_real("gamma_range[1]", gamma_range[1]))
-    if not g_lo < g_hi:
-        raise ValueError(f"gamma_range must be increasing, got {gamma_range!r}")
+    g_lo, g_hi = _check_gamma_range(gamma_range)
     gammas = np.linspace(g_lo, g_hi, n)
     values = [_alpha_max(g, d, delta)[0] for g in gammas]
     if not np.isfinite(values).any():

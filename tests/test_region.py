@@ -184,7 +184,7 @@ def test_boundary_curve_accepts_numpy_integer_n():
 
 
 @pytest.mark.parametrize("gamma, d, delta", [(0.0, 0, PAPER_DELTA), (1.5, 0, PAPER_DELTA),
-                                             (-0.5, 5, 0.1)])
+                                             (-0.5, 5, 0.1), (0.5, 200, 1e-4)])
 def test_boundary_curve_z1_segment_closes_the_region(gamma, d, delta):
     c = boundary_curve(gamma=gamma, d=d, delta=delta, n=100)
     z1 = [s for s in c.segments if s.root == "z=1"]
@@ -398,6 +398,134 @@ def test_limits_match_a_400x400_grid_for_gamma_1_5():
 
 
 # --------------------------------------------------------------------------
+# long delays (the region found by counting crossings, issue 10)
+# --------------------------------------------------------------------------
+
+def schur_cohn_stable(coeffs):
+    """All roots of a real polynomial (highest power first) strictly inside the
+    unit circle: the textbook Schur-Cohn recursion on the reflection
+    coefficients ``k = p_0 / p_n``, written here apart from the library's.
+    Reliable for points whose roots keep ~1e-6 from the circle."""
+    p = np.array(coeffs, dtype=float)
+    while p.size > 1:
+        k = p[-1] / p[0]
+        if not abs(k) < 1:
+            return False
+        p = (p - k * p[::-1])[:-1]
+        p = p / p[0]
+    return True
+
+
+def first_principles_arc_alphas(beta, gamma, d, delta, theta_end, n=64):
+    """alpha of the first-principles arc (eq. (2)) where its beta equals ``beta``,
+    for theta in (0, theta_end): a scan and mpmath.findroot at 30 digits."""
+    with mpmath.workdps(30):
+        f = lambda t: first_principles_boundary_point(t, gamma, d, delta)[1] - beta  # noqa: E731
+        grid = [mpmath.mpf(theta_end) * k / n for k in range(1, n + 1)]
+        values = [f(t) for t in grid]
+        roots = [mpmath.findroot(f, (a, b), solver="anderson")
+                 for a, b, fa, fb in zip(grid[:-1], grid[1:], values[:-1], values[1:]) if fa * fb < 0]
+        return [float(first_principles_boundary_point(t, gamma, d, delta)[0]) for t in roots]
+
+
+@pytest.mark.parametrize("gamma, d, delta, beta", [
+    (0.5, 200, 1e-4, 0.003), (0.5, 200, 1e-4, 0.0068), (0.0, 200, PAPER_DELTA, 0.004),
+    (0.5, 1000, 1e-4, 0.001),
+])
+def test_long_delay_alpha_interval_matches_first_principles(gamma, d, delta, beta):
+    """At d = 200 and 1000 the stable alpha interval is [0, top]: the top lies on
+    the first-principles arc (30 digits), points inside it are stable and points
+    just outside are not (Schur-Cohn on the 30-digit eq. (4) coefficients)."""
+    runs = StabilityRegion(gamma=gamma, d=d, delta=delta).alpha_intervals(beta)
+    assert len(runs) == 1, runs
+    lo, hi = runs[0]
+    assert lo == 0.0          # chi(1) = alpha (n1 + n0) (eq. (4)): z = 1 is a root at alpha = 0
+    arc = first_principles_arc_alphas(beta, gamma, d, delta, theta_end=4.0 / (d + 1))
+    assert arc and min(abs(hi - a) for a in arc) <= 1e-9 * hi, (hi, arc)
+    width = hi - lo
+    for alpha, stable in ((0.5 * (lo + hi), True), (lo + 1e-3 * width, True),
+                          (hi - 1e-3 * width, True), (hi + 1e-3 * width, False),
+                          (lo - 1e-3 * width, False)):
+        assert schur_cohn_stable(eq4_chi_float(alpha, beta, gamma, d, delta)) == stable, alpha
+
+
+def test_limits_at_d_200_agree_with_the_30_digit_interval_scan():
+    """limits() at d = 200: the interval at beta_at_alpha_max reaches alpha_max, and the
+    slow 30-digit reference scan (stability.stable_alpha_intervals, roots of the
+    30-digit coefficients) finds the same interval at another beta."""
+    gamma, d, delta, beta = 0.5, 200, 1e-4, 0.003
+    lim = limits(gamma=gamma, d=d, delta=delta)
+    assert abs(lim.beta_min + delta) <= 1e-9 * delta
+    top = lim.alpha_interval(lim.beta_at_alpha_max)
+    assert top and top[-1][1] == pytest.approx(lim.alpha_max, rel=1e-6)
+    (lo, hi), = lim.alpha_interval(beta)
+    # three scan points (-0.3, 0.45, 1.2 of the top) and bisection to 1e-6: ~45 root finds
+    ref = symstab.stability.stable_alpha_intervals(beta=beta, gamma=gamma, d=d, delta=delta,
+                                                   alpha_low=-0.3 * hi, alpha_high=1.2 * hi,
+                                                   n=3, xtol=1e-6 * hi)
+    assert len(ref) == 1
+    assert abs(ref[0][0] - lo) <= 2e-6 * hi and abs(ref[0][1] - hi) <= 2e-6 * hi, (ref, (lo, hi))
+
+
+# --------------------------------------------------------------------------
+# count parameters and gamma_range (issue 10: one rule for every count)
+# --------------------------------------------------------------------------
+
+COUNT_CALLS = {
+    "boundary_curve n": (lambda v: boundary_curve(gamma=0.0, d=0, delta=PAPER_DELTA, n=v,
+                                                  segments=False), "n", 2),
+    "limits n_beta": (lambda v: limits(gamma=0.0, d=0, delta=PAPER_DELTA, n_beta=v), "n_beta", 3),
+    "best_virtual_mass n": (lambda v: best_virtual_mass(d=0, delta=PAPER_DELTA, n=v), "n", 3),
+}
+
+
+@pytest.mark.parametrize("call", sorted(COUNT_CALLS))
+@pytest.mark.parametrize("value, error", [(801.0, TypeError), (2.5, TypeError), ("5", TypeError),
+                                          (True, TypeError), (None, TypeError),
+                                          (1, ValueError), (-4, ValueError)])
+def test_every_count_parameter_follows_one_rule(call, value, error):
+    """A non-integer kind is a TypeError, an integer out of range a ValueError, both
+    naming the parameter (limits(n_beta=801.0) was a ValueError, boundary_curve(n=2.0)
+    a TypeError)."""
+    function, name, low = COUNT_CALLS[call]
+    with pytest.raises(error) as excinfo:
+        function(value)
+    assert_message_names(excinfo, name)
+    if error is ValueError:
+        assert f">= {low}" in str(excinfo.value)
+
+
+@pytest.mark.parametrize("gamma_range, error", [
+    ((0,), ValueError), ((0.0, 1.0, 2.0), ValueError), ((1.0, 0.0), ValueError),
+    ((0.5, 0.5), ValueError), ((0.0, math.inf), ValueError), ((math.nan, 1.0), ValueError),
+    (1.5, TypeError), ("01", TypeError), ((0.0, "1"), TypeError), (None, None),
+])
+def test_best_virtual_mass_validates_gamma_range(gamma_range, error):
+    """gamma_range=(0,) was an IndexError; (0, 1, 2) was silently cut to (0, 1)."""
+    if error is None:     # the default range is fine
+        best_virtual_mass(d=0, delta=PAPER_DELTA, gamma_range=gamma_range, n=3)
+        return
+    with pytest.raises(error) as excinfo:
+        best_virtual_mass(d=0, delta=PAPER_DELTA, gamma_range=gamma_range)
+    assert_message_names(excinfo, "gamma_range")
+
+
+def test_boundary_curve_refuses_an_n_that_does_not_fit(monkeypatch):
+    """boundary --n 1000000000 grew to 23 GB; now it is refused before any work,
+    naming n and the limit."""
+    monkeypatch.setenv("SYMSTAB_MEMORY_LIMIT", "1G")
+    with pytest.raises(ValueError) as excinfo:
+        boundary_curve(gamma=0.0, d=0, delta=PAPER_DELTA, n=10**9)
+    assert_message_names(excinfo, "n")
+    assert "1000000000" in str(excinfo.value) and "1 GiB" in str(excinfo.value)
+    assert "SYMSTAB_MEMORY_LIMIT" in str(excinfo.value)
+    # within the limit it works, in chunks: 2e6 points need 48 MB
+    c = boundary_curve(gamma=0.0, d=0, delta=PAPER_DELTA, n=2 * 10**6, segments=False)
+    assert c.alpha.shape == (2 * 10**6,) and np.all(np.isfinite(c.alpha))
+    assert abs(c.theta_max - theta_max_30(0.0, 0, PAPER_DELTA)) <= 1e-13
+
+
+# --------------------------------------------------------------------------
 # empty regions
 # --------------------------------------------------------------------------
 
@@ -528,8 +656,9 @@ def test_device_conversions_round_trip(device):
     assert isinstance(device.alpha([1.0, 2.0]), np.ndarray)
 
 
-@pytest.mark.parametrize("name", ["m", "b", "T"])
-@pytest.mark.parametrize("value", [0.0, -1.0, float("nan"), float("inf")])
+@pytest.mark.parametrize("name, value", [
+    (name, value) for name in ("m", "b", "T") for value in (0.0, -1.0, float("nan"), float("inf"))
+    if (name, value) != ("b", 0.0)])   # b = 0 is a frictionless device (tests/test_units.py)
 def test_device_rejects_bad_parameters(name, value):
     kwargs = dict(m=0.0128, b=0.0324, T=1e-3)
     kwargs[name] = value
