@@ -38,7 +38,7 @@ import math
 import numpy as np
 
 from ._generated import kernels
-from ._resources import check_memory, chunk_slices
+from ._resources import CHUNK_BYTES, check_memory
 from ._validate import check_real, check_loop
 from .curves import Segment, _check_count, bracketed_root, minus_one_line, scan_grid
 from .stability import MARGINAL, STABLE, UNSTABLE, classify, loop_coefficients
@@ -48,7 +48,8 @@ __all__ = ["StabilityRegion", "Limits", "limits", "BestVirtualMass", "best_virtu
 #: Largest number of vertical lines in the scan that finds where the region is.
 _SCAN_LINES = 512
 #: Working bytes per crossing of a line with the boundary (positions, angles,
-#: the terms of the crossing direction); crossings per line are about d + 2.
+#: the terms of the crossing direction); lines are processed in chunks of
+#: :data:`symstab._resources.CHUNK_BYTES` of crossings.
 _BYTES_PER_CROSSING = 640
 
 
@@ -369,6 +370,38 @@ class StabilityRegion:
         low[values == 0] = -1
         return low, high
 
+    def _line_chunks(self, axis, values):
+        """Slices of ``values`` whose crossings fit in :data:`CHUNK_BYTES` together.
+
+        Most lines cross the boundary about d + 2 times, but a line along
+        which the arc keeps returning (alpha = 0 itself) crosses it up to
+        once per segment, so the crossings are counted first (O(segments)).
+        """
+        if len(values) == 0:
+            return []
+        coord = self._beta if axis == "beta" else self._alpha
+        order = np.argsort(values)
+        c0, c1 = coord[self._segments], coord[self._segments + 1]
+        rising = c1 > c0
+        start = np.where(rising, np.searchsorted(values[order], c0, "left"),
+                         np.searchsorted(values[order], c1, "right"))
+        stop = np.maximum(start, np.where(rising, np.searchsorted(values[order], c1, "left"),
+                                          np.searchsorted(values[order], c0, "right")))
+        step = np.zeros(len(values) + 1)
+        np.add.at(step, start, 1)
+        np.add.at(step, stop, -1)
+        per_line = np.empty(len(values))
+        per_line[order] = np.cumsum(step)[:-1]
+        weight = _BYTES_PER_CROSSING * (per_line + 3)
+        chunks, begin, total = [], 0, 0.0
+        for i, w in enumerate(weight):
+            if i > begin and total + w > CHUNK_BYTES:
+                chunks.append(slice(begin, i))
+                begin, total = i, 0.0
+            total += w
+        chunks.append(slice(begin, len(values)))
+        return chunks
+
     def _counted_runs(self, axis, values):
         """Stable intervals on each line by counting; ``None`` where the check fails.
 
@@ -378,7 +411,7 @@ class StabilityRegion:
         none is left in doubt.
         """
         out = [None] * len(values)
-        for part in chunk_slices(len(values), _BYTES_PER_CROSSING * (self.d + 8)):
+        for part in self._line_chunks(axis, values):
             chunk = values[part]
             cuts = self._all_cuts(axis, chunk, precise=False)
             low, high = self._end_counts(axis, chunk)
