@@ -13,11 +13,18 @@ evaluates them the same way: always with mpmath numbers, never Python floats.
 """
 
 import functools
+import json
 import os
 import pathlib
 import re
+import shutil
 import subprocess
 import sys
+
+try:
+    import fcntl
+except ImportError:  # Windows: no shared runs between xdist workers
+    fcntl = None
 
 import mpmath
 import numpy as np
@@ -317,6 +324,36 @@ def _main_in_process(argv):
     return code, out.getvalue(), err.getvalue()
 
 
+def run_once_per_session(tmp_path_factory, name, produce):
+    """``produce(folder)`` run once for the whole test session, also under pytest-xdist.
+
+    A session fixture is built once per xdist worker.  For a whole command
+    run that is one run too many: the first worker to get here runs it into
+    a folder shared by the workers (the xdist idiom: the parent of the
+    worker's base temporary folder) and writes its JSON result there, under
+    a file lock; the others wait and read it.  Without xdist, or without
+    ``fcntl`` (Windows), it simply runs.
+    """
+    base = tmp_path_factory.getbasetemp()
+    if os.environ.get("PYTEST_XDIST_WORKER") is None or fcntl is None:
+        folder = base / name
+        folder.mkdir()
+        return produce(folder)
+    root = base.parent
+    done = root / f"{name}.json"
+    with open(root / f"{name}.lock", "w") as lock:
+        fcntl.flock(lock, fcntl.LOCK_EX)
+        if done.is_file():
+            return json.loads(done.read_text(encoding="utf-8"))
+        folder = root / name
+        if folder.exists():   # a worker failed here before: start again
+            shutil.rmtree(folder)
+        folder.mkdir()
+        result = produce(folder)
+        done.write_text(json.dumps(result), encoding="utf-8")
+        return result
+
+
 @pytest.fixture(scope="session")
 def derive_subprocess_runs(tmp_path_factory, rendered_files, generated_code):
     """``symstab derive`` runs shared by the session: one subprocess, two in-process.
@@ -326,31 +363,35 @@ def derive_subprocess_runs(tmp_path_factory, rendered_files, generated_code):
     process's (:func:`hash_seed_other_than_ours`), so comparing its files
     with the in-process ones tests that the output does not depend on the
     hash seed.  ``check_edited`` runs ``derive --check`` (``cli.main``, in
-    this process: the proofs are cached here, a subprocess would redo them)
+    process: the proofs are cached there, a subprocess would redo them)
     on a copy of the in-process output in which :data:`EDITED_FILE` was
     edited by hand, ``check_edited_code`` on one in which
-    :data:`EDITED_CODE_FILE` was.
+    :data:`EDITED_CODE_FILE` was.  Built once per session
+    (:func:`run_once_per_session`).
 
     Returns ``{name: ((returncode, stdout, stderr), (derivations dir, code dir))}``.
     """
-    base = tmp_path_factory.mktemp("derive_runs")
-    _copy_files(base / "edited", rendered_files, EDITED_FILE)
-    _copy_files(base / "edited_code_ok", generated_code)
-    _copy_files(base / "fresh", rendered_files)
-    _copy_files(base / "edited_code", generated_code, EDITED_CODE_FILE)
-    seed = hash_seed_other_than_ours()
-    out, code = base / "seed1", base / "seed1_code"
-    proc = subprocess.run([sys.executable, "-m", "symstab", "derive", "--out", str(out),
-                           "--codegen-out", str(code)], cwd=base,
-                          env=dict(os.environ, PYTHONHASHSEED=seed),
-                          capture_output=True, text=True, timeout=900)
-    runs = {"seed1": ((proc.returncode, proc.stdout, proc.stderr), (out, code))}
-    for name, (out, code) in {"check_edited": (base / "edited", base / "edited_code_ok"),
-                              "check_edited_code": (base / "fresh", base / "edited_code")}.items():
-        result = _main_in_process(["derive", "--out", str(out), "--codegen-out", str(code),
-                                   "--check"])
-        runs[name] = (result, (out, code))
-    return runs
+    def produce(base):
+        _copy_files(base / "edited", rendered_files, EDITED_FILE)
+        _copy_files(base / "edited_code_ok", generated_code)
+        _copy_files(base / "fresh", rendered_files)
+        _copy_files(base / "edited_code", generated_code, EDITED_CODE_FILE)
+        out, code = base / "seed1", base / "seed1_code"
+        proc = subprocess.run([sys.executable, "-m", "symstab", "derive", "--out", str(out),
+                               "--codegen-out", str(code)], cwd=base,
+                              env=dict(os.environ, PYTHONHASHSEED=hash_seed_other_than_ours()),
+                              capture_output=True, text=True, timeout=900)
+        runs = {"seed1": ((proc.returncode, proc.stdout, proc.stderr), (str(out), str(code)))}
+        for name, (out, code) in {"check_edited": (base / "edited", base / "edited_code_ok"),
+                                  "check_edited_code": (base / "fresh", base / "edited_code")}.items():
+            result = _main_in_process(["derive", "--out", str(out), "--codegen-out", str(code),
+                                       "--check"])
+            runs[name] = (result, (str(out), str(code)))
+        return runs
+
+    runs = run_once_per_session(tmp_path_factory, "derive_runs", produce)
+    return {name: (tuple(result), tuple(pathlib.Path(p) for p in dirs))
+            for name, (result, dirs) in runs.items()}
 
 
 @pytest.fixture(scope="session")
@@ -359,27 +400,24 @@ def audit_run(tmp_path_factory):
 
     Returns ``(CompletedProcess, report path, json path)``.
     """
-    out = tmp_path_factory.mktemp("audit")
-    report, js = out / "REPORT.md", out / "audit.json"
-    proc = subprocess.run([sys.executable, "-m", "symstab", "audit", "--report", str(report),
-                           "--json", str(js)], capture_output=True, text=True, timeout=900)
-    return proc, report, js
+    def produce(out):
+        report, js = out / "REPORT.md", out / "audit.json"
+        proc = subprocess.run([sys.executable, "-m", "symstab", "audit", "--report", str(report),
+                               "--json", str(js)], capture_output=True, text=True, timeout=900)
+        return [proc.args, proc.returncode, proc.stdout, proc.stderr, str(report), str(js)]
+
+    args, returncode, stdout, stderr, report, js = run_once_per_session(
+        tmp_path_factory, "audit", produce)
+    return (subprocess.CompletedProcess(args, returncode, stdout, stderr),
+            pathlib.Path(report), pathlib.Path(js))
 
 
-#: Session fixtures that run a whole command, and the xdist group of their tests.
-_SHARED_RUNS = {"audit_run": "audit", "derive_subprocess_runs": "derive"}
+#: Session fixtures that run a whole command.
+_SHARED_RUNS = ("audit_run", "derive_subprocess_runs")
 
 
 def pytest_collection_modifyitems(config, items):
-    """Keep the tests of one shared command run on one xdist worker; mark them slow.
-
-    A session fixture is built once per worker, so with ``-n 2 --dist
-    loadgroup`` the tests that share the audit (or the derive) subprocess go
-    to the same worker and the command runs once per session.
-    """
+    """Mark the tests that wait for a whole command run (audit, derive) slow."""
     for item in items:
-        for fixture, group in _SHARED_RUNS.items():
-            if fixture in getattr(item, "fixturenames", ()):
-                item.add_marker(pytest.mark.xdist_group(group))
-                item.add_marker(pytest.mark.slow)
-                break
+        if any(fixture in getattr(item, "fixturenames", ()) for fixture in _SHARED_RUNS):
+            item.add_marker(pytest.mark.slow)
