@@ -42,7 +42,7 @@ def _add_nonideal_options(p):
 
 
 def _nonideal(args, setup):
-    from .simulate import PAPER_ENCODER_RESOLUTION, Nonidealities
+    from .simulate import PAPER_ENCODER_RESOLUTION, Nonidealities, check_x0
 
     resolution = args.encoder_resolution
     if args.paper_encoder:
@@ -58,7 +58,8 @@ def _nonideal(args, setup):
                          "defaults), not --delta")
     if setup.physical:
         nonideal.check(setup.device.T)
-    x0 = args.x0 if args.x0 is not None else (1.0 if nonideal.ideal else 0.01)
+    # Checked here, not only by the simulator, so that nothing is printed before the error.
+    x0 = check_x0(args.x0) if args.x0 is not None else (1.0 if nonideal.ideal else 0.01)
     return nonideal, x0
 
 
@@ -96,20 +97,20 @@ def _cmd_simulate(args):
     from .simulate import simulate
     from .stability import MARGINAL, STABLE, UNSTABLE, classify, spectral_radius
 
-    from .simulate import default_horizon, progress_printer
+    from .simulate import check_steps, progress_printer
 
     setup = _resolve(args)
     alpha, beta = _point(args, setup)
     nonideal, x0 = _nonideal(args, setup)
     _outputs([("--out", args.out)])
-    steps = default_horizon(setup.d) if args.steps is None else args.steps
+    steps = check_steps(args.steps, setup.d)
     record = args.out is not None
-    if record and steps > 0:
+    if record:
         check_memory(f"the --out trajectory of {steps} periods", (steps + 1) * _TRAJECTORY_ROW_BYTES)
     run = simulate(alpha=alpha, beta=beta, gamma=setup.gamma, d=setup.d,
                    delta=None if setup.physical else setup.delta, steps=steps, x0=x0,
                    device=setup.device, nonideal=nonideal, record=record,
-                   progress=progress_printer("simulating", steps) if steps > 0 else None)
+                   progress=progress_printer("simulating", steps))
     for line in setup.echo:
         print(line)
     code = classify(alpha=alpha, beta=beta, gamma=setup.gamma, d=setup.d, delta=setup.delta)
@@ -155,7 +156,7 @@ def _grid(text, name):
 
 
 def _cmd_map(args):
-    from .simulate import default_horizon, progress_printer, stability_map
+    from .simulate import check_steps, progress_printer, stability_map
     from .stability import MARGINAL, STABLE, classify
 
     setup = _resolve(args)
@@ -170,9 +171,9 @@ def _cmd_map(args):
     paths = _outputs([("--out", args.out), ("--png", png)])
     out, png_path = paths["--out"], paths.get("--png")
     check_memory(f"a map of {alpha.size} x {beta.size} cells", alpha.size * beta.size * _MAP_CELL_BYTES)
+    steps = check_steps(args.steps, setup.d)
     for line in setup.echo:
         print(line)
-    steps = default_horizon(setup.d) if args.steps is None else args.steps
     result = stability_map(alpha=alpha, beta=beta, gamma=setup.gamma, d=setup.d,
                            delta=None if setup.physical else setup.delta, steps=steps, x0=x0,
                            device=setup.device, nonideal=nonideal,

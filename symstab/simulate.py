@@ -54,7 +54,7 @@ from ._resources import _env_int, check_memory, chunk_slices
 from ._validate import check_array, check_delay, check_loop, check_real
 
 __all__ = ["Nonidealities", "Simulation", "simulate", "StabilityMap", "stability_map",
-           "default_horizon", "max_steps", "progress_printer", "PAPER_ENCODER_RESOLUTION",
+           "default_horizon", "check_steps", "check_x0", "max_steps", "progress_printer", "PAPER_ENCODER_RESOLUTION",
            "MAX_STEPS_ENV"]
 
 #: The paper's encoder: better than 3 arc seconds after quadrature and gear
@@ -173,6 +173,42 @@ def default_horizon(d):
     longer horizon.
     """
     return 12000 + 800 * check_delay(d)
+
+
+def check_x0(x0):
+    """Return the initial position ``x0`` as a float in ``X0_MIN <= |x0| <= X0_MAX``.
+
+    Raises
+    ------
+    TypeError, ValueError
+        Naming ``x0`` and the range.
+    """
+    x0 = check_real("x0", x0)
+    if not X0_MIN <= abs(x0) <= X0_MAX:
+        raise ValueError(f"x0 must be a finite real number with {X0_MIN:g} <= |x0| <= {X0_MAX:g} "
+                         f"(the verdict compares amplitudes and calls |x| > {_OVERFLOW:g} "
+                         f"divergence), got {x0!r}")
+    return x0
+
+
+def check_steps(steps, d):
+    """Return ``steps`` (None: :func:`default_horizon` of ``d``) as an int from 8 to :func:`max_steps`.
+
+    Raises
+    ------
+    ValueError
+        Naming ``steps``, the range and the variable that raises the limit.
+    """
+    steps = default_horizon(d) if steps is None else steps
+    if isinstance(steps, bool) or not isinstance(steps, (int, np.integer)) or steps < 8:
+        raise ValueError(f"steps must be an integer >= 8, got {steps!r}")
+    steps = int(steps)
+    limit = max_steps(d)
+    if steps > limit:
+        raise ValueError(f"steps must be an integer from 8 to {limit}, got {steps} (about "
+                         f"{steps * 3e-5 / 3600:.2g} hours per point; raise the limit with "
+                         f"{MAX_STEPS_ENV})")
+    return steps
 
 
 def max_steps(d):
@@ -317,20 +353,8 @@ def simulate(*, alpha, beta, gamma, d, delta, steps=None, x0=1.0, v0=None, devic
     if delta is None:
         raise TypeError("delta must be a real number (or None with a device), got None")
     _, d, delta = check_loop(0.0, d, delta)
-    steps = default_horizon(d) if steps is None else steps
-    if isinstance(steps, bool) or not isinstance(steps, (int, np.integer)) or steps < 8:
-        raise ValueError(f"steps must be an integer >= 8, got {steps!r}")
-    steps = int(steps)
-    limit = max_steps(d)
-    if steps > limit:
-        raise ValueError(f"steps must be an integer from 8 to {limit}, got {steps} (about "
-                         f"{steps * 3e-5 / 3600:.2g} hours per point; raise the limit with "
-                         f"{MAX_STEPS_ENV})")
-    x0 = check_real("x0", x0)
-    if not X0_MIN <= abs(x0) <= X0_MAX:
-        raise ValueError(f"x0 must be a finite real number with {X0_MIN:g} <= |x0| <= {X0_MAX:g} "
-                         f"(the verdict compares amplitudes and calls |x| > {_OVERFLOW:g} "
-                         f"divergence), got {x0!r}")
+    steps = check_steps(steps, d)
+    x0 = check_x0(x0)
     v0 = x0 / 100 if v0 is None else check_real("v0", v0, low=-X0_MAX, high=X0_MAX)
     n_points = alpha.size
     point_bytes = 8 * (d + 1 + _FLOATS_PER_POINT)
