@@ -639,20 +639,33 @@ class StabilityRegion:
         -------
         tuple of :class:`symstab.curves.Segment`
         """
-        if self.beta_range() is None:
+        extent = self.beta_range()
+        if extent is None:
             return ()
         c = self.minus_one
         out = []
+
+        def within(ends):
+            # Only pieces inside the region's beta range can border it (at
+            # large d the arc meets alpha = 0 thousands of times elsewhere).
+            # The searches for the extremes may stop an ulp-scale step short
+            # of a corner: a corner that close stands for the extreme.
+            tol = 1e-9 * (extent[1] - extent[0])
+            ends = ends[(ends >= extent[0] - tol) & (ends <= extent[1] + tol)]
+            extra = [b for b in extent if math.isfinite(b)
+                     and (ends.size == 0 or np.min(np.abs(ends - b)) > tol)]
+            return np.union1d(ends, extra)
+
         # z = 1: alpha = 0; the region borders a piece when a stable interval
         # of the vertical line through its middle starts or ends at 0.
         ends = self._corners()
         if math.isfinite(c):
             ends = np.union1d(ends, [c / 2])
-        out += self._bordering_pieces("z=1", np.unique(ends), lambda b: 0.0)
+        out += self._bordering_pieces("z=1", within(ends), lambda b: 0.0)
         if math.isfinite(c):
             # z = -1: alpha + 2 beta = c, cut where the arc crosses it and at alpha = 0.
             ends = np.union1d(self._arc_roots(lambda a, b: a + 2 * b - c), [c / 2])
-            out += self._bordering_pieces("z=-1", ends, lambda b: c - 2 * b)
+            out += self._bordering_pieces("z=-1", within(ends), lambda b: c - 2 * b)
         return tuple(out)
 
     def _bordering_pieces(self, root, ends, line_alpha):
