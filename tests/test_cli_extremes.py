@@ -149,11 +149,16 @@ def _limited_address_space():
 
 @pytest.mark.slow
 @pytest.mark.parametrize("args", [
-    ["limits", "--delta", "0.0025", "--d", "5000"],
+    ["limits", "--delta", "0.0025", "--d", "2000"],
     ["boundary", "--delta", "0.0025", "--d", "2000", "--n", "11"],
-], ids=["limits-d5000", "boundary-d2000"])
+], ids=["limits-d2000", "boundary-d2000"])
 def test_long_delays_answer_or_refuse_in_one_line(tmp_path, args):
-    """MemoryError tracebacks before; now an answer within 3 GiB, or one line naming a limit."""
+    """MemoryError tracebacks before; now an answer within 3 GiB, or one line naming a limit.
+
+    d = 2000: limits needed over 4 GB there (issue 10).  The issue's d = 5000
+    also answers (27 s and 106 MB peak on the loaded machine, 58 s in a
+    loaded test run): too slow for every test run until limits gets faster.
+    """
     result = subprocess.run([sys.executable, "-m", "symstab", *args, "--format", "json"],
                             capture_output=True, text=True, cwd=tmp_path, timeout=600,
                             preexec_fn=_limited_address_space)
@@ -172,7 +177,7 @@ def test_long_delays_answer_or_refuse_in_one_line(tmp_path, args):
 
         lim = payload["limits"]
         codes = [classify(alpha=f * lim["alpha_max"], beta=lim["beta_at_alpha_max"], gamma=0.0,
-                          d=5000, delta=0.0025) for f in (0.9, 1.1)]
+                          d=2000, delta=0.0025) for f in (0.9, 1.1)]
         assert codes == [STABLE, UNSTABLE]
     else:
         theta = [row["theta [rad]"] for row in payload["rows"]]
