@@ -13,20 +13,28 @@ test or a user can change them without re-importing:
     ``G`` (powers of 1024); default ``2G``.
 ``SYMSTAB_MAX_DELAY``
     Largest loop delay ``d`` in samples; default 10000.  Classification is
-    O(d**2) per point, so larger delays are slow rather than impossible.
+    O(d) per point and the region engine a little more, so larger delays are
+    slow rather than impossible.
+``SYMSTAB_MAX_STEPS``
+    Most sampling periods of one simulation; default 10 million (a period
+    costs tens of microseconds, so that is minutes per point).  The
+    simulator's default horizon is always allowed
+    (:func:`symstab.simulate.max_steps`).
 """
 
 import os
 
 __all__ = [
-    "MEMORY_LIMIT_ENV", "MAX_DELAY_ENV", "CHUNK_BYTES",
-    "memory_limit", "max_delay", "format_bytes", "check_memory", "chunk_slices",
+    "MEMORY_LIMIT_ENV", "MAX_DELAY_ENV", "MAX_STEPS_ENV", "CHUNK_BYTES",
+    "memory_limit", "max_delay", "max_steps", "format_bytes", "check_memory", "chunk_slices",
 ]
 
 MEMORY_LIMIT_ENV = "SYMSTAB_MEMORY_LIMIT"
 MAX_DELAY_ENV = "SYMSTAB_MAX_DELAY"
+MAX_STEPS_ENV = "SYMSTAB_MAX_STEPS"
 _DEFAULT_MEMORY_LIMIT = 2 * 2**30
 _DEFAULT_MAX_DELAY = 10_000
+_DEFAULT_MAX_STEPS = 10_000_000
 #: Working set of one chunk of grid work (bytes).
 CHUNK_BYTES = 32 * 2**20
 _SUFFIXES = {"": 1, "K": 2**10, "M": 2**20, "G": 2**30, "T": 2**40}
@@ -60,6 +68,11 @@ def memory_limit():
 def max_delay():
     """The largest loop delay ``d`` (samples) accepted."""
     return _env_int(MAX_DELAY_ENV, _DEFAULT_MAX_DELAY, int)
+
+
+def max_steps():
+    """The most sampling periods of one simulation (before the default-horizon floor)."""
+    return _env_int(MAX_STEPS_ENV, _DEFAULT_MAX_STEPS, int)
 
 
 def format_bytes(n):

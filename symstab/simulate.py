@@ -50,7 +50,8 @@ import time
 import numpy as np
 
 from ._generated import kernels
-from ._resources import _env_int, check_memory, chunk_slices
+from ._resources import MAX_STEPS_ENV, check_memory, chunk_slices
+from ._resources import max_steps as _max_steps_setting
 from ._validate import check_array, check_delay, check_loop, check_real
 
 __all__ = ["Nonidealities", "Simulation", "simulate", "StabilityMap", "stability_map",
@@ -76,14 +77,6 @@ X0_MAX = _OVERFLOW * 1e-50
 #: sampled positions, filter and actuator states, four amplitudes, three
 #: environment coefficients, alpha, beta, gamma and about six temporaries.
 _FLOATS_PER_POINT = 22
-#: Environment variable: the largest ``steps`` of one run.  A period costs
-#: about 30 us for one point and 40 us for 10000 (numbers loaded with other
-#: jobs), so the default of 10 million periods is minutes, not hours; the
-#: default horizon is always allowed, whatever the limit.
-MAX_STEPS_ENV = "SYMSTAB_MAX_STEPS"
-_DEFAULT_MAX_STEPS = 10_000_000
-
-
 @dataclasses.dataclass(frozen=True)
 class Nonidealities:
     """Departures from the ideal loop, in physical units; ``None``/False is off.
@@ -217,7 +210,7 @@ def max_steps(d):
     ``SYMSTAB_MAX_STEPS`` (default 10 million), or :func:`default_horizon`
     of ``d`` when that is longer.
     """
-    return max(_env_int(MAX_STEPS_ENV, _DEFAULT_MAX_STEPS, int), default_horizon(d))
+    return max(_max_steps_setting(), default_horizon(d))
 
 
 @dataclasses.dataclass(frozen=True)
