@@ -131,10 +131,17 @@ def check_delta(delta, *, name="delta"):
     return check_real(name, delta, low=0.0, high=DELTA_MAX)
 
 
-def check_loop(gamma, d, delta):
+def check_loop(gamma, d, delta, *, zero_delta=True):
     """Validate the loop parameters of a dimensionless entry point.
 
     Returns ``(gamma, d, delta)`` as ``(float, int, float)``; ``delta`` must
-    be in ``[0, DELTA_MAX]``.
+    be in ``[0, DELTA_MAX]``, and positive with ``zero_delta=False`` (the
+    high-precision references evaluate the derivation's forms in ``Gamma``
+    and ``delta``, whose common factor ``delta**2`` vanishes at 0).
     """
-    return check_real("gamma", gamma), check_delay(d), check_delta(delta)
+    out = check_real("gamma", gamma), check_delay(d), check_delta(delta)
+    if not zero_delta and out[2] == 0:
+        raise ValueError("delta must be > 0 for the high-precision reference (the derivation's "
+                         "forms carry a factor delta**2); the float API (classify, "
+                         "boundary_curve, arc_end_angle, limits) accepts delta = 0")
+    return out

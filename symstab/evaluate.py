@@ -43,7 +43,7 @@ def boundary_point(theta, *, gamma, d, delta, dps=30):
     dps : int
         Working precision in decimal digits.
     """
-    gamma, d, delta = check_loop(gamma, d, delta)
+    gamma, d, delta = check_loop(gamma, d, delta, zero_delta=False)
     values, _ = _functions()
     with mpmath.workdps(dps):
         na, nb, den = values(mpmath.mpf(theta), mpmath.mpf(gamma), d, mpmath.mpf(delta))
@@ -71,7 +71,7 @@ def alpha_max_on_arc(*, gamma, d, delta, dps=30, grid=400):
     (theta, alpha, beta) : tuple of float
         ``nan`` throughout when no arc enters alpha > 0.
     """
-    gamma, d, delta = check_loop(gamma, d, delta)
+    gamma, d, delta = check_loop(gamma, d, delta, zero_delta=False)
     t_end = theta_max(gamma=gamma, d=d, delta=delta, dps=dps)
     if not mpmath.isfinite(t_end):
         return (float("nan"),) * 3

@@ -151,7 +151,9 @@ def theta_max(*, gamma, d, delta, dps=30):
     d : int
         Delay in samples, ``d >= 0``.
     delta : float
-        ``b T / m > 0``.
+        ``b T / m > 0``: the derivation's N_alpha carries a factor that
+        vanishes at delta = 0, so this reference refuses it (the float
+        :func:`symstab.arc_end_angle` handles delta = 0).
     dps : int
         mpmath working precision.
 
@@ -168,7 +170,7 @@ def theta_max(*, gamma, d, delta, dps=30):
     >>> round(theta_max(gamma=0.0, d=0, delta=0.0324e-3 / 0.0128), 4)
     1.5725
     """
-    gamma, d, delta = check_loop(gamma, d, delta)
+    gamma, d, delta = check_loop(gamma, d, delta, zero_delta=False)
     f = alpha_numerator_function()
     # N_alpha ~ theta**3 near 0 out of terms of size 1: the extra digits keep
     # its sign right down to the first grid point, pi/n * 1e-10.
@@ -186,14 +188,19 @@ def theta_max(*, gamma, d, delta, dps=30):
             if values[k] == 0:
                 return float(grid[k])
             if values[k] < 0 < values[k - 1]:
-                root = mpmath.findroot(g, (grid[k - 1], grid[k]), solver="anderson")
+                # N_alpha grows like exp(2 delta): a tolerance on its value
+                # means nothing at large delta, so keep the bracket instead.
+                lo, hi = grid[k - 1], grid[k]
+                root = mpmath.findroot(g, (lo, hi), solver="anderson", verify=False)
+                if not lo <= root <= hi:
+                    root = mpmath.findroot(g, (lo, hi), solver="bisect", verify=False)
                 return float(root)
         return float(mpmath.pi)
 
 
 def theta_max_newton(*, d, delta):
     """theta_max for gamma = 0 by the one-step Newton form (approximate)."""
-    _, d, delta = check_loop(0.0, d, delta)
+    _, d, delta = check_loop(0.0, d, delta, zero_delta=False)
     # The Newton quotient cancels: evaluate at 30 digits from the exact
     # binary value of delta (a 15-digit Float lost up to 1e-7 at d = 100).
     with mpmath.workdps(30):

@@ -185,3 +185,22 @@ def test_theta_max_rejects_wrong_kinds(name, value):
 def test_theta_max_is_keyword_only():
     with pytest.raises(TypeError):
         theta_max(0.0, 0, PAPER_DELTA)
+
+
+@pytest.mark.parametrize("delta", [400.0, 710.0, 1e4])
+def test_theta_max_at_large_delta_agrees_with_the_float_arc_end(delta):
+    """N_alpha grows like exp(2 delta): findroot's value tolerance failed at 710."""
+    from symstab import arc_end_angle
+    exact = theta_max(gamma=0.5, d=3, delta=delta)
+    assert exact == pytest.approx(arc_end_angle(gamma=0.5, d=3, delta=delta), rel=1e-13)
+
+
+@pytest.mark.parametrize("func", ["theta_max", "boundary_point", "theta_max_newton"])
+def test_references_refuse_delta_zero_instead_of_dividing_zero_by_zero(func):
+    import symstab
+    from symstab.evaluate import boundary_point
+    calls = {"theta_max": lambda: theta_max(gamma=0.0, d=0, delta=0.0),
+             "boundary_point": lambda: boundary_point(0.5, gamma=0.0, d=0, delta=0.0),
+             "theta_max_newton": lambda: symstab.theta_max_newton(d=0, delta=0.0)}
+    with pytest.raises(ValueError, match="delta must be > 0 for the high-precision reference"):
+        calls[func]()
