@@ -6,31 +6,106 @@ Every sub-command validates its arguments, and checks its output paths
 traceback.  Ctrl-C (SIGINT) and SIGTERM print ``symstab <command>:
 interrupted`` and exit with status 130 and 143; files are written
 atomically (:func:`write_output`), so an interrupted run leaves none behind.
+
+Default output paths of ``derive`` and ``audit`` are resolved from the
+source checkout that holds the package (:func:`project_root`), never from
+the current folder; an installed copy has none, and ``derive`` then checks
+the installed kernels (``--check``) or asks for ``--out``.
 """
 
 import argparse
+import importlib.metadata
 import os
 import pathlib
+import re
 import signal
 import sys
 import tempfile
+import textwrap
 import time
 import warnings
 
-__all__ = ["main", "check_outputs", "write_output"]
+__all__ = ["main", "check_outputs", "write_output", "project_root", "package_version",
+           "add_command"]
 
-#: Where ``symstab derive`` writes without ``--out``.
+#: Where ``symstab derive`` writes without ``--out``, relative to the project root.
 DEFAULT_DERIVATIONS = pathlib.Path("derivations") / "generated"
-#: Where ``symstab derive`` writes the generated kernels without ``--codegen-out``.
+#: Where ``symstab derive`` writes the generated kernels without ``--codegen-out``,
+#: relative to the project root.
 DEFAULT_CODEGEN = pathlib.Path("symstab") / "_generated"
-#: Where ``symstab audit`` writes its report without ``--report``.
+#: Where ``symstab audit`` writes its report without ``--report``, relative to
+#: the project root (outside a checkout: ``REPORT.md`` in the current folder).
 DEFAULT_REPORT = pathlib.Path("paper_checks") / "REPORT.md"
+#: The folder of the installed package, and of its generated kernels.
+PACKAGE_DIR = pathlib.Path(__file__).resolve().parent
+INSTALLED_CODEGEN = PACKAGE_DIR / "_generated"
+
+
+def project_root(package_dir=PACKAGE_DIR):
+    """The source checkout that holds ``package_dir``, or None for an installed copy.
+
+    A checkout is the folder just above the package with a ``pyproject.toml``
+    that names the ``symstab`` project; a copy installed by ``pip`` sits in
+    ``site-packages``, which has none.
+
+    Parameters
+    ----------
+    package_dir : path-like
+        The ``symstab`` package folder (default: the one running).
+
+    Returns
+    -------
+    pathlib.Path or None
+    """
+    root = pathlib.Path(package_dir).resolve().parent
+    try:
+        text = (root / "pyproject.toml").read_text(encoding="utf-8")
+    except OSError:
+        return None
+    return root if re.search(r"""^name\s*=\s*["']symstab["']""", text, re.M) else None
+
+
+def package_version():
+    """The installed version of symstab (package metadata), else the checkout's, else "unknown".
+
+    A checkout run without ``pip install`` has no metadata: its
+    ``pyproject.toml`` gives the version, marked "not installed".
+    """
+    try:
+        return importlib.metadata.version("symstab")
+    except importlib.metadata.PackageNotFoundError:
+        pass
+    root = project_root()
+    if root is not None:
+        try:
+            import tomllib
+        except ImportError:   # Python 3.10: no TOML reader in the standard library
+            tomllib = None
+        if tomllib is not None:
+            with open(root / "pyproject.toml", "rb") as fh:
+                version = tomllib.load(fh).get("project", {}).get("version")
+            if version:
+                return f"{version} (source checkout {root}, not installed)"
+    return "unknown (not installed: no package metadata)"
 
 
 class _Parser(argparse.ArgumentParser):
     def error(self, message):
         # self.prog is "symstab" or "symstab <command>" for a sub-parser.
         self.exit(2, f"{self.prog}: error: {message}\n")
+
+
+def add_command(sub, name, *, help, description, example, func):
+    """Add the sub-command ``name``: a one-sentence ``description`` and an ``example`` in --help.
+
+    ``help`` is the short line of the command list of ``symstab --help``;
+    ``example`` is the command line printed (indented) under "example:".
+    """
+    parser = sub.add_parser(name, help=help, description=textwrap.fill(description, 79),
+                            epilog=f"example:\n  {example}",
+                            formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser.set_defaults(func=func)
+    return parser
 
 
 # --------------------------------------------------------------------------
@@ -127,34 +202,74 @@ def write_output(path, data, flag):
 # Commands
 
 
+def _derive_paths(args):
+    """``(out, code_out, root)`` of ``symstab derive``: the defaults come from the checkout.
+
+    ``out`` is None when ``--check`` has no derivations to compare with (no
+    ``--out`` and no ``derivations/generated`` in a checkout).  Without
+    ``--check``, outside a checkout, a missing ``--out``/``--codegen-out``
+    is an error: nothing is written into the current folder, nor into the
+    installed package.
+    """
+    root = project_root()
+    out = None if args.out is None else pathlib.Path(args.out)
+    code_out = None if args.codegen_out is None else pathlib.Path(args.codegen_out)
+    if args.check:
+        if out is None and root is not None and (root / DEFAULT_DERIVATIONS).is_dir():
+            out = root / DEFAULT_DERIVATIONS
+        # In a checkout the installed package is the checkout's symstab/.
+        return out, code_out or INSTALLED_CODEGEN, root
+    if root is None and (out is None or code_out is None):
+        missing = " and ".join(flag for flag, path in (("--out", out), ("--codegen-out", code_out))
+                               if path is None)
+        raise ValueError(f"not in a source checkout of symstab (no pyproject.toml above "
+                         f"{PACKAGE_DIR}): give {missing} for the files to write")
+    return (out or root / DEFAULT_DERIVATIONS, code_out or root / DEFAULT_CODEGEN, root)
+
+
 def _cmd_derive(args):
     from . import codegen, derive
 
     start = time.perf_counter()
-    out, code_out = pathlib.Path(args.out), pathlib.Path(args.codegen_out)
+    out, code_out, root = _derive_paths(args)
     if args.check:   # reads only
         for flag, path in (("--out", out), ("--codegen-out", code_out)):
-            if path.exists() and not path.is_dir():
+            if path is not None and path.exists() and not path.is_dir():
                 raise ValueError(f"{flag} must be a directory, got file {path}")
     else:
         check_outputs([("--out", out, "dir"), ("--codegen-out", code_out, "dir")])
-    print("deriving: ZOH, characteristic polynomial, unit circle, boundary, limits, "
-          "theta_max, proofs, code generation ...", file=sys.stderr)
-    outputs = [(out, derive.render(derive.derivation_steps()), derive.OWNED),
-               (code_out, codegen.generated_files(), codegen.OWNED)]
+    if out is None:
+        # Installed without a checkout (or a checkout without derivations/):
+        # the kernels are what the package runs on, and all there is to check.
+        where = (f"no source checkout above {PACKAGE_DIR}" if root is None
+                 else f"no {root / DEFAULT_DERIVATIONS}")
+        print(f"{where} to compare the derivations with: checking the kernels in "
+              f"{code_out} against a fresh generation")
+        print("generating the NumPy and C kernels ...", file=sys.stderr)
+        outputs = [(code_out, codegen.generated_files(), codegen.OWNED)]
+    else:
+        print("deriving: ZOH, characteristic polynomial, unit circle, boundary, limits, "
+              "theta_max, proofs, code generation ...", file=sys.stderr)
+        outputs = [(out, derive.render(derive.derivation_steps()), derive.OWNED),
+                   (code_out, codegen.generated_files(), codegen.OWNED)]
     if args.check:
-        command = "symstab derive"
-        if out != DEFAULT_DERIVATIONS:
-            command += f" --out {out}"
-        if code_out != DEFAULT_CODEGEN:
-            command += f" --codegen-out {code_out}"
-        stale = [path for folder, files, owned in outputs
-                 for path in derive.check(folder, files, owned=owned)]
-        for path in stale:
-            print(f"drift: {path} differs from a fresh derivation; run `{command}`")
+        command = "run `symstab derive" + "".join(
+            f" {flag} {path}" for flag, path in (("--out", args.out),
+                                                 ("--codegen-out", args.codegen_out))
+            if path is not None) + "`"
+        stale = []
+        for folder, files, owned in outputs:
+            # `symstab derive` cannot mend an installed package (and outside
+            # a checkout refuses to write without --out and --codegen-out).
+            advice = ("reinstall symstab" if root is None and folder == INSTALLED_CODEGEN
+                      else command)
+            stale += [(path, advice) for path in derive.check(folder, files, owned=owned)]
+        for path, advice in stale:
+            print(f"drift: {path} differs from a fresh derivation; {advice}")
         if stale:
             return 1
-        print(f"{sum(len(files) for _, files, _ in outputs)} files in {out} and {code_out} "
+        print(f"{sum(len(files) for _, files, _ in outputs)} files in "
+              f"{' and '.join(str(folder) for folder, _, _ in outputs)} "
               f"match a fresh derivation ({time.perf_counter() - start:.1f} s)")
         return 0
     written = [derive.write(folder, files) for folder, files, _ in outputs]
@@ -163,12 +278,19 @@ def _cmd_derive(args):
     return 0
 
 
+def _report_path(args):
+    if args.report is not None:
+        return args.report
+    root = project_root()
+    return root / DEFAULT_REPORT if root is not None else pathlib.Path("REPORT.md")
+
+
 def _cmd_audit(args):
     try:
         from paper_checks import audit
     except ImportError as exc:  # pragma: no cover - packaging problem
         raise ValueError(f"the paper_checks package is not installed ({exc})") from exc
-    paths = check_outputs([("--report", args.report, "file"), ("--json", args.json, "file")])
+    paths = check_outputs([("--report", _report_path(args), "file"), ("--json", args.json, "file")])
     start = time.perf_counter()
 
     def progress(n, total, cid):
@@ -219,30 +341,53 @@ def build_parser():
     """Return the argument parser of the ``symstab`` command."""
     parser = _Parser(prog="symstab", description=(
         "Derive, audit and evaluate the stability boundary of a sampled haptic loop "
-        "(Mashayekhi et al., IEEE Trans. Haptics 2025)."))
-    sub = parser.add_subparsers(dest="command", required=True, parser_class=_Parser)
-    p = sub.add_parser("derive", help="regenerate every derived object as LaTeX and srepr JSON")
-    p.add_argument("--out", default=str(DEFAULT_DERIVATIONS),
-                   help=f"output directory (default: {DEFAULT_DERIVATIONS})")
-    p.add_argument("--codegen-out", default=str(DEFAULT_CODEGEN),
-                   help=f"output directory of the generated NumPy and C kernels (default: {DEFAULT_CODEGEN})")
+        "(Mashayekhi et al., IEEE Trans. Haptics 2025)."),
+        epilog="Run `symstab <command> --help` for the options of a command.")
+    parser.add_argument("--version", action="version", version=f"symstab {package_version()}")
+    # Not required: without a command main() prints this help (argparse
+    # would print one line naming no command).
+    sub = parser.add_subparsers(dest="command", metavar="command", title="commands",
+                                parser_class=_Parser)
+    p = add_command(
+        sub, "derive", help="regenerate every derived object as LaTeX and srepr JSON, "
+                            "and the NumPy and C kernels",
+        description="Re-derive with SymPy every object of the paper's loop (ZOH, characteristic "
+                    "polynomial, unit-circle split, boundary, limits, theta_max), prove the "
+                    "rewritten forms equal, and write them as LaTeX and srepr JSON together with "
+                    "the generated NumPy and C kernels.",
+        example="symstab derive --check", func=_cmd_derive)
+    p.add_argument("--out", help=f"output directory (default: {DEFAULT_DERIVATIONS} in the "
+                                 "source checkout; outside one, --check skips it and writing "
+                                 "needs --out)")
+    p.add_argument("--codegen-out",
+                   help=f"output directory of the generated NumPy and C kernels (default: "
+                        f"{DEFAULT_CODEGEN} in the source checkout; outside one, --check checks "
+                        "the installed package's kernels and writing needs --codegen-out)")
     p.add_argument("--check", action="store_true",
                    help="compare both output directories with a fresh run; exit 1 on drift")
-    p.set_defaults(func=_cmd_derive)
-    p = sub.add_parser("audit", help="check every equation and claim of the paper; write REPORT.md")
-    p.add_argument("--report", default=str(DEFAULT_REPORT),
-                   help=f"Markdown report (default: {DEFAULT_REPORT})")
+    p = add_command(
+        sub, "audit", help="check every equation and claim of the paper; write REPORT.md",
+        description="Check every printed equation and claim of the paper against the "
+                    "derivation and write the verdicts as a Markdown report (and JSON).",
+        example="symstab audit --report REPORT.md --json audit.json", func=_cmd_audit)
+    p.add_argument("--report", help=f"Markdown report (default: {DEFAULT_REPORT} in the source "
+                                    "checkout, REPORT.md outside one)")
     p.add_argument("--json", metavar="PATH", help="also write the verdicts as JSON")
     p.add_argument("-v", "--verbose", action="store_true", help="print each check as it runs")
-    p.set_defaults(func=_cmd_audit)
-    p = sub.add_parser("figures", help="draw the paper's figures as PNG")
+    p = add_command(
+        sub, "figures", help="draw the paper's figures as PNG",
+        description="Redraw the paper's figures from the derived boundary and the numeric API "
+                    "and save them as PNG, one line per figure on what symstab finds.",
+        example="symstab figures --out figures", func=_cmd_figures)
     p.add_argument("--out", default="figures", help="output directory (default: figures)")
-    p.set_defaults(func=_cmd_figures)
-    p = sub.add_parser("reproduce", help="derive (with the drift check), audit and draw every "
-                                         "figure; write index.md")
+    p = add_command(
+        sub, "reproduce", help="derive (with the drift check), audit and draw every figure; "
+                               "write index.md",
+        description="Run the derivation (with the drift check), the audit and every figure in "
+                    "one go and write an index.md that links the report and the figures.",
+        example="symstab reproduce --out reproduction --workers 2", func=_cmd_reproduce)
     p.add_argument("--out", default="reproduction", help="output directory (default: reproduction)")
     p.add_argument("--workers", type=int, default=2, help="worker processes, >= 1 (default 2)")
-    p.set_defaults(func=_cmd_reproduce)
     from . import cli_numeric, cli_simulate
 
     cli_numeric.add_commands(sub)
@@ -293,6 +438,15 @@ def main(argv=None):
         args, extra = parser.parse_known_args(argv)
     except SystemExit as exc:  # --help, or a usage error already printed
         return exc.code
+    if args.command is None:
+        if extra:
+            print(f"symstab: error: unrecognized arguments: {' '.join(extra)}", file=sys.stderr)
+        else:
+            # The usage and the list of commands, then the one error line.
+            parser.print_help(sys.stderr)
+            print("\nsymstab: error: no command given: choose one of the commands above",
+                  file=sys.stderr)
+        return 2
     prog = f"symstab {args.command}"
     if extra:  # argparse would blame "symstab", not the command
         print(f"{prog}: error: unrecognized arguments: {' '.join(extra)}", file=sys.stderr)
