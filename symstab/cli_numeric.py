@@ -18,6 +18,7 @@ import io
 import json
 import math
 import sys
+import textwrap
 
 import numpy as np
 
@@ -42,17 +43,21 @@ class Setup:
     delta: float
     units: dict
     echo: tuple  # lines describing the inputs
+    mass: bool = True  # False: the command searches over gamma; no virtual mass is an input
 
     @property
     def physical(self):
         return self.device is not None
 
     def as_dict(self):
-        out = {"gamma": self.gamma, "d": self.d, "delta": self.delta}
+        out = {"gamma": self.gamma} if self.mass else {}
+        out.update(d=self.d, delta=self.delta)
         if self.physical:
             out.update(m=self.device.m, b=self.device.b, T=self.device.T,
-                       Td=self.device.delay(self.d), M_w=self.device.mass(self.gamma),
-                       units=self.units)
+                       Td=self.device.delay(self.d))
+            if self.mass:
+                out.update(M_w=self.device.mass(self.gamma))
+            out.update(units=self.units)
         return out
 
 
@@ -86,8 +91,12 @@ def _integer(text):
     return int(value)
 
 
-def _resolve(args):
-    """Turn the parsed options into a :class:`Setup` (raises ValueError)."""
+def _resolve(args, *, mass=True):
+    """Turn the parsed options into a :class:`Setup` (raises ValueError).
+
+    ``mass=False`` (``design``, which searches over the virtual mass) leaves
+    the virtual mass out of the echo and of the JSON inputs.
+    """
     from .units import PAPER_DEVICE, Device
 
     physical = [name for name in ("m", "b", "T", "Td") if getattr(args, name) is not None]
@@ -100,8 +109,9 @@ def _resolve(args):
         from ._validate import check_loop
         gamma, d, delta = check_loop(0.0 if args.gamma is None else args.gamma,
                                      0 if args.d is None else args.d, args.delta)
-        echo = (f"dimensionless: delta = {delta:.6g}, d = {d}, gamma = {gamma:.6g}",)
-        return Setup(None, gamma, d, delta, {}, echo)
+        echo = (f"dimensionless: delta = {delta:.6g}, d = {d}"
+                + (f", gamma = {gamma:.6g}" if mass else ""),)
+        return Setup(None, gamma, d, delta, {}, echo, mass)
     if args.Td is not None and args.d is not None:
         raise ValueError("give the delay once: --Td (seconds) or --d (samples)")
     device = Device(m=PAPER_DEVICE.m if args.m is None else args.m,
@@ -118,10 +128,11 @@ def _resolve(args):
     units = device.units(rotary=not args.linear)
     mass_unit = units["M_w"]
     echo = (f"device: m = {device.m:g} {mass_unit}, b = {device.b:g} {units['B_w']}, "
-            f"T = {device.T:g} s; delay Td = {device.delay(d):g} s (d = {d}); "
-            f"virtual mass M_w = {device.mass(gamma):g} {mass_unit} (gamma = {gamma:g})",
+            f"T = {device.T:g} s; delay Td = {device.delay(d):g} s (d = {d})"
+            + (f"; virtual mass M_w = {device.mass(gamma):g} {mass_unit} (gamma = {gamma:g})"
+               if mass else ""),
             f"dimensionless: delta = b T / m = {device.delta:.6g}")
-    return Setup(device, gamma, d, device.delta, units, echo)
+    return Setup(device, gamma, d, device.delta, units, echo, mass)
 
 
 # --------------------------------------------------------------------------
@@ -226,14 +237,27 @@ def _cmd_boundary(args):
     return 0
 
 
+#: The quantities of ``symstab limits``: (name in the table and the JSON, attribute of
+#: :class:`symstab.region.Limits`, meaning, physical name, physical unit).  The
+#: names say what each is: the library's ``beta_min``/``beta_max`` are the ends
+#: of the stable region's beta range, which a reader of the paper would take
+#: for its beta_min = -delta, the damping where the boundary arc starts.
+_LIMITS = (
+    ("alpha_max", "alpha_max", "largest stable alpha = K_w T^2 / m (the renderable stiffness)",
+     "K_max", "K_w"),
+    ("beta_at_alpha_max", "beta_at_alpha_max", "the beta at which alpha_max is reached",
+     "B_w at K_max", "B_w"),
+    ("beta_left", "beta_min", "leftmost beta of the stable region (not the paper's "
+     "beta_min = -delta, where the boundary arc starts)", "B_left", "B_w"),
+    ("beta_right", "beta_max", "rightmost beta of the stable region", "B_right", "B_w"),
+    ("z_width", "z_width", "area of the stable region in the (beta, alpha) plane", "Z-width", None),
+)
+
+
 def _limits_rows(setup, lim):
-    quantities = [("alpha_max", lim.alpha_max, "K_max", "K_w"),
-                  ("beta_at_alpha_max", lim.beta_at_alpha_max, "B_w at K_max", "B_w"),
-                  ("beta_max", lim.beta_max, "B_max", "B_w"),
-                  ("beta_min", lim.beta_min, "B_min", "B_w"),
-                  ("z_width", lim.z_width, "Z-width", None)]
     rows = []
-    for name, value, label, unit in quantities:
+    for name, attribute, _, label, unit in _LIMITS:
+        value = getattr(lim, attribute)
         row = [name, value]
         if setup.physical:
             dev = setup.device
@@ -245,11 +269,18 @@ def _limits_rows(setup, lim):
                 phys = dev.damping(value)
             else:  # area in the (B_w, K_w) plane
                 phys = value * (dev.m / dev.T) * (dev.m / dev.T**2)
-                unit_text = f"({setup.units['B_w']})({setup.units['K_w']})"
-            row += [label, phys, setup.units[unit] if unit else unit_text]
+            row += [label, phys, setup.units[unit] if unit else
+                    f"({setup.units['B_w']})({setup.units['K_w']})"]
         rows.append(tuple(row))
     columns = ["quantity", "value"] + (["physical", "physical value", "unit"] if setup.physical else [])
     return columns, rows
+
+
+def _limits_json(lim):
+    """The ``limits`` object of the JSON output, under the names of the table."""
+    out = {name: getattr(lim, attribute) for name, attribute, _, _, _ in _LIMITS}
+    out["message"] = lim.message
+    return out
 
 
 def _cmd_limits(args):
@@ -259,7 +290,11 @@ def _cmd_limits(args):
     lim = limits(gamma=setup.gamma, d=setup.d, delta=setup.delta)
     columns, rows = _limits_rows(setup, lim)
     notes = [lim.message] if lim.message else []
-    result = {"limits": {k: v for k, v in lim.as_dict().items() if k not in ("gamma", "d", "delta")}}
+    if not lim.empty and not math.isclose(lim.beta_min, -setup.delta, rel_tol=1e-9, abs_tol=1e-12):
+        notes.append(f"beta_left = {lim.beta_min:.10g} is the leftmost beta of the stable region; "
+                     f"the paper's beta_min = -delta = {-setup.delta:.10g} is where the boundary "
+                     "arc starts (theta = 0)")
+    result = {"limits": _limits_json(lim)}
     damping = None
     if args.beta is not None or args.Bw is not None:
         if args.Bw is not None:
@@ -342,7 +377,7 @@ def _cmd_classify(args):
 def _cmd_design(args):
     from .region import best_virtual_mass, limits
 
-    setup = _resolve(args)
+    setup = _resolve(args, mass=False)
     print("searching gamma for the largest renderable stiffness ...", file=sys.stderr, flush=True)
     best = best_virtual_mass(d=setup.d, delta=setup.delta)
     rows = [("gamma (best)", best.gamma), ("beta at alpha_max", best.beta),
@@ -371,26 +406,48 @@ def _cmd_design(args):
 
 def add_commands(sub):
     """Register the numeric sub-commands on an argparse sub-parser set."""
-    p = sub.add_parser("boundary", help="the stability boundary alpha(theta), beta(theta)")
+    from .cli import add_command
+
+    p = add_command(
+        sub, "boundary", help="the stability boundary alpha(theta), beta(theta)",
+        description="Compute the stability boundary arc alpha(theta), beta(theta) of the "
+                    "paper's eq. (7) for one virtual mass, delay and device, with K_w and B_w "
+                    "in physical units, and the straight segments that close the region.",
+        example="symstab boundary --Td 0.01 --n 11", func=_cmd_boundary)
     _add_model_options(p)
     p.add_argument("--n", type=int, default=101, help="points on the arc (default 101)")
-    p.set_defaults(func=_cmd_boundary)
 
-    p = sub.add_parser("limits", help="alpha_max, the beta range and the Z-width")
+    p = add_command(
+        sub, "limits", help="alpha_max, the beta range and the Z-width",
+        description="Compute the largest stable stiffness alpha_max (K_max), the damping at "
+                    "which it is reached, the range of damping over the stable region and its "
+                    "area (Z-width), and with --beta/--Bw the stable stiffness intervals at that "
+                    "damping.",
+        example="symstab limits --Td 0.04 --Mw 0.0128", func=_cmd_limits)
+    p.epilog = "quantities (table rows and JSON keys of \"limits\"):\n" + "\n".join(
+        textwrap.fill(meaning, 79, initial_indent=f"  {name:<18} ", subsequent_indent=" " * 21)
+        for name, _, meaning, _, _ in _LIMITS) + "\n\n" + p.epilog
     _add_model_options(p)
     x = p.add_mutually_exclusive_group()
     x.add_argument("--beta", type=float, help="also give the stable alpha interval(s) at this beta")
     x.add_argument("--Bw", type=float, help="also give the stable K_w interval(s) at this damping")
-    p.set_defaults(func=_cmd_limits)
 
-    p = sub.add_parser("classify", help="stable, unstable or marginal, with the spectral radius")
+    p = add_command(
+        sub, "classify", help="stable, unstable or marginal, with the spectral radius",
+        description="Decide by counting the roots of the loop polynomial outside the unit "
+                    "circle (Schur-Cohn) whether each stiffness-damping point is stable, "
+                    "unstable or marginal, and give the spectral radius of the loop.",
+        example="symstab classify --Td 0.01 --Kw 1,3,10 --Bw 0.2", func=_cmd_classify)
     _add_model_options(p)
     p.add_argument("--alpha", help="dimensionless stiffness(es), comma-separated")
     p.add_argument("--beta", help="dimensionless damping(s), comma-separated")
     p.add_argument("--Kw", help="virtual stiffness(es), comma-separated (physical)")
     p.add_argument("--Bw", help="virtual damping(s), comma-separated (physical)")
-    p.set_defaults(func=_cmd_classify)
 
-    p = sub.add_parser("design", help="the virtual mass that maximises the renderable stiffness")
+    p = add_command(
+        sub, "design", help="the virtual mass that maximises the renderable stiffness",
+        description="Search the virtual mass gamma = M_w / m that maximises the largest stable "
+                    "stiffness for one delay and device, and report that stiffness, its damping "
+                    "and the gain over no virtual mass.",
+        example="symstab design --Td 0.04", func=_cmd_design)
     _add_model_options(p)
-    p.set_defaults(func=_cmd_design)

@@ -161,7 +161,13 @@ def _cmd_map(args):
 
     setup = _resolve(args)
     nonideal, x0 = _nonideal(args, setup)
-    alpha, beta = (np.atleast_1d(x) for x in stiffness_and_damping(args, setup, _grid))
+    given = {}  # the grids as the user gave them, by flag: the PNG is drawn in their units
+
+    def grid(text, flag):
+        given[flag] = _grid(text, flag)
+        return given[flag]
+
+    alpha, beta = (np.atleast_1d(x) for x in stiffness_and_damping(args, setup, grid))
     if not args.out.endswith((".csv", ".npz")):
         raise ValueError(f"--out must end in .csv or .npz, got {args.out}")
     if args.no_png and args.png is not None:
@@ -181,20 +187,32 @@ def _cmd_map(args):
     A, B = np.meshgrid(alpha, beta, indexing="ij")
     code = classify(alpha=A, beta=B, gamma=setup.gamma, d=setup.d, delta=setup.delta)
     exact = code == STABLE
+    physical = {}  # K_w and B_w beside alpha and beta, in the units of the echo
+    if setup.physical:
+        dev = setup.device
+        physical = {"K_w": given.get("--Kw", np.atleast_1d(dev.stiffness(alpha))),
+                    "B_w": given.get("--Bw", np.atleast_1d(dev.damping(beta)))}
     if out.suffix == ".npz":
         buf = io.BytesIO()
-        np.savez(buf, alpha=alpha, beta=beta, stable=result.stable, growth=result.growth,
-                 exact_stable=exact, exact_code=code, gamma=setup.gamma, d=setup.d,
-                 delta=setup.delta, steps=steps)
+        units = {f"{name}_unit": np.array(setup.units[name]) for name in physical}
+        np.savez(buf, alpha=alpha, beta=beta, **physical, **units, stable=result.stable,
+                 growth=result.growth, exact_stable=exact, exact_code=code, gamma=setup.gamma,
+                 d=setup.d, delta=setup.delta, steps=steps,
+                 nonidealities=np.array(_nonideal_text(nonideal, args)))
         data = buf.getvalue()
     else:
         buf = io.StringIO()
-        buf.write("alpha,beta,stable,exact_stable,growth\n")
-        for a, b, s, e, g in zip(A.ravel(), B.ravel(), result.stable.ravel(), exact.ravel(),
-                                 result.growth.ravel()):
-            buf.write(f"{a:.12g},{b:.12g},{int(s)},{int(e)},{g:.6g}\n")
+        columns = ["alpha", "beta"] + [f"{name} [{setup.units[name]}]" for name in physical]
+        buf.write(",".join(columns + ["stable", "exact_stable", "growth"]) + "\n")
+        cells = [A.ravel(), B.ravel()]
+        if physical:
+            K, Bw = np.meshgrid(physical["K_w"], physical["B_w"], indexing="ij")
+            cells += [K.ravel(), Bw.ravel()]
+        for *values, s, e, g in zip(*cells, result.stable.ravel(), exact.ravel(),
+                                    result.growth.ravel()):
+            buf.write(",".join(f"{v:.12g}" for v in values) + f",{int(s)},{int(e)},{g:.6g}\n")
         data = buf.getvalue().encode()
-    png = _png(args, setup, result, exact) if png_path is not None else None
+    png = _png(args, setup, result, nonideal, given) if png_path is not None else None
     _write(out, data, "--out")
     written = [str(out)]
     if png is not None:
@@ -209,8 +227,62 @@ def _cmd_map(args):
     return 0
 
 
-def _png(args, setup, result, exact):
-    """The map as PNG bytes, or None without matplotlib."""
+def _nonideal_text(nonideal, args):
+    """The non-idealities of a run in one line, for the PNG title and the NPZ."""
+    position, force = ("m", "N") if args.linear else ("rad", "N m")
+    parts = []
+    if nonideal.encoder_resolution is not None:
+        parts.append(f"encoder quantum {nonideal.encoder_resolution:.4g} {position}")
+    if nonideal.velocity_cutoff is not None:
+        parts.append(f"velocity filter {nonideal.velocity_cutoff:g} Hz")
+    if nonideal.coulomb_friction is not None:
+        parts.append(f"Coulomb friction {nonideal.coulomb_friction:g} {force}"
+                     + (f" (stiction {nonideal.stiction:g})" if nonideal.stiction is not None else "")
+                     + (", compensated" if nonideal.friction_compensation else ""))
+    if nonideal.actuator_bandwidth is not None:
+        parts.append(f"actuator lag {nonideal.actuator_bandwidth:g} Hz")
+    return ", ".join(parts) if parts else "ideal loop: no quantization, filter, friction or lag"
+
+
+def _tex_unit(unit):
+    """A unit string of :meth:`symstab.units.Device.units` for matplotlib ("kg m^2" -> "kg m$^2$")."""
+    return unit.replace("^2", "$^2$")
+
+
+def _map_axes(setup, given, result):
+    """``(x, y, x label, y label, to_x, to_y)`` in the units of the grids the user gave.
+
+    ``to_x``/``to_y`` convert beta/alpha (the boundary curve) to the axes.
+    """
+    dev, units = setup.device, setup.units
+    if "--Bw" in given:
+        x, xlabel, to_x = given["--Bw"], f"$B_w$ [{_tex_unit(units['B_w'])}]", dev.damping
+    else:
+        x, xlabel, to_x = result.beta, r"$\beta = B_w T / m$", np.asarray
+    if "--Kw" in given:
+        y, ylabel, to_y = given["--Kw"], f"$K_w$ [{_tex_unit(units['K_w'])}]", dev.stiffness
+    else:
+        y, ylabel, to_y = result.alpha, r"$\alpha = K_w T^2 / m$", np.asarray
+    return x, y, xlabel, ylabel, to_x, to_y
+
+
+def _map_title(setup, nonideal, args, steps_text):
+    if setup.physical:
+        dev, units = setup.device, setup.units
+        loop = (f"$T_d$ = {dev.delay(setup.d) * 1e3:g} ms (d = {setup.d}), "
+                f"$M_w$ = {float(dev.mass(setup.gamma)):g} {_tex_unit(units['M_w'])}")
+    else:
+        loop = f"$\\delta$ = {setup.delta:g}, d = {setup.d}, $\\gamma$ = {setup.gamma:g}"
+    return (f"stable by simulation (green, {steps_text}); {loop}\n"
+            f"{_nonideal_text(nonideal, args)}")
+
+
+def _png(args, setup, result, nonideal, given):
+    """The map as PNG bytes, or None without matplotlib.
+
+    Drawn in the units of the grids the user gave (K_w, B_w or alpha, beta),
+    with the non-idealities of the simulation in the title.
+    """
     from .curves import boundary_curve
     from .figures import pyplot
 
@@ -222,20 +294,21 @@ def _png(args, setup, result, exact):
 
     from matplotlib.colors import ListedColormap
 
-    fig, ax = plt.subplots(figsize=(6, 4.5), dpi=120)
-    x, y = result.beta, result.alpha
+    x, y, xlabel, ylabel, to_x, to_y = _map_axes(setup, given, result)
+    fig, ax = plt.subplots(figsize=(6.4, 4.8), dpi=120)
     ax.pcolormesh(x, y, result.stable.astype(float), shading="nearest",
                   cmap=ListedColormap(["white", "#7fc97f"]), vmin=0, vmax=1)
     curve = boundary_curve(gamma=setup.gamma, d=setup.d, delta=setup.delta, n=2000, segments=False)
     if not curve.empty:
-        ax.plot(curve.beta, curve.alpha, "k-", lw=1.2, label="boundary, eq. (7)")
+        ax.plot(to_x(curve.beta), to_y(curve.alpha), "k-", lw=1.2,
+                label="boundary of the ideal loop, eq. (7)")
     ax.set_xlim(x[0], x[-1])
     ax.set_ylim(y[0], y[-1])
-    ax.set_xlabel(r"$\beta = B_w T / m$")
-    ax.set_ylabel(r"$\alpha = K_w T^2 / m$")
-    ax.set_title(f"stable by simulation (green); $\\gamma$ = {setup.gamma:g}, d = {setup.d}", fontsize=10)
+    ax.set_xlabel(xlabel)
+    ax.set_ylabel(ylabel)
+    ax.set_title(_map_title(setup, nonideal, args, f"{result.steps} periods"), fontsize=10)
     if not curve.empty:
-        ax.legend(loc="upper right", fontsize=8)
+        ax.legend(loc="upper right", fontsize=9)
     fig.tight_layout()
     buf = io.BytesIO()
     fig.savefig(buf, format="png", metadata={"Software": None})
@@ -245,7 +318,15 @@ def _png(args, setup, result, exact):
 
 def add_commands(sub):
     """Register ``simulate`` and ``map``."""
-    p = sub.add_parser("simulate", help="simulate one point; write its trajectory as CSV")
+    from .cli import add_command
+
+    p = add_command(
+        sub, "simulate", help="simulate one point; write its trajectory as CSV",
+        description="Simulate the sampled loop at one stiffness-damping point, with the "
+                    "encoder quantization, velocity filter, friction and actuator lag you "
+                    "switch on, and compare its verdict with the ideal loop's root count.",
+        example="symstab simulate --Td 0.01 --Kw 30 --Bw 1 --paper-encoder --out trajectory.csv",
+        func=_cmd_simulate)
     _add_model_options(p)
     _add_nonideal_options(p)
     p.add_argument("--alpha", help="dimensionless stiffness")
@@ -253,9 +334,15 @@ def add_commands(sub):
     p.add_argument("--Kw", help="virtual stiffness (physical)")
     p.add_argument("--Bw", help="virtual damping (physical)")
     p.add_argument("--out", help="CSV file for the trajectory (k, t, x)")
-    p.set_defaults(func=_cmd_simulate)
 
-    p = sub.add_parser("map", help="stability of a grid by simulation; write CSV or NPZ and a PNG")
+    p = add_command(
+        sub, "map", help="stability of a grid by simulation; write CSV or NPZ and a PNG",
+        description="Simulate every point of a stiffness-damping grid and write which are "
+                    "stable (CSV or NPZ, with the ideal loop's root count beside) and a PNG "
+                    "of the map with the ideal loop's boundary, in the units of the grid.",
+        example="symstab map --Td 0.01 --Kw 0,70,100 --Bw=-0.1,2,100 --paper-encoder "
+                "--velocity-cutoff 50 --out map.npz",
+        func=_cmd_map)
     _add_model_options(p)
     _add_nonideal_options(p)
     p.add_argument("--alpha", metavar="LOW,HIGH,N", help="alpha grid (write --alpha=LOW,... "
@@ -266,4 +353,3 @@ def add_commands(sub):
     p.add_argument("--out", required=True, help="output file, .csv or .npz")
     p.add_argument("--png", help="PNG file (default: --out with .png)")
     p.add_argument("--no-png", action="store_true", help="do not draw the PNG")
-    p.set_defaults(func=_cmd_map)

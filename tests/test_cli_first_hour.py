@@ -1,25 +1,30 @@
 """What a new user meets first on the command line (issue 13).
 
-``symstab`` alone and ``--version``; ``derive`` outside a source checkout
-and from another folder.  Most
+``symstab`` alone and ``--version``; a description and an example in every
+``--help``; ``derive`` outside a source checkout and from another folder;
+``design`` echoing only the inputs it uses; ``limits`` naming its beta range
+for what it is; ``map`` drawn and stored in the units of its grid.  Most
 commands run in-process (:func:`symstab.cli.main` with capsys); what needs
 an installed copy without a checkout runs ``python -m symstab`` on a copy of
 the package in a temporary folder.
 """
 
 import importlib.metadata
+import json
 import os
 import pathlib
+import shlex
 import shutil
 import subprocess
 import sys
 
+import numpy as np
 import pytest
 
 import symstab
 from symstab import cli
 
-from conftest import REPO
+from conftest import PAPER_DELTA, PAPER_M, PAPER_T, REPO, python_control_closed_loop
 
 #: Every sub-command; a new one must be added here (and gets its --help checked).
 COMMANDS = ("derive", "audit", "figures", "reproduce", "boundary", "limits", "classify",
@@ -77,6 +82,29 @@ def test_the_command_list_is_the_one_this_file_checks(capsys):
     parser = cli.build_parser()
     sub = next(a for a in parser._actions if a.dest == "command")
     assert tuple(sub.choices) == COMMANDS
+
+
+# --------------------------------------------------------------------------
+# --help: what the command computes, and an example
+
+
+@pytest.mark.parametrize("command", COMMANDS)
+def test_help_has_a_description_and_an_example_that_parses(capsys, command):
+    status, out, _ = _main(capsys, command, "--help")
+    assert status == 0
+    paragraphs = out.split("\n\n")
+    assert paragraphs[0].startswith(f"usage: symstab {command}")
+    description = " ".join(paragraphs[1].split())
+    # A sentence, not the first option group.
+    assert not description.endswith(":") and ":\n" not in paragraphs[1], paragraphs[1]
+    assert len(description) > 40 and description.endswith("."), description
+    examples = [line for line in out.splitlines() if line.startswith(f"  symstab {command} ")]
+    assert len(examples) == 1, out
+    assert out.splitlines()[out.splitlines().index(examples[0]) - 1] == "example:"
+    words = shlex.split(examples[0])
+    assert words[:2] == ["symstab", command]
+    args = cli.build_parser().parse_args(words[1:])   # raises SystemExit if it does not parse
+    assert args.command == command
 
 
 # --------------------------------------------------------------------------
@@ -159,3 +187,165 @@ def test_derive_check_from_another_folder_compares_with_the_checkout(
     assert list(tmp_path.iterdir()) == []
 
 
+# --------------------------------------------------------------------------
+# design echoes only what was given
+
+
+def test_design_does_not_echo_a_virtual_mass_it_searches_over(capsys):
+    status, out, err = _main(capsys, "design", "--Td", "0.01")
+    assert status == 0
+    echo = out.split("\n\n")[0]
+    assert "Td = 0.01 s (d = 10)" in echo
+    assert "M_w" not in echo and "gamma" not in echo, echo
+    status, out, _ = _main(capsys, "design", "--delta", str(PAPER_DELTA), "--d", "10",
+                           "--gamma", "1", "--format", "json")
+    data = json.loads(out)
+    assert "gamma" not in data["inputs"] and "M_w" not in data["inputs"]
+    assert data["inputs"]["d"] == 10
+    assert any("ignored" in note for note in data["notes"])
+
+
+# --------------------------------------------------------------------------
+# limits: the leftmost beta of the region is not the paper's beta_min
+
+
+def _stable_by_python_control(alpha, beta, gamma):
+    loop = python_control_closed_loop(alpha=alpha, beta=beta, gamma=gamma, d=0, delta=PAPER_DELTA,
+                                      m=PAPER_M, T=PAPER_T)
+    return bool(np.all(np.abs(loop.poles()) < 1))
+
+
+def test_limits_names_the_ends_of_the_region_beta_left_and_beta_right(capsys):
+    status, out, _ = _main(capsys, "limits", "--delta", str(PAPER_DELTA), "--gamma", "1.5",
+                           "--format", "json")
+    assert status == 0
+    lim = json.loads(out)["limits"]
+    assert {"beta_left", "beta_right"} <= set(lim) and not {"beta_min", "beta_max"} & set(lim)
+    left, right, alpha_max = lim["beta_left"], lim["beta_right"], lim["alpha_max"]
+    # What the names say, by python-control's poles: something is stable just
+    # right of beta_left (the CLI's own interval there), nothing just left of it.
+    width = right - left
+    status, out, _ = _main(capsys, "limits", "--delta", str(PAPER_DELTA), "--gamma", "1.5",
+                           "--beta", repr(left + 0.01 * width), "--format", "json")
+    (lo, hi), = json.loads(out)["alpha_intervals"]["intervals"]
+    assert _stable_by_python_control((lo + hi) / 2, left + 0.01 * width, 1.5)
+    assert not any(_stable_by_python_control(a, left - 0.01 * width, 1.5)
+                   for a in np.linspace(0, 1.2 * alpha_max, 121))
+    # ... and it is not the paper's beta_min = -delta, which the table says.
+    assert left < -10 * PAPER_DELTA
+    status, out, _ = _main(capsys, "limits", "--delta", str(PAPER_DELTA), "--gamma", "1.5")
+    rows = {line.split()[0] for line in out.splitlines() if line.startswith(" ") and line.split()}
+    assert {"beta_left", "beta_right"} <= rows and not {"beta_min", "beta_max"} & rows
+    assert "the paper's beta_min = -delta = -0.00253125 is where the boundary arc starts" in out
+
+
+def test_limits_beta_left_is_minus_delta_without_virtual_mass(capsys):
+    """The paper (Sec. IV, after [15], [24]): the region starts at beta = -b T / m for gamma = 0."""
+    status, out, _ = _main(capsys, "limits", "--delta", str(PAPER_DELTA), "--format", "json")
+    data = json.loads(out)
+    assert data["limits"]["beta_left"] == pytest.approx(-PAPER_DELTA, rel=1e-8)
+    assert "notes" not in data   # nothing to tell apart
+
+
+def test_limits_help_documents_every_json_key(capsys):
+    _, out, _ = _main(capsys, "limits", "--delta", str(PAPER_DELTA), "--format", "json")
+    keys = set(json.loads(out)["limits"]) - {"message"}
+    _, text, _ = _main(capsys, "limits", "--help")
+    table = text.split("quantities")[1].split("\n\n")[0]
+    documented = {line.split()[0] for line in table.splitlines()[1:]
+                  if line.startswith("  ") and not line.startswith("   ")}
+    assert keys == documented
+
+
+# --------------------------------------------------------------------------
+# map: in the units of the grid, with its non-idealities
+
+
+GRID = ["--Td", "0.01", "--Kw", "0,70,5", "--Bw=-0.1,2,4", "--steps", "400"]
+
+
+def test_map_stores_Kw_and_Bw_with_units_beside_alpha_and_beta(tmp_path, capsys):
+    out = tmp_path / "m.npz"
+    status, _, err = _main(capsys, "map", *GRID, "--paper-encoder", "--out", str(out), "--no-png")
+    assert status == 0, err
+    with np.load(out) as z:
+        np.testing.assert_array_equal(z["K_w"], np.linspace(0, 70, 5))
+        np.testing.assert_array_equal(z["B_w"], np.linspace(-0.1, 2, 4))
+        np.testing.assert_allclose(z["alpha"], z["K_w"] * PAPER_T**2 / PAPER_M, rtol=1e-14)
+        np.testing.assert_allclose(z["beta"], z["B_w"] * PAPER_T / PAPER_M, rtol=1e-14)
+        assert str(z["K_w_unit"]) == "N m/rad" and str(z["B_w_unit"]) == "N m s/rad"
+        assert "encoder quantum 1.454e-05 rad" in str(z["nonidealities"])
+
+    csv_out = tmp_path / "m.csv"
+    status, _, _ = _main(capsys, "map", *GRID, "--linear", "--out", str(csv_out), "--no-png")
+    lines = csv_out.read_text().splitlines()
+    assert lines[0] == "alpha,beta,K_w [N/m],B_w [N s/m],stable,exact_stable,growth"
+    rows = np.array([[float(v) for v in line.split(",")[:4]] for line in lines[1:]])
+    assert len(rows) == 20
+    np.testing.assert_allclose(rows[:, 2], rows[:, 0] * PAPER_M / PAPER_T**2, rtol=1e-11, atol=1e-9)
+    np.testing.assert_allclose(rows[:, 3], rows[:, 1] * PAPER_M / PAPER_T, rtol=1e-11)
+    assert sorted(set(rows[:, 3])) == pytest.approx(np.linspace(-0.1, 2, 4))
+
+
+@pytest.fixture
+def drawn(monkeypatch):
+    """The axes of every figure saved (labels, limits, title), in order."""
+    from matplotlib.figure import Figure
+
+    seen, savefig = [], Figure.savefig
+
+    def record(fig, *args, **kwargs):
+        ax = fig.axes[0]
+        seen.append(dict(xlabel=ax.get_xlabel(), ylabel=ax.get_ylabel(), title=ax.get_title(),
+                         xlim=ax.get_xlim(), ylim=ax.get_ylim()))
+        return savefig(fig, *args, **kwargs)
+
+    monkeypatch.setattr(Figure, "savefig", record)
+    return seen
+
+
+def test_map_png_is_drawn_in_the_units_of_the_grid_with_its_nonidealities(tmp_path, capsys, drawn):
+    out = tmp_path / "m.npz"
+    status, _, err = _main(capsys, "map", *GRID, "--paper-encoder", "--velocity-cutoff", "50",
+                           "--out", str(out))
+    assert status == 0, err
+    assert (tmp_path / "m.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    (axes,) = drawn
+    assert axes["xlabel"].startswith("$B_w$") and "N m s/rad" in axes["xlabel"]
+    assert axes["ylabel"].startswith("$K_w$") and "N m/rad" in axes["ylabel"]
+    assert axes["xlim"] == pytest.approx((-0.1, 2.0)) and axes["ylim"] == pytest.approx((0, 70))
+    assert "encoder quantum 1.454e-05 rad" in axes["title"]
+    assert "velocity filter 50 Hz" in axes["title"]
+
+
+def test_map_png_of_a_dimensionless_grid_stays_dimensionless(tmp_path, capsys, drawn):
+    status, _, err = _main(capsys, "map", "--delta", str(PAPER_DELTA), "--d", "10",
+                           "--alpha", "0,0.006,4", "--beta=-0.01,0.16,3", "--steps", "400",
+                           "--out", str(tmp_path / "m.csv"))
+    assert status == 0, err
+    (axes,) = drawn
+    assert axes["xlabel"].startswith(r"$\beta") and axes["ylabel"].startswith(r"$\alpha")
+    assert "ideal loop" in axes["title"]
+
+
+def test_map_example_frames_the_stable_region(tmp_path, capsys):
+    """The example of ``symstab map --help`` (the README's): not 96 % empty."""
+    _, text, _ = _main(capsys, "map", "--help")
+    (example,) = [line for line in text.splitlines() if line.startswith("  symstab map ")]
+    words = shlex.split(example)[1:]
+    args = cli.build_parser().parse_args(words)
+    (k_lo, k_hi), (b_lo, b_hi) = ([float(v) for v in grid.split(",")[:2]]
+                                  for grid in (args.Kw, args.Bw))
+    # The ideal region's extent at this delay, in N m/rad and N m s/rad.
+    _, out, _ = _main(capsys, "limits", "--Td", str(args.Td), "--format", "json")
+    lim = json.loads(out)["limits"]
+    k_max = lim["alpha_max"] * PAPER_M / PAPER_T**2
+    left, right = (lim[k] * PAPER_M / PAPER_T for k in ("beta_left", "beta_right"))
+    assert 0.6 * k_hi < k_max < k_hi and k_lo <= 0
+    assert b_lo < left and right < b_hi and right - left > 0.6 * (b_hi - b_lo)
+    # And the map itself: over a third of the cells stable.
+    words[words.index("--out") + 1] = str(tmp_path / "map.npz")
+    status, _, err = _main(capsys, *words, "--no-png")
+    assert status == 0, err
+    with np.load(tmp_path / "map.npz") as z:
+        assert z["exact_stable"].mean() > 0.4 and z["stable"].mean() > 0.2
