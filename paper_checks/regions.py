@@ -42,7 +42,7 @@ from symstab.boundary import boundary
 from symstab.small_theta import small_theta_limits
 from symstab.loop import characteristic_polynomial
 from symstab.stability import coefficients_at, stable_alpha_intervals, unstable_root_count
-from symstab.theta_max import theta_max
+from symstab.curves import arc_end_angle
 
 __all__ = [
     "DEFAULT_DELTA", "MARGINAL_TOL",
@@ -652,7 +652,9 @@ def classify(gamma, d, delta=DEFAULT_DELTA, *, n_beta=41, n_alpha=201, beta_marg
         if isinstance(value, bool) or not isinstance(value, int) or value < 3:
             raise ValueError(f"{name} must be an integer >= 3, got {value!r}")
     start = initial_direction(gamma, d, delta)
-    t_end = theta_max(gamma=gamma, d=d, delta=delta)
+    # The float arc end, to the last bit (symstab.curves); the 30-digit
+    # theta_max agrees with it to 1e-13 (tests/test_theta_max.py).
+    t_end = arc_end_angle(gamma=gamma, d=d, delta=delta)
     if not np.isfinite(t_end):
         why = ("theta_max found no arc although alpha_theta2 > 0: the arc is shorter than "
                "its first grid step" if start.alpha_theta2 > 0 else "alpha_theta2 <= 0")
