@@ -260,12 +260,12 @@ def schur_cohn(coefficients):
 
 
 def _circle_values(theta, d, em, r, c3, c4, c5, c6):
-    """chi(exp(j theta)) / (delta**2 Gamma), ``|z - 1|`` and ``|z - r|``.
+    """chi and d chi / d theta at ``z = exp(j theta)``, ``|z - 1|`` and ``|z - r|``.
 
-    ``chi = exp(j (d+2) theta) A + B`` with ``A = (z - 1)(z - r)`` in the
-    factored form (``cos(theta) - r = em - 2 sin(theta/2)**2`` has no
-    cancellation) and ``B = c3 z**3 + c4 z**2 + c5 z + c6``.  Rows of the
-    parameters broadcast against columns of ``theta``.
+    ``chi / (delta**2 Gamma) = exp(j (d+2) theta) A + B`` with ``A = (z -
+    1)(z - r)`` in the factored form (``cos(theta) - r = em - 2
+    sin(theta/2)**2`` has no cancellation) and ``B = c3 z**3 + c4 z**2 + c5
+    z + c6``.  Rows of the parameters broadcast against columns of ``theta``.
     """
     s_half = np.sin(0.5 * theta)
     sin_t = np.sin(theta)
@@ -274,7 +274,12 @@ def _circle_values(theta, d, em, r, c3, c4, c5, c6):
     a = z_minus_1 * z_minus_r
     z = np.exp(1j * theta)
     b = ((c3 * z + c4) * z + c5) * z + c6
-    return np.exp(1j * ((d + 2) * theta)) * a + b, 2.0 * np.abs(s_half), np.abs(z_minus_r)
+    spin = np.exp(1j * ((d + 2) * theta))
+    # d/d theta = j z d/dz.
+    a_slope = 1j * z * (z_minus_1 + z_minus_r)
+    b_slope = 1j * z * ((3 * c3 * z + 2 * c4) * z + c5)
+    chi_slope = spin * (1j * (d + 2) * a + a_slope) + b_slope
+    return spin * a + b, chi_slope, 2.0 * np.abs(s_half), np.abs(z_minus_r)
 
 
 def unstable_root_counts(*, alpha, beta, gamma, d, delta):
@@ -286,7 +291,10 @@ def unstable_root_counts(*, alpha, beta, gamma, d, delta):
     pi (the coefficients are real).  The change is summed arc by arc, and an
     arc counts only when a bound on ``|d chi / d theta|`` over it and a
     bound on the rounding error keep its whole image inside a disc that
-    excludes 0; other arcs are halved, up to 48 times.  The count is then
+    excludes 0 (first order), or a bound on the second derivative keeps it
+    inside a tube around the midpoint's tangent that excludes 0 (second
+    order: a simple root next to the circle then costs a few halvings); other
+    arcs are halved, up to 48 times.  The count is then
     exact for the polynomial whose coefficients are within 64 ulps of the
     generated kernel's (measured within a few ulps of the exact ones).  O(d)
     per point.
@@ -334,6 +342,7 @@ def _root_counts_chunk(c7, em, d, n_arcs):
     # local (|dz / d theta| = 1): on an arc of half-width h around z_m,
     # |A| <= (|z_m - 1| + h)(|z_m - r| + h), |A'| <= |z_m - 1| + |z_m - r| + 2 h.
     b_slope = 3 * np.abs(c3) + 2 * np.abs(c4) + np.abs(c5)
+    b_curve = 9 * np.abs(c3) + 4 * np.abs(c4) + np.abs(c5)
     # Rounding of chi at one angle, doubled for the bounds' own rounding:
     # the phase (d+2) theta and the factored A carry errors relative to |A|;
     # B those of its evaluation and of the coefficients themselves (64 ulps).
@@ -342,12 +351,13 @@ def _root_counts_chunk(c7, em, d, n_arcs):
 
     theta = np.linspace(0.0, np.pi, 2 * n_arcs + 1)
     with np.errstate(all="ignore"):
-        chi, to_one, to_r = _circle_values(theta[None, :], *args)
+        chi, dchi, to_one, to_r = _circle_values(theta[None, :], *args)
     row = np.repeat(np.arange(n_rows), n_arcs)
     lo, mid, hi = (np.broadcast_to(theta[k:len(theta) - 2 + k:2], (n_rows, n_arcs)).ravel()
                    for k in range(3))
     chi_lo, chi_mid, chi_hi = (chi[:, k:chi.shape[1] - 2 + k:2].ravel() for k in range(3))
-    to_one, to_r = (np.broadcast_to(x[:, 1::2], (n_rows, n_arcs)).ravel() for x in (to_one, to_r))
+    to_one, to_r, dchi_mid = (np.broadcast_to(x[:, 1::2], (n_rows, n_arcs)).ravel()
+                              for x in (to_one, to_r, dchi))
     change = np.zeros(n_rows)
     undecided = np.zeros(n_rows, dtype=bool)
     for _ in range(_MAX_ROUNDS):
@@ -356,6 +366,17 @@ def _root_counts_chunk(c7, em, d, n_arcs):
         slope = (d + 2) * a_max + to_one + to_r + 2 * half + b_slope[row, 0]
         error = 2 * _U * (4 * np.pi * (d + 4) + 16) * a_max + b_error[row, 0]
         ok = slope * half * (1 + 4 * _U) + error < np.abs(chi_mid)
+        # Second order: chi(theta) = chi_m + chi'_m t + R, |t| <= h, with
+        # |R| <= M2 h**2 / 2; the tube around that segment must miss 0.
+        a_slope_max = to_one + to_r + 2 * half
+        curve = ((d + 2) ** 2 * a_max + 2 * (d + 2) * a_slope_max + a_slope_max + 2
+                 + b_curve[row, 0])
+        slope_error = 2 * (d + 4) * error + 2 * _U * (8 + _COEFFICIENT_ULPS) * b_slope[row, 0]
+        radius = (0.5 * curve * half**2 + error + slope_error * half) * (1 + 8 * _U)
+        with np.errstate(all="ignore"):
+            t = -np.real(np.conj(dchi_mid) * chi_mid) / np.abs(dchi_mid) ** 2
+            t = np.clip(np.nan_to_num(t), -half, half)
+            ok |= np.abs(chi_mid + dchi_mid * t) * (1 - 4 * _U) > radius
         with np.errstate(all="ignore"):
             step = np.angle(chi_hi / chi_mid) - np.angle(chi_lo / chi_mid)
         np.add.at(change, row[ok], step[ok])
@@ -373,12 +394,13 @@ def _root_counts_chunk(c7, em, d, n_arcs):
         q1, q3 = 0.5 * (lo + mid), 0.5 * (mid + hi)
         sub = (d, em[row], r[row], c3[row], c4[row], c5[row], c6[row])
         with np.errstate(all="ignore"):
-            chi_q1, one_q1, r_q1 = _circle_values(q1[:, None], *sub)
-            chi_q3, one_q3, r_q3 = _circle_values(q3[:, None], *sub)
+            chi_q1, dchi_q1, one_q1, r_q1 = _circle_values(q1[:, None], *sub)
+            chi_q3, dchi_q3, one_q3, r_q3 = _circle_values(q3[:, None], *sub)
         row = np.concatenate([row, row])
         lo, hi, mid = np.concatenate([lo, mid]), np.concatenate([mid, hi]), np.concatenate([q1, q3])
         chi_lo, chi_hi = np.concatenate([chi_lo, chi_mid]), np.concatenate([chi_mid, chi_hi])
         chi_mid = np.concatenate([chi_q1.ravel(), chi_q3.ravel()])
+        dchi_mid = np.concatenate([dchi_q1.ravel(), dchi_q3.ravel()])
         to_one = np.concatenate([np.broadcast_to(one_q1, r_q1.shape).ravel(),
                                  np.broadcast_to(one_q3, r_q3.shape).ravel()])
         to_r = np.concatenate([r_q1.ravel(), r_q3.ravel()])
