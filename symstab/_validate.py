@@ -11,8 +11,8 @@ import numpy as np
 
 from ._resources import MAX_DELAY_ENV, max_delay
 
-__all__ = ["check_real", "check_delay", "check_delay_samples", "check_array", "check_delta",
-           "check_loop", "DELTA_MAX"]
+__all__ = ["check_real", "check_count", "check_delay", "check_delay_samples", "check_array",
+           "check_delta", "check_loop", "DELTA_MAX"]
 
 
 def _describe_range(low, high, low_open, high_open):
@@ -51,6 +51,20 @@ def check_real(name, value, *, low=None, high=None, low_open=False, high_open=Fa
     if bad:
         raise ValueError(f"{name} must be {allowed}, got {value!r}")
     return x
+
+
+def check_count(name, value, low):
+    """Return an integer count ``value >= low`` as an ``int``.
+
+    The one check of every count parameter (``n``, ``n_beta``, ...): a
+    non-integer kind (bool, float, str, None) is a :class:`TypeError`, an
+    integer below ``low`` a :class:`ValueError`, both naming ``name``.
+    """
+    if isinstance(value, bool) or not isinstance(value, numbers.Integral):
+        raise TypeError(f"{name} must be an integer >= {low}, got {type(value).__name__}")
+    if value < low:
+        raise ValueError(f"{name} must be an integer >= {low}, got {value!r}")
+    return int(value)
 
 
 def check_delay(d, *, name="d"):

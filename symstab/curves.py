@@ -15,31 +15,15 @@ Here it is used to find where the arc ends and to sample it:
 """
 
 import dataclasses
-import numbers
 
 import numpy as np
 
 from ._generated import kernels
 from ._resources import check_memory, chunk_slices
-from ._validate import check_loop
+from ._validate import check_count, check_loop
 
 __all__ = ["arc_end_angle", "minus_one_line", "BoundaryCurve", "Segment", "boundary_curve",
            "scan_grid", "bracketed_root"]
-
-
-def _check_count(name, value, low):
-    """Return an integer count ``value >= low`` as an ``int``.
-
-    The one check of every count parameter (``n``, ``n_beta``, ...): a
-    non-integer kind (bool, float, str, None) is a :class:`TypeError`, an
-    integer below ``low`` a :class:`ValueError`, both naming ``name``.
-    (Meant to move to :mod:`symstab._validate`.)
-    """
-    if isinstance(value, bool) or not isinstance(value, numbers.Integral):
-        raise TypeError(f"{name} must be an integer >= {low}, got {type(value).__name__}")
-    if value < low:
-        raise ValueError(f"{name} must be an integer >= {low}, got {value!r}")
-    return int(value)
 
 
 def scan_grid(d, *, n=None, upper=np.pi):
@@ -276,7 +260,7 @@ def boundary_curve(*, gamma, d, delta, n=1000, segments=True):
     (0.0, -0.00253125, 1.5725)
     """
     gamma, d, delta = check_loop(gamma, d, delta)
-    n = _check_count("n", n, 2)
+    n = check_count("n", n, 2)
     # theta, alpha and beta are kept; the kernel's temporaries are chunked.
     check_memory(f"boundary_curve with n = {n} points", 3 * 8 * n + _KERNEL_CHUNK_BYTES)
     t_end = arc_end_angle(gamma=gamma, d=d, delta=delta)

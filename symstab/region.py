@@ -39,8 +39,8 @@ import numpy as np
 
 from ._generated import kernels
 from ._resources import CHUNK_BYTES, check_memory
-from ._validate import check_real, check_loop
-from .curves import Segment, _check_count, bracketed_root, minus_one_line, scan_grid
+from ._validate import check_count, check_loop, check_real
+from .curves import Segment, bracketed_root, minus_one_line, scan_grid
 from .stability import MARGINAL, STABLE, UNSTABLE, classify, loop_coefficients
 
 __all__ = ["StabilityRegion", "Limits", "limits", "BestVirtualMass", "best_virtual_mass"]
@@ -878,7 +878,7 @@ def limits(*, gamma, d, delta, n_beta=801):
     >>> round(lim.alpha_max, 4), round(lim.beta_max, 4)
     (0.6897, 2.0034)
     """
-    n_beta = _check_count("n_beta", n_beta, 3)
+    n_beta = check_count("n_beta", n_beta, 3)
     check_memory(f"limits with n_beta = {n_beta} vertical lines", 4 * 8 * n_beta)
     return StabilityRegion(gamma=gamma, d=d, delta=delta).limits(n_beta=n_beta)
 
@@ -975,7 +975,7 @@ def best_virtual_mass(*, d, delta, gamma_range=None, n=17):
     True
     """
     _, d, delta = check_loop(0.0, d, delta)
-    n = _check_count("n", n, 3)
+    n = check_count("n", n, 3)
     if gamma_range is None:
         gamma_range = (-1.0 - (d + 1) * delta + 1e-3, 3.0)
     g_lo, g_hi = _check_gamma_range(gamma_range)
