@@ -239,17 +239,17 @@ def _cmd_boundary(args):
 
 #: The quantities of ``symstab limits``: (name in the table and the JSON, attribute of
 #: :class:`symstab.region.Limits`, meaning, physical name, physical unit).  The
-#: names say what each is: the library's ``beta_min``/``beta_max`` are the ends
-#: of the stable region's beta range, which a reader of the paper would take
+#: names say what each is: ``beta_left``/``beta_right`` are the ends of the
+#: stable region's beta range, which a reader of the paper would otherwise take
 #: for its beta_min = -delta, the damping where the boundary arc starts.
 _LIMITS = (
     ("alpha_max", "alpha_max", "largest stable alpha = K_w T^2 / m (the renderable stiffness)",
      "K_max", "K_w"),
     ("beta_at_alpha_max", "beta_at_alpha_max", "the beta at which alpha_max is reached",
      "B_w at K_max", "B_w"),
-    ("beta_left", "beta_min", "leftmost beta of the stable region (not the paper's "
+    ("beta_left", "beta_left", "leftmost beta of the stable region (not the paper's "
      "beta_min = -delta, where the boundary arc starts)", "B_left", "B_w"),
-    ("beta_right", "beta_max", "rightmost beta of the stable region", "B_right", "B_w"),
+    ("beta_right", "beta_right", "rightmost beta of the stable region", "B_right", "B_w"),
     ("z_width", "z_width", "area of the stable region in the (beta, alpha) plane", "Z-width", None),
 )
 
@@ -290,8 +290,8 @@ def _cmd_limits(args):
     lim = limits(gamma=setup.gamma, d=setup.d, delta=setup.delta)
     columns, rows = _limits_rows(setup, lim)
     notes = [lim.message] if lim.message else []
-    if not lim.empty and not math.isclose(lim.beta_min, -setup.delta, rel_tol=1e-9, abs_tol=1e-12):
-        notes.append(f"beta_left = {lim.beta_min:.10g} is the leftmost beta of the stable region; "
+    if not lim.empty and not math.isclose(lim.beta_left, -setup.delta, rel_tol=1e-9, abs_tol=1e-12):
+        notes.append(f"beta_left = {lim.beta_left:.10g} is the leftmost beta of the stable region; "
                      f"the paper's beta_min = -delta = {-setup.delta:.10g} is where the boundary "
                      "arc starts (theta = 0)")
     result = {"limits": _limits_json(lim)}

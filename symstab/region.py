@@ -159,6 +159,9 @@ class StabilityRegion:
     [(1.266, 2.232)]
     """
 
+    def __repr__(self):
+        return f"StabilityRegion(gamma={self.gamma:g}, d={self.d}, delta={self.delta:g})"
+
     def __init__(self, *, gamma, d, delta):
         self.gamma, self.d, self.delta = check_loop(gamma, d, delta)
         theta = np.concatenate([[0.0], scan_grid(self.d, upper=np.pi * (1 - 1e-9))])
@@ -805,8 +808,11 @@ class Limits:
         Largest stable alpha (the renderable stiffness ``K_w T**2 / m``).
     beta_at_alpha_max : float or None
         The beta at which alpha_max is reached.
-    beta_max, beta_min : float or None
-        The range of beta over the stable region.
+    beta_right, beta_left : float or None
+        The ends of the stable region's beta range.  ``beta_left`` is not
+        the paper's beta_min = -delta (where the boundary arc starts) unless
+        the region reaches that corner; ``beta_max`` and ``beta_min`` are
+        older names of the same two numbers.
     z_width : float
         Area of the stable region in the (beta, alpha) plane (0 when empty).
     message : str
@@ -816,10 +822,30 @@ class Limits:
     region: StabilityRegion
     alpha_max: float
     beta_at_alpha_max: float
-    beta_max: float
-    beta_min: float
+    beta_right: float
+    beta_left: float
     z_width: float
     message: str = ""
+
+    @property
+    def beta_max(self):
+        """Older name of :attr:`beta_right`."""
+        return self.beta_right
+
+    @property
+    def beta_min(self):
+        """Older name of :attr:`beta_left`."""
+        return self.beta_left
+
+    def __repr__(self):
+        where = (f"gamma={self.region.gamma:g}, d={self.region.d}, "
+                 f"delta={self.region.delta:g}")
+        if self.empty:
+            return f"Limits({where}: empty, {self.message!r})"
+        text = (f"Limits({where}: alpha_max={self.alpha_max:.6g} at "
+                f"beta={self.beta_at_alpha_max:.6g}, beta from {self.beta_left:.6g} "
+                f"to {self.beta_right:.6g}, z_width={self.z_width:.6g}")
+        return text + (f", {self.message!r})" if self.message else ")")
 
     @classmethod
     def empty_region(cls, region, message):
@@ -846,7 +872,7 @@ class Limits:
         """The numbers, for tables and JSON."""
         return {"gamma": self.region.gamma, "d": self.region.d, "delta": self.region.delta,
                 "alpha_max": self.alpha_max, "beta_at_alpha_max": self.beta_at_alpha_max,
-                "beta_max": self.beta_max, "beta_min": self.beta_min,
+                "beta_left": self.beta_left, "beta_right": self.beta_right,
                 "z_width": self.z_width, "message": self.message}
 
 
@@ -875,8 +901,10 @@ def limits(*, gamma, d, delta, n_beta=801):
     Examples
     --------
     >>> lim = limits(gamma=0.0, d=0, delta=0.00253125)
-    >>> round(lim.alpha_max, 4), round(lim.beta_max, 4)
+    >>> round(lim.alpha_max, 4), round(lim.beta_right, 4)
     (0.6897, 2.0034)
+    >>> lim  # doctest: +ELLIPSIS
+    Limits(gamma=0, d=0, delta=0.00253125: alpha_max=0.68967 at beta=0.827933, beta from ...)
     """
     n_beta = check_count("n_beta", n_beta, 3)
     check_memory(f"limits with n_beta = {n_beta} vertical lines", 4 * 8 * n_beta)

@@ -684,3 +684,22 @@ def test_device_rejects_non_numbers():
     with pytest.raises(ValueError) as excinfo:
         PAPER_DEVICE.alpha([1.0, float("nan")])
     assert_message_names(excinfo, "K_w")
+
+
+def test_limits_and_region_print_their_content():
+    """Issue 13: Limits printed as region=<symstab.region.StabilityRegion object at 0x...>."""
+    lim = symstab.limits(gamma=0.0, d=0, delta=PAPER_DELTA)
+    text = repr(lim)
+    assert " at 0x" not in text
+    assert f"alpha_max={lim.alpha_max:.6g}" in text and "z_width=" in text
+    assert repr(lim.region) == "StabilityRegion(gamma=0, d=0, delta=0.00253125)"
+    empty = symstab.limits(gamma=2.2, d=5, delta=PAPER_DELTA)
+    assert "empty" in repr(empty) and " at 0x" not in repr(empty)
+
+
+def test_limits_names_the_region_beta_range_left_and_right():
+    lim = symstab.limits(gamma=1.5, d=0, delta=PAPER_DELTA)
+    # The leftmost beta of the region is not the paper's beta_min = -delta here.
+    assert lim.beta_left < -PAPER_DELTA
+    assert (lim.beta_min, lim.beta_max) == (lim.beta_left, lim.beta_right)
+    assert {"beta_left", "beta_right"} <= set(lim.as_dict())
