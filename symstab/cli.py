@@ -17,7 +17,6 @@ import argparse
 import importlib.metadata
 import os
 import pathlib
-import re
 import signal
 import sys
 import tempfile
@@ -37,32 +36,9 @@ DEFAULT_CODEGEN = pathlib.Path("symstab") / "_generated"
 #: the project root (outside a checkout: ``REPORT.md`` in the current folder).
 DEFAULT_REPORT = pathlib.Path("paper_checks") / "REPORT.md"
 #: The folder of the installed package, and of its generated kernels.
-PACKAGE_DIR = pathlib.Path(__file__).resolve().parent
+from ._project import PACKAGE_DIR, project_root  # noqa: E402  (re-exported)
+
 INSTALLED_CODEGEN = PACKAGE_DIR / "_generated"
-
-
-def project_root(package_dir=PACKAGE_DIR):
-    """The source checkout that holds ``package_dir``, or None for an installed copy.
-
-    A checkout is the folder just above the package with a ``pyproject.toml``
-    that names the ``symstab`` project; a copy installed by ``pip`` sits in
-    ``site-packages``, which has none.
-
-    Parameters
-    ----------
-    package_dir : path-like
-        The ``symstab`` package folder (default: the one running).
-
-    Returns
-    -------
-    pathlib.Path or None
-    """
-    root = pathlib.Path(package_dir).resolve().parent
-    try:
-        text = (root / "pyproject.toml").read_text(encoding="utf-8")
-    except OSError:
-        return None
-    return root if re.search(r"""^name\s*=\s*["']symstab["']""", text, re.M) else None
 
 
 def package_version():

@@ -115,6 +115,7 @@ def _figure_task(name):
 
 def _derive(out, log):
     from . import codegen, derive
+    from ._project import project_root
 
     files = derive.render(derive.derivation_steps())
     code = codegen.generated_files()
@@ -123,8 +124,9 @@ def _derive(out, log):
     package_code = pathlib.Path(__file__).parent / "_generated"
     drift = [f"symstab/_generated/{pathlib.Path(p).name}"
              for p in derive.check(package_code, code, owned=codegen.OWNED)]
-    checkout = pathlib.Path("derivations") / "generated"
-    if checkout.is_dir():
+    root = project_root()
+    checkout = None if root is None else root / "derivations" / "generated"
+    if checkout is not None and checkout.is_dir():
         drift += derive.check(checkout, files)
         where = "the installed package's symstab/_generated and derivations/generated"
     else:
