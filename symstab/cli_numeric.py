@@ -68,7 +68,7 @@ def _add_model_options(p):
     g.add_argument("--T", type=float, help="sample period, s, > 0 (default 0.001)")
     g.add_argument("--Td", type=float, help="loop delay, s, a whole number of periods (default 0)")
     g = p.add_argument_group("device and delay (dimensionless, instead of --m --b --T --Td)")
-    g.add_argument("--delta", type=float, help="b T / m > 0")
+    g.add_argument("--delta", type=float, help="b T / m, from 0 (frictionless) to 1e6")
     g.add_argument("--d", type=_integer, help="delay in samples, an integer >= 0 (also allowed "
                                                "with the physical options instead of --Td)")
     g = p.add_argument_group("virtual mass")
@@ -435,7 +435,8 @@ def add_commands(sub):
     p = add_command(
         sub, "classify", help="stable, unstable or marginal, with the spectral radius",
         description="Decide by counting the roots of the loop polynomial outside the unit "
-                    "circle (Schur-Cohn) whether each stiffness-damping point is stable, "
+                    "circle (Schur-Cohn, or a certified count by the argument principle where "
+                    "that is not decisive) whether each stiffness-damping point is stable, "
                     "unstable or marginal, and give the spectral radius of the loop.",
         example="symstab classify --Td 0.01 --Kw 1,3,10 --Bw 0.2", func=_cmd_classify)
     _add_model_options(p)
