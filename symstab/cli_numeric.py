@@ -64,7 +64,7 @@ class Setup:
 def _add_model_options(p):
     g = p.add_argument_group("device and delay (physical; default: the paper's device)")
     g.add_argument("--m", type=float, help="effective mass, kg (or kg m^2), > 0 (default 0.0128)")
-    g.add_argument("--b", type=float, help="viscous friction, N s/m (or N m s/rad), > 0 (default 0.0324)")
+    g.add_argument("--b", type=float, help="viscous friction, N s/m (or N m s/rad), >= 0 (default 0.0324)")
     g.add_argument("--T", type=float, help="sample period, s, > 0 (default 0.001)")
     g.add_argument("--Td", type=float, help="loop delay, s, a whole number of periods (default 0)")
     g = p.add_argument_group("device and delay (dimensionless, instead of --m --b --T --Td)")
