@@ -31,6 +31,14 @@ DELTA = PAPER_DEVICE.delta
 #: The delays of Figs. 6, 8, 11 and 12.
 DELAYS = (0, 1, 5, 10)
 _COLORS = ("#1f77b4", "#d62728", "#2ca02c", "#ff7f0e", "#9467bd", "#8c564b", "#e377c2")
+#: Font sizes (pt).  A figure's own title sits above its panels' titles, so it
+#: is the largest; legends stay readable at the saved 110 dpi (6-7 pt was not).
+SUPTITLE_SIZE = 13
+PANEL_TITLE_SIZE = 11
+LEGEND_SIZE = 8
+#: Legend of the arc's end angle in Figs. 3 and 4, in words rather than in
+#: the derivation's terms ("first root of alpha").
+_THETA_MAX_EXACT = r"exact: where the arc ends, $\alpha(\theta_{\max}) = 0$"
 
 
 @dataclasses.dataclass
@@ -64,6 +72,22 @@ def pyplot():
     return plt
 
 
+def _label_log_axis(ax):
+    """Label 1-2-5 steps on a log y axis that spans less than three decades.
+
+    Over so few decades matplotlib labels only the powers of ten -- two or
+    three ticks; the steps between them are written as plain numbers.  Call
+    it after plotting, so the limits are the data's.
+    """
+    from matplotlib import ticker
+
+    lo, hi = ax.get_ylim()
+    if math.log10(hi / lo) < 3:
+        ax.yaxis.set_major_locator(ticker.LogLocator(base=10.0, subs=(1.0, 2.0, 5.0)))
+        ax.yaxis.set_major_formatter(ticker.FuncFormatter(lambda v, _: f"{v:g}"))
+        ax.yaxis.set_minor_formatter(ticker.NullFormatter())
+
+
 def _labels(ax, physical=False):
     if physical:
         ax.set_xlabel(r"$B_w$ (N m s/rad)")
@@ -93,7 +117,7 @@ def fig3():
         closed = np.array([float(form(mpmath.mpf(g), mpmath.mpf(DELTA), mpmath.exp(DELTA)).real)
                            for g in gammas])
     fig, ax = plt.subplots(figsize=(6, 4))
-    ax.plot(gammas, exact, "-", color=_COLORS[0], lw=2, label="first root of alpha (exact)")
+    ax.plot(gammas, exact, "-", color=_COLORS[0], lw=2, label=_THETA_MAX_EXACT)
     ax.plot(gammas[::6], closed[::6], "o", color=_COLORS[1], ms=4, label="closed form (8)")
     ax.set_xlabel(r"$\gamma = M_w/m$")
     ax.set_ylabel(r"$\theta_{\max}$ (rad)")
@@ -124,10 +148,11 @@ def fig4():
     form = sp.lambdify((model.d, model.delta, model.Gamma), newton_form_gamma0().theta_newton, "mpmath")
     newton = np.array([float(form(int(d), DELTA, math.exp(DELTA))) if d > 0 else np.nan for d in ds])
     fig, ax = plt.subplots(figsize=(6, 4))
-    ax.semilogy(ds, exact, "-", color=_COLORS[0], lw=2, label="first root of alpha (exact)")
+    ax.semilogy(ds, exact, "-", color=_COLORS[0], lw=2, label=_THETA_MAX_EXACT)
     ax.semilogy(ds[1:], newton[1:], "--", color=_COLORS[1], lw=1.5, label="one Newton step, eq. (12)")
-    ax.set_xlabel("delay d = T_d / T (samples)")
+    ax.set_xlabel(r"delay $d = T_d / T$ (samples)")
     ax.set_ylabel(r"$\theta_{\max}$ (rad)")
+    _label_log_axis(ax)  # theta_max spans two decades, 1.6 to 0.017 rad
     ax.set_title(r"Fig. 4: $\theta_{\max}$ versus $d$, $\gamma = 0$")
     ax.legend()
     err = np.abs(newton[1:] - exact[1:]) / exact[1:]
@@ -153,7 +178,8 @@ def fig5():
     t = curve.theta[1:]
     pa, pb = fa(t, DELTA, math.exp(DELTA)), fb(t, DELTA, math.exp(DELTA))
     fig, ax = plt.subplots(figsize=(6, 4))
-    ax.plot(curve.beta, curve.alpha, "-", color=_COLORS[2], lw=2.5, label="symstab (derived, any d, gamma)")
+    ax.plot(curve.beta, curve.alpha, "-", color=_COLORS[2], lw=2.5,
+            label=r"symstab (derived for any $d$ and $\gamma$)")
     ax.plot(pb, pa, "--", color=_COLORS[0], lw=1.5, label="eq. (14) as printed")
     _labels(ax)
     ax.set_title(r"Fig. 5: boundary for $d = 0$, $\gamma = 0$")
@@ -218,20 +244,24 @@ def _overlay(ax, gammas, d, n, verdicts):
             ax.plot([], [], "-", color=color, label=fr"$\gamma$ = {g:g} (no arc)")
     ax.set_xlim(b0, b1)
     ax.set_ylim(a0, a1)
-    ax.set_title(f"d = {d} (simulated {figure_horizon(d)} periods)")
+    ax.set_title(f"$d = {d}$ (simulated {figure_horizon(d)} periods)", fontsize=PANEL_TITLE_SIZE)
     _labels(ax)
-    ax.legend(fontsize=7, loc="upper right")
+    ax.legend(fontsize=LEGEND_SIZE, loc="upper right")
 
 
-def _fig_overlay(name, title, gammas, n, paper, claimed):
-    """Boundaries over simulated areas; ``claimed[(gamma, d)]`` is the paper's S, U or B."""
+def _fig_overlay(name, title, suptitle, gammas, n, paper, claimed):
+    """Boundaries over simulated areas; ``claimed[(gamma, d)]`` is the paper's S, U or B.
+
+    ``title`` is the plain-text line of the reproduction's index, ``suptitle``
+    the same in mathtext for the figure.
+    """
     plt = pyplot()
     fig, axes = plt.subplots(2, 2, figsize=(11, 8.5))
     verdicts = []
     for ax, d in zip(axes.ravel(), DELAYS):
         _overlay(ax, gammas, d, n, verdicts)
-    fig.suptitle(title + " (curves: theory, eq. (7); shaded: stable by simulation, "
-                 f"{n} x {n} grid)", fontsize=10)
+    fig.suptitle(suptitle + " (curves: theory, eq. (7); shaded: stable by simulation, "
+                 fr"${n} \times {n}$ grid)", fontsize=SUPTITLE_SIZE)
     fig.tight_layout()
     text = "; ".join(f"d={d}: " + ", ".join(f"{g:g} {v}" for g, dd, v, _ in verdicts if dd == d)
                      for d in DELAYS)
@@ -252,7 +282,8 @@ def _fig_overlay(name, title, gammas, n, paper, claimed):
 def fig6(n=100):
     """Negative virtual mass: gamma = 0, -0.25, -0.5, -0.75 at d = 0, 1, 5, 10."""
     gammas = (0.0, -0.25, -0.5, -0.75)
-    return _fig_overlay("fig06_negative_mass_regions", "Fig. 6: gamma <= 0", gammas, n,
+    return _fig_overlay("fig06_negative_mass_regions", "Fig. 6: gamma <= 0",
+                        r"Fig. 6: $\gamma \leq 0$", gammas, n,
                         "stable regions shrink as d grows; every curve bounds a stable region.",
                         {(g, d): "S" for g in gammas for d in DELAYS})
 
@@ -266,7 +297,8 @@ def fig8(n=100):
     claimed.update({(g, 1): "U" for g in (1.5, 2.0)})
     for d in (5, 10):
         claimed.update({(g, d): "S" if g <= 1 else "U" for g in gammas})
-    return _fig_overlay("fig08_positive_mass_regions", "Fig. 8: gamma >= 0", gammas, n,
+    return _fig_overlay("fig08_positive_mass_regions", "Fig. 8: gamma >= 0",
+                        r"Fig. 8: $\gamma \geq 0$", gammas, n,
                         "d=0: gamma < 2 stable, 2 boundary (B), 2.2 unstable; d=1: 1.5 and 2 "
                         "unstable, the rest (2.2 included) stable; d=5, 10: 0, 0.5, 1 stable, 1.5, 2, "
                         "2.2 unstable.", claimed)
@@ -301,7 +333,7 @@ def fig7():
     ax.set_ylim(0, 4.5)
     _labels(ax)
     ax.set_title(r"Fig. 7: boundaries for $d = 0$; S: a stable region, U: none (root counting)")
-    ax.legend(fontsize=8, loc="upper right")
+    ax.legend(fontsize=LEGEND_SIZE, loc="upper right")
     text = ", ".join(f"{k}: (beta {b:.4f}, alpha {a:.4f})" for k, b, a in points)
     return FigureResult(
         "fig07_gamma_0_to_3_d0", "boundaries for gamma 0..3 at d = 0, numbered points", fig,
@@ -337,9 +369,11 @@ def fig10(n=40):
         ax.plot([], [], "k-", label="theory, eq. (7)")
         ax.plot([], [], "s", color="#9ecae1", label="simulation, ideal (PI(-), QF(-))")
         ax.plot([], [], "--", color="#2ca02c", label="simulation, quantized + 50 Hz filter (PI(-), QF(+))")
-        ax.set_title(f"$M_w$ = {g:g} m, $T_d$ = 40 ms")
+        # M_w is a multiple of the device's inertia m; "0.5 m" would read as metres.
+        ax.set_title(fr"$M_w = {g:g} \cdot m$ ($\gamma = {g:g}$), $T_d = 40$ ms",
+                     fontsize=PANEL_TITLE_SIZE)
         _labels(ax, physical=True)
-        ax.legend(fontsize=7, loc="upper right")
+        ax.legend(fontsize=LEGEND_SIZE, loc="upper right")
         A, Bm = np.meshgrid(alpha, beta, indexing="ij")
 
         def top(mask):
@@ -347,14 +381,14 @@ def fig10(n=40):
 
         (ki, bi), (kq, bq) = top(ideal.stable), top(quant.stable)
         found.append((g, float(dev.stiffness(lim.alpha_max)), ki, kq, bi, bq))
-    fig.suptitle("Fig. 10: physical units, T_d = 40 ms (the PI current-controller cases and the "
-                 "experiments are not modelled)", fontsize=10)
+    fig.suptitle(r"Fig. 10: physical units, $T_d = 40$ ms (the PI current-controller cases and "
+                 "the experiments are not modelled)", fontsize=SUPTITLE_SIZE)
     fig.tight_layout()
-    text = "; ".join(f"M_w = {g:g} m: K_max theory {kt:.2f}, ideal sim {ki:.2f}, QF sim {kq:.2f} N m/rad "
+    text = "; ".join(f"gamma = {g:g}: K_max theory {kt:.2f}, ideal sim {ki:.2f}, QF sim {kq:.2f} N m/rad "
                      f"(QF/ideal {kq / ki if ki else float('nan'):.2f}); B_max QF/ideal "
                      f"{bq / bi if bi else float('nan'):.2f}" for g, kt, ki, kq, bi, bq in found)
     return FigureResult(
-        "fig10_physical_td40", "physical units at Td = 40 ms, M_w = -0.5m, 0, 0.5m, m", fig,
+        "fig10_physical_td40", "physical units at Td = 40 ms, gamma = M_w/m = -0.5, 0, 0.5, 1", fig,
         "theory against simulations (ideal; quantization + filter; PI controller high/low gains) and "
         "experiments; PI(-), QF(+) gives a lower K_max than the theory.",
         f"{text} (grid {n} x {n}, so K and B are resolved to one cell). "
@@ -365,12 +399,17 @@ def fig10(n=40):
            "as the paper reports. " if all(kq < ki for _, _, ki, kq, _, _ in found)
            else "quantization with the 50 Hz filter does not lower K_max in every panel, unlike the "
                 "paper's report. ")
-        + "The PI current-controller runs and the experiments are not modelled. At M_w = m the arc "
+        + "The PI current-controller runs and the experiments are not modelled. At gamma = 1 the arc "
           "of eq. (7) encloses more than the stable set, which is the band along its upper edge "
           "(the lower edge is another part of the boundary).")
 
 
-def _fig_limits(name, title, gammas, paper, note):
+def _fig_limits(name, title, suptitle, gammas, paper, note):
+    """beta_max, alpha_max and Z-width versus ``gammas``, one panel per delay.
+
+    ``title`` is the plain-text line of the reproduction's index, ``suptitle``
+    the same in mathtext for the figure.
+    """
     plt = pyplot()
     fig, axes = plt.subplots(2, 2, figsize=(11, 8.5))
     summary, facts = [], []
@@ -392,8 +431,9 @@ def _fig_limits(name, title, gammas, paper, note):
                             transform=ax.get_xaxis_transform(), label="no stable region")
         ax.set_xlabel(r"$\gamma = M_w/m$")
         ax.set_ylabel("dimensionless (log scale)")
-        ax.set_title(f"d = {d}")
-        ax.legend(fontsize=7)
+        _label_log_axis(ax)
+        ax.set_title(f"$d = {d}$", fontsize=PANEL_TITLE_SIZE)
+        ax.legend(fontsize=LEGEND_SIZE)
         k = int(np.nanargmax(am))
         edge = np.flatnonzero(~empty)[0 if gammas[0] < 0 else -1]
         facts.append(dict(d=d, am=am, bm=bm, zw=zw, edge=edge, empty=empty))
@@ -401,15 +441,16 @@ def _fig_limits(name, title, gammas, paper, note):
                        f"{'first' if gammas[0] < 0 else 'last'} gamma of the scan with a region "
                        f"{gammas[edge]:.2f}: alpha_max {am[edge]:.3g}, beta_max {bm[edge]:.3g}, "
                        f"Z-width {zw[edge]:.3g}")
-    fig.suptitle(title, fontsize=10)
+    fig.suptitle(suptitle, fontsize=SUPTITLE_SIZE)
     fig.tight_layout()
     return FigureResult(name, title, fig, paper, "; ".join(summary) + "; " + note(facts))
 
 
-def fig11():
-    """beta_max, alpha_max and Z-width versus gamma < 0."""
-    gammas = np.linspace(-1.0, 0.0, 26)
-    return _fig_limits("fig11_limits_negative_mass", "Fig. 11: limits versus gamma <= 0", gammas,
+def fig11(n=26):
+    """beta_max, alpha_max and Z-width versus gamma < 0, at ``n`` values of gamma."""
+    gammas = np.linspace(-1.0, 0.0, n)
+    return _fig_limits("fig11_limits_negative_mass", "Fig. 11: limits versus gamma <= 0",
+                       r"Fig. 11: limits versus $\gamma \leq 0$", gammas,
                        "beta_max, alpha_max and Z-width decrease continuously as gamma goes from 0 "
                        "to -1, where all are zero.",
                        lambda facts: (
@@ -422,10 +463,11 @@ def fig11():
                            + "."))
 
 
-def fig12():
-    """beta_max, alpha_max and Z-width versus gamma > 0."""
-    gammas = np.linspace(0.0, 2.5, 36)
-    return _fig_limits("fig12_limits_positive_mass", "Fig. 12: limits versus gamma >= 0", gammas,
+def fig12(n=36):
+    """beta_max, alpha_max and Z-width versus gamma > 0, at ``n`` values of gamma."""
+    gammas = np.linspace(0.0, 2.5, n)
+    return _fig_limits("fig12_limits_positive_mass", "Fig. 12: limits versus gamma >= 0",
+                       r"Fig. 12: limits versus $\gamma \geq 0$", gammas,
                        "d = 0: largest gamma 2, beta_max falls from gamma 0 to 2; alpha_max and "
                        "Z-width rise, then fall; for d > 0 the Z-width reaches zero while beta_max "
                        "and alpha_max do not.",
