@@ -196,6 +196,8 @@ def _derive_paths(args):
         # In a checkout the installed package is the checkout's symstab/.
         return out, code_out or INSTALLED_CODEGEN, root
     if root is None and (out is None or code_out is None):
+        # What the user did give is checked first: its error is the one to fix.
+        check_outputs([("--out", out, "dir"), ("--codegen-out", code_out, "dir")])
         missing = " and ".join(flag for flag, path in (("--out", out), ("--codegen-out", code_out))
                                if path is None)
         raise ValueError(f"not in a source checkout of symstab (no pyproject.toml above "

@@ -206,8 +206,8 @@ def _window(gammas, d):
         lim = limits(gamma=g, d=d, delta=DELTA, n_beta=101)
         if not lim.empty:
             tops.append(lim.alpha_max)
-            lows.append(lim.beta_min)
-            highs.append(lim.beta_max)
+            lows.append(lim.beta_left)
+            highs.append(lim.beta_right)
     if not tops:
         return (0.0, 1.0 / (d + 1)), (-0.1, 2.0 / (d + 1))
     lo, hi = min(lows), max(highs)
@@ -356,7 +356,7 @@ def fig10(n=40):
     for ax, g in zip(axes.ravel(), (-0.5, 0.0, 0.5, 1.0)):
         lim = limits(gamma=g, d=d, delta=DELTA)
         alpha = np.linspace(0, 1.25 * lim.alpha_max, n)
-        beta = np.linspace(lim.beta_min, 1.2 * lim.beta_max, n)
+        beta = np.linspace(lim.beta_left, 1.2 * lim.beta_right, n)
         ideal = stability_map(alpha=alpha, beta=beta, gamma=g, d=d, delta=DELTA)
         quant = stability_map(alpha=alpha, beta=beta, gamma=g, d=d, delta=None, device=dev,
                               nonideal=qf, x0=0.01)
@@ -415,7 +415,7 @@ def _fig_limits(name, title, suptitle, gammas, paper, note):
     summary, facts = [], []
     for ax, d in zip(axes.ravel(), DELAYS):
         rows = [limits(gamma=g, d=d, delta=DELTA, n_beta=101) for g in gammas]
-        bm = np.array([np.nan if r.empty else r.beta_max for r in rows])
+        bm = np.array([np.nan if r.empty else r.beta_right for r in rows])
         am = np.array([np.nan if r.empty else r.alpha_max for r in rows])
         zw = np.array([r.z_width for r in rows])
         # One log axis: at d = 10 alpha_max and the Z-width are 30 and 300
