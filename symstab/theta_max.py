@@ -19,6 +19,7 @@ Three forms are derived here:
 
 import dataclasses
 import functools
+import math
 
 import mpmath
 import sympy as sp
@@ -172,16 +173,22 @@ def theta_max(*, gamma, d, delta, dps=30):
     """
     gamma, d, delta = check_loop(gamma, d, delta, zero_delta=False)
     f = alpha_numerator_function()
-    # N_alpha ~ theta**3 near 0 out of terms of size 1: the extra digits keep
-    # its sign right down to the first grid point, pi/n * 1e-10.
+    # N_alpha ~ theta**3 delta**2 near 0 out of terms of size 1: the extra
+    # digits keep its sign right down to the first grid point, pi/n * 1e-10;
+    # on the uniform grid (theta >= pi/n) it cancels at most
+    # log10(n**3 / delta**2) digits, so fewer extra digits do there.
+    n = max(400, 16 * (d + 1))
+    uniform_extra = 10 + int(3 * math.log10(n) + 2 * max(0.0, -math.log10(delta)))
     with mpmath.workdps(dps + 40):
         g_, d_ = mpmath.mpf(gamma), mpmath.mpf(delta)
         g = lambda t: f(t, g_, d, d_)  # noqa: E731
-        n = max(400, 16 * (d + 1))
         step = mpmath.pi / n
         short = [step * mpmath.mpf(10) ** (-k / mpmath.mpf(4)) for k in range(40, 0, -1)]
-        grid = short + [step * k for k in range(1, n + 1)]
-        values = [g(t) for t in grid]
+        uniform = [step * k for k in range(1, n + 1)]
+        grid = short + uniform
+        values = [g(t) for t in short]
+        with mpmath.workdps(dps + min(40, uniform_extra)):
+            values += [g(t) for t in uniform]
         if values[0] <= 0:
             return float("nan")
         for k in range(1, len(grid)):
