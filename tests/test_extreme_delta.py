@@ -71,3 +71,17 @@ def test_design_at_delta_400_from_the_command_line():
     best = result["best"]
     assert math.isfinite(best["alpha_max"]) and best["alpha_max"] > 0
     assert math.isfinite(best["gain"]) and best["gain"] > 0
+
+
+@pytest.mark.parametrize("delta", [0.0, 800.0])
+def test_simulation_at_extreme_delta_agrees_with_python_control(delta):
+    """simulate(delta=800) called every point diverged (Gamma overflowed in the plant step)."""
+    from symstab.simulate import simulate
+
+    scale = 1.0 if delta < 1 else 400.0
+    alphas = np.array([0.1, 0.4, 5.0]) * scale
+    run = simulate(alpha=alphas, beta=0.5, gamma=0.0, d=1, delta=delta)
+    oracle_delta = delta if delta > 0 else 1e-300
+    expected = [_python_control_stable(a, 0.5, 0.0, 1, oracle_delta) for a in alphas]
+    assert run.stable.tolist() == expected
+    assert True in expected and False in expected
