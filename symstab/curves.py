@@ -223,6 +223,15 @@ class BoundaryCurve:
         """True when there is no arc."""
         return self.theta.size == 0
 
+    def __repr__(self):
+        where = f"gamma={self.gamma:g}, d={self.d}, delta={self.delta:g}"
+        if self.empty:
+            return f"BoundaryCurve({where}: no arc, {self.message!r})"
+        return (f"BoundaryCurve({where}: {self.theta.size} points, theta_max={self.theta_max:.6g}, "
+                f"alpha up to {float(np.max(self.alpha)):.6g}, beta from "
+                f"{float(np.min(self.beta)):.6g} to {float(np.max(self.beta)):.6g}, "
+                f"{len(self.segments)} straight segment{'s' if len(self.segments) != 1 else ''})")
+
 
 def boundary_curve(*, gamma, d, delta, n=1000, segments=True):
     """Sample the boundary arc from theta = 0 to theta_max.

@@ -237,6 +237,16 @@ class Simulation:
     stable: np.ndarray
     steps: int
 
+    def __repr__(self):
+        stable = np.asarray(self.stable)
+        n_stable, n_diverged = int(np.count_nonzero(stable)), int(np.count_nonzero(self.diverged))
+        size = f"{stable.size} point{'s' if stable.size != 1 else ''}"
+        if stable.ndim > 1:
+            size += " (" + " x ".join(map(str, stable.shape)) + ")"
+        recorded = ", positions recorded" if self.positions is not None else ""
+        return (f"Simulation({size}, {self.steps} steps: {n_stable} stable, "
+                f"{stable.size - n_stable} unstable of which {n_diverged} diverged{recorded})")
+
 
 def progress_printer(label, total, stream=None, min_seconds=2.0):
     """A callback ``(done)`` that draws a bar once a run takes longer than ``min_seconds``.

@@ -703,3 +703,11 @@ def test_limits_names_the_region_beta_range_left_and_right():
     assert lim.beta_left < -PAPER_DELTA
     assert (lim.beta_min, lim.beta_max) == (lim.beta_left, lim.beta_right)
     assert {"beta_left", "beta_right"} <= set(lim.as_dict())
+
+
+def test_boundary_curve_prints_a_summary_not_its_arrays():
+    curve = symstab.boundary_curve(gamma=0.0, d=0, delta=PAPER_DELTA, n=1000)
+    text = repr(curve)
+    assert "array(" not in text and "1000 points" in text
+    assert f"theta_max={curve.theta_max:.6g}" in text
+    assert "no arc" in repr(symstab.boundary_curve(gamma=-3.0, d=0, delta=PAPER_DELTA, n=10))

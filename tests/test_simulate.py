@@ -982,3 +982,13 @@ def test_steps_beyond_the_limit_are_refused_naming_it(monkeypatch):
     with pytest.raises(ValueError, match="from 8 to 12000"):   # the default horizon at d = 0
         simulate(**STABLE_POINT, steps=12001)
     assert simulate(**STABLE_POINT, steps=12000).steps == 12000
+
+
+def test_simulation_prints_its_verdicts_not_its_arrays():
+    """Issue 13: result objects print their content, readably."""
+    from symstab.simulate import simulate
+    run = simulate(alpha=np.array([[0.1, 5.0]]), beta=0.5, gamma=0.0, d=1, delta=PAPER_DELTA)
+    text = repr(run)
+    assert "array(" not in text
+    assert text == (f"Simulation(2 points (1 x 2), {run.steps} steps: 1 stable, "
+                    "1 unstable of which 1 diverged)")
