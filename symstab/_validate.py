@@ -12,7 +12,7 @@ import numpy as np
 from ._resources import MAX_DELAY_ENV, max_delay
 
 __all__ = ["check_real", "check_count", "check_delay", "check_delay_samples", "check_array",
-           "check_delta", "check_loop", "DELTA_MAX"]
+           "check_delta", "check_loop", "DELTA_MAX", "PARAMETER_MAX"]
 
 
 def _describe_range(low, high, low_open, high_open):
@@ -130,6 +130,10 @@ def check_array(name, value, *, low=None, low_open=False, high=None):
         raise ValueError(f"{name} must be {allowed}, got {float(first)!r}{where}")
     return arr
 
+
+#: The largest |alpha|, |beta|, |gamma| the numeric API accepts: the root
+#: count squares and multiplies them, and past ~1e154 that overflows.
+PARAMETER_MAX = 1e150
 
 #: The largest delta = b T / m accepted.  The kernels are accurate to a few
 #: ulps up to here (tests/test_generated_kernels.py); far beyond it the

@@ -29,7 +29,7 @@ import numpy as np
 
 from ._generated import kernels
 from ._resources import CHUNK_BYTES, check_memory, chunk_slices
-from ._validate import DELTA_MAX, check_array, check_delay
+from ._validate import DELTA_MAX, PARAMETER_MAX, check_array, check_delay
 from .loop import characteristic_polynomial
 
 __all__ = [
@@ -63,8 +63,10 @@ _EIG_BATCH_BYTES = 64 * 2**20
 
 def _points(alpha, beta, gamma, d, delta):
     """Validate and broadcast; return (alpha, beta, gamma, delta, d, shape)."""
-    arrays = [check_array("alpha", alpha), check_array("beta", beta),
-              check_array("gamma", gamma), check_array("delta", delta, low=0.0, high=DELTA_MAX)]
+    bound = dict(low=-PARAMETER_MAX, high=PARAMETER_MAX)
+    arrays = [check_array("alpha", alpha, **bound), check_array("beta", beta, **bound),
+              check_array("gamma", gamma, **bound),
+              check_array("delta", delta, low=0.0, high=DELTA_MAX)]
     d = check_delay(d)
     try:
         arrays = np.broadcast_arrays(*arrays)
@@ -86,7 +88,7 @@ def _kernel_coefficients(alpha, beta, gamma, delta):
         values = ", ".join(f"{n} = {np.broadcast_to(v, shape).ravel()[i]!r}"
                            for n, v in zip(names, (alpha, beta, gamma, delta)))
         raise ValueError(f"the loop polynomial's coefficients overflow at {values}: "
-                         f"alpha, beta and gamma must be below about 1e300 in magnitude")
+                         f"alpha, beta and gamma must be at most {PARAMETER_MAX:g} in magnitude")
     return out
 
 
@@ -149,8 +151,8 @@ def _polish(c, roots, steps=3):
     the coefficients bring them to the accuracy the coefficients allow.
     """
     for _ in range(steps):
-        value, slope = _horner(c, roots)
         with np.errstate(all="ignore"):
+            value, slope = _horner(c, roots)
             trial = roots - value / slope
             better = np.isfinite(trial) & (np.abs(_horner(c, trial)[0]) < np.abs(value))
         roots = np.where(better, trial, roots)
@@ -371,12 +373,18 @@ def _root_counts_chunk(c7, em, d, n_arcs):
         a_slope_max = to_one + to_r + 2 * half
         curve = ((d + 2) ** 2 * a_max + 2 * (d + 2) * a_slope_max + a_slope_max + 2
                  + b_curve[row, 0])
-        slope_error = 2 * (d + 4) * error + 2 * _U * (8 + _COEFFICIENT_ULPS) * b_slope[row, 0]
+        slope_error = (2 * (d + 4) * error + 2 * _U * (8 + _COEFFICIENT_ULPS) * b_slope[row, 0]
+                       + 16 * _U * a_slope_max)
         radius = (0.5 * curve * half**2 + error + slope_error * half) * (1 + 8 * _U)
         with np.errstate(all="ignore"):
-            t = -np.real(np.conj(dchi_mid) * chi_mid) / np.abs(dchi_mid) ** 2
-            t = np.clip(np.nan_to_num(t), -half, half)
-            ok |= np.abs(chi_mid + dchi_mid * t) * (1 - 4 * _U) > radius
+            # The nearest point to 0 on the segment: t = -Re(chi_m / chi'_m)
+            # (a quotient, not |chi'_m|**2, which could overflow); a flat
+            # segment (chi'_m = 0) is its midpoint; anything not finite fails.
+            flat = dchi_mid == 0
+            t = np.where(flat, 0.0, -np.real(chi_mid / np.where(flat, 1.0, dchi_mid)))
+            t = np.clip(t, -half, half)
+            near = np.abs(chi_mid + dchi_mid * t) * (1 - 4 * _U)
+            ok |= np.isfinite(t) & np.isfinite(near) & (near > radius)
         with np.errstate(all="ignore"):
             step = np.angle(chi_hi / chi_mid) - np.angle(chi_lo / chi_mid)
         np.add.at(change, row[ok], step[ok])
@@ -419,9 +427,12 @@ def classify(*, alpha, beta, gamma, d, delta, refine=True):
     """Classify parameter points as stable, unstable or marginal.
 
     A fast floating-point Schur-Cohn test (:func:`schur_cohn`) decides the
-    points it decides with a margin of at least 1e-6; every other point,
-    and every point from d = 48 on, is decided by the certified root count
-    of :func:`unstable_root_counts`.  :data:`MARGINAL` means that a root lies
+    points it decides with a margin of at least 1e-6 (below d = 48): that
+    verdict carries no error bound; it agreed with 50- and 80-digit root
+    counts on every point tried (the tests, and 44 800 points with margins
+    from 1e-6 to 1e-2 in a review).  Every other point, and every point
+    from d = 48 on, is decided by the certified root count of
+    :func:`unstable_root_counts`.  :data:`MARGINAL` means that a root lies
     on the unit circle to within the rounding of the coefficients (a point
     on the boundary, to about 1e-13 relative): the verdict is then not
     certain either way.
@@ -445,7 +456,8 @@ def classify(*, alpha, beta, gamma, d, delta, refine=True):
     ------
     TypeError, ValueError
         For non-real, non-finite or out-of-range parameters (``delta`` in
-        [0, 1e6], ``d`` up to ``SYMSTAB_MAX_DELAY``).
+        [0, 1e6], ``|alpha|, |beta|, |gamma| <= 1e150``, ``d`` up to
+        ``SYMSTAB_MAX_DELAY``).
 
     Examples
     --------

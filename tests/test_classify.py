@@ -510,10 +510,13 @@ def test_a_point_exactly_on_the_z_equals_1_line_is_marginal():
 
 
 def test_classify_a_large_grid_in_bounded_chunks(monkeypatch):
-    """A 3000 x 3000 grid passed 4 GB; with a 64 MiB limit the same call must fit.
+    """A 3000 x 3000 grid passed 4 GB before chunking; here 600 x 600 under a 400 MiB limit.
 
-    The memory limit is what check_memory enforces on one allocation; the grid
-    work is chunked, so only the 9e6 input points themselves are whole arrays.
+    The limit is what check_memory enforces on single allocations (the dense
+    coefficient array alone would be 600 * 600 * 15 * 8 = 43 MB, the root
+    count's arrays several times that); peak memory itself is not measured
+    here (tests/test_cli_extremes.py runs long delays under an address-space
+    cap).  The verdicts are spot-checked against python-control.
     """
     monkeypatch.setenv("SYMSTAB_MEMORY_LIMIT", "400M")
     alpha = np.linspace(0.0, 0.5, 600)[:, None]
@@ -527,3 +530,24 @@ def test_classify_a_large_grid_in_bounded_chunks(monkeypatch):
         radius = np.max(np.abs(loop.poles()))
         assert abs(radius - 1) > 1e-9
         assert codes[i, j] == (STABLE if radius < 1 else UNSTABLE)
+
+
+@pytest.mark.parametrize("alpha", [1e120, 1e150])
+def test_root_count_at_the_largest_accepted_stiffness_is_an_integer_or_marginal(alpha):
+    """|chi'| ~ alpha squared overflowed in the tangent test before (review finding).
+
+    Oracle: numpy's roots of the (scaled) coefficients, used only where no
+    root is within 1e-6 of the circle.
+    """
+    checked = 0
+    for d, delta in ((0, 0.0), (50, 0.0025), (3, 1.0)):
+        count = symstab.stability.unstable_root_counts(alpha=alpha, beta=0.5, gamma=0.0, d=d,
+                                                        delta=delta)
+        assert -1 <= count <= d + 4
+        coeffs = symstab.stability.loop_coefficients(alpha=alpha, beta=0.5, gamma=0.0, d=d,
+                                                     delta=delta)
+        moduli = np.abs(np.roots(coeffs / np.max(np.abs(coeffs))))
+        if np.min(np.abs(moduli - 1)) > 1e-6:
+            assert count == int(np.sum(moduli > 1))
+            checked += 1
+    assert checked >= 2

@@ -339,3 +339,18 @@ def test_map_prints_nothing_before_refusing(capsys, tmp_path, monkeypatch, args,
     _assert_one_line_error(status, err, "map", needle)
     assert out == ""
     assert list(tmp_path.iterdir()) == []
+
+
+def test_huge_stiffness_is_one_line_not_an_assertion(capsys):
+    """Review: alpha = 1e200 overflowed the root count's tangent test (AssertionError)."""
+    status, out, err = _main(capsys, "classify", "--delta", "0", "--d", "50",
+                             "--alpha", "1e200", "--beta", "0.5")
+    _assert_one_line_error(status, err, "classify", "alpha", "1e+150")
+
+
+def test_classify_at_d_5000_gives_verdicts_without_the_cubic_radius(capsys):
+    status, out, err = _main(capsys, "classify", "--d", "5000", "--delta", "0.0025",
+                             "--alpha", "1e-7,1e-5", "--beta", "1e-5")
+    assert status == 0, err
+    assert "stable" in out and "unstable" in out
+    assert "spectral radius not computed for d > 1000" in out
