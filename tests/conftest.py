@@ -13,6 +13,7 @@ evaluates them the same way: always with mpmath numbers, never Python floats.
 """
 
 import functools
+import math
 import json
 import os
 import pathlib
@@ -102,6 +103,39 @@ def loop_gain_parts(z, d, delta):
     one = mpmath.mpf(1)
     base = z ** (-d) * eq4_pulse_transfer_function(z, one, delta, one, exp=mpmath.exp)
     return base, base * (z - 1) / z, base * (z - 1) ** 2 / z**2
+
+
+def first_principles_chi(alpha, beta, gamma, d, delta):
+    """Loop polynomial from the printed eqs. (1), (2), (4), divided by delta**2 (mpmath).
+
+    With m = T = 1 and b = delta, eq. (4) is ``G(z) = (n1 z + n0) /
+    (delta**2 (z - 1)(z - E))`` with ``E = exp(-delta)``, ``n1 = E - 1 +
+    delta``, ``n0 = 1 - (1 + delta) E``, and eq. (1) is ``VE(z) = (alpha
+    z**2 + beta z (z - 1) + gamma (z - 1)**2) / z**2``; 1 + VE z^-d G = 0
+    times ``z**(d+2) (z - 1)(z - E)`` is ``z**(d+2) (z - 1)(z - E) + V(z)
+    (n1 z + n0) / delta**2``.  At delta = 0, ``n1 / delta**2 = n0 /
+    delta**2 = 1/2``.  Coefficients highest first, at the caller's mpmath
+    precision (computed with the digits that n1 and n0 cancel added).
+    """
+    extra = int(3 * max(0.0, -math.log10(delta))) if delta > 0 else 0
+    with mpmath.workdps(mpmath.mp.dps + extra):
+        a, b, g, dl = (mpmath.mpf(x) for x in (alpha, beta, gamma, delta))
+        E = mpmath.exp(-dl)
+        if dl == 0:
+            h1 = h0 = mpmath.mpf(1) / 2
+        else:
+            h1, h0 = (E - 1 + dl) / dl**2, (1 - (1 + dl) * E) / dl**2
+        coeffs = [mpmath.mpf(1), -(1 + E), E] + [mpmath.mpf(0)] * (d + 2)
+        v2, v1, v0 = a + b + g, -(b + 2 * g), g
+        for k, c in enumerate((v2 * h1, v2 * h0 + v1 * h1, v1 * h0 + v0 * h1, v0 * h0)):
+            coeffs[-4 + k] += c
+    return [+c for c in coeffs]
+
+
+def first_principles_chi_float(alpha, beta, gamma, d, delta, dps=30):
+    """:func:`first_principles_chi` at ``dps`` digits, rounded once to floats."""
+    with mpmath.workdps(dps):
+        return np.array([float(c) for c in first_principles_chi(alpha, beta, gamma, d, delta)])
 
 
 def delta_of_z(z, *, alpha, beta, gamma, d, delta):

@@ -37,7 +37,8 @@ from symstab import MARGINAL, STABLE, UNSTABLE, classify, is_stable, spectral_ra
 from symstab.evaluate import boundary_point
 from symstab.stability import loop_coefficients, schur_cohn
 
-from conftest import (PAPER_DELTA, assert_message_names, dimensionless,
+from conftest import (PAPER_DELTA, assert_message_names, dimensionless, first_principles_chi,
+                      first_principles_chi_float,
                       python_control_closed_loop, random_loop_points)
 
 
@@ -45,32 +46,10 @@ from conftest import (PAPER_DELTA, assert_message_names, dimensionless,
 # Independent oracle: chi(z) from the printed eqs. (1), (2), (4)
 # --------------------------------------------------------------------------
 
-def eq4_chi(alpha, beta, gamma, d, delta):
-    """Coefficients (highest first, mpmath, current dps) of the loop polynomial.
-
-    With m = T = 1 and b = delta, eq. (4) is
-    ``G(z) = (n1 z + n0) / (delta**2 (z - 1)(z - E))`` with ``E = exp(-delta)``,
-    ``n1 = E - 1 + delta``, ``n0 = 1 - (1 + delta) E``, and eq. (1) is
-    ``VE(z) = (alpha z**2 + beta z (z - 1) + gamma (z - 1)**2) / z**2``, so
-    1 + VE z^-d G = 0 multiplied by ``delta**2 z**(d+2) (z - 1)(z - E)`` gives
-    ``delta**2 z**(d+2) (z - 1)(z - E) + (alpha z**2 + beta (z**2 - z)
-    + gamma (z - 1)**2)(n1 z + n0)``.
-    """
-    a, b, g, dl = (mpmath.mpf(x) for x in (alpha, beta, gamma, delta))
-    E = mpmath.exp(-dl)
-    n1, n0 = E - 1 + dl, 1 - (1 + dl) * E
-    coeffs = [dl**2, -dl**2 * (1 + E), dl**2 * E] + [mpmath.mpf(0)] * (d + 2)
-    v2, v1, v0 = a + b + g, -(b + 2 * g), g
-    direct = [v2 * n1, v2 * n0 + v1 * n1, v1 * n0 + v0 * n1, v0 * n0]
-    for k in range(4):
-        coeffs[-4 + k] += direct[k]
-    return coeffs
-
-
-def eq4_chi_float(alpha, beta, gamma, d, delta):
-    """:func:`eq4_chi` at 30 digits, rounded once to floats."""
-    with mpmath.workdps(30):
-        return np.array([float(c) for c in eq4_chi(alpha, beta, gamma, d, delta)])
+#: The first-principles polynomial (tests/conftest.py), at the current mpmath
+#: precision, and rounded once to floats from 30 digits.
+eq4_chi = first_principles_chi
+eq4_chi_float = first_principles_chi_float
 
 
 def polished_roots(coeffs_mp, dps=40, near=None):

@@ -36,7 +36,8 @@ import numpy as np
 import pytest
 import sympy as sp
 
-from conftest import PAPER_DELTA, REPO, relative_error
+from conftest import (PAPER_DELTA, REPO, first_principles_chi, first_principles_chi_float,
+                      relative_error)
 import symstab
 from symstab import model
 from symstab._generated import kernels as numpy_kernels
@@ -575,28 +576,8 @@ def test_boundary_on_a_dense_grid_mixed_error(gamma, d, delta):
 
 
 def _first_principles_coefficients(alpha, beta, gamma, d, delta, dps=60):
-    """chi(z) / (delta**2 Gamma) from eqs. (1), (2), (4) in exp(-delta), at ``dps`` digits.
-
-    ``z**(d+2) (z - 1)(z - E) + V(z) (n1 z + n0) / delta**2`` with ``E =
-    exp(-delta)``, ``n1 = E - 1 + delta``, ``n0 = 1 - (1 + delta) E``; at
-    delta = 0 the limits ``n1 / delta**2 = n0 / delta**2 = 1/2``.
-    """
-    # n1 and n0 cancel to delta**2: carry the digits they lose.
-    dps += int(3 * max(0.0, -math.log10(delta))) if delta > 0 else 0
-    with mpmath.workdps(dps):
-        a, b, g, dl = (mpmath.mpf(x) for x in (alpha, beta, gamma, delta))
-        E = mpmath.exp(-dl)
-        if dl == 0:
-            h1 = h0 = mpmath.mpf(1) / 2
-        else:
-            h1, h0 = (E - 1 + dl) / dl**2, (1 - (1 + dl) * E) / dl**2
-        v = [a + b + g, -b - 2 * g, g]
-        out = [mpmath.mpf(0)] * (d + 5)
-        for k, c in enumerate((1, -(1 + E), E)):
-            out[k] += c
-        for k, c in enumerate((v[0] * h1, v[0] * h0 + v[1] * h1, v[1] * h0 + v[2] * h1, v[2] * h0)):
-            out[d + 1 + k] += c
-        return [float(c) for c in out]
+    """chi(z) / (delta**2 Gamma) from eqs. (1), (2), (4) (tests/conftest.py), at ``dps`` digits."""
+    return list(first_principles_chi_float(alpha, beta, gamma, d, delta, dps=dps))
 
 
 EXTREME_DELTAS = (0.0, 1e-300, 400.0, 710.0, 1e4, 1e6)
@@ -631,7 +612,7 @@ def test_classification_at_extreme_delta_matches_60_digit_roots(delta, d):
     radii = symstab.spectral_radius(alpha=alphas, beta=beta, gamma=0.0, d=d, delta=delta)
     with mpmath.workdps(60):
         for a, code, radius in zip(alphas, codes, radii):
-            roots = mpmath.polyroots(_first_principles_coefficients(a, beta, 0.0, d, delta),
+            roots = mpmath.polyroots(first_principles_chi(a, beta, 0.0, d, delta),
                                      maxsteps=200, extraprec=200)
             exact = max(abs(r) for r in roots)
             assert abs(exact - 1) > 1e-9, "test point too close to the boundary"

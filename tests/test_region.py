@@ -41,24 +41,13 @@ from symstab import (PAPER_DEVICE, STABLE, Device, StabilityRegion, arc_end_angl
                      best_virtual_mass, boundary_curve, classify, limits)
 from symstab.evaluate import alpha_max_on_arc, boundary_point
 
-from conftest import PAPER_DELTA, assert_message_names, first_principles_boundary_point
+from conftest import (PAPER_DELTA, assert_message_names, first_principles_boundary_point,
+                      first_principles_chi_float)
 
 
-def eq4_chi_float(alpha, beta, gamma, d, delta):
-    """Loop polynomial from the printed eqs. (1), (2), (4), m = T = 1, b = delta
-    (as in test_classify.eq4_chi), at 30 digits, rounded once to floats:
-    ``delta**2 z**(d+2) (z - 1)(z - E) + (alpha z**2 + beta (z**2 - z)
-    + gamma (z - 1)**2)(n1 z + n0)``, ``E = exp(-delta)``,
-    ``n1 = E - 1 + delta``, ``n0 = 1 - (1 + delta) E``."""
-    with mpmath.workdps(30):
-        a, b, g, dl = (mpmath.mpf(x) for x in (alpha, beta, gamma, delta))
-        E = mpmath.exp(-dl)
-        n1, n0 = E - 1 + dl, 1 - (1 + dl) * E
-        coeffs = [dl**2, -dl**2 * (1 + E), dl**2 * E] + [mpmath.mpf(0)] * (d + 2)
-        v2, v1, v0 = a + b + g, -(b + 2 * g), g
-        for k, c in enumerate([v2 * n1, v2 * n0 + v1 * n1, v1 * n0 + v0 * n1, v0 * n0]):
-            coeffs[-4 + k] += c
-        return np.array([float(c) for c in coeffs])
+#: The first-principles polynomial of eqs. (1), (2), (4) (tests/conftest.py),
+#: at 30 digits, rounded once to floats.
+eq4_chi_float = first_principles_chi_float
 
 
 @functools.lru_cache(maxsize=None)
