@@ -133,12 +133,21 @@ def test_a_trajectory_beyond_the_memory_limit_is_refused_before_simulating(capsy
 
 
 def test_numpy_warnings_never_reach_the_user(tmp_path):
-    """alpha = 1e300 overflowed inside the kernels and printed RuntimeWarnings."""
-    result = run_symstab("classify", "--delta", "0.0025", "--alpha", "1e300", "--beta", "0.5",
+    """alpha = 1e300 overflowed inside the kernels and printed RuntimeWarnings.
+
+    It is now refused in one line (|alpha| <= 1e150); the largest accepted
+    value is classified without a warning.
+    """
+    result = run_symstab("classify", "--delta", "0.0025", "--alpha", "1e150", "--beta", "0.5",
                          cwd=tmp_path)
     assert result.returncode == 0, result.stderr
     assert result.stderr == ""
     assert "unstable" in result.stdout
+    result = run_symstab("classify", "--delta", "0.0025", "--alpha", "1e300", "--beta", "0.5",
+                         cwd=tmp_path)
+    assert result.returncode == 2
+    assert result.stderr.count("\n") == 1 and "Warning" not in result.stderr
+    assert "alpha must be a finite real number >= -1e+150 and <= 1e+150" in result.stderr
 
 
 def _limited_address_space():
