@@ -30,6 +30,7 @@ module's checks then start with every result cached, so no result is
 computed twice and the order of the checks does not matter.
 """
 
+import collections
 import concurrent.futures
 import dataclasses
 import importlib
@@ -209,44 +210,58 @@ def _check_task(cid, cached):
     return func()
 
 
-def _run_parallel(checks, progress, executor):
-    """Run ``checks`` as tasks of ``executor``: the prefetches first, then their users."""
-    from ._common import Memo
+def _run_parallel(checks, progress, executor, in_flight=None):
+    """Run ``checks`` as tasks of ``executor``: the prefetches first, then their users.
 
-    waiting = set()    # checks of modules with a prefetch: they start when it is done
-    calls = []
+    At most ``in_flight`` tasks (default: one more than the workers) are
+    queued at once, so that the checks released when their module's
+    prefetches are done go ahead of the checks that need none: the longest
+    chains then start early instead of forming the tail.
+    """
+    waiting = {}       # module -> its checks, released when its prefetches are done
+    calls = {}         # (name, args) -> the modules that wait for it
     for module in dict.fromkeys(entry[3].__module__ for entry in checks.values()):
         prefetch = getattr(sys.modules[module], "prefetch", None)
         if prefetch is None:
             continue
-        waiting |= {cid for cid, entry in checks.items() if entry[3].__module__ == module}
-        calls += [(memo.name, args) for memo, args in prefetch() if (memo.name, args) not in calls]
-    pending = {executor.submit(_prefetch_task, name, args): ("prefetch", name, args)
-               for name, args in calls}
-    pending.update({executor.submit(_check_task, cid, {}): ("check", cid)
-                    for cid in checks if cid not in waiting})
-    cached, outcomes = {}, {}
+        waiting[module] = [cid for cid, entry in checks.items() if entry[3].__module__ == module]
+        for memo, args in prefetch():
+            calls.setdefault((memo.name, args), set()).add(module)
+    waited = {cid for cids in waiting.values() for cid in cids}
+    ready = collections.deque(("prefetch", name, args) for name, args in calls)
+    ready.extend(("check", cid) for cid in checks if cid not in waited)
+    limit = in_flight or (getattr(executor, "_max_workers", None) or 2) + 1
+    pending, cached, outcomes = {}, {}, {}
 
-    def release():
-        for cid in checks:
-            if cid in waiting:
-                pending[executor.submit(_check_task, cid, cached)] = ("check", cid)
-        waiting.clear()
+    def submit():
+        while ready and len(pending) < limit:
+            task = ready.popleft()
+            if task[0] == "prefetch":
+                future = executor.submit(_prefetch_task, task[1], task[2])
+            else:
+                future = executor.submit(_check_task, task[1], cached if task[1] in waited else {})
+            pending[future] = task
 
-    if not calls:
-        release()
+    def release_done_modules():
+        for module in list(waiting):
+            if not any(module in mods for key, mods in calls.items()
+                       if key[0] not in cached or key[1] not in cached[key[0]]):
+                ready.extendleft(("check", cid) for cid in reversed(waiting.pop(module)))
+
+    release_done_modules()
+    submit()
     while pending:
         done, _ = concurrent.futures.wait(pending, return_when=concurrent.futures.FIRST_COMPLETED)
         for future in done:
             task = pending.pop(future)
             if task[0] == "prefetch":
                 cached.setdefault(task[1], {})[task[2]] = future.result()
+                release_done_modules()
                 continue
             outcomes[task[1]] = future.result()
             if progress is not None:
                 progress(len(outcomes), len(checks), task[1])
-        if waiting and not any(t[0] == "prefetch" for t in pending.values()):
-            release()
+        submit()
     return [_finding(cid, entry, outcomes[cid]) for cid, entry in checks.items()]
 
 
