@@ -76,20 +76,19 @@ def _points(alpha, beta, gamma, d, delta):
 
 
 def _kernel_coefficients(alpha, beta, gamma, delta):
-    """The seven distinct coefficients of chi / (delta**2 Gamma), as (N,) arrays."""
-    with np.errstate(all="ignore"):
-        c = kernels.loop_coefficients(alpha, beta, gamma, delta)
+    """The seven distinct coefficients of chi / (delta**2 Gamma), as (N,) arrays.
+
+    Finite for every input :func:`_points` accepts: |alpha|, |beta|,
+    |gamma| <= PARAMETER_MAX and the ZOH functions of delta are at most 1.
+    """
+    c = kernels.loop_coefficients(alpha, beta, gamma, delta)
     shape = np.broadcast(alpha, beta, gamma, delta).shape
-    out = [np.broadcast_to(np.asarray(ck, dtype=float), shape).ravel() for ck in c]
-    bad = ~np.all([np.isfinite(ck) for ck in out], axis=0)
-    if np.any(bad):
-        i = int(np.flatnonzero(bad)[0])
-        names = ("alpha", "beta", "gamma", "delta")
-        values = ", ".join(f"{n} = {np.broadcast_to(v, shape).ravel()[i]!r}"
-                           for n, v in zip(names, (alpha, beta, gamma, delta)))
-        raise ValueError(f"the loop polynomial's coefficients overflow at {values}: "
-                         f"alpha, beta and gamma must be at most {PARAMETER_MAX:g} in magnitude")
-    return out
+    return [np.broadcast_to(np.asarray(ck, dtype=float), shape).ravel() for ck in c]
+
+
+def _one_minus_r(delta, shape):
+    """``em = 1 - exp(-delta)`` per point, for the factored ``z - r`` of the root count."""
+    return np.broadcast_to(-np.expm1(-delta), shape).ravel()
 
 
 def _dense(c7, d, rows=slice(None)):
@@ -316,7 +315,7 @@ def unstable_root_counts(*, alpha, beta, gamma, d, delta):
     """
     alpha, beta, gamma, delta, d, shape = _points(alpha, beta, gamma, d, delta)
     c7 = _kernel_coefficients(alpha, beta, gamma, delta)
-    em = np.broadcast_to(-np.expm1(-delta), shape).ravel()
+    em = _one_minus_r(delta, shape)
     out = _root_counts(c7, em, d)
     out = out.reshape(shape)
     return int(out) if out.ndim == 0 else out
@@ -468,7 +467,7 @@ def classify(*, alpha, beta, gamma, d, delta, refine=True):
     """
     alpha, beta, gamma, delta, d, shape = _points(alpha, beta, gamma, d, delta)
     c7 = _kernel_coefficients(alpha, beta, gamma, delta)
-    em = np.broadcast_to(-np.expm1(-delta), shape).ravel()
+    em = _one_minus_r(delta, shape)
     size = len(em)
     out = np.empty(size, dtype=np.int8)
     if refine and d >= _COUNT_ALL_FROM_DELAY:
