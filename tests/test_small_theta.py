@@ -93,3 +93,51 @@ def test_alpha_sign_condition_predicts_sign_of_alpha_near_zero(d, delta, offset)
                                            model.delta: sp.Float(delta, 40),
                                            model.Gamma: sp.exp(sp.Float(delta, 40))})
     assert bool(holds) is bool(alpha > 0)
+
+
+# The Taylor coefficients are read from trigonometric Taylor polynomials
+# (symstab.small_theta._trig_taylor) instead of sympy.series; sympy.series is
+# the oracle for both the fast path and its fallback.
+_t, _d, _g = model.theta, model.d, model.Gamma
+
+
+@pytest.mark.parametrize("expr, fast", [
+    (_g * sp.sin((_d + 2) * _t) - 3 * sp.cos(_d * _t) + _d**2 * sp.sin(2 * _t)**2, True),
+    (sp.cos(_t) * sp.sin(_d * _t - _t) / (_g - 1) + sp.exp(model.delta), True),
+    (sp.sin(_t + 1) + sp.cos(_d * _t), False),    # not c * theta: falls back
+    (sp.exp(_t) * sp.sin(_t), False),             # another function of theta
+])
+def test_series_coefficients_equal_sympy_series(expr, fast):
+    from symstab.small_theta import _series_coefficients, _trig_taylor
+
+    order = 5
+    assert (_trig_taylor(expr, order) is not None) is fast
+    series = sp.expand(sp.series(expr, _t, 0, order + 1).removeO())
+    expected = [series.coeff(_t, k) for k in range(order + 1)]
+    got = _series_coefficients(expr, order)
+    assert [sp.simplify(a - b) for a, b in zip(got, expected)] == [0] * (order + 1)
+
+
+def test_boundary_forms_take_the_fast_path():
+    from symstab.boundary import boundary
+    from symstab.small_theta import _trig_taylor
+
+    bd = boundary()
+    for expr in (bd.alpha_numerator, bd.beta_numerator, bd.denominator):
+        assert _trig_taylor(expr, 5) is not None
+
+
+def test_quotient_series_against_sympy_series():
+    from symstab.small_theta import _quotient_series
+
+    x = sp.Symbol("x")
+    num = [0, _g, 2, -_d, 1, 0]
+    den = [0, _g - 1, _d, 0, 3, 1]
+    n = sp.Add(*[c * x**k for k, c in enumerate(num)])
+    dd = sp.Add(*[c * x**k for k, c in enumerate(den)])
+    series = sp.expand(sp.series(n / dd, x, 0, 4).removeO())
+    got = _quotient_series(num, den, 4)
+    assert len(got) == 4
+    assert [sp.simplify(q - series.coeff(x, k)) for k, q in enumerate(got)] == [0] * 4
+    with pytest.raises(AssertionError, match="pole"):
+        _quotient_series([1, 0, 0], [0, 1, 0], 2)
