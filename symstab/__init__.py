@@ -21,6 +21,10 @@ numeric API builds on those: :mod:`~symstab.units` (:class:`Device`),
 :mod:`~symstab.curves` (:func:`boundary_curve`), :mod:`~symstab.stability`
 (:func:`spectral_radius`, :func:`is_stable`, :func:`classify`) and
 :mod:`~symstab.region` (:func:`limits`, :func:`best_virtual_mass`).
+
+Any other loop -- the user's own plant and virtual environment -- is a
+:class:`Loop` (:mod:`~symstab.any_loop`), derived and classified the same
+way, and can be read from a TOML loop file (:func:`load_loop`).
 """
 
 from .boundary import boundary, coefficients
@@ -35,6 +39,8 @@ from .units import PAPER_DEVICE, Device
 from .curves import BoundaryCurve, arc_end_angle, boundary_curve
 from .stability import MARGINAL, STABLE, UNSTABLE, classify, is_stable, spectral_radius
 from .region import BestVirtualMass, Limits, StabilityRegion, best_virtual_mass, limits
+from .any_loop import Loop, LoopBoundary, LoopLimits
+from .loop_files import load_loop
 
 __all__ = [
     "boundary", "coefficients",
@@ -47,4 +53,5 @@ __all__ = [
     "BoundaryCurve", "arc_end_angle", "boundary_curve",
     "STABLE", "MARGINAL", "UNSTABLE", "classify", "is_stable", "spectral_radius",
     "StabilityRegion", "Limits", "limits", "BestVirtualMass", "best_virtual_mass",
+    "Loop", "LoopBoundary", "LoopLimits", "load_loop",
 ]

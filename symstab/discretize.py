@@ -58,3 +58,123 @@ def dimensionless_pulse_transfer_function():
     if result.has(model.m) or result.has(model.T):
         raise AssertionError(f"pulse transfer function did not become dimensionless: {result}")
     return result
+
+
+def linear_poles(F, s=model.s):
+    """Poles of a rational ``F(s)`` with multiplicities, if all are linear factors.
+
+    Returns ``{pole: multiplicity}`` when the denominator factors, over the
+    parameters, into factors of degree 1 in ``s`` (each pole then has a short
+    closed form such as ``-b/m``); otherwise ``None``.
+    """
+    _, den = sp.fraction(sp.together(F))
+    _, factors = sp.factor_list(sp.expand(den), s)
+    poles = {}
+    for factor, power in factors:
+        degree = sp.degree(factor, s)
+        if degree == 0:
+            continue
+        if degree > 1:
+            return None
+        pole = sp.solve(factor, s)[0]
+        poles[pole] = poles.get(pole, 0) + power
+    return poles
+
+
+def zoh_pulse_transfer_function(G, *, s=model.s, z=model.z, T=model.T):
+    """Z[ZOH G(s)] for a proper rational ``G(s)`` whose poles are linear factors.
+
+    ``(1 - 1/z) Z[G(s) / s]`` by the residues of
+    ``G(s) / s * z / (z - exp(s T))`` at every pole, repeated poles and poles
+    at 0 included (a frictionless mass ``1 / (m s**2)`` has a triple pole of
+    ``G / s`` at 0).
+
+    Returns
+    -------
+    sympy.Expr
+        A rational function of ``z`` (``cancel``-ed), with ``exp`` of the
+        poles times ``T`` in its coefficients.
+
+    Raises
+    ------
+    ValueError
+        If ``G`` is not proper, or a pole is not a linear factor (then use
+        :func:`numeric_zoh`).
+    """
+    F = sp.together(G / s)
+    if linear_poles(F, s) is None:
+        raise ValueError("the plant's poles are not all linear factors over its parameters")
+    step_response = z_transform_by_residues(F, s=s, z=z, T=T)
+    return sp.cancel(sp.together((1 - 1 / z) * step_response))
+
+
+def _charpoly(A):
+    """Characteristic polynomial det(z I - A) of an mpmath matrix, highest power first.
+
+    Faddeev-LeVerrier: exact in exact arithmetic, and at 30+ digits more than
+    good enough for the few states of a haptic device.
+    """
+    import mpmath
+
+    n = A.rows
+    coefficients = [mpmath.mpf(1)]
+    M = mpmath.zeros(n, n)
+    for k in range(1, n + 1):
+        M = A * M + coefficients[-1] * mpmath.eye(n)
+        AM = A * M
+        coefficients.append(-sum(AM[i, i] for i in range(n)) / k)
+    return coefficients
+
+
+def numeric_zoh(numerator, denominator, T, *, dps=30):
+    """Z[ZOH G] of a numeric proper ``G(s)`` by the matrix exponential.
+
+    ``G = num / den`` (coefficients highest power first) is realised in
+    controllable canonical form ``(A, B, C, D)``; ``exp([[A, B], [0, 0]] T)``
+    gives ``Phi`` and ``Gamma``, and
+
+        Z[ZOH G](z) = C (z I - Phi)^-1 Gamma + D
+                    = (det(z I - Phi + Gamma C) - det(z I - Phi)) / det(z I - Phi) + D
+
+    by the matrix determinant lemma.  Everything is computed at ``dps``
+    digits with mpmath.
+
+    Returns
+    -------
+    (list of mpmath.mpf, list of mpmath.mpf)
+        Numerator and denominator of the pulse transfer function in ``z``,
+        highest power first; the denominator is monic of the plant's order.
+    """
+    import mpmath
+
+    with mpmath.workdps(dps):
+        den = [mpmath.mpf(c) for c in denominator]
+        num = [mpmath.mpf(c) for c in numerator]
+        while den and den[0] == 0:
+            den.pop(0)
+        n = len(den) - 1
+        if n < 1:
+            raise ValueError("the plant must have at least one pole")
+        num = [c / den[0] for c in num]
+        den = [c / den[0] for c in den]
+        if len(num) > n + 1:
+            if any(c != 0 for c in num[: len(num) - n - 1]):
+                raise ValueError("the plant must be proper (degree of numerator <= degree of denominator)")
+            num = num[len(num) - n - 1:]
+        num = [mpmath.mpf(0)] * (n + 1 - len(num)) + num
+        direct = num[0]
+        rest = [num[k] - direct * den[k] for k in range(1, n + 1)]
+        A = mpmath.zeros(n + 1, n + 1)
+        for j in range(n):
+            A[0, j] = -den[j + 1]
+        for i in range(1, n):
+            A[i, i - 1] = 1
+        A[0, n] = 1
+        E = mpmath.expm(A * T)
+        Phi = E[:n, :n]
+        Gamma = E[:n, n]
+        C = mpmath.matrix([rest])
+        open_loop = _charpoly(Phi)
+        shifted = _charpoly(Phi - Gamma * C)
+        numerator = [shifted[k] - open_loop[k] + direct * open_loop[k] for k in range(n + 1)]
+        return numerator, open_loop

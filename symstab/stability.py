@@ -37,6 +37,7 @@ __all__ = [
     "loop_coefficients", "spectral_radius", "schur_cohn", "unstable_root_counts",
     "classify", "is_stable",
     "coefficients_at", "unstable_root_count", "stable_alpha_intervals",
+    "polynomial_root_counts", "classify_polynomials", "polynomial_spectral_radius",
 ]
 
 #: Codes returned by :func:`classify`.
@@ -487,6 +488,195 @@ def classify(*, alpha, beta, gamma, d, delta, refine=True):
                                        np.where(counts == 0, STABLE, UNSTABLE))
         out[rows] = part
     return _shaped(out, shape)
+
+
+def polynomial_spectral_radius(coefficients):
+    """Largest root modulus of each row of real polynomials (highest power first).
+
+    Batched companion eigenvalues, the largest polished by Newton steps, as
+    in :func:`spectral_radius`; rows are processed in chunks.
+
+    Parameters
+    ----------
+    coefficients : ndarray, shape (N, n + 1)
+        Leading coefficients nonzero.
+
+    Returns
+    -------
+    ndarray, shape (N,)
+    """
+    p = np.asarray(coefficients, dtype=float)
+    n = p.shape[1] - 1
+    check_memory(f"the spectral radius of degree {n}", 4 * 8 * n * n)
+    out = np.empty(len(p))
+    for rows in chunk_slices(len(p), 8 * (n + 1)):
+        out[rows] = _radius(p[rows])
+    return out
+
+
+def _horner_circle(p, theta):
+    """p(exp(j theta)) and d p / d theta for rows of ``p`` and columns of ``theta``."""
+    z = np.exp(1j * theta)
+    n = p.shape[1] - 1
+    value = np.zeros(np.broadcast(p[:, :1], z).shape, dtype=complex)
+    slope = np.zeros_like(value)
+    for k in range(n + 1):
+        slope = slope * z + value
+        value = value * z + p[:, k, None]
+    # d/d theta = j z d/dz.
+    return value, 1j * z * slope
+
+
+def polynomial_root_counts(coefficients, *, coefficient_ulps=_COEFFICIENT_ULPS):
+    """Certified number of roots outside the unit circle of real polynomials.
+
+    The argument principle over ``theta`` in [0, pi], as in
+    :func:`unstable_root_counts`, for any real polynomial: an arc counts
+    when, with ``S_k = sum_j j**k |c_j|``, the first-order bound
+    ``S_1 h`` plus the rounding of Horner's scheme keeps its image off 0, or
+    the second-order tube (``S_2 h**2 / 2``) around the midpoint's tangent
+    misses 0; other arcs are halved, up to 48 times.  The count is exact for
+    every polynomial whose coefficients are within ``coefficient_ulps`` ulps
+    of the given ones (relative to ``S_0``).
+
+    Parameters
+    ----------
+    coefficients : ndarray, shape (N, n + 1)
+        Real coefficients, highest power first, leading ones nonzero.
+    coefficient_ulps : float
+        Error assumed of each coefficient, in units of ``2**-53 S_0``.
+
+    Returns
+    -------
+    ndarray of int, shape (N,)
+        Roots with modulus > 1, or -1 where a root is on the circle to
+        within rounding (marginal).
+    """
+    p = np.asarray(coefficients, dtype=float)
+    n = p.shape[1] - 1
+    n_arcs = max(64, 8 * n)
+    counts = np.empty(len(p), dtype=np.int64)
+    per_row = 16 * (2 * n_arcs + 1) * 4 + 8 * (n + 1) * (2 * n_arcs + 1)
+    for part in chunk_slices(len(p), per_row, CHUNK_BYTES):
+        counts[part] = _polynomial_counts_chunk(p[part], n_arcs, coefficient_ulps)
+    return counts
+
+
+def _polynomial_counts_chunk(p, n_arcs, coefficient_ulps):
+    n = p.shape[1] - 1
+    n_rows = len(p)
+    scale = np.max(np.abs(p), axis=1, keepdims=True)
+    p = p / scale
+    powers = np.arange(n, -1, -1, dtype=float)
+    s0 = np.sum(np.abs(p), axis=1)
+    s1 = np.sum(powers * np.abs(p), axis=1)
+    s2 = np.sum(powers**2 * np.abs(p), axis=1)
+    # Horner's rounding at |z| = 1 (complex: a few units per step, doubled for
+    # the bounds' own rounding), plus the coefficients' own error.
+    error = 2 * _U * (8 * (n + 2) + coefficient_ulps) * s0
+    slope_error = 2 * _U * (8 * (n + 2) + coefficient_ulps) * s1
+
+    theta = np.linspace(0.0, np.pi, 2 * n_arcs + 1)
+    with np.errstate(all="ignore"):
+        chi, dchi = _horner_circle(p, theta[None, :])
+    row = np.repeat(np.arange(n_rows), n_arcs)
+    lo, mid, hi = (np.broadcast_to(theta[k:len(theta) - 2 + k:2], (n_rows, n_arcs)).ravel()
+                   for k in range(3))
+    chi_lo, chi_mid, chi_hi = (chi[:, k:chi.shape[1] - 2 + k:2].ravel() for k in range(3))
+    dchi_mid = dchi[:, 1::2].ravel()
+    change = np.zeros(n_rows)
+    undecided = np.zeros(n_rows, dtype=bool)
+    for _ in range(_MAX_ROUNDS):
+        half = 0.5 * (hi - lo)
+        ok = s1[row] * half * (1 + 4 * _U) + error[row] < np.abs(chi_mid)
+        radius = (0.5 * s2[row] * half**2 + error[row] + slope_error[row] * half) * (1 + 8 * _U)
+        with np.errstate(all="ignore"):
+            flat = dchi_mid == 0
+            t = np.where(flat, 0.0, -np.real(chi_mid / np.where(flat, 1.0, dchi_mid)))
+            t = np.clip(t, -half, half)
+            near = np.abs(chi_mid + dchi_mid * t) * (1 - 4 * _U)
+            ok |= np.isfinite(t) & np.isfinite(near) & (near > radius)
+            step = np.angle(chi_hi / chi_mid) - np.angle(chi_lo / chi_mid)
+        np.add.at(change, row[ok], step[ok])
+        bad = ~ok
+        crowded = np.bincount(row[bad], minlength=n_rows) > _MAX_OPEN_ARCS
+        undecided |= crowded
+        bad &= ~crowded[row]
+        if not bad.any():
+            break
+        row, lo, mid, hi = row[bad], lo[bad], mid[bad], hi[bad]
+        chi_lo, chi_mid, chi_hi = chi_lo[bad], chi_mid[bad], chi_hi[bad]
+        q1, q3 = 0.5 * (lo + mid), 0.5 * (mid + hi)
+        with np.errstate(all="ignore"):
+            chi_q1, dchi_q1 = (x[:, 0] for x in _horner_circle(p[row], q1[:, None]))
+            chi_q3, dchi_q3 = (x[:, 0] for x in _horner_circle(p[row], q3[:, None]))
+        row = np.concatenate([row, row])
+        lo, hi, mid = np.concatenate([lo, mid]), np.concatenate([mid, hi]), np.concatenate([q1, q3])
+        chi_lo, chi_hi = np.concatenate([chi_lo, chi_mid]), np.concatenate([chi_mid, chi_hi])
+        chi_mid = np.concatenate([chi_q1, chi_q3])
+        dchi_mid = np.concatenate([dchi_q1, dchi_q3])
+        if not np.all(hi > lo):
+            undecided[np.unique(row[~(hi > lo)])] = True
+    else:
+        undecided[np.unique(row)] = True
+    inside = change / np.pi
+    whole = np.rint(inside)
+    if np.any(~undecided & (np.abs(inside - whole) > 0.25)):
+        raise AssertionError("the certified argument change is not a multiple of pi")
+    return np.where(undecided, -1, n - whole.astype(np.int64))
+
+
+def classify_polynomials(coefficients, *, refine=True):
+    """Classify real polynomials by their roots: stable, unstable or marginal.
+
+    The same decision as :func:`classify`, for any polynomials: the float
+    Schur-Cohn test decides the rows it decides with a margin of at least
+    1e-6 (below degree 48); every other row is decided by the certified
+    count of :func:`polynomial_root_counts`.  A row whose leading
+    coefficient vanishes to within rounding has a root at infinity (an
+    ill-posed loop) and is :data:`MARGINAL`.
+
+    Parameters
+    ----------
+    coefficients : array_like, shape (..., n + 1)
+        Real coefficients, highest power first.
+    refine : bool
+        As in :func:`classify`.
+
+    Returns
+    -------
+    ndarray of int8, shape (...)
+        :data:`STABLE`, :data:`MARGINAL` or :data:`UNSTABLE`.
+    """
+    p = np.asarray(coefficients, dtype=float)
+    shape = p.shape[:-1]
+    p = p.reshape(-1, p.shape[-1])
+    n = p.shape[1] - 1
+    out = np.full(len(p), MARGINAL, dtype=np.int8)
+    with np.errstate(all="ignore"):
+        scale = np.max(np.abs(p), axis=1)
+        degenerate = ~(np.abs(p[:, 0]) > 2 * _U * (n + 1) * _COEFFICIENT_ULPS * scale)
+    live = np.flatnonzero(~degenerate)
+    if n == 0:
+        out[live] = STABLE
+        return out.reshape(shape)
+    if refine and n >= _COUNT_ALL_FROM_DELAY:
+        close = live
+    else:
+        close = []
+        for rows in chunk_slices(len(live), 8 * (n + 1) * 4):
+            index = live[rows]
+            stable, margin = schur_cohn(p[index] / scale[index, None])
+            out[index] = np.where(stable, STABLE, UNSTABLE)
+            if not refine:
+                out[index[margin == 0]] = MARGINAL
+            else:
+                close.append(index[margin < _SCHUR_COHN_SAFE])
+        close = np.concatenate(close) if close else np.empty(0, dtype=np.int64)
+    if refine and len(close):
+        counts = polynomial_root_counts(p[close])
+        out[close] = np.where(counts < 0, MARGINAL, np.where(counts == 0, STABLE, UNSTABLE))
+    return out.reshape(shape)
 
 
 def _shaped(codes, shape):

@@ -1,0 +1,1020 @@
+"""Any sampled haptic loop: the user's own plant and virtual environment.
+
+:class:`Loop` takes a plant ``G(s)`` (force through the zero-order hold to
+measured position) and an environment ``VE(z)`` (force law on the sampled
+position), both with named parameters, and closes the loop with a delay of
+``d`` samples::
+
+    1 + VE(z) z**-d Z[ZOH G](z) = 0.
+
+With ``VE = Ve_n / Ve_d`` and ``Z[ZOH G] = P_n / P_d`` the closed-loop poles
+are the roots of
+
+    chi(z) = z**d Ve_d(z) P_d(z) + Ve_n(z) P_n(z),
+
+a *delayed part* and a *direct part*, as for the paper's loop
+(:mod:`symstab.loop`).  The derivation is SymPy's: the pulse transfer
+function by residues when every pole of ``G(s)/s`` is a linear factor over
+the parameters (repeated poles and poles at 0 included), otherwise by the
+matrix exponential at 30 digits once the plant's values are known
+(:attr:`Loop.zoh_method` says which).
+
+Numbers: the environment's polynomials come from a NumPy kernel generated
+for the loop (:mod:`symstab.loop_codegen`, cached on disk); the plant's
+pulse transfer function is evaluated at 30 digits for each distinct set of
+plant values (its closed form cancels badly in floating point when
+``b T / m`` is small) and rounded once.  Classification is
+:func:`symstab.stability.classify_polynomials` (float Schur-Cohn where its
+margin is safe, the certified root count elsewhere).  The boundary of a
+parameter plane is the D-decomposition: on ``z = exp(j theta)`` the two real
+equations ``Re chi = Im chi = 0`` are linear in the plane's parameters
+``(x, y)`` and solved per ``theta``; ``z = 1``, ``z = -1`` and a vanishing
+leading coefficient give straight lines.
+"""
+
+import dataclasses
+import functools
+import math
+import numbers
+
+import mpmath
+import numpy as np
+import sympy as sp
+from sympy.parsing.sympy_parser import convert_xor, parse_expr, standard_transformations
+
+from . import model
+from ._resources import check_memory
+from ._validate import check_array, check_count, check_delay, check_real
+from .discretize import linear_poles, numeric_zoh, zoh_pulse_transfer_function
+from .loop_codegen import kernel, load_numpy_kernels
+from .region import _golden_max
+from .stability import (MARGINAL, STABLE, UNSTABLE, classify_polynomials, polynomial_root_counts,
+                        polynomial_spectral_radius)
+
+__all__ = ["Loop", "LoopLimits", "LoopBoundary", "parse_plant", "parse_environment"]
+
+#: Names with a fixed meaning in every loop.
+RESERVED = ("s", "z", "T", "d")
+_DPS = 30
+
+_PARSE_GLOBALS = {
+    "Integer": sp.Integer, "Float": sp.Float, "Rational": sp.Rational, "Symbol": sp.Symbol,
+    "exp": sp.exp, "sqrt": sp.sqrt, "pi": sp.pi,
+}
+
+
+def _parse(text, what):
+    local = {"s": model.s, "z": model.z, "T": model.T}
+    try:
+        expr = parse_expr(text, local_dict=local, global_dict=dict(_PARSE_GLOBALS),
+                          transformations=standard_transformations + (convert_xor,))
+    except Exception as exc:
+        raise ValueError(f"{what} {text!r} is not a valid expression: {exc}") from None
+    if not isinstance(expr, sp.Expr):
+        raise ValueError(f"{what} {text!r} is not an expression")
+    return expr
+
+
+def _real_symbols(expr):
+    """Replace every parameter symbol by a real one of the same name (T stays positive)."""
+    swap = {}
+    for symbol in expr.free_symbols:
+        name = str(symbol)
+        if name == "d":
+            raise ValueError("the delay d is not part of the plant or the environment: "
+                             "the loop applies z**-d itself")
+        if symbol in (model.s, model.z, model.T):
+            continue
+        if name in ("s", "z", "T"):
+            swap[symbol] = {"s": model.s, "z": model.z, "T": model.T}[name]
+        else:
+            swap[symbol] = sp.Symbol(name, real=True)
+    return expr.xreplace(swap)
+
+
+def _plant_from_control(plant):
+    num, den = plant.num[0][0], plant.den[0][0]
+    if plant.ninputs != 1 or plant.noutputs != 1:
+        raise ValueError("plant must be a single-input single-output transfer function")
+    if plant.dt not in (0, None):
+        raise ValueError(f"plant must be continuous-time (dt = 0), got dt = {plant.dt!r}")
+    s = model.s
+
+    def poly(coefficients):
+        return sp.Add(*[sp.Rational(float(c)) * s**k
+                        for k, c in enumerate(reversed(list(coefficients)))])
+
+    return poly(num) / poly(den)
+
+
+def _check_rational(expr, variable, what, other):
+    if expr.has(other):
+        raise ValueError(f"{what} must not contain {other}")
+    if not expr.is_rational_function(variable):
+        raise ValueError(f"{what} must be a rational function of {variable}, got {expr}")
+    num, den = sp.fraction(sp.cancel(sp.together(expr)))
+    if den == 0 or sp.simplify(num) == 0:
+        raise ValueError(f"{what} must not be zero")
+    nd, dd = sp.degree(num, variable), sp.degree(den, variable)
+    if nd > dd:
+        raise ValueError(f"{what} must be proper (degree of numerator {nd} <= degree of "
+                         f"denominator {dd} in {variable}), got {expr}")
+    return num, den
+
+
+def parse_plant(plant):
+    """The plant ``G(s)`` as a SymPy expression, checked: rational in ``s`` and proper.
+
+    ``plant`` is a string, a SymPy expression or a ``control.TransferFunction``
+    (continuous-time, numeric).
+
+    Raises
+    ------
+    TypeError
+        For another kind of object.
+    ValueError
+        If it is not rational in ``s``, not proper, zero, or uses ``z`` or ``d``.
+    """
+    if isinstance(plant, str):
+        expr = _parse(plant, "plant")
+    elif isinstance(plant, sp.Basic):
+        expr = sp.sympify(plant)
+    elif hasattr(plant, "num") and hasattr(plant, "den") and hasattr(plant, "dt"):
+        expr = _plant_from_control(plant)
+    else:
+        raise TypeError(f"plant must be a string, a SymPy expression or a "
+                        f"control.TransferFunction, got {type(plant).__name__}")
+    expr = _real_symbols(expr)
+    _check_rational(expr, model.s, "plant G(s)", model.z)
+    return expr
+
+
+def parse_environment(environment):
+    """The environment ``VE(z)`` as a SymPy expression, checked: rational in ``z`` and proper.
+
+    Raises
+    ------
+    TypeError
+        If it is not a string or a SymPy expression.
+    ValueError
+        If it is not rational in ``z``, not proper (not causal), zero, or uses
+        ``s`` or ``d``.
+    """
+    if isinstance(environment, str):
+        expr = _parse(environment, "environment")
+    elif isinstance(environment, sp.Basic):
+        expr = sp.sympify(environment)
+    else:
+        raise TypeError(f"environment must be a string or a SymPy expression, "
+                        f"got {type(environment).__name__}")
+    expr = _real_symbols(expr)
+    _check_rational(expr, model.z, "environment VE(z)", model.s)
+    return expr
+
+
+def _poly_coeffs(expr, z):
+    return sp.Poly(sp.expand(expr), z).all_coeffs()
+
+
+def _is_affine(coefficients, symbols):
+    """Whether every coefficient is a polynomial of total degree <= 1 in ``symbols``."""
+    for c in coefficients:
+        c = sp.expand(c)
+        if not c.has(*symbols):
+            continue
+        try:
+            poly = sp.Poly(c, *symbols)
+        except sp.PolynomialError:
+            return False
+        if poly.total_degree() > 1 or any(g.has(*symbols) for g in poly.gens if g not in symbols):
+            return False
+        if any(coef.has(*symbols) for coef in poly.coeffs()):
+            return False
+    return True
+
+
+@dataclasses.dataclass(frozen=True)
+class LoopLimits:
+    """Extent of the stable set of a loop in an ``(x, y)`` parameter plane.
+
+    Attributes
+    ----------
+    x, y : str
+        The plane's parameters.
+    y_max : float
+        Largest ``y`` of a stable point (``inf`` if unbounded, ``nan`` if the
+        set is empty).
+    x_at_y_max : float
+        The ``x`` where it is reached.
+    x_min, x_max : float
+        Extent of the stable set in ``x``.
+    area : float
+        Area of the stable set (the Z-width when ``x, y`` are damping and
+        stiffness), by the trapezoid rule over the scanned lines.
+    n_lines : int
+        Lines of constant ``x`` scanned.
+    """
+
+    x: str
+    y: str
+    y_max: float
+    x_at_y_max: float
+    x_min: float
+    x_max: float
+    area: float
+    n_lines: int
+
+    @property
+    def empty(self):
+        """True when no stable point was found."""
+        return math.isnan(self.y_max)
+
+    def __repr__(self):
+        if self.empty:
+            return f"LoopLimits({self.x}, {self.y}: no stable point found)"
+        return (f"LoopLimits({self.y}_max={self.y_max:.6g} at {self.x}={self.x_at_y_max:.6g}, "
+                f"{self.x} in [{self.x_min:.6g}, {self.x_max:.6g}], area={self.area:.6g})")
+
+
+@dataclasses.dataclass(frozen=True)
+class LoopBoundary:
+    """The D-decomposition of an ``(x, y)`` plane.
+
+    Attributes
+    ----------
+    x, y : str
+        The plane's parameters.
+    theta : ndarray
+        Angles in (0, pi).
+    x_values, y_values : ndarray
+        The point of the plane at which ``z = exp(j theta)`` is a root (NaN
+        where the 2 x 2 system is singular).
+    lines : dict
+        ``{"z = 1": (c0, cx, cy), "z = -1": ..., "leading": ...}``: the line
+        ``c0 + cx x + cy y = 0`` on which that real root (or a root at
+        infinity) appears; a line whose ``cx`` and ``cy`` are both 0 is left
+        out.
+    """
+
+    x: str
+    y: str
+    theta: np.ndarray
+    x_values: np.ndarray
+    y_values: np.ndarray
+    lines: dict
+
+    def __repr__(self):
+        finite = np.isfinite(self.x_values) & np.isfinite(self.y_values)
+        return (f"LoopBoundary({self.x}, {self.y}: {int(finite.sum())} arc points, "
+                f"lines {', '.join(self.lines) or 'none'})")
+
+
+class Loop:
+    """A sampled haptic loop: plant, zero-order hold, delay and virtual environment.
+
+    Parameters
+    ----------
+    plant : str, sympy.Expr or control.TransferFunction
+        ``G(s)``, force to position, proper and rational in ``s``, e.g.
+        ``"1/(m*s**2 + b*s)"``.
+    environment : str or sympy.Expr
+        ``VE(z)``, sampled position to force, proper and rational in ``z``;
+        ``T`` is the sample period, e.g.
+        ``"K + B*(z - 1)/(T*z) + M*(z - 1)**2/(T**2*z**2)"``.
+    values : dict, optional
+        Default values of parameters (used where a call does not give one).
+    name : str, optional
+        A label for reprs and generated files.
+    units : dict, optional
+        Unit of each parameter, as text (shown by the CLI), e.g.
+        ``{"K": "N/m"}``.
+    description : str, optional
+        One line on what the loop is.
+
+    Raises
+    ------
+    TypeError, ValueError
+        If the plant or the environment is not a proper rational function
+        of its variable, or uses ``d`` (the delay is the loop's).
+
+    Examples
+    --------
+    >>> loop = Loop("1/(m*s**2 + b*s)", "K + B*(z - 1)/(T*z)")
+    >>> loop.parameters
+    ('B', 'K', 'b', 'm', 'T', 'd')
+    >>> loop.zoh_method
+    'residues'
+    >>> bool(loop.is_stable(K=300.0, B=0.5, m=0.0128, b=0.0324, T=1e-3, d=0))
+    True
+    """
+
+    def __init__(self, plant, environment, *, values=None, name=None, units=None,
+                 description=""):
+        self.plant = parse_plant(plant)
+        self.environment = parse_environment(environment)
+        self.name = name or "loop"
+        self.description = description
+        symbols = {str(x): x for x in self.plant.free_symbols | self.environment.free_symbols}
+        symbols.pop("s", None)
+        symbols.pop("z", None)
+        symbols.pop("T", None)
+        self._symbols = dict(sorted(symbols.items()))
+        self._symbols["T"] = model.T
+        self._plant_names = tuple(n for n in self._symbols
+                                  if self._symbols[n] in self.plant.free_symbols)
+        self._environment_names = tuple(n for n in self._symbols
+                                        if self._symbols[n] in self.environment.free_symbols)
+        self.parameters = tuple(self._symbols) + ("d",)
+        self.defaults = {}
+        for key, value in (values or {}).items():
+            if key not in self.parameters:
+                raise ValueError(f"values: {key!r} is not a parameter of this loop "
+                                 f"(parameters: {', '.join(self.parameters)})")
+            self.defaults[key] = value
+        self.units = {}
+        for key, unit in (units or {}).items():
+            if key not in self.parameters:
+                raise ValueError(f"units: {key!r} is not a parameter of this loop "
+                                 f"(parameters: {', '.join(self.parameters)})")
+            self.units[key] = str(unit)
+        poles = linear_poles(sp.together(self.plant / model.s))
+        numeric_plant = not (self.plant.free_symbols - {model.s})
+        self.zoh_method = "residues" if poles is not None and not numeric_plant else "matrix exponential"
+
+    def __repr__(self):
+        return (f"Loop(plant={str(self.plant)!r}, environment={str(self.environment)!r}, "
+                f"zoh={self.zoh_method!r})")
+
+    # -- symbolic ---------------------------------------------------------
+
+    @functools.cached_property
+    def _environment_parts(self):
+        num, den = sp.fraction(sp.cancel(sp.together(self.environment)))
+        return _poly_coeffs(num, model.z), _poly_coeffs(den, model.z)
+
+    @functools.cached_property
+    def _plant_parts(self):
+        """(P_n, P_d) coefficient lists in z (symbolic), or None for the numeric path."""
+        if self.zoh_method != "residues":
+            return None
+        pulse = zoh_pulse_transfer_function(self.plant)
+        num, den = sp.fraction(sp.cancel(pulse))
+        return _poly_coeffs(num, model.z), _poly_coeffs(den, model.z)
+
+    def pulse_transfer_function(self):
+        """``Z[ZOH G](z)`` as a SymPy rational function of ``z``.
+
+        Raises
+        ------
+        ValueError
+            If the loop's plant is discretised numerically (see
+            :attr:`zoh_method`).
+        """
+        if self._plant_parts is None:
+            raise ValueError("this plant's poles are not linear factors over its parameters: "
+                             "its pulse transfer function is computed numerically "
+                             "(zoh_method = 'matrix exponential') once its values are given")
+        num, den = self._plant_parts
+        z = model.z
+        return sp.Add(*[c * z**k for k, c in enumerate(reversed(num))]) / sp.Add(
+            *[c * z**k for k, c in enumerate(reversed(den))])
+
+    def characteristic_polynomial(self, **values):
+        """``chi(z) = z**d Ve_d P_d + Ve_n P_n`` with a symbolic integer delay ``d``.
+
+        Parameters
+        ----------
+        **values
+            Parameter values to substitute (optional).  A plant discretised
+            numerically needs the values of all its parameters and ``T``.
+
+        Returns
+        -------
+        sympy.Expr
+            Its roots in ``z`` are the closed-loop poles.
+        """
+        unknown = set(values) - set(self.parameters)
+        if unknown:
+            raise TypeError(f"unknown parameter(s) {', '.join(sorted(unknown))}; "
+                            f"parameters: {', '.join(self.parameters)}")
+        z = model.z
+        delayed, direct = self._symbolic_parts(values)
+        poly = (z**model.d * sp.Add(*[c * z**k for k, c in enumerate(reversed(delayed))])
+                + sp.Add(*[c * z**k for k, c in enumerate(reversed(direct))]))
+        sub = {self._symbols[k]: v for k, v in values.items() if k != "d"}
+        poly = poly.subs(sub)
+        if "d" in values:
+            poly = poly.subs(model.d, check_delay(values["d"]))
+        return poly
+
+    def _symbolic_parts(self, values=None):
+        ve_n, ve_d = self._environment_parts
+        if self._plant_parts is None:
+            need = [n for n in self._plant_names + ("T",) if n not in (values or {})]
+            if need:
+                raise ValueError(f"the plant is discretised numerically: give "
+                                 f"{', '.join(need)} to get its polynomial")
+            p_n, p_d = self._numeric_plant(tuple(float(values[n]) for n in self._plant_names),
+                                           float(values["T"]))
+            p_n = [sp.Float(str(c), _DPS) for c in p_n]
+            p_d = [sp.Float(str(c), _DPS) for c in p_d]
+        else:
+            p_n, p_d = self._plant_parts
+        z = model.z
+
+        def product(a, b):
+            pa = sp.Add(*[c * z**k for k, c in enumerate(reversed(a))])
+            pb = sp.Add(*[c * z**k for k, c in enumerate(reversed(b))])
+            return _poly_coeffs(pa * pb, z)
+
+        return product(ve_d, p_d), product(ve_n, p_n)
+
+    @functools.cached_property
+    def _parts(self):
+        """Delayed and direct coefficient lists (symbolic path only)."""
+        return self._symbolic_parts()
+
+    def affine_parameters(self):
+        """Names of the parameters in which the characteristic polynomial is affine.
+
+        These can be the axes of a parameter plane (:meth:`boundary`,
+        :meth:`limits`) or the variable of :meth:`stable_intervals`.  With a
+        plant discretised numerically only environment parameters qualify.
+        """
+        out = []
+        for name in self._symbols:
+            if self._affine((name,)):
+                out.append(name)
+        return tuple(out)
+
+    @functools.lru_cache(maxsize=None)
+    def _affine(self, names):
+        symbols = [self._symbols[n] for n in names]
+        if self._plant_parts is None:
+            if any(n in self._plant_names or n == "T" for n in names):
+                return False
+            ve_n, ve_d = self._environment_parts
+            return _is_affine(ve_n + ve_d, symbols)
+        if len(names) == 2 and any(n in self._plant_names for n in names) and not all(
+                n in self._plant_names for n in names):
+            # One in each block: affine only if the cross terms cancel, which
+            # the slopes computed block by block would miss; refuse instead.
+            return False
+        delayed, direct = self._parts
+        if any(n in self._plant_names and n in self._environment_names for n in names):
+            return False
+        return _is_affine(delayed + direct, symbols)
+
+    def _check_plane(self, names):
+        for name in names:
+            if not isinstance(name, str):
+                raise TypeError(f"a plane parameter must be a name (str), got {type(name).__name__}")
+            if name not in self._symbols:
+                raise ValueError(f"{name!r} is not a parameter of this loop "
+                                 f"(parameters: {', '.join(self._symbols)})")
+        if len(set(names)) != len(names):
+            raise ValueError(f"the plane's parameters must differ, got {names[0]!r} twice")
+        for name in names:
+            if not self._affine((name,)):
+                raise ValueError(
+                    f"parameter {name!r} does not enter the characteristic polynomial affinely; "
+                    f"a plane or a line needs affine parameters: "
+                    f"{', '.join(self.affine_parameters()) or 'none'}")
+        if len(names) == 2 and not self._affine(tuple(names)):
+            raise ValueError(f"parameters {names[0]!r} and {names[1]!r} do not enter the "
+                             f"characteristic polynomial jointly affinely (a product of the two "
+                             f"appears)")
+
+    # -- kernels ----------------------------------------------------------
+
+    @functools.cached_property
+    def _kernels(self):
+        names = self._environment_names + ("T",) if model.T in self.environment.free_symbols \
+            else self._environment_names
+        names = tuple(dict.fromkeys(names))
+        args = [(self._symbols[n], f"parameter {n}") for n in names]
+        ve_n, ve_d = self._environment_parts
+        outputs = ([(f"num{k}", c, f"coefficient of z^{len(ve_n) - 1 - k} of Ve_n")
+                    for k, c in enumerate(ve_n)]
+                   + [(f"den{k}", c, f"coefficient of z^{len(ve_d) - 1 - k} of Ve_d")
+                      for k, c in enumerate(ve_d)])
+        kernels = [kernel("environment", args, outputs,
+                          f"Numerator and denominator of VE(z) = {self.environment}, "
+                          f"highest power of z first.")]
+        for name in self._environment_names:
+            symbol = self._symbols[name]
+            if _is_affine(ve_n + ve_d, [symbol]):
+                kernels.append(kernel(
+                    f"environment_slope_{name}", args,
+                    [(o, sp.diff(c, symbol), f"d/d{name} of {text}") for o, c, text in outputs],
+                    f"Derivatives of the environment's coefficients in {name} (constant: "
+                    f"they enter affinely)."))
+        module = load_numpy_kernels(kernels, title=f"NumPy kernels of the loop {self.name}: "
+                                                   f"VE(z) = {self.environment}.")
+        return module, names, len(ve_n), len(ve_d)
+
+    def kernel_file(self):
+        """Where the loop's generated NumPy module lives (None if in memory)."""
+        return self._kernels[0].__file__
+
+    # -- numeric evaluation ----------------------------------------------
+
+    def _values(self, given, *, scalar=(), drop=()):
+        unknown = set(given) - set(self.parameters)
+        if unknown:
+            raise TypeError(f"unknown parameter(s) {', '.join(sorted(unknown))}; "
+                            f"parameters of this loop: {', '.join(self.parameters)}")
+        values = dict(self.defaults)
+        values.update(given)
+        missing = [n for n in self.parameters if n not in values and n not in drop]
+        if missing:
+            raise TypeError(f"missing value(s) for {', '.join(missing)}")
+        d = check_delay(values.pop("d"))
+        out = {}
+        for name in self._symbols:
+            if name in drop:
+                continue
+            if name == "T":
+                out[name] = check_array("T", values[name], low=0.0, low_open=True)
+            else:
+                out[name] = check_array(name, values[name])
+            if name in scalar and out[name].ndim:
+                raise ValueError(f"{name} must be a single value here, got an array of "
+                                 f"shape {out[name].shape}")
+        return out, d
+
+    def _numeric_plant(self, plant_values, T):
+        return self._plant_cache(tuple(plant_values), T)
+
+    @functools.cached_property
+    def _plant_functions(self):
+        """mpmath functions of (plant values..., T) giving P_n and P_d (symbolic path)."""
+        args = [self._symbols[n] for n in self._plant_names] + [model.T]
+        num, den = self._plant_parts
+        return sp.lambdify(args, [list(num), list(den)], modules="mpmath")
+
+    @functools.lru_cache(maxsize=4096)
+    def _plant_cache(self, plant_values, T):
+        """(P_n, P_d) as float arrays, monic P_d, evaluated at 30 digits."""
+        with mpmath.workdps(_DPS):
+            point = [mpmath.mpf(float(v)) for v in plant_values]
+            if self._plant_parts is None:
+                sub = {self._symbols[n]: sp.Float(float(v), _DPS)
+                       for n, v in zip(self._plant_names, plant_values)}
+                num, den = sp.fraction(sp.together(self.plant.subs(sub)))
+                num = [mpmath.mpf(sp.Float(c, _DPS)) for c in sp.Poly(num, model.s).all_coeffs()]
+                den = [mpmath.mpf(sp.Float(c, _DPS)) for c in sp.Poly(den, model.s).all_coeffs()]
+                p_n, p_d = numeric_zoh(num, den, mpmath.mpf(float(T)), dps=_DPS)
+            else:
+                try:
+                    p_n, p_d = self._plant_functions(*point, mpmath.mpf(float(T)))
+                except ZeroDivisionError:
+                    p_n, p_d = [mpmath.nan], [mpmath.mpf(0)]
+                p_n = [mpmath.mpf(c) for c in p_n]
+                p_d = [mpmath.mpf(c) for c in p_d]
+            lead = p_d[0]
+            if lead == 0 or not all(mpmath.isfinite(c) for c in p_n + p_d):
+                given = ", ".join(f"{n} = {float(v):g}" for n, v in zip(self._plant_names, plant_values))
+                raise ValueError(f"the plant's pulse transfer function is not defined at "
+                                 f"{given}, T = {float(T):g} (a pole cancels a parameter, "
+                                 f"e.g. b = 0 in 1/(m s**2 + b s)? write that plant with b = 0)")
+            return (np.array([float(c / lead) for c in p_n]),
+                    np.array([float(c / lead) for c in p_d]))
+
+    def _plant_arrays(self, values, shape):
+        """(P_n, P_d) per point, shape ``shape + (k,)``, one 30-digit evaluation per distinct row."""
+        names = self._plant_names + ("T",)
+        columns = np.stack([np.broadcast_to(values[n], shape).ravel() for n in names], axis=-1)
+        unique, inverse = np.unique(columns, axis=0, return_inverse=True)
+        parts = [self._numeric_plant(tuple(row[:-1]), float(row[-1])) for row in unique]
+        p_n = np.array([p[0] for p in parts])[inverse.ravel()]
+        p_d = np.array([p[1] for p in parts])[inverse.ravel()]
+        return p_n.reshape(shape + p_n.shape[-1:]), p_d.reshape(shape + p_d.shape[-1:])
+
+    def _environment_arrays(self, values, shape, slope=None):
+        module, names, n_num, n_den = self._kernels
+        function = module.environment if slope is None else getattr(module, f"environment_slope_{slope}")
+        with np.errstate(all="ignore"):
+            out = function(*[values[n] for n in names])
+        out = [np.broadcast_to(np.asarray(c, dtype=float), shape) for c in out]
+        return np.stack(out[:n_num], axis=-1), np.stack(out[n_num:], axis=-1)
+
+    def _dense(self, delayed, direct, d):
+        n = d + delayed.shape[-1] - 1
+        out = np.zeros(delayed.shape[:-1] + (n + 1,))
+        out[..., : delayed.shape[-1]] += delayed
+        out[..., n + 1 - direct.shape[-1]:] += direct
+        return out
+
+    @staticmethod
+    def _convolve(a, b):
+        out = np.zeros(np.broadcast_shapes(a.shape[:-1], b.shape[:-1]) + (a.shape[-1] + b.shape[-1] - 1,))
+        for i in range(a.shape[-1]):
+            out[..., i:i + b.shape[-1]] += a[..., i, None] * b
+        return out
+
+    def _coefficients(self, values, d, shape, *, slope=None, plant=None):
+        if plant is None:
+            plant = self._plant_arrays(values, shape)
+        p_n, p_d = plant
+        if slope is None or slope in self._environment_names:
+            ve_n, ve_d = self._environment_arrays(values, shape, slope)
+            delayed, direct = self._convolve(ve_d, p_d), self._convolve(ve_n, p_n)
+        else:
+            # A plant parameter: the slope of P_n, P_d (30 digits) by the
+            # exact derivative of their symbolic coefficients.
+            ve_n, ve_d = self._environment_arrays(values, shape)
+            dp_n, dp_d = self._plant_slope(values, shape, slope)
+            delayed, direct = self._convolve(ve_d, dp_d), self._convolve(ve_n, dp_n)
+        return self._dense(delayed, direct, d)
+
+    def _plant_slope(self, values, shape, name):
+        # P_d is normalised to be monic in _plant_cache, which would make an
+        # affine dependence rational; so differentiate the unnormalised
+        # coefficients, scaled by the same leading coefficient (constant in
+        # ``name`` when the loop is affine in it, checked by _check_plane).
+        num, den = self._plant_parts
+        symbol = self._symbols[name]
+        if sp.diff(den[0], symbol) != 0:
+            raise ValueError(f"parameter {name!r} scales the plant's denominator; use it as a "
+                             f"fixed value")
+        names = self._plant_names + ("T",)
+        columns = np.stack([np.broadcast_to(values[n], shape).ravel() for n in names], axis=-1)
+        unique, inverse = np.unique(columns, axis=0, return_inverse=True)
+        rows = []
+        for row in unique:
+            sub = {self._symbols[n]: sp.Float(repr(float(v)), _DPS) for n, v in zip(names, row)}
+            lead = den[0].subs(sub).evalf(_DPS)
+            rows.append(([float(sp.diff(c, symbol).subs(sub).evalf(_DPS) / lead) for c in num],
+                         [float(sp.diff(c, symbol).subs(sub).evalf(_DPS) / lead) for c in den]))
+        dp_n = np.array([r[0] for r in rows])[inverse.ravel()].reshape(shape + (len(num),))
+        dp_d = np.array([r[1] for r in rows])[inverse.ravel()].reshape(shape + (len(den),))
+        return dp_n, dp_d
+
+    def _prepare(self, given, scalar=(), drop=()):
+        values, d = self._values(given, scalar=scalar, drop=drop)
+        try:
+            shape = np.broadcast_shapes(*[v.shape for v in values.values()])
+        except ValueError as exc:
+            raise ValueError(f"parameter arrays must broadcast together: {exc}") from None
+        return values, d, shape
+
+    def coefficients(self, **values):
+        """Coefficients of ``chi(z)`` (highest power first), divided by ``P_d``'s leading one.
+
+        Parameters
+        ----------
+        **values
+            Every parameter (:attr:`parameters`), or its default; arrays
+            broadcast; ``d`` is an integer.
+
+        Returns
+        -------
+        ndarray
+            Shape ``broadcast_shape + (degree + 1,)``.
+        """
+        values, d, shape = self._prepare(values)
+        size = int(np.prod(shape))
+        check_memory("the loop's coefficients", 8 * size * (d + 16))
+        return self._coefficients(values, d, shape)
+
+    def spectral_radius(self, **values):
+        """Largest modulus of the closed-loop poles (batched eigenvalues).
+
+        Parameters are as in :meth:`coefficients`.  Returns a float or an
+        array of the broadcast shape.
+        """
+        c = self.coefficients(**values)
+        r = polynomial_spectral_radius(c.reshape(-1, c.shape[-1])).reshape(c.shape[:-1])
+        return float(r) if r.ndim == 0 else r
+
+    def classify(self, **values):
+        """Stable (1), marginal (0) or unstable (-1) at each point.
+
+        Certified as :func:`symstab.stability.classify_polynomials` is: for
+        the polynomial with the coefficients as computed (each within an ulp
+        or so of the exact value: the plant at 30 digits, the environment in
+        double precision).  Parameters are as in :meth:`coefficients`.
+
+        Returns
+        -------
+        int or ndarray of int8
+        """
+        c = self.coefficients(**values)
+        codes = classify_polynomials(c)
+        return int(codes) if codes.ndim == 0 else codes
+
+    def is_stable(self, **values):
+        """Whether each point is stable: bool, or a masked bool array (masked = marginal).
+
+        A single point gives ``True``, ``False`` or ``None`` (marginal).
+        """
+        codes = self.classify(**values)
+        if np.ndim(codes) == 0:
+            return None if codes == MARGINAL else bool(codes == STABLE)
+        return np.ma.masked_array(codes == STABLE, mask=codes == MARGINAL)
+
+    def unstable_root_counts(self, **values):
+        """Certified number of closed-loop poles outside the unit circle (-1: marginal)."""
+        c = self.coefficients(**values)
+        counts = polynomial_root_counts(c.reshape(-1, c.shape[-1])).reshape(c.shape[:-1])
+        return int(counts) if counts.ndim == 0 else counts
+
+    # -- lines and planes ---------------------------------------------------
+
+    def _basis(self, names, given):
+        """(A0, A_x[, A_y]) coefficient rows with the named parameters set to 0."""
+        self._check_plane(names)
+        values, d, shape = self._prepare(given, scalar=self.parameters, drop=names)
+        for name in names:
+            values[name] = np.asarray(0.0)
+        plant = self._plant_arrays(values, shape)
+        base = self._coefficients(values, d, shape, plant=plant)
+        slopes = [self._coefficients(values, d, shape, slope=n, plant=plant) for n in names]
+        return base, slopes, d
+
+    def stable_intervals(self, name, **values):
+        """The stable intervals of one parameter, the others fixed.
+
+        The polynomial is ``A0(z) + p A1(z)`` in the parameter ``p``, so a
+        root crosses the unit circle only at the ``p`` where ``A0 + p A1``
+        vanishes at some ``z = exp(j theta)``: where ``Im(A0 conj A1) = 0``
+        (found as roots of a polynomial and by a sign scan, then refined),
+        at ``z = +-1``, and where the leading coefficient vanishes.  Each
+        stretch between those values is classified at its midpoint.
+
+        Parameters
+        ----------
+        name : str
+            A parameter in :meth:`affine_parameters`.
+        **values
+            Single values of every other parameter (``d`` included).
+
+        Returns
+        -------
+        list of (float, float)
+            Stable intervals ``(lo, hi)``, increasing; ``lo`` may be
+            ``-inf`` and ``hi`` ``inf``.  Endpoints are unstable or marginal.
+        """
+        base, (slope,), _ = self._basis((name,), values)
+        return _line_intervals(base, slope)
+
+    def boundary(self, x, y, n=1000, **values):
+        """The D-decomposition of the ``(x, y)`` plane.
+
+        Parameters
+        ----------
+        x, y : str
+            Two parameters entering the polynomial jointly affinely.
+        n : int
+            Angles in (0, pi).
+        **values
+            Single values of every other parameter.
+
+        Returns
+        -------
+        LoopBoundary
+        """
+        n = check_count("n", n, 2)
+        check_memory("the boundary", 64 * n)
+        base, (ax, ay), _ = self._basis((x, y), values)
+        theta = np.pi * (np.arange(1, n + 1) - 0.5) / n
+        a0, cx, cy = (_on_circle(c, theta) for c in (base, ax, ay))
+        with np.errstate(all="ignore"):
+            det = cx.real * cy.imag - cy.real * cx.imag
+            xs = (-a0.real * cy.imag + cy.real * a0.imag) / det
+            ys = (-cx.real * a0.imag + a0.real * cx.imag) / det
+            singular = np.abs(det) <= 1e-12 * np.abs(cx) * np.abs(cy)
+        xs[singular] = np.nan
+        ys[singular] = np.nan
+        lines = {}
+        for label, point in (("z = 1", 1.0), ("z = -1", -1.0)):
+            c = [float(np.polyval(p, point)) for p in (base, ax, ay)]
+            if c[1] or c[2]:
+                lines[label] = tuple(c)
+        lead = (float(base[0]), float(ax[0]), float(ay[0]))
+        if lead[1] or lead[2]:
+            lines["leading"] = lead
+        return LoopBoundary(x=x, y=y, theta=theta, x_values=xs, y_values=ys, lines=lines)
+
+    def limits(self, x, y, *, n_lines=201, **values):
+        """The extent and area of the stable set in the ``(x, y)`` plane.
+
+        Lines of constant ``x`` are cut into stable intervals of ``y``
+        (:meth:`stable_intervals`); the scanned window of ``x`` is the extent
+        of the D-decomposition's finite arc points and line intersections,
+        widened while the stable set reaches its edge.  ``x_min``, ``x_max``
+        are refined by bisection and ``y_max`` by golden-section search.
+
+        Parameters
+        ----------
+        x, y : str
+            The plane's parameters (jointly affine).
+        n_lines : int
+            Lines of constant ``x`` scanned over the stable set's extent.
+        **values
+            Single values of every other parameter.
+
+        Returns
+        -------
+        LoopLimits
+        """
+        n_lines = check_count("n_lines", n_lines, 8)
+        base, (ax, ay), _ = self._basis((x, y), values)
+
+        def intervals(xv):
+            return _line_intervals(base + xv * ax, ay)
+
+        def top(xv):
+            found = intervals(xv)
+            return max((hi for _, hi in found), default=-np.inf)
+
+        seeds = _stable_seeds(base, ax, ay)
+        if seeds.size == 0:
+            return LoopLimits(x, y, np.nan, np.nan, np.nan, np.nan, 0.0, 0)
+        scale = max(float(np.ptp(seeds)), 1e-12 * max(1.0, float(np.max(np.abs(seeds)))))
+
+        def reach(start, direction):
+            """Walk from a stable line until a line has no stable point; bisect back."""
+            inside, step = start, 0.01 * scale
+            for _ in range(80):
+                trial = inside + direction * step
+                if not intervals(trial):
+                    break
+                inside, step = trial, 2 * step
+            else:
+                return direction * np.inf
+            outside = inside + direction * step
+            for _ in range(60):
+                mid = 0.5 * (inside + outside)
+                if mid in (inside, outside):
+                    break
+                if intervals(mid):
+                    inside = mid
+                else:
+                    outside = mid
+            return inside
+
+        x_min = reach(float(np.min(seeds)), -1.0)
+        x_max = reach(float(np.max(seeds)), 1.0)
+        if not (np.isfinite(x_min) and np.isfinite(x_max)):
+            return LoopLimits(x, y, np.inf, np.nan, x_min, x_max, np.inf, 0)
+        grid = np.linspace(x_min, x_max, n_lines)
+        lines = [intervals(v) for v in grid]
+        tops = np.array([max((h for _, h in iv), default=-np.inf) for iv in lines])
+        if np.any(np.isinf(tops) & (tops > 0)):
+            return LoopLimits(x, y, np.inf, float(grid[np.argmax(tops)]), x_min, x_max, np.inf,
+                              n_lines)
+        lengths = np.array([sum(h - l for l, h in iv) for iv in lines])
+        if not np.all(np.isfinite(lengths)):
+            area = np.inf
+        else:
+            area = float(np.sum(0.5 * (lengths[1:] + lengths[:-1]) * np.diff(grid)))
+        best = int(np.argmax(tops))
+        a, b = grid[max(best - 1, 0)], grid[min(best + 1, n_lines - 1)]
+        x_best = float(_golden_max(np.vectorize(top), a, b, iterations=60))
+        y_best = top(x_best)
+        if not y_best >= tops[best]:
+            x_best, y_best = float(grid[best]), float(tops[best])
+        return LoopLimits(x, y, float(y_best), x_best, float(x_min), float(x_max), area, n_lines)
+
+    def closed_loop(self, **values):
+        """The closed loop from a force at the plant's input to the position.
+
+        ``P / (1 + VE z**-d P) = z**d Ve_d P_n / chi(z)``, built from the
+        polynomials (nothing cancelled), so its poles are the roots of
+        ``chi``.  Needs python-control.
+
+        Returns
+        -------
+        control.TransferFunction
+            Discrete time, ``dt = T``.
+        """
+        try:
+            import control
+        except ImportError:
+            raise ImportError("Loop.closed_loop needs python-control: pip install control") from None
+        values, d, shape = self._prepare(values, scalar=self.parameters)
+        chi = self._coefficients(values, d, shape)
+        p_n, _ = self._plant_arrays(values, shape)
+        _, ve_d = self._environment_arrays(values, shape)
+        num = np.concatenate([self._convolve(ve_d, p_n), np.zeros(d)])
+        return control.tf(num, chi, float(values["T"]))
+
+
+def _on_circle(c, theta):
+    """Values of the polynomial rows ``c`` (highest first) at ``exp(j theta)``."""
+    z = np.exp(1j * np.asarray(theta))
+    out = np.zeros_like(z)
+    for ck in c:
+        out = out * z + ck
+    return out
+
+
+def _circle_candidates(a0, a1):
+    """Parameter values ``p`` at which ``a0 + p a1`` has a root on the unit circle.
+
+    Angles where ``Im(a0 conj a1) = 0``: the unit-circle roots of the
+    polynomial ``a0 rev(a1) - rev(a0) a1`` (eigenvalues, polished), joined
+    with the sign changes on a scan of the angle (refined by the root
+    bracketer), and the ends ``theta = 0, pi``.
+    """
+    from .curves import bracketed_root
+
+    n = len(a0) - 1
+    h = np.polysub(np.polymul(a0, a1[::-1]), np.polymul(a0[::-1], a1))
+    angles = [0.0, np.pi]
+    h = np.trim_zeros(h, "f")
+    if len(h) > 1 and np.any(h):
+        with np.errstate(all="ignore"):
+            roots = np.roots(h)
+        near = roots[np.abs(np.abs(roots) - 1) < 1e-4]
+        angles += [float(abs(np.angle(r))) for r in near]
+
+    def g(theta):
+        v0, v1 = _on_circle(a0, theta), _on_circle(a1, theta)
+        return (v0 * np.conj(v1)).imag
+
+    grid = np.linspace(0.0, np.pi, max(512, 32 * (n + 1)))
+    values = g(grid)
+    change = np.flatnonzero(np.sign(values[:-1]) * np.sign(values[1:]) < 0)
+    if change.size:
+        angles += list(bracketed_root(g, grid[change], grid[change + 1]))
+    angles = np.unique(np.clip(angles, 0.0, np.pi))
+    v0, v1 = _on_circle(a0, angles), _on_circle(a1, angles)
+    with np.errstate(all="ignore"):
+        p = -(v0 * np.conj(v1)).real / np.abs(v1) ** 2
+        residual = np.abs(v0 + p * v1)
+    scale = np.abs(v0) + np.abs(p * v1)
+    keep = np.isfinite(p) & (residual <= 1e-6 * np.where(scale > 0, scale, 1.0))
+    return p[keep]
+
+
+def _line_intervals(a0, a1):
+    """Stable intervals of ``p`` for the polynomial ``a0 + p a1`` (rows, highest first)."""
+    a0, a1 = np.asarray(a0, dtype=float), np.asarray(a1, dtype=float)
+    candidates = list(_circle_candidates(a0, a1))
+    if a1[0] != 0:
+        candidates.append(-a0[0] / a1[0])
+    candidates = np.unique(np.array(candidates, dtype=float))
+    candidates = candidates[np.isfinite(candidates)]
+    if candidates.size == 0:
+        tests = np.array([0.0])
+    else:
+        pad = max(1.0, float(np.max(np.abs(candidates))))
+        tests = np.concatenate([[candidates[0] - pad], 0.5 * (candidates[1:] + candidates[:-1]),
+                                [candidates[-1] + pad]])
+    codes = classify_polynomials(a0[None, :] + tests[:, None] * a1[None, :])
+    edges = np.concatenate([[-np.inf], candidates, [np.inf]])
+    out = []
+    for k, code in enumerate(codes):
+        if code != STABLE:
+            continue
+        lo, hi = float(edges[k]), float(edges[k + 1])
+        if out and out[-1][1] == lo:
+            out[-1] = (out[-1][0], hi)
+        else:
+            out.append((lo, hi))
+    return out
+
+
+def _stable_seeds(base, ax, ay):
+    """The ``x`` of stable points next to the D-decomposition's curves.
+
+    Every cell of the plane is bounded by pieces of the arc and of the lines,
+    so a stable cell has arc points (or line intersections) on its edge:
+    eight points around each of them, a small step away, are classified at
+    once and the stable ones kept.
+    """
+    n = len(base) - 1
+    theta = np.pi * (np.arange(1, 16 * (n + 4) + 1) - 0.5) / (16 * (n + 4))
+    a0, cx, cy = (_on_circle(c, theta) for c in (base, ax, ay))
+    with np.errstate(all="ignore"):
+        det = cx.real * cy.imag - cy.real * cx.imag
+        xs = (-a0.real * cy.imag + cy.real * a0.imag) / det
+        ys = (-cx.real * a0.imag + a0.real * cx.imag) / det
+    lines = [(np.polyval(base, p), np.polyval(ax, p), np.polyval(ay, p)) for p in (1.0, -1.0)]
+    lines.append((base[0], ax[0], ay[0]))
+    for i in range(len(lines)):
+        for j in range(i + 1, len(lines)):
+            (c0, c1, c2), (e0, e1, e2) = lines[i], lines[j]
+            det = c1 * e2 - c2 * e1
+            if det != 0:
+                xs = np.append(xs, (-c0 * e2 + c2 * e0) / det)
+                ys = np.append(ys, (-c1 * e0 + c0 * e1) / det)
+    keep = np.isfinite(xs) & np.isfinite(ys)
+    xs, ys = xs[keep], ys[keep]
+    if xs.size == 0:
+        return xs
+    sx = np.median(np.abs(xs)) or 1.0
+    sy = np.median(np.abs(ys)) or 1.0
+    steps = 10.0 ** np.arange(-6, -1)
+    px, py = [], []
+    for step in steps:
+        for ux, uy in ((1, 0), (-1, 0), (0, 1), (0, -1), (1, 1), (1, -1), (-1, 1), (-1, -1)):
+            px.append(xs + ux * step * (np.abs(xs) + sx))
+            py.append(ys + uy * step * (np.abs(ys) + sy))
+    px, py = np.concatenate(px), np.concatenate(py)
+    codes = classify_polynomials(base[None, :] + px[:, None] * ax[None, :] + py[:, None] * ay[None, :],
+                                 refine=False)
+    return px[codes == STABLE]

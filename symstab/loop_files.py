@@ -1,0 +1,101 @@
+"""Loop files: a loop, its default values and their units, in a small TOML file.
+
+::
+
+    name = "paper"
+    description = "The paper's device: a mass with viscous friction"
+    plant = "1/(m*s**2 + b*s)"
+    environment = "K + B*(z - 1)/(T*z) + M*(z - 1)**2/(T**2*z**2)"
+
+    [parameters]
+    m = { value = 0.0128, unit = "kg" }
+    b = { value = 0.0324, unit = "N s/m" }
+    T = { value = 1e-3, unit = "s" }
+    d = { value = 0, unit = "samples" }
+    K = 300.0                       # a bare number: no unit
+
+:func:`load_loop` reads one into a :class:`symstab.Loop`; every mistake is
+a :class:`ValueError` that names the file and the key.
+"""
+
+import math
+import pathlib
+import sys
+
+if sys.version_info >= (3, 11):
+    import tomllib
+else:   # pragma: no cover - Python 3.10
+    import tomli as tomllib
+
+from .any_loop import Loop
+
+__all__ = ["load_loop", "parse_loop_text"]
+
+_KEYS = {"name", "description", "plant", "environment", "parameters"}
+
+
+def parse_loop_text(text, *, source="<loop file>"):
+    """Build a :class:`Loop` from the text of a loop file.
+
+    Raises
+    ------
+    ValueError
+        For invalid TOML, a missing or unknown key, a value that is not a
+        finite number, or a plant or environment the loop refuses.
+    """
+    try:
+        data = tomllib.loads(text)
+    except tomllib.TOMLDecodeError as exc:
+        raise ValueError(f"{source}: not valid TOML: {exc}") from None
+    unknown = set(data) - _KEYS
+    if unknown:
+        raise ValueError(f"{source}: unknown key(s) {', '.join(sorted(unknown))}; "
+                         f"allowed: {', '.join(sorted(_KEYS))}")
+    for key in ("plant", "environment"):
+        if not isinstance(data.get(key), str):
+            raise ValueError(f"{source}: {key!r} must be given as a string")
+    values, units = {}, {}
+    parameters = data.get("parameters", {})
+    if not isinstance(parameters, dict):
+        raise ValueError(f"{source}: [parameters] must be a table")
+    for key, entry in parameters.items():
+        if isinstance(entry, dict):
+            extra = set(entry) - {"value", "unit"}
+            if extra or "value" not in entry:
+                raise ValueError(f"{source}: parameter {key!r} must be a number or "
+                                 f"{{ value = ..., unit = \"...\" }}")
+            value, unit = entry["value"], entry.get("unit")
+        else:
+            value, unit = entry, None
+        if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
+            raise ValueError(f"{source}: parameter {key!r} must be a finite number, got {value!r}")
+        values[key] = value
+        if unit is not None:
+            units[key] = str(unit)
+    try:
+        return Loop(data["plant"], data["environment"], values=values, units=units,
+                    name=str(data.get("name", pathlib.Path(source).stem)),
+                    description=str(data.get("description", "")))
+    except (TypeError, ValueError) as exc:
+        raise ValueError(f"{source}: {exc}") from None
+
+
+def load_loop(path):
+    """Read a loop file (TOML) into a :class:`Loop` with its default values and units.
+
+    Parameters
+    ----------
+    path : str or path-like
+
+    Raises
+    ------
+    ValueError
+        If the file cannot be read or is not a valid loop file (the message
+        names the file).
+    """
+    path = pathlib.Path(path)
+    try:
+        text = path.read_text(encoding="utf-8")
+    except OSError as exc:
+        raise ValueError(f"cannot read loop file {str(path)!r}: {exc.strerror or exc}") from None
+    return parse_loop_text(text, source=str(path))
