@@ -290,6 +290,9 @@ class Loop:
         ``{"K": "N/m"}``.
     description : str, optional
         One line on what the loop is.
+    plane : (str, str), optional
+        The default ``(x, y)`` plane of :meth:`boundary` and :meth:`limits`
+        (for example ``("B", "K")``); checked to be jointly affine.
 
     Raises
     ------
@@ -309,7 +312,7 @@ class Loop:
     """
 
     def __init__(self, plant, environment, *, values=None, name=None, units=None,
-                 description=""):
+                 description="", plane=None):
         self.plant = parse_plant(plant)
         self.environment = parse_environment(environment)
         self.name = name or "loop"
@@ -340,6 +343,13 @@ class Loop:
         poles = linear_poles(sp.together(self.plant / model.s))
         numeric_plant = not (self.plant.free_symbols - {model.s})
         self.zoh_method = "residues" if poles is not None and not numeric_plant else "matrix exponential"
+        self.plane = None
+        if plane is not None:
+            plane = tuple(plane)
+            if len(plane) != 2:
+                raise ValueError(f"plane must be two parameter names, got {plane!r}")
+            self._check_plane(plane)
+            self.plane = plane
 
     def __repr__(self):
         return (f"Loop(plant={str(self.plant)!r}, environment={str(self.environment)!r}, "
@@ -759,13 +769,21 @@ class Loop:
         base, (slope,), _ = self._basis((name,), values)
         return _line_intervals(base, slope)
 
-    def boundary(self, x, y, n=1000, **values):
+    def _plane(self, x, y):
+        if x is None and y is None and self.plane is not None:
+            return self.plane
+        if x is None or y is None:
+            raise TypeError("give the plane's parameters x and y (this loop has no default plane)")
+        return x, y
+
+    def boundary(self, x=None, y=None, n=1000, **values):
         """The D-decomposition of the ``(x, y)`` plane.
 
         Parameters
         ----------
         x, y : str
-            Two parameters entering the polynomial jointly affinely.
+            Two parameters entering the polynomial jointly affinely
+            (default: the loop's :attr:`plane`).
         n : int
             Angles in (0, pi).
         **values
@@ -775,6 +793,7 @@ class Loop:
         -------
         LoopBoundary
         """
+        x, y = self._plane(x, y)
         n = check_count("n", n, 2)
         check_memory("the boundary", 64 * n)
         base, (ax, ay), _ = self._basis((x, y), values)
@@ -797,7 +816,7 @@ class Loop:
             lines["leading"] = lead
         return LoopBoundary(x=x, y=y, theta=theta, x_values=xs, y_values=ys, lines=lines)
 
-    def limits(self, x, y, *, n_lines=201, **values):
+    def limits(self, x=None, y=None, *, n_lines=201, **values):
         """The extent and area of the stable set in the ``(x, y)`` plane.
 
         Lines of constant ``x`` are cut into stable intervals of ``y``
@@ -809,7 +828,8 @@ class Loop:
         Parameters
         ----------
         x, y : str
-            The plane's parameters (jointly affine).
+            The plane's parameters, jointly affine (default: the loop's
+            :attr:`plane`).
         n_lines : int
             Lines of constant ``x`` scanned over the stable set's extent.
         **values
@@ -819,6 +839,7 @@ class Loop:
         -------
         LoopLimits
         """
+        x, y = self._plane(x, y)
         n_lines = check_count("n_lines", n_lines, 8)
         base, (ax, ay), _ = self._basis((x, y), values)
 

@@ -6,6 +6,7 @@
     description = "The paper's device: a mass with viscous friction"
     plant = "1/(m*s**2 + b*s)"
     environment = "K + B*(z - 1)/(T*z) + M*(z - 1)**2/(T**2*z**2)"
+    plane = ["B", "K"]              # optional: the default (x, y) plane
 
     [parameters]
     m = { value = 0.0128, unit = "kg" }
@@ -31,7 +32,7 @@ from .any_loop import Loop
 
 __all__ = ["load_loop", "parse_loop_text"]
 
-_KEYS = {"name", "description", "plant", "environment", "parameters"}
+_KEYS = {"name", "description", "plant", "environment", "plane", "parameters"}
 
 
 def parse_loop_text(text, *, source="<loop file>"):
@@ -72,10 +73,14 @@ def parse_loop_text(text, *, source="<loop file>"):
         values[key] = value
         if unit is not None:
             units[key] = str(unit)
+    plane = data.get("plane")
+    if plane is not None and not (isinstance(plane, list) and len(plane) == 2
+                                  and all(isinstance(p, str) for p in plane)):
+        raise ValueError(f"{source}: 'plane' must be two parameter names, e.g. [\"B\", \"K\"]")
     try:
         return Loop(data["plant"], data["environment"], values=values, units=units,
                     name=str(data.get("name", pathlib.Path(source).stem)),
-                    description=str(data.get("description", "")))
+                    description=str(data.get("description", "")), plane=plane)
     except (TypeError, ValueError) as exc:
         raise ValueError(f"{source}: {exc}") from None
 
