@@ -14,7 +14,7 @@ import sympy as sp
 from symstab import model
 from symstab.boundary import boundary, coefficients
 from symstab.evaluate import boundary_point
-from symstab.small_theta import small_theta_limits
+from symstab.small_theta import small_theta_limits, taylor_coefficients
 
 from ._common import DEVICE_DELTA, compare, show, where, with_printed_coefficients
 from .audit import Outcome, check
@@ -26,9 +26,7 @@ theta = model.theta
 
 def _leading(expr, order=8):
     """(power, coefficient) of the leading term of ``expr`` in theta."""
-    series = sp.expand(sp.series(expr, theta, 0, order).removeO())
-    for p in range(order):
-        c = sp.factor(series.coeff(theta, p))
+    for p, c in enumerate(taylor_coefficients(expr, order - 1)):
         if c != 0:
             return p, c
     raise AssertionError(f"no term below theta^{order}")

@@ -18,7 +18,7 @@ import sympy as sp
 from . import model
 from .boundary import boundary
 
-__all__ = ["SmallThetaLimits", "small_theta_limits"]
+__all__ = ["SmallThetaLimits", "small_theta_limits", "taylor_coefficients"]
 
 
 @dataclasses.dataclass(frozen=True)
@@ -50,12 +50,12 @@ def _trig_taylor(expr, order):
     """``expr`` with each sin(c theta), cos(c theta) replaced by its Taylor polynomial.
 
     ``c`` may depend on any symbol but theta (here it is ``d + k``).  The
-    result agrees with ``expr`` to ``O(theta**(order + 1))`` and is a
-    polynomial in theta, so its coefficients are read off directly: the
-    boundary forms are sums of such terms, and this takes 0.15 s where
-    ``sympy.series`` of the whole expressions took 2.7 s (the same
-    coefficients, the same factored forms).  Returns None when ``expr`` holds any other function of
-    theta.
+    result agrees with ``expr`` to ``O(theta**(order + 1))``; when it is a
+    polynomial in theta its coefficients are read off directly.  The
+    boundary forms are sums of such terms: their limits take 0.15 s this
+    way, where ``sympy.series`` of the whole expressions took 2.7 s (the
+    same coefficients, the same factored forms).  Returns None when
+    ``expr`` holds any other function of theta.
     """
     theta = model.theta
     replace = {}
@@ -72,12 +72,30 @@ def _trig_taylor(expr, order):
     return taylor
 
 
-def _series_coefficients(expr, order):
-    """Return the Taylor coefficients of ``expr`` in theta up to ``order``."""
+def taylor_coefficients(expr, order):
+    """The Taylor coefficients of ``expr`` in theta at 0, factored.
+
+    Parameters
+    ----------
+    expr : sympy.Expr
+        A function of :data:`symstab.model.theta` analytic at 0.
+    order : int
+        The highest power kept.
+
+    Returns
+    -------
+    list of sympy.Expr
+        ``order + 1`` coefficients, of theta**0 to theta**order, each
+        through :func:`sympy.factor`.
+    """
     taylor = _trig_taylor(expr, order)
     if taylor is not None:
-        poly = sp.Poly(taylor, model.theta)
-        return [sp.factor(poly.coeff_monomial(model.theta**k)) for k in range(order + 1)]
+        try:
+            poly = sp.Poly(taylor, model.theta)
+        except sp.PolynomialError:     # theta also in a denominator or a root
+            poly = None
+        if poly is not None:
+            return [sp.factor(poly.coeff_monomial(model.theta**k)) for k in range(order + 1)]
     series = sp.expand(sp.series(expr, model.theta, 0, order + 1).removeO())
     return [sp.factor(series.coeff(model.theta, k)) for k in range(order + 1)]
 
@@ -109,9 +127,9 @@ def small_theta_limits():
     """
     bd = boundary()
     order = 5
-    den = _series_coefficients(bd.denominator, order)
-    alpha = _quotient_series(_series_coefficients(bd.alpha_numerator, order), den, 3)
-    beta = _quotient_series(_series_coefficients(bd.beta_numerator, order), den, 3)
+    den = taylor_coefficients(bd.denominator, order)
+    alpha = _quotient_series(taylor_coefficients(bd.alpha_numerator, order), den, 3)
+    beta = _quotient_series(taylor_coefficients(bd.beta_numerator, order), den, 3)
     a2 = sp.factor(alpha[2])
     # Remove factors that are positive on the model's domain (delta > 0,
     # Gamma = exp(delta) > 1 so Gamma - 1 > 0 and squares).
