@@ -22,6 +22,7 @@ import textwrap
 
 import numpy as np
 
+from . import cli_loop
 from ._resources import check_memory
 
 __all__ = ["add_commands"]
@@ -217,6 +218,8 @@ def _physical_columns(setup, names):
 
 
 def _cmd_boundary(args):
+    if cli_loop.uses_loop(args):
+        return cli_loop.run(args)
     from .curves import boundary_curve
 
     setup = _resolve(args)
@@ -284,6 +287,8 @@ def _limits_json(lim):
 
 
 def _cmd_limits(args):
+    if cli_loop.uses_loop(args):
+        return cli_loop.run(args)
     from .region import limits
 
     setup = _resolve(args)
@@ -354,6 +359,8 @@ _RADIUS_MAX_DELAY = 1000
 
 
 def _cmd_classify(args):
+    if cli_loop.uses_loop(args):
+        return cli_loop.run(args)
     from .stability import MARGINAL, STABLE, classify, spectral_radius
 
     setup = _resolve(args)
@@ -388,6 +395,8 @@ def _cmd_classify(args):
 
 
 def _cmd_design(args):
+    if cli_loop.uses_loop(args):
+        return cli_loop.run(args)
     from .region import best_virtual_mass, limits
 
     setup = _resolve(args, mass=False)
@@ -429,6 +438,7 @@ def add_commands(sub):
         example="symstab boundary --Td 0.01 --n 11", func=_cmd_boundary)
     _add_model_options(p)
     p.add_argument("--n", type=int, default=101, help="points on the arc (default 101)")
+    cli_loop.add_loop_options(p, "boundary")
 
     p = add_command(
         sub, "limits", help="alpha_max, the beta range and the Z-width",
@@ -444,6 +454,7 @@ def add_commands(sub):
     x = p.add_mutually_exclusive_group()
     x.add_argument("--beta", type=float, help="also give the stable alpha interval(s) at this beta")
     x.add_argument("--Bw", type=float, help="also give the stable K_w interval(s) at this damping")
+    cli_loop.add_loop_options(p, "limits")
 
     p = add_command(
         sub, "classify", help="stable, unstable or marginal, with the spectral radius",
@@ -457,6 +468,7 @@ def add_commands(sub):
     p.add_argument("--beta", help="dimensionless damping(s), comma-separated")
     p.add_argument("--Kw", help="virtual stiffness(es), comma-separated (physical)")
     p.add_argument("--Bw", help="virtual damping(s), comma-separated (physical)")
+    cli_loop.add_loop_options(p, "classify")
 
     p = add_command(
         sub, "design", help="the virtual mass that maximises the renderable stiffness",
@@ -465,3 +477,4 @@ def add_commands(sub):
                     "and the gain over no virtual mass.",
         example="symstab design --Td 0.04", func=_cmd_design)
     _add_model_options(p)
+    cli_loop.add_loop_options(p, "design")

@@ -15,6 +15,7 @@ import sys
 
 import numpy as np
 
+from . import cli_loop
 from ._resources import check_memory
 from .cli_numeric import _add_model_options, _parse_list, _resolve, stiffness_and_damping
 
@@ -156,6 +157,8 @@ def _grid(text, name):
 
 
 def _cmd_map(args):
+    if cli_loop.uses_loop(args):
+        return cli_loop.run(args)
     from .simulate import check_steps, progress_printer, stability_map
     from .stability import MARGINAL, STABLE, classify
 
@@ -353,3 +356,4 @@ def add_commands(sub):
     p.add_argument("--out", required=True, help="output file, .csv or .npz")
     p.add_argument("--png", help="PNG file (default: --out with .png)")
     p.add_argument("--no-png", action="store_true", help="do not draw the PNG")
+    cli_loop.add_loop_options(p, "map")

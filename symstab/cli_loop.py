@@ -1,0 +1,672 @@
+"""``--loop FILE`` and ``--set NAME=VALUE``: the numeric commands on any loop.
+
+``boundary``, ``limits``, ``classify``, ``design`` and ``map`` take a loop
+file (:func:`symstab.load_loop`) instead of the paper's device options; the
+file's default values are changed with ``--set NAME=VALUE`` (repeatable) and
+the parameter plane is the file's ``plane`` unless ``--x``/``--y`` name
+another.  Every number is in the loop file's units, and every value used is
+echoed with its unit.
+
+The paper's device options (``--m --b --T --Td --delta --gamma --Mw`` and
+the stiffness and damping options) are refused with ``--loop`` (one line
+saying which ``--set`` replaces them); ``--d`` is the one that keeps its
+meaning and sets the delay ``d``.  Everything is checked before the work:
+the ``--set`` syntax, the file, the names, the plane, the values (the loop
+evaluated once at the given point) and the output paths.  The caller
+(:func:`symstab.cli.main`) turns ``ValueError``/``TypeError`` into one line
+``symstab <command>: error: ...`` and exit status 2.
+"""
+
+import dataclasses
+import io
+import math
+import pathlib
+import sys
+import textwrap
+
+import numpy as np
+
+from ._resources import CHUNK_BYTES, check_memory, chunk_slices
+
+__all__ = ["add_loop_options", "uses_loop", "run"]
+
+#: The paper's device options every numeric command has, with the ``--set``
+#: that replaces each under ``--loop`` (None: there is no such parameter).
+_DEVICE_OPTIONS = (
+    ("--m", "m", "--set m=..."), ("--b", "b", "--set b=..."), ("--T", "T", "--set T=..."),
+    ("--Td", "Td", "--set d=... (the delay in samples)"),
+    ("--delta", "delta", "--set with the loop's own parameters"),
+    ("--gamma", "gamma", "--set with the loop's virtual mass, e.g. --set M=..."),
+    ("--Mw", "Mw", "--set with the loop's virtual mass, e.g. --set M=..."),
+    ("--linear", "linear", "the units of the loop file"),
+)
+#: Stiffness and damping options: points (classify, limits) and grids (map).
+_POINT_OPTIONS = (
+    ("--alpha", "alpha", "--set with the loop's parameters, e.g. --set K=..."),
+    ("--beta", "beta", "--set with the loop's parameters, e.g. --set B=..."),
+    ("--Kw", "Kw", "--set with the loop's parameters, e.g. --set K=..."),
+    ("--Bw", "Bw", "--set with the loop's parameters, e.g. --set B=..."),
+)
+_GRID_OPTIONS = tuple((flag, dest, "--x-range/--y-range (the plane is --x/--y)")
+                      for flag, dest, _ in _POINT_OPTIONS)
+#: The simulation options of ``map``: a general loop has no simulator.
+_SIMULATION_OPTIONS = tuple(
+    (flag, dest, None) for flag, dest in (
+        ("--encoder-resolution", "encoder_resolution"), ("--paper-encoder", "paper_encoder"),
+        ("--velocity-cutoff", "velocity_cutoff"), ("--coulomb", "coulomb"),
+        ("--stiction", "stiction"), ("--friction-compensation", "friction_compensation"),
+        ("--actuator-bandwidth", "actuator_bandwidth"), ("--substeps", "substeps"),
+        ("--steps", "steps"), ("--x0", "x0")))
+
+#: The options each command refuses with ``--loop``.
+REFUSED = {
+    "boundary": _DEVICE_OPTIONS,
+    "limits": _DEVICE_OPTIONS + _POINT_OPTIONS[1::2],   # --beta and --Bw: use --at
+    "classify": _DEVICE_OPTIONS + _POINT_OPTIONS,
+    "design": _DEVICE_OPTIONS,
+    "map": _DEVICE_OPTIONS + _GRID_OPTIONS + _SIMULATION_OPTIONS,
+}
+#: The options that only mean something with ``--loop``, per command.
+_LOOP_ONLY = {
+    "boundary": ("set_values", "x", "y"),
+    "limits": ("set_values", "x", "y", "at"),
+    "classify": ("set_values",),
+    "design": ("set_values", "x", "y", "at"),
+    "map": ("set_values", "x", "y", "x_range", "y_range"),
+}
+_FLAGS = {"set_values": "--set", "x": "--x", "y": "--y", "at": "--at",
+          "x_range": "--x-range", "y_range": "--y-range"}
+
+#: Memory per classified point of a map, per coefficient: the coefficients,
+#: the environment's and the plant's arrays and the classifier's working
+#: copies (generous).
+_BYTES_PER_COEFFICIENT = 64
+#: Bytes per map cell in the CSV and NPZ written (as cli_simulate's map).
+_MAP_CELL_BYTES = 300
+
+_EXAMPLE = "examples/loops/paper.toml"
+
+
+#: What each command gives for a loop file, for its --help.
+_WHAT = {
+    "boundary": "boundary --loop gives the D-decomposition of the plane: the (x, y) at which "
+                "z = exp(j theta) is a closed-loop pole, and the lines c0 + cx x + cy y = 0 "
+                "on which a pole is at z = 1, z = -1 or infinity (leading coefficient 0).",
+    "limits": "limits --loop gives the largest stable y, the x where it is reached, the x "
+              "extent and the area of the stable set in the plane (with --at X the stable "
+              "intervals of y at x = X).",
+    "classify": "classify --loop gives the verdict, the spectral radius and the certified "
+                "number of closed-loop poles outside the unit circle at the file's values "
+                "changed by --set (comma lists: several points).",
+    "design": "design --loop gives the largest stable y, the x where it is reached, and the "
+              "stable intervals of y at that x (or at --at X).",
+    "map": "map --loop classifies every cell of an x-y grid by its root count (no "
+           "simulation) and draws the D-decomposition over it.",
+}
+#: The example of each command with a loop file.
+_LOOP_EXAMPLES = {
+    "boundary": f"symstab boundary --loop {_EXAMPLE} --set d=10 --n 11",
+    "limits": f"symstab limits --loop {_EXAMPLE} --set M=0.0128 --at 0.3",
+    "classify": f"symstab classify --loop {_EXAMPLE} --set K=1,3,10 --set B=0.2",
+    "design": f"symstab design --loop {_EXAMPLE} --set d=10",
+    "map": f"symstab map --loop {_EXAMPLE} --x-range=-0.1,0.6,141 --y-range=0,6,121 "
+           "--out map.npz",
+}
+
+
+def add_loop_options(p, command):
+    """Add ``--loop``, ``--set`` (and the plane options) of ``command`` to parser ``p``.
+
+    Call it after the command's other options: the refused ones are recorded
+    with their defaults, so that a refused option is recognised when given.
+    """
+    g = p.add_argument_group(
+        "any loop (instead of the device options above)",
+        textwrap.fill(f"A loop file (TOML, see {_EXAMPLE}) names the plant, the environment, the "
+                      "default values and their units; --set changes a value, in those units.  "
+                      f"{_WHAT[command]}  With --loop the paper's device options are refused "
+                      "(--d still sets the delay d).", 77)
+        + f"\nexample: {_LOOP_EXAMPLES[command]}")
+    g.add_argument("--loop", metavar="FILE", help="loop file (TOML)")
+    many = " (classify: a comma-separated list, one point per entry)" if command == "classify" else ""
+    g.add_argument("--set", metavar="NAME=VALUE", action="append", dest="set_values",
+                   help="set a parameter of the loop, in the file's units; repeatable; d is a "
+                        f"whole number of samples{many}")
+    if command != "classify":
+        g.add_argument("--x", metavar="NAME", help="horizontal parameter of the plane "
+                                                   "(default: the file's plane)")
+        g.add_argument("--y", metavar="NAME", help="vertical parameter of the plane "
+                                                   "(default: the file's plane)")
+    if command in ("limits", "design"):
+        g.add_argument("--at", type=float, metavar="X",
+                       help="also give the stable intervals of y at x = X"
+                            + (" (default: the x of the largest y)" if command == "design" else ""))
+    if command == "map":
+        g.add_argument("--x-range", metavar="LOW,HIGH,N", help="grid of x (--x-range=-0.1,0.6,200)")
+        g.add_argument("--y-range", metavar="LOW,HIGH,N", help="grid of y (--y-range=0,6,200)")
+    refused = tuple((flag, dest, p.get_default(dest), instead)
+                    for flag, dest, instead in REFUSED[command])
+    p.set_defaults(loop_command=command, loop_refused=refused)
+
+
+def uses_loop(args):
+    """True when the command runs on a loop file; refuses loop options without one."""
+    if getattr(args, "loop", None) is not None:
+        return True
+    for dest in _LOOP_ONLY[args.loop_command]:
+        if getattr(args, dest, None) is not None:
+            raise ValueError(f"{_FLAGS[dest]} needs a loop file: give --loop FILE "
+                             f"(e.g. --loop {_EXAMPLE})")
+    return False
+
+
+def run(args):
+    """Run ``args.loop_command`` on the loop file of ``args.loop``."""
+    return _COMMANDS[args.loop_command](args)
+
+
+# --------------------------------------------------------------------------
+# Inputs
+
+
+def _refuse_device_options(args):
+    for flag, dest, default, instead in args.loop_refused:
+        if getattr(args, dest, default) != default:
+            if instead is None:
+                raise ValueError(f"{flag} is an option of the paper's device simulation; "
+                                 f"map --loop classifies the loop by its roots and takes no "
+                                 f"simulation options")
+            raise ValueError(f"{flag} is an option of the paper's device; with --loop use "
+                             f"{instead}")
+
+
+def _parse_number(name, text, flag, *, lists):
+    """The value(s) of one ``--set``: a float, d an integer; a list where allowed."""
+    items = [t.strip() for t in text.split(",")]
+    if len(items) > 1 and not lists:
+        raise ValueError(f"{flag}: {name} takes one value here (lists are for classify)")
+    if not all(items):
+        raise ValueError(f"{flag}: VALUE must be a number"
+                         + (" or a comma-separated list without empty items" if lists else ""))
+    values = []
+    for item in items:
+        try:
+            value = float(item)
+        except ValueError:
+            raise ValueError(f"{flag}: {item!r} is not a number") from None
+        if not math.isfinite(value):
+            raise ValueError(f"{flag}: {name} must be a finite number, got {item!r}")
+        if name == "d":
+            if not (value.is_integer() and value >= 0):
+                raise ValueError(f"{flag}: delay d must be a non-negative integer, got {item!r}")
+            value = int(value)
+        values.append(value)
+    if name == "d" and len(values) > 1:
+        raise ValueError(f"{flag}: d takes one value (run classify once per delay)")
+    return values if len(values) > 1 else values[0]
+
+
+def _parse_sets(texts, *, lists):
+    """``{name: value}`` of the ``--set NAME=VALUE`` options, in the order given."""
+    out = {}
+    for text in texts or ():
+        flag = f"--set {text}"
+        name, eq, value = text.partition("=")
+        name = name.strip()
+        if not eq or not name:
+            raise ValueError(f"{flag}: expected NAME=VALUE, e.g. --set K=300")
+        if name in out:
+            raise ValueError(f"--set {name} is given twice; give each parameter once")
+        out[name] = _parse_number(name, value, flag, lists=lists)
+    return out
+
+
+@dataclasses.dataclass(frozen=True)
+class LoopSetup:
+    """The resolved inputs of a loop command: what :func:`symstab.cli_numeric._emit` prints."""
+
+    path: str
+    loop: object          # symstab.Loop
+    values: dict          # every value used, axes excluded
+    given: tuple          # names set on the command line
+    x: str = None
+    y: str = None
+    echo: tuple = ()
+
+    def unit(self, name):
+        return self.loop.units.get(name, "")
+
+    def label(self, name):
+        """``"K [N/m]"``, or the bare name when the file gives no unit."""
+        unit = self.unit(name)
+        return f"{name} [{unit}]" if unit else name
+
+    def as_dict(self):
+        loop = self.loop
+        out = {"loop": self.path, "name": loop.name, "plant": str(loop.plant),
+               "environment": str(loop.environment), "zoh": loop.zoh_method,
+               "values": {k: (v.tolist() if isinstance(v, np.ndarray) else v)
+                          for k, v in self.values.items()},
+               "set": list(self.given)}
+        if self.x is not None:
+            out["plane"] = {"x": self.x, "y": self.y}
+        out["units"] = {k: loop.units[k] for k in loop.parameters if k in loop.units}
+        return out
+
+
+def _quantity(setup, name, value):
+    """``"K = 300 N/m"``, ``"K = [1, 3] N/m"``, ``"d = 40 samples"``."""
+    unit = setup.unit(name) or ("samples" if name == "d" else "")
+    if unit == "samples" and value == 1:
+        unit = "sample"
+    if isinstance(value, (list, tuple, np.ndarray)):
+        text = "[" + ", ".join(f"{v:.10g}" for v in value) + "]"
+    else:
+        text = f"{value:.10g}" if isinstance(value, float) else str(value)
+    return f"{name} = {text}" + (f" {unit}" if unit else "")
+
+
+def _echo(setup):
+    loop = setup.loop
+    lines = [f"loop {loop.name} ({setup.path}): G(s) = {loop.plant}, VE(z) = {loop.environment}"
+             f"; ZOH by {loop.zoh_method}"]
+    parts = [_quantity(setup, n, setup.values[n]) + (" (--set)" if n in setup.given else "")
+             for n in loop.parameters if n in setup.values]
+    lines.append("values: " + ", ".join(parts))
+    if setup.x is not None:
+        lines.append(f"plane: x = {setup.label(setup.x)}, y = {setup.label(setup.y)}")
+    return tuple(lines)
+
+
+def _load(path):
+    from .loop_files import load_loop
+
+    return load_loop(path)
+
+
+def _plane(args, loop):
+    x, y = args.x, args.y
+    if (x is None) != (y is None):
+        raise ValueError("give the plane as both --x NAME and --y NAME, or neither "
+                         "(the file's plane)")
+    if x is None:
+        if loop.plane is None:
+            raise ValueError(f"the loop file {args.loop} names no plane: give --x NAME --y NAME "
+                             f"(affine parameters: {', '.join(loop.affine_parameters()) or 'none'})")
+        x, y = loop.plane
+    return x, y
+
+
+def _resolve(args, *, plane=True, lists=False):
+    """Check every input of a loop command and return its :class:`LoopSetup`.
+
+    Raises ValueError (one line for the user) before any long work: the
+    values are checked by evaluating the loop once (the plane's D-
+    decomposition at two angles, or the polynomial at the given points).
+    """
+    _refuse_device_options(args)
+    sets = _parse_sets(args.set_values, lists=lists)
+    if getattr(args, "d", None) is not None:
+        if "d" in sets:
+            raise ValueError("give the delay once: --d or --set d=...")
+        sets["d"] = args.d
+    loop = _load(args.loop)
+    unknown = [n for n in sets if n not in loop.parameters]
+    if unknown:
+        raise ValueError(f"--set {unknown[0]}: {unknown[0]!r} is not a parameter of the loop in "
+                         f"{args.loop} (parameters: {', '.join(loop.parameters)})")
+    x = y = None
+    axes = ()
+    if plane:
+        x, y = _plane(args, loop)
+        for name in (x, y):
+            if name not in loop.parameters:
+                raise ValueError(f"{'--x' if name == x else '--y'} {name}: not a parameter of the "
+                                 f"loop in {args.loop} (parameters: {', '.join(loop.parameters)})")
+        axes = (x, y)
+        for name in axes:
+            if name in sets:
+                raise ValueError(f"--set {name}: {name} is an axis of the plane ({'x' if name == x else 'y'}) "
+                                 f"and takes no single value here"
+                                 + ("; use --at for the stable intervals at one x"
+                                    if name == x and hasattr(args, "at") else ""))
+    values = {n: v for n, v in loop.defaults.items() if n not in axes}
+    values.update(sets)
+    missing = [n for n in loop.parameters if n not in values and n not in axes]
+    if missing:
+        raise ValueError(f"no value for {', '.join(missing)}: the loop file {args.loop} gives "
+                         f"none; add --set {missing[0]}=VALUE")
+    if plane:
+        loop.boundary(x=x, y=y, n=2, **values)   # checks the plane (affine) and the values
+    else:
+        check_memory("the points' coefficients", 8 * _points(values) * (values["d"] + 64))
+        loop.coefficients(**_broadcast(values))
+    setup = LoopSetup(str(args.loop), loop, values, tuple(sets), x, y)
+    return dataclasses.replace(setup, echo=_echo(setup))
+
+
+def _points(values):
+    return max((len(v) for v in values.values() if isinstance(v, list)), default=1)
+
+
+def _broadcast(values):
+    """The values as arrays of one length (lists of one length or single values)."""
+    lengths = {n: len(v) for n, v in values.items() if isinstance(v, list)}
+    if len(set(lengths.values())) > 1:
+        text = ", ".join(f"{n} has {k}" for n, k in lengths.items())
+        raise ValueError(f"--set lists must have the same length or one value: {text}")
+    return {n: (np.array(v, dtype=float) if isinstance(v, list) else v) for n, v in values.items()}
+
+
+# --------------------------------------------------------------------------
+# Commands
+
+
+def _emit(setup, fmt, columns, rows, **kwargs):
+    from .cli_numeric import _emit as emit
+
+    emit(setup, fmt, columns, rows, **kwargs)
+
+
+def _signed(terms):
+    """``"a + b x - c y"`` from ``[(a, ""), (b, "x"), (c, "y")]`` (the first term keeps its sign)."""
+    text = ""
+    for k, (value, name) in enumerate(terms):
+        number = f"{abs(value) if k else value:.10g}" + (f" {name}" if name else "")
+        text += number if k == 0 else f" {'-' if math.copysign(1.0, value) < 0 else '+'} {number}"
+    return text
+
+
+def _line_text(setup, label, line):
+    """``z = 1: c0 + cx x + cy y = 0``, and solved for y (or x) when it can be."""
+    c0, cx, cy = line
+    x, y = setup.x, setup.y
+    text = f"line {label}: {_signed([(c0, ''), (cx, x), (cy, y)])} = 0"
+    if cy != 0:
+        text += f", i.e. {y} = {_signed([(-c0 / cy + 0.0, ''), (-cx / cy + 0.0, x)])}"
+    elif cx != 0:
+        text += f", i.e. {x} = {-c0 / cx + 0.0:.10g}"
+    return text
+
+
+def _cmd_boundary(args):
+    from ._validate import check_count
+
+    setup = _resolve(args)
+    n = check_count("n", args.n, 2)
+    from .cli_numeric import _BYTES_PER_ROW
+    check_memory(f"--n {n} boundary points", n * _BYTES_PER_ROW)
+    curve = setup.loop.boundary(x=setup.x, y=setup.y, n=n, **setup.values)
+    columns = ["theta [rad]", setup.label(setup.x), setup.label(setup.y)]
+    rows = list(zip(curve.theta, curve.x_values, curve.y_values))
+    notes = [f"D-decomposition: z = exp(j theta) is a closed-loop pole at ({setup.x}, {setup.y}) "
+             "(nan: the 2 x 2 system is singular at that theta)"]
+    notes += [_line_text(setup, label, line) for label, line in curve.lines.items()]
+    if not curve.lines:
+        notes.append("no real-root or leading-coefficient line crosses this plane")
+    result = {"lines": {label: dict(zip(("c0", "cx", "cy"), line))
+                        for label, line in curve.lines.items()}}
+    _emit(setup, args.format, columns, rows, result=result, notes=notes)
+    return 0
+
+
+def _intervals(setup, at):
+    """The stable intervals of y at x = ``at``: (rows, notes, json)."""
+    from ._validate import check_real
+
+    at = check_real(f"--at ({setup.x})", at)
+    runs = setup.loop.stable_intervals(setup.y, **{setup.x: at}, **setup.values)
+    unit_x = f" {setup.unit(setup.x)}" if setup.unit(setup.x) else ""
+    unit_y = f" {setup.unit(setup.y)}" if setup.unit(setup.y) else ""
+    text = ", ".join(f"[{lo:.10g}, {hi:.10g}]" for lo, hi in runs) or "none"
+    notes = [f"stable {setup.y} at {setup.x} = {at:.10g}{unit_x}: {text}{unit_y if runs else ''}"]
+    # The z = 1 line of a loop with an integrator lies at y = 0 up to rounding
+    # (1e-12 of the interval): no minimum worth naming.
+    if runs and runs[0][0] > 1e-9 * (runs[0][1] - runs[0][0]):
+        notes.append(f"a minimum is needed: {setup.y} > {runs[0][0]:.10g}{unit_y}")
+    return notes, {"x": at, "intervals": [list(r) for r in runs]}
+
+
+def _limits_rows(setup, lim):
+    ux, uy = setup.unit(setup.x), setup.unit(setup.y)
+    area_unit = f"({ux})({uy})" if ux and uy else (ux or uy)
+    x, y = setup.x, setup.y
+    return [(f"{y}_max", lim.y_max, uy, f"largest stable {y}"),
+            (f"{x} at {y}_max", lim.x_at_y_max, ux, f"the {x} where it is reached"),
+            (f"{x}_min", lim.x_min, ux, f"leftmost {x} of the stable set"),
+            (f"{x}_max", lim.x_max, ux, f"rightmost {x} of the stable set"),
+            ("area", lim.area, area_unit, f"area of the stable set in the ({x}, {y}) plane")]
+
+
+def _limits_notes(setup, lim):
+    if lim.empty:
+        return [f"no stable point found in the ({setup.x}, {setup.y}) plane at these values"]
+    if math.isinf(lim.y_max) or math.isinf(lim.area):
+        return [f"the stable set is unbounded in the ({setup.x}, {setup.y}) plane"]
+    return []
+
+
+def _limits_result(lim):
+    return {"limits": {"x": lim.x, "y": lim.y, "y_max": lim.y_max, "x_at_y_max": lim.x_at_y_max,
+                       "x_min": lim.x_min, "x_max": lim.x_max, "area": lim.area,
+                       "n_lines": lim.n_lines}}
+
+
+def _cmd_limits(args):
+    setup = _resolve(args)
+    if args.at is not None:
+        from ._validate import check_real
+        check_real(f"--at ({setup.x})", args.at)
+    lim = setup.loop.limits(x=setup.x, y=setup.y, **setup.values)
+    rows = _limits_rows(setup, lim)
+    notes = _limits_notes(setup, lim)
+    result = _limits_result(lim)
+    if args.at is not None:
+        more, result["at"] = _intervals(setup, args.at)
+        notes += more
+    _emit(setup, args.format, ["quantity", "value", "unit", "meaning"], rows, result=result,
+          notes=notes, json_rows=False)
+    return 0
+
+
+def _cmd_design(args):
+    setup = _resolve(args)
+    if args.at is not None:
+        from ._validate import check_real
+        check_real(f"--at ({setup.x})", args.at)
+    print(f"searching the ({setup.x}, {setup.y}) plane for the largest stable {setup.y} ...",
+          file=sys.stderr, flush=True)
+    lim = setup.loop.limits(x=setup.x, y=setup.y, **setup.values)
+    rows = _limits_rows(setup, lim)[:2]
+    notes = _limits_notes(setup, lim)
+    result = _limits_result(lim)
+    at = args.at
+    if at is None and not lim.empty and math.isfinite(lim.x_at_y_max):
+        at = lim.x_at_y_max
+    if at is not None:
+        more, result["at"] = _intervals(setup, at)
+        notes += more
+        runs = result["at"]["intervals"]
+        if runs:
+            lo, hi = runs[-1]
+            rows.append((f"{setup.y} range at {setup.x} = {at:.6g}", hi - lo, setup.unit(setup.y),
+                         f"width of the top stable interval of {setup.y} at that {setup.x}"))
+            if args.at is None and hi - lo < 0.05 * lim.y_max:
+                notes.append(f"{setup.y}_max is reached at the tip of a thin sliver of the stable "
+                             f"set: it needs precise tuning of {setup.x}; give --at X for the "
+                             f"stable {setup.y} at another {setup.x}")
+    notes.append(f"design --loop does not search a third parameter (the paper's design searches "
+                 f"the virtual mass): compare {setup.y}_max for a few --set values of it")
+    _emit(setup, args.format, ["quantity", "value", "unit", "meaning"], rows, result=result,
+          notes=notes, json_rows=False)
+    return 0
+
+
+#: Above this delay ``classify --loop`` gives verdicts without the spectral radius
+#: (eigenvalues of a (d + n)-square companion matrix per point).
+_RADIUS_MAX_DELAY = 1000
+
+
+def _cmd_classify(args):
+    from .stability import MARGINAL, STABLE
+
+    setup = _resolve(args, plane=False, lists=True)
+    loop, values = setup.loop, _broadcast(setup.values)
+    n = _points(setup.values)
+    for name, value in values.items():
+        if name != "d" and np.ndim(value) == 0:
+            values[name] = np.full(n, float(value))
+    code = np.atleast_1d(loop.classify(**values))
+    counts = np.atleast_1d(loop.unstable_root_counts(**values))
+    notes = []
+    if setup.values["d"] <= _RADIUS_MAX_DELAY:
+        radius = np.atleast_1d(loop.spectral_radius(**values))
+    else:
+        radius = np.full(code.shape, np.nan)
+        notes.append(f"spectral radius not computed for d > {_RADIUS_MAX_DELAY} (eigenvalues of "
+                     f"a large companion matrix per point); the verdicts are certified root counts")
+    names = list(setup.given) or ([n for n in loop.plane] if loop.plane else [])
+    names = [n for n in names if n != "d"]
+    columns = [setup.label(n) for n in names] + ["spectral radius", "unstable poles", "verdict"]
+    rows = []
+    for k in range(n):
+        verdict = "stable" if code[k] == STABLE else "marginal" if code[k] == MARGINAL else "unstable"
+        poles = None if counts[k] < 0 else int(counts[k])
+        rows.append(tuple(float(np.broadcast_to(values[m], (n,))[k]) for m in names)
+                    + (float(radius[k]), poles, verdict))
+    notes.append("unstable poles: closed-loop poles outside the unit circle, a certified count "
+                 "(empty: a pole on the circle to within rounding, marginal)")
+    _emit(setup, args.format, columns, rows, notes=notes)
+    return 0
+
+
+def _cmd_map(args):
+    from .cli import check_outputs, write_output
+    from .cli_simulate import _grid
+    from .simulate import progress_printer
+    from .stability import MARGINAL, STABLE
+
+    setup = _resolve(args)
+    if args.x_range is None or args.y_range is None:
+        raise ValueError("map --loop needs the grid: --x-range LOW,HIGH,N and --y-range LOW,HIGH,N")
+    xs, ys = _grid(args.x_range, "--x-range"), _grid(args.y_range, "--y-range")
+    if not args.out.endswith((".csv", ".npz")):
+        raise ValueError(f"--out must end in .csv or .npz, got {args.out}")
+    if args.no_png and args.png is not None:
+        raise ValueError("give --png or --no-png, not both")
+    png = None if args.no_png else (
+        str(pathlib.Path(args.out).with_suffix(".png")) if args.png is None else args.png)
+    paths = check_outputs([("--out", args.out, "file"), ("--png", png, "file")])
+    out, png_path = paths["--out"], paths.get("--png")
+    loop, values = setup.loop, setup.values
+    degree = loop.coefficients(**{setup.x: 0.0, setup.y: 0.0}, **values).shape[-1]
+    check_memory(f"a map of {xs.size} x {ys.size} cells",
+                 xs.size * ys.size * (_MAP_CELL_BYTES + _BYTES_PER_COEFFICIENT * degree))
+    for line in setup.echo:
+        print(line)
+    code = np.empty((xs.size, ys.size), dtype=np.int8)
+    progress = progress_printer("classifying", xs.size)
+    for part in chunk_slices(xs.size, ys.size * _BYTES_PER_COEFFICIENT * degree, CHUNK_BYTES):
+        X, Y = np.meshgrid(xs[part], ys, indexing="ij")
+        code[part] = loop.classify(**{setup.x: X, setup.y: Y}, **values)
+        progress(part.stop)
+    stable = code == STABLE
+    if out.suffix == ".npz":
+        buf = io.BytesIO()
+        np.savez(buf, x=xs, y=ys, x_name=np.array(setup.x), y_name=np.array(setup.y),
+                 x_unit=np.array(setup.unit(setup.x)), y_unit=np.array(setup.unit(setup.y)),
+                 code=code, stable=stable,
+                 values=np.array([_quantity(setup, n, values[n]) for n in loop.parameters
+                                  if n in values]),
+                 loop=np.array(str(setup.path)))
+        data = buf.getvalue()
+    else:
+        X, Y = np.meshgrid(xs, ys, indexing="ij")
+        buf = io.StringIO()
+        buf.write(f"{setup.label(setup.x)},{setup.label(setup.y)},code,stable\n")
+        for xv, yv, c in zip(X.ravel(), Y.ravel(), code.ravel()):
+            buf.write(f"{xv:.12g},{yv:.12g},{int(c)},{int(c == STABLE)}\n")
+        data = buf.getvalue()
+    image = _png(setup, xs, ys, code) if png_path is not None else None
+    write_output(out, data, "--out")
+    written = [str(out)]
+    if image is not None:
+        write_output(png_path, image, "--png")
+        written.append(str(png_path))
+    print(f"{int(stable.sum())} of {code.size} cells stable, {int((code == MARGINAL).sum())} "
+          f"marginal (code 1 stable, 0 marginal, -1 unstable; certified root counts)")
+    print("wrote " + ", ".join(written))
+    return 0
+
+
+def _visible(values, lo, hi):
+    """``values`` with NaN where far outside [lo, hi], so that a line breaks there."""
+    span = hi - lo
+    out = np.array(values, dtype=float)
+    out[~((out > lo - 2 * span) & (out < hi + 2 * span))] = np.nan
+    return out
+
+
+def _png(setup, xs, ys, code):
+    """The map as PNG bytes (None without matplotlib), with the D-decomposition drawn over it."""
+    from .cli_simulate import _tex_unit
+    from .figures import pyplot
+    from .stability import MARGINAL, STABLE
+
+    try:
+        plt = pyplot()
+    except ValueError:
+        print("matplotlib is not installed: no PNG", file=sys.stderr)
+        return None
+    from matplotlib.colors import ListedColormap
+    from matplotlib.patches import Patch
+
+    loop, x, y = setup.loop, setup.x, setup.y
+    fig, ax = plt.subplots(figsize=(6.4, 4.8), dpi=120)
+    shade = np.where(code == STABLE, 2, np.where(code == MARGINAL, 1, 0)).T
+    ax.pcolormesh(xs, ys, shade, shading="nearest", vmin=0, vmax=2,
+                  cmap=ListedColormap(["white", "#bdbdbd", "#7fc97f"]))
+    curve = loop.boundary(x=x, y=y, n=4000, **setup.values)
+    bx, by = _visible(curve.x_values, xs[0], xs[-1]), _visible(curve.y_values, ys[0], ys[-1])
+    bx[np.isnan(by)] = np.nan
+    handles = [Patch(facecolor="#7fc97f", label="stable")]
+    if np.any(code == MARGINAL):
+        handles.append(Patch(facecolor="#bdbdbd", label="marginal"))
+    if np.any(np.isfinite(bx)):
+        handles += ax.plot(bx, by, "k-", lw=1.2, label=r"$z = e^{j\theta}$ root (D-decomposition)")
+    styles = {"z = 1": ("C0", "--"), "z = -1": ("C3", "--"), "leading": ("C1", ":")}
+    for label, (c0, cx, cy) in curve.lines.items():
+        color, style = styles.get(label, ("C4", "-."))
+        if cy != 0:
+            px, py = xs[[0, -1]], -(c0 + cx * xs[[0, -1]]) / cy
+        else:
+            px, py = np.full(2, -c0 / cx), ys[[0, -1]]
+        if np.all(py < ys[0]) or np.all(py > ys[-1]) or np.all(px < xs[0]) or np.all(px > xs[-1]):
+            continue   # the line misses the window
+        handles += ax.plot(px, py, color=color, ls=style, lw=1.2,
+                           label=label.replace("leading", "leading coefficient 0")
+                           .replace("z = 1", "root z = 1").replace("z = -1", "root z = -1"))
+    ax.set_xlim(xs[0], xs[-1])
+    ax.set_ylim(ys[0], ys[-1])
+
+    def axis_label(name):
+        unit = setup.unit(name)
+        return f"{name} [{_tex_unit(unit)}]" if unit else name
+
+    ax.set_xlabel(axis_label(x))
+    ax.set_ylabel(axis_label(y))
+    fixed = ", ".join(_quantity(setup, n, setup.values[n]) for n in loop.parameters
+                      if n in setup.values and n != "T")
+    title = f"loop {loop.name}: stable set in the ({x}, {y}) plane (root counts)"
+    ax.set_title(f"{title}\n{fixed}, T = {setup.values['T']:g} s"
+                 if "T" in setup.values else f"{title}\n{fixed}", fontsize=9)
+    ax.legend(handles=handles, loc="best", fontsize=8, framealpha=0.9)
+    fig.tight_layout()
+    buf = io.BytesIO()
+    fig.savefig(buf, format="png", metadata={"Software": None})
+    plt.close(fig)
+    return buf.getvalue()
+
+
+_COMMANDS = {"boundary": _cmd_boundary, "limits": _cmd_limits, "classify": _cmd_classify,
+             "design": _cmd_design, "map": _cmd_map}
