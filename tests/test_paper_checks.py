@@ -272,3 +272,28 @@ def test_memo_computes_once_and_accepts_values_computed_elsewhere():
 def test_run_audit_rejects_a_bad_worker_count(workers):
     with pytest.raises(ValueError, match="workers"):
         audit.run_audit(["eq1"], workers=workers)
+
+
+def test_gamma2_claims_do_not_hang_on_one_sample(monkeypatch):
+    """alpha_max at gamma = 2 is the top of a sliver: raising the scan's arc
+    polyline by 1e-11 (relative) made the scan miss its top sample (3.9571
+    instead of 4.0068, and 5.74-fold instead of 5.8).  The claims read it from
+    symstab.limits, which does not sample."""
+    from paper_checks import regions
+
+    ids = ["claim:alpha_max_gamma2", "claim:fold_5.8", "claim:max_gamma_2_d0"]
+    checks = audit.registered()
+    exact = {cid: checks[cid][3]() for cid in ids}
+    polyline = regions._arc_polyline
+
+    def raised(*args):
+        betas, alphas = polyline(*args)
+        return betas, alphas * (1 + 1e-11)
+
+    monkeypatch.setattr(regions, "_arc_polyline", raised)
+    for memo in (claims._classify, claims._limits):
+        monkeypatch.setattr(memo, "values", {})
+    assert {cid: checks[cid][3]() for cid in ids} == exact
+    assert exact["claim:alpha_max_gamma2"].verdict == "confirmed"
+    assert "largest stable alpha 4.0068 at beta = -2.0034" in exact["claim:alpha_max_gamma2"].evidence
+    assert exact["claim:fold_5.8"].verdict == "confirmed"
