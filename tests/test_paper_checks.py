@@ -297,3 +297,13 @@ def test_gamma2_claims_do_not_hang_on_one_sample(monkeypatch):
     assert exact["claim:alpha_max_gamma2"].verdict == "confirmed"
     assert "largest stable alpha 4.0068 at beta = -2.0034" in exact["claim:alpha_max_gamma2"].evidence
     assert exact["claim:fold_5.8"].verdict == "confirmed"
+
+
+@pytest.mark.parametrize("call", ["classify", "initial_direction"])
+def test_regions_refuse_delta_zero_by_name(call):
+    # The 30-digit forms carry delta**2 (Gamma - 1 in the limits): at delta = 0
+    # they are 0/0, which used to surface as a bare ZeroDivisionError.
+    from paper_checks import regions
+
+    with pytest.raises(ValueError, match="delta must be > 0"):
+        getattr(regions, call)(0.0, 0, 0.0)
