@@ -179,12 +179,16 @@ def test_proved_identities_hold_numerically():
         # scale: the sizes of the top-level terms of both sides
         terms = sp.Add(*[sp.Abs(t) for t in sp.Add.make_args(sp.sympify(lhs))
                          + sp.Add.make_args(sp.sympify(rhs))])
-        args = (model.theta, model.gamma, model.d, model.delta, model.Gamma, model.alpha, model.beta)
+        # m, T and z appear in the proofs of the paper's loop built by symstab.Loop.
+        args = (model.theta, model.gamma, model.d, model.delta, model.Gamma, model.alpha, model.beta,
+                model.m, model.T, model.z)
         f = sp.lambdify(args, [expr, terms], modules="mpmath")
         with mpmath.workdps(40):
             for _ in range(3):
                 dl = mpmath.mpf(10 ** rng.uniform(-3, 0))
                 value, size = f(mpmath.mpf(rng.uniform(0.05, 3.0)), mpmath.mpf(rng.uniform(-0.9, 2.5)),
                                 int(rng.integers(0, 13)), dl, mpmath.exp(dl),
-                                mpmath.mpf(rng.uniform(-1, 3)), mpmath.mpf(rng.uniform(-1, 3)))
+                                mpmath.mpf(rng.uniform(-1, 3)), mpmath.mpf(rng.uniform(-1, 3)),
+                                mpmath.mpf(10 ** rng.uniform(-3, 1)), mpmath.mpf(10 ** rng.uniform(-4, -1)),
+                                mpmath.mpf(rng.uniform(-2, 2)))
                 assert abs(value) <= mpmath.mpf(10) ** -28 * size, name
