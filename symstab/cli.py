@@ -205,9 +205,60 @@ def _derive_paths(args):
     return (out or root / DEFAULT_DERIVATIONS, code_out or root / DEFAULT_CODEGEN, root)
 
 
+def _derive_loop(args):
+    """``symstab derive --loop FILE``: the derivation and kernels of one loop, in one folder.
+
+    Everything that can be refused is refused before the derivation starts:
+    the loop file, ``--out`` (default ``<loop name>_derivation`` in the
+    current folder), and a file of the user's in ``--out`` under a name the
+    derivation would write (never overwritten).
+    """
+    from . import derive, loop_derive
+    from .loop_files import load_loop
+
+    start = time.perf_counter()
+    if args.codegen_out is not None:
+        raise ValueError("--codegen-out is for the paper's kernels; with --loop the kernels "
+                         "are written to --out with the derivation")
+    loop = load_loop(args.loop)
+    out = pathlib.Path(args.out if args.out is not None
+                       else f"{loop_derive.c_name(loop)}_derivation")
+    loop_derive.check_names(loop)
+    names = loop_derive.file_names(loop)
+    if args.check:   # reads only
+        if out.exists() and not out.is_dir():
+            raise ValueError(f"--out must be a directory, got file {out}")
+    else:
+        check_outputs([("--out", out, "dir")])
+        for name in names:
+            path = out / name
+            if path.exists() and not (path.is_file() and loop_derive.is_generated(path)):
+                raise ValueError(f"--out {out}: {path} exists and was not written by "
+                                 f"`{loop_derive.COMMAND}`; move it away or choose another --out")
+    print(f"deriving the loop {loop.name} ({loop.zoh_method}): ZOH, characteristic polynomial, "
+          "affine parameters, NumPy and C kernels ...", file=sys.stderr)
+    files = loop_derive.loop_files(loop)
+    if args.check:
+        stale = derive.check(out, files, owned=loop_derive.OWNED)
+        command = f"symstab derive --loop {args.loop}" + (
+            f" --out {args.out}" if args.out is not None else "")
+        for path in stale:
+            print(f"drift: {path} differs from a fresh derivation; run `{command}`")
+        if stale:
+            return 1
+        print(f"{len(files)} files in {out} match a fresh derivation of the loop {loop.name} "
+              f"({time.perf_counter() - start:.1f} s)")
+        return 0
+    written = derive.write(out, files)
+    print(f"wrote {len(written)} files to {out} ({time.perf_counter() - start:.1f} s)")
+    return 0
+
+
 def _cmd_derive(args):
     from . import codegen, derive
 
+    if args.loop is not None:
+        return _derive_loop(args)
     start = time.perf_counter()
     out, code_out, root = _derive_paths(args)
     if args.check:   # reads only
@@ -332,17 +383,22 @@ def build_parser():
         description="Re-derive with SymPy every object of the paper's loop (ZOH, characteristic "
                     "polynomial, unit-circle split, boundary, limits, theta_max), prove the "
                     "rewritten forms equal, and write them as LaTeX and srepr JSON together with "
-                    "the generated NumPy and C kernels.",
+                    "the generated NumPy and C kernels; with --loop FILE, the same for the loop "
+                    "of a loop file.",
         example="symstab derive --check", func=_cmd_derive)
     p.add_argument("--out", help=f"output directory (default: {DEFAULT_DERIVATIONS} in the "
                                  "source checkout; outside one, --check skips it and writing "
-                                 "needs --out)")
+                                 "needs --out; with --loop: <loop name>_derivation)")
     p.add_argument("--codegen-out",
                    help=f"output directory of the generated NumPy and C kernels (default: "
                         f"{DEFAULT_CODEGEN} in the source checkout; outside one, --check checks "
                         "the installed package's kernels and writing needs --codegen-out)")
     p.add_argument("--check", action="store_true",
                    help="compare both output directories with a fresh run; exit 1 on drift")
+    p.add_argument("--loop", metavar="FILE",
+                   help="derive the loop of a TOML loop file (see examples/loops/) instead of the "
+                        "paper's: its derivation (JSON, LaTeX) and its NumPy and C kernels go to "
+                        "--out (default: <loop name>_derivation in the current folder)")
     p = add_command(
         sub, "audit", help="check every equation and claim of the paper; write REPORT.md",
         description="Check every printed equation and claim of the paper against the "

@@ -1,0 +1,498 @@
+"""Tests of ``symstab derive --loop`` (:mod:`symstab.loop_derive`).
+
+* The files are deterministic (two runs, two hash seeds: the same bytes) and
+  carry no date, version or path.
+* The generated code is tested by numbers: the C library (compiled with the
+  system compiler, ``-Werror``) against the NumPy module, the plant's pulse
+  transfer function against python-control's ``c2d``, and the polynomial
+  assembled from the C kernels against :meth:`symstab.Loop.coefficients`.
+* ``--check`` reports a hand-edited, a missing and a stale extra file; a bad
+  loop file is one error line and exit 2, with nothing written; a file of the
+  user's is never overwritten.
+* The proofs that the paper's loop built by :class:`symstab.Loop` is today's
+  derivation run in ``symstab derive`` and fail for another loop.
+"""
+
+import contextlib
+import ctypes
+import importlib.util
+import io
+import json
+import math
+import os
+import re
+import shutil
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+
+from conftest import REPO, hash_seed_other_than_ours
+from symstab import cli, loop_derive
+from symstab.identity import check_identity
+from symstab.loop_codegen import _digest
+from symstab.loop_files import load_loop, parse_loop_text
+
+PAPER_FILE = REPO / "examples" / "loops" / "paper.toml"
+
+#: A plant whose poles are not linear factors: the numeric (matrix
+#: exponential) path.  A damper through a first-order filter as environment.
+NUMERIC_LOOP = """\
+name = "spring device"
+description = "A mass on a spring with viscous friction"
+plant = "1/(m*s**2 + b*s + k)"
+environment = "K + B*(z - 1)/(T*z)"
+plane = ["B", "K"]
+
+[parameters]
+m = { value = 0.0128, unit = "kg" }
+b = { value = 0.0324, unit = "N s/m" }
+k = { value = 50.0, unit = "N/m" }
+T = { value = 1e-3, unit = "s" }
+d = { value = 3, unit = "samples" }
+"""
+
+#: The flags the generated C must compile under without a warning; unused
+#: parameters are allowed (a slope kernel takes every parameter of its
+#: environment so that all of them share one signature).
+C_FLAGS = ["-std=c99", "-O2", "-Wall", "-Wextra", "-pedantic", "-Werror",
+           "-Wno-unused-parameter", "-fPIC", "-shared"]
+
+
+@pytest.fixture(scope="module")
+def cache_dir(tmp_path_factory):
+    """Per-loop NumPy kernels go to a temporary cache, never to ~/.cache."""
+    folder = tmp_path_factory.mktemp("symstab_cache")
+    with pytest.MonkeyPatch.context() as mp:
+        mp.setenv("SYMSTAB_CACHE_DIR", str(folder))
+        yield folder
+
+
+@pytest.fixture(autouse=True)
+def _cache(cache_dir, monkeypatch):
+    monkeypatch.setenv("SYMSTAB_CACHE_DIR", str(cache_dir))
+
+
+def run_cli(*argv):
+    """``symstab.cli.main(argv)`` in this process: (status, stdout, stderr)."""
+    out, err = io.StringIO(), io.StringIO()
+    with contextlib.redirect_stdout(out), contextlib.redirect_stderr(err):
+        status = cli.main(list(argv))
+    return status, out.getvalue(), err.getvalue()
+
+
+@pytest.fixture(scope="module")
+def paper_folder(tmp_path_factory, cache_dir):
+    folder = tmp_path_factory.mktemp("paper") / "out"
+    status, _, err = run_cli("derive", "--loop", str(PAPER_FILE), "--out", str(folder))
+    assert status == 0, err
+    return folder
+
+
+@pytest.fixture(scope="module")
+def numeric_file(tmp_path_factory):
+    path = tmp_path_factory.mktemp("numeric") / "spring.toml"
+    path.write_text(NUMERIC_LOOP, encoding="utf-8")
+    return path
+
+
+@pytest.fixture(scope="module")
+def numeric_folder(numeric_file, cache_dir):
+    folder = numeric_file.parent / "out"
+    status, _, err = run_cli("derive", "--loop", str(numeric_file), "--out", str(folder))
+    assert status == 0, err
+    return folder
+
+
+def _files(folder):
+    return {p.name: p.read_bytes() for p in sorted(folder.iterdir())}
+
+
+# --------------------------------------------------------------------------
+# Files: what is written, deterministic, checked
+
+
+def test_derive_loop_writes_the_loop_files(paper_folder):
+    expected = loop_derive.loop_files(load_loop(PAPER_FILE))
+    assert sorted(expected) == [
+        "01_loop.json", "01_loop.tex", "02_zoh.json", "02_zoh.tex",
+        "03_characteristic_polynomial.json", "03_characteristic_polynomial.tex",
+        "04_affine_parameters.json", "04_affine_parameters.tex",
+        "paper_kernels.c", "paper_kernels.h", "paper_kernels.py"]
+    assert _files(paper_folder) == {k: v.encode("utf-8") for k, v in expected.items()}
+    for name, text in expected.items():
+        assert loop_derive.is_generated(paper_folder / name), name
+        if name.endswith(".json"):
+            data = json.loads(text)
+            assert data["step"] == name[:-5] and data["generated_by"] == "symstab derive --loop"
+
+
+def test_derive_loop_is_byte_identical_in_another_process_and_hash_seed(paper_folder, tmp_path,
+                                                                       cache_dir):
+    out = tmp_path / "again"
+    env = dict(os.environ, PYTHONHASHSEED=hash_seed_other_than_ours(),
+               SYMSTAB_CACHE_DIR=str(cache_dir))
+    proc = subprocess.run([sys.executable, "-m", "symstab", "derive", "--loop", str(PAPER_FILE),
+                           "--out", str(out)], capture_output=True, text=True, env=env,
+                          cwd=tmp_path, timeout=300)
+    assert proc.returncode == 0, proc.stderr
+    assert _files(out) == _files(paper_folder)
+
+
+def test_output_has_no_dates_versions_or_paths(paper_folder, numeric_folder, numeric_file):
+    import importlib.metadata
+    import platform
+
+    versions = {importlib.metadata.version(p) for p in ("sympy", "mpmath", "numpy", "symstab")}
+    versions.add(platform.python_version())
+    for folder in (paper_folder, numeric_folder):
+        for name, data in _files(folder).items():
+            text = data.decode("utf-8")
+            assert not re.search(r"\b(19|20)\d\d-\d\d-\d\d\b", text), name
+            assert not re.search(r"\b\d\d:\d\d:\d\d\b", text), name
+            for v in versions:
+                assert v not in text, (name, v)
+            for path in (str(REPO), str(folder), str(numeric_file), "/tmp", "/home"):
+                assert path not in text, (name, path)
+
+
+def test_numpy_module_is_the_module_the_loop_runs_on():
+    """The kernels written are those :class:`symstab.Loop` generates and caches (same hash)."""
+    for text in (PAPER_FILE.read_text(encoding="utf-8"), NUMERIC_LOOP,
+                 NUMERIC_LOOP.replace('"K + B*(z - 1)/(T*z)"', '"K + 2*B*(z - 1)/(T*(z + 1))"')):
+        loop = parse_loop_text(text)
+        module = loop._kernels[0]
+        assert _digest(loop_derive.environment_kernels(loop)) == module.__symstab_digest__
+
+
+def test_check_passes_then_reports_edited_missing_and_extra_files(tmp_path, paper_folder):
+    folder = tmp_path / "copy"
+    shutil.copytree(paper_folder, folder)
+    argv = ("derive", "--loop", str(PAPER_FILE), "--out", str(folder), "--check")
+    status, out, _ = run_cli(*argv)
+    assert status == 0 and "11 files" in out
+    edited = folder / "paper_kernels.c"
+    edited.write_text(edited.read_text(encoding="utf-8").replace("*num2 = M;", "*num2 = -M;"),
+                      encoding="utf-8")
+    (folder / "02_zoh.json").unlink()
+    (folder / "05_old_step.tex").write_text("% generated by `symstab derive --loop`\n")
+    (folder / "notes.txt").write_text("the user's: not ours, not drift\n")
+    status, out, _ = run_cli(*argv)
+    assert status == 1
+    named = sorted(re.findall(r"^drift: (\S+) differs", out, re.MULTILINE))
+    assert named == sorted(str(folder / n) for n in ("paper_kernels.c", "02_zoh.json",
+                                                     "05_old_step.tex"))
+    assert f"symstab derive --loop {PAPER_FILE} --out {folder}" in out
+    status, out, _ = run_cli("derive", "--loop", str(PAPER_FILE), "--out",
+                             str(tmp_path / "absent"), "--check")
+    assert status == 1 and out.count("drift:") == 11
+    assert not (tmp_path / "absent").exists()
+
+
+def test_default_out_is_the_loop_name_in_the_current_folder(tmp_path, monkeypatch, numeric_file):
+    monkeypatch.chdir(tmp_path)
+    status, out, err = run_cli("derive", "--loop", str(numeric_file))
+    assert status == 0, err
+    # "spring device": the name as a C identifier names the folder and the files.
+    folder = tmp_path / "spring_device_derivation"
+    assert sorted(os.listdir(tmp_path)) == ["spring_device_derivation"]
+    assert {"spring_device_kernels.c", "spring_device_kernels.h",
+            "spring_device_kernels.py"} <= set(os.listdir(folder))
+    # A second run overwrites its own files.
+    assert run_cli("derive", "--loop", str(numeric_file))[0] == 0
+
+
+def test_a_file_of_the_users_is_never_overwritten(tmp_path):
+    folder = tmp_path / "out"
+    folder.mkdir()
+    mine = folder / "paper_kernels.c"
+    mine.write_text("int main(void) { return 0; }\n")
+    status, out, err = run_cli("derive", "--loop", str(PAPER_FILE), "--out", str(folder))
+    assert status == 2 and out == ""
+    assert err.count("\n") == 1 and err.startswith("symstab derive: error: --out")
+    assert str(mine) in err
+    assert mine.read_text() == "int main(void) { return 0; }\n"
+    assert os.listdir(folder) == ["paper_kernels.c"]
+
+
+_BAD_FILES = {
+    "missing": None,
+    "not_toml": "plant = \n",
+    "improper_plant": 'plant = "s**2/(m*s + b)"\nenvironment = "K"\n',
+    "not_rational": 'plant = "1/(m*s**2 + sin(s))"\nenvironment = "K"\n',
+    "unknown_key": 'plant = "1/(m*s**2)"\nenvironment = "K"\ncolour = "red"\n',
+    "c_keyword_parameter": 'plant = "1/(m*s**2)"\nenvironment = "int + B*(z - 1)/(T*z)"\n',
+}
+
+
+@pytest.mark.parametrize("case", sorted(_BAD_FILES))
+def test_a_bad_loop_file_is_one_line_and_exit_2_with_nothing_written(case, tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    path = tmp_path / f"{case}.toml"
+    if _BAD_FILES[case] is not None:
+        path.write_text(_BAD_FILES[case], encoding="utf-8")
+    before = sorted(os.listdir(tmp_path))
+    status, out, err = run_cli("derive", "--loop", str(path))
+    assert status == 2, (out, err)
+    lines = err.splitlines()
+    assert len(lines) == 1 and lines[0].startswith("symstab derive: error: "), err
+    if case == "c_keyword_parameter":
+        assert "'int'" in lines[0]
+    else:
+        assert str(path) in lines[0]
+    assert sorted(os.listdir(tmp_path)) == before
+
+
+def test_codegen_out_is_refused_with_loop(tmp_path):
+    status, _, err = run_cli("derive", "--loop", str(PAPER_FILE), "--codegen-out", str(tmp_path))
+    assert status == 2 and err.count("\n") == 1 and "--codegen-out" in err
+    assert os.listdir(tmp_path) == []
+
+
+# --------------------------------------------------------------------------
+# The generated code, by numbers
+
+
+def _compile(folder, tmp_path):
+    compiler = shutil.which("cc") or shutil.which("gcc")
+    if compiler is None:
+        pytest.skip("no C compiler found on PATH (tried cc, gcc)")
+    (source,) = folder.glob("*_kernels.c")
+    library = tmp_path / (source.stem + ".so")
+    command = [compiler, *C_FLAGS, f"-I{folder}", str(source), "-o", str(library), "-lm"]
+    proc = subprocess.run(command, capture_output=True, text=True, timeout=120)
+    if proc.returncode != 0:
+        pytest.fail(f"compiling the generated C failed ({' '.join(command)}):\n{proc.stderr}")
+    lib = ctypes.CDLL(str(library))
+    header = source.with_suffix(".h").read_text(encoding="utf-8")
+    functions = {}
+    for name, params in re.findall(r"^void (symstab_\w+)\(([^)]*)\);$", header, re.MULTILINE):
+        params = [p.strip() for p in params.split(",")]
+        n_in = sum(1 for p in params if re.fullmatch(r"double \w+", p))
+        n_out = sum(1 for p in params if re.fullmatch(r"double \*\w+", p))
+        assert n_in + n_out == len(params), params
+        function = getattr(lib, name)
+        function.restype = None
+        function.argtypes = [ctypes.c_double] * n_in + [ctypes.POINTER(ctypes.c_double)] * n_out
+
+        def call(*args, _f=function, _n=n_out):
+            out = [ctypes.c_double(math.nan) for _ in range(_n)]
+            _f(*(float(a) for a in args), *(ctypes.byref(x) for x in out))
+            return np.array([x.value for x in out])
+
+        functions[name] = call
+    return functions
+
+
+def _numpy_module(folder):
+    (path,) = folder.glob("*_kernels.py")
+    spec = importlib.util.spec_from_file_location(f"generated_{path.stem}", path)
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
+def _paper_points(n, seed):
+    """Physical points of the paper's loop: a light device, 0.1 to 2 ms, delta from 1e-3 to 1."""
+    rng = np.random.default_rng(seed)
+    for _ in range(n):
+        m = 10 ** rng.uniform(-2.5, 0)
+        T = 10 ** rng.uniform(-4, -2.7)
+        b = 10 ** rng.uniform(-3, 0) * m / T
+        yield dict(m=m, b=b, T=T, K=rng.uniform(-50, 3000), B=rng.uniform(-1, 5),
+                   M=rng.uniform(-0.01, 0.05))
+
+
+def _assemble(delayed, direct, d):
+    """Coefficients of z**d delayed(z) + direct(z), highest power first."""
+    n = d + len(delayed) - 1
+    out = np.zeros(n + 1)
+    out[: len(delayed)] += delayed
+    out[n + 1 - len(direct):] += direct
+    return out
+
+
+def test_c_and_numpy_environment_kernels_agree(paper_folder, tmp_path):
+    c = _compile(paper_folder, tmp_path)
+    numpy_module = _numpy_module(paper_folder)
+    for point in _paper_points(40, seed=11):
+        args = (point["B"], point["K"], point["M"], point["T"])
+        for name in ("environment", "environment_slope_B", "environment_slope_K",
+                     "environment_slope_M"):
+            expected = np.array(getattr(numpy_module, name)(*args), dtype=float)
+            np.testing.assert_allclose(c[f"symstab_paper_{name}"](*args), expected,
+                                       rtol=1e-15, atol=0, err_msg=name)
+
+
+def test_c_pulse_transfer_function_matches_eq4_and_python_control(paper_folder, tmp_path):
+    """The residue-path kernel against eq. (4) at 50 digits and python-control's ``c2d``.
+
+    The coefficients as derived cancel about log10(4 / delta**2) digits
+    (6.6 at delta = 1e-3): 1e-8 relative against eq. (4).  python-control
+    (``c2d(..., 'zoh')``, then the transfer function of the state space)
+    is itself off by up to 4.8e-9 relative at these points (measured
+    against eq. (4)), so it is held to 1e-7, at delta from 0.05 to 1.
+    """
+    import mpmath
+
+    control = pytest.importorskip("control")
+    c = _compile(paper_folder, tmp_path)
+    rng = np.random.default_rng(3)
+    for k in range(40):
+        m, T = 10 ** rng.uniform(-2.5, 0), 10 ** rng.uniform(-4, -2.7)
+        delta = 10 ** rng.uniform(-3, 0) if k % 2 else 10 ** rng.uniform(-1.3, 0)
+        b = delta * m / T
+        out = c["symstab_paper_pulse_transfer_function"](b, m, T)
+        num, den = out[:2] / out[2], out[2:] / out[2]
+        with mpmath.workdps(50):
+            # eq. (4): ((e - 1 + bT/m) z + 1 - (1 + bT/m) e) / ((b^2/m) (z - 1)(z - e))
+            mb, mm, mT = (mpmath.mpf(x) for x in (b, m, T))
+            e, x = mpmath.exp(-mb * mT / mm), mb * mT / mm
+            scale = mb**2 / mm
+            eq4_num = [float((e - 1 + x) / scale), float((1 - (1 + x) * e) / scale)]
+            eq4_den = [1.0, float(-(1 + e)), float(e)]
+        np.testing.assert_allclose(num, eq4_num, rtol=1e-8)
+        np.testing.assert_allclose(den, eq4_den, rtol=1e-13)
+        if delta >= 0.05:
+            sampled = control.c2d(control.tf([1.0], [m, b, 0.0]), T, "zoh")
+            ref_num, ref_den = (np.trim_zeros(np.asarray(x[0][0], dtype=float), "f")
+                                for x in (sampled.num, sampled.den))
+            np.testing.assert_allclose(num, ref_num / ref_den[0], rtol=1e-7)
+            np.testing.assert_allclose(den, ref_den / ref_den[0], rtol=1e-7)
+
+
+def test_c_kernels_assemble_the_loops_polynomial(paper_folder, tmp_path):
+    """z**d Ve_d P_d + Ve_n P_n from the C kernels equals ``Loop.coefficients``.
+
+    Loop.coefficients evaluates the plant at 30 digits; the C prints its
+    coefficients as derived, which cancel ~log10(4 / delta**2) digits (at
+    most 6.6 here, delta >= 1e-3): 1e-8 relative leaves room for that.
+    """
+    c = _compile(paper_folder, tmp_path)
+    loop = load_loop(PAPER_FILE)
+    for k, point in enumerate(_paper_points(30, seed=7)):
+        d = k % 5
+        ve = c["symstab_paper_environment"](point["B"], point["K"], point["M"], point["T"])
+        plant = c["symstab_paper_pulse_transfer_function"](point["b"], point["m"], point["T"])
+        ve_n, ve_d, p_n, p_d = ve[:3], ve[3:], plant[:2], plant[2:]
+        lead = p_d[0]
+        ours = _assemble(np.convolve(ve_d, p_d / lead), np.convolve(ve_n, p_n / lead), d)
+        theirs = loop.coefficients(d=d, **point)
+        assert theirs.shape == ours.shape
+        # Each coefficient against the size of the terms it is made of.
+        scale = _assemble(np.abs(np.convolve(ve_d, p_d / lead)), np.convolve(np.abs(ve_n),
+                                                                               np.abs(p_n / lead)), d)
+        assert np.all(np.abs(ours - theirs) <= 1e-8 * scale), (point, d, ours, theirs)
+
+
+def test_numeric_path_loop_derivation_and_kernels(numeric_folder, tmp_path):
+    """A plant with a complex pole pair: matrix exponential, no plant kernel, numbers at the values.
+
+    The polynomial written at the file's values is checked against the one
+    built from python-control's ``c2d`` of the plant.
+    """
+    control = pytest.importorskip("control")
+    zoh = json.loads((numeric_folder / "02_zoh.json").read_text(encoding="utf-8"))
+    assert [o["srepr"] for o in zoh["objects"]] == ["'matrix exponential'"]
+    header = (numeric_folder / "spring_device_kernels.h").read_text(encoding="utf-8")
+    assert "pulse_transfer_function" not in header
+    assert "computed numerically" in header
+
+    import sympy as sp
+
+    steps = json.loads((numeric_folder / "03_characteristic_polynomial.json").read_text("utf-8"))
+    objects = {o["name"]: eval(o["srepr"], vars(sp).copy()) for o in steps["objects"]}  # noqa: S307
+    assert set(objects) == {"chi", "chi_at_values", "delayed_part", "direct_part"}
+    m, b, k, T = 0.0128, 0.0324, 50.0, 1e-3
+    sampled = control.c2d(control.tf([1.0], [m, b, k]), T, "zoh")
+    p_n = np.trim_zeros(np.asarray(sampled.num[0][0], dtype=float), "f")
+    p_d = np.asarray(sampled.den[0][0], dtype=float)
+    p_n, p_d = p_n / p_d[0], p_d / p_d[0]
+    symbols = {str(x): x for x in objects["direct_part"].free_symbols}
+    for B, K in ((0.0, 0.0), (0.3, 100.0), (-1.0, 2500.0)):
+        # VE = K + B (z - 1) / (T z) = (K T z + B z - B) / (T z)
+        ve_n, ve_d = np.array([K * T + B, -B]), np.array([T, 0.0])
+        direct = [float(c.subs({symbols["B"]: B, symbols["K"]: K})) for c in objects["direct_part"]]
+        np.testing.assert_allclose(direct, np.convolve(ve_n, p_n), rtol=1e-9,
+                                   atol=1e-12 * np.max(np.abs(np.convolve(ve_n, p_n))) + 1e-300)
+        np.testing.assert_allclose([float(c) for c in objects["delayed_part"]],
+                                   np.convolve(ve_d, p_d), rtol=1e-9, atol=1e-18)
+    c = _compile(numeric_folder, tmp_path)
+    numpy_module = _numpy_module(numeric_folder)
+    for B, K, T in ((0.3, 100.0, 1e-3), (-2.0, 1e4, 2.5e-4)):
+        np.testing.assert_allclose(c["symstab_spring_device_environment"](B, K, T),
+                                   np.array(numpy_module.environment(B, K, T), dtype=float),
+                                   rtol=1e-15, atol=0)
+
+
+# --------------------------------------------------------------------------
+# The paper's loop through the general path: the proofs
+
+
+PROOF_NAMES = ("paper_loop_delayed_part", "paper_loop_direct_part", "paper_loop_plane_determinant",
+               "paper_loop_boundary_real_part", "paper_loop_boundary_imag_part")
+
+
+def test_paper_loop_proofs_are_proved_in_symstab_derive(rendered_files):
+    data = json.loads(rendered_files["07_proofs.json"])
+    found = {o["name"]: o["description"] for o in data["objects"]}
+    for name in PROOF_NAMES:
+        assert name in found, name
+        assert found[name].endswith("[proved: difference is the zero rational function]"), name
+    # The common factor and the Table I scales, derived by hand:
+    # b = delta m / T gives Ve_d P_d = T^2 z^2 b^2 (...) = m^2 delta^2 (...);
+    # beta = B T / m, alpha = K T^2 / m.
+    assert "= (m**2) * today's delayed part" in found["paper_loop_delayed_part"]
+    assert "= (m**2) * today's direct part" in found["paper_loop_direct_part"]
+    assert "= (-T**3*m**2) * D" in found["paper_loop_plane_determinant"]
+    assert "B = (m/T) beta(theta), K = (m/T**2) alpha(theta)" in found["paper_loop_boundary_real_part"]
+
+
+def test_the_paper_loop_proofs_fail_for_another_loop():
+    """The same statements for a Tustin damper instead of eq. (1)'s backward difference."""
+    tustin = "K + 2*B*(z - 1)/(T*(z + 1)) + M*(z - 1)**2/(T**2*z**2)"
+    wrong = {name: (lhs, rhs) for name, _, lhs, rhs in
+             loop_derive._against_the_paper(loop_derive.PAPER_PLANT, tustin)}
+    for name in ("paper_loop_delayed_part", "paper_loop_direct_part",
+                 "paper_loop_boundary_real_part"):
+        assert check_identity(*wrong[name]).equal is False, name
+
+
+PI_LOOP = """\
+name = "filtered damper"
+plant = "1/(m*s**2 + b*s)"
+environment = "K + B*(1 - exp(-2*pi*f_c*T))*(z - 1)/(T*(z - exp(-2*pi*f_c*T)))"
+
+[parameters]
+m = 0.0128
+b = 0.0324
+f_c = 50.0
+T = 1e-3
+"""
+
+
+@pytest.mark.parametrize("source", ["pi"] + sorted(p.name for p in PAPER_FILE.parent.glob("*.toml")))
+def test_every_example_loop_compiles_and_its_c_matches_numpy(source, tmp_path):
+    """Every shipped example, and a loop with pi (printed M_PI, which strict C99 lacks)."""
+    if source == "pi":
+        path = tmp_path / "pi.toml"
+        path.write_text(PI_LOOP, encoding="utf-8")
+    else:
+        path = PAPER_FILE.parent / source
+    folder = tmp_path / "out"
+    status, _, err = run_cli("derive", "--loop", str(path), "--out", str(folder))
+    assert status == 0, err
+    c = _compile(folder, tmp_path)
+    numpy_module = _numpy_module(folder)
+    loop = load_loop(path)
+    stem = loop_derive.c_name(loop)
+    rng = np.random.default_rng(1)
+    for kernel in loop_derive.environment_kernels(loop):
+        names = [str(symbol) for symbol, _, _ in kernel.args]
+        for _ in range(5):
+            args = [loop.defaults.get(n, 1.0) * rng.uniform(0.5, 2.0) for n in names]
+            expected = np.array(getattr(numpy_module, kernel.name)(*args), dtype=float)
+            np.testing.assert_allclose(c[f"symstab_{stem}_{kernel.name}"](*args),
+                                       np.broadcast_to(expected, expected.shape), rtol=1e-14,
+                                       atol=1e-300, err_msg=kernel.name)
