@@ -3,7 +3,9 @@
 Each notebook walks through one derivation step by calling :mod:`symstab`
 and :mod:`paper_checks` (it derives nothing of its own) and asserts the
 audit's verdicts as it goes, so executing it is a test of both the library
-and the narrative.  The notebooks are stored without outputs; these tests
+and the narrative; the last one walks one loop of ``examples/loops/``
+through :class:`symstab.Loop` and asserts its answers against
+python-control's poles.  The notebooks are stored without outputs; these tests
 execute them in a fresh ``python3`` kernel with nbclient and fail on any cell
 error.  The execution tests are skipped when nbclient or ipykernel is not
 installed; the storage tests only need the standard library.
@@ -16,7 +18,7 @@ import pytest
 
 DERIVATIONS = pathlib.Path(__file__).resolve().parents[1] / "derivations"
 
-#: The notebooks, one per derivation step, in order.
+#: The notebooks, one per derivation step, in order; then any loop.
 EXPECTED = (
     "01_zoh_plant.ipynb",
     "02_characteristic_polynomial.ipynb",
@@ -25,6 +27,7 @@ EXPECTED = (
     "05_theta_max.ipynb",
     "06_small_theta_limits.ipynb",
     "07_code_generation.ipynb",
+    "08_any_loop.ipynb",
 )
 
 KERNELSPEC = {"name": "python3", "display_name": "Python 3", "language": "python"}
@@ -35,7 +38,7 @@ def _load(name):
         return json.load(fh)
 
 
-def test_the_seven_notebooks_exist_in_order():
+def test_the_notebooks_exist_in_order():
     found = tuple(sorted(path.name for path in DERIVATIONS.glob("*.ipynb")))
     assert found == EXPECTED
 
@@ -66,10 +69,13 @@ def _notebook_client():
 
 
 @pytest.mark.parametrize("name", EXPECTED)
-def test_notebook_executes_without_errors(name):
+def test_notebook_executes_without_errors(name, tmp_path, monkeypatch):
     nbclient = _notebook_client()
     import nbformat
 
+    # The kernel inherits the environment: a loop's generated kernels go to a
+    # temporary cache, not to the user's ~/.cache.
+    monkeypatch.setenv("SYMSTAB_CACHE_DIR", str(tmp_path / "cache"))
     nb = nbformat.read(DERIVATIONS / name, as_version=4)
     client = nbclient.NotebookClient(nb, timeout=300, kernel_name="python3",
                                      resources={"metadata": {"path": str(DERIVATIONS)}})
