@@ -61,7 +61,8 @@ _SIMULATION_OPTIONS = tuple(
 #: The options each command refuses with ``--loop``.
 REFUSED = {
     "boundary": _DEVICE_OPTIONS,
-    "limits": _DEVICE_OPTIONS + _POINT_OPTIONS[1::2],   # --beta and --Bw: use --at
+    "limits": _DEVICE_OPTIONS + (("--beta", "beta", "--at X (the stable y at x = X)"),
+                                 ("--Bw", "Bw", "--at X (the stable y at x = X)")),
     "classify": _DEVICE_OPTIONS + _POINT_OPTIONS,
     "design": _DEVICE_OPTIONS,
     "map": _DEVICE_OPTIONS + _GRID_OPTIONS + _SIMULATION_OPTIONS,

@@ -1,0 +1,395 @@
+"""``--loop FILE`` and ``--set NAME=VALUE`` on boundary, limits, classify, design and map.
+
+The paper's loop file (``examples/loops/paper.toml``, linear units: kg,
+N s/m, N/m) must give the numbers of today's paper commands run with
+``--linear`` (converted from alpha, beta by K_w = alpha m / T^2 and
+B_w = beta m / T); the boundary is checked against the derivation's
+alpha(theta), beta(theta) at 30 digits and the root counts against
+python-control's poles.  Bad input is one line ``symstab <cmd>: error:`` and
+exit status 2 with nothing written; an interrupted map leaves no file.
+"""
+
+import json
+import math
+
+import numpy as np
+import pytest
+
+import symstab
+from symstab import cli
+
+from conftest import PAPER_DELTA, PAPER_M, PAPER_T, REPO, python_control_closed_loop
+
+PAPER = str(REPO / "examples" / "loops" / "paper.toml")
+
+
+def _session_cache(tmp_path_factory):
+    return tmp_path_factory.getbasetemp() / "loop-kernels"
+
+
+@pytest.fixture(autouse=True)
+def _cache_dir(tmp_path_factory, monkeypatch):
+    folder = _session_cache(tmp_path_factory)
+    folder.mkdir(exist_ok=True)
+    monkeypatch.setenv("SYMSTAB_CACHE_DIR", str(folder))
+
+
+def run(capsys, *args):
+    status = cli.main([str(a) for a in args])
+    out, err = capsys.readouterr()
+    return status, out, err
+
+
+def run_json(capsys, *args):
+    status, out, err = run(capsys, *args, "--format", "json")
+    assert status == 0, err
+    return json.loads(out)
+
+
+def stiffness(alpha):
+    return alpha * PAPER_M / PAPER_T**2
+
+
+def damping(beta):
+    return beta * PAPER_M / PAPER_T
+
+
+# --------------------------------------------------------------------------
+# The paper's loop file gives today's numbers
+
+
+def test_limits_of_the_paper_file_are_todays_K_max(capsys):
+    """K_max at Td = 40 ms (the file's d = 40) as `symstab limits --Td 40e-3 --linear`."""
+    loop = run_json(capsys, "limits", "--loop", PAPER)
+    paper = run_json(capsys, "limits", "--Td", "40e-3", "--linear")["limits"]
+    lim = loop["limits"]
+    assert (lim["x"], lim["y"]) == ("B", "K")
+    assert loop["inputs"]["values"]["d"] == 40 and loop["inputs"]["units"]["K"] == "N/m"
+    assert lim["y_max"] == pytest.approx(stiffness(paper["alpha_max"]), rel=1e-6)
+    assert lim["x_at_y_max"] == pytest.approx(damping(paper["beta_at_alpha_max"]), rel=1e-6)
+    assert lim["x_max"] == pytest.approx(damping(paper["beta_right"]), rel=1e-6)
+    # Loop.limits brackets the left tip (a cusp at K = 0, B = -b) by the
+    # existence of a stable K on a line, and integrates the area with the
+    # trapezoid rule on 201 lines: both agree to 3e-5 only (measured
+    # 1.6e-5 and 2.8e-5), hence the looser tolerance.
+    assert lim["x_min"] == pytest.approx(damping(paper["beta_left"]), rel=1e-4)
+    area = paper["z_width"] * (PAPER_M / PAPER_T) * (PAPER_M / PAPER_T**2)
+    assert lim["area"] == pytest.approx(area, rel=1e-4)
+
+
+def test_limits_text_names_the_units_of_the_file(capsys):
+    status, out, _ = run(capsys, "limits", "--loop", PAPER, "--d", "10", "--at", "0.3")
+    assert status == 0
+    assert "d = 10 samples (--set)" in out and "plane: x = B [N s/m], y = K [N/m]" in out
+    line = next(line for line in out.splitlines() if line.strip().startswith("K_max"))
+    k_max = stiffness(symstab.limits(gamma=0.0, d=10, delta=PAPER_DELTA).alpha_max)
+    assert float(line.split()[1]) == pytest.approx(k_max, rel=1e-6) and "N/m" in line
+    assert "stable K at B = 0.3 N s/m: [" in out
+
+
+def test_classify_gives_todays_radius_and_python_controls_pole_count(capsys):
+    kw, bw = [1.0, 3.0, 10.0, 40.0], [0.2, 0.2, 0.2, 0.05]
+    loop = run_json(capsys, "classify", "--loop", PAPER, "--set", "d=10",
+                    "--set", "K=" + ",".join(map(str, kw)), "--set", "B=" + ",".join(map(str, bw)))
+    paper = run_json(capsys, "classify", "--Td", "0.01", "--linear",
+                     "--Kw", ",".join(map(str, kw)), "--Bw", ",".join(map(str, bw)))
+    assert len(loop["rows"]) == 4
+    verdicts = set()
+    for row, today, k, b in zip(loop["rows"], paper["rows"], kw, bw):
+        assert (row["K [N/m]"], row["B [N s/m]"]) == (k, b)
+        assert row["spectral radius"] == pytest.approx(today["spectral radius"], rel=1e-6)
+        assert row["verdict"] == today["verdict"]
+        poles = python_control_closed_loop(alpha=k * PAPER_T**2 / PAPER_M,
+                                           beta=b * PAPER_T / PAPER_M, gamma=0.0, d=10,
+                                           delta=PAPER_DELTA, m=PAPER_M, T=PAPER_T).poles()
+        assert row["unstable poles"] == int(np.sum(np.abs(poles) > 1))
+        verdicts.add(row["verdict"])
+    assert verdicts == {"stable", "unstable"}
+
+
+def test_classify_one_point_echoes_every_value_with_its_unit(capsys):
+    status, out, _ = run(capsys, "classify", "--loop", PAPER, "--set", "K=300", "--d", "0")
+    assert status == 0
+    assert "K = 300 N/m (--set)" in out and "m = 0.0128 kg" in out and "d = 0 samples" in out
+    radius = symstab.spectral_radius(alpha=300 * PAPER_T**2 / PAPER_M, beta=0.1 * PAPER_T / PAPER_M,
+                                     gamma=0.0, d=0, delta=PAPER_DELTA)
+    row = out.split("\n\n")[1].splitlines()[2].split()
+    assert float(row[0]) == 300.0 and float(row[1]) == pytest.approx(radius, rel=1e-6)
+    assert row[-1] == ("stable" if radius < 1 else "unstable")
+
+
+def test_boundary_lies_on_the_derived_curve_and_names_its_lines(capsys):
+    from symstab.curves import minus_one_line
+    from symstab.evaluate import boundary_point
+
+    data = run_json(capsys, "boundary", "--loop", PAPER, "--set", "d=10", "--n", "40")
+    rows = data["rows"]
+    assert len(rows) == 40
+    checked = 0
+    for row in rows:
+        theta, b, k = row["theta [rad]"], row["B [N s/m]"], row["K [N/m]"]
+        if b is None:
+            continue
+        alpha, beta = boundary_point(theta, gamma=0.0, d=10, delta=PAPER_DELTA)
+        assert k == pytest.approx(stiffness(float(alpha)), rel=1e-6)
+        assert b == pytest.approx(damping(float(beta)), rel=1e-6)
+        checked += 1
+    assert checked >= 38
+    lines = data["lines"]
+    # z = 1: K = 0 (a pole at z = 1 whenever the spring is off).
+    one = lines["z = 1"]
+    assert one["cx"] == 0 and abs(one["c0"] / one["cy"]) < 1e-9
+    # z = -1: alpha + 2 beta = c of the derivation, in N/m and N s/m.
+    c0, cx, cy = (lines["z = -1"][k] for k in ("c0", "cx", "cy"))
+    # alpha + 2 beta = c is K + (2 / T) B = c m / T**2.
+    assert cx / cy == pytest.approx(2 / PAPER_T, rel=1e-9)
+    c = minus_one_line(gamma=0.0, d=10, delta=PAPER_DELTA)
+    assert -c0 / cy == pytest.approx(stiffness(c), rel=1e-6)
+    assert any(n.startswith("line z = -1: ") and n.endswith(" B") for n in data["notes"])
+
+
+def test_design_gives_K_max_and_the_stable_K_at_its_damping(capsys):
+    design = run_json(capsys, "design", "--loop", PAPER, "--set", "d=10")
+    paper = run_json(capsys, "limits", "--d", "10", "--linear")["limits"]
+    assert design["limits"]["y_max"] == pytest.approx(stiffness(paper["alpha_max"]), rel=1e-6)
+    b_best = design["limits"]["x_at_y_max"]
+    assert b_best == pytest.approx(damping(paper["beta_at_alpha_max"]), rel=1e-6)
+    (lo, hi), = design["at"]["intervals"]
+    assert design["at"]["x"] == b_best
+    assert abs(lo) < 1e-9 and hi == pytest.approx(stiffness(paper["alpha_max"]), rel=1e-6)
+    # --at: today's `limits --Bw` intervals.
+    design = run_json(capsys, "design", "--loop", PAPER, "--set", "d=10", "--at", "1.5")
+    today = run_json(capsys, "limits", "--d", "10", "--linear", "--Bw", "1.5")
+    (lo, hi), = design["at"]["intervals"]
+    (alo, ahi), = today["alpha_intervals"]["intervals"]
+    assert hi == pytest.approx(stiffness(ahi), rel=1e-6)
+    assert lo == pytest.approx(stiffness(alo), abs=1e-9)
+
+
+def test_map_is_todays_root_count_classification(capsys, tmp_path):
+    grid_k, grid_b = "0,2500,9", "-2,12,8"
+    out = tmp_path / "loop.npz"
+    status, text, err = run(capsys, "map", "--loop", PAPER, "--set", "d=1", f"--x-range={grid_b}",
+                            f"--y-range={grid_k}", "--out", out, "--no-png")
+    assert status == 0, err
+    assert "wrote " + str(out) in text
+    paper = tmp_path / "paper.npz"
+    status, _, err = run(capsys, "map", "--d", "1", "--linear", f"--Kw={grid_k}", f"--Bw={grid_b}",
+                         "--steps", "20", "--out", paper, "--no-png")
+    assert status == 0, err
+    with np.load(out) as f, np.load(paper) as g:
+        assert (str(f["x_name"]), str(f["y_name"]), str(f["y_unit"])) == ("B", "K", "N/m")
+        np.testing.assert_array_equal(f["x"], g["B_w"])
+        np.testing.assert_array_equal(f["y"], g["K_w"])
+        code, today = f["code"], g["exact_code"].T   # today's map is (K_w, B_w)
+        stable = f["stable"]
+    decided = (code != symstab.MARGINAL) & (today != symstab.MARGINAL)
+    assert decided.sum() >= 60 and 0 < stable.sum() < stable.size
+    np.testing.assert_array_equal(code[decided], today[decided])
+    np.testing.assert_array_equal(stable, code == symstab.STABLE)
+
+
+def test_map_csv_and_png_in_the_units_of_the_file(capsys, tmp_path, monkeypatch):
+    from matplotlib.figure import Figure
+
+    seen, savefig = [], Figure.savefig
+
+    def record(fig, *args, **kwargs):
+        ax = fig.axes[0]
+        seen.append((ax.get_xlabel(), ax.get_ylabel(), ax.get_xlim(), ax.get_ylim(),
+                     [t.get_text() for t in ax.get_legend().get_texts()]))
+        return savefig(fig, *args, **kwargs)
+
+    monkeypatch.setattr(Figure, "savefig", record)
+    out = tmp_path / "m.csv"
+    status, _, err = run(capsys, "map", "--loop", PAPER, "--d", "1", "--x-range=-2,12,5",
+                         "--y-range=0,2500,4", "--out", out)
+    assert status == 0, err
+    lines = out.read_text().splitlines()
+    assert lines[0] == "B [N s/m],K [N/m],code,stable" and len(lines) == 21
+    rows = np.array([[float(v) for v in line.split(",")] for line in lines[1:]])
+    code = symstab.classify(alpha=rows[:, 1] * PAPER_T**2 / PAPER_M,
+                            beta=rows[:, 0] * PAPER_T / PAPER_M, gamma=0.0, d=1, delta=PAPER_DELTA)
+    decided = (code != symstab.MARGINAL) & (rows[:, 2] != symstab.MARGINAL)
+    np.testing.assert_array_equal(rows[decided, 2], code[decided])
+    assert (tmp_path / "m.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    (xlabel, ylabel, xlim, ylim, legend), = seen
+    assert (xlabel, ylabel) == ("B [N s/m]", "K [N/m]")
+    assert xlim == pytest.approx((-2, 12)) and ylim == pytest.approx((0, 2500))
+    assert "stable" in legend and any("D-decomposition" in t for t in legend)
+
+
+def test_map_files_are_the_same_bytes_run_to_run(capsys, tmp_path):
+    for name in ("a", "b"):
+        status, _, err = run(capsys, "map", "--loop", PAPER, "--d", "1", "--x-range=-2,12,5",
+                             "--y-range=0,2500,4", "--out", tmp_path / f"{name}.npz")
+        assert status == 0, err
+    for suffix in (".npz", ".png"):
+        assert (tmp_path / f"a{suffix}").read_bytes() == (tmp_path / f"b{suffix}").read_bytes()
+
+
+# --------------------------------------------------------------------------
+# Written atomically: an interrupted map leaves nothing behind
+
+
+def test_map_interrupted_while_classifying_writes_nothing(capsys, tmp_path, monkeypatch):
+    from symstab.any_loop import Loop
+
+    def interrupted(self, **values):
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(Loop, "classify", interrupted)
+    monkeypatch.chdir(tmp_path)
+    status, _, err = run(capsys, "map", "--loop", PAPER, "--d", "1", "--x-range=0,1,3",
+                         "--y-range=0,1,3", "--out", "m.npz")
+    assert status == 130 and err.strip().splitlines()[-1] == "symstab map: interrupted"
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_map_interrupted_while_writing_leaves_no_partial_file(capsys, tmp_path, monkeypatch):
+    from symstab import derive
+
+    def interrupted(path, mode):
+        raise KeyboardInterrupt   # after the bytes are in the temporary file
+
+    monkeypatch.setattr(derive.os, "chmod", interrupted)
+    monkeypatch.chdir(tmp_path)
+    status, _, err = run(capsys, "map", "--loop", PAPER, "--d", "1", "--x-range=0,1,3",
+                         "--y-range=0,1,3", "--out", "m.csv", "--no-png")
+    assert status == 130, err
+    assert list(tmp_path.iterdir()) == []
+
+
+# --------------------------------------------------------------------------
+# Bad input: one line, exit 2, decided before the work, nothing written
+
+
+L = ["--loop", PAPER]
+MAP = ["--x-range=0,1,3", "--y-range=0,1,3", "--out", "m.npz"]
+
+
+@pytest.mark.parametrize("args, needle", [
+    (["limits", *L, "--Td", "0.04"], "--Td is an option of the paper's device; with --loop use --set d="),
+    (["limits", *L, "--gamma", "1"], "--set M="),
+    (["limits", *L, "--m", "0.1"], "--set m="),
+    (["limits", *L, "--linear"], "units of the loop file"),
+    (["limits", *L, "--Bw", "0.1"], "--at X"),
+    (["classify", *L, "--Kw", "1"], "--set K="),
+    (["classify", *L, "--alpha", "1"], "--set K="),
+    (["map", *L, "--Kw=0,1,3", *MAP], "--x-range"),
+    (["map", *L, "--paper-encoder", *MAP], "simulation"),
+    (["map", *L, "--steps", "100", *MAP], "simulation"),
+    (["limits", *L, "--set", "K300"], "NAME=VALUE"),
+    (["limits", *L, "--set", "=3"], "NAME=VALUE"),
+    (["limits", *L, "--set", "Q=1"], "'Q' is not a parameter"),
+    (["limits", *L, "--set", "m=abc"], "'abc' is not a number"),
+    (["limits", *L, "--set", "m="], "must be a number"),
+    (["limits", *L, "--set", "m=nan"], "finite"),
+    (["limits", *L, "--set", "m=inf"], "finite"),
+    (["limits", *L, "--set", "d=2.5"], "delay d"),
+    (["limits", *L, "--set", "d=-1"], "delay d"),
+    (["limits", *L, "--set", "T=-1"], "T must be"),
+    (["limits", *L, "--set", "T=0"], "T must be"),
+    (["limits", *L, "--set", "m=0"], "not defined"),
+    (["limits", *L, "--set", "m=1", "--set", "m=2"], "twice"),
+    (["limits", *L, "--set", "d=1", "--d", "2"], "once"),
+    (["limits", *L, "--set", "M=1,2"], "one value here"),
+    (["limits", *L, "--set", "K=3"], "axis"),
+    (["design", *L, "--set", "B=0.3"], "--at"),
+    (["limits", *L, "--x", "B"], "--x NAME and --y NAME"),
+    (["limits", *L, "--x", "Q", "--y", "K"], "--x Q"),
+    (["limits", *L, "--x", "m", "--y", "K"], "affinely"),
+    (["limits", *L, "--x", "K", "--y", "K"], "differ"),
+    (["limits", *L, "--at", "nan"], "--at"),
+    (["boundary", *L, "--n", "1"], "n must be"),
+    (["classify", *L, "--set", "K=1,2", "--set", "B=1,2,3"], "same length"),
+    (["classify", *L, "--set", "K=1,,2"], "empty"),
+    (["classify", *L, "--set", "d=1,2"], "d takes one value"),
+    (["map", *L, "--x-range=0,1,3", "--out", "m.npz"], "--y-range"),
+    (["map", *L, "--x-range=0,1", "--y-range=0,1,3", "--out", "m.npz"], "--x-range"),
+    (["map", *L, "--x-range=0,1,3", "--y-range=0,1,3", "--out", "m.txt"], "--out"),
+    (["map", *L, *MAP, "--png", "missing/m.png"], "folder"),
+    (["limits", "--set", "K=1"], "--set needs a loop file"),
+    (["boundary", "--x", "B"], "--x needs a loop file"),
+    (["map", "--alpha=0,1,3", "--beta=0,1,3", "--x-range=0,1,3", "--out", "m.npz"],
+     "--x-range needs a loop file"),
+    (["limits", "--loop", "missing.toml"], "missing.toml"),
+])
+def test_bad_input_is_one_line_and_exit_2(capsys, tmp_path, monkeypatch, args, needle):
+    monkeypatch.chdir(tmp_path)
+    status, out, err = run(capsys, *args)
+    assert status == 2, err
+    lines = err.strip().splitlines()
+    assert len(lines) == 1 and lines[0].startswith(f"symstab {args[0]}: error:"), err
+    assert needle in lines[0], lines[0]
+    assert "Traceback" not in err and out == ""
+    assert list(tmp_path.iterdir()) == []
+
+
+@pytest.mark.parametrize("text, needle", [
+    ("plant = [", "not valid TOML"),
+    ('plant = "1/(m*s**2 + b*s)"\nenvironment = "K*z**3"\n', "proper"),
+    ('plant = "1/(m*s**2 + b*s)"\nenvironment = "K + B*(z - 1)/(T*z)"\nplane = ["B", "K"]\n'
+     '[parameters]\nm = 1.0\nb = 0.1\nT = 1e-3\n', "no value for d"),
+])
+def test_a_bad_loop_file_is_one_line_naming_the_file(capsys, tmp_path, monkeypatch, text, needle):
+    path = tmp_path / "in" / "bad.toml"
+    path.parent.mkdir()
+    path.write_text(text)
+    work = tmp_path / "work"
+    work.mkdir()
+    monkeypatch.chdir(work)
+    status, out, err = run(capsys, "limits", "--loop", path)
+    assert status == 2 and out == ""
+    (line,) = err.strip().splitlines()
+    assert line.startswith("symstab limits: error:") and needle in line and "bad.toml" in line
+    assert list(work.iterdir()) == []
+
+
+def test_a_file_without_a_plane_asks_for_one(capsys, tmp_path):
+    path = tmp_path / "noplane.toml"
+    path.write_text('plant = "1/(m*s**2 + b*s)"\nenvironment = "K + B*(z - 1)/(T*z)"\n'
+                    '[parameters]\nm = 0.0128\nb = 0.0324\nT = 1e-3\nd = 1\n')
+    status, _, err = run(capsys, "limits", "--loop", path)
+    assert status == 2 and "names no plane: give --x NAME --y NAME" in err
+    assert "affine parameters: B, K" in err
+    data = run_json(capsys, "limits", "--loop", path, "--x", "B", "--y", "K")
+    k_max = stiffness(symstab.limits(gamma=0.0, d=1, delta=PAPER_DELTA).alpha_max)
+    assert data["limits"]["y_max"] == pytest.approx(k_max, rel=1e-6)
+
+
+def test_without_loop_the_paper_commands_are_unchanged(capsys):
+    """No --loop: the output has no loop keys and today's inputs."""
+    data = run_json(capsys, "limits", "--d", "1")
+    assert "alpha_max" in data["limits"] and "loop" not in data["inputs"]
+    assert math.isclose(data["inputs"]["delta"], PAPER_DELTA)
+
+
+@pytest.mark.parametrize("command", ["boundary", "limits", "classify", "design", "map"])
+def test_help_shows_a_loop_example_that_parses(capsys, command):
+    import shlex
+
+    status, out, _ = run(capsys, command, "--help")
+    assert status == 0
+    (line,) = [line for line in out.splitlines() if line.startswith(f"  example: symstab {command} ")]
+    words = shlex.split(line.split("example:")[1])
+    args = cli.build_parser().parse_args(words[1:])
+    assert args.command == command and args.loop == "examples/loops/paper.toml"
+    assert (REPO / args.loop).is_file()
+
+
+def test_the_map_help_example_frames_the_stable_set(capsys, tmp_path, monkeypatch):
+    import shlex
+
+    _, out, _ = run(capsys, "map", "--help")
+    (line,) = [line for line in out.splitlines() if line.startswith("  example: symstab map ")]
+    words = shlex.split(line.split("example:")[1])[1:]
+    words[words.index("--out") + 1] = str(tmp_path / "map.npz")
+    monkeypatch.chdir(REPO)
+    status, _, err = run(capsys, *words, "--no-png")
+    assert status == 0, err
+    with np.load(tmp_path / "map.npz") as f:
+        assert 0.3 < f["stable"].mean() < 0.8
+        stable = f["stable"]
+        # The stable set does not touch the window's left, right or top edge.
+        assert not stable[0].any() and not stable[-1].any() and not stable[:, -1].any()
