@@ -381,8 +381,8 @@ def test_c_kernels_assemble_the_loops_polynomial(paper_folder, tmp_path):
         theirs = loop.coefficients(d=d, **point)
         assert theirs.shape == ours.shape
         # Each coefficient against the size of the terms it is made of.
-        scale = _assemble(np.abs(np.convolve(ve_d, p_d / lead)), np.convolve(np.abs(ve_n),
-                                                                               np.abs(p_n / lead)), d)
+        scale = _assemble(np.convolve(np.abs(ve_d), np.abs(p_d / lead)),
+                          np.convolve(np.abs(ve_n), np.abs(p_n / lead)), d)
         assert np.all(np.abs(ours - theirs) <= 1e-8 * scale), (point, d, ours, theirs)
 
 
