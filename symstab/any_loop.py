@@ -565,7 +565,13 @@ class Loop:
 
     @functools.lru_cache(maxsize=4096)
     def _plant_cache(self, plant_values, T):
-        """(P_n, P_d) as float arrays, monic P_d, evaluated at 30 digits."""
+        """(P_n, P_d, ends) as float arrays, monic P_d, evaluated at 30 digits.
+
+        ``ends`` is ``(P_n(1), P_d(1), P_n(-1), P_d(-1))``, summed at 30
+        digits: a pole at z = 1 then gives ``P_d(1)`` of 1e-30, not of the
+        coefficients' rounding, and the line z = 1 of a plane comes out
+        where it is.
+        """
         with mpmath.workdps(_DPS):
             point = [mpmath.mpf(float(v)) for v in plant_values]
             if self._plant_parts is None:
@@ -588,18 +594,23 @@ class Loop:
                 raise ValueError(f"the plant's pulse transfer function is not defined at "
                                  f"{given}, T = {float(T):g} (a pole cancels a parameter, "
                                  f"e.g. b = 0 in 1/(m s**2 + b s)? write that plant with b = 0)")
+            ends = [sum(c * sign**k for k, c in enumerate(reversed(part)))
+                    for sign in (1, -1) for part in (p_n, p_d)]
             return (np.array([float(c / lead) for c in p_n]),
-                    np.array([float(c / lead) for c in p_d]))
+                    np.array([float(c / lead) for c in p_d]),
+                    np.array([float(c / lead) for c in ends]))
 
     def _plant_arrays(self, values, shape):
-        """(P_n, P_d) per point, shape ``shape + (k,)``, one 30-digit evaluation per distinct row."""
+        """(P_n, P_d, ends) per point, shape ``shape + (k,)``, one 30-digit evaluation per distinct row."""
         names = self._plant_names + ("T",)
         columns = np.stack([np.broadcast_to(values[n], shape).ravel() for n in names], axis=-1)
         unique, inverse = np.unique(columns, axis=0, return_inverse=True)
         parts = [self._numeric_plant(tuple(row[:-1]), float(row[-1])) for row in unique]
         p_n = np.array([p[0] for p in parts])[inverse.ravel()]
         p_d = np.array([p[1] for p in parts])[inverse.ravel()]
-        return p_n.reshape(shape + p_n.shape[-1:]), p_d.reshape(shape + p_d.shape[-1:])
+        ends = np.array([p[2] for p in parts])[inverse.ravel()]
+        return (p_n.reshape(shape + p_n.shape[-1:]), p_d.reshape(shape + p_d.shape[-1:]),
+                ends.reshape(shape + (4,)))
 
     def _environment_arrays(self, values, shape, slope=None):
         module, names, n_num, n_den = self._kernels
@@ -626,7 +637,7 @@ class Loop:
     def _coefficients(self, values, d, shape, *, slope=None, plant=None):
         if plant is None:
             plant = self._plant_arrays(values, shape)
-        p_n, p_d = plant
+        p_n, p_d = plant[:2]
         if slope is None or slope in self._environment_names:
             ve_n, ve_d = self._environment_arrays(values, shape, slope)
             delayed, direct = self._convolve(ve_d, p_d), self._convolve(ve_n, p_n)
@@ -637,6 +648,23 @@ class Loop:
             dp_n, dp_d = self._plant_slope(values, shape, slope)
             delayed, direct = self._convolve(ve_d, dp_d), self._convolve(ve_n, dp_n)
         return self._dense(delayed, direct, d)
+
+    def _end_values(self, values, d, shape, *, slope=None, plant):
+        """``chi(1)`` and ``chi(-1)`` (or their slopes), from the plant's 30-digit end values."""
+        ends = plant[2]
+        if slope is not None and slope not in self._environment_names:
+            dense = self._coefficients(values, d, shape, slope=slope, plant=plant)
+            return np.stack([np.sum(dense, axis=-1),
+                             np.sum(dense * (-1.0) ** np.arange(dense.shape[-1] - 1, -1, -1), axis=-1)],
+                            axis=-1)
+        ve_n, ve_d = self._environment_arrays(values, shape, slope)
+
+        def at(c, sign):
+            return np.sum(c * sign ** np.arange(c.shape[-1] - 1, -1, -1, dtype=float), axis=-1)
+
+        plus = at(ve_d, 1.0) * ends[..., 1] + at(ve_n, 1.0) * ends[..., 0]
+        minus = (-1.0) ** d * at(ve_d, -1.0) * ends[..., 3] + at(ve_n, -1.0) * ends[..., 2]
+        return np.stack([plus, minus], axis=-1)
 
     def _plant_slope(self, values, shape, name):
         # P_d is normalised to be monic in _plant_cache, which would make an
@@ -741,7 +769,9 @@ class Loop:
         plant = self._plant_arrays(values, shape)
         base = self._coefficients(values, d, shape, plant=plant)
         slopes = [self._coefficients(values, d, shape, slope=n, plant=plant) for n in names]
-        return base, slopes, d
+        ends = [self._end_values(values, d, shape, plant=plant)] + [
+            self._end_values(values, d, shape, slope=n, plant=plant) for n in names]
+        return base, slopes, ends
 
     def stable_intervals(self, name, **values):
         """The stable intervals of one parameter, the others fixed.
@@ -766,8 +796,8 @@ class Loop:
             Stable intervals ``(lo, hi)``, increasing; ``lo`` may be
             ``-inf`` and ``hi`` ``inf``.  Endpoints are unstable or marginal.
         """
-        base, (slope,), _ = self._basis((name,), values)
-        return _line_intervals(base, slope)
+        base, (slope,), (base_ends, slope_ends) = self._basis((name,), values)
+        return _line_intervals(base, slope, base_ends, slope_ends)
 
     def _plane(self, x, y):
         if x is None and y is None and self.plane is not None:
@@ -796,7 +826,7 @@ class Loop:
         x, y = self._plane(x, y)
         n = check_count("n", n, 2)
         check_memory("the boundary", 64 * n)
-        base, (ax, ay), _ = self._basis((x, y), values)
+        base, (ax, ay), ends = self._basis((x, y), values)
         theta = np.pi * (np.arange(1, n + 1) - 0.5) / n
         a0, cx, cy = (_on_circle(c, theta) for c in (base, ax, ay))
         with np.errstate(all="ignore"):
@@ -807,8 +837,8 @@ class Loop:
         xs[singular] = np.nan
         ys[singular] = np.nan
         lines = {}
-        for label, point in (("z = 1", 1.0), ("z = -1", -1.0)):
-            c = [float(np.polyval(p, point)) for p in (base, ax, ay)]
+        for index, label in enumerate(("z = 1", "z = -1")):
+            c = [float(e[index]) for e in ends]
             if c[1] or c[2]:
                 lines[label] = tuple(c)
         lead = (float(base[0]), float(ax[0]), float(ay[0]))
@@ -841,16 +871,16 @@ class Loop:
         """
         x, y = self._plane(x, y)
         n_lines = check_count("n_lines", n_lines, 8)
-        base, (ax, ay), _ = self._basis((x, y), values)
+        base, (ax, ay), (base_ends, x_ends, y_ends) = self._basis((x, y), values)
 
         def intervals(xv):
-            return _line_intervals(base + xv * ax, ay)
+            return _line_intervals(base + xv * ax, ay, base_ends + xv * x_ends, y_ends)
 
         def top(xv):
             found = intervals(xv)
             return max((hi for _, hi in found), default=-np.inf)
 
-        seeds = _stable_seeds(base, ax, ay)
+        seeds = _stable_seeds(base, ax, ay, (base_ends, x_ends, y_ends))
         if seeds.size == 0:
             return LoopLimits(x, y, np.nan, np.nan, np.nan, np.nan, 0.0, 0)
         scale = max(float(np.ptp(seeds)), 1e-12 * max(1.0, float(np.max(np.abs(seeds)))))
@@ -866,7 +896,7 @@ class Loop:
             else:
                 return direction * np.inf
             outside = inside + direction * step
-            for _ in range(60):
+            while abs(outside - inside) > 1e-10 * scale:
                 mid = 0.5 * (inside + outside)
                 if mid in (inside, outside):
                     break
@@ -893,7 +923,7 @@ class Loop:
             area = float(np.sum(0.5 * (lengths[1:] + lengths[:-1]) * np.diff(grid)))
         best = int(np.argmax(tops))
         a, b = grid[max(best - 1, 0)], grid[min(best + 1, n_lines - 1)]
-        x_best = float(_golden_max(np.vectorize(top), a, b, iterations=60))
+        x_best = float(_golden_max(np.vectorize(top, otypes=[float]), a, b, iterations=40))
         y_best = top(x_best)
         if not y_best >= tops[best]:
             x_best, y_best = float(grid[best]), float(tops[best])
@@ -917,7 +947,7 @@ class Loop:
             raise ImportError("Loop.closed_loop needs python-control: pip install control") from None
         values, d, shape = self._prepare(values, scalar=self.parameters)
         chi = self._coefficients(values, d, shape)
-        p_n, _ = self._plant_arrays(values, shape)
+        p_n = self._plant_arrays(values, shape)[0]
         _, ve_d = self._environment_arrays(values, shape)
         num = np.concatenate([self._convolve(ve_d, p_n), np.zeros(d)])
         return control.tf(num, chi, float(values["T"]))
@@ -932,66 +962,148 @@ def _on_circle(c, theta):
     return out
 
 
-def _circle_candidates(a0, a1):
+def _circle_candidates(a0, a1, a0_ends, a1_ends):
     """Parameter values ``p`` at which ``a0 + p a1`` has a root on the unit circle.
 
-    Angles where ``Im(a0 conj a1) = 0``: the unit-circle roots of the
-    polynomial ``a0 rev(a1) - rev(a0) a1`` (eigenvalues, polished), joined
-    with the sign changes on a scan of the angle (refined by the root
-    bracketer), and the ends ``theta = 0, pi``.
+    Angles where ``Im(a0 conj a1) = 0``: the sign changes on a scan of the
+    angle (refined by the root bracketer) and the ends ``theta = 0, pi``,
+    joined with the unit-circle roots of the polynomial
+    ``a0 rev(a1) - rev(a0) a1`` that the scan missed.  Returns ``(p,
+    theta)``, the crossings' parameter values and angles.
     """
-    from .curves import bracketed_root
+    from .curves import bracketed_root, scan_grid
 
     n = len(a0) - 1
-    h = np.polysub(np.polymul(a0, a1[::-1]), np.polymul(a0[::-1], a1))
-    angles = [0.0, np.pi]
-    h = np.trim_zeros(h, "f")
-    if len(h) > 1 and np.any(h):
-        with np.errstate(all="ignore"):
-            roots = np.roots(h)
-        near = roots[np.abs(np.abs(roots) - 1) < 1e-4]
-        angles += [float(abs(np.angle(r))) for r in near]
 
     def g(theta):
         v0, v1 = _on_circle(a0, theta), _on_circle(a1, theta)
         return (v0 * np.conj(v1)).imag
 
-    grid = np.linspace(0.0, np.pi, max(512, 32 * (n + 1)))
+    # The sign scan, refined to a few ulps, finds every crossing whose
+    # neighbours on the scan are apart; theta = 0 and pi are always there.
+    # g vanishes at 0 and pi, so the scan approaches both geometrically.
+    grid = scan_grid(n, n=max(256, 16 * (n + 1)))[:-1]
+    grid = np.concatenate([grid, np.pi - (grid[:40][::-1])])
     values = g(grid)
     change = np.flatnonzero(np.sign(values[:-1]) * np.sign(values[1:]) < 0)
+    found = [0.0, np.pi]
     if change.size:
-        angles += list(bracketed_root(g, grid[change], grid[change + 1]))
-    angles = np.unique(np.clip(angles, 0.0, np.pi))
+        found += list(bracketed_root(g, grid[change], grid[change + 1]))
+    found = np.array(found)
+    # The polynomial's unit-circle roots add those the scan cannot see (a
+    # close pair between two scan points, a double root); near a scanned
+    # angle they are the same crossing, less accurately.
+    h = np.trim_zeros(np.polysub(np.polymul(a0, a1[::-1]), np.polymul(a0[::-1], a1)), "f")
+    extra = []
+    if len(h) > 1 and np.any(h):
+        with np.errstate(all="ignore"):
+            roots = np.roots(h)
+        near = np.abs(np.angle(roots[np.abs(np.abs(roots) - 1) < 1e-4]))
+        for a in np.sort(near):
+            # Conjugates and the pairs z, 1/conj(z) of h give each angle twice.
+            if np.min(np.abs(found - a)) > 1e-6 and (not extra or a - extra[-1] > 1e-6):
+                extra.append(a)
+    angles = np.unique(np.clip(np.concatenate([found, extra]), 0.0, np.pi))
     v0, v1 = _on_circle(a0, angles), _on_circle(a1, angles)
+    # At z = +-1 exactly: exp(j pi) has an imaginary part of 1e-16.
+    for index, end in enumerate((0.0, np.pi)):
+        v0[angles == end] = a0_ends[index]
+        v1[angles == end] = a1_ends[index]
     with np.errstate(all="ignore"):
         p = -(v0 * np.conj(v1)).real / np.abs(v1) ** 2
         residual = np.abs(v0 + p * v1)
-    scale = np.abs(v0) + np.abs(p * v1)
+    # Rounding of a0 + p a1 on the circle is relative to the sums of the
+    # coefficients' moduli, not to |a0(z)|, which cancels near a root.
+    scale = np.sum(np.abs(a0)) + np.abs(p) * np.sum(np.abs(a1))
     keep = np.isfinite(p) & (residual <= 1e-6 * np.where(scale > 0, scale, 1.0))
-    return p[keep]
+    return p[keep], angles[keep]
 
 
-def _line_intervals(a0, a1):
-    """Stable intervals of ``p`` for the polynomial ``a0 + p a1`` (rows, highest first)."""
+def _crossing_changes(a0, a1, p, theta):
+    """Change of the number of roots outside the circle as ``p`` increases through each crossing.
+
+    At a crossing the root ``z = exp(j theta)`` of ``a0 + p a1`` moves with
+    ``dz/dp = -a1(z) / chi'(z)``; outward (``Re(conj(z) dz/dp) > 0``) adds
+    two roots outside (a complex pair) or one (``z = +-1``).  NaN where the
+    crossing is tangential or the root is multiple: undecided.
+    """
+    z = np.exp(1j * theta)
+    chi_slope = _on_circle(np.polyder(a0), theta) + p * _on_circle(np.polyder(a1), theta)
+    with np.errstate(all="ignore"):
+        velocity = -_on_circle(a1, theta) / chi_slope
+        radial = (np.conj(z) * velocity).real
+    size = np.where((theta == 0) | (theta == np.pi), 1.0, 2.0)
+    clear = np.isfinite(radial) & (np.abs(radial) > 1e-8 * np.abs(velocity))
+    return np.where(clear, size * np.sign(radial), np.nan)
+
+
+def _line_intervals(a0, a1, a0_ends, a1_ends):
+    """Stable intervals of ``p`` for the polynomial ``a0 + p a1`` (rows, highest first).
+
+    ``a0_ends``, ``a1_ends`` are the polynomials' values at ``z = 1`` and
+    ``z = -1``, computed more accurately than from the coefficients.
+
+    The number of roots outside the circle is counted (certified) at the
+    first test point and carried across each crossing by its direction
+    (:func:`_crossing_changes`); every test point the bookkeeping calls
+    stable, and every one after an undecided crossing, is counted afresh,
+    and a disagreement sends every test point to the certified count.
+    """
     a0, a1 = np.asarray(a0, dtype=float), np.asarray(a1, dtype=float)
-    candidates = list(_circle_candidates(a0, a1))
+    p, theta = _circle_candidates(a0, a1, a0_ends, a1_ends)
+    changes = list(_crossing_changes(a0, a1, p, theta))
+    p = list(p)
     if a1[0] != 0:
-        candidates.append(-a0[0] / a1[0])
-    candidates = np.unique(np.array(candidates, dtype=float))
-    candidates = candidates[np.isfinite(candidates)]
+        # The leading coefficient vanishes: a root passes through infinity,
+        # outside on both sides.
+        p.append(-a0[0] / a1[0])
+        changes.append(0.0)
+    p, changes = np.array(p, dtype=float), np.array(changes, dtype=float)
+    keep = np.isfinite(p)
+    p, changes = p[keep], changes[keep]
+    order = np.argsort(p, kind="stable")
+    p, changes = p[order], changes[order]
+    # Crossings at the same p add up.
+    candidates, at = np.unique(p, return_inverse=True)
+    summed = np.zeros(len(candidates))
+    np.add.at(summed, at, changes)
     if candidates.size == 0:
         tests = np.array([0.0])
     else:
         pad = max(1.0, float(np.max(np.abs(candidates))))
         tests = np.concatenate([[candidates[0] - pad], 0.5 * (candidates[1:] + candidates[:-1]),
                                 [candidates[-1] + pad]])
-    codes = classify_polynomials(a0[None, :] + tests[:, None] * a1[None, :])
+    rows = a0[None, :] + tests[:, None] * a1[None, :]
+
+    def count(index):
+        c = polynomial_root_counts(rows[index])
+        lead_ok = classify_polynomials(rows[index], refine=False) != MARGINAL
+        return np.where(lead_ok, c, -1)
+
+    counts = np.full(len(tests), -2, dtype=np.int64)     # -2: not known
+    known = np.zeros(len(tests), dtype=bool)
+    first = count(np.array([0]))[0]
+    counts[0], known[0] = first, True
+    for k in range(1, len(tests)):
+        step = summed[k - 1]
+        if counts[k - 1] >= 0 and np.isfinite(step):
+            counts[k] = counts[k - 1] + int(step)
+        else:
+            counts[k] = count(np.array([k]))[0]
+            known[k] = True
+    claim = np.flatnonzero(~known & (counts <= 0))
+    if claim.size:
+        fresh = count(claim)
+        if np.any(fresh != counts[claim]):
+            counts = count(np.arange(len(tests)))
+        else:
+            counts[claim] = fresh
     edges = np.concatenate([[-np.inf], candidates, [np.inf]])
     out = []
-    for k, code in enumerate(codes):
-        if code != STABLE:
+    for k, c in enumerate(counts):
+        if c != 0:
             continue
-        lo, hi = float(edges[k]), float(edges[k + 1])
+        lo, hi = float(edges[k]) + 0.0, float(edges[k + 1]) + 0.0     # no -0.0
         if out and out[-1][1] == lo:
             out[-1] = (out[-1][0], hi)
         else:
@@ -999,7 +1111,7 @@ def _line_intervals(a0, a1):
     return out
 
 
-def _stable_seeds(base, ax, ay):
+def _stable_seeds(base, ax, ay, ends):
     """The ``x`` of stable points next to the D-decomposition's curves.
 
     Every cell of the plane is bounded by pieces of the arc and of the lines,
@@ -1014,7 +1126,7 @@ def _stable_seeds(base, ax, ay):
         det = cx.real * cy.imag - cy.real * cx.imag
         xs = (-a0.real * cy.imag + cy.real * a0.imag) / det
         ys = (-cx.real * a0.imag + a0.real * cx.imag) / det
-    lines = [(np.polyval(base, p), np.polyval(ax, p), np.polyval(ay, p)) for p in (1.0, -1.0)]
+    lines = [tuple(e[k] for e in ends) for k in range(2)]
     lines.append((base[0], ax[0], ay[0]))
     for i in range(len(lines)):
         for j in range(i + 1, len(lines)):
