@@ -255,16 +255,18 @@ class LoopSetup:
         return out
 
 
+def _quantity_text(name, value):
+    if isinstance(value, (list, tuple, np.ndarray)):
+        return f"{name} = [" + ", ".join(f"{v:.10g}" for v in value) + "]"
+    return f"{name} = {value:.10g}" if isinstance(value, float) else f"{name} = {value}"
+
+
 def _quantity(setup, name, value):
     """``"K = 300 N/m"``, ``"K = [1, 3] N/m"``, ``"d = 40 samples"``."""
     unit = setup.unit(name) or ("samples" if name == "d" else "")
     if unit == "samples" and value == 1:
         unit = "sample"
-    if isinstance(value, (list, tuple, np.ndarray)):
-        text = "[" + ", ".join(f"{v:.10g}" for v in value) + "]"
-    else:
-        text = f"{value:.10g}" if isinstance(value, float) else str(value)
-    return f"{name} = {text}" + (f" {unit}" if unit else "")
+    return _quantity_text(name, value) + (f" {unit}" if unit else "")
 
 
 def _echo(setup):
@@ -339,9 +341,17 @@ def _resolve(args, *, plane=True, lists=False):
                          f"none; add --set {missing[0]}=VALUE")
     if plane:
         loop.boundary(x=x, y=y, n=2, **values)   # checks the plane (affine) and the values
+        point = {**values, x: 0.0, y: 0.0}
     else:
         check_memory("the points' coefficients", 8 * _points(values) * (values["d"] + 64))
-        loop.coefficients(**_broadcast(values))
+        point = _broadcast(values)
+    if not np.all(np.isfinite(loop.coefficients(**point))):
+        # An overflow in the plant's pulse transfer function (exp(-b T / m)
+        # at T = 1e300, say) would surface later as a NaN deep in the work.
+        given = ", ".join(_quantity_text(n, values[n]) for n in loop.parameters
+                          if n in values and n not in axes)
+        raise ValueError(f"the loop's characteristic polynomial is not finite at {given}: a "
+                         f"value is outside the range floating point can represent")
     setup = LoopSetup(str(args.loop), loop, values, tuple(sets), x, y)
     return dataclasses.replace(setup, echo=_echo(setup))
 
@@ -458,6 +468,9 @@ def _cmd_limits(args):
     if args.at is not None:
         from ._validate import check_real
         check_real(f"--at ({setup.x})", args.at)
+    # Seconds (hundreds of stable-interval searches at d = 40): say what runs.
+    print(f"scanning the ({setup.x}, {setup.y}) plane for the extent of the stable set ...",
+          file=sys.stderr, flush=True)
     lim = setup.loop.limits(x=setup.x, y=setup.y, **setup.values)
     rows = _limits_rows(setup, lim)
     notes = _limits_notes(setup, lim)
@@ -532,11 +545,14 @@ def _cmd_classify(args):
     rows = []
     for k in range(n):
         verdict = "stable" if code[k] == STABLE else "marginal" if code[k] == MARGINAL else "unstable"
-        poles = None if counts[k] < 0 else int(counts[k])
+        # A marginal verdict (a pole on the circle, or at infinity: the leading
+        # coefficient lost in rounding) has no count to trust.
+        poles = None if counts[k] < 0 or code[k] == MARGINAL else int(counts[k])
         rows.append(tuple(float(np.broadcast_to(values[m], (n,))[k]) for m in names)
                     + (float(radius[k]), poles, verdict))
     notes.append("unstable poles: closed-loop poles outside the unit circle, a certified count "
-                 "(empty: a pole on the circle to within rounding, marginal)")
+                 "(empty where marginal: a pole on the circle to within rounding, or at "
+                 "infinity where the leading coefficient vanishes)")
     _emit(setup, args.format, columns, rows, notes=notes)
     return 0
 
@@ -561,8 +577,11 @@ def _cmd_map(args):
     out, png_path = paths["--out"], paths.get("--png")
     loop, values = setup.loop, setup.values
     degree = loop.coefficients(**{setup.x: 0.0, setup.y: 0.0}, **values).shape[-1]
+    # The cells are classified a chunk of x at a time; what stays is the codes
+    # and the file's text.
     check_memory(f"a map of {xs.size} x {ys.size} cells",
-                 xs.size * ys.size * (_MAP_CELL_BYTES + _BYTES_PER_COEFFICIENT * degree))
+                 xs.size * ys.size * _MAP_CELL_BYTES
+                 + max(CHUNK_BYTES, ys.size * _BYTES_PER_COEFFICIENT * degree))
     for line in setup.echo:
         print(line)
     code = np.empty((xs.size, ys.size), dtype=np.int8)
@@ -656,11 +675,12 @@ def _png(setup, xs, ys, code):
 
     ax.set_xlabel(axis_label(x))
     ax.set_ylabel(axis_label(y))
-    fixed = ", ".join(_quantity(setup, n, setup.values[n]) for n in loop.parameters
-                      if n in setup.values and n != "T")
-    title = f"loop {loop.name}: stable set in the ({x}, {y}) plane (root counts)"
-    ax.set_title(f"{title}\n{fixed}, T = {setup.values['T']:g} s"
-                 if "T" in setup.values else f"{title}\n{fixed}", fontsize=9)
+    # Wrapped to the width of the figure (a two-mass device has eight values),
+    # between values only: no-break spaces inside each.
+    fixed = ", ".join(_quantity(setup, n, setup.values[n]).replace(" ", "\u00a0")
+                      for n in loop.parameters if n in setup.values)
+    ax.set_title("\n".join([f"loop {loop.name}: stable set in the ({x}, {y}) plane (root counts)"]
+                           + textwrap.wrap(fixed, 90)), fontsize=9)
     ax.legend(handles=handles, loc="best", fontsize=8, framealpha=0.9)
     fig.tight_layout()
     buf = io.BytesIO()

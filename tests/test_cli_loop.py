@@ -118,6 +118,16 @@ def test_classify_one_point_echoes_every_value_with_its_unit(capsys):
     assert row[-1] == ("stable" if radius < 1 else "unstable")
 
 
+def test_a_marginal_verdict_gives_no_pole_count(capsys):
+    """K = 1e300: the leading coefficient is lost in rounding (a pole at infinity).
+
+    The verdict is marginal; the count beside it was 41 (the polynomial's
+    roots with its leading coefficient as rounded), which contradicted it.
+    """
+    (row,) = run_json(capsys, "classify", "--loop", PAPER, "--set", "K=1e300")["rows"]
+    assert row["verdict"] == "marginal" and row["unstable poles"] is None
+
+
 def test_boundary_lies_on_the_derived_curve_and_names_its_lines(capsys):
     from symstab.curves import minus_one_line
     from symstab.evaluate import boundary_point
@@ -291,6 +301,9 @@ MAP = ["--x-range=0,1,3", "--y-range=0,1,3", "--out", "m.npz"]
     (["limits", *L, "--set", "T=-1"], "T must be"),
     (["limits", *L, "--set", "T=0"], "T must be"),
     (["limits", *L, "--set", "m=0"], "not defined"),
+    # Was "Array must not contain infs or NaNs" from the eigenvalues, after the work began.
+    (["classify", *L, "--set", "T=1e300"], "not finite at"),
+    (["limits", *L, "--set", "T=1e300"], "T = 1e+300"),
     (["limits", *L, "--set", "m=1", "--set", "m=2"], "twice"),
     (["limits", *L, "--set", "d=1", "--d", "2"], "once"),
     (["limits", *L, "--set", "M=1,2"], "one value here"),
