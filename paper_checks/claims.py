@@ -280,17 +280,17 @@ def _kmax(gamma):
     """K_max from symstab.limits (the supremum of the stable region, to the last bit).
 
     The root-counting scan of :mod:`paper_checks.regions` gives a grid-limited
-    lower bound on thin regions (20.51 against 20.52 at gamma = 1); it is kept
-    as the evidence of the region's shape.
+    lower bound on thin regions (20.51 against 20.52 at gamma = 1);
+    claim:kmax_theory_gamma1 quotes it as the evidence of the region's shape.
     """
     lim = limits(gamma=gamma, d=D_EXPERIMENT, delta=DEVICE_DELTA)
-    return lim.alpha_max * M / T**2, lim, _classify(gamma, D_EXPERIMENT)
+    return lim.alpha_max * M / T**2, lim
 
 
 @check("claim:kmax_theory_gamma0", kind="claim", where="Sec. VII, line 457",
        claim="theoretical K_max = 4.94 N m/rad (gamma = 0, T = 1 ms, Td = 40 ms)")
 def kmax0():
-    k, lim, _ = _kmax(0.0)
+    k, lim = _kmax(0.0)
     out = _number(k, "4.94", "K_max (N m/rad)")
     return Outcome(out.verdict, out.evidence + f" (alpha_max = {lim.alpha_max:.6g} at beta = "
                    f"{lim.beta_at_alpha_max:.4g}, symstab.limits; K = alpha m / T^2)")
@@ -299,7 +299,8 @@ def kmax0():
 @check("claim:kmax_theory_gamma1", kind="claim", where="Sec. VII, line 457",
        claim="theoretical K_max = 20.35 N m/rad (gamma = 1, T = 1 ms, Td = 40 ms)")
 def kmax1():
-    k, lim, r = _kmax(1.0)
+    k, lim = _kmax(1.0)
+    r = _classify(1.0, D_EXPERIMENT)
     out = _number(k, "20.35", "K_max (N m/rad)")
     return Outcome(out.verdict, out.evidence + f" (alpha_max = {lim.alpha_max:.6g} at beta = "
                    f"{lim.beta_at_alpha_max:.4g}, symstab.limits; a root-counting scan finds "
@@ -365,5 +366,6 @@ def prefetch():
     """The shared results of these checks, ``[(Memo, args), ...]``: computed first, in parallel."""
     cases = {(c.gamma, c.d) for c in regions.FIGURE_CASES}
     cases |= {(g, d) for d in (0, 10) for g in (-1.0, -1.001)} | {(2.0, 0), (2.01, 0)}
+    cases |= {(1.0, D_EXPERIMENT)}
     return ([(_kmax, (0.0,)), (_kmax, (1.0,))]
             + [(_classify, case) for case in sorted(cases, key=lambda c: (-c[1], c[0]))])
