@@ -31,7 +31,7 @@ from ._resources import CHUNK_BYTES, check_memory, chunk_slices
 __all__ = ["add_loop_options", "uses_loop", "run"]
 
 #: The paper's device options every numeric command has, with the ``--set``
-#: that replaces each under ``--loop`` (None: there is no such parameter).
+#: that replaces each under ``--loop`` (None: nothing does, as for the simulation options).
 _DEVICE_OPTIONS = (
     ("--m", "m", "--set m=..."), ("--b", "b", "--set b=..."), ("--T", "T", "--set T=..."),
     ("--Td", "Td", "--set d=... (the delay in samples)"),
@@ -59,7 +59,7 @@ _SIMULATION_OPTIONS = tuple(
         ("--steps", "steps"), ("--x0", "x0")))
 
 #: The options each command refuses with ``--loop``.
-REFUSED = {
+_REFUSED = {
     "boundary": _DEVICE_OPTIONS,
     "limits": _DEVICE_OPTIONS + (("--beta", "beta", "--at X (the stable y at x = X)"),
                                  ("--Bw", "Bw", "--at X (the stable y at x = X)")),
@@ -146,7 +146,7 @@ def add_loop_options(p, command):
         g.add_argument("--x-range", metavar="LOW,HIGH,N", help="grid of x (--x-range=-0.1,0.6,200)")
         g.add_argument("--y-range", metavar="LOW,HIGH,N", help="grid of y (--y-range=0,6,200)")
     refused = tuple((flag, dest, p.get_default(dest), instead)
-                    for flag, dest, instead in REFUSED[command])
+                    for flag, dest, instead in _REFUSED[command])
     p.set_defaults(loop_command=command, loop_refused=refused)
 
 
@@ -198,9 +198,11 @@ def _parse_number(name, text, flag, *, lists):
         if not math.isfinite(value):
             raise ValueError(f"{flag}: {name} must be a finite number, got {item!r}")
         if name == "d":
-            if not (value.is_integer() and value >= 0):
-                raise ValueError(f"{flag}: delay d must be a non-negative integer, got {item!r}")
-            value = int(value)
+            from ._validate import check_delay
+            try:
+                value = check_delay(value)
+            except ValueError as exc:
+                raise ValueError(f"{flag}: {exc}") from None
         values.append(value)
     if name == "d" and len(values) > 1:
         raise ValueError(f"{flag}: d takes one value (run classify once per delay)")
@@ -327,12 +329,12 @@ def _resolve(args, *, plane=True, lists=False):
                 raise ValueError(f"{'--x' if name == x else '--y'} {name}: not a parameter of the "
                                  f"loop in {args.loop} (parameters: {', '.join(loop.parameters)})")
         axes = (x, y)
-        for name in axes:
+        for axis, name in (("x", x), ("y", y)):
             if name in sets:
-                raise ValueError(f"--set {name}: {name} is an axis of the plane ({'x' if name == x else 'y'}) "
-                                 f"and takes no single value here"
-                                 + ("; use --at for the stable intervals at one x"
-                                    if name == x and hasattr(args, "at") else ""))
+                hint = ("; use --at for the stable intervals at one x"
+                        if axis == "x" and hasattr(args, "at") else "")
+                raise ValueError(f"--set {name}: {name} is the plane's {axis} axis and takes no "
+                                 f"single value here{hint}")
     values = {n: v for n, v in loop.defaults.items() if n not in axes}
     values.update(sets)
     missing = [n for n in loop.parameters if n not in values and n not in axes]
@@ -402,10 +404,10 @@ def _line_text(setup, label, line):
 
 def _cmd_boundary(args):
     from ._validate import check_count
+    from .cli_numeric import _BYTES_PER_ROW
 
     setup = _resolve(args)
     n = check_count("n", args.n, 2)
-    from .cli_numeric import _BYTES_PER_ROW
     check_memory(f"--n {n} boundary points", n * _BYTES_PER_ROW)
     curve = setup.loop.boundary(x=setup.x, y=setup.y, n=n, **setup.values)
     columns = ["theta [rad]", setup.label(setup.x), setup.label(setup.y)]

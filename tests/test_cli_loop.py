@@ -23,13 +23,10 @@ from conftest import PAPER_DELTA, PAPER_M, PAPER_T, REPO, python_control_closed_
 PAPER = str(REPO / "examples" / "loops" / "paper.toml")
 
 
-def _session_cache(tmp_path_factory):
-    return tmp_path_factory.getbasetemp() / "loop-kernels"
-
-
 @pytest.fixture(autouse=True)
 def _cache_dir(tmp_path_factory, monkeypatch):
-    folder = _session_cache(tmp_path_factory)
+    """The loop's generated kernels go to one temporary folder per run, never to ~/.cache."""
+    folder = tmp_path_factory.getbasetemp() / "loop-kernels"
     folder.mkdir(exist_ok=True)
     monkeypatch.setenv("SYMSTAB_CACHE_DIR", str(folder))
 
