@@ -1,0 +1,342 @@
+"""symstab.Loop: the general loop against python-control, mpmath and the paper's path.
+
+The example loop files have their own tests (test_any_loop_examples.py);
+here: the derivation (ZOH by residues and by the matrix exponential), the
+paper's loop through the general path against today's numbers, the generic
+polynomial classification, the kernel cache, and the refusals.
+"""
+
+import os
+
+import mpmath
+import numpy as np
+import pytest
+import sympy as sp
+
+import symstab
+from symstab import model
+from symstab.any_loop import Loop
+from symstab.discretize import numeric_zoh, zoh_pulse_transfer_function
+from symstab.stability import (MARGINAL, STABLE, UNSTABLE, classify_polynomials,
+                               polynomial_root_counts, polynomial_spectral_radius)
+
+from conftest import PAPER_B, PAPER_M, PAPER_T, assert_rel_close, python_control_closed_loop
+
+control = pytest.importorskip("control")
+
+PLANT = "1/(m*s**2 + b*s)"
+ENVIRONMENT = "K + B*(z - 1)/(T*z) + M*(z - 1)**2/(T**2*z**2)"
+DEVICE = dict(m=PAPER_M, b=PAPER_B, T=PAPER_T)
+
+
+@pytest.fixture(autouse=True)
+def _cache(tmp_path, monkeypatch):
+    monkeypatch.setenv("SYMSTAB_CACHE_DIR", str(tmp_path / "cache"))
+
+
+@pytest.fixture(scope="module")
+def paper_loop():
+    return Loop(PLANT, ENVIRONMENT)
+
+
+def _physical(alpha, beta, gamma):
+    return dict(K=alpha * PAPER_M / PAPER_T**2, B=beta * PAPER_M / PAPER_T, M=gamma * PAPER_M)
+
+
+# -- the derivation ---------------------------------------------------------
+
+def test_parameters_and_method(paper_loop):
+    assert paper_loop.parameters == ("B", "K", "M", "b", "m", "T", "d")
+    assert paper_loop.zoh_method == "residues"
+    assert paper_loop.affine_parameters() == ("B", "K", "M")
+
+
+def test_characteristic_polynomial_keeps_d_symbolic(paper_loop):
+    chi = paper_loop.characteristic_polynomial()
+    assert model.d in chi.free_symbols
+    # At a concrete point its roots are python-control's closed-loop poles.
+    alpha, beta, gamma, d = 0.01, 0.2, 0.5, 3
+    values = dict(_physical(alpha, beta, gamma), **DEVICE, d=d)
+    poly = sp.Poly(paper_loop.characteristic_polynomial(**values), model.z)
+    ours = np.sort_complex(np.roots([float(c) for c in poly.all_coeffs()]))
+    oracle = python_control_closed_loop(alpha=alpha, beta=beta, gamma=gamma, d=d,
+                                        delta=PAPER_B * PAPER_T / PAPER_M, m=PAPER_M, T=PAPER_T)
+    # python-control keeps a pole at 0 that its transfer-function algebra
+    # does not cancel against a zero at 0; chi has none.
+    theirs = oracle.poles()
+    theirs = np.sort_complex(theirs[np.abs(theirs) > 1e-12])
+    assert len(ours) == len(theirs) == d + 4
+    np.testing.assert_allclose(ours, theirs, atol=1e-7)
+
+
+def test_frictionless_mass_by_residues():
+    """b = 0: G/s has a triple pole at 0; the textbook double-integrator ZOH is T^2 (z+1) / (2 m (z-1)^2)."""
+    m, T, z = sp.Symbol("m", positive=True), model.T, model.z
+    P = zoh_pulse_transfer_function(1 / (m * model.s**2))
+    assert sp.simplify(P - T**2 * (z + 1) / (2 * m * (z - 1) ** 2)) == 0
+    loop = Loop("1/(m*s**2)", ENVIRONMENT)
+    assert loop.zoh_method == "residues"
+    rng = np.random.default_rng(5)
+    for _ in range(20):
+        K, B, M = rng.uniform(0, 40), rng.uniform(0, 0.3), rng.uniform(-0.005, 0.02)
+        d = int(rng.integers(0, 6))
+        r = loop.spectral_radius(K=K, B=B, M=M, m=PAPER_M, T=PAPER_T, d=d)
+        G = control.sample_system(control.tf([1], [PAPER_M, 0, 0]), PAPER_T, "zoh")
+        zz = control.tf([1, 0], [1], PAPER_T)
+        VE = K + B * (zz - 1) / (PAPER_T * zz) + M * (zz - 1) ** 2 / (PAPER_T**2 * zz**2)
+        delay = control.tf([1], [1] + [0] * d, PAPER_T)
+        oracle = max(abs(control.feedback(G, VE * delay).poles()))
+        assert r == pytest.approx(oracle, rel=1e-7, abs=1e-7)
+
+
+def test_numeric_zoh_matches_python_control():
+    """The matrix-exponential path against scipy's (through python-control)."""
+    num, den, T = [2.0, 3.0, 50.0], [0.01, 0.3, 40.0, 100.0, 0.0], 1e-3
+    p_n, p_d = numeric_zoh(num, den, T)
+    oracle = control.sample_system(control.tf(num, den), T, "zoh")
+    o_num, o_den = np.array(oracle.num[0][0]), np.array(oracle.den[0][0])
+    ours_num = np.array([float(c) for c in p_n])
+    ours_num = ours_num[np.argmax(ours_num != 0):]
+    np.testing.assert_allclose([float(c) for c in p_d], o_den / o_den[0], rtol=1e-9)
+    np.testing.assert_allclose(ours_num, o_num / o_den[0], rtol=1e-7)
+
+
+def test_numeric_path_for_a_quadratic_factor():
+    """An operator's arm (mass-spring-damper to ground) makes a quadratic the residues skip."""
+    loop = Loop("1/((m + m_h)*s**2 + (b + b_h)*s + k_h)", "K + B*(z - 1)/(T*z)")
+    assert loop.zoh_method == "matrix exponential"
+    with pytest.raises(ValueError, match="numerically"):
+        loop.pulse_transfer_function()
+    values = dict(m=PAPER_M, m_h=0.05, b=PAPER_B, b_h=1.0, k_h=100.0, T=PAPER_T)
+    for K, B, d in ((300.0, 0.5, 0), (2000.0, 2.0, 2), (50.0, 0.1, 10)):
+        G = control.sample_system(control.tf([1], [PAPER_M + 0.05, PAPER_B + 1.0, 100.0]),
+                                  PAPER_T, "zoh")
+        zz = control.tf([1, 0], [1], PAPER_T)
+        VE = K + B * (zz - 1) / (PAPER_T * zz)
+        delay = control.tf([1], [1] + [0] * d, PAPER_T)
+        oracle = max(abs(control.feedback(G, VE * delay).poles()))
+        assert loop.spectral_radius(K=K, B=B, d=d, **values) == pytest.approx(oracle, rel=1e-8)
+
+
+def test_control_transfer_function_as_plant():
+    G = control.tf([1], [PAPER_M, PAPER_B, 0])
+    loop = Loop(G, "K + B*(z - 1)/(T*z)")
+    assert loop.zoh_method == "matrix exponential"
+    ours = Loop(PLANT, "K + B*(z - 1)/(T*z)")
+    for K, B, d in ((300.0, 0.5, 0), (3.0, 0.1, 40)):
+        assert loop.spectral_radius(K=K, B=B, T=PAPER_T, d=d) == pytest.approx(
+            ours.spectral_radius(K=K, B=B, d=d, **DEVICE), rel=1e-10)
+
+
+# -- the paper's loop through the general path --------------------------------
+
+def test_paper_loop_spectral_radius_and_classification_match_today(paper_loop):
+    rng = np.random.default_rng(11)
+    alpha, beta = rng.uniform(-0.001, 0.02, 2000), rng.uniform(-0.01, 0.4, 2000)
+    delta = PAPER_B * PAPER_T / PAPER_M
+    for gamma, d in ((0.0, 0), (0.5, 4), (1.0, 10)):
+        values = dict(_physical(alpha, beta, gamma), **DEVICE, d=d)
+        ours = paper_loop.classify(**values)
+        today = symstab.classify(alpha=alpha, beta=beta, gamma=gamma, d=d, delta=delta)
+        r = symstab.spectral_radius(alpha=alpha, beta=beta, gamma=gamma, d=d, delta=delta)
+        both = (ours != MARGINAL) & (today != MARGINAL) & (np.abs(r - 1) > 1e-9)
+        assert np.array_equal(ours[both], today[both])
+        assert np.mean(ours == STABLE) > 0.05 and np.mean(ours == UNSTABLE) > 0.05
+        np.testing.assert_allclose(paper_loop.spectral_radius(**values), r, rtol=1e-9)
+
+
+@pytest.mark.parametrize("d, gamma", [(40, 0.0), (10, 1.0), (0, 0.5)])
+def test_paper_loop_limits_match_today(paper_loop, d, gamma):
+    """K_max at T_d = 40 ms and the rest of Limits, through the general path."""
+    delta = PAPER_B * PAPER_T / PAPER_M
+    today = symstab.limits(gamma=gamma, d=d, delta=delta)
+    ours = paper_loop.limits("B", "K", M=gamma * PAPER_M, d=d, **DEVICE)
+    assert_rel_close(ours.y_max, today.alpha_max * PAPER_M / PAPER_T**2, 1e-7, "K_max")
+    assert_rel_close(ours.x_at_y_max, today.beta_at_alpha_max * PAPER_M / PAPER_T, 1e-3,
+                     "B at K_max")
+    assert_rel_close(ours.x_max, today.beta_right * PAPER_M / PAPER_T, 1e-7, "B_max")
+    # The left edge B = -b is a corner where two roots meet at z = 1: the
+    # general polynomial resolves it to about 1e-4 (the paper's kernel
+    # factors (z - 1)(z - r) and does better).
+    assert_rel_close(ours.x_min, today.beta_left * PAPER_M / PAPER_T, 1e-4, "B_min")
+    assert_rel_close(ours.area, today.z_width * PAPER_M**2 / PAPER_T**3, 1e-3, "area")
+
+
+def test_paper_loop_stable_intervals_against_python_control(paper_loop):
+    """Endpoints of the stable K interval agree with a bisection on python-control's loop.
+
+    python-control builds the closed loop; its poles come from eigenvalues,
+    which at d = 40 miss the modulus by 1e-5, so the roots of its
+    denominator are found by mpmath at 40 digits instead.
+    """
+    delta = PAPER_B * PAPER_T / PAPER_M
+
+    def stable(K, B, d):
+        cl = python_control_closed_loop(alpha=K * PAPER_T**2 / PAPER_M, beta=B * PAPER_T / PAPER_M,
+                                        gamma=0.0, d=d, delta=delta, m=PAPER_M, T=PAPER_T)
+        den = np.trim_zeros(np.asarray(cl.den[0][0], dtype=float), "b")   # drop the pole at 0
+        with mpmath.workdps(40):
+            roots = mpmath.polyroots([mpmath.mpf(float(c)) for c in den], maxsteps=400,
+                                     extraprec=400)
+            return max(abs(r) for r in roots) < 1
+
+    for B, d in ((0.3, 40), (1.0, 10), (5.0, 0)):
+        (lo, hi), = paper_loop.stable_intervals("K", B=B, M=0.0, d=d, **DEVICE)
+        assert lo == 0.0
+        a, b = 0.5 * hi, 2 * hi
+        assert stable(a, B, d) and not stable(b, B, d)
+        for _ in range(50):
+            mid = 0.5 * (a + b)
+            a, b = (mid, b) if stable(mid, B, d) else (a, mid)
+        assert hi == pytest.approx(a, rel=1e-6)
+
+
+def test_boundary_points_put_a_root_on_the_circle(paper_loop):
+    curve = paper_loop.boundary("B", "K", n=50, M=0.0, d=5, **DEVICE)
+    assert set(curve.lines) == {"z = 1", "z = -1"}
+    for theta, B, K in list(zip(curve.theta, curve.x_values, curve.y_values))[::7]:
+        coefficients = paper_loop.coefficients(K=K, B=B, M=0.0, d=5, **DEVICE)
+        roots = np.roots(coefficients)
+        target = np.exp(1j * theta)
+        assert np.min(np.abs(roots - target)) < 1e-6
+    c0, cx, cy = curve.lines["z = 1"]
+    assert c0 == 0.0 and cx == 0.0 and cy > 0     # the line K = 0
+
+
+def test_closed_loop_poles_are_the_characteristic_roots(paper_loop):
+    values = dict(K=300.0, B=0.5, M=0.002, d=3, **DEVICE)
+    cl = paper_loop.closed_loop(**values)
+    assert cl.dt == PAPER_T
+    oracle = python_control_closed_loop(alpha=300.0 * PAPER_T**2 / PAPER_M, beta=0.5 * PAPER_T / PAPER_M,
+                                        gamma=0.002 / PAPER_M, d=3, delta=PAPER_B * PAPER_T / PAPER_M,
+                                        m=PAPER_M, T=PAPER_T)
+    theirs = oracle.poles()
+    theirs = theirs[np.abs(theirs) > 1e-12]      # python-control's uncancelled pole at 0
+    np.testing.assert_allclose(np.sort_complex(cl.poles()), np.sort_complex(theirs), atol=1e-8)
+
+
+# -- generic polynomials --------------------------------------------------------
+
+def _mp_outside(coefficients):
+    with mpmath.workdps(40):
+        roots = mpmath.polyroots([mpmath.mpf(float(c)) for c in coefficients], maxsteps=200,
+                                 extraprec=200)
+        return sum(1 for r in roots if abs(r) > 1), min(abs(abs(r) - 1) for r in roots)
+
+
+def test_polynomial_root_counts_against_mpmath():
+    """Never a wrong count; marginal only where the coefficients cannot decide.
+
+    Degree 40 from random roots has coefficients up to 1e10 times its values
+    on the circle, and some of those are rightly left marginal.
+    """
+    rng = np.random.default_rng(3)
+    checked, marginal = 0, 0
+    for degree in (1, 2, 5, 9, 20):
+        for _ in range(15):
+            roots = rng.uniform(0.3, 1.6, degree) * np.exp(1j * rng.uniform(0, np.pi, degree))
+            c = np.real(np.poly(np.concatenate([roots, np.conj(roots)])))
+            outside, gap = _mp_outside(c)
+            if gap < 1e-9:
+                continue
+            count = polynomial_root_counts(c[None, :])[0]
+            code = classify_polynomials(c)
+            expected = STABLE if outside == 0 else UNSTABLE
+            if count == -1:
+                # Schur-Cohn may still decide it with a safe margin.
+                assert degree == 20 and code in (MARGINAL, expected)
+                marginal += 1
+                continue
+            assert count == outside
+            assert code == expected
+            r = polynomial_spectral_radius(c[None, :])[0]
+            with mpmath.workdps(40):
+                exact = max(abs(x) for x in mpmath.polyroots([mpmath.mpf(float(v)) for v in c],
+                                                             maxsteps=200, extraprec=200))
+            assert r == pytest.approx(float(exact), rel=1e-8)
+            checked += 1
+    assert checked > 50 and marginal <= 5
+
+
+def test_a_root_on_the_circle_is_marginal():
+    c = np.real(np.poly([np.exp(0.7j), np.exp(-0.7j), 0.5]))
+    assert polynomial_root_counts(c[None, :])[0] == -1
+    assert classify_polynomials(c) == MARGINAL
+    # A vanishing leading coefficient is a root at infinity: marginal too.
+    assert classify_polynomials([0.0, 1.0, 0.2]) == MARGINAL
+
+
+# -- kernels on disk -------------------------------------------------------------
+
+def test_kernels_are_cached_by_the_hash_of_their_expressions(tmp_path, monkeypatch):
+    monkeypatch.setenv("SYMSTAB_CACHE_DIR", str(tmp_path / "k"))
+    first = Loop(PLANT, "K + B*(z - 1)/(T*z) + 0.5*M*(z - 1)**2/(T**2*z**2)")
+    r1 = first.spectral_radius(K=300.0, B=0.5, M=0.001, d=2, **DEVICE)
+    path = first.kernel_file()
+    assert path and os.path.dirname(path) == str(tmp_path / "k" / "loops")
+    text = open(path, encoding="utf-8").read()
+    assert "do not edit" in text and "import numpy" in text
+    again = Loop(PLANT, "K + B*(z - 1)/(T*z) + 0.5*M*(z - 1)**2/(T**2*z**2)")
+    again.spectral_radius(K=300.0, B=0.5, M=0.001, d=2, **DEVICE)
+    assert again.kernel_file() == path
+    other = Loop(PLANT, "K + B*(z - 1)/(T*z) + 0.25*M*(z - 1)**2/(T**2*z**2)")
+    r2 = other.spectral_radius(K=300.0, B=0.5, M=0.002, d=2, **DEVICE)
+    assert other.kernel_file() != path
+    assert r1 == pytest.approx(r2, rel=1e-12)     # 0.5 * 0.001 == 0.25 * 0.002
+
+
+def test_unwritable_cache_compiles_in_memory(tmp_path, monkeypatch):
+    blocker = tmp_path / "file"
+    blocker.write_text("not a folder")
+    monkeypatch.setenv("SYMSTAB_CACHE_DIR", str(blocker))
+    loop = Loop(PLANT, "K + B*(z - 1)/(T*z) + 0.125*M*(z - 1)**2/(T**2*z**2)")
+    assert loop.classify(K=300.0, B=0.5, M=0.0, d=0, **DEVICE) == STABLE
+    assert loop.kernel_file() is None
+
+
+# -- refusals --------------------------------------------------------------------
+
+@pytest.mark.parametrize("plant, environment, match", [
+    ("s/(m*s + b)*s", ENVIRONMENT, "proper"),
+    ("exp(-s*tau)/(m*s**2)", ENVIRONMENT, "rational"),
+    (PLANT, "K*z**2/(z - 1)", "proper"),
+    (PLANT, "K*z**(-d)", "delay d"),
+    ("1/(m*s**2 + b*s*z)", ENVIRONMENT, "must not contain z"),
+    (PLANT, "K + B*s", "must not contain s"),
+    ("0", ENVIRONMENT, "zero"),
+    (PLANT, "K +* B", "not a valid expression"),
+])
+def test_bad_loops_are_refused(plant, environment, match):
+    with pytest.raises(ValueError, match=match):
+        Loop(plant, environment)
+
+
+def test_bad_calls_name_the_parameter(paper_loop):
+    with pytest.raises(TypeError, match="missing value.*M"):
+        paper_loop.classify(K=1.0, B=0.1, d=0, **DEVICE)
+    with pytest.raises(TypeError, match="unknown parameter.*Q"):
+        paper_loop.classify(K=1.0, B=0.1, M=0.0, Q=1.0, d=0, **DEVICE)
+    with pytest.raises(ValueError, match="T must be"):
+        paper_loop.classify(K=1.0, B=0.1, M=0.0, d=0, m=PAPER_M, b=PAPER_B, T=-1.0)
+    with pytest.raises(ValueError, match="delay d"):
+        paper_loop.classify(K=1.0, B=0.1, M=0.0, d=1.5, **DEVICE)
+    with pytest.raises(ValueError, match="'m' does not enter .* affinely"):
+        paper_loop.stable_intervals("m", K=1.0, B=0.1, M=0.0, d=0, b=PAPER_B, T=PAPER_T)
+    with pytest.raises(ValueError, match="single value"):
+        paper_loop.stable_intervals("K", B=[0.1, 0.2], M=0.0, d=0, **DEVICE)
+    squared = Loop(PLANT, "K**2 + B*(z - 1)/(T*z)")
+    with pytest.raises(ValueError, match="'K' does not enter"):
+        squared.limits("B", "K", d=0, **DEVICE)
+    product = Loop(PLANT, "K*B + B*(z - 1)/(T*z) + K")
+    with pytest.raises(ValueError, match="jointly"):
+        product.limits("B", "K", d=0, **DEVICE)
+
+
+def test_arrays_broadcast(paper_loop):
+    K = np.linspace(0, 600, 7)[:, None]
+    B = np.array([0.2, 0.5, 1.0])[None, :]
+    codes = paper_loop.classify(K=K, B=B, M=0.0, d=0, **DEVICE)
+    assert codes.shape == (7, 3)
+    r = paper_loop.spectral_radius(K=K, B=B, M=0.0, d=0, **DEVICE)
+    assert r.shape == (7, 3)
+    assert np.array_equal(codes == STABLE, r < 1)
