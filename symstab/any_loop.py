@@ -34,8 +34,9 @@ leading coefficient give straight lines.
 
 import dataclasses
 import functools
+import keyword
 import math
-import numbers
+import re
 
 import mpmath
 import numpy as np
@@ -56,6 +57,31 @@ __all__ = ["Loop", "LoopLimits", "LoopBoundary", "parse_plant", "parse_environme
 #: Names with a fixed meaning in every loop.
 RESERVED = ("s", "z", "T", "d")
 _DPS = 30
+#: Parameter names the generated NumPy and C kernels cannot take.
+_C_KEYWORDS = frozenset(
+    "auto break case char const continue default do double else enum extern float for goto if "
+    "inline int long register restrict return short signed sizeof static struct switch typedef "
+    "union unsigned void volatile while _Bool _Complex _Imaginary".split())
+_GENERATED_NAME = re.compile(r"(num|den|pn|pd|x)\d+|numpy|_.*")
+
+
+def check_parameter_name(name):
+    """Refuse a parameter name the generated kernels cannot use.
+
+    A Python or C keyword, ``numpy`` (the NumPy module in the generated
+    code), a name starting with ``_``, or a name the generated code uses
+    itself (outputs ``num<k>``, ``den<k>``, ``pn<k>``, ``pd<k>``,
+    temporaries ``x<k>``).
+
+    Raises
+    ------
+    ValueError
+        Naming the parameter.
+    """
+    if keyword.iskeyword(name) or name in _C_KEYWORDS or _GENERATED_NAME.fullmatch(name):
+        raise ValueError(f"parameter {name!r} cannot be a name in the generated NumPy and C kernels "
+                         f"(a Python or C keyword, 'numpy', a leading '_', or a name the kernels "
+                         f"use: num<k>, den<k>, pn<k>, pd<k>, x<k>): rename it in the loop")
 
 _PARSE_GLOBALS = {
     "Integer": sp.Integer, "Float": sp.Float, "Rational": sp.Rational, "Symbol": sp.Symbol,
@@ -321,6 +347,8 @@ class Loop:
         symbols.pop("s", None)
         symbols.pop("z", None)
         symbols.pop("T", None)
+        for name in symbols:
+            check_parameter_name(name)
         self._symbols = dict(sorted(symbols.items()))
         self._symbols["T"] = model.T
         self._plant_names = tuple(n for n in self._symbols
@@ -424,7 +452,7 @@ class Loop:
             if need:
                 raise ValueError(f"the plant is discretised numerically: give "
                                  f"{', '.join(need)} to get its polynomial")
-            p_n, p_d = self._numeric_plant(tuple(float(values[n]) for n in self._plant_names),
+            p_n, p_d, _ = self._numeric_plant(tuple(float(values[n]) for n in self._plant_names),
                                            float(values["T"]))
             p_n = [sp.Float(str(c), _DPS) for c in p_n]
             p_d = [sp.Float(str(c), _DPS) for c in p_d]
@@ -497,8 +525,20 @@ class Loop:
 
     # -- kernels ----------------------------------------------------------
 
+    def kernels(self):
+        """The loop's generated kernels, as :class:`symstab.codegen.Kernel` objects.
+
+        ``environment`` gives the coefficients of ``Ve_n`` and ``Ve_d``
+        (highest power of ``z`` first) from the environment's parameters
+        (and ``T``); ``environment_slope_<name>`` their derivatives in each
+        parameter that enters them affinely.  Their NumPy module is what the
+        loop runs on (:meth:`kernel_file`); ``symstab derive --loop`` prints
+        them in C as well.
+        """
+        return list(self._kernel_list[0])
+
     @functools.cached_property
-    def _kernels(self):
+    def _kernel_list(self):
         names = self._environment_names + ("T",) if model.T in self.environment.free_symbols \
             else self._environment_names
         names = tuple(dict.fromkeys(names))
@@ -519,9 +559,16 @@ class Loop:
                     [(o, sp.diff(c, symbol), f"d/d{name} of {text}") for o, c, text in outputs],
                     f"Derivatives of the environment's coefficients in {name} (constant: "
                     f"they enter affinely)."))
-        module = load_numpy_kernels(kernels, title=f"NumPy kernels of the loop {self.name}: "
-                                                   f"VE(z) = {self.environment}.")
-        return module, names, len(ve_n), len(ve_d)
+        return kernels, names, len(ve_n), len(ve_d)
+
+    def kernel_title(self):
+        """The title line of the loop's generated NumPy module."""
+        return f"NumPy kernels of the loop {self.name}: VE(z) = {self.environment}."
+
+    @functools.cached_property
+    def _kernels(self):
+        kernels, names, n_num, n_den = self._kernel_list
+        return load_numpy_kernels(kernels, title=self.kernel_title()), names, n_num, n_den
 
     def kernel_file(self):
         """Where the loop's generated NumPy module lives (None if in memory)."""
@@ -603,6 +650,11 @@ class Loop:
     def _plant_arrays(self, values, shape):
         """(P_n, P_d, ends) per point, shape ``shape + (k,)``, one 30-digit evaluation per distinct row."""
         names = self._plant_names + ("T",)
+        if all(np.ndim(values[n]) == 0 for n in names):
+            # One plant for every point: the common case of a plane sweep.
+            parts = self._numeric_plant(tuple(float(values[n]) for n in names[:-1]),
+                                        float(values["T"]))
+            return tuple(np.broadcast_to(part, shape + part.shape) for part in parts)
         columns = np.stack([np.broadcast_to(values[n], shape).ravel() for n in names], axis=-1)
         unique, inverse = np.unique(columns, axis=0, return_inverse=True)
         parts = [self._numeric_plant(tuple(row[:-1]), float(row[-1])) for row in unique]
@@ -714,7 +766,19 @@ class Loop:
         values, d, shape = self._prepare(values)
         size = int(np.prod(shape))
         check_memory("the loop's coefficients", 8 * size * (d + 16))
-        return self._coefficients(values, d, shape)
+        return self._finite(self._coefficients(values, d, shape), values)
+
+    @staticmethod
+    def _finite(c, values):
+        """``c`` if every coefficient is finite, else a ValueError naming the values."""
+        bad = ~np.all(np.isfinite(c), axis=-1)
+        if np.any(bad):
+            index = np.unravel_index(int(np.flatnonzero(bad.ravel())[0]), bad.shape)
+            point = ", ".join(f"{n} = {float(v[index] if v.ndim else v):g}"
+                              for n, v in values.items())
+            raise ValueError(f"the characteristic polynomial overflows at {point}: a parameter is "
+                             f"too large or too small for double precision")
+        return c
 
     def spectral_radius(self, **values):
         """Largest modulus of the closed-loop poles (batched eigenvalues).
@@ -753,9 +817,17 @@ class Loop:
         return np.ma.masked_array(codes == STABLE, mask=codes == MARGINAL)
 
     def unstable_root_counts(self, **values):
-        """Certified number of closed-loop poles outside the unit circle (-1: marginal)."""
+        """Certified number of closed-loop poles outside the unit circle (-1: marginal).
+
+        Parameters are as in :meth:`coefficients`; -1 also where a root is at
+        infinity to within rounding (an ill-posed loop), as in :meth:`classify`.
+        """
         c = self.coefficients(**values)
-        counts = polynomial_root_counts(c.reshape(-1, c.shape[-1])).reshape(c.shape[:-1])
+        rows = c.reshape(-1, c.shape[-1])
+        counts = polynomial_root_counts(rows)
+        # A root at infinity (vanishing leading coefficient) is marginal, as in classify.
+        counts[classify_polynomials(rows, refine=False) == MARGINAL] = -1
+        counts = counts.reshape(c.shape[:-1])
         return int(counts) if counts.ndim == 0 else counts
 
     # -- lines and planes ---------------------------------------------------

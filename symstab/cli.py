@@ -223,7 +223,6 @@ def _derive_loop(args):
     loop = load_loop(args.loop)
     out = pathlib.Path(args.out if args.out is not None
                        else f"{loop_derive.c_name(loop)}_derivation")
-    loop_derive.check_names(loop)
     names = loop_derive.file_names(loop)
     if args.check:   # reads only
         if out.exists() and not out.is_dir():

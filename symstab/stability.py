@@ -576,6 +576,11 @@ def _polynomial_counts_chunk(p, n_arcs, coefficient_ulps):
     error = 2 * _U * (8 * (n + 2) + coefficient_ulps) * s0
     slope_error = 2 * _U * (8 * (n + 2) + coefficient_ulps) * s1
 
+    # A root at z = 1 or -1 to within rounding: marginal, without halving
+    # arcs down to it.
+    signs = (-1.0) ** powers
+    on_circle = ((np.abs(np.sum(p, axis=1)) <= error)
+                 | (np.abs(np.sum(p * signs, axis=1)) <= error))
     theta = np.linspace(0.0, np.pi, 2 * n_arcs + 1)
     with np.errstate(all="ignore"):
         chi, dchi = _horner_circle(p, theta[None, :])
@@ -585,8 +590,13 @@ def _polynomial_counts_chunk(p, n_arcs, coefficient_ulps):
     chi_lo, chi_mid, chi_hi = (chi[:, k:chi.shape[1] - 2 + k:2].ravel() for k in range(3))
     dchi_mid = dchi[:, 1::2].ravel()
     change = np.zeros(n_rows)
-    undecided = np.zeros(n_rows, dtype=bool)
+    undecided = on_circle.copy()
+    live = ~on_circle[row]
+    row, lo, mid, hi = row[live], lo[live], mid[live], hi[live]
+    chi_lo, chi_mid, chi_hi, dchi_mid = chi_lo[live], chi_mid[live], chi_hi[live], dchi_mid[live]
     for _ in range(_MAX_ROUNDS):
+        if row.size == 0:
+            break
         half = 0.5 * (hi - lo)
         ok = s1[row] * half * (1 + 4 * _U) + error[row] < np.abs(chi_mid)
         radius = (0.5 * s2[row] * half**2 + error[row] + slope_error[row] * half) * (1 + 8 * _U)

@@ -21,7 +21,10 @@ def test_readme_audit_summary_matches_the_report():
     assert _table(block) == _table(summary) and len(_table(block)) == 6
 
 
-def test_readme_python_examples_run():
+def test_readme_python_examples_run(monkeypatch, tmp_path):
+    # The README builds loops, whose kernels go to the cache: keep it out of ~/.cache.
+    monkeypatch.setenv("SYMSTAB_CACHE_DIR", str(tmp_path))
+    monkeypatch.chdir(REPO)
     readme = (REPO / "README.md").read_text(encoding="utf-8")
     parser = doctest.DocTestParser()
     test = parser.get_doctest(readme, {}, "README.md", str(REPO / "README.md"), 0)
@@ -32,8 +35,10 @@ def test_readme_python_examples_run():
 
 
 @pytest.mark.parametrize("module", ["symstab.units", "symstab.curves", "symstab.stability",
-                                    "symstab.region", "symstab.model", "symstab.theta_max"])
-def test_docstring_examples_run(module):
+                                    "symstab.region", "symstab.model", "symstab.theta_max",
+                                    "symstab.any_loop"])
+def test_docstring_examples_run(module, monkeypatch, tmp_path):
+    monkeypatch.setenv("SYMSTAB_CACHE_DIR", str(tmp_path))
     mod = importlib.import_module(module)
     failures, tried = doctest.testmod(mod, optionflags=doctest.NORMALIZE_WHITESPACE)
     assert tried > 0 and failures == 0
