@@ -783,8 +783,16 @@ class Loop:
     def spectral_radius(self, **values):
         """Largest modulus of the closed-loop poles (batched eigenvalues).
 
-        Parameters are as in :meth:`coefficients`.  Returns a float or an
-        array of the broadcast shape.
+        Parameters
+        ----------
+        **values
+            Every parameter (:attr:`parameters`) or its default; arrays
+            broadcast; ``d`` is an integer.
+
+        Returns
+        -------
+        float or ndarray
+            Of the broadcast shape.
         """
         c = self.coefficients(**values)
         r = polynomial_spectral_radius(c.reshape(-1, c.shape[-1])).reshape(c.shape[:-1])
@@ -796,7 +804,13 @@ class Loop:
         Certified as :func:`symstab.stability.classify_polynomials` is: for
         the polynomial with the coefficients as computed (each within an ulp
         or so of the exact value: the plant at 30 digits, the environment in
-        double precision).  Parameters are as in :meth:`coefficients`.
+        double precision).
+
+        Parameters
+        ----------
+        **values
+            Every parameter (:attr:`parameters`) or its default; arrays
+            broadcast; ``d`` is an integer.
 
         Returns
         -------
@@ -810,6 +824,12 @@ class Loop:
         """Whether each point is stable: bool, or a masked bool array (masked = marginal).
 
         A single point gives ``True``, ``False`` or ``None`` (marginal).
+
+        Parameters
+        ----------
+        **values
+            Every parameter (:attr:`parameters`) or its default; arrays
+            broadcast; ``d`` is an integer.
         """
         codes = self.classify(**values)
         if np.ndim(codes) == 0:
@@ -819,8 +839,14 @@ class Loop:
     def unstable_root_counts(self, **values):
         """Certified number of closed-loop poles outside the unit circle (-1: marginal).
 
-        Parameters are as in :meth:`coefficients`; -1 also where a root is at
-        infinity to within rounding (an ill-posed loop), as in :meth:`classify`.
+        -1 also where a root is at infinity to within rounding (an ill-posed
+        loop), as in :meth:`classify`.
+
+        Parameters
+        ----------
+        **values
+            Every parameter (:attr:`parameters`) or its default; arrays
+            broadcast; ``d`` is an integer.
         """
         c = self.coefficients(**values)
         rows = c.reshape(-1, c.shape[-1])
@@ -1007,6 +1033,11 @@ class Loop:
         ``P / (1 + VE z**-d P) = z**d Ve_d P_n / chi(z)``, built from the
         polynomials (nothing cancelled), so its poles are the roots of
         ``chi``.  Needs python-control.
+
+        Parameters
+        ----------
+        **values
+            A single value of every parameter (or its default).
 
         Returns
         -------

@@ -315,7 +315,19 @@ def check_identity(lhs, rhs, *, samples=12, dps=40, seed=0):
 
 
 def assert_identity(lhs, rhs, **kwargs):
-    """Raise :class:`AssertionError` unless :func:`check_identity` proves it."""
+    """Raise :class:`AssertionError` unless :func:`check_identity` proves ``lhs == rhs``.
+
+    Parameters
+    ----------
+    lhs, rhs : sympy.Expr
+        The two sides.
+    **kwargs
+        Passed to :func:`check_identity`.
+
+    Returns
+    -------
+    IdentityResult
+    """
     result = check_identity(lhs, rhs, **kwargs)
     if result.equal is not True:
         raise AssertionError(

@@ -534,7 +534,13 @@ class StabilityRegion:
         return self._intervals("beta", [check_real("beta", beta)], confirm=True)[0]
 
     def beta_intervals(self, alpha):
-        """The stable beta intervals at stiffness ``alpha`` (as :meth:`alpha_intervals`)."""
+        """The stable beta intervals at stiffness ``alpha`` (as :meth:`alpha_intervals`).
+
+        Parameters
+        ----------
+        alpha : float
+            Dimensionless stiffness.
+        """
         return self._intervals("alpha", [check_real("alpha", alpha)], confirm=True)[0]
 
     # -- where the region is ----------------------------------------------
@@ -752,7 +758,15 @@ class StabilityRegion:
         return ends[0], ends[1]
 
     def z_width(self, beta_min, beta_max, n_beta=801):
-        """Area of the stable region: the stable length on verticals, trapezoid rule."""
+        """Area of the stable region: the stable length on verticals, trapezoid rule.
+
+        Parameters
+        ----------
+        beta_min, beta_max : float
+            The region's extent in beta.
+        n_beta : int
+            Vertical lines (the two ends included).
+        """
         betas = np.linspace(beta_min, beta_max, n_beta)
         # No boundary piece is vertical (the arc is vertical at points only,
         # the lines z = +-1 are not), so the stable length is 0 at the two
@@ -764,7 +778,13 @@ class StabilityRegion:
         return float(np.sum(0.5 * (lengths[1:] + lengths[:-1]) * np.diff(betas)))
 
     def limits(self, *, n_beta=801):
-        """alpha_max, the beta range and the Z-width (see :func:`limits`)."""
+        """alpha_max, the beta range and the Z-width (see :func:`limits`).
+
+        Parameters
+        ----------
+        n_beta : int
+            Vertical lines for the Z-width.
+        """
         beta_range = self.beta_range()
         top = self.alpha_max() if beta_range else None
         if top is None:
@@ -804,6 +824,8 @@ class Limits:
 
     Attributes
     ----------
+    region : StabilityRegion
+        The region these numbers describe (its intervals on any line).
     alpha_max : float or None
         Largest stable alpha (the renderable stiffness ``K_w T**2 / m``).
     beta_at_alpha_max : float or None
@@ -857,13 +879,24 @@ class Limits:
         return self.alpha_max is None
 
     def alpha_interval(self, beta):
-        """The stable alpha intervals at ``beta``; see :meth:`StabilityRegion.alpha_intervals`."""
+        """The stable alpha intervals at ``beta``; see :meth:`StabilityRegion.alpha_intervals`.
+
+        Parameters
+        ----------
+        beta : float
+            Dimensionless damping.
+        """
         return self.region.alpha_intervals(beta)
 
     def minimum_stiffness(self, beta):
         """The smallest stable alpha at ``beta`` (0 unless a minimum stiffness is needed).
 
         ``None`` when nothing is stable at ``beta``.
+
+        Parameters
+        ----------
+        beta : float
+            Dimensionless damping.
         """
         runs = self.region.alpha_intervals(beta)
         return runs[0][0] if runs else None
@@ -917,6 +950,10 @@ class BestVirtualMass:
 
     Attributes
     ----------
+    d : int
+        Delay in samples.
+    delta : float
+        ``b T / m``.
     gamma, beta : float or None
         The best ``M_w / m`` and the damping at which alpha_max is reached.
     alpha_max : float or None

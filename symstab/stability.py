@@ -191,7 +191,14 @@ def spectral_radius(*, alpha, beta, gamma, d, delta):
     :func:`classify`, which is certified; this is the O(d**3) per point
     measure of how far a point is from the boundary.
 
-    Parameters are as in :func:`loop_coefficients`.
+    Parameters
+    ----------
+    alpha, beta, gamma : float or array_like
+        Dimensionless stiffness, damping and virtual mass (broadcast).
+    d : int
+        Delay in samples, ``d >= 0``.
+    delta : float or array_like
+        ``b T / m``, from 0 (frictionless) to ``DELTA_MAX`` (1e6).
 
     Returns
     -------
@@ -696,6 +703,15 @@ def _shaped(codes, shape):
 
 def is_stable(*, alpha, beta, gamma, d, delta):
     """Whether each point is stable; marginal points are undecided.
+
+    Parameters
+    ----------
+    alpha, beta, gamma : float or array_like
+        Dimensionless stiffness, damping and virtual mass (broadcast).
+    d : int
+        Delay in samples, ``d >= 0``.
+    delta : float or array_like
+        ``b T / m``, from 0 (frictionless) to ``DELTA_MAX`` (1e6).
 
     Returns
     -------

@@ -68,47 +68,102 @@ class Device:
 
     # physical -> dimensionless
     def delay_samples(self, Td):
-        """``d = Td / T`` as an int; ``Td`` must be a whole number of samples."""
+        """``d = Td / T`` as an int.
+
+        Parameters
+        ----------
+        Td : float
+            Loop delay (s), a whole number of sample periods.
+        """
         Td = check_real("Td", Td, low=0.0)
         return check_delay_samples(Td / self.T, name="Td / T")
 
     def alpha(self, K_w):
-        """``alpha = K_w T**2 / m`` for a stiffness ``K_w`` (N/m or N m/rad)."""
+        """``alpha = K_w T**2 / m``.
+
+        Parameters
+        ----------
+        K_w : float or array_like
+            Virtual stiffness (N/m or N m/rad).
+        """
         K_w = check_array("K_w", K_w)
         return _as_float(_converted("alpha = K_w T^2 / m", K_w, lambda: K_w * (self.T / self.m) * self.T))
 
     def beta(self, B_w):
-        """``beta = B_w T / m`` for a damping ``B_w`` (N s/m or N m s/rad)."""
+        """``beta = B_w T / m``.
+
+        Parameters
+        ----------
+        B_w : float or array_like
+            Virtual damping (N s/m or N m s/rad).
+        """
         B_w = check_array("B_w", B_w)
         return _as_float(_converted("beta = B_w T / m", B_w, lambda: B_w * (self.T / self.m)))
 
     def gamma(self, M_w):
-        """``gamma = M_w / m`` for a virtual mass ``M_w`` (kg or kg m^2)."""
+        """``gamma = M_w / m``.
+
+        Parameters
+        ----------
+        M_w : float or array_like
+            Virtual virtual mass (kg or kg m^2).
+        """
         M_w = check_array("M_w", M_w)
         return _as_float(_converted("gamma = M_w / m", M_w, lambda: M_w / self.m))
 
     # dimensionless -> physical
     def delay(self, d):
-        """``Td = d T`` (s)."""
+        """``Td = d T`` (s).
+
+        Parameters
+        ----------
+        d : int
+            Delay in samples.
+        """
         return check_delay(d) * self.T
 
     def stiffness(self, alpha):
-        """``K_w = alpha m / T**2``."""
+        """``K_w = alpha m / T**2``.
+
+        Parameters
+        ----------
+        alpha : float or array_like
+            The dimensionless value (Table I).
+        """
         alpha = check_array("alpha", alpha)
         return _as_float(_converted("K_w = alpha m / T^2", alpha, lambda: alpha * (self.m / self.T) / self.T))
 
     def damping(self, beta):
-        """``B_w = beta m / T``."""
+        """``B_w = beta m / T``.
+
+        Parameters
+        ----------
+        beta : float or array_like
+            The dimensionless value (Table I).
+        """
         beta = check_array("beta", beta)
         return _as_float(_converted("B_w = beta m / T", beta, lambda: beta * (self.m / self.T)))
 
     def mass(self, gamma):
-        """``M_w = gamma m``."""
+        """``M_w = gamma m``.
+
+        Parameters
+        ----------
+        gamma : float or array_like
+            The dimensionless value (Table I).
+        """
         gamma = check_array("gamma", gamma)
         return _as_float(_converted("M_w = gamma m", gamma, lambda: gamma * self.m))
 
     def units(self, rotary=True):
-        """Unit strings of ``K_w, B_w, M_w`` (rotary: N m/rad, N m s/rad, kg m^2)."""
+        """Unit strings of ``K_w, B_w, M_w`` and ``Td``.
+
+        Parameters
+        ----------
+        rotary : bool
+            Rotary units (N m/rad, N m s/rad, kg m^2), else linear (N/m,
+            N s/m, kg).
+        """
         if rotary:
             return {"K_w": "N m/rad", "B_w": "N m s/rad", "M_w": "kg m^2", "Td": "s"}
         return {"K_w": "N/m", "B_w": "N s/m", "M_w": "kg", "Td": "s"}
