@@ -307,3 +307,25 @@ def test_regions_refuse_delta_zero_by_name(call):
 
     with pytest.raises(ValueError, match="delta must be > 0"):
         getattr(regions, call)(0.0, 0, 0.0)
+
+
+@pytest.mark.parametrize("gamma, d", [(2.0, 0), (0.0, 10), (1.0, 40)])
+def test_arc_polyline_points_are_the_nearest_doubles(gamma, d):
+    """Oracle: eq. (2) solved by Cramer's rule at 80 digits (conftest).  The
+    polyline's first points sit where the boundary forms cancel most; at a
+    flat 20 digits they were off by up to 4e-11."""
+    import mpmath
+    import numpy as np
+    from conftest import PAPER_DELTA, first_principles_boundary_point
+    from paper_checks import regions
+    from symstab.curves import arc_end_angle
+
+    t_end = arc_end_angle(gamma=gamma, d=d, delta=PAPER_DELTA)
+    n = int(200 + 20 * d * t_end)
+    betas, alphas = regions._arc_polyline(gamma, d, PAPER_DELTA, t_end, (0.0, -PAPER_DELTA), n)
+    for k in (1, 2, 3, n // 2, n - 1):
+        with mpmath.workdps(80):
+            alpha, beta = first_principles_boundary_point(mpmath.mpf(t_end) * k / n, gamma, d,
+                                                          PAPER_DELTA)
+        assert (alphas[k], betas[k]) == (float(alpha), float(beta)), k
+    assert np.isclose(alphas[-1], 0.0, atol=1e-14)
