@@ -60,6 +60,8 @@ def _trig_taylor(expr, order):
     theta = model.theta
     replace = {}
     for func in expr.atoms(sp.sin, sp.cos):
+        if not func.has(theta):
+            continue
         c = sp.expand(func.args[0] / theta)
         if c.has(theta):
             return None

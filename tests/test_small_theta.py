@@ -104,6 +104,7 @@ _t, _d, _g = model.theta, model.d, model.Gamma
 @pytest.mark.parametrize("expr, fast", [
     (_g * sp.sin((_d + 2) * _t) - 3 * sp.cos(_d * _t) + _d**2 * sp.sin(2 * _t)**2, True),
     (sp.cos(_t) * sp.sin(_d * _t - _t) / (_g - 1) + sp.exp(model.delta), True),
+    (sp.sin(model.delta) * sp.sin(_t) + sp.cos(2), True),   # constants stay as they are
     (sp.sin(_t + 1) + sp.cos(_d * _t), False),    # not c * theta: falls back
     (sp.exp(_t) * sp.sin(_t), False),             # another function of theta
     (sp.sin(_d * _t) / _t + sp.cos(_t), True),    # not a polynomial after all: falls back
