@@ -22,9 +22,12 @@ import tempfile
 
 import sympy as sp
 
+from . import model
 from .codegen import CKernelPrinter, Kernel, NumPyKernelPrinter, _c_function, _python_function
+from .loop_assembly import is_affine
 
-__all__ = ["CACHE_ENV", "cache_dir", "numpy_source", "c_source", "load_numpy_kernels"]
+__all__ = ["CACHE_ENV", "cache_dir", "numpy_source", "c_source", "load_numpy_kernels",
+           "environment_kernels"]
 
 CACHE_ENV = "SYMSTAB_CACHE_DIR"
 #: Bumped when the layout of the generated text changes (part of the hash).
@@ -129,3 +132,43 @@ def kernel(name, args, outputs, doc):
     """
     return Kernel(name, tuple((symbol, "double", text) for symbol, text in args),
                   tuple(outputs), doc)
+
+
+def environment_kernels(loop):
+    """The kernels of a loop's environment, and their argument names.
+
+    ``environment`` gives the coefficients of ``Ve_n`` and ``Ve_d``
+    (highest power of ``z`` first) from the environment's parameters (and
+    ``T``); ``environment_slope_<name>`` their derivatives in each parameter
+    that enters them affinely (constants).
+
+    Parameters
+    ----------
+    loop : symstab.loop_assembly.LoopModel
+
+    Returns
+    -------
+    (list of Kernel, tuple of str)
+    """
+    names = loop._environment_names
+    if model.T in loop.environment.free_symbols:
+        names = names + ("T",)
+    names = tuple(dict.fromkeys(names))
+    args = [(loop._symbols[n], f"parameter {n}") for n in names]
+    ve_n, ve_d = loop._environment_parts
+    outputs = ([(f"num{k}", c, f"coefficient of z^{len(ve_n) - 1 - k} of Ve_n")
+                for k, c in enumerate(ve_n)]
+               + [(f"den{k}", c, f"coefficient of z^{len(ve_d) - 1 - k} of Ve_d")
+                  for k, c in enumerate(ve_d)])
+    kernels = [kernel("environment", args, outputs,
+                      f"Numerator and denominator of VE(z) = {loop.environment}, "
+                      f"highest power of z first.")]
+    for name in loop._environment_names:
+        symbol = loop._symbols[name]
+        if is_affine(ve_n + ve_d, [symbol]):
+            kernels.append(kernel(
+                f"environment_slope_{name}", args,
+                [(o, sp.diff(c, symbol), f"d/d{name} of {text}") for o, c, text in outputs],
+                f"Derivatives of the environment's coefficients in {name} (constant: "
+                f"they enter affinely)."))
+    return kernels, names

@@ -1,0 +1,459 @@
+"""A sampled loop as SymPy objects: plant, zero-order hold, delay and environment.
+
+:class:`LoopModel` parses a plant ``G(s)`` and an environment ``VE(z)``
+with named parameters, checks that they are proper rational functions, and
+derives the closed loop ``1 + VE(z) z**-d Z[ZOH G](z) = 0`` as
+
+    chi(z) = z**d Ve_d(z) P_d(z) + Ve_n(z) P_n(z),
+
+a *delayed part* and a *direct part* (as :mod:`symstab.loop` does for the
+paper's loop).  The pulse transfer function ``P_n / P_d`` is derived by
+residues when every pole of ``G(s)/s`` is a linear factor over the
+parameters (:func:`symstab.discretize.zoh_pulse_transfer_function`), else
+by the matrix exponential at 30 digits once the plant's values are known
+(:func:`symstab.discretize.numeric_zoh`); :attr:`LoopModel.zoh_method`
+says which.  It also decides which parameters enter ``chi`` affinely (the
+axes a parameter plane may have) and evaluates the plant's polynomials at
+30 digits.  Everything numeric on top of it is :class:`symstab.Loop`.
+"""
+
+import functools
+import keyword
+import re
+
+import mpmath
+import numpy as np
+import sympy as sp
+from sympy.parsing.sympy_parser import convert_xor, parse_expr, standard_transformations
+
+from . import model
+from ._validate import check_delay
+from .discretize import linear_poles, numeric_zoh, zoh_pulse_transfer_function
+
+__all__ = ["LoopModel", "parse_plant", "parse_environment", "check_parameter_name", "is_affine",
+           "poly_coeffs"]
+
+#: Names with a fixed meaning in every loop.
+RESERVED = ("s", "z", "T", "d")
+_DPS = 30
+#: Parameter names the generated NumPy and C kernels cannot take.
+_C_KEYWORDS = frozenset(
+    "auto break case char const continue default do double else enum extern float for goto if "
+    "inline int long register restrict return short signed sizeof static struct switch typedef "
+    "union unsigned void volatile while _Bool _Complex _Imaginary".split())
+_GENERATED_NAME = re.compile(r"(num|den|pn|pd|x)\d+|numpy|_.*")
+
+
+def check_parameter_name(name):
+    """Refuse a parameter name the generated kernels cannot use.
+
+    A Python or C keyword, ``numpy`` (the NumPy module in the generated
+    code), a name starting with ``_``, or a name the generated code uses
+    itself (outputs ``num<k>``, ``den<k>``, ``pn<k>``, ``pd<k>``,
+    temporaries ``x<k>``).
+
+    Raises
+    ------
+    ValueError
+        Naming the parameter.
+    """
+    if keyword.iskeyword(name) or name in _C_KEYWORDS or _GENERATED_NAME.fullmatch(name):
+        raise ValueError(f"parameter {name!r} cannot be a name in the generated NumPy and C kernels "
+                         f"(a Python or C keyword, 'numpy', a leading '_', or a name the kernels "
+                         f"use: num<k>, den<k>, pn<k>, pd<k>, x<k>): rename it in the loop")
+
+_PARSE_GLOBALS = {
+    "Integer": sp.Integer, "Float": sp.Float, "Rational": sp.Rational, "Symbol": sp.Symbol,
+    "exp": sp.exp, "sqrt": sp.sqrt, "pi": sp.pi,
+}
+
+
+def _parse(text, what):
+    local = {"s": model.s, "z": model.z, "T": model.T}
+    try:
+        expr = parse_expr(text, local_dict=local, global_dict=dict(_PARSE_GLOBALS),
+                          transformations=standard_transformations + (convert_xor,))
+    except Exception as exc:
+        raise ValueError(f"{what} {text!r} is not a valid expression: {exc}") from None
+    if not isinstance(expr, sp.Expr):
+        raise ValueError(f"{what} {text!r} is not an expression")
+    return expr
+
+
+def _real_symbols(expr):
+    """Replace every parameter symbol by a real one of the same name (T stays positive)."""
+    swap = {}
+    for symbol in expr.free_symbols:
+        name = str(symbol)
+        if name == "d":
+            raise ValueError("the delay d is not part of the plant or the environment: "
+                             "the loop applies z**-d itself")
+        if symbol in (model.s, model.z, model.T):
+            continue
+        if name in ("s", "z", "T"):
+            swap[symbol] = {"s": model.s, "z": model.z, "T": model.T}[name]
+        else:
+            swap[symbol] = sp.Symbol(name, real=True)
+    return expr.xreplace(swap)
+
+
+def _plant_from_control(plant):
+    num, den = plant.num[0][0], plant.den[0][0]
+    if plant.ninputs != 1 or plant.noutputs != 1:
+        raise ValueError("plant must be a single-input single-output transfer function")
+    if plant.dt not in (0, None):
+        raise ValueError(f"plant must be continuous-time (dt = 0), got dt = {plant.dt!r}")
+    s = model.s
+
+    def poly(coefficients):
+        return sp.Add(*[sp.Rational(float(c)) * s**k
+                        for k, c in enumerate(reversed(list(coefficients)))])
+
+    return poly(num) / poly(den)
+
+
+def _check_rational(expr, variable, what, other):
+    if expr.has(other):
+        raise ValueError(f"{what} must not contain {other}")
+    if not expr.is_rational_function(variable):
+        raise ValueError(f"{what} must be a rational function of {variable}, got {expr}")
+    num, den = sp.fraction(sp.cancel(sp.together(expr)))
+    if den == 0 or sp.simplify(num) == 0:
+        raise ValueError(f"{what} must not be zero")
+    nd, dd = sp.degree(num, variable), sp.degree(den, variable)
+    if nd > dd:
+        raise ValueError(f"{what} must be proper (degree of numerator {nd} <= degree of "
+                         f"denominator {dd} in {variable}), got {expr}")
+    return num, den
+
+
+def parse_plant(plant):
+    """The plant ``G(s)`` as a SymPy expression, checked: rational in ``s`` and proper.
+
+    ``plant`` is a string, a SymPy expression or a ``control.TransferFunction``
+    (continuous-time, numeric).
+
+    Raises
+    ------
+    TypeError
+        For another kind of object.
+    ValueError
+        If it is not rational in ``s``, not proper, zero, or uses ``z`` or ``d``.
+    """
+    if isinstance(plant, str):
+        expr = _parse(plant, "plant")
+    elif isinstance(plant, sp.Basic):
+        expr = sp.sympify(plant)
+    elif hasattr(plant, "num") and hasattr(plant, "den") and hasattr(plant, "dt"):
+        expr = _plant_from_control(plant)
+    else:
+        raise TypeError(f"plant must be a string, a SymPy expression or a "
+                        f"control.TransferFunction, got {type(plant).__name__}")
+    expr = _real_symbols(expr)
+    _check_rational(expr, model.s, "plant G(s)", model.z)
+    return expr
+
+
+def parse_environment(environment):
+    """The environment ``VE(z)`` as a SymPy expression, checked: rational in ``z`` and proper.
+
+    Raises
+    ------
+    TypeError
+        If it is not a string or a SymPy expression.
+    ValueError
+        If it is not rational in ``z``, not proper (not causal), zero, or uses
+        ``s`` or ``d``.
+    """
+    if isinstance(environment, str):
+        expr = _parse(environment, "environment")
+    elif isinstance(environment, sp.Basic):
+        expr = sp.sympify(environment)
+    else:
+        raise TypeError(f"environment must be a string or a SymPy expression, "
+                        f"got {type(environment).__name__}")
+    expr = _real_symbols(expr)
+    _check_rational(expr, model.z, "environment VE(z)", model.s)
+    return expr
+
+
+def poly_coeffs(expr, z):
+    """Coefficients of a polynomial ``expr`` in ``z``, highest power first."""
+    return sp.Poly(sp.expand(expr), z).all_coeffs()
+
+
+def is_affine(coefficients, symbols):
+    """Whether every coefficient is a polynomial of total degree <= 1 in ``symbols``."""
+    for c in coefficients:
+        c = sp.expand(c)
+        if not c.has(*symbols):
+            continue
+        try:
+            poly = sp.Poly(c, *symbols)
+        except sp.PolynomialError:
+            return False
+        if poly.total_degree() > 1 or any(g.has(*symbols) for g in poly.gens if g not in symbols):
+            return False
+        if any(coef.has(*symbols) for coef in poly.coeffs()):
+            return False
+    return True
+
+
+class LoopModel:
+    """The symbolic loop: plant, environment, their parameters and the loop polynomial.
+
+    Parameters
+    ----------
+    plant : str, sympy.Expr or control.TransferFunction
+        ``G(s)``, force to position, proper and rational in ``s``.
+    environment : str or sympy.Expr
+        ``VE(z)``, sampled position to force, proper and rational in ``z``.
+    values : dict, optional
+        Default values of parameters.
+    name : str, optional
+        A label for reprs and generated files.
+    units : dict, optional
+        Unit of each parameter, as text.
+    description : str, optional
+        One line on what the loop is.
+    plane : (str, str), optional
+        The default ``(x, y)`` parameter plane; checked to be jointly affine.
+
+    Raises
+    ------
+    TypeError, ValueError
+        If the plant or the environment is not a proper rational function
+        of its variable, uses ``d``, or names a parameter the generated
+        kernels cannot take (:func:`check_parameter_name`).
+    """
+
+    def __init__(self, plant, environment, *, values=None, name=None, units=None,
+                 description="", plane=None):
+        self.plant = parse_plant(plant)
+        self.environment = parse_environment(environment)
+        self.name = name or "loop"
+        self.description = description
+        symbols = {str(x): x for x in self.plant.free_symbols | self.environment.free_symbols}
+        symbols.pop("s", None)
+        symbols.pop("z", None)
+        symbols.pop("T", None)
+        for name in symbols:
+            check_parameter_name(name)
+        self._symbols = dict(sorted(symbols.items()))
+        self._symbols["T"] = model.T
+        self._plant_names = tuple(n for n in self._symbols
+                                  if self._symbols[n] in self.plant.free_symbols)
+        self._environment_names = tuple(n for n in self._symbols
+                                        if self._symbols[n] in self.environment.free_symbols)
+        self.parameters = tuple(self._symbols) + ("d",)
+        self.defaults = {}
+        for key, value in (values or {}).items():
+            if key not in self.parameters:
+                raise ValueError(f"values: {key!r} is not a parameter of this loop "
+                                 f"(parameters: {', '.join(self.parameters)})")
+            self.defaults[key] = value
+        self.units = {}
+        for key, unit in (units or {}).items():
+            if key not in self.parameters:
+                raise ValueError(f"units: {key!r} is not a parameter of this loop "
+                                 f"(parameters: {', '.join(self.parameters)})")
+            self.units[key] = str(unit)
+        poles = linear_poles(sp.together(self.plant / model.s))
+        numeric_plant = not (self.plant.free_symbols - {model.s})
+        self.zoh_method = "residues" if poles is not None and not numeric_plant else "matrix exponential"
+        self.plane = None
+        if plane is not None:
+            plane = tuple(plane)
+            if len(plane) != 2:
+                raise ValueError(f"plane must be two parameter names, got {plane!r}")
+            self._check_plane(plane)
+            self.plane = plane
+
+    def __repr__(self):
+        return (f"Loop(plant={str(self.plant)!r}, environment={str(self.environment)!r}, "
+                f"zoh={self.zoh_method!r})")
+
+    @functools.cached_property
+    def _environment_parts(self):
+        num, den = sp.fraction(sp.cancel(sp.together(self.environment)))
+        return poly_coeffs(num, model.z), poly_coeffs(den, model.z)
+
+    @functools.cached_property
+    def _plant_parts(self):
+        """(P_n, P_d) coefficient lists in z (symbolic), or None for the numeric path."""
+        if self.zoh_method != "residues":
+            return None
+        pulse = zoh_pulse_transfer_function(self.plant)
+        num, den = sp.fraction(sp.cancel(pulse))
+        return poly_coeffs(num, model.z), poly_coeffs(den, model.z)
+
+    def pulse_transfer_function(self):
+        """``Z[ZOH G](z)`` as a SymPy rational function of ``z``.
+
+        Raises
+        ------
+        ValueError
+            If the loop's plant is discretised numerically (see
+            :attr:`zoh_method`).
+        """
+        if self._plant_parts is None:
+            raise ValueError("this plant's poles are not linear factors over its parameters: "
+                             "its pulse transfer function is computed numerically "
+                             "(zoh_method = 'matrix exponential') once its values are given")
+        num, den = self._plant_parts
+        z = model.z
+        return sp.Add(*[c * z**k for k, c in enumerate(reversed(num))]) / sp.Add(
+            *[c * z**k for k, c in enumerate(reversed(den))])
+
+    def characteristic_polynomial(self, **values):
+        """``chi(z) = z**d Ve_d P_d + Ve_n P_n`` with a symbolic integer delay ``d``.
+
+        Parameters
+        ----------
+        **values
+            Parameter values to substitute (optional).  A plant discretised
+            numerically needs the values of all its parameters and ``T``.
+
+        Returns
+        -------
+        sympy.Expr
+            Its roots in ``z`` are the closed-loop poles.
+        """
+        unknown = set(values) - set(self.parameters)
+        if unknown:
+            raise TypeError(f"unknown parameter(s) {', '.join(sorted(unknown))}; "
+                            f"parameters: {', '.join(self.parameters)}")
+        z = model.z
+        delayed, direct = self._symbolic_parts(values)
+        poly = (z**model.d * sp.Add(*[c * z**k for k, c in enumerate(reversed(delayed))])
+                + sp.Add(*[c * z**k for k, c in enumerate(reversed(direct))]))
+        sub = {self._symbols[k]: v for k, v in values.items() if k != "d"}
+        poly = poly.subs(sub)
+        if "d" in values:
+            poly = poly.subs(model.d, check_delay(values["d"]))
+        return poly
+
+    def _symbolic_parts(self, values=None):
+        ve_n, ve_d = self._environment_parts
+        if self._plant_parts is None:
+            need = [n for n in self._plant_names + ("T",) if n not in (values or {})]
+            if need:
+                raise ValueError(f"the plant is discretised numerically: give "
+                                 f"{', '.join(need)} to get its polynomial")
+            p_n, p_d, _ = self._numeric_plant(tuple(float(values[n]) for n in self._plant_names),
+                                           float(values["T"]))
+            p_n = [sp.Float(str(c), _DPS) for c in p_n]
+            p_d = [sp.Float(str(c), _DPS) for c in p_d]
+        else:
+            p_n, p_d = self._plant_parts
+        z = model.z
+
+        def product(a, b):
+            pa = sp.Add(*[c * z**k for k, c in enumerate(reversed(a))])
+            pb = sp.Add(*[c * z**k for k, c in enumerate(reversed(b))])
+            return poly_coeffs(pa * pb, z)
+
+        return product(ve_d, p_d), product(ve_n, p_n)
+
+    @functools.cached_property
+    def _parts(self):
+        """Delayed and direct coefficient lists (symbolic path only)."""
+        return self._symbolic_parts()
+
+    def affine_parameters(self):
+        """Names of the parameters in which the characteristic polynomial is affine.
+
+        These can be the axes of a parameter plane (:meth:`boundary`,
+        :meth:`limits`) or the variable of :meth:`stable_intervals`.  With a
+        plant discretised numerically only environment parameters qualify.
+        """
+        out = []
+        for name in self._symbols:
+            if self._affine((name,)):
+                out.append(name)
+        return tuple(out)
+
+    @functools.lru_cache(maxsize=None)
+    def _affine(self, names):
+        symbols = [self._symbols[n] for n in names]
+        if self._plant_parts is None:
+            if any(n in self._plant_names or n == "T" for n in names):
+                return False
+            ve_n, ve_d = self._environment_parts
+            return is_affine(ve_n + ve_d, symbols)
+        if len(names) == 2 and any(n in self._plant_names for n in names) and not all(
+                n in self._plant_names for n in names):
+            # One in each block: affine only if the cross terms cancel, which
+            # the slopes computed block by block would miss; refuse instead.
+            return False
+        delayed, direct = self._parts
+        if any(n in self._plant_names and n in self._environment_names for n in names):
+            return False
+        return is_affine(delayed + direct, symbols)
+
+    def _check_plane(self, names):
+        for name in names:
+            if not isinstance(name, str):
+                raise TypeError(f"a plane parameter must be a name (str), got {type(name).__name__}")
+            if name not in self._symbols:
+                raise ValueError(f"{name!r} is not a parameter of this loop "
+                                 f"(parameters: {', '.join(self._symbols)})")
+        if len(set(names)) != len(names):
+            raise ValueError(f"the plane's parameters must differ, got {names[0]!r} twice")
+        for name in names:
+            if not self._affine((name,)):
+                raise ValueError(
+                    f"parameter {name!r} does not enter the characteristic polynomial affinely; "
+                    f"a plane or a line needs affine parameters: "
+                    f"{', '.join(self.affine_parameters()) or 'none'}")
+        if len(names) == 2 and not self._affine(tuple(names)):
+            raise ValueError(f"parameters {names[0]!r} and {names[1]!r} do not enter the "
+                             f"characteristic polynomial jointly affinely (a product of the two "
+                             f"appears)")
+
+    def _numeric_plant(self, plant_values, T):
+        return self._plant_cache(tuple(plant_values), T)
+
+    @functools.cached_property
+    def _plant_functions(self):
+        """mpmath functions of (plant values..., T) giving P_n and P_d (symbolic path)."""
+        args = [self._symbols[n] for n in self._plant_names] + [model.T]
+        num, den = self._plant_parts
+        return sp.lambdify(args, [list(num), list(den)], modules="mpmath")
+
+    @functools.lru_cache(maxsize=4096)
+    def _plant_cache(self, plant_values, T):
+        """(P_n, P_d, ends) as float arrays, monic P_d, evaluated at 30 digits.
+
+        ``ends`` is ``(P_n(1), P_d(1), P_n(-1), P_d(-1))``, summed at 30
+        digits: a pole at z = 1 then gives ``P_d(1)`` of 1e-30, not of the
+        coefficients' rounding, and the line z = 1 of a plane comes out
+        where it is.
+        """
+        with mpmath.workdps(_DPS):
+            point = [mpmath.mpf(float(v)) for v in plant_values]
+            if self._plant_parts is None:
+                sub = {self._symbols[n]: sp.Float(float(v), _DPS)
+                       for n, v in zip(self._plant_names, plant_values)}
+                num, den = sp.fraction(sp.together(self.plant.subs(sub)))
+                num = [mpmath.mpf(sp.Float(c, _DPS)) for c in sp.Poly(num, model.s).all_coeffs()]
+                den = [mpmath.mpf(sp.Float(c, _DPS)) for c in sp.Poly(den, model.s).all_coeffs()]
+                p_n, p_d = numeric_zoh(num, den, mpmath.mpf(float(T)), dps=_DPS)
+            else:
+                try:
+                    p_n, p_d = self._plant_functions(*point, mpmath.mpf(float(T)))
+                except ZeroDivisionError:
+                    p_n, p_d = [mpmath.nan], [mpmath.mpf(0)]
+                p_n = [mpmath.mpf(c) for c in p_n]
+                p_d = [mpmath.mpf(c) for c in p_d]
+            lead = p_d[0]
+            if lead == 0 or not all(mpmath.isfinite(c) for c in p_n + p_d):
+                given = ", ".join(f"{n} = {float(v):g}" for n, v in zip(self._plant_names, plant_values))
+                raise ValueError(f"the plant's pulse transfer function is not defined at "
+                                 f"{given}, T = {float(T):g} (a pole cancels a parameter, "
+                                 f"e.g. b = 0 in 1/(m s**2 + b s)? write that plant with b = 0)")
+            ends = [sum(c * sign**k for k, c in enumerate(reversed(part)))
+                    for sign in (1, -1) for part in (p_n, p_d)]
+            return (np.array([float(c / lead) for c in p_n]),
+                    np.array([float(c / lead) for c in p_d]),
+                    np.array([float(c / lead) for c in ends]))
