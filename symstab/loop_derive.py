@@ -470,11 +470,11 @@ def paper_loop_proofs():
 def _against_the_paper(plant, environment):
     """:func:`paper_loop_proofs` for the loop of ``plant`` and ``environment`` (parameters
     ``m, b`` and ``K, B, M``): the tests give another loop, whose statements must fail."""
-    from .any_loop import Loop
+    from .loop_assembly import LoopModel
     from .boundary import boundary
     from .loop import characteristic_polynomial
 
-    loop = Loop(plant, environment)
+    loop = LoopModel(plant, environment)
     chi = loop.characteristic_polynomial()
     names = {str(x): x for x in chi.free_symbols}
     physical = {names["m"]: model.m, names["b"]: model.b, names["K"]: model.K_w,
