@@ -215,7 +215,31 @@ def theta_max(*, gamma, d, delta, dps=30):
 
 
 def theta_max_newton(*, d, delta):
-    """theta_max for gamma = 0 by the one-step Newton form (approximate)."""
+    """theta_max for gamma = 0 by the one-step Newton form (approximate).
+
+    One Newton step on ``N_alpha / delta**2 = A_S sin((d+1) theta) + A_D
+    sin(d theta)`` from ``theta_0 = pi / (2 (d + 1))``
+    (:func:`newton_form_gamma0`, the paper's eq. (12)).
+
+    Parameters
+    ----------
+    d : int
+        Delay in samples, ``d >= 0``.
+    delta : float
+        ``b T / m > 0``.
+
+    Returns
+    -------
+    float
+        The Newton estimate of theta_max; :func:`theta_max` gives the exact
+        root.
+
+    Raises
+    ------
+    TypeError, ValueError
+        If ``d`` or ``delta`` has the wrong kind or is out of range
+        (``delta = 0`` included).
+    """
     _, d, delta = check_loop(0.0, d, delta, zero_delta=False)
     # The Newton quotient cancels: evaluate at 30 digits from the exact
     # binary value of delta (a 15-digit Float lost up to 1e-7 at d = 100).
