@@ -284,7 +284,7 @@ def bench_classify(args, oracles):
     import control
 
     import symstab
-    from symstab.stability import MARGINAL, STABLE
+    from symstab.numeric.stability import MARGINAL, STABLE
 
     loop = _paper_loop()
     m, b, T = M_DEV, B_DEV, T_DEV

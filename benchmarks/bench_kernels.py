@@ -13,7 +13,7 @@ runs after one warm-up, timed with ``time.perf_counter``.
    c2d included, then ``.poles()``; and the same with ``Gd = c2d(G)`` built
    once and ``feedback(VE z^-d Gd, 1)``), against ``symstab.spectral_radius``
    (batched eigenvalues) and against a ``numpy.roots`` loop on the
-   coefficients of ``symstab.stability.loop_coefficients``.  python-control
+   coefficients of ``symstab.numeric.stability.loop_coefficients``.  python-control
    is timed per point on a random subset of the grid (``--pc-points``); its
    median per point is extrapolated to the 10^4 points, and its verdicts are
    checked against ``classify`` on the subset.  Ratio = alternative per point
@@ -102,7 +102,7 @@ def bench_grid(args, oracles):
     import control
 
     import symstab
-    from symstab.stability import MARGINAL, STABLE, UNSTABLE, loop_coefficients
+    from symstab.numeric.stability import MARGINAL, STABLE, UNSTABLE, loop_coefficients
 
     A, B = np.meshgrid(np.linspace(*ALPHA_WINDOW, N_GRID), np.linspace(*BETA_WINDOW, N_GRID))
     n_points = A.size
@@ -263,7 +263,8 @@ def _c_kernel(theta_max, runs):
 def _lambdified_boundary():
     import sympy as sp
 
-    from symstab import boundary, model
+    from symstab import boundary
+    from symstab.symbolic import model
 
     bd = boundary()
     args = (model.theta, model.gamma, model.d, model.delta)

@@ -24,8 +24,8 @@ import numpy as np
 import scipy.signal
 
 import symstab
-from symstab.simulate import simulate
-from symstab.stability import loop_coefficients
+from symstab.numeric.simulate import simulate
+from symstab.numeric.stability import loop_coefficients
 
 
 def _companion(coeffs):
@@ -76,7 +76,7 @@ def main():
         scipy.signal.dlsim(system, u, x0=x0)
         rates.append(args.steps / (time.perf_counter() - start))
     theirs = statistics.median(rates)
-    print(f"  symstab.simulate (all points at once)   {ours:10.3g} point-steps/s "
+    print(f"  symstab.numeric.simulate (all points at once)   {ours:10.3g} point-steps/s "
           f"(median {statistics.median(times):.2f} s per run)")
     print(f"  scipy.signal.dlsim per point            {theirs:10.3g} point-steps/s "
           f"(median over {args.dlsim_points} points)")

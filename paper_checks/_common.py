@@ -4,7 +4,7 @@ import functools
 
 import sympy as sp
 
-from symstab.identity import check_identity
+from symstab.proof.identity import check_identity
 
 from .audit import Outcome
 from .printed import C, PRINTED_COEFFICIENTS, printed

@@ -9,12 +9,12 @@ roots outside the unit circle (:mod:`paper_checks.regions`), not by the
 
 import decimal
 
-from symstab import model
-from symstab.evaluate import alpha_max_on_arc, arc_end, boundary_point
-from symstab.small_theta import small_theta_limits
-from symstab.region import limits
-from symstab.stability import stable_alpha_intervals
-from symstab.theta_max import theta_max
+from symstab.symbolic import model
+from symstab.numeric.evaluate import alpha_max_on_arc, arc_end, boundary_point
+from symstab.symbolic.small_theta import small_theta_limits
+from symstab.numeric.region import limits
+from symstab.numeric.stability import stable_alpha_intervals
+from symstab.symbolic.theta_max import theta_max
 
 from . import regions
 from ._common import DEVICE_DELTA, Memo, show

@@ -9,9 +9,9 @@
 
 import sympy as sp
 
-from symstab import model
-from symstab.boundary import boundary, coefficients
-from symstab.unit_circle import unit_circle_split
+from symstab.symbolic import model
+from symstab.symbolic.boundary import boundary, coefficients
+from symstab.symbolic.unit_circle import unit_circle_split
 
 from ._common import compare, prove, show, where, with_printed_coefficients
 from .audit import Outcome, check

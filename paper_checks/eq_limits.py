@@ -11,10 +11,10 @@
 import mpmath
 import sympy as sp
 
-from symstab import model
-from symstab.boundary import boundary, coefficients
-from symstab.evaluate import boundary_point
-from symstab.small_theta import small_theta_limits, taylor_coefficients
+from symstab.symbolic import model
+from symstab.symbolic.boundary import boundary, coefficients
+from symstab.numeric.evaluate import boundary_point
+from symstab.symbolic.small_theta import small_theta_limits, taylor_coefficients
 
 from ._common import DEVICE_DELTA, compare, show, where, with_printed_coefficients
 from .audit import Outcome, check

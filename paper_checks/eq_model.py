@@ -11,9 +11,9 @@
 
 import sympy as sp
 
-from symstab import model
-from symstab.discretize import pulse_transfer_function
-from symstab.loop import characteristic_polynomial
+from symstab.symbolic import model
+from symstab.symbolic.discretize import pulse_transfer_function
+from symstab.symbolic.loop import characteristic_polynomial
 
 from ._common import compare, prove, show, where
 from .audit import Outcome, check

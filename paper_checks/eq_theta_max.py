@@ -10,9 +10,9 @@
 import mpmath
 import sympy as sp
 
-from symstab import model
-from symstab.boundary import boundary, coefficients
-from symstab.theta_max import closed_form_d0, newton_form_gamma0, theta_max
+from symstab.symbolic import model
+from symstab.symbolic.boundary import boundary, coefficients
+from symstab.symbolic.theta_max import closed_form_d0, newton_form_gamma0, theta_max
 
 from ._common import DEVICE_DELTA, Memo, compare, prove, show, where, with_printed_coefficients
 from .audit import Outcome, check

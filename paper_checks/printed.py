@@ -41,7 +41,7 @@ import dataclasses
 
 import sympy as sp
 
-from symstab.model import (
+from symstab.symbolic.model import (
     B_w, Gamma, K_w, M_w, T, alpha, b, beta, d, delta, gamma, m, s, theta, z,
 )
 

@@ -17,10 +17,10 @@ places where the arc, ``alpha = 0`` and the ``z = -1`` line cut that vertical,
 so each cell the arc cuts out gets at least one sample however thin it is.
 Roots come from NumPy's companion-matrix eigenvalues; the coefficients of
 chi(z), affine in alpha and beta, are evaluated once per ``(gamma, d)`` at 30
-digits from :func:`symstab.loop.characteristic_polynomial` (and checked
-against :func:`symstab.stability.coefficients_at`).  Stability changes are
+digits from :func:`symstab.symbolic.loop.characteristic_polynomial` (and checked
+against :func:`symstab.numeric.stability.coefficients_at`).  Stability changes are
 refined by bisection, and one vertical is re-scanned with
-:func:`symstab.stability.stable_alpha_intervals` as a cross-check.
+:func:`symstab.numeric.stability.stable_alpha_intervals` as a cross-check.
 
 :data:`FIGURE_CASES` transcribes what the paper says about each curve of
 Figs. 6 and 8, and :data:`LIMIT_CASES` its limits ``gamma <= -1`` (no stable
@@ -37,13 +37,13 @@ import mpmath
 import numpy as np
 import sympy as sp
 
-from symstab import model
+from symstab.symbolic import model
 from symstab._validate import check_loop
-from symstab.boundary import boundary
-from symstab.small_theta import small_theta_limits
-from symstab.loop import characteristic_polynomial
-from symstab.stability import coefficients_at, stable_alpha_intervals, unstable_root_count
-from symstab.curves import arc_end_angle
+from symstab.symbolic.boundary import boundary
+from symstab.symbolic.small_theta import small_theta_limits
+from symstab.symbolic.loop import characteristic_polynomial
+from symstab.numeric.stability import coefficients_at, stable_alpha_intervals, unstable_root_count
+from symstab.numeric.curves import arc_end_angle
 
 __all__ = [
     "DEFAULT_DELTA", "MARGINAL_TOL",
@@ -53,7 +53,7 @@ __all__ = [
 ]
 
 #: ``b T / m`` of the paper's device (m = 0.0128 kg m^2, b = 0.0324 N m s/rad,
-#: T = 1 ms), from :func:`symstab.model.dimensionless_values`.
+#: T = 1 ms), from :func:`symstab.symbolic.model.dimensionless_values`.
 DEFAULT_DELTA = model.dimensionless_values(m=0.0128, b=0.0324, T=1e-3)["delta"]
 
 #: A root whose modulus is within this of 1 is marginal: neither stable nor
@@ -81,7 +81,7 @@ class InitialDirection:
     """How the arc leaves its starting point.
 
     Near theta = 0, ``beta = beta_start + beta_theta2 theta**2`` and
-    ``alpha = alpha_theta2 theta**2`` (:mod:`symstab.small_theta`).
+    ``alpha = alpha_theta2 theta**2`` (:mod:`symstab.symbolic.small_theta`).
 
     Attributes
     ----------
@@ -144,7 +144,7 @@ def side(gamma, d, delta=DEFAULT_DELTA):
     """Return "right", "left" or "straight": the arc's initial direction.
 
     The sign of ``beta_theta2`` in ``beta = -delta + beta_theta2 theta**2``
-    (:func:`symstab.small_theta.small_theta_limits`); see :func:`initial_direction`
+    (:func:`symstab.symbolic.small_theta.small_theta_limits`); see :func:`initial_direction`
     for the coefficients themselves.
 
     Parameters
@@ -193,7 +193,7 @@ def minus_one_line(gamma, d, delta=DEFAULT_DELTA):
     """The line on which chi(z) has a root at ``z = -1``.
 
     ``chi(-1) = (-1)**d delayed(-1) + direct(-1)`` is taken from
-    :func:`symstab.loop.characteristic_polynomial` with ``d`` concrete and
+    :func:`symstab.symbolic.loop.characteristic_polynomial` with ``d`` concrete and
     split into its alpha, beta and constant parts (evaluated at 30 digits).
 
     Parameters
@@ -478,15 +478,15 @@ class RegionResult:
     beta_step : float
         Spacing of the uniform verticals: the resolution of the beta extents.
     probes : tuple of Probe
-        Root counts from :func:`symstab.stability.unstable_root_count` at a
+        Root counts from :func:`symstab.numeric.stability.unstable_root_count` at a
         point just inside the arc below its top, above the top, below
         ``alpha = 0``, beyond the arc's end, and inside the stable set.
     library_check : dict
         The vertical through the arc's top re-scanned with
-        :func:`symstab.stability.stable_alpha_intervals`: both interval
+        :func:`symstab.numeric.stability.stable_alpha_intervals`: both interval
         lists and ``agrees``; also ``coefficient_error``, the largest
         relative difference of the fast coefficients from
-        :func:`symstab.stability.coefficients_at`.
+        :func:`symstab.numeric.stability.coefficients_at`.
     seconds : float
         Wall time of the call.
     """
@@ -638,7 +638,7 @@ def classify(gamma, d, delta=DEFAULT_DELTA, *, n_beta=41, n_alpha=201, beta_marg
         cuts corners.
     cross_check : bool, optional
         Re-scan the vertical through the arc's top with
-        :func:`symstab.stability.stable_alpha_intervals`.
+        :func:`symstab.numeric.stability.stable_alpha_intervals`.
 
     Returns
     -------
@@ -665,7 +665,7 @@ def classify(gamma, d, delta=DEFAULT_DELTA, *, n_beta=41, n_alpha=201, beta_marg
         if isinstance(value, bool) or not isinstance(value, int) or value < 3:
             raise ValueError(f"{name} must be an integer >= 3, got {value!r}")
     start = initial_direction(gamma, d, delta)
-    # The float arc end, to the last bit (symstab.curves); the 30-digit
+    # The float arc end, to the last bit (symstab.numeric.curves); the 30-digit
     # theta_max agrees with it to 1e-13 (tests/test_theta_max.py).
     t_end = arc_end_angle(gamma=gamma, d=d, delta=delta)
     if not np.isfinite(t_end):

@@ -6,41 +6,42 @@ delay of ``d`` samples and a virtual mass-spring-damper (Mashayekhi et al.,
 IEEE Trans. Haptics, 2025), and checks the paper's printed equations against
 it.
 
-The modules follow the data flow: :mod:`~symstab.model` (symbols, plant,
-environment) -> :mod:`~symstab.discretize` (ZOH pulse transfer function) ->
-:mod:`~symstab.loop` (characteristic polynomial) ->
-:mod:`~symstab.unit_circle` -> :mod:`~symstab.boundary` (alpha(theta),
-beta(theta), C-coefficients) -> :mod:`~symstab.small_theta`,
-:mod:`~symstab.theta_max`; :mod:`~symstab.identity` is the exact equality
-checker and :mod:`~symstab.derive` writes everything out.
+The modules follow the data flow: :mod:`~symstab.symbolic.model` (symbols, plant,
+environment) -> :mod:`~symstab.symbolic.discretize` (ZOH pulse transfer function) ->
+:mod:`~symstab.symbolic.loop` (characteristic polynomial) ->
+:mod:`~symstab.symbolic.unit_circle` -> :mod:`~symstab.symbolic.boundary` (alpha(theta),
+beta(theta), C-coefficients) -> :mod:`~symstab.symbolic.small_theta`,
+:mod:`~symstab.symbolic.theta_max`; :mod:`~symstab.proof.identity` is the exact equality
+checker and :mod:`~symstab.proof.derive` writes everything out.
 
-:mod:`~symstab.kernel_forms` rewrites the boundary and the loop polynomial in
-forms that keep their digits in floating point, :mod:`~symstab.codegen`
+:mod:`~symstab.codegen.forms` rewrites the boundary and the loop polynomial in
+forms that keep their digits in floating point, :mod:`~symstab.codegen.generator`
 prints them as NumPy and C99 kernels into ``symstab/_generated``, and the
-numeric API builds on those: :mod:`~symstab.units` (:class:`Device`),
-:mod:`~symstab.curves` (:func:`boundary_curve`), :mod:`~symstab.stability`
+numeric API builds on those: :mod:`~symstab.numeric.units` (:class:`Device`),
+:mod:`~symstab.numeric.curves` and :mod:`~symstab.numeric.region` (:func:`boundary_curve`), :mod:`~symstab.numeric.stability`
 (:func:`spectral_radius`, :func:`is_stable`, :func:`classify`) and
-:mod:`~symstab.region` (:func:`limits`, :func:`best_virtual_mass`).
+:mod:`~symstab.numeric.region` (:func:`limits`, :func:`best_virtual_mass`).
 
 Any other loop -- the user's own plant and virtual environment -- is a
-:class:`Loop` (:mod:`~symstab.any_loop`), derived and classified the same
+:class:`Loop` (:mod:`~symstab.numeric.any_loop`), derived and classified the same
 way, and can be read from a TOML loop file (:func:`load_loop`).
 """
 
-from .boundary import boundary, coefficients
-from .discretize import dimensionless_pulse_transfer_function, pulse_transfer_function
-from .identity import IdentityResult, assert_identity, check_identity
-from .small_theta import small_theta_limits
-from .loop import characteristic_polynomial
-from .model import dimensionless_values
-from .theta_max import closed_form_d0, newton_form_gamma0, theta_max, theta_max_newton
-from .unit_circle import unit_circle_split
-from .units import PAPER_DEVICE, Device
-from .curves import BoundaryCurve, arc_end_angle, boundary_curve
-from .stability import MARGINAL, STABLE, UNSTABLE, classify, is_stable, spectral_radius
-from .region import BestVirtualMass, Limits, StabilityRegion, best_virtual_mass, limits
-from .any_loop import Loop, LoopBoundary, LoopLimits
-from .loop_files import load_loop
+from .symbolic.boundary import boundary, coefficients
+from .symbolic.discretize import dimensionless_pulse_transfer_function, pulse_transfer_function
+from .proof.identity import IdentityResult, assert_identity, check_identity
+from .symbolic.small_theta import small_theta_limits
+from .symbolic.loop import characteristic_polynomial
+from .symbolic.model import dimensionless_values
+from .symbolic.theta_max import closed_form_d0, newton_form_gamma0, theta_max, theta_max_newton
+from .symbolic.unit_circle import unit_circle_split
+from .numeric.units import PAPER_DEVICE, Device
+from .numeric.curves import BoundaryCurve, arc_end_angle
+from .numeric.region import boundary_curve
+from .numeric.stability import MARGINAL, STABLE, UNSTABLE, classify, is_stable, spectral_radius
+from .numeric.region import BestVirtualMass, Limits, StabilityRegion, best_virtual_mass, limits
+from .numeric.any_loop import Loop, LoopBoundary, LoopLimits
+from .numeric.loop_files import load_loop
 
 __all__ = [
     "boundary", "coefficients",

@@ -6,7 +6,7 @@ shows in it, and what symstab finds -- the line that goes into the
 reproduction's ``index.md``.  :func:`make_figures` writes them all as PNGs.
 
 Figures 6, 8 and 10 overlay stable areas found by simulation
-(:func:`symstab.simulate.stability_map`) on the theoretical boundaries;
+(:func:`symstab.numeric.simulate.stability_map`) on the theoretical boundaries;
 they take most of the time.  Everything is in the paper's device
 (m = 0.0128 kg m^2, b = 0.0324 N m s/rad, T = 1 ms) unless a figure says
 otherwise.
@@ -20,10 +20,11 @@ import time
 
 import numpy as np
 
-from .curves import arc_end_angle, boundary_curve
-from .region import StabilityRegion, limits
-from .simulate import PAPER_ENCODER_RESOLUTION, Nonidealities, stability_map
-from .units import PAPER_DEVICE
+from .numeric.curves import arc_end_angle
+from .numeric.region import boundary_curve
+from .numeric.region import StabilityRegion, limits
+from .numeric.simulate import PAPER_ENCODER_RESOLUTION, Nonidealities, stability_map
+from .numeric.units import PAPER_DEVICE
 
 __all__ = ["FigureResult", "FIGURES", "make_figures", "pyplot", "require_matplotlib"]
 
@@ -103,8 +104,8 @@ def _labels(ax, physical=False):
 
 def fig3():
     """theta_max versus gamma, d = 0 (eq. (8))."""
-    from .theta_max import closed_form_d0
-    from . import model
+    from .symbolic.theta_max import closed_form_d0
+    from .symbolic import model
     import sympy as sp
 
     plt = pyplot()
@@ -140,8 +141,8 @@ def fig4():
     """theta_max versus d, gamma = 0: exact and the Newton form (12)."""
     plt = pyplot()
     import sympy as sp
-    from . import model
-    from .theta_max import newton_form_gamma0
+    from .symbolic import model
+    from .symbolic.theta_max import newton_form_gamma0
 
     ds = np.arange(0, 101)
     exact = np.array([arc_end_angle(gamma=0.0, d=int(d), delta=DELTA) for d in ds])
@@ -167,7 +168,7 @@ def fig4():
 def fig5():
     """The eq. (14) boundary (d = 0, gamma = 0), printed form against the derivation."""
     import sympy as sp
-    from . import model
+    from .symbolic import model
     from paper_checks.printed import printed
 
     plt = pyplot()
@@ -220,7 +221,7 @@ def figure_horizon(d):
 
     Enough for the picture (on the paper's 32 grids it changes 6 of 320 000
     cells, all next to the boundary); the tests use the full
-    :func:`symstab.simulate.default_horizon`.
+    :func:`symstab.numeric.simulate.default_horizon`.
     """
     return 4000 + 400 * d
 
@@ -489,7 +490,7 @@ def make_figures(out_dir, progress=None):
 
     ``progress(name, seconds)`` is called after each figure.
     """
-    from .derive import write_bytes
+    from .proof.derive import write_bytes
 
     plt = pyplot()
     out = pathlib.Path(out_dir)

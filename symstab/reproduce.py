@@ -23,7 +23,6 @@ and exit with status 130 and 143 (128 + the signal number).
 import concurrent.futures
 import contextlib
 import io
-import multiprocessing
 import os
 import pathlib
 import signal
@@ -32,72 +31,14 @@ import tempfile
 import threading
 import time
 
+from ._workers import default_workers, worker_pool
+
 __all__ = ["reproduce", "render_index", "worker_pool", "default_workers"]
 
 #: Figures in decreasing cost (measured: the limits of Figs. 11 and 12 take
 #: longest), so that the longest tasks start first and the audit's many
 #: short checks fill the workers at the end.
 _ORDER = ("fig12", "fig11", "fig10", "fig8", "fig6", "fig7", "fig4", "fig5", "fig3")
-
-
-def default_workers():
-    """Worker processes used by default: the cores, at most two.
-
-    The main job was sized for two cores; more workers only add start-up
-    and duplicated symbolic work.
-    """
-    return max(1, min(2, os.cpu_count() or 1))
-
-
-def _worker_init():
-    # Ctrl-C reaches the whole process group: the parent alone decides
-    # (and stops the workers), so a worker neither prints a traceback nor
-    # runs the parent's SIGTERM handler, which a forked child inherits.
-    signal.signal(signal.SIGINT, signal.SIG_IGN)
-    signal.signal(signal.SIGTERM, signal.SIG_DFL)
-
-
-def _stop_workers(pool):
-    """Cancel what is queued and end the workers now, without waiting for their tasks."""
-    processes = list((getattr(pool, "_processes", None) or {}).values())
-    for process in processes:
-        with contextlib.suppress(Exception):
-            process.terminate()
-    deadline = time.monotonic() + 1.0
-    for process in processes:
-        process.join(max(0.0, deadline - time.monotonic()))
-        if process.is_alive():
-            with contextlib.suppress(Exception):
-                process.kill()
-            process.join(1.0)
-    pool.shutdown(wait=False, cancel_futures=True)
-
-
-@contextlib.contextmanager
-def worker_pool(workers):
-    """A process pool whose workers are stopped at once if the block fails.
-
-    ``concurrent.futures`` waits for running tasks on the way out of a
-    ``with`` block, also after Ctrl-C (a minute and more here); this pool
-    terminates its workers instead on any exception, KeyboardInterrupt and
-    SIGTERM included.  Workers are forked where the platform allows it, so
-    that they inherit what the parent has already derived and cached.
-
-    Parameters
-    ----------
-    workers : int
-        Number of worker processes, ``>= 1``.
-    """
-    methods = multiprocessing.get_all_start_methods()
-    context = multiprocessing.get_context("fork" if "fork" in methods else None)
-    pool = concurrent.futures.ProcessPoolExecutor(max_workers=workers, mp_context=context,
-                                                  initializer=_worker_init)
-    try:
-        yield pool
-    except BaseException:
-        _stop_workers(pool)
-        raise
-    pool.shutdown(wait=True)
 
 
 def _figure_task(name):
@@ -114,7 +55,8 @@ def _figure_task(name):
 
 
 def _derive(out, log):
-    from . import codegen, derive
+    from .codegen import generator as codegen
+    from .proof import derive
     from ._project import project_root
 
     files = derive.render(derive.derivation_steps())
@@ -270,7 +212,7 @@ def _run(out, workers, log):
     from paper_checks import audit
 
     from . import figures
-    from .derive import write, write_bytes
+    from .proof.derive import write, write_bytes
 
     total = time.perf_counter()
     timings = []

@@ -32,9 +32,9 @@ import numpy as np
 import pytest
 import sympy as sp
 
-from symstab import model
-from symstab.boundary import boundary
-from symstab.loop import characteristic_polynomial
+from symstab.symbolic import model
+from symstab.symbolic.boundary import boundary
+from symstab.symbolic.loop import characteristic_polynomial
 
 REPO = pathlib.Path(__file__).resolve().parents[1]
 
@@ -293,14 +293,14 @@ def bd():
 @pytest.fixture(scope="session")
 def derivation():
     """derivation_steps(), built once (about 6 s)."""
-    from symstab.derive import derivation_steps
+    from symstab.proof.derive import derivation_steps
 
     return derivation_steps()
 
 
 @pytest.fixture(scope="session")
 def rendered_files(derivation):
-    from symstab.derive import render
+    from symstab.proof.derive import render
 
     return render(derivation)
 
@@ -321,7 +321,7 @@ def run_symstab(*args, env_extra=None, cwd=None, timeout=300):
 @pytest.fixture(scope="session")
 def generated_code():
     """codegen.generated_files(), built once."""
-    from symstab.codegen import generated_files
+    from symstab.codegen.generator import generated_files
 
     return generated_files()
 
@@ -346,11 +346,11 @@ def hash_seed_other_than_ours():
 
 
 def _main_in_process(argv):
-    """``symstab.cli.main(argv)`` here, as ``(returncode, stdout, stderr)``."""
+    """``symstab.cli.commands.main(argv)`` here, as ``(returncode, stdout, stderr)``."""
     import contextlib
     import io
 
-    from symstab import cli
+    from symstab.cli import commands as cli
 
     out, err = io.StringIO(), io.StringIO()
     with contextlib.redirect_stdout(out), contextlib.redirect_stderr(err):

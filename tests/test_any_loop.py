@@ -14,10 +14,10 @@ import pytest
 import sympy as sp
 
 import symstab
-from symstab import model
-from symstab.any_loop import Loop
-from symstab.discretize import numeric_zoh, zoh_pulse_transfer_function
-from symstab.stability import (MARGINAL, STABLE, UNSTABLE, classify_polynomials,
+from symstab.symbolic import model
+from symstab.numeric.any_loop import Loop
+from symstab.symbolic.discretize import numeric_zoh, zoh_pulse_transfer_function
+from symstab.numeric.stability import (MARGINAL, STABLE, UNSTABLE, classify_polynomials,
                                polynomial_root_counts, polynomial_spectral_radius)
 
 from conftest import PAPER_B, PAPER_M, PAPER_T, assert_rel_close, python_control_closed_loop

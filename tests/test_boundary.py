@@ -7,11 +7,11 @@ import numpy as np
 import pytest
 import sympy as sp
 
-from symstab import model
-from symstab.boundary import (
+from symstab.symbolic import model
+from symstab.symbolic.boundary import (
     ALPHA_MONOMIALS, boundary, BETA_MONOMIALS, DENOMINATOR_MONOMIALS, beta_relations, coefficients,
 )
-from symstab.theta_max import theta_max
+from symstab.symbolic.theta_max import theta_max
 
 from conftest import (
     PAPER_DELTA, assert_rel_close, boundary_point_mp, chi_mp,

@@ -34,8 +34,8 @@ import pytest
 
 import symstab
 from symstab import MARGINAL, STABLE, UNSTABLE, classify, is_stable, spectral_radius
-from symstab.evaluate import boundary_point
-from symstab.stability import loop_coefficients, schur_cohn
+from symstab.numeric.evaluate import boundary_point
+from symstab.numeric.stability import loop_coefficients, schur_cohn
 
 from conftest import (PAPER_DELTA, assert_message_names, dimensionless, first_principles_chi,
                       first_principles_chi_float,
@@ -429,7 +429,7 @@ def test_unstable_root_counts_match_polished_roots(d):
     beta = rng.uniform(-0.5, 2.0, 12) / (d + 1)
     gamma = rng.uniform(-1.2, 2.5, 12)
     delta = 10 ** rng.uniform(-5, 1, 12)
-    counts = symstab.stability.unstable_root_counts(alpha=alpha, beta=beta, gamma=gamma, d=d,
+    counts = symstab.numeric.stability.unstable_root_counts(alpha=alpha, beta=beta, gamma=gamma, d=d,
                                                      delta=delta)
     checked = 0
     for i in range(12):
@@ -468,7 +468,7 @@ def test_long_delay_verdicts_match_polished_roots(d):
     alphas = np.array([1e-6, 2e-5, 1e-4, 1e-3]) if d == 200 else np.array([1e-6, 1e-4])
     beta, gamma, delta = 1e-3, 0.0, PAPER_DELTA
     codes = classify(alpha=alphas, beta=beta, gamma=gamma, d=d, delta=delta)
-    counts = symstab.stability.unstable_root_counts(alpha=alphas, beta=beta, gamma=gamma, d=d,
+    counts = symstab.numeric.stability.unstable_root_counts(alpha=alphas, beta=beta, gamma=gamma, d=d,
                                                      delta=delta)
     for alpha, code, count in zip(alphas, codes, counts):
         expected = _count_outside(alpha, beta, gamma, d, delta, dps=30, near=1e-8)
@@ -482,7 +482,7 @@ def test_a_point_exactly_on_the_z_equals_1_line_is_marginal():
     # (beta = 0.3 lies in the region's span) every other root inside.
     for d in (0, 60):
         assert classify(alpha=0.0, beta=0.3 / (d + 1), gamma=0.0, d=d, delta=0.01) == MARGINAL
-        assert symstab.stability.unstable_root_counts(alpha=0.0, beta=0.3 / (d + 1), gamma=0.0,
+        assert symstab.numeric.stability.unstable_root_counts(alpha=0.0, beta=0.3 / (d + 1), gamma=0.0,
                                                        d=d, delta=0.01) == -1
     # With another root outside, a root on the circle does not make it marginal.
     assert classify(alpha=0.0, beta=0.5, gamma=0.3, d=7, delta=0.01) == UNSTABLE
@@ -520,10 +520,10 @@ def test_root_count_at_the_largest_accepted_stiffness_is_an_integer_or_marginal(
     """
     checked = 0
     for d, delta in ((0, 0.0), (50, 0.0025), (3, 1.0)):
-        count = symstab.stability.unstable_root_counts(alpha=alpha, beta=0.5, gamma=0.0, d=d,
+        count = symstab.numeric.stability.unstable_root_counts(alpha=alpha, beta=0.5, gamma=0.0, d=d,
                                                         delta=delta)
         assert -1 <= count <= d + 4
-        coeffs = symstab.stability.loop_coefficients(alpha=alpha, beta=0.5, gamma=0.0, d=d,
+        coeffs = symstab.numeric.stability.loop_coefficients(alpha=alpha, beta=0.5, gamma=0.0, d=d,
                                                      delta=delta)
         moduli = np.abs(np.roots(coeffs / np.max(np.abs(coeffs))))
         if np.min(np.abs(moduli - 1)) > 1e-6:

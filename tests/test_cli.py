@@ -2,7 +2,7 @@
 
 import pytest
 
-from symstab import cli
+from symstab.cli import commands as cli
 
 from conftest import EDITED_CODE_FILE, EDITED_FILE, REPO, run_symstab
 
@@ -70,7 +70,7 @@ def test_check_exits_1_and_names_only_the_edited_generated_file(derive_subproces
 
 
 def test_check_exits_0_on_fresh_output(tmp_path, rendered_files, generated_code, capsys):
-    from symstab import derive
+    from symstab.proof import derive
 
     derive.write(tmp_path / "derivations", rendered_files)
     derive.write(tmp_path / "code", generated_code)
@@ -80,7 +80,7 @@ def test_check_exits_0_on_fresh_output(tmp_path, rendered_files, generated_code,
 
 
 def test_check_reports_a_stray_generated_file(tmp_path, rendered_files, generated_code, capsys):
-    from symstab import derive
+    from symstab.proof import derive
 
     derive.write(tmp_path / "derivations", rendered_files)
     derive.write(tmp_path / "code", generated_code)
@@ -91,7 +91,7 @@ def test_check_reports_a_stray_generated_file(tmp_path, rendered_files, generate
 
 
 def test_committed_kernels_match_a_fresh_generation(generated_code):
-    from symstab import derive
+    from symstab.proof import derive
 
     committed = REPO / "symstab" / "_generated"
     stale = derive.check(committed, generated_code, owned=("*.py", "*.c", "*.h"))

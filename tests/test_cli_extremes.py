@@ -4,7 +4,7 @@ Every failure is one line ``symstab <command>: error: ...`` and exit status
 2, decided before the long work; NumPy warnings never reach the user;
 SIGINT and SIGTERM print one line and exit 130 and 143, leaving no file;
 output paths are checked (collisions, folders, writability) before the work.
-Most commands run in-process through :func:`symstab.cli.main` (a traceback
+Most commands run in-process through :func:`symstab.cli.commands.main` (a traceback
 would escape it as an exception and fail the test); what only a process
 shows (warnings on stderr, signals, memory of a long delay) runs in a
 subprocess.
@@ -20,7 +20,7 @@ import tracemalloc
 
 import pytest
 
-from symstab import cli
+from symstab.cli import commands as cli
 
 from conftest import run_symstab
 
@@ -106,9 +106,9 @@ def test_the_delay_cap_follows_its_environment_variable(capsys, monkeypatch):
 
 def test_a_billion_boundary_points_are_refused_before_any_allocation(capsys, monkeypatch):
     """boundary --n 1e9 grew to 23 GB; now refused naming --n and the limit, allocating nothing."""
-    from symstab import curves
+    from symstab.numeric import region
 
-    _forbid(monkeypatch, curves, "boundary_curve", "boundary_curve")
+    _forbid(monkeypatch, region, "boundary_curve", "boundary_curve")
     tracemalloc.start()
     try:
         status, out, err = _main(capsys, "boundary", "--n", "1000000000", "--format", "csv")
@@ -121,7 +121,7 @@ def test_a_billion_boundary_points_are_refused_before_any_allocation(capsys, mon
 
 def test_a_trajectory_beyond_the_memory_limit_is_refused_before_simulating(capsys, tmp_path,
                                                                           monkeypatch):
-    from symstab import simulate
+    from symstab.numeric import simulate
 
     monkeypatch.chdir(tmp_path)
     monkeypatch.setenv("SYMSTAB_MEMORY_LIMIT", "1M")
@@ -200,7 +200,7 @@ def test_long_delays_answer_or_refuse_in_one_line(tmp_path, args):
 @pytest.mark.parametrize("png", ["m.npz", "./m.npz", "sub/../m.npz", "ABSOLUTE"])
 def test_map_refuses_png_and_out_naming_the_same_file(capsys, tmp_path, monkeypatch, png):
     """--png m.npz overwrote the NPZ with the PNG and reported both written."""
-    from symstab import simulate
+    from symstab.numeric import simulate
 
     monkeypatch.chdir(tmp_path)
     (tmp_path / "sub").mkdir()
@@ -228,7 +228,7 @@ def _unwritable_folder(tmp_path):
 def test_output_folder_is_checked_before_the_simulation(capsys, tmp_path, monkeypatch, command,
                                                        where):
     """An unwritable --out folder was found after the whole run, named by a temporary file."""
-    from symstab import simulate
+    from symstab.numeric import simulate
 
     monkeypatch.chdir(tmp_path)
     if where == "missing":
@@ -251,7 +251,7 @@ def test_output_folder_is_checked_before_the_simulation(capsys, tmp_path, monkey
 
 
 def test_map_png_folder_is_checked_before_the_simulation(capsys, tmp_path, monkeypatch):
-    from symstab import simulate
+    from symstab.numeric import simulate
 
     monkeypatch.chdir(tmp_path)
     target = str(tmp_path / "missing" / "m.png")
@@ -324,7 +324,7 @@ def test_a_signal_stops_a_long_map_with_one_line_and_no_file(tmp_path, signum, s
 
 def test_interrupted_in_process_returns_130(capsys, monkeypatch):
     """Ctrl-C inside a command: one line and 130 from main(), not a KeyboardInterrupt."""
-    from symstab import stability
+    from symstab.numeric import stability
 
     def interrupted(**kwargs):
         raise KeyboardInterrupt

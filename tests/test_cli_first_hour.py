@@ -4,7 +4,7 @@
 ``--help``; ``derive`` outside a source checkout and from another folder;
 ``design`` echoing only the inputs it uses; ``limits`` naming its beta range
 for what it is; ``map`` drawn and stored in the units of its grid.  Most
-commands run in-process (:func:`symstab.cli.main` with capsys); what needs
+commands run in-process (:func:`symstab.cli.commands.main` with capsys); what needs
 an installed copy without a checkout runs ``python -m symstab`` on a copy of
 the package in a temporary folder.
 """
@@ -22,7 +22,7 @@ import numpy as np
 import pytest
 
 import symstab
-from symstab import cli
+from symstab.cli import commands as cli
 
 from conftest import PAPER_DELTA, PAPER_M, PAPER_T, REPO, python_control_closed_loop
 
@@ -173,7 +173,8 @@ def test_derive_outside_a_checkout_refuses_to_write_without_out(tmp_path):
 def test_derive_check_from_another_folder_compares_with_the_checkout(
         tmp_path, monkeypatch, capsys, rendered_files, generated_code):
     """Was: the default paths were relative to the current folder: all drift."""
-    from symstab import codegen, derive
+    from symstab.codegen import generator as codegen
+    from symstab.proof import derive
 
     # The session's derivation, not a second one of its own.
     monkeypatch.setattr(derive, "derivation_steps", lambda: None)

@@ -16,7 +16,7 @@ import numpy as np
 import pytest
 
 import symstab
-from symstab import cli
+from symstab.cli import commands as cli
 
 from conftest import PAPER_DELTA, PAPER_M, PAPER_T, REPO, python_control_closed_loop
 
@@ -126,8 +126,8 @@ def test_a_marginal_verdict_gives_no_pole_count(capsys):
 
 
 def test_boundary_lies_on_the_derived_curve_and_names_its_lines(capsys):
-    from symstab.curves import minus_one_line
-    from symstab.evaluate import boundary_point
+    from symstab.numeric.curves import minus_one_line
+    from symstab.numeric.evaluate import boundary_point
 
     data = run_json(capsys, "boundary", "--loop", PAPER, "--set", "d=10", "--n", "40")
     rows = data["rows"]
@@ -240,7 +240,7 @@ def test_map_files_are_the_same_bytes_run_to_run(capsys, tmp_path):
 
 
 def test_map_interrupted_while_classifying_writes_nothing(capsys, tmp_path, monkeypatch):
-    from symstab.any_loop import Loop
+    from symstab.numeric.any_loop import Loop
 
     def interrupted(self, **values):
         raise KeyboardInterrupt
@@ -254,7 +254,7 @@ def test_map_interrupted_while_classifying_writes_nothing(capsys, tmp_path, monk
 
 
 def test_map_interrupted_while_writing_leaves_no_partial_file(capsys, tmp_path, monkeypatch):
-    from symstab import derive
+    from symstab.proof import derive
 
     def interrupted(path, mode):
         raise KeyboardInterrupt   # after the bytes are in the temporary file

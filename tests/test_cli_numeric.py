@@ -14,7 +14,7 @@ import numpy as np
 import pytest
 
 import symstab
-from symstab import cli
+from symstab.cli import commands as cli
 
 from conftest import PAPER_B, PAPER_DELTA, PAPER_M, PAPER_T, python_control_closed_loop
 

@@ -1,4 +1,4 @@
-"""Tests of symstab.derive: deterministic, parseable, drift-checked output."""
+"""Tests of symstab.proof.derive: deterministic, parseable, drift-checked output."""
 
 import difflib
 import importlib.metadata
@@ -13,7 +13,8 @@ import numpy as np
 import pytest
 import sympy as sp
 
-from symstab import derive, model
+from symstab.proof import derive
+from symstab.symbolic import model
 
 from conftest import REPO, hash_seed_other_than_ours
 

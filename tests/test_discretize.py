@@ -1,12 +1,12 @@
-"""Tests of symstab.discretize: Z[ZOH G(s)] by residues, against eq. (4)."""
+"""Tests of symstab.symbolic.discretize: Z[ZOH G(s)] by residues, against eq. (4)."""
 
 import mpmath
 import numpy as np
 import pytest
 import sympy as sp
 
-from symstab import model
-from symstab.discretize import (
+from symstab.symbolic import model
+from symstab.symbolic.discretize import (
     dimensionless_pulse_transfer_function, pulse_transfer_function, z_transform_by_residues,
 )
 

@@ -1,11 +1,11 @@
-"""symstab.evaluate against a first-principles boundary (eqs. (1), (2), (4))."""
+"""symstab.numeric.evaluate against a first-principles boundary (eqs. (1), (2), (4))."""
 
 import mpmath
 import numpy as np
 import pytest
 
-from symstab.evaluate import alpha_max_on_arc, arc_end, boundary_point
-from symstab.theta_max import theta_max
+from symstab.numeric.evaluate import alpha_max_on_arc, arc_end, boundary_point
+from symstab.symbolic.theta_max import theta_max
 
 from conftest import PAPER_DELTA, first_principles_alpha, first_principles_boundary_point
 

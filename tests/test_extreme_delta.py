@@ -76,7 +76,7 @@ def test_design_at_delta_400_from_the_command_line():
 @pytest.mark.parametrize("delta", [0.0, 800.0])
 def test_simulation_at_extreme_delta_agrees_with_python_control(delta):
     """simulate(delta=800) called every point diverged (Gamma overflowed in the plant step)."""
-    from symstab.simulate import simulate
+    from symstab.numeric.simulate import simulate
 
     scale = 1.0 if delta < 1 else 400.0
     alphas = np.array([0.1, 0.4, 5.0]) * scale

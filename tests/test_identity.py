@@ -1,4 +1,4 @@
-"""Tests of symstab.identity: the exact equality checker and its forms."""
+"""Tests of symstab.proof.identity: the exact equality checker and its forms."""
 
 import mpmath
 import pytest
@@ -6,12 +6,10 @@ import sympy as sp
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from symstab import model
-from symstab.boundary import coefficients
-from symstab.identity import (
-    E, IdentityResult, UnsupportedExpression, assert_identity, check_identity, exponential_form,
-    numeric_difference, trig_form, w,
-)
+from symstab.symbolic import model
+from symstab.symbolic.boundary import coefficients
+from symstab.symbolic.forms import E, UnsupportedExpression, exponential_form, trig_form, w
+from symstab.proof.identity import IdentityResult, assert_identity, check_identity, numeric_difference
 
 theta, d, delta, Gamma = model.theta, model.d, model.delta, model.Gamma
 sin, cos = sp.sin, sp.cos

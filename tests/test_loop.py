@@ -1,4 +1,4 @@
-"""Tests of symstab.loop: the closed-loop characteristic polynomial.
+"""Tests of symstab.symbolic.loop: the closed-loop characteristic polynomial.
 
 The main oracle is python-control: the physical loop of Fig. 2 built from
 ``control.c2d`` and ``control.feedback`` must have the same poles as the
@@ -13,7 +13,7 @@ import pytest
 import sympy as sp
 from scipy.optimize import linear_sum_assignment
 
-from symstab import model
+from symstab.symbolic import model
 
 from conftest import (
     assert_message_names, assert_rel_close, delta_of_z, dimensionless, loop_coefficients_mp,

@@ -1,4 +1,4 @@
-"""Tests of ``symstab derive --loop`` (:mod:`symstab.loop_derive`).
+"""Tests of ``symstab derive --loop`` (:mod:`symstab.proof.loop_derive`).
 
 * The files are deterministic (two runs, two hash seeds: the same bytes) and
   carry no date, version or path.
@@ -29,10 +29,11 @@ import numpy as np
 import pytest
 
 from conftest import REPO, hash_seed_other_than_ours
-from symstab import cli, loop_derive
-from symstab.identity import check_identity
-from symstab.loop_codegen import _digest
-from symstab.loop_files import load_loop, parse_loop_text
+from symstab.cli import commands as cli
+from symstab.proof import loop_derive
+from symstab.proof.identity import check_identity
+from symstab.codegen.loop_kernels import _digest
+from symstab.numeric.loop_files import load_loop, parse_loop_text
 
 PAPER_FILE = REPO / "examples" / "loops" / "paper.toml"
 
@@ -75,7 +76,7 @@ def _cache(cache_dir, monkeypatch):
 
 
 def run_cli(*argv):
-    """``symstab.cli.main(argv)`` in this process: (status, stdout, stderr)."""
+    """``symstab.cli.commands.main(argv)`` in this process: (status, stdout, stderr)."""
     out, err = io.StringIO(), io.StringIO()
     with contextlib.redirect_stdout(out), contextlib.redirect_stderr(err):
         status = cli.main(list(argv))

@@ -1,4 +1,4 @@
-"""Tests of symstab.model: symbols, G(s), the ZOH, VE(z) and Table I."""
+"""Tests of symstab.symbolic.model: symbols, G(s), the ZOH, VE(z) and Table I."""
 
 import math
 
@@ -6,8 +6,8 @@ import numpy as np
 import pytest
 import sympy as sp
 
-from symstab import model
-from symstab.model import dimensionless_values
+from symstab.symbolic import model
+from symstab.symbolic.model import dimensionless_values
 
 from conftest import (
     PAPER_B, PAPER_DELTA, PAPER_M, PAPER_T, assert_message_names, assert_rel_close,

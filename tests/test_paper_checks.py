@@ -318,7 +318,7 @@ def test_arc_polyline_points_are_the_nearest_doubles(gamma, d):
     import numpy as np
     from conftest import PAPER_DELTA, first_principles_boundary_point
     from paper_checks import regions
-    from symstab.curves import arc_end_angle
+    from symstab.numeric.curves import arc_end_angle
 
     t_end = arc_end_angle(gamma=gamma, d=d, delta=PAPER_DELTA)
     n = int(200 + 20 * d * t_end)

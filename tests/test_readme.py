@@ -34,9 +34,9 @@ def test_readme_python_examples_run(monkeypatch, tmp_path):
     assert runner.failures == 0
 
 
-@pytest.mark.parametrize("module", ["symstab.units", "symstab.curves", "symstab.stability",
-                                    "symstab.region", "symstab.model", "symstab.theta_max",
-                                    "symstab.any_loop"])
+@pytest.mark.parametrize("module", ["symstab.numeric.units", "symstab.numeric.curves", "symstab.numeric.stability",
+                                    "symstab.numeric.region", "symstab.symbolic.model", "symstab.theta_max",
+                                    "symstab.numeric.any_loop"])
 def test_docstring_examples_run(module, monkeypatch, tmp_path):
     monkeypatch.setenv("SYMSTAB_CACHE_DIR", str(tmp_path))
     mod = importlib.import_module(module)

@@ -6,7 +6,7 @@ Oracles:
 * ``symstab.theta_max`` (30 digits) for the float theta_max;
 * ``conftest.first_principles_boundary_point``: the boundary solved directly
   from the printed eqs. (1), (2), (4) with mpmath;
-* ``symstab.evaluate.alpha_max_on_arc`` and ``boundary_point`` (30 digits);
+* ``symstab.numeric.evaluate.alpha_max_on_arc`` and ``boundary_point`` (30 digits);
 * the area under the arc by Green's theorem, ``A = int alpha dbeta`` along
   the first-principles arc, with ``mpmath.quad`` and ``mpmath.diff``;
 * brute-force scans and grids classified point by point, whose edge points
@@ -39,7 +39,7 @@ import pytest
 import symstab
 from symstab import (PAPER_DEVICE, STABLE, Device, StabilityRegion, arc_end_angle,
                      best_virtual_mass, boundary_curve, classify, limits)
-from symstab.evaluate import alpha_max_on_arc, boundary_point
+from symstab.numeric.evaluate import alpha_max_on_arc, boundary_point
 
 from conftest import (PAPER_DELTA, assert_message_names, first_principles_boundary_point,
                       first_principles_chi_float)
@@ -58,7 +58,7 @@ def theta_max_30(gamma, d, delta):
 
 @functools.lru_cache(maxsize=None)
 def arc_top_30(gamma, d, delta):
-    """symstab.evaluate.alpha_max_on_arc (30 digits), cached."""
+    """symstab.numeric.evaluate.alpha_max_on_arc (30 digits), cached."""
     return alpha_max_on_arc(gamma=gamma, d=d, delta=delta)
 
 
@@ -449,7 +449,7 @@ def test_limits_at_d_200_agree_with_the_30_digit_interval_scan():
     assert top and top[-1][1] == pytest.approx(lim.alpha_max, rel=1e-6)
     (lo, hi), = lim.alpha_interval(beta)
     # three scan points (-0.3, 0.45, 1.2 of the top) and bisection to 1e-6: ~45 root finds
-    ref = symstab.stability.stable_alpha_intervals(beta=beta, gamma=gamma, d=d, delta=delta,
+    ref = symstab.numeric.stability.stable_alpha_intervals(beta=beta, gamma=gamma, d=d, delta=delta,
                                                    alpha_low=-0.3 * hi, alpha_high=1.2 * hi,
                                                    n=3, xtol=1e-6 * hi)
     assert len(ref) == 1
@@ -676,7 +676,7 @@ def test_device_rejects_non_numbers():
 
 
 def test_limits_and_region_print_their_content():
-    """Issue 13: Limits printed as region=<symstab.region.StabilityRegion object at 0x...>."""
+    """Issue 13: Limits printed as region=<symstab.numeric.region.StabilityRegion object at 0x...>."""
     lim = symstab.limits(gamma=0.0, d=0, delta=PAPER_DELTA)
     text = repr(lim)
     assert " at 0x" not in text

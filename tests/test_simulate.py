@@ -1,4 +1,4 @@
-"""Tests of the time-domain simulator :mod:`symstab.simulate`.
+"""Tests of the time-domain simulator :mod:`symstab.numeric.simulate`.
 
 Oracles, none of them the simulator's own code:
 
@@ -30,8 +30,8 @@ import symstab
 from conftest import (PAPER_B, PAPER_DELTA, PAPER_M, PAPER_T, assert_message_names,
                       python_control_closed_loop)
 from symstab._generated import kernels
-from symstab.curves import minus_one_line
-from symstab.simulate import (PAPER_ENCODER_RESOLUTION, Nonidealities, default_horizon,
+from symstab.numeric.curves import minus_one_line
+from symstab.numeric.simulate import (PAPER_ENCODER_RESOLUTION, Nonidealities, default_horizon,
                               simulate, stability_map)
 
 PAPER_DEVICE = symstab.Device(m=PAPER_M, b=PAPER_B, T=PAPER_T)
@@ -932,7 +932,7 @@ def test_recording_beyond_the_memory_limit_is_refused_before_running(monkeypatch
 
 def _small_chunks(monkeypatch, budget):
     from symstab import _resources
-    from symstab import simulate as module
+    from symstab.numeric import simulate as module
 
     monkeypatch.setattr(module, "chunk_slices",
                         lambda n, size: _resources.chunk_slices(n, size, budget=budget))
@@ -986,7 +986,7 @@ def test_steps_beyond_the_limit_are_refused_naming_it(monkeypatch):
 
 def test_simulation_prints_its_verdicts_not_its_arrays():
     """Issue 13: result objects print their content, readably."""
-    from symstab.simulate import simulate
+    from symstab.numeric.simulate import simulate
     run = simulate(alpha=np.array([[0.1, 5.0]]), beta=0.5, gamma=0.0, d=1, delta=PAPER_DELTA)
     text = repr(run)
     assert "array(" not in text

@@ -1,4 +1,4 @@
-"""Tests of symstab.small_theta: the boundary near theta = 0.
+"""Tests of symstab.symbolic.small_theta: the boundary near theta = 0.
 
 Oracle: alpha(theta), beta(theta) solved directly from eq. (2) with eqs. (1)
 and (4) (conftest.first_principles_boundary_point) at 80 digits and a tiny
@@ -10,8 +10,8 @@ import mpmath
 import pytest
 import sympy as sp
 
-from symstab import model
-from symstab.small_theta import small_theta_limits
+from symstab.symbolic import model
+from symstab.symbolic.small_theta import small_theta_limits
 
 from conftest import PAPER_DELTA, assert_rel_close, first_principles_boundary_point
 
@@ -96,7 +96,7 @@ def test_alpha_sign_condition_predicts_sign_of_alpha_near_zero(d, delta, offset)
 
 
 # The Taylor coefficients are read from trigonometric Taylor polynomials
-# (symstab.small_theta._trig_taylor) instead of sympy.series; sympy.series is
+# (symstab.symbolic.small_theta._trig_taylor) instead of sympy.series; sympy.series is
 # the oracle for both the fast path and its fallback.
 _t, _d, _g = model.theta, model.d, model.Gamma
 
@@ -110,7 +110,7 @@ _t, _d, _g = model.theta, model.d, model.Gamma
     (sp.sin(_d * _t) / _t + sp.cos(_t), True),    # not a polynomial after all: falls back
 ])
 def test_taylor_coefficients_equal_sympy_series(expr, fast):
-    from symstab.small_theta import taylor_coefficients, _trig_taylor
+    from symstab.symbolic.small_theta import taylor_coefficients, _trig_taylor
 
     order = 5
     assert (_trig_taylor(expr, order) is not None) is fast
@@ -121,8 +121,8 @@ def test_taylor_coefficients_equal_sympy_series(expr, fast):
 
 
 def test_boundary_forms_take_the_fast_path():
-    from symstab.boundary import boundary
-    from symstab.small_theta import _trig_taylor
+    from symstab.symbolic.boundary import boundary
+    from symstab.symbolic.small_theta import _trig_taylor
 
     bd = boundary()
     for expr in (bd.alpha_numerator, bd.beta_numerator, bd.denominator):
@@ -130,7 +130,7 @@ def test_boundary_forms_take_the_fast_path():
 
 
 def test_quotient_series_against_sympy_series():
-    from symstab.small_theta import _quotient_series
+    from symstab.symbolic.small_theta import _quotient_series
 
     x = sp.Symbol("x")
     num = [0, _g, 2, -_d, 1, 0]

@@ -1,10 +1,10 @@
-"""symstab.stability: root counting against python-control's poles."""
+"""symstab.numeric.stability: root counting against python-control's poles."""
 
 import numpy as np
 import pytest
 
-from symstab.evaluate import boundary_point
-from symstab.stability import (coefficients_at, spectral_radius, stable_alpha_intervals,
+from symstab.numeric.evaluate import boundary_point
+from symstab.numeric.stability import (coefficients_at, spectral_radius, stable_alpha_intervals,
                                unstable_root_count)
 
 from conftest import PAPER_DELTA, dimensionless, python_control_closed_loop, random_loop_points

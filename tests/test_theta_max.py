@@ -10,8 +10,8 @@ import mpmath
 import pytest
 import sympy as sp
 
-from symstab import model
-from symstab.theta_max import closed_form_d0, theta_max, theta_max_newton
+from symstab.symbolic import model
+from symstab.symbolic.theta_max import closed_form_d0, theta_max, theta_max_newton
 
 from conftest import (
     PAPER_DELTA, assert_message_names, assert_rel_close, first_principles_alpha,
@@ -198,7 +198,7 @@ def test_theta_max_at_large_delta_agrees_with_the_float_arc_end(delta):
 @pytest.mark.parametrize("func", ["theta_max", "boundary_point", "theta_max_newton"])
 def test_references_refuse_delta_zero_instead_of_dividing_zero_by_zero(func):
     import symstab
-    from symstab.evaluate import boundary_point
+    from symstab.numeric.evaluate import boundary_point
     calls = {"theta_max": lambda: theta_max(gamma=0.0, d=0, delta=0.0),
              "boundary_point": lambda: boundary_point(0.5, gamma=0.0, d=0, delta=0.0),
              "theta_max_newton": lambda: symstab.theta_max_newton(d=0, delta=0.0)}

@@ -1,4 +1,4 @@
-"""Tests of symstab.unit_circle: chi(exp(j theta)) split into Re and Im."""
+"""Tests of symstab.symbolic.unit_circle: chi(exp(j theta)) split into Re and Im."""
 
 import functools
 
@@ -7,8 +7,8 @@ import numpy as np
 import pytest
 import sympy as sp
 
-from symstab import model
-from symstab.unit_circle import on_unit_circle, unit_circle_split
+from symstab.symbolic import model
+from symstab.symbolic.unit_circle import on_unit_circle, unit_circle_split
 
 from conftest import assert_rel_close, chi_mp, delta_of_z, loop_coefficients_mp
 

@@ -1,4 +1,4 @@
-"""Tests of symstab.units: the Device conversions at the edges of floating point.
+"""Tests of symstab.numeric.units: the Device conversions at the edges of floating point.
 
 The issue's cases: ``Device(T=1e200).alpha(1)`` raised OverflowError (or
 returned inf), b = 0 (a frictionless device) was refused, and a conversion

@@ -18,14 +18,16 @@ import tempfile
 
 import sympy as sp
 
-from . import kernel_forms, loop_derive, model
-from .boundary import boundary, coefficients, beta_relations
-from .discretize import dimensionless_pulse_transfer_function, pulse_transfer_function
+from ..codegen import forms as kernel_forms
+from . import loop_derive
+from ..symbolic import model
+from ..symbolic.boundary import boundary, coefficients, beta_relations
+from ..symbolic.discretize import dimensionless_pulse_transfer_function, pulse_transfer_function
 from .identity import check_identity
-from .small_theta import small_theta_limits
-from .loop import characteristic_polynomial
-from .theta_max import closed_form_d0, newton_form_gamma0
-from .unit_circle import unit_circle_split
+from ..symbolic.small_theta import small_theta_limits
+from ..symbolic.loop import characteristic_polynomial
+from ..symbolic.theta_max import closed_form_d0, newton_form_gamma0
+from ..symbolic.unit_circle import unit_circle_split
 
 __all__ = ["Step", "derivation_steps", "render", "write", "write_bytes", "check", "proofs", "OWNED"]
 
@@ -76,7 +78,7 @@ def proofs():
     for key, (lhs, rhs) in beta_relations().items():
         out.append((f"beta_monomial_{'_'.join(map(str, key))}",
                     f"coefficient of monomial {key} in N_beta", lhs, rhs))
-    # The forms the numeric kernels are generated from (symstab.codegen).
+    # The forms the numeric kernels are generated from (symstab.codegen.generator).
     out += kernel_forms.proofs()
     # The paper's loop built by the general path (symstab.Loop) is this one.
     out += loop_derive.paper_loop_proofs()

@@ -11,10 +11,10 @@ import functools
 import mpmath
 import sympy as sp
 
-from . import model
-from ._validate import check_loop
-from .boundary import boundary
-from .theta_max import theta_max
+from ..symbolic import model
+from .._validate import check_loop
+from ..symbolic.boundary import boundary
+from ..symbolic.theta_max import theta_max
 
 __all__ = ["boundary_point", "alpha_max_on_arc", "arc_end"]
 

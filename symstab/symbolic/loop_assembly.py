@@ -6,12 +6,12 @@ derives the closed loop ``1 + VE(z) z**-d Z[ZOH G](z) = 0`` as
 
     chi(z) = z**d Ve_d(z) P_d(z) + Ve_n(z) P_n(z),
 
-a *delayed part* and a *direct part* (as :mod:`symstab.loop` does for the
+a *delayed part* and a *direct part* (as :mod:`symstab.symbolic.loop` does for the
 paper's loop).  The pulse transfer function ``P_n / P_d`` is derived by
 residues when every pole of ``G(s)/s`` is a linear factor over the
-parameters (:func:`symstab.discretize.zoh_pulse_transfer_function`), else
+parameters (:func:`symstab.symbolic.discretize.zoh_pulse_transfer_function`), else
 by the matrix exponential at 30 digits once the plant's values are known
-(:func:`symstab.discretize.numeric_zoh`); :attr:`LoopModel.zoh_method`
+(:func:`symstab.symbolic.discretize.numeric_zoh`); :attr:`LoopModel.zoh_method`
 says which.  It also decides which parameters enter ``chi`` affinely (the
 axes a parameter plane may have) and evaluates the plant's polynomials at
 30 digits.  Everything numeric on top of it is :class:`symstab.Loop`.
@@ -27,7 +27,7 @@ import sympy as sp
 from sympy.parsing.sympy_parser import convert_xor, parse_expr, standard_transformations
 
 from . import model
-from ._validate import check_delay
+from .._validate import check_delay
 from .discretize import linear_poles, numeric_zoh, zoh_pulse_transfer_function
 
 __all__ = ["LoopModel", "parse_plant", "parse_environment", "check_parameter_name", "is_affine",

@@ -4,13 +4,13 @@ Every period ``T`` the position is sampled, the virtual environment of
 eq. (1) computes a force from the sampled positions
 (:func:`symstab._generated.kernels.environment_force`), the force waits
 ``d`` samples, and a zero-order hold applies it to the device, whose state
-advances by the exact step derived in :mod:`symstab.sampled_plant`
+advances by the exact step derived in :mod:`symstab.symbolic.sampled_plant`
 (:func:`symstab._generated.kernels.plant_step_coefficients`).  The state
 lives in Table I's units: position, ``v T``, force ``f T**2 / m``.  All
 points run together as NumPy arrays, one loop over time.
 
 Non-idealities (:class:`Nonidealities`, physical units, each off by
-default) need a :class:`symstab.units.Device`:
+default) need a :class:`symstab.numeric.units.Device`:
 
 * ``encoder_resolution`` -- the sampled position is rounded to this step;
 * ``velocity_cutoff`` -- the velocity used by the damper and mass terms is
@@ -49,10 +49,10 @@ import time
 
 import numpy as np
 
-from ._generated import kernels
-from ._resources import MAX_STEPS_ENV, check_memory, chunk_slices
-from ._resources import max_steps as _max_steps_setting
-from ._validate import check_array, check_delay, check_loop, check_real
+from .._generated import kernels
+from .._resources import MAX_STEPS_ENV, check_memory, chunk_slices
+from .._resources import max_steps as _max_steps_setting
+from .._validate import check_array, check_delay, check_loop, check_real
 
 __all__ = ["Nonidealities", "Simulation", "simulate", "StabilityMap", "stability_map",
            "default_horizon", "check_steps", "check_x0", "max_steps", "progress_printer", "PAPER_ENCODER_RESOLUTION",
@@ -303,7 +303,7 @@ def simulate(*, alpha, beta, gamma, d, delta, steps=None, x0=1.0, v0=None, devic
     v0 : float
         Initial velocity times T (position per period); default ``x0 / 100``;
         ``|v0| <= 1e50``.
-    device : symstab.units.Device
+    device : symstab.numeric.units.Device
         Needed for the non-idealities (physical units).
     nonideal : Nonidealities
         Off by default.
@@ -330,7 +330,7 @@ def simulate(*, alpha, beta, gamma, d, delta, steps=None, x0=1.0, v0=None, devic
     if nonideal is None:
         nonideal = Nonidealities()
     elif not isinstance(nonideal, Nonidealities):
-        raise TypeError(f"nonideal must be a symstab.simulate.Nonidealities or None, "
+        raise TypeError(f"nonideal must be a symstab.numeric.simulate.Nonidealities or None, "
                         f"got {type(nonideal).__name__}")
     if device is not None and not isinstance(device, Device):
         raise TypeError(f"device must be a symstab.Device or None, got {type(device).__name__}")

@@ -14,7 +14,7 @@ import dataclasses
 
 import numpy as np
 
-from ._validate import check_array, check_delay, check_delay_samples, check_delta, check_real
+from .._validate import check_array, check_delay, check_delay_samples, check_delta, check_real
 
 __all__ = ["Device", "PAPER_DEVICE"]
 

@@ -36,7 +36,7 @@ DEFAULT_CODEGEN = pathlib.Path("symstab") / "_generated"
 #: the project root (outside a checkout: ``REPORT.md`` in the current folder).
 DEFAULT_REPORT = pathlib.Path("paper_checks") / "REPORT.md"
 #: The folder of the installed package, and of its generated kernels.
-from ._project import PACKAGE_DIR, project_root  # noqa: E402  (re-exported)
+from .._project import PACKAGE_DIR, project_root  # noqa: E402  (re-exported)
 
 INSTALLED_CODEGEN = PACKAGE_DIR / "_generated"
 
@@ -161,10 +161,10 @@ def write_output(path, data, flag):
     """Write ``data`` (bytes or str) to ``path`` atomically; errors name ``flag`` and ``path``.
 
     The bytes go to a temporary file in the same folder, renamed into place
-    (:func:`symstab.derive.write_bytes`), which is removed on any failure,
+    (:func:`symstab.proof.derive.write_bytes`), which is removed on any failure,
     Ctrl-C and SIGTERM included.
     """
-    from .derive import write_bytes
+    from ..proof.derive import write_bytes
 
     if isinstance(data, str):
         data = data.encode("utf-8")
@@ -213,8 +213,9 @@ def _derive_loop(args):
     current folder), and a file of the user's in ``--out`` under a name the
     derivation would write (never overwritten).
     """
-    from . import derive, loop_derive
-    from .loop_files import load_loop
+    from ..proof import derive
+    from ..proof import loop_derive
+    from ..numeric.loop_files import load_loop
 
     start = time.perf_counter()
     if args.codegen_out is not None:
@@ -254,7 +255,8 @@ def _derive_loop(args):
 
 
 def _cmd_derive(args):
-    from . import codegen, derive
+    from ..codegen import generator as codegen
+    from ..proof import derive
 
     if args.loop is not None:
         return _derive_loop(args)
@@ -345,7 +347,7 @@ def _cmd_audit(args):
 
 
 def _cmd_reproduce(args):
-    from .reproduce import reproduce
+    from ..reproduce import reproduce
 
     check_outputs([("--out", args.out, "dir")])
     _, drift = reproduce(args.out, workers=args.workers)
@@ -353,7 +355,7 @@ def _cmd_reproduce(args):
 
 
 def _cmd_figures(args):
-    from .figures import make_figures
+    from ..figures import make_figures
 
     def progress(name, seconds):
         print(f"{name}.png ({seconds:.1f} s)", file=sys.stderr, flush=True)
@@ -421,7 +423,8 @@ def build_parser():
         example="symstab reproduce --out reproduction --workers 2", func=_cmd_reproduce)
     p.add_argument("--out", default="reproduction", help="output directory (default: reproduction)")
     p.add_argument("--workers", type=int, default=2, help="worker processes, >= 1 (default 2)")
-    from . import cli_numeric, cli_simulate
+    from . import numeric as cli_numeric
+    from . import simulate as cli_simulate
 
     cli_numeric.add_commands(sub)
     cli_simulate.add_commands(sub)
@@ -448,7 +451,7 @@ EXIT_SIGTERM = 128 + signal.SIGTERM
 def _one_line(exc):
     """The message of a last-resort error: one line, saying what to do."""
     if isinstance(exc, MemoryError):
-        from ._resources import MEMORY_LIMIT_ENV
+        from .._resources import MEMORY_LIMIT_ENV
 
         return (f"out of memory{f' ({exc})' if str(exc) else ''}: use a smaller problem; "
                 f"{MEMORY_LIMIT_ENV} sets the limit symstab checks against")

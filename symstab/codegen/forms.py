@@ -45,10 +45,10 @@ import functools
 import sympy as sp
 from sympy.codegen.cfunctions import expm1
 
-from . import model
-from .boundary import boundary
-from .loop import characteristic_polynomial, dimensionless_environment
-from .sampled_plant import dimensionless_step
+from ..symbolic import model
+from ..symbolic.boundary import boundary
+from ..symbolic.loop import characteristic_polynomial, dimensionless_environment
+from ..symbolic.sampled_plant import dimensionless_step
 
 __all__ = [
     "SeriesFunction", "zoh_b1", "zoh_b0", "zoh_gap", "decay_mean", "SERIES_FUNCTIONS",
@@ -68,7 +68,7 @@ class SeriesFunction(sp.Function):
     :attr:`switch`, proved equal to the definition), the Taylor coefficient
     :meth:`coefficient` and the number of :attr:`terms` kept below the
     switch (the first neglected term is below ``2**-53`` of the value on
-    ``[0, switch)``).  The code printers of :mod:`symstab.codegen` print a
+    ``[0, switch)``).  The code printers of :mod:`symstab.codegen.generator` print a
     call of the generated helper of the same name.
     """
 
@@ -259,7 +259,7 @@ def plant_step_forms():
 
     Returns ``(Phi, Gamma_u)`` (2x2 and 2x1 matrices) for the state
     ``(x, v T)`` and the force ``f T**2 / m``: ``Phi = [[1, mean], [0, r]]``,
-    ``Gamma_u = [b1, mean]`` (see :mod:`symstab.sampled_plant`); at
+    ``Gamma_u = [b1, mean]`` (see :mod:`symstab.symbolic.sampled_plant`); at
     ``delta = 0`` the frictionless double integrator.
     """
     return sp.Matrix([[1, mean], [0, r]]), sp.Matrix([b1, mean])

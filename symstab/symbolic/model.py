@@ -119,7 +119,7 @@ def dimensionless_values(*, m, b, T, K_w=0.0, B_w=0.0, M_w=0.0, Td=0.0):
     >>> round(v["delta"], 6), v["d"]
     (0.002531, 40)
     """
-    from ._validate import check_delay_samples, check_real
+    from .._validate import check_delay_samples, check_real
 
     m = check_real("m", m, low=0.0, low_open=True)
     b = check_real("b", b, low=0.0)

@@ -1,11 +1,11 @@
 """``symstab simulate`` (one point, a CSV trajectory) and ``symstab map`` (a grid).
 
 The device and delay options are those of the numeric commands
-(:mod:`symstab.cli_numeric`); the non-idealities are given in physical
+(:mod:`symstab.cli.numeric`); the non-idealities are given in physical
 units and need the physical device options (the default device is the
 paper's).  Output paths are checked before the simulation
-(:func:`symstab.cli.check_outputs`) and files are written atomically
-(:func:`symstab.cli.write_output`): a failed or interrupted run leaves
+(:func:`symstab.cli.commands.check_outputs`) and files are written atomically
+(:func:`symstab.cli.commands.write_output`): a failed or interrupted run leaves
 nothing behind.
 """
 
@@ -15,9 +15,9 @@ import sys
 
 import numpy as np
 
-from . import cli_loop
-from ._resources import check_memory
-from .cli_numeric import _add_model_options, _parse_list, _resolve, stiffness_and_damping
+from . import loop as cli_loop
+from .._resources import check_memory
+from .numeric import _add_model_options, _parse_list, _resolve, stiffness_and_damping
 
 __all__ = ["add_commands"]
 
@@ -43,7 +43,7 @@ def _add_nonideal_options(p):
 
 
 def _nonideal(args, setup):
-    from .simulate import PAPER_ENCODER_RESOLUTION, Nonidealities, check_x0
+    from ..numeric.simulate import PAPER_ENCODER_RESOLUTION, Nonidealities, check_x0
 
     resolution = args.encoder_resolution
     if args.paper_encoder:
@@ -71,13 +71,13 @@ _MAP_CELL_BYTES = 300
 
 
 def _outputs(pairs):
-    from .cli import check_outputs
+    from .commands import check_outputs
 
     return check_outputs([(flag, path, "file") for flag, path in pairs])
 
 
 def _write(path, data, flag):
-    from .cli import write_output
+    from .commands import write_output
 
     write_output(path, data, flag)
 
@@ -95,10 +95,10 @@ def _point(args, setup):
 
 
 def _cmd_simulate(args):
-    from .simulate import simulate
-    from .stability import MARGINAL, STABLE, UNSTABLE, classify, spectral_radius
+    from ..numeric.simulate import simulate
+    from ..numeric.stability import MARGINAL, STABLE, UNSTABLE, classify, spectral_radius
 
-    from .simulate import check_steps, progress_printer
+    from ..numeric.simulate import check_steps, progress_printer
 
     setup = _resolve(args)
     alpha, beta = _point(args, setup)
@@ -159,8 +159,8 @@ def _grid(text, name):
 def _cmd_map(args):
     if cli_loop.uses_loop(args):
         return cli_loop.run(args)
-    from .simulate import check_steps, progress_printer, stability_map
-    from .stability import MARGINAL, STABLE, classify
+    from ..numeric.simulate import check_steps, progress_printer, stability_map
+    from ..numeric.stability import MARGINAL, STABLE, classify
 
     setup = _resolve(args)
     nonideal, x0 = _nonideal(args, setup)
@@ -248,7 +248,7 @@ def _nonideal_text(nonideal, args):
 
 
 def _tex_unit(unit):
-    """A unit string of :meth:`symstab.units.Device.units` for matplotlib ("kg m^2" -> "kg m$^2$")."""
+    """A unit string of :meth:`symstab.numeric.units.Device.units` for matplotlib ("kg m^2" -> "kg m$^2$")."""
     return unit.replace("^2", "$^2$")
 
 
@@ -286,8 +286,8 @@ def _png(args, setup, result, nonideal, given):
     Drawn in the units of the grids the user gave (K_w, B_w or alpha, beta),
     with the non-idealities of the simulation in the title.
     """
-    from .curves import boundary_curve
-    from .figures import pyplot
+    from ..numeric.region import boundary_curve
+    from ..figures import pyplot
 
     try:
         plt = pyplot()
@@ -321,7 +321,7 @@ def _png(args, setup, result, nonideal, given):
 
 def add_commands(sub):
     """Register ``simulate`` and ``map``."""
-    from .cli import add_command
+    from .commands import add_command
 
     p = add_command(
         sub, "simulate", help="simulate one point; write its trajectory as CSV",

@@ -80,7 +80,7 @@ def taylor_coefficients(expr, order):
     Parameters
     ----------
     expr : sympy.Expr
-        A function of :data:`symstab.model.theta` analytic at 0.
+        A function of :data:`symstab.symbolic.model.theta` analytic at 0.
     order : int
         The highest power kept.
 

@@ -1,4 +1,4 @@
-"""The boundary arc in floating point: theta_max and ``boundary_curve``.
+"""The boundary arc in floating point: theta_max, the arc's samples, the root bracketer.
 
 The generated kernel :func:`symstab._generated.kernels.boundary` evaluates
 alpha(theta), beta(theta) to about 1e-14 relative (tests/test_generated_kernels.py).
@@ -8,22 +8,22 @@ Here it is used to find where the arc ends and to sample it:
   (0, pi), bracketed on a grid fine enough for the delay and refined by
   bisection to the last bit (the float counterpart of the 30-digit
   :func:`symstab.theta_max.theta_max`);
-* :func:`boundary_curve` -- the arc from theta = 0 to theta_max on ``n``
-  points, with the other pieces of the boundary of the stable region (the
-  real-axis crossings z = 1 and z = -1, straight lines in the alpha-beta
-  plane) where they bound it.
+* :class:`BoundaryCurve` -- the arc from theta = 0 to theta_max, with the
+  other pieces of the boundary of the stable region (z = 1 and z = -1,
+  straight lines in the alpha-beta plane) where they bound it; built by
+  :func:`symstab.numeric.region.boundary_curve`, which finds those pieces in
+  the region (so this module does not import the region engine).
 """
 
 import dataclasses
 
 import numpy as np
 
-from ._generated import kernels
-from ._resources import check_memory, chunk_slices
-from ._validate import check_count, check_loop
+from .._generated import kernels
+from .._validate import check_loop
 
-__all__ = ["arc_end_angle", "minus_one_line", "BoundaryCurve", "Segment", "boundary_curve",
-           "scan_grid", "bracketed_root"]
+__all__ = ["arc_end_angle", "minus_one_line", "BoundaryCurve", "Segment", "scan_grid",
+           "bracketed_root"]
 
 
 def scan_grid(d, *, n=None, upper=np.pi):
@@ -154,7 +154,7 @@ def minus_one_line(*, gamma, d, delta):
 
     chi(-1) / (delta**2 Gamma) = (-1)**d 2 (1 + exp(-delta))
     - (alpha + 2 beta + 4 gamma) delta zoh_gap(delta) (see
-    :mod:`symstab.kernel_forms`); far away (~ 24 / delta) for small delta,
+    :mod:`symstab.codegen.forms`); far away (~ 24 / delta) for small delta,
     and at infinity (``(-1)**d inf``) for delta = 0, where z = -1 is never
     a root.
     """
@@ -203,7 +203,7 @@ class BoundaryCurve:
     segments : tuple of Segment
         The pieces of the lines z = 1 (alpha = 0) and z = -1 that bound the
         stable region, found from the region itself
-        (:class:`symstab.region.StabilityRegion`).
+        (:class:`symstab.numeric.region.StabilityRegion`).
     message : str
         Empty, or why there is no arc.
     """
@@ -231,64 +231,3 @@ class BoundaryCurve:
                 f"alpha up to {float(np.max(self.alpha)):.6g}, beta from "
                 f"{float(np.min(self.beta)):.6g} to {float(np.max(self.beta)):.6g}, "
                 f"{len(self.segments)} straight segment{'s' if len(self.segments) != 1 else ''})")
-
-
-def boundary_curve(*, gamma, d, delta, n=1000, segments=True):
-    """Sample the boundary arc from theta = 0 to theta_max.
-
-    Parameters
-    ----------
-    gamma : float
-        ``M_w / m``.
-    d : int
-        Delay in samples, ``d >= 0``.
-    delta : float
-        ``b T / m > 0``.
-    n : int
-        Number of points on the arc, ``n >= 2``; about 24 bytes each are
-        kept, so ``n`` is limited by the memory limit
-        (:mod:`symstab._resources`, ``SYMSTAB_MEMORY_LIMIT``).
-    segments : bool
-        Also find the straight pieces (z = +-1) that bound the stable region
-        (a stability scan; skip it when only the arc is wanted).
-
-    Returns
-    -------
-    BoundaryCurve
-
-    Raises
-    ------
-    TypeError, ValueError
-        For a non-real, non-finite or out-of-range parameter, and
-        ValueError for an ``n`` whose arrays would exceed the memory limit.
-
-    Examples
-    --------
-    >>> c = boundary_curve(gamma=0.0, d=0, delta=0.00253125, n=5, segments=False)
-    >>> float(c.alpha[0]), round(float(c.beta[0]), 8), round(c.theta_max, 4)
-    (0.0, -0.00253125, 1.5725)
-    """
-    gamma, d, delta = check_loop(gamma, d, delta)
-    n = check_count("n", n, 2)
-    # theta, alpha and beta are kept; the kernel's temporaries are chunked.
-    check_memory(f"boundary_curve with n = {n} points", 3 * 8 * n + _KERNEL_CHUNK_BYTES)
-    t_end = arc_end_angle(gamma=gamma, d=d, delta=delta)
-    if not np.isfinite(t_end):
-        empty = np.empty(0)
-        return BoundaryCurve(gamma, d, delta, empty, empty, empty, t_end, (),
-                             "no boundary arc: alpha < 0 just after theta = 0, so the arc never "
-                             "enters alpha > 0 (1 + gamma + (d + 1) delta <= 0 or close to it)")
-    theta = np.linspace(0.0, t_end, n)
-    alpha, beta = np.empty(n), np.empty(n)
-    for part in chunk_slices(n, _KERNEL_BYTES_PER_POINT, _KERNEL_CHUNK_BYTES):
-        alpha[part], beta[part] = kernels.boundary(theta[part], gamma, d, delta)
-    # The ends are exact: the arc starts at (-delta, 0) and ends on alpha = 0.
-    alpha[0], beta[0] = 0.0, -delta
-    if t_end < np.pi:
-        alpha[-1] = 0.0
-    pieces = ()
-    if segments:
-        from .region import StabilityRegion
-
-        pieces = StabilityRegion(gamma=gamma, d=d, delta=delta).line_segments()
-    return BoundaryCurve(gamma, d, delta, theta, alpha, beta, t_end, pieces)

@@ -3,7 +3,7 @@
 A :class:`symstab.Loop` needs its environment's polynomials ``VE(z) =
 Ve_n(z) / Ve_d(z)`` on arrays of parameter values, and the slope of each in
 every parameter that enters them affinely.  This module prints them with the
-printers of :mod:`symstab.codegen` (``cse``, strict printing, no date or
+printers of :mod:`symstab.codegen.generator` (``cse``, strict printing, no date or
 version in the text) and caches the NumPy module on disk under a hash of the
 expressions it was generated from: a changed derivation gets a new file, so a
 stale kernel is never loaded.
@@ -22,9 +22,9 @@ import tempfile
 
 import sympy as sp
 
-from . import model
-from .codegen import CKernelPrinter, Kernel, NumPyKernelPrinter, _c_function, _python_function
-from .loop_assembly import is_affine
+from ..symbolic import model
+from .generator import CKernelPrinter, Kernel, NumPyKernelPrinter, _c_function, _python_function
+from ..symbolic.loop_assembly import is_affine
 
 __all__ = ["CACHE_ENV", "cache_dir", "numpy_source", "c_source", "load_numpy_kernels",
            "environment_kernels"]
@@ -125,7 +125,7 @@ def load_numpy_kernels(kernels, *, title):
 
 
 def kernel(name, args, outputs, doc):
-    """Shorthand for :class:`symstab.codegen.Kernel` with float arguments.
+    """Shorthand for :class:`symstab.codegen.generator.Kernel` with float arguments.
 
     ``args`` is a sequence of ``(symbol, description)``; ``outputs`` of
     ``(name, expression, description)``.
@@ -144,7 +144,7 @@ def environment_kernels(loop):
 
     Parameters
     ----------
-    loop : symstab.loop_assembly.LoopModel
+    loop : symstab.symbolic.loop_assembly.LoopModel
 
     Returns
     -------

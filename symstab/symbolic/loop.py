@@ -21,7 +21,7 @@ import numpy as np
 import sympy as sp
 
 from . import model
-from ._validate import check_delay, check_real
+from .._validate import check_delay, check_real
 from .discretize import dimensionless_pulse_transfer_function
 
 __all__ = ["LoopPolynomial", "characteristic_polynomial", "dimensionless_environment"]

@@ -13,7 +13,7 @@ saying which ``--set`` replaces them); ``--d`` is the one that keeps its
 meaning and sets the delay ``d``.  Everything is checked before the work:
 the ``--set`` syntax, the file, the names, the plane, the values (the loop
 evaluated once at the given point) and the output paths.  The caller
-(:func:`symstab.cli.main`) turns ``ValueError``/``TypeError`` into one line
+(:func:`symstab.cli.commands.main`) turns ``ValueError``/``TypeError`` into one line
 ``symstab <command>: error: ...`` and exit status 2.
 """
 
@@ -26,7 +26,7 @@ import textwrap
 
 import numpy as np
 
-from ._resources import CHUNK_BYTES, check_memory, chunk_slices
+from .._resources import CHUNK_BYTES, check_memory, chunk_slices
 
 __all__ = ["add_loop_options", "uses_loop", "run"]
 
@@ -198,7 +198,7 @@ def _parse_number(name, text, flag, *, lists):
         if not math.isfinite(value):
             raise ValueError(f"{flag}: {name} must be a finite number, got {item!r}")
         if name == "d":
-            from ._validate import check_delay
+            from .._validate import check_delay
             try:
                 value = check_delay(value)
             except ValueError as exc:
@@ -226,7 +226,7 @@ def _parse_sets(texts, *, lists):
 
 @dataclasses.dataclass(frozen=True)
 class LoopSetup:
-    """The resolved inputs of a loop command: what :func:`symstab.cli_numeric._emit` prints."""
+    """The resolved inputs of a loop command: what :func:`symstab.cli.numeric._emit` prints."""
 
     path: str
     loop: object          # symstab.Loop
@@ -284,7 +284,7 @@ def _echo(setup):
 
 
 def _load(path):
-    from .loop_files import load_loop
+    from ..numeric.loop_files import load_loop
 
     return load_loop(path)
 
@@ -372,7 +372,7 @@ def _broadcast(values):
 
 
 def _emit(setup, fmt, columns, rows, **kwargs):
-    from .cli_numeric import _emit as emit
+    from .numeric import _emit as emit
 
     emit(setup, fmt, columns, rows, **kwargs)
 
@@ -399,8 +399,8 @@ def _line_text(setup, label, line):
 
 
 def _cmd_boundary(args):
-    from ._validate import check_count
-    from .cli_numeric import _BYTES_PER_ROW
+    from .._validate import check_count
+    from .numeric import _BYTES_PER_ROW
 
     setup = _resolve(args)
     n = check_count("n", args.n, 2)
@@ -421,7 +421,7 @@ def _cmd_boundary(args):
 
 def _intervals(setup, at):
     """The stable intervals of y at x = ``at``: (rows, notes, json)."""
-    from ._validate import check_real
+    from .._validate import check_real
 
     at = check_real(f"--at ({setup.x})", at)
     runs = setup.loop.stable_intervals(setup.y, **{setup.x: at}, **setup.values)
@@ -464,7 +464,7 @@ def _limits_result(lim):
 def _cmd_limits(args):
     setup = _resolve(args)
     if args.at is not None:
-        from ._validate import check_real
+        from .._validate import check_real
         check_real(f"--at ({setup.x})", args.at)
     # Seconds (hundreds of stable-interval searches at d = 40): say what runs.
     print(f"scanning the ({setup.x}, {setup.y}) plane for the extent of the stable set ...",
@@ -484,7 +484,7 @@ def _cmd_limits(args):
 def _cmd_design(args):
     setup = _resolve(args)
     if args.at is not None:
-        from ._validate import check_real
+        from .._validate import check_real
         check_real(f"--at ({setup.x})", args.at)
     print(f"searching the ({setup.x}, {setup.y}) plane for the largest stable {setup.y} ...",
           file=sys.stderr, flush=True)
@@ -520,7 +520,7 @@ _RADIUS_MAX_DELAY = 1000
 
 
 def _cmd_classify(args):
-    from .stability import MARGINAL, STABLE
+    from ..numeric.stability import MARGINAL, STABLE
 
     setup = _resolve(args, plane=False, lists=True)
     loop, values = setup.loop, _broadcast(setup.values)
@@ -556,10 +556,10 @@ def _cmd_classify(args):
 
 
 def _cmd_map(args):
-    from .cli import check_outputs, write_output
-    from .cli_simulate import _grid
-    from .simulate import progress_printer
-    from .stability import MARGINAL, STABLE
+    from .commands import check_outputs, write_output
+    from .simulate import _grid
+    from ..numeric.simulate import progress_printer
+    from ..numeric.stability import MARGINAL, STABLE
 
     setup = _resolve(args)
     if args.x_range is None or args.y_range is None:
@@ -627,9 +627,9 @@ def _visible(values, lo, hi):
 
 def _png(setup, xs, ys, code):
     """The map as PNG bytes (None without matplotlib), with the D-decomposition drawn over it."""
-    from .cli_simulate import _tex_unit
-    from .figures import pyplot
-    from .stability import MARGINAL, STABLE
+    from .simulate import _tex_unit
+    from ..figures import pyplot
+    from ..numeric.stability import MARGINAL, STABLE
 
     try:
         plt = pyplot()

@@ -13,18 +13,18 @@ are the roots of
     chi(z) = z**d Ve_d(z) P_d(z) + Ve_n(z) P_n(z),
 
 a *delayed part* and a *direct part*, as for the paper's loop
-(:mod:`symstab.loop`).  The derivation is SymPy's: the pulse transfer
+(:mod:`symstab.symbolic.loop`).  The derivation is SymPy's: the pulse transfer
 function by residues when every pole of ``G(s)/s`` is a linear factor over
 the parameters (repeated poles and poles at 0 included), otherwise by the
 matrix exponential at 30 digits once the plant's values are known
 (:attr:`Loop.zoh_method` says which).
 
 Numbers: the environment's polynomials come from a NumPy kernel generated
-for the loop (:mod:`symstab.loop_codegen`, cached on disk); the plant's
+for the loop (:mod:`symstab.codegen.loop_kernels`, cached on disk); the plant's
 pulse transfer function is evaluated at 30 digits for each distinct set of
 plant values (its closed form cancels badly in floating point when
 ``b T / m`` is small) and rounded once.  Classification is
-:func:`symstab.stability.classify_polynomials` (float Schur-Cohn where its
+:func:`symstab.numeric.stability.classify_polynomials` (float Schur-Cohn where its
 margin is safe, the certified root count elsewhere).  The boundary of a
 parameter plane is the D-decomposition: on ``z = exp(j theta)`` the two real
 equations ``Re chi = Im chi = 0`` are linear in the plane's parameters
@@ -39,10 +39,10 @@ import math
 import numpy as np
 import sympy as sp
 
-from ._resources import check_memory
-from ._validate import check_array, check_count, check_delay
-from .loop_assembly import LoopModel, parse_environment, parse_plant
-from .loop_codegen import environment_kernels, load_numpy_kernels
+from .._resources import check_memory
+from .._validate import check_array, check_count, check_delay
+from ..symbolic.loop_assembly import LoopModel, parse_environment, parse_plant
+from ..codegen.loop_kernels import environment_kernels, load_numpy_kernels
 from .region import _golden_max
 from .stability import (MARGINAL, STABLE, classify_polynomials, polynomial_root_counts,
                         polynomial_spectral_radius)
@@ -170,7 +170,7 @@ class Loop(LoopModel):
     """
 
     def kernels(self):
-        """The loop's generated kernels, as :class:`symstab.codegen.Kernel` objects.
+        """The loop's generated kernels, as :class:`symstab.codegen.generator.Kernel` objects.
 
         ``environment`` gives the coefficients of ``Ve_n`` and ``Ve_d``
         (highest power of ``z`` first) from the environment's parameters
@@ -378,7 +378,7 @@ class Loop(LoopModel):
     def classify(self, **values):
         """Stable (1), marginal (0) or unstable (-1) at each point.
 
-        Certified as :func:`symstab.stability.classify_polynomials` is: for
+        Certified as :func:`symstab.numeric.stability.classify_polynomials` is: for
         the polynomial with the coefficients as computed (each within an ulp
         or so of the exact value: the plant at 30 digits, the environment in
         double precision).

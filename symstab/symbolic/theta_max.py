@@ -25,9 +25,9 @@ import mpmath
 import sympy as sp
 
 from . import model
-from ._validate import check_loop
+from .._validate import check_loop
 from .boundary import boundary
-from .identity import E, exponential_form, trig_form, w
+from .forms import E, exponential_form, trig_form, w
 
 __all__ = [
     "ClosedFormD0", "NewtonFormGamma0",
@@ -171,7 +171,7 @@ def theta_max(*, gamma, d, delta, dps=30):
     float
         theta_max in (0, pi]; ``pi`` when alpha does not return to zero
         before theta = pi, and ``nan`` when alpha < 0 just after theta = 0
-        (no arc enters alpha > 0; see :mod:`symstab.small_theta`), or when the
+        (no arc enters alpha > 0; see :mod:`symstab.symbolic.small_theta`), or when the
         arc is shorter than ``1e-10 pi / n`` for the scan's ``n`` points.
 
     Examples

@@ -1,13 +1,13 @@
 """The stability boundary alpha(theta), beta(theta) and its C-coefficients.
 
 On the unit circle the real and imaginary parts of chi(exp(j theta)) are two
-equations, linear in alpha and beta (:mod:`symstab.unit_circle`).  SymPy
+equations, linear in alpha and beta (:mod:`symstab.symbolic.unit_circle`).  SymPy
 solves them by Cramer's rule; the determinant is the common denominator.
 
 Each numerator and the denominator is then written as a polynomial in gamma
 and delta with ``Gamma`` kept as its own symbol, and every coefficient is put
 in a canonical trigonometric form (a sum of sines and cosines of
-``p theta / 2 + q d theta``) through :func:`symstab.identity.trig_form`.  The
+``p theta / 2 + q d theta``) through :func:`symstab.proof.identity.trig_form`.  The
 Cramer determinant already reads ``C6 + delta**2 C7 + delta C8`` with
 ``C7 = K3 sin(theta)``; no rescaling is applied.
 
@@ -35,7 +35,7 @@ import functools
 import sympy as sp
 
 from . import model
-from .identity import conjugate_on_circle, exponential_form, trig_form, w
+from .forms import conjugate_on_circle, exponential_form, trig_form, w
 from .discretize import dimensionless_pulse_transfer_function
 from .unit_circle import unit_circle_split
 

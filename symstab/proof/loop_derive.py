@@ -3,14 +3,14 @@
 ``symstab derive --loop FILE`` writes, for the :class:`symstab.Loop` of a
 loop file, what ``symstab derive`` writes for the paper's loop: the
 derivation steps as srepr JSON and LaTeX (:func:`derivation_steps`, printed
-by :func:`symstab.derive.render`), and the loop's kernels as a NumPy module
+by :func:`symstab.proof.derive.render`), and the loop's kernels as a NumPy module
 and a C99 source and header (:func:`kernel_files`).  :func:`loop_files`
 collects them as ``{filename: text}``; nothing here touches the disk.
 
 :func:`paper_loop_proofs` builds the paper's loop through the general path,
 ``Loop("1/(m*s**2 + b*s)", VE(z))``, and states the identities that make it
-today's derivation (:func:`symstab.loop.characteristic_polynomial`,
-:func:`symstab.boundary.boundary`); :func:`symstab.derive.proofs` proves them
+today's derivation (:func:`symstab.symbolic.loop.characteristic_polynomial`,
+:func:`symstab.boundary.boundary`); :func:`symstab.proof.derive.proofs` proves them
 with the exact checker in every ``symstab derive``.
 """
 
@@ -19,9 +19,9 @@ import re
 
 import sympy as sp
 
-from . import model
-from .codegen import _c_comment, _c_signature
-from .loop_codegen import c_source, kernel, numpy_source
+from ..symbolic import model
+from ..codegen.generator import _c_comment, _c_signature
+from ..codegen.loop_kernels import c_source, kernel, numpy_source
 
 __all__ = ["COMMAND", "OWNED", "MARKER", "PAPER_PLANT", "PAPER_ENVIRONMENT", "delay_parts",
            "environment_kernels", "environment_title", "plant_kernel", "c_name",
@@ -83,7 +83,7 @@ def environment_kernels(loop):
 
     Returns
     -------
-    list of symstab.codegen.Kernel
+    list of symstab.codegen.generator.Kernel
     """
     return loop.kernels()
 
@@ -115,7 +115,7 @@ def plant_kernel(loop):
 
     Returns
     -------
-    symstab.codegen.Kernel or None
+    symstab.codegen.generator.Kernel or None
         None when the loop's ZOH is computed numerically
         (``loop.zoh_method == "matrix exponential"``).
     """
@@ -244,7 +244,7 @@ def _poly_expr(coefficients, z=model.z):
 
 
 def derivation_steps(loop):
-    """The derivation of ``loop`` as :class:`symstab.derive.Step` objects (no I/O).
+    """The derivation of ``loop`` as :class:`symstab.proof.derive.Step` objects (no I/O).
 
     ``01_loop`` the plant, the environment and the file's values;
     ``02_zoh`` the ZOH pulse transfer function (or how it is computed);
@@ -258,7 +258,7 @@ def derivation_steps(loop):
 
     Returns
     -------
-    list of symstab.derive.Step
+    list of symstab.proof.derive.Step
     """
     from .derive import Step
 
@@ -444,12 +444,12 @@ def paper_loop_proofs():
     """The identities that make the paper's loop, built by :class:`symstab.Loop`, today's.
 
     ``Loop("1/(m*s**2 + b*s)", "K + B*(z - 1)/(T*z) + M*(z - 1)**2/(T**2*z**2)")``
-    is written in Table I's terms (:func:`symstab.model.dimensionless_substitution`:
+    is written in Table I's terms (:func:`symstab.symbolic.model.dimensionless_substitution`:
     ``b = delta m / T``, ``K = alpha m / T**2``, ``B = beta m / T``,
     ``M = gamma m``; ``exp(delta) = Gamma``).  Then
 
     * its delayed and direct parts are those of
-      :func:`symstab.loop.characteristic_polynomial` times one factor ``c``
+      :func:`symstab.symbolic.loop.characteristic_polynomial` times one factor ``c``
       (``m**2``: found as the ratio of the leading coefficients, and stated);
     * the general D-decomposition in its plane ``(B, K)`` -- the 2 x 2
       system of ``Re chi = Im chi = 0`` on ``z = exp(j theta)`` -- has the
@@ -470,9 +470,9 @@ def paper_loop_proofs():
 def _against_the_paper(plant, environment):
     """:func:`paper_loop_proofs` for the loop of ``plant`` and ``environment`` (parameters
     ``m, b`` and ``K, B, M``): the tests give another loop, whose statements must fail."""
-    from .loop_assembly import LoopModel
-    from .boundary import boundary
-    from .loop import characteristic_polynomial
+    from ..symbolic.loop_assembly import LoopModel
+    from ..symbolic.boundary import boundary
+    from ..symbolic.loop import characteristic_polynomial
 
     loop = LoopModel(plant, environment)
     chi = loop.characteristic_polynomial()

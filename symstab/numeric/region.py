@@ -9,7 +9,7 @@ meets
   (a pair of complex roots on the circle), from the generated kernel;
 * the line ``alpha = 0`` (a root at z = 1);
 * the line ``alpha + 2 beta = c`` (a root at z = -1,
-  :func:`symstab.curves.minus_one_line`).
+  :func:`symstab.numeric.curves.minus_one_line`).
 
 Between two consecutive crossings the number N of roots outside the unit
 circle is constant, and across a crossing it changes by +-2 (the arc) or +-1
@@ -17,9 +17,9 @@ circle is constant, and across a crossing it changes by +-2 (the arc) or +-1
 ends of a line N is known in closed form.  So N in every gap follows by
 counting, with no classification and no probe near the boundary: the stable
 intervals along a line are the gaps with N = 0, exact up to the root-finding
-of the crossings (to the last bit, by :func:`symstab.curves.bracketed_root`),
+of the crossings (to the last bit, by :func:`symstab.numeric.curves.bracketed_root`),
 with no scan of alpha.  A line whose count fails its consistency check is
-decided gap by gap with :func:`symstab.stability.classify`.  The cost per
+decided gap by gap with :func:`symstab.numeric.stability.classify`.  The cost per
 line is O(d) kernel evaluations, not the O(d**2) of a Schur-Cohn test or the
 O(d**3) of eigenvalues, so d in the thousands stays interactive.
 
@@ -37,13 +37,15 @@ import math
 
 import numpy as np
 
-from ._generated import kernels
-from ._resources import CHUNK_BYTES, check_memory
-from ._validate import check_count, check_loop, check_real
-from .curves import Segment, bracketed_root, minus_one_line, scan_grid
+from .._generated import kernels
+from .._resources import CHUNK_BYTES, check_memory, chunk_slices
+from .._validate import check_count, check_loop, check_real
+from .curves import (_KERNEL_BYTES_PER_POINT, _KERNEL_CHUNK_BYTES, BoundaryCurve, Segment,
+                     arc_end_angle, bracketed_root, minus_one_line, scan_grid)
 from .stability import MARGINAL, STABLE, UNSTABLE, classify, loop_coefficients
 
-__all__ = ["StabilityRegion", "Limits", "limits", "BestVirtualMass", "best_virtual_mass"]
+__all__ = ["StabilityRegion", "Limits", "limits", "BestVirtualMass", "best_virtual_mass",
+           "boundary_curve"]
 
 #: Largest number of vertical lines in the scan that finds where the region is.
 _SCAN_LINES = 512
@@ -63,7 +65,7 @@ def _ranges(start, stop):
 
 def _loop_basis(gamma, d, delta):
     """chi = P(z) + alpha A(z) + beta B(z): the powers of z that occur and their
-    coefficients in P, A and B (from :func:`symstab.stability.loop_coefficients`;
+    coefficients in P, A and B (from :func:`symstab.numeric.stability.loop_coefficients`;
     chi is affine in alpha and beta, so three evaluations give it all)."""
     base = loop_coefficients(alpha=0.0, beta=0.0, gamma=gamma, d=d, delta=delta)
     d_alpha = loop_coefficients(alpha=1.0, beta=0.0, gamma=gamma, d=d, delta=delta) - base
@@ -141,7 +143,7 @@ class StabilityRegion:
     one end must arrive at the other end's value and never go below 0.  A
     line that fails the check (a crossing whose direction rounding cannot
     tell, at a corner or a tangency) is decided gap by gap with
-    :func:`symstab.stability.classify` instead.
+    :func:`symstab.numeric.stability.classify` instead.
 
     Parameters
     ----------
@@ -517,7 +519,7 @@ class StabilityRegion:
         """The stable alpha intervals at damping ``beta``.
 
         Each interval found by counting is checked by one Schur-Cohn test
-        (:func:`symstab.stability.classify`) of its middle; a line where they
+        (:func:`symstab.numeric.stability.classify`) of its middle; a line where they
         disagree is classified gap by gap.
 
         Parameters
@@ -646,7 +648,7 @@ class StabilityRegion:
 
         Returns
         -------
-        tuple of :class:`symstab.curves.Segment`
+        tuple of :class:`symstab.numeric.curves.Segment`
         """
         extent = self.beta_range()
         if extent is None:
@@ -1072,3 +1074,62 @@ def best_virtual_mass(*, d, delta, gamma_range=None, n=17):
     alpha_zero = _alpha_max(0.0, d, delta)[0]
     return BestVirtualMass(d, delta, float(best_gamma), best.beta_at_alpha_max, best.alpha_max,
                            float(alpha_zero), float(best.alpha_max / alpha_zero), best.z_width)
+
+
+def boundary_curve(*, gamma, d, delta, n=1000, segments=True):
+    """Sample the boundary arc from theta = 0 to theta_max.
+
+    Parameters
+    ----------
+    gamma : float
+        ``M_w / m``.
+    d : int
+        Delay in samples, ``d >= 0``.
+    delta : float
+        ``b T / m > 0``.
+    n : int
+        Number of points on the arc, ``n >= 2``; about 24 bytes each are
+        kept, so ``n`` is limited by the memory limit
+        (:mod:`symstab._resources`, ``SYMSTAB_MEMORY_LIMIT``).
+    segments : bool
+        Also find the straight pieces (z = +-1) that bound the stable region
+        (a stability scan; skip it when only the arc is wanted).
+
+    Returns
+    -------
+    BoundaryCurve
+
+    Raises
+    ------
+    TypeError, ValueError
+        For a non-real, non-finite or out-of-range parameter, and
+        ValueError for an ``n`` whose arrays would exceed the memory limit.
+
+    Examples
+    --------
+    >>> c = boundary_curve(gamma=0.0, d=0, delta=0.00253125, n=5, segments=False)
+    >>> float(c.alpha[0]), round(float(c.beta[0]), 8), round(c.theta_max, 4)
+    (0.0, -0.00253125, 1.5725)
+    """
+    gamma, d, delta = check_loop(gamma, d, delta)
+    n = check_count("n", n, 2)
+    # theta, alpha and beta are kept; the kernel's temporaries are chunked.
+    check_memory(f"boundary_curve with n = {n} points", 3 * 8 * n + _KERNEL_CHUNK_BYTES)
+    t_end = arc_end_angle(gamma=gamma, d=d, delta=delta)
+    if not np.isfinite(t_end):
+        empty = np.empty(0)
+        return BoundaryCurve(gamma, d, delta, empty, empty, empty, t_end, (),
+                             "no boundary arc: alpha < 0 just after theta = 0, so the arc never "
+                             "enters alpha > 0 (1 + gamma + (d + 1) delta <= 0 or close to it)")
+    theta = np.linspace(0.0, t_end, n)
+    alpha, beta = np.empty(n), np.empty(n)
+    for part in chunk_slices(n, _KERNEL_BYTES_PER_POINT, _KERNEL_CHUNK_BYTES):
+        alpha[part], beta[part] = kernels.boundary(theta[part], gamma, d, delta)
+    # The ends are exact: the arc starts at (-delta, 0) and ends on alpha = 0.
+    alpha[0], beta[0] = 0.0, -delta
+    if t_end < np.pi:
+        alpha[-1] = 0.0
+    pieces = ()
+    if segments:
+        pieces = StabilityRegion(gamma=gamma, d=d, delta=delta).line_segments()
+    return BoundaryCurve(gamma, d, delta, theta, alpha, beta, t_end, pieces)

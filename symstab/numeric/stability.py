@@ -27,10 +27,10 @@ audit was built on.
 
 import numpy as np
 
-from ._generated import kernels
-from ._resources import CHUNK_BYTES, check_memory, chunk_slices
-from ._validate import DELTA_MAX, PARAMETER_MAX, check_array, check_delay
-from .loop import characteristic_polynomial
+from .._generated import kernels
+from .._resources import CHUNK_BYTES, check_memory, chunk_slices
+from .._validate import DELTA_MAX, PARAMETER_MAX, check_array, check_delay
+from ..symbolic.loop import characteristic_polynomial
 
 __all__ = [
     "STABLE", "MARGINAL", "UNSTABLE",
@@ -757,7 +757,7 @@ def stable_alpha_intervals(*, beta, gamma, d, delta, alpha_low=-1.0, alpha_high=
     each change of stability is refined by bisection on the spectral radius
     (roots of the 30-digit coefficients) to ``xtol``.  It is slow and
     independent of the generated kernels;
-    :meth:`symstab.region.StabilityRegion.alpha_intervals` finds the same
+    :meth:`symstab.numeric.region.StabilityRegion.alpha_intervals` finds the same
     intervals from the boundary curves, fast and without a scan.
 
     Returns

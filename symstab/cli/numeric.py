@@ -7,7 +7,7 @@ CSV or JSON.  Physical inputs are echoed with the output and results are
 given in both unit systems.  Validation happens in the library, and sizes
 (``--n``, list lengths) are checked against the memory limit
 (:func:`symstab._resources.check_memory`) before the work; the caller
-(:func:`symstab.cli.main`) turns ``ValueError``/``TypeError`` into one line
+(:func:`symstab.cli.commands.main`) turns ``ValueError``/``TypeError`` into one line
 on stderr and exit status 2.
 """
 
@@ -22,8 +22,8 @@ import textwrap
 
 import numpy as np
 
-from . import cli_loop
-from ._resources import check_memory
+from . import loop as cli_loop
+from .._resources import check_memory
 
 __all__ = ["add_commands"]
 
@@ -38,7 +38,7 @@ _BYTES_PER_ROW = 1000
 class Setup:
     """The resolved inputs of a numeric command."""
 
-    device: object  # symstab.units.Device or None (dimensionless input)
+    device: object  # symstab.numeric.units.Device or None (dimensionless input)
     gamma: float
     d: int
     delta: float
@@ -98,7 +98,7 @@ def _resolve(args, *, mass=True):
     ``mass=False`` (``design``, which searches over the virtual mass) leaves
     the virtual mass out of the echo and of the JSON inputs.
     """
-    from .units import PAPER_DEVICE, Device
+    from ..numeric.units import PAPER_DEVICE, Device
 
     physical = [name for name in ("m", "b", "T", "Td") if getattr(args, name) is not None]
     if args.delta is not None:
@@ -107,7 +107,7 @@ def _resolve(args, *, mass=True):
                              "(physical); give one or the other")
         if args.Mw is not None:
             raise ValueError("--Mw needs a physical device (--m); use --gamma with --delta")
-        from ._validate import check_loop
+        from .._validate import check_loop
         gamma, d, delta = check_loop(0.0 if args.gamma is None else args.gamma,
                                      0 if args.d is None else args.d, args.delta)
         echo = (f"dimensionless: delta = {delta:.6g}, d = {d}"
@@ -119,12 +119,12 @@ def _resolve(args, *, mass=True):
                     b=PAPER_DEVICE.b if args.b is None else args.b,
                     T=PAPER_DEVICE.T if args.T is None else args.T)
     if args.d is not None:
-        from ._validate import check_delay
+        from .._validate import check_delay
         d = check_delay(args.d)
     else:
         d = device.delay_samples(0.0 if args.Td is None else args.Td)
     gamma = device.gamma(args.Mw) if args.Mw is not None else (0.0 if args.gamma is None else args.gamma)
-    from ._validate import check_real
+    from .._validate import check_real
     gamma = check_real("gamma", gamma)
     units = device.units(rotary=not args.linear)
     mass_unit = units["M_w"]
@@ -220,7 +220,7 @@ def _physical_columns(setup, names):
 def _cmd_boundary(args):
     if cli_loop.uses_loop(args):
         return cli_loop.run(args)
-    from .curves import boundary_curve
+    from ..numeric.region import boundary_curve
 
     setup = _resolve(args)
     check_memory(f"--n {args.n} boundary points", args.n * _BYTES_PER_ROW)
@@ -241,7 +241,7 @@ def _cmd_boundary(args):
 
 
 #: The quantities of ``symstab limits``: (name in the table and the JSON, attribute of
-#: :class:`symstab.region.Limits`, meaning, physical name, physical unit).  The
+#: :class:`symstab.numeric.region.Limits`, meaning, physical name, physical unit).  The
 #: names say what each is: ``beta_left``/``beta_right`` are the ends of the
 #: stable region's beta range, which a reader of the paper would otherwise take
 #: for its beta_min = -delta, the damping where the boundary arc starts.
@@ -289,7 +289,7 @@ def _limits_json(lim):
 def _cmd_limits(args):
     if cli_loop.uses_loop(args):
         return cli_loop.run(args)
-    from .region import limits
+    from ..numeric.region import limits
 
     setup = _resolve(args)
     lim = limits(gamma=setup.gamma, d=setup.d, delta=setup.delta)
@@ -308,7 +308,7 @@ def _cmd_limits(args):
             damping = float(setup.device.beta(args.Bw))
         else:
             damping = args.beta
-        from ._validate import check_real
+        from .._validate import check_real
         damping = check_real("beta", damping)
         runs = [] if lim.empty else lim.alpha_interval(damping)
         text = ", ".join(f"[{lo:.10g}, {hi:.10g}]" for lo, hi in runs) or "none"
@@ -361,7 +361,7 @@ _RADIUS_MAX_DELAY = 1000
 def _cmd_classify(args):
     if cli_loop.uses_loop(args):
         return cli_loop.run(args)
-    from .stability import MARGINAL, STABLE, classify, spectral_radius
+    from ..numeric.stability import MARGINAL, STABLE, classify, spectral_radius
 
     setup = _resolve(args)
     alpha, beta = (np.atleast_1d(x) for x in stiffness_and_damping(args, setup, _parse_list))
@@ -397,7 +397,7 @@ def _cmd_classify(args):
 def _cmd_design(args):
     if cli_loop.uses_loop(args):
         return cli_loop.run(args)
-    from .region import best_virtual_mass, limits
+    from ..numeric.region import best_virtual_mass, limits
 
     setup = _resolve(args, mass=False)
     print("searching gamma for the largest renderable stiffness ...", file=sys.stderr, flush=True)
@@ -428,7 +428,7 @@ def _cmd_design(args):
 
 def add_commands(sub):
     """Register the numeric sub-commands on an argparse sub-parser set."""
-    from .cli import add_command
+    from .commands import add_command
 
     p = add_command(
         sub, "boundary", help="the stability boundary alpha(theta), beta(theta)",

@@ -1,0 +1,4 @@
+"""The derivation in SymPy: the model, the ZOH pulse transfer function, the loop
+polynomial, its split on the unit circle, the boundary, theta_max and the
+small-theta limits, and any loop's symbolic assembly.
+"""
