@@ -2,7 +2,7 @@
 
     python benchmarks/bench_simulate.py [--runs 5] [--dlsim-points 40]
 
-1. symstab.simulate.simulate on a 100 x 100 (alpha, beta) grid at d = 10 on
+1. symstab.numeric.simulate.simulate on a 100 x 100 (alpha, beta) grid at d = 10 on
    the paper's device, ideal loop, 8000 periods: point-steps per second
    (median of ``--runs``).
 2. The obvious alternative, side by side in the same run: for each point of

@@ -35,7 +35,7 @@ def test_readme_python_examples_run(monkeypatch, tmp_path):
 
 
 @pytest.mark.parametrize("module", ["symstab.numeric.units", "symstab.numeric.curves", "symstab.numeric.stability",
-                                    "symstab.numeric.region", "symstab.symbolic.model", "symstab.theta_max",
+                                    "symstab.numeric.region", "symstab.symbolic.model", "symstab.symbolic.theta_max",
                                     "symstab.numeric.any_loop"])
 def test_docstring_examples_run(module, monkeypatch, tmp_path):
     monkeypatch.setenv("SYMSTAB_CACHE_DIR", str(tmp_path))
