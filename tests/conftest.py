@@ -1,19 +1,12 @@
-"""Shared oracles, fixtures and assertion helpers for the symstab tests.
+"""Fixtures, shared command runs and assertion helpers for the symstab tests.
 
-The oracles here do not go through symstab's derivation:
-
-* the printed eqs. (1), (2) and (4) of the paper (believed correct), evaluated
-  with mpmath -- :func:`eq4_pulse_transfer_function`, :func:`loop_gain_parts`,
-  :func:`first_principles_boundary_point`, :func:`first_principles_theta_max`;
-* python-control -- :func:`python_control_closed_loop`.
-
-Helpers that *do* evaluate symstab objects at high precision
-(:func:`loop_coefficients_mp`, :func:`chi_mp`) are here so that every test
-evaluates them the same way: always with mpmath numbers, never Python floats.
+The oracles (first principles, python-control, the mpmath references) are in
+``oracles.py``; here are the session fixtures (the derivation, the generated
+code, the ``audit`` and ``derive`` runs shared by the xdist workers under a
+file lock), :func:`run_symstab`, the paper's device and the assertion
+helpers.  It applies to every test folder below ``tests/``.
 """
 
-import functools
-import math
 import json
 import os
 import pathlib
@@ -28,13 +21,18 @@ except ImportError:  # Windows: no shared runs between xdist workers
     fcntl = None
 
 import mpmath
-import numpy as np
 import pytest
-import sympy as sp
 
-from symstab.symbolic import model
 from symstab.symbolic.boundary import boundary
 from symstab.symbolic.loop import characteristic_polynomial
+
+# Re-exported for the test files not yet moved into the layer folders
+# (test_classify, test_region, test_stability, test_any_loop, test_paper_checks
+# import them from here); new code imports them from oracles.
+from oracles import (  # noqa: F401
+    dimensionless, first_principles_boundary_point, first_principles_chi,
+    first_principles_chi_float, python_control_closed_loop, random_loop_points,
+)
 
 REPO = pathlib.Path(__file__).resolve().parents[1]
 
@@ -70,210 +68,6 @@ def assert_message_names(excinfo, name):
     message = str(excinfo.value)
     assert re.search(rf"(?<![\w]){re.escape(name)}(?![\w])", message), (
         f"message does not name {name!r}: {message!r}")
-
-
-# --------------------------------------------------------------------------
-# First-principles oracle: the paper's eqs. (1), (2), (4)
-# --------------------------------------------------------------------------
-
-def eq4_pulse_transfer_function(z, m, b, T, exp=sp.exp):
-    """Z[ZOH G(s)] as printed in the paper's eq. (4) (line 171 of the text).
-
-    ``((e^{-bT/m} - 1 + bT/m) z + 1 - (1 + bT/m) e^{-bT/m})
-    / ((z - 1) b^2/m (z - e^{-bT/m}))``.
-    Pass ``exp=mpmath.exp`` for numbers.
-    """
-    e = exp(-b * T / m)
-    return (((e - 1 + b * T / m) * z + 1 - (1 + b * T / m) * e)
-            / ((z - 1) * b**2 / m * (z - e)))
-
-
-def eq1_virtual_environment(z, K_w, B_w, M_w, T):
-    """VE(z) as printed in the paper's eq. (1)."""
-    return K_w + B_w * (z - 1) / (T * z) + M_w * (z - 1) ** 2 / (T**2 * z**2)
-
-
-def loop_gain_parts(z, d, delta):
-    """``(A, B, C)`` with eq. (2)'s Delta(z) = 1 + alpha A + beta B + gamma C.
-
-    Eq. (2) with eqs. (1) and (4) in Table I's variables: the loop is
-    invariant under the scaling of Table I, so m = T = 1, b = delta,
-    K_w = alpha, B_w = beta, M_w = gamma.
-    """
-    one = mpmath.mpf(1)
-    base = z ** (-d) * eq4_pulse_transfer_function(z, one, delta, one, exp=mpmath.exp)
-    return base, base * (z - 1) / z, base * (z - 1) ** 2 / z**2
-
-
-def first_principles_chi(alpha, beta, gamma, d, delta):
-    """Loop polynomial from the printed eqs. (1), (2), (4), divided by delta**2 (mpmath).
-
-    With m = T = 1 and b = delta, eq. (4) is ``G(z) = (n1 z + n0) /
-    (delta**2 (z - 1)(z - E))`` with ``E = exp(-delta)``, ``n1 = E - 1 +
-    delta``, ``n0 = 1 - (1 + delta) E``, and eq. (1) is ``VE(z) = (alpha
-    z**2 + beta z (z - 1) + gamma (z - 1)**2) / z**2``; 1 + VE z^-d G = 0
-    times ``z**(d+2) (z - 1)(z - E)`` is ``z**(d+2) (z - 1)(z - E) + V(z)
-    (n1 z + n0) / delta**2``.  At delta = 0, ``n1 / delta**2 = n0 /
-    delta**2 = 1/2``.  Coefficients highest first, at the caller's mpmath
-    precision (computed with the digits that n1 and n0 cancel added).
-    """
-    extra = int(3 * max(0.0, -math.log10(delta))) if delta > 0 else 0
-    with mpmath.workdps(mpmath.mp.dps + extra):
-        a, b, g, dl = (mpmath.mpf(x) for x in (alpha, beta, gamma, delta))
-        E = mpmath.exp(-dl)
-        if dl == 0:
-            h1 = h0 = mpmath.mpf(1) / 2
-        else:
-            h1, h0 = (E - 1 + dl) / dl**2, (1 - (1 + dl) * E) / dl**2
-        coeffs = [mpmath.mpf(1), -(1 + E), E] + [mpmath.mpf(0)] * (d + 2)
-        v2, v1, v0 = a + b + g, -(b + 2 * g), g
-        for k, c in enumerate((v2 * h1, v2 * h0 + v1 * h1, v1 * h0 + v0 * h1, v0 * h0)):
-            coeffs[-4 + k] += c
-    return [+c for c in coeffs]
-
-
-def first_principles_chi_float(alpha, beta, gamma, d, delta, dps=30):
-    """:func:`first_principles_chi` at ``dps`` digits, rounded once to floats."""
-    with mpmath.workdps(dps):
-        return np.array([float(c) for c in first_principles_chi(alpha, beta, gamma, d, delta)])
-
-
-def delta_of_z(z, *, alpha, beta, gamma, d, delta):
-    """Eq. (2): Delta(z) = 1 + VE(z) z^-d Z[ZOH G] in Table I's variables."""
-    A, B, C = loop_gain_parts(z, d, delta)
-    return 1 + alpha * A + beta * B + gamma * C
-
-
-def first_principles_boundary_point(theta, gamma, d, delta):
-    """(alpha, beta) with Delta(exp(j theta)) = 0, by Cramer's rule on Re and Im."""
-    theta, gamma, delta = mpmath.mpf(theta), mpmath.mpf(gamma), mpmath.mpf(delta)
-    A, B, C = loop_gain_parts(mpmath.expj(theta), d, delta)
-    R = -(1 + gamma * C)
-    det = A.real * B.imag - A.imag * B.real
-    return ((R.real * B.imag - R.imag * B.real) / det,
-            (A.real * R.imag - A.imag * R.real) / det)
-
-
-def first_principles_alpha(theta, gamma, d, delta):
-    return first_principles_boundary_point(theta, gamma, d, delta)[0]
-
-
-def first_principles_theta_max(gamma, d, delta, *, dps=40, n=None):
-    """First theta in (0, pi) where the first-principles alpha(theta) turns negative.
-
-    A fine scan (spacing well below a quarter period of sin(d theta)) finds the
-    first sign change; mpmath refines it on alpha itself, which is O(1), so the
-    stopping rule |alpha| < eps is a tight one.  Returns None if alpha < 0 at the
-    first grid point or never changes sign.
-    """
-    with mpmath.workdps(dps):
-        f = lambda t: first_principles_alpha(t, gamma, d, delta)  # noqa: E731
-        n = n or max(1000, 32 * (d + 1))
-        prev_t, prev = None, None
-        for k in range(1, n):
-            t = mpmath.pi * k / n
-            value = f(t)
-            if prev is None and value < 0:
-                return None
-            if prev is not None and prev > 0 > value:
-                return mpmath.findroot(f, (prev_t, t), solver="anderson")
-            prev_t, prev = t, value
-        return None
-
-
-# --------------------------------------------------------------------------
-# symstab objects at high precision
-# --------------------------------------------------------------------------
-
-def mpf_args(*values):
-    return tuple(mpmath.mpf(v) for v in values)
-
-
-@functools.lru_cache(maxsize=None)
-def _coefficient_function(d):
-    args = (model.alpha, model.beta, model.gamma, model.delta, model.Gamma)
-    return sp.lambdify(args, characteristic_polynomial().coeffs(d), modules="mpmath")
-
-
-def loop_coefficients_mp(*, alpha, beta, gamma, d, delta):
-    """``characteristic_polynomial().coeffs(d)`` at a point, in mpmath (current dps)."""
-    a, b, g, dl = mpf_args(alpha, beta, gamma, delta)
-    return _coefficient_function(d)(a, b, g, dl, mpmath.exp(dl))
-
-
-def chi_mp(z, coeffs):
-    """Return ``(chi(z), sum |c_k| |z|^k)`` for coefficients highest first."""
-    value, size = mpmath.mpf(0), mpmath.mpf(0)
-    for c in coeffs:
-        value = value * z + c
-        size = size * abs(z) + abs(c)
-    return value, size
-
-
-@functools.lru_cache(maxsize=None)
-def boundary_functions():
-    """mpmath functions alpha(theta, gamma, d, delta, Gamma), beta(...) of boundary()."""
-    bd = boundary()
-    args = (model.theta, model.gamma, model.d, model.delta, model.Gamma)
-    return (sp.lambdify(args, bd.alpha, modules="mpmath"),
-            sp.lambdify(args, bd.beta, modules="mpmath"))
-
-
-def boundary_point_mp(theta, gamma, d, delta):
-    """(alpha, beta) of symstab's boundary() at a point, in mpmath (current dps)."""
-    fa, fb = boundary_functions()
-    t, g, dl = mpf_args(theta, gamma, delta)
-    return fa(t, g, d, dl, mpmath.exp(dl)), fb(t, g, d, dl, mpmath.exp(dl))
-
-
-# --------------------------------------------------------------------------
-# python-control oracle
-# --------------------------------------------------------------------------
-
-def python_control_closed_loop(*, alpha, beta, gamma, d, delta, m, T):
-    """Closed loop of Fig. 2 built with python-control from physical values.
-
-    G(s) = 1/(m s^2 + b s) discretised with a ZOH by ``control.c2d``; VE(z)
-    of eq. (1); a delay of ``d`` samples; negative feedback, so the poles are
-    the roots of 1 + G(z) VE(z) z^-d (eq. (2)).
-    """
-    import control
-
-    b = delta * m / T
-    K_w, B_w, M_w = alpha * m / T**2, beta * m / T, gamma * m
-    G = control.c2d(control.tf([1], [m, b, 0]), T, "zoh")
-    z = control.tf([1, 0], [1], T)
-    VE = eq1_virtual_environment(z, K_w, B_w, M_w, T)
-    delay = control.tf([1], [1] + [0] * d, T)
-    return control.feedback(G, VE * delay)
-
-
-def random_loop_points(seed, n, *, delta_range=(1e-4, 1.0)):
-    """Seeded random parameter points, physical and dimensionless.
-
-    delta log-uniform in ``delta_range``, d in 0..12, gamma in [-0.9, 2.5],
-    alpha in [-1, 5], beta in [-2, 3]; m log-uniform in [0.005, 0.5] and T
-    log-uniform in [0.25, 4] ms (haptic devices; far outside, python-control's
-    own polynomial arithmetic loses digits once K_w = alpha m / T^2 ~ 1e9).
-    """
-    rng = np.random.default_rng(seed)
-    lo, hi = np.log10(delta_range[0]), np.log10(delta_range[1])
-    points = []
-    for _ in range(n):
-        points.append(dict(
-            delta=float(10 ** rng.uniform(lo, hi)),
-            d=int(rng.integers(0, 13)),
-            gamma=float(rng.uniform(-0.9, 2.5)),
-            alpha=float(rng.uniform(-1.0, 5.0)),
-            beta=float(rng.uniform(-2.0, 3.0)),
-            m=float(10 ** rng.uniform(np.log10(0.005), np.log10(0.5))),
-            T=float(10 ** rng.uniform(np.log10(2.5e-4), np.log10(4e-3))),
-        ))
-    return points
-
-
-def dimensionless(point):
-    return {k: point[k] for k in ("alpha", "beta", "gamma", "d", "delta")}
 
 
 # --------------------------------------------------------------------------

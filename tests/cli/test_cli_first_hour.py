@@ -24,7 +24,8 @@ import pytest
 import symstab
 from symstab.cli import commands as cli
 
-from conftest import PAPER_DELTA, PAPER_M, PAPER_T, REPO, python_control_closed_loop
+from conftest import PAPER_DELTA, PAPER_M, PAPER_T, REPO
+from oracles import python_control_closed_loop
 
 #: Every sub-command; a new one must be added here (and gets its --help checked).
 COMMANDS = ("derive", "audit", "figures", "reproduce", "boundary", "limits", "classify",

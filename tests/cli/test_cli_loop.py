@@ -18,7 +18,8 @@ import pytest
 import symstab
 from symstab.cli import commands as cli
 
-from conftest import PAPER_DELTA, PAPER_M, PAPER_T, REPO, python_control_closed_loop
+from conftest import PAPER_DELTA, PAPER_M, PAPER_T, REPO
+from oracles import python_control_closed_loop
 
 PAPER = str(REPO / "examples" / "loops" / "paper.toml")
 

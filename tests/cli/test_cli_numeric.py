@@ -16,7 +16,8 @@ import pytest
 import symstab
 from symstab.cli import commands as cli
 
-from conftest import PAPER_B, PAPER_DELTA, PAPER_M, PAPER_T, python_control_closed_loop
+from conftest import PAPER_B, PAPER_DELTA, PAPER_M, PAPER_T
+from oracles import python_control_closed_loop
 
 
 def run(capsys, *args):

@@ -36,8 +36,8 @@ import numpy as np
 import pytest
 import sympy as sp
 
-from conftest import (PAPER_DELTA, REPO, first_principles_chi, first_principles_chi_float,
-                      relative_error)
+from conftest import PAPER_DELTA, REPO, relative_error
+from oracles import first_principles_chi, first_principles_chi_float
 import symstab
 from symstab.symbolic import model
 from symstab._generated import kernels as numpy_kernels
@@ -576,7 +576,7 @@ def test_boundary_on_a_dense_grid_mixed_error(gamma, d, delta):
 
 
 def _first_principles_coefficients(alpha, beta, gamma, d, delta, dps=60):
-    """chi(z) / (delta**2 Gamma) from eqs. (1), (2), (4) (tests/conftest.py), at ``dps`` digits."""
+    """chi(z) / (delta**2 Gamma) from eqs. (1), (2), (4) (tests/oracles.py), at ``dps`` digits."""
     return list(first_principles_chi_float(alpha, beta, gamma, d, delta, dps=dps))
 
 

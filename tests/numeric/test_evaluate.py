@@ -7,7 +7,8 @@ import pytest
 from symstab.numeric.evaluate import alpha_max_on_arc, arc_end, boundary_point
 from symstab.symbolic.theta_max import theta_max
 
-from conftest import PAPER_DELTA, first_principles_alpha, first_principles_boundary_point
+from conftest import PAPER_DELTA
+from oracles import first_principles_alpha, first_principles_boundary_point
 
 
 @pytest.mark.parametrize("theta, gamma, d, delta", [

@@ -18,7 +18,7 @@ import pytest
 
 import symstab
 
-from conftest import python_control_closed_loop
+from oracles import python_control_closed_loop
 
 
 def _python_control_stable(alpha, beta, gamma, d, delta):

@@ -14,7 +14,7 @@ Oracles, none of them the simulator's own code:
 * the exact closed-form motion of a device under Coulomb friction;
 * for stability: :func:`symstab.classify` / :func:`symstab.spectral_radius`
   (independent of the simulator: polynomial roots) and python-control's
-  closed-loop poles (:func:`conftest.python_control_closed_loop`).
+  closed-loop poles (:func:`oracles.python_control_closed_loop`).
 """
 
 import math
@@ -27,8 +27,8 @@ import pytest
 import scipy.signal
 
 import symstab
-from conftest import (PAPER_B, PAPER_DELTA, PAPER_M, PAPER_T, assert_message_names,
-                      python_control_closed_loop)
+from conftest import PAPER_B, PAPER_DELTA, PAPER_M, PAPER_T, assert_message_names
+from oracles import python_control_closed_loop
 from symstab._generated import kernels
 from symstab.numeric.curves import minus_one_line
 from symstab.numeric.simulate import (PAPER_ENCODER_RESOLUTION, Nonidealities, default_horizon,

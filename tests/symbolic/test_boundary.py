@@ -13,9 +13,9 @@ from symstab.symbolic.boundary import (
 )
 from symstab.symbolic.theta_max import theta_max
 
-from conftest import (
-    PAPER_DELTA, assert_rel_close, boundary_point_mp, chi_mp,
-    first_principles_boundary_point, loop_coefficients_mp,
+from conftest import PAPER_DELTA, assert_rel_close
+from oracles import (
+    boundary_point_mp, chi_mp, first_principles_boundary_point, loop_coefficients_mp,
 )
 
 ARGS = (model.theta, model.gamma, model.d, model.delta, model.Gamma)

@@ -10,7 +10,8 @@ from symstab.symbolic.discretize import (
     dimensionless_pulse_transfer_function, pulse_transfer_function, z_transform_by_residues,
 )
 
-from conftest import PAPER_B, PAPER_M, PAPER_T, assert_rel_close, eq4_pulse_transfer_function
+from conftest import PAPER_B, PAPER_M, PAPER_T, assert_rel_close
+from oracles import eq4_pulse_transfer_function
 
 s, z, T = model.s, model.z, model.T
 a = sp.Symbol("a", positive=True)

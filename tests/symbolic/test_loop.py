@@ -15,9 +15,10 @@ from scipy.optimize import linear_sum_assignment
 
 from symstab.symbolic import model
 
-from conftest import (
-    assert_message_names, assert_rel_close, delta_of_z, dimensionless, loop_coefficients_mp,
-    python_control_closed_loop, random_loop_points,
+from conftest import assert_message_names, assert_rel_close
+from oracles import (
+    delta_of_z, dimensionless, loop_coefficients_mp, python_control_closed_loop,
+    random_loop_points,
 )
 
 alpha, beta, gamma, delta, Gamma, z = (model.alpha, model.beta, model.gamma, model.delta,

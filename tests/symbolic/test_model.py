@@ -9,10 +9,8 @@ import sympy as sp
 from symstab.symbolic import model
 from symstab.symbolic.model import dimensionless_values
 
-from conftest import (
-    PAPER_B, PAPER_DELTA, PAPER_M, PAPER_T, assert_message_names, assert_rel_close,
-    eq1_virtual_environment,
-)
+from conftest import PAPER_B, PAPER_DELTA, PAPER_M, PAPER_T, assert_message_names, assert_rel_close
+from oracles import eq1_virtual_environment
 
 
 # Symbols and blocks ---------------------------------------------------------

@@ -1,7 +1,7 @@
 """Tests of symstab.symbolic.small_theta: the boundary near theta = 0.
 
 Oracle: alpha(theta), beta(theta) solved directly from eq. (2) with eqs. (1)
-and (4) (conftest.first_principles_boundary_point) at 80 digits and a tiny
+and (4) (oracles.first_principles_boundary_point) at 80 digits and a tiny
 theta, so that alpha / theta^2 and (beta + delta) / theta^2 approximate the
 Taylor coefficients to O(theta^2).
 """
@@ -13,7 +13,8 @@ import sympy as sp
 from symstab.symbolic import model
 from symstab.symbolic.small_theta import small_theta_limits
 
-from conftest import PAPER_DELTA, assert_rel_close, first_principles_boundary_point
+from conftest import PAPER_DELTA, assert_rel_close
+from oracles import first_principles_boundary_point
 
 THETA = mpmath.mpf("1e-12")
 

@@ -1,7 +1,7 @@
 """Tests of symstab.theta_max: where a boundary arc ends.
 
 Oracle: the first positive root of alpha(theta) solved from eq. (2) with
-eqs. (1) and (4) (conftest.first_principles_theta_max), at 40 digits.
+eqs. (1) and (4) (oracles.first_principles_theta_max), at 40 digits.
 """
 
 import math
@@ -13,10 +13,8 @@ import sympy as sp
 from symstab.symbolic import model
 from symstab.symbolic.theta_max import closed_form_d0, theta_max, theta_max_newton
 
-from conftest import (
-    PAPER_DELTA, assert_message_names, assert_rel_close, first_principles_alpha,
-    first_principles_theta_max,
-)
+from conftest import PAPER_DELTA, assert_message_names, assert_rel_close
+from oracles import first_principles_alpha, first_principles_theta_max
 
 #: (gamma, d, delta) with an arc that ends before pi.
 ARCS = [(0.0, 0, PAPER_DELTA), (-0.5, 0, PAPER_DELTA), (0.0, 5, PAPER_DELTA),

@@ -10,7 +10,8 @@ import sympy as sp
 from symstab.symbolic import model
 from symstab.symbolic.unit_circle import on_unit_circle, unit_circle_split
 
-from conftest import assert_rel_close, chi_mp, delta_of_z, loop_coefficients_mp
+from conftest import assert_rel_close
+from oracles import chi_mp, delta_of_z, loop_coefficients_mp
 
 ARGS = (model.theta, model.alpha, model.beta, model.gamma, model.d, model.delta, model.Gamma)
 
