@@ -90,6 +90,20 @@ def test_every_layer_is_a_folder_and_every_module_in_one():
         _layer(parts)
 
 
+def test_the_test_folders_are_the_layers():
+    """The tests mirror the package: ``tests/<layer>/`` for each layer folder, no other folder.
+
+    The front ends' tests (``cli``, ``figures``, ``reproduce``) are in
+    ``tests/cli``; the tests about the whole project (README, notebooks,
+    layers, docstrings, the audit) at the top of ``tests/``.
+    """
+    tests = pathlib.Path(__file__).resolve().parent
+    folders = {p.name for p in tests.iterdir() if p.is_dir() and not p.name.startswith((".", "_"))}
+    layers = {p.name for p in PACKAGE.iterdir() if p.is_dir() and (p / "__init__.py").exists()
+              and not p.name.startswith("_")}
+    assert folders == layers == {"symbolic", "codegen", "proof", "numeric", "cli"}
+
+
 def test_no_public_name_shadows_a_submodule():
     """``symstab.boundary`` is the function, and there is no module of that name to hide."""
     submodules = {p.stem for p in PACKAGE.glob("*.py")} | {
