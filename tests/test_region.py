@@ -219,6 +219,11 @@ INTERVAL_CASES = [
 @pytest.mark.parametrize("gamma, d, delta, beta, starts_at_zero", INTERVAL_CASES)
 def test_alpha_intervals_match_a_brute_force_scan(gamma, d, delta, beta, starts_at_zero):
     runs = StabilityRegion(gamma=gamma, d=d, delta=delta).alpha_intervals(beta)
+    _assert_runs_match_a_brute_force_scan(runs, gamma, d, delta, beta, starts_at_zero)
+
+
+def _assert_runs_match_a_brute_force_scan(runs, gamma, d, delta, beta, starts_at_zero):
+    """``runs`` at ``beta`` against 20 001 classified points and first-principles radii."""
     if runs:
         lo, hi = runs[0][0], runs[-1][1]
         width = hi - lo
@@ -248,6 +253,32 @@ def test_alpha_intervals_match_a_brute_force_scan(gamma, d, delta, beta, starts_
         assert runs[0][0] > 0
     minimum = limits(gamma=gamma, d=d, delta=delta).minimum_stiffness(beta)
     assert minimum == runs[0][0]
+
+
+#: The cases of INTERVAL_CASES that share a region, grouped: one call per region.
+_CASES_BY_REGION = {}
+for _case in INTERVAL_CASES:
+    _CASES_BY_REGION.setdefault(_case[:3], []).append(_case[3:])
+
+
+@pytest.mark.parametrize("gamma, d, delta", list(_CASES_BY_REGION))
+def test_alpha_intervals_on_many_lines_match_a_brute_force_scan(gamma, d, delta):
+    """The lines are found and counted together: each gets its own intervals
+    (the lines are given in decreasing order; at gamma = 0, d = 0 two of them
+    meet no stable point)."""
+    cases = sorted(_CASES_BY_REGION[(gamma, d, delta)], key=lambda c: -c[0])
+    region = StabilityRegion(gamma=gamma, d=d, delta=delta)
+    runs = region.alpha_intervals_on([beta for beta, _ in cases])
+    assert len(runs) == len(cases)
+    for r, (beta, starts_at_zero) in zip(runs, cases):
+        _assert_runs_match_a_brute_force_scan(r, gamma, d, delta, beta, starts_at_zero)
+
+
+@pytest.mark.parametrize("betas, error", [
+    ([[0.1, 0.2]], ValueError), ([0.1, np.nan], ValueError), (["a"], TypeError), ([True], TypeError)])
+def test_alpha_intervals_on_refuses_bad_lines(betas, error):
+    with pytest.raises(error, match="betas"):
+        StabilityRegion(gamma=0.0, d=0, delta=PAPER_DELTA).alpha_intervals_on(betas)
 
 
 def test_minimum_stiffness_of_fig7_circle6_is_above_one():
