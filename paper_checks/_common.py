@@ -10,10 +10,7 @@ from .audit import Outcome
 from .printed import C, PRINTED_COEFFICIENTS, printed
 
 __all__ = ["where", "with_printed_coefficients", "prove", "compare",
-           "show", "DEVICE_DELTA", "Memo"]
-
-#: delta = b T / m of the paper's device (m = 0.0128, b = 0.0324, T = 1 ms).
-DEVICE_DELTA = 0.0324 * 1e-3 / 0.0128
+           "show", "Memo"]
 
 
 class Memo:

@@ -3,8 +3,9 @@
 Numbers are compared at the paper's own precision: a value is reproduced
 when the derived number, rounded to the digits the paper prints, equals the
 printed number.  Stability of a region is decided by counting characteristic
-roots outside the unit circle (:mod:`paper_checks.regions`), not by the
-"right-sided / left-sided" shape of a curve.
+roots outside the unit circle (:mod:`symstab.numeric.region`, through
+:mod:`paper_checks.regions`), not by the "right-sided / left-sided" shape of a
+curve.  The device is :data:`symstab.PAPER_DEVICE`.
 """
 
 import decimal
@@ -14,17 +15,16 @@ from symstab.numeric.evaluate import alpha_max_on_arc, arc_end, boundary_point
 from symstab.symbolic.small_theta import small_theta_limits
 from symstab.numeric.region import limits
 from symstab.numeric.stability import stable_alpha_intervals
+from symstab.numeric.units import PAPER_DEVICE
 from symstab.symbolic.theta_max import theta_max
 
 from . import regions
-from ._common import DEVICE_DELTA, Memo, show
+from ._common import Memo, show
 from .audit import Outcome, check
 from .eq_limits import gamma_threshold
 
-#: The paper's device (Section VI).
-M, B, T = 0.0128, 0.0324, 1e-3
-#: Td = 40 ms in samples.
-D_EXPERIMENT = 40
+#: Td = 40 ms in samples of the paper's device (Section VI, symstab.PAPER_DEVICE).
+D_EXPERIMENT = PAPER_DEVICE.delay_samples(Td=40e-3)
 
 
 def rounds_to(value, printed):
@@ -43,24 +43,24 @@ def _number(derived, printed, what):
 
 @Memo
 def _classify(gamma, d):
-    return regions.classify(gamma, d, DEVICE_DELTA)
+    return regions.classify(gamma, d, PAPER_DEVICE.delta)
 
 
 def _stable_intervals(beta, gamma, d=0, **kw):
-    intervals = stable_alpha_intervals(beta=beta, gamma=gamma, d=d, delta=DEVICE_DELTA, **kw)
+    intervals = stable_alpha_intervals(beta=beta, gamma=gamma, d=d, delta=PAPER_DEVICE.delta, **kw)
     return intervals
 
 
 @check("claim:theta_max_1.5725", kind="claim", where="Sec. IV-C, line 252",
        claim="theta_max = 1.5725 rad for d = 0, gamma = 0 (paper's device)")
 def theta_max_value():
-    return _number(theta_max(gamma=0.0, d=0, delta=DEVICE_DELTA), "1.5725", "theta_max")
+    return _number(theta_max(gamma=0.0, d=0, delta=PAPER_DEVICE.delta), "1.5725", "theta_max")
 
 
 @check("claim:alpha_max_gamma0", kind="claim", where="Sec. V, lines 304-306 (circle 1 of Fig. 7)",
        claim="alpha_max = 0.6896 at beta = 0.8206 (gamma = 0, d = 0)")
 def alpha_max_gamma0():
-    t, a, b = alpha_max_on_arc(gamma=0.0, d=0, delta=DEVICE_DELTA)
+    t, a, b = alpha_max_on_arc(gamma=0.0, d=0, delta=PAPER_DEVICE.delta)
     alpha_ok, beta_ok = rounds_to(a, "0.6896"), rounds_to(b, "0.8206")
     verdict = "confirmed" if alpha_ok and beta_ok else "not-reproduced"
     return Outcome(verdict,
@@ -72,9 +72,9 @@ def alpha_max_gamma0():
 
 def _alpha_on_arc_at_beta(beta):
     import mpmath
-    f = lambda t: boundary_point(t, gamma=0.0, d=0, delta=DEVICE_DELTA)[1] - beta  # noqa: E731
+    f = lambda t: boundary_point(t, gamma=0.0, d=0, delta=PAPER_DEVICE.delta)[1] - beta  # noqa: E731
     t = mpmath.findroot(f, (0.9, 1.3), solver="anderson")
-    return boundary_point(t, gamma=0.0, d=0, delta=DEVICE_DELTA)[0]
+    return boundary_point(t, gamma=0.0, d=0, delta=PAPER_DEVICE.delta)[0]
 
 
 def _stable_alpha_top(beta, gamma, printed, what):
@@ -109,12 +109,12 @@ def alpha_beta_m1_gamma15():
 def _limits(gamma, d):
     """symstab.limits: alpha_max to the last bit, also on thin regions.
 
-    The scan of :mod:`paper_checks.regions` only samples a region; at
-    gamma = 2 the region's top is a sliver whose top sample the scan finds
-    or misses by chance (4.0068 or 3.9571 as the arc's polyline moves by
-    1e-11).
+    At gamma = 2 the region's top is a sliver: a scan of sample points
+    finds or misses its top by chance (4.0068 or 3.9571 as an arc's
+    polyline moved by 1e-11); symstab.limits counts roots along lines and
+    does not sample.
     """
-    return limits(gamma=gamma, d=d, delta=DEVICE_DELTA)
+    return limits(gamma=gamma, d=d, delta=PAPER_DEVICE.delta)
 
 
 @check("claim:alpha_max_gamma2", kind="claim", where="Sec. V, line 310 (circle 4 of Fig. 7)",
@@ -133,7 +133,7 @@ def alpha_max_gamma2():
 @check("claim:fold_5.8", kind="claim", where="Abstract; Sec. V, line 310; Sec. VIII, line 512",
        claim="virtual mass raises alpha_max about 5.8-fold at d = 0 (4 / 0.6896)")
 def fold():
-    a0 = alpha_max_on_arc(gamma=0.0, d=0, delta=DEVICE_DELTA)[1]
+    a0 = alpha_max_on_arc(gamma=0.0, d=0, delta=PAPER_DEVICE.delta)[1]
     lim = _limits(2.0, 0)
     if lim.empty:
         return Outcome("not-reproduced", f"no stable point at gamma = 2, d = 0 (symstab.limits: {lim.message})")
@@ -148,14 +148,14 @@ def beta_min():
     if lim != -model.delta:
         return Outcome("not-reproduced", f"derived start beta = {show(lim)}")
     return Outcome("confirmed", f"every arc starts at beta = {show(lim)} (Taylor limit with symbolic d, "
-                   f"gamma); for the device -delta = {-DEVICE_DELTA:.6g}, which rounds to -0.00253")
+                   f"gamma); for the device -delta = {-PAPER_DEVICE.delta:.6g}, which rounds to -0.00253")
 
 
 @check("claim:beta_max_2", kind="claim", where="Sec. IV-C, line 252; Sec. V, lines 268, 339",
        claim="beta_max = 2, reached at d = 0, gamma = 0, and the largest over d and gamma")
 def beta_max():
-    _, b00 = arc_end(gamma=0.0, d=0, delta=DEVICE_DELTA)
-    others = {(g, d): arc_end(gamma=g, d=d, delta=DEVICE_DELTA)[1]
+    _, b00 = arc_end(gamma=0.0, d=0, delta=PAPER_DEVICE.delta)
+    others = {(g, d): arc_end(gamma=g, d=d, delta=PAPER_DEVICE.delta)[1]
               for g, d in ((-0.25, 0), (0.5, 0), (0.0, 1), (0.5, 1), (0.0, 5))}
     largest = max(others.values())
     ok = rounds_to(b00, "2") and largest < b00
@@ -174,7 +174,7 @@ def no_region():
     if not stable:
         return Outcome("confirmed", "no stable point at gamma = -1, -1.001 (d = 0, 10)")
     threshold = gamma_threshold()
-    at = {dd: float(threshold.subs({model.d: dd, model.delta: DEVICE_DELTA})) for dd in (0, 10)}
+    at = {dd: float(threshold.subs({model.d: dd, model.delta: PAPER_DEVICE.delta})) for dd in (0, 10)}
     return Outcome("not-reproduced",
                    f"alpha > 0 along the start of the arc iff {show(lim.alpha_sign_condition)}, i.e. "
                    f"gamma > {show(threshold)} = {at[0]:.6f} (d = 0), {at[10]:.6f} "
@@ -209,7 +209,8 @@ def gamma2_boundary():
     lo_hi = _stable_intervals(-1.0, 2.0, alpha_low=1.9, alpha_high=2.1, n=400)
     return Outcome("not-reproduced",
                    f"the gamma = 2 arc is a thin loop (start direction {r.start.side}, end beta "
-                   f"{r.arc_beta_end:.6f}) enclosing a stable sliver of area {r.region_area:.3g}; "
+                   f"{r.arc_beta_end:.6f}) enclosing a stable sliver of area {r.region_area:.3g} "
+                   f"(symstab.limits); "
                    f"at beta = -1 the stable alpha interval is {lo_hi} (root counting)")
 
 
@@ -277,14 +278,9 @@ def min_stiffness():
 
 @Memo
 def _kmax(gamma):
-    """K_max from symstab.limits (the supremum of the stable region, to the last bit).
-
-    The root-counting scan of :mod:`paper_checks.regions` gives a grid-limited
-    lower bound on thin regions (20.51 against 20.52 at gamma = 1);
-    claim:kmax_theory_gamma1 quotes it as the evidence of the region's shape.
-    """
-    lim = limits(gamma=gamma, d=D_EXPERIMENT, delta=DEVICE_DELTA)
-    return lim.alpha_max * M / T**2, lim
+    """K_max from symstab.limits (the supremum of the stable region, to the last bit)."""
+    lim = limits(gamma=gamma, d=D_EXPERIMENT, delta=PAPER_DEVICE.delta)
+    return PAPER_DEVICE.stiffness(lim.alpha_max), lim
 
 
 @check("claim:kmax_theory_gamma0", kind="claim", where="Sec. VII, line 457",
@@ -302,10 +298,10 @@ def kmax1():
     k, lim = _kmax(1.0)
     r = _classify(1.0, D_EXPERIMENT)
     out = _number(k, "20.35", "K_max (N m/rad)")
+    shape = ("a thin band needing a minimum stiffness" if r.min_alpha_positive
+             else "a band reaching down to K_w = 0")
     return Outcome(out.verdict, out.evidence + f" (alpha_max = {lim.alpha_max:.6g} at beta = "
-                   f"{lim.beta_at_alpha_max:.4g}, symstab.limits; a root-counting scan finds "
-                   f"{r.region_alpha_max * M / T**2:.4g} on its grid; the stable set is a thin band "
-                   f"needing a minimum stiffness)")
+                   f"{lim.beta_at_alpha_max:.4g}, symstab.limits; the stable set is {shape})")
 
 
 @check("claim:increase_412", kind="claim", where="Sec. VII, line 457; Abstract ('4.1 times')",
@@ -342,10 +338,11 @@ def exp_inc():
 
 
 def _window(B_w, text):
-    beta = B_w * T / M
-    intervals = stable_alpha_intervals(beta=beta, gamma=1.0, d=D_EXPERIMENT, delta=DEVICE_DELTA,
+    beta = PAPER_DEVICE.beta(B_w)
+    intervals = stable_alpha_intervals(beta=beta, gamma=1.0, d=D_EXPERIMENT, delta=PAPER_DEVICE.delta,
                                        alpha_low=0.0, alpha_high=3e-3, n=600)
-    k = ", ".join(f"{lo * M / T**2:.2f} < K_w < {hi * M / T**2:.2f}" for lo, hi in intervals) or "none"
+    k = ", ".join(f"{PAPER_DEVICE.stiffness(lo):.2f} < K_w < {PAPER_DEVICE.stiffness(hi):.2f}"
+                  for lo, hi in intervals) or "none"
     return _experimental(text, f"at B_w = {B_w} N m s/rad, M_w = m, Td = 40 ms the linear model is "
                          f"stable for {k} N m/rad (root counting)")
 

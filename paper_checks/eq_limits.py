@@ -15,8 +15,9 @@ from symstab.symbolic import model
 from symstab.symbolic.boundary import boundary, coefficients
 from symstab.numeric.evaluate import boundary_point
 from symstab.symbolic.small_theta import small_theta_limits, taylor_coefficients
+from symstab.numeric.units import PAPER_DEVICE
 
-from ._common import DEVICE_DELTA, compare, show, where, with_printed_coefficients
+from ._common import compare, show, where, with_printed_coefficients
 from .audit import Outcome, check
 from .eq_boundary import BETA_CORRECTED
 from .printed import Delta, const, eta, printed, xi
@@ -107,9 +108,9 @@ def eq67():
                     modules="mpmath")
     rows = []
     with mpmath.workdps(30):
-        delta = mpmath.mpf(DEVICE_DELTA)
+        delta = mpmath.mpf(PAPER_DEVICE.delta)
         for g, d, t in ((0.0, 0, 0.01), (0.0, 0, 0.1), (1.0, 0, 0.1), (0.0, 10, 0.05)):
-            exact = boundary_point(t, gamma=g, d=d, delta=DEVICE_DELTA)[0]
+            exact = boundary_point(t, gamma=g, d=d, delta=PAPER_DEVICE.delta)[0]
             approx = f(mpmath.mpf(t), mpmath.mpf(g), d, delta, mpmath.exp(delta))
             rows.append(f"gamma={g:g}, d={d}, theta={t:g}: {float(abs(approx / exact - 1)):.1e}")
     return Outcome("approximation",

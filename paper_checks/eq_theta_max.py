@@ -13,8 +13,9 @@ import sympy as sp
 from symstab.symbolic import model
 from symstab.symbolic.boundary import boundary, coefficients
 from symstab.symbolic.theta_max import closed_form_d0, newton_form_gamma0, theta_max
+from symstab.numeric.units import PAPER_DEVICE
 
-from ._common import DEVICE_DELTA, Memo, compare, prove, show, where, with_printed_coefficients
+from ._common import Memo, compare, prove, show, where, with_printed_coefficients
 from .audit import Outcome, check
 from .printed import PRINTED_D0_COEFFICIENTS, printed, u, xi
 
@@ -289,7 +290,7 @@ NEWTON_DELAYS = (1, 2, 3, 5, 10, 20, 40, 100, 200)
 @Memo
 def _exact_theta_max_gamma0(dd):
     """The exact theta_max at gamma = 0 on the paper's device, shared by (12), (58), (63)."""
-    return theta_max(gamma=0.0, d=dd, delta=DEVICE_DELTA)
+    return theta_max(gamma=0.0, d=dd, delta=PAPER_DEVICE.delta)
 
 
 def prefetch():
@@ -302,7 +303,7 @@ def _newton_error(expr, label):
     derived = sp.lambdify((d, dl, Gamma), newton_form_gamma0().theta_newton, modules="mpmath")
     rows = []
     with mpmath.workdps(30):
-        delta = mpmath.mpf(DEVICE_DELTA)
+        delta = mpmath.mpf(PAPER_DEVICE.delta)
         for dd in NEWTON_DELAYS:
             approx = f(dd, delta, mpmath.exp(delta))
             step = derived(dd, delta, mpmath.exp(delta))
@@ -315,7 +316,7 @@ def _newton_error(expr, label):
     return Outcome("approximation",
                    f"{label}; it equals symstab's one Newton step on the derived N_alpha to "
                    f"{same:.1e} relative. Relative error against the exact first root of alpha "
-                   f"(paper's device, delta = {DEVICE_DELTA:.6g}): {table}; largest {worst[3]:.2e} "
+                   f"(paper's device, delta = {PAPER_DEVICE.delta:.6g}): {table}; largest {worst[3]:.2e} "
                    f"at d = {worst[0]} ({worst[1]:.6f} vs exact {worst[2]:.6f})")
 
 

@@ -275,22 +275,27 @@ def test_run_audit_rejects_a_bad_worker_count(workers):
 
 
 def test_gamma2_claims_do_not_hang_on_one_sample(monkeypatch):
-    """alpha_max at gamma = 2 is the top of a sliver: raising the scan's arc
-    polyline by 1e-11 (relative) made the scan miss its top sample (3.9571
-    instead of 4.0068, and 5.74-fold instead of 5.8).  The claims read it from
-    symstab.limits, which does not sample."""
+    """alpha_max at gamma = 2 is the top of a sliver: raising the arc polyline
+    of the region scan by 1e-11 (relative) made that scan miss its top sample
+    (3.9571 instead of 4.0068, and 5.74-fold instead of 5.8).  The claims and
+    paper_checks.regions read the region from symstab's root count along
+    lines, which does not sample the arc: raising the arc's samples changes
+    nothing."""
+    import dataclasses
+
     from paper_checks import regions
 
-    ids = ["claim:alpha_max_gamma2", "claim:fold_5.8", "claim:max_gamma_2_d0"]
+    ids = ["claim:alpha_max_gamma2", "claim:fold_5.8", "claim:max_gamma_2_d0",
+           "claim:gamma2_is_boundary"]
     checks = audit.registered()
     exact = {cid: checks[cid][3]() for cid in ids}
-    polyline = regions._arc_polyline
+    curve = regions.boundary_curve
 
-    def raised(*args):
-        betas, alphas = polyline(*args)
-        return betas, alphas * (1 + 1e-11)
+    def raised(**kw):
+        arc = curve(**kw)
+        return dataclasses.replace(arc, alpha=arc.alpha * (1 + 1e-11))
 
-    monkeypatch.setattr(regions, "_arc_polyline", raised)
+    monkeypatch.setattr(regions, "boundary_curve", raised)
     for memo in (claims._classify, claims._limits):
         monkeypatch.setattr(memo, "values", {})
     assert {cid: checks[cid][3]() for cid in ids} == exact
@@ -309,23 +314,67 @@ def test_regions_refuse_delta_zero_by_name(call):
         getattr(regions, call)(0.0, 0, 0.0)
 
 
-@pytest.mark.parametrize("gamma, d", [(2.0, 0), (0.0, 10), (1.0, 40)])
-def test_arc_polyline_points_are_the_nearest_doubles(gamma, d):
-    """Oracle: eq. (2) solved by Cramer's rule at 80 digits (conftest).  The
-    polyline's first points sit where the boundary forms cancel most; at a
-    flat 20 digits they were off by up to 4e-11."""
+def _arc_top_first_principles(gamma, d, delta, theta_end):
+    """(alpha, beta) at the top of the arc: eq. (2) by Cramer's rule at 40 digits
+    (conftest), its alpha maximised by a scan and Newton on d alpha / d theta."""
     import mpmath
-    import numpy as np
-    from conftest import PAPER_DELTA, first_principles_boundary_point
+    from conftest import first_principles_boundary_point
+
+    with mpmath.workdps(40):
+        def alpha(t):
+            return first_principles_boundary_point(t, gamma, d, delta)[0]
+
+        grid = [mpmath.mpf(theta_end) * k / 400 for k in range(1, 400)]
+        best = max(grid, key=alpha)
+        top = mpmath.findroot(lambda t: mpmath.diff(alpha, t), best)
+        a, b = first_principles_boundary_point(top, gamma, d, delta)
+    return float(a), float(b)
+
+
+@pytest.mark.parametrize("gamma, d", [(2.0, 0), (0.0, 0), (0.0, 10)])
+def test_region_top_is_the_top_of_the_arc(gamma, d):
+    """Where the region's top is the arc's top, paper_checks.regions finds it
+    to 1e-12.  Its own eigenvalue scan found the gamma = 2 sliver's top only
+    on its grid: 3.9571 against 4.0068."""
     from paper_checks import regions
     from symstab.numeric.curves import arc_end_angle
+    from symstab.numeric.units import PAPER_DEVICE
 
-    t_end = arc_end_angle(gamma=gamma, d=d, delta=PAPER_DELTA)
-    n = int(200 + 20 * d * t_end)
-    betas, alphas = regions._arc_polyline(gamma, d, PAPER_DELTA, t_end, (0.0, -PAPER_DELTA), n)
-    for k in (1, 2, 3, n // 2, n - 1):
-        with mpmath.workdps(80):
-            alpha, beta = first_principles_boundary_point(mpmath.mpf(t_end) * k / n, gamma, d,
-                                                          PAPER_DELTA)
-        assert (alphas[k], betas[k]) == (float(alpha), float(beta)), k
-    assert np.isclose(alphas[-1], 0.0, atol=1e-14)
+    delta = PAPER_DEVICE.delta
+    r = regions.classify(gamma, d)
+    alpha, beta = _arc_top_first_principles(gamma, d, delta, arc_end_angle(gamma=gamma, d=d, delta=delta))
+    assert abs(r.region_alpha_max - alpha) <= 1e-12 * alpha, (r.region_alpha_max, alpha)
+    # The arc is flat at its top: its beta is known to about sqrt(1e-16).
+    assert abs(r.region_beta_at_alpha_max - beta) <= 1e-6 * max(1.0, abs(beta))
+
+
+@pytest.mark.parametrize("gamma, d", [(1.5, 0), (1.0, 0), (1.0, 5), (-1.0, 10)])
+def test_regions_agree_with_the_30_digit_interval_scan(gamma, d):
+    """The vertical through the arc's top, re-scanned with the slow 30-digit
+    reference (roots of the polynomial at 201 alphas, edges bisected), has
+    the counted intervals: a minimum stiffness at gamma = 1.5 and 1, a d = 5
+    band and a tiny gamma = -1 region.  (The gamma = 2 sliver is thinner
+    than the reference's grid step there: the comparison would be empty.)"""
+    from paper_checks import regions
+
+    r = regions.classify(gamma, d, cross_check=True)
+    check = r.library_check
+    assert check["agrees"], check
+    assert check["reference"], check
+
+
+def test_the_paper_device_has_one_home():
+    """No module of paper_checks types the device's m or b: they come from
+    symstab.PAPER_DEVICE (m = 0.0128, b = 0.0324 were typed in three modules)."""
+    import ast
+    import pathlib
+
+    import paper_checks
+
+    typed = []
+    for path in sorted(pathlib.Path(paper_checks.__file__).parent.glob("*.py")):
+        for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
+            if isinstance(node, ast.Constant) and not isinstance(node.value, bool) \
+                    and isinstance(node.value, float) and node.value in (0.0128, 0.0324):
+                typed.append(f"{path.name}:{node.lineno}")
+    assert typed == []
