@@ -2,8 +2,8 @@
 
     python benchmarks/bench_kernels.py [--runs 7] [--pc-points 200] [--quick]
 
-Everything is on the paper's device (m = 0.0128, b = 0.0324, T = 1 ms, so
-delta = b T / m = 0.00253125); each measurement is a median of ``--runs``
+Everything is on the paper's device, ``symstab.PAPER_DEVICE`` (m = 0.0128,
+b = 0.0324, T = 1 ms, so delta = b T / m = 0.00253125); each measurement is a median of ``--runs``
 runs after one warm-up, timed with ``time.perf_counter``.
 
 1. Classification of a 100 x 100 (alpha, beta) grid at d = 10 (alpha in
@@ -46,10 +46,13 @@ import time
 
 import numpy as np
 
+from symstab.numeric.units import PAPER_DEVICE
+
 REPO = pathlib.Path(__file__).resolve().parents[1]
 
-M, B_FRICTION, T = 0.0128, 0.0324, 1e-3
-DELTA = B_FRICTION * T / M
+#: The paper's device, from its one home (symstab.PAPER_DEVICE).
+M, B_FRICTION, T = PAPER_DEVICE.m, PAPER_DEVICE.b, PAPER_DEVICE.T
+DELTA = PAPER_DEVICE.delta
 D_GRID = 10
 N_GRID = 100
 ALPHA_WINDOW = (0.0, 0.03)
