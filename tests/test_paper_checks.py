@@ -316,9 +316,9 @@ def test_regions_refuse_delta_zero_by_name(call):
 
 def _arc_top_first_principles(gamma, d, delta, theta_end):
     """(alpha, beta) at the top of the arc: eq. (2) by Cramer's rule at 40 digits
-    (conftest), its alpha maximised by a scan and Newton on d alpha / d theta."""
+    (tests/oracles.py), its alpha maximised by a scan and Newton on d alpha / d theta."""
     import mpmath
-    from conftest import first_principles_boundary_point
+    from oracles import first_principles_boundary_point
 
     with mpmath.workdps(40):
         def alpha(t):
