@@ -362,8 +362,10 @@ def classify(gamma, d, delta=PAPER_DEVICE.delta, *, n_beta=41, arc_points=None,
         whose stable intervals are tested against the arc; the line through
         the region's top is added.
     arc_points : int, optional
-        Samples of the arc (:func:`symstab.numeric.region.boundary_curve`);
-        by default ``200 + 20 d theta_max``.
+        Steps of theta between the arc's samples
+        (:func:`symstab.numeric.region.boundary_curve`, ``arc_points + 1``
+        samples from theta = 0 to theta_max); by default ``200 + 20 d
+        theta_max``.
     tolerance : float, optional
         Stable points outside the closed curve but within this distance of
         it (in units of the arc's extent) still count as inside: the
