@@ -136,7 +136,7 @@ def check_array(name, value, *, low=None, low_open=False, high=None):
 PARAMETER_MAX = 1e150
 
 #: The largest delta = b T / m accepted.  The kernels are accurate to a few
-#: ulps up to here (tests/test_generated_kernels.py); far beyond it the
+#: ulps up to here (tests/codegen/test_generated_kernels.py); far beyond it the
 #: products of the ZOH coefficients (~ 1 / delta**3) underflow.
 DELTA_MAX = 1e6
 

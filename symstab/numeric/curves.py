@@ -1,7 +1,7 @@
 """The boundary arc in floating point: theta_max, the arc's samples, the root bracketer.
 
 The generated kernel :func:`symstab._generated.kernels.boundary` evaluates
-alpha(theta), beta(theta) to about 1e-14 relative (tests/test_generated_kernels.py).
+alpha(theta), beta(theta) to about 1e-14 relative (tests/codegen/test_generated_kernels.py).
 Here it is used to find where the arc ends and to sample it:
 
 * :func:`arc_end_angle` -- theta_max, the first root of alpha(theta) in
