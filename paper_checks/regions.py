@@ -257,7 +257,7 @@ class RegionResult:
         Extent of the stable region in beta; ``nan`` without stable points.
     region_area : float
         Area of the stable region (0 without stable points).
-    lines : ndarray
+    lines : tuple of float
         The vertical lines through the stable region on which its intervals
         were taken (``n_beta`` evenly spaced, and the one through its top).
     inside_arc : bool or None
@@ -307,7 +307,7 @@ class RegionResult:
     region_beta_min: float
     region_beta_max: float
     region_area: float
-    lines: np.ndarray
+    lines: tuple
     inside_arc: object
     outside_max_distance: float
     min_alpha_positive: bool
@@ -483,7 +483,7 @@ def classify(gamma, d, delta=PAPER_DEVICE.delta, *, n_beta=41, arc_points=None,
         region_beta_at_alpha_max=nan if lim.empty else float(lim.beta_at_alpha_max),
         region_beta_min=nan if lim.empty else float(lim.beta_left),
         region_beta_max=nan if lim.empty else float(lim.beta_right),
-        region_area=float(lim.z_width), lines=lines,
+        region_area=float(lim.z_width), lines=tuple(float(b) for b in lines),
         inside_arc=inside_arc, outside_max_distance=outside,
         min_alpha_positive=bool(raised), min_alpha_where=min_alpha_where,
         min_alpha_betas=min_alpha_betas,
