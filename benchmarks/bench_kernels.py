@@ -9,7 +9,7 @@ runs after one warm-up, timed with ``time.perf_counter``.
 1. Classification of a 100 x 100 (alpha, beta) grid at d = 10 (alpha in
    [0, 0.03], beta in [-0.01, 0.3]: the stable region and its boundary),
    gamma = 0 and 1: ``symstab.classify`` against python-control per point
-   (the closed loop of ``python_control_closed_loop`` in tests/conftest.py,
+   (the closed loop of ``python_control_closed_loop`` in tests/oracles.py,
    c2d included, then ``.poles()``; and the same with ``Gd = c2d(G)`` built
    once and ``feedback(VE z^-d Gd, 1)``), against ``symstab.spectral_radius``
    (batched eigenvalues) and against a ``numpy.roots`` loop on the
@@ -85,8 +85,8 @@ def _times(fn, runs, warmup=1):
 
 
 def _oracles():
-    """tests/conftest.py as a module (python_control_closed_loop, first-principles points)."""
-    spec = importlib.util.spec_from_file_location("_symstab_test_oracles", REPO / "tests" / "conftest.py")
+    """tests/oracles.py as a module (python_control_closed_loop, first-principles points)."""
+    spec = importlib.util.spec_from_file_location("_symstab_test_oracles", REPO / "tests" / "oracles.py")
     module = importlib.util.module_from_spec(spec)
     spec.loader.exec_module(module)
     return module
