@@ -44,8 +44,8 @@ from .._validate import check_array, check_count, check_delay
 from ..symbolic.loop_assembly import LoopModel, parse_environment, parse_plant
 from ..codegen.loop_kernels import environment_kernels, load_numpy_kernels
 from .region import _golden_max
-from .stability import (MARGINAL, STABLE, classify_polynomials, polynomial_root_counts,
-                        polynomial_spectral_radius)
+from .stability import (MARGINAL, STABLE, _leading_vanishes, classify_polynomials,
+                        polynomial_root_counts, polynomial_spectral_radius)
 
 __all__ = ["Loop", "LoopLimits", "LoopBoundary", "parse_plant", "parse_environment"]
 
@@ -429,7 +429,7 @@ class Loop(LoopModel):
         rows = c.reshape(-1, c.shape[-1])
         counts = polynomial_root_counts(rows)
         # A root at infinity (vanishing leading coefficient) is marginal, as in classify.
-        counts[classify_polynomials(rows, refine=False) == MARGINAL] = -1
+        counts[_leading_vanishes(rows)] = -1
         counts = counts.reshape(c.shape[:-1])
         return int(counts) if counts.ndim == 0 else counts
 
@@ -549,9 +549,15 @@ class Loop(LoopModel):
         def intervals(xv):
             return _line_intervals(base + xv * ax, ay, base_ends + xv * x_ends, y_ends)
 
+        tops_seen = {}
+
         def top(xv):
-            found = intervals(xv)
-            return max((hi for _, hi in found), default=-np.inf)
+            # Memoised: the vectorised golden-section search evaluates both
+            # inner points at every step, one of which it has seen before.
+            xv = float(xv)
+            if xv not in tops_seen:
+                tops_seen[xv] = max((hi for _, hi in intervals(xv)), default=-np.inf)
+            return tops_seen[xv]
 
         seeds = _stable_seeds(base, ax, ay, (base_ends, x_ends, y_ends))
         if seeds.size == 0:
@@ -640,6 +646,60 @@ def _on_circle(c, theta):
     return out
 
 
+#: Largest table of cos(k theta), sin(k theta) on the scan kept per degree (bytes).
+_SCAN_TABLE_BYTES = 4 * 2**20
+
+
+@functools.lru_cache(maxsize=4)
+def _scan_table(n):
+    """The sign scan of :func:`_circle_candidates` for degree ``n``: ``(grid, cos, sin)``.
+
+    ``cos``, ``sin`` are ``cos(k theta)``, ``sin(k theta)`` for ``k = n ..
+    0`` (shape ``(n + 1, len(grid))``), or None where they would take more
+    than ``_SCAN_TABLE_BYTES``; all read-only.
+    """
+    from .curves import scan_grid
+
+    grid = scan_grid(n, n=max(256, 16 * (n + 1)))[:-1]
+    grid = np.concatenate([grid, np.pi - (grid[:40][::-1])])
+    out = [grid, None, None]
+    if 16 * (n + 1) * len(grid) <= _SCAN_TABLE_BYTES:
+        angles = np.multiply.outer(np.arange(n, -1, -1, dtype=float), grid)
+        out[1:] = np.cos(angles), np.sin(angles)
+    for part in out:
+        if part is not None:
+            part.flags.writeable = False
+    return tuple(out)
+
+
+def _sine_series_angles(h):
+    """Angles in [0, pi] of the roots of the anti-palindromic ``h`` within 1e-4 of the circle.
+
+    ``h`` (degree ``2 n``, highest first, ``rev(h) = -h``) is ``z**n`` times
+    ``sum_k -h[n + k] (z**k - z**-k)``, that is ``2j z**n sin(theta) q(cos
+    theta)`` on the circle with ``q = sum_k -h[n + k] U_{k-1}`` (Chebyshev
+    polynomials of the second kind).  The roots of ``q`` (degree ``n - 1``,
+    from its Chebyshev series: a colleague matrix of half the size of
+    ``h``'s companion, an eighth of the work) are ``w = (z + 1/z) / 2`` for
+    the root pairs ``z, 1/z`` of ``h`` other than ``+-1``.
+    """
+    n = (len(h) - 1) // 2
+    u = -np.asarray(h[n + 1:], dtype=float)       # u[m]: coefficient of U_m
+    if n < 1 or not np.any(u):
+        return np.empty(0)
+    # U_m = 2 (T_m + T_{m-2} + ...), with T_0 counted once: Chebyshev
+    # coefficient j sums 2 u[m] over m >= j of j's parity.
+    t = np.zeros(n)
+    for parity in (0, 1):
+        t[parity::2] = 2 * np.cumsum(u[parity::2][::-1])[::-1]
+    t[0] -= np.sum(u[0::2])
+    with np.errstate(all="ignore"):
+        w = np.polynomial.chebyshev.chebroots(t).astype(complex)
+        z = w + np.sqrt(w * w - 1)
+        keep = np.isfinite(z) & (np.abs(np.abs(z) - 1) < 1e-4)
+    return np.abs(np.angle(z[keep]))
+
+
 def _circle_candidates(a0, a1, a0_ends, a1_ends):
     """Parameter values ``p`` at which ``a0 + p a1`` has a root on the unit circle.
 
@@ -649,34 +709,43 @@ def _circle_candidates(a0, a1, a0_ends, a1_ends):
     ``a0 rev(a1) - rev(a0) a1`` that the scan missed.  Returns ``(p,
     theta)``, the crossings' parameter values and angles.
     """
-    from .curves import bracketed_root, scan_grid
+    from .curves import bracketed_root
 
     n = len(a0) - 1
+    h = np.convolve(a0, a1[::-1]) - np.convolve(a0[::-1], a1)
+    sine = -h[n + 1:]
+    multiples = np.arange(1, n + 1, dtype=float)
 
-    def g(theta):
-        v0, v1 = _on_circle(a0, theta), _on_circle(a1, theta)
-        return (v0 * np.conj(v1)).imag
+    def g(theta, index=None):
+        # g = sum_k sine[k-1] sin(k theta) (see _sine_series_angles): for
+        # the few brackets one vectorised step, cheaper than n steps of
+        # Horner's scheme on both polynomials, and rounding no worse (k
+        # theta carries the error that Horner's powers of z accumulate).
+        return np.sin(np.multiply.outer(theta, multiples)) @ sine
 
     # The sign scan, refined to a few ulps, finds every crossing whose
     # neighbours on the scan are apart; theta = 0 and pi are always there.
     # g vanishes at 0 and pi, so the scan approaches both geometrically.
-    grid = scan_grid(n, n=max(256, 16 * (n + 1)))[:-1]
-    grid = np.concatenate([grid, np.pi - (grid[:40][::-1])])
-    values = g(grid)
+    grid, cos_k, sin_k = _scan_table(n)
+    if cos_k is None:
+        v = _on_circle(np.stack([a0, a1], axis=-1), grid[:, None])
+        values = (v[:, 0] * np.conj(v[:, 1])).imag
+    else:
+        # The values of a0, a1 on the scan as products with the table.
+        re, im = np.stack([a0, a1]) @ cos_k, np.stack([a0, a1]) @ sin_k
+        values = im[0] * re[1] - re[0] * im[1]
     change = np.flatnonzero(np.sign(values[:-1]) * np.sign(values[1:]) < 0)
     found = [0.0, np.pi]
     if change.size:
-        found += list(bracketed_root(g, grid[change], grid[change + 1]))
+        found += list(bracketed_root(g, grid[change], grid[change + 1], indexed=True))
     found = np.array(found)
-    # The polynomial's unit-circle roots add those the scan cannot see (a
-    # close pair between two scan points, a double root); near a scanned
-    # angle they are the same crossing, less accurately.
-    h = np.trim_zeros(np.polysub(np.polymul(a0, a1[::-1]), np.polymul(a0[::-1], a1)), "f")
+    # The unit-circle roots of the polynomial h = a0 rev(a1) - rev(a0) a1
+    # (z**n (2j) g on the circle) add those the scan cannot see (a close
+    # pair between two scan points, a double root); near a scanned angle
+    # they are the same crossing, less accurately.
     extra = []
-    if len(h) > 1 and np.any(h):
-        with np.errstate(all="ignore"):
-            roots = np.roots(h)
-        near = np.abs(np.angle(roots[np.abs(np.abs(roots) - 1) < 1e-4]))
+    near = _sine_series_angles(h)
+    if near.size:
         for a in np.sort(near):
             # Conjugates and the pairs z, 1/conj(z) of h give each angle twice.
             if np.min(np.abs(found - a)) > 1e-6 and (not extra or a - extra[-1] > 1e-6):
@@ -755,8 +824,7 @@ def _line_intervals(a0, a1, a0_ends, a1_ends):
 
     def count(index):
         c = polynomial_root_counts(rows[index])
-        lead_ok = classify_polynomials(rows[index], refine=False) != MARGINAL
-        return np.where(lead_ok, c, -1)
+        return np.where(_leading_vanishes(rows[index]), -1, c)
 
     counts = np.full(len(tests), -2, dtype=np.int64)     # -2: not known
     known = np.zeros(len(tests), dtype=bool)
