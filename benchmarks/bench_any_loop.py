@@ -151,8 +151,8 @@ def _ratio(value):
 
 
 def _oracles():
-    """tests/conftest.py as a module (eq1_virtual_environment)."""
-    spec = importlib.util.spec_from_file_location("_symstab_test_oracles", REPO / "tests" / "conftest.py")
+    """tests/oracles.py as a module (eq1_virtual_environment)."""
+    spec = importlib.util.spec_from_file_location("_symstab_test_oracles", REPO / "tests" / "oracles.py")
     module = importlib.util.module_from_spec(spec)
     spec.loader.exec_module(module)
     return module
