@@ -60,9 +60,12 @@ import time
 
 import numpy as np
 
+from symstab.numeric.units import PAPER_DEVICE
+
 REPO = pathlib.Path(__file__).resolve().parents[1]
 
-M_DEV, B_DEV, T_DEV = 0.0128, 0.0324, 1e-3
+#: The paper's device, from its one home.
+M_DEV, B_DEV, T_DEV = PAPER_DEVICE.m, PAPER_DEVICE.b, PAPER_DEVICE.T
 PAPER_ENVIRONMENT = "K + B*(z - 1)/(T*z) + M*(z - 1)**2/(T**2*z**2)"
 DEVICE = dict(m=M_DEV, b=B_DEV, T=T_DEV)
 RENDERED = dict(K=2.0, B=0.1, M=0.0, d=10)

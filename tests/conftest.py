@@ -26,14 +26,6 @@ import pytest
 from symstab.symbolic.boundary import boundary
 from symstab.symbolic.loop import characteristic_polynomial
 
-# Re-exported for the test files not yet moved into the layer folders
-# (test_classify, test_region, test_stability, test_any_loop, test_paper_checks
-# import them from here); new code imports them from oracles.
-from oracles import (  # noqa: F401
-    dimensionless, first_principles_boundary_point, first_principles_chi,
-    first_principles_chi_float, python_control_closed_loop, random_loop_points,
-)
-
 REPO = pathlib.Path(__file__).resolve().parents[1]
 
 # The paper's device (Section IV-A): T = 1 ms, m = 0.0128 kg m^2, b = 0.0324 N m s/rad.

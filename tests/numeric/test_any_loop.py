@@ -20,7 +20,8 @@ from symstab.symbolic.discretize import numeric_zoh, zoh_pulse_transfer_function
 from symstab.numeric.stability import (MARGINAL, STABLE, UNSTABLE, classify_polynomials,
                                polynomial_root_counts, polynomial_spectral_radius)
 
-from conftest import PAPER_B, PAPER_M, PAPER_T, assert_rel_close, python_control_closed_loop
+from conftest import PAPER_B, PAPER_M, PAPER_T, assert_rel_close
+from oracles import python_control_closed_loop
 
 control = pytest.importorskip("control")
 
@@ -340,3 +341,43 @@ def test_arrays_broadcast(paper_loop):
     r = paper_loop.spectral_radius(K=K, B=B, M=0.0, d=0, **DEVICE)
     assert r.shape == (7, 3)
     assert np.array_equal(codes == STABLE, r < 1)
+
+
+# -- the line engine's pieces ------------------------------------------------------
+
+def test_sine_series_angles_are_the_unit_circle_roots_of_h():
+    """The Chebyshev route to h's unit-circle roots against numpy.roots of h itself."""
+    from symstab.numeric.any_loop import _sine_series_angles
+
+    rng = np.random.default_rng(17)
+    for degree in (2, 5, 12, 30, 44):
+        a0, a1 = rng.normal(size=degree + 1), rng.normal(size=degree + 1)
+        h = np.polysub(np.polymul(a0, a1[::-1]), np.polymul(a0[::-1], a1))
+        roots = np.roots(h)
+        on_circle = roots[np.abs(np.abs(roots) - 1) < 1e-6]
+        # +-1 are roots of every such h; the Chebyshev series leaves them out.
+        expected = np.sort(np.unique(np.round(np.abs(np.angle(on_circle)), 7)))
+        expected = expected[(expected > 1e-6) & (expected < np.pi - 1e-6)]
+        got = np.sort(np.unique(np.round(_sine_series_angles(h), 7)))
+        got = got[(got > 1e-6) & (got < np.pi - 1e-6)]
+        np.testing.assert_allclose(got, expected, atol=1e-6)
+
+
+def test_root_counts_next_to_the_circle_are_right_or_marginal():
+    """Roots 1e-12 to 1e-3 from the circle: the certified count is mpmath's, or -1; never wrong."""
+    rng = np.random.default_rng(23)
+    decided = marginal = 0
+    for _ in range(60):
+        degree = int(rng.integers(2, 14))
+        gap = 10.0 ** rng.uniform(-12, -3)
+        radius = np.where(rng.random(degree) < 0.5, 1 - gap, 1 + gap)
+        roots = radius * np.exp(1j * rng.uniform(0.01, np.pi - 0.01, degree))
+        c = np.real(np.poly(np.concatenate([roots, np.conj(roots)])))
+        outside, nearest = _mp_outside(c)
+        count = polynomial_root_counts(c[None, :])[0]
+        if count == -1:
+            marginal += 1
+            continue
+        assert count == outside, (c.tolist(), count, outside, nearest)
+        decided += 1
+    assert decided >= 30, (decided, marginal)

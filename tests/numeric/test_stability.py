@@ -7,7 +7,8 @@ from symstab.numeric.evaluate import boundary_point
 from symstab.numeric.stability import (coefficients_at, spectral_radius, stable_alpha_intervals,
                                unstable_root_count)
 
-from conftest import PAPER_DELTA, dimensionless, python_control_closed_loop, random_loop_points
+from conftest import PAPER_DELTA
+from oracles import dimensionless, python_control_closed_loop, random_loop_points
 
 
 @pytest.mark.parametrize("point", random_loop_points(seed=7, n=20, delta_range=(1e-3, 1.0)))

@@ -4,7 +4,7 @@ StabilityRegion, limits, best_virtual_mass and Device.
 Oracles:
 
 * ``symstab.theta_max`` (30 digits) for the float theta_max;
-* ``conftest.first_principles_boundary_point``: the boundary solved directly
+* ``oracles.first_principles_boundary_point``: the boundary solved directly
   from the printed eqs. (1), (2), (4) with mpmath;
 * ``symstab.numeric.evaluate.alpha_max_on_arc`` and ``boundary_point`` (30 digits);
 * the area under the arc by Green's theorem, ``A = int alpha dbeta`` along
@@ -41,11 +41,11 @@ from symstab import (PAPER_DEVICE, STABLE, Device, StabilityRegion, arc_end_angl
                      best_virtual_mass, boundary_curve, classify, limits)
 from symstab.numeric.evaluate import alpha_max_on_arc, boundary_point
 
-from conftest import (PAPER_DELTA, assert_message_names, first_principles_boundary_point,
-                      first_principles_chi_float)
+from conftest import PAPER_DELTA, assert_message_names
+from oracles import first_principles_boundary_point, first_principles_chi_float
 
 
-#: The first-principles polynomial of eqs. (1), (2), (4) (tests/conftest.py),
+#: The first-principles polynomial of eqs. (1), (2), (4) (tests/oracles.py),
 #: at 30 digits, rounded once to floats.
 eq4_chi_float = first_principles_chi_float
 
@@ -678,7 +678,7 @@ def test_device_conversions_round_trip(device):
 
 @pytest.mark.parametrize("name, value", [
     (name, value) for name in ("m", "b", "T") for value in (0.0, -1.0, float("nan"), float("inf"))
-    if (name, value) != ("b", 0.0)])   # b = 0 is a frictionless device (tests/test_units.py)
+    if (name, value) != ("b", 0.0)])   # b = 0 is a frictionless device (tests/numeric/test_units.py)
 def test_device_rejects_bad_parameters(name, value):
     kwargs = dict(m=0.0128, b=0.0324, T=1e-3)
     kwargs[name] = value

@@ -4,7 +4,7 @@ Oracles (none of them goes through symstab's kernels; symstab's 30/50-digit
 ``boundary_point`` only places test points on the boundary):
 
 * python-control: the closed loop of Fig. 2 built from physical values
-  (``conftest.python_control_closed_loop``), its poles' largest modulus;
+  (``oracles.python_control_closed_loop``), its poles' largest modulus;
 * the characteristic polynomial written out from the paper's eqs. (1), (2)
   and (4) with m = T = 1, b = delta (:func:`eq4_chi`), evaluated in mpmath;
   its roots by ``mpmath.polyroots`` at 40 digits (d = 40), or by
@@ -37,16 +37,16 @@ from symstab import MARGINAL, STABLE, UNSTABLE, classify, is_stable, spectral_ra
 from symstab.numeric.evaluate import boundary_point
 from symstab.numeric.stability import loop_coefficients, schur_cohn
 
-from conftest import (PAPER_DELTA, assert_message_names, dimensionless, first_principles_chi,
-                      first_principles_chi_float,
-                      python_control_closed_loop, random_loop_points)
+from conftest import PAPER_DELTA, assert_message_names
+from oracles import (dimensionless, first_principles_chi, first_principles_chi_float,
+                     python_control_closed_loop, random_loop_points)
 
 
 # --------------------------------------------------------------------------
 # Independent oracle: chi(z) from the printed eqs. (1), (2), (4)
 # --------------------------------------------------------------------------
 
-#: The first-principles polynomial (tests/conftest.py), at the current mpmath
+#: The first-principles polynomial (tests/oracles.py), at the current mpmath
 #: precision, and rounded once to floats from 30 digits.
 eq4_chi = first_principles_chi
 eq4_chi_float = first_principles_chi_float
@@ -494,7 +494,7 @@ def test_classify_a_large_grid_in_bounded_chunks(monkeypatch):
     The limit is what check_memory enforces on single allocations (the dense
     coefficient array alone would be 600 * 600 * 15 * 8 = 43 MB, the root
     count's arrays several times that); peak memory itself is not measured
-    here (tests/test_cli_extremes.py runs long delays under an address-space
+    here (tests/cli/test_cli_extremes.py runs long delays under an address-space
     cap).  The verdicts are spot-checked against python-control.
     """
     monkeypatch.setenv("SYMSTAB_MEMORY_LIMIT", "400M")
