@@ -14,8 +14,9 @@ are the roots of
 
 a *delayed part* and a *direct part*, as for the paper's loop
 (:mod:`symstab.symbolic.loop`).  The derivation is SymPy's: the pulse transfer
-function by residues when every pole of ``G(s)/s`` is a linear factor over
-the parameters (repeated poles and poles at 0 included), otherwise by the
+function by residues when the denominator of ``G(s)/s`` factors, over the
+parameters, into factors of degree 1 or 2 in ``s`` (repeated poles, complex
+pairs and poles at 0 included), otherwise by the
 matrix exponential at 30 digits once the plant's values are known
 (:attr:`Loop.zoh_method` says which).
 

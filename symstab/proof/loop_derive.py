@@ -117,11 +117,18 @@ def plant_kernel(loop):
     -------
     symstab.codegen.generator.Kernel or None
         None when the loop's ZOH is computed numerically
-        (``loop.zoh_method == "matrix exponential"``).
+        (``loop.zoh_method == "matrix exponential"``), or when its poles are
+        written with square roots (a complex pair would need complex
+        arithmetic in C).
     """
     if loop.zoh_method != "residues":
         return None
-    num, den = sp.fraction(loop.pulse_transfer_function())
+    pulse = loop.pulse_transfer_function()
+    if any(not p.exp.is_integer for p in pulse.atoms(sp.Pow)):
+        # A complex pole pair is written with the square root of a negative
+        # number: a double-precision C kernel would print NaN.
+        return None
+    num, den = sp.fraction(pulse)
     z = model.z
     p_n, p_d = sp.Poly(num, z).all_coeffs(), sp.Poly(den, z).all_coeffs()
     args = [(x, f"parameter {x}") for x in _parameter_symbols(loop, loop.plant) if x != model.T]
@@ -195,7 +202,10 @@ def kernel_files(loop):
     c_title = (f"C99 kernels of the loop {loop.name} (need only <math.h>, link with -lm): "
                f"VE(z) = {loop.environment}"
                + (f", and Z[ZOH G] of G(s) = {loop.plant}." if plant is not None else
-                  "; the plant's pulse transfer function is computed numerically."))
+                  "; the plant's pulse transfer function is computed numerically."
+                  if loop.zoh_method != "residues" else
+                  "; the plant's pulse transfer function (poles with square roots) is not "
+                  "printed in C: symstab.Loop evaluates it at 30 digits."))
     source = c_source(c_kernels, title=c_title, prefix=prefix, command=COMMAND)
     # SymPy's C99 printer writes pi as M_PI, which <math.h> defines only
     # outside strict C99 (POSIX): define it where the compiler does not.
@@ -283,8 +293,8 @@ def derivation_steps(loop):
         chi = loop.characteristic_polynomial()
         chi_note = "chi(z) = z^d Ve_d(z) P_d(z) + Ve_n(z) P_n(z), symbolic delay d"
     else:
-        zoh = (("zoh_method", "how Z[ZOH G] is derived: the plant's poles are not linear factors "
-                "over its parameters, so Z[ZOH G] is computed numerically, by the matrix "
+        zoh = (("zoh_method", "how Z[ZOH G] is derived: the plant's denominator has a factor of "
+                "degree 3 or more in s, so Z[ZOH G] is computed numerically, by the matrix "
                 "exponential at 30 digits, once the plant's values are given",
                 "matrix exponential"),)
         P_n, P_d = sp.Function("P_n")(z), sp.Function("P_d")(z)

@@ -13,7 +13,7 @@ import sympy as sp
 from . import model
 
 __all__ = [
-    "z_transform_by_residues",
+    "z_transform_by_residues", "written_poles", "zoh_pulse_transfer_function", "numeric_zoh",
     "pulse_transfer_function",
     "dimensionless_pulse_transfer_function",
 ]
@@ -60,12 +60,16 @@ def dimensionless_pulse_transfer_function():
     return result
 
 
-def linear_poles(F, s=model.s):
-    """Poles of a rational ``F(s)`` with multiplicities, if all are linear factors.
+def written_poles(F, s=model.s):
+    """Poles of a rational ``F(s)`` with multiplicities, if SymPy writes them briefly.
 
     Returns ``{pole: multiplicity}`` when the denominator factors, over the
-    parameters, into factors of degree 1 in ``s`` (each pole then has a short
-    closed form such as ``-b/m``); otherwise ``None``.
+    parameters, into factors of degree 1 or 2 in ``s``: each pole is then
+    ``-b/m`` or ``(-b +- sqrt(b**2 - 4 m k)) / (2 m)`` (a complex pair when
+    the factor is underdamped; their terms of the pulse transfer function
+    add up to a real one).  Otherwise ``None``: the roots of a cubic or a
+    quartic in radicals are too large to be worth carrying, and the plant
+    is discretised numerically (:func:`numeric_zoh`).
     """
     _, den = sp.fraction(sp.together(F))
     _, factors = sp.factor_list(sp.expand(den), s)
@@ -74,20 +78,22 @@ def linear_poles(F, s=model.s):
         degree = sp.degree(factor, s)
         if degree == 0:
             continue
-        if degree > 1:
+        if degree > 2:
             return None
-        pole = sp.solve(factor, s)[0]
-        poles[pole] = poles.get(pole, 0) + power
+        for pole, multiplicity in sp.roots(factor, s).items():
+            poles[pole] = poles.get(pole, 0) + power * multiplicity
     return poles
 
 
 def zoh_pulse_transfer_function(G, *, s=model.s, z=model.z, T=model.T):
-    """Z[ZOH G(s)] for a proper rational ``G(s)`` whose poles are linear factors.
+    """Z[ZOH G(s)] for a proper rational ``G(s)`` whose poles SymPy writes (:func:`written_poles`).
 
-    ``(1 - 1/z) Z[G(s) / s]`` by the residues of
-    ``G(s) / s * z / (z - exp(s T))`` at every pole, repeated poles and poles
-    at 0 included (a frictionless mass ``1 / (m s**2)`` has a triple pole of
-    ``G / s`` at 0).
+    ``(1 - 1/z) Z[G(s) / s]``, with ``Z[G(s) / s]`` the sum over the poles
+    ``p`` of ``G(s) / s`` of the residues of ``G(s) / s * z / (z - exp(s
+    T))``: at a simple pole ``N(p) / D'(p) * z / (z - exp(p T))`` (a series
+    expansion there is needlessly slow for a complex pair), at a repeated
+    one by SymPy's ``residue`` (a frictionless mass ``1 / (m s**2)`` has a
+    triple pole of ``G / s`` at 0).
 
     Returns
     -------
@@ -98,14 +104,26 @@ def zoh_pulse_transfer_function(G, *, s=model.s, z=model.z, T=model.T):
     Raises
     ------
     ValueError
-        If ``G`` is not proper, or a pole is not a linear factor (then use
-        :func:`numeric_zoh`).
+        If ``G`` is not proper, or its denominator has a factor of degree 3
+        or more in ``s`` (then use :func:`numeric_zoh`).
     """
     F = sp.together(G / s)
-    if linear_poles(F, s) is None:
-        raise ValueError("the plant's poles are not all linear factors over its parameters")
-    step_response = z_transform_by_residues(F, s=s, z=z, T=T)
-    return sp.cancel(sp.together((1 - 1 / z) * step_response))
+    poles = written_poles(F, s)
+    if poles is None:
+        raise ValueError("the plant's denominator has a factor of degree 3 or more in s over "
+                         "its parameters: its poles are not written in closed form")
+    num, den = sp.fraction(F)
+    if sp.degree(num, s) >= sp.degree(den, s):
+        raise ValueError("G(s) must be proper")
+    slope = sp.diff(den, s)
+    kernel = F * z / (z - sp.exp(s * T))
+    terms = []
+    for pole, multiplicity in poles.items():
+        if multiplicity == 1:
+            terms.append(num.subs(s, pole) / slope.subs(s, pole) * z / (z - sp.exp(pole * T)))
+        else:
+            terms.append(sp.residue(kernel, s, pole))
+    return sp.cancel(sp.together((1 - 1 / z) * sp.Add(*terms)))
 
 
 def _charpoly(A):

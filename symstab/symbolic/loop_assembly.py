@@ -8,8 +8,9 @@ derives the closed loop ``1 + VE(z) z**-d Z[ZOH G](z) = 0`` as
 
 a *delayed part* and a *direct part* (as :mod:`symstab.symbolic.loop` does for the
 paper's loop).  The pulse transfer function ``P_n / P_d`` is derived by
-residues when every pole of ``G(s)/s`` is a linear factor over the
-parameters (:func:`symstab.symbolic.discretize.zoh_pulse_transfer_function`), else
+residues when the denominator of ``G(s)/s`` factors, over the parameters,
+into factors of degree 1 or 2 in ``s``
+(:func:`symstab.symbolic.discretize.zoh_pulse_transfer_function`), else
 by the matrix exponential at 30 digits once the plant's values are known
 (:func:`symstab.symbolic.discretize.numeric_zoh`); :attr:`LoopModel.zoh_method`
 says which.  It also decides which parameters enter ``chi`` affinely (the
@@ -28,7 +29,7 @@ from sympy.parsing.sympy_parser import convert_xor, parse_expr, standard_transfo
 
 from . import model
 from .._validate import check_delay
-from .discretize import linear_poles, numeric_zoh, zoh_pulse_transfer_function
+from .discretize import numeric_zoh, written_poles, zoh_pulse_transfer_function
 
 __all__ = ["LoopModel", "parse_plant", "parse_environment", "check_parameter_name", "is_affine",
            "poly_coeffs"]
@@ -42,6 +43,26 @@ _C_KEYWORDS = frozenset(
     "inline int long register restrict return short signed sizeof static struct switch typedef "
     "union unsigned void volatile while _Bool _Complex _Imaginary".split())
 _GENERATED_NAME = re.compile(r"(num|den|pn|pd|x)\d+|numpy|_.*")
+
+
+def _real_floats(values):
+    """Floats of mpmath numbers that are real up to rounding.
+
+    A complex pole pair is written with the square root of a negative
+    number; its terms of the pulse transfer function add up to real
+    coefficients, with imaginary parts of the working precision's rounding.
+    Anything larger is a defect, not rounding, and raises.
+    """
+    scale = max((abs(v) for v in values), default=mpmath.mpf(0))
+    out = []
+    for v in values:
+        if isinstance(v, mpmath.mpc):
+            if abs(v.imag) > mpmath.mpf(10) ** (10 - mpmath.mp.dps) * scale:
+                raise ArithmeticError(f"the plant's pulse transfer function has a complex "
+                                      f"coefficient {v}")
+            v = v.real
+        out.append(float(v))
+    return out
 
 
 def check_parameter_name(name):
@@ -258,7 +279,7 @@ class LoopModel:
                 raise ValueError(f"units: {key!r} is not a parameter of this loop "
                                  f"(parameters: {', '.join(self.parameters)})")
             self.units[key] = str(unit)
-        poles = linear_poles(sp.together(self.plant / model.s))
+        poles = written_poles(sp.together(self.plant / model.s))
         numeric_plant = not (self.plant.free_symbols - {model.s})
         self.zoh_method = "residues" if poles is not None and not numeric_plant else "matrix exponential"
         self.plane = None
@@ -297,7 +318,7 @@ class LoopModel:
             :attr:`zoh_method`).
         """
         if self._plant_parts is None:
-            raise ValueError("this plant's poles are not linear factors over its parameters: "
+            raise ValueError("this plant's denominator has a factor of degree 3 or more in s: "
                              "its pulse transfer function is computed numerically "
                              "(zoh_method = 'matrix exponential') once its values are given")
         num, den = self._plant_parts
@@ -444,8 +465,8 @@ class LoopModel:
                     p_n, p_d = self._plant_functions(*point, mpmath.mpf(float(T)))
                 except ZeroDivisionError:
                     p_n, p_d = [mpmath.nan], [mpmath.mpf(0)]
-                p_n = [mpmath.mpf(c) for c in p_n]
-                p_d = [mpmath.mpf(c) for c in p_d]
+                p_n = [mpmath.mpmathify(c) for c in p_n]
+                p_d = [mpmath.mpmathify(c) for c in p_d]
             lead = p_d[0]
             if lead == 0 or not all(mpmath.isfinite(c) for c in p_n + p_d):
                 given = ", ".join(f"{n} = {float(v):g}" for n, v in zip(self._plant_names, plant_values))
@@ -454,6 +475,5 @@ class LoopModel:
                                  f"e.g. b = 0 in 1/(m s**2 + b s)? write that plant with b = 0)")
             ends = [sum(c * sign**k for k, c in enumerate(reversed(part)))
                     for sign in (1, -1) for part in (p_n, p_d)]
-            return (np.array([float(c / lead) for c in p_n]),
-                    np.array([float(c / lead) for c in p_d]),
-                    np.array([float(c / lead) for c in ends]))
+            return tuple(np.array(_real_floats([c / lead for c in part]))
+                         for part in (p_n, p_d, ends))

@@ -102,20 +102,36 @@ def test_numeric_zoh_matches_python_control():
     np.testing.assert_allclose(ours_num, o_num / o_den[0], rtol=1e-7)
 
 
-def test_numeric_path_for_a_quadratic_factor():
-    """An operator's arm (mass-spring-damper to ground) makes a quadratic the residues skip."""
+def _python_control_radius(den, K, B, d):
+    """Spectral radius of the loop with G = 1 / den(s) and VE = K + B (z - 1) / (T z), by python-control."""
+    G = control.sample_system(control.tf([1], den), PAPER_T, "zoh")
+    zz = control.tf([1, 0], [1], PAPER_T)
+    VE = K + B * (zz - 1) / (PAPER_T * zz)
+    delay = control.tf([1], [1] + [0] * d, PAPER_T)
+    return max(abs(control.feedback(G, VE * delay).poles()))
+
+
+@pytest.mark.parametrize("k_h", [100.0, 0.5])     # underdamped (a complex pair), overdamped
+def test_a_quadratic_factor_by_residues(k_h):
+    """An operator's arm (mass-spring-damper to ground): poles written with a square root."""
     loop = Loop("1/((m + m_h)*s**2 + (b + b_h)*s + k_h)", "K + B*(z - 1)/(T*z)")
+    assert loop.zoh_method == "residues"
+    assert any(not p.exp.is_integer for p in loop.pulse_transfer_function().atoms(sp.Pow))
+    values = dict(m=PAPER_M, m_h=0.05, b=PAPER_B, b_h=1.0, k_h=k_h, T=PAPER_T)
+    for K, B, d in ((300.0, 0.5, 0), (2000.0, 2.0, 2), (50.0, 0.1, 10)):
+        oracle = _python_control_radius([PAPER_M + 0.05, PAPER_B + 1.0, k_h], K, B, d)
+        assert loop.spectral_radius(K=K, B=B, d=d, **values) == pytest.approx(oracle, rel=1e-8)
+
+
+def test_numeric_path_for_a_cubic_factor():
+    """An irreducible cubic is left to the matrix exponential, and says so."""
+    loop = Loop("1/(m*s**3 + b*s**2 + k*s + c)", "K + B*(z - 1)/(T*z)")
     assert loop.zoh_method == "matrix exponential"
     with pytest.raises(ValueError, match="numerically"):
         loop.pulse_transfer_function()
-    values = dict(m=PAPER_M, m_h=0.05, b=PAPER_B, b_h=1.0, k_h=100.0, T=PAPER_T)
-    for K, B, d in ((300.0, 0.5, 0), (2000.0, 2.0, 2), (50.0, 0.1, 10)):
-        G = control.sample_system(control.tf([1], [PAPER_M + 0.05, PAPER_B + 1.0, 100.0]),
-                                  PAPER_T, "zoh")
-        zz = control.tf([1, 0], [1], PAPER_T)
-        VE = K + B * (zz - 1) / (PAPER_T * zz)
-        delay = control.tf([1], [1] + [0] * d, PAPER_T)
-        oracle = max(abs(control.feedback(G, VE * delay).poles()))
+    values = dict(m=PAPER_M, b=PAPER_B, k=50.0, c=10.0, T=PAPER_T)
+    for K, B, d in ((30.0, 0.5, 0), (200.0, 2.0, 2), (5.0, 0.1, 10)):
+        oracle = _python_control_radius([PAPER_M, PAPER_B, 50.0, 10.0], K, B, d)
         assert loop.spectral_radius(K=K, B=B, d=d, **values) == pytest.approx(oracle, rel=1e-8)
 
 

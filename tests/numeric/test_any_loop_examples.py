@@ -102,7 +102,7 @@ def _two_mass_plant(p):
 class Oracle:
     plant: object          # values -> continuous control.tf / control.ss
     environment: object    # (values, K, B) -> (num rows, den rows) in z
-    zoh_method: str        # what the loop must report: poles linear or not
+    zoh_method: str        # what the loop must report: factors of degree <= 2 or not
     affine: frozenset      # parameters chi is affine in, from the physics
 
 
@@ -120,16 +120,16 @@ ORACLES = {
     "actuator_lag": Oracle(lambda p: control.tf([1.0], np.polymul([p["tau"], 1.0],
                                                                    [p["m"], p["b"], 0.0])),
                            _eq1_environment, "residues", EQ1),
-    # s times an irreducible cubic: not linear factors.
+    # s times an irreducible cubic: no closed form worth carrying.
     "two_mass": Oracle(_two_mass_plant, _eq1_environment, "matrix exponential", EQ1),
     "lowpass_velocity": Oracle(lambda p: control.tf([1.0], [p["m"], p["b"], 0.0]),
                                _lowpass_environment, "residues", frozenset({"K", "B"})),
     "tustin_damper": Oracle(lambda p: control.tf([1.0], [p["m"], p["b"], 0.0]),
                             _tustin_environment, "residues", frozenset({"K", "B"})),
-    # A complex pair (m + m_h) s^2 + (b + b_h) s + k_h: needs a square root.
+    # A complex pair (m + m_h) s^2 + (b + b_h) s + k_h: written with a square root.
     "operator_arm": Oracle(lambda p: control.tf([1.0], [p["m"] + p["m_h"], p["b"] + p["b_h"],
                                                         p["k_h"]]),
-                           _eq1_environment, "matrix exponential", EQ1),
+                           _eq1_environment, "residues", EQ1),
 }
 
 
