@@ -502,22 +502,8 @@ class Loop(LoopModel):
         check_memory("the boundary", 64 * n)
         base, (ax, ay), ends = self._basis((x, y), values)
         theta = np.pi * (np.arange(1, n + 1) - 0.5) / n
-        a0, cx, cy = (_on_circle(c, theta) for c in (base, ax, ay))
-        with np.errstate(all="ignore"):
-            det = cx.real * cy.imag - cy.real * cx.imag
-            xs = (-a0.real * cy.imag + cy.real * a0.imag) / det
-            ys = (-cx.real * a0.imag + a0.real * cx.imag) / det
-            singular = np.abs(det) <= 1e-12 * np.abs(cx) * np.abs(cy)
-        xs[singular] = np.nan
-        ys[singular] = np.nan
-        lines = {}
-        for index, label in enumerate(("z = 1", "z = -1")):
-            c = [float(e[index]) for e in ends]
-            if c[1] or c[2]:
-                lines[label] = tuple(c)
-        lead = (float(base[0]), float(ax[0]), float(ay[0]))
-        if lead[1] or lead[2]:
-            lines["leading"] = lead
+        xs, ys = _arc_points(base, ax, ay, theta)
+        lines = {label: c for label, c in _lines(base, ax, ay, ends).items() if c[1] or c[2]}
         return LoopBoundary(x=x, y=y, theta=theta, x_values=xs, y_values=ys, lines=lines)
 
     def limits(self, x=None, y=None, *, n_lines=201, **values):
@@ -858,6 +844,36 @@ def _line_intervals(a0, a1, a0_ends, a1_ends):
     return out
 
 
+def _arc_points(base, ax, ay, theta):
+    """The D-decomposition's arc: the (x, y) at which ``exp(j theta)`` is a root.
+
+    ``base + x ax + y ay`` vanishes there: its real and imaginary parts are
+    two linear equations in ``(x, y)``, solved by Cramer's rule; NaN where
+    they are singular (the arc runs off to infinity).
+    """
+    a0, cx, cy = (_on_circle(c, theta) for c in (base, ax, ay))
+    with np.errstate(all="ignore"):
+        det = cx.real * cy.imag - cy.real * cx.imag
+        xs = (-a0.real * cy.imag + cy.real * a0.imag) / det
+        ys = (-cx.real * a0.imag + a0.real * cx.imag) / det
+        singular = ~(np.abs(det) > 1e-12 * np.abs(cx) * np.abs(cy))
+    xs[singular] = np.nan
+    ys[singular] = np.nan
+    return xs, ys
+
+
+def _lines(base, ax, ay, ends):
+    """``{"z = 1": (c0, cx, cy), "z = -1": ..., "leading": ...}``: ``c0 + cx x + cy y = 0``.
+
+    The real roots z = +-1 (from the values at +-1 in ``ends``) and a root
+    at infinity (the leading coefficient).
+    """
+    out = {label: tuple(float(e[index]) for e in ends)
+           for index, label in enumerate(("z = 1", "z = -1"))}
+    out["leading"] = (float(base[0]), float(ax[0]), float(ay[0]))
+    return out
+
+
 def _stable_seeds(base, ax, ay, ends):
     """The ``x`` of stable points next to the D-decomposition's curves.
 
@@ -868,13 +884,8 @@ def _stable_seeds(base, ax, ay, ends):
     """
     n = len(base) - 1
     theta = np.pi * (np.arange(1, 16 * (n + 4) + 1) - 0.5) / (16 * (n + 4))
-    a0, cx, cy = (_on_circle(c, theta) for c in (base, ax, ay))
-    with np.errstate(all="ignore"):
-        det = cx.real * cy.imag - cy.real * cx.imag
-        xs = (-a0.real * cy.imag + cy.real * a0.imag) / det
-        ys = (-cx.real * a0.imag + a0.real * cx.imag) / det
-    lines = [tuple(e[k] for e in ends) for k in range(2)]
-    lines.append((base[0], ax[0], ay[0]))
+    xs, ys = _arc_points(base, ax, ay, theta)
+    lines = list(_lines(base, ax, ay, ends).values())
     for i in range(len(lines)):
         for j in range(i + 1, len(lines)):
             (c0, c1, c2), (e0, e1, e2) = lines[i], lines[j]
