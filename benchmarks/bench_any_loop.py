@@ -63,6 +63,8 @@ import numpy as np
 from symstab.numeric.units import PAPER_DEVICE
 
 REPO = pathlib.Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(REPO / "benchmarks"))
+from _timing import fmt  # noqa: E402  (the benchmarks' shared helpers)
 
 #: The paper's device, from its one home.
 M_DEV, B_DEV, T_DEV = PAPER_DEVICE.m, PAPER_DEVICE.b, PAPER_DEVICE.T
@@ -112,27 +114,8 @@ print(json.dumps(dict(import_s=imported - start, build_s=built - imported, zoh=l
 """
 
 
-def _fmt(seconds):
-    """A time with a unit that keeps 3 significant digits readable."""
-    for unit, scale in (("s", 1.0), ("ms", 1e-3), ("us", 1e-6), ("ns", 1e-9)):
-        if abs(seconds) >= scale or unit == "ns":
-            return f"{seconds / scale:.3g} {unit}"
-
-
-def _times(fn, runs, warmup=1):
-    """Run ``fn`` ``warmup`` times untimed, then ``runs`` times; return the times."""
-    for _ in range(warmup):
-        fn()
-    out = []
-    for _ in range(runs):
-        start = time.perf_counter()
-        fn()
-        out.append(time.perf_counter() - start)
-    return out
-
-
 def _times_interleaved(fns, runs, warmup=1):
-    """As :func:`_times` for several functions, run in turn so that they see the same load."""
+    """As :func:`timed_runs` for several functions, run in turn so that they see the same load."""
     for _ in range(warmup):
         for fn in fns:
             fn()
@@ -265,12 +248,12 @@ def bench_build(args):
         radius = _python_control_radius(spec)
         agrees = (code == 1) == (radius < 1) and abs(radius - 1) > NEAR_ONE
         worst = max(worst, build, warm)
-        print(f"  {name:<14} {cold[0][1]['zoh']:<19} {_fmt(build):>11} {_fmt(imported):>8} "
-              f"{_fmt(wall):>11} {_fmt(warm):>11}  {_verdict(max(build, warm) < BUILD_TARGET):<6} "
+        print(f"  {name:<14} {cold[0][1]['zoh']:<19} {fmt(build):>11} {fmt(imported):>8} "
+              f"{fmt(wall):>11} {fmt(warm):>11}  {_verdict(max(build, warm) < BUILD_TARGET):<6} "
               f"code {code:+d}, radius {radius:.6f}: {'agree' if agrees else 'DISAGREE'}"
               + ("" if fresh else "  (kernel NOT written to the empty cache!)"))
     print(f"   target: build < {BUILD_TARGET:g} s -> {_verdict(worst < BUILD_TARGET and not failed)} "
-          f"(slowest median {_fmt(worst)}; the cold subprocess adds the interpreter and import)")
+          f"(slowest median {fmt(worst)}; the cold subprocess adds the interpreter and import)")
 
 
 # --------------------------------------------------------------------------
@@ -335,11 +318,11 @@ def bench_classify(args, oracles):
             [lambda: loop.classify(**kw), lambda: symstab.classify(**dkw)], args.runs))
         per_loop = t_loop / n_points
         kernel_ratios.append(t_loop / t_paper)
-        print(f"  {'Loop.classify (per-loop kernel)':<46} {_fmt(t_loop):>11} {_fmt(per_loop):>10} "
+        print(f"  {'Loop.classify (per-loop kernel)':<46} {fmt(t_loop):>11} {fmt(per_loop):>10} "
               f"{'1x':>9}")
-        print(f"  {'symstab.classify (paper kernel, alpha..delta)':<46} {_fmt(t_paper):>11} "
-              f"{_fmt(t_paper / n_points):>10} {_ratio(t_paper / t_loop):>9}  "
-              f"(+ {_fmt(t_convert)} once: dimensionless_values per point)")
+        print(f"  {'symstab.classify (paper kernel, alpha..delta)':<46} {fmt(t_paper):>11} "
+              f"{fmt(t_paper / n_points):>10} {_ratio(t_paper / t_loop):>9}  "
+              f"(+ {fmt(t_convert)} once: dimensionless_values per point)")
 
         builds = {"c2d in": pc_full, "Gd once": pc_hoisted}
         for build in builds.values():
@@ -356,8 +339,8 @@ def bench_classify(args, oracles):
         for name in builds:
             per_pc = statistics.median(per[name])
             pc_ratios.append(per_pc / per_loop)
-            print(f"  {'python-control per point (' + name + ')':<46} {'~' + _fmt(per_pc * n_points):>11} "
-                  f"{_fmt(per_pc):>10} {_ratio(per_pc / per_loop):>9}")
+            print(f"  {'python-control per point (' + name + ')':<46} {'~' + fmt(per_pc * n_points):>11} "
+                  f"{fmt(per_pc):>10} {_ratio(per_pc / per_loop):>9}")
 
         flat, paper_flat = codes.ravel(), paper_codes.ravel()
         differ = np.flatnonzero(flat != paper_flat)
@@ -438,8 +421,8 @@ def bench_limits(args):
             diffs["K intervals"] = max(ends, default=0.0)
             worst = max(diffs, key=diffs.get)
             worst_all = max(worst_all, diffs[worst])
-            print(f"  {d:>3} {M_w:>7g} {_fmt(t_loop):>12} {_fmt(t_paper):>15} {t_loop / t_paper:>6.1f}x "
-                  f"{_fmt(t_int):>17} {_fmt(t_ref_int):>16}  {lim.y_max:<12.6g}  "
+            print(f"  {d:>3} {M_w:>7g} {fmt(t_loop):>12} {fmt(t_paper):>15} {t_loop / t_paper:>6.1f}x "
+                  f"{fmt(t_int):>17} {fmt(t_ref_int):>16}  {lim.y_max:<12.6g}  "
                   + ", ".join(f"{k} {v:.1e}" for k, v in diffs.items()))
     print(f"   Loop vs symstab.limits: largest relative difference {worst_all:.1e} (Loop.limits' "
           f"area is a trapezoid rule over its n_lines = 201 lines of constant B)")

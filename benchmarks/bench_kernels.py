@@ -41,6 +41,7 @@ import platform
 import shutil
 import statistics
 import subprocess
+import sys
 import tempfile
 import time
 
@@ -49,6 +50,8 @@ import numpy as np
 from symstab.numeric.units import PAPER_DEVICE
 
 REPO = pathlib.Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(REPO / "benchmarks"))
+from _timing import fmt, timed_runs  # noqa: E402  (the benchmarks' shared helpers)
 
 #: The paper's device, from its one home (symstab.PAPER_DEVICE).
 M, B_FRICTION, T = PAPER_DEVICE.m, PAPER_DEVICE.b, PAPER_DEVICE.T
@@ -63,25 +66,6 @@ NEAR_ONE = 1e-6
 TARGET_RATIO = 1000.0
 CURVE = dict(gamma=0.5, d=10, n=100_000)
 CURVE_TARGET = 20e-3
-
-
-def _fmt(seconds):
-    """A time with a unit that keeps 3 significant digits readable."""
-    for unit, scale in (("s", 1.0), ("ms", 1e-3), ("us", 1e-6), ("ns", 1e-9)):
-        if abs(seconds) >= scale or unit == "ns":
-            return f"{seconds / scale:.3g} {unit}"
-
-
-def _times(fn, runs, warmup=1):
-    """Run ``fn`` ``warmup`` times untimed, then ``runs`` times; return the times."""
-    for _ in range(warmup):
-        fn()
-    out = []
-    for _ in range(runs):
-        start = time.perf_counter()
-        fn()
-        out.append(time.perf_counter() - start)
-    return out
 
 
 def _oracles():
@@ -137,24 +121,24 @@ def bench_grid(args, oracles):
         print(f" gamma = {gamma:g}")
         kw = dict(alpha=A, beta=B, gamma=gamma, d=D_GRID, delta=DELTA)
         codes = symstab.classify(**kw)
-        t_cls = statistics.median(_times(lambda: symstab.classify(**kw), args.runs))
+        t_cls = statistics.median(timed_runs(lambda: symstab.classify(**kw), args.runs))
         per_cls = t_cls / n_points
         counts = {name: int(np.count_nonzero(codes == c))
                   for name, c in (("stable", STABLE), ("marginal", MARGINAL), ("unstable", UNSTABLE))}
-        _row("symstab.classify", _fmt(t_cls), _fmt(per_cls), 1.0,
+        _row("symstab.classify", fmt(t_cls), fmt(per_cls), 1.0,
              ", ".join(f"{k} {v}" for k, v in counts.items()))
 
         radius = symstab.spectral_radius(**kw)
-        t_rad = statistics.median(_times(lambda: symstab.spectral_radius(**kw), args.runs))
-        _row("symstab.spectral_radius (batched eig)", _fmt(t_rad), _fmt(t_rad / n_points), t_rad / t_cls)
+        t_rad = statistics.median(timed_runs(lambda: symstab.spectral_radius(**kw), args.runs))
+        _row("symstab.spectral_radius (batched eig)", fmt(t_rad), fmt(t_rad / n_points), t_rad / t_cls)
 
         def roots_loop():
             coeffs = loop_coefficients(**kw).reshape(n_points, -1)
             return np.array([np.max(np.abs(np.roots(c))) for c in coeffs])
 
         r_roots = roots_loop()
-        t_roots = statistics.median(_times(roots_loop, args.runs))
-        _row("loop_coefficients + numpy.roots per point", _fmt(t_roots), _fmt(t_roots / n_points),
+        t_roots = statistics.median(timed_runs(roots_loop, args.runs))
+        _row("loop_coefficients + numpy.roots per point", fmt(t_roots), fmt(t_roots / n_points),
              t_roots / t_cls)
 
         # python-control: every subset point timed once per build (after a
@@ -173,9 +157,9 @@ def bench_grid(args, oracles):
                 radii[name].append(np.max(np.abs(poles)))
         per_pc, r_pc = statistics.median(per["conftest"]), np.array(radii["conftest"])
         per_h, r_h = statistics.median(per["hoisted"]), np.array(radii["hoisted"])
-        _row("python-control per point (conftest, c2d in)", "~" + _fmt(per_pc * n_points), _fmt(per_pc),
+        _row("python-control per point (conftest, c2d in)", "~" + fmt(per_pc * n_points), fmt(per_pc),
              per_pc / per_cls)
-        _row("python-control per point (Gd built once)", "~" + _fmt(per_h * n_points), _fmt(per_h),
+        _row("python-control per point (Gd built once)", "~" + fmt(per_h * n_points), fmt(per_h),
              per_h / per_cls)
         headline.append((gamma, per_pc / per_cls, per_h / per_cls))
 
@@ -301,20 +285,20 @@ def bench_curve(args, oracles):
     def ns(seconds):
         return f"{seconds / n * 1e9:.0f} ns"
 
-    t_curve = statistics.median(_times(lambda: symstab.boundary_curve(**curve_kw), args.runs))
-    _row("symstab.boundary_curve (theta_max + arc)", _fmt(t_curve), ns(t_curve), 1.0,
-         f"target < {_fmt(CURVE_TARGET)}: {'met' if t_curve < CURVE_TARGET else 'NOT met'}")
-    t_kernel = statistics.median(_times(lambda: kernels.boundary(theta, gamma, d, DELTA), args.runs))
-    _row("  of which the NumPy kernel on the arc", _fmt(t_kernel), ns(t_kernel), t_kernel / t_curve)
+    t_curve = statistics.median(timed_runs(lambda: symstab.boundary_curve(**curve_kw), args.runs))
+    _row("symstab.boundary_curve (theta_max + arc)", fmt(t_curve), ns(t_curve), 1.0,
+         f"target < {fmt(CURVE_TARGET)}: {'met' if t_curve < CURVE_TARGET else 'NOT met'}")
+    t_kernel = statistics.median(timed_runs(lambda: kernels.boundary(theta, gamma, d, DELTA), args.runs))
+    _row("  of which the NumPy kernel on the arc", fmt(t_kernel), ns(t_kernel), t_kernel / t_curve)
 
     start = time.perf_counter()
     f_alpha, f_beta = _lambdified_boundary()
     t_setup = time.perf_counter() - start
     with np.errstate(invalid="ignore", divide="ignore"):
-        t_lamb = statistics.median(_times(lambda: (f_alpha(theta, gamma, d, DELTA),
+        t_lamb = statistics.median(timed_runs(lambda: (f_alpha(theta, gamma, d, DELTA),
                                                    f_beta(theta, gamma, d, DELTA)), args.runs))
-    _row("lambdify(boundary().alpha, .beta), numpy", _fmt(t_lamb), ns(t_lamb), t_lamb / t_curve,
-         f"(+ {_fmt(t_setup)} once: boundary() and lambdify)")
+    _row("lambdify(boundary().alpha, .beta), numpy", fmt(t_lamb), ns(t_lamb), t_lamb / t_curve,
+         f"(+ {fmt(t_setup)} once: boundary() and lambdify)")
 
     ref_a, ref_b = kernels.boundary(theta, gamma, d, DELTA)
     c_result = _c_kernel(curve.theta_max, args.runs)
@@ -325,7 +309,7 @@ def bench_curve(args, oracles):
         t_c = statistics.median(c_times)
         c_dev = max(max(abs(a - ref_a[k]) / np.max(np.abs(ref_a)), abs(b - ref_b[k]) / np.max(np.abs(ref_b)))
                     for k, (a, b) in c_points.items())
-        _row("C kernel symstab_boundary, C loop (cc -O2)", _fmt(t_c), ns(t_c), t_c / t_curve,
+        _row("C kernel symstab_boundary, C loop (cc -O2)", fmt(t_c), ns(t_c), t_c / t_curve,
              f"(C vs NumPy kernel at {len(c_points)} angles: {c_dev:.1e})")
 
     # Accuracy of the lambdified expression for small delta.  Reference: the
@@ -361,12 +345,12 @@ def bench_region(args):
     for d in (0, 10, 40):
         cells = []
         for gamma in GAMMAS:
-            t = statistics.median(_times(lambda: symstab.limits(gamma=gamma, d=d, delta=DELTA),
+            t = statistics.median(timed_runs(lambda: symstab.limits(gamma=gamma, d=d, delta=DELTA),
                                          args.limits_runs))
-            cells.append(f"gamma {gamma:g}: {_fmt(t):>9}")
+            cells.append(f"gamma {gamma:g}: {fmt(t):>9}")
         print(f"  limits, d = {d:<3} " + "   ".join(cells))
-    t = statistics.median(_times(lambda: symstab.best_virtual_mass(d=0, delta=DELTA), args.limits_runs))
-    print(f"  best_virtual_mass, d = 0   {_fmt(t)}")
+    t = statistics.median(timed_runs(lambda: symstab.best_virtual_mass(d=0, delta=DELTA), args.limits_runs))
+    print(f"  best_virtual_mass, d = 0   {fmt(t)}")
 
 
 def main():

@@ -20,7 +20,6 @@ evaluated once at the given point) and the output paths.  The caller
 import dataclasses
 import io
 import math
-import pathlib
 import sys
 import textwrap
 
@@ -556,8 +555,8 @@ def _cmd_classify(args):
 
 
 def _cmd_map(args):
-    from .commands import check_outputs, write_output
-    from .simulate import _grid
+    from .commands import write_output
+    from .simulate import _grid, map_outputs
     from ..numeric.simulate import progress_printer
     from ..numeric.stability import MARGINAL, STABLE
 
@@ -565,14 +564,7 @@ def _cmd_map(args):
     if args.x_range is None or args.y_range is None:
         raise ValueError("map --loop needs the grid: --x-range LOW,HIGH,N and --y-range LOW,HIGH,N")
     xs, ys = _grid(args.x_range, "--x-range"), _grid(args.y_range, "--y-range")
-    if not args.out.endswith((".csv", ".npz")):
-        raise ValueError(f"--out must end in .csv or .npz, got {args.out}")
-    if args.no_png and args.png is not None:
-        raise ValueError("give --png or --no-png, not both")
-    png = None if args.no_png else (
-        str(pathlib.Path(args.out).with_suffix(".png")) if args.png is None else args.png)
-    paths = check_outputs([("--out", args.out, "file"), ("--png", png, "file")])
-    out, png_path = paths["--out"], paths.get("--png")
+    out, png_path = map_outputs(args)
     loop, values = setup.loop, setup.values
     degree = loop.coefficients(**{setup.x: 0.0, setup.y: 0.0}, **values).shape[-1]
     # The cells are classified a chunk of x at a time; what stays is the codes

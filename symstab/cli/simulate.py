@@ -76,6 +76,22 @@ def _outputs(pairs):
     return check_outputs([(flag, path, "file") for flag, path in pairs])
 
 
+def map_outputs(args):
+    """``(out, png)`` paths of ``map``, checked before any work (png None with --no-png).
+
+    ``--out`` must be a .csv or .npz file; the PNG defaults to ``--out``
+    with the suffix .png.
+    """
+    if not args.out.endswith((".csv", ".npz")):
+        raise ValueError(f"--out must end in .csv or .npz, got {args.out}")
+    if args.no_png and args.png is not None:
+        raise ValueError("give --png or --no-png, not both")
+    png = None if args.no_png else (
+        str(pathlib.Path(args.out).with_suffix(".png")) if args.png is None else args.png)
+    paths = _outputs([("--out", args.out), ("--png", png)])
+    return paths["--out"], paths.get("--png")
+
+
 def _write(path, data, flag):
     from .commands import write_output
 
@@ -171,14 +187,7 @@ def _cmd_map(args):
         return given[flag]
 
     alpha, beta = (np.atleast_1d(x) for x in stiffness_and_damping(args, setup, grid))
-    if not args.out.endswith((".csv", ".npz")):
-        raise ValueError(f"--out must end in .csv or .npz, got {args.out}")
-    if args.no_png and args.png is not None:
-        raise ValueError("give --png or --no-png, not both")
-    png = None if args.no_png else (
-        str(pathlib.Path(args.out).with_suffix(".png")) if args.png is None else args.png)
-    paths = _outputs([("--out", args.out), ("--png", png)])
-    out, png_path = paths["--out"], paths.get("--png")
+    out, png_path = map_outputs(args)
     check_memory(f"a map of {alpha.size} x {beta.size} cells", alpha.size * beta.size * _MAP_CELL_BYTES)
     steps = check_steps(args.steps, setup.d)
     for line in setup.echo:
