@@ -349,13 +349,14 @@ class Loop(LoopModel):
     @staticmethod
     def _finite(c, values):
         """``c`` if every coefficient is finite, else a ValueError naming the values."""
-        bad = ~np.all(np.isfinite(c), axis=-1)
+        # Not finite (overflow), or nothing left (every coefficient underflowed).
+        bad = ~np.all(np.isfinite(c), axis=-1) | ~np.any(c != 0, axis=-1)
         if np.any(bad):
             index = np.unravel_index(int(np.flatnonzero(bad.ravel())[0]), bad.shape)
             point = ", ".join(f"{n} = {float(v[index] if v.ndim else v):g}"
                               for n, v in values.items())
-            raise ValueError(f"the characteristic polynomial overflows at {point}: a parameter is "
-                             f"too large or too small for double precision")
+            raise ValueError(f"the characteristic polynomial overflows or underflows at {point}: a "
+                             f"parameter is too large or too small for double precision")
         return c
 
     def spectral_radius(self, **values):
@@ -441,8 +442,10 @@ class Loop(LoopModel):
         for name in names:
             values[name] = np.asarray(0.0)
         plant = self._plant_arrays(values, shape)
-        base = self._coefficients(values, d, shape, plant=plant)
-        slopes = [self._coefficients(values, d, shape, slope=n, plant=plant) for n in names]
+        with np.errstate(all="ignore"):     # an overflow is the ValueError of _finite
+            base = self._finite(self._coefficients(values, d, shape, plant=plant), values)
+            slopes = [self._finite(self._coefficients(values, d, shape, slope=n, plant=plant),
+                                   values) for n in names]
         ends = [self._end_values(values, d, shape, plant=plant)] + [
             self._end_values(values, d, shape, slope=n, plant=plant) for n in names]
         return base, slopes, ends
@@ -471,7 +474,14 @@ class Loop(LoopModel):
             ``-inf`` and ``hi`` ``inf``.  Endpoints are unstable or marginal.
         """
         base, (slope,), (base_ends, slope_ends) = self._basis((name,), values)
-        return _line_intervals(base, slope, base_ends, slope_ends)
+        try:
+            return _line_intervals(base, slope, base_ends, slope_ends)
+        except _Unresolved:
+            fixed = ", ".join(f"{k} = {v:g}" for k, v in values.items() if k != "d")
+            raise ValueError(f"the loop's polynomial along {name} cannot be resolved in double "
+                             f"precision at {fixed}, d = {values.get('d', self.defaults.get('d'))}: "
+                             f"every stretch has a root on the unit circle to within rounding "
+                             f"(a value far outside the loop's usual range?)") from None
 
     def _plane(self, x, y):
         if x is None and y is None and self.plane is not None:
@@ -533,8 +543,14 @@ class Loop(LoopModel):
         n_lines = check_count("n_lines", n_lines, 8)
         base, (ax, ay), (base_ends, x_ends, y_ends) = self._basis((x, y), values)
 
+        unresolved = []
+
         def intervals(xv):
-            return _line_intervals(base + xv * ax, ay, base_ends + xv * x_ends, y_ends)
+            try:
+                return _line_intervals(base + xv * ax, ay, base_ends + xv * x_ends, y_ends)
+            except _Unresolved:
+                unresolved.append(xv)
+                return []
 
         tops_seen = {}
 
@@ -548,6 +564,13 @@ class Loop(LoopModel):
 
         seeds = _stable_seeds(base, ax, ay, (base_ends, x_ends, y_ends))
         if seeds.size == 0:
+            intervals(0.0)
+            if unresolved:
+                fixed = ", ".join(f"{k} = {v:g}" for k, v in values.items() if k != "d")
+                raise ValueError(f"the loop's polynomial in the ({x}, {y}) plane cannot be resolved "
+                                 f"in double precision at {fixed}: its roots lie on the unit "
+                                 f"circle to within rounding (a value far outside the loop's "
+                                 f"usual range?)")
             return LoopLimits(x, y, np.nan, np.nan, np.nan, np.nan, 0.0, 0)
         scale = max(float(np.ptp(seeds)), 1e-12 * max(1.0, float(np.max(np.abs(seeds)))))
 
@@ -771,6 +794,10 @@ def _crossing_changes(a0, a1, p, theta):
     return np.where(clear, size * np.sign(radial), np.nan)
 
 
+class _Unresolved(ArithmeticError):
+    """Every stretch of a line has a root on the unit circle to within rounding."""
+
+
 def _line_intervals(a0, a1, a0_ends, a1_ends):
     """Stable intervals of ``p`` for the polynomial ``a0 + p a1`` (rows, highest first).
 
@@ -831,6 +858,8 @@ def _line_intervals(a0, a1, a0_ends, a1_ends):
             counts = count(np.arange(len(tests)))
         else:
             counts[claim] = fresh
+    if np.all(counts == -1):
+        raise _Unresolved
     edges = np.concatenate([[-np.inf], candidates, [np.inf]])
     out = []
     for k, c in enumerate(counts):

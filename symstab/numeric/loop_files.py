@@ -68,11 +68,16 @@ def parse_loop_text(text, *, source="<loop file>"):
             value, unit = entry["value"], entry.get("unit")
         else:
             value, unit = entry, None
+        if isinstance(value, int) and not isinstance(value, bool) and abs(value) > 1e300:
+            value = math.inf   # past what a float holds: refused just below
         if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
             raise ValueError(f"{source}: parameter {key!r} must be a finite number, got {value!r}")
         values[key] = value
         if unit is not None:
-            units[key] = str(unit)
+            if not isinstance(unit, str) or not unit.isprintable():
+                raise ValueError(f"{source}: the unit of {key!r} must be one line of text, "
+                                 f"got {unit!r}")
+            units[key] = unit
     plane = data.get("plane")
     if plane is not None and not (isinstance(plane, list) and len(plane) == 2
                                   and all(isinstance(p, str) for p in plane)):
@@ -103,4 +108,6 @@ def load_loop(path):
         text = path.read_text(encoding="utf-8")
     except OSError as exc:
         raise ValueError(f"cannot read loop file {str(path)!r}: {exc.strerror or exc}") from None
+    except UnicodeDecodeError:
+        raise ValueError(f"loop file {str(path)!r} is not UTF-8 text") from None
     return parse_loop_text(text, source=str(path))

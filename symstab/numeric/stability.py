@@ -618,7 +618,9 @@ def _polynomial_counts_chunk(p, n_arcs, coefficient_ulps):
     n = p.shape[1] - 1
     n_rows = len(p)
     scale = np.max(np.abs(p), axis=1, keepdims=True)
-    p = p / scale
+    # A row of zeros (every coefficient underflowed) has no roots to count.
+    zero = scale[:, 0] == 0
+    p = p / np.where(scale == 0, 1.0, scale)
     powers = np.arange(n, -1, -1, dtype=float)
     s0 = np.sum(np.abs(p), axis=1)
     s1 = np.sum(powers * np.abs(p), axis=1)
@@ -657,7 +659,7 @@ def _polynomial_counts_chunk(p, n_arcs, coefficient_ulps):
     dchi_mid = dchi[:, 1::2].ravel()
     d2chi_mid = np.abs(d2chi[:, 1::2]).ravel()
     change = np.zeros(n_rows)
-    undecided = on_circle.copy()
+    undecided = on_circle | zero
     live = ~on_circle[row]
     row, lo, mid, hi = row[live], lo[live], mid[live], hi[live]
     chi_lo, chi_mid, chi_hi, dchi_mid = chi_lo[live], chi_mid[live], chi_hi[live], dchi_mid[live]

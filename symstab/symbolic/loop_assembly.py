@@ -18,6 +18,7 @@ axes a parameter plane may have) and evaluates the plant's polynomials at
 30 digits.  Everything numeric on top of it is :class:`symstab.Loop`.
 """
 
+import ast
 import functools
 import keyword
 import re
@@ -25,7 +26,6 @@ import re
 import mpmath
 import numpy as np
 import sympy as sp
-from sympy.parsing.sympy_parser import convert_xor, parse_expr, standard_transformations
 
 from . import model
 from .._validate import check_delay
@@ -43,6 +43,9 @@ _C_KEYWORDS = frozenset(
     "inline int long register restrict return short signed sizeof static struct switch typedef "
     "union unsigned void volatile while _Bool _Complex _Imaginary".split())
 _GENERATED_NAME = re.compile(r"(num|den|pn|pd|x)\d+|numpy|_.*")
+#: Keyword arguments of Loop's methods: a parameter of the same name would
+#: be taken for them.
+_ARGUMENT_NAMES = frozenset({"self", "name", "x", "y", "n", "n_lines", "values"})
 
 
 def _real_floats(values):
@@ -78,23 +81,72 @@ def check_parameter_name(name):
     ValueError
         Naming the parameter.
     """
+    if name in _ARGUMENT_NAMES:
+        raise ValueError(f"parameter {name!r} has the name of an argument of Loop's methods "
+                         f"({', '.join(sorted(_ARGUMENT_NAMES))}): rename it in the loop")
     if keyword.iskeyword(name) or name in _C_KEYWORDS or _GENERATED_NAME.fullmatch(name):
         raise ValueError(f"parameter {name!r} cannot be a name in the generated NumPy and C kernels "
                          f"(a Python or C keyword, 'numpy', a leading '_', or a name the kernels "
                          f"use: num<k>, den<k>, pn<k>, pd<k>, x<k>): rename it in the loop")
 
-_PARSE_GLOBALS = {
-    "Integer": sp.Integer, "Float": sp.Float, "Rational": sp.Rational, "Symbol": sp.Symbol,
-    "exp": sp.exp, "sqrt": sp.sqrt, "pi": sp.pi,
-}
+
+#: Highest order of a plant and degree of an environment, and the largest
+#: literal exponent: the ZOH, the polynomial and its root count grow with
+#: them, and a haptic loop needs a few tens at most.
+MAX_ORDER = 100
+
+_BINARY = {ast.Add: sp.Add, ast.Mult: sp.Mul,
+           ast.Sub: lambda a, b: a - b, ast.Div: lambda a, b: a / b, ast.Pow: lambda a, b: a**b}
+_FUNCTIONS = {"exp": sp.exp, "sqrt": sp.sqrt}
 
 
 def _parse(text, what):
-    local = {"s": model.s, "z": model.z, "T": model.T}
+    """A SymPy expression from arithmetic text, built from its syntax tree, never evaluated.
+
+    Only numbers, names, ``+ - * / **`` (or ``^``), brackets and calls of
+    ``exp`` and ``sqrt`` are allowed: anything else (attributes,
+    subscripts, other calls, comparisons, lambdas) is refused, so a string
+    from a loop file cannot run code.  A literal exponent is at most
+    :data:`MAX_ORDER` and an exponent holds no power (``2**(10**10)`` would
+    take SymPy forever).
+    """
     try:
-        expr = parse_expr(text, local_dict=local, global_dict=dict(_PARSE_GLOBALS),
-                          transformations=standard_transformations + (convert_xor,))
-    except Exception as exc:
+        tree = ast.parse(text.replace("^", "**"), mode="eval")
+    except SyntaxError as exc:
+        raise ValueError(f"{what} {text!r} is not a valid expression: {exc.msg}") from None
+    fixed = {"s": model.s, "z": model.z, "T": model.T, "pi": sp.pi}
+
+    def build(node, in_exponent=False):
+        if isinstance(node, ast.BinOp) and type(node.op) in _BINARY:
+            exponent = isinstance(node.op, ast.Pow)
+            if exponent and in_exponent:
+                raise ValueError(f"{what} {text!r}: a power inside an exponent is not allowed")
+            return _BINARY[type(node.op)](build(node.left, in_exponent),
+                                          build(node.right, in_exponent or exponent))
+        if isinstance(node, ast.UnaryOp) and isinstance(node.op, (ast.UAdd, ast.USub)):
+            value = build(node.operand, in_exponent)
+            return -value if isinstance(node.op, ast.USub) else value
+        if isinstance(node, ast.Constant) and type(node.value) in (int, float):
+            if in_exponent and abs(node.value) > MAX_ORDER:
+                raise ValueError(f"{what} {text!r}: exponent {node.value} is above the limit "
+                                 f"{MAX_ORDER}")
+            if isinstance(node.value, int):
+                return sp.Integer(node.value)
+            return sp.Float(repr(node.value))
+        if isinstance(node, ast.Name) and not node.id.startswith("_"):
+            return fixed.get(node.id) or sp.Symbol(node.id)
+        if (isinstance(node, ast.Call) and isinstance(node.func, ast.Name)
+                and node.func.id in _FUNCTIONS and len(node.args) == 1 and not node.keywords):
+            return _FUNCTIONS[node.func.id](build(node.args[0], in_exponent))
+        shown = ast.get_source_segment(text.replace("^", "**"), node) or type(node).__name__
+        raise ValueError(f"{what} {text!r}: {shown!r} is not allowed (numbers, names, + - * / **, "
+                         f"brackets, exp() and sqrt() only)")
+
+    try:
+        expr = build(tree.body)
+    except (TypeError, ValueError, ZeroDivisionError, OverflowError) as exc:
+        if isinstance(exc, ValueError) and str(exc).startswith(what):
+            raise
         raise ValueError(f"{what} {text!r} is not a valid expression: {exc}") from None
     if not isinstance(expr, sp.Expr):
         raise ValueError(f"{what} {text!r} is not an expression")
@@ -142,6 +194,8 @@ def _check_rational(expr, variable, what, other):
     if den == 0 or sp.simplify(num) == 0:
         raise ValueError(f"{what} must not be zero")
     nd, dd = sp.degree(num, variable), sp.degree(den, variable)
+    if dd > MAX_ORDER:
+        raise ValueError(f"{what} has degree {dd} in {variable}, above the limit {MAX_ORDER}")
     if nd > dd:
         raise ValueError(f"{what} must be proper (degree of numerator {nd} <= degree of "
                          f"denominator {dd} in {variable}), got {expr}")

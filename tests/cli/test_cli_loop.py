@@ -300,7 +300,7 @@ MAP = ["--x-range=0,1,3", "--y-range=0,1,3", "--out", "m.npz"]
     (["limits", *L, "--set", "T=0"], "T must be"),
     (["limits", *L, "--set", "m=0"], "not defined"),
     # Was "Array must not contain infs or NaNs" from the eigenvalues, after the work began.
-    (["classify", *L, "--set", "T=1e300"], "overflows at"),
+    (["classify", *L, "--set", "T=1e300"], "overflows or underflows at"),
     (["limits", *L, "--set", "T=1e300"], "T = 1e+300"),
     (["limits", *L, "--set", "m=1", "--set", "m=2"], "twice"),
     (["limits", *L, "--set", "d=1", "--d", "2"], "once"),

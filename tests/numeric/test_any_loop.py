@@ -322,10 +322,43 @@ def test_unwritable_cache_compiles_in_memory(tmp_path, monkeypatch):
     (PLANT, "K + B*s", "must not contain s"),
     ("0", ENVIRONMENT, "zero"),
     (PLANT, "K +* B", "not a valid expression"),
+    # Only arithmetic is parsed: no attribute, subscript, call or conditional.
+    ("1/(m*s**2) + 0*exp.eval.__globals__['__builtins__']", ENVIRONMENT, "not allowed"),
+    ("1/(m*s**2) if True else 0", ENVIRONMENT, "not allowed"),
+    ("__import__('os')", ENVIRONMENT, "not allowed"),
+    (PLANT, "sin(z)", "not allowed"),
+    # Sizes SymPy would take forever on are refused before any algebra.
+    ("1/s**1000", ENVIRONMENT, "above the limit 100"),
+    (PLANT, "K*2**(10**10)", "power inside an exponent"),
+    # Names that Loop's methods take as arguments.
+    (PLANT, "K + n_lines", "argument of Loop's methods"),
+    (PLANT, "K + x*B", "argument of Loop's methods"),
 ])
+
 def test_bad_loops_are_refused(plant, environment, match):
     with pytest.raises(ValueError, match=match):
         Loop(plant, environment)
+
+
+def test_a_loop_string_cannot_run_code(tmp_path):
+    """The parser builds SymPy objects from the syntax tree: nothing is evaluated."""
+    marker = tmp_path / "ran"
+    attack = (f"1/(m*s**2) + 0*exp.eval.__globals__['__builtins__']['__import__']('os')"
+              f".system('touch {marker}')")
+    with pytest.raises(ValueError, match="not allowed"):
+        Loop(attack, "K")
+    assert not marker.exists()
+
+
+def test_values_beyond_double_precision_are_an_error_not_an_empty_set(paper_loop):
+    # At T = 1e-30 the plant's numerator cancels to nothing even at 30 digits.
+    with pytest.raises(ValueError, match="cannot be resolved in double precision|underflows"):
+        paper_loop.limits("B", "K", M=0.0, m=PAPER_M, b=PAPER_B, T=1e-30, d=0)
+    with pytest.raises(ValueError, match="overflows or underflows"):
+        paper_loop.stable_intervals("K", B=0.1, M=0.0, m=PAPER_M, b=PAPER_B, T=1e-300, d=0)
+    with pytest.raises(ValueError, match="overflows or underflows"):
+        paper_loop.stable_intervals("K", B=0.1, M=0.0, m=PAPER_M, b=PAPER_B, T=1e300, d=0)
+
 
 
 def test_bad_calls_name_the_parameter(paper_loop):
