@@ -113,7 +113,11 @@ def check_array(name, value, *, low=None, low_open=False, high=None):
     objects raise :class:`TypeError`; NaN, infinite or out-of-range entries
     raise :class:`ValueError` naming ``name`` and the allowed range.
     """
-    arr = np.asarray(value)
+    try:
+        arr = np.asarray(value)
+    except ValueError:   # a ragged nested list
+        raise ValueError(f"{name} must be a real number or a rectangular array of real numbers, "
+                         f"got a ragged {type(value).__name__}") from None
     if arr.dtype == bool or arr.dtype.kind not in "iuf":
         raise TypeError(f"{name} must be a real number or an array of real numbers, "
                         f"got {type(value).__name__} of {arr.dtype}")

@@ -134,3 +134,10 @@ def test_check_delta_accepts_zero_up_to_the_limit(value, ok):
     else:
         with pytest.raises(ValueError, match=r"delta must be a finite real number >= 0 and <= 1e\+06"):
             check_delta(value)
+
+
+def test_a_ragged_list_is_refused_naming_the_parameter():
+    from symstab._validate import check_array
+
+    with pytest.raises(ValueError, match="alpha must be a real number or a rectangular array"):
+        check_array("alpha", [[1.0, 2.0], [3.0]])

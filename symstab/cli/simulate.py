@@ -166,9 +166,11 @@ def _grid(text, name):
         lo, hi, n = float(parts[0]), float(parts[1]), int(parts[2])
     except ValueError:
         raise ValueError(f"{name} must be LOW,HIGH,N with a whole N, got {text!r}") from None
-    if not (np.isfinite(lo) and np.isfinite(hi) and lo < hi and 2 <= n <= MAX_GRID):
-        raise ValueError(f"{name} must have finite LOW < HIGH and 2 <= N <= {MAX_GRID}, "
-                         f"got {text!r}")
+    # HIGH - LOW must be finite too: linspace takes it (1e308 - -1e308 is inf).
+    if not (np.isfinite(lo) and np.isfinite(hi) and lo < hi and np.isfinite(hi - lo)
+            and 2 <= n <= MAX_GRID):
+        raise ValueError(f"{name} must have finite LOW < HIGH (and HIGH - LOW finite) and "
+                         f"2 <= N <= {MAX_GRID}, got {text!r}")
     return np.linspace(lo, hi, n)
 
 

@@ -301,6 +301,8 @@ MAP = ["--x-range=0,1,3", "--y-range=0,1,3", "--out", "m.npz"]
     (["limits", *L, "--set", "m=0"], "not defined"),
     # Was "Array must not contain infs or NaNs" from the eigenvalues, after the work began.
     (["classify", *L, "--set", "T=1e300"], "overflows or underflows at"),
+    # linspace of -1e308..1e308 is NaN: the grid, not K, is what is wrong.
+    (["map", *L, "--x-range=0,1,10", "--y-range=-1e308,1e308,20", "--out", "m.npz"], "--y-range"),
     (["limits", *L, "--set", "T=1e300"], "T = 1e+300"),
     (["limits", *L, "--set", "m=1", "--set", "m=2"], "twice"),
     (["limits", *L, "--set", "d=1", "--d", "2"], "once"),
