@@ -42,7 +42,7 @@ import sympy as sp
 
 from .._resources import check_memory
 from .._validate import check_array, check_count, check_delay
-from ..symbolic.loop_assembly import LoopModel, parse_environment, parse_plant
+from ..symbolic.loop_assembly import _DPS, LoopModel, parse_environment, parse_plant
 from ..codegen.loop_kernels import environment_kernels, load_numpy_kernels
 from .region import _golden_max
 from .stability import (MARGINAL, STABLE, _leading_vanishes, classify_polynomials,
@@ -50,7 +50,6 @@ from .stability import (MARGINAL, STABLE, _leading_vanishes, classify_polynomial
 
 __all__ = ["Loop", "LoopLimits", "LoopBoundary", "parse_plant", "parse_environment"]
 
-_DPS = 30
 
 
 @dataclasses.dataclass(frozen=True)

@@ -24,7 +24,7 @@ from ..codegen.generator import _c_comment, _c_signature
 from ..codegen.loop_kernels import c_source, kernel, numpy_source
 
 __all__ = ["COMMAND", "OWNED", "MARKER", "PAPER_PLANT", "PAPER_ENVIRONMENT", "delay_parts",
-           "environment_kernels", "environment_title", "plant_kernel", "c_name",
+           "plant_kernel", "c_name",
            "derivation_steps", "kernel_files", "file_names", "loop_files", "is_generated",
            "unit_circle_system", "paper_loop_proofs"]
 
@@ -72,34 +72,6 @@ def _parameter_symbols(loop, expr):
     """The loop's parameter symbols in ``expr``, in the order of ``loop.parameters``."""
     by_name = {str(x): x for x in expr.free_symbols if x not in (model.s, model.z)}
     return [by_name[n] for n in loop.parameters if n in by_name]
-
-
-def environment_kernels(loop):
-    """The kernels of the loop's environment: :meth:`symstab.Loop.kernels`.
-
-    Parameters
-    ----------
-    loop : symstab.Loop
-
-    Returns
-    -------
-    list of symstab.codegen.generator.Kernel
-    """
-    return loop.kernels()
-
-
-def environment_title(loop):
-    """The title of the loop's NumPy module: :meth:`symstab.Loop.kernel_title`.
-
-    Parameters
-    ----------
-    loop : symstab.Loop
-
-    Returns
-    -------
-    str
-    """
-    return loop.kernel_title()
 
 
 def plant_kernel(loop):
@@ -175,7 +147,7 @@ def _c_header(kernels, *, title, prefix, guard):
 def kernel_files(loop):
     """``{filename: text}`` of the loop's NumPy module and C99 source and header.
 
-    The NumPy module holds :func:`environment_kernels` (what the loop runs
+    The NumPy module holds :meth:`symstab.Loop.kernels` (what the loop runs
     on); the C files add :func:`plant_kernel` on the residue path.  C
     symbols are ``symstab_<name>_<kernel>``.
 
@@ -195,7 +167,7 @@ def kernel_files(loop):
         output name of its kernel).
     """
     stem = c_name(loop)
-    environment = environment_kernels(loop)
+    environment = loop.kernels()
     plant = plant_kernel(loop)
     c_kernels = environment + ([plant] if plant is not None else [])
     prefix = f"symstab_{stem}_"
@@ -214,7 +186,7 @@ def kernel_files(loop):
     source = source.replace("#include <math.h>\n",
                             f'#include <math.h>\n#include "{stem}_kernels.h"\n{pi}', 1)
     return {
-        f"{stem}_kernels.py": numpy_source(environment, title=environment_title(loop),
+        f"{stem}_kernels.py": numpy_source(environment, title=loop.kernel_title(),
                                            command=COMMAND),
         f"{stem}_kernels.c": source,
         f"{stem}_kernels.h": _c_header(c_kernels, title=c_title, prefix=prefix,

@@ -165,7 +165,7 @@ def test_numpy_module_is_the_module_the_loop_runs_on():
                  NUMERIC_LOOP.replace('"K + B*(z - 1)/(T*z)"', '"K + 2*B*(z - 1)/(T*(z + 1))"')):
         loop = parse_loop_text(text)
         module = loop._kernels[0]
-        assert _digest(loop_derive.environment_kernels(loop)) == module.__symstab_digest__
+        assert _digest(loop.kernels()) == module.__symstab_digest__
 
 
 def test_check_passes_then_reports_edited_missing_and_extra_files(tmp_path, paper_folder):
@@ -493,7 +493,7 @@ def test_every_example_loop_compiles_and_its_c_matches_numpy(source, tmp_path):
     loop = load_loop(path)
     stem = loop_derive.c_name(loop)
     rng = np.random.default_rng(1)
-    for kernel in loop_derive.environment_kernels(loop):
+    for kernel in loop.kernels():
         names = [str(symbol) for symbol, _, _ in kernel.args]
         for _ in range(5):
             args = [loop.defaults.get(n, 1.0) * rng.uniform(0.5, 2.0) for n in names]
