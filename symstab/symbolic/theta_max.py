@@ -32,7 +32,7 @@ from .forms import E, exponential_form, trig_form, w
 __all__ = [
     "ClosedFormD0", "NewtonFormGamma0",
     "closed_form_d0", "newton_form_gamma0", "theta_max", "theta_max_newton",
-    "alpha_numerator_function",
+    "alpha_numerator_function", "ReducedEquation", "reduced_equation",
 ]
 
 #: u = 1 - cos(theta), the variable of the d = 0 closed form.
@@ -252,3 +252,96 @@ def theta_max_newton(*, d, delta):
 def _newton_function():
     return sp.lambdify((model.d, model.delta, model.Gamma), newton_form_gamma0().theta_newton,
                        modules="mpmath")
+
+
+# -- The reduced equation: theta_max in the general case -------------------
+
+@dataclasses.dataclass(frozen=True)
+class ReducedEquation:
+    """N_alpha with its positive factors divided out, for any (gamma, d, delta).
+
+    With ``u = 1 - cos(theta)`` and ``phi = (d + 1) theta``::
+
+        N_alpha = scale * u * R(theta)
+        R(theta) = sin(theta) (gamma (1 + q u) + cos(phi)) + (delta + r u) sin(phi)
+
+    ``scale = 2 delta**2 (Gamma - 1)**2 > 0`` and ``u > 0`` on (0, pi], so
+    theta_max is the first positive root of ``R``.  ``R`` has no cancelling
+    high-frequency terms (``N_alpha`` is a third difference of
+    ``sin((d + k) theta)``, which is why one Newton step on it errs), and
+    ``R(theta) = slope0 theta + O(theta**3)`` with ``slope0 = gamma + 1 +
+    delta (d + 1)``: an arc enters alpha > 0 exactly when ``slope0 > 0``.
+
+    Attributes
+    ----------
+    scale, q, r : sympy.Expr
+        Functions of ``delta`` and ``Gamma`` only (``q -> -1/2`` and
+        ``r -> 0`` as ``delta -> 0``).
+    R : sympy.Expr
+        ``R(theta)`` in theta, gamma, d, delta, Gamma.
+    slope0 : sympy.Expr
+        ``dR/dtheta`` at theta = 0.
+    """
+
+    scale: sp.Expr
+    q: sp.Expr
+    r: sp.Expr
+    R: sp.Expr
+    slope0: sp.Expr
+
+
+@functools.lru_cache(maxsize=None)
+def reduced_equation():
+    """Derive :class:`ReducedEquation` from the boundary's ``N_alpha``.
+
+    Every ``sin(k theta + d theta)`` of ``N_alpha`` is written around
+    ``phi = (d + 1) theta`` as ``sin(phi) cos(j theta) + cos(phi) sin(j
+    theta)``, and the low-frequency factors as polynomials in ``u`` by
+    Chebyshev's polynomials; the result is proved equal to ``N_alpha`` by the
+    exponential form (exactly, for symbolic d).
+
+    Raises
+    ------
+    AssertionError
+        If the derivation no longer has the shape stated in
+        :class:`ReducedEquation`.
+    """
+    theta, d, delta, Gamma, gamma = model.theta, model.d, model.delta, model.Gamma, model.gamma
+    num = sp.expand(boundary().alpha_numerator)
+    by_rate = {}
+    for sine in num.atoms(sp.sin):
+        rate = sp.expand(sine.args[0] / theta)
+        by_rate[rate] = sp.expand(by_rate.get(rate, 0) + num.coeff(sine))
+    c = 1 - u
+    S = C = P = sp.S.Zero
+    for rate, coeff in by_rate.items():
+        offset = sp.expand(rate - (d + 1))
+        if rate.has(d):
+            if not offset.is_integer:
+                raise AssertionError(f"N_alpha has sin({rate} theta): not an integer offset from d + 1")
+            j = int(offset)
+            S += coeff * sp.chebyshevt(abs(j), c)
+            if j:
+                C += coeff * sp.sign(j) * sp.chebyshevu(abs(j) - 1, c)
+        else:
+            if not (rate.is_integer and rate > 0 and sp.expand(coeff / gamma).free_symbols <= {delta, Gamma}):
+                raise AssertionError(f"N_alpha has {coeff} sin({rate} theta): not gamma times a harmonic")
+            P += coeff / gamma * sp.chebyshevu(int(rate) - 1, c)
+    P, S, C = (sp.Poly(sp.expand(e), u).all_coeffs()[::-1] for e in (P, S, C))
+    P, S, C = ([sp.factor(x) for x in e] + [0] * (3 - len(e)) for e in (P, S, C))
+    scale = P[1]
+    if not (P[0] == S[0] == C[0] == C[2] == 0 and len(P) == len(S) == len(C) == 3
+            and sp.expand(C[1] - scale) == 0 and sp.expand(S[1] - delta * scale) == 0
+            and sp.factor(scale - 2 * delta**2 * (Gamma - 1) ** 2) == 0):
+        raise AssertionError(f"N_alpha is not scale u R(theta): P={P}, S={S}, C={C}")
+    q, r = sp.factor(P[2] / scale), sp.factor(S[2] / scale)
+    phi = (d + 1) * theta
+    uu = 1 - sp.cos(theta)
+    # scale u R, written with the polynomial coefficients (q and r divide by scale).
+    rebuilt = (sp.sin(theta) * (gamma * (P[1] * uu + P[2] * uu**2) + C[1] * uu * sp.cos(phi))
+               + (S[1] * uu + S[2] * uu**2) * sp.sin(phi))
+    if sp.expand(exponential_form(num - rebuilt)) != 0:
+        raise AssertionError("scale u R(theta) differs from N_alpha")
+    R = sp.sin(theta) * (gamma * (1 + q * uu) + sp.cos(phi)) + (delta + r * uu) * sp.sin(phi)
+    slope0 = sp.factor(sp.diff(R, theta).subs(theta, 0))
+    return ReducedEquation(scale=scale, q=q, r=r, R=R, slope0=slope0)
