@@ -19,7 +19,7 @@ import tempfile
 import sympy as sp
 
 from ..codegen import forms as kernel_forms
-from . import loop_derive
+from . import loop_derive, necessity
 from ..symbolic import model
 from ..symbolic.boundary import boundary, coefficients, beta_relations
 from ..symbolic.discretize import dimensionless_pulse_transfer_function, pulse_transfer_function
@@ -82,6 +82,8 @@ def proofs():
     out += kernel_forms.proofs()
     # The paper's loop built by the general path (symstab.Loop) is this one.
     out += loop_derive.paper_loop_proofs()
+    # The identities of the necessity proofs (alpha > 0, the z = -1 line, |gamma| bound).
+    out += necessity.proofs()
     return out
 
 
@@ -174,6 +176,10 @@ def derivation_steps():
         # The object is the verdict itself: True means proved identical.
         proved.append((name, f"{statement} [proved: {_proof_note(name, lhs, rhs)}]", sp.S.true))
     steps.append(Step("07_proofs", "Identities proved by the exact checker", tuple(proved)))
+    # Their signs and exponent comparisons are decided when the conditions are built
+    # (a failure raises); their identities are in 07_proofs.
+    steps.append(Step("08_necessity", "Necessary conditions for stability, for every delay d",
+                      necessity.objects()))
     return steps
 
 
