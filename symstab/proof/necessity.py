@@ -3,13 +3,21 @@
 The loop is stable when every root of chi(z) lies strictly inside the unit
 circle.  chi has real coefficients, degree ``n = d + 4`` and leading
 coefficient ``a_n``; three classical necessary conditions (the first steps of
-Jury's test) follow from its values at ``z = 1``, ``z = -1`` and ``z = 0``:
+Jury's test) follow from its values at ``z = 1``, ``z = -1`` and ``z = 0``,
+and a fourth from its slope at ``z = 1``:
 
 * **z = 1.**  When ``a_n chi(1) < 0``, chi changes sign on ``[1, inf)``
   (``chi(x) -> sign(a_n) inf``): a real root ``> 1`` (intermediate values).
   When ``chi(1) = 0``, z = 1 is a root.  For this loop ``chi(1) = alpha q(delta)``
   with ``q > 0`` and ``a_n > 0``: **alpha <= 0 is never stable** (alpha < 0: a
   real root > 1; alpha = 0: a root at z = 1).
+* **z = 1, first order: the minimum damping.**  If every root ``z_i`` is
+  inside the circle, ``chi'(1) / chi(1) = sum 1 / (1 - z_i)`` and each
+  ``Re 1 / (1 - z_i) > 1/2``, so ``2 chi'(1) - n chi(1) > 0`` (with
+  ``chi(1) > 0``).  For this loop that is, for every d and gamma (gamma drops
+  out), **beta > -delta + s(d, delta) alpha** with
+  ``s = d/2 + 1/delta - Gamma/(Gamma - 1)``; for ``d >= 2``, ``s > 0`` and
+  beta > -delta (the paper's minimum damping ``B_w > -b``) is necessary.
 * **z = -1.**  ``(-1)**n chi(x) -> sign(a_n) inf`` as ``x -> -inf``, so
   ``a_n (-1)**n chi(-1) < 0`` gives a real root ``< -1`` and ``chi(-1) = 0``
   a root at z = -1.  For this loop ``(-1)**n chi(-1) = a(delta) (alpha + 2 beta
@@ -296,10 +304,61 @@ def _gamma_bound(chi, leading):
         decisions=decisions)
 
 
+def _minimum_damping(chi, leading):
+    """z = 1, first order: 2 chi'(1) - n chi(1) > 0, a line through (-delta, 0)."""
+    n, _, decisions = leading
+    alpha, beta, gamma, z = model.alpha, model.beta, model.gamma, model.z
+    at_one = sp.expand(chi.as_expr().subs(z, 1))
+    slope_at_one = sp.expand(sp.diff(chi.as_expr(), z).subs(z, 1))
+    if slope_at_one.has(z):
+        raise ProofFailed(f"chi'(1) still depends on z: {slope_at_one}")
+    condition = sp.expand(2 * slope_at_one - n * at_one)
+    scale = sp.factor(sp.diff(condition, beta))
+    start = sp.factor(-condition.subs({alpha: 0, beta: 0, gamma: 0}) / scale)
+    slope = sp.factor(-sp.diff(condition, alpha) / scale)
+    # Re 1/(1 - z) > 1/2 inside the unit circle: with z = x + j y,
+    # Re 1/(1 - z) - 1/2 = (1 - |z|**2) / (2 |1 - z|**2).
+    x, y = sp.symbols("x y", real=True)
+    lemma = ("necessity_re_one_over_one_minus_z",
+             "Re 1/(1 - z) - 1/2 = (1 - |z|^2) / (2 |1 - z|^2) for z = x + j y",
+             sp.re(1 / (1 - x - sp.I * y)) - sp.Rational(1, 2),
+             (1 - x**2 - y**2) / (2 * ((1 - x)**2 + y**2)))
+    identities = [lemma,
+                  ("necessity_minimum_damping_line",
+                   f"2 chi'(1) - n chi(1) = ({sp.sstr(scale)}) (beta - ({sp.sstr(start)}) "
+                   f"- ({sp.sstr(slope)}) alpha), for every d",
+                   condition, scale * (beta - start - slope * alpha))]
+    # For d = 2 + j (j >= 0) the slope times the positive scale is affine in j
+    # with a positive coefficient and a positive value at j = 0.
+    j = sp.Symbol("j", integer=True, nonnegative=True)
+    scaled = sp.expand((slope * scale).subs(model.d, 2 + j))
+    if sp.Poly(scaled, j).degree() > 1:
+        raise ProofFailed(f"slope * scale is not affine in d: {scaled}")
+    signs = (positive_for_positive_delta(scale, name="scale = d (2 chi'(1) - n chi(1)) / d beta"),
+             positive_for_positive_delta(scaled.coeff(j, 1), name="d (slope * scale) / d d"),
+             positive_for_positive_delta(scaled.subs(j, 0), name="slope * scale at d = 2"))
+    theorem = (
+        "If every root z_i is inside the unit circle, chi'(1) / chi(1) = sum 1/(1 - z_i) and "
+        "Re 1/(1 - z_i) > 1/2, so chi'(1) / chi(1) > n/2; with chi(1) > 0 (alpha > 0, "
+        f"alpha_positive): 2 chi'(1) - n chi(1) = ({sp.sstr(scale)}) (beta - ({sp.sstr(start)}) "
+        f"- s alpha) > 0 with the scale > 0, i.e. the minimum damping beta > {sp.sstr(start)} "
+        f"+ s alpha, s = {sp.sstr(slope)}, for every d and gamma (gamma drops out). "
+        "For d >= 2, s > 0, so beta > -delta is necessary; for d = 0, 1 the line leans "
+        "to beta < -delta as alpha grows.")
+    return NecessaryCondition(
+        name="minimum_damping",
+        theorem=theorem,
+        objects=(("chi_prime_at_1", "chi'(1) (d/dz z^(d + j) = d + j at z = 1)", slope_at_one),
+                 ("minimum_damping_start", "beta where the line meets alpha = 0", start),
+                 ("minimum_damping_slope", "s: the line is beta = start + s alpha", slope)),
+        identities=tuple(identities), signs=signs, decisions=decisions)
+
+
 @functools.lru_cache(maxsize=None)
 def _conditions(chi):
     leading = _extreme_term(chi, highest=True)
-    return (_alpha_positive(chi, leading), _minus_one_line(chi, leading), _gamma_bound(chi, leading))
+    return (_alpha_positive(chi, leading), _minimum_damping(chi, leading),
+            _minus_one_line(chi, leading), _gamma_bound(chi, leading))
 
 
 def necessary_conditions():
@@ -308,8 +367,8 @@ def necessary_conditions():
     Returns
     -------
     tuple of NecessaryCondition
-        ``alpha_positive`` (z = 1), ``minus_one_line`` (z = -1) and
-        ``gamma_bound`` (z = 0).  Their sign facts and exponent comparisons
+        ``alpha_positive`` (z = 1), ``minimum_damping`` (chi'(1)),
+        ``minus_one_line`` (z = -1) and ``gamma_bound`` (z = 0).  Their sign facts and exponent comparisons
         are decided here; their identities are proved by ``symstab derive``
         (:func:`proofs`).
 

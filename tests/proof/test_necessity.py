@@ -80,6 +80,28 @@ def test_gamma_bound_is_the_root_product_and_exceeds_two(delta):
             assert np.max(np.abs(roots)) >= 1.0 - 1e-9
 
 
+@pytest.mark.parametrize("gamma, d, delta", [(0.0, 0, 0.05), (1.0, 1, 0.3), (0.0, 2, 0.01),
+                                            (-0.5, 5, 0.2), (1.0, 10, 2.5e-3)])
+def test_every_stable_point_lies_beyond_the_minimum_damping_line(gamma, d, delta):
+    objects = {name: expr for name, _, expr in _conditions()["minimum_damping"].objects}
+    start = _evaluate(objects["minimum_damping_start"], delta=delta)
+    slope = _evaluate(objects["minimum_damping_slope"].subs(model.d, d), delta=delta)
+    assert start == pytest.approx(-delta, rel=1e-12)
+    # First principles: 2 chi'(1) - n chi(1) > 0 from the roots' log derivative.
+    assert slope == pytest.approx(d / 2 + 1 / delta - 1 / -np.expm1(-delta), rel=1e-9, abs=1e-12)
+    if d >= 2:
+        assert slope > 0
+    # A window around the start (-delta, 0), where the line is the binding bound.
+    stable = []
+    for beta in np.linspace(-delta - 0.05, -delta + 0.1, 31):
+        for alpha in np.linspace(1e-4, 0.05, 25):
+            if np.max(np.abs(_roots(alpha, beta, gamma, d, delta))) < 1.0:
+                stable.append((beta, alpha))
+    assert len(stable) > 20          # the check is not vacuous
+    for beta, alpha in stable:
+        assert beta > start + slope * alpha
+
+
 def test_gamma_max_tends_to_two():
     objects = {name: expr for name, _, expr in _conditions()["gamma_bound"].objects}
     assert objects["gamma_max_small_delta"] == 2
@@ -87,7 +109,7 @@ def test_gamma_max_tends_to_two():
 
 def test_the_theorems_hold_for_symbolic_d():
     conditions = _conditions()
-    assert set(conditions) == {"alpha_positive", "minus_one_line", "gamma_bound"}
+    assert set(conditions) == {"alpha_positive", "minimum_damping", "minus_one_line", "gamma_bound"}
     objects = dict((name, expr) for c in conditions.values() for name, _, expr in c.objects)
     assert objects["leading_exponent"] == model.d + 4
     assert not objects["chi_at_1"].has(model.d)
@@ -125,6 +147,8 @@ def _perturbed(*, delayed=None, direct=None):
     (dict(delayed=lambda p: -p), "leading coefficient"),
     # The constant term is no longer proportional to gamma's positive factor.
     (dict(direct=lambda p: p - 3 * model.gamma * (model.Gamma - model.delta - 1)), "g = a_0 / gamma"),
+    # chi(1) gains a beta term: 2 chi'(1) - n chi(1) is no longer d-free in beta.
+    (dict(direct=lambda p: p + model.beta * model.delta**2), "scale"),
 ])
 def test_a_changed_polynomial_fails_a_sign(monkeypatch, perturbation, match):
     monkeypatch.setattr(necessity, "characteristic_polynomial", lambda: _perturbed(**perturbation))
@@ -133,8 +157,9 @@ def test_a_changed_polynomial_fails_a_sign(monkeypatch, perturbation, match):
 
 
 def test_a_changed_polynomial_fails_symstab_derive(monkeypatch):
-    """chi(1) gains a beta term (every sign still holds): derive's identity check fails."""
-    perturbed = _perturbed(direct=lambda p: p + model.beta * model.delta**2)
+    """chi(1) gains a gamma term (every sign still holds): derive's identity check fails."""
+    perturbed = _perturbed(direct=lambda p: p + model.gamma * model.delta**3 * model.z)
+    assert necessity._conditions(perturbed)      # the signs alone do not see it
     monkeypatch.setattr(necessity, "characteristic_polynomial", lambda: perturbed)
     proofs = dict((name, (lhs, rhs)) for name, _, lhs, rhs in necessity.proofs())
     assert derive.check_identity(*proofs["necessity_chi_at_1_is_alpha_q"]).equal is False
