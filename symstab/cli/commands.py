@@ -423,11 +423,13 @@ def build_parser():
         example="symstab reproduce --out reproduction --workers 2", func=_cmd_reproduce)
     p.add_argument("--out", default="reproduction", help="output directory (default: reproduction)")
     p.add_argument("--workers", type=int, default=2, help="worker processes, >= 1 (default 2)")
+    from . import locus as cli_locus
     from . import numeric as cli_numeric
     from . import simulate as cli_simulate
 
     cli_numeric.add_commands(sub)
     cli_simulate.add_commands(sub)
+    cli_locus.add_commands(sub)
     return parser
 
 

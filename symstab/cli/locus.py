@@ -1,0 +1,608 @@
+"""``symstab locus``: the closed-loop poles along a path of the stiffness or the damping.
+
+The paper's loop takes the device and delay options of the numeric
+commands (:mod:`symstab.cli.numeric`) and a path: one of the stiffness
+(``--Kw``/``--alpha``) and the damping (``--Bw``/``--beta``) as a range
+``LOW:HIGH[:N]``, the other as one value.  A loop file takes ``--loop FILE``
+and ``--set NAME=VALUE``, one of the ``--set`` values a range.  The
+crossings of the unit circle (:func:`symstab.numeric.locus.locus`) are
+printed as one table; ``--png`` draws the poles in the z-plane, coloured by
+the path's parameter, beside their largest modulus along the path.  Every
+input is checked before the work; the PNG is written atomically.
+"""
+
+import dataclasses
+import io
+import math
+
+import numpy as np
+
+from . import loop as cli_loop
+from .numeric import _add_model_options, _emit, _resolve
+
+__all__ = ["add_commands"]
+
+#: Points of a path given as LOW:HIGH, and the most a path may have.
+DEFAULT_POINTS = 401
+MAX_POINTS = 100_000
+#: Poles farther out than this are left out of the z-plane panel (said in its title).
+_PLANE_LIMIT = 3.0
+#: The paper's options refused with --loop, and what replaces each.
+_DEVICE_OPTIONS = (
+    ("--m", "m", "--set m=..."), ("--b", "b", "--set b=..."), ("--T", "T", "--set T=..."),
+    ("--Td", "Td", "--set d=... (the delay in samples)"),
+    ("--delta", "delta", "--set with the loop's own parameters"),
+    ("--gamma", "gamma", "--set with the loop's virtual mass, e.g. --set M=..."),
+    ("--Mw", "Mw", "--set with the loop's virtual mass, e.g. --set M=..."),
+    ("--alpha", "alpha", "--set with the loop's parameters, e.g. --set K=LOW:HIGH"),
+    ("--beta", "beta", "--set with the loop's parameters, e.g. --set B=..."),
+    ("--Kw", "Kw", "--set with the loop's parameters, e.g. --set K=LOW:HIGH"),
+    ("--Bw", "Bw", "--set with the loop's parameters, e.g. --set B=..."),
+)
+_EXAMPLE_LOOP = "examples/loops/paper.toml"
+
+
+def add_commands(sub):
+    """Register ``symstab locus`` on an argparse sub-parser set."""
+    from .commands import add_command
+
+    p = add_command(
+        sub, "locus", help="the closed-loop poles along a path of the stiffness or the damping",
+        description="Track every closed-loop pole as the stiffness (or the damping) runs "
+                    "along a range, the other fixed, and list where a pole crosses the unit "
+                    "circle: a complex pair (the boundary arc, at the angle theta, oscillating "
+                    "at theta / (2 pi T)) or a real pole at z = 1 or z = -1; --png draws the "
+                    "poles in the z-plane and their largest modulus along the path.",
+        example="symstab locus --Td 0.04 --Bw 0.1 --Kw 0:30 --png locus.png", func=_cmd_locus)
+    _add_model_options(p)
+    g = p.add_argument_group(
+        "the path (one option a range LOW:HIGH or LOW:HIGH:N, default N = "
+        f"{DEFAULT_POINTS}; a negative LOW needs '=', e.g. --Kw=-5:30)")
+    g.add_argument("--alpha", help="dimensionless stiffness: a range, or one value")
+    g.add_argument("--beta", help="dimensionless damping: a range, or one value")
+    g.add_argument("--Kw", help="virtual stiffness (physical): a range, or one value")
+    g.add_argument("--Bw", help="virtual damping (physical): a range, or one value")
+    p.add_argument("--png", metavar="FILE", help="also draw the locus as PNG")
+    g = p.add_argument_group(
+        "any loop (instead of the device and path options above)",
+        f"A loop file (TOML, see {_EXAMPLE_LOOP}); --set NAME=VALUE changes a value in its "
+        "units, and one --set gives the path as a range, e.g. --set K=0:30.  --d still sets "
+        f"the delay.\nexample: symstab locus --loop {_EXAMPLE_LOOP} --set B=0.1 --set K=0:30 "
+        "--png locus.png")
+    g.add_argument("--loop", metavar="FILE", help="loop file (TOML)")
+    g.add_argument("--set", metavar="NAME=VALUE", action="append", dest="set_values",
+                   help="set a parameter of the loop, or give the path as NAME=LOW:HIGH[:N]; "
+                        "repeatable")
+
+
+# --------------------------------------------------------------------------
+# Inputs
+
+
+def _is_range(text):
+    return text is not None and ":" in text
+
+
+def _path(text, flag):
+    """The values of a range ``LOW:HIGH`` or ``LOW:HIGH:N``."""
+    parts = [t.strip() for t in text.split(":")]
+    if len(parts) not in (2, 3):
+        raise ValueError(f"{flag} must be LOW:HIGH or LOW:HIGH:N, got {text!r}")
+    try:
+        low, high = float(parts[0]), float(parts[1])
+    except ValueError:
+        raise ValueError(f"{flag} must be LOW:HIGH or LOW:HIGH:N with numbers, got {text!r}") \
+            from None
+    n = DEFAULT_POINTS
+    if len(parts) == 3:
+        try:
+            n = int(parts[2])
+        except ValueError:
+            raise ValueError(f"{flag}: N must be a whole number of points, got {parts[2]!r}") \
+                from None
+    if not (math.isfinite(low) and math.isfinite(high) and math.isfinite(high - low)):
+        raise ValueError(f"{flag} must have finite LOW and HIGH, got {text!r}")
+    if low == high:
+        raise ValueError(f"{flag} must have LOW != HIGH (a path), got {text!r}")
+    if not 2 <= n <= MAX_POINTS:
+        raise ValueError(f"{flag}: N must be from 2 to {MAX_POINTS}, got {n}")
+    return np.linspace(low, high, n)
+
+
+def _single(text, flag):
+    try:
+        value = float(text)
+    except ValueError:
+        raise ValueError(f"{flag} must be a number (or a range LOW:HIGH), got {text!r}") from None
+    if not math.isfinite(value):
+        raise ValueError(f"{flag} must be a finite number, got {text!r}")
+    return value
+
+
+class _View:
+    """What the output needs: the inputs' echo, the locus and how to show its parameter."""
+
+    def __init__(self, setup, locus, name, unit, tex, show, T, dimensionless=None, given=None):
+        self.setup = setup          # has .echo and .as_dict() (numeric.Setup or loop.LoopSetup)
+        self.locus = locus
+        self.name = name            # "K_w", "alpha", "K"
+        self.unit = unit
+        self.tex = tex              # the axis label, mathtext
+        self.show = show            # path values -> shown values
+        self.T = T                  # sample period (s) or None
+        self.dimensionless = dimensionless   # "alpha" or "beta" beside a physical value
+        self.given = given          # the path as the user gave it (in the shown units)
+
+    def label(self):
+        return f"{self.name} [{self.unit}]" if self.unit else self.name
+
+
+def _paper(args):
+    """The paper's loop: resolve the options, run :func:`paper_locus`; return a :class:`_View`."""
+    from ..numeric.locus import paper_locus
+    from .simulate import _tex_unit
+
+    for flag, dest in (("--set", "set_values"),):
+        if getattr(args, dest) is not None:
+            raise ValueError(f"{flag} needs a loop file: give --loop FILE "
+                             f"(e.g. --loop {_EXAMPLE_LOOP})")
+    setup = _resolve(args)
+    stiffness = [(f, getattr(args, d)) for f, d in (("--alpha", "alpha"), ("--Kw", "Kw"))
+                 if getattr(args, d) is not None]
+    damping = [(f, getattr(args, d)) for f, d in (("--beta", "beta"), ("--Bw", "Bw"))
+               if getattr(args, d) is not None]
+    if len(stiffness) != 1 or len(damping) != 1:
+        raise ValueError("give the stiffness (--alpha or --Kw) and the damping (--beta or --Bw), "
+                         "once each, one of them a range LOW:HIGH (the path)")
+    (s_flag, s_text), (d_flag, d_text) = stiffness[0], damping[0]
+    if _is_range(s_text) == _is_range(d_text):
+        raise ValueError(f"exactly one of {s_flag} and {d_flag} must be a range LOW:HIGH "
+                         f"(the path), the other one value; got {s_flag} {s_text} and "
+                         f"{d_flag} {d_text}")
+    for flag in (s_flag, d_flag):
+        if flag in ("--Kw", "--Bw") and not setup.physical:
+            raise ValueError(f"{flag} needs a physical device; use --alpha and --beta with "
+                             f"--delta")
+    path_flag, path_text, fixed_flag, fixed_text = (
+        (s_flag, s_text, d_flag, d_text) if _is_range(s_text) else (d_flag, d_text, s_flag, s_text))
+    given = _path(path_text, path_flag)
+    fixed = _single(fixed_text, fixed_flag)
+    dev = setup.device
+    to_dimensionless = {"--alpha": np.asarray, "--beta": np.asarray,
+                        "--Kw": (lambda v: dev.alpha(v)), "--Bw": (lambda v: dev.beta(v))}
+    parameter = "alpha" if path_flag in ("--alpha", "--Kw") else "beta"
+    other = "beta" if parameter == "alpha" else "alpha"
+    values = np.asarray(to_dimensionless[path_flag](given), dtype=float)
+    fixed_value = float(to_dimensionless[fixed_flag](fixed))
+    locus = paper_locus(parameter=parameter, values=values, gamma=setup.gamma, d=setup.d,
+                        delta=setup.delta, **{other: fixed_value})
+    fixed_name = fixed_flag[2:]
+    unit_of = {"Kw": "K_w", "Bw": "B_w"}
+    fixed_text = (f"{unit_of[fixed_name]} = {fixed:.10g} {setup.units[unit_of[fixed_name]]}"
+                  if fixed_name in unit_of else f"{fixed_name} = {fixed:.10g}")
+    if fixed_name in unit_of:
+        fixed_text += f" ({other} = {fixed_value:.10g})"
+    names = {"Kw": "K_w", "Bw": "B_w"}
+    setup = _with_echo(setup, f"path: {names.get(path_flag[2:], path_flag[2:])} from {given[0]:.10g} to {given[-1]:.10g} "
+                              f"({given.size} points) at {fixed_text}")
+    T = dev.T if setup.physical else None
+    if path_flag == "--Kw":
+        show, name, unit = dev.stiffness, "K_w", setup.units["K_w"]
+        tex = f"$K_w$ [{_tex_unit(unit)}]"
+    elif path_flag == "--Bw":
+        show, name, unit = dev.damping, "B_w", setup.units["B_w"]
+        tex = f"$B_w$ [{_tex_unit(unit)}]"
+    else:
+        show, name, unit = np.asarray, parameter, ""
+        tex = r"$\alpha = K_w T^2 / m$" if parameter == "alpha" else r"$\beta = B_w T / m$"
+    dimensionless = parameter if path_flag in ("--Kw", "--Bw") else None
+    return _View(setup, locus, name, unit, tex, lambda v: np.asarray(show(v), dtype=float), T,
+                 dimensionless, given)
+
+
+def _with_echo(setup, line):
+    return dataclasses.replace(setup, echo=tuple(setup.echo) + (line,))
+
+
+def _loop(args):
+    """A loop file: resolve ``--loop``/``--set``, run :func:`locus`; return a :class:`_View`."""
+    from ..numeric.locus import locus as track
+
+    for flag, dest, instead in _DEVICE_OPTIONS:
+        if getattr(args, dest) is not None:
+            raise ValueError(f"{flag} is an option of the paper's device; with --loop use "
+                             f"{instead}")
+    if args.linear:
+        raise ValueError("--linear is an option of the paper's device; with --loop the units "
+                         "are the loop file's")
+    sets, path = {}, None
+    for text in args.set_values or ():
+        flag = f"--set {text}"
+        name, eq, value = text.partition("=")
+        name = name.strip()
+        if not eq or not name:
+            raise ValueError(f"{flag}: expected NAME=VALUE or NAME=LOW:HIGH, e.g. --set K=0:30")
+        if name in sets or (path is not None and path[0] == name):
+            raise ValueError(f"--set {name} is given twice; give each parameter once")
+        if _is_range(value):
+            if path is not None:
+                raise ValueError(f"{flag}: the path is already --set {path[0]}=...; give one "
+                                 f"range (the others single values)")
+            if name == "d":
+                raise ValueError(f"{flag}: the delay d is a whole number of samples, not a path")
+            path = (name, _path(value, flag))
+        else:
+            sets[name] = cli_loop._parse_number(name, value, flag, lists=False)
+    if path is None:
+        raise ValueError("give the path as one --set NAME=LOW:HIGH[:N], e.g. --set K=0:30")
+    if args.d is not None:
+        if "d" in sets:
+            raise ValueError("give the delay once: --d or --set d=...")
+        sets["d"] = args.d
+    loop = cli_loop._load(args.loop)
+    for name in list(sets) + [path[0]]:
+        if name not in loop.parameters:
+            raise ValueError(f"--set {name}: {name!r} is not a parameter of the loop in "
+                             f"{args.loop} (parameters: {', '.join(loop.parameters)})")
+    values = {n: v for n, v in loop.defaults.items() if n != path[0]}
+    values.update(sets)
+    missing = [n for n in loop.parameters if n not in values and n != path[0]]
+    if missing:
+        raise ValueError(f"no value for {', '.join(missing)}: the loop file {args.loop} gives "
+                         f"none; add --set {missing[0]}=VALUE")
+    name, given = path
+    result = track(loop, name, given, **values)
+    setup = cli_loop.LoopSetup(str(args.loop), loop, values, tuple(sets))
+    unit = setup.unit(name)
+    setup = dataclasses.replace(setup, echo=cli_loop._echo(setup) + (
+        f"path: {name} from {given[0]:.10g} to {given[-1]:.10g}{' ' + unit if unit else ''} "
+        f"({given.size} points)",))
+    from .simulate import _tex_unit
+
+    tex = f"{name} [{_tex_unit(unit)}]" if unit else name
+    T = values.get("T") if "T" in loop.parameters else None
+    return _View(setup, result, name, unit, tex, lambda v: np.asarray(v, dtype=float),
+                 None if T is None else float(T), given=given)
+
+
+# --------------------------------------------------------------------------
+# Output
+
+
+def _stretches(view):
+    """``[(low, high, count)]``: the path cut at its crossings, with the unstable count of each.
+
+    The count of one stretch comes from a path point in it (the tracked
+    poles) and is carried across each crossing by its change (+-2 a pair,
+    +-1 a real pole); ``None`` where no point of the path says.
+    """
+    locus = view.locus
+    values, counts = locus.values, locus.unstable_counts()
+    forward = 1.0 if values[-1] > values[0] else -1.0
+    cuts = [c.value for c in locus.crossings]
+    edges = [float(values[0])] + cuts + [float(values[-1])]
+    # The stretch of each path point: the crossings it has passed.
+    position = np.searchsorted(forward * np.array(cuts), forward * values, side="right")
+    known = {}
+    for k, c in zip(position, counts):
+        if c >= 0 and k not in known:
+            known[int(k)] = int(c)
+    out = [None] * (len(cuts) + 1)
+    if known:
+        start = min(known)
+        out[start] = known[start]
+        for k in range(start + 1, len(out)):
+            out[k] = out[k - 1] + locus.crossings[k - 1].change
+        for k in range(start - 1, -1, -1):
+            out[k] = out[k + 1] - locus.crossings[k].change
+    return [(edges[k], edges[k + 1], out[k]) for k in range(len(out))]
+
+
+def _certified(view):
+    """Certified root counts at the path's points, or None where not available."""
+    locus = view.locus
+    if view.setup.__class__.__name__ == "LoopSetup":
+        return np.atleast_1d(view.setup.loop.unstable_root_counts(
+            **view.setup.values, **{locus.parameter: locus.values}))
+    from ..numeric.stability import unstable_root_counts
+
+    fixed = dict(locus.fixed)
+    return np.atleast_1d(unstable_root_counts(**fixed, **{locus.parameter: locus.values}))
+
+
+#: A crossing value within this fraction of the path's span from 0 is
+#: printed as 0: the eigenvalues put a root at z = 1 for K = 0 at K = 1e-12 or so.
+_ZERO = 1e-9
+
+
+def _snap(view, value):
+    span = abs(view.locus.values[-1] - view.locus.values[0])
+    return 0.0 if abs(value) <= _ZERO * span else float(value)
+
+
+def _printed(view, value):
+    """The shown value of a path value (0 where it is 0 to within rounding)."""
+    return float(view.show(_snap(view, value)))
+
+
+def _rows(view):
+    locus = view.locus
+    columns = [view.label()]
+    if view.dimensionless:
+        columns.append(view.dimensionless)
+    columns += ["crossing", "direction", "theta [rad]"]
+    if view.T is not None:
+        columns.append("frequency [Hz]")
+    columns.append("unstable poles after")
+    stretches = _stretches(view)
+    rows = []
+    for k, c in enumerate(locus.crossings):
+        row = [_printed(view, c.value)]
+        if view.dimensionless:
+            row.append(_snap(view, c.value))
+        row += [c.kind, c.direction, c.angle]
+        if view.T is not None:
+            row.append(c.angle / (2 * math.pi * view.T))
+        after = stretches[k + 1][2]
+        row.append(after)
+        rows.append(tuple(row))
+    return columns, rows, stretches
+
+
+def _notes(view, stretches, certified):
+    locus = view.locus
+    unit = f" {view.unit}" if view.unit else ""
+    notes = []
+    if not locus.crossings:
+        count = stretches[0][2]
+        notes.append(f"no pole crosses the unit circle along the path; "
+                     f"{'unknown' if count is None else count} pole(s) outside it throughout")
+    stable = [(lo, hi) for lo, hi, c in stretches if c == 0]
+    text = ", ".join(f"[{_printed(view, min(lo, hi)):.10g}, {_printed(view, max(lo, hi)):.10g}]"
+                     for lo, hi in stable) or "none"
+    notes.append(f"stable along the path: {view.name} in {text}{unit if stable else ''}")
+    if any(_snap(view, c.value) == 0.0 != c.value for c in locus.crossings):
+        notes.append(f"a crossing within {_ZERO:g} of the path's span from 0 is printed as 0 "
+                     f"(the eigenvalues' rounding; the JSON output keeps the value found)")
+    notes.append(f"{locus.poles.shape[1]} closed-loop poles tracked at {len(locus.values)} points; "
+                 "theta: the crossing pole's angle, the boundary arc's parameter")
+    counts = locus.unstable_counts()
+    both = (counts >= 0) & (certified >= 0)
+    differ = np.flatnonzero(both & (counts != certified))
+    if differ.size:
+        first = differ[0]
+        notes.append(f"warning: the tracked poles and the certified root count disagree at "
+                     f"{differ.size} point(s), first at {view.name} = "
+                     f"{view.given[first]:.10g} ({counts[first]} against "
+                     f"{certified[first]}): trust the certified count (symstab classify)")
+    else:
+        notes.append(f"the unstable counts agree with the certified root count at all "
+                     f"{int(both.sum())} decided path points"
+                     + (f" ({int((~both).sum())} marginal)" if (~both).any() else ""))
+    return notes
+
+
+def _json(view, stretches, certified):
+    locus = view.locus
+    return {"path": {"parameter": view.name, "unit": view.unit,
+                     "low": float(view.given[0]), "high": float(view.given[-1]),
+                     "n": int(len(locus.values))},
+            "crossings": [{"value": float(view.show(c.value)), "parameter_value": c.value,
+                           "kind": c.kind, "direction": c.direction, "theta": c.angle,
+                           "z": [c.z.real, c.z.imag], "pole": c.pole_index}
+                          for c in locus.crossings],
+            "stretches": [{"low": float(view.show(lo)), "high": float(view.show(hi)),
+                           "unstable_poles": c} for lo, hi, c in stretches],
+            "certified_agree": bool(np.all((locus.unstable_counts() == certified)
+                                           | (locus.unstable_counts() < 0) | (certified < 0)))}
+
+
+def _cmd_locus(args):
+    from .commands import check_outputs, write_output
+
+    png = None
+    if args.png is not None:
+        png = check_outputs([("--png", args.png, "file")])["--png"]
+        from ..figures import require_matplotlib
+        require_matplotlib()
+    view = _loop(args) if args.loop is not None else _paper(args)
+    certified = _certified(view)
+    columns, rows, stretches = _rows(view)
+    notes = _notes(view, stretches, certified)
+    image = _png(view, stretches) if png is not None else None
+    if image is not None:
+        write_output(png, image, "--png")
+        notes.append(f"wrote {png}")
+    _emit(view.setup, args.format, columns, rows, result=_json(view, stretches, certified),
+          notes=notes, json_rows=False)
+    return 0
+
+
+# --------------------------------------------------------------------------
+# The figure
+
+
+def _zoom(poles, crossings, limit):
+    """``(x0, x1, y0, y1)``: a square window on where the poles move and cross.
+
+    The bounding box of the poles that move at least a tenth as far as the
+    one that moves most, with the crossings; if that is most of the plane,
+    the stretch of the first crossing pole's path (a pair's first) near
+    its crossing, or where a pole comes nearest the circle.
+    """
+    finite = np.isfinite(poles) & (np.abs(poles) <= limit)
+    steps = np.where(finite[1:] & finite[:-1], np.abs(np.diff(np.where(finite, poles, 0), axis=0)),
+                     0.0)
+    moved = steps.sum(axis=0)
+    points = [complex(c.z) for c in crossings] + [complex(c.z).conjugate() for c in crossings]
+    if moved.max() > 0:
+        columns = moved >= 0.1 * moved.max()
+        points += list(poles[:, columns][finite[:, columns]])
+    half = _half_width(points)
+    if half is None or half > 0.4 * limit:
+        if crossings:
+            pick = next((c for c in crossings if c.kind == "pair"), crossings[0])
+            path = poles[:, pick.pole_index]
+            near = finite[:, pick.pole_index] & (np.abs(path - pick.z) <= 0.3)
+            points = [complex(pick.z), complex(pick.z).conjugate()] + list(path[near])
+        else:
+            distance = np.where(finite, np.abs(np.abs(poles) - 1.0), np.inf)
+            points = [complex(poles.flat[int(np.argmin(distance))])]
+        half = max(_half_width(points), 0.05)
+    box = np.array(points)
+    centre = (0.5 * (box.real.min() + box.real.max()), 0.5 * (box.imag.min() + box.imag.max()))
+    return centre[0] - half, centre[0] + half, centre[1] - half, centre[1] + half
+
+
+def _half_width(points):
+    if not points:
+        return None
+    box = np.array(points)
+    return max(0.5 * max(np.ptp(box.real), np.ptp(box.imag)) * 1.15, 0.01)
+
+
+_MARKS = {"pair": ("*", "C3", "complex pair crossing"), "z = 1": ("s", "C1", "real pole crossing"),
+          "z = -1": ("D", "C1", "real pole crossing")}
+
+
+def _plane(ax, view, norm, limit, window=None):
+    """One z-plane panel: the poles coloured by the path's value, the circle, the crossings."""
+    locus = view.locus
+    poles = locus.poles
+    shown = np.asarray(view.given, dtype=float)
+    finite = np.isfinite(poles)
+    keep = finite & (np.abs(poles) <= limit)
+    if window is not None:
+        x0, x1, y0, y1 = window
+        keep &= (poles.real >= x0) & (poles.real <= x1) & (poles.imag >= y0) & (poles.imag <= y1)
+    colour = np.broadcast_to(shown[:, None], poles.shape)
+    theta = np.linspace(0, 2 * np.pi, 20001)
+    ax.plot(np.cos(theta), np.sin(theta), color="0.25", lw=1.0, zorder=1,
+            label=r"unit circle $|z| = 1$")
+    dots = ax.scatter(poles.real[keep], poles.imag[keep], c=colour[keep], s=4, cmap="viridis",
+                      norm=norm, zorder=2, linewidths=0)
+    start = keep[0]
+    ax.plot(poles.real[0][start], poles.imag[0][start], "o", mfc="none", mec="0.4", ms=4,
+            mew=0.7, lw=0, zorder=3,
+            label=f"poles at the start, {view.tex.split(' [')[0]} = {shown[0]:.4g}")
+    labelled = set()
+    for k, c in enumerate(locus.crossings):
+        marker, color, label = _MARKS[c.kind]
+        for imag in ((c.z.imag, -c.z.imag) if c.kind == "pair" else (c.z.imag,)):
+            ax.plot([c.z.real], [imag], marker, color=color, mec="k", ms=11, zorder=4,
+                    label=None if label in labelled else label)
+            labelled.add(label)
+        ax.annotate(f"{k + 1}", (c.z.real, c.z.imag), xytext=(8, 6), textcoords="offset points",
+                    fontsize=10, fontweight="bold", zorder=5,
+                    bbox=dict(boxstyle="round,pad=0.15", fc="white", ec="none", alpha=0.8))
+    if window is None:
+        ax.set_xlim(-limit, limit)
+        ax.set_ylim(-limit, limit)
+    else:
+        ax.set_xlim(window[0], window[1])
+        ax.set_ylim(window[2], window[3])
+    ax.set_aspect("equal")
+    ax.set_xlabel(r"Re $z$")
+    ax.set_ylabel(r"Im $z$")
+    return dots
+
+
+def _png(view, stretches):
+    """The locus as PNG bytes: the z-plane, a zoom on where the poles cross, the largest modulus."""
+    from ..figures import LEGEND_SIZE, PANEL_TITLE_SIZE, SUPTITLE_SIZE, pyplot
+
+    plt = pyplot()
+    from matplotlib.colors import Normalize
+    from matplotlib.patches import Rectangle
+
+    locus = view.locus
+    shown = np.asarray(view.given, dtype=float)
+    poles = locus.poles
+    finite = np.isfinite(poles)
+    radius = float(np.max(np.abs(poles[finite]))) if finite.any() else 1.0
+    limit = min(max(1.15, 1.05 * radius), _PLANE_LIMIT)
+    norm = Normalize(vmin=float(min(shown[0], shown[-1])), vmax=float(max(shown[0], shown[-1])))
+    fig = plt.figure(figsize=(11.5, 10.5))
+    grid = fig.add_gridspec(2, 2, height_ratios=[1.25, 1.0])
+    ax, zx, bx = fig.add_subplot(grid[0, 0]), fig.add_subplot(grid[0, 1]), fig.add_subplot(grid[1, :])
+    dots = _plane(ax, view, norm, limit)
+    window = _zoom(poles, locus.crossings, limit)
+    _plane(zx, view, norm, limit, window)
+    ax.add_patch(Rectangle((window[0], window[2]), window[1] - window[0], window[3] - window[2],
+                           fill=False, ec="C3", lw=1.0, ls="--", zorder=6))
+    hidden = bool((finite & (np.abs(poles) > limit)).any())
+    ax.set_title("closed-loop poles in the $z$-plane" + (
+        f"\n(poles beyond $|z|$ = {limit:g} not shown)" if hidden else ""),
+        fontsize=PANEL_TITLE_SIZE)
+    zx.set_title("zoom on the dashed square: where the poles move and cross",
+                 fontsize=PANEL_TITLE_SIZE)
+    handles, labels = ax.get_legend_handles_labels()
+    fig.legend(handles, labels, loc="upper center", bbox_to_anchor=(0.5, 0.505), ncol=4,
+               fontsize=LEGEND_SIZE + 1, frameon=False)
+    # The largest modulus along the path, the stable stretches shaded.
+    rho = locus.spectral_radius()
+    bx.plot(shown, rho, color="C0", lw=1.6, label=r"largest pole modulus $\max|z|$")
+    bx.axhline(1.0, color="0.25", lw=1.0, ls="--", label=r"$|z| = 1$")
+    first = True
+    top = bx.get_ylim()[1]
+    for lo, hi, count in stretches:
+        lo, hi = sorted((float(view.show(lo)), float(view.show(hi))))
+        if count == 0:
+            bx.axvspan(lo, hi, color="#7fc97f", alpha=0.35, lw=0,
+                       label="stable (no pole outside)" if first else None)
+            first = False
+        if count is not None and hi - lo > 0.06 * abs(shown[-1] - shown[0]):
+            bx.text(0.5 * (lo + hi), top, f"{count} outside", ha="center", va="bottom",
+                    fontsize=9, color="0.2")
+    for k, c in enumerate(locus.crossings):
+        x = float(view.show(c.value))
+        marker, color, _ = _MARKS[c.kind]
+        bx.axvline(x, color=color, lw=0.9, ls=":")
+        bx.plot([x], [1.0], marker, color=color, mec="k", ms=9, zorder=4)
+        # Alternately below and above the line: neighbouring crossings stay apart.
+        bx.annotate(f"{k + 1}", (x, 1.0), xytext=(6, -14 if k % 2 == 0 else 6),
+                    textcoords="offset points",
+                    fontsize=10, fontweight="bold")
+    bx.set_xlabel(view.tex)
+    bx.set_ylabel(r"$\max|z|$")
+    bx.set_xlim(float(min(shown[0], shown[-1])), float(max(shown[0], shown[-1])))
+    bx.set_title("largest pole modulus along the path; crossings numbered as in the table, "
+                 "poles outside the circle counted above", fontsize=PANEL_TITLE_SIZE, pad=18)
+    bx.legend(fontsize=LEGEND_SIZE + 1, loc="upper center", bbox_to_anchor=(0.5, -0.12), ncol=3,
+              frameon=False)
+    fig.suptitle(_title(view), fontsize=SUPTITLE_SIZE)
+    fig.subplots_adjust(left=0.07, right=0.89, top=0.92, bottom=0.1, hspace=0.45, wspace=0.22)
+    # The colour bar beside the z-plane panels, in an axes of its own (so
+    # that it takes no width from the zoom).
+    place = zx.get_position()
+    bar = fig.colorbar(dots, cax=fig.add_axes([0.91, place.y0, 0.015, place.height]))
+    bar.set_label("pole colour: " + view.tex)
+    buf = io.BytesIO()
+    fig.savefig(buf, format="png", metadata={"Software": None})
+    plt.close(fig)
+    return buf.getvalue()
+
+
+def _title(view):
+    setup = view.setup
+    if setup.__class__.__name__ == "LoopSetup":
+        fixed = ", ".join(f"{n} = {v:g}" + (f" {setup.unit(n)}" if setup.unit(n) else "")
+                          for n, v in setup.values.items() if n != "d")
+        return (f"root locus of the loop {setup.loop.name} along {view.name}: {fixed}, "
+                f"d = {setup.values['d']}")
+    locus = view.locus
+    other = "beta" if locus.parameter == "alpha" else "alpha"
+    fixed = locus.fixed[other]
+    if setup.physical:
+        dev, units = setup.device, setup.units
+        if other == "beta":
+            where = f"$B_w$ = {float(dev.damping(fixed)):g} {units['B_w']}"
+        else:
+            where = f"$K_w$ = {float(dev.stiffness(fixed)):g} {units['K_w']}"
+        from .simulate import _tex_unit
+        return (f"root locus at {where}, $T_d$ = {dev.delay(setup.d) * 1e3:g} ms "
+                f"($d$ = {setup.d}), $M_w$ = {float(dev.mass(setup.gamma)):g} "
+                f"{_tex_unit(units['M_w'])}")
+    symbol = r"\beta" if other == "beta" else r"\alpha"
+    return (f"root locus at ${symbol}$ = {fixed:g}, $\\gamma$ = {setup.gamma:g}, $d$ = {setup.d}, "
+            f"$\\delta$ = {setup.delta:g}")
