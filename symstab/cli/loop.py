@@ -455,9 +455,51 @@ def _limits_notes(setup, lim):
 
 
 def _limits_result(lim):
-    return {"limits": {"x": lim.x, "y": lim.y, "y_max": lim.y_max, "x_at_y_max": lim.x_at_y_max,
-                       "x_min": lim.x_min, "x_max": lim.x_max, "area": lim.area,
-                       "n_lines": lim.n_lines}}
+    out = {"x": lim.x, "y": lim.y, "y_max": lim.y_max, "x_at_y_max": lim.x_at_y_max,
+           "x_min": lim.x_min, "x_max": lim.x_max, "area": lim.area}
+    # How the set was found: scanned lines, or (issue 12) the stable cells
+    # of the complete D-decomposition; whichever LoopLimits carries.
+    for name in ("n_lines", "cells"):
+        if hasattr(lim, name):
+            out[name] = getattr(lim, name)
+    return {"limits": out}
+
+
+def _passive(setup, lim):
+    """The passive set beside the stable one: (notes, json), one line per fact.
+
+    Colgate and Schenkel's condition with the device's friction ``b``
+    (:func:`symstab.numeric.passivity.passive_region`); a loop it does not
+    cover (no ``b``, a plant other than ``1/(m s**2 + b s)``) gets a note
+    saying why, not an error: the stable limits stand on their own.
+    """
+    from ..numeric.passivity import passive_region
+
+    x, y = setup.x, setup.y
+    try:
+        region = passive_region(setup.loop, x=x, y=y, **setup.values)
+    except (ValueError, TypeError, ArithmeticError) as exc:
+        return [f"passive set (Colgate-Schenkel) not computed: {exc}"], {"error": str(exc)}
+    ux, uy = setup.unit(x), setup.unit(y)
+    area_unit = f"({ux})({uy})" if ux and uy else (ux or uy)
+    out = {"x": x, "y": y, "y_max": region.y_max, "x_at_y_max": region.x_at_y_max,
+           "area": region.area, "bounded": region.bounded,
+           "x_range": list(region.x_range), "y_range": list(region.y_range)}
+    if region.empty:
+        return [f"passive set (Colgate-Schenkel, damping b = {setup.values.get('b', math.nan):.10g}"
+                f"{' ' + setup.unit('b') if setup.unit('b') else ''}): no passive point in the "
+                f"({x}, {y}) plane"], out
+    notes = [f"passive {y}_max = {region.y_max:.10g}{' ' + uy if uy else ''} at {x} = "
+             f"{region.x_at_y_max:.10g}{' ' + ux if ux else ''} (Colgate-Schenkel with the "
+             f"delay; stable {y}_max = {lim.y_max:.10g})"]
+    if region.bounded:
+        notes.append(f"passive area = {region.area:.10g}{' ' + area_unit if area_unit else ''} "
+                     f"(stable area = {lim.area:.10g})")
+    else:
+        notes.append(f"the passive set is unbounded; its area inside {x} in "
+                     f"[{region.x_range[0]:.6g}, {region.x_range[1]:.6g}], {y} in "
+                     f"[{region.y_range[0]:.6g}, {region.y_range[1]:.6g}] is {region.area:.10g}")
+    return notes, out
 
 
 def _cmd_limits(args):
@@ -475,6 +517,8 @@ def _cmd_limits(args):
     if args.at is not None:
         more, result["at"] = _intervals(setup, args.at)
         notes += more
+    more, result["passive"] = _passive(setup, lim)
+    notes += more
     _emit(setup, args.format, ["quantity", "value", "unit", "meaning"], rows, result=result,
           notes=notes, json_rows=False)
     return 0

@@ -286,6 +286,38 @@ def _limits_json(lim):
     return out
 
 
+def _passive(setup, lim):
+    """The passive set beside the stable region: (notes, json), one line per fact.
+
+    Colgate and Schenkel's condition with the device's friction and the
+    delay (:func:`symstab.numeric.passivity.paper_passive_region`).
+    """
+    from ..numeric.passivity import paper_passive_region
+
+    if setup.delta == 0:
+        return (["passive set (Colgate-Schenkel): none, the device has no damping (delta = 0)"],
+                {"alpha_max": None, "beta_at_alpha_max": None, "area": 0.0})
+    region = paper_passive_region(gamma=setup.gamma, d=setup.d, delta=setup.delta)
+    if region.empty:
+        return ([f"passive set (Colgate-Schenkel, with the delay): no passive point at "
+                 f"gamma = {setup.gamma:.6g}, d = {setup.d}, delta = {setup.delta:.6g}"],
+                {"alpha_max": None, "beta_at_alpha_max": None, "area": 0.0})
+    out = {"alpha_max": region.y_max, "beta_at_alpha_max": region.x_at_y_max,
+           "area": region.area}
+    notes = [f"passive alpha_max = {region.y_max:.10g} at beta = {region.x_at_y_max:.10g} "
+             f"(Colgate-Schenkel with the delay; stable alpha_max = "
+             f"{_number(lim.alpha_max) or 'none'})"]
+    if setup.physical:
+        dev = setup.device
+        k_max, b_at = float(dev.stiffness(region.y_max)), float(dev.damping(region.x_at_y_max))
+        out.update(K_max=k_max, B_w_at_K_max=b_at)
+        notes.append(f"passive K_max = {k_max:.10g} {setup.units['K_w']} at B_w = {b_at:.10g} "
+                     f"{setup.units['B_w']}")
+    notes.append(f"passive area = {region.area:.10g} in the (beta, alpha) plane (stable "
+                 f"z_width = {_number(lim.z_width) or 'none'})")
+    return notes, out
+
+
 def _cmd_limits(args):
     if cli_loop.uses_loop(args):
         return cli_loop.run(args)
@@ -322,6 +354,8 @@ def _cmd_limits(args):
         if runs and runs[0][0] > 0:
             notes.append(f"a minimum stiffness is needed: alpha > {runs[0][0]:.10g}")
         result["alpha_intervals"] = {"beta": damping, "intervals": [list(r) for r in runs]}
+    more, result["passive"] = _passive(setup, lim)
+    notes += more
     _emit(setup, args.format, columns, rows, result=result, notes=notes, json_rows=False)
     return 0
 

@@ -103,7 +103,7 @@ def test_virtual_wall_is_colgate_and_schenkels_triangle():
         distance = np.min(np.abs(region.polygon - corner) / [b, 2 * b / T], axis=0)
         assert np.all(distance < 1e-9), (corner, region.polygon)
     assert region.area == pytest.approx(2 * b**2 / T, rel=1e-9)
-    assert region.y_max == pytest.approx(2 * b / T, rel=1e-10)
+    assert region.y_max == pytest.approx(2 * b / T, rel=1e-13)
     assert abs(region.x_at_y_max) < 1e-9 * b
     # Counter-clockwise.
     assert region.area > 0
