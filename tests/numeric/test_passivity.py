@@ -182,6 +182,55 @@ def test_filtered_velocity_environment_against_the_sweep(d):
     check_against_sweep(region, terms, PAPER_B, {}, lambda p: p["K"], rng)
 
 
+def refined_worst_margin(environment_terms, point, damping, T, d, n=2000):
+    """``max_theta RHS - damping`` at 30 digits: the sweep, then a golden-section search
+    around its three best local maxima (an end point counts as one)."""
+    def rhs(theta):
+        z = mpmath.expj(theta)
+        u = 1 - 1 / z
+        h = sum(mpmath.mpf(point[name]) * term
+                for name, term in environment_terms(u, z).items())
+        return T / (2 * (1 - mpmath.cos(theta))) * mpmath.re(u * h * mpmath.expj(-d * theta))
+
+    with mpmath.workdps(30):
+        grid = [mpmath.pi * (k + mpmath.mpf(1) / 2) / n for k in range(n)]
+        values = [rhs(t) for t in grid]
+        peaks = [k for k in range(n) if (k == 0 or values[k] >= values[k - 1])
+                 and (k == n - 1 or values[k] >= values[k + 1])]
+        peaks.sort(key=lambda k: -values[k])
+        best = max(values)
+        ratio = (mpmath.sqrt(5) - 1) / 2
+        for k in peaks[:3]:
+            a = grid[k - 1] if k else mpmath.mpf(10) ** -12
+            b = grid[k + 1] if k < n - 1 else mpmath.pi
+            for _ in range(90):
+                x1, x2 = b - ratio * (b - a), a + ratio * (b - a)
+                if rhs(x1) < rhs(x2):
+                    a = x1
+                else:
+                    b = x2
+            best = max(best, rhs((a + b) / 2))
+        return float(best - damping)
+
+
+def test_vertices_lie_within_the_tolerance_of_the_boundary():
+    # Every vertex of the polygon is outside the passive set of b (it is an
+    # intersection of half-planes the set obeys) and inside that of
+    # b (1 + 1e-6) (the cutting planes' tolerance): -rounding <= margin <= 1e-6 b.
+    # A grid of angles alone leaves vertices 1e-5 b out on the curved parts.
+    d, M = 4, 2e-6
+    region = passive_region(paper_loop(d=d, M=M))
+    assert len(region.polygon) > 50        # the boundary is curved here
+    rng = np.random.default_rng(3)
+    for vertex in region.polygon[rng.choice(len(region.polygon), 12, replace=False)]:
+        point = {"B": vertex[0], "K": vertex[1], "M": M}
+        margin = refined_worst_margin(paper_terms, point, PAPER_B, PAPER_T, d)
+        if abs(vertex[1]) < 1e-9:
+            assert margin <= 1.01e-6 * PAPER_B     # on K = 0: the static edge
+        else:
+            assert -1e-12 * PAPER_B <= margin <= 1.01e-6 * PAPER_B, (vertex, margin)
+
+
 def test_physical_and_normalised_forms_agree():
     d, gamma = 3, 0.2 * PAPER_DELTA
     physical = passive_region(paper_loop(d=d, M=gamma * PAPER_M))
