@@ -1,4 +1,4 @@
-"""theta_max certified: an enclosure proved by interval arithmetic.
+"""theta_max certified by interval arithmetic, and approximated in closed form.
 
 theta_max is the first root of alpha(theta) in (0, pi], that is the first
 positive root of the reduced equation
@@ -25,6 +25,10 @@ integer ``d``): the arc runs to theta = pi.
 
 :func:`certify_theta_max` runs the same proof on an interval the caller
 proposes and raises :class:`NotCertified` when it fails.
+
+:func:`theta_max_approx` is the float closed form: a start from the model's
+small-theta series and a fixed number of Newton steps on the phase form of
+``R`` (:func:`symstab.symbolic.theta_max.phase_equation`).
 """
 
 import dataclasses
@@ -35,12 +39,13 @@ import mpmath
 from mpmath import iv
 import sympy as sp
 
-from .._validate import check_loop, check_real
+from .._validate import check_count, check_loop, check_real
 from ..symbolic import model
-from ..symbolic.theta_max import reduced_equation, theta_max
+from ..symbolic.theta_max import phase_equation, q_sym, r_sym, reduced_equation
 from .curves import arc_end_angle
 
-__all__ = ["ThetaMaxEnclosure", "NotCertified", "theta_max_enclosure", "certify_theta_max"]
+__all__ = ["ThetaMaxEnclosure", "NotCertified", "theta_max_enclosure", "certify_theta_max",
+           "theta_max_approx", "APPROX_WORST_RELATIVE_ERROR"]
 
 #: Working precision of the interval arithmetic, in bits (about 50 digits):
 #: q and r cancel about 2 log10(1/delta) digits (12 at delta = 1e-6) and
@@ -141,6 +146,30 @@ def _negative(x):
     return x.b < 0
 
 
+def _positive_near_zero(reduced, upper):
+    """Step 1: an ``a <= upper`` with ``R' > 0`` on ``[0, a]``, so ``R > 0`` on ``(0, a]``."""
+    a = mpmath.mpf(min(upper, 0.25 / float(reduced.rate)))
+    for _ in range(80):
+        if _positive(reduced.slope(_interval(0, a))):
+            return a
+        a /= 2
+    raise NotCertified("R' > 0 near theta = 0 not proved (the arc is too short to certify)")
+
+
+def _piece_positive(reduced, x0, x1):
+    """True if ``R > 0`` on ``[x0, x1]`` is proved."""
+    slope = reduced.slope(_interval(x0, x1))
+    if _positive(slope) and _positive(reduced.value(iv.mpf(x0))):
+        return True
+    if _negative(slope) and _positive(reduced.value(iv.mpf(x1))):
+        return True
+    return _positive(reduced.value(_interval(x0, x1)))
+
+
+def _too_narrow(x0, x1):
+    return x1 - x0 < mpmath.mpf(2) ** -60 * x1
+
+
 def _prove(reduced, lo, hi, max_pieces):
     """Steps 1-3 of the module docstring; returns the piece count or raises NotCertified."""
     lo_, hi_ = iv.mpf(lo), iv.mpf(hi)
@@ -150,44 +179,68 @@ def _prove(reduced, lo, hi, max_pieces):
         raise NotCertified(f"R(hi) < 0 not proved at hi = {hi!r}")
     if not _negative(reduced.slope(_interval(lo_, hi_))):
         raise NotCertified(f"R' < 0 on [{lo!r}, {hi!r}] not proved: the root may not be unique")
-    # Step 1: R(0) = 0 and R' > 0 on [0, a].
-    a = mpmath.mpf(min(lo, 0.25 / float(reduced.rate)))
-    for _ in range(80):
-        if _positive(reduced.slope(_interval(0, a))):
-            break
-        a /= 2
-    else:
-        raise NotCertified("R' > 0 near theta = 0 not proved (the arc is too short to certify)")
+    a = _positive_near_zero(reduced, mpmath.mpf(lo))
     # Step 2: R > 0 on [a, lo], piece by piece.
-    width = mpmath.mpf(0.25) / reduced.rate
-    stack = []
-    x = mpmath.mpf(lo)
-    while x > a:
-        stack.append((max(a, x - width), x))
-        x -= width
+    # One piece to start: bisection puts short pieces only where R is
+    # small for its variation (in the jump regime R stays far from 0 on most
+    # of (0, lo), and fixed pieces of a quarter period cost 10 times more).
+    stack = [(a, mpmath.mpf(lo))]
     pieces = 0
     while stack:
         x0, x1 = stack.pop()
         pieces += 1
         if pieces > max_pieces:
             raise NotCertified(f"R > 0 on (0, lo] not proved within {max_pieces} pieces")
-        X = _interval(x0, x1)
-        slope = reduced.slope(X)
-        if _positive(slope) and _positive(reduced.value(iv.mpf(x0))):
-            continue
-        if _negative(slope) and _positive(reduced.value(iv.mpf(x1))):
-            continue
-        if _positive(reduced.value(X)):
+        if _piece_positive(reduced, x0, x1):
             continue
         middle = (x0 + x1) / 2
         if _negative(reduced.value(iv.mpf(middle))):
             raise NotCertified(f"R < 0 at theta = {float(middle)!r} < lo: [lo, hi] does not hold "
                                f"the first root")
-        if x1 - x0 < mpmath.mpf(2) ** -60 * x1:
+        if _too_narrow(x0, x1):
             raise NotCertified(f"R > 0 near theta = {float(middle)!r} not proved (R is too close to 0)")
         stack.append((x0, middle))
         stack.append((middle, x1))
     return pieces
+
+
+def _first_root_search(reduced, max_pieces):
+    """The first root of R located by the same interval tests, left to right.
+
+    Pieces of ``[a, pi + 1/(4 (d + 1))]`` are taken leftmost first: each is
+    either proved positive, or found to hold a sign change with ``R' < 0``
+    (its left end is the right end of a piece proved positive, so this is
+    the first root), or bisected.  Returns the root to about 1e-17 (by
+    bisection on point values); :func:`certify_theta_max` then proves it.
+    This finds roots between two close ones that a sampling scan steps over.
+    """
+    a = _positive_near_zero(reduced, mpmath.pi)
+    stack = [(a, mpmath.pi + mpmath.mpf(0.25) / reduced.rate)]
+    pieces = 0
+    while stack:
+        x0, x1 = stack.pop()
+        pieces += 1
+        if pieces > max_pieces:
+            break
+        if _piece_positive(reduced, x0, x1):
+            continue
+        if _negative(reduced.value(iv.mpf(x1))) and _negative(reduced.slope(_interval(x0, x1))):
+            for _ in range(70):
+                middle = (x0 + x1) / 2
+                value = reduced.value(iv.mpf(middle))
+                if _positive(value):
+                    x0 = middle
+                elif _negative(value):
+                    x1 = middle
+                else:
+                    break
+            return float((x0 + x1) / 2)
+        if _too_narrow(x0, x1):
+            break
+        middle = (x0 + x1) / 2
+        stack.append((middle, x1))
+        stack.append((x0, middle))
+    raise NotCertified(f"the first root of R was not isolated within {pieces} pieces")
 
 
 def _check_domain(gamma, d, delta):
@@ -265,13 +318,22 @@ def _reduced_mp():
     return value, slope
 
 
+def _search(gamma, d, delta, max_pieces):
+    old = iv.prec
+    iv.prec = _PREC
+    try:
+        return _first_root_search(_Reduced(gamma, d, delta), max_pieces)
+    finally:
+        iv.prec = old
+
+
 def theta_max_enclosure(*, gamma, d, delta, max_pieces=MAX_PIECES):
     """A certified enclosure of theta_max, two floats a few ulps apart.
 
-    A candidate root (the float :func:`symstab.arc_end_angle`, refined by
-    Newton's method on the reduced equation at 40 digits; the 30-digit scan
-    :func:`symstab.symbolic.theta_max.theta_max` if that fails) is bracketed
-    by its neighbouring floats and the bracket is proved with
+    A candidate root (the float :func:`symstab.arc_end_angle`; if that is
+    not the first root, a left-to-right interval search that cannot step
+    over a root; both refined by Newton's method on the reduced equation at
+    40 digits) is bracketed by its neighbouring floats and the bracket is proved with
     :func:`certify_theta_max`, widened up to 2**20 ulps if a bound sits too
     close to the root for its sign to be proved.
 
@@ -303,8 +365,8 @@ def theta_max_enclosure(*, gamma, d, delta, max_pieces=MAX_PIECES):
     Examples
     --------
     >>> box = theta_max_enclosure(gamma=0.0, d=40, delta=0.00253125)
-    >>> box.lo <= 0.0398589358788432 <= box.hi, box.width < 1e-16
-    (True, True)
+    >>> round(box.mid, 12), box.width < 1e-16
+    (0.039858935879, True)
     """
     gamma, d, delta = _check_domain(gamma, d, delta)
     value, slope = _reduced_mp()
@@ -314,8 +376,12 @@ def theta_max_enclosure(*, gamma, d, delta, max_pieces=MAX_PIECES):
     reduced_mp = (lambda t: value(t, g_, d, dl_, G_), lambda t: slope(t, g_, d, dl_, G_))
     failures = []
     for guess in (lambda: arc_end_angle(gamma=gamma, d=d, delta=delta),
-                  lambda: theta_max(gamma=gamma, d=d, delta=delta)):
-        start = guess()
+                  lambda: _search(gamma, d, delta, max_pieces)):
+        try:
+            start = guess()
+        except NotCertified as exc:
+            failures.append(str(exc))
+            continue
         if not 0 < start <= math.pi:   # nan: the float scan saw no arc
             failures.append(f"candidate {start!r}")
             continue
@@ -337,3 +403,205 @@ def theta_max_enclosure(*, gamma, d, delta, max_pieces=MAX_PIECES):
                     break
     raise NotCertified(f"theta_max not certified for gamma={gamma!r}, d={d}, delta={delta!r}: "
                        + "; ".join(failures))
+
+
+# -- The closed-form approximation -------------------------------------------
+
+#: Newton steps of :func:`theta_max_approx` after its start.
+APPROX_STEPS = 8
+
+#: The worst relative error of :func:`theta_max_approx` measured against the
+#: certified enclosure over gamma in [-1, 3], d in 0..200, delta in [1e-6, 1]
+#: (a 14 x 12 x 9 grid with the box's corners and 3000 seeded random points;
+#: benchmarks/bench_theta_max_approx.py): the bound the tests hold it to.
+APPROX_WORST_RELATIVE_ERROR = 1e-10
+
+
+def _q_r(delta):
+    """q(delta), r(delta) of the reduced equation without cancellation at small delta.
+
+    With ``e2 = (expm1(delta) - delta) / delta**2`` and ``e3 = (e2 - 1/2) /
+    delta`` (both by their Taylor series for delta <= 1)::
+
+        q = -2 e2 (1 - e2 (1 - delta)) / (1 + delta e2)**2
+        r = -delta (2 e3 + delta e2**2) / (1 + delta e2)**2
+
+    (the symbolic q, r divided through by delta**4 and delta**3).
+    """
+    if delta <= 1.0:
+        # e3 = sum delta**k / (k + 3)!: 18 terms reach 1e-20 at delta = 1.
+        e3, term = 0.0, 1.0 / 6.0
+        for k in range(18):
+            e3 += term
+            term *= delta / (k + 4)
+        e2 = 0.5 + delta * e3
+        den = (1.0 + delta * e2) ** 2
+        return -2.0 * e2 * (1.0 - e2 * (1.0 - delta)) / den, -delta * (2.0 * e3 + delta * e2**2) / den
+    # Large delta (Gamma up to exp(1e6) overflows a float): 30 digits.
+    q_of, r_of = _qr_functions()
+    with mpmath.workdps(30):
+        dl = mpmath.mpf(delta)
+        G = mpmath.exp(dl)
+        return float(q_of(dl, G)), float(r_of(dl, G))
+
+
+@functools.lru_cache(maxsize=None)
+def _phase_functions():
+    """Float A, A', B, B', C, C' of the phase form, and kappa."""
+    eq = phase_equation()
+    theta = model.theta
+    args = (theta, model.gamma, model.delta, q_sym, r_sym)
+    parts = [eq.A, sp.diff(eq.A, theta), eq.B, sp.diff(eq.B, theta), eq.C, sp.diff(eq.C, theta)]
+    kappa = sp.lambdify((model.gamma, model.d, model.delta, q_sym, r_sym), eq.kappa, modules="math")
+    return sp.lambdify(args, parts, modules="math"), kappa
+
+
+class _Phase:
+    """``h = (d+1) theta - psi - sign arccos(x) - 2 pi k`` and its slope, in floats."""
+
+    def __init__(self, gamma, d, delta):
+        self.gamma, self.rate, self.delta = gamma, d + 1, delta
+        self.q, self.r = _q_r(delta)
+        self.parts = _phase_functions()[0]
+
+    def window(self, t):
+        """``(C - rho, d(C - rho)/dtheta)``: positive where R cannot vanish."""
+        A, Ap, B, Bp, C, Cp = self.parts(t, self.gamma, self.delta, self.q, self.r)
+        rho = math.hypot(A, B)
+        return C - rho, Cp - (A * Ap + B * Bp) / rho
+
+    def phase(self, t, k=0, sign=1):
+        """``(h, dh/dtheta, x')``, or None where ``|x| >= 1`` (no root of R there)."""
+        A, Ap, B, Bp, C, Cp = self.parts(t, self.gamma, self.delta, self.q, self.r)
+        rho2 = A * A + B * B
+        # rho**2 - C**2 = B**2 + A**2 (1 + g)(1 - g) with g = gamma (1 + q u),
+        # each factor summed from exact parts: at gamma = -1 and a short arc
+        # x = -C/rho is 1 - 1e-7, and arccos(x) from a rounded x loses half
+        # its digits.
+        u = 2 * math.sin(t / 2) ** 2
+        gqu = self.gamma * self.q * u
+        sine2 = B * B + A * A * ((1 + self.gamma) + gqu) * ((1 - self.gamma) - gqu)
+        if not sine2 > 0:
+            return None
+        rho = math.sqrt(rho2)
+        sine = math.sqrt(sine2)
+        x_slope = -(Cp - C * (A * Ap + B * Bp) / rho2) / rho
+        h = self.rate * t - math.atan2(B, A) - sign * math.atan2(sine, -C) - 2 * math.pi * k
+        slope = self.rate - (A * Bp - B * Ap) / rho2 + sign * x_slope * rho / sine
+        return h, slope, x_slope
+
+
+def _first_branch(ph, start, steps):
+    """Newton on k = 0 from ``start``; None if an iterate leaves the domain or has not converged."""
+    t, step = start, math.inf
+    for _ in range(steps):
+        got = ph.phase(t)
+        if got is None:
+            return None
+        step = got[0] / got[1]
+        t -= step
+        if not 0 < t <= math.pi:
+            return None
+    return t if abs(step) <= 1e-6 * t else None
+
+
+def _after_window(ph, steps):
+    """The first root after the window where ``C > rho`` (heavy virtual mass).
+
+    The window closes at theta_c (``C = rho``, Newton from its delta -> 0
+    value ``u = (1/gamma - 1)/q``).  Beyond it the band ``|phi - psi - pi|
+    < pi - arccos(x)`` where R < 0 opens like ``sqrt(theta - theta_c)``: R's
+    first root is where the band first meets the phase, either catching it
+    from behind (sign -1) or at the next band (sign +1).  The start solves
+    that meeting with the band's square-root growth, and Newton runs in
+    ``y = sqrt(theta - theta_c)`` where the square root is regular.
+    """
+    u = min(2.0, (1 / ph.gamma - 1) / ph.q)
+    tc = math.acos(1 - u)
+    for _ in range(4):
+        value, slope = ph.window(tc)
+        tc -= value / slope
+    A, Ap, B, Bp, C, Cp = ph.parts(tc, ph.gamma, ph.delta, ph.q, ph.r)
+    rho2 = A * A + B * B
+    rho = math.sqrt(rho2)
+    x_slope = -(Cp - C * (A * Ap + B * Bp) / rho2) / rho
+    drift = ph.rate - (A * Bp - B * Ap) / rho2
+    behind = ph.rate * tc - math.atan2(B, A) - math.pi
+    k = math.floor(behind / (2 * math.pi))
+    offset = behind - 2 * math.pi * k
+    disc = 2 * x_slope - 4 * drift * offset
+    if disc >= 0:
+        sign, y = -1, (math.sqrt(2 * x_slope) - math.sqrt(disc)) / (2 * drift)
+    else:
+        sign, y = 1, (-math.sqrt(2 * x_slope)
+                      + math.sqrt(2 * x_slope + 4 * drift * (2 * math.pi - offset))) / (2 * drift)
+    if tc + y * y >= math.pi:
+        return math.pi
+    for _ in range(steps):
+        got = ph.phase(tc + y * y, k + 1, sign)
+        if got is None:
+            return math.nan
+        y -= got[0] / (2 * y * got[1])
+    return min(math.pi, tc + y * y)
+
+
+def theta_max_approx(*, gamma, d, delta, steps=APPROX_STEPS):
+    """theta_max in closed form: a derived start and a fixed number of Newton steps.
+
+    No fitted constant: the start is the smaller of the paper's
+    ``pi / (2 (d + 1))`` and the short-arc end ``sqrt(slope0 / kappa)`` from
+    the model's small-theta series (:class:`~symstab.symbolic.theta_max.PhaseEquation`),
+    and ``steps`` Newton steps solve ``(d + 1) theta = psi(theta) +
+    arccos(x(theta))``.  When a heavy virtual mass (gamma > 1) opens a
+    window where R cannot vanish before that root, the root after the
+    window is taken instead (see ``_after_window``).
+
+    Measured worst relative error against the certified enclosure
+    (:func:`theta_max_enclosure`) over gamma in [-1, 3], d in 0..200, delta in
+    [1e-6, 1], with 6 steps: below 1e-11 on a grid with the box's corners and
+    on 3000 seeded random points, i.e. the float rounding of short arcs
+    (gamma = -1, delta = 1e-6); :data:`APPROX_WORST_RELATIVE_ERROR` is the
+    bound the tests hold it to.  The paper's one Newton step (eq. (12),
+    gamma = 0 only) errs by up to 5 on the same grid (d = 3, delta = 0.3)
+    and 5e-3 at d = 40 on the paper's device.  Outside the box the error is
+    not measured.
+
+    Parameters
+    ----------
+    gamma : float
+        ``M_w / m``, with ``gamma > -1 - delta (d + 1)`` (an arc exists).
+    d : int
+        Delay in samples, ``d >= 0``.
+    delta : float
+        ``b T / m > 0``.
+    steps : int
+        Newton steps after the start (the measured error is for 6).
+
+    Returns
+    -------
+    float
+        The approximate theta_max in (0, pi]; ``nan`` if the Newton
+        iterates leave the domain (never seen in the box).
+
+    Raises
+    ------
+    TypeError, ValueError
+        If an argument has the wrong kind or is out of range.
+
+    Examples
+    --------
+    >>> round(theta_max_approx(gamma=0.0, d=40, delta=0.00253125), 12)
+    0.039858935879
+    """
+    gamma, d, delta = _check_domain(gamma, d, delta)
+    steps = check_count("steps", steps, 1)
+    ph = _Phase(gamma, d, delta)
+    kappa = _phase_functions()[1](gamma, d, delta, ph.q, ph.r)
+    slope0 = gamma + 1 + delta * (d + 1)
+    start = math.pi / (2 * (d + 1))
+    if kappa > 0:
+        start = min(start, math.sqrt(slope0 / kappa))
+    root = _first_branch(ph, start, steps)
+    if root is None and gamma > 1:
+        root = _after_window(ph, steps)
+    return math.nan if root is None else root

@@ -28,11 +28,13 @@ from . import model
 from .._validate import check_loop
 from .boundary import boundary
 from .forms import E, exponential_form, trig_form, w
+from .small_theta import taylor_coefficients
 
 __all__ = [
     "ClosedFormD0", "NewtonFormGamma0",
     "closed_form_d0", "newton_form_gamma0", "theta_max", "theta_max_newton",
     "alpha_numerator_function", "ReducedEquation", "reduced_equation",
+    "PhaseEquation", "phase_equation",
 ]
 
 #: u = 1 - cos(theta), the variable of the d = 0 closed form.
@@ -345,3 +347,69 @@ def reduced_equation():
     R = sp.sin(theta) * (gamma * (1 + q * uu) + sp.cos(phi)) + (delta + r * uu) * sp.sin(phi)
     slope0 = sp.factor(sp.diff(R, theta).subs(theta, 0))
     return ReducedEquation(scale=scale, q=q, r=r, R=R, slope0=slope0)
+
+
+#: Placeholders for the functions q(delta), r(delta) of :class:`ReducedEquation`
+#: in :class:`PhaseEquation`: a float evaluator supplies them in a form that
+#: does not cancel at small delta.
+q_sym, r_sym = sp.symbols("q r", real=True)
+
+
+@dataclasses.dataclass(frozen=True)
+class PhaseEquation:
+    """The reduced equation as a phase condition, the start of theta_max_approx.
+
+    ``R = A cos(phi) + B sin(phi) + C`` with ``phi = (d + 1) theta``,
+    ``u = 2 sin(theta/2)**2 = 1 - cos(theta)`` and::
+
+        A = sin(theta),  B = delta + r u,  C = gamma (1 + q u) sin(theta),
+
+    low-frequency functions of theta only.  With ``rho = hypot(A, B)``,
+    ``psi = atan2(B, A)`` and ``x = -C / rho``, ``R = rho (cos(phi - psi) -
+    x)``, so wherever ``|x| <= 1`` the roots of R solve::
+
+        (d + 1) theta = psi(theta) +- arccos(x(theta)) + 2 pi k
+
+    for an integer k: a fixed-point form whose right side varies slowly
+    with theta, on which Newton's method converges from far away.
+
+    Attributes
+    ----------
+    A, B, C : sympy.Expr
+        In theta, gamma, delta and the placeholders :data:`q_sym`, :data:`r_sym`.
+    kappa : sympy.Expr
+        ``R = slope0 theta - kappa theta**3 + O(theta**5)`` (in d, gamma,
+        delta, q, r); ``sqrt(slope0 / kappa)`` estimates a short arc's end.
+    """
+
+    A: sp.Expr
+    B: sp.Expr
+    C: sp.Expr
+    kappa: sp.Expr
+
+
+@functools.lru_cache(maxsize=None)
+def phase_equation():
+    """Derive :class:`PhaseEquation` from :func:`reduced_equation`.
+
+    Raises
+    ------
+    AssertionError
+        If ``A cos(phi) + B sin(phi) + C`` is not the reduced ``R``.
+    """
+    theta, d, gamma = model.theta, model.d, model.gamma
+    eq = reduced_equation()
+    # u = 2 sin(theta/2)**2, not 1 - cos(theta): a float evaluator keeps
+    # its relative accuracy near theta = 0, where short arcs end.
+    uu = 2 * sp.sin(theta / 2) ** 2
+    A = sp.sin(theta)
+    B = model.delta + r_sym * uu
+    C = gamma * (1 + q_sym * uu) * sp.sin(theta)
+    phi = (d + 1) * theta
+    R = A * sp.cos(phi) + B * sp.sin(phi) + C
+    if sp.cancel(sp.expand(exponential_form(R.subs({q_sym: eq.q, r_sym: eq.r}) - eq.R))) != 0:
+        raise AssertionError("A cos(phi) + B sin(phi) + C is not the reduced equation")
+    series = taylor_coefficients(R, 3)
+    if sp.expand(series[1] - eq.slope0) != 0 or series[0] != 0 or series[2] != 0:
+        raise AssertionError(f"R does not start as slope0 theta: {series}")
+    return PhaseEquation(A=A, B=B, C=C, kappa=sp.factor(-series[3]))

@@ -1,7 +1,9 @@
 """Tests of symstab.numeric.theta_bounds: theta_max certified by interval arithmetic.
 
 Oracles: the 30-digit scan :func:`symstab.symbolic.theta_max.theta_max` (an
-independent root finder on the unreduced N_alpha) and the paper's own
+independent root finder on the unreduced N_alpha; it can step over a narrow
+first dip or a root in its last grid cell, see the tests near pi and of a
+narrow dip) and the paper's own
 eqs. (1), (2), (4) at 40 digits (``oracles.first_principles_alpha``), whose
 sign must be + at ``lo`` and - at ``hi``.
 """
@@ -74,6 +76,19 @@ def test_enclosure_near_pi(gamma, delta, root):
         assert abs(box.mid - root) < 1e-6
         assert _alpha(box.lo, gamma, 0, delta) > 0 > _alpha(box.hi, gamma, 0, delta)
         assert _alpha(3.139, gamma, 0, delta) > 0
+
+
+def test_a_narrow_first_dip_is_found():
+    """alpha < 0 only on ~1e-4 rad near 1.7662: narrower than a sampling scan's step (~1e-3 at d = 200).
+
+    The 30-digit scan returns the next root, 1.7961; the enclosure must hold
+    the first one, where the paper's alpha turns negative.
+    """
+    gamma, d, delta = 2.4818442699578145, 200, 0.007024254262425767
+    box = theta_max_enclosure(gamma=gamma, d=d, delta=delta)
+    assert 1.76617 < box.lo < box.hi < 1.76619
+    assert _alpha(box.lo, gamma, d, delta) > 0 > _alpha(box.hi, gamma, d, delta)
+    assert _alpha(1.7662, gamma, d, delta) < 0 < _alpha(1.7663, gamma, d, delta)
 
 
 def test_short_arc_is_certified():
