@@ -523,7 +523,8 @@ def _crossings(p, tracked, coefficients):
         return np.abs(pole(x, index)) - 1.0
 
     everything = np.arange(len(start))
-    value = bracketed_root(excess, pa, pb, indexed=True)
+    # The bracketer wants lo < hi; a decreasing path has them the other way.
+    value = bracketed_root(excess, np.minimum(pa, pb), np.maximum(pa, pb), indexed=True)
     z = pole(value, everything)
     out = []
     for i in everything:
