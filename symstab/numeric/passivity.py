@@ -403,8 +403,9 @@ def _worst(plane, grid, table, vx, vy):
     a0, ax, ay = table
     best = np.empty(len(vx))
     where = np.empty(len(vx))
-    # Chunks of vertices keep the (vertices x grid) table small.
-    rows_per_chunk = max(1, 2**22 // len(grid))
+    # Chunks of vertices keep each (vertices x grid) table to 8 MB (a few
+    # such tables are alive at once).
+    rows_per_chunk = max(1, 2**20 // len(grid))
     for start in range(0, len(vx), rows_per_chunk):
         sl = slice(start, start + rows_per_chunk)
         values = a0[None, :] + (vx[sl, None] * plane.sx) * ax[None, :] + (
@@ -421,7 +422,8 @@ def _worst(plane, grid, table, vx, vy):
         py = np.broadcast_to(vy[sl, None], top.shape)
         valid = np.isfinite(top_values)
         lo, hi, px, py = lo[valid], hi[valid], px[valid], py[valid]
-        theta = _golden_max(lambda t: plane.at(t, px, py), lo, hi, iterations=60)
+        # 40 steps shrink a bracket of two grid steps to 1e-8 of itself.
+        theta = _golden_max(lambda t: plane.at(t, px, py), lo, hi, iterations=40)
         refined = np.full(top.shape, -np.inf)
         refined[valid] = plane.at(theta, px, py)
         angles = np.full(top.shape, np.nan)
