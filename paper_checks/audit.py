@@ -18,8 +18,9 @@ A check is a function registered with :func:`check`; it returns an
     experimental, figure-only or notation-only content, with the reason and
     the theory value where one exists.
 
-The check modules (``eq_*.py``, ``claims.py``) only call :mod:`symstab` and
-read :mod:`paper_checks.printed`; no formula is derived here.
+The check modules (``eq_*.py``, ``claims.py``, ``open_questions.py``) only
+call :mod:`symstab` and read :mod:`paper_checks.printed`; no formula is
+derived here.
 
 The checks are independent, so :func:`run_audit` runs them in worker
 processes (two by default).  A module whose checks share expensive results
@@ -51,6 +52,7 @@ CHECK_MODULES = (
     "paper_checks.eq_theta_max",
     "paper_checks.eq_limits",
     "paper_checks.claims",
+    "paper_checks.open_questions",
 )
 
 

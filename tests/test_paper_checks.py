@@ -146,6 +146,24 @@ EXPECTED_VERDICTS = {
     'claim:exp_increase_349': 'not-checkable',
     'claim:exp_window_hg': 'not-checkable',
     'claim:exp_window_lg': 'not-checkable',
+    # The open questions of Sec. VIII (paper_checks/open_questions.py): alpha > 0
+    # proved for every d; the minimum damping -b is proved for d >= 2 only, and at
+    # d = 0 the stable regions of gamma = 1, 1.5 reach beta = -0.35, -1.07; gamma >=
+    # gamma_max(delta) = 2.0034 proved never stable; every left-sided arc has
+    # unstable roots on both sides.  The Fig. 8 panels at d = 0, 1 disagree as
+    # claim:fig8_d0, claim:fig8_d1 do (the gamma = 2 sliver, gamma = 2.2 at d = 1).
+    'claim:open_alpha_positive': 'confirmed',
+    'claim:open_minimum_damping': 'not-reproduced',
+    'claim:open_gamma_bound': 'confirmed',
+    'claim:open_left_sided': 'confirmed',
+    'claim:open_root_counts_fig6_d0': 'confirmed',
+    'claim:open_root_counts_fig6_d1': 'confirmed',
+    'claim:open_root_counts_fig6_d5': 'confirmed',
+    'claim:open_root_counts_fig6_d10': 'confirmed',
+    'claim:open_root_counts_fig8_d0': 'not-reproduced',
+    'claim:open_root_counts_fig8_d1': 'not-reproduced',
+    'claim:open_root_counts_fig8_d5': 'confirmed',
+    'claim:open_root_counts_fig8_d10': 'confirmed',
 }
 
 
@@ -378,3 +396,53 @@ def test_the_paper_device_has_one_home():
                     and isinstance(node.value, float) and node.value in (0.0128, 0.0324):
                 typed.append(f"{path.name}:{node.lineno}")
     assert typed == []
+
+
+@pytest.mark.parametrize("gamma, d", [(0.0, 0), (-0.75, 1), (2.2, 0), (1.5, 1), (2.0, 5), (1.5, 10)])
+def test_open_question_counts_match_first_principles(gamma, d):
+    """The counts on the two sides of an arc, against numpy roots of the printed
+    eqs. (1), (2), (4) at points of the first-principles boundary (Cramer's rule
+    on eq. (2), tests/oracles.py) stepped up and down in alpha."""
+    import mpmath
+    import numpy as np
+
+    from oracles import first_principles_boundary_point, first_principles_chi_float
+    from paper_checks import open_questions
+    from symstab.numeric.units import PAPER_DEVICE
+
+    delta = PAPER_DEVICE.delta
+    counted = open_questions.curve_counts(gamma, d)
+    for fraction, pair in zip(open_questions.FRACTIONS, counted.counts):
+        with mpmath.workdps(40):
+            alpha, beta = (float(x) for x in first_principles_boundary_point(
+                mpmath.mpf(fraction) * counted.theta_max, gamma, d, delta))
+        sides = []
+        for step in (1e-4, -1e-4):
+            roots = np.roots(first_principles_chi_float(alpha + step * abs(alpha), beta, gamma, d, delta))
+            sides.append(int(np.sum(np.abs(roots) > 1.0)))
+        assert sorted(sides) == sorted(pair), (fraction, sides, pair)
+        assert abs(pair[0] - pair[1]) == 2     # a complex pair crosses the circle on the arc
+    assert counted.numpy_agrees
+
+
+def test_open_questions_explain_the_left_sided_curves():
+    from paper_checks import open_questions, regions
+
+    left = [c for c in regions.FIGURE_CASES if c.claimed_side == "left"]
+    assert len(left) == 9
+    for c in left:
+        assert open_questions.curve_counts(c.gamma, c.d).unstable_both_sides, c
+    for c in regions.FIGURE_CASES:
+        if c.figure.startswith("6"):
+            assert all(pair == (0, 2) for pair in open_questions.curve_counts(c.gamma, c.d).counts)
+    outcome = audit.registered()["claim:open_left_sided"][3]()
+    assert outcome.verdict == "confirmed"
+    assert "2/4, 4/6, 6/8, 8/10" in outcome.evidence
+
+
+def test_open_minimum_damping_states_what_is_proved_and_what_is_numerical():
+    outcome = audit.registered()["claim:open_minimum_damping"][3]()
+    assert outcome.verdict == "not-reproduced"
+    assert "For d >= 2, s > 0, so beta > -delta is necessary (proved)" in outcome.evidence
+    assert "numerical evidence only" in outcome.evidence
+    assert "within the proved bound" in outcome.evidence
