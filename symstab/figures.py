@@ -5,14 +5,21 @@ matplotlib and returns a :class:`FigureResult`: the figure, what the paper
 shows in it, and what symstab finds -- the line that goes into the
 reproduction's ``index.md``.  :func:`make_figures` writes them all as PNGs.
 
-Figures 6, 8 and 10 overlay stable areas found by simulation
-(:func:`symstab.numeric.simulate.stability_map`) on the theoretical boundaries;
-they take most of the time.  Everything is in the paper's device
+Figures 6, 7, 8 and 10 draw the whole boundary -- the arc of eq. (7) up to
+theta_max (solid) and the same curve on to theta = pi (dashed), which bounds
+stable sets too (the lower edge of the gamma = 1 band in Fig. 10) -- and
+fill the stable set found by exact root counting
+(:meth:`symstab.numeric.region.StabilityRegion.alpha_intervals_on`).
+Simulation (:func:`symstab.numeric.simulate.stability_map`) is drawn over it
+as a check, hatched; it takes most of the time.  Fig. 10 writes in every
+cell its number of unstable closed-loop poles; Figs. 11 and 12 end the
+Z-width at the gamma where the region vanishes, found by bisection.  Everything is in the paper's device
 (m = 0.0128 kg m^2, b = 0.0324 N m s/rad, T = 1 ms) unless a figure says
 otherwise.
 """
 
 import dataclasses
+import functools
 import io
 import math
 import pathlib
@@ -20,10 +27,12 @@ import time
 
 import numpy as np
 
+from ._generated import kernels
 from .numeric.curves import arc_end_angle
 from .numeric.region import boundary_curve
 from .numeric.region import StabilityRegion, limits
 from .numeric.simulate import PAPER_ENCODER_RESOLUTION, Nonidealities, stability_map
+from .numeric.stability import unstable_root_counts
 from .numeric.units import PAPER_DEVICE
 
 __all__ = ["FigureResult", "FIGURES", "make_figures", "pyplot", "require_matplotlib"]
@@ -197,23 +206,240 @@ def fig5():
 
 
 # --------------------------------------------------------------------------
-# Boundaries over simulated stable areas
+# The whole boundary, the stable set and the root counts in the cells
+
+#: Styles of the boundary's parts, shared by the panels and the legends.
+_ARC = {"ls": "-", "lw": 1.6}                       # eq. (7): theta from 0 to theta_max
+_BEYOND = {"ls": (0, (4, 2)), "lw": 0.9}            # the same curve for theta_max < theta < pi
+_Z_ONE = {"color": "0.35", "ls": "-", "lw": 0.9}    # alpha = 0: a root at z = 1
+#: How the simulation is drawn: hatched, over the exact stable set's fill.
+_SIM_HATCH = "////"
+#: Opacity of the exact stable set's fill.
+_FILL_ALPHA = 0.28
+#: Caption of the line styles, for the figures' legends.
+_COUNTS_NOTE = ("numbers: closed-loop poles outside the unit circle in that cell "
+                "(certified root count)")
+
+
+@functools.lru_cache(maxsize=64)
+def _region(gamma, d):
+    """The stable region of ``(gamma, d)``, kept: the panels, fills and verdicts share its scan."""
+    return StabilityRegion(gamma=gamma, d=d, delta=DELTA)
+
+
+def _arc_pieces(gamma, d, window):
+    """The whole boundary arc, 0 < theta < pi, for drawing in ``window``.
+
+    Returns ``(first, beyond)``, each an ``(n, 2)`` array of ``(beta, alpha)``
+    rows: the arc of eq. (7) from theta = 0 to theta_max, and the rest up to
+    pi (empty when there is no theta_max).  Rows of NaN cut the curve where
+    it runs far from the window -- through a pole it goes to infinity and
+    comes back from the other side, and a straight line across would be
+    drawn.  The samples resolve the arc's turns: sin(d theta) has d / 2
+    periods on the way, so 400 samples a period.
+    """
+    (b0, b1), (a0, a1) = window
+    t_max = arc_end_angle(gamma=gamma, d=d, delta=DELTA)
+    theta = np.linspace(0.0, np.pi, 4000 + 400 * d + 1)[1:-1]
+    if np.isfinite(t_max):
+        theta = np.union1d(theta, [t_max])
+    alpha, beta = kernels.boundary(theta, gamma, d, DELTA)
+    span_b, span_a = b1 - b0, a1 - a0
+    with np.errstate(invalid="ignore"):
+        far = ~(np.isfinite(alpha) & np.isfinite(beta)) \
+            | (beta < b0 - 5 * span_b) | (beta > b1 + 5 * span_b) \
+            | (alpha < a0 - 5 * span_a) | (alpha > a1 + 5 * span_a)
+    points = np.column_stack([beta, alpha])
+    points[far] = np.nan
+    # The arc starts exactly at the corner (-delta, 0), the z = 1 root's line.
+    points = np.vstack([[-DELTA, 0.0], points])
+    if not np.isfinite(t_max):
+        return np.empty((0, 2)), points
+    k = int(np.searchsorted(theta, t_max)) + 1
+    return points[: k + 1], points[k:]
+
+
+def _stable_strips(gamma, d, window, scale=(1.0, 1.0), n_lines=400):
+    """The stable set in ``window``: its exact alpha intervals on ``n_lines`` verticals.
+
+    Each interval becomes a strip one line-spacing wide, so the fill is
+    exact in alpha and resolved to ``1 / n_lines`` of the window in beta.
+    ``scale`` multiplies (beta, alpha) into the plotted units.  Returns the
+    strips as ``(4, 2)`` polygons.
+    """
+    (b0, b1), (a0, a1) = window
+    h = (b1 - b0) / n_lines
+    betas = b0 + h * (np.arange(n_lines) + 0.5)
+    runs = _region(gamma, d).alpha_intervals_on(betas)
+    sx, sy = scale
+    strips = []
+    for b, run in zip(betas, runs):
+        for lo, hi in run:
+            lo, hi = max(lo, a0), min(hi, a1)
+            if hi > lo:
+                strips.append(np.array([[b - h / 2, lo], [b + h / 2, lo],
+                                        [b + h / 2, hi], [b - h / 2, hi]]) * (sx, sy))
+    return strips
+
+
+def _fill_stable(ax, gamma, d, window, color, scale=(1.0, 1.0)):
+    """Fill the exact stable set of ``(gamma, d)`` in ``window``; True when it meets the window."""
+    from matplotlib.collections import PolyCollection
+
+    strips = _stable_strips(gamma, d, window, scale)
+    if strips:
+        # No edges and no antialiasing: the strips abut without seams.
+        ax.add_collection(PolyCollection(strips, facecolors=color, edgecolors="none",
+                                         alpha=_FILL_ALPHA, antialiased=False, zorder=1))
+    return bool(strips)
+
+
+def _shade_cells(ax, decomposition, color, scale=(1.0, 1.0), counts=False, min_share=0.01):
+    """Fill the stable cells of a D-decomposition, holes included; optionally write every cell's count.
+
+    ``decomposition`` is a :class:`symstab.numeric.decomposition.Decomposition`
+    (x = beta, y = alpha); ``scale`` multiplies its coordinates into the
+    plotted units.  A cell's count is written at its interior point when
+    the cell covers at least ``min_share`` of the plotted window.
+    """
+    from matplotlib.patches import PathPatch
+    from matplotlib.path import Path
+
+    sx, sy = scale
+
+    def ring(points, clockwise):
+        # A hole must wind the other way round than its outline to be left empty.
+        x, y = points[:, 0] * sx, points[:, 1] * sy
+        area = 0.5 * np.sum(x * np.roll(y, -1) - np.roll(x, -1) * y)
+        if (area < 0) != clockwise:
+            x, y = x[::-1], y[::-1]
+        vertices = np.column_stack([np.append(x, x[0]), np.append(y, y[0])])
+        codes = np.full(len(vertices), Path.LINETO)
+        codes[0], codes[-1] = Path.MOVETO, Path.CLOSEPOLY
+        return vertices, codes
+
+    for cell in decomposition.stable:
+        parts = [ring(cell.outer, False)] + [ring(h, True) for h in cell.holes]
+        path = Path(np.concatenate([v for v, _ in parts]), np.concatenate([c for _, c in parts]))
+        ax.add_patch(PathPatch(path, facecolor=color, edgecolor="none", alpha=_FILL_ALPHA, zorder=1))
+    if counts:
+        (x0, x1), (y0, y1) = decomposition.x_range, decomposition.y_range
+        for cell in decomposition.cells:
+            if cell.count >= 0 and cell.area >= min_share * (x1 - x0) * (y1 - y0):
+                _count_text(ax, cell.point[0] * sx, cell.point[1] * sy, cell.count)
+
+
+def _count_text(ax, x, y, count):
+    ax.text(x, y, str(count), ha="center", va="center", fontsize=10, fontweight="bold",
+            color="0.15", zorder=5,
+            bbox={"boxstyle": "circle,pad=0.2", "fc": "white", "ec": "0.5", "lw": 0.6, "alpha": 0.85})
+
+
+def _write_counts(ax, gamma, d, window, scale=(1.0, 1.0), n=40, min_share=0.01, min_depth=2):
+    """Write the number of unstable roots in every cell of ``window`` that is big enough to hold it.
+
+    The cells are found on an ``n`` x ``n`` grid of certified root counts
+    (:func:`symstab.numeric.stability.unstable_root_counts`): points of one
+    count that touch make a cell.  The number goes at the cell's deepest
+    grid point (the last one left when the cell is eroded step by step),
+    so it is the certified count at the point where it is written.  Cells
+    under ``min_share`` of the window, or narrower than ``2 min_depth + 1``
+    grid points, are left unlabelled.  Returns the ``(beta, alpha, count)``
+    written.
+    """
+    (b0, b1), (a0, a1) = window
+    beta = b0 + (b1 - b0) * (np.arange(n) + 0.5) / n
+    alpha = a0 + (a1 - a0) * (np.arange(n) + 0.5) / n
+    A, B = np.meshgrid(alpha, beta, indexing="ij")
+    counts = unstable_root_counts(alpha=A, beta=B, gamma=gamma, d=d, delta=DELTA)
+    seen = np.zeros(counts.shape, dtype=bool)
+    written = []
+    for i0, j0 in zip(*np.nonzero(counts >= 0)):
+        if seen[i0, j0]:
+            continue
+        cell = np.zeros(counts.shape, dtype=bool)
+        stack = [(i0, j0)]
+        seen[i0, j0] = True
+        while stack:
+            i, j = stack.pop()
+            cell[i, j] = True
+            for k, l in ((i + 1, j), (i - 1, j), (i, j + 1), (i, j - 1)):
+                if 0 <= k < n and 0 <= l < n and not seen[k, l] and counts[k, l] == counts[i0, j0]:
+                    seen[k, l] = True
+                    stack.append((k, l))
+        if cell.sum() < min_share * n * n:
+            continue
+        core, depth = cell, 0
+        while True:
+            inner = core.copy()
+            inner[1:, :] &= core[:-1, :]
+            inner[:-1, :] &= core[1:, :]
+            inner[:, 1:] &= core[:, :-1]
+            inner[:, :-1] &= core[:, 1:]
+            if not inner.any():
+                break
+            core, depth = inner, depth + 1
+        if depth < min_depth:
+            continue  # a sliver: its number would sit on the curves around it
+        i, j = np.argwhere(core)[len(np.argwhere(core)) // 2]
+        _count_text(ax, B[i, j] * scale[0], A[i, j] * scale[1], int(counts[i, j]))
+        written.append((float(B[i, j]), float(A[i, j]), int(counts[i, j])))
+    return written
+
+
+def _draw_boundary(ax, gamma, d, window, color, scale=(1.0, 1.0), beyond=True):
+    """Draw the arc of eq. (7) (solid) and, with ``beyond``, the rest of the arc up to pi (dashed)."""
+    first, rest = _arc_pieces(gamma, d, window)
+    sx, sy = scale
+    if len(first):
+        ax.plot(first[:, 0] * sx, first[:, 1] * sy, color=color, zorder=3, **_ARC)
+    if beyond and len(rest):
+        ax.plot(rest[:, 0] * sx, rest[:, 1] * sy, color=color, zorder=3, **_BEYOND)
+    return first, rest
+
+
+def _style_handles(color="k", beyond=True, z_one=True):
+    """Legend handles for the boundary's parts."""
+    from matplotlib.lines import Line2D
+
+    handles = [Line2D([], [], color=color, **_ARC,
+                      label=r"eq. (7), $0 < \theta \leq \theta_{\max}$")]
+    if beyond:
+        handles.append(Line2D([], [], color=color, **_BEYOND,
+                              label=r"the same curve, $\theta_{\max} < \theta < \pi$"))
+    if z_one:
+        handles.append(Line2D([], [], **_Z_ONE, label=r"$\alpha = 0$: a root at $z = 1$"))
+    return handles
 
 
 def _window(gammas, d):
-    """A common (alpha, beta) window for the regions of ``gammas`` at delay ``d``."""
+    """A common ``((beta0, beta1), (alpha0, alpha1))`` window for the stable regions of ``gammas`` at delay ``d``."""
     tops, lows, highs = [], [], []
     for g in gammas:
-        lim = limits(gamma=g, d=d, delta=DELTA, n_beta=101)
+        lim = _region(g, d).limits(n_beta=101)
         if not lim.empty:
             tops.append(lim.alpha_max)
             lows.append(lim.beta_left)
             highs.append(lim.beta_right)
     if not tops:
-        return (0.0, 1.0 / (d + 1)), (-0.1, 2.0 / (d + 1))
+        return (-0.1, 2.0 / (d + 1)), (-0.04 / (d + 1), 1.0 / (d + 1))
     lo, hi = min(lows), max(highs)
     pad = 0.05 * (hi - lo)
-    return (0.0, 1.12 * max(tops)), (lo - pad, hi + pad)
+    top = 1.12 * max(tops)
+    # A strip below alpha = 0 shows the z = 1 line and that nothing under it is stable.
+    return (lo - pad, hi + pad), (-0.04 * top, top)
+
+
+def _arcs_window(gammas, d):
+    """``((beta0, beta1), (alpha0, alpha1))`` window that holds every arc of eq. (7) of ``gammas`` whole."""
+    b, a = [], []
+    for g in gammas:
+        curve = boundary_curve(gamma=g, d=d, delta=DELTA, n=2000, segments=False)
+        b.append(curve.beta)
+        a.append(curve.alpha)
+    b, a = np.concatenate(b), np.concatenate(a)
+    pad_b, top = 0.04 * (b.max() - b.min()), 1.06 * a.max()
+    return (float(b.min() - pad_b), float(b.max() + pad_b)), (-0.04 * float(top), float(top))
 
 
 def figure_horizon(d):
@@ -226,67 +452,157 @@ def figure_horizon(d):
     return 4000 + 400 * d
 
 
-def _overlay(ax, gammas, d, n, verdicts):
-    (a0, a1), (b0, b1) = _window(gammas, d)
-    alpha, beta = np.linspace(a0, a1, n), np.linspace(b0, b1, n)
+def _simulated(ax, gamma, d, window, n, color, scale=(1.0, 1.0), **kwargs):
+    """Simulate an ``n`` x ``n`` grid of the window's alpha >= 0 part; hatch what stays bounded."""
+    import matplotlib
+
+    (b0, b1), (a0, a1) = window
+    alpha, beta = np.linspace(max(a0, 0.0), a1, n), np.linspace(b0, b1, n)
+    result = stability_map(alpha=alpha, beta=beta, gamma=gamma, d=d, delta=kwargs.pop("delta", DELTA),
+                           steps=kwargs.pop("steps", figure_horizon(d)), **kwargs)
+    if result.stable.any():
+        with matplotlib.rc_context({"hatch.color": color, "hatch.linewidth": 0.7}):
+            ax.contourf(beta * scale[0], alpha * scale[1], result.stable.astype(float),
+                        levels=[0.5, 1.5], colors="none", hatches=[_SIM_HATCH], zorder=2)
+    return result, alpha, beta
+
+
+def _gamma_handles(gammas, verdicts):
+    from matplotlib.lines import Line2D
+
+    return [Line2D([], [], color=c, lw=2.5, label=fr"$\gamma = {g:g}$ ({verdicts[g]})")
+            for g, c in zip(gammas, _COLORS)]
+
+
+def _legend_below(fig, handles, ncol):
+    """One legend for the whole figure, under the panels, where it covers nothing.
+
+    Lays the panels out in the space above it (call it last, after the
+    suptitle).
+    """
+    legend = fig.legend(handles=handles, loc="lower center", ncol=ncol, fontsize=LEGEND_SIZE + 1,
+                        frameon=False, bbox_to_anchor=(0.5, 0.0))
+    height = legend.get_window_extent(fig.canvas.get_renderer()).height / fig.bbox.height
+    fig.tight_layout(rect=(0, height + 0.01, 1, 1))
+    return legend
+
+
+def _regions_panel(ax, gammas, d, window, n, verdicts, beyond=True):
+    """Exact stable sets (filled), every branch of the boundary, simulation (hatched)."""
+    (b0, b1), (a0, a1) = window
+    ax.axhline(0.0, zorder=2, **_Z_ONE)
     for g, color in zip(gammas, _COLORS):
-        result = stability_map(alpha=alpha, beta=beta, gamma=g, d=d, delta=DELTA,
-                               steps=figure_horizon(d))
-        if result.stable.any():
-            ax.contourf(beta, alpha, result.stable.astype(float), levels=[0.5, 1.5],
-                        colors=[color], alpha=0.25)
-        curve = boundary_curve(gamma=g, d=d, delta=DELTA, n=1500, segments=False)
-        verdict = "S" if result.stable.any() else "U"
-        verdicts.append((g, d, verdict, int(result.stable.sum())))
-        if not curve.empty:
-            ax.plot(curve.beta, curve.alpha, "-", color=color, lw=1.4,
-                    label=fr"$\gamma$ = {g:g} ({verdict})")
-        else:
-            ax.plot([], [], "-", color=color, label=fr"$\gamma$ = {g:g} (no arc)")
+        exact = _fill_stable(ax, g, d, window, color)
+        result, _, _ = _simulated(ax, g, d, window, n, color) if n else (None, None, None)
+        _draw_boundary(ax, g, d, window, color, beyond=beyond)
+        if result is not None:
+            verdicts.append((g, d, "S" if result.stable.any() else "U", int(result.stable.sum()), exact))
     ax.set_xlim(b0, b1)
     ax.set_ylim(a0, a1)
-    ax.set_title(f"$d = {d}$ (simulated {figure_horizon(d)} periods)", fontsize=PANEL_TITLE_SIZE)
     _labels(ax)
-    ax.legend(fontsize=LEGEND_SIZE, loc="upper right")
 
 
-def _fig_overlay(name, title, suptitle, gammas, n, paper, claimed):
-    """Boundaries over simulated areas; ``claimed[(gamma, d)]`` is the paper's S, U or B.
+def _fig_overlay(name, title, suptitle, gammas, n, paper, claimed, extra_row=None):
+    """Boundaries, exact stable sets and simulated ones; ``claimed[(gamma, d)]`` is the paper's S, U or B.
 
     ``title`` is the plain-text line of the reproduction's index, ``suptitle``
-    the same in mathtext for the figure.
+    the same in mathtext for the figure.  ``extra_row(axes, windows)``, when
+    given, draws a second row of panels under the first (Fig. 8's whole
+    arcs and zoom).
     """
     plt = pyplot()
-    fig, axes = plt.subplots(2, 2, figsize=(11, 8.5))
-    verdicts = []
-    for ax, d in zip(axes.ravel(), DELAYS):
-        _overlay(ax, gammas, d, n, verdicts)
-    fig.suptitle(suptitle + " (curves: theory, eq. (7); shaded: stable by simulation, "
-                 fr"${n} \times {n}$ grid)", fontsize=SUPTITLE_SIZE)
-    fig.tight_layout()
-    text = "; ".join(f"d={d}: " + ", ".join(f"{g:g} {v}" for g, dd, v, _ in verdicts if dd == d)
+    if extra_row is None:
+        fig, axes = plt.subplots(2, 2, figsize=(11, 9.4))
+        top = axes.ravel()
+    else:
+        fig, axes = plt.subplots(2, 4, figsize=(16, 9.4))
+        top = axes[0]
+    verdicts, windows = [], {}
+    for ax, d in zip(top, DELAYS):
+        windows[d] = _arcs_window(gammas, d) if extra_row and d == 0 else _window(gammas, d)
+        _regions_panel(ax, gammas, d, windows[d], n, verdicts)
+        ax.set_title(f"$d = {d}$", fontsize=PANEL_TITLE_SIZE)
+    if extra_row is not None:
+        extra_row(axes[1], windows)
+    marks = {}
+    for g in gammas:
+        stable = [d for gg, d, v, _, _ in verdicts if gg == g and v == "S"]
+        unstable = [d for gg, d, v, _, _ in verdicts if gg == g and v == "U"]
+        marks[g] = ("S" if not unstable else "U" if not stable else
+                    f"S at $d = {', '.join(map(str, stable))}$, U at $d = {', '.join(map(str, unstable))}$")
+    from matplotlib.patches import Patch
+
+    handles = _gamma_handles(gammas, marks) + _style_handles() + [
+        Patch(facecolor="0.6", alpha=_FILL_ALPHA + 0.1, label="stable (root counting, exact)"),
+        Patch(facecolor="none", edgecolor="0.3", hatch=_SIM_HATCH,
+              label=fr"stable by simulation, ${n} \times {n}$ grid (a check)")]
+    fig.suptitle(suptitle + ": the boundary, the exact stable sets (filled; S: stable region, "
+                 "U: none) and a simulated check (hatched)", fontsize=SUPTITLE_SIZE)
+    _legend_below(fig, handles, ncol=5 if extra_row else 3)
+    text = "; ".join(f"d={d}: " + ", ".join(f"{g:g} {v}" for g, dd, v, _, _ in verdicts if dd == d)
                      for d in DELAYS)
     differ = [f"gamma {g:g}, d {d}: paper {claimed[(g, d)]}, simulation {v}"
-              for g, d, v, _ in verdicts if claimed[(g, d)] != v]
+              for g, d, v, _, _ in verdicts if claimed[(g, d)] != v]
     verdict = ("every verdict agrees with the paper" if not differ
                else "differs from the paper at " + "; ".join(differ))
-    counted = {(g, d): "U" if limits(gamma=g, d=d, delta=DELTA, n_beta=21).empty else "S"
-               for g, d, _, _ in verdicts}
-    split = [f"gamma {g:g}, d {d}" for g, d, v, _ in verdicts if counted[(g, d)] != v]
+    counted = {(g, d): "U" if _region(g, d).limits(n_beta=21).empty else "S"
+               for g, d, _, _, _ in verdicts}
+    split = [f"gamma {g:g}, d {d}" for g, d, v, _, _ in verdicts if counted[(g, d)] != v]
     check = ("root counting (symstab.limits) gives the same verdicts" if not split
              else "root counting disagrees with the simulation at " + ", ".join(split))
     return FigureResult(name, title, fig, paper,
                         "simulated verdicts (S: some stable cell, U: none): " + text + "; " + verdict
-                        + "; " + check + ".")
+                        + "; " + check + ". Filled: the stable set by exact root counting; hatched: "
+                        "stable in simulation; solid: the arc of eq. (7) up to theta_max, dashed: "
+                        "the same curve beyond theta_max (another branch of the boundary); the z = -1 "
+                        "line alpha + 2 beta = c lies at |c| ~ 9500, outside every panel.")
 
 
 def fig6(n=100):
     """Negative virtual mass: gamma = 0, -0.25, -0.5, -0.75 at d = 0, 1, 5, 10."""
     gammas = (0.0, -0.25, -0.5, -0.75)
     return _fig_overlay("fig06_negative_mass_regions", "Fig. 6: gamma <= 0",
-                        r"Fig. 6: $\gamma \leq 0$", gammas, n,
+                        r"Fig. 6, $\gamma \leq 0$", gammas, n,
                         "stable regions shrink as d grows; every curve bounds a stable region.",
                         {(g, d): "S" for g in gammas for d in DELAYS})
+
+
+def _fig8_second_row(gammas):
+    """Fig. 8's lower panels: the gamma = 2 sliver at d = 0 magnified, every arc whole at d > 0."""
+    from matplotlib.patches import Rectangle
+
+    def draw(axes, windows):
+        # d = 0: the sliver between the two halves of the gamma = 2 arc, at beta = -1.
+        zoom = ((-1.011, -0.989), (1.978, 2.022))
+        ax = axes[0]
+        _regions_panel(ax, (2.0,), 0, zoom, 0, [], beyond=False)
+        # Keep gamma = 2's colour from the upper panel.
+        for line in ax.lines[1:]:
+            line.set_color(_COLORS[gammas.index(2.0)])
+        for coll in ax.collections:
+            coll.set_facecolor(_COLORS[gammas.index(2.0)])
+        ax.set_title(r"$d = 0$, magnified: the $\gamma = 2$ sliver", fontsize=PANEL_TITLE_SIZE)
+        (b0, b1), (a0, a1) = zoom
+        axes_top = axes[0].figure.axes[0]
+        axes_top.add_patch(Rectangle((b0, a0), b1 - b0, a1 - a0, fill=False, ec="k", lw=1.0, zorder=6))
+        axes_top.annotate("magnified below", (b1, a0), xytext=(12, -18), textcoords="offset points",
+                          fontsize=8, arrowprops={"arrowstyle": "-", "lw": 0.6})
+        for ax, d in zip(axes[1:], DELAYS[1:]):
+            whole = _arcs_window(gammas, d)
+            (b0, b1), (a0, a1) = whole
+            ax.axhline(0.0, zorder=2, **_Z_ONE)
+            for g, color in zip(gammas, _COLORS):
+                _fill_stable(ax, g, d, whole, color)
+                _draw_boundary(ax, g, d, whole, color, beyond=False)
+            (zb0, zb1), (za0, za1) = windows[d]
+            ax.add_patch(Rectangle((zb0, za0), zb1 - zb0, za1 - za0, fill=False, ec="k", lw=1.0,
+                                   zorder=6))
+            ax.set_xlim(b0, b1)
+            ax.set_ylim(a0, a1)
+            _labels(ax)
+            ax.set_title(f"$d = {d}$, zoomed out: every arc whole", fontsize=PANEL_TITLE_SIZE)
+
+    return draw
 
 
 def fig8(n=100):
@@ -299,23 +615,48 @@ def fig8(n=100):
     for d in (5, 10):
         claimed.update({(g, d): "S" if g <= 1 else "U" for g in gammas})
     return _fig_overlay("fig08_positive_mass_regions", "Fig. 8: gamma >= 0",
-                        r"Fig. 8: $\gamma \geq 0$", gammas, n,
+                        r"Fig. 8, $\gamma \geq 0$", gammas, n,
                         "d=0: gamma < 2 stable, 2 boundary (B), 2.2 unstable; d=1: 1.5 and 2 "
                         "unstable, the rest (2.2 included) stable; d=5, 10: 0, 0.5, 1 stable, 1.5, 2, "
-                        "2.2 unstable.", claimed)
+                        "2.2 unstable.", claimed, extra_row=_fig8_second_row(gammas))
+
+
+def _loop_counts(gamma, first, beta):
+    """Root counts inside and just outside a thin loop of the arc, on the vertical ``beta``.
+
+    ``first`` is the arc of eq. (7) as ``(beta, alpha)`` rows; it runs up
+    to its tip and back, so it meets the vertical twice.  Returns
+    ``(inside, outside, alpha_tip, beta_tip)``.
+    """
+    ok = np.all(np.isfinite(first), axis=1)
+    b, a = first[ok, 0], first[ok, 1]
+    tip = int(np.argmax(a))
+    heights = []
+    for half in (slice(0, tip + 1), slice(tip, None)):
+        order = np.argsort(b[half])
+        heights.append(np.interp(beta, b[half][order], a[half][order]))
+    lo, hi = sorted(heights)
+    inside, outside = unstable_root_counts(alpha=np.array([0.5 * (lo + hi), hi + 0.25]),
+                                           beta=np.array([beta, beta]), gamma=gamma, d=0, delta=DELTA)
+    return int(inside), int(outside), float(a[tip]), float(b[tip])
 
 
 def fig7():
     """Boundaries for gamma 0 .. 3 at d = 0 with the numbered points."""
     plt = pyplot()
-    fig, ax = plt.subplots(figsize=(7.5, 5.5))
+    fig, ax = plt.subplots(figsize=(11, 6.4))
     gammas = (0.0, 0.5, 1.0, 1.5, 2.0, 2.5, 3.0)
+    window = ((-4.5, 2.2), (-0.25, 6.6))
+    ax.axhline(0.0, zorder=2, **_Z_ONE)
+    loops = {}
     for g, color in zip(gammas, _COLORS):
-        curve = boundary_curve(gamma=g, d=0, delta=DELTA, n=2000, segments=False)
         lim = limits(gamma=g, d=0, delta=DELTA, n_beta=101)
         tag = "U" if lim.empty else ("S, a thin sliver" if lim.z_width < 0.05 else "S")
-        if not curve.empty:
-            ax.plot(curve.beta, curve.alpha, "-", color=color, lw=1.5, label=fr"$\gamma$ = {g:g} ({tag})")
+        _fill_stable(ax, g, 0, window, color)
+        first, _ = _draw_boundary(ax, g, 0, window, color)
+        ax.plot([], [], color=color, lw=2.5, label=fr"$\gamma = {g:g}$ ({tag})")
+        if lim.empty:
+            loops[g] = (_loop_counts(g, first, -1.5), color)
     points = []
     lim0 = limits(gamma=0.0, d=0, delta=DELTA)
     points.append((1, lim0.beta_at_alpha_max, lim0.alpha_max))
@@ -326,16 +667,38 @@ def fig7():
     points.append((4, lim2.beta_at_alpha_max, lim2.alpha_max))
     (lo, hi), = StabilityRegion(gamma=1.5, d=0, delta=DELTA).alpha_intervals(-0.5)
     points += [(5, -0.5, hi), (6, -0.5, lo)]
+    # Each number sits beside its circle, on a white box, where no curve runs.
+    offsets = {1: (0, 16), 2: (18, 8), 3: (0, 17), 4: (0, 17), 5: (20, 4), 6: (20, -6)}
     for k, b, a in points:
-        ax.plot(b, a, "o", ms=13, mfc="none", mec="k")
-        ax.annotate(str(k), (b, a), ha="center", va="center", fontsize=8)
-    ax.axvline(-0.5, color="k", ls="--", lw=0.8)
-    ax.set_xlim(-2.5, 2.2)
-    ax.set_ylim(0, 4.5)
+        ax.plot(b, a, "o", ms=11, mfc="none", mec="k", mew=1.2, zorder=6)
+        ax.annotate(str(k), (b, a), xytext=offsets[k], textcoords="offset points", ha="center",
+                    va="center", fontsize=9, fontweight="bold", zorder=7,
+                    bbox={"boxstyle": "round,pad=0.15", "fc": "white", "ec": "none"})
+    ax.axvline(-0.5, color="k", ls=":", lw=0.8, zorder=2)
+    ax.annotate(r"$\beta = -0.5$", (-0.5, 3.7), xytext=(4, 0), textcoords="offset points",
+                fontsize=8, va="center")
+    for row, (g, ((inside, outside, a_tip, b_tip), color)) in enumerate(sorted(loops.items())):
+        ax.annotate(fr"$\gamma = {g:g}$: both lines are one thin loop of eq. (7)," "\n"
+                    fr"its tip at $\alpha = {a_tip:.2f}$; {inside} poles outside the unit" "\n"
+                    f"circle inside the loop, {outside} outside it: no stable cell",
+                    (b_tip, a_tip), xytext=(-0.3, 4.75 + 1.1 * row), textcoords="data", fontsize=8,
+                    color=color, va="center", zorder=7,
+                    bbox={"boxstyle": "round,pad=0.25", "fc": "white", "ec": color, "lw": 0.6},
+                    arrowprops={"arrowstyle": "->", "color": color, "lw": 0.8})
+    (b0, b1), (a0, a1) = window
+    ax.set_xlim(b0, b1)
+    ax.set_ylim(a0, a1)
     _labels(ax)
-    ax.set_title(r"Fig. 7: boundaries for $d = 0$; S: a stable region, U: none (root counting)")
-    ax.legend(fontsize=LEGEND_SIZE, loc="upper right")
+    ax.set_title(r"Fig. 7: boundaries for $d = 0$; S: a stable region (filled), U: none "
+                 "(root counting)", fontsize=PANEL_TITLE_SIZE + 1)
+    handles, _ = ax.get_legend_handles_labels()
+    ax.legend(handles=handles + _style_handles(), fontsize=LEGEND_SIZE + 1, loc="upper left",
+              bbox_to_anchor=(1.01, 1.0), borderaxespad=0.0)
+    fig.tight_layout()
     text = ", ".join(f"{k}: (beta {b:.4f}, alpha {a:.4f})" for k, b, a in points)
+    loop_text = "; ".join(f"gamma = {g:g}: the two parallel lines are one thin loop of eq. (7) with its "
+                          f"tip at alpha {a:.2f}, beta {b:.2f} ({i} unstable poles inside it, {o} "
+                          f"outside)" for g, ((i, o, a, b), _) in sorted(loops.items()))
     return FigureResult(
         "fig07_gamma_0_to_3_d0", "boundaries for gamma 0..3 at d = 0, numbered points", fig,
         "circles 1-6: alpha_max 0.6896 at beta 0.8206 (gamma 0); alpha 2 at beta 0, gamma 1; "
@@ -343,51 +706,78 @@ def fig7():
         "the largest (5) and the smallest (6) stable alpha; gamma = 2 is a boundary case.",
         f"circles {text}. Circle 1 is at beta {lim0.beta_at_alpha_max:.4f}, not 0.8206 "
         f"(alpha_max {lim0.alpha_max:.5f}); at gamma = 2 the region is "
-        + (f"a thin stable sliver (Z-width {lim2.z_width:.4f}), not a line." if not lim2.empty
-           else "empty."))
+        + (f"a thin stable sliver (Z-width {lim2.z_width:.4f}), not a line" if not lim2.empty
+           else "empty") + "; " + loop_text + ".")
+
+
+def _mass_label(g):
+    """``M_w = g m`` in mathtext: a multiple of the device's inertia (``0.5 m`` would read as metres)."""
+    if g == 0:
+        return r"M_w = 0"
+    if g == 1:
+        return r"M_w = m"
+    return fr"M_w = {g:g}\,m"
 
 
 def fig10(n=40):
     """Physical units at Td = 40 ms: theory and simulations, ideal and quantized + filtered."""
+    import matplotlib
+    from matplotlib.lines import Line2D
+    from matplotlib.patches import Patch
+
     plt = pyplot()
     dev, d = PAPER_DEVICE, 40
+    # K_w and B_w are alpha and beta times constants: the plane is only rescaled.
+    scale = (float(dev.damping(1.0)), float(dev.stiffness(1.0)))
     qf = Nonidealities(encoder_resolution=PAPER_ENCODER_RESOLUTION, velocity_cutoff=50.0)
-    fig, axes = plt.subplots(2, 2, figsize=(11, 8.5))
-    found = []
+    fig, axes = plt.subplots(2, 2, figsize=(11, 9.6))
+    found, counted = [], {}
     for ax, g in zip(axes.ravel(), (-0.5, 0.0, 0.5, 1.0)):
         lim = limits(gamma=g, d=d, delta=DELTA)
-        alpha = np.linspace(0, 1.25 * lim.alpha_max, n)
-        beta = np.linspace(lim.beta_left, 1.2 * lim.beta_right, n)
+        curve = boundary_curve(gamma=g, d=d, delta=DELTA, n=1000, segments=False)
+        top = 1.12 * float(curve.alpha.max())
+        pad = 0.06 * float(curve.beta.max() - curve.beta.min())
+        window = ((float(curve.beta.min()) - pad, float(curve.beta.max()) + pad), (-0.05 * top, top))
+        (b0, b1), (a0, a1) = window
+        ax.axhline(0.0, zorder=2, **_Z_ONE)
+        _fill_stable(ax, g, d, window, "#4292c6", scale)
+        alpha, beta = np.linspace(0.0, a1, n), np.linspace(b0, b1, n)
         ideal = stability_map(alpha=alpha, beta=beta, gamma=g, d=d, delta=DELTA)
         quant = stability_map(alpha=alpha, beta=beta, gamma=g, d=d, delta=None, device=dev,
                               nonideal=qf, x0=0.01)
         K, B = dev.stiffness(alpha), dev.damping(beta)
-        ax.contourf(B, K, ideal.stable.astype(float), levels=[0.5, 1.5], colors=["#9ecae1"], alpha=0.6)
+        with matplotlib.rc_context({"hatch.color": "#08519c", "hatch.linewidth": 0.6}):
+            ax.contourf(B, K, ideal.stable.astype(float), levels=[0.5, 1.5], colors="none",
+                        hatches=[_SIM_HATCH], zorder=2)
         ax.contour(B, K, quant.stable.astype(float), levels=[0.5], colors=["#2ca02c"],
-                   linestyles="--", linewidths=1.5)
-        curve = boundary_curve(gamma=g, d=d, delta=DELTA, n=1000, segments=False)
-        ax.plot(dev.damping(curve.beta), dev.stiffness(curve.alpha), "k-", lw=1.5)
-        ax.plot([], [], "k-", label="theory, eq. (7)")
-        ax.plot([], [], "s", color="#9ecae1", label="simulation, ideal (PI(-), QF(-))")
-        ax.plot([], [], "--", color="#2ca02c", label="simulation, quantized + 50 Hz filter (PI(-), QF(+))")
-        # M_w is a multiple of the device's inertia m; "0.5 m" would read as metres.
-        ax.set_title(fr"$M_w = {g:g} \cdot m$ ($\gamma = {g:g}$), $T_d = 40$ ms",
-                     fontsize=PANEL_TITLE_SIZE)
+                   linestyles="--", linewidths=1.6, zorder=4)
+        _draw_boundary(ax, g, d, window, "k", scale)
+        counted[g] = _write_counts(ax, g, d, window, scale)
+        ax.set_xlim(b0 * scale[0], b1 * scale[0])
+        ax.set_ylim(a0 * scale[1], a1 * scale[1])
+        ax.set_title(fr"${_mass_label(g)}$ ($\gamma = {g:g}$)", fontsize=PANEL_TITLE_SIZE)
         _labels(ax, physical=True)
-        ax.legend(fontsize=LEGEND_SIZE, loc="upper right")
         A, Bm = np.meshgrid(alpha, beta, indexing="ij")
 
-        def top(mask):
+        def top_of(mask):
             return (dev.stiffness(A[mask].max()), dev.damping(Bm[mask].max())) if mask.any() else (0.0, 0.0)
 
-        (ki, bi), (kq, bq) = top(ideal.stable), top(quant.stable)
+        (ki, bi), (kq, bq) = top_of(ideal.stable), top_of(quant.stable)
         found.append((g, float(dev.stiffness(lim.alpha_max)), ki, kq, bi, bq))
+    handles = _style_handles("k") + [
+        Patch(facecolor="#4292c6", alpha=_FILL_ALPHA + 0.1, label="stable (root counting, exact)"),
+        Patch(facecolor="none", edgecolor="#08519c", hatch=_SIM_HATCH,
+              label="stable in simulation, ideal: PI(−), QF(−) (a check)"),
+        Line2D([], [], color="#2ca02c", ls="--", lw=1.6,
+               label="edge of the stable set in simulation, quantized + 50 Hz filter: PI(−), QF(+)"),
+        Line2D([], [], ls="none", marker="$2$", color="0.15", ms=8, label=_COUNTS_NOTE)]
     fig.suptitle(r"Fig. 10: physical units, $T_d = 40$ ms (the PI current-controller cases and "
                  "the experiments are not modelled)", fontsize=SUPTITLE_SIZE)
-    fig.tight_layout()
+    _legend_below(fig, handles, ncol=2)
     text = "; ".join(f"gamma = {g:g}: K_max theory {kt:.2f}, ideal sim {ki:.2f}, QF sim {kq:.2f} N m/rad "
                      f"(QF/ideal {kq / ki if ki else float('nan'):.2f}); B_max QF/ideal "
                      f"{bq / bi if bi else float('nan'):.2f}" for g, kt, ki, kq, bi, bq in found)
+    band = sorted({c for _, _, c in counted[1.0]})
     return FigureResult(
         "fig10_physical_td40", "physical units at Td = 40 ms, gamma = M_w/m = -0.5, 0, 0.5, 1", fig,
         "theory against simulations (ideal; quantization + filter; PI controller high/low gains) and "
@@ -401,67 +791,146 @@ def fig10(n=40):
            else "quantization with the 50 Hz filter does not lower K_max in every panel, unlike the "
                 "paper's report. ")
         + "The PI current-controller runs and the experiments are not modelled. At gamma = 1 the arc "
-          "of eq. (7) encloses more than the stable set, which is the band along its upper edge "
-          "(the lower edge is another part of the boundary).")
+          "of eq. (7) encloses more than the stable set: the stable set is the band along its upper "
+          "edge, and the band's lower edge is the same curve beyond theta_max (dashed); the cells "
+          f"the boundary cuts the window into hold {', '.join(map(str, band))} unstable poles "
+          "(numbers in the cells).")
+
+
+# --------------------------------------------------------------------------
+# Limits versus gamma
+
+
+def _vanishing_gamma(d, inside, outside, tol=5e-5):
+    """Where the stable region vanishes: ``(last gamma with a region, first without)``.
+
+    Bisection between ``inside`` (a gamma with a region) and ``outside``
+    (one without) on the certified emptiness of :func:`symstab.limits`,
+    until the two are ``tol`` apart.
+    """
+    while abs(outside - inside) > tol:
+        middle = 0.5 * (inside + outside)
+        if limits(gamma=middle, d=d, delta=DELTA, n_beta=3).empty:
+            outside = middle
+        else:
+            inside = middle
+    return inside, outside
 
 
 def _fig_limits(name, title, suptitle, gammas, paper, note):
-    """beta_max, alpha_max and Z-width versus ``gammas``, one panel per delay.
+    """beta_max, alpha_max and the Z-width versus ``gammas``, one column per delay.
 
-    ``title`` is the plain-text line of the reproduction's index, ``suptitle``
-    the same in mathtext for the figure.
+    Upper row: the three on a log axis (at d = 10 alpha_max and the Z-width
+    are 30 and 300 times smaller than beta_max and would lie flat on a
+    linear one).  Lower row: the Z-width on a linear axis, where it can
+    reach zero -- at the gamma where the region vanishes, found by
+    bisection on the certified emptiness of :func:`symstab.limits`, not on
+    the grid.  ``title`` is the plain-text line of the reproduction's
+    index, ``suptitle`` the same in mathtext for the figure.
     """
+    from matplotlib.lines import Line2D
+    from matplotlib.patches import Patch
+
     plt = pyplot()
-    fig, axes = plt.subplots(2, 2, figsize=(11, 8.5))
+    fig, axes = plt.subplots(2, 4, figsize=(16, 8.6), sharex=True)
     summary, facts = [], []
-    for ax, d in zip(axes.ravel(), DELAYS):
+    for column, d in enumerate(DELAYS):
         rows = [limits(gamma=g, d=d, delta=DELTA, n_beta=101) for g in gammas]
+        empty = np.array([r.empty for r in rows])
+        have = np.flatnonzero(~empty)
+        right = gammas[0] >= 0  # Fig. 12: the region ends on the right
+        edge = have[-1] if right else have[0]
+        beyond = edge + 1 if right else edge - 1
+        vanish, edge_rows = None, []
+        if 0 <= beyond < len(gammas) and empty[beyond]:
+            vanish = _vanishing_gamma(d, gammas[edge], gammas[beyond])
+            # A few points between the last grid gamma and the vanishing one,
+            # closer and closer, show how the Z-width goes to zero.
+            edge_rows = [(g, limits(gamma=g, d=d, delta=DELTA, n_beta=101)) for g in
+                         (vanish[0] + (gammas[edge] - vanish[0]) * s for s in (0.3, 0.1, 0.0))]
+        g_edge = [g for g, _ in edge_rows]
+        z_edge = [r.z_width for _, r in edge_rows]
+        g_all = np.array(gammas, dtype=float)
         bm = np.array([np.nan if r.empty else r.beta_right for r in rows])
         am = np.array([np.nan if r.empty else r.alpha_max for r in rows])
         zw = np.array([r.z_width for r in rows])
-        # One log axis: at d = 10 alpha_max and the Z-width are 30 and 300
-        # times smaller than beta_max and would lie flat on a linear one.
+        ax, lin = axes[0, column], axes[1, column]
         ax.set_yscale("log")
-        ax.plot(gammas, bm, "-", color=_COLORS[0], lw=1.8, label=r"$\beta_{\max}$")
-        ax.plot(gammas, am, "--", color=_COLORS[1], lw=1.8, label=r"$\alpha_{\max}$")
-        ax.plot(gammas, np.where(zw > 0, zw, np.nan), ":", color=_COLORS[3], lw=2.2,
-                label="Z-width (area)")
-        empty = np.array([r.empty for r in rows])
-        if empty.any():
-            ax.fill_between(gammas, 0, 1, where=empty, color="red", alpha=0.15,
-                            transform=ax.get_xaxis_transform(), label="no stable region")
-        ax.set_xlabel(r"$\gamma = M_w/m$")
-        ax.set_ylabel("dimensionless (log scale)")
+        # beta_max and alpha_max up to the vanishing gamma (where they stay
+        # finite); the Z-width on the grid only: its last few points fall by
+        # decades and would stretch the log axis.
+        order = np.argsort(np.concatenate([g_all, [g for g, _ in edge_rows]]))
+        g_ab = np.concatenate([g_all, [g for g, _ in edge_rows]])[order]
+        b_ab = np.concatenate([bm, [r.beta_right for _, r in edge_rows]])[order]
+        a_ab = np.concatenate([am, [r.alpha_max for _, r in edge_rows]])[order]
+        with np.errstate(invalid="ignore"):
+            ax.plot(g_ab, np.where(b_ab > 0, b_ab, np.nan), "-", color=_COLORS[0], lw=1.8)
+            ax.plot(g_ab, np.where(a_ab > 0, a_ab, np.nan), "--", color=_COLORS[1], lw=1.8)
+            ax.plot(g_all, np.where(zw > 0, zw, np.nan), ":", color=_COLORS[3], lw=2.2)
+        # The Z-width, linear: the grid, then the points that close on the vanishing gamma.
+        order = np.argsort(np.concatenate([g_all[~empty], g_edge]))
+        g_lin = np.concatenate([g_all[~empty], g_edge])[order]
+        z_lin = np.concatenate([zw[~empty], z_edge])[order]
+        if vanish is not None:
+            g_lin = np.append(g_lin, vanish[1]) if right else np.insert(g_lin, 0, vanish[1])
+            z_lin = np.append(z_lin, 0.0) if right else np.insert(z_lin, 0, 0.0)
+        lin.plot(g_lin, z_lin, ":", color=_COLORS[3], lw=2.2)
+        lin.set_ylim(0.0, 1.1 * float(np.max(z_lin)))
+        for a in (ax, lin):
+            if vanish is not None:
+                lo, hi = (vanish[1], gammas[-1]) if right else (gammas[0], vanish[1])
+                a.axvspan(lo, hi, color="red", alpha=0.15, lw=0)
+                a.axvline(vanish[1], color="red", lw=0.9)
+            a.set_xlim(gammas[0], gammas[-1])
+        if vanish is not None:
+            lin.annotate(fr"$\gamma^* = {vanish[1]:.4f}$", (vanish[1], 0.0), xytext=(-6 if right else 6, 30),
+                         textcoords="offset points", ha="right" if right else "left", fontsize=9,
+                         color="darkred", arrowprops={"arrowstyle": "->", "color": "darkred", "lw": 0.8},
+                         bbox={"boxstyle": "round,pad=0.2", "fc": "white", "ec": "none"})
+        lin.set_xlabel(r"$\gamma = M_w/m$")
+        ax.set_ylabel("dimensionless, log scale")
+        lin.set_ylabel("Z-width, linear scale")
         _label_log_axis(ax)
         ax.set_title(f"$d = {d}$", fontsize=PANEL_TITLE_SIZE)
-        ax.legend(fontsize=LEGEND_SIZE)
         k = int(np.nanargmax(am))
-        edge = np.flatnonzero(~empty)[0 if gammas[0] < 0 else -1]
-        facts.append(dict(d=d, am=am, bm=bm, zw=zw, edge=edge, empty=empty))
+        facts.append(dict(d=d, am=am, bm=bm, zw=zw, edge=edge, empty=empty, vanish=vanish,
+                          z_lin=z_lin, g_lin=g_lin))
         summary.append(f"d={d}: alpha_max peaks at {am[k]:.4g} (gamma {gammas[k]:.2f}); "
-                       f"{'first' if gammas[0] < 0 else 'last'} gamma of the scan with a region "
+                       f"{'last' if right else 'first'} gamma of the scan with a region "
                        f"{gammas[edge]:.2f}: alpha_max {am[edge]:.3g}, beta_max {bm[edge]:.3g}, "
-                       f"Z-width {zw[edge]:.3g}")
-    fig.suptitle(suptitle, fontsize=SUPTITLE_SIZE)
-    fig.tight_layout()
-    return FigureResult(name, title, fig, paper, "; ".join(summary) + "; " + note(facts))
+                       f"Z-width {zw[edge]:.3g}"
+                       + (f"; the region vanishes at gamma = {vanish[1]:.5f} (bisection on "
+                          f"root counting, to {abs(vanish[1] - vanish[0]):.0e})" if vanish else ""))
+    handles = [Line2D([], [], color=_COLORS[0], lw=1.8, label=r"$\beta_{\max}$"),
+               Line2D([], [], color=_COLORS[1], ls="--", lw=1.8, label=r"$\alpha_{\max}$"),
+               Line2D([], [], color=_COLORS[3], ls=":", lw=2.2, label="Z-width (area of the stable set)"),
+               Patch(facecolor="red", alpha=0.15,
+                     label=r"no stable region (from $\gamma^*$, found by bisection on root counting)")]
+    fig.suptitle(suptitle + ": upper row on a log scale, lower row the Z-width on a linear scale",
+                 fontsize=SUPTITLE_SIZE)
+    _legend_below(fig, handles, ncol=4)
+    return FigureResult(name, title, fig, paper, "; ".join(summary) + "; " + note(facts)
+                        + " Upper panels: log scale (the three span up to three decades); lower "
+                          "panels: the Z-width on a linear scale, closing to 0 at gamma*.")
 
 
-def fig11(n=26):
-    """beta_max, alpha_max and Z-width versus gamma < 0, at ``n`` values of gamma."""
-    gammas = np.linspace(-1.0, 0.0, n)
+def fig11(n=22):
+    """beta_max, alpha_max and Z-width versus gamma < 0, at ``n`` values of gamma from -1.05."""
+    gammas = np.linspace(-1.05, 0.0, n)
     return _fig_limits("fig11_limits_negative_mass", "Fig. 11: limits versus gamma <= 0",
                        r"Fig. 11: limits versus $\gamma \leq 0$", gammas,
                        "beta_max, alpha_max and Z-width decrease continuously as gamma goes from 0 "
                        "to -1, where all are zero.",
                        lambda facts: (
                            ("all three decrease towards gamma = -1" if all(
-                               np.all(np.diff(f["am"]) > 0) and np.all(np.diff(f["zw"]) > 0)
+                               np.all(np.diff(f["am"][~f["empty"]]) > 0)
+                               and np.all(np.diff(f["zw"][~f["empty"]]) > 0)
                                for f in facts) else "they do not all decrease monotonically")
-                           + ("; at gamma = -1 they are tiny, not zero: a region exists while "
-                              "gamma > -1 - (d + 1) delta (REPORT.md, claim:no_region_gamma_le_-1)"
-                              if all(f["zw"][0] > 0 for f in facts) else "; at gamma = -1 they are 0")
-                           + "."))
+                           + "; the region vanishes at gamma* = " + ", ".join(
+                               f"{f['vanish'][1]:.5f} (d = {f['d']})" for f in facts if f["vanish"])
+                           + ", just below -1: a region exists while gamma > -1 - (d + 1) delta "
+                             "(REPORT.md, claim:no_region_gamma_le_-1), so at gamma = -1 the limits "
+                             "are tiny, not zero."))
 
 
 def fig12(n=36):
@@ -475,7 +944,7 @@ def fig12(n=36):
                        lambda facts: "; ".join(
                            f"d={f['d']}: the Z-width "
                            + ("rises, then falls" if np.nanargmax(f["zw"]) > 0 else "falls")
-                           + (" to zero" if f["empty"][-1] else "")
+                           + (f" to zero at gamma* = {f['vanish'][1]:.5f}" if f["vanish"] else "")
                            + ("; where the region ends beta_max and alpha_max are still nonzero"
                               if f["bm"][f["edge"]] > 0 and f["am"][f["edge"]] > 0 else "")
                            for f in facts) + ".")
