@@ -2,9 +2,9 @@
 
 The theorem (J. E. Colgate and G. G. Schenkel, "Passivity of a class of
 sampled-data systems: application to haptic interfaces", J. Robotic Systems
-14(1), 37-47, 1997; restated as a necessary and sufficient condition in
-Colgate and Brown's virtual-wall work).  Its hypotheses, as this module
-applies them:
+14(1), 37-47, 1997; quoted as a necessary and sufficient condition in
+J. M. Brown and J. E. Colgate's virtual-wall work at Northwestern).  Its
+hypotheses, as this module applies them:
 
 * the device is one degree of freedom, a rigid mass ``m`` with viscous
   friction ``b``, ``G(s) = 1/(m s**2 + b s)``, driven by an ideal actuator
@@ -22,8 +22,10 @@ Then the system is passive if and only if
 
 for ``0 <= w <= pi / T`` (at ``w = 0`` the limit).  The device's mass does not
 appear.  Necessity comes from a small-gain argument and sufficiency from
-Parseval's theorem, so ``H`` must be a stable pulse transfer function: this
-module refuses an environment with a pole on or outside the unit circle.
+Parseval's theorem (the paper's abstract).  The frequency response of ``H``
+describes the environment only when ``H`` is stable, so this module refuses
+an environment with a pole on or outside the unit circle (with a pole on it
+the bound is infinite at that frequency).
 
 The loop's delay belongs to the environment: ``H(z) = VE(z) z**-d``, since
 the force the hold applies at step ``k`` is ``VE`` applied to the position
@@ -134,7 +136,10 @@ class PassiveRegion:
     area: float
     y_max: float
     x_at_y_max: float
-    _halfplanes: np.ndarray = dataclasses.field(default=None, repr=False, compare=False)
+    # The half-planes c0 + cx x + cy y <= 0 whose intersection the polygon
+    # is (before the window): set by _solve, read by contains().
+    _halfplanes: np.ndarray = dataclasses.field(default=None, init=False, repr=False,
+                                                compare=False)
 
     @property
     def empty(self):
@@ -517,8 +522,9 @@ def _solve(plane, x, y, x_range, y_range, hints=(1.0, 1.0)):
 
     halfplanes = rows * np.array([1.0, 1.0 / plane.sx, 1.0 / plane.sy])
     if len(polygon) == 0:
-        return PassiveRegion(x, y, np.zeros((0, 2)), True, tuple(window[0]), tuple(window[1]),
-                             0.0, math.nan, math.nan, halfplanes)
+        return _with_halfplanes(PassiveRegion(x, y, np.zeros((0, 2)), True, tuple(window[0]),
+                                              tuple(window[1]), 0.0, math.nan, math.nan),
+                                halfplanes)
     full = polygon * unscale + 0.0     # no -0.0
     (x0, x1), (y0, y1) = window
     inside = (full[:, 0] >= x0) & (full[:, 0] <= x1) & (full[:, 1] >= y0) & (full[:, 1] <= y1)
@@ -536,9 +542,15 @@ def _solve(plane, x, y, x_range, y_range, hints=(1.0, 1.0)):
         level = full[:, 1] >= top - 1e-12 * max(abs(top), 1e-300)
         y_max = float(top)
         x_at = float(0.5 * (full[level, 0].min() + full[level, 0].max()))
-    return PassiveRegion(x, y, clipped if len(clipped) else np.zeros((0, 2)), bounded,
-                         (float(x0), float(x1)), (float(y0), float(y1)), _area(clipped),
-                         y_max, x_at, halfplanes)
+    return _with_halfplanes(
+        PassiveRegion(x, y, clipped if len(clipped) else np.zeros((0, 2)), bounded,
+                      (float(x0), float(x1)), (float(y0), float(y1)), _area(clipped), y_max, x_at),
+        halfplanes)
+
+
+def _with_halfplanes(region, halfplanes):
+    object.__setattr__(region, "_halfplanes", halfplanes)
+    return region
 
 
 def _check_window(name, value):
