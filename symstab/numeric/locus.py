@@ -263,7 +263,7 @@ def paper_locus(*, parameter, values, gamma, d, delta, alpha=None, beta=None):
 
     Examples
     --------
-    >>> path = paper_locus(parameter="alpha", values=[0.001, 0.01], beta=0.0078,
+    >>> path = paper_locus(parameter="alpha", values=[0.0001, 0.001], beta=0.0078,
     ...                    gamma=0.0, d=40, delta=0.0025)
     >>> [(c.kind, c.direction) for c in path.crossings]
     [('pair', 'out')]
