@@ -30,6 +30,7 @@ import numpy as np
 from ._generated import kernels
 from .numeric.curves import arc_end_angle
 from .numeric.region import boundary_curve
+from .numeric.passivity import paper_passive_region
 from .numeric.region import StabilityRegion, limits
 from .numeric.simulate import PAPER_ENCODER_RESOLUTION, Nonidealities, stability_map
 from .numeric.stability import unstable_root_counts
@@ -216,7 +217,9 @@ _Z_ONE = {"color": "0.35", "ls": "-", "lw": 0.9}    # alpha = 0: a root at z = 1
 _SIM_HATCH = "////"
 #: Opacity of the exact stable set's fill.
 _FILL_ALPHA = 0.28
-#: Caption of the line styles, for the figures' legends.
+#: Colour of the passive set's outline.
+_PASSIVE = "#d62728"
+#: Caption of the root counts, for the figures' legends.
 _COUNTS_NOTE = ("numbers: closed-loop poles outside the unit circle in that cell "
                 "(certified root count)")
 
@@ -376,6 +379,8 @@ def _write_counts(ax, gamma, d, window, scale=(1.0, 1.0), n=40, min_share=0.01, 
             inner[:-1, :] &= core[1:, :]
             inner[:, 1:] &= core[:, :-1]
             inner[:, :-1] &= core[:, 1:]
+            inner[[0, -1], :] = False  # the window's edge is a cell's edge too
+            inner[:, [0, -1]] = False
             if not inner.any():
                 break
             core, depth = inner, depth + 1
@@ -731,7 +736,7 @@ def fig10(n=40):
     scale = (float(dev.damping(1.0)), float(dev.stiffness(1.0)))
     qf = Nonidealities(encoder_resolution=PAPER_ENCODER_RESOLUTION, velocity_cutoff=50.0)
     fig, axes = plt.subplots(2, 2, figsize=(11, 9.6))
-    found, counted = [], {}
+    found, counted, passive_k = [], {}, {}
     for ax, g in zip(axes.ravel(), (-0.5, 0.0, 0.5, 1.0)):
         lim = limits(gamma=g, d=d, delta=DELTA)
         curve = boundary_curve(gamma=g, d=d, delta=DELTA, n=1000, segments=False)
@@ -752,10 +757,16 @@ def fig10(n=40):
         ax.contour(B, K, quant.stable.astype(float), levels=[0.5], colors=["#2ca02c"],
                    linestyles="--", linewidths=1.6, zorder=4)
         _draw_boundary(ax, g, d, window, "k", scale)
+        passive = paper_passive_region(gamma=g, d=d, delta=DELTA)
+        if not passive.empty:
+            outline = np.vstack([passive.polygon, passive.polygon[:1]]) * scale
+            ax.plot(outline[:, 0], outline[:, 1], color=_PASSIVE, ls="--", lw=1.5, zorder=5)
+        passive_k[g] = None if passive.empty else float(dev.stiffness(passive.y_max))
         counted[g] = _write_counts(ax, g, d, window, scale)
         ax.set_xlim(b0 * scale[0], b1 * scale[0])
         ax.set_ylim(a0 * scale[1], a1 * scale[1])
-        ax.set_title(fr"${_mass_label(g)}$ ($\gamma = {g:g}$)", fontsize=PANEL_TITLE_SIZE)
+        ax.set_title(fr"${_mass_label(g)}$ ($\gamma = {g:g}$)"
+                     + (", no passive point" if passive.empty else ""), fontsize=PANEL_TITLE_SIZE)
         _labels(ax, physical=True)
         A, Bm = np.meshgrid(alpha, beta, indexing="ij")
 
@@ -770,6 +781,7 @@ def fig10(n=40):
               label="stable in simulation, ideal: PI(−), QF(−) (a check)"),
         Line2D([], [], color="#2ca02c", ls="--", lw=1.6,
                label="edge of the stable set in simulation, quantized + 50 Hz filter: PI(−), QF(+)"),
+        Line2D([], [], color=_PASSIVE, ls="--", lw=1.5, label="passive (Colgate–Schenkel)"),
         Line2D([], [], ls="none", marker="$2$", color="0.15", ms=8, label=_COUNTS_NOTE)]
     fig.suptitle(r"Fig. 10: physical units, $T_d = 40$ ms (the PI current-controller cases and "
                  "the experiments are not modelled)", fontsize=SUPTITLE_SIZE)
@@ -794,7 +806,14 @@ def fig10(n=40):
           "of eq. (7) encloses more than the stable set: the stable set is the band along its upper "
           "edge, and the band's lower edge is the same curve beyond theta_max (dashed); the cells "
           f"the boundary cuts the window into hold {', '.join(map(str, band))} unstable poles "
-          "(numbers in the cells).")
+          "(numbers in the cells). Passivity (Colgate-Schenkel, with the delay; dashed): "
+        + "; ".join(f"gamma = {g:g}: " + ("no passive point" if k is None else
+                                          f"passive K_max {k:.2f} N m/rad against the stable "
+                                          f"{kt:.2f}")
+                    for (g, k), (_, kt, _, _, _, _) in zip(passive_k.items(), found))
+        + ("; the loop is stable far outside the passive set." if any(
+            k is not None and k < kt for (_, k), (_, kt, _, _, _, _) in zip(passive_k.items(), found))
+           else "."))
 
 
 # --------------------------------------------------------------------------

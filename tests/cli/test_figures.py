@@ -268,3 +268,20 @@ def test_fig10_counts_in_the_cells_agree_with_numpy_roots(drawn):
             B, K = t.get_position()
             alpha, beta = K / dev.stiffness(1.0), B / dev.damping(1.0)
             assert _numpy_unstable(alpha, beta, g, 40) == int(t.get_text()), (g, B, K)
+
+
+def test_fig10_passive_outline_lies_in_the_stable_set(drawn):
+    # Colgate-Schenkel: a passive environment on the passive device is stable,
+    # so the outline drawn as passive must lie in the stable set (numpy's roots).
+    from symstab.numeric.units import PAPER_DEVICE as dev
+
+    ax = drawn["fig10"].axes[1]  # gamma = 0: the only panel with a passive set
+    outline, = [line for line in ax.lines if line.get_color() == figures._PASSIVE]
+    xy = np.asarray(outline.get_xydata())
+    centre = xy.mean(axis=0)
+    for B, K in centre + 0.98 * (xy[::max(1, len(xy) // 40)] - centre):
+        alpha, beta = K / dev.stiffness(1.0), B / dev.damping(1.0)
+        assert _numpy_unstable(alpha, beta, 0.0, 40) == 0, (B, K)
+    for ax in drawn["fig10"].axes[:4]:
+        has_outline = any(line.get_color() == figures._PASSIVE for line in ax.lines)
+        assert has_outline != ("no passive point" in ax.get_title()), ax.get_title()
