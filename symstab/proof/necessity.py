@@ -60,6 +60,7 @@ import sympy as sp
 
 from ..symbolic import model
 from ..symbolic.loop import characteristic_polynomial
+from .identity import check_identity
 
 __all__ = ["ProofFailed", "SignFact", "NecessaryCondition", "positive_for_positive_delta",
            "necessary_conditions", "proofs", "objects"]
@@ -123,7 +124,8 @@ class NecessaryCondition:
     signs : tuple of SignFact
         Decided when the record was built.
     decisions : tuple of str
-        Exponent comparisons SymPy decided for symbolic ``d >= 0``.
+        Other facts decided when the record was built (exponent comparisons
+        for symbolic ``d >= 0``, a lemma), each saying how.
     """
 
     name: str
@@ -202,8 +204,9 @@ def _extreme_term(chi, *, highest):
         if all(gap.is_positive is True for gap in gaps):
             others = [other for other, _ in terms if other != exponent]
             relation = "exceeds" if highest else "is below"
-            decision = _decide(f"{sp.sstr(exponent)} {relation} every other exponent of chi "
-                               f"({', '.join(sp.sstr(e) for e in others)})",
+            decision = _decide(f"for every integer d >= 0: {sp.sstr(exponent)} {relation} every other "
+                               f"exponent of chi ({', '.join(sp.sstr(e) for e in others)}) "
+                               "[decided by SymPy's assumptions]",
                                all(gap.is_positive for gap in gaps))
             return exponent, coefficient, (decision,)
     which = "highest" if highest else "lowest"
@@ -318,13 +321,15 @@ def _minimum_damping(chi, leading):
     slope = sp.factor(-sp.diff(condition, alpha) / scale)
     # Re 1/(1 - z) > 1/2 inside the unit circle: with z = x + j y,
     # Re 1/(1 - z) - 1/2 = (1 - |z|**2) / (2 |1 - z|**2).
+    # The lemma holds for any z, not only for this loop: it is proved here, once,
+    # and not among the derivation's identities (whose symbols are the model's).
     x, y = sp.symbols("x y", real=True)
-    lemma = ("necessity_re_one_over_one_minus_z",
-             "Re 1/(1 - z) - 1/2 = (1 - |z|^2) / (2 |1 - z|^2) for z = x + j y",
-             sp.re(1 / (1 - x - sp.I * y)) - sp.Rational(1, 2),
-             (1 - x**2 - y**2) / (2 * ((1 - x)**2 + y**2)))
-    identities = [lemma,
-                  ("necessity_minimum_damping_line",
+    lemma = "Re 1/(1 - z) - 1/2 = (1 - |z|^2) / (2 |1 - z|^2) for z = x + j y"
+    result = check_identity(sp.re(1 / (1 - x - sp.I * y)) - sp.Rational(1, 2),
+                            (1 - x**2 - y**2) / (2 * ((1 - x)**2 + y**2)))
+    if result.equal is not True:
+        raise ProofFailed(f"lemma not proved: {lemma} ({result.note})")
+    identities = [("necessity_minimum_damping_line",
                    f"2 chi'(1) - n chi(1) = ({sp.sstr(scale)}) (beta - ({sp.sstr(start)}) "
                    f"- ({sp.sstr(slope)}) alpha), for every d",
                    condition, scale * (beta - start - slope * alpha))]
@@ -351,7 +356,8 @@ def _minimum_damping(chi, leading):
         objects=(("chi_prime_at_1", "chi'(1) (d/dz z^(d + j) = d + j at z = 1)", slope_at_one),
                  ("minimum_damping_start", "beta where the line meets alpha = 0", start),
                  ("minimum_damping_slope", "s: the line is beta = start + s alpha", slope)),
-        identities=tuple(identities), signs=signs, decisions=decisions)
+        identities=tuple(identities), signs=signs,
+        decisions=decisions + (f"{lemma} [proved by the exact checker]",))
 
 
 @functools.lru_cache(maxsize=None)
@@ -408,9 +414,7 @@ def objects():
                         f"{fact.name}: {sp.sstr(fact.expression)} > 0 for delta > 0 [proved: {fact.note}]",
                         sp.S.true))
         for j, decision in enumerate(condition.decisions):
-            out.append((f"{condition.name}_exponent_{j}",
-                        f"for every integer d >= 0: {decision} [decided by SymPy's assumptions]",
-                        sp.S.true))
+            out.append((f"{condition.name}_decision_{j}", decision, sp.S.true))
         out.append((f"{condition.name}_theorem", condition.theorem, sp.S.true))
     return tuple(out)
 
