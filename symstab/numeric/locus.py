@@ -335,20 +335,19 @@ def _roots(c):
     return out
 
 
-def _sphere(z):
-    """Points of the Riemann sphere (unit vectors) of ``z``; infinity is the north pole."""
-    with np.errstate(all="ignore"):
-        square = np.abs(z) ** 2
-        scale = 1.0 / (1.0 + square)
-        out = np.stack([2 * z.real * scale, 2 * z.imag * scale, (square - 1.0) * scale], axis=-1)
-    out[~np.isfinite(z)] = (0.0, 0.0, 1.0)
-    return out
-
-
 def _distances(a, b):
-    """Chordal distances between the roots of ``a`` (rows) and of ``b`` (columns), per point."""
-    sa, sb = _sphere(a), _sphere(b)
-    return np.linalg.norm(sa[..., :, None, :] - sb[..., None, :, :], axis=-1)
+    """Chordal distances between the roots of ``a`` (rows) and of ``b`` (columns), per point.
+
+    On the Riemann sphere of diameter 1: ``|z - w| / sqrt((1 + |z|**2) (1 +
+    |w|**2))``, and ``1 / sqrt(1 + |z|**2)`` from ``z`` to infinity.
+    """
+    a, b = a[..., :, None], b[..., None, :]
+    with np.errstate(all="ignore"):
+        out = np.abs(a - b) / np.sqrt((1.0 + np.abs(a) ** 2) * (1.0 + np.abs(b) ** 2))
+        ia, ib = ~np.isfinite(a), ~np.isfinite(b)
+        out = np.where(ia & ~ib, 1.0 / np.sqrt(1.0 + np.abs(b) ** 2), out)
+        out = np.where(ib & ~ia, 1.0 / np.sqrt(1.0 + np.abs(a) ** 2), out)
+    return np.where(ia & ib, 0.0, out)
 
 
 def _nearest(a, b):
@@ -364,7 +363,7 @@ def _nearest(a, b):
     rows, n = a.shape
     match = np.empty((rows, n), dtype=int)
     clear = np.ones(rows, dtype=bool)
-    for part in chunk_slices(rows, 64 * n * n):
+    for part in chunk_slices(rows, 96 * n * n):
         dist = _distances(a[part], b[part])
         match[part] = np.argmin(dist, axis=-1)
         if n > 1:
@@ -437,6 +436,13 @@ def _assignment(cost):
 # Tracking and crossings
 
 
+def _steps(a, b):
+    """``(match, clear, turn)`` of consecutive points: :func:`_nearest`, and whether a pole changes side."""
+    match, clear = _nearest(a, b)
+    turn = np.any(_sides(a) * np.take_along_axis(_sides(b), match, axis=-1) < 0, axis=-1)
+    return match, clear, turn
+
+
 def _track(values, coefficients):
     """The roots along the path, refined where a match is not clear.
 
@@ -445,29 +451,33 @@ def _track(values, coefficients):
     """
     p = np.array(values, dtype=float)
     roots = _roots(coefficients(p))
+    match, clear, turn = _steps(roots[:-1], roots[1:])
     halvings = np.zeros(len(p) - 1, dtype=int)
     added = 0
     budget = _added_budget(len(values))
     while True:
-        match, clear = _nearest(roots[:-1], roots[1:])
         # A step where a pole changes side is halved too: its crossing is
         # then bracketed closely, between roots that move by little.
-        sides = _sides(roots)
-        turn = np.any(sides[:-1] * np.take_along_axis(sides[1:], match, axis=-1) < 0, axis=-1)
         split = np.flatnonzero((~clear & (halvings < _MAX_HALVINGS))
                                | (turn & (halvings < _CROSSING_HALVINGS)))
         if split.size == 0 or added + split.size > budget:
             break
         middle = 0.5 * (p[split] + p[split + 1])
         fresh = _roots(coefficients(middle))
+        # Step ``split`` becomes (start, middle) and a new step (middle,
+        # end) follows it; only those are matched again.
+        left, right = _steps(roots[split], fresh), _steps(fresh, roots[split + 1])
         at = split + 1
         p = np.insert(p, at, middle)
         roots = np.insert(roots, at, fresh, axis=0)
-        # Both halves of a split step inherit its count of halvings, plus one.
         halvings[split] += 1
         halvings = np.insert(halvings, at, halvings[split])
+        parts = []
+        for whole, l_part, r_part in zip((match, clear, turn), left, right):
+            whole[split] = l_part
+            parts.append(np.insert(whole, at, r_part, axis=0))
+        match, clear, turn = parts
         added += split.size
-    match, clear = _nearest(roots[:-1], roots[1:])
     for i in np.flatnonzero(~clear):
         match[i] = _assignment(_distances(roots[i], roots[i + 1]))
     # Columns in a fixed order at the start: by real part, then imaginary part.
