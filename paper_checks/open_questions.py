@@ -177,7 +177,9 @@ def _panel_outcome(figure, d):
     found = {c.gamma: curve_counts(c.gamma, c.d) for c in claims}
     rows = ", ".join(f"gamma {c.gamma:g} ({_label(c)}) "
                      + " ".join(f"{lo}/{hi}" for lo, hi in found[c.gamma].counts) for c in claims)
-    wrong = [f"gamma {c.gamma:g} (paper {c.claim})" for c in claims if not _agrees(c, found[c.gamma])]
+    wrong = [f"gamma {c.gamma:g} (paper {c.claim}; the counts give "
+             f"{'a stable side' if found[c.gamma].has_stable_side else 'no stable side'})"
+             for c in claims if not _agrees(c, found[c.gamma])]
     numpy_note = ("numpy.roots agrees at every probe" if all(f.numpy_agrees for f in found.values())
                   else "numpy.roots disagrees at a probe of gamma "
                   + ", ".join(f"{g:g}" for g, f in found.items() if not f.numpy_agrees))
@@ -200,8 +202,9 @@ def _run(condition):
               if check_identity(lhs, rhs, samples=10, dps=40, seed=0).equal is not True]
     if failed:
         raise AssertionError(f"necessity identities not proved: {failed}")
-    return (f"{len(condition.identities)} identities proved by the exact checker, "
-            f"{len(condition.signs)} signs decided for every delta > 0")
+    n, m = len(condition.identities), len(condition.signs)
+    return (f"{n} {'identity' if n == 1 else 'identities'} proved by the exact checker, "
+            f"{m} {'sign' if m == 1 else 'signs'} decided for every delta > 0")
 
 
 @check("claim:open_alpha_positive", kind="claim", where="Appendix E, lines 840-851; Sec. VIII, line 527",
