@@ -14,6 +14,7 @@ input is checked before the work; the PNG is written atomically.
 import dataclasses
 import io
 import math
+import sys
 
 import numpy as np
 
@@ -132,6 +133,8 @@ class _View:
         self.T = T                  # sample period (s) or None
         self.dimensionless = dimensionless   # "alpha" or "beta" beside a physical value
         self.given = given          # the path as the user gave it (in the shown units)
+        self.symbol = {"K_w": "$K_w$", "B_w": "$B_w$", "alpha": r"$\alpha$",
+                       "beta": r"$\beta$"}.get(name, name)
 
     def label(self):
         return f"{self.name} [{self.unit}]" if self.unit else self.name
@@ -174,6 +177,7 @@ def _paper(args):
     other = "beta" if parameter == "alpha" else "alpha"
     values = np.asarray(to_dimensionless[path_flag](given), dtype=float)
     fixed_value = float(to_dimensionless[fixed_flag](fixed))
+    _announce(setup.d + 4, values.size)
     locus = paper_locus(parameter=parameter, values=values, gamma=setup.gamma, d=setup.d,
                         delta=setup.delta, **{other: fixed_value})
     fixed_name = fixed_flag[2:]
@@ -198,6 +202,17 @@ def _paper(args):
     dimensionless = parameter if path_flag in ("--Kw", "--Bw") else None
     return _View(setup, locus, name, unit, tex, lambda v: np.asarray(show(v), dtype=float), T,
                  dimensionless, given)
+
+
+#: From this many poles on, say on stderr what runs (the eigenvalues are
+#: O(degree**3) a point: seconds at 100 poles, minutes at 200 on a busy machine).
+_ANNOUNCE_DEGREE = 80
+
+
+def _announce(degree, n):
+    if degree >= _ANNOUNCE_DEGREE:
+        print(f"tracking {degree} closed-loop poles at {n}+ points (the eigenvalues of a "
+              f"{degree}-square matrix per point) ...", file=sys.stderr, flush=True)
 
 
 def _with_echo(setup, line):
@@ -251,6 +266,7 @@ def _loop(args):
         raise ValueError(f"no value for {', '.join(missing)}: the loop file {args.loop} gives "
                          f"none; add --set {missing[0]}=VALUE")
     name, given = path
+    _announce(loop.coefficients(**values, **{name: given[0]}).shape[-1] - 1, given.size)
     result = track(loop, name, given, **values)
     setup = cli_loop.LoopSetup(str(args.loop), loop, values, tuple(sets))
     unit = setup.unit(name)
@@ -484,7 +500,7 @@ def _plane(ax, view, norm, limit, window=None):
     start = keep[0]
     ax.plot(poles.real[0][start], poles.imag[0][start], "o", mfc="none", mec="0.4", ms=4,
             mew=0.7, lw=0, zorder=3,
-            label=f"poles at the start, {view.tex.split(' [')[0]} = {shown[0]:.4g}")
+            label=f"poles at the start, {view.symbol} = {shown[0]:.4g}")
     labelled = set()
     for k, c in enumerate(locus.crossings):
         marker, color, label = _MARKS[c.kind]
