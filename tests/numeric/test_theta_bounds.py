@@ -13,8 +13,10 @@ import math
 import mpmath
 import numpy as np
 import pytest
+import sympy as sp
 
 from symstab.numeric.theta_bounds import NotCertified, certify_theta_max, theta_max_enclosure
+from symstab.symbolic.small_theta import small_theta_limits
 from symstab.symbolic.theta_max import reduced_equation, theta_max
 
 from conftest import PAPER_DELTA, assert_message_names
@@ -22,7 +24,7 @@ from oracles import first_principles_alpha
 
 
 def _sample(seed, n):
-    """Seeded (gamma, d, delta) over the box of issue 12: gamma in [-1, 3], d in 0..200, delta in [1e-6, 1]."""
+    """Seeded (gamma, d, delta) in the box of issue 12: gamma in [-1, 3], d in 0..200, delta in [1e-6, 1]."""
     rng = np.random.default_rng(seed)
     points = []
     for _ in range(n):
@@ -89,6 +91,16 @@ def test_a_narrow_first_dip_is_found():
     assert 1.76617 < box.lo < box.hi < 1.76619
     assert _alpha(box.lo, gamma, d, delta) > 0 > _alpha(box.hi, gamma, d, delta)
     assert _alpha(1.7662, gamma, d, delta) < 0 < _alpha(1.7663, gamma, d, delta)
+
+
+@pytest.mark.parametrize("gamma, lobe", [(2.4819247598228142, (1.7662, 1.7663)),
+                                         (2.4819247598228147, (1.7961, 1.7962))])
+def test_both_sides_of_a_jump_are_certified(gamma, lobe):
+    """Adjacent floats of gamma on either side of where the first dip stops reaching alpha < 0."""
+    d, delta = 200, 0.007024254262425767
+    box = theta_max_enclosure(gamma=gamma, d=d, delta=delta)
+    assert lobe[0] < box.lo < box.hi < lobe[1]
+    assert _alpha(box.lo, gamma, d, delta) > 0 > _alpha(box.hi, gamma, d, delta)
 
 
 def test_short_arc_is_certified():
@@ -162,7 +174,5 @@ def test_bad_candidate_bounds_are_refused(lo, hi, name):
 
 def test_reduced_equation_starts_with_the_arc_condition():
     """R'(0) = gamma + 1 + delta (d + 1): the small-theta condition of small_theta.py."""
-    from symstab.symbolic.small_theta import small_theta_limits
-    import sympy as sp
     condition = small_theta_limits().alpha_sign_condition
     assert sp.expand(condition.lhs - reduced_equation().slope0) == 0

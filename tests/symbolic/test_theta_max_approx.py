@@ -82,7 +82,10 @@ def test_phase_form_is_the_reduced_equation_at_numbers():
             assert abs(a - b) <= mpmath.mpf(10) ** -30 * abs(b)
 
 
-SAMPLE = CORNERS + _sample(7, 16) + [(0.0, 40, PAPER_DELTA), (2.5, 1, 0.3), (3.0, 200, 1e-6)]
+#: The seeded sample, the paper's device, and the benchmark's worst point (where
+#: 6 Newton steps instead of 8 left 6e-11).
+SAMPLE = CORNERS + _sample(7, 16) + [(0.0, 40, PAPER_DELTA), (2.5, 1, 0.3), (3.0, 200, 1e-6),
+                                     (2.0687057548855345, 2, 0.8613678167788827)]
 
 
 @pytest.mark.parametrize("gamma, d, delta", SAMPLE)
