@@ -315,3 +315,19 @@ def test_memory_limit_is_checked_first(paper_loop, monkeypatch):
     monkeypatch.setenv("SYMSTAB_MEMORY_LIMIT", "1M")
     with pytest.raises(ValueError, match="memory limit"):
         locus(paper_loop, "K", np.linspace(0.0, 30.0, 5000), B=0.1)
+
+
+def test_a_stable_window_between_two_unstable_points_is_found():
+    """γ = 1, d = 0, β = -0.25: stable only for α in (1.097, 2.146); a path of two points
+    on either side, both unstable, still finds the way in and out (by halving its step)."""
+    kw = dict(parameter="alpha", beta=-0.25, gamma=1.0, d=0, delta=0.0025)
+    fine = paper_locus(values=np.linspace(0.5, 3.0, 400), **kw)
+    coarse = paper_locus(values=[0.5, 3.0], **kw)
+    assert list(coarse.unstable_counts()) == [2, 2]
+    assert [c.direction for c in fine.crossings] == [c.direction for c in coarse.crossings] \
+        == ["in", "out"]
+    np.testing.assert_allclose([c.value for c in coarse.crossings],
+                               [c.value for c in fine.crossings], rtol=1e-9)
+    certified = unstable_root_counts(alpha=np.mean([c.value for c in coarse.crossings]),
+                                     beta=-0.25, gamma=1.0, d=0, delta=0.0025)
+    assert certified == 0
