@@ -13,9 +13,10 @@ mpmath's interval arithmetic (outward rounding, every sine and cosine
 enclosed), of three facts:
 
 1. ``R > 0`` on ``(0, a]``: ``R(0) = 0`` exactly and ``R' > 0`` on ``[0, a]``;
-2. ``R > 0`` on ``[a, lo]``: the interval is cut into pieces, and on each
-   piece either the interval value of ``R`` is positive, or ``R'`` has one
-   sign on it and ``R`` is positive at the end where it is smallest;
+2. ``R > 0`` on ``[a, lo]``: the interval is cut into pieces by bisection,
+   and on each piece either ``R'`` has one sign and ``R`` is positive at the
+   end where it is smallest, or the interval value of ``R`` (plain, or the
+   mean-value form ``R(m) + R'(X) (X - m)``) is positive;
 3. exactly one root in ``[lo, hi]``: ``R(lo) > 0 > R(hi)`` and ``R' < 0`` on
    ``[lo, hi]``.
 

@@ -15,7 +15,11 @@ import numpy as np
 import pytest
 import sympy as sp
 
+from mpmath import iv
+
+from symstab.numeric import theta_bounds
 from symstab.numeric.theta_bounds import NotCertified, certify_theta_max, theta_max_enclosure
+from symstab.symbolic import model
 from symstab.symbolic.small_theta import small_theta_limits
 from symstab.symbolic.theta_max import reduced_equation, theta_max
 
@@ -176,3 +180,31 @@ def test_reduced_equation_starts_with_the_arc_condition():
     """R'(0) = gamma + 1 + delta (d + 1): the small-theta condition of small_theta.py."""
     condition = small_theta_limits().alpha_sign_condition
     assert sp.expand(condition.lhs - reduced_equation().slope0) == 0
+
+
+@pytest.mark.parametrize("theta, gamma, d, delta", [(0.3, 0.5, 3, 0.01), (2.9, -0.7, 0, 0.9),
+                                                    (0.01, 2.0, 150, 1e-6), (1.2, 3.0, 40, 1.0)])
+def test_interval_forms_hold_the_derived_r_and_its_slope(theta, gamma, d, delta):
+    """The proof's hand-written R and R' enclose the derivation's R and dR/dtheta (40 digits)."""
+    eq = reduced_equation()
+    args = (model.theta, model.gamma, model.d, model.delta, model.Gamma)
+    R = sp.lambdify(args, eq.R, modules="mpmath")
+    dR = sp.lambdify(args, sp.diff(eq.R, model.theta), modules="mpmath")
+    old = iv.prec
+    iv.prec = 170
+    try:
+        reduced = theta_bounds._Reduced(gamma, d, delta)
+        value, slope = reduced.value(iv.mpf(theta)), reduced.slope(iv.mpf(theta))
+    finally:
+        iv.prec = old
+    with mpmath.workdps(60):
+        # theta as an mpf: a float theta times (d + 1) would round in Python.
+        t, dl = mpmath.mpf(theta), mpmath.mpf(delta)
+        for interval, exact in ((value, R(t, gamma, d, dl, mpmath.exp(dl))),
+                                (slope, dR(t, gamma, d, dl, mpmath.exp(dl)))):
+            # The endpoints as exact binary numbers (comparing an interval
+            # number would round the reference at the interval context's
+            # current precision).
+            lo, hi = (mpmath.mpf(end) for end in interval._mpi_)
+            assert lo <= exact <= hi
+            assert hi - lo <= mpmath.mpf(10) ** -25 * abs(exact)

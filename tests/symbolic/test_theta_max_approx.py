@@ -76,9 +76,9 @@ def test_phase_form_is_the_reduced_equation_at_numbers():
     f, g = sp.lambdify(args, form, modules="mpmath"), sp.lambdify(args, eq.R, modules="mpmath")
     with mpmath.workdps(40):
         for values in [(0.2, 1.5, 7, 0.3), (3.0, -0.2, 0, 1e-3)]:
-            dl = mpmath.mpf(values[3])
-            a = f(values[0], values[1], values[2], dl, mpmath.exp(dl))
-            b = g(values[0], values[1], values[2], dl, mpmath.exp(dl))
+            t, dl = mpmath.mpf(values[0]), mpmath.mpf(values[3])
+            a = f(t, values[1], values[2], dl, mpmath.exp(dl))
+            b = g(t, values[1], values[2], dl, mpmath.exp(dl))
             assert abs(a - b) <= mpmath.mpf(10) ** -30 * abs(b)
 
 
