@@ -268,9 +268,10 @@ class ReducedEquation:
         R(theta) = sin(theta) (gamma (1 + q u) + cos(phi)) + (delta + r u) sin(phi)
 
     ``scale = 2 delta**2 (Gamma - 1)**2 > 0`` and ``u > 0`` on (0, pi], so
-    theta_max is the first positive root of ``R``.  ``R`` has no cancelling
-    high-frequency terms (``N_alpha`` is a third difference of
-    ``sin((d + k) theta)``, which is why one Newton step on it errs), and
+    theta_max is the first positive root of ``R``.  ``R`` has one
+    high-frequency pair, ``cos(phi)`` and ``sin(phi)``, where ``N_alpha``
+    has five sines ``sin((d + k) theta)`` that cancel to ``O(theta**3)``
+    near 0, so interval arithmetic and Newton's method work well on it; and
     ``R(theta) = slope0 theta + O(theta**3)`` with ``slope0 = gamma + 1 +
     delta (d + 1)``: an arc enters alpha > 0 exactly when ``slope0 > 0``.
 
