@@ -204,15 +204,15 @@ def _paper(args):
                  dimensionless, given)
 
 
-#: From this many poles on, say on stderr what runs (the eigenvalues are
-#: O(degree**3) a point: seconds at 100 poles, minutes at 200 on a busy machine).
-_ANNOUNCE_DEGREE = 80
+#: From this many poles on, say on stderr what runs (some seconds: 8 s for
+#: 401 points at 204 poles on a busy machine).
+_ANNOUNCE_DEGREE = 150
 
 
 def _announce(degree, n):
     if degree >= _ANNOUNCE_DEGREE:
-        print(f"tracking {degree} closed-loop poles at {n}+ points (the eigenvalues of a "
-              f"{degree}-square matrix per point) ...", file=sys.stderr, flush=True)
+        print(f"tracking {degree} closed-loop poles at {n}+ points ...", file=sys.stderr,
+              flush=True)
 
 
 def _with_echo(setup, line):

@@ -9,7 +9,10 @@ pole crosses the unit circle.
 
 * Roots: companion-matrix eigenvalues per point, polished by Newton steps
   on the polynomial (:func:`symstab.numeric.stability.spectral_radius`
-  does the same for the largest).
+  does the same for the largest); from degree 64 on, the path's points
+  after the first continue the previous point's roots by Newton's steps
+  (O(degree**2) a point, not O(degree**3)), kept only where every root
+  settles a clear way from the others, else the eigenvalues.
 * Tracking: the roots of consecutive points are matched by distance on the
   Riemann sphere (so that a root through infinity, where the leading
   coefficient vanishes, is followed too).  A match is taken when each pole
@@ -42,7 +45,7 @@ import numpy as np
 from .._resources import check_memory, chunk_slices
 from .._validate import check_array, check_loop, check_real
 from .curves import bracketed_root
-from .stability import _leading_vanishes, _polish, loop_coefficients
+from .stability import _horner, _leading_vanishes, _polish, loop_coefficients
 
 __all__ = ["Locus", "Crossing", "locus", "paper_locus", "ON_CIRCLE"]
 
@@ -67,6 +70,10 @@ _REAL = 1e-9
 #: Bytes per pole of a tracked point: the roots (complex), the coefficients,
 #: the sphere coordinates and the distance matrices of a chunk (generous).
 _BYTES_PER_POLE = 96
+#: From this degree on, the path's points take their roots by continuation
+#: (:func:`_roots_along`), with at most this many Newton steps a point.
+_CONTINUATION_DEGREE = 64
+_CONTINUATION_STEPS = 12
 #: Rows of companion matrices handed to LAPACK at once (bytes).
 _EIG_BATCH_BYTES = 32 * 2**20
 
@@ -450,7 +457,7 @@ def _track(values, coefficients):
     (column ``k`` one pole) and the indices of the user's values in it.
     """
     p = np.array(values, dtype=float)
-    roots = _roots(coefficients(p))
+    roots = _roots_along(coefficients(p))
     match, clear, turn = _steps(roots[:-1], roots[1:])
     halvings = np.zeros(len(p) - 1, dtype=int)
     added = 0
@@ -494,6 +501,54 @@ def _track(values, coefficients):
 
 def _added_budget(n):
     return _MAX_ADDED * n + _ADDED_FIXED
+
+
+def _roots_along(c):
+    """The roots of consecutive rows of a path: :func:`_roots`, or continued from row to row.
+
+    From :data:`_CONTINUATION_DEGREE` on, each row's roots are Newton's
+    steps on its polynomial from the previous row's roots, O(degree**2)
+    where the eigenvalues are O(degree**3); they are kept only when every
+    root settled (a last step below 1e-12 of its size) a clear way from
+    every other root (it moved less than a third of the distance to its
+    nearest neighbour, so no two converged to one root: ``degree`` distinct
+    roots are all of them).  Any other row takes the eigenvalues.
+    """
+    c = np.asarray(c, dtype=float)
+    rows, n = c.shape[0], c.shape[1] - 1
+    if n < _CONTINUATION_DEGREE or rows < 2:
+        return _roots(c)
+    out = np.empty((rows, n), dtype=complex)
+    out[0] = _roots(c[:1])[0]
+    infinite = _leading_vanishes(c)
+    for i in range(1, rows):
+        z = None if infinite[i] or not np.all(np.isfinite(out[i - 1])) else \
+            _continued(c[i], out[i - 1])
+        out[i] = _roots(c[i:i + 1])[0] if z is None else z
+    return out
+
+
+def _continued(c, start):
+    """The roots of ``c`` by Newton's steps from ``start``, or None where they do not settle apart."""
+    row = c[None, :]
+    z = start.copy()
+    with np.errstate(all="ignore"):
+        for _ in range(_CONTINUATION_STEPS):
+            value, slope = _horner(row, z[None, :])
+            step = value[0] / slope[0]
+            z = z - step
+            if not np.all(np.isfinite(z)):
+                return None
+            if np.all(np.abs(step) <= 1e-12 * np.maximum(1.0, np.abs(z))):
+                break
+        else:
+            return None
+        gap = np.abs(z[:, None] - z[None, :])
+        np.fill_diagonal(gap, np.inf)
+        nearest = gap.min(axis=1)
+        if not np.all(np.abs(z - start) < _CLEAR_MATCH * nearest):
+            return None
+    return z
 
 
 def _sides(tracked):

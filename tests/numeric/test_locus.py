@@ -331,3 +331,29 @@ def test_a_stable_window_between_two_unstable_points_is_found():
     certified = unstable_root_counts(alpha=np.mean([c.value for c in coarse.crossings]),
                                      beta=-0.25, gamma=1.0, d=0, delta=0.0025)
     assert certified == 0
+
+
+def test_continued_roots_are_the_eigenvalues(paper_loop):
+    """From degree 64 on the path's roots are continued by Newton's steps: the same sets."""
+    values = np.linspace(0.0, 200.0, 61)
+    coefficients = paper_loop.coefficients(K=values, B=0.1, d=100)
+    assert coefficients.shape[1] - 1 >= locus_module._CONTINUATION_DEGREE
+    continued = locus_module._roots_along(coefficients)
+    eigenvalues = locus_module._roots(coefficients)
+    assert max(_hausdorff(a, b) for a, b in zip(continued, eigenvalues)) < 1e-10
+    path = locus(paper_loop, "K", values, B=0.1, d=100)
+    _assert_counts_agree(path.unstable_counts(),
+                         paper_loop.unstable_root_counts(K=values, B=0.1, d=100))
+    (_, top), = paper_loop.stable_intervals("K", B=0.1, d=100)
+    assert path.crossings[0].value == pytest.approx(top, rel=1e-9)
+
+
+def test_continuation_falls_back_where_roots_collide():
+    """Two roots that converge together (a double root) are refused, not kept twice."""
+    c = np.poly([0.5, 0.5 + 1e-9, -0.3])
+    assert locus_module._continued(c, np.array([0.49, 0.51, -0.3])) is None
+    # Two starts that both converge to the simple root 0.5 (0.9 is missed).
+    c = np.poly([0.5, 0.9, -0.3])
+    assert locus_module._continued(c, np.array([0.5, 0.52, -0.3])) is None
+    z = locus_module._continued(np.poly([0.5, 0.7, -0.3]), np.array([0.49, 0.71, -0.31]))
+    np.testing.assert_allclose(np.sort_complex(z), [-0.3, 0.5, 0.7], atol=1e-14)
