@@ -8,7 +8,8 @@ at every point is the certified enclosure
 about 4e-16, proved by interval arithmetic; the 30-digit scan
 :func:`symstab.theta_max` agrees with it inside the box and is timed beside
 it on a few points).  Grids: ``small`` (9 gamma x 8 d x 6 delta = 432
-points, under a minute) and ``full`` (14 x 12 x 9 = 1512, a few minutes);
+points, about 15 s) and ``full`` (14 x 12 x 9 = 1512; with ``--random 3000``
+about a minute);
 both contain the box's 8 corners.  ``--random N`` adds N seeded random points
 (delta log-uniform, 30 % of them with d <= 5 where the arcs are long).
 
