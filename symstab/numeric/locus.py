@@ -470,7 +470,7 @@ def _track(values, coefficients):
         if split.size == 0 or added + split.size > budget:
             break
         middle = 0.5 * (p[split] + p[split + 1])
-        fresh = _roots(coefficients(middle))
+        fresh = _roots_near(coefficients(middle), roots[split])
         # Step ``split`` becomes (start, middle) and a new step (middle,
         # end) follows it; only those are matched again.
         left, right = _steps(roots[split], fresh), _steps(fresh, roots[split + 1])
@@ -524,6 +524,24 @@ def _roots_along(c):
     for i in range(1, rows):
         z = None if infinite[i] or not np.all(np.isfinite(out[i - 1])) else \
             _continued(c[i], out[i - 1])
+        out[i] = _roots(c[i:i + 1])[0] if z is None else z
+    return out
+
+
+def _roots_near(c, start):
+    """The roots of each row of ``c``, continued from the row of ``start`` next to it.
+
+    As :func:`_roots_along` (from :data:`_CONTINUATION_DEGREE` on, else or
+    where it fails the eigenvalues), for the halvings' new points.
+    """
+    c = np.asarray(c, dtype=float)
+    if c.shape[1] - 1 < _CONTINUATION_DEGREE:
+        return _roots(c)
+    out = np.empty(start.shape, dtype=complex)
+    infinite = _leading_vanishes(c)
+    for i in range(len(c)):
+        z = None if infinite[i] or not np.all(np.isfinite(start[i])) else \
+            _continued(c[i], start[i])
         out[i] = _roots(c[i:i + 1])[0] if z is None else z
     return out
 
