@@ -593,10 +593,11 @@ def _crossings(p, tracked, coefficients):
     def pole(x, index):
         """The root at ``x`` that Newton's steps reach from the pole's straight path.
 
-        The bracket is a step of a clear match, halved at least
-        :data:`_CROSSING_HALVINGS` times: the straight path is much closer
-        to the pole than to any other root, and Newton's steps (O(degree),
-        where the eigenvalues are O(degree**3)) converge to it.
+        The bracket is a step of a clear match, halved (up to
+        :data:`_CROSSING_HALVINGS` times) because a pole crosses in it: the
+        straight path is much closer to the pole than to any other root,
+        and Newton's steps (O(degree) each, where the eigenvalues are
+        O(degree**3)) converge to it.
         """
         guess = za[index] + (x - pa[index]) / (pb[index] - pa[index]) * (zb[index] - za[index])
         c = coefficients(x)
