@@ -167,3 +167,14 @@ def check_loop(gamma, d, delta, *, zero_delta=True):
                          "forms carry a factor delta**2); the float API (classify, "
                          "boundary_curve, arc_end_angle, limits) accepts delta = 0")
     return out
+
+
+def check_window(name, value):
+    """Return a window ``(lo, hi)`` of two finite reals with ``lo < hi``."""
+    arr = check_array(name, value)
+    if arr.shape != (2,):
+        raise ValueError(f"{name} must be a pair (lo, hi), got an array of shape {arr.shape}")
+    lo, hi = float(arr[0]), float(arr[1])
+    if not lo < hi:
+        raise ValueError(f"{name} must be (lo, hi) with lo < hi, got ({lo:g}, {hi:g})")
+    return lo, hi

@@ -41,10 +41,11 @@ import numpy as np
 import sympy as sp
 
 from .._resources import check_memory
-from .._validate import check_array, check_count, check_delay
+from .._validate import check_array, check_count, check_delay, check_window
 from ..symbolic.loop_assembly import _DPS, LoopModel, parse_environment, parse_plant
 from ..codegen.loop_kernels import environment_kernels, load_numpy_kernels
-from .region import _golden_max
+from .decomposition import arc_points, decompose
+from .decomposition import lines as _lines
 from .stability import (MARGINAL, STABLE, _leading_vanishes, classify_polynomials,
                         polynomial_root_counts, polynomial_spectral_radius)
 
@@ -69,9 +70,10 @@ class LoopLimits:
         Extent of the stable set in ``x``.
     area : float
         Area of the stable set (the Z-width when ``x, y`` are damping and
-        stiffness), by the trapezoid rule over the scanned lines.
-    n_lines : int
-        Lines of constant ``x`` scanned.
+        stiffness), from the stable cells' polygons.
+    cells : int
+        The stable cells of :meth:`Loop.region` (the stable set's
+        connected pieces).
     """
 
     x: str
@@ -81,7 +83,7 @@ class LoopLimits:
     x_min: float
     x_max: float
     area: float
-    n_lines: int
+    cells: int
 
     @property
     def empty(self):
@@ -511,111 +513,95 @@ class Loop(LoopModel):
         check_memory("the boundary", 64 * n)
         base, (ax, ay), ends = self._basis((x, y), values)
         theta = np.pi * (np.arange(1, n + 1) - 0.5) / n
-        xs, ys = _arc_points(base, ax, ay, theta)
+        xs, ys, _ = arc_points(base, ax, ay, theta)
         lines = {label: c for label, c in _lines(base, ax, ay, ends).items() if c[1] or c[2]}
         return LoopBoundary(x=x, y=y, theta=theta, x_values=xs, y_values=ys, lines=lines)
 
-    def limits(self, x=None, y=None, *, n_lines=201, **values):
-        """The extent and area of the stable set in the ``(x, y)`` plane.
+    def region(self, x=None, y=None, *, x_range=None, y_range=None, **values):
+        """The complete D-decomposition of the ``(x, y)`` plane: cells, root counts, stable set.
 
-        Lines of constant ``x`` are cut into stable intervals of ``y``
-        (:meth:`stable_intervals`); the scanned window of ``x`` is the extent
-        of the D-decomposition's finite arc points and line intersections,
-        widened while the stable set reaches its edge.  ``x_min``, ``x_max``
-        are refined by bisection and ``y_max`` by golden-section search.
+        Every branch of the arc (``theta`` over all of (0, pi)), the z = 1,
+        z = -1 and leading-coefficient lines, the cells they cut the window
+        into and the certified count of unstable roots in each
+        (:func:`symstab.numeric.decomposition.decompose`).
 
         Parameters
         ----------
         x, y : str
             The plane's parameters, jointly affine (default: the loop's
             :attr:`plane`).
-        n_lines : int
-            Lines of constant ``x`` scanned over the stable set's extent.
+        x_range, y_range : (float, float), optional
+            The window.  A side not given is found: the window starts around
+            the stable points next to the arc and the lines and is widened
+            (up to 10 times) while a stable cell reaches that side; if it
+            still does, the side is in :attr:`Decomposition.unbounded`.
         **values
             Single values of every other parameter.
 
         Returns
         -------
-        LoopLimits
+        symstab.numeric.decomposition.Decomposition
+
+        Examples
+        --------
+        >>> loop = Loop("1/(m*s**2 + b*s)", "K + B*(z - 1)/(T*z)",
+        ...             values=dict(m=0.0128, b=0.0324, T=1e-3, d=10))
+        >>> region = loop.region("B", "K")
+        >>> [cell.count for cell in region.stable]
+        [0]
         """
         x, y = self._plane(x, y)
-        n_lines = check_count("n_lines", n_lines, 8)
-        base, (ax, ay), (base_ends, x_ends, y_ends) = self._basis((x, y), values)
+        given = {key: None if window is None else check_window(key, window)
+                 for key, window in (("x_range", x_range), ("y_range", y_range))}
+        base, (ax, ay), ends = self._basis((x, y), values)
+        auto = _start_window(base, ax, ay, ends)
+        box = [*(given["x_range"] or auto[0]), *(given["y_range"] or auto[1])]
+        free = {"x_min": given["x_range"] is None, "x_max": given["x_range"] is None,
+                "y_min": given["y_range"] is None, "y_max": given["y_range"] is None}
+        for _ in range(11):
+            found = decompose(base, ax, ay, ends, x_range=box[:2], y_range=box[2:], names=(x, y))
+            grow = [side for side in found.unbounded if free[side]]
+            if not grow:
+                return found
+            span = (box[1] - box[0], box[3] - box[2])
+            for side in grow:
+                k = ("x_min", "x_max", "y_min", "y_max").index(side)
+                box[k] += (-1 if k % 2 == 0 else 1) * span[k // 2]
+        return found
 
-        unresolved = []
+    def limits(self, x=None, y=None, **values):
+        """The extent and area of the stable set in the ``(x, y)`` plane.
 
-        def intervals(xv):
-            try:
-                return _line_intervals(base + xv * ax, ay, base_ends + xv * x_ends, y_ends)
-            except _Unresolved:
-                unresolved.append(xv)
-                return []
+        Read from :meth:`region`: the stable cells' polygons give the area
+        (exact up to the chords of the sampled arc), and their extreme
+        vertices the extent, refined along the arc by golden-section search
+        where the extreme is a smooth turn of the arc rather than a corner.
 
-        tops_seen = {}
+        Parameters
+        ----------
+        x, y : str
+            The plane's parameters, jointly affine (default: the loop's
+            :attr:`plane`).
+        **values
+            Single values of every other parameter (and ``x_range`` /
+            ``y_range`` for :meth:`region`).
 
-        def top(xv):
-            # Memoised: the vectorised golden-section search evaluates both
-            # inner points at every step, one of which it has seen before.
-            xv = float(xv)
-            if xv not in tops_seen:
-                tops_seen[xv] = max((hi for _, hi in intervals(xv)), default=-np.inf)
-            return tops_seen[xv]
-
-        seeds = _stable_seeds(base, ax, ay, (base_ends, x_ends, y_ends))
-        if seeds.size == 0:
-            intervals(0.0)
-            if unresolved:
-                fixed = ", ".join(f"{k} = {v:g}" for k, v in values.items() if k != "d")
-                raise ValueError(f"the loop's polynomial in the ({x}, {y}) plane cannot be resolved "
-                                 f"in double precision at {fixed}: its roots lie on the unit "
-                                 f"circle to within rounding (a value far outside the loop's "
-                                 f"usual range?)")
-            return LoopLimits(x, y, np.nan, np.nan, np.nan, np.nan, 0.0, 0)
-        scale = max(float(np.ptp(seeds)), 1e-12 * max(1.0, float(np.max(np.abs(seeds)))))
-
-        def reach(start, direction):
-            """Walk from a stable line until a line has no stable point; bisect back."""
-            inside, step = start, 0.01 * scale
-            for _ in range(80):
-                trial = inside + direction * step
-                if not intervals(trial):
-                    break
-                inside, step = trial, 2 * step
-            else:
-                return direction * np.inf
-            outside = inside + direction * step
-            while abs(outside - inside) > 1e-10 * scale:
-                mid = 0.5 * (inside + outside)
-                if mid in (inside, outside):
-                    break
-                if intervals(mid):
-                    inside = mid
-                else:
-                    outside = mid
-            return inside
-
-        x_min = reach(float(np.min(seeds)), -1.0)
-        x_max = reach(float(np.max(seeds)), 1.0)
-        if not (np.isfinite(x_min) and np.isfinite(x_max)):
-            return LoopLimits(x, y, np.inf, np.nan, x_min, x_max, np.inf, 0)
-        grid = np.linspace(x_min, x_max, n_lines)
-        lines = [intervals(v) for v in grid]
-        tops = np.array([max((h for _, h in iv), default=-np.inf) for iv in lines])
-        if np.any(np.isinf(tops) & (tops > 0)):
-            return LoopLimits(x, y, np.inf, float(grid[np.argmax(tops)]), x_min, x_max, np.inf,
-                              n_lines)
-        lengths = np.array([sum(h - l for l, h in iv) for iv in lines])
-        if not np.all(np.isfinite(lengths)):
-            area = np.inf
-        else:
-            area = float(np.sum(0.5 * (lengths[1:] + lengths[:-1]) * np.diff(grid)))
-        best = int(np.argmax(tops))
-        a, b = grid[max(best - 1, 0)], grid[min(best + 1, n_lines - 1)]
-        x_best = float(_golden_max(np.vectorize(top, otypes=[float]), a, b, iterations=40))
-        y_best = top(x_best)
-        if not y_best >= tops[best]:
-            x_best, y_best = float(grid[best]), float(tops[best])
-        return LoopLimits(x, y, float(y_best), x_best, float(x_min), float(x_max), area, n_lines)
+        Returns
+        -------
+        LoopLimits
+        """
+        found = self.region(x, y, **values)
+        if not found.stable:
+            return LoopLimits(found.x, found.y, np.nan, np.nan, np.nan, np.nan, 0.0, 0)
+        (y_max, x_at), (x_min, _), (x_max, _) = (found.extreme(*which) for which in
+                                                  (("y", 1), ("x", -1), ("x", 1)))
+        sides = set(found.unbounded)
+        y_max = np.inf if "y_max" in sides else y_max
+        x_min = -np.inf if "x_min" in sides else x_min
+        x_max = np.inf if "x_max" in sides else x_max
+        area = np.inf if sides else found.area
+        return LoopLimits(found.x, found.y, float(y_max), float(x_at), float(x_min), float(x_max),
+                          float(area), len(found.stable))
 
     def closed_loop(self, **values):
         """The closed loop from a force at the plant's input to the position.
@@ -872,47 +858,34 @@ def _line_intervals(a0, a1, a0_ends, a1_ends):
     return out
 
 
-def _arc_points(base, ax, ay, theta):
-    """The D-decomposition's arc: the (x, y) at which ``exp(j theta)`` is a root.
+def _start_window(base, ax, ay, ends):
+    """A first window for :meth:`Loop.region`: around the stable points next to the curves.
 
-    ``base + x ax + y ay`` vanishes there: its real and imaginary parts are
-    two linear equations in ``(x, y)``, solved by Cramer's rule; NaN where
-    they are singular (the arc runs off to infinity).
+    Without any, the extent of the arc's finite points (their middle 90 %)
+    and of the lines' crossings.  A quarter of the span is added on each side.
     """
-    a0, cx, cy = (_on_circle(c, theta) for c in (base, ax, ay))
-    with np.errstate(all="ignore"):
-        det = cx.real * cy.imag - cy.real * cx.imag
-        xs = (-a0.real * cy.imag + cy.real * a0.imag) / det
-        ys = (-cx.real * a0.imag + a0.real * cx.imag) / det
-        singular = ~(np.abs(det) > 1e-12 * np.abs(cx) * np.abs(cy))
-    xs[singular] = np.nan
-    ys[singular] = np.nan
-    return xs, ys
+    xs, ys = _stable_seeds(base, ax, ay, ends)
+    if xs.size == 0:
+        xs, ys, _ = _curve_points(base, ax, ay, ends)
+        if xs.size:
+            keep = ((xs >= np.quantile(xs, 0.05)) & (xs <= np.quantile(xs, 0.95))
+                    & (ys >= np.quantile(ys, 0.05)) & (ys <= np.quantile(ys, 0.95)))
+            xs, ys = (xs[keep], ys[keep]) if keep.any() else (xs, ys)
+    if xs.size == 0:
+        return (-1.0, 1.0), (-1.0, 1.0)
+    out = []
+    for v in (xs, ys):
+        lo, hi = float(np.min(v)), float(np.max(v))
+        pad = 0.25 * (hi - lo) or 0.1 * max(abs(lo), abs(hi), 1e-300)
+        out.append((lo - pad, hi + pad))
+    return tuple(out)
 
 
-def _lines(base, ax, ay, ends):
-    """``{"z = 1": (c0, cx, cy), "z = -1": ..., "leading": ...}``: ``c0 + cx x + cy y = 0``.
-
-    The real roots z = +-1 (from the values at +-1 in ``ends``) and a root
-    at infinity (the leading coefficient).
-    """
-    out = {label: tuple(float(e[index]) for e in ends)
-           for index, label in enumerate(("z = 1", "z = -1"))}
-    out["leading"] = (float(base[0]), float(ax[0]), float(ay[0]))
-    return out
-
-
-def _stable_seeds(base, ax, ay, ends):
-    """The ``x`` of stable points next to the D-decomposition's curves.
-
-    Every cell of the plane is bounded by pieces of the arc and of the lines,
-    so a stable cell has arc points (or line intersections) on its edge:
-    eight points around each of them, a small step away, are classified at
-    once and the stable ones kept.
-    """
+def _curve_points(base, ax, ay, ends):
+    """Points of the arc (finite ones) and the lines' pairwise crossings."""
     n = len(base) - 1
     theta = np.pi * (np.arange(1, 16 * (n + 4) + 1) - 0.5) / (16 * (n + 4))
-    xs, ys = _arc_points(base, ax, ay, theta)
+    xs, ys, _ = arc_points(base, ax, ay, theta)
     lines = list(_lines(base, ax, ay, ends).values())
     for i in range(len(lines)):
         for j in range(i + 1, len(lines)):
@@ -922,9 +895,20 @@ def _stable_seeds(base, ax, ay, ends):
                 xs = np.append(xs, (-c0 * e2 + c2 * e0) / det)
                 ys = np.append(ys, (-c1 * e0 + c0 * e1) / det)
     keep = np.isfinite(xs) & np.isfinite(ys)
-    xs, ys = xs[keep], ys[keep]
+    return xs[keep], ys[keep], theta
+
+
+def _stable_seeds(base, ax, ay, ends):
+    """Stable points ``(x, y)`` next to the D-decomposition's curves.
+
+    Every cell of the plane is bounded by pieces of the arc and of the lines,
+    so a stable cell has arc points (or line intersections) on its edge:
+    eight points around each of them, a small step away, are classified at
+    once and the stable ones kept.
+    """
+    xs, ys, _ = _curve_points(base, ax, ay, ends)
     if xs.size == 0:
-        return xs
+        return xs, ys
     sx = np.median(np.abs(xs)) or 1.0
     sy = np.median(np.abs(ys)) or 1.0
     steps = 10.0 ** np.arange(-6, -1)
@@ -936,4 +920,4 @@ def _stable_seeds(base, ax, ay, ends):
     px, py = np.concatenate(px), np.concatenate(py)
     codes = classify_polynomials(base[None, :] + px[:, None] * ax[None, :] + py[:, None] * ay[None, :],
                                  refine=False)
-    return px[codes == STABLE]
+    return px[codes == STABLE], py[codes == STABLE]

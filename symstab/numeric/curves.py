@@ -16,6 +16,7 @@ Here it is used to find where the arc ends and to sample it:
 """
 
 import dataclasses
+import math
 
 import numpy as np
 
@@ -231,3 +232,18 @@ class BoundaryCurve:
                 f"alpha up to {float(np.max(self.alpha)):.6g}, beta from "
                 f"{float(np.min(self.beta)):.6g} to {float(np.max(self.beta)):.6g}, "
                 f"{len(self.segments)} straight segment{'s' if len(self.segments) != 1 else ''})")
+
+
+def _golden_max(f, a, b, iterations=80):
+    """Vectorised golden-section search for the maximum of f on [a, b]."""
+    ratio = (math.sqrt(5) - 1) / 2
+    a, b = np.array(a, dtype=float), np.array(b, dtype=float)
+    x1, x2 = b - ratio * (b - a), a + ratio * (b - a)
+    f1, f2 = f(x1), f(x2)
+    for _ in range(iterations):
+        left = f1 < f2
+        a = np.where(left, x1, a)
+        b = np.where(left, b, x2)
+        x1, x2 = np.where(left, x2, b - ratio * (b - a)), np.where(left, a + ratio * (b - a), x1)
+        f1, f2 = np.where(left, f2, f(x1)), np.where(left, f(x2), f1)
+    return 0.5 * (a + b)

@@ -39,9 +39,10 @@ import numpy as np
 
 from .._generated import kernels
 from .._resources import CHUNK_BYTES, check_memory, chunk_slices
-from .._validate import check_array, check_count, check_loop, check_real
+from .._validate import check_array, check_count, check_loop, check_real, check_window
 from .curves import (_KERNEL_BYTES_PER_POINT, _KERNEL_CHUNK_BYTES, BoundaryCurve, Segment,
-                     arc_end_angle, bracketed_root, minus_one_line, scan_grid)
+                     _golden_max, arc_end_angle, bracketed_root, minus_one_line, scan_grid)
+from .decomposition import decompose
 from .stability import MARGINAL, STABLE, UNSTABLE, classify, loop_coefficients
 
 __all__ = ["StabilityRegion", "Limits", "limits", "BestVirtualMass", "best_virtual_mass",
@@ -183,6 +184,50 @@ class StabilityRegion:
         self._segments = np.flatnonzero(segment)
         self.minus_one = minus_one_line(gamma=self.gamma, d=self.d, delta=self.delta)
         self._basis = _loop_basis(self.gamma, self.d, self.delta)
+
+    def decomposition(self, x_range, y_range):
+        """The complete D-decomposition of a window of the (beta, alpha) plane.
+
+        Every branch of eq. (7) over all of (0, pi) -- not only the first
+        arc, up to theta_max --, the z = 1 line (alpha = 0) and the z = -1
+        line, the cells they cut the window into and each cell's certified
+        count of unstable roots (:func:`symstab.numeric.decomposition.decompose`).
+
+        Parameters
+        ----------
+        x_range : (float, float)
+            The window's beta, ``lo < hi``.
+        y_range : (float, float)
+            The window's alpha, ``lo < hi``.
+
+        Returns
+        -------
+        symstab.numeric.decomposition.Decomposition
+            With ``x = "beta"``, ``y = "alpha"``.
+
+        Examples
+        --------
+        >>> r = StabilityRegion(gamma=0.0, d=10, delta=0.00253125)
+        >>> cells = r.decomposition((-0.05, 0.2), (-0.001, 0.0062)).cells
+        >>> sorted(cell.count for cell in cells)
+        [0, 1, 2, 3]
+        """
+        x_range = check_window("x_range", x_range)
+        y_range = check_window("y_range", y_range)
+        coefficients = [loop_coefficients(alpha=a, beta=b, gamma=self.gamma, d=self.d,
+                                          delta=self.delta)
+                        for a, b in ((0.0, 0.0), (0.0, 1.0), (1.0, 0.0))]
+        base = coefficients[0]
+        ax, ay = coefficients[1] - base, coefficients[2] - base
+        signs = (-1.0) ** np.arange(len(base) - 1, -1, -1)
+        ends = []
+        for c in (base, ax, ay):
+            # chi(+-1): a sum below its own rounding is 0 (alpha = 0 is exactly z = 1).
+            values = np.array([np.sum(c), np.sum(c * signs)])
+            values[np.abs(values) <= 64 * np.finfo(float).eps * np.sum(np.abs(c))] = 0.0
+            ends.append(values)
+        return decompose(base, ax, ay, ends, x_range=x_range, y_range=y_range,
+                         names=("beta", "alpha"))
 
     def _extrema(self, theta):
         """The angles of the local extrema of alpha(theta) and beta(theta).
@@ -831,21 +876,6 @@ class StabilityRegion:
             beta_range = (min(beta_range[0], beta_at), max(beta_range[1], beta_at))
         return Limits(self, alpha_max, beta_at, beta_range[1], beta_range[0],
                       self.z_width(*beta_range, n_beta=n_beta), "")
-
-
-def _golden_max(f, a, b, iterations=80):
-    """Vectorised golden-section search for the maximum of f on [a, b]."""
-    ratio = (math.sqrt(5) - 1) / 2
-    a, b = np.array(a, dtype=float), np.array(b, dtype=float)
-    x1, x2 = b - ratio * (b - a), a + ratio * (b - a)
-    f1, f2 = f(x1), f(x2)
-    for _ in range(iterations):
-        left = f1 < f2
-        a = np.where(left, x1, a)
-        b = np.where(left, b, x2)
-        x1, x2 = np.where(left, x2, b - ratio * (b - a)), np.where(left, a + ratio * (b - a), x1)
-        f1, f2 = np.where(left, f2, f(x1)), np.where(left, f(x2), f1)
-    return 0.5 * (a + b)
 
 
 @dataclasses.dataclass(frozen=True)

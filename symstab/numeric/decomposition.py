@@ -1,0 +1,820 @@
+"""The complete D-decomposition of a parameter plane: every branch, every cell, its root count.
+
+For a loop whose characteristic polynomial is affine in two parameters,
+
+    chi(z; x, y) = A0(z) + x Ax(z) + y Ay(z),
+
+the number of roots outside the unit circle can change only where a root
+crosses the circle (or passes through infinity).  The places where it can
+happen cut the plane into *cells*:
+
+* the **arc**: for each ``theta`` in (0, pi), ``chi(exp(j theta)) = 0`` is
+  two real equations, linear in ``(x, y)``, with one solution -- a curve
+  parametrised by ``theta`` over the whole of (0, pi), which may cross itself
+  and run off to infinity (where the 2 x 2 system is singular) and come back;
+  the paper draws only its first piece, from ``theta = 0`` to ``theta_max``;
+* the **z = 1** and **z = -1** lines, ``chi(+-1) = 0`` (a real root on the
+  circle), straight lines because ``chi(+-1)`` is affine in ``(x, y)``;
+* the **leading** line, where the leading coefficient vanishes (a root
+  through infinity; it stays outside the circle, so the count does not change
+  across it, but the polynomial's degree does).
+
+The arc's two ends are exact: as ``theta -> 0`` the equations become
+``chi(1) = chi'(1) = 0`` and as ``theta -> pi`` ``chi(-1) = chi'(-1) = 0``,
+two linear equations each.
+
+:func:`decompose` samples the arc adaptively inside a window, intersects all
+the pieces with each other and with the window's edges, builds the planar
+graph and walks its faces: each bounded face is a :class:`Cell` (a polygon,
+with holes where another piece floats inside it).  Each cell's count of
+unstable roots is the certified argument-principle count
+(:func:`symstab.numeric.stability.polynomial_root_counts`) at one interior
+point, and every edge shared by two cells is checked against the crossing
+rule: across the arc the count changes by 2 (a complex pair), across
+``z = +-1`` by 1 and across the leading line by 0.  The stable set is the
+union of the cells with count 0; its area (the Z-width when the plane is
+damping and stiffness) is exact up to the chords of the sampled arc.
+"""
+
+import dataclasses
+import math
+
+import numpy as np
+
+from .._resources import check_memory
+from .curves import _golden_max
+from .stability import _leading_vanishes, polynomial_root_counts
+
+__all__ = ["Branch", "Cell", "Decomposition", "decompose", "arc_points"]
+
+#: The labels of the pieces; ``"window"`` marks an edge of the window.
+LABELS = ("arc", "z = 1", "z = -1", "leading")
+#: Change of the unstable count across each piece (crossing rule).
+_CHANGE = {"arc": 2, "z = 1": 1, "z = -1": 1, "leading": 0}
+#: Longest chord of the sampled arc, as a fraction of the window.
+_CHORD = 2e-3
+#: Largest turn between two chords of the arc (radians).
+_TURN = 0.05
+#: Rounds of arc refinement and points the arc may have in all.
+_ROUNDS = 40
+_MAX_ARC_POINTS = 400_000
+#: Rounds of refinement of the arc where it crosses a piece, and the angle
+#: step it stops at.
+_CROSSING_ROUNDS = 6
+_CROSSING_GAP = 1e-9
+#: Distance (in units of the window) within which two nodes are one.
+_MERGE = 1e-10
+#: Tolerance on the segment parameters of an intersection.
+_ENDS = 1e-9
+
+
+@dataclasses.dataclass(frozen=True, repr=False)
+class Branch:
+    """One piece of the D-decomposition, clipped to nothing: as sampled.
+
+    Attributes
+    ----------
+    label : str
+        ``"arc"``, ``"z = 1"``, ``"z = -1"`` or ``"leading"``.
+    points : ndarray, shape (n, 2)
+        ``(x, y)`` along the piece; rows of NaN separate its parts (where the
+        arc runs off to infinity).
+    theta : ndarray or None
+        The arc's angle at each point (NaN at the separators); None for a line.
+    """
+
+    label: str
+    points: np.ndarray
+    theta: object = None
+
+    def __repr__(self):
+        parts = 1 + int(np.sum(np.isnan(self.points[:, 0])))
+        return f"Branch({self.label!r}, {len(self.points)} points, {parts} part(s))"
+
+
+@dataclasses.dataclass(frozen=True, repr=False)
+class Cell:
+    """A cell of the D-decomposition: a polygon on which the root count is constant.
+
+    Attributes
+    ----------
+    outer : ndarray, shape (n, 2)
+        The boundary, counter-clockwise, not closed (the last vertex is not
+        the first again).
+    holes : tuple of ndarray
+        Boundaries of the holes, clockwise.
+    count : int
+        Closed-loop roots outside the unit circle inside the cell, or -1 when
+        the interior point had a root on the circle to within rounding.
+    point : tuple of float
+        The interior point where ``count`` was computed.
+    area : float
+        Area of the cell (holes excluded).
+    """
+
+    outer: np.ndarray
+    holes: tuple
+    count: int
+    point: tuple
+    area: float
+
+    def __repr__(self):
+        holes = f", {len(self.holes)} hole(s)" if self.holes else ""
+        return (f"Cell(count={self.count}, area={self.area:.6g}, {len(self.outer)} vertices{holes}, "
+                f"point=({self.point[0]:.6g}, {self.point[1]:.6g}))")
+
+    def contains(self, x, y):
+        """Whether points lie inside the cell (boolean array, broadcast ``x``, ``y``)."""
+        x, y = np.broadcast_arrays(np.asarray(x, dtype=float), np.asarray(y, dtype=float))
+        inside = _inside(self.outer, x, y)
+        for hole in self.holes:
+            inside &= ~_inside(hole, x, y)
+        return inside
+
+
+@dataclasses.dataclass(frozen=True, repr=False)
+class Decomposition:
+    """The D-decomposition of an ``(x, y)`` plane inside a window.
+
+    Attributes
+    ----------
+    x, y : str
+        The plane's parameters.
+    x_range, y_range : tuple of float
+        The window.
+    branches : tuple of Branch
+        Every piece: the arc over all of (0, pi) and the lines.
+    cells : tuple of Cell
+        The cells the pieces cut the window into.
+    mismatches : tuple
+        ``(i, j, label, change)`` for each pair of neighbouring cells whose
+        counts break the crossing rule across a piece ``label`` (empty when
+        every count is consistent).
+    unbounded : tuple of str
+        The window's sides (``"x_min"``, ``"x_max"``, ``"y_min"``,
+        ``"y_max"``) that a stable cell touches: the stable set may go on
+        beyond them.
+    polynomial : tuple of ndarray
+        ``(A0, Ax, Ay)``, the coefficients the decomposition is of.
+    """
+
+    x: str
+    y: str
+    x_range: tuple
+    y_range: tuple
+    branches: tuple
+    cells: tuple
+    mismatches: tuple
+    unbounded: tuple
+    polynomial: tuple = dataclasses.field(default=(), compare=False)
+
+    @property
+    def stable(self):
+        """The cells with no root outside the unit circle."""
+        return tuple(c for c in self.cells if c.count == 0)
+
+    @property
+    def area(self):
+        """Area of the stable set inside the window (the Z-width for damping and stiffness)."""
+        return float(sum(c.area for c in self.stable))
+
+    def contains(self, x, y):
+        """Whether points lie in the stable set (boolean array, broadcast ``x``, ``y``)."""
+        x, y = np.broadcast_arrays(np.asarray(x, dtype=float), np.asarray(y, dtype=float))
+        out = np.zeros(x.shape, dtype=bool)
+        for cell in self.stable:
+            out |= cell.contains(x, y)
+        return out
+
+    def count_at(self, x, y):
+        """The unstable count of the cell containing each point (-2 outside every cell)."""
+        x, y = np.broadcast_arrays(np.asarray(x, dtype=float), np.asarray(y, dtype=float))
+        out = np.full(x.shape, -2, dtype=np.int64)
+        for cell in self.cells:
+            out[cell.contains(x, y)] = cell.count
+        return out
+
+    def extreme(self, coordinate, sense=1):
+        """The largest (``sense=1``) or smallest (``sense=-1``) coordinate of the stable set.
+
+        The extreme vertex of the stable cells; where it is a smooth turn of
+        the arc (its neighbours along the arc are on the same cell's
+        boundary), refined along the arc by golden-section search in theta.
+
+        Parameters
+        ----------
+        coordinate : {"x", "y"}
+            Which coordinate.
+        sense : {1, -1}
+            Maximum or minimum.
+
+        Returns
+        -------
+        value, other : float
+            The extreme value and the other coordinate where it is reached
+            (NaN, NaN if the stable set is empty).
+        """
+        if coordinate not in ("x", "y") or sense not in (1, -1):
+            raise ValueError(f"coordinate must be 'x' or 'y' and sense 1 or -1, got "
+                             f"{coordinate!r}, {sense!r}")
+        k = 0 if coordinate == "x" else 1
+        best, ring_of = None, None
+        for cell in self.stable:
+            i = int(np.argmax(sense * cell.outer[:, k]))
+            if best is None or sense * cell.outer[i, k] > sense * best[k]:
+                best, ring_of = cell.outer[i], cell.outer
+        if best is None:
+            return math.nan, math.nan
+        arc = next((b for b in self.branches if b.label == "arc"), None)
+        value, other = float(best[k]), float(best[1 - k])
+        if arc is None or not self.polynomial:
+            return value, other
+        scale = np.array([self.x_range[1] - self.x_range[0], self.y_range[1] - self.y_range[0]])
+        near = np.hypot(*((arc.points - best) / scale).T)
+        j = int(np.nanargmin(near)) if np.isfinite(near).any() else -1
+        if j < 1 or j >= len(arc.points) - 1 or near[j] > 1e-9:
+            return value, other
+        neighbours = arc.points[[j - 1, j + 1]]
+        theta = arc.theta[[j - 1, j + 1]]
+        if not np.all(np.isfinite(theta)):
+            return value, other
+        on_ring = [np.min(np.hypot(*((ring_of - q) / scale).T)) < 1e-9 for q in neighbours]
+        if not all(on_ring):
+            return value, other
+        base, ax, ay = self.polynomial
+
+        def f(t):
+            xy = arc_points(base, ax, ay, np.atleast_1d(t))[:2]
+            return sense * xy[k]
+
+        t = float(np.atleast_1d(_golden_max(f, float(theta[0]), float(theta[1]), iterations=60))[0])
+        xy = [float(v[0]) for v in arc_points(base, ax, ay, np.array([t]))[:2]]
+        if sense * xy[k] >= sense * value:
+            return xy[k], xy[1 - k]
+        return value, other
+
+    def __repr__(self):
+        counts = sorted({c.count for c in self.cells})
+        return (f"Decomposition({self.x} in [{self.x_range[0]:.6g}, {self.x_range[1]:.6g}], "
+                f"{self.y} in [{self.y_range[0]:.6g}, {self.y_range[1]:.6g}]: "
+                f"{len(self.cells)} cells, counts {counts}, {len(self.stable)} stable, "
+                f"stable area {self.area:.6g})")
+
+
+# --------------------------------------------------------------------------
+# The pieces
+
+
+def _on_circle(c, theta):
+    """Values of the polynomial ``c`` (highest first) at ``exp(j theta)``."""
+    z = np.exp(1j * np.asarray(theta, dtype=float))
+    out = np.zeros_like(z)
+    for ck in c:
+        out = out * z + ck
+    return out
+
+
+def arc_points(base, ax, ay, theta):
+    """The arc: the ``(x, y)`` at which ``exp(j theta)`` is a root, and the system's determinant.
+
+    ``base + x ax + y ay`` vanishes there: its real and imaginary parts are
+    two linear equations in ``(x, y)``, solved by Cramer's rule; NaN where
+    they are singular (the arc runs off to infinity).
+
+    Parameters
+    ----------
+    base, ax, ay : ndarray
+        Coefficient rows of ``A0``, ``Ax``, ``Ay`` (highest power first).
+    theta : array_like
+        Angles in (0, pi).
+
+    Returns
+    -------
+    x, y, det : ndarray
+    """
+    a0, cx, cy = (_on_circle(c, theta) for c in (base, ax, ay))
+    with np.errstate(all="ignore"):
+        det = cx.real * cy.imag - cy.real * cx.imag
+        xs = (-a0.real * cy.imag + cy.real * a0.imag) / det
+        ys = (-cx.real * a0.imag + a0.real * cx.imag) / det
+        singular = ~(np.abs(det) > 1e-12 * np.abs(cx) * np.abs(cy))
+    xs[singular] = np.nan
+    ys[singular] = np.nan
+    return xs, ys, det
+
+
+def lines(base, ax, ay, ends):
+    """``{"z = 1": (c0, cx, cy), "z = -1": ..., "leading": ...}``: ``c0 + cx x + cy y = 0``.
+
+    ``ends`` holds the values at ``z = 1`` and ``z = -1`` of ``A0``, ``Ax``
+    and ``Ay`` (three pairs); the leading line is the leading coefficients.
+    """
+    out = {label: tuple(float(e[index]) for e in ends)
+           for index, label in enumerate(("z = 1", "z = -1"))}
+    out["leading"] = (float(base[0]), float(ax[0]), float(ay[0]))
+    return out
+
+
+def _arc_ends(base, ax, ay, ends):
+    """The arc's exact ends: ``chi(+-1) = chi'(+-1) = 0``, or None where singular."""
+    out = []
+    n = len(base) - 1
+    powers = np.arange(n, -1, -1, dtype=float)
+    for index, sign in ((0, 1.0), (1, -1.0)):
+        # chi'(sign) = sum_k k c_k sign**(k - 1)
+        slope = [float(np.sum(powers * c * sign ** np.maximum(powers - 1, 0))) for c in (base, ax, ay)]
+        value = [float(e[index]) for e in ends]
+        det = value[1] * slope[2] - value[2] * slope[1]
+        scale = max(abs(value[1] * slope[2]), abs(value[2] * slope[1]), 1e-300)
+        if abs(det) <= 1e-12 * scale:
+            out.append(None)
+            continue
+        x = (-value[0] * slope[2] + value[2] * slope[0]) / det
+        y = (-value[1] * slope[0] + value[0] * slope[1]) / det
+        out.append((x, y))
+    return out
+
+
+def _sample_arc(base, ax, ay, to_unit, theta=None):
+    """Angles and points of the arc, refined until every chord inside the window is short.
+
+    Returns the angles, the points and the determinant's sign; the caller
+    splits the arc where the sign changes (through infinity).
+    """
+    if theta is None:
+        n = len(base) - 1
+        m = max(1024, 32 * (n + 4))
+        theta = np.pi * np.arange(1, m) / m
+    for _ in range(_ROUNDS):
+        xs, ys, det = arc_points(base, ax, ay, theta)
+        u, v = to_unit(xs, ys)
+        finite = np.isfinite(u) & np.isfinite(v)
+        du, dv = np.diff(u), np.diff(v)
+        length = np.hypot(du, dv)
+        both = finite[1:] & finite[:-1]
+        # A chord matters if it may pass near the window (padded by its length).
+        lo_u, hi_u = np.minimum(u[1:], u[:-1]), np.maximum(u[1:], u[:-1])
+        lo_v, hi_v = np.minimum(v[1:], v[:-1]), np.maximum(v[1:], v[:-1])
+        near = both & (hi_u > -0.5) & (lo_u < 1.5) & (hi_v > -0.5) & (lo_v < 1.5)
+        split = near & (length > _CHORD)
+        # A sharp turn between two chords near the window: refine both.
+        with np.errstate(invalid="ignore", divide="ignore"):
+            angle = np.arctan2(dv, du)
+            turn = np.abs(np.angle(np.exp(1j * np.diff(angle))))
+        sharp = near[1:] & near[:-1] & (turn > _TURN) & (length[1:] + length[:-1] > 1e-7)
+        split[1:] |= sharp
+        split[:-1] |= sharp
+        # Through infinity, or into a singular point: follow it closer.
+        flip = (np.sign(det[1:]) != np.sign(det[:-1])) | (finite[1:] != finite[:-1])
+        split |= flip & (np.diff(theta) > 1e-13)
+        split &= np.diff(theta) > 4e-16 * np.pi
+        if not split.any():
+            break
+        if len(theta) + int(split.sum()) > _MAX_ARC_POINTS:
+            break
+        mids = 0.5 * (theta[1:] + theta[:-1])[split]
+        theta = np.sort(np.concatenate([theta, mids]))
+    xs, ys, det = arc_points(base, ax, ay, theta)
+    return theta, xs, ys, np.sign(det)
+
+
+def _pieces(base, ax, ay, ends, theta, xs, ys, sign, to_unit, from_unit, box):
+    """The branches (in the plane's units) and the polylines to intersect (in window units).
+
+    Each polyline is ``(points, label, theta)`` (``theta`` None for a line
+    and for the window's edges), cut to the runs of segments that reach the
+    window.
+    """
+    polylines, branches = [], []
+    u, v = to_unit(xs, ys)
+    finite = np.isfinite(u) & np.isfinite(v)
+    ends_xy = _arc_ends(base, ax, ay, ends)
+    cut = np.flatnonzero((sign[1:] != sign[:-1]) | ~finite[1:] | ~finite[:-1]) + 1
+    arc_rows, arc_theta = [], []
+    for part in np.split(np.arange(len(theta)), cut):
+        part = part[finite[part]]
+        if len(part) == 0:
+            continue
+        pts = np.column_stack([u[part], v[part]])
+        th = theta[part]
+        # The exact ends at theta = 0 and pi, when this part reaches them.
+        if part[0] == 0 and ends_xy[0] is not None:
+            pts = np.vstack([np.column_stack(to_unit(*ends_xy[0])), pts])
+            th = np.concatenate([[0.0], th])
+        if part[-1] == len(theta) - 1 and ends_xy[1] is not None:
+            pts = np.vstack([pts, np.column_stack(to_unit(*ends_xy[1]))])
+            th = np.concatenate([th, [np.pi]])
+        arc_rows.append(from_unit(pts))
+        arc_theta.append(th)
+        if len(pts) >= 2:
+            polylines.append((pts, "arc", th))
+    if arc_rows:
+        gap = np.full((1, 2), np.nan)
+        branches.append(Branch("arc", np.vstack(sum(([r, gap] for r in arc_rows), [])[:-1]),
+                               np.concatenate(sum(([t, [np.nan]] for t in arc_theta), [])[:-1])))
+    for label, c in lines(base, ax, ay, ends).items():
+        if not (c[1] or c[2]):
+            continue
+        seg = _clip_line(c, box)
+        if seg is None:
+            continue
+        branches.append(Branch(label, seg))
+        polylines.append((np.column_stack(to_unit(seg[:, 0], seg[:, 1])), label, None))
+    square = np.array([[0, 0], [1, 0], [1, 1], [0, 1], [0, 0]], dtype=float)
+    polylines.append((square, "window", None))
+    # Keep only the runs of segments that reach the window.
+    kept = []
+    for pts, label, th in polylines:
+        lo, hi = np.minimum(pts[1:], pts[:-1]), np.maximum(pts[1:], pts[:-1])
+        near = ((hi[:, 0] >= -1e-9) & (lo[:, 0] <= 1 + 1e-9)
+                & (hi[:, 1] >= -1e-9) & (lo[:, 1] <= 1 + 1e-9))
+        idx = np.flatnonzero(near)
+        for run in np.split(idx, np.flatnonzero(np.diff(idx) > 1) + 1) if len(idx) else ():
+            keep = slice(run[0], run[-1] + 2)
+            kept.append((pts[keep], label, None if th is None else th[keep]))
+    return kept, tuple(branches)
+
+
+def _clip_line(c, box):
+    """The segment of ``c0 + cx x + cy y = 0`` inside ``box`` (x0, x1, y0, y1), or None."""
+    c0, cx, cy = c
+    x0, x1, y0, y1 = box
+    points = []
+    if cy != 0:
+        for xv in (x0, x1):
+            points.append((xv, -(c0 + cx * xv) / cy))
+    if cx != 0:
+        for yv in (y0, y1):
+            points.append((-(c0 + cy * yv) / cx, yv))
+    sx, sy = x1 - x0, y1 - y0
+    inside = [(px, py) for px, py in points
+              if x0 - 1e-9 * sx <= px <= x1 + 1e-9 * sx and y0 - 1e-9 * sy <= py <= y1 + 1e-9 * sy]
+    if len(inside) < 2:
+        return None
+    inside.sort()
+    return np.array([inside[0], inside[-1]])
+
+
+# --------------------------------------------------------------------------
+# The planar graph
+
+
+class _Nodes:
+    """Points of the plane (window units), merged when closer than :data:`_MERGE`."""
+
+    def __init__(self):
+        self.xy = []
+        self._grid = {}
+
+    def add(self, u, v):
+        key = (math.floor(u / _MERGE), math.floor(v / _MERGE))
+        for du in (-1, 0, 1):
+            for dv in (-1, 0, 1):
+                for index in self._grid.get((key[0] + du, key[1] + dv), ()):
+                    pu, pv = self.xy[index]
+                    if abs(pu - u) <= _MERGE and abs(pv - v) <= _MERGE:
+                        return index
+        self.xy.append((u, v))
+        self._grid.setdefault(key, []).append(len(self.xy) - 1)
+        return len(self.xy) - 1
+
+
+def _segments(polylines):
+    """Flatten polylines into segments: start, end, polyline index, position in it."""
+    starts, ends, owner, position = [], [], [], []
+    for k, (points, _, _) in enumerate(polylines):
+        count = len(points) - 1
+        starts.append(points[:-1])
+        ends.append(points[1:])
+        owner.append(np.full(count, k))
+        position.append(np.arange(count))
+    return (np.concatenate(starts), np.concatenate(ends), np.concatenate(owner),
+            np.concatenate(position))
+
+
+def _intersections(p, q, owner, position):
+    """All pairs of crossing segments: (i, j, t_i, t_j)."""
+    r = q - p
+    n = len(p)
+    lo = np.minimum(p, q) - 1e-12
+    hi = np.maximum(p, q) + 1e-12
+    out = []
+    block = max(1, 2_000_000 // max(n, 1))
+    for start in range(0, n, block):
+        i = np.arange(start, min(n, start + block))[:, None]
+        j = np.arange(n)[None, :]
+        hit = ((j > i) & (lo[i, 0] <= hi[j, 0]) & (lo[j, 0] <= hi[i, 0])
+               & (lo[i, 1] <= hi[j, 1]) & (lo[j, 1] <= hi[i, 1]))
+        ii, jj = np.nonzero(hit)
+        ii = ii + start
+        # Neighbours along one polyline share their end point: not a crossing.
+        same = owner[ii] == owner[jj]
+        gap = np.abs(position[ii] - position[jj])
+        adjacent = same & (gap == 1)
+        ii, jj = ii[~adjacent], jj[~adjacent]
+        if not len(ii):
+            continue
+        ri, rj = r[ii], r[jj]
+        w = p[jj] - p[ii]
+        denom = ri[:, 0] * rj[:, 1] - ri[:, 1] * rj[:, 0]
+        with np.errstate(all="ignore"):
+            t = (w[:, 0] * rj[:, 1] - w[:, 1] * rj[:, 0]) / denom
+            s = (w[:, 0] * ri[:, 1] - w[:, 1] * ri[:, 0]) / denom
+        ok = ((np.abs(denom) > 1e-300) & (t >= -_ENDS) & (t <= 1 + _ENDS)
+              & (s >= -_ENDS) & (s <= 1 + _ENDS))
+        out.append(np.stack([ii[ok], jj[ok], np.clip(t[ok], 0, 1), np.clip(s[ok], 0, 1)], axis=1))
+    return np.concatenate(out) if out else np.zeros((0, 4))
+
+
+def _faces(xy, edges):
+    """The cycles of the planar graph: lists of half-edge indices, each face on its left."""
+    src = np.concatenate([edges[:, 0], edges[:, 1]])
+    dst = np.concatenate([edges[:, 1], edges[:, 0]])
+    n_edges = len(edges)
+    twin = np.concatenate([np.arange(n_edges, 2 * n_edges), np.arange(n_edges)])
+    angle = np.arctan2(xy[dst, 1] - xy[src, 1], xy[dst, 0] - xy[src, 0])
+    order = np.lexsort((angle, src))
+    rank = np.empty_like(order)
+    rank[order] = np.arange(len(order))
+    first = np.searchsorted(src[order], np.arange(len(xy)))
+    degree = np.bincount(src, minlength=len(xy))
+    # Next half-edge of the face on the left: at the head, the edge just
+    # clockwise of the way back.
+    t = twin
+    head = dst
+    nxt = order[first[head] + (rank[t] - first[head] - 1) % degree[head]]
+    seen = np.zeros(len(src), dtype=bool)
+    cycles = []
+    for h in range(len(src)):
+        if seen[h]:
+            continue
+        cycle = []
+        while not seen[h]:
+            seen[h] = True
+            cycle.append(h)
+            h = nxt[h]
+        cycles.append(cycle)
+    return src, dst, twin, cycles
+
+
+def _signed_area(poly):
+    x, y = poly[:, 0], poly[:, 1]
+    return 0.5 * float(np.sum(x * np.roll(y, -1) - np.roll(x, -1) * y))
+
+
+def _inside(poly, x, y):
+    """Even-odd point-in-polygon test, vectorised over points."""
+    inside = np.zeros(np.shape(x), dtype=bool)
+    px, py = poly[:, 0], poly[:, 1]
+    qx, qy = np.roll(px, -1), np.roll(py, -1)
+    for ax_, ay_, bx, by in zip(px, py, qx, qy):
+        crosses = (ay_ > y) != (by > y)
+        with np.errstate(all="ignore"):
+            xc = ax_ + (y - ay_) * (bx - ax_) / (by - ay_)
+        inside ^= crosses & (x < xc)
+    return inside
+
+
+def _interval_midpoints(rings, value, axis):
+    """The inside intervals of the line ``axis-coordinate = value`` through the rings."""
+    other = 1 - axis
+    cuts = []
+    for ring in rings:
+        a, b = ring, np.roll(ring, -1, axis=0)
+        crosses = (a[:, axis] > value) != (b[:, axis] > value)
+        a, b = a[crosses], b[crosses]
+        cuts.append(a[:, other] + (value - a[:, axis]) * (b[:, other] - a[:, other])
+                    / (b[:, axis] - a[:, axis]))
+    cuts = np.sort(np.concatenate(cuts)) if cuts else np.zeros(0)
+    return cuts.reshape(-1, 2) if len(cuts) % 2 == 0 else np.zeros((0, 2))
+
+
+def _interior_point(rings):
+    """A point well inside the polygon ``rings`` (outer first, then holes), in window units."""
+    outer = rings[0]
+    v0, v1 = outer[:, 1].min(), outer[:, 1].max()
+    best, best_width = None, -1.0
+    for f in (0.5, 0.25, 0.75, 0.125, 0.375, 0.625, 0.875, 0.0625, 0.9375, 0.03125, 0.96875):
+        v = v0 + f * (v1 - v0)
+        for lo, hi in _interval_midpoints(rings, v, 1):
+            if hi - lo > best_width:
+                best, best_width = (0.5 * (lo + hi), v), hi - lo
+    if best is None:
+        return None
+    # Centre it vertically too, on the vertical line through it.
+    u = best[0]
+    spans = _interval_midpoints(rings, u, 0)
+    for lo, hi in spans:
+        if lo <= best[1] <= hi:
+            return (u, 0.5 * (lo + hi))
+    return best
+
+
+# --------------------------------------------------------------------------
+# The decomposition
+
+
+def decompose(base, ax, ay, ends, *, x_range, y_range, names=("x", "y")):
+    """The D-decomposition of ``chi = base + x ax + y ay`` inside a window.
+
+    Parameters
+    ----------
+    base, ax, ay : ndarray, shape (n + 1,)
+        Coefficients (highest power first) of ``A0``, ``Ax`` and ``Ay``.
+    ends : sequence of three pairs
+        The values at ``z = 1`` and ``z = -1`` of ``A0``, ``Ax`` and ``Ay``
+        (exact ones where the caller has them: the z = +-1 lines come from
+        these).
+    x_range, y_range : (float, float)
+        The window, ``lo < hi``, finite.
+    names : (str, str)
+        The plane's parameter names.
+
+    Returns
+    -------
+    Decomposition
+    """
+    base, ax, ay = (np.asarray(c, dtype=float) for c in (base, ax, ay))
+    x0, x1 = (float(v) for v in x_range)
+    y0, y1 = (float(v) for v in y_range)
+    for name, (lo, hi) in ((names[0], (x0, x1)), (names[1], (y0, y1))):
+        if not (math.isfinite(lo) and math.isfinite(hi) and lo < hi):
+            raise ValueError(f"the window of {name} must be finite with lo < hi, got ({lo}, {hi})")
+    sx, sy = x1 - x0, y1 - y0
+
+    def to_unit(x, y):
+        return (np.asarray(x) - x0) / sx, (np.asarray(y) - y0) / sy
+
+    def from_unit(uv):
+        return np.column_stack([x0 + sx * uv[:, 0], y0 + sy * uv[:, 1]])
+
+    theta = None
+    for _ in range(_CROSSING_ROUNDS):
+        theta, xs, ys, sign = _sample_arc(base, ax, ay, to_unit, theta)
+        polylines, branches = _pieces(base, ax, ay, ends, theta, xs, ys, sign, to_unit, from_unit,
+                                      (x0, x1, y0, y1))
+        p, q, owner, position = _segments(polylines)
+        labels = [label for _, label, _ in polylines]
+        hits = _intersections(p, q, owner, position)
+        # Where the arc crosses a piece, the crossing of two chords is off the
+        # curves' by the chords' sag: refine the arc there until it is not.
+        hot = []
+        for i, j, ti, tj in hits:
+            for k, t in ((int(i), ti), (int(j), tj)):
+                th = polylines[owner[k]][2]
+                if th is None or not (1e-6 < t < 1 - 1e-6):
+                    continue
+                a_, b_ = th[position[k]], th[position[k] + 1]
+                if b_ - a_ > _CROSSING_GAP and 1e-4 < a_ and b_ < np.pi - 1e-4:
+                    hot.append((a_, b_))
+        if not hot:
+            break
+        hot = np.array(hot)
+        extra = (hot[:, :1] + (hot[:, 1:] - hot[:, :1]) * np.arange(1, 16)[None, :] / 16).ravel()
+        theta = np.unique(np.concatenate([theta, extra]))
+    n_segments = len(p)
+    check_memory(f"the D-decomposition's {n_segments} segments", 64 * n_segments * 64)
+
+    # Split each segment at its crossings; nodes merged within _MERGE.
+    nodes = _Nodes()
+    cuts = [[(0.0, None), (1.0, None)] for _ in range(len(p))]
+    for i, j, ti, tj in hits:
+        i, j = int(i), int(j)
+        point = p[i] + ti * (q[i] - p[i])
+        node = nodes.add(float(point[0]), float(point[1]))
+        cuts[i].append((ti, node))
+        cuts[j].append((tj, node))
+    edge_list, edge_label = [], []
+    for k in range(len(p)):
+        entries = []
+        for t, node in cuts[k]:
+            if node is None:
+                point = p[k] if t == 0.0 else q[k]
+                node = nodes.add(float(point[0]), float(point[1]))
+            entries.append((t, node))
+        entries.sort()
+        for (_, a), (_, b) in zip(entries[:-1], entries[1:]):
+            if a != b:
+                edge_list.append((a, b))
+                edge_label.append(labels[owner[k]])
+    xy = np.array(nodes.xy)
+    edges = np.array(edge_list, dtype=np.int64).reshape(-1, 2)
+    edge_label = np.array(edge_label, dtype=object)
+    # One edge per pair of nodes; inside the window only.
+    key = np.sort(edges, axis=1)
+    _, unique = np.unique(key, axis=0, return_index=True)
+    unique = np.sort(unique)
+    edges, edge_label = edges[unique], edge_label[unique]
+    mid = 0.5 * (xy[edges[:, 0]] + xy[edges[:, 1]])
+    inside = np.all((mid >= -1e-9) & (mid <= 1 + 1e-9), axis=1)
+    edges, edge_label = edges[inside], edge_label[inside]
+    # Dangling pieces bound no cell.
+    while len(edges):
+        degree = np.bincount(edges.ravel(), minlength=len(xy))
+        loose = (degree[edges[:, 0]] < 2) | (degree[edges[:, 1]] < 2)
+        if not loose.any():
+            break
+        edges, edge_label = edges[~loose], edge_label[~loose]
+
+    cells = []
+    mismatches = []
+    if len(edges):
+        src, dst, twin, cycles = _faces(xy, edges)
+        half_label = np.concatenate([edge_label, edge_label])
+        rings = [xy[src[c]] for c in cycles]
+        areas = np.array([_signed_area(r) for r in rings])
+        # Connected components, to put floating pieces as holes into their face.
+        component = _components(len(xy), edges)
+        faces = [k for k in range(len(cycles)) if areas[k] > 1e-14]
+        holes = {k: [] for k in faces}
+        corner = nodes.add(0.0, 0.0)
+        for k in range(len(cycles)):
+            if areas[k] > 1e-14 or component[src[cycles[k][0]]] == component[corner]:
+                continue
+            if areas[k] > -1e-14:
+                continue
+            probe = rings[k][0]
+            around = [f for f in faces if component[src[cycles[f][0]]] != component[src[cycles[k][0]]]
+                      and _inside(rings[f], probe[0], probe[1])]
+            if around:
+                holes[min(around, key=lambda f: areas[f])].append(k)
+        face_of = np.full(len(src), -1)
+        points, keep = [], []
+        for f in faces:
+            face_of[cycles[f]] = f
+            ring_list = [rings[f]] + [rings[h] for h in holes[f]]
+            pt = _interior_point(ring_list)
+            if pt is None:
+                continue
+            keep.append(f)
+            points.append(pt)
+        points = from_unit(np.array(points).reshape(-1, 2))
+        rows = base[None, :] + points[:, :1] * ax[None, :] + points[:, 1:] * ay[None, :]
+        counts = polynomial_root_counts(rows) if len(rows) else np.zeros(0, dtype=np.int64)
+        counts[_leading_vanishes(rows)] = -1
+        count_of = dict(zip(keep, counts))
+        index_of = {f: n for n, f in enumerate(keep)}
+        scale = sx * sy
+        for n, f in enumerate(keep):
+            outer = from_unit(rings[f])
+            hole_rings = tuple(from_unit(rings[h]) for h in holes[f])
+            area = scale * (areas[f] + sum(areas[h] for h in holes[f]))
+            cells.append(Cell(outer, hole_rings, int(counts[n]), (float(points[n, 0]),
+                                                                   float(points[n, 1])), float(area)))
+        # The crossing rule across each edge between two cells.
+        seen = set()
+        for h in range(len(src)):
+            a, b = face_of[h], face_of[twin[h]]
+            label = half_label[h]
+            if a < 0 or b < 0 or a not in count_of or b not in count_of or label == "window":
+                continue
+            pair = (min(a, b), max(a, b), label)
+            if pair in seen:
+                continue
+            seen.add(pair)
+            ca, cb = count_of[a], count_of[b]
+            if ca < 0 or cb < 0:
+                continue
+            if abs(int(ca) - int(cb)) != _CHANGE[label]:
+                mismatches.append((index_of[a], index_of[b], label, int(cb) - int(ca)))
+    unbounded = _touching(cells, (x0, x1, y0, y1))
+    return Decomposition(x=names[0], y=names[1], x_range=(x0, x1), y_range=(y0, y1),
+                         branches=tuple(branches), cells=tuple(cells),
+                         mismatches=tuple(mismatches), unbounded=unbounded,
+                         polynomial=(base, ax, ay))
+
+
+def _components(n, edges):
+    parent = np.arange(n)
+
+    def find(a):
+        while parent[a] != a:
+            parent[a] = parent[parent[a]]
+            a = parent[a]
+        return a
+
+    for a, b in edges:
+        ra, rb = find(a), find(b)
+        if ra != rb:
+            parent[ra] = rb
+    return np.array([find(a) for a in range(n)])
+
+
+def _touching(cells, box):
+    """The window's sides that a stable cell reaches."""
+    x0, x1, y0, y1 = box
+    tol_x, tol_y = 1e-9 * (x1 - x0), 1e-9 * (y1 - y0)
+    sides = set()
+    for cell in cells:
+        if cell.count != 0:
+            continue
+        pts = cell.outer
+        if np.any(pts[:, 0] <= x0 + tol_x):
+            sides.add("x_min")
+        if np.any(pts[:, 0] >= x1 - tol_x):
+            sides.add("x_max")
+        if np.any(pts[:, 1] <= y0 + tol_y):
+            sides.add("y_min")
+        if np.any(pts[:, 1] >= y1 - tol_y):
+            sides.add("y_max")
+    return tuple(s for s in ("x_min", "x_max", "y_min", "y_max") if s in sides)
