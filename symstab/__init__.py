@@ -42,6 +42,11 @@ from .numeric.stability import MARGINAL, STABLE, UNSTABLE, classify, is_stable, 
 from .numeric.region import BestVirtualMass, Limits, StabilityRegion, best_virtual_mass, limits
 from .numeric.any_loop import Loop, LoopBoundary, LoopLimits
 from .numeric.loop_files import load_loop
+from .numeric.decomposition import Branch, Cell, Decomposition
+from .numeric.passivity import PassiveRegion, paper_passive_region, passive_region
+from .numeric.locus import Crossing, Locus, locus, paper_locus
+from .numeric.theta_bounds import (ThetaMaxEnclosure, certify_theta_max, theta_max_approx,
+                                   theta_max_enclosure)
 
 __all__ = [
     "boundary", "coefficients",
@@ -55,4 +60,9 @@ __all__ = [
     "STABLE", "MARGINAL", "UNSTABLE", "classify", "is_stable", "spectral_radius",
     "StabilityRegion", "Limits", "limits", "BestVirtualMass", "best_virtual_mass",
     "Loop", "LoopBoundary", "LoopLimits", "load_loop",
+    "Decomposition", "Cell", "Branch",
+    "PassiveRegion", "passive_region", "paper_passive_region",
+    "Locus", "Crossing", "locus", "paper_locus",
+    "ThetaMaxEnclosure", "theta_max_enclosure", "certify_theta_max",
+    "theta_max_approx",
 ]

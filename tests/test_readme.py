@@ -36,7 +36,9 @@ def test_readme_python_examples_run(monkeypatch, tmp_path):
 
 @pytest.mark.parametrize("module", ["symstab.numeric.units", "symstab.numeric.curves", "symstab.numeric.stability",
                                     "symstab.numeric.region", "symstab.symbolic.model", "symstab.symbolic.theta_max",
-                                    "symstab.numeric.any_loop"])
+                                    "symstab.numeric.any_loop", "symstab.numeric.decomposition",
+                                    "symstab.numeric.theta_bounds", "symstab.numeric.passivity",
+                                    "symstab.numeric.locus"])
 def test_docstring_examples_run(module, monkeypatch, tmp_path):
     monkeypatch.setenv("SYMSTAB_CACHE_DIR", str(tmp_path))
     mod = importlib.import_module(module)

@@ -456,12 +456,7 @@ def _limits_notes(setup, lim):
 
 def _limits_result(lim):
     out = {"x": lim.x, "y": lim.y, "y_max": lim.y_max, "x_at_y_max": lim.x_at_y_max,
-           "x_min": lim.x_min, "x_max": lim.x_max, "area": lim.area}
-    # How the set was found: scanned lines, or (issue 12) the stable cells
-    # of the complete D-decomposition; whichever LoopLimits carries.
-    for name in ("n_lines", "cells"):
-        if hasattr(lim, name):
-            out[name] = getattr(lim, name)
+           "x_min": lim.x_min, "x_max": lim.x_max, "area": lim.area, "cells": lim.cells}
     return {"limits": out}
 
 

@@ -45,6 +45,7 @@ from .._validate import check_array, check_count, check_delay, check_window
 from ..symbolic.loop_assembly import _DPS, LoopModel, parse_environment, parse_plant
 from ..codegen.loop_kernels import environment_kernels, load_numpy_kernels
 from .decomposition import arc_points, decompose
+from .passivity import passive_region
 from .decomposition import lines as _lines
 from .stability import (MARGINAL, STABLE, _leading_vanishes, classify_polynomials,
                         polynomial_root_counts, polynomial_spectral_radius)
@@ -602,6 +603,32 @@ class Loop(LoopModel):
         area = np.inf if sides else found.area
         return LoopLimits(found.x, found.y, float(y_max), float(x_at), float(x_min), float(x_max),
                           float(area), len(found.stable))
+
+    def passive_region(self, x=None, y=None, *, damping="b", x_range=None, y_range=None, **values):
+        """The passive set of the environment behind the loop's delay, in the ``(x, y)`` plane.
+
+        Colgate and Schenkel's condition, with the delay:
+        :func:`symstab.numeric.passivity.passive_region` states the theorem,
+        its hypotheses and the construction.
+
+        Parameters
+        ----------
+        x, y : str, optional
+            Environment parameters (in its numerator, jointly affine) or the
+            damping (default: the loop's :attr:`plane`).
+        damping : str
+            The plant parameter that is the device's viscous friction.
+        x_range, y_range : (float, float), optional
+            The window (default: fitted to the set).
+        **values
+            Single values of the other parameters.
+
+        Returns
+        -------
+        symstab.numeric.passivity.PassiveRegion
+        """
+        return passive_region(self, x, y, damping=damping, x_range=x_range, y_range=y_range,
+                              **values)
 
     def closed_loop(self, **values):
         """The closed loop from a force at the plant's input to the position.

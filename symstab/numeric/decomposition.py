@@ -124,7 +124,17 @@ class Cell:
                 f"point=({self.point[0]:.6g}, {self.point[1]:.6g}))")
 
     def contains(self, x, y):
-        """Whether points lie inside the cell (boolean array, broadcast ``x``, ``y``)."""
+        """Whether points lie inside the cell.
+
+        Parameters
+        ----------
+        x, y : array_like
+            Coordinates (broadcast together).
+
+        Returns
+        -------
+        ndarray of bool
+        """
         x, y = np.broadcast_arrays(np.asarray(x, dtype=float), np.asarray(y, dtype=float))
         inside = _inside(self.outer, x, y)
         for hole in self.holes:
@@ -179,7 +189,17 @@ class Decomposition:
         return float(sum(c.area for c in self.stable))
 
     def contains(self, x, y):
-        """Whether points lie in the stable set (boolean array, broadcast ``x``, ``y``)."""
+        """Whether points lie in the stable set.
+
+        Parameters
+        ----------
+        x, y : array_like
+            Coordinates (broadcast together).
+
+        Returns
+        -------
+        ndarray of bool
+        """
         x, y = np.broadcast_arrays(np.asarray(x, dtype=float), np.asarray(y, dtype=float))
         out = np.zeros(x.shape, dtype=bool)
         for cell in self.stable:
@@ -187,7 +207,19 @@ class Decomposition:
         return out
 
     def count_at(self, x, y):
-        """The unstable count of the cell containing each point (-2 outside every cell)."""
+        """The unstable count of the cell containing each point.
+
+        Parameters
+        ----------
+        x, y : array_like
+            Coordinates (broadcast together).
+
+        Returns
+        -------
+        ndarray of int
+            The cell's count; -2 outside every cell (on a boundary, or
+            outside the window).
+        """
         x, y = np.broadcast_arrays(np.asarray(x, dtype=float), np.asarray(y, dtype=float))
         out = np.full(x.shape, -2, dtype=np.int64)
         for cell in self.cells:
@@ -633,6 +665,17 @@ def decompose(base, ax, ay, ends, *, x_range, y_range, names=("x", "y")):
     Returns
     -------
     Decomposition
+
+    Examples
+    --------
+    ``z**2 + x z + y``: the z = 1 line ``1 + x + y = 0``, the z = -1 line
+    ``1 - x + y = 0`` and the arc ``y = 1`` bound the stable triangle
+    ``|x| < 1 + y < 2`` of area 4.
+
+    >>> found = decompose([1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0],
+    ...                   [(1.0, 1.0), (1.0, -1.0), (1.0, 1.0)], x_range=(-3, 3), y_range=(-2, 2))
+    >>> sorted(cell.count for cell in found.cells), round(found.area, 12)
+    ([0, 1, 1, 2, 2], 4.0)
     """
     base, ax, ay = (np.asarray(c, dtype=float) for c in (base, ax, ay))
     x0, x1 = (float(v) for v in x_range)

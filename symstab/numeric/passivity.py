@@ -85,7 +85,7 @@ import numpy as np
 import sympy as sp
 
 from .._validate import check_delay, check_loop, check_real
-from .region import _golden_max
+from .curves import _golden_max
 
 __all__ = ["PassiveRegion", "passive_region", "paper_passive_region"]
 

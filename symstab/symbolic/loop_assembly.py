@@ -45,7 +45,8 @@ _C_KEYWORDS = frozenset(
 _GENERATED_NAME = re.compile(r"(num|den|pn|pd|x)\d+|numpy|_.*")
 #: Keyword arguments of Loop's methods: a parameter of the same name would
 #: be taken for them.
-_ARGUMENT_NAMES = frozenset({"self", "name", "x", "y", "n", "n_lines", "values"})
+_ARGUMENT_NAMES = frozenset({"self", "name", "x", "y", "n", "values", "x_range", "y_range",
+                             "damping"})
 
 
 def _real_floats(values):
