@@ -331,7 +331,7 @@ def test_unwritable_cache_compiles_in_memory(tmp_path, monkeypatch):
     ("1/s**1000", ENVIRONMENT, "above the limit 100"),
     (PLANT, "K*2**(10**10)", "power inside an exponent"),
     # Names that Loop's methods take as arguments.
-    (PLANT, "K + n_lines", "argument of Loop's methods"),
+    (PLANT, "K + x_range", "argument of Loop's methods"),
     (PLANT, "K + x*B", "argument of Loop's methods"),
 ])
 

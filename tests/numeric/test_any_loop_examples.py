@@ -302,7 +302,7 @@ def test_limits_find_the_stable_region(path, examples):
     just above it; the default x lies in ``[x_min, x_max]``.
     """
     example = examples(path)
-    lim = example.loop.limits(d=1, n_lines=32)
+    lim = example.loop.limits(d=1)
     assert not lim.empty and np.isfinite(lim.y_max), lim
     assert lim.x_min <= example.values[example.x] <= lim.x_max, lim
     below, above = example.stable(lim.x_at_y_max, lim.y_max - INTERVAL_RTOL * abs(lim.y_max)
