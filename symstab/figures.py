@@ -8,8 +8,8 @@ reproduction's ``index.md``.  :func:`make_figures` writes them all as PNGs.
 Figures 6, 7, 8 and 10 draw the whole boundary -- the arc of eq. (7) up to
 theta_max (solid) and the same curve on to theta = pi (dashed), which bounds
 stable sets too (the lower edge of the gamma = 1 band in Fig. 10) -- and
-fill the stable set found by exact root counting
-(:meth:`symstab.numeric.region.StabilityRegion.alpha_intervals_on`).
+fill the stable set: the cells of the exact D-decomposition with no
+unstable pole (:meth:`symstab.numeric.region.StabilityRegion.decomposition`).
 Simulation (:func:`symstab.numeric.simulate.stability_map`) is drawn over it
 as a check, hatched; it takes most of the time.  Fig. 10 writes in every
 cell its number of unstable closed-loop poles; Figs. 11 and 12 end the
@@ -262,48 +262,33 @@ def _arc_pieces(gamma, d, window):
     return points[: k + 1], points[k:]
 
 
-def _stable_strips(gamma, d, window, scale=(1.0, 1.0), n_lines=400):
-    """The stable set in ``window``: its exact alpha intervals on ``n_lines`` verticals.
+@functools.lru_cache(maxsize=64)
+def _decomposition(gamma, d, window):
+    """The D-decomposition of ``window`` (``((beta0, beta1), (alpha0, alpha1))``), kept.
 
-    Each interval becomes a strip one line-spacing wide, so the fill is
-    exact in alpha and resolved to ``1 / n_lines`` of the window in beta.
-    ``scale`` multiplies (beta, alpha) into the plotted units.  Returns the
-    strips as ``(4, 2)`` polygons.
+    Every branch of the boundary cuts the window into cells; each cell
+    carries its number of unstable closed-loop poles, and the stable set
+    is the union of the cells with none
+    (:meth:`symstab.numeric.region.StabilityRegion.decomposition`).
     """
-    (b0, b1), (a0, a1) = window
-    h = (b1 - b0) / n_lines
-    betas = b0 + h * (np.arange(n_lines) + 0.5)
-    runs = _region(gamma, d).alpha_intervals_on(betas)
-    sx, sy = scale
-    strips = []
-    for b, run in zip(betas, runs):
-        for lo, hi in run:
-            lo, hi = max(lo, a0), min(hi, a1)
-            if hi > lo:
-                strips.append(np.array([[b - h / 2, lo], [b + h / 2, lo],
-                                        [b + h / 2, hi], [b - h / 2, hi]]) * (sx, sy))
-    return strips
+    x_range, y_range = window
+    return _region(gamma, d).decomposition(x_range=tuple(map(float, x_range)),
+                                           y_range=tuple(map(float, y_range)))
 
 
 def _fill_stable(ax, gamma, d, window, color, scale=(1.0, 1.0)):
     """Fill the exact stable set of ``(gamma, d)`` in ``window``; True when it meets the window."""
-    from matplotlib.collections import PolyCollection
-
-    strips = _stable_strips(gamma, d, window, scale)
-    if strips:
-        # No edges and no antialiasing: the strips abut without seams.
-        ax.add_collection(PolyCollection(strips, facecolors=color, edgecolors="none",
-                                         alpha=_FILL_ALPHA, antialiased=False, zorder=1))
-    return bool(strips)
+    decomposition = _decomposition(gamma, d, window)
+    _shade_cells(ax, decomposition, color, scale)
+    return bool(decomposition.stable)
 
 
-def _shade_cells(ax, decomposition, color, scale=(1.0, 1.0), counts=False, min_share=0.01):
-    """Fill the stable cells of a D-decomposition, holes included; optionally write every cell's count.
+def _shade_cells(ax, decomposition, color, scale=(1.0, 1.0)):
+    """Fill the stable cells of a D-decomposition, holes included.
 
     ``decomposition`` is a :class:`symstab.numeric.decomposition.Decomposition`
     (x = beta, y = alpha); ``scale`` multiplies its coordinates into the
-    plotted units.  A cell's count is written at its interior point when
-    the cell covers at least ``min_share`` of the plotted window.
+    plotted units.
     """
     from matplotlib.patches import PathPatch
     from matplotlib.path import Path
@@ -325,11 +310,6 @@ def _shade_cells(ax, decomposition, color, scale=(1.0, 1.0), counts=False, min_s
         parts = [ring(cell.outer, False)] + [ring(h, True) for h in cell.holes]
         path = Path(np.concatenate([v for v, _ in parts]), np.concatenate([c for _, c in parts]))
         ax.add_patch(PathPatch(path, facecolor=color, edgecolor="none", alpha=_FILL_ALPHA, zorder=1))
-    if counts:
-        (x0, x1), (y0, y1) = decomposition.x_range, decomposition.y_range
-        for cell in decomposition.cells:
-            if cell.count >= 0 and cell.area >= min_share * (x1 - x0) * (y1 - y0):
-                _count_text(ax, cell.point[0] * sx, cell.point[1] * sy, cell.count)
 
 
 def _count_text(ax, x, y, count):
@@ -338,57 +318,35 @@ def _count_text(ax, x, y, count):
             bbox={"boxstyle": "circle,pad=0.2", "fc": "white", "ec": "0.5", "lw": 0.6, "alpha": 0.85})
 
 
-def _write_counts(ax, gamma, d, window, scale=(1.0, 1.0), n=40, min_share=0.01, min_depth=2):
-    """Write the number of unstable roots in every cell of ``window`` that is big enough to hold it.
+def _pixels_to_edge(ax, ring, point):
+    """Distance in pixels from ``point`` to the closed polyline ``ring`` (both in data units)."""
+    xy = ax.transData.transform(np.vstack([ring, ring[:1]]))
+    p = ax.transData.transform([point])[0]
+    a, ab = xy[:-1], np.diff(xy, axis=0)
+    t = np.clip(np.sum((p - a) * ab, axis=1) / np.maximum(np.sum(ab * ab, axis=1), 1e-300), 0.0, 1.0)
+    return float(np.min(np.hypot(*(a + t[:, None] * ab - p).T)))
 
-    The cells are found on an ``n`` x ``n`` grid of certified root counts
-    (:func:`symstab.numeric.stability.unstable_root_counts`): points of one
-    count that touch make a cell.  The number goes at the cell's deepest
-    grid point (the last one left when the cell is eroded step by step),
-    so it is the certified count at the point where it is written.  Cells
-    under ``min_share`` of the window, or narrower than ``2 min_depth + 1``
-    grid points, are left unlabelled.  Returns the ``(beta, alpha, count)``
-    written.
+
+def _write_counts(ax, gamma, d, window, scale=(1.0, 1.0), room=9.0):
+    """Write its number of unstable closed-loop poles in every cell of ``window`` with room for it.
+
+    The number goes at the cell's interior point, where the decomposition
+    counted it (Schur-Cohn, checked against the crossing rule); cells whose
+    point lies within ``room`` pixels of the cell's edge are left
+    unlabelled, so no number sits on a curve.  Call it after the axes'
+    limits are set.  Returns the ``(beta, alpha, count)`` written.
     """
-    (b0, b1), (a0, a1) = window
-    beta = b0 + (b1 - b0) * (np.arange(n) + 0.5) / n
-    alpha = a0 + (a1 - a0) * (np.arange(n) + 0.5) / n
-    A, B = np.meshgrid(alpha, beta, indexing="ij")
-    counts = unstable_root_counts(alpha=A, beta=B, gamma=gamma, d=d, delta=DELTA)
-    seen = np.zeros(counts.shape, dtype=bool)
+    sx, sy = scale
     written = []
-    for i0, j0 in zip(*np.nonzero(counts >= 0)):
-        if seen[i0, j0]:
+    for cell in _decomposition(gamma, d, window).cells:
+        if cell.count < 0:
+            continue  # marginal or unresolved: no number to write
+        x, y = cell.point
+        rings = [cell.outer * (sx, sy)] + [h * (sx, sy) for h in cell.holes]
+        if min(_pixels_to_edge(ax, r, (x * sx, y * sy)) for r in rings) < room:
             continue
-        cell = np.zeros(counts.shape, dtype=bool)
-        stack = [(i0, j0)]
-        seen[i0, j0] = True
-        while stack:
-            i, j = stack.pop()
-            cell[i, j] = True
-            for k, l in ((i + 1, j), (i - 1, j), (i, j + 1), (i, j - 1)):
-                if 0 <= k < n and 0 <= l < n and not seen[k, l] and counts[k, l] == counts[i0, j0]:
-                    seen[k, l] = True
-                    stack.append((k, l))
-        if cell.sum() < min_share * n * n:
-            continue
-        core, depth = cell, 0
-        while True:
-            inner = core.copy()
-            inner[1:, :] &= core[:-1, :]
-            inner[:-1, :] &= core[1:, :]
-            inner[:, 1:] &= core[:, :-1]
-            inner[:, :-1] &= core[:, 1:]
-            inner[[0, -1], :] = False  # the window's edge is a cell's edge too
-            inner[:, [0, -1]] = False
-            if not inner.any():
-                break
-            core, depth = inner, depth + 1
-        if depth < min_depth:
-            continue  # a sliver: its number would sit on the curves around it
-        i, j = np.argwhere(core)[len(np.argwhere(core)) // 2]
-        _count_text(ax, B[i, j] * scale[0], A[i, j] * scale[1], int(counts[i, j]))
-        written.append((float(B[i, j]), float(A[i, j]), int(counts[i, j])))
+        _count_text(ax, x * sx, y * sy, cell.count)
+        written.append((float(x), float(y), int(cell.count)))
     return written
 
 
@@ -492,11 +450,11 @@ def _legend_below(fig, handles, ncol):
     return legend
 
 
-def _regions_panel(ax, gammas, d, window, n, verdicts, beyond=True):
+def _regions_panel(ax, gammas, d, window, n, verdicts, beyond=True, colors=_COLORS):
     """Exact stable sets (filled), every branch of the boundary, simulation (hatched)."""
     (b0, b1), (a0, a1) = window
     ax.axhline(0.0, zorder=2, **_Z_ONE)
-    for g, color in zip(gammas, _COLORS):
+    for g, color in zip(gammas, colors):
         exact = _fill_stable(ax, g, d, window, color)
         result, _, _ = _simulated(ax, g, d, window, n, color) if n else (None, None, None)
         _draw_boundary(ax, g, d, window, color, beyond=beyond)
@@ -580,12 +538,7 @@ def _fig8_second_row(gammas):
         # d = 0: the sliver between the two halves of the gamma = 2 arc, at beta = -1.
         zoom = ((-1.011, -0.989), (1.978, 2.022))
         ax = axes[0]
-        _regions_panel(ax, (2.0,), 0, zoom, 0, [], beyond=False)
-        # Keep gamma = 2's colour from the upper panel.
-        for line in ax.lines[1:]:
-            line.set_color(_COLORS[gammas.index(2.0)])
-        for coll in ax.collections:
-            coll.set_facecolor(_COLORS[gammas.index(2.0)])
+        _regions_panel(ax, (2.0,), 0, zoom, 0, [], beyond=False, colors=(_COLORS[gammas.index(2.0)],))
         ax.set_title(r"$d = 0$, magnified: the $\gamma = 2$ sliver", fontsize=PANEL_TITLE_SIZE)
         (b0, b1), (a0, a1) = zoom
         axes_top = axes[0].figure.axes[0]
@@ -597,7 +550,8 @@ def _fig8_second_row(gammas):
             (b0, b1), (a0, a1) = whole
             ax.axhline(0.0, zorder=2, **_Z_ONE)
             for g, color in zip(gammas, _COLORS):
-                _fill_stable(ax, g, d, whole, color)
+                # The stable sets lie in the upper panel's window: its decomposition serves.
+                _fill_stable(ax, g, d, windows[d], color)
                 _draw_boundary(ax, g, d, whole, color, beyond=False)
             (zb0, zb1), (za0, za1) = windows[d]
             ax.add_patch(Rectangle((zb0, za0), zb1 - zb0, za1 - za0, fill=False, ec="k", lw=1.0,
@@ -762,9 +716,9 @@ def fig10(n=40):
             outline = np.vstack([passive.polygon, passive.polygon[:1]]) * scale
             ax.plot(outline[:, 0], outline[:, 1], color=_PASSIVE, ls="--", lw=1.5, zorder=5)
         passive_k[g] = None if passive.empty else float(dev.stiffness(passive.y_max))
-        counted[g] = _write_counts(ax, g, d, window, scale)
         ax.set_xlim(b0 * scale[0], b1 * scale[0])
         ax.set_ylim(a0 * scale[1], a1 * scale[1])
+        counted[g] = _write_counts(ax, g, d, window, scale)
         ax.set_title(fr"${_mass_label(g)}$ ($\gamma = {g:g}$)"
                      + (", no passive point" if passive.empty else ""), fontsize=PANEL_TITLE_SIZE)
         _labels(ax, physical=True)
