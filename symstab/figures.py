@@ -627,7 +627,7 @@ def fig7():
     (lo, hi), = StabilityRegion(gamma=1.5, d=0, delta=DELTA).alpha_intervals(-0.5)
     points += [(5, -0.5, hi), (6, -0.5, lo)]
     # Each number sits beside its circle, on a white box, where no curve runs.
-    offsets = {1: (0, 16), 2: (18, 8), 3: (0, 17), 4: (0, 17), 5: (20, 4), 6: (20, -6)}
+    offsets = {1: (0, -17), 2: (18, 8), 3: (0, 17), 4: (0, 17), 5: (20, 4), 6: (30, 0)}
     for k, b, a in points:
         ax.plot(b, a, "o", ms=11, mfc="none", mec="k", mew=1.2, zorder=6)
         ax.annotate(str(k), (b, a), xytext=offsets[k], textcoords="offset points", ha="center",

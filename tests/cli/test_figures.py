@@ -138,14 +138,17 @@ def _panels(fig, d):
     return [ax for ax in fig.axes if f"$d = {d}$" in ax.get_title()]
 
 
-@pytest.mark.parametrize("name, gammas", [("fig6", (0.0, -0.25, -0.5, -0.75)),
-                                          ("fig8", (0.0, 0.5, 1.0, 1.5, 2.0, 2.2))])
-def test_every_named_arc_is_whole_in_some_panel_of_its_delay(drawn, name, gammas):
-    # Fig. 8 showed gamma = 1.5, 2 and 2.2 at d = 1 as stubs at the left edge.
+@pytest.mark.parametrize("name, gammas, delays", [
+    ("fig6", (0.0, -0.25, -0.5, -0.75), figures.DELAYS),
+    ("fig7", (0.0, 0.5, 1.0, 1.5, 2.0, 2.5, 3.0), (0,)),
+    ("fig8", (0.0, 0.5, 1.0, 1.5, 2.0, 2.2), figures.DELAYS)])
+def test_every_named_arc_is_whole_in_some_panel_of_its_delay(drawn, name, gammas, delays):
+    # Fig. 8 showed gamma = 1.5, 2 and 2.2 at d = 1 as stubs at the left edge;
+    # Fig. 7 cut the tips of gamma = 2.5 and 3, which then read as two lines each.
     from symstab.numeric.region import boundary_curve
 
     fig = drawn[name]
-    for d in figures.DELAYS:
+    for d in delays:
         panels = _panels(fig, d)
         assert panels, (name, d)
         for g in gammas:
@@ -285,3 +288,32 @@ def test_fig10_passive_outline_lies_in_the_stable_set(drawn):
     for ax in drawn["fig10"].axes[:4]:
         has_outline = any(line.get_color() == figures._PASSIVE for line in ax.lines)
         assert has_outline != ("no passive point" in ax.get_title()), ax.get_title()
+
+
+def test_fig7_numbers_are_not_struck_through(drawn):
+    # The numbers sat at the circles' centres, on the curves.
+    fig = drawn["fig7"]
+    ax = fig.axes[0]
+    renderer = fig.canvas.get_renderer()
+    numbers = [t for t in ax.texts if t.get_text() in {"1", "2", "3", "4", "5", "6"}]
+    assert len(numbers) == 6
+    points = _data_points(ax)
+    for t in numbers:
+        box = t.get_window_extent(renderer)
+        inside = ((points[:, 0] > box.x0) & (points[:, 0] < box.x1)
+                  & (points[:, 1] > box.y0) & (points[:, 1] < box.y1))
+        assert not inside.any(), t.get_text()
+
+
+@pytest.mark.parametrize("name", ("fig6", "fig8", "fig10"))
+def test_simulation_is_a_hatched_check_over_the_exact_fill(drawn, name):
+    # The simulated map was the only shading; now the exact stable cells are
+    # filled and the simulation is hatched over them.
+    import matplotlib.patches
+
+    fig = drawn[name]
+    for ax in fig.axes[:4]:
+        fills = [p for p in ax.patches if isinstance(p, matplotlib.patches.PathPatch) and p.get_fill()]
+        hatched = [c for c in ax.collections if any(getattr(c, "hatches", None) or [c.get_hatch()])]
+        assert fills, ax.get_title()
+        assert hatched, ax.get_title()
