@@ -555,19 +555,40 @@ class Loop(LoopModel):
         given = {key: None if window is None else check_window(key, window)
                  for key, window in (("x_range", x_range), ("y_range", y_range))}
         base, (ax, ay), ends = self._basis((x, y), values)
-        auto = _start_window(base, ax, ay, ends)
-        box = [*(given["x_range"] or auto[0]), *(given["y_range"] or auto[1])]
         free = {"x_min": given["x_range"] is None, "x_max": given["x_range"] is None,
                 "y_min": given["y_range"] is None, "y_max": given["y_range"] is None}
-        for _ in range(11):
-            found = decompose(base, ax, ay, ends, x_range=box[:2], y_range=box[2:], names=(x, y))
+
+        def run(box):
+            return decompose(base, ax, ay, ends, x_range=box[:2], y_range=box[2:], names=(x, y))
+
+        for auto in _start_windows(base, ax, ay, ends):
+            box = [*(given["x_range"] or auto[0]), *(given["y_range"] or auto[1])]
+            found = run(box)
+            if found.stable:
+                break
+        # Widen the free sides a stable cell reaches; once it reaches none, fit
+        # them to the stable set, a quarter of its extent around it.
+        fitted = not any(free.values())
+        for _ in range(12):
             grow = [side for side in found.unbounded if free[side]]
-            if not grow:
-                return found
-            span = (box[1] - box[0], box[3] - box[2])
-            for side in grow:
-                k = ("x_min", "x_max", "y_min", "y_max").index(side)
-                box[k] += (-1 if k % 2 == 0 else 1) * span[k // 2]
+            if grow:
+                span = (box[1] - box[0], box[3] - box[2])
+                for side in grow:
+                    k = ("x_min", "x_max", "y_min", "y_max").index(side)
+                    box[k] += (-1 if k % 2 == 0 else 1) * span[k // 2]
+                fitted = False
+            elif found.stable and not fitted:
+                points = np.vstack([cell.outer for cell in found.stable])
+                for k, side in enumerate(free):
+                    if free[side]:
+                        column = points[:, k // 2]
+                        lo, hi = float(column.min()), float(column.max())
+                        pad = 0.25 * (hi - lo) or 0.05 * (box[k // 2 * 2 + 1] - box[k // 2 * 2])
+                        box[k] = lo - pad if k % 2 == 0 else hi + pad
+                fitted = True
+            else:
+                break
+            found = run(box)
         return found
 
     def limits(self, x=None, y=None, **values):
@@ -885,33 +906,52 @@ def _line_intervals(a0, a1, a0_ends, a1_ends):
     return out
 
 
-def _start_window(base, ax, ay, ends):
-    """A first window for :meth:`Loop.region`: around the stable points next to the curves.
+def _start_windows(base, ax, ay, ends):
+    """First windows for :meth:`Loop.region`, tried in turn until one holds a stable cell.
 
-    Without any, the extent of the arc's finite points (their middle 90 %)
-    and of the lines' crossings.  A quarter of the span is added on each side.
+    First the extent of stable points next to the curves (a few steps off
+    the arc's points and the lines' crossings, classified at once): it is
+    on the scale of the stable set however far the arc runs.  Then the
+    extent of the curves themselves, without the outer 2 % on each side (the
+    arc may run off to infinity), then all of it.  A quarter of the span is
+    added on each side.
     """
-    xs, ys = _stable_seeds(base, ax, ay, ends)
+    xs, ys, _ = _curve_points(base, ax, ay, ends, per_degree=4)
     if xs.size == 0:
-        xs, ys, _ = _curve_points(base, ax, ay, ends)
-        if xs.size:
-            keep = ((xs >= np.quantile(xs, 0.05)) & (xs <= np.quantile(xs, 0.95))
-                    & (ys >= np.quantile(ys, 0.05)) & (ys <= np.quantile(ys, 0.95)))
-            xs, ys = (xs[keep], ys[keep]) if keep.any() else (xs, ys)
-    if xs.size == 0:
-        return (-1.0, 1.0), (-1.0, 1.0)
+        return [((-1.0, 1.0), (-1.0, 1.0))]
+    sx = np.median(np.abs(xs)) or 1.0
+    sy = np.median(np.abs(ys)) or 1.0
+    px, py = [], []
+    for step in (1e-5, 1e-3, 1e-2):
+        for ux, uy in ((1, 1), (1, -1), (-1, 1), (-1, -1)):
+            px.append(xs + ux * step * (np.abs(xs) + sx))
+            py.append(ys + uy * step * (np.abs(ys) + sy))
+    px, py = np.concatenate(px), np.concatenate(py)
+    check_memory("the stable points that start a region's window", 8 * len(px) * len(base))
+    codes = classify_polynomials(base[None, :] + px[:, None] * ax[None, :] + py[:, None] * ay[None, :],
+                                 refine=False)
+    candidates = [(px[codes == STABLE], py[codes == STABLE], 0.0)]
+    xs, ys, _ = _curve_points(base, ax, ay, ends)
+    candidates += [(xs, ys, 0.02), (xs, ys, 0.0)]
     out = []
-    for v in (xs, ys):
-        lo, hi = float(np.min(v)), float(np.max(v))
-        pad = 0.25 * (hi - lo) or 0.1 * max(abs(lo), abs(hi), 1e-300)
-        out.append((lo - pad, hi + pad))
-    return tuple(out)
+    for cx, cy, q in candidates:
+        if cx.size == 0:
+            continue
+        window = []
+        for v in (cx, cy):
+            lo, hi = float(np.quantile(v, q)), float(np.quantile(v, 1 - q))
+            pad = 0.25 * (hi - lo) or 0.1 * max(abs(lo), abs(hi), 1e-300)
+            window.append((lo - pad, hi + pad))
+        if tuple(window) not in out and all(np.isfinite(window).ravel()):
+            out.append(tuple(window))
+    return out or [((-1.0, 1.0), (-1.0, 1.0))]
 
 
-def _curve_points(base, ax, ay, ends):
-    """Points of the arc (finite ones) and the lines' pairwise crossings."""
+def _curve_points(base, ax, ay, ends, per_degree=16):
+    """Points of the arc (finite ones, at ``per_degree (n + 4)`` angles) and the lines' crossings."""
     n = len(base) - 1
-    theta = np.pi * (np.arange(1, 16 * (n + 4) + 1) - 0.5) / (16 * (n + 4))
+    m = per_degree * (n + 4)
+    theta = np.pi * (np.arange(1, m + 1) - 0.5) / m
     xs, ys, _ = arc_points(base, ax, ay, theta)
     lines = list(_lines(base, ax, ay, ends).values())
     for i in range(len(lines)):
@@ -923,28 +963,3 @@ def _curve_points(base, ax, ay, ends):
                 ys = np.append(ys, (-c1 * e0 + c0 * e1) / det)
     keep = np.isfinite(xs) & np.isfinite(ys)
     return xs[keep], ys[keep], theta
-
-
-def _stable_seeds(base, ax, ay, ends):
-    """Stable points ``(x, y)`` next to the D-decomposition's curves.
-
-    Every cell of the plane is bounded by pieces of the arc and of the lines,
-    so a stable cell has arc points (or line intersections) on its edge:
-    eight points around each of them, a small step away, are classified at
-    once and the stable ones kept.
-    """
-    xs, ys, _ = _curve_points(base, ax, ay, ends)
-    if xs.size == 0:
-        return xs, ys
-    sx = np.median(np.abs(xs)) or 1.0
-    sy = np.median(np.abs(ys)) or 1.0
-    steps = 10.0 ** np.arange(-6, -1)
-    px, py = [], []
-    for step in steps:
-        for ux, uy in ((1, 0), (-1, 0), (0, 1), (0, -1), (1, 1), (1, -1), (-1, 1), (-1, -1)):
-            px.append(xs + ux * step * (np.abs(xs) + sx))
-            py.append(ys + uy * step * (np.abs(ys) + sy))
-    px, py = np.concatenate(px), np.concatenate(py)
-    codes = classify_polynomials(base[None, :] + px[:, None] * ax[None, :] + py[:, None] * ay[None, :],
-                                 refine=False)
-    return px[codes == STABLE], py[codes == STABLE]

@@ -53,8 +53,11 @@ LABELS = ("arc", "z = 1", "z = -1", "leading")
 _CHANGE = {"arc": 2, "z = 1": 1, "z = -1": 1, "leading": 0}
 #: Longest chord of the sampled arc, as a fraction of the window.
 _CHORD = 2e-3
-#: Largest turn between two chords of the arc (radians).
+#: Largest turn between two chords of the arc (radians), unless both are
+#: shorter than _TURN_FLOOR (a fraction of the window): a loop smaller than
+#: that is not followed turn by turn (its sag is below 1e-6 of the window).
 _TURN = 0.05
+_TURN_FLOOR = 1e-4
 #: Rounds of arc refinement and points the arc may have in all.
 _ROUNDS = 40
 _MAX_ARC_POINTS = 400_000
@@ -393,7 +396,7 @@ def _sample_arc(base, ax, ay, to_unit, theta=None):
         with np.errstate(invalid="ignore", divide="ignore"):
             angle = np.arctan2(dv, du)
             turn = np.abs(np.angle(np.exp(1j * np.diff(angle))))
-        sharp = near[1:] & near[:-1] & (turn > _TURN) & (length[1:] + length[:-1] > 1e-7)
+        sharp = near[1:] & near[:-1] & (turn > _TURN) & (length[1:] + length[:-1] > _TURN_FLOOR)
         split[1:] |= sharp
         split[:-1] |= sharp
         # Through infinity, or into a singular point: follow it closer.
@@ -524,37 +527,76 @@ def _segments(polylines):
             np.concatenate(position))
 
 
+def _candidate_pairs(lo, hi):
+    """Pairs ``i < j`` of segments whose bounding boxes may overlap.
+
+    Short segments (the sampled arc) are hashed into a grid of cells as
+    large as the longest of them, so each lies in at most four cells and
+    only segments sharing a cell are paired; the few long ones (the lines,
+    the window's edges) are paired with everything.
+    """
+    n = len(lo)
+    extent = np.max(hi - lo, axis=1)
+    long_ = extent > 0.02
+    short = np.flatnonzero(~long_)
+    pairs = []
+    if len(short):
+        h = max(float(np.max(extent[short])), 1e-6)
+        cells = []
+        for kx in (0, 1):
+            for ky in (0, 1):
+                cx = np.floor((lo[short, 0] if kx == 0 else hi[short, 0]) / h).astype(np.int64)
+                cy = np.floor((lo[short, 1] if ky == 0 else hi[short, 1]) / h).astype(np.int64)
+                cells.append(np.stack([cx, cy, short], axis=1))
+        cells = np.concatenate(cells)
+        # Sorted by cell, then segment, each (cell, segment) once.
+        cells = cells[np.lexsort((cells[:, 2], cells[:, 1], cells[:, 0]))]
+        fresh = np.ones(len(cells), dtype=bool)
+        fresh[1:] = np.any(cells[1:] != cells[:-1], axis=1)
+        cells = cells[fresh]
+        same = np.ones(len(cells), dtype=bool)
+        for k in range(1, len(cells)):
+            same = same[:-1] & np.all(cells[k:, :2] == cells[:-k, :2], axis=1)
+            if not same.any():
+                break
+            pairs.append(np.stack([cells[:-k, 2][same], cells[k:, 2][same]], axis=1))
+    for i in np.flatnonzero(long_):
+        others = np.arange(n)
+        pairs.append(np.stack([np.full(n, i), others], axis=1))
+    if not pairs:
+        return np.zeros(0, dtype=np.int64), np.zeros(0, dtype=np.int64)
+    pairs = np.sort(np.concatenate(pairs), axis=1)
+    key = np.unique(pairs[:, 0] * n + pairs[:, 1])
+    i, j = key // n, key % n
+    return i[i != j], j[i != j]
+
+
 def _intersections(p, q, owner, position):
     """All pairs of crossing segments: (i, j, t_i, t_j)."""
     r = q - p
-    n = len(p)
     lo = np.minimum(p, q) - 1e-12
     hi = np.maximum(p, q) + 1e-12
+    ii, jj = _candidate_pairs(lo, hi)
     out = []
-    block = max(1, 2_000_000 // max(n, 1))
-    for start in range(0, n, block):
-        i = np.arange(start, min(n, start + block))[:, None]
-        j = np.arange(n)[None, :]
-        hit = ((j > i) & (lo[i, 0] <= hi[j, 0]) & (lo[j, 0] <= hi[i, 0])
-               & (lo[i, 1] <= hi[j, 1]) & (lo[j, 1] <= hi[i, 1]))
-        ii, jj = np.nonzero(hit)
-        ii = ii + start
+    for part in range(0, len(ii), 1_000_000):
+        i, j = ii[part:part + 1_000_000], jj[part:part + 1_000_000]
+        overlap = ((lo[i, 0] <= hi[j, 0]) & (lo[j, 0] <= hi[i, 0])
+                   & (lo[i, 1] <= hi[j, 1]) & (lo[j, 1] <= hi[i, 1]))
         # Neighbours along one polyline share their end point: not a crossing.
-        same = owner[ii] == owner[jj]
-        gap = np.abs(position[ii] - position[jj])
-        adjacent = same & (gap == 1)
-        ii, jj = ii[~adjacent], jj[~adjacent]
-        if not len(ii):
+        adjacent = (owner[i] == owner[j]) & (np.abs(position[i] - position[j]) == 1)
+        keep = overlap & ~adjacent
+        i, j = i[keep], j[keep]
+        if not len(i):
             continue
-        ri, rj = r[ii], r[jj]
-        w = p[jj] - p[ii]
+        ri, rj = r[i], r[j]
+        w = p[j] - p[i]
         denom = ri[:, 0] * rj[:, 1] - ri[:, 1] * rj[:, 0]
         with np.errstate(all="ignore"):
             t = (w[:, 0] * rj[:, 1] - w[:, 1] * rj[:, 0]) / denom
             s = (w[:, 0] * ri[:, 1] - w[:, 1] * ri[:, 0]) / denom
         ok = ((np.abs(denom) > 1e-300) & (t >= -_ENDS) & (t <= 1 + _ENDS)
               & (s >= -_ENDS) & (s <= 1 + _ENDS))
-        out.append(np.stack([ii[ok], jj[ok], np.clip(t[ok], 0, 1), np.clip(s[ok], 0, 1)], axis=1))
+        out.append(np.stack([i[ok], j[ok], np.clip(t[ok], 0, 1), np.clip(s[ok], 0, 1)], axis=1))
     return np.concatenate(out) if out else np.zeros((0, 4))
 
 
@@ -709,12 +751,13 @@ def decompose(base, ax, ay, ends, *, x_range, y_range, names=("x", "y")):
                     continue
                 a_, b_ = th[position[k]], th[position[k] + 1]
                 if b_ - a_ > _CROSSING_GAP and 1e-4 < a_ and b_ < np.pi - 1e-4:
-                    hot.append((a_, b_))
+                    # Two new angles close around the chords' crossing: the
+                    # chord through it is 32 times shorter, its sag 1000 times.
+                    middle = a_ + t * (b_ - a_)
+                    hot.extend([max(a_, middle - (b_ - a_) / 64), min(b_, middle + (b_ - a_) / 64)])
         if not hot:
             break
-        hot = np.array(hot)
-        extra = (hot[:, :1] + (hot[:, 1:] - hot[:, :1]) * np.arange(1, 16)[None, :] / 16).ravel()
-        theta = np.unique(np.concatenate([theta, extra]))
+        theta = np.unique(np.concatenate([theta, hot]))
     n_segments = len(p)
     check_memory(f"the D-decomposition's {n_segments} segments", 64 * n_segments * 64)
 
