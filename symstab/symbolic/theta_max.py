@@ -14,7 +14,17 @@ Three forms are derived here:
   written as ``A_S sin((d+1) theta) + A_D sin(d theta)`` and one Newton step
   from ``theta_0 = pi / (2 (d + 1))`` approximates the root.
 * :func:`theta_max` -- the exact first positive root for any (gamma, d,
-  delta), bracketed on a grid and refined by mpmath's Anderson-Bjorck solver.
+  delta), isolated by :func:`first_sign_change` and refined by mpmath's
+  Anderson-Bjorck solver.
+
+:func:`first_sign_change` is the one scan for the first root of the reduced
+equation R (:func:`reduced_equation`) in every arithmetic: it proves each
+cell before the root free of roots with a bound on ``|R''|``
+(:func:`reduced_curvature`), so it cannot step over a narrow dip of alpha
+below zero nor a root next to theta = pi.  The float
+:func:`symstab.numeric.curves.arc_end_angle` uses it too, and the interval
+enclosure (:mod:`symstab.numeric.theta_bounds`) shares its R
+(:func:`reduced_value_slope`) and q, r.
 """
 
 import dataclasses
@@ -22,6 +32,7 @@ import functools
 import math
 
 import mpmath
+import numpy as np
 import sympy as sp
 
 from . import model
@@ -35,6 +46,8 @@ __all__ = [
     "closed_form_d0", "newton_form_gamma0", "theta_max", "theta_max_newton",
     "alpha_numerator_function", "ReducedEquation", "reduced_equation",
     "PhaseEquation", "phase_equation",
+    "reduced_qr", "reduced_qr_functions", "reduced_value_slope", "reduced_curvature",
+    "first_sign_change", "RootNotIsolated",
 ]
 
 #: u = 1 - cos(theta), the variable of the d = 0 closed form.
@@ -150,10 +163,13 @@ def alpha_numerator_function():
 def theta_max(*, gamma, d, delta, dps=30):
     """Exact theta_max: the first root of alpha(theta) in (0, pi].
 
-    The numerator of alpha is sampled on a grid fine enough for the delay
-    (spacing below a quarter period of ``sin(d theta)``), the first sign
-    change after theta = 0 is bracketed, and mpmath's Anderson-Bjorck solver
-    refines it at ``dps`` digits.
+    The first positive root of the reduced equation ``R`` (``N_alpha = scale
+    u R`` with ``scale u > 0`` on (0, pi], :class:`ReducedEquation`), isolated
+    by :func:`first_sign_change`: every grid cell before it is proved free of
+    roots by the bound on ``|R''|`` of :func:`reduced_curvature` (halved where it
+    is not), so no root is stepped over, however narrow the dip of alpha below
+    zero or close to theta = pi; mpmath's Anderson-Bjorck solver then refines
+    it at ``dps`` digits.
 
     Parameters
     ----------
@@ -173,8 +189,16 @@ def theta_max(*, gamma, d, delta, dps=30):
     float
         theta_max in (0, pi]; ``pi`` when alpha does not return to zero
         before theta = pi, and ``nan`` when alpha < 0 just after theta = 0
-        (no arc enters alpha > 0; see :mod:`symstab.symbolic.small_theta`), or when the
-        arc is shorter than ``1e-10 pi / n`` for the scan's ``n`` points.
+        (``gamma + 1 + delta (d + 1) <= 0``: no arc enters alpha > 0; see
+        :mod:`symstab.symbolic.small_theta`).
+
+    Raises
+    ------
+    TypeError, ValueError
+        If an argument has the wrong kind or is out of range.
+    RootNotIsolated
+        If R is so close to zero over so long a stretch that the scan's
+        budget of points runs out (never seen).
 
     Examples
     --------
@@ -182,38 +206,48 @@ def theta_max(*, gamma, d, delta, dps=30):
     1.5725
     """
     gamma, d, delta = check_loop(gamma, d, delta, zero_delta=False)
-    f = _alpha_numerator_gamma()
-    # N_alpha ~ theta**3 delta**2 near 0 out of terms of size 1: the extra
-    # digits keep its sign right down to the first grid point, pi/n * 1e-10;
-    # on the uniform grid (theta >= pi/n) it cancels at most
-    # log10(n**3 / delta**2) digits, so fewer extra digits do there.
-    n = max(400, 16 * (d + 1))
-    uniform_extra = 10 + int(3 * math.log10(n) + 2 * max(0.0, -math.log10(delta)))
-    with mpmath.workdps(dps + 40):
-        g_, d_ = mpmath.mpf(gamma), mpmath.mpf(delta)
-        e_ = mpmath.exp(d_)
-        g = lambda t: f(t, g_, d, d_, e_)  # noqa: E731
-        step = mpmath.pi / n
-        short = [step * mpmath.mpf(10) ** (-k / mpmath.mpf(4)) for k in range(40, 0, -1)]
-        uniform = [step * k for k in range(1, n + 1)]
-        grid = short + uniform
-        values = [g(t) for t in short]
-        with mpmath.workdps(dps + min(40, uniform_extra)):
-            values += [g(t) for t in uniform]
-        if values[0] <= 0:
+    rate = d + 1
+    # gamma + 1 + delta (d + 1) = R'(0) decides whether an arc enters alpha
+    # > 0; decided exactly (the inputs are binary floats).
+    with mpmath.workprec(4096):
+        if not mpmath.mpf(gamma) + 1 + mpmath.mpf(delta) * rate > 0:
             return float("nan")
-        for k in range(1, len(grid)):
-            if values[k] == 0:
-                return float(grid[k])
-            if values[k] < 0 < values[k - 1]:
-                # N_alpha grows like exp(2 delta): a tolerance on its value
-                # means nothing at large delta, so keep the bracket instead.
-                lo, hi = grid[k - 1], grid[k]
-                root = mpmath.findroot(g, (lo, hi), solver="anderson", verify=False)
-                if not lo <= root <= hi:
-                    root = mpmath.findroot(g, (lo, hi), solver="bisect", verify=False)
-                return float(root)
-        return float(mpmath.pi)
+    # R has no O(theta**3) cancellation (N_alpha has): 10 guard digits do
+    # for R, and q, r cancel about 4 log10(1/delta) more.
+    work = dps + 10
+    with mpmath.workdps(work + 10 + int(4 * max(0.0, -math.log10(delta)))):
+        g_, dl_ = mpmath.mpf(gamma), mpmath.mpf(delta)
+        q_of, r_of = reduced_qr_functions()
+        G_ = mpmath.exp(dl_)
+        q_, r_ = q_of(dl_, G_), r_of(dl_, G_)
+    with mpmath.workdps(work):
+        q_, r_ = +q_, +r_
+        eps = mpmath.mpf(2) ** (-mpmath.mp.prec)
+
+        def evaluate(ts):
+            rows = [reduced_value_slope(t, g_, rate, dl_, q_, r_, sin=mpmath.sin, cos=mpmath.cos, eps=eps)
+                    for t in ts]
+            return tuple(np.array([row[j] for row in rows], dtype=object) for j in range(4))
+
+        slope0 = g_ + 1 + dl_ * rate
+        n = max(64, 4 * rate)
+        grid = np.array([mpmath.pi * k / n for k in range(n + 1)], dtype=object)
+        found = first_sign_change(evaluate, grid, slope0=slope0,
+                                  slope0_error=4 * eps * (abs(g_ + 1) + dl_ * rate),
+                                  curvature=reduced_curvature(g_, rate, dl_, q_, r_), root_at_end=True)
+        if found is None:
+            return float(mpmath.pi)
+        lo, hi = found
+
+        def g(t):
+            return reduced_value_slope(t, g_, rate, dl_, q_, r_, sin=mpmath.sin, cos=mpmath.cos)[0]
+
+        if lo == hi or g(hi) == 0:
+            return float(hi)
+        root = mpmath.findroot(g, (lo, hi), solver="anderson", verify=False)
+        if not lo <= root <= hi:
+            root = mpmath.findroot(g, (lo, hi), solver="bisect", verify=False)
+        return float(root)
 
 
 def theta_max_newton(*, d, delta):
@@ -414,3 +448,237 @@ def phase_equation():
     if sp.expand(series[1] - eq.slope0) != 0 or series[0] != 0 or series[2] != 0:
         raise AssertionError(f"R does not start as slope0 theta: {series}")
     return PhaseEquation(A=A, B=B, C=C, kappa=sp.factor(-series[3]))
+
+
+# -- The first root of R: a scan that cannot step over one ------------------
+#
+# theta_max (30 digits, here), the float arc_end_angle (symstab.numeric.curves)
+# and the certified enclosure (symstab.numeric.theta_bounds) all need R and
+# R' in one non-symbolic arithmetic or another; the formulas live here, below
+# all three.
+
+def reduced_qr(delta):
+    """q(delta), r(delta) of :class:`ReducedEquation` as floats, without cancellation.
+
+    With ``e2 = (expm1(delta) - delta) / delta**2`` and ``e3 = (e2 - 1/2) /
+    delta`` (both by their Taylor series for delta <= 1)::
+
+        q = -2 e2 (1 - e2 (1 - delta)) / (1 + delta e2)**2
+        r = -delta (2 e3 + delta e2**2) / (1 + delta e2)**2
+
+    (the symbolic q, r divided through by delta**4 and delta**3); for delta > 1,
+    where nothing cancels, the symbolic q, r written in ``E = exp(-delta)``
+    (no overflow at large delta)::
+
+        q = -2 (1 - (1 + delta) E) (delta - 1 + E) / (delta (1 - E))**2
+        r = -(1 - 2 delta E - E**2) / (1 - E)**2
+
+    ``q`` lies in [-1/2, 0) and ``r`` in (-1, 0]; delta = 0 gives (-1/2, 0).
+
+    Parameters
+    ----------
+    delta : float
+        ``b T / m >= 0`` (not validated: the callers have).
+
+    Returns
+    -------
+    (float, float)
+    """
+    if delta <= 1.0:
+        # e3 = sum delta**k / (k + 3)!: 18 terms reach 1e-20 at delta = 1.
+        e3, term = 0.0, 1.0 / 6.0
+        for k in range(18):
+            e3 += term
+            term *= delta / (k + 4)
+        e2 = 0.5 + delta * e3
+        den = (1.0 + delta * e2) ** 2
+        return -2.0 * e2 * (1.0 - e2 * (1.0 - delta)) / den, -delta * (2.0 * e3 + delta * e2**2) / den
+    E = math.exp(-delta)
+    one_minus = -math.expm1(-delta)
+    q = -2.0 * (1.0 - (1.0 + delta) * E) * (delta - 1.0 + E) / (delta * one_minus) ** 2
+    r = -(1.0 - 2.0 * delta * E - E * E) / one_minus**2
+    return q, r
+
+
+@functools.lru_cache(maxsize=None)
+def reduced_qr_functions():
+    """``q(delta, Gamma)``, ``r(delta, Gamma)`` of :class:`ReducedEquation` for mpmath.
+
+    Plain arithmetic in delta and Gamma: lambdify's "mpmath" printer leaves
+    the integer constants as Python ints, so interval numbers (``mpmath.iv``)
+    work too.  They cancel about ``2 log10(1/delta)`` digits each.
+    """
+    eq = reduced_equation()
+    args = (model.delta, model.Gamma)
+    return (sp.lambdify(args, eq.q, modules="mpmath"), sp.lambdify(args, eq.r, modules="mpmath"))
+
+
+def reduced_value_slope(t, gamma, rate, delta, q, r, *, sin, cos, eps=None):
+    """``R(t)`` and ``R'(t)`` of :class:`ReducedEquation` in any arithmetic.
+
+    ``sin`` and ``cos`` pick it: :mod:`numpy`'s for float arrays, :mod:`mpmath`'s
+    for mpf, ``mpmath.iv``'s for intervals (the certified enclosure).
+    ``rate = d + 1``; ``u = 2 sin(t/2)**2`` keeps its relative accuracy near 0.
+
+    With ``eps`` (the unit roundoff of the arithmetic) two more results bound
+    the rounding errors of the value and the slope: ``eps`` times a multiple
+    of the sizes of their terms, each sine and cosine of ``phi`` taken as
+    wrong by the rounding of ``phi = rate t`` too (``eps rate t``).  Near
+    theta = 0 the terms are O(t), so the bound is relative there, like R's
+    own accuracy.
+    """
+    s = sin(t)
+    u = 2 * sin(t / 2) ** 2
+    phi = rate * t
+    sp_, cp = sin(phi), cos(phi)
+    vers = 2 * sin(phi / 2) ** 2     # 1 - cos(phi)
+    # gamma (1 + q u) + cos(phi), summed from parts that are small together
+    # near theta = 0 when gamma is near -1 (a short arc): gamma + 1 is exact
+    # there for binary gamma (Sterbenz) and R keeps its relative accuracy.
+    w = (gamma + 1) + gamma * q * u - vers
+    b = delta + r * u
+    value = s * w + b * sp_
+    slope = (1 - u) * w + s * s * gamma * q + (r * s - rate * s) * sp_ + rate * b * cp
+    if eps is None:
+        return value, slope
+    a_s, a_b, a_sp, a_cp = abs(s), abs(b), abs(sp_), abs(cp)
+    shift = rate * abs(t)            # |rounding of phi| / eps
+    w_size = abs(gamma + 1) + 2 * abs(gamma * q * u) + 2 * vers + shift * a_sp
+    sp_size = a_sp + shift * a_cp
+    value_error = 16 * eps * (a_s * w_size + (a_b + abs(r * u)) * sp_size)
+    slope_error = 16 * eps * ((abs(1 - u) + u) * w_size + s * s * abs(gamma * q)
+                              + a_s * (abs(r) + rate) * sp_size
+                              + rate * (a_b + abs(r * u)) * (a_cp + shift * a_sp))
+    return value, slope, value_error, slope_error
+
+
+def reduced_curvature(gamma, rate, delta, q, r):
+    """A bound on ``|R''(theta)|`` over all real theta.
+
+    With ``g = gamma (1 + q u)`` and ``b = delta + r u`` (``u`` in [0, 2], so
+    ``|g| <= |gamma| max(1, |1 + 2q|)`` and ``|b| <= max(|delta|, |delta + 2r|)``)::
+
+        R'' = -sin g + 3 gamma q sin cos - (1 + rate**2) sin cos(phi)
+              - 2 rate cos sin(phi) + r cos sin(phi) + 2 r rate sin cos(phi)
+              - rate**2 b sin(phi)
+
+    bounded term by term.
+    """
+    gmax = abs(gamma) * max(1, abs(1 + 2 * q))
+    bmax = max(abs(delta), abs(delta + 2 * r))
+    return (gmax + abs(gamma * q) * 3 / 2 + (1 + rate) ** 2 + abs(r) * (1 + 2 * rate)
+            + rate**2 * bmax)
+
+
+class RootNotIsolated(ArithmeticError):
+    """:func:`first_sign_change` ran out of its budget of points."""
+
+
+#: Open cells halved per round of :func:`first_sign_change`, leftmost first:
+#: bounds its work where R stays within its rounding of zero over a stretch.
+_HALVED_PER_ROUND = 64
+
+
+def first_sign_change(evaluate, grid, *, slope0, slope0_error, curvature, root_at_end,
+                      max_points=100000):
+    """The first root of R in ``(grid[0], grid[-1]]``, isolated without stepping over one.
+
+    R vanishes at ``grid[0]`` (theta = 0) with slope ``slope0 > 0``, and also at
+    ``grid[-1]`` if ``root_at_end`` (theta = pi, where ``R(pi) = 0`` for every
+    integer d).  A cell ``[a, b]`` of the grid is proved free of roots when on
+    each half the Taylor bound from its end stays positive: with ``|R''| <=
+    curvature = C`` and ``h = b - a``, ``R(a) > 0`` and ``R(a) + R'(a) h/2 -
+    C h**2/8 > 0`` (and the same from b), or, at an end where R is exactly 0,
+    ``R'`` pointing into the cell by more than ``C h/4``; every value and
+    slope is taken at the worst end of its rounding error.  Cells before the
+    first point where R <= 0 that are not proved are halved (the leftmost
+    ``_HALVED_PER_ROUND`` each round), and so on, until every cell before
+    that point is proved and ``R' < 0`` is proved on the cell that ends
+    there, so that it holds one root, the first.
+
+    Parameters
+    ----------
+    evaluate : callable
+        ``evaluate(t) -> (R, R', error of R, error of R')`` for a 1-D array
+        ``t`` (float, or object arrays of mpf), as
+        :func:`reduced_value_slope` with ``eps``.
+    grid : ndarray
+        Increasing, from 0 to the end of the search.
+    slope0, slope0_error : number
+        ``R'(0) > 0`` and its rounding error.
+    curvature : number
+        A bound on ``|R''|`` (:func:`reduced_curvature`).
+    root_at_end : bool
+        R vanishes exactly at ``grid[-1]``.
+    max_points : int
+        Budget of points.
+
+    Returns
+    -------
+    tuple or None
+        ``(lo, hi)``: the first root lies in ``[lo, hi]``, R changes sign
+        there (``R(lo) > 0 >= R(hi)``) and is decreasing (or the bracket is
+        a few ulps wide); ``(t, t)`` where the first root could not be
+        separated from zero by the evaluation's rounding (R is within its
+        rounding of 0 at ``t``, a root to working precision); ``None`` when
+        R > 0 on the whole of ``(grid[0], grid[-1])``: the first root is
+        ``grid[-1]``.
+
+    Raises
+    ------
+    RootNotIsolated
+        If more than ``max_points`` points were needed.
+    """
+    t = np.asarray(grid)
+    v, p, ve, pe = evaluate(t[1:])
+    nought = t[0] * 0
+    v, ve = np.concatenate([[nought], v]), np.concatenate([[nought], ve])
+    p, pe = np.concatenate([[slope0], p]), np.concatenate([[slope0_error], pe])
+    zero = np.zeros(t.size, dtype=bool)
+    zero[0] = True
+    if root_at_end:
+        v[-1], ve[-1] = nought, nought
+        zero[-1] = True
+    while True:
+        bad = np.flatnonzero(np.asarray((v <= 0) & ~zero, dtype=bool))
+        k = int(bad[0]) if bad.size else None
+        if k is not None:
+            t, v, p, ve, pe, zero = t[:k + 1], v[:k + 1], p[:k + 1], ve[:k + 1], pe[:k + 1], zero[:k + 1]
+        a, b = t[:-1], t[1:]
+        h = b - a
+        drop = curvature * h * h / 8
+        va, vb = v[:-1] - ve[:-1], v[1:] - ve[1:]          # lower bounds of R
+        pa, pb = p[:-1] - pe[:-1], p[1:] + pe[1:]          # R' at its worst for each end
+        proved = (np.where(zero[:-1], pa - curvature * h / 4 > 0,
+                           (va > 0) & (va + pa * h / 2 - drop > 0))
+                  & np.where(zero[1:], -pb - curvature * h / 4 > 0,
+                             (vb > 0) & (vb - pb * h / 2 - drop > 0)))
+        proved = np.asarray(proved, dtype=bool)
+        if k is not None:
+            # The last cell holds a sign change: the first root, and the
+            # only one if R' < 0 on it (R' <= R'(end) + C h/2 on each half).
+            bound = curvature * h[-1] / 2
+            proved[-1] = bool(p[-2] + pe[-2] + bound < 0 and p[-1] + pe[-1] + bound < 0)
+        open_ = np.flatnonzero(~proved)[:_HALVED_PER_ROUND]
+        if open_.size == 0:
+            return None if k is None else (t[k - 1], t[k])
+        middle = (a[open_] + b[open_]) / 2
+        stuck = np.flatnonzero(np.asarray((middle <= a[open_]) | (middle >= b[open_]), dtype=bool))
+        if stuck.size:
+            if stuck[0] == 0:
+                i = int(open_[0])
+                if k is not None and i == t.size - 2:
+                    # A sign change a few ulps wide (from 0 itself: the
+                    # arc is that short).
+                    return (t[k], t[k]) if zero[k - 1] else (t[k - 1], t[k])
+                # The first open cell is a few ulps wide and R is not
+                # separated from 0 on it: a root to working precision.
+                at = t[i + 1] if zero[i] or zero[i + 1] or v[i + 1] < v[i] else t[i]
+                return at, at
+            open_, middle = open_[:stuck[0]], middle[:stuck[0]]
+        if t.size + open_.size > max_points:
+            raise RootNotIsolated(f"the first root of R was not isolated within {max_points} points")
+        mv, mp, mve, mpe = evaluate(middle)
+        at = open_ + 1
+        t, v, p = np.insert(t, at, middle), np.insert(v, at, mv), np.insert(p, at, mp)
+        ve, pe, zero = np.insert(ve, at, mve), np.insert(pe, at, mpe), np.insert(zero, at, False)

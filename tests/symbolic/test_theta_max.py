@@ -7,6 +7,7 @@ eqs. (1) and (4) (oracles.first_principles_theta_max), at 40 digits.
 import math
 
 import mpmath
+import numpy as np
 import pytest
 import sympy as sp
 
@@ -202,3 +203,121 @@ def test_references_refuse_delta_zero_instead_of_dividing_zero_by_zero(func):
              "theta_max_newton": lambda: symstab.theta_max_newton(d=0, delta=0.0)}
     with pytest.raises(ValueError, match="delta must be > 0 for the high-precision reference"):
         calls[func]()
+
+
+# No root stepped over: the scan isolates with a bound on R'' ------------------
+#
+# Oracles: the certified interval enclosure (symstab.numeric.theta_bounds,
+# its R proved equal to the derivation's in tests/numeric/test_theta_bounds.py)
+# and the paper's alpha from eqs. (1), (2), (4) at 40 digits, whose sign must
+# be + just below theta_max and - just above.
+
+#: Cases the grid scan got wrong: the arc runs to pi (N(pi) = 0 in the last
+#: cell; it returned pi * 399/400), a root inside the last cell (it returned
+#: pi), and a dip of alpha below 0 only ~1e-4 rad wide (it returned the next
+#: root, 1.7961).
+MISSED = [(1000.0, 0, 0.5), (1e6, 0, 1e-6), (2.4818442699578145, 200, 0.007024254262425767)]
+
+
+def _box_sample(seed, n):
+    """Seeded (gamma, d, delta): the box of issue 12 (gamma in [-1, 3], d in 0..200,
+    delta in [1e-6, 1]) and, one draw in five, a heavy virtual mass up to 1e6."""
+    rng = np.random.default_rng(seed)
+    points = []
+    while len(points) < n:
+        delta = float(10 ** rng.uniform(-6, 0))
+        d = int(rng.choice([int(rng.integers(0, 13)), int(rng.integers(0, 201))]))
+        gamma = float(rng.uniform(-1, 3)) if rng.uniform() < 0.8 else float(10 ** rng.uniform(0, 6))
+        if gamma + 1 + delta * (d + 1) > 0:
+            points.append((gamma, d, delta))
+    return points
+
+
+@pytest.mark.parametrize("gamma, d, delta", MISSED + _box_sample(1212, 10))
+def test_theta_max_is_the_certified_first_root(gamma, d, delta):
+    from symstab.numeric.theta_bounds import theta_max_enclosure
+    box = theta_max_enclosure(gamma=gamma, d=d, delta=delta)
+    top = theta_max(gamma=gamma, d=d, delta=delta)
+    assert box.lo <= top <= box.hi, (top, box)
+    if box.hi < math.pi:
+        with mpmath.workdps(40):
+            t = mpmath.mpf(top)
+            assert first_principles_alpha(t * (1 - mpmath.mpf(1e-12)), gamma, d, delta) > 0
+            assert first_principles_alpha(t * (1 + mpmath.mpf(1e-12)), gamma, d, delta) < 0
+
+
+def test_a_dip_narrower_than_the_old_grid_step_ends_the_arc():
+    """alpha < 0 on about 1e-4 rad around 1.7662 (d = 200: the old step was 1e-3)."""
+    gamma, d, delta = MISSED[2]
+    assert theta_max(gamma=gamma, d=d, delta=delta) == pytest.approx(1.7661805108331596, rel=1e-15)
+    with mpmath.workdps(40):
+        assert first_principles_alpha(mpmath.mpf("1.7662"), gamma, d, delta) < 0
+        assert first_principles_alpha(mpmath.mpf("1.7663"), gamma, d, delta) > 0
+
+
+def test_an_arc_that_runs_to_pi_returns_pi():
+    gamma, d, delta = MISSED[0]
+    assert theta_max(gamma=gamma, d=d, delta=delta) == math.pi
+    with mpmath.workdps(40):
+        for t in ("3.13", "3.1337", "3.14", "3.1415"):
+            assert first_principles_alpha(mpmath.mpf(t), gamma, d, delta) > 0, t
+
+
+def _reduced_mp(derivative):
+    from symstab.symbolic.theta_max import reduced_equation
+    eq = reduced_equation()
+    args = (model.theta, model.gamma, model.d, model.delta, model.Gamma)
+    return sp.lambdify(args, sp.diff(eq.R, model.theta, derivative), modules="mpmath")
+
+
+@pytest.mark.parametrize("gamma, d, delta", [(-1.0, 0, 1e-6), (3.0, 200, 1.0), (0.0, 40, PAPER_DELTA),
+                                             (1e6, 0, 1e-6), (-0.5, 7, 30.0), (2.0, 1, 1e4)])
+def test_curvature_bound_holds_the_derived_second_derivative(gamma, d, delta):
+    """reduced_curvature >= |R''| of the derivation's R, on a fine grid of [0, pi] (40 digits)."""
+    from symstab.symbolic.theta_max import reduced_curvature, reduced_qr
+    second = _reduced_mp(2)
+    q, r = reduced_qr(delta)
+    bound = reduced_curvature(gamma, d + 1, delta, q, r)
+    with mpmath.workdps(40):
+        dl = mpmath.mpf(delta)
+        G = mpmath.exp(dl)
+        worst = max(abs(second(mpmath.pi * k / 2000, gamma, d, dl, G)) for k in range(2001))
+    assert worst <= bound
+    assert bound <= 10 * worst      # a bound, not a blanket
+
+
+@pytest.mark.parametrize("delta", [0.0, 1e-9, 1e-6, 0.0025, 0.3, 1.0, 1.0000001, 2.0, 30.0, 800.0, 1e5])
+def test_float_q_r_are_the_derived_ones(delta):
+    """The series (delta <= 1) and the exp(-delta) form (delta > 1) against the symbolic q, r at 60 digits."""
+    from symstab.symbolic.theta_max import reduced_equation, reduced_qr
+    q, r = reduced_qr(delta)
+    if delta == 0.0:
+        assert (q, r) == (-0.5, 0.0)
+        return
+    eq = reduced_equation()
+    with mpmath.workdps(60):
+        dl = mpmath.mpf(delta)
+        values = {model.delta: dl, model.Gamma: mpmath.exp(dl)}
+        q_exact = sp.lambdify(tuple(values), eq.q, modules="mpmath")(*values.values())
+        r_exact = sp.lambdify(tuple(values), eq.r, modules="mpmath")(*values.values())
+        assert abs(q - q_exact) <= 4e-16 * abs(q_exact)
+        assert abs(r - r_exact) <= 4e-16 * abs(r_exact)
+
+
+@pytest.mark.parametrize("seed", [1, 2, 3])
+def test_float_rounding_bounds_hold(seed):
+    """The float R, R' lie within the error bounds of reduced_value_slope of the 40-digit ones."""
+    from symstab.symbolic.theta_max import reduced_qr, reduced_value_slope
+    value, slope = _reduced_mp(0), _reduced_mp(1)
+    for gamma, d, delta in _box_sample(seed, 4) + [(-1.0 - 3e-3 + 1e-9, 2, 1e-3)]:
+        q, r = reduced_qr(delta)
+        t = np.concatenate([np.geomspace(1e-9, 0.1, 20), np.linspace(0.1, np.pi, 200)])
+        v, p, ve, pe = reduced_value_slope(t, gamma, d + 1, delta, q, r, sin=np.sin, cos=np.cos,
+                                           eps=np.finfo(float).eps)
+        with mpmath.workdps(40):
+            dl = mpmath.mpf(delta)
+            G = mpmath.exp(dl)
+            for k, x in enumerate(t):
+                x = mpmath.mpf(x)
+                assert abs(v[k] - value(x, gamma, d, dl, G)) <= ve[k], (gamma, d, delta, x)
+                assert abs(p[k] - slope(x, gamma, d, dl, G)) <= pe[k], (gamma, d, delta, x)
