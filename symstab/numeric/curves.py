@@ -2,12 +2,13 @@
 
 The generated kernel :func:`symstab._generated.kernels.boundary` evaluates
 alpha(theta), beta(theta) to about 1e-14 relative (tests/codegen/test_generated_kernels.py).
-Here it is used to find where the arc ends and to sample it:
+Here it is used to sample the arc, and alpha's reduced numerator R to find
+where the arc ends:
 
 * :func:`arc_end_angle` -- theta_max, the first root of alpha(theta) in
-  (0, pi), bracketed on a grid fine enough for the delay and refined by
-  bisection to the last bit (the float counterpart of the 30-digit
-  :func:`symstab.theta_max.theta_max`);
+  (0, pi], isolated with a bound on R'' so that no root is stepped over
+  and refined by regula falsi to a few ulps (the float counterpart of the
+  30-digit :func:`symstab.symbolic.theta_max.theta_max`);
 * :class:`BoundaryCurve` -- the arc from theta = 0 to theta_max, with the
   other pieces of the boundary of the stable region (z = 1 and z = -1,
   straight lines in the alpha-beta plane) where they bound it; built by
@@ -16,12 +17,14 @@ Here it is used to find where the arc ends and to sample it:
 """
 
 import dataclasses
+import fractions
 import math
 
 import numpy as np
 
 from .._generated import kernels
 from .._validate import check_loop
+from ..symbolic.theta_max import first_sign_change, reduced_curvature, reduced_qr, reduced_value_slope
 
 __all__ = ["arc_end_angle", "minus_one_line", "BoundaryCurve", "Segment", "scan_grid",
            "bracketed_root"]
@@ -110,7 +113,15 @@ def bracketed_root(f, lo, hi, iterations=64, *, indexed=False):
 
 
 def arc_end_angle(*, gamma, d, delta):
-    """theta_max: the first root of alpha(theta) in (0, pi).
+    """theta_max: the first root of alpha(theta) in (0, pi].
+
+    The float counterpart of :func:`symstab.symbolic.theta_max.theta_max`:
+    the first positive root of the reduced equation ``R`` (alpha's numerator
+    over positive factors), isolated by
+    :func:`~symstab.symbolic.theta_max.first_sign_change` -- every cell before
+    it proved free of roots by the bound on ``|R''|``, so a narrow dip of alpha
+    below zero or a root next to pi is not stepped over -- and refined by
+    :func:`bracketed_root` to a few ulps.
 
     Parameters
     ----------
@@ -119,13 +130,16 @@ def arc_end_angle(*, gamma, d, delta):
     d : int
         Delay in samples, ``d >= 0``.
     delta : float
-        ``b T / m > 0``.
+        ``b T / m >= 0``.
 
     Returns
     -------
     float
         theta_max; ``pi`` when alpha stays positive up to pi; ``nan`` when
-        alpha < 0 just after theta = 0 (no arc enters alpha > 0).
+        alpha < 0 just after theta = 0 (``gamma + 1 + delta (d + 1) <= 0``:
+        no arc enters alpha > 0), or when ``gamma + 1 + delta (d + 1)`` is
+        positive by less than its rounding (``1e-15 (|gamma + 1| + delta
+        (d + 1))``).
 
     Examples
     --------
@@ -133,21 +147,38 @@ def arc_end_angle(*, gamma, d, delta):
     1.5725
     """
     gamma, d, delta = check_loop(gamma, d, delta)
-
-    def alpha(t):
-        return kernels.boundary(t, gamma, d, delta)[0]
-
-    grid = scan_grid(d)
-    values = alpha(grid)
-    if not values[0] > 0:
+    rate = d + 1
+    # R'(0) = gamma + 1 + delta (d + 1) decides whether an arc enters
+    # alpha > 0; its sign decided exactly (the inputs are binary floats).
+    if not fractions.Fraction(gamma) + 1 + fractions.Fraction(delta) * rate > 0:
         return float("nan")
-    negative = np.flatnonzero(values <= 0)
-    if negative.size == 0:
+    q, r = reduced_qr(delta)
+
+    eps = np.finfo(float).eps
+
+    def evaluate(t):
+        return reduced_value_slope(t, gamma, rate, delta, q, r, sin=np.sin, cos=np.cos, eps=eps)
+
+    slope0 = (gamma + 1) + delta * rate
+    slope0_error = 4 * eps * (abs(gamma + 1) + delta * rate)
+    if not slope0 > slope0_error:
+        # R'(0) > 0 is lost in the rounding of its two terms: no arc to
+        # float arithmetic.
+        return float("nan")
+    found = first_sign_change(evaluate, np.linspace(0.0, np.pi, _ARC_SCAN_CELLS * rate + 1),
+                              slope0=slope0, slope0_error=slope0_error,
+                              curvature=reduced_curvature(gamma, rate, delta, q, r), root_at_end=True)
+    if found is None:
         return float(np.pi)
-    k = negative[0]
-    if values[k] == 0:
-        return float(grid[k])
-    return float(bracketed_root(alpha, grid[k - 1], grid[k]))
+    lo, hi = found
+    if lo == hi:
+        return float(hi)
+    return float(bracketed_root(lambda t: evaluate(t)[0], lo, hi))
+
+
+#: Cells per period of ``sin((d + 1) theta)`` of the scan grid of
+#: :func:`arc_end_angle` (halved where the bound on R'' does not prove a cell).
+_ARC_SCAN_CELLS = 8
 
 
 def minus_one_line(*, gamma, d, delta):

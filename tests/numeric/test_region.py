@@ -3,7 +3,8 @@ StabilityRegion, limits, best_virtual_mass and Device.
 
 Oracles:
 
-* ``symstab.theta_max`` (30 digits) for the float theta_max;
+* ``symstab.theta_max`` (30 digits) and the certified interval enclosure
+  ``theta_max_enclosure`` for the float theta_max;
 * ``oracles.first_principles_boundary_point``: the boundary solved directly
   from the printed eqs. (1), (2), (4) with mpmath;
 * ``symstab.numeric.evaluate.alpha_max_on_arc`` and ``boundary_point`` (30 digits);
@@ -87,6 +88,59 @@ def test_arc_end_angle_matches_30_digit_theta_max(gamma, d, delta):
         assert 1 + gamma + (d + 1) * delta < 0
     else:
         assert abs(got - expected) <= 1e-13 * expected, (got, expected)
+
+
+#: Where a grid scan goes wrong (see tests/symbolic/test_theta_max.py): the arc
+#: runs to pi, a root inside the last cell, and a dip of alpha below 0 only
+#: ~1e-4 rad wide, which the float scan stepped over (returning 1.7961).
+MISSED = [(1000.0, 0, 0.5), (1e6, 0, 1e-6), (2.4818442699578145, 200, 0.007024254262425767)]
+
+
+def _box_points(seed, n):
+    """Seeded (gamma, d, delta) with an arc: gamma in [-1, 3] (one in five up to 1e6),
+    d in 0..200, delta in [1e-6, 1]."""
+    rng = np.random.default_rng(seed)
+    points = []
+    while len(points) < n:
+        delta = float(10 ** rng.uniform(-6, 0))
+        d = int(rng.choice([int(rng.integers(0, 13)), int(rng.integers(0, 201))]))
+        gamma = float(rng.uniform(-1, 3)) if rng.uniform() < 0.8 else float(10 ** rng.uniform(0, 6))
+        if gamma + 1 + delta * (d + 1) > 0:
+            points.append((gamma, d, delta))
+    return points
+
+
+@pytest.mark.parametrize("gamma, d, delta", MISSED + _box_points(2012, 12))
+def test_arc_end_angle_is_the_certified_first_root(gamma, d, delta):
+    """Against the interval enclosure; 1e-12: R in floats at gamma = 1e6 is conditioned to ~5e-14."""
+    from symstab.numeric.theta_bounds import theta_max_enclosure
+    box = theta_max_enclosure(gamma=gamma, d=d, delta=delta)
+    got = arc_end_angle(gamma=gamma, d=d, delta=delta)
+    assert abs(got - box.mid) <= 1e-12 * box.mid, (got, box)
+
+
+def test_boundary_curve_stops_at_a_narrow_first_dip():
+    """The arc ends where alpha first reaches 0 (1.76618), not at the next root 1.7961.
+
+    Without the straight segments: finding them fails at this point in the
+    region's line scan (a negative sample count), a separate defect.
+    """
+    from oracles import first_principles_alpha
+    gamma, d, delta = MISSED[2]
+    curve = boundary_curve(gamma=gamma, d=d, delta=delta, n=50, segments=False)
+    assert curve.theta_max == pytest.approx(1.7661805108331596, rel=1e-14)
+    assert curve.theta[-1] <= curve.theta_max
+    with mpmath.workdps(40):
+        assert first_principles_alpha(mpmath.mpf("1.7662"), gamma, d, delta) < 0
+
+
+@pytest.mark.parametrize("gamma, d, delta", [(-1 - 3 * PAPER_DELTA + 1e-9, 2, PAPER_DELTA),
+                                             (-1 - 41 * PAPER_DELTA + 1e-12, 40, PAPER_DELTA)])
+def test_arc_end_angle_of_a_very_short_arc(gamma, d, delta):
+    """gamma + 1 + delta (d + 1) = 1e-9 and 1e-12: R keeps its relative accuracy near 0."""
+    expected = theta_max_30(gamma, d, delta)
+    assert expected < 1e-4
+    assert arc_end_angle(gamma=gamma, d=d, delta=delta) == pytest.approx(expected, rel=1e-3)
 
 
 def test_the_nan_cases_give_an_empty_curve_with_a_message():
