@@ -42,7 +42,8 @@ import sympy as sp
 
 from .._validate import check_count, check_loop, check_real
 from ..symbolic import model
-from ..symbolic.theta_max import phase_equation, q_sym, r_sym, reduced_equation
+from ..symbolic.theta_max import (phase_equation, q_sym, r_sym, reduced_equation, reduced_qr,
+                                   reduced_qr_functions, reduced_value_slope)
 from .curves import arc_end_angle
 
 __all__ = ["ThetaMaxEnclosure", "NotCertified", "theta_max_enclosure", "certify_theta_max",
@@ -97,42 +98,31 @@ class ThetaMaxEnclosure:
         return self.lo <= theta <= self.hi
 
 
-@functools.lru_cache(maxsize=None)
-def _qr_functions():
-    eq = reduced_equation()
-    args = (model.delta, model.Gamma)
-    # Plain arithmetic in delta and Gamma: lambdify's "mpmath" printer leaves
-    # the integer constants as Python ints, which interval numbers accept.
-    return (sp.lambdify(args, eq.q, modules="mpmath"), sp.lambdify(args, eq.r, modules="mpmath"))
-
-
 class _Reduced:
-    """R and R' of one loop in interval arithmetic (at the caller's ``iv.prec``)."""
+    """R and R' of one loop in interval arithmetic (at the caller's ``iv.prec``).
+
+    The formulas are :func:`~symstab.symbolic.theta_max.reduced_value_slope`'s,
+    the ones the 30-digit and the float scans for theta_max use.
+    """
 
     def __init__(self, gamma, d, delta):
         self.gamma = iv.mpf(gamma)
         self.delta = iv.mpf(delta)
         self.rate = iv.mpf(d + 1)
-        q_of, r_of = _qr_functions()
+        q_of, r_of = reduced_qr_functions()
         Gamma = iv.exp(self.delta)
         self.q = q_of(self.delta, Gamma)
         self.r = r_of(self.delta, Gamma)
 
-    def _parts(self, x):
-        s = iv.sin(x)
-        u = 2 * iv.sin(x / 2) ** 2      # 1 - cos(x) without cancellation near 0
-        phi = self.rate * x
-        return s, u, iv.sin(phi), iv.cos(phi)
+    def _both(self, x):
+        return reduced_value_slope(x, self.gamma, self.rate, self.delta, self.q, self.r,
+                                   sin=iv.sin, cos=iv.cos)
 
     def value(self, x):
-        s, u, sp_, cp = self._parts(x)
-        return s * (self.gamma * (1 + self.q * u) + cp) + (self.delta + self.r * u) * sp_
+        return self._both(x)[0]
 
     def slope(self, x):
-        s, u, sp_, cp = self._parts(x)
-        c = 1 - u
-        return (c * (self.gamma * (1 + self.q * u) + cp) + s * s * self.gamma * self.q
-                + (self.r * s - self.rate * s) * sp_ + self.rate * (self.delta + self.r * u) * cp)
+        return self._both(x)[1]
 
 
 def _interval(lo, hi):
@@ -424,34 +414,6 @@ APPROX_STEPS = 8
 APPROX_WORST_RELATIVE_ERROR = 1e-13
 
 
-def _q_r(delta):
-    """q(delta), r(delta) of the reduced equation without cancellation at small delta.
-
-    With ``e2 = (expm1(delta) - delta) / delta**2`` and ``e3 = (e2 - 1/2) /
-    delta`` (both by their Taylor series for delta <= 1)::
-
-        q = -2 e2 (1 - e2 (1 - delta)) / (1 + delta e2)**2
-        r = -delta (2 e3 + delta e2**2) / (1 + delta e2)**2
-
-    (the symbolic q, r divided through by delta**4 and delta**3).
-    """
-    if delta <= 1.0:
-        # e3 = sum delta**k / (k + 3)!: 18 terms reach 1e-20 at delta = 1.
-        e3, term = 0.0, 1.0 / 6.0
-        for k in range(18):
-            e3 += term
-            term *= delta / (k + 4)
-        e2 = 0.5 + delta * e3
-        den = (1.0 + delta * e2) ** 2
-        return -2.0 * e2 * (1.0 - e2 * (1.0 - delta)) / den, -delta * (2.0 * e3 + delta * e2**2) / den
-    # Large delta (Gamma up to exp(1e6) overflows a float): 30 digits.
-    q_of, r_of = _qr_functions()
-    with mpmath.workdps(30):
-        dl = mpmath.mpf(delta)
-        G = mpmath.exp(dl)
-        return float(q_of(dl, G)), float(r_of(dl, G))
-
-
 @functools.lru_cache(maxsize=None)
 def _phase_functions():
     """Float A, A', B, B', C, C' of the phase form, and kappa."""
@@ -468,7 +430,7 @@ class _Phase:
 
     def __init__(self, gamma, d, delta):
         self.gamma, self.rate, self.delta = gamma, d + 1, delta
-        self.q, self.r = _q_r(delta)
+        self.q, self.r = reduced_qr(delta)
         self.parts = _phase_functions()[0]
 
     def window(self, t):
