@@ -447,8 +447,12 @@ def _worst(plane, grid, table, vx, vy):
 # The region
 
 
-def _solve(plane, x, y, x_range, y_range, hints=(1.0, 1.0)):
-    """The :class:`PassiveRegion` of a prepared plane."""
+def _solve(plane, x, y, x_range, y_range, hints=(0.0, 0.0)):
+    """The :class:`PassiveRegion` of a prepared plane.
+
+    ``hints`` are sizes of the axes (the loop's defaults) used only where
+    the condition gives no scale of its own (no line crosses that axis).
+    """
     n_series = plane.series.shape[0] - 1
     grid = _grid(max(n_series, len(plane.r) - 1))
     table = plane.terms(grid)
@@ -462,7 +466,12 @@ def _solve(plane, x, y, x_range, y_range, hints=(1.0, 1.0)):
             ratio = np.abs(table[0][big]) / slope[big]
         ratio = ratio[np.isfinite(ratio) & (ratio > 0)]
         s = float(np.median(ratio)) if ratio.size else 0.0
-        s = max(s, abs(hint)) if hint else s
+        # The set's own scale wins over the hint: the cuts start in a box
+        # of _BOX units and drop vertices closer than 1e-9 of the polygon's
+        # span, so a unit much larger than the set (a hint of 1 with a
+        # damping of 1e-6) loses it to rounding (an empty set).
+        if not s > 0:
+            s = abs(hint)
         scales.append(s if s > 0 else 1.0)
     plane.sx, plane.sy = scales
     tolerance = _RTOL * (plane.damping if plane.damping_axis is None else scales[plane.damping_axis])

@@ -78,3 +78,19 @@ def test_loop_the_theorem_does_not_cover_is_a_note_not_an_error(capsys):
     data = json.loads(out)
     assert "1/(m*s**2 + b*s)" in data["passive"]["error"]
     assert data["limits"]["y_max"] > 0
+
+
+def test_tiny_damping_keeps_its_passive_set(capsys):
+    # Closed form at d = 0: alpha_max = 2 delta, area 2 delta**2 (was "no passive point" for delta <= 1e-6).
+    status, out, _ = run(capsys, "limits", "--delta", "1e-6", "--d", "0", "--format", "json")
+    assert status == 0
+    passive = json.loads(out)["passive"]
+    assert passive["alpha_max"] == pytest.approx(2e-6, rel=1e-9)
+    assert passive["area"] == pytest.approx(2e-12, rel=1e-9)
+    # A loop file: b = 1e-12 N s/m gives K_max = 2 b / T (the file's defaults K, B no longer set the unit).
+    path = str(REPO / "examples" / "loops" / "paper.toml")
+    status, out, _ = run(capsys, "limits", "--loop", path, "--set", "b=1e-12", "--set", "d=0",
+                         "--set", "M=0", "--format", "json")
+    assert status == 0
+    data = json.loads(out)
+    assert data["passive"]["y_max"] == pytest.approx(2e-12 / data["inputs"]["values"]["T"], rel=1e-9)

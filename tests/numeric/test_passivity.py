@@ -123,6 +123,43 @@ def test_delayed_spring_loses_kt_of_damping_per_sample(d):
     assert region.y_max > k_max * 1.01
 
 
+@pytest.mark.parametrize("d", [0, 5, 40])
+def test_paper_set_scales_with_the_damping(d):
+    """At gamma = 0 the condition is homogeneous in (alpha, beta, delta): region(delta) = delta region(1).
+
+    A fixed unit of 1 in the scaled plane lost the set to rounding for
+    delta <= 1e-6 (empty at d = 0, area/delta**2 = 2e-8 instead of 0.30 at
+    d = 5).  Closed forms: at beta = 0 the set is the delayed spring's,
+    0 <= alpha < 2 delta / (2 d + 1); at d = 0 it is alpha/2 + |beta| < delta,
+    of area 2 delta**2 and alpha_max = 2 delta.
+    """
+    reference = paper_passive_region(gamma=0.0, d=d, delta=1.0)
+    for delta in (1e-12, 1e-9, 1e-6, 1.0):
+        region = paper_passive_region(gamma=0.0, d=d, delta=delta)
+        assert not region.empty and region.bounded, (delta, region)
+        spring = 2 * delta / (2 * d + 1)
+        inside = region.contains([0.0] * 3, [1e-3 * spring, spring * (1 - 1e-5), spring * (1 + 1e-5)])
+        assert inside.tolist() == [True, True, False], (delta, region)
+        assert region.area / delta**2 == pytest.approx(reference.area, rel=1e-9), delta
+        assert region.y_max / delta == pytest.approx(reference.y_max, rel=1e-9), delta
+        if d == 0:
+            assert region.area == pytest.approx(2 * delta**2, rel=1e-9)
+            assert region.y_max == pytest.approx(2 * delta, rel=1e-12)
+
+
+def test_loop_set_of_a_tiny_damping_is_the_wall_triangle():
+    """b = 1e-12 with examples/loops/paper.toml's defaults K = 2, B = 0.1: K_max = 2 b / T.
+
+    The defaults once set the plane's unit, 1e11 times the set's size: the
+    set came out empty.
+    """
+    b = 1e-12
+    loop = symstab.load_loop(REPO / "examples" / "loops" / "paper.toml")
+    region = passive_region(loop, b=b, d=0, M=0.0)
+    assert region.y_max == pytest.approx(2 * b / PAPER_T, rel=1e-9)
+    assert region.area == pytest.approx(2 * b**2 / PAPER_T, rel=1e-9)
+
+
 def test_virtual_mass_alone():
     loop = symstab.Loop("1/(m*s**2 + b*s)", PAPER_ENVIRONMENT, plane=("M", "K"),
                         values=dict(m=PAPER_M, b=PAPER_B, T=PAPER_T, d=0, B=0.0))
