@@ -165,9 +165,10 @@ def arc_end_angle(*, gamma, d, delta):
         # R'(0) > 0 is lost in the rounding of its two terms: no arc to
         # float arithmetic.
         return float("nan")
-    found = first_sign_change(evaluate, np.linspace(0.0, np.pi, _ARC_SCAN_CELLS * rate + 1),
-                              slope0=slope0, slope0_error=slope0_error,
-                              curvature=reduced_curvature(gamma, rate, delta, q, r), root_at_end=True)
+    cells = _ARC_SCAN_CELLS * rate
+    found = first_sign_change(evaluate, lambda k: np.pi * k / cells, cells, slope0=slope0,
+                              slope0_error=slope0_error, root_at_end=True,
+                              curvature=reduced_curvature(gamma, rate, delta, q, r))
     if found is None:
         return float(np.pi)
     lo, hi = found

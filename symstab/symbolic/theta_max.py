@@ -231,10 +231,14 @@ def theta_max(*, gamma, d, delta, dps=30):
 
         slope0 = g_ + 1 + dl_ * rate
         n = max(64, 4 * rate)
-        grid = np.array([mpmath.pi * k / n for k in range(n + 1)], dtype=object)
-        found = first_sign_change(evaluate, grid, slope0=slope0,
+
+        def points(ks):
+            return np.array([mpmath.pi * int(k) / n for k in ks], dtype=object)
+
+        found = first_sign_change(evaluate, points, n, slope0=slope0,
                                   slope0_error=4 * eps * (abs(g_ + 1) + dl_ * rate),
-                                  curvature=reduced_curvature(g_, rate, dl_, q_, r_), root_at_end=True)
+                                  curvature=reduced_curvature(g_, rate, dl_, q_, r_), root_at_end=True,
+                                  chunk=32)
         if found is None:
             return float(mpmath.pi)
         lo, hi = found
@@ -579,13 +583,13 @@ class RootNotIsolated(ArithmeticError):
 _HALVED_PER_ROUND = 64
 
 
-def first_sign_change(evaluate, grid, *, slope0, slope0_error, curvature, root_at_end,
-                      max_points=100000):
-    """The first root of R in ``(grid[0], grid[-1]]``, isolated without stepping over one.
+def first_sign_change(evaluate, points, cells, *, slope0, slope0_error, curvature, root_at_end,
+                      chunk=256, max_points=100000):
+    """The first root of R in ``(points(0), points(cells)]``, isolated without stepping over one.
 
-    R vanishes at ``grid[0]`` (theta = 0) with slope ``slope0 > 0``, and also at
-    ``grid[-1]`` if ``root_at_end`` (theta = pi, where ``R(pi) = 0`` for every
-    integer d).  A cell ``[a, b]`` of the grid is proved free of roots when on
+    R vanishes at ``points(0) = 0`` (theta = 0) with slope ``slope0 > 0``, and
+    also at the last point if ``root_at_end`` (theta = pi, where ``R(pi) = 0``
+    for every integer d).  A cell ``[a, b]`` of the grid is proved free of roots when on
     each half the Taylor bound from its end stays positive: with ``|R''| <=
     curvature = C`` and ``h = b - a``, ``R(a) > 0`` and ``R(a) + R'(a) h/2 -
     C h**2/8 > 0`` (and the same from b), or, at an end where R is exactly 0,
@@ -602,16 +606,22 @@ def first_sign_change(evaluate, grid, *, slope0, slope0_error, curvature, root_a
         ``evaluate(t) -> (R, R', error of R, error of R')`` for a 1-D array
         ``t`` (float, or object arrays of mpf), as
         :func:`reduced_value_slope` with ``eps``.
-    grid : ndarray
-        Increasing, from 0 to the end of the search.
+    points : callable
+        ``points(k)`` for an integer array ``k`` in ``0..cells``: the grid,
+        increasing from ``points(0) = 0`` to the end of the search.
+    cells : int
+        Cells of the grid.
     slope0, slope0_error : number
         ``R'(0) > 0`` and its rounding error.
     curvature : number
         A bound on ``|R''|`` (:func:`reduced_curvature`).
     root_at_end : bool
         R vanishes exactly at ``grid[-1]``.
+    chunk : int
+        Cells of the grid evaluated at a time, from the left (the rest only
+        if R > 0 is proved on all of them).
     max_points : int
-        Budget of points.
+        Budget of points per chunk.
 
     Returns
     -------
@@ -629,16 +639,29 @@ def first_sign_change(evaluate, grid, *, slope0, slope0_error, curvature, root_a
     RootNotIsolated
         If more than ``max_points`` points were needed.
     """
-    t = np.asarray(grid)
-    v, p, ve, pe = evaluate(t[1:])
-    nought = t[0] * 0
-    v, ve = np.concatenate([[nought], v]), np.concatenate([[nought], ve])
-    p, pe = np.concatenate([[slope0], p]), np.concatenate([[slope0_error], pe])
-    zero = np.zeros(t.size, dtype=bool)
-    zero[0] = True
-    if root_at_end:
-        v[-1], ve[-1] = nought, nought
-        zero[-1] = True
+    origin = points(np.arange(1))
+    nought = origin[0] * 0
+    # The grid is made and taken ``chunk`` cells at a time from the left: at
+    # a long delay the arc ends in the first few of thousands of cells.
+    start = (origin, np.array([nought]), np.array([slope0]), np.array([nought]),
+             np.array([slope0_error]), np.array([True]))
+    for first in range(1, cells + 1, chunk):
+        more = points(np.arange(first, min(first + chunk, cells + 1)))
+        values = evaluate(more)
+        t, v, p, ve, pe = (np.concatenate([old, new]) for old, new in zip(start, (more,) + tuple(values)))
+        zero = np.concatenate([start[5], np.zeros(more.size, dtype=bool)])
+        if root_at_end and first + chunk > cells:
+            v[-1], ve[-1] = nought, nought
+            zero[-1] = True
+        found = _isolate(evaluate, t, v, p, ve, pe, zero, curvature, max_points)
+        if found is not None:
+            return found
+        start = tuple(x[-1:] for x in (t, v, p, ve, pe, zero))
+    return None
+
+
+def _isolate(evaluate, t, v, p, ve, pe, zero, curvature, max_points):
+    """:func:`first_sign_change` on one stretch; None if every cell of it is proved free of roots."""
     while True:
         bad = np.flatnonzero(np.asarray((v <= 0) & ~zero, dtype=bool))
         k = int(bad[0]) if bad.size else None
