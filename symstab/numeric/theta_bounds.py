@@ -42,20 +42,30 @@ import sympy as sp
 
 from .._validate import check_count, check_loop, check_real
 from ..symbolic import model
-from ..symbolic.theta_max import (phase_equation, q_sym, r_sym, reduced_equation, reduced_qr,
-                                   reduced_qr_functions, reduced_value_slope)
+from ..symbolic.theta_max import (phase_equation, q_sym, r_sym, reduced_qr, reduced_qr_functions,
+                                   reduced_value_slope)
 from .curves import arc_end_angle
 
 __all__ = ["ThetaMaxEnclosure", "NotCertified", "theta_max_enclosure", "certify_theta_max",
            "theta_max_approx", "APPROX_WORST_RELATIVE_ERROR"]
 
 #: Working precision of the interval arithmetic, in bits (about 50 digits):
-#: q and r cancel about 2 log10(1/delta) digits (12 at delta = 1e-6) and
-#: R(lo) at one ulp from the root is 1e-16 of its terms.
+#: R(lo) at one ulp from the root is 1e-16 of its terms.  q and r, which
+#: cancel with a small delta, are enclosed at more (:func:`_qr_bits`).
 _PREC = 170
 
 #: The most pieces the proof of step 2 may cut [a, lo] into before it gives up.
 MAX_PIECES = 20000
+
+
+def _qr_bits(delta, bits):
+    """Bits at which q, r from delta and Gamma = exp(delta) keep ``bits`` of their own.
+
+    Their formulas cancel the O(1) terms down to q = O(1) and r = O(delta):
+    about ``3 log2(1/delta)`` bits are lost for delta < 1 (at 40 digits
+    Gamma = 1 exactly for delta = 1e-50, a division by zero).
+    """
+    return bits + 32 + (3 * math.ceil(-math.log2(delta)) if delta < 1 else 0)
 
 
 class NotCertified(ArithmeticError):
@@ -102,7 +112,9 @@ class _Reduced:
     """R and R' of one loop in interval arithmetic (at the caller's ``iv.prec``).
 
     The formulas are :func:`~symstab.symbolic.theta_max.reduced_value_slope`'s,
-    the ones the 30-digit and the float scans for theta_max use.
+    the ones the 30-digit and the float scans for theta_max use.  q and r
+    are enclosed at the raised precision of :func:`_qr_bits` (their
+    cancellation grows with log(1/delta)), the rest at the caller's.
     """
 
     def __init__(self, gamma, d, delta):
@@ -110,9 +122,15 @@ class _Reduced:
         self.delta = iv.mpf(delta)
         self.rate = iv.mpf(d + 1)
         q_of, r_of = reduced_qr_functions()
-        Gamma = iv.exp(self.delta)
-        self.q = q_of(self.delta, Gamma)
-        self.r = r_of(self.delta, Gamma)
+        old = iv.prec
+        iv.prec = _qr_bits(delta, old)
+        try:
+            wide_delta = iv.mpf(delta)
+            Gamma = iv.exp(wide_delta)
+            self.q = q_of(wide_delta, Gamma)
+            self.r = r_of(wide_delta, Gamma)
+        finally:
+            iv.prec = old
 
     def _both(self, x):
         return reduced_value_slope(x, self.gamma, self.rate, self.delta, self.q, self.r,
@@ -293,26 +311,30 @@ def certify_theta_max(lo, hi, *, gamma, d, delta, max_pieces=MAX_PIECES):
     return ThetaMaxEnclosure(lo=lo, hi=hi, gamma=gamma, d=d, delta=delta, pieces=pieces)
 
 
-def _root_near(reduced_mp, guess):
-    """Newton on R at 40 digits from ``guess``; a float bracket of 2 ulps around the result."""
+def _root_near(gamma, d, delta, guess):
+    """Newton on R at 40 digits from ``guess``; the root as a float.
+
+    R is :func:`~symstab.symbolic.theta_max.reduced_value_slope` with q, r
+    taken at the precision of :func:`_qr_bits` (40 digits' worth), so a
+    tiny delta neither cancels them to noise nor divides by Gamma - 1 = 0.
+    """
+    q_of, r_of = reduced_qr_functions()
+    with mpmath.workprec(_qr_bits(delta, 133)):
+        wide_delta = mpmath.mpf(delta)
+        Gamma = mpmath.exp(wide_delta)
+        q, r = q_of(wide_delta, Gamma), r_of(wide_delta, Gamma)
     with mpmath.workdps(40):
+        g_, dl_, q, r = mpmath.mpf(gamma), mpmath.mpf(delta), +q, +r
         x = mpmath.mpf(guess)
         for _ in range(8):
-            step = reduced_mp[0](x) / reduced_mp[1](x)
+            value, slope = reduced_value_slope(x, g_, d + 1, dl_, q, r,
+                                               sin=mpmath.sin, cos=mpmath.cos)
+            step = value / slope
             x -= step
             if abs(step) < mpmath.mpf(10) ** -35 * abs(x):
                 break
         f = float(x)
     return f
-
-
-@functools.lru_cache(maxsize=None)
-def _reduced_mp():
-    eq = reduced_equation()
-    args = (model.theta, model.gamma, model.d, model.delta, model.Gamma)
-    value = sp.lambdify(args, eq.R, modules="mpmath")
-    slope = sp.lambdify(args, sp.diff(eq.R, model.theta), modules="mpmath")
-    return value, slope
 
 
 def _search(gamma, d, delta, max_pieces):
@@ -366,11 +388,6 @@ def theta_max_enclosure(*, gamma, d, delta, max_pieces=MAX_PIECES):
     (0.039858935879, True)
     """
     gamma, d, delta = _check_domain(gamma, d, delta)
-    value, slope = _reduced_mp()
-    with mpmath.workdps(40):
-        g_, dl_ = mpmath.mpf(gamma), mpmath.mpf(delta)
-        G_ = mpmath.exp(dl_)
-    reduced_mp = (lambda t: value(t, g_, d, dl_, G_), lambda t: slope(t, g_, d, dl_, G_))
     failures = []
     for guess in (lambda: arc_end_angle(gamma=gamma, d=d, delta=delta),
                   lambda: _search(gamma, d, delta, max_pieces)):
@@ -382,7 +399,7 @@ def theta_max_enclosure(*, gamma, d, delta, max_pieces=MAX_PIECES):
         if not 0 < start <= math.pi:   # nan: the float scan saw no arc
             failures.append(f"candidate {start!r}")
             continue
-        root = _root_near(reduced_mp, start)
+        root = _root_near(gamma, d, delta, start)
         if not 0 < root < 4:
             failures.append(f"Newton from {start!r} left (0, pi]")
             continue

@@ -107,6 +107,27 @@ def test_both_sides_of_a_jump_are_certified(gamma, lobe):
     assert _alpha(box.lo, gamma, d, delta) > 0 > _alpha(box.hi, gamma, d, delta)
 
 
+@pytest.mark.parametrize("delta", [1e-20, 1e-50, 1e-300, 5e-324])
+@pytest.mark.parametrize("gamma, d, limit", [
+    # delta -> 0: R / sin(theta) -> gamma (1 + cos theta)/2 + cos((d + 1) theta), whose first
+    # root is arccos((sqrt(17) - 1)/8) for gamma = 1, d = 1 and pi / (2 (d + 1)) for gamma = 0;
+    # theta_max moves by O(delta) from it, far below the box's width.
+    (1.0, 1, lambda: mpmath.acos((mpmath.sqrt(17) - 1) / 8)),
+    (0.0, 40, lambda: mpmath.pi / 82),
+])
+def test_tiny_damping_is_certified(gamma, d, limit, delta):
+    # q, r from Gamma = exp(delta) cancel 3 log10(1/delta) digits: at 40 digits
+    # delta = 1e-50 divided by Gamma - 1 = 0 (ZeroDivisionError) and 1e-20 was NotCertified.
+    box = theta_max_enclosure(gamma=gamma, d=d, delta=delta)
+    with mpmath.workdps(30):
+        assert box.lo < limit() < box.hi, box
+    assert box.width <= 1e-14 * box.lo
+    # The paper's alpha at a precision that survives its own cancellation.
+    with mpmath.workdps(40 + 3 * round(-math.log10(delta))):
+        assert first_principles_alpha(mpmath.mpf(box.lo), gamma, d, delta) > 0
+        assert first_principles_alpha(mpmath.mpf(box.hi), gamma, d, delta) < 0
+
+
 def test_short_arc_is_certified():
     """gamma just above -1 - delta (d + 1): the arc ends near theta = 0."""
     gamma = -1 - PAPER_DELTA * 3 + 1e-6
