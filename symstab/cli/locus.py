@@ -210,6 +210,13 @@ _ANNOUNCE_DEGREE = 150
 
 
 def _announce(degree, n):
+    """Refuse a locus that cannot fit, then say on stderr what runs (long ones only).
+
+    The memory is decided first so that a refusal is the one error line.
+    """
+    from ..numeric.locus import check_locus_memory
+
+    check_locus_memory(n, degree)
     if degree >= _ANNOUNCE_DEGREE:
         print(f"tracking {degree} closed-loop poles at {n}+ points ...", file=sys.stderr,
               flush=True)

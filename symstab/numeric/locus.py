@@ -42,7 +42,7 @@ import dataclasses
 
 import numpy as np
 
-from .._resources import check_memory, chunk_slices
+from .._resources import CHUNK_BYTES, check_memory, chunk_slices
 from .._validate import check_array, check_loop, check_real
 from .curves import bracketed_root
 from .stability import _horner, _leading_vanishes, _polish, loop_coefficients
@@ -67,9 +67,13 @@ _MAX_ADDED = 4
 _ADDED_FIXED = 256
 #: A crossing pole with an imaginary part at most this is a real pole (z = +-1).
 _REAL = 1e-9
-#: Bytes per pole of a tracked point: the roots (complex), the coefficients,
-#: the sphere coordinates and the distance matrices of a chunk (generous).
+#: Bytes per pole of a tracked point: the roots (complex), the tracked
+#: roots, the coefficients and the matches (generous).
 _BYTES_PER_POLE = 96
+#: Bytes per pair of poles of one step of the path: the chordal distances of
+#: two consecutive points and their temporaries in :func:`_nearest` (and in
+#: :func:`_assignment`'s cost), a chunk of points at a time (generous).
+_BYTES_PER_PAIR = 96
 #: From this degree on, the path's points take their roots by continuation
 #: (:func:`_roots_along`), with at most this many Newton steps a point.
 _CONTINUATION_DEGREE = 64
@@ -630,12 +634,50 @@ def _crossings(p, tracked, coefficients):
     return tuple(out)
 
 
+def _locus_bytes(n_points, degree):
+    """The most bytes a locus of ``n_points`` values and ``degree`` poles holds at once.
+
+    The path's arrays (with the halvings' points), plus the larger of the
+    two chunked working sets, which are never alive together: the distance
+    matrices of :func:`_nearest` (``degree**2`` a point, :data:`CHUNK_BYTES`
+    a chunk but at least one point), and a batch of companion matrices
+    with LAPACK's copy of each (``8 degree**2`` a point,
+    :data:`_EIG_BATCH_BYTES` a batch but at least one point).  Nothing
+    grows as ``degree**3``: that is the eigenvalues' time, not their memory.
+    """
+    n = max(int(degree), 1)
+    rows = n_points + _added_budget(n_points)
+    pair = _BYTES_PER_PAIR * n * n
+    nearest = pair * min(rows, max(1, CHUNK_BYTES // pair))
+    companion = 8 * n * n
+    eigen = 2 * companion * min(rows, max(1, _EIG_BATCH_BYTES // companion))
+    return rows * n * _BYTES_PER_POLE + max(nearest, eigen)
+
+
+def check_locus_memory(n_points, degree):
+    """Refuse a locus that would not fit in the memory limit, before any work.
+
+    Parameters
+    ----------
+    n_points : int
+        Values on the path.
+    degree : int
+        Closed-loop poles (the characteristic polynomial's degree).
+
+    Raises
+    ------
+    ValueError
+        If the locus's working set exceeds ``SYMSTAB_MEMORY_LIMIT`` (named,
+        with the estimate).
+    """
+    check_memory(f"the locus of {n_points} points of {degree} poles",
+                 _locus_bytes(n_points, degree))
+
+
 def _locus(parameter, values, fixed, coefficients):
     first = coefficients(values[:1])
     degree = first.shape[-1] - 1
-    check_memory(f"the locus of {len(values)} points of {degree} poles",
-                 (len(values) + _added_budget(len(values))) * max(degree, 1) * _BYTES_PER_POLE
-                 + 8 * degree * degree * max(degree, 1))
+    check_locus_memory(len(values), degree)
     p, tracked, kept = _track(values, coefficients)
     crossings = _crossings(p, tracked, coefficients)
     poles = tracked[kept]

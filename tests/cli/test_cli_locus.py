@@ -158,3 +158,18 @@ def test_help_names_the_path_syntax(capsys):
     status, out, _ = run(capsys, "locus", "--help")
     assert status == 0
     assert "LOW:HIGH" in out and "--set" in out and "example:" in out
+
+
+@pytest.mark.parametrize("where", [["--d", "1000", "--beta", "0.001", "--alpha", "0:0.000001:3"],
+                                   ["--loop", PAPER, "--set", "d=1000", "--set", "K=0:1:3"]])
+def test_a_locus_over_the_memory_limit_is_one_line_before_any_progress(capsys, tmp_path,
+                                                                         monkeypatch, where):
+    # 1004 poles: one point's distance matrices alone are about 92 MiB.  The
+    # "tracking ... poles" progress line came before the refusal (two lines).
+    monkeypatch.setenv("SYMSTAB_MEMORY_LIMIT", "16M")
+    png = tmp_path / "locus.png"
+    status, out, err = run(capsys, "locus", *where, "--png", png)
+    assert status == 2
+    assert err.count("\n") == 1 and err.startswith("symstab locus: error: "), err
+    assert "memory limit of 16 MiB" in err and "1004 poles" in err
+    assert out == "" and not png.exists()

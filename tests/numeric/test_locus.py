@@ -317,6 +317,37 @@ def test_memory_limit_is_checked_first(paper_loop, monkeypatch):
         locus(paper_loop, "K", np.linspace(0.0, 30.0, 5000), B=0.1)
 
 
+def test_a_high_degree_locus_fits_a_limit_its_degree_cubed_did_not(monkeypatch):
+    """d = 400 (404 poles) under a 128 MiB limit: 8 degree**3 bytes (528 MB) once refused it.
+
+    The working set is degree**2 a point (distances, companion matrices);
+    tracemalloc's peak is measured, and the poles are numpy's roots of the
+    30-digit first-principles coefficients.
+    """
+    import tracemalloc
+
+    monkeypatch.setenv("SYMSTAB_MEMORY_LIMIT", "128M")
+    values = [1e-7, 1e-6]
+    tracemalloc.start()
+    try:
+        path = paper_locus(parameter="alpha", values=values, beta=0.001, gamma=0.0, d=400,
+                           delta=PAPER_DELTA)
+        peak = tracemalloc.get_traced_memory()[1]
+    finally:
+        tracemalloc.stop()
+    assert peak < 128 * 2**20
+    for k, alpha in enumerate(values):
+        with mpmath.workdps(30):
+            coefficients = [float(c) for c in loop_coefficients_mp(
+                alpha=alpha, beta=0.001, gamma=0.0, d=400, delta=PAPER_DELTA)]
+        assert _hausdorff(path.poles[k], np.roots(coefficients)) < 1e-10
+    # What cannot fit is still refused: one point's distance matrices alone are 15 MB.
+    monkeypatch.setenv("SYMSTAB_MEMORY_LIMIT", "8M")
+    with pytest.raises(ValueError, match="memory limit of 8 MiB"):
+        paper_locus(parameter="alpha", values=values, beta=0.001, gamma=0.0, d=400,
+                    delta=PAPER_DELTA)
+
+
 def test_a_stable_window_between_two_unstable_points_is_found():
     """γ = 1, d = 0, β = -0.25: stable only for α in (1.097, 2.146); a path of two points
     on either side, both unstable, still finds the way in and out (by halving its step)."""
