@@ -589,8 +589,8 @@ def first_sign_change(evaluate, points, cells, *, slope0, slope0_error, curvatur
 
     R vanishes at ``points(0) = 0`` (theta = 0) with slope ``slope0 > 0``, and
     also at the last point if ``root_at_end`` (theta = pi, where ``R(pi) = 0``
-    for every integer d).  A cell ``[a, b]`` of the grid is proved free of roots when on
-    each half the Taylor bound from its end stays positive: with ``|R''| <=
+    for every integer d).  A cell ``[a, b]`` of the grid is proved free of
+    roots when on each half the Taylor bound from its end stays positive: with ``|R''| <=
     curvature = C`` and ``h = b - a``, ``R(a) > 0`` and ``R(a) + R'(a) h/2 -
     C h**2/8 > 0`` (and the same from b), or, at an end where R is exactly 0,
     ``R'`` pointing into the cell by more than ``C h/4``; every value and
@@ -616,7 +616,7 @@ def first_sign_change(evaluate, points, cells, *, slope0, slope0_error, curvatur
     curvature : number
         A bound on ``|R''|`` (:func:`reduced_curvature`).
     root_at_end : bool
-        R vanishes exactly at ``grid[-1]``.
+        R vanishes exactly at the last point, ``points(cells)``.
     chunk : int
         Cells of the grid evaluated at a time, from the left (the rest only
         if R > 0 is proved on all of them).
@@ -631,8 +631,8 @@ def first_sign_change(evaluate, points, cells, *, slope0, slope0_error, curvatur
         a few ulps wide); ``(t, t)`` where the first root could not be
         separated from zero by the evaluation's rounding (R is within its
         rounding of 0 at ``t``, a root to working precision); ``None`` when
-        R > 0 on the whole of ``(grid[0], grid[-1])``: the first root is
-        ``grid[-1]``.
+        R > 0 between the first and the last point: the first root is the
+        last point.
 
     Raises
     ------
