@@ -241,3 +241,32 @@ def pytest_collection_modifyitems(config, items):
     for item in items:
         if any(fixture in getattr(item, "fixturenames", ()) for fixture in _SHARED_RUNS):
             item.add_marker(pytest.mark.slow)
+
+
+# --------------------------------------------------------------------------
+# Command runs in-process, and the loops' kernel cache
+# --------------------------------------------------------------------------
+
+@pytest.fixture
+def loop_cache_dir(tmp_path_factory, monkeypatch):
+    """The loops' generated kernels go to one temporary folder per run, never to ~/.cache."""
+    folder = tmp_path_factory.getbasetemp() / "loop-kernels"
+    folder.mkdir(exist_ok=True)
+    monkeypatch.setenv("SYMSTAB_CACHE_DIR", str(folder))
+    return folder
+
+
+def run_cli(capsys, *args):
+    """``symstab ARGS`` in this process: (exit status, stdout, stderr)."""
+    from symstab import cli
+
+    status = cli.main([str(a) for a in args])
+    out, err = capsys.readouterr()
+    return status, out, err
+
+
+def run_cli_json(capsys, *args):
+    """``symstab ARGS --format json``, which must succeed; its parsed output."""
+    status, out, err = run_cli(capsys, *args, "--format", "json")
+    assert status == 0, err
+    return json.loads(out)

@@ -28,18 +28,10 @@ DEFAULT_POINTS = 401
 MAX_POINTS = 100_000
 #: Poles farther out than this are left out of the z-plane panel (said in its title).
 _PLANE_LIMIT = 3.0
-#: The paper's options refused with --loop, and what replaces each.
-_DEVICE_OPTIONS = (
-    ("--m", "m", "--set m=..."), ("--b", "b", "--set b=..."), ("--T", "T", "--set T=..."),
-    ("--Td", "Td", "--set d=... (the delay in samples)"),
-    ("--delta", "delta", "--set with the loop's own parameters"),
-    ("--gamma", "gamma", "--set with the loop's virtual mass, e.g. --set M=..."),
-    ("--Mw", "Mw", "--set with the loop's virtual mass, e.g. --set M=..."),
-    ("--alpha", "alpha", "--set with the loop's parameters, e.g. --set K=LOW:HIGH"),
-    ("--beta", "beta", "--set with the loop's parameters, e.g. --set B=..."),
-    ("--Kw", "Kw", "--set with the loop's parameters, e.g. --set K=LOW:HIGH"),
-    ("--Bw", "Bw", "--set with the loop's parameters, e.g. --set B=..."),
-)
+#: The paper's options refused with --loop, and what replaces each (those of
+#: the other numeric commands, but --linear, which locus does not have).
+_DEVICE_OPTIONS = tuple(option for option in cli_loop._DEVICE_OPTIONS
+                        if option[0] != "--linear") + cli_loop._POINT_OPTIONS
 _EXAMPLE_LOOP = "examples/loops/paper.toml"
 
 

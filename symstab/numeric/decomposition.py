@@ -43,7 +43,7 @@ import numpy as np
 
 from .._resources import check_memory
 from .curves import _golden_max
-from .stability import _leading_vanishes, polynomial_root_counts
+from .stability import STABLE, _leading_vanishes, classify_polynomials, polynomial_root_counts
 
 __all__ = ["Branch", "Cell", "Decomposition", "decompose", "arc_points"]
 
@@ -67,6 +67,14 @@ _CROSSING_ROUNDS = 6
 _CROSSING_GAP = 1e-9
 #: Distance (in units of the window) within which two nodes are one.
 _MERGE = 1e-10
+#: Largest sag of the arc's chords on a stable cell's boundary, as a
+#: fraction of the cell's thinner extent.
+_RESOLUTION = 1e-3
+#: Smallest extent of a stable cell, as a fraction of the window's.
+_SMALLEST = 1e-5
+#: Smallest area of a cell, as a fraction of the window's (a cycle of the
+#: graph with less is a path walked there and back, not a cell).
+_AREA = 1e-24
 #: Tolerance on the segment parameters of an intersection.
 _ENDS = 1e-9
 
@@ -107,8 +115,11 @@ class Cell:
     holes : tuple of ndarray
         Boundaries of the holes, clockwise.
     count : int
-        Closed-loop roots outside the unit circle inside the cell, or -1 when
-        the interior point had a root on the circle to within rounding.
+        Closed-loop roots outside the unit circle inside the cell
+        (certified; where the certified bounds cannot close, a stable cell is
+        still recognised by the Schur-Cohn test with a safe margin).  A cell
+        whose count cannot be decided either way is an error
+        (:func:`decompose` raises), not a count.
     point : tuple of float
         The interior point where ``count`` was computed.
     area : float
@@ -169,6 +180,10 @@ class Decomposition:
         beyond them.
     polynomial : tuple of ndarray
         ``(A0, Ax, Ay)``, the coefficients the decomposition is of.
+    resolution : float
+        The largest sag of the sampled arc's chords on a stable cell's
+        boundary (chord length times turn over 8), as a fraction of the
+        cell's thinner extent (:func:`decompose` keeps it below 1e-3).
     """
 
     x: str
@@ -180,6 +195,7 @@ class Decomposition:
     mismatches: tuple
     unbounded: tuple
     polynomial: tuple = dataclasses.field(default=(), compare=False)
+    resolution: float = 0.0
 
     @property
     def stable(self):
@@ -370,7 +386,7 @@ def _arc_ends(base, ax, ay, ends):
     return out
 
 
-def _sample_arc(base, ax, ay, to_unit, theta=None):
+def _sample_arc(base, ax, ay, to_unit, theta=None, fine=1.0):
     """Angles and points of the arc, refined until every chord inside the window is short.
 
     Returns the angles, the points and the determinant's sign; the caller
@@ -391,12 +407,12 @@ def _sample_arc(base, ax, ay, to_unit, theta=None):
         lo_u, hi_u = np.minimum(u[1:], u[:-1]), np.maximum(u[1:], u[:-1])
         lo_v, hi_v = np.minimum(v[1:], v[:-1]), np.maximum(v[1:], v[:-1])
         near = both & (hi_u > -0.5) & (lo_u < 1.5) & (hi_v > -0.5) & (lo_v < 1.5)
-        split = near & (length > _CHORD)
+        split = near & (length > _CHORD * fine)
         # A sharp turn between two chords near the window: refine both.
         with np.errstate(invalid="ignore", divide="ignore"):
             angle = np.arctan2(dv, du)
             turn = np.abs(np.angle(np.exp(1j * np.diff(angle))))
-        sharp = near[1:] & near[:-1] & (turn > _TURN) & (length[1:] + length[:-1] > _TURN_FLOOR)
+        sharp = near[1:] & near[:-1] & (turn > _TURN) & (length[1:] + length[:-1] > _TURN_FLOOR * fine**2)
         split[1:] |= sharp
         split[:-1] |= sharp
         # Through infinity, or into a singular point: follow it closer.
@@ -597,7 +613,32 @@ def _intersections(p, q, owner, position):
         ok = ((np.abs(denom) > 1e-300) & (t >= -_ENDS) & (t <= 1 + _ENDS)
               & (s >= -_ENDS) & (s <= 1 + _ENDS))
         out.append(np.stack([i[ok], j[ok], np.clip(t[ok], 0, 1), np.clip(s[ok], 0, 1)], axis=1))
-    return np.concatenate(out) if out else np.zeros((0, 4))
+    hits = np.concatenate(out) if out else np.zeros((0, 4))
+    return np.concatenate([hits, _end_touches(p, q, owner, position)])
+
+
+def _end_touches(p, q, owner, position):
+    """A piece that ends on another (the arc at theta = 0 or pi ends on z = +-1).
+
+    It may arrive tangentially, where the crossing of two chords is
+    ill-conditioned: so each piece's end point is also projected on every
+    segment, and one within :data:`_MERGE` of it touches it there.
+    """
+    first = np.flatnonzero(np.r_[True, owner[1:] != owner[:-1]])
+    last = np.flatnonzero(np.r_[owner[1:] != owner[:-1], True])
+    ends = np.concatenate([first, last])
+    at = np.concatenate([p[first], q[last]])
+    t_end = np.concatenate([np.zeros(len(first)), np.ones(len(last))])
+    r = q - p
+    length2 = np.sum(r * r, axis=1)
+    out = []
+    for k, point, t in zip(ends, at, t_end):
+        with np.errstate(all="ignore"):
+            s = np.clip(np.sum((point - p) * r, axis=1) / length2, 0.0, 1.0)
+        gap = np.hypot(*(p + s[:, None] * r - point).T)
+        near = np.flatnonzero((gap <= _MERGE) & (owner != owner[k]))
+        out.extend((k, j, t, s[j]) for j in near)
+    return np.array(out, dtype=float).reshape(-1, 4)
 
 
 def _faces(xy, edges):
@@ -708,6 +749,13 @@ def decompose(base, ax, ay, ends, *, x_range, y_range, names=("x", "y")):
     -------
     Decomposition
 
+    Raises
+    ------
+    ValueError
+        If the window is not finite with ``lo < hi``, or if two neighbouring
+        cells break the crossing rule even with the arc sampled 8 times
+        finer (the window is too coarse for the curves in it).
+
     Examples
     --------
     ``z**2 + x z + y``: the z = 1 line ``1 + x + y = 0``, the z = -1 line
@@ -719,6 +767,33 @@ def decompose(base, ax, ay, ends, *, x_range, y_range, names=("x", "y")):
     >>> sorted(cell.count for cell in found.cells), round(found.area, 12)
     ([0, 1, 1, 2, 2], 4.0)
     """
+    found = _decompose(base, ax, ay, ends, x_range=x_range, y_range=y_range, names=names,
+                       fine=1.0)
+    if found.mismatches or found.resolution > _RESOLUTION:
+        # A stable cell small for its window: the arc sampled finer (not
+        # beyond 64 times: a window that needs more is refused below).
+        fine = max(min(0.125, 0.5 * _RESOLUTION / max(found.resolution, 1e-300)), 1 / 64)
+        fine = 1 / 64 if math.isinf(found.resolution) else fine
+        found = _decompose(base, ax, ay, ends, x_range=x_range, y_range=y_range, names=names,
+                           fine=fine)
+    if found.resolution > _RESOLUTION:
+        raise ValueError(
+            f"the stable set is too small to be resolved in the window {found.x} in "
+            f"[{found.x_range[0]:g}, {found.x_range[1]:g}], {found.y} in "
+            f"[{found.y_range[0]:g}, {found.y_range[1]:g}]: narrow the window around it")
+    if found.mismatches:
+        i, j, label, change = found.mismatches[0]
+        raise ValueError(
+            f"the D-decomposition of {found.x} in [{found.x_range[0]:g}, {found.x_range[1]:g}], "
+            f"{found.y} in [{found.y_range[0]:g}, {found.y_range[1]:g}] is not resolved: across "
+            f"the {label} piece the counts of two neighbouring cells ({found.cells[i].count}, "
+            f"{found.cells[j].count}) differ by {abs(change)}, not {_CHANGE[label]}; narrow "
+            f"the window around the region of interest")
+    return found
+
+
+def _decompose(base, ax, ay, ends, *, x_range, y_range, names, fine):
+    """:func:`decompose` with the arc's chords ``fine`` times the usual length."""
     base, ax, ay = (np.asarray(c, dtype=float) for c in (base, ax, ay))
     x0, x1 = (float(v) for v in x_range)
     y0, y1 = (float(v) for v in y_range)
@@ -735,7 +810,7 @@ def decompose(base, ax, ay, ends, *, x_range, y_range, names=("x", "y")):
 
     theta = None
     for _ in range(_CROSSING_ROUNDS):
-        theta, xs, ys, sign = _sample_arc(base, ax, ay, to_unit, theta)
+        theta, xs, ys, sign = _sample_arc(base, ax, ay, to_unit, theta, fine)
         polylines, branches = _pieces(base, ax, ay, ends, theta, xs, ys, sign, to_unit, from_unit,
                                       (x0, x1, y0, y1))
         p, q, owner, position = _segments(polylines)
@@ -787,6 +862,9 @@ def decompose(base, ax, ay, ends, *, x_range, y_range, names=("x", "y")):
     edges = np.array(edge_list, dtype=np.int64).reshape(-1, 2)
     edge_label = np.array(edge_label, dtype=object)
     # One edge per pair of nodes; inside the window only.
+    # Where a piece runs along the window's edge, the edge is the piece's.
+    order = np.argsort(edge_label == "window", kind="stable")
+    edges, edge_label = edges[order], edge_label[order]
     key = np.sort(edges, axis=1)
     _, unique = np.unique(key, axis=0, return_index=True)
     unique = np.sort(unique)
@@ -811,13 +889,13 @@ def decompose(base, ax, ay, ends, *, x_range, y_range, names=("x", "y")):
         areas = np.array([_signed_area(r) for r in rings])
         # Connected components, to put floating pieces as holes into their face.
         component = _components(len(xy), edges)
-        faces = [k for k in range(len(cycles)) if areas[k] > 1e-14]
+        faces = [k for k in range(len(cycles)) if areas[k] > _AREA]
         holes = {k: [] for k in faces}
         corner = nodes.add(0.0, 0.0)
         for k in range(len(cycles)):
-            if areas[k] > 1e-14 or component[src[cycles[k][0]]] == component[corner]:
+            if areas[k] > _AREA or component[src[cycles[k][0]]] == component[corner]:
                 continue
-            if areas[k] > -1e-14:
+            if areas[k] > -_AREA:
                 continue
             probe = rings[k][0]
             around = [f for f in faces if component[src[cycles[f][0]]] != component[src[cycles[k][0]]]
@@ -837,7 +915,22 @@ def decompose(base, ax, ay, ends, *, x_range, y_range, names=("x", "y")):
         points = from_unit(np.array(points).reshape(-1, 2))
         rows = base[None, :] + points[:, :1] * ax[None, :] + points[:, 1:] * ay[None, :]
         counts = polynomial_root_counts(rows) if len(rows) else np.zeros(0, dtype=np.int64)
-        counts[_leading_vanishes(rows)] = -1
+        infinite = _leading_vanishes(rows)
+        counts[infinite] = -1
+        # Where the count's bounds cannot be closed in double precision (long
+        # delays: thousands of roots near the circle), the float Schur-Cohn
+        # test with its safe margin can still tell a stable cell.
+        open_ = np.flatnonzero((counts == -1) & ~infinite)
+        if len(open_):
+            counts[open_[classify_polynomials(rows[open_]) == STABLE]] = 0
+            open_ = np.flatnonzero((counts == -1) & ~infinite)
+        if len(open_):
+            p = points[open_[0]]
+            raise ValueError(
+                f"the unstable roots of {len(open_)} of the {len(rows)} cells cannot be counted in "
+                f"double precision (degree {len(base) - 1}; e.g. at {names[0]} = {p[0]:.6g}, "
+                f"{names[1]} = {p[1]:.6g}): roots too close to the unit circle for the "
+                f"certified count")
         count_of = dict(zip(keep, counts))
         index_of = {f: n for n, f in enumerate(keep)}
         scale = sx * sy
@@ -863,11 +956,48 @@ def decompose(base, ax, ay, ends, *, x_range, y_range, names=("x", "y")):
                 continue
             if abs(int(ca) - int(cb)) != _CHANGE[label]:
                 mismatches.append((index_of[a], index_of[b], label, int(cb) - int(ca)))
-    unbounded = _touching(cells, (x0, x1, y0, y1))
+        # The window's sides a stable cell has an edge on (a piece running
+        # along the window's edge is the piece's, not the window's).
+        touched = set()
+        for n, f in enumerate(keep):
+            if counts[n] != 0:
+                continue
+            for h in cycles[f]:
+                if half_label[h] == "window":
+                    u, v = 0.5 * (xy[src[h]] + xy[dst[h]])
+                    touched.add("x_min" if u < 1e-6 else "x_max" if u > 1 - 1e-6
+                                else "y_min" if v < 1e-6 else "y_max")
+        unbounded = tuple(side for side in ("x_min", "x_max", "y_min", "y_max") if side in touched)
+        # How finely the arc draws each stable cell.
+        resolution = 0.0
+        for n, f in enumerate(keep):
+            if counts[n] != 0:
+                continue
+            extent = float(np.min(np.ptp(rings[f], axis=0)))
+            if extent < _SMALLEST:
+                # The merging and end tolerances are the window's: they
+                # would be visible on a cell this small.
+                resolution = math.inf
+                break
+            cycle = np.array(cycles[f])
+            on_arc = half_label[cycle] == "arc"
+            both = on_arc & np.roll(on_arc, 1)
+            if both.any() and extent > 0:
+                # The sag of two chords meeting at an angle phi is about
+                # L phi / 8: against the cell's thinner extent.
+                step = xy[dst[cycle]] - xy[src[cycle]]
+                length = np.hypot(step[:, 0], step[:, 1])
+                heading = np.arctan2(step[:, 1], step[:, 0])
+                phi = np.abs(np.angle(np.exp(1j * (heading - np.roll(heading, 1)))))
+                sag = np.maximum(length, np.roll(length, 1)) * phi / 8
+                resolution = max(resolution, float(np.max(sag[both])) / extent)
+    else:
+        unbounded = ()
+        resolution = 0.0
     return Decomposition(x=names[0], y=names[1], x_range=(x0, x1), y_range=(y0, y1),
                          branches=tuple(branches), cells=tuple(cells),
                          mismatches=tuple(mismatches), unbounded=unbounded,
-                         polynomial=(base, ax, ay))
+                         polynomial=(base, ax, ay), resolution=resolution)
 
 
 def _components(n, edges):
@@ -884,23 +1014,3 @@ def _components(n, edges):
         if ra != rb:
             parent[ra] = rb
     return np.array([find(a) for a in range(n)])
-
-
-def _touching(cells, box):
-    """The window's sides that a stable cell reaches."""
-    x0, x1, y0, y1 = box
-    tol_x, tol_y = 1e-9 * (x1 - x0), 1e-9 * (y1 - y0)
-    sides = set()
-    for cell in cells:
-        if cell.count != 0:
-            continue
-        pts = cell.outer
-        if np.any(pts[:, 0] <= x0 + tol_x):
-            sides.add("x_min")
-        if np.any(pts[:, 0] >= x1 - tol_x):
-            sides.add("x_max")
-        if np.any(pts[:, 1] <= y0 + tol_y):
-            sides.add("y_min")
-        if np.any(pts[:, 1] >= y1 - tol_y):
-            sides.add("y_max")
-    return tuple(s for s in ("x_min", "x_max", "y_min", "y_max") if s in sides)

@@ -18,30 +18,13 @@ import pytest
 import symstab
 from symstab.cli import commands as cli
 
-from conftest import PAPER_DELTA, PAPER_M, PAPER_T, REPO
+from conftest import PAPER_DELTA, PAPER_M, PAPER_T, REPO, run_cli as run, run_cli_json as run_json
 from oracles import python_control_closed_loop
 
 PAPER = str(REPO / "examples" / "loops" / "paper.toml")
 
 
-@pytest.fixture(autouse=True)
-def _cache_dir(tmp_path_factory, monkeypatch):
-    """The loop's generated kernels go to one temporary folder per run, never to ~/.cache."""
-    folder = tmp_path_factory.getbasetemp() / "loop-kernels"
-    folder.mkdir(exist_ok=True)
-    monkeypatch.setenv("SYMSTAB_CACHE_DIR", str(folder))
-
-
-def run(capsys, *args):
-    status = cli.main([str(a) for a in args])
-    out, err = capsys.readouterr()
-    return status, out, err
-
-
-def run_json(capsys, *args):
-    status, out, err = run(capsys, *args, "--format", "json")
-    assert status == 0, err
-    return json.loads(out)
+pytestmark = pytest.mark.usefixtures("loop_cache_dir")
 
 
 def stiffness(alpha):

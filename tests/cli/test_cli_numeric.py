@@ -14,16 +14,9 @@ import numpy as np
 import pytest
 
 import symstab
-from symstab.cli import commands as cli
 
-from conftest import PAPER_B, PAPER_DELTA, PAPER_M, PAPER_T
+from conftest import PAPER_B, PAPER_DELTA, PAPER_M, PAPER_T, run_cli as run
 from oracles import python_control_closed_loop
-
-
-def run(capsys, *args):
-    status = cli.main(list(args))
-    out, err = capsys.readouterr()
-    return status, out, err
 
 
 def test_limits_physical_echoes_units_and_matches_the_library(capsys):

@@ -10,15 +10,7 @@ import json
 
 import pytest
 
-from symstab.cli.commands import main
-
-from conftest import PAPER_B, PAPER_DELTA, PAPER_T, REPO
-
-
-def run(capsys, *argv):
-    status = main(list(argv))
-    out, err = capsys.readouterr()
-    return status, out, err
+from conftest import PAPER_B, PAPER_DELTA, PAPER_T, REPO, run_cli as run
 
 
 def test_paper_limits_give_the_wall_passive_k_max_in_both_units(capsys):

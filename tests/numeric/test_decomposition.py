@@ -213,3 +213,46 @@ def test_window_validation_names_the_parameter():
     with pytest.raises(ValueError, match="x_range"):
         StabilityRegion(gamma=0.0, d=0, delta=DELTA).decomposition((0.0, 1.0, 2.0), (0, 1))
     assert isinstance(Cell, type)
+
+
+# --------------------------------------------------------------------------
+# Found by an attack on the first version
+
+
+def test_a_piece_ending_tangentially_on_a_line_still_cuts_the_plane():
+    """A biproper plant: the arc ends on z = -1 along it; the point below the arc is unstable."""
+    import control
+    from symstab import Loop
+
+    loop = Loop("(s + a)/(s + p)", "K + B*(z-1)/(T*z)",
+                values=dict(a=10.0, p=100.0, T=1e-3, d=0, B=0.0, K=1.0))
+    found = loop.region("B", "K", x_range=(-2, 2), y_range=(-50, 50))
+    B, K = 0.0937, -6.387
+    poles = np.abs(control.poles(loop.closed_loop(B=B, K=K)))
+    assert int(found.count_at(B, K)) == int(np.sum(poles > 1)) == 2
+    assert found.mismatches == ()
+
+
+def test_a_window_edge_on_the_sets_own_boundary_is_not_unbounded():
+    loop = load_loop(os.path.join(ROOT, "examples", "loops", "paper.toml"))
+    whole = loop.limits()
+    for window in (dict(y_range=(0.0, 10.0)), dict(x_range=(-0.0324, 1.0))):
+        lim = loop.limits(**window)
+        assert lim.area == pytest.approx(whole.area, rel=1e-6), window
+        assert lim.x_min == pytest.approx(-0.0324, rel=1e-9)
+
+
+def test_a_window_too_coarse_for_the_stable_set_is_refused():
+    """gamma = 0, d = 4: a stable set 0.3 wide in a window 2e4 wide cannot be drawn by its chords."""
+    region = StabilityRegion(gamma=0.0, d=4, delta=DELTA)
+    fine = region.decomposition((-1.0, 1.0), (-1.0, 1.0)).area
+    with pytest.raises(ValueError, match="narrow the window"):
+        region.decomposition((-1e4, 1e4), (-1e4, 1e4))
+    # Monte-Carlo in the fine window's stable bounding box agrees with it.
+    rng = np.random.default_rng(7)
+    n = 20000
+    x, y = rng.uniform(-0.01, 0.33, n), rng.uniform(0.0, 0.03, n)
+    rows = loop_coefficients(alpha=y, beta=x, gamma=0.0, d=4, delta=DELTA)
+    p = np.mean(_outside(rows) == 0)
+    box = 0.34 * 0.03
+    assert abs(fine - box * p) <= 3 * box * np.sqrt(p * (1 - p) / n)

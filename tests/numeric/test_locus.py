@@ -26,12 +26,7 @@ PAPER = REPO / "examples" / "loops" / "paper.toml"
 TUSTIN = REPO / "examples" / "loops" / "tustin_damper.toml"
 
 
-@pytest.fixture(autouse=True)
-def _cache_dir(tmp_path_factory, monkeypatch):
-    """The loops' generated kernels go to one temporary folder per run, never to ~/.cache."""
-    folder = tmp_path_factory.getbasetemp() / "loop-kernels"
-    folder.mkdir(exist_ok=True)
-    monkeypatch.setenv("SYMSTAB_CACHE_DIR", str(folder))
+pytestmark = pytest.mark.usefixtures("loop_cache_dir")
 
 
 @pytest.fixture(scope="module")
