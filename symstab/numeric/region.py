@@ -635,10 +635,13 @@ class StabilityRegion:
         ok = np.isfinite(self._beta) & (np.abs(self._beta) < 1e6) & np.isfinite(self._alpha)
         betas = np.unique(self._beta[ok])
         if len(betas) > _SCAN_LINES:
-            negative = np.flatnonzero(self._alpha[1:] <= 0)
-            end = negative[0] + 2 if negative.size else len(self._theta)
+            # The lobe ends where alpha first falls to 0: arc_end_angle, which
+            # a grid of alpha could step over (a dip narrower than its step).
+            stop = arc_end_angle(gamma=self.gamma, d=self.d, delta=self.delta)
+            end = (int(np.searchsorted(self._theta, stop)) + 1 if np.isfinite(stop)
+                   else len(self._theta))
             lobe = np.unique(self._beta[:end][ok[:end]])
-            keep = np.linspace(0, len(betas) - 1, _SCAN_LINES - len(lobe)).astype(int)
+            keep = np.linspace(0, len(betas) - 1, max(_SCAN_LINES - len(lobe), 2)).astype(int)
             betas = np.union1d(betas[keep], lobe)
         lines = 0.5 * (betas[1:] + betas[:-1])
         # Lines through the corner (-delta, 0), where the samples near

@@ -119,15 +119,16 @@ def test_arc_end_angle_is_the_certified_first_root(gamma, d, delta):
     assert abs(got - box.mid) <= 1e-12 * box.mid, (got, box)
 
 
-def test_boundary_curve_stops_at_a_narrow_first_dip():
+@pytest.mark.parametrize("segments", [False, True])
+def test_boundary_curve_stops_at_a_narrow_first_dip(segments):
     """The arc ends where alpha first reaches 0 (1.76618), not at the next root 1.7961.
 
-    Without the straight segments: finding them fails at this point in the
-    region's line scan (a negative sample count), a separate defect.
+    With the straight segments too: their line scan thinned its lines to a
+    negative count there, and took the lobe's end from a grid of alpha.
     """
     from oracles import first_principles_alpha
     gamma, d, delta = MISSED[2]
-    curve = boundary_curve(gamma=gamma, d=d, delta=delta, n=50, segments=False)
+    curve = boundary_curve(gamma=gamma, d=d, delta=delta, n=50, segments=segments)
     assert curve.theta_max == pytest.approx(1.7661805108331596, rel=1e-14)
     assert curve.theta[-1] <= curve.theta_max
     with mpmath.workdps(40):
