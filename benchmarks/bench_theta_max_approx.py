@@ -6,9 +6,9 @@ The box is gamma in [-1, 3], d in 0..200, delta in [1e-6, 1].  The reference
 at every point is the certified enclosure
 (:func:`symstab.numeric.theta_bounds.theta_max_enclosure`, relative width
 about 4e-16, proved by interval arithmetic; the 30-digit scan
-:func:`symstab.theta_max` is timed beside it on a few points; it can step
-over a narrow first dip of alpha, even inside the box, see
-tests/numeric/test_theta_bounds.py).  Grids: ``small`` (9 gamma x 8 d x 6
+:func:`symstab.theta_max` is timed beside it on a few points; since the
+scan proves every cell before the first root root-free, it no longer steps
+over a narrow first dip of alpha).  Grids: ``small`` (9 gamma x 8 d x 6
 delta = 432 points, about 15 s) and ``full`` (14 x 12 x 9 = 1512; with
 ``--random 3000`` about a minute); both contain the box's 8 corners.  ``--random N`` adds N seeded random points
 (delta log-uniform, 30 % of them with d <= 5 where the arcs are long).

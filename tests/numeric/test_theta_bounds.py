@@ -1,11 +1,11 @@
 """Tests of symstab.numeric.theta_bounds: theta_max certified by interval arithmetic.
 
-Oracles: the 30-digit scan :func:`symstab.symbolic.theta_max.theta_max` (an
-independent root finder on the unreduced N_alpha; it can step over a narrow
-first dip or a root in its last grid cell, see the tests near pi and of a
-narrow dip) and the paper's own
-eqs. (1), (2), (4) at 40 digits (``oracles.first_principles_alpha``), whose
-sign must be + at ``lo`` and - at ``hi``.
+Oracles: the paper's own eqs. (1), (2), (4) at 40 digits
+(``oracles.first_principles_alpha``), whose sign must be + at ``lo`` and -
+at ``hi`` -- independent of the reduced equation both modules share.  The
+30-digit :func:`symstab.symbolic.theta_max.theta_max` is compared too; since
+it scans the same reduced equation R (with its own certified step bound), it
+is a cross-check of the two implementations, not an independent oracle.
 """
 
 import math
