@@ -425,7 +425,7 @@ def bench_limits(args):
                   f"{fmt(t_int):>17} {fmt(t_ref_int):>16}  {lim.y_max:<12.6g}  "
                   + ", ".join(f"{k} {v:.1e}" for k, v in diffs.items()))
     print(f"   Loop vs symstab.limits: largest relative difference {worst_all:.1e} (Loop.limits' "
-          f"area is a trapezoid rule over its n_lines = 201 lines of constant B)")
+          f"area is its stable polygons', symstab.limits' a trapezoid rule over 801 lines)")
 
 
 def main():
