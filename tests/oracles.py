@@ -240,3 +240,20 @@ def boundary_point_mp(theta, gamma, d, delta):
     fa, fb = boundary_functions()
     t, g, dl = mpf_args(theta, gamma, delta)
     return fa(t, g, d, dl, mpmath.exp(dl)), fb(t, g, d, dl, mpmath.exp(dl))
+
+
+def theta_max_box_sample(seed, n):
+    """Seeded ``(gamma, d, delta)`` with an arc, in the box of issue 12.
+
+    gamma in [-1, 3] (one draw in five a heavy virtual mass up to 1e6),
+    d in 0..200 (half of them in 0..12), delta log-uniform in [1e-6, 1].
+    """
+    rng = np.random.default_rng(seed)
+    points = []
+    while len(points) < n:
+        delta = float(10 ** rng.uniform(-6, 0))
+        d = int(rng.choice([int(rng.integers(0, 13)), int(rng.integers(0, 201))]))
+        gamma = float(rng.uniform(-1, 3)) if rng.uniform() < 0.8 else float(10 ** rng.uniform(0, 6))
+        if gamma + 1 + delta * (d + 1) > 0:
+            points.append((gamma, d, delta))
+    return points

@@ -43,7 +43,8 @@ from symstab import (PAPER_DEVICE, STABLE, Device, StabilityRegion, arc_end_angl
 from symstab.numeric.evaluate import alpha_max_on_arc, boundary_point
 
 from conftest import PAPER_DELTA, assert_message_names
-from oracles import first_principles_boundary_point, first_principles_chi_float
+from oracles import (first_principles_boundary_point, first_principles_chi_float,
+                     theta_max_box_sample)
 
 
 #: The first-principles polynomial of eqs. (1), (2), (4) (tests/oracles.py),
@@ -96,21 +97,7 @@ def test_arc_end_angle_matches_30_digit_theta_max(gamma, d, delta):
 MISSED = [(1000.0, 0, 0.5), (1e6, 0, 1e-6), (2.4818442699578145, 200, 0.007024254262425767)]
 
 
-def _box_points(seed, n):
-    """Seeded (gamma, d, delta) with an arc: gamma in [-1, 3] (one in five up to 1e6),
-    d in 0..200, delta in [1e-6, 1]."""
-    rng = np.random.default_rng(seed)
-    points = []
-    while len(points) < n:
-        delta = float(10 ** rng.uniform(-6, 0))
-        d = int(rng.choice([int(rng.integers(0, 13)), int(rng.integers(0, 201))]))
-        gamma = float(rng.uniform(-1, 3)) if rng.uniform() < 0.8 else float(10 ** rng.uniform(0, 6))
-        if gamma + 1 + delta * (d + 1) > 0:
-            points.append((gamma, d, delta))
-    return points
-
-
-@pytest.mark.parametrize("gamma, d, delta", MISSED + _box_points(2012, 12))
+@pytest.mark.parametrize("gamma, d, delta", MISSED + theta_max_box_sample(2012, 12))
 def test_arc_end_angle_is_the_certified_first_root(gamma, d, delta):
     """Against the interval enclosure; 1e-12: R in floats at gamma = 1e6 is conditioned to ~5e-14."""
     from symstab.numeric.theta_bounds import theta_max_enclosure

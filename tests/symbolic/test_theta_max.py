@@ -15,7 +15,7 @@ from symstab.symbolic import model
 from symstab.symbolic.theta_max import closed_form_d0, theta_max, theta_max_newton
 
 from conftest import PAPER_DELTA, assert_message_names, assert_rel_close
-from oracles import first_principles_alpha, first_principles_theta_max
+from oracles import first_principles_alpha, first_principles_theta_max, theta_max_box_sample
 
 #: (gamma, d, delta) with an arc that ends before pi.
 ARCS = [(0.0, 0, PAPER_DELTA), (-0.5, 0, PAPER_DELTA), (0.0, 5, PAPER_DELTA),
@@ -219,21 +219,7 @@ def test_references_refuse_delta_zero_instead_of_dividing_zero_by_zero(func):
 MISSED = [(1000.0, 0, 0.5), (1e6, 0, 1e-6), (2.4818442699578145, 200, 0.007024254262425767)]
 
 
-def _box_sample(seed, n):
-    """Seeded (gamma, d, delta): the box of issue 12 (gamma in [-1, 3], d in 0..200,
-    delta in [1e-6, 1]) and, one draw in five, a heavy virtual mass up to 1e6."""
-    rng = np.random.default_rng(seed)
-    points = []
-    while len(points) < n:
-        delta = float(10 ** rng.uniform(-6, 0))
-        d = int(rng.choice([int(rng.integers(0, 13)), int(rng.integers(0, 201))]))
-        gamma = float(rng.uniform(-1, 3)) if rng.uniform() < 0.8 else float(10 ** rng.uniform(0, 6))
-        if gamma + 1 + delta * (d + 1) > 0:
-            points.append((gamma, d, delta))
-    return points
-
-
-@pytest.mark.parametrize("gamma, d, delta", MISSED + _box_sample(1212, 10))
+@pytest.mark.parametrize("gamma, d, delta", MISSED + theta_max_box_sample(1212, 10))
 def test_theta_max_is_the_certified_first_root(gamma, d, delta):
     from symstab.numeric.theta_bounds import theta_max_enclosure
     box = theta_max_enclosure(gamma=gamma, d=d, delta=delta)
@@ -309,7 +295,7 @@ def test_float_rounding_bounds_hold(seed):
     """The float R, R' lie within the error bounds of reduced_value_slope of the 40-digit ones."""
     from symstab.symbolic.theta_max import reduced_qr, reduced_value_slope
     value, slope = _reduced_mp(0), _reduced_mp(1)
-    for gamma, d, delta in _box_sample(seed, 4) + [(-1.0 - 3e-3 + 1e-9, 2, 1e-3)]:
+    for gamma, d, delta in theta_max_box_sample(seed, 4) + [(-1.0 - 3e-3 + 1e-9, 2, 1e-3)]:
         q, r = reduced_qr(delta)
         t = np.concatenate([np.geomspace(1e-9, 0.1, 20), np.linspace(0.1, np.pi, 200)])
         v, p, ve, pe = reduced_value_slope(t, gamma, d + 1, delta, q, r, sin=np.sin, cos=np.cos,
