@@ -561,11 +561,18 @@ class Loop(LoopModel):
         def run(box):
             return decompose(base, ax, ay, ends, x_range=box[:2], y_range=box[2:], names=(x, y))
 
+        found, refused = None, None
         for auto in _start_windows(base, ax, ay, ends):
             box = [*(given["x_range"] or auto[0]), *(given["y_range"] or auto[1])]
-            found = run(box)
+            try:
+                found = run(box)
+            except ValueError as exc:    # a first window too wide to resolve: try the next
+                refused = exc
+                continue
             if found.stable:
                 break
+        if found is None:
+            raise refused
         # Widen the free sides a stable cell reaches; once it reaches none, fit
         # them to the stable set, a quarter of its extent around it.
         fitted = not any(free.values())
@@ -916,16 +923,18 @@ def _start_windows(base, ax, ay, ends):
     arc may run off to infinity), then all of it.  A quarter of the span is
     added on each side.
     """
-    xs, ys, _ = _curve_points(base, ax, ay, ends, per_degree=4)
+    xs, ys, _ = _curve_points(base, ax, ay, ends, per_degree=4, first_lobe=64)
     if xs.size == 0:
         return [((-1.0, 1.0), (-1.0, 1.0))]
-    sx = np.median(np.abs(xs)) or 1.0
-    sy = np.median(np.abs(ys)) or 1.0
+    # Steps on each point's own scale: its size and the distance to its
+    # neighbour (at long delays the stable set is tiny beside the arc's reach).
+    sx = np.abs(xs) + np.abs(np.diff(xs, append=xs[-1])) + 1e-300
+    sy = np.abs(ys) + np.abs(np.diff(ys, append=ys[-1])) + 1e-300
     px, py = [], []
-    for step in (1e-5, 1e-3, 1e-2):
+    for step in (1e-5, 1e-3, 1e-2, 1e-1):
         for ux, uy in ((1, 1), (1, -1), (-1, 1), (-1, -1)):
-            px.append(xs + ux * step * (np.abs(xs) + sx))
-            py.append(ys + uy * step * (np.abs(ys) + sy))
+            px.append(xs + ux * step * sx)
+            py.append(ys + uy * step * sy)
     px, py = np.concatenate(px), np.concatenate(py)
     check_memory("the stable points that start a region's window", 8 * len(px) * len(base))
     codes = classify_polynomials(base[None, :] + px[:, None] * ax[None, :] + py[:, None] * ay[None, :],
@@ -947,11 +956,17 @@ def _start_windows(base, ax, ay, ends):
     return out or [((-1.0, 1.0), (-1.0, 1.0))]
 
 
-def _curve_points(base, ax, ay, ends, per_degree=16):
-    """Points of the arc (finite ones, at ``per_degree (n + 4)`` angles) and the lines' crossings."""
+def _curve_points(base, ax, ay, ends, per_degree=16, first_lobe=0):
+    """Points of the arc (finite ones) and the lines' crossings.
+
+    The arc at ``per_degree (n + 4)`` angles, plus ``first_lobe`` more below
+    ``8 pi / (n + 4)``, where at long delays the stable set's arc lies.
+    """
     n = len(base) - 1
     m = per_degree * (n + 4)
     theta = np.pi * (np.arange(1, m + 1) - 0.5) / m
+    if first_lobe:
+        theta = np.union1d(theta, 8 * np.pi / (n + 4) * np.arange(1, first_lobe + 1) / first_lobe)
     xs, ys, _ = arc_points(base, ax, ay, theta)
     lines = list(_lines(base, ax, ay, ends).values())
     for i in range(len(lines)):

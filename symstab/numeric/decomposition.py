@@ -72,6 +72,8 @@ _MERGE = 1e-10
 _RESOLUTION = 1e-3
 #: Smallest extent of a stable cell, as a fraction of the window's.
 _SMALLEST = 1e-5
+#: Most pairs of chords one decomposition may intersect.
+_MAX_PAIRS = 20_000_000
 #: Smallest area of a cell, as a fraction of the window's (a cycle of the
 #: graph with less is a path walked there and back, not a cell).
 _AREA = 1e-24
@@ -570,12 +572,19 @@ def _candidate_pairs(lo, hi):
         fresh = np.ones(len(cells), dtype=bool)
         fresh[1:] = np.any(cells[1:] != cells[:-1], axis=1)
         cells = cells[fresh]
-        same = np.ones(len(cells), dtype=bool)
-        for k in range(1, len(cells)):
-            same = same[:-1] & np.all(cells[k:, :2] == cells[:-k, :2], axis=1)
-            if not same.any():
-                break
-            pairs.append(np.stack([cells[:-k, 2][same], cells[k:, 2][same]], axis=1))
+        # Each segment is paired with those after it in its grid cell.
+        starts = np.flatnonzero(np.r_[True, np.any(cells[1:, :2] != cells[:-1, :2], axis=1)])
+        sizes = np.diff(np.r_[starts, len(cells)])
+        after = np.repeat(sizes, sizes) - (np.arange(len(cells)) - np.repeat(starts, sizes)) - 1
+        total = int(after.sum()) + int(long_.sum()) * n
+        if total > _MAX_PAIRS:
+            raise ValueError(f"the window holds too many pieces of the boundary ({total:,} pairs of "
+                             f"chords to intersect, more than {_MAX_PAIRS:,}): narrow it")
+        check_memory("the D-decomposition's pairs of chords", 48 * total)
+        rows = np.arange(len(cells))
+        for k in range(1, int(after.max(initial=0)) + 1):
+            rows = rows[after[rows] >= k]
+            pairs.append(np.stack([cells[rows, 2], cells[rows + k, 2]], axis=1))
     for i in np.flatnonzero(long_):
         others = np.arange(n)
         pairs.append(np.stack([np.full(n, i), others], axis=1))

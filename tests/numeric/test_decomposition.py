@@ -256,3 +256,28 @@ def test_a_window_too_coarse_for_the_stable_set_is_refused():
     p = np.mean(_outside(rows) == 0)
     box = 0.34 * 0.03
     assert abs(fine - box * p) <= 3 * box * np.sqrt(p * (1 - p) / n)
+
+
+def test_a_long_delay_finds_its_small_stable_set():
+    """d = 500: the stable set is 1e-6 of the arc's reach; the first window must still find it
+    (it found nothing and then hung in a window of the whole arc)."""
+    import symstab
+
+    loop = load_loop(os.path.join(ROOT, "examples", "loops", "paper.toml"))
+    ours = loop.limits(d=500)
+    today = symstab.limits(gamma=0.0, d=500, delta=DELTA)
+    assert ours.y_max == pytest.approx(today.alpha_max * M / T**2, rel=1e-9)
+    assert ours.x_max == pytest.approx(today.beta_right * M / T, rel=1e-8)
+
+
+def test_a_window_with_too_many_crossings_is_refused_quickly():
+    base, ax, ay, ends = _paper_basis(0.0, 500)
+    with pytest.raises(ValueError, match="too many pieces"):
+        decompose(base, ax, ay, ends, x_range=(-5875.0, 5610.0), y_range=(-1.12e7, 1.14e7))
+
+
+def _paper_basis(gamma, d):
+    """The (B, K) basis of the paper's loop file (as Loop.region builds it)."""
+    loop = load_loop(os.path.join(ROOT, "examples", "loops", "paper.toml"))
+    base, (ax, ay), ends = loop._basis(("B", "K"), {"d": d, "M": gamma * M})
+    return base, ax, ay, ends
