@@ -47,9 +47,8 @@ from .stability import STABLE, _leading_vanishes, classify_polynomials, polynomi
 
 __all__ = ["Branch", "Cell", "Decomposition", "decompose", "arc_points"]
 
-#: The labels of the pieces; ``"window"`` marks an edge of the window.
-LABELS = ("arc", "z = 1", "z = -1", "leading")
-#: Change of the unstable count across each piece (crossing rule).
+#: Change of the unstable count across each piece (crossing rule); the
+#: window's edges are labelled ``"window"``.
 _CHANGE = {"arc": 2, "z = 1": 1, "z = -1": 1, "leading": 0}
 #: Longest chord of the sampled arc, as a fraction of the window.
 _CHORD = 2e-3

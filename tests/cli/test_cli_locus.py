@@ -7,8 +7,6 @@ counts.  Bad input is one line ``symstab locus: error: ...``, exit status 2,
 and no PNG.
 """
 
-import json
-
 import numpy as np
 import pytest
 

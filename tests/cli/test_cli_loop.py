@@ -9,7 +9,6 @@ python-control's poles.  Bad input is one line ``symstab <cmd>: error:`` and
 exit status 2 with nothing written; an interrupted map leaves no file.
 """
 
-import json
 import math
 
 import numpy as np
