@@ -502,7 +502,7 @@ def _cmd_limits(args):
     if args.at is not None:
         from .._validate import check_real
         check_real(f"--at ({setup.x})", args.at)
-    # Seconds (hundreds of stable-interval searches at d = 40): say what runs.
+    # Seconds at long delays (the plane's D-decomposition, and the passive set): say what runs.
     print(f"scanning the ({setup.x}, {setup.y}) plane for the extent of the stable set ...",
           file=sys.stderr, flush=True)
     lim = setup.loop.limits(x=setup.x, y=setup.y, **setup.values)

@@ -698,7 +698,7 @@ def _inside(poly, x, y):
     return inside
 
 
-def _interval_midpoints(rings, value, axis):
+def _inside_intervals(rings, value, axis):
     """The inside intervals of the line ``axis-coordinate = value`` through the rings."""
     other = 1 - axis
     cuts = []
@@ -719,14 +719,14 @@ def _interior_point(rings):
     best, best_width = None, -1.0
     for f in (0.5, 0.25, 0.75, 0.125, 0.375, 0.625, 0.875, 0.0625, 0.9375, 0.03125, 0.96875):
         v = v0 + f * (v1 - v0)
-        for lo, hi in _interval_midpoints(rings, v, 1):
+        for lo, hi in _inside_intervals(rings, v, 1):
             if hi - lo > best_width:
                 best, best_width = (0.5 * (lo + hi), v), hi - lo
     if best is None:
         return None
     # Centre it vertically too, on the vertical line through it.
     u = best[0]
-    spans = _interval_midpoints(rings, u, 0)
+    spans = _inside_intervals(rings, u, 0)
     for lo, hi in spans:
         if lo <= best[1] <= hi:
             return (u, 0.5 * (lo + hi))
