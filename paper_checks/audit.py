@@ -222,6 +222,7 @@ def _run_parallel(checks, progress, executor, in_flight=None):
     """
     waiting = {}       # module -> its checks, released when its prefetches are done
     calls = {}         # (name, args) -> the modules that wait for it
+    needs = {}         # module -> the (name, args) its prefetch lists
     for module in dict.fromkeys(entry[3].__module__ for entry in checks.values()):
         prefetch = getattr(sys.modules[module], "prefetch", None)
         if prefetch is None:
@@ -229,11 +230,23 @@ def _run_parallel(checks, progress, executor, in_flight=None):
         waiting[module] = [cid for cid, entry in checks.items() if entry[3].__module__ == module]
         for memo, args in prefetch():
             calls.setdefault((memo.name, args), set()).add(module)
+            needs.setdefault(module, []).append((memo.name, args))
     waited = {cid for cids in waiting.values() for cid in cids}
     ready = collections.deque(("prefetch", name, args) for name, args in calls)
     ready.extend(("check", cid) for cid in checks if cid not in waited)
     limit = in_flight or (getattr(executor, "_max_workers", None) or 2) + 1
     pending, cached, outcomes = {}, {}, {}
+
+    def snapshot(cid):
+        # A new dict of the values this check's module needs, built here and
+        # never touched again: a process pool pickles a task's arguments
+        # later, in its feeder thread, so handing it ``cached`` itself (which
+        # this loop keeps filling) raced ("dictionary changed size during
+        # iteration").
+        values = {}
+        for name, args in needs.get(checks[cid][3].__module__, ()) if cid in waited else ():
+            values.setdefault(name, {})[args] = cached[name][args]
+        return values
 
     def submit():
         while ready and len(pending) < limit:
@@ -241,7 +254,7 @@ def _run_parallel(checks, progress, executor, in_flight=None):
             if task[0] == "prefetch":
                 future = executor.submit(_prefetch_task, task[1], task[2])
             else:
-                future = executor.submit(_check_task, task[1], cached if task[1] in waited else {})
+                future = executor.submit(_check_task, task[1], snapshot(task[1]))
             pending[future] = task
 
     def release_done_modules():

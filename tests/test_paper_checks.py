@@ -266,6 +266,121 @@ def test_parallel_audit_gives_the_serial_findings(monkeypatch):
     assert [n for n, _, _ in seen] == list(range(1, len(ids) + 1))
 
 
+def _prefetching_modules(monkeypatch, values=(int, int)):
+    """Fake check modules, each with a prefetched Memo and two checks using it.
+
+    ``values``: how each module's Memo makes its value of n = 0, 1, 2.
+    """
+    import sys
+    import types
+
+    from paper_checks._common import Memo
+
+    checks, memos = {}, []
+    for tag, value in zip("abc", values):
+        module = types.ModuleType(f"fake_checks_{tag}")
+        monkeypatch.setitem(sys.modules, module.__name__, module)
+
+        def shared(n, value=value):
+            return value(n)
+
+        shared.__module__, shared.__qualname__ = module.__name__, f"shared_{tag}"
+        memo = Memo(shared)
+        memos.append(memo)
+        module.prefetch = lambda memo=memo: [(memo, (n,)) for n in range(3)]
+        for k in range(2):
+            def run(memo=memo, k=k):
+                return audit.Outcome("confirmed", f"{memo.name} {k}: "
+                                     f"{sum(memo.values[(n,)] for n in range(3))}")
+
+            run.__module__ = module.__name__
+            checks[f"eq{tag}{k}"] = ("equation", "nowhere", "n/a", run)
+    audit.registered()
+    for cid, entry in checks.items():   # where a worker's task looks its check up
+        monkeypatch.setitem(audit._REGISTRY, cid, entry)
+    return checks, memos
+
+
+def test_a_task_s_arguments_never_change_after_they_are_handed_over(monkeypatch):
+    """What the scheduler gives the pool is not mutated later.
+
+    A process pool pickles a task's arguments later, in its feeder thread;
+    the scheduler once handed every check the shared dict of prefetched
+    values and went on filling it, so the pickling raced with the filling
+    ("dictionary changed size during iteration", issue 18).  This executor
+    runs each task at once and then compares, at the end, every task's
+    arguments with what they were when submitted.
+    """
+    import concurrent.futures
+    import pickle
+
+    from paper_checks._common import Memo
+
+    class Recorder(concurrent.futures.Executor):
+        _max_workers = 1
+
+        def __init__(self):
+            self.handed = []
+
+        def submit(self, fn, *args):
+            self.handed.append((args, pickle.dumps(args)))
+            future = concurrent.futures.Future()
+            future.set_result(fn(*pickle.loads(pickle.dumps(args))))
+            return future
+
+    checks, memos = _prefetching_modules(monkeypatch)
+    try:
+        executor = Recorder()
+        # One task in flight: module a's checks are handed over while module
+        # b's prefetches are still to come.
+        outcomes = audit._run_parallel(checks, None, executor, in_flight=1)
+        assert [f.evidence for f in outcomes] == [
+            f"{m.name} {k}: 3" for m in memos for k in range(2)]
+        assert len(executor.handed) == 6 + 4
+        for args, at_submit in executor.handed:
+            assert pickle.dumps(args) == at_submit
+    finally:
+        for memo in memos:
+            del Memo.registry[memo.name]
+
+
+class _SlowToPickle(int):
+    """A prefetched value whose pickling takes a while, as a big region's does."""
+
+    def __reduce__(self):
+        import time
+
+        time.sleep(0.1)
+        return (_SlowToPickle, (int(self),))
+
+
+def _slow_to_compute(n):
+    import time
+
+    time.sleep(0.15)
+    return n
+
+
+@pytest.mark.skipif("fork" not in multiprocessing.get_all_start_methods(),
+                    reason="the workers must inherit the fake check modules")
+def test_parallel_audit_survives_slow_pickling_of_prefetched_values(monkeypatch):
+    """The interleaving that broke CI: pickling in the feeder thread, filling in the main one."""
+    from paper_checks._common import Memo
+    from symstab._workers import worker_pool
+
+    # Module a's values take 0.3 s to pickle with a check of a, while module
+    # c's prefetches, slow to compute and already queued, come back.
+    checks, memos = _prefetching_modules(monkeypatch, values=(_SlowToPickle, int, _slow_to_compute))
+    try:
+        with worker_pool(2) as pool:
+            outcomes = audit._run_parallel(checks, None, pool, in_flight=len(checks) + 9)
+        assert [f.evidence for f in outcomes] == [
+            f"{m.name} {k}: 3" for m in memos for k in range(2)]
+    finally:
+        for memo in memos:
+            del Memo.registry[memo.name]
+
+
 def test_memo_computes_once_and_accepts_values_computed_elsewhere():
     from paper_checks._common import Memo
 
