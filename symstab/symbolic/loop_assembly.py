@@ -198,8 +198,8 @@ def _check_rational(expr, variable, what, other):
     if dd > MAX_ORDER:
         raise ValueError(f"{what} has degree {dd} in {variable}, above the limit {MAX_ORDER}")
     if nd > dd:
-        raise ValueError(f"{what} must be proper (degree of numerator {nd} <= degree of "
-                         f"denominator {dd} in {variable}), got {expr}")
+        raise ValueError(f"{what} must be proper: the degree of its numerator in {variable} "
+                         f"({nd}) exceeds that of its denominator ({dd}); got {expr}")
     return num, den
 
 
