@@ -19,8 +19,10 @@ forms that keep their digits in floating point, :mod:`~symstab.codegen.generator
 prints them as NumPy and C99 kernels into ``symstab/_generated``, and the
 numeric API builds on those: :mod:`~symstab.numeric.units` (:class:`Device`),
 :mod:`~symstab.numeric.curves` and :mod:`~symstab.numeric.region` (:func:`boundary_curve`), :mod:`~symstab.numeric.stability`
-(:func:`spectral_radius`, :func:`is_stable`, :func:`classify`) and
-:mod:`~symstab.numeric.region` (:func:`limits`, :func:`best_virtual_mass`).
+(:func:`spectral_radius`, :func:`is_stable`, :func:`classify`),
+:mod:`~symstab.numeric.region` (:func:`limits`, :func:`best_virtual_mass`) and
+:mod:`~symstab.numeric.simulate` (:func:`simulate`, :func:`stability_map`, with
+the :class:`Nonidealities` of a real device).
 
 Any other loop -- the user's own plant and virtual environment -- is a
 :class:`Loop` (:mod:`~symstab.numeric.any_loop`), derived and classified the same
@@ -45,6 +47,7 @@ from .numeric.loop_files import load_loop
 from .numeric.decomposition import Branch, Cell, Decomposition
 from .numeric.passivity import PassiveRegion, paper_passive_region, passive_region
 from .numeric.locus import Crossing, Locus, locus, paper_locus
+from .numeric.simulate import Nonidealities, Simulation, StabilityMap, simulate, stability_map
 from .numeric.theta_bounds import (ThetaMaxEnclosure, certify_theta_max, theta_max_approx,
                                    theta_max_enclosure)
 
@@ -65,4 +68,5 @@ __all__ = [
     "Locus", "Crossing", "locus", "paper_locus",
     "ThetaMaxEnclosure", "theta_max_enclosure", "certify_theta_max",
     "theta_max_approx",
+    "Nonidealities", "Simulation", "simulate", "StabilityMap", "stability_map",
 ]

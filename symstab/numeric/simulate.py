@@ -140,6 +140,16 @@ class Nonidealities:
 
         The fields themselves are checked at construction; what depends on
         ``T`` is the velocity filter's cut-off, below the Nyquist frequency.
+
+        Parameters
+        ----------
+        T : float
+            The sample period (s).
+
+        Raises
+        ------
+        ValueError
+            Naming ``velocity_cutoff`` and its range when it is not below ``0.5 / T``.
         """
         if self.velocity_cutoff is not None:
             check_real("velocity_cutoff", self.velocity_cutoff, low=0.0, low_open=True,
