@@ -7,9 +7,9 @@ import sympy as sp
 from symstab.proof.identity import check_identity
 
 from .audit import Outcome
-from .printed import C, PRINTED_COEFFICIENTS, printed
+from .printed import C, PRINTED_COEFFICIENTS, printed, section_of
 
-__all__ = ["where", "with_printed_coefficients", "prove", "compare",
+__all__ = ["where", "place", "with_printed_coefficients", "prove", "compare",
            "show", "Memo"]
 
 
@@ -51,11 +51,31 @@ class Memo:
 
 
 def where(id):
-    """'eq. (N), line L' (or lines L1-L2) for a printed entry."""
+    """'eq. (N), Sec. X' for a printed entry: its number and the part of the paper holding it."""
     p = printed(id)
-    first, last = p.lines
-    span = f"line {first}" if first == last else f"lines {first}-{last}"
-    return f"eq. ({p.equation}), {span}"
+    return f"eq. ({p.equation}), {place(*p.lines)}"
+
+
+def place(*cited, note=""):
+    """Where a claim stands in the paper, in the words of a reader who has the paper.
+
+    Parameters
+    ----------
+    *cited : int or str
+        Lines of the paper file (provenance, kept in the check's source),
+        each named by its section (:func:`paper_checks.printed.section_of`),
+        or a text such as ``"Fig. 10(d) caption"``, kept as it is.
+    note : str, optional
+        Added in parentheses, e.g. ``"circle 1 of Fig. 7"``.
+
+    Returns
+    -------
+    str
+        The parts, each once, in the order cited, joined by "; ".
+    """
+    parts = list(dict.fromkeys(item if isinstance(item, str) else section_of(item)
+                               for item in cited))
+    return "; ".join(parts) + (f" ({note})" if note else "")
 
 
 def with_printed_coefficients(expr):

@@ -5,7 +5,9 @@ when the derived number, rounded to the digits the paper prints, equals the
 printed number.  Stability of a region is decided by counting characteristic
 roots outside the unit circle (:mod:`symstab.numeric.region`, through
 :mod:`paper_checks.regions`), not by the "right-sided / left-sided" shape of a
-curve.  The device is :data:`symstab.PAPER_DEVICE`.
+curve, and so are the stable intervals along a line, whose ends are exact
+where they are known (alpha = 0 on the z = 1 line).  The device is
+:data:`symstab.PAPER_DEVICE`.
 """
 
 import decimal
@@ -14,12 +16,11 @@ from symstab.symbolic import model
 from symstab.numeric.evaluate import alpha_max_on_arc, arc_end, boundary_point
 from symstab.symbolic.small_theta import small_theta_limits
 from symstab.numeric.region import limits
-from symstab.numeric.stability import stable_alpha_intervals
 from symstab.numeric.units import PAPER_DEVICE
 from symstab.symbolic.theta_max import theta_max
 
 from . import regions
-from ._common import Memo, show
+from ._common import Memo, place, show
 from .audit import Outcome, check
 from .eq_limits import gamma_threshold
 
@@ -46,18 +47,43 @@ def _classify(gamma, d):
     return regions.classify(gamma, d, PAPER_DEVICE.delta)
 
 
-def _stable_intervals(beta, gamma, d=0, **kw):
-    intervals = stable_alpha_intervals(beta=beta, gamma=gamma, d=d, delta=PAPER_DEVICE.delta, **kw)
-    return intervals
+def _stable_intervals(beta, gamma, d=0):
+    """The stable alpha intervals at ``beta``, by symstab's certified count along the line.
+
+    Read from the region :func:`_classify` already holds
+    (:meth:`symstab.StabilityRegion.alpha_intervals`): every end is where
+    the line crosses the boundary, and an interval that starts on the
+    z = 1 line starts at alpha = 0 exactly.  (A scan of the spectral
+    radius put that end at -6.2e-12, where alpha <= 0 is proved never
+    stable: claim:open_alpha_positive.)
+    """
+    return _classify(gamma, d).limits.alpha_interval(beta)
 
 
-@check("claim:theta_max_1.5725", kind="claim", where="Sec. IV-C, line 252",
+def _interval(lo, hi, digits=6):
+    """A stable interval as the report prints it: open, with alpha = 0 written exactly.
+
+    Both ends lie on the boundary, where a root is on the unit circle
+    (marginal, not stable): hence the round brackets.
+    """
+    return f"({'0' if lo == 0.0 else f'{lo:.{digits}g}'}, {hi:.{digits}g})"
+
+
+def _ends_note(intervals):
+    """What the report says about the ends of ``intervals``."""
+    text = "both ends marginal, with a root on the unit circle"
+    if intervals and intervals[0][0] == 0.0:
+        text += "; alpha = 0 is the z = 1 line, exactly"
+    return text
+
+
+@check("claim:theta_max_1.5725", kind="claim", where=place(252),
        claim="theta_max = 1.5725 rad for d = 0, gamma = 0 (paper's device)")
 def theta_max_value():
     return _number(theta_max(gamma=0.0, d=0, delta=PAPER_DEVICE.delta), "1.5725", "theta_max")
 
 
-@check("claim:alpha_max_gamma0", kind="claim", where="Sec. V, lines 304-306 (circle 1 of Fig. 7)",
+@check("claim:alpha_max_gamma0", kind="claim", where=place(304, 306, note="circle 1 of Fig. 7"),
        claim="alpha_max = 0.6896 at beta = 0.8206 (gamma = 0, d = 0)")
 def alpha_max_gamma0():
     t, a, b = alpha_max_on_arc(gamma=0.0, d=0, delta=PAPER_DEVICE.delta)
@@ -83,23 +109,24 @@ def _stable_alpha_top(beta, gamma, printed, what):
         return Outcome("not-reproduced", f"no stable alpha at beta = {beta}, gamma = {gamma} (root count)")
     lo, hi = intervals[-1]
     outcome = _number(hi, printed, what)
-    return Outcome(outcome.verdict, outcome.evidence + f" (stable alpha interval ({lo:.4g}, {hi:.6g}) "
-                   f"at beta = {beta}, gamma = {gamma}, d = 0, by root counting)")
+    return Outcome(outcome.verdict, outcome.evidence + f" (stable alpha interval {_interval(lo, hi)} "
+                   f"at beta = {beta:g}, gamma = {gamma:g}, d = 0, by the certified root count along "
+                   f"the line, symstab.StabilityRegion.alpha_intervals; {_ends_note(intervals)})")
 
 
-@check("claim:alpha_beta0_gamma0", kind="claim", where="Sec. V, line 306",
+@check("claim:alpha_beta0_gamma0", kind="claim", where=place(306),
        claim="alpha = 0.005 at beta = 0, gamma = 0, d = 0")
 def alpha_beta0_gamma0():
     return _stable_alpha_top(0.0, 0.0, "0.005", "largest stable alpha")
 
 
-@check("claim:alpha_beta0_gamma1", kind="claim", where="Sec. V, line 306 (circle 2 of Fig. 7)",
+@check("claim:alpha_beta0_gamma1", kind="claim", where=place(306, note="circle 2 of Fig. 7"),
        claim="alpha = 2 at beta = 0, gamma = 1, d = 0")
 def alpha_beta0_gamma1():
     return _stable_alpha_top(0.0, 1.0, "2", "largest stable alpha")
 
 
-@check("claim:alpha_beta-1_gamma1.5", kind="claim", where="Sec. V, line 308 (circle 3 of Fig. 7)",
+@check("claim:alpha_beta-1_gamma1.5", kind="claim", where=place(308, note="circle 3 of Fig. 7"),
        claim="alpha ~ 3 at beta = -1, gamma = 1.5, d = 0")
 def alpha_beta_m1_gamma15():
     return _stable_alpha_top(-1.0, 1.5, "3", "largest stable alpha")
@@ -117,7 +144,7 @@ def _limits(gamma, d):
     return limits(gamma=gamma, d=d, delta=PAPER_DEVICE.delta)
 
 
-@check("claim:alpha_max_gamma2", kind="claim", where="Sec. V, line 310 (circle 4 of Fig. 7)",
+@check("claim:alpha_max_gamma2", kind="claim", where=place(310, note="circle 4 of Fig. 7"),
        claim="alpha_max ~ 4 at beta = -2, gamma = 2, d = 0")
 def alpha_max_gamma2():
     lim, r = _limits(2.0, 0), _classify(2.0, 0)
@@ -130,7 +157,7 @@ def alpha_max_gamma2():
                    f"{r.arc_alpha_max:.4f} at beta = {r.arc_beta_at_alpha_max:.4f}")
 
 
-@check("claim:fold_5.8", kind="claim", where="Abstract; Sec. V, line 310; Sec. VIII, line 512",
+@check("claim:fold_5.8", kind="claim", where=place(7, 310, 512),
        claim="virtual mass raises alpha_max about 5.8-fold at d = 0 (4 / 0.6896)")
 def fold():
     a0 = alpha_max_on_arc(gamma=0.0, d=0, delta=PAPER_DEVICE.delta)[1]
@@ -141,7 +168,7 @@ def fold():
     return _number(a2 / a0, "5.8", f"ratio {a2:.4f} / {a0:.4f}")
 
 
-@check("claim:beta_min", kind="claim", where="Sec. V, line 268; Sec. IV, line 262; Sec. VIII, line 508",
+@check("claim:beta_min", kind="claim", where=place(256, 268, 508),
        claim="beta_min = -bT/m = -0.00253 for every d and gamma")
 def beta_min():
     lim = small_theta_limits().beta_limit
@@ -151,7 +178,7 @@ def beta_min():
                    f"gamma); for the device -delta = {-PAPER_DEVICE.delta:.6g}, which rounds to -0.00253")
 
 
-@check("claim:beta_max_2", kind="claim", where="Sec. IV-C, line 252; Sec. V, lines 268, 339",
+@check("claim:beta_max_2", kind="claim", where=place(252, 268, 339),
        claim="beta_max = 2, reached at d = 0, gamma = 0, and the largest over d and gamma")
 def beta_max():
     _, b00 = arc_end(gamma=0.0, d=0, delta=PAPER_DEVICE.delta)
@@ -164,7 +191,7 @@ def beta_max():
                    + ", ".join(f"({g:g}, {d}): {v:.4f}" for (g, d), v in others.items()))
 
 
-@check("claim:no_region_gamma_le_-1", kind="claim", where="Sec. V, lines 264-266; Sec. VII, line 463",
+@check("claim:no_region_gamma_le_-1", kind="claim", where=place(264, 266, 463, note="Figs. 6, 11"),
        claim="no stable region for gamma <= -1")
 def no_region():
     lim = small_theta_limits()
@@ -184,7 +211,7 @@ def no_region():
                    + ". The region for gamma <= -1 is tiny but not empty")
 
 
-@check("claim:max_gamma_2_d0", kind="claim", where="Abstract; Sec. VII, line 465",
+@check("claim:max_gamma_2_d0", kind="claim", where=place(7, 465, note="Fig. 12(a)"),
        claim="the maximum renderable gamma is 2, at d = 0")
 def max_gamma():
     r_in, r_out = _classify(2.0, 0), _classify(2.01, 0)
@@ -200,18 +227,20 @@ def max_gamma():
                    f"gamma at d = 0 lies in [2, 2.01), which rounds to the printed 2")
 
 
-@check("claim:gamma2_is_boundary", kind="claim", where="Sec. V, lines 296-298, 327 (Figs. 7, 8(a))",
+@check("claim:gamma2_is_boundary", kind="claim", where=place(296, 298, 327, note="Figs. 7, 8(a)"),
        claim="at gamma = 2, d = 0 the curve is a straight line: the boundary case B with no stable area")
 def gamma2_boundary():
     r = _classify(2.0, 0)
     if not r.stable_exists:
         return Outcome("confirmed", "no stable point at gamma = 2, d = 0")
-    lo_hi = _stable_intervals(-1.0, 2.0, alpha_low=1.9, alpha_high=2.1, n=400)
+    intervals = _stable_intervals(-1.0, 2.0)
     return Outcome("not-reproduced",
                    f"the gamma = 2 arc is a thin loop (start direction {r.start.side}, end beta "
                    f"{r.arc_beta_end:.6f}) enclosing a stable sliver of area {r.region_area:.3g} "
-                   f"(symstab.limits); "
-                   f"at beta = -1 the stable alpha interval is {lo_hi} (root counting)")
+                   f"(symstab.limits); at beta = -1 the stable alpha "
+                   + ("interval is " if len(intervals) == 1 else "intervals are ")
+                   + ", ".join(_interval(lo, hi) for lo, hi in intervals)
+                   + f" (certified root count along the line; {_ends_note(intervals)})")
 
 
 def _figure_claim(cases):
@@ -236,17 +265,19 @@ def _register_figure(figure, d, where, text):
 
 
 for _d in (0, 1, 5, 10):
-    _register_figure("6", _d, "Sec. V, lines 264-266 (Fig. 6)",
+    _register_figure("6", _d, place(264, 266, note="Fig. 6"),
                      f"d = {_d}: the regions of gamma = 0, -0.25, -0.5, -0.75 are stable")
-_register_figure("8", 0, "Sec. V, lines 325-327 (Fig. 8(a))",
+_register_figure("8", 0, place(325, 327, note="Fig. 8(a)"),
                  "d = 0: gamma < 2 stable, gamma = 2 boundary, gamma = 2.2 unstable")
-_register_figure("8", 1, "Sec. V, line 331 (Fig. 8(b))",
+_register_figure("8", 1, place(331, note="Fig. 8(b)"),
                  "d = 1: gamma = 1.5, 2 unstable; all others (0, 0.5, 1, 2.2) stable")
-_register_figure("8", 5, "Sec. V, line 333 (Fig. 8(c))", "d = 5: gamma = 0, 0.5, 1 stable; 1.5, 2, 2.2 unstable")
-_register_figure("8", 10, "Sec. V, line 333 (Fig. 8(d))", "d = 10: gamma = 0, 0.5, 1 stable; 1.5, 2, 2.2 unstable")
+_register_figure("8", 5, place(333, note="Fig. 8(c)"),
+                 "d = 5: gamma = 0, 0.5, 1 stable; 1.5, 2, 2.2 unstable")
+_register_figure("8", 10, place(333, note="Fig. 8(d)"),
+                 "d = 10: gamma = 0, 0.5, 1 stable; 1.5, 2, 2.2 unstable")
 
 
-@check("claim:sided_rule", kind="claim", where="Sec. V, lines 287-298, 329",
+@check("claim:sided_rule", kind="claim", where=place(287, 298, 329, note="Figs. 7, 8"),
        claim="right-sided curves bound stable regions, left-sided curves unstable ones")
 def sided_rule():
     wrong = []
@@ -265,15 +296,19 @@ def sided_rule():
                    + "; symstab decides stability by counting roots outside the unit circle instead")
 
 
-@check("claim:min_stiffness_fig7", kind="claim", where="Sec. V, line 319 (circles 5, 6 of Fig. 7)",
+@check("claim:min_stiffness_fig7", kind="claim", where=place(319, note="circles 5, 6 of Fig. 7"),
        claim="gamma = 1.5, beta = -0.5, d = 0: stability needs a nonzero minimum alpha")
 def min_stiffness():
     intervals = _stable_intervals(-0.5, 1.5)
-    if intervals and intervals[0][0] > 1e-6:
+    # The count puts an interval that reaches down to the z = 1 line at
+    # alpha = 0 exactly, so any positive start is a minimum stiffness.
+    if intervals and intervals[0][0] > 0.0:
         lo, hi = intervals[0]
-        return Outcome("confirmed", f"stable alpha interval ({lo:.4f}, {hi:.4f}) by root counting: "
-                       f"circle 6 at alpha = {lo:.4f}, circle 5 at {hi:.4f}")
-    return Outcome("not-reproduced", f"stable alpha intervals {intervals}")
+        return Outcome("confirmed", f"stable alpha interval {_interval(lo, hi, 5)} by the certified "
+                       f"root count along the line: circle 6 at alpha = {lo:.4f}, circle 5 at {hi:.4f}")
+    return Outcome("not-reproduced", "stable alpha intervals "
+                   + (", ".join(_interval(lo, hi) for lo, hi in intervals) or "none")
+                   + f" at beta = -0.5 ({_ends_note(intervals)})")
 
 
 @Memo
@@ -283,7 +318,7 @@ def _kmax(gamma):
     return PAPER_DEVICE.stiffness(lim.alpha_max), lim
 
 
-@check("claim:kmax_theory_gamma0", kind="claim", where="Sec. VII, line 457",
+@check("claim:kmax_theory_gamma0", kind="claim", where=place(457),
        claim="theoretical K_max = 4.94 N m/rad (gamma = 0, T = 1 ms, Td = 40 ms)")
 def kmax0():
     k, lim = _kmax(0.0)
@@ -292,7 +327,7 @@ def kmax0():
                    f"{lim.beta_at_alpha_max:.4g}, symstab.limits; K = alpha m / T^2)")
 
 
-@check("claim:kmax_theory_gamma1", kind="claim", where="Sec. VII, line 457",
+@check("claim:kmax_theory_gamma1", kind="claim", where=place(457),
        claim="theoretical K_max = 20.35 N m/rad (gamma = 1, T = 1 ms, Td = 40 ms)")
 def kmax1():
     k, lim = _kmax(1.0)
@@ -304,7 +339,7 @@ def kmax1():
                    f"{lim.beta_at_alpha_max:.4g}, symstab.limits; the stable set is {shape})")
 
 
-@check("claim:increase_412", kind="claim", where="Sec. VII, line 457; Abstract ('4.1 times')",
+@check("claim:increase_412", kind="claim", where=place(457, "Abstract ('4.1 times')"),
        claim="virtual mass gamma = 1 raises the theoretical K_max by 412 % (4.1-fold) at Td = 40 ms")
 def increase():
     k0 = _kmax(0.0)[0]
@@ -318,19 +353,19 @@ def _experimental(text, theory):
     return Outcome("not-checkable", f"experimental result ({text}); theory: {theory}")
 
 
-@check("claim:exp_kmax_gamma0", kind="claim", where="Sec. VII, line 457",
+@check("claim:exp_kmax_gamma0", kind="claim", where=place(457),
        claim="measured K_max = 4.3 N m/rad (gamma = 0, high gains)")
 def exp_k0():
     return _experimental("measured on the device", f"K_max = {_kmax(0.0)[0]:.3f} N m/rad")
 
 
-@check("claim:exp_kmax_gamma1", kind="claim", where="Sec. VII, line 457",
+@check("claim:exp_kmax_gamma1", kind="claim", where=place(457),
        claim="measured K_max = 15 N m/rad (gamma = 1, high gains)")
 def exp_k1():
     return _experimental("measured on the device", f"K_max = {_kmax(1.0)[0]:.3f} N m/rad")
 
 
-@check("claim:exp_increase_349", kind="claim", where="Sec. VII, line 457; Abstract ('3.5')",
+@check("claim:exp_increase_349", kind="claim", where=place(457, "Abstract ('3.5')"),
        claim="measured increase 349 % (15 / 4.3)")
 def exp_inc():
     return _experimental("measured on the device",
@@ -338,22 +373,27 @@ def exp_inc():
 
 
 def _window(B_w, text):
-    beta = PAPER_DEVICE.beta(B_w)
-    intervals = stable_alpha_intervals(beta=beta, gamma=1.0, d=D_EXPERIMENT, delta=PAPER_DEVICE.delta,
-                                       alpha_low=0.0, alpha_high=3e-3, n=600)
+    """The theory beside a measured window: the certified stable K_w at B_w, M_w = m, Td = 40 ms."""
+    lim = _kmax(1.0)[1]
+    intervals = lim.alpha_interval(PAPER_DEVICE.beta(B_w))
+    at = f"at B_w = {B_w:g} N m s/rad, M_w = m, Td = 40 ms the linear model is stable"
+    how = "(certified root count along the line, symstab.limits)"
+    if not intervals:
+        left, right = (PAPER_DEVICE.damping(b) for b in (lim.beta_left, lim.beta_right))
+        return _experimental(text, f"{at} for no K_w: its stable set spans only {left:.4g} < B_w < "
+                             f"{right:.4g} N m s/rad (certified root count, symstab.limits)")
     k = ", ".join(f"{PAPER_DEVICE.stiffness(lo):.2f} < K_w < {PAPER_DEVICE.stiffness(hi):.2f}"
-                  for lo, hi in intervals) or "none"
-    return _experimental(text, f"at B_w = {B_w} N m s/rad, M_w = m, Td = 40 ms the linear model is "
-                         f"stable for {k} N m/rad (root counting)")
+                  for lo, hi in intervals)
+    return _experimental(text, f"{at} for {k} N m/rad {how}")
 
 
-@check("claim:exp_window_hg", kind="claim", where="Fig. 10(d) caption, line 391; Sec. VII, line 451",
+@check("claim:exp_window_hg", kind="claim", where=place("Fig. 10(d) caption", 451),
        claim="high gains, B_w = 0.45, M_w = m: stable for 5 < K_w < 15")
 def exp_window_hg():
     return _window(0.45, "measured window with the PI current loop, quantization and filter")
 
 
-@check("claim:exp_window_lg", kind="claim", where="Fig. 10(d) caption, line 391; Sec. VII, line 451",
+@check("claim:exp_window_lg", kind="claim", where=place("Fig. 10(d) caption", 451),
        claim="low gains, B_w = 0.60, M_w = m: stable for 5 < K_w < 11")
 def exp_window_lg():
     return _window(0.60, "measured window with the PI current loop, quantization and filter")

@@ -34,7 +34,8 @@ def _derived(part, *, gamma=None, d=None):
 
 
 @check("eq7.alpha", kind="equation", where=where("eq7.alpha"),
-       claim="alpha(theta) = (gC1 + g d^2 C2 + g d C3 + d^3 C4 + d^2 C5)/(C6 + d^2 C7 + d C8)")
+       claim="alpha(theta) = (gamma C1 + gamma delta^2 C2 + gamma delta C3 + delta^3 C4 + delta^2 C5)"
+             "/(C6 + delta^2 C7 + delta C8)")
 def eq7_alpha():
     return compare(with_printed_coefficients(printed("eq7.alpha").expr), _derived("alpha"),
                    derived_name="alpha(theta) solved from the unit-circle split")
@@ -47,7 +48,8 @@ BETA_CORRECTED = (-g * C1 - g * dl**2 * C2 + g * dl * C9 + dl**3 * C10 + dl**2 *
 
 
 @check("eq7.beta", kind="equation", where=where("eq7.beta"),
-       claim="beta(theta) = (-gC1 - g d^2 C2 + g d C3 + d^3 C4 + d^2 C5)/(C6 + d^2 C7 + d C8)")
+       claim="beta(theta) = (-gamma C1 - gamma delta^2 C2 + gamma delta C3 + delta^3 C4 + delta^2 C5)"
+             "/(C6 + delta^2 C7 + delta C8)")
 def eq7_beta():
     return compare(
         with_printed_coefficients(printed("eq7.beta").expr), _derived("beta"),
@@ -59,14 +61,14 @@ def eq7_beta():
 
 
 @check("eq11.alpha", kind="equation", where=where("eq11.alpha"),
-       claim="gamma = 0: alpha = (d^3 C4 + d^2 C5)/(C6 + d^2 C7 + d C8)")
+       claim="gamma = 0: alpha = (delta^3 C4 + delta^2 C5)/(C6 + delta^2 C7 + delta C8)")
 def eq11_alpha():
     return compare(with_printed_coefficients(printed("eq11.alpha").expr),
                    _derived("alpha", gamma=0), derived_name="alpha(theta) at gamma = 0")
 
 
 @check("eq11.beta", kind="equation", where=where("eq11.beta"),
-       claim="gamma = 0: beta = (d^3 C10 + d^2 C11)/(C6 + d^2 C7 + d C8)")
+       claim="gamma = 0: beta = (delta^3 C10 + delta^2 C11)/(C6 + delta^2 C7 + delta C8)")
 def eq11_beta():
     return compare(with_printed_coefficients(printed("eq11.beta").expr),
                    _derived("beta", gamma=0), derived_name="beta(theta) at gamma = 0")

@@ -81,14 +81,16 @@ for _i in range(1, 12):
           claim=f"C{_i} near theta = 0 as printed")(lambda _i=_i: _c_order(f"C{_i}"))
 
 
-@check("eq66", kind="equation", where=where("eq66"), claim="alpha = (gC1 + ... + d^2 C5)/(C6 + d^2 C7 + d C8)")
+@check("eq66", kind="equation", where=where("eq66"),
+       claim="alpha = (gamma C1 + ... + delta^2 C5)/(C6 + delta^2 C7 + delta C8)")
 def eq66():
     return compare(with_printed_coefficients(printed("eq66").expr), boundary().alpha,
                    derived_name="alpha(theta) solved from the unit-circle split")
 
 
 @check("eq69", kind="equation", where=where("eq69"),
-       claim="beta = (-gC1 - g d^2 C2 + g d C3 + d^3 C10 + d^2 C11)/(C6 + d^2 C7 + d C8)")
+       claim="beta = (-gamma C1 - gamma delta^2 C2 + gamma delta C3 + delta^3 C10 + delta^2 C11)"
+             "/(C6 + delta^2 C7 + delta C8)")
 def eq69():
     return compare(with_printed_coefficients(printed("eq69").expr), boundary().beta,
                    corrected=with_printed_coefficients(BETA_CORRECTED),

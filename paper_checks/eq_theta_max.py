@@ -107,7 +107,8 @@ def eq45():
 
 
 @check("eq36", kind="equation", where=where("eq36"),
-       claim="theta_max (d = 0) zeroes gC1 + g d^2 C2 + g d C3 + d^3 C4 + d^2 C5")
+       claim="theta_max (d = 0) zeroes gamma C1 + gamma delta^2 C2 + gamma delta C3 + delta^3 C4 "
+             "+ delta^2 C5")
 def eq36():
     return compare(with_printed_coefficients(printed("eq36").expr), boundary().alpha_numerator,
                    derived_name="the derived numerator N_alpha of alpha(theta)")

@@ -1,12 +1,12 @@
-"""The paper's open questions (Sec. VIII, line 527), answered by the package.
+"""The paper's open questions (Sec. VIII), answered by the package.
 
 The paper leaves two theoretical questions to future work: "providing a more
 rigorous analytical proof of the necessity of alpha > 0, and fully
 characterizing why the 'left-sided' stability curves do not correspond to
-stable regions".  Its Appendix E (lines 840-851) argues alpha > 0 from the
-small-angle expansion of the arc, its conclusion (lines 511-512) states that
+stable regions".  Its Appendix E argues alpha > 0 from the
+small-angle expansion of the arc, its conclusion (Sec. VIII) states that
 "the minimum virtual damping is always B_w,min = -b, independent of time
-delay and virtual mass", and Sec. V (line 329) that "right-sided curves
+delay and virtual mass", and Sec. V that "right-sided curves
 always represent stable regions, left-sided curves correspond to unstable
 regions".
 
@@ -39,7 +39,7 @@ from symstab.proof.identity import check_identity
 from symstab.symbolic import model
 
 from . import regions
-from ._common import Memo, show
+from ._common import Memo, place, show
 from .audit import Outcome, check
 
 __all__ = ["CurveCounts", "curve_counts", "FRACTIONS"]
@@ -207,7 +207,7 @@ def _run(condition):
             f"{m} {'sign' if m == 1 else 'signs'} decided for every delta > 0")
 
 
-@check("claim:open_alpha_positive", kind="claim", where="Appendix E, lines 840-851; Sec. VIII, line 527",
+@check("claim:open_alpha_positive", kind="claim", where=place(766, 773, 527),
        claim="alpha > 0 is necessary for stability (the paper argues from the small-angle expansion; "
              "a rigorous proof is left to future work)")
 def alpha_positive():
@@ -238,7 +238,7 @@ def _leftmost(gamma, d):
 _DAMPING_CASES = tuple((g, d) for d in (0, 1) for g in (0.0, 1.0, 1.5))
 
 
-@check("claim:open_minimum_damping", kind="claim", where="Sec. VIII, lines 511-512",
+@check("claim:open_minimum_damping", kind="claim", where=place(511, 512),
        claim="the minimum virtual damping is always B_w,min = -b (beta > -delta), independent of "
              "time delay and virtual mass")
 def minimum_damping():
@@ -280,7 +280,7 @@ def minimum_damping():
     return Outcome("confirmed", text)
 
 
-@check("claim:open_gamma_bound", kind="claim", where="Sec. V, line 327 (Fig. 8(a)); Abstract",
+@check("claim:open_gamma_bound", kind="claim", where=place(7, 327, note="Fig. 8(a)"),
        claim="for gamma > 2 no stable region exists (the largest renderable virtual mass is 2)")
 def gamma_bound():
     c = _conditions()["gamma_bound"]
@@ -294,7 +294,7 @@ def gamma_bound():
                    f"(claim:max_gamma_2_d0)")
 
 
-@check("claim:open_left_sided", kind="claim", where="Sec. V, line 329; Sec. VIII, line 527",
+@check("claim:open_left_sided", kind="claim", where=place(329, 527),
        claim="the regions beneath left-sided curves are unstable (why is left to future work)")
 def left_sided():
     left = [c for c in regions.FIGURE_CASES if c.claimed_side == "left"]
@@ -338,14 +338,14 @@ def _register_panel(figure, d, where, text):
 
 
 for _d, _panel in zip((0, 1, 5, 10), "abcd"):
-    _register_panel("6", _d, f"Fig. 6({_panel}); Sec. V, lines 264-266; Sec. VIII, line 527",
+    _register_panel("6", _d, place(f"Fig. 6({_panel})", 264, 266, 527),
                     f"d = {_d}: the region beneath each curve gamma = 0, -0.25, -0.5, -0.75 is stable")
-_register_panel("8", 0, "Fig. 8(a); Sec. V, lines 325-327; Sec. VIII, line 527",
+_register_panel("8", 0, place("Fig. 8(a)", 325, 327, 527),
                 "d = 0: gamma < 2 bound stable regions, gamma = 2 is the boundary, gamma = 2.2 (left-sided) none")
-_register_panel("8", 1, "Fig. 8(b); Sec. V, line 331; Sec. VIII, line 527",
+_register_panel("8", 1, place("Fig. 8(b)", 331, 527),
                 "d = 1: gamma = 1.5, 2 (left-sided) bound no stable region; 0, 0.5, 1, 2.2 do")
 for _d, _panel in ((5, "c"), (10, "d")):
-    _register_panel("8", _d, f"Fig. 8({_panel}); Sec. V, line 333; Sec. VIII, line 527",
+    _register_panel("8", _d, place(f"Fig. 8({_panel})", 333, 527),
                     f"d = {_d}: gamma = 0, 0.5, 1 bound stable regions; 1.5, 2, 2.2 (left-sided) none")
 del _d, _panel
 

@@ -47,9 +47,68 @@ from symstab.symbolic.model import (
 
 __all__ = [
     "Printed", "KINDS", "PRINTED", "PRINTED_COEFFICIENTS",
-    "PRINTED_D0_COEFFICIENTS", "printed",
+    "PRINTED_D0_COEFFICIENTS", "printed", "SECTIONS", "section_of",
     "C", "u", "k", "xi", "eta", "Delta", "const",
 ]
+
+#: The paper's parts as a reader names them, by the first line of the paper
+#: file in which each stands (its heading).  Line numbers are provenance
+#: only: the report names the part (:func:`section_of`), never the line,
+#: since its readers have the paper, not this text file.
+SECTIONS = (
+    (1, "Abstract"),
+    (11, "Sec. I"),
+    (57, "Sec. II"),
+    (145, "Sec. III"),
+    (157, "Sec. IV"),
+    (192, "Sec. IV-A"),
+    (215, "Sec. IV-B"),
+    (237, "Sec. IV-C"),
+    (258, "Sec. V"),
+    (343, "Sec. VI"),
+    (435, "Sec. VII"),
+    (500, "Sec. VIII"),
+    (529, "Appendix"),
+    (531, "Appendix A"),
+    (541, "Appendix B"),
+    (577, "Appendix C"),
+    (637, "Appendix D"),
+    (723, "Appendix E"),
+    (776, "References"),
+)
+
+
+def section_of(line):
+    """The part of the paper (``"Sec. IV-A"``, ``"Appendix C"``, ...) holding a line of its file.
+
+    Parameters
+    ----------
+    line : int
+        A 1-based line of the paper file, ``line >= 1``.
+
+    Returns
+    -------
+    str
+        The name of the section (or subsection) that line belongs to.
+
+    Raises
+    ------
+    TypeError
+        If ``line`` is not an integer.
+    ValueError
+        If ``line < 1``.
+
+    Examples
+    --------
+    >>> section_of(175), section_of(545)
+    ('Sec. IV', 'Appendix B')
+    """
+    if isinstance(line, bool) or not isinstance(line, int):
+        raise TypeError(f"line must be an integer, got {type(line).__name__}")
+    if line < 1:
+        raise ValueError(f"line must be >= 1, got {line}")
+    return [name for first, name in SECTIONS if first <= line][-1]
+
 
 #: Allowed values of :attr:`Printed.kind`.
 KINDS = (

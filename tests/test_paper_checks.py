@@ -561,3 +561,123 @@ def test_open_minimum_damping_states_what_is_proved_and_what_is_numerical():
     assert "For d >= 2, s > 0, so beta > -delta is necessary (proved)" in outcome.evidence
     assert "numerical evidence only" in outcome.evidence
     assert "within the proved bound" in outcome.evidence
+
+
+# --------------------------------------------------------------------------
+# The report as a reader meets it (issue 18): where, symbols, intervals, words
+# --------------------------------------------------------------------------
+
+def _report_rows(text):
+    """The table rows of REPORT.md as lists of cells (id, where, claimed, verdict, ...)."""
+    rows = []
+    for line in text.splitlines():
+        if line.startswith("| ") and line.count(" | ") >= 5 and not line.startswith("| id |") \
+                and not line.startswith("| ---"):
+            rows.append([cell.strip() for cell in line.strip("|").split(" | ")])
+    return rows
+
+
+def test_committed_report_is_the_fresh_audit(audit_run):
+    """paper_checks/REPORT.md is what `symstab audit` writes today (regenerate it with
+    `symstab audit`): a stale report would show the reader verdicts nobody computed."""
+    from conftest import REPO
+
+    _, report, _ = audit_run
+    committed = (REPO / "paper_checks" / "REPORT.md").read_text(encoding="utf-8")
+    assert committed == report.read_text(encoding="utf-8"), "run `symstab audit` and commit REPORT.md"
+
+
+#: Where the paper says its equations stand, in its own words ("provided in
+#: subsection A of the Appendix", "coefficients listed in the Appendix,
+#: subsection B", "derived in Appendix C", ...): the section each number belongs to.
+_EQUATION_SECTIONS = [((1, 1), "Sec. III"), ((2, 7), "Sec. IV"), ((8, 10), "Sec. IV-A"),
+                      ((11, 13), "Sec. IV-B"), ((14, 15), "Sec. IV-C"), ((16, 17), "Sec. VI"),
+                      ((18, 19), "Appendix A"), ((20, 34), "Appendix B"), ((35, 47), "Appendix C"),
+                      ((48, 63), "Appendix D"), ((64, 70), "Appendix E")]
+
+
+def test_report_names_sections_not_lines_of_a_file_the_reader_lacks(audit_run):
+    """The "where" column and the header named lines of `000_6344edfcd45519c7.txt`."""
+    import re
+
+    _, report, _ = audit_run
+    text = report.read_text(encoding="utf-8")
+    assert "000_6344" not in text and ".txt" not in text
+    assert not re.search(r"\blines? \d", text), re.search(r".{60}\blines? \d.{20}", text).group(0)
+    rows = _report_rows(text)
+    assert len(rows) == len(EXPECTED_VERDICTS)
+    section = r"(Abstract|Sec\. (I|II|III|IV|V|VI|VII|VIII)(-[A-C])?|Appendix [A-E])"
+    for cid, where, *_ in rows:
+        if cid.startswith("claim:"):
+            assert re.search(section, where), (cid, where)
+            continue
+        number = int(re.fullmatch(r"eq\. \((\d+)\), " + section, where).group(1))
+        (expected,) = [name for (lo, hi), name in _EQUATION_SECTIONS if lo <= number <= hi]
+        assert where == f"eq. ({number}), {expected}", (cid, where)
+
+
+def test_section_of_refuses_what_is_not_a_line():
+    with pytest.raises(TypeError, match="line"):
+        printed.section_of(2.5)
+    with pytest.raises(ValueError, match="line must be >= 1"):
+        printed.section_of(0)
+
+
+def test_claimed_column_spells_delta_and_gamma():
+    """(7), (11), (36), (66), (69) were shown as 'gC1 + g d^2 C2 + ... d^3 C4',
+    with g for gamma and d for delta -- and d is the delay everywhere else."""
+    import re
+
+    for cid, (_, _, claim, _) in audit.registered().items():
+        assert not re.search(r"\bg\b|\bgC\d", claim), (cid, claim)
+        assert not re.search(r"\bd\^|\bd C\d", claim), (cid, claim)
+    claim = audit.registered()["eq7.alpha"][2]
+    assert "gamma C1 + gamma delta^2 C2 + gamma delta C3 + delta^3 C4 + delta^2 C5" in claim
+
+
+def test_no_stable_alpha_interval_has_a_negative_end(audit_run):
+    """alpha <= 0 is proved never stable (claim:open_alpha_positive), and the
+    report printed the stable interval (-6.219e-12, 0.00506464): a scan of the
+    spectral radius, not symstab's certified count, whose interval starts on
+    the z = 1 line at alpha = 0 exactly."""
+    import re
+
+    _, report, _ = audit_run
+    text = report.read_text(encoding="utf-8")
+    number = r"(-?[0-9.]+(?:e[-+]?[0-9]+)?)"
+    found = re.findall(r"stable alpha intervals? (?:is |are )?\[?\(" + number + r", " + number + r"\)",
+                       text)
+    assert len(found) >= 6
+    assert all(float(lo) >= 0.0 for lo, _ in found), found
+    evidence = audit.registered()["claim:alpha_beta0_gamma0"][3]().evidence
+    assert "stable alpha interval (0, 0.00506464)" in evidence
+    assert "alpha = 0 is the z = 1 line, exactly" in evidence
+
+
+def test_an_empty_window_is_said_in_words_and_is_empty_for_python_control(audit_run):
+    """'the linear model is stable for none N m/rad' (claim:exp_window_lg).
+    Oracle: python-control's closed-loop poles along B_w = 0.6 N m s/rad,
+    M_w = m, Td = 40 ms, for K_w from 0 to 40 N m/rad: none inside the circle;
+    and at B_w = 0.45 the middle of the stated window is stable."""
+    import re
+
+    import numpy as np
+    from oracles import python_control_closed_loop
+    from symstab.numeric.units import PAPER_DEVICE as dev
+
+    _, report, _ = audit_run
+    assert "none N" not in report.read_text(encoding="utf-8")
+    low = audit.registered()["claim:exp_window_lg"][3]().evidence
+    assert "at B_w = 0.6 N m s/rad, M_w = m, Td = 40 ms the linear model is stable for no K_w" in low
+    high = audit.registered()["claim:exp_window_hg"][3]().evidence
+    k_lo, k_hi = (float(x) for x in re.search(r"stable for ([0-9.]+) < K_w < ([0-9.]+) N m/rad",
+                                                high).groups())
+
+    def radius(K_w, B_w):
+        loop = python_control_closed_loop(alpha=dev.alpha(K_w), beta=dev.beta(B_w), gamma=1.0,
+                                          d=claims.D_EXPERIMENT, delta=dev.delta, m=dev.m, T=dev.T)
+        return float(np.max(np.abs(loop.poles())))
+
+    assert all(radius(K_w, 0.6) > 1.0 for K_w in np.linspace(0.0, 40.0, 81))
+    assert radius(0.5 * (k_lo + k_hi), 0.45) < 1.0
+    assert radius(k_lo - 0.1, 0.45) > 1.0 and radius(k_hi + 0.1, 0.45) > 1.0
