@@ -17,10 +17,19 @@
 
 :func:`load_loop` reads one into a :class:`symstab.Loop`; every mistake is
 a :class:`ValueError` that names the file and the key.
+
+A loop file is data, exchanged between colleagues, and nothing in it is
+run: the plant and the environment are built from their syntax tree
+(numbers, parameter names, ``+ - * / **``, ``exp``, ``sqrt``), never
+evaluated; ``name`` is a word of 1 to 64 ASCII letters, digits, ``_``, ``-``
+and ``.`` (it becomes a file stem; without it the file's stem is used, made
+such a word); ``description`` and every unit are one line of printable text;
+a parameter's name is an ASCII identifier.  Anything else is refused.
 """
 
 import math
 import pathlib
+import re
 import sys
 
 if sys.version_info >= (3, 11):
@@ -33,6 +42,16 @@ from .any_loop import Loop
 __all__ = ["load_loop", "parse_loop_text"]
 
 _KEYS = {"name", "description", "plant", "environment", "plane", "parameters"}
+
+
+def _default_name(source):
+    """A loop's name when its file gives none: the file's stem, made a word.
+
+    The user did not write it, so it is not refused: the characters
+    :data:`symstab.symbolic.loop_assembly.NAME_PATTERN` does not allow become ``_``.
+    """
+    stem = re.sub(r"[^A-Za-z0-9_.-]+", "_", pathlib.Path(source).stem).strip("_.-")[:64]
+    return stem or "loop"
 
 
 def parse_loop_text(text, *, source="<loop file>"):
@@ -55,6 +74,9 @@ def parse_loop_text(text, *, source="<loop file>"):
     for key in ("plant", "environment"):
         if not isinstance(data.get(key), str):
             raise ValueError(f"{source}: {key!r} must be given as a string")
+    for key in ("name", "description"):
+        if key in data and not isinstance(data[key], str):
+            raise ValueError(f"{source}: {key!r} must be a string, got {type(data[key]).__name__}")
     values, units = {}, {}
     parameters = data.get("parameters", {})
     if not isinstance(parameters, dict):
@@ -84,8 +106,8 @@ def parse_loop_text(text, *, source="<loop file>"):
         raise ValueError(f"{source}: 'plane' must be two parameter names, e.g. [\"B\", \"K\"]")
     try:
         return Loop(data["plant"], data["environment"], values=values, units=units,
-                    name=str(data.get("name", pathlib.Path(source).stem)),
-                    description=str(data.get("description", "")), plane=plane)
+                    name=data.get("name", _default_name(source)),
+                    description=data.get("description", ""), plane=plane)
     except (TypeError, ValueError) as exc:
         raise ValueError(f"{source}: {exc}") from None
 

@@ -31,8 +31,8 @@ from . import model
 from .._validate import check_delay
 from .discretize import numeric_zoh, written_poles, zoh_pulse_transfer_function
 
-__all__ = ["LoopModel", "parse_plant", "parse_environment", "check_parameter_name", "is_affine",
-           "poly_coeffs"]
+__all__ = ["LoopModel", "parse_plant", "parse_environment", "check_parameter_name",
+           "check_loop_name", "check_text_line", "NAME_PATTERN", "is_affine", "poly_coeffs"]
 
 #: Names with a fixed meaning in every loop.
 RESERVED = ("s", "z", "T", "d")
@@ -47,6 +47,14 @@ _GENERATED_NAME = re.compile(r"(num|den|pn|pd|x)\d+|numpy|_.*")
 #: be taken for them.
 _ARGUMENT_NAMES = frozenset({"self", "name", "x", "y", "n", "values", "x_range", "y_range",
                              "damping"})
+#: A loop's name: it becomes a file stem, part of C identifiers and a word in
+#: generated headers, so it is a word of ASCII letters, digits, ``_``, ``-``
+#: and ``.`` (no leading ``-`` or ``.``: not an option, not a hidden file).
+NAME_PATTERN = re.compile(r"[A-Za-z0-9_][A-Za-z0-9_.-]{0,63}")
+#: A parameter's name: an identifier in Python and C, a symbol in LaTeX.
+_PARAMETER_PATTERN = re.compile(r"[A-Za-z][A-Za-z0-9_]{0,39}")
+#: Longest description and unit text (one line each).
+_TEXT_LIMITS = {"description": 200, "unit": 60}
 
 
 def _real_floats(values):
@@ -69,11 +77,80 @@ def _real_floats(values):
     return out
 
 
+def check_loop_name(name):
+    """Refuse a loop name that is not a plain word: it becomes a file stem and C identifiers.
+
+    Parameters
+    ----------
+    name : str
+        1 to 64 ASCII letters, digits, ``_``, ``-`` and ``.``, starting with
+        a letter, a digit or ``_`` (:data:`NAME_PATTERN`).
+
+    Returns
+    -------
+    str
+        ``name``.
+
+    Raises
+    ------
+    TypeError
+        If it is not a string.
+    ValueError
+        Naming ``name`` and the characters allowed.
+    """
+    if not isinstance(name, str):
+        raise TypeError(f"name must be a string, got {type(name).__name__}")
+    if not NAME_PATTERN.fullmatch(name):
+        raise ValueError(f"name {name!r} is not allowed: 1 to 64 ASCII letters, digits, '_', "
+                         f"'-' and '.', starting with a letter, a digit or '_' (it becomes a "
+                         f"file name)")
+    return name
+
+
+def check_text_line(what, text):
+    """Refuse text that is not one short line of printable characters.
+
+    A description or a unit is shown by the CLI and written into generated
+    files (escaped there too); a line break, a control or a bidirectional
+    formatting character could make what is shown differ from what is
+    there.
+
+    Parameters
+    ----------
+    what : str
+        ``"description"`` or ``"unit"`` (with the parameter's name after it,
+        e.g. ``"unit of 'K'"``): names the item in the message and decides
+        the length limit (200 and 60 characters).
+    text : str
+
+    Returns
+    -------
+    str
+        ``text``.
+
+    Raises
+    ------
+    TypeError
+        If ``text`` is not a string.
+    ValueError
+        If it holds a line break or another non-printable character, or is
+        longer than the limit.
+    """
+    if not isinstance(text, str):
+        raise TypeError(f"{what} must be a string, got {type(text).__name__}")
+    limit = _TEXT_LIMITS[what.split()[0]]
+    if not text.isprintable() or len(text) > limit:
+        raise ValueError(f"{what} must be one line of at most {limit} printable characters "
+                         f"(no line breaks, tabs or control characters), got {text!r}")
+    return text
+
+
 def check_parameter_name(name):
     """Refuse a parameter name the generated kernels cannot use.
 
-    A Python or C keyword, ``numpy`` (the NumPy module in the generated
-    code), a name starting with ``_``, or a name the generated code uses
+    A name that is not ASCII letters, digits and ``_`` starting with a
+    letter (at most 40), a Python or C keyword, ``numpy`` (the NumPy module
+    in the generated code), or a name the generated code uses
     itself (outputs ``num<k>``, ``den<k>``, ``pn<k>``, ``pd<k>``,
     temporaries ``x<k>``).
 
@@ -82,6 +159,10 @@ def check_parameter_name(name):
     ValueError
         Naming the parameter.
     """
+    if not _PARAMETER_PATTERN.fullmatch(name):
+        raise ValueError(f"parameter {name!r} cannot be a name in the generated NumPy and C "
+                         f"kernels: a parameter is 1 to 40 ASCII letters, digits and '_', "
+                         f"starting with a letter; rename it in the loop")
     if name in _ARGUMENT_NAMES:
         raise ValueError(f"parameter {name!r} has the name of an argument of Loop's methods "
                          f"({', '.join(sorted(_ARGUMENT_NAMES))}): rename it in the loop")
@@ -287,11 +368,12 @@ class LoopModel:
     values : dict, optional
         Default values of parameters.
     name : str, optional
-        A label for reprs and generated files.
+        A label for reprs and generated files: it becomes a file stem, so
+        it is a word (:func:`check_loop_name`); default ``"loop"``.
     units : dict, optional
-        Unit of each parameter, as text.
+        Unit of each parameter, as one line of text (:func:`check_text_line`).
     description : str, optional
-        One line on what the loop is.
+        One line of printable text on what the loop is (:func:`check_text_line`).
     plane : (str, str), optional
         The default ``(x, y)`` parameter plane; checked to be jointly affine.
 
@@ -300,15 +382,16 @@ class LoopModel:
     TypeError, ValueError
         If the plant or the environment is not a proper rational function
         of its variable, uses ``d``, or names a parameter the generated
-        kernels cannot take (:func:`check_parameter_name`).
+        kernels cannot take (:func:`check_parameter_name`); if the name,
+        the description or a unit is not the text allowed.
     """
 
     def __init__(self, plant, environment, *, values=None, name=None, units=None,
                  description="", plane=None):
         self.plant = parse_plant(plant)
         self.environment = parse_environment(environment)
-        self.name = name or "loop"
-        self.description = description
+        self.name = check_loop_name("loop" if name is None else name)
+        self.description = check_text_line("description", description)
         symbols = {str(x): x for x in self.plant.free_symbols | self.environment.free_symbols}
         symbols.pop("s", None)
         symbols.pop("z", None)
@@ -333,7 +416,7 @@ class LoopModel:
             if key not in self.parameters:
                 raise ValueError(f"units: {key!r} is not a parameter of this loop "
                                  f"(parameters: {', '.join(self.parameters)})")
-            self.units[key] = str(unit)
+            self.units[key] = check_text_line(f"unit of {key!r}", str(unit))
         poles = written_poles(sp.together(self.plant / model.s))
         numeric_plant = not (self.plant.free_symbols - {model.s})
         self.zoh_method = "residues" if poles is not None and not numeric_plant else "matrix exponential"

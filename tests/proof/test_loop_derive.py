@@ -40,7 +40,7 @@ PAPER_FILE = REPO / "examples" / "loops" / "paper.toml"
 #: A plant whose denominator is an irreducible cubic: the numeric (matrix
 #: exponential) path.  A spring and a damper as environment.
 NUMERIC_LOOP = """\
-name = "spring device"
+name = "spring-device"
 description = "A third-order device: a mass on a spring with friction and an elastic ground"
 plant = "1/(m*s**3 + b*s**2 + k*s + c)"
 environment = "K + B*(z - 1)/(T*z)"
@@ -196,7 +196,7 @@ def test_default_out_is_the_loop_name_in_the_current_folder(tmp_path, monkeypatc
     monkeypatch.chdir(tmp_path)
     status, out, err = run_cli("derive", "--loop", str(numeric_file))
     assert status == 0, err
-    # "spring device": the name as a C identifier names the folder and the files.
+    # "spring-device": the name as a C identifier names the folder and the files.
     folder = tmp_path / "spring_device_derivation"
     assert sorted(os.listdir(tmp_path)) == ["spring_device_derivation"]
     assert {"spring_device_kernels.c", "spring_device_kernels.h",
@@ -465,7 +465,7 @@ def test_the_paper_loop_proofs_fail_for_another_loop():
 
 
 PI_LOOP = """\
-name = "filtered damper"
+name = "filtered_damper"
 plant = "1/(m*s**2 + b*s)"
 environment = "K + B*(1 - exp(-2*pi*f_c*T))*(z - 1)/(T*(z - exp(-2*pi*f_c*T)))"
 
