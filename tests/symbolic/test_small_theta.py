@@ -40,11 +40,17 @@ def test_beta_limit_is_minus_delta():
 
 @pytest.mark.parametrize("gamma, d, delta", CASES)
 def test_limits_match_eq2_at_tiny_theta(gamma, d, delta):
+    """small_theta_limits()'s alpha_limit and beta_limit, evaluated at the case
+    (60 digits), against the exact boundary of eq. (2) at theta = 1e-12 (80
+    digits): the boundary is within O(theta^2) = 1e-24 (times the Taylor
+    coefficient, below 1e4 in every case) of its limits."""
+    lim = small_theta_limits()
+    alpha_limit = _subs(lim.alpha_limit, gamma, d, delta)
+    beta_limit = _subs(lim.beta_limit, gamma, d, delta)
     with mpmath.workdps(80):
         alpha, beta = first_principles_boundary_point(THETA, gamma, d, delta)
-        assert abs(alpha) < mpmath.mpf(10) ** -20
-        # beta = -delta + O(theta^2), theta^2 = 1e-24
-        assert_rel_close(beta, -mpmath.mpf(delta), mpmath.mpf(10) ** -15, "beta(0+)")
+        assert abs(alpha - alpha_limit) < mpmath.mpf(10) ** -20, ("alpha(0+)", alpha, alpha_limit)
+        assert_rel_close(beta_limit, beta, mpmath.mpf(10) ** -18, "beta(0+)")
 
 
 @pytest.mark.parametrize("gamma, d, delta", CASES)
