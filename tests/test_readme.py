@@ -44,3 +44,47 @@ def test_docstring_examples_run(module, monkeypatch, tmp_path):
     mod = importlib.import_module(module)
     failures, tried = doctest.testmod(mod, optionflags=doctest.NORMALIZE_WHITESPACE)
     assert tried > 0 and failures == 0
+
+
+def _readme_commands():
+    """The ``symstab`` command lines of the README's console and bash blocks, as argument lists."""
+    import shlex
+
+    readme = (REPO / "README.md").read_text(encoding="utf-8")
+    commands = []
+    for block in re.findall(r"```(?:console|bash)\n(.*?)```", readme, re.S):
+        for line in block.splitlines():
+            for part in line.removeprefix("$ ").split("&&"):
+                words = shlex.split(part, comments=True)
+                if words[:1] == ["symstab"]:
+                    commands.append(words[1:])
+    return commands
+
+
+def test_readme_console_examples_write_only_under_the_ignored_out_folder():
+    """They left map.npz, map.png, locus.png, tustin.png and operator_arm_derivation/
+    in the checkout (issue 18).  Every file a README command writes -- its
+    ``--out``, ``--png``, ``--report``, ``--json``, the PNG that ``map`` writes beside
+    its ``--out``, the folder ``derive --loop`` writes -- is under ``out/``, which
+    .gitignore ignores; ``reproduce`` writes the ignored ``reproduction/``."""
+    import pathlib
+
+    from symstab.cli import commands as cli
+
+    assert "/out/" in (REPO / ".gitignore").read_text(encoding="utf-8").splitlines()
+    parser = cli.build_parser()
+    written = []
+    for words in _readme_commands():
+        args = parser.parse_args(words)
+        paths = {flag: getattr(args, flag, None) for flag in ("out", "png", "report", "json")}
+        if args.command == "map" and paths["png"] is None and "--no-png" not in words:
+            paths["png"] = str(pathlib.Path(paths["out"]).with_suffix(".png"))
+        if args.command == "derive" and getattr(args, "loop", None) and paths["out"] is None:
+            paths["out"] = "<loop name>_derivation"   # the current folder
+        for flag, path in paths.items():
+            if path is None or (args.command == "reproduce" and path == "reproduction"):
+                continue
+            written.append((" ".join(["symstab", *words]), flag, path))
+    assert len(written) >= 5
+    outside = [w for w in written if pathlib.PurePath(w[2]).parts[0] != "out"]
+    assert not outside, outside
