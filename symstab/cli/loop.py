@@ -656,6 +656,29 @@ def _visible(values, lo, hi):
     return out
 
 
+def draw_lines(ax, lines, xs, ys, to_x=np.asarray, to_y=np.asarray):
+    """Draw the D-decomposition's lines ``c0 + cx x + cy y = 0`` across a window; return the handles.
+
+    ``xs`` and ``ys`` are the window's grids in the lines' plane; ``to_x`` and
+    ``to_y`` take that plane's coordinates to the axes' (a map drawn in
+    other units).
+    """
+    styles = {"z = 1": ("C0", "--"), "z = -1": ("C3", "--"), "leading": ("C1", ":")}
+    handles = []
+    for label, (c0, cx, cy) in lines.items():
+        color, style = styles.get(label, ("C4", "-."))
+        if cy != 0:
+            px, py = xs[[0, -1]], -(c0 + cx * xs[[0, -1]]) / cy
+        else:
+            px, py = np.full(2, -c0 / cx), ys[[0, -1]]
+        if np.all(py < ys[0]) or np.all(py > ys[-1]) or np.all(px < xs[0]) or np.all(px > xs[-1]):
+            continue   # the line misses the window
+        handles += ax.plot(to_x(px), to_y(py), color=color, ls=style, lw=1.2,
+                           label=label.replace("leading", "leading coefficient 0")
+                           .replace("z = 1", "root z = 1").replace("z = -1", "root z = -1"))
+    return handles
+
+
 def _png(setup, xs, ys, code):
     """The map as PNG bytes (None without matplotlib), with the D-decomposition drawn over it."""
     from .simulate import _tex_unit
@@ -683,18 +706,7 @@ def _png(setup, xs, ys, code):
         handles.append(Patch(facecolor="#bdbdbd", label="marginal"))
     if np.any(np.isfinite(bx)):
         handles += ax.plot(bx, by, "k-", lw=1.2, label=r"$z = e^{j\theta}$ root (D-decomposition)")
-    styles = {"z = 1": ("C0", "--"), "z = -1": ("C3", "--"), "leading": ("C1", ":")}
-    for label, (c0, cx, cy) in curve.lines.items():
-        color, style = styles.get(label, ("C4", "-."))
-        if cy != 0:
-            px, py = xs[[0, -1]], -(c0 + cx * xs[[0, -1]]) / cy
-        else:
-            px, py = np.full(2, -c0 / cx), ys[[0, -1]]
-        if np.all(py < ys[0]) or np.all(py > ys[-1]) or np.all(px < xs[0]) or np.all(px > xs[-1]):
-            continue   # the line misses the window
-        handles += ax.plot(px, py, color=color, ls=style, lw=1.2,
-                           label=label.replace("leading", "leading coefficient 0")
-                           .replace("z = 1", "root z = 1").replace("z = -1", "root z = -1"))
+    handles += draw_lines(ax, curve.lines, xs, ys)
     ax.set_xlim(xs[0], xs[-1])
     ax.set_ylim(ys[0], ys[-1])
 

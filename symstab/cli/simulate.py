@@ -110,9 +110,17 @@ def _point(args, setup):
     return float(alpha), float(beta)
 
 
+def _theory(setup, nonideal):
+    """The :class:`symstab.numeric.simulate.LinearTheory` of the loop simulated."""
+    from ..numeric.simulate import linear_theory
+
+    return linear_theory(gamma=setup.gamma, d=setup.d, delta=setup.delta,
+                         device=setup.device, nonideal=nonideal)
+
+
 def _cmd_simulate(args):
     from ..numeric.simulate import simulate
-    from ..numeric.stability import MARGINAL, STABLE, UNSTABLE, classify, spectral_radius
+    from ..numeric.stability import MARGINAL, STABLE, UNSTABLE
 
     from ..numeric.simulate import check_steps, progress_printer
 
@@ -124,14 +132,17 @@ def _cmd_simulate(args):
     record = args.out is not None
     if record:
         check_memory(f"the --out trajectory of {steps} periods", (steps + 1) * _TRAJECTORY_ROW_BYTES)
+    # The theory is that of the loop simulated (its linear part), decided
+    # before the run so that a refusal costs no simulation.
+    theory = _theory(setup, nonideal)
+    code = theory.classify(alpha, beta)
+    radius = theory.spectral_radius(alpha, beta)
     run = simulate(alpha=alpha, beta=beta, gamma=setup.gamma, d=setup.d,
                    delta=None if setup.physical else setup.delta, steps=steps, x0=x0,
                    device=setup.device, nonideal=nonideal, record=record,
                    progress=progress_printer("simulating", steps))
     for line in setup.echo:
         print(line)
-    code = classify(alpha=alpha, beta=beta, gamma=setup.gamma, d=setup.d, delta=setup.delta)
-    radius = spectral_radius(alpha=alpha, beta=beta, gamma=setup.gamma, d=setup.d, delta=setup.delta)
     verdict = "diverged (unstable)" if run.diverged else ("stable" if run.stable else "unstable")
     amp = run.amplitude
     print(f"point: alpha = {alpha:.10g}, beta = {beta:.10g}"
@@ -139,7 +150,7 @@ def _cmd_simulate(args):
              f"B_w = {float(setup.device.damping(beta)):.10g} {setup.units['B_w']})" if setup.physical else ""))
     print(f"simulated {run.steps} periods from x0 = {x0:g}: {verdict}; max |x| per quarter: "
           + ", ".join(f"{a:.4g}" for a in amp))
-    print(f"theory (ideal loop): spectral radius {radius:.12g} -> "
+    print(f"theory ({theory.description}): spectral radius {radius:.12g} -> "
           + {STABLE: "stable", MARGINAL: "marginal", UNSTABLE: "unstable"}[code])
     if args.out is not None:
         k = np.arange(run.steps + 1)
@@ -178,7 +189,7 @@ def _cmd_map(args):
     if cli_loop.uses_loop(args):
         return cli_loop.run(args)
     from ..numeric.simulate import check_steps, progress_printer, stability_map
-    from ..numeric.stability import MARGINAL, STABLE, classify
+    from ..numeric.stability import MARGINAL, STABLE
 
     setup = _resolve(args)
     nonideal, x0 = _nonideal(args, setup)
@@ -192,14 +203,17 @@ def _cmd_map(args):
     out, png_path = map_outputs(args)
     check_memory(f"a map of {alpha.size} x {beta.size} cells", alpha.size * beta.size * _MAP_CELL_BYTES)
     steps = check_steps(args.steps, setup.d)
+    # The loop simulated, classified by its roots before the simulation (a
+    # refusal then costs no run): its linear part, filter and lag included.
+    theory = _theory(setup, nonideal)
+    A, B = np.meshgrid(alpha, beta, indexing="ij")
+    code = theory.classify(A, B)
     for line in setup.echo:
         print(line)
     result = stability_map(alpha=alpha, beta=beta, gamma=setup.gamma, d=setup.d,
                            delta=None if setup.physical else setup.delta, steps=steps, x0=x0,
                            device=setup.device, nonideal=nonideal,
                            progress=progress_printer("simulating", steps))
-    A, B = np.meshgrid(alpha, beta, indexing="ij")
-    code = classify(alpha=A, beta=B, gamma=setup.gamma, d=setup.d, delta=setup.delta)
     exact = code == STABLE
     physical = {}  # K_w and B_w beside alpha and beta, in the units of the echo
     if setup.physical:
@@ -212,7 +226,8 @@ def _cmd_map(args):
         np.savez(buf, alpha=alpha, beta=beta, **physical, **units, stable=result.stable,
                  growth=result.growth, exact_stable=exact, exact_code=code, gamma=setup.gamma,
                  d=setup.d, delta=setup.delta, steps=steps,
-                 nonidealities=np.array(_nonideal_text(nonideal, args)))
+                 nonidealities=np.array(_nonideal_text(nonideal, args)),
+                 theory=np.array(theory.description))
         data = buf.getvalue()
     else:
         buf = io.StringIO()
@@ -226,7 +241,7 @@ def _cmd_map(args):
                                     result.growth.ravel()):
             buf.write(",".join(f"{v:.12g}" for v in values) + f",{int(s)},{int(e)},{g:.6g}\n")
         data = buf.getvalue().encode()
-    png = _png(args, setup, result, nonideal, given) if png_path is not None else None
+    png = _png(args, setup, result, nonideal, given, theory) if png_path is not None else None
     _write(out, data, "--out")
     written = [str(out)]
     if png is not None:
@@ -236,7 +251,7 @@ def _cmd_map(args):
     differ = int(np.count_nonzero((result.stable != exact) & decided))
     print(f"{int(result.stable.sum())} of {result.stable.size} cells stable by simulation "
           f"({steps} periods); {differ} of the {int(decided.sum())} cells that are not marginal "
-          f"differ from the root-counting classification of the ideal loop")
+          f"differ from the root-counting classification of the {theory.description}")
     print("wrote " + ", ".join(written))
     return 0
 
@@ -263,18 +278,30 @@ def _tex_unit(unit):
     return unit.replace("^2", "$^2$")
 
 
+def _keep_nan(convert):
+    """``convert`` (a Device's, which refuses NaN) applied to the finite entries only."""
+    def apply(values):
+        values = np.asarray(values, dtype=float)
+        out = np.full(values.shape, np.nan)
+        finite = np.isfinite(values)
+        out[finite] = convert(values[finite])
+        return out
+    return apply
+
+
 def _map_axes(setup, given, result):
     """``(x, y, x label, y label, to_x, to_y)`` in the units of the grids the user gave.
 
-    ``to_x``/``to_y`` convert beta/alpha (the boundary curve) to the axes.
+    ``to_x``/``to_y`` convert beta/alpha (the boundary curve) to the axes,
+    keeping the NaN that break a curve between its branches.
     """
     dev, units = setup.device, setup.units
     if "--Bw" in given:
-        x, xlabel, to_x = given["--Bw"], f"$B_w$ [{_tex_unit(units['B_w'])}]", dev.damping
+        x, xlabel, to_x = given["--Bw"], f"$B_w$ [{_tex_unit(units['B_w'])}]", _keep_nan(dev.damping)
     else:
         x, xlabel, to_x = result.beta, r"$\beta = B_w T / m$", np.asarray
     if "--Kw" in given:
-        y, ylabel, to_y = given["--Kw"], f"$K_w$ [{_tex_unit(units['K_w'])}]", dev.stiffness
+        y, ylabel, to_y = given["--Kw"], f"$K_w$ [{_tex_unit(units['K_w'])}]", _keep_nan(dev.stiffness)
     else:
         y, ylabel, to_y = result.alpha, r"$\alpha = K_w T^2 / m$", np.asarray
     return x, y, xlabel, ylabel, to_x, to_y
@@ -291,13 +318,13 @@ def _map_title(setup, nonideal, args, steps_text):
             f"{_nonideal_text(nonideal, args)}")
 
 
-def _png(args, setup, result, nonideal, given):
+def _png(args, setup, result, nonideal, given, theory):
     """The map as PNG bytes, or None without matplotlib.
 
     Drawn in the units of the grids the user gave (K_w, B_w or alpha, beta),
-    with the non-idealities of the simulation in the title.
+    with the non-idealities of the simulation in the title and the boundary
+    of the loop simulated (its linear part, ``theory``) over it.
     """
-    from ..numeric.region import boundary_curve
     from ..figures import pyplot
 
     try:
@@ -312,17 +339,24 @@ def _png(args, setup, result, nonideal, given):
     fig, ax = plt.subplots(figsize=(6.4, 4.8), dpi=120)
     ax.pcolormesh(x, y, result.stable.astype(float), shading="nearest",
                   cmap=ListedColormap(["white", "#7fc97f"]), vmin=0, vmax=1)
-    curve = boundary_curve(gamma=setup.gamma, d=setup.d, delta=setup.delta, n=2000, segments=False)
-    if not curve.empty:
-        ax.plot(to_x(curve.beta), to_y(curve.alpha), "k-", lw=1.2,
-                label="boundary of the ideal loop, eq. (7)")
+    arc_beta, arc_alpha, lines = theory.boundary(n=4000 if theory.loop is not None else 2000)
+    arc_beta = cli_loop._visible(arc_beta, result.beta[0], result.beta[-1])
+    arc_alpha = cli_loop._visible(arc_alpha, result.alpha[0], result.alpha[-1])
+    arc_beta[np.isnan(arc_alpha)] = np.nan
+    drawn = []
+    if np.any(np.isfinite(arc_beta)):
+        name = ("the ideal loop, eq. (7)" if theory.loop is None
+                else f"the {theory.label} (D-decomposition)")
+        drawn += ax.plot(to_x(arc_beta), to_y(arc_alpha), "k-", lw=1.2,
+                         label=f"boundary of {name}")
+    drawn += cli_loop.draw_lines(ax, lines, result.beta, result.alpha, to_x, to_y)
     ax.set_xlim(x[0], x[-1])
     ax.set_ylim(y[0], y[-1])
     ax.set_xlabel(xlabel)
     ax.set_ylabel(ylabel)
     ax.set_title(_map_title(setup, nonideal, args, f"{result.steps} periods"), fontsize=10)
-    if not curve.empty:
-        ax.legend(loc="upper right", fontsize=9)
+    if drawn:
+        ax.legend(handles=drawn, loc="upper right", fontsize=9)
     fig.tight_layout()
     buf = io.BytesIO()
     fig.savefig(buf, format="png", metadata={"Software": None})
@@ -338,7 +372,9 @@ def add_commands(sub):
         sub, "simulate", help="simulate one point; write its trajectory as CSV",
         description="Simulate the sampled loop at one stiffness-damping point, with the "
                     "encoder quantization, velocity filter, friction and actuator lag you "
-                    "switch on, and compare its verdict with the ideal loop's root count.",
+                    "switch on, and compare its verdict with the root count of the loop simulated "
+                    "(its linear part, the filter and the actuator lag included; quantization "
+                    "and friction are left out).",
         example="symstab simulate --Td 0.01 --Kw 30 --Bw 1 --paper-encoder --out trajectory.csv",
         func=_cmd_simulate)
     _add_model_options(p)
@@ -352,9 +388,10 @@ def add_commands(sub):
     p = add_command(
         sub, "map", help="stability of a grid by simulation; write CSV or NPZ and a PNG",
         description="Simulate every point of a stiffness-damping grid and write which are "
-                    "stable (CSV or NPZ, with the ideal loop's root count beside) and a PNG "
-                    "of the map with the ideal loop's boundary, in the units of the grid.",
-        example="symstab map --Td 0.01 --Kw 0,70,100 --Bw=-0.1,2,100 --paper-encoder "
+                    "stable (CSV or NPZ, with the root count of the loop simulated beside, its "
+                    "linear part with the filter and the actuator lag) and a PNG of the map with "
+                    "that loop's boundary, in the units of the grid.",
+        example="symstab map --Td 0.01 --Kw 0,50,100 --Bw=-0.1,1.8,100 --paper-encoder "
                 "--velocity-cutoff 50 --out map.npz",
         func=_cmd_map)
     _add_model_options(p)

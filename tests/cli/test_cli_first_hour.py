@@ -23,6 +23,7 @@ import pytest
 
 import symstab
 from symstab.cli import commands as cli
+from symstab.numeric.simulate import Nonidealities, linear_theory
 
 from conftest import PAPER_DELTA, PAPER_M, PAPER_T, REPO
 from oracles import python_control_closed_loop
@@ -331,7 +332,7 @@ def test_map_png_of_a_dimensionless_grid_stays_dimensionless(tmp_path, capsys, d
     assert "ideal loop" in axes["title"]
 
 
-def test_map_example_frames_the_stable_region(tmp_path, capsys):
+def test_map_example_frames_the_stable_region(tmp_path, capsys, loop_cache_dir):
     """The example of ``symstab map --help`` (the README's): not 96 % empty."""
     _, text, _ = _main(capsys, "map", "--help")
     (example,) = [line for line in text.splitlines() if line.startswith("  symstab map ")]
@@ -339,11 +340,14 @@ def test_map_example_frames_the_stable_region(tmp_path, capsys):
     args = cli.build_parser().parse_args(words)
     (k_lo, k_hi), (b_lo, b_hi) = ([float(v) for v in grid.split(",")[:2]]
                                   for grid in (args.Kw, args.Bw))
-    # The ideal region's extent at this delay, in N m/rad and N m s/rad.
-    _, out, _ = _main(capsys, "limits", "--Td", str(args.Td), "--format", "json")
-    lim = json.loads(out)["limits"]
-    k_max = lim["alpha_max"] * PAPER_M / PAPER_T**2
-    left, right = (lim[k] * PAPER_M / PAPER_T for k in ("beta_left", "beta_right"))
+    # The extent at this delay of the region mapped, in N m/rad and N m s/rad:
+    # the loop with the example's velocity filter (its theory is what the map
+    # compares with and draws).
+    assert args.velocity_cutoff is not None
+    theory = linear_theory(gamma=0.0, d=round(args.Td / PAPER_T), device=symstab.PAPER_DEVICE,
+                           nonideal=Nonidealities(velocity_cutoff=args.velocity_cutoff))
+    lim = theory.loop.limits(**theory.values)
+    k_max, left, right = lim.y_max, lim.x_min, lim.x_max
     assert 0.6 * k_hi < k_max < k_hi and k_lo <= 0
     assert b_lo < left and right < b_hi and right - left > 0.6 * (b_hi - b_lo)
     # And the map itself: over a third of the cells stable.
