@@ -4,8 +4,13 @@
 file (:func:`symstab.load_loop`) instead of the paper's device options; the
 file's default values are changed with ``--set NAME=VALUE`` (repeatable) and
 the parameter plane is the file's ``plane`` unless ``--x``/``--y`` name
-another.  Every number is in the loop file's units, and every value used is
-echoed with its unit.
+another.  The file's values are converted to SI when it is read
+(:mod:`symstab.numeric.loop_units`); a ``--set`` value is in the file's unit
+for that parameter, or in the unit it gives (``--set T=0.5ms``), converted
+the same way and checked against the file's bounds.  Everything else on the
+command line (``--at``, ``--x-range``, ``--y-range``) and every result is in
+the SI unit the labels show, and every value used is echoed with its unit
+(as written, then as used where they differ).
 
 The paper's device options (``--m --b --T --Td --delta --gamma --Mw`` and
 the stiffness and damping options) are refused with ``--loop`` (one line
@@ -20,6 +25,7 @@ evaluated once at the given point) and the output paths.  The caller
 import dataclasses
 import io
 import math
+import re
 import sys
 import textwrap
 
@@ -37,7 +43,7 @@ _DEVICE_OPTIONS = (
     ("--delta", "delta", "--set with the loop's own parameters"),
     ("--gamma", "gamma", "--set with the loop's virtual mass, e.g. --set M=..."),
     ("--Mw", "Mw", "--set with the loop's virtual mass, e.g. --set M=..."),
-    ("--linear", "linear", "the units of the loop file"),
+    ("--linear", "linear", None),
 )
 #: Stiffness and damping options: points (classify, limits) and grids (map).
 _POINT_OPTIONS = (
@@ -123,15 +129,20 @@ def add_loop_options(p, command):
     g = p.add_argument_group(
         "any loop (instead of the device options above)",
         textwrap.fill(f"A loop file (TOML, see {_EXAMPLE}) names the plant, the environment, the "
-                      "default values and their units; --set changes a value, in those units.  "
+                      "default values and their units, converted to SI when the file is read; "
+                      "--set changes a value, in the file's unit for it or in the unit it "
+                      "gives.  --at, the ranges and the results are in the SI units shown.  "
                       f"{_WHAT[command]}  With --loop the paper's device options are refused "
                       "(--d still sets the delay d).", 77)
         + f"\nexample: {_LOOP_EXAMPLES[command]}")
     g.add_argument("--loop", metavar="FILE", help="loop file (TOML)")
     many = " (classify: a comma-separated list, one point per entry)" if command == "classify" else ""
     g.add_argument("--set", metavar="NAME=VALUE", action="append", dest="set_values",
-                   help="set a parameter of the loop, in the file's units; repeatable; d is a "
-                        f"whole number of samples{many}")
+                   help="set a parameter of the loop: VALUE is in the unit the file gives NAME "
+                        "(SI where the file gives a bare number), or in the unit written after "
+                        "it (--set T=0.5ms, --set \"K=3 N/mm\"), of the same dimension; "
+                        "converted to SI and checked against the file's bounds; repeatable; d "
+                        f"is a whole number of samples{many}")
     if command != "classify":
         g.add_argument("--x", metavar="NAME", help="horizontal parameter of the plane "
                                                    "(default: the file's plane)")
@@ -172,12 +183,42 @@ def run(args):
 def _refuse_device_options(args):
     for flag, dest, default, instead in args.loop_refused:
         if getattr(args, dest, default) != default:
+            if flag == "--linear":
+                raise ValueError("--linear names the units of the paper's device options (rotary "
+                                 "by default, linear with --linear: the same numbers); with "
+                                 "--loop every value is in the units of the loop file, "
+                                 "converted to SI: drop --linear")
             if instead is None:
                 raise ValueError(f"{flag} is an option of the paper's device simulation; "
                                  f"map --loop classifies the loop by its roots and takes no "
                                  f"simulation options")
             raise ValueError(f"{flag} is an option of the paper's device; with --loop use "
                              f"{instead}")
+
+
+#: A number at the start of a --set value, before its unit (0.25ms, 1e-3 s, 3 1/s).
+_LEADING_NUMBER = re.compile(r"[+-]?(?:\d+(?:\.\d*)?|\.\d+)(?:[eE][+-]?\d+)?")
+
+
+def _split_unit(text, flag):
+    """``("0.25", "ms")`` from ``"0.25ms"`` or ``"0.25 ms"``; ``(text, None)`` without a unit.
+
+    A list takes one unit, after its last value (``1,3,10 N/mm``).
+    """
+    head, comma, last = text.rpartition(",")
+    last = last.strip()
+    try:
+        float(last)
+        return text, None
+    except ValueError:
+        pass
+    number = _LEADING_NUMBER.match(last)
+    unit = last[number.end():].strip() if number else ""
+    if not number or not unit:
+        return text, None   # not a number: said so by _parse_number
+    if "," in unit:
+        raise ValueError(f"{flag}: give the unit once, after the last value")
+    return head + comma + number.group(), unit
 
 
 def _parse_number(name, text, flag, *, lists):
@@ -209,7 +250,10 @@ def _parse_number(name, text, flag, *, lists):
 
 
 def _parse_sets(texts, *, lists):
-    """``{name: value}`` of the ``--set NAME=VALUE`` options, in the order given."""
+    """``{name: (value, unit)}`` of the ``--set NAME=VALUE [UNIT]`` options, in the order given.
+
+    ``unit`` is None where the option gives none (the file's unit is meant).
+    """
     out = {}
     for text in texts or ():
         flag = f"--set {text}"
@@ -219,8 +263,41 @@ def _parse_sets(texts, *, lists):
             raise ValueError(f"{flag}: expected NAME=VALUE, e.g. --set K=300")
         if name in out:
             raise ValueError(f"--set {name} is given twice; give each parameter once")
-        out[name] = _parse_number(name, value, flag, lists=lists)
+        value, unit = _split_unit(value, flag)
+        out[name] = (_parse_number(name, value, flag, lists=lists), unit)
     return out
+
+
+def _convert_sets(loop, sets):
+    """The ``--set`` values in SI: (values, written), converted as the file's own.
+
+    A value without a unit is in the file's unit for that parameter (SI where
+    the file gives a bare number); one with a unit is converted from it,
+    which must have the dimension of the parameter (from the file's unit, or
+    implied by the loop).  ``written`` keeps what was typed, for the echo.
+    """
+    from ..numeric.loop_units import FileParameters, convert
+
+    known = getattr(loop, "file_parameters", None) or FileParameters({})
+    values, written = {}, {}
+    for name, (value, unit) in sets.items():
+        flag = f"--set {name}"
+        file_unit = known.file_unit(name)
+        if unit is None:
+            unit = file_unit
+        many = isinstance(value, list)
+        items = [convert(name, v, unit, where=flag) for v in (value if many else [value])]
+        info = items[0].info
+        expected = (known.values[name].info.dimensions if file_unit is not None and name != "d"
+                    else known.dimensions.get(name))
+        if info is not None and expected is not None and info.dimensions != tuple(expected):
+            from ..numeric.loop_units import dimension_name
+            raise ValueError(f"{flag}: unit {unit!r} is {dimension_name(info.dimensions)}, and "
+                             f"{name} is in {dimension_name(expected)}"
+                             + (f" (the file gives it in {file_unit!r})" if file_unit else ""))
+        values[name] = [i.si_value for i in items] if many else items[0].si_value
+        written[name] = (value, items[0].unit, items[0].si_unit)
+    return values, written
 
 
 @dataclasses.dataclass(frozen=True)
@@ -234,6 +311,9 @@ class LoopSetup:
     x: str = None
     y: str = None
     echo: tuple = ()
+    #: What the file or a --set wrote where it differs from the SI value used:
+    #: {name: (value as written, unit as written, SI unit)}.
+    written: dict = dataclasses.field(default_factory=dict)
 
     def unit(self, name):
         return self.loop.units.get(name, "")
@@ -253,6 +333,10 @@ class LoopSetup:
         if self.x is not None:
             out["plane"] = {"x": self.x, "y": self.y}
         out["units"] = {k: loop.units[k] for k in loop.parameters if k in loop.units}
+        written = {k: {"value": v, "unit": u} for k, (v, u, _) in self.written.items()
+                   if k in self.values}
+        if written:
+            out["as_written"] = written   # converted to "values", in "units"
         return out
 
 
@@ -263,11 +347,21 @@ def _quantity_text(name, value):
 
 
 def _quantity(setup, name, value):
-    """``"K = 300 N/m"``, ``"K = [1, 3] N/m"``, ``"d = 40 samples"``."""
+    """``"K = 300 N/m"``, ``"K = [1, 3] N/m"``, ``"d = 40 samples"``, ``"T = 0.25 ms (0.00025 s)"``.
+
+    A value the file or a ``--set`` gave in another unit is shown as written
+    and, in brackets, as used (SI).
+    """
     unit = setup.unit(name) or ("samples" if name == "d" else "")
     if unit == "samples" and value == 1:
         unit = "sample"
-    return _quantity_text(name, value) + (f" {unit}" if unit else "")
+    text = _quantity_text(name, value) + (f" {unit}" if unit else "")
+    if name in setup.written and name != "d":
+        given, given_unit, _ = setup.written[name]
+        shown = _quantity_text(name, given) + f" {given_unit}"
+        if shown != text:
+            return f"{shown} ({text.partition(' = ')[2]})"
+    return text
 
 
 def _echo(setup):
@@ -313,12 +407,13 @@ def _resolve(args, *, plane=True, lists=False):
     if getattr(args, "d", None) is not None:
         if "d" in sets:
             raise ValueError("give the delay once: --d or --set d=...")
-        sets["d"] = args.d
+        sets["d"] = (args.d, None)
     loop = _load(args.loop)
     unknown = [n for n in sets if n not in loop.parameters]
     if unknown:
         raise ValueError(f"--set {unknown[0]}: {unknown[0]!r} is not a parameter of the loop in "
                          f"{args.loop} (parameters: {', '.join(loop.parameters)})")
+    sets, written_sets = _convert_sets(loop, sets)
     x = y = None
     axes = ()
     if plane:
@@ -340,6 +435,18 @@ def _resolve(args, *, plane=True, lists=False):
     if missing:
         raise ValueError(f"no value for {', '.join(missing)}: the loop file {args.loop} gives "
                          f"none; add --set {missing[0]}=VALUE")
+    known = getattr(loop, "file_parameters", None)
+    written = {}
+    if known is not None:
+        from ..numeric.loop_units import check_bounds
+
+        written = {n: (v.value, v.unit, v.si_unit) for n, v in known.values.items()
+                   if v.converted}
+        # The bounds the file declares hold at the --set values too (the
+        # file's own were checked when it was read).
+        check_bounds(known, values, skip=axes, where=lambda names: (
+            ", ".join(f"--set {n}=..." for n in sets if n in names) or str(args.loop)))
+    written.update({n: w for n, w in written_sets.items()})
     if plane:
         loop.boundary(x=x, y=y, n=2, **values)   # checks the plane (affine) and the values
         point = {**values, x: 0.0, y: 0.0}
@@ -349,7 +456,7 @@ def _resolve(args, *, plane=True, lists=False):
     # An overflow in the plant's pulse transfer function (exp(-b T / m) at
     # T = 1e300, say) is a ValueError of the loop's, here before the work.
     loop.coefficients(**point)
-    setup = LoopSetup(str(args.loop), loop, values, tuple(sets), x, y)
+    setup = LoopSetup(str(args.loop), loop, values, tuple(sets), x, y, written=written)
     return dataclasses.replace(setup, echo=_echo(setup))
 
 
@@ -423,16 +530,22 @@ def _intervals(setup, at):
     from .._validate import check_real
 
     at = check_real(f"--at ({setup.x})", at)
+    from .numeric import interval_texts
+
     runs = setup.loop.stable_intervals(setup.y, **{setup.x: at}, **setup.values)
     unit_x = f" {setup.unit(setup.x)}" if setup.unit(setup.x) else ""
     unit_y = f" {setup.unit(setup.y)}" if setup.unit(setup.y) else ""
-    text = ", ".join(f"[{lo:.10g}, {hi:.10g}]" for lo, hi in runs) or "none"
-    notes = [f"stable {setup.y} at {setup.x} = {at:.10g}{unit_x}: {text}{unit_y if runs else ''}"]
+    codes = [tuple(setup.loop.classify(**{setup.x: at, setup.y: end}, **setup.values)
+                   if math.isfinite(end) else None for end in run) for run in runs]
+    text, ends, kinds = interval_texts(runs, codes, setup.y, setup.unit(setup.y))
+    notes = [f"stable {setup.y} at {setup.x} = {at:.10g}{unit_x}: {text}"]
+    if ends:
+        notes.append(ends)
     # The z = 1 line of a loop with an integrator lies at y = 0 up to rounding
     # (1e-12 of the interval): no minimum worth naming.
     if runs and runs[0][0] > 1e-9 * (runs[0][1] - runs[0][0]):
         notes.append(f"a minimum is needed: {setup.y} > {runs[0][0]:.10g}{unit_y}")
-    return notes, {"x": at, "intervals": [list(r) for r in runs]}
+    return notes, {"x": at, "intervals": [list(r) for r in runs], "ends": kinds}
 
 
 def _limits_rows(setup, lim):

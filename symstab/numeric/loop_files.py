@@ -11,12 +11,20 @@
     [parameters]
     m = { value = 0.0128, unit = "kg" }
     b = { value = 0.0324, unit = "N s/m" }
-    T = { value = 1e-3, unit = "s" }
+    T = { value = 1, unit = "ms" }  # converted: T = 0.001 s
     d = { value = 0, unit = "samples" }
-    K = 300.0                       # a bare number: no unit
+    K = 300.0                       # a bare number: taken in SI, unchecked
+    B = { value = 0.5, unit = "N s/m", min = 0 }   # a bound, checked
+
+(``examples/loops/lowpass_velocity.toml`` bounds its filter's cut-off by the
+Nyquist frequency: ``below = "1/(2*T)"``.)
 
 :func:`load_loop` reads one into a :class:`symstab.Loop`; every mistake is
-a :class:`ValueError` that names the file and the key.
+a :class:`ValueError` that names the file and the key.  Every value with a
+unit is converted to SI with pint, its dimension checked against the loop,
+and its bounds checked (:mod:`symstab.numeric.loop_units`); the loop holds
+the SI values (``defaults``) and SI units (``units``), and what the file
+wrote in ``loop.file_parameters``.
 
 A loop file is data, exchanged between colleagues, and nothing in it is
 run: the plant and the environment are built from their syntax tree
@@ -27,7 +35,6 @@ such a word); ``description`` and every unit are one line of printable text;
 a parameter's name is an ASCII identifier.  Anything else is refused.
 """
 
-import math
 import pathlib
 import re
 import sys
@@ -38,6 +45,7 @@ else:   # pragma: no cover - Python 3.10
     import tomli as tomllib
 
 from .any_loop import Loop
+from .loop_units import check_loop_units, read_parameters
 
 __all__ = ["load_loop", "parse_loop_text"]
 
@@ -77,39 +85,23 @@ def parse_loop_text(text, *, source="<loop file>"):
     for key in ("name", "description"):
         if key in data and not isinstance(data[key], str):
             raise ValueError(f"{source}: {key!r} must be a string, got {type(data[key]).__name__}")
-    values, units = {}, {}
-    parameters = data.get("parameters", {})
-    if not isinstance(parameters, dict):
-        raise ValueError(f"{source}: [parameters] must be a table")
-    for key, entry in parameters.items():
-        if isinstance(entry, dict):
-            extra = set(entry) - {"value", "unit"}
-            if extra or "value" not in entry:
-                raise ValueError(f"{source}: parameter {key!r} must be a number or "
-                                 f"{{ value = ..., unit = \"...\" }}")
-            value, unit = entry["value"], entry.get("unit")
-        else:
-            value, unit = entry, None
-        if isinstance(value, int) and not isinstance(value, bool) and abs(value) > 1e300:
-            value = math.inf   # past what a float holds: refused just below
-        if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
-            raise ValueError(f"{source}: parameter {key!r} must be a finite number, got {value!r}")
-        values[key] = value
-        if unit is not None:
-            if not isinstance(unit, str) or not unit.isprintable():
-                raise ValueError(f"{source}: the unit of {key!r} must be one line of text, "
-                                 f"got {unit!r}")
-            units[key] = unit
+    # Every value in SI, each unit read by pint (symstab.numeric.loop_units).
+    values, units, file_values, bounds = read_parameters(data.get("parameters", {}),
+                                                         source=source)
     plane = data.get("plane")
     if plane is not None and not (isinstance(plane, list) and len(plane) == 2
                                   and all(isinstance(p, str) for p in plane)):
         raise ValueError(f"{source}: 'plane' must be two parameter names, e.g. [\"B\", \"K\"]")
     try:
-        return Loop(data["plant"], data["environment"], values=values, units=units,
+        loop = Loop(data["plant"], data["environment"], values=values, units=units,
                     name=data.get("name", _default_name(source)),
                     description=data.get("description", ""), plane=plane)
     except (TypeError, ValueError) as exc:
         raise ValueError(f"{source}: {exc}") from None
+    # What the file wrote (units, bounds) beside the SI values the loop holds:
+    # the CLI echoes it and converts --set with it.
+    loop.file_parameters = check_loop_units(loop, file_values, bounds, source=source)
+    return loop
 
 
 def load_loop(path):

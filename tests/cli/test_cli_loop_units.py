@@ -1,0 +1,118 @@
+"""``--loop`` with units: ``--set`` converted like the file's values, bounds checked, echo as used.
+
+The oracle of each conversion is the same command with the value written in
+SI.  Every test here failed before the conversion (the unit was a label,
+``--set`` took its number as SI, a bound was not a key a loop file could
+have, ``--linear`` was refused without saying why).
+"""
+
+import re
+
+import pytest
+
+from conftest import REPO, run_cli as run, run_cli_json as run_json
+
+pytestmark = pytest.mark.usefixtures("loop_cache_dir")
+
+PAPER = REPO / "examples" / "loops" / "paper.toml"
+LOWPASS = str(REPO / "examples" / "loops" / "lowpass_velocity.toml")
+
+
+@pytest.fixture
+def paper_ms(tmp_path):
+    """The paper's loop file with T written as 1 ms."""
+    text = PAPER.read_text(encoding="utf-8")
+    old = 'T = { value = 1e-3, unit = "s" }'
+    assert old in text
+    path = tmp_path / "paper_ms.toml"
+    path.write_text(text.replace(old, 'T = { value = 1, unit = "ms" }'), encoding="utf-8")
+    return str(path)
+
+
+def _radius(capsys, *args):
+    out = run_json(capsys, "classify", *args)
+    return [row["spectral radius"] for row in out["rows"]], out
+
+
+def test_set_is_in_the_files_unit(capsys, paper_ms):
+    """--set T=0.5 in a file that gives T in ms is 0.5 ms, as --set T=5e-4 is in the SI file."""
+    ours, out = _radius(capsys, "--loop", paper_ms, "--set", "T=0.5", "--set", "K=1,3,10",
+                        "--set", "d=4")
+    reference, _ = _radius(capsys, "--loop", PAPER, "--set", "T=5e-4", "--set", "K=1,3,10",
+                           "--set", "d=4")
+    assert ours == pytest.approx(reference, rel=1e-12)
+    assert out["inputs"]["values"]["T"] == 5e-4 and out["inputs"]["units"]["T"] == "s"
+    assert out["inputs"]["as_written"]["T"] == {"value": 0.5, "unit": "ms"}
+
+
+@pytest.mark.parametrize("given, si", [
+    (["--set", "T=0.5ms"], ["--set", "T=5e-4"]),
+    (["--set", "T=500 us"], ["--set", "T=5e-4"]),
+    (["--set", "K=1,3,10 N/mm"], ["--set", "K=1000,3000,10000"]),
+    (["--set", "B=20 g/s"], ["--set", "B=0.02"]),
+    (["--set", "M=6.4 g"], ["--set", "M=0.0064"]),
+])
+def test_set_with_a_unit_is_converted(capsys, given, si):
+    base = ["--loop", PAPER, "--set", "d=4"]
+    base_k = [] if any(a.startswith("K=") for a in given) else ["--set", "K=1,3"]
+    ours, _ = _radius(capsys, *base, *base_k, *given)
+    reference, _ = _radius(capsys, *base, *base_k, *si)
+    assert ours == pytest.approx(reference, rel=1e-12)
+
+
+def test_the_echo_shows_the_value_as_written_and_as_used(capsys, paper_ms):
+    status, out, err = run(capsys, "classify", "--loop", paper_ms, "--set", "K=2,3",
+                           "--set", "B=0.3 kN s/km")
+    assert status == 0, err
+    values = next(line for line in out.splitlines() if line.startswith("values: "))
+    assert "T = 1 ms (0.001 s)" in values
+    assert "B = 0.3 kN s/km (0.3 N s/m) (--set)" in values
+    assert "K = [2, 3] N/m (--set)" in values      # already in SI: shown once
+
+
+@pytest.mark.parametrize("setting, match", [
+    ("T=3kg", r"--set T: parameter 'T' has unit 'kg'.*a time"),
+    ("K=3 kg", r"--set K: unit 'kg' is kg, and K is in N/m"),
+    ("K=3 furlongs_per_parsec", r"--set K: parameter 'K': unit 'furlongs_per_parsec' is not a unit "
+                                r"pint knows"),
+    ("d=4 ms", r"--set d: parameter 'd' has unit 'ms'"),
+])
+def test_set_with_a_unit_of_the_wrong_dimension_is_refused_in_one_line(capsys, setting, match):
+    status, out, err = run(capsys, "classify", "--loop", PAPER, "--set", setting)
+    assert status == 2 and out == ""
+    assert err.count("\n") == 1 and re.search(match, err), err
+
+
+@pytest.mark.parametrize("cut_off", ["f_c=3000", "f_c=3kHz"])
+def test_a_cut_off_above_nyquist_is_refused_like_the_simulators(capsys, tmp_path, cut_off):
+    """The file's bound below = "1/(2*T)": --set f_c=3000 at T = 0.25 ms, as map --velocity-cutoff 3000."""
+    out_file = tmp_path / "map.npz"
+    status, out, err = run(capsys, "map", "--loop", LOWPASS, "--set", "T=0.25ms", "--set", cut_off,
+                           "--x-range=0,1,3", "--y-range=0,1,3", "--out", out_file)
+    assert status == 2 and out == "" and not out_file.exists()
+    assert err.count("\n") == 1 and err.startswith("symstab map: error: --set T=..., --set f_c=...: ")
+    status, _, simulator = run(capsys, "map", "--velocity-cutoff", "3000", "--T", "0.00025",
+                               "--out", tmp_path / "paper.npz")
+    assert status == 2
+    wording = simulator.strip().split(" must be ", 1)[1]   # "a finite real number > 0 and < 2000, got 3000.0"
+    assert f"f_c must be {wording} Hz" in err
+
+
+def test_a_cut_off_below_nyquist_is_accepted(capsys):
+    out = run_json(capsys, "classify", "--loop", LOWPASS, "--set", "T=0.25ms", "--set", "f_c=1999",
+                   "--set", "d=1")
+    assert out["inputs"]["values"]["f_c"] == 1999.0
+
+
+def test_linear_with_a_loop_is_refused_saying_why(capsys):
+    status, out, err = run(capsys, "limits", "--loop", PAPER, "--linear")
+    assert status == 2 and err.count("\n") == 1
+    assert "rotary by default" in err and "units of the loop file" in err and "drop --linear" in err
+
+
+def test_the_help_says_what_set_does_with_units(capsys):
+    status, out, _ = run(capsys, "classify", "--help")
+    assert status == 0
+    text = " ".join(out.split())
+    assert "in the unit the file gives NAME" in text and "--set T=0.5ms" in text
+    assert "checked against the file's bounds" in text
