@@ -227,8 +227,9 @@ def _loop(args):
             raise ValueError(f"{flag} is an option of the paper's device; with --loop use "
                              f"{instead}")
     if args.linear:
-        raise ValueError("--linear is an option of the paper's device; with --loop the units "
-                         "are the loop file's")
+        raise ValueError("--linear names the units of the paper's device options (rotary by "
+                         "default, linear with --linear: the same numbers); with --loop every "
+                         "value is in the units of the loop file, converted to SI: drop --linear")
     sets, path = {}, None
     for text in args.set_values or ():
         flag = f"--set {text}"
@@ -246,28 +247,41 @@ def _loop(args):
                 raise ValueError(f"{flag}: the delay d is a whole number of samples, not a path")
             path = (name, _path(value, flag))
         else:
-            sets[name] = cli_loop._parse_number(name, value, flag, lists=False)
+            value, unit = cli_loop._split_unit(value, flag)
+            sets[name] = (cli_loop._parse_number(name, value, flag, lists=False), unit)
     if path is None:
         raise ValueError("give the path as one --set NAME=LOW:HIGH[:N], e.g. --set K=0:30")
     if args.d is not None:
         if "d" in sets:
             raise ValueError("give the delay once: --d or --set d=...")
-        sets["d"] = args.d
+        sets["d"] = (args.d, None)
     loop = cli_loop._load(args.loop)
     for name in list(sets) + [path[0]]:
         if name not in loop.parameters:
             raise ValueError(f"--set {name}: {name!r} is not a parameter of the loop in "
                              f"{args.loop} (parameters: {', '.join(loop.parameters)})")
+    # In the file's units, as every --set (symstab.cli.loop): to SI here.
+    sets, written = cli_loop._convert_sets(loop, sets)
+    ends = cli_loop._convert_sets(loop, {path[0]: ([path[1][0], path[1][-1]], None)})[0][path[0]]
+    path = (path[0], np.linspace(ends[0], ends[1], path[1].size))
     values = {n: v for n, v in loop.defaults.items() if n != path[0]}
     values.update(sets)
     missing = [n for n in loop.parameters if n not in values and n != path[0]]
     if missing:
         raise ValueError(f"no value for {', '.join(missing)}: the loop file {args.loop} gives "
                          f"none; add --set {missing[0]}=VALUE")
+    known = getattr(loop, "file_parameters", None)
+    if known is not None:
+        from ..numeric.loop_units import check_bounds
+
+        check_bounds(known, values, skip=(path[0],), where=lambda names: (
+            ", ".join(f"--set {n}=..." for n in sets if n in names) or str(args.loop)))
+        written = {**{n: (v.value, v.unit, v.si_unit) for n, v in known.values.items()
+                      if v.converted}, **written}
     name, given = path
     _announce(loop.coefficients(**values, **{name: given[0]}).shape[-1] - 1, given.size)
     result = track(loop, name, given, **values)
-    setup = cli_loop.LoopSetup(str(args.loop), loop, values, tuple(sets))
+    setup = cli_loop.LoopSetup(str(args.loop), loop, values, tuple(sets), written=written)
     unit = setup.unit(name)
     setup = dataclasses.replace(setup, echo=cli_loop._echo(setup) + (
         f"path: {name} from {given[0]:.10g} to {given[-1]:.10g}{' ' + unit if unit else ''} "

@@ -116,3 +116,22 @@ def test_the_help_says_what_set_does_with_units(capsys):
     text = " ".join(out.split())
     assert "in the unit the file gives NAME" in text and "--set T=0.5ms" in text
     assert "checked against the file's bounds" in text
+
+
+def test_locus_takes_its_set_and_its_path_in_the_files_units(capsys, tmp_path):
+    """K in N/mm: --set K=0:0.03 is the SI file's K = 0:30 N/m, and T = 1 ms is 0.001 s."""
+    text = PAPER.read_text(encoding="utf-8")
+    for old, new in (('T = { value = 1e-3, unit = "s" }', 'T = { value = 1, unit = "ms" }'),
+                     ('K = { value = 2.0, unit = "N/m" }', 'K = { value = 2.0, unit = "N/mm" }')):
+        assert old in text
+        text = text.replace(old, new)
+    path = tmp_path / "paper_mm.toml"
+    path.write_text(text, encoding="utf-8")
+    status, ours, err = run(capsys, "locus", "--loop", path, "--set", "B=100 g/s", "--set",
+                            "K=0:0.03:50", "--set", "d=4")
+    assert status == 0, err
+    status, reference, err = run(capsys, "locus", "--loop", PAPER, "--set", "B=0.1", "--set",
+                                 "K=0:30:50", "--set", "d=4")
+    assert status == 0, err
+    assert "path: K from 0 to 30 N/m (50 points)" in ours
+    assert ours.split("\npath: ", 1)[1] == reference.split("\npath: ", 1)[1]
