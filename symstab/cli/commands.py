@@ -17,6 +17,7 @@ import argparse
 import importlib.metadata
 import os
 import pathlib
+import shlex
 import signal
 import sys
 import tempfile
@@ -240,8 +241,9 @@ def _derive_loop(args):
     files = loop_derive.loop_files(loop)
     if args.check:
         stale = derive.check(out, files, owned=loop_derive.OWNED)
-        command = f"symstab derive --loop {args.loop}" + (
-            f" --out {args.out}" if args.out is not None else "")
+        # Quoted for a shell: the path is the user's and may hold anything.
+        command = shlex.join(["symstab", "derive", "--loop", str(args.loop)]
+                             + (["--out", str(args.out)] if args.out is not None else []))
         for path in stale:
             print(f"drift: {path} differs from a fresh derivation; run `{command}`")
         if stale:
