@@ -62,10 +62,22 @@ class Setup:
         return out
 
 
+#: The one rule for the units of the paper's device options (also in the README).
+UNITS_RULE = ("Units: the device options are rotary by default, as the paper's device is a "
+              "paddle (m and M_w in kg m^2, b and B_w in N m s/rad, K_w in N m/rad); --linear "
+              "reads and prints the same numbers as a sliding mass's (kg, N s/m, N/m): the "
+              "equations are the same, only the units' names change.  T and Td are in s.  A "
+              "loop file (--loop) has its own units, converted to SI; --linear does not apply "
+              "to it.")
+
+
 def _add_model_options(p):
-    g = p.add_argument_group("device and delay (physical; default: the paper's device)")
-    g.add_argument("--m", type=float, help="effective mass, kg (or kg m^2), > 0 (default 0.0128)")
-    g.add_argument("--b", type=float, help="viscous friction, N s/m (or N m s/rad), >= 0 (default 0.0324)")
+    g = p.add_argument_group("device and delay (physical; default: the paper's device)",
+                             textwrap.fill(UNITS_RULE, 77))
+    g.add_argument("--m", type=float, help="effective mass (inertia), kg m^2 (kg with --linear), "
+                                           "> 0 (default 0.0128)")
+    g.add_argument("--b", type=float, help="viscous friction, N m s/rad (N s/m with --linear), "
+                                           ">= 0 (default 0.0324)")
     g.add_argument("--T", type=float, help="sample period, s, > 0 (default 0.001)")
     g.add_argument("--Td", type=float, help="loop delay, s, a whole number of periods (default 0)")
     g = p.add_argument_group("device and delay (dimensionless, instead of --m --b --T --Td)")
@@ -75,10 +87,11 @@ def _add_model_options(p):
     g = p.add_argument_group("virtual mass")
     x = g.add_mutually_exclusive_group()
     x.add_argument("--gamma", type=float, help="M_w / m (default 0)")
-    x.add_argument("--Mw", type=float, help="virtual mass, kg (or kg m^2)")
+    x.add_argument("--Mw", type=float, help="virtual mass, kg m^2 (kg with --linear)")
     p.add_argument("--linear", action="store_true",
-                   help="label physical units for a linear device (N/m, N s/m, kg) "
-                        "instead of a rotary one (N m/rad, N m s/rad, kg m^2)")
+                   help="linear units (kg, N s/m, N/m) instead of the rotary default (kg m^2, "
+                        "N m s/rad, N m/rad) for the device options and the results: the same "
+                        "numbers; not with --loop")
     p.add_argument("--format", choices=FORMATS, default="table", help="output format (default: table)")
 
 

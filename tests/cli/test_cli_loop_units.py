@@ -135,3 +135,20 @@ def test_locus_takes_its_set_and_its_path_in_the_files_units(capsys, tmp_path):
     assert status == 0, err
     assert "path: K from 0 to 30 N/m (50 points)" in ours
     assert ours.split("\npath: ", 1)[1] == reference.split("\npath: ", 1)[1]
+
+
+def test_one_rule_for_the_units_of_the_device_options_in_the_help_and_the_readme(capsys):
+    """--m 0.2 echoed kg m^2 while the README called the device's K N/m: the rule is stated once."""
+    from symstab.cli.numeric import UNITS_RULE
+
+    status, out, _ = run(capsys, "limits", "--help")
+    assert status == 0 and " ".join(UNITS_RULE.split()) in " ".join(out.split())
+    readme = " ".join((REPO / "README.md").read_text(encoding="utf-8").replace("`", "").split())
+    assert ("The device options are rotary by default, as the paper's device is a paddle "
+            "(m and M_w in kg m², b and B_w in N m s/rad, K_w in N m/rad); --linear reads and "
+            "prints the same numbers as a sliding mass's (kg, N s/m, N/m)") in readme
+    assert "--linear does not apply to it and is refused with --loop" in readme
+    status, out, _ = run(capsys, "limits", "--m", "0.2", "--format", "table")
+    assert status == 0 and "m = 0.2 kg m^2" in out and "N m/rad" in out
+    status, out, _ = run(capsys, "limits", "--m", "0.2", "--linear")
+    assert status == 0 and "m = 0.2 kg," in out and "N m/rad" not in out and "N/m" in out

@@ -242,3 +242,35 @@ def test_every_unit_of_every_example_file_is_converted(path):
         assert loop.defaults[name] == pytest.approx(expected, rel=1e-15), name
         assert loop.file_parameters.values[name].unit == entry["unit"]
 
+
+
+FACTORS.update({"us": 1e-6, "N mm/rad": 1e-3, "lbf/in": 4.4482216152605 / 0.0254})
+
+
+def test_every_unit_in_the_readme_is_converted_or_said_to_be_refused():
+    readme = (REPO / "README.md").read_text(encoding="utf-8")
+    units = set(re.findall(r'unit = "([^"]*)"', readme))
+    assert {"ms", "g", "N/mm"} <= units
+    refused = set(re.findall(r'unit = "([^"]*)"[^\n]*# refused', readme))
+    assert {"kg", "degC", "rad/s"} <= refused
+    listed = re.search(r"any unit pint\s+knows — (.*?) — is converted", readme, re.S).group(1)
+    named = set(re.findall(r"`([^`]+)`", listed))
+    assert len(named) >= 10
+    for unit in sorted((units | named) - refused - {"samples"}):
+        assert unit in FACTORS, unit
+        assert float(unit_info(unit).factor) == pytest.approx(FACTORS[unit], rel=1e-14), unit
+    for unit in sorted(refused):
+        with pytest.raises(ValueError, match=rf"parameter 'K'.*'{re.escape(unit)}'"):
+            parse_loop_text(_paper(K=f'{{ value = 2.0, unit = "{unit}" }}'))
+
+
+def test_the_readmes_loop_file_is_read_as_its_comments_say():
+    readme = (REPO / "README.md").read_text(encoding="utf-8")
+    block = re.search(r"## Loop files.*?```toml\n(.*?)```", readme, re.S).group(1)
+    loop = parse_loop_text(block, source="README")
+    assert loop.name == "my_paddle" and loop.plane == ("B", "K")
+    assert loop.defaults == pytest.approx({"m": 0.0128, "b": 0.0324, "T": 0.00025, "d": 1,
+                                           "K": 2000.0, "B": 0.5}, rel=1e-15)
+    assert loop.units == {"m": "kg", "b": "N s/m", "T": "s", "d": "samples", "K": "N/m"}
+    with pytest.raises(ValueError, match=r"K must be a finite real number >= 0, got -1\.0"):
+        check_bounds(loop.file_parameters, dict(loop.defaults, K=-1.0), where="--set")
