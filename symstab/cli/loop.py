@@ -484,7 +484,12 @@ def _emit(setup, fmt, columns, rows, **kwargs):
 
 
 def _signed(terms):
-    """``"a + b x - c y"`` from ``[(a, ""), (b, "x"), (c, "y")]`` (the first term keeps its sign)."""
+    """``"a + b x - c y"`` from ``[(a, ""), (b, "x"), (c, "y")]`` (the first term keeps its sign).
+
+    Terms that are exactly 0 are left out ("K = 0", not "K = 0 + 0 B"): the
+    lines' coefficients are exact zeros where the loop makes them so.
+    """
+    terms = [(value, name) for value, name in terms if value != 0] or [(0.0, "")]
     text = ""
     for k, (value, name) in enumerate(terms):
         number = f"{abs(value) if k else value:.10g}" + (f" {name}" if name else "")

@@ -164,6 +164,68 @@ def _number(x):
     return "nan" if math.isnan(x) else f"{x:.10g}"
 
 
+def _end_text(value):
+    # -0.0 (an end computed as -c0/c1 with c0 = 0) is the end 0.
+    return "-inf" if value == -math.inf else "inf" if value == math.inf else f"{value + 0.0:.10g}"
+
+
+def _listed(words):
+    return words[0] if len(words) == 1 else ", ".join(words[:-1]) + " and " + words[-1]
+
+
+def interval_texts(runs, codes, name, unit=""):
+    """Stable intervals as text, open at every end, and what their finite ends are.
+
+    A stable set is open: an interval's end is on the boundary, where a pole
+    is on the unit circle (marginal), so "[0, ...]" would call a point stable
+    that is not.  The ends are printed as computed, and exact where they are
+    exact (the z = 1 line of a plant with an integrator is K = 0).
+
+    Parameters
+    ----------
+    runs : list of (float, float)
+        The stable intervals, increasing; an end may be infinite.
+    codes : list of (int, int)
+        The classification (:data:`symstab.numeric.stability.MARGINAL`,
+        ``UNSTABLE`` or ``STABLE``) of each finite end (ignored for infinite ones).
+    name, unit : str
+        The parameter along the intervals, and its unit.
+
+    Returns
+    -------
+    (str, str or None, list)
+        ``"(0, 108.8220385) N/m"`` (or ``"none"``), the note on the ends
+        (None without finite ends) and, per interval, the kind of each end
+        (``"marginal"``, ``"unstable"``, ``"boundary"`` or ``"infinite"``) for JSON.
+    """
+    from ..numeric.stability import MARGINAL, UNSTABLE
+
+    suffix = f" {unit}" if unit else ""
+    if not runs:
+        return "none", None, []
+    text = ", ".join(f"({_end_text(lo)}, {_end_text(hi)})" for lo, hi in runs) + suffix
+    kinds, found = [], {"marginal": [], "unstable": [], "boundary": []}
+    for (lo, hi), pair in zip(runs, codes):
+        row = []
+        for value, code in zip((lo, hi), pair):
+            if math.isinf(value):
+                row.append("infinite")
+                continue
+            # A finite end the root count calls stable is on the boundary to
+            # within the rounding of the end itself: not stable either.
+            kind = "marginal" if code == MARGINAL else "unstable" if code == UNSTABLE else "boundary"
+            row.append(kind)
+            if _end_text(value) not in found[kind]:
+                found[kind].append(_end_text(value))
+        kinds.append(row)
+    said = {"marginal": "marginal (a pole on the unit circle)", "unstable": "unstable",
+            "boundary": "on the boundary to within rounding"}
+    parts = [f"{said[kind]} at {name} = {_listed(values)}{suffix}"
+             for kind, values in found.items() if values]
+    note = ("open intervals: their ends are not stable; " + "; ".join(parts)) if parts else None
+    return text, note, kinds
+
+
 def _emit(setup, fmt, columns, rows, *, result=None, notes=(), out=None, json_rows=True):
     """Print ``rows`` (tuples matching ``columns``) in ``fmt``.
 
@@ -356,17 +418,29 @@ def _cmd_limits(args):
         from .._validate import check_real
         damping = check_real("beta", damping)
         runs = [] if lim.empty else lim.alpha_interval(damping)
-        text = ", ".join(f"[{lo:.10g}, {hi:.10g}]" for lo, hi in runs) or "none"
+        from ..numeric.stability import classify
+
+        codes = [tuple(int(classify(alpha=end, beta=damping, gamma=setup.gamma, d=setup.d,
+                                    delta=setup.delta)) if math.isfinite(end) else None
+                       for end in run) for run in runs]
+        text, ends, kinds = interval_texts(runs, codes, "alpha")
         notes.append(f"stable alpha at beta = {damping:.10g}: {text}")
         if setup.physical and runs:
             dev = setup.device
-            notes.append("stable K_w at B_w = {:.10g} {}: {}".format(
-                float(dev.damping(damping)), setup.units["B_w"],
-                ", ".join(f"[{float(dev.stiffness(lo)):.10g}, {float(dev.stiffness(hi)):.10g}]"
-                          for lo, hi in runs) + f" {setup.units['K_w']}"))
+
+            def stiffness(alpha):
+                return alpha if math.isinf(alpha) else float(dev.stiffness(alpha))
+
+            physical = [tuple(stiffness(end) for end in run) for run in runs]
+            text, ends, _ = interval_texts(physical, codes, "K_w", setup.units["K_w"])
+            notes.append(f"stable K_w at B_w = {float(dev.damping(damping)):.10g} "
+                         f"{setup.units['B_w']}: {text}")
+        if ends:
+            notes.append(ends)
         if runs and runs[0][0] > 0:
             notes.append(f"a minimum stiffness is needed: alpha > {runs[0][0]:.10g}")
-        result["alpha_intervals"] = {"beta": damping, "intervals": [list(r) for r in runs]}
+        result["alpha_intervals"] = {"beta": damping, "intervals": [list(r) for r in runs],
+                                     "ends": kinds}
     more, result["passive"] = _passive(setup, lim)
     notes += more
     _emit(setup, args.format, columns, rows, result=result, notes=notes, json_rows=False)

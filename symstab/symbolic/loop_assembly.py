@@ -613,5 +613,11 @@ class LoopModel:
                                  f"e.g. b = 0 in 1/(m s**2 + b s)? write that plant with b = 0)")
             ends = [sum(c * sign**k for k, c in enumerate(reversed(part)))
                     for sign in (1, -1) for part in (p_n, p_d)]
+            # A pole at z = 1 (an integrator) makes P_d(1) vanish, but the sum
+            # keeps the 30-digit rounding of its terms (1e-30 of them: K =
+            # 6e-25 N/m for the z = 1 line at T = 0.25 ms); an end within
+            # 1000 ulps of its terms is that zero.
+            ends = [mpmath.mpf(0) if abs(end) <= mpmath.mpf(10)**(3 - _DPS) * sum(abs(c) for c in part)
+                    else end for end, part in zip(ends, (p_n, p_d, p_n, p_d))]
             return tuple(np.array(_real_floats([c / lead for c in part]))
                          for part in (p_n, p_d, ends))
