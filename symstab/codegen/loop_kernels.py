@@ -17,8 +17,9 @@ name, the expressions) enters the module only as a string literal or an
 escaped comment (:func:`symstab.codegen.generator.comment_text`).
 
 The cache folder is ``$SYMSTAB_CACHE_DIR``, else ``$XDG_CACHE_HOME/symstab``,
-else ``~/.cache/symstab``; where it cannot be written no copy is kept
-(the module's ``__file__`` is None).
+else ``~/.cache/symstab`` (:func:`symstab.symbolic.derivation_cache.cache_dir`; the
+loop's derivation is cached there too); where it cannot be written no copy
+is kept (the module's ``__file__`` is None).
 """
 
 import hashlib
@@ -32,22 +33,14 @@ import sympy as sp
 from ..symbolic import model
 from .generator import (CKernelPrinter, Kernel, NumPyKernelPrinter, _c_function,
                         _python_function, comment_text)
+from ..symbolic.derivation_cache import CACHE_ENV, cache_dir
 from ..symbolic.loop_assembly import is_affine
 
 __all__ = ["CACHE_ENV", "cache_dir", "header", "numpy_source", "c_source", "load_numpy_kernels",
            "environment_kernels"]
 
-CACHE_ENV = "SYMSTAB_CACHE_DIR"
 #: Bumped when the layout of the generated text changes (part of the hash).
 _LAYOUT = "loop-kernels-2"
-
-
-def cache_dir():
-    """The folder of cached per-loop kernels (it may not exist yet)."""
-    if os.environ.get(CACHE_ENV):
-        return pathlib.Path(os.environ[CACHE_ENV])
-    base = os.environ.get("XDG_CACHE_HOME") or os.path.join(os.path.expanduser("~"), ".cache")
-    return pathlib.Path(base) / "symstab"
 
 
 def header(language, title, command):

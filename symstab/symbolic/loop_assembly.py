@@ -29,6 +29,7 @@ import sympy as sp
 
 from . import model
 from .._validate import check_delay
+from .derivation_cache import DerivationCache
 from .discretize import numeric_zoh, written_poles, zoh_pulse_transfer_function
 
 __all__ = ["LoopModel", "parse_plant", "parse_environment", "check_parameter_name",
@@ -433,18 +434,39 @@ class LoopModel:
                 f"zoh={self.zoh_method!r})")
 
     @functools.cached_property
+    def _derivation(self):
+        """The loop's derivation cached on disk (:mod:`symstab.symbolic.derivation_cache`)."""
+        return DerivationCache(self.plant, self.environment,
+                               dict(self._symbols, s=model.s, z=model.z))
+
+    def _derived(self, name, derive):
+        """``derive()``, or what an earlier derivation of this loop stored under ``name``."""
+        value = self._derivation.get(name)
+        if value is DerivationCache.MISSING:
+            value = derive()
+            self._derivation.put(name, value)
+        return value
+
+    @functools.cached_property
     def _environment_parts(self):
-        num, den = sp.fraction(sp.cancel(sp.together(self.environment)))
-        return poly_coeffs(num, model.z), poly_coeffs(den, model.z)
+        def derive():
+            num, den = sp.fraction(sp.cancel(sp.together(self.environment)))
+            return poly_coeffs(num, model.z), poly_coeffs(den, model.z)
+
+        return self._derived("environment_parts", derive)
 
     @functools.cached_property
     def _plant_parts(self):
         """(P_n, P_d) coefficient lists in z (symbolic), or None for the numeric path."""
         if self.zoh_method != "residues":
             return None
-        pulse = zoh_pulse_transfer_function(self.plant)
-        num, den = sp.fraction(sp.cancel(pulse))
-        return poly_coeffs(num, model.z), poly_coeffs(den, model.z)
+
+        def derive():
+            pulse = zoh_pulse_transfer_function(self.plant)
+            num, den = sp.fraction(sp.cancel(pulse))
+            return poly_coeffs(num, model.z), poly_coeffs(den, model.z)
+
+        return self._derived("plant_parts", derive)
 
     def pulse_transfer_function(self):
         """``Z[ZOH G](z)`` as a SymPy rational function of ``z``.
@@ -517,7 +539,7 @@ class LoopModel:
     @functools.cached_property
     def _parts(self):
         """Delayed and direct coefficient lists (symbolic path only)."""
-        return self._symbolic_parts()
+        return self._derived("parts", self._symbolic_parts)
 
     def affine_parameters(self):
         """Names of the parameters in which the characteristic polynomial is affine.
@@ -534,6 +556,9 @@ class LoopModel:
 
     @functools.lru_cache(maxsize=None)
     def _affine(self, names):
+        return self._derived(f"affine {','.join(names)}", lambda: self._decide_affine(names))
+
+    def _decide_affine(self, names):
         symbols = [self._symbols[n] for n in names]
         if self._plant_parts is None:
             if any(n in self._plant_names or n == "T" for n in names):
