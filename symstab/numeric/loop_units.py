@@ -148,8 +148,8 @@ def unit_info(text):
     Raises
     ------
     ValueError
-        If pint does not know it, it is an offset unit (degC) or it is not
-        a unit (a number other than 1 alone, a long exponent).
+        If pint does not know it, it is an offset unit (degC), its size is
+        0 or not a float, or an exponent is not a short number.
     """
     if not isinstance(text, str):
         raise TypeError(f"a unit must be a string, got {type(text).__name__}")
@@ -169,13 +169,17 @@ def unit_info(text):
         base = quantity.to_base_units()
         zero = registry.Quantity(0, quantity.units).to_base_units().magnitude
         factor = fractions.Fraction(base.magnitude)
+        size = float(factor)
     except Exception as exc:   # pint's own errors (undefined unit, syntax) and arithmetic ones
-        reason = str(exc).strip() or type(exc).__name__
+        try:
+            reason = str(exc).strip() or type(exc).__name__
+        except Exception:   # some of pint's messages cannot format their own Fractions
+            reason = type(exc).__name__
         raise ValueError(f"unit {text!r} is not a unit pint knows ({reason})") from None
     if zero != 0:
         raise ValueError(f"unit {text!r} has an offset (like degC): give a unit without one "
                          f"(K, for a temperature)")
-    if not factor or not math.isfinite(float(factor)):
+    if not size or not math.isfinite(size):
         raise ValueError(f"unit {text!r} has no finite nonzero size")
     dims = quantity.dimensionality
     unknown = [k for k in dims if k not in _BASES]
@@ -281,7 +285,10 @@ def convert(name, value, unit, *, where):
         raise ValueError(f"{where}: parameter {name!r} has unit {unit!r}, an angular frequency: "
                          f"give it in Hz or 1/s, as the loop's expressions use it (SI takes "
                          f"1 rad/s as 1/s, a factor 2 pi from 1 Hz)")
-    si_value = float(fractions.Fraction(value) * info.factor)
+    try:
+        si_value = float(fractions.Fraction(value) * info.factor)
+    except OverflowError:
+        si_value = math.inf
     if not math.isfinite(si_value) or (si_value == 0 and value != 0):
         raise ValueError(f"{where}: parameter {name!r} = {value!r} {unit} is not representable "
                          f"as a float in SI ({info.si})")
@@ -508,7 +515,7 @@ def _check_dimensions(loop, file_values, bounds, source):
                 needs.setdefault(name, set())
                 if result[name] is not None:
                     needs[name].add(dimension_name(result[name]))
-    reason = _reason(system, known)
+    reason = _reason(system, known, loop)
     law = ("the plant G(s) maps force to displacement and VE(z) displacement to force, "
            "N/m or N m/rad; s is 1/time, z has no unit")
 
@@ -559,7 +566,7 @@ def _written(entry):
     return repr(entry.unit) + ("" if named == entry.unit else f" ({named})")
 
 
-def _reason(system, known):
+def _reason(system, known, loop):
     """The first constraint that the given units break on their own, in words."""
     sub = {}
     for name, dims in known.items():
@@ -578,12 +585,19 @@ def _reason(system, known):
         if any(v.free_symbols for v in values) or not any(values):
             continue
         if where == "loop":
-            return "the loop gain VE(z) G(s) is not dimensionless"
+            return (f"the plant G(s) is in {_dimension_text(dims_of(loop.plant))} and the "
+                    f"environment VE(z) in {_dimension_text(dims_of(loop.environment))}: the "
+                    f"loop gain VE(z) G(s) must have no unit")
         if b is None:
             return f"in {where}, {a} must be dimensionless, and is {_dimension_text(dims_of(a))}"
         return (f"in {where}, {a} ({_dimension_text(dims_of(a))}) and {b} "
                 f"({_dimension_text(dims_of(b))}) are added")
-    return "the dimensions have no solution"
+    for what, expr, need in (("the plant G(s)", loop.plant, "m/N or rad/(N m)"),
+                             ("the environment VE(z)", loop.environment, "N/m or N m/rad")):
+        have = dims_of(expr)
+        if have is not None:
+            return f"{what} is in {_dimension_text(have)}, and must be in {need}"
+    return "no dimensions of the parameters without a unit make it fit"
 
 
 # --------------------------------------------------------------------------

@@ -167,6 +167,30 @@ def test_two_units_that_do_not_fit_together_name_both():
         parse_loop_text(text)
 
 
+def test_a_plant_that_is_not_force_to_displacement_is_refused_saying_so():
+    """Each term of m s^3 + b s^2 + k s + c agrees, but G(s) is then s^3/kg, not m/N."""
+    text = _paper(b='{ value = 0.0324, unit = "kg/s" }').replace(
+        'plant = "1/(m*s**2 + b*s)"', 'plant = "1/(m*s**3 + b*s**2 + k*s + c)"').replace(
+        "[parameters]", '[parameters]\nk = { value = 50.0, unit = "N/m" }\n'
+                        'c = { value = 10.0, unit = "N/(m s)" }')
+    with pytest.raises(ValueError, match=r"the units of .* do not fit the loop \(the plant G\(s\) "
+                                         r"is in kg\^-1 s\^3 and the environment VE\(z\) in "
+                                         r"kg s\^-2: the loop gain VE\(z\) G\(s\) must have no unit"):
+        parse_loop_text(text)
+    bare = text.replace('K = { value = 2.0, unit = "N/m" }', "K = 2.0").replace(
+        'B = { value = 0.1, unit = "N s/m" }', "B = 0.1").replace('M = { value = 0.0, unit = "kg" }',
+                                                                 "M = 0.0")
+    with pytest.raises(ValueError, match=r"the plant G\(s\) is in kg\^-1 s\^3, and must be in "
+                                         r"m/N or rad/\(N m\)"):
+        parse_loop_text(bare)
+
+
+@pytest.mark.parametrize("unit", ["1e99999", "1e-99999 m", ';l""mbp\\+s#2@*', "10**10**10"])
+def test_a_unit_that_is_no_size_or_no_unit_is_refused_with_a_value_error(unit):
+    with pytest.raises(ValueError, match=r"parameter 'K'"):
+        parse_loop_text(_paper(K=f"{{ value = 2.0, unit = '{unit}' }}"))
+
+
 def test_a_bare_number_is_taken_in_si_and_unchecked():
     loop = parse_loop_text(_paper(K="2.0", T="0.001"))
     assert loop.defaults["K"] == 2.0 and "K" not in loop.units

@@ -38,7 +38,8 @@ from symstab.numeric.loop_files import load_loop, parse_loop_text
 PAPER_FILE = REPO / "examples" / "loops" / "paper.toml"
 
 #: A plant whose denominator is an irreducible cubic: the numeric (matrix
-#: exponential) path.  A spring and a damper as environment.
+#: exponential) path.  A spring and a damper as environment.  The units are
+#: those that make G(s) force to displacement (loop files' units are checked).
 NUMERIC_LOOP = """\
 name = "spring-device"
 description = "A third-order device: a mass on a spring with friction and an elastic ground"
@@ -47,10 +48,10 @@ environment = "K + B*(z - 1)/(T*z)"
 plane = ["B", "K"]
 
 [parameters]
-m = { value = 0.0128, unit = "kg" }
-b = { value = 0.0324, unit = "N s/m" }
-k = { value = 50.0, unit = "N/m" }
-c = { value = 10.0, unit = "N/(m s)" }
+m = { value = 0.0128, unit = "N s^3/m" }
+b = { value = 0.0324, unit = "N s^2/m" }
+k = { value = 50.0, unit = "N s/m" }
+c = { value = 10.0, unit = "N/m" }
 T = { value = 1e-3, unit = "s" }
 d = { value = 3, unit = "samples" }
 """
