@@ -505,7 +505,10 @@ class LoopModel:
             raise TypeError(f"unknown parameter(s) {', '.join(sorted(unknown))}; "
                             f"parameters: {', '.join(self.parameters)}")
         z = model.z
-        delayed, direct = self._symbolic_parts(values)
+        # The residue path's parts do not depend on the values: derived (or
+        # read from the cache) once.
+        delayed, direct = (self._parts if self._plant_parts is not None
+                           else self._symbolic_parts(values))
         poly = (z**model.d * sp.Add(*[c * z**k for k, c in enumerate(reversed(delayed))])
                 + sp.Add(*[c * z**k for k, c in enumerate(reversed(direct))]))
         sub = {self._symbols[k]: v for k, v in values.items() if k != "d"}
