@@ -105,7 +105,12 @@ def parse_loop_text(text, *, source="<loop file>"):
 
 
 def load_loop(path):
-    """Read a loop file (TOML) into a :class:`Loop` with its default values and units.
+    """Read a loop file (TOML) into a :class:`Loop` with its default values in SI.
+
+    The values the file gives with a unit are converted to SI (and their
+    dimensions and bounds checked); ``loop.units`` names the SI units and
+    ``loop.file_parameters`` keeps what the file wrote
+    (:class:`symstab.numeric.loop_units.FileParameters`).
 
     Parameters
     ----------

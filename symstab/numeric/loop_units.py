@@ -253,11 +253,25 @@ def convert(name, value, unit, *, where):
     dimension of any other parameter is checked against the loop by
     :func:`check_loop_units`.
 
+    Parameters
+    ----------
+    name : str
+        The parameter.
+    value : int or float
+        As written (finite).
+    unit : str or None
+        As written; None for a bare number, taken in SI and returned as is.
+    where : str
+        Begins every message: the file, or the ``--set`` option.
+
+    Returns
+    -------
+    FileValue
+
     Raises
     ------
     ValueError
-        Beginning with ``where`` (the file, or the ``--set`` option), naming
-        the parameter, the unit given and the one expected.
+        Naming the parameter, the unit given and the one expected.
     """
     from ..symbolic.loop_assembly import check_text_line
 
@@ -301,6 +315,14 @@ def _vector(mapping):
 
 def read_parameters(parameters, *, source):
     """The ``[parameters]`` table of a loop file: its values in SI and their units.
+
+    Parameters
+    ----------
+    parameters : dict
+        The table as TOML reads it: a bare number or ``{ value, unit, min,
+        max, above, below }`` per parameter.
+    source : str
+        The file, for messages.
 
     Returns
     -------
