@@ -19,7 +19,7 @@ import sys
 import numpy as np
 
 from . import loop as cli_loop
-from .numeric import _add_model_options, _emit, _resolve
+from .numeric import _add_model_options, _emit, _resolve, interval_texts
 
 __all__ = ["add_commands"]
 
@@ -380,16 +380,32 @@ def _rows(view):
 
 def _notes(view, stretches, certified):
     locus = view.locus
-    unit = f" {view.unit}" if view.unit else ""
     notes = []
     if not locus.crossings:
         count = stretches[0][2]
         notes.append(f"no pole crosses the unit circle along the path; "
                      f"{'unknown' if count is None else count} pole(s) outside it throughout")
-    stable = [(lo, hi) for lo, hi, c in stretches if c == 0]
-    text = ", ".join(f"[{_printed(view, min(lo, hi)):.10g}, {_printed(view, max(lo, hi)):.10g}]"
-                     for lo, hi in stable) or "none"
-    notes.append(f"stable along the path: {view.name} in {text}{unit if stable else ''}")
+    from ..numeric.stability import MARGINAL, STABLE, UNSTABLE
+
+    stable, codes = [], []
+    ends = {float(locus.values[0]): certified[0], float(locus.values[-1]): certified[-1]}
+    for lo, hi, c in stretches:
+        if c != 0:
+            continue
+        # A crossing has a pole on the unit circle (marginal, an open end); an
+        # end of the path is what its certified count says (stable: closed).
+        pair = [MARGINAL if value not in ends else
+                STABLE if ends[value] == 0 else MARGINAL if ends[value] < 0 else UNSTABLE
+                for value in (lo, hi)]
+        shown = [_printed(view, lo), _printed(view, hi)]
+        order = (0, 1) if shown[0] <= shown[1] else (1, 0)
+        stable.append(tuple(shown[k] for k in order))
+        codes.append(tuple(pair[k] for k in order))
+    text, ends_note, _ = interval_texts(stable, codes, view.name, view.unit or "",
+                                        stable_ends="closed")
+    notes.append(f"stable along the path: {view.name} in {text}")
+    if ends_note:
+        notes.append(ends_note)
     if any(_snap(view, c.value) == 0.0 != c.value for c in locus.crossings):
         notes.append(f"a crossing within {_ZERO:g} of the path's span from 0 is printed as 0 "
                      f"(the eigenvalues' rounding; the JSON output keeps the value found)")

@@ -173,8 +173,8 @@ def _listed(words):
     return words[0] if len(words) == 1 else ", ".join(words[:-1]) + " and " + words[-1]
 
 
-def interval_texts(runs, codes, name, unit=""):
-    """Stable intervals as text, open at every end, and what their finite ends are.
+def interval_texts(runs, codes, name, unit="", *, stable_ends="boundary"):
+    """Stable intervals as text, open at every end that is not stable, and what those ends are.
 
     A stable set is open: an interval's end is on the boundary, where a pole
     is on the unit circle (marginal), so "[0, ...]" would call a point stable
@@ -190,26 +190,40 @@ def interval_texts(runs, codes, name, unit=""):
         ``UNSTABLE`` or ``STABLE``) of each finite end (ignored for infinite ones).
     name, unit : str
         The parameter along the intervals, and its unit.
+    stable_ends : {"boundary", "closed"}
+        What an end classified stable is: a computed boundary point, stable
+        only by its rounding ("boundary", the default), or a stable end of
+        the range searched (a path's end: "closed", printed with a bracket).
 
     Returns
     -------
     (str, str or None, list)
         ``"(0, 108.8220385) N/m"`` (or ``"none"``), the note on the ends
         (None without finite ends) and, per interval, the kind of each end
-        (``"marginal"``, ``"unstable"``, ``"boundary"`` or ``"infinite"``) for JSON.
+        (``"marginal"``, ``"unstable"``, ``"boundary"``, ``"stable"`` or
+        ``"infinite"``) for JSON.
     """
-    from ..numeric.stability import MARGINAL, UNSTABLE
+    from ..numeric.stability import MARGINAL, STABLE, UNSTABLE
 
+    if stable_ends not in ("boundary", "closed"):
+        raise ValueError(f"stable_ends must be 'boundary' or 'closed', got {stable_ends!r}")
     suffix = f" {unit}" if unit else ""
     if not runs:
         return "none", None, []
-    text = ", ".join(f"({_end_text(lo)}, {_end_text(hi)})" for lo, hi in runs) + suffix
+    closed = [tuple(stable_ends == "closed" and code == STABLE and not math.isinf(value)
+                    for value, code in zip(run, pair)) for run, pair in zip(runs, codes)]
+    text = ", ".join(f"{'[' if shut[0] else '('}{_end_text(lo)}, {_end_text(hi)}"
+                     f"{']' if shut[1] else ')'}"
+                     for (lo, hi), shut in zip(runs, closed)) + suffix
     kinds, found = [], {"marginal": [], "unstable": [], "boundary": []}
     for (lo, hi), pair in zip(runs, codes):
         row = []
         for value, code in zip((lo, hi), pair):
             if math.isinf(value):
                 row.append("infinite")
+                continue
+            if stable_ends == "closed" and code == STABLE:
+                row.append("stable")
                 continue
             # A finite end the root count calls stable is on the boundary to
             # within the rounding of the end itself: not stable either.

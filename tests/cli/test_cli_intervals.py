@@ -93,3 +93,23 @@ def test_interval_texts_open_infinite_and_unstable_ends():
                     "within rounding at K = 2 N/m")
     assert kinds == [["infinite", "marginal"], ["unstable", "boundary"], ["marginal", "infinite"]]
     assert interval_texts([], [], "K") == ("none", None, [])
+
+
+def test_locus_path_ends_are_closed_where_stable_and_crossings_open(capsys):
+    # From K_w = 0.5 (stable, an end of the path: closed) across the crossing
+    # at 2.9536 (a pair on the unit circle: open) at d = 40, B_w = 0.1.
+    status, out, err = run_cli(capsys, "locus", "--Td", "0.04", "--Bw", "0.1", "--Kw", "0.5:30")
+    assert status == 0, err
+    found = re.search(r"stable along the path: K_w in \[0\.5, ([0-9.]+)\) N m/rad\n", out)
+    assert found, out
+    top = float(found.group(1))
+    # python-control's poles of this degree-43 loop carry about 2e-6: the
+    # crossing is checked by the sign change of the radius 2 % either side.
+    assert python_control_radius(0.98 * top, 0.1, T=1e-3, d=40) < 1
+    assert python_control_radius(1.02 * top, 0.1, T=1e-3, d=40) > 1
+    assert python_control_radius(top, 0.1, T=1e-3, d=40) == pytest.approx(1, abs=1e-5)
+    assert (f"open intervals: their ends are not stable; marginal (a pole on the unit circle) "
+            f"at K_w = {found.group(1)} N m/rad") in out
+    status, out, err = run_cli(capsys, "locus", "--Td", "0.04", "--Bw", "0.1", "--Kw", "0.5:1")
+    assert "stable along the path: K_w in [0.5, 1] N m/rad" in out
+    assert "open intervals" not in out

@@ -59,7 +59,8 @@ def test_table_lists_each_crossing_once(capsys):
                                                                 for r in rows[1:]]
     assert rows[0][0] == "0"                      # K = 0 to within rounding, printed as 0
     assert [r[-1] for r in rows] == ["0", "2", "4", "6", "8"]
-    assert "stable along the path: K_w in [0, 2.95362954" in out
+    # Open: K = 0 has the pole at z = 1, 2.9536 a pair on the circle.
+    assert "stable along the path: K_w in (0, 2.95362954" in out
 
 
 def test_dimensionless_path_along_beta(capsys):
