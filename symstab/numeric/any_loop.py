@@ -44,7 +44,7 @@ from .._resources import check_memory
 from .._validate import check_array, check_count, check_delay, check_window
 from ..symbolic.loop_assembly import _DPS, LoopModel, parse_environment, parse_plant
 from ..codegen.loop_kernels import environment_kernels, load_numpy_kernels
-from .decomposition import arc_points, decompose
+from .decomposition import Decomposition, arc_points, decompose, stable_hull
 from .passivity import passive_region
 from .decomposition import lines as _lines
 from .stability import (MARGINAL, STABLE, _leading_vanishes, classify_polynomials,
@@ -75,6 +75,12 @@ class LoopLimits:
     cells : int
         The stable cells of :meth:`Loop.region` (the stable set's
         connected pieces).
+    reason : str
+        When the set is empty, why: no point of the plane passes the
+        necessary condition of
+        :func:`symstab.numeric.decomposition.stable_hull`, or every cell of
+        a window holding every point that does has a root outside the unit
+        circle (or, with a window given, every cell of that window).
     """
 
     x: str
@@ -85,15 +91,16 @@ class LoopLimits:
     x_max: float
     area: float
     cells: int
+    reason: str = ""
 
     @property
     def empty(self):
-        """True when no stable point was found."""
+        """True when the stable set is empty (in the window, when one was given): see :attr:`reason`."""
         return math.isnan(self.y_max)
 
     def __repr__(self):
         if self.empty:
-            return f"LoopLimits({self.x}, {self.y}: no stable point found)"
+            return f"LoopLimits({self.x}, {self.y}: empty, {self.reason or 'no stable point'})"
         return (f"LoopLimits({self.y}_max={self.y_max:.6g} at {self.x}={self.x_at_y_max:.6g}, "
                 f"{self.x} in [{self.x_min:.6g}, {self.x_max:.6g}], area={self.area:.6g})")
 
@@ -532,16 +539,26 @@ class Loop(LoopModel):
             The plane's parameters, jointly affine (default: the loop's
             :attr:`plane`).
         x_range, y_range : (float, float), optional
-            The window.  A side not given is found: the window starts around
-            the stable points next to the arc and the lines and is widened
-            (up to 10 times) while a stable cell reaches that side; if it
-            still does, the side is in :attr:`Decomposition.unbounded`.
+            The window.  A side not given is found.  First, where a stable
+            point can be at all (:func:`symstab.numeric.decomposition.stable_hull`,
+            exact): when nowhere, that is the answer; when in a bounded
+            polygon, no window goes beyond its box.  The window starts
+            around the stable points next to the arc and the lines (or,
+            when none is sampled, is the box itself, so a set too small to
+            be sampled is still found, and a set not found there is empty)
+            and is widened (up to 10 times) while a stable cell reaches that
+            side; if it still does, the side is in
+            :attr:`Decomposition.unbounded`.
         **values
             Single values of every other parameter.
 
         Returns
         -------
         symstab.numeric.decomposition.Decomposition
+            Its ``hull`` is the enclosure used (None when both ranges are
+            given).  When the enclosure is empty, no point is stable and the
+            decomposition has no cells (its window is the curves' extent, or
+            the one given).
 
         Examples
         --------
@@ -561,8 +578,18 @@ class Loop(LoopModel):
         def run(box):
             return decompose(base, ax, ay, ends, x_range=box[:2], y_range=box[2:], names=(x, y))
 
+        # Where a stable point can be at all (exact): an empty enclosure is the
+        # answer, a bounded one caps every window a free side may take.
+        hull = stable_hull(base, ax, ay) if any(free.values()) else None
+        enclosure = hull.box() if hull is not None else None
+        if hull is not None and hull.empty:
+            auto = _curve_windows(base, ax, ay, ends)[-1]
+            box = [*(given["x_range"] or auto[0]), *(given["y_range"] or auto[1])]
+            return Decomposition(x=x, y=y, x_range=tuple(box[:2]), y_range=tuple(box[2:]),
+                                 branches=(), cells=(), mismatches=(), unbounded=(),
+                                 polynomial=(base, ax, ay), hull=hull)
         found, refused = None, None
-        for auto in _start_windows(base, ax, ay, ends):
+        for auto in _start_windows(base, ax, ay, ends, enclosure):
             box = [*(given["x_range"] or auto[0]), *(given["y_range"] or auto[1])]
             try:
                 found = run(box)
@@ -573,16 +600,24 @@ class Loop(LoopModel):
                 break
         if found is None:
             raise refused
-        # Widen the free sides a stable cell reaches; once it reaches none, fit
-        # them to the stable set, a quarter of its extent around it.
+        # Widen the free sides a stable cell reaches (never past the enclosure,
+        # which holds the whole stable set); once it reaches none, fit them to
+        # the stable set, a quarter of its extent around it.
+        limit = [-math.inf, math.inf, -math.inf, math.inf]
+        if enclosure is not None:
+            limit = [*enclosure[0], *enclosure[1]]
         fitted = not any(free.values())
         for _ in range(12):
             grow = [side for side in found.unbounded if free[side]]
+            before = list(box)
             if grow:
                 span = (box[1] - box[0], box[3] - box[2])
                 for side in grow:
                     k = ("x_min", "x_max", "y_min", "y_max").index(side)
                     box[k] += (-1 if k % 2 == 0 else 1) * span[k // 2]
+                    box[k] = max(box[k], limit[k]) if k % 2 == 0 else min(box[k], limit[k])
+                if box == before:
+                    break
                 fitted = False
             elif found.stable and not fitted:
                 points = np.vstack([cell.outer for cell in found.stable])
@@ -596,7 +631,7 @@ class Loop(LoopModel):
             else:
                 break
             found = run(box)
-        return found
+        return dataclasses.replace(found, hull=hull)
 
     def limits(self, x=None, y=None, **values):
         """The extent and area of the stable set in the ``(x, y)`` plane.
@@ -618,10 +653,14 @@ class Loop(LoopModel):
         Returns
         -------
         LoopLimits
+            Empty (``y_max`` NaN, ``area`` 0, :attr:`LoopLimits.reason` says
+            why) when no point is stable: proved, not a failure to find one
+            (see :meth:`region`).
         """
         found = self.region(x, y, **values)
         if not found.stable:
-            return LoopLimits(found.x, found.y, np.nan, np.nan, np.nan, np.nan, 0.0, 0)
+            return LoopLimits(found.x, found.y, np.nan, np.nan, np.nan, np.nan, 0.0, 0,
+                              _empty_reason(found))
         (y_max, x_at), (x_min, _), (x_max, _) = (found.extreme(*which) for which in
                                                   (("y", 1), ("x", -1), ("x", 1)))
         sides = set(found.unbounded)
@@ -685,6 +724,21 @@ class Loop(LoopModel):
         _, ve_d = self._environment_arrays(values, shape)
         num = np.concatenate([self._convolve(ve_d, p_n), np.zeros(d)])
         return control.tf(num, chi, float(values["T"]))
+
+
+def _empty_reason(found):
+    """Why the decomposition ``found`` (of :meth:`Loop.region`) has no stable cell."""
+    hull = found.hull
+    if hull is not None and hull.empty:
+        return hull.reason
+    where = (f"{found.x} in [{found.x_range[0]:.6g}, {found.x_range[1]:.6g}], {found.y} in "
+             f"[{found.y_range[0]:.6g}, {found.y_range[1]:.6g}]")
+    box = hull.box(0.0) if hull is not None else None
+    if box is not None and all(w[0] <= b[0] and b[1] <= w[1]
+                               for w, b in zip((found.x_range, found.y_range), box)):
+        return (f"every cell of the window {where}, which holds every point that passes the "
+                f"necessary condition of the roots inside the unit circle, has a root outside it")
+    return f"every cell of the window {where} has a root outside the unit circle"
 
 
 def _on_circle(c, theta):
@@ -913,60 +967,94 @@ def _line_intervals(a0, a1, a0_ends, a1_ends):
     return out
 
 
-def _start_windows(base, ax, ay, ends):
+def _start_windows(base, ax, ay, ends, enclosure=None):
     """First windows for :meth:`Loop.region`, tried in turn until one holds a stable cell.
 
     First the extent of stable points next to the curves (a few steps off
     the arc's points and the lines' crossings, classified at once): it is
-    on the scale of the stable set however far the arc runs.  Then the
-    extent of the curves themselves, without the outer 2 % on each side (the
-    arc may run off to infinity), then all of it.  A quarter of the span is
-    added on each side.
+    on the scale of the stable set however far the arc runs.  Then, when
+    the stable set has a bounded ``enclosure`` (``(x_range, y_range)`` from
+    :func:`symstab.numeric.decomposition.stable_hull`), the enclosure
+    itself, which holds every stable point: a stable set too small for the
+    steps is found there, and one that is not found there is empty.
+    Without one, the extent of the curves themselves, without the outer 2 %
+    on each side (the arc may run off to infinity), then all of it.  A
+    quarter of the span is added on each side, and each window is cut to
+    the enclosure.
     """
     xs, ys, _ = _curve_points(base, ax, ay, ends, per_degree=4, first_lobe=64)
-    if xs.size == 0:
-        return [((-1.0, 1.0), (-1.0, 1.0))]
-    # Steps on each point's own scale: its size and the distance to its
-    # neighbour (at long delays the stable set is tiny beside the arc's reach).
-    sx = np.abs(xs) + np.abs(np.diff(xs, append=xs[-1])) + 1e-300
-    sy = np.abs(ys) + np.abs(np.diff(ys, append=ys[-1])) + 1e-300
-    px, py = [], []
-    for step in (1e-5, 1e-3, 1e-2, 1e-1):
-        for ux, uy in ((1, 1), (1, -1), (-1, 1), (-1, -1)):
-            px.append(xs + ux * step * sx)
-            py.append(ys + uy * step * sy)
-    px, py = np.concatenate(px), np.concatenate(py)
-    check_memory("the stable points that start a region's window", 8 * len(px) * len(base))
-    codes = classify_polynomials(base[None, :] + px[:, None] * ax[None, :] + py[:, None] * ay[None, :],
-                                 refine=False)
-    candidates = [(px[codes == STABLE], py[codes == STABLE], 0.0)]
+    candidates = []
+    if xs.size:
+        # Steps on each point's own scale: its size and the distance to its
+        # neighbour (at long delays the stable set is tiny beside the arc's reach).
+        sx = np.abs(xs) + np.abs(np.diff(xs, append=xs[-1])) + 1e-300
+        sy = np.abs(ys) + np.abs(np.diff(ys, append=ys[-1])) + 1e-300
+        px, py = [], []
+        for step in (1e-5, 1e-3, 1e-2, 1e-1):
+            for ux, uy in ((1, 1), (1, -1), (-1, 1), (-1, -1)):
+                px.append(xs + ux * step * sx)
+                py.append(ys + uy * step * sy)
+        px, py = np.concatenate(px), np.concatenate(py)
+        check_memory("the stable points that start a region's window", 8 * len(px) * len(base))
+        codes = classify_polynomials(
+            base[None, :] + px[:, None] * ax[None, :] + py[:, None] * ay[None, :], refine=False)
+        candidates.append((px[codes == STABLE], py[codes == STABLE], 0.0))
+    out = _extent_windows(candidates, enclosure)
+    if enclosure is not None:
+        out.append(tuple(enclosure))
+    else:
+        out += [w for w in _curve_windows(base, ax, ay, ends) if w not in out]
+    return out or [((-1.0, 1.0), (-1.0, 1.0))]
+
+
+def _curve_windows(base, ax, ay, ends):
+    """The extent of the arc and the lines' crossings: without the outer 2 % on each side, then all."""
     xs, ys, _ = _curve_points(base, ax, ay, ends)
-    candidates += [(xs, ys, 0.02), (xs, ys, 0.0)]
+    return _extent_windows([(xs, ys, 0.02), (xs, ys, 0.0)]) or [((-1.0, 1.0), (-1.0, 1.0))]
+
+
+def _extent_windows(candidates, enclosure=None):
+    """A window per ``(xs, ys, q)``: the ``q`` to ``1 - q`` quantiles, a quarter of the span added.
+
+    Each is cut to ``enclosure`` (``(x_range, y_range)``) when given; an
+    empty or repeated window is left out.
+    """
     out = []
     for cx, cy, q in candidates:
         if cx.size == 0:
             continue
         window = []
-        for v in (cx, cy):
+        for k, v in enumerate((cx, cy)):
             lo, hi = float(np.quantile(v, q)), float(np.quantile(v, 1 - q))
             pad = 0.25 * (hi - lo) or 0.1 * max(abs(lo), abs(hi), 1e-300)
-            window.append((lo - pad, hi + pad))
-        if tuple(window) not in out and all(np.isfinite(window).ravel()):
+            lo, hi = lo - pad, hi + pad
+            if enclosure is not None:
+                lo, hi = max(lo, enclosure[k][0]), min(hi, enclosure[k][1])
+            window.append((lo, hi))
+        ok = all(np.isfinite(window).ravel()) and all(lo < hi for lo, hi in window)
+        if ok and tuple(window) not in out:
             out.append(tuple(window))
-    return out or [((-1.0, 1.0), (-1.0, 1.0))]
+    return out
 
 
 def _curve_points(base, ax, ay, ends, per_degree=16, first_lobe=0):
     """Points of the arc (finite ones) and the lines' crossings.
 
     The arc at ``per_degree (n + 4)`` angles, plus ``first_lobe`` more below
-    ``8 pi / (n + 4)``, where at long delays the stable set's arc lies.
+    ``8 pi / (n + 4)``, where at long delays the stable set's arc lies, and
+    with ``first_lobe`` 24 more spaced geometrically from ``1e-6`` of the
+    first angle up to it, and as many next to pi: a stable set next to an
+    end of the arc can be bounded by a piece far shorter than the grid's
+    step (at gamma = -1 the paper's loop has its whole set below theta =
+    0.03, under the first angle of a grid of 48).
     """
     n = len(base) - 1
     m = per_degree * (n + 4)
     theta = np.pi * (np.arange(1, m + 1) - 0.5) / m
     if first_lobe:
-        theta = np.union1d(theta, 8 * np.pi / (n + 4) * np.arange(1, first_lobe + 1) / first_lobe)
+        lobe = 8 * np.pi / (n + 4) * np.arange(1, first_lobe + 1) / first_lobe
+        near = theta[0] * np.geomspace(1e-6, 1.0, 24, endpoint=False)
+        theta = np.union1d(theta, np.concatenate([lobe, near, np.pi - near]))
     xs, ys, _ = arc_points(base, ax, ay, theta)
     lines = list(_lines(base, ax, ay, ends).values())
     for i in range(len(lines)):

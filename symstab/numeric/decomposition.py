@@ -45,7 +45,8 @@ from .._resources import check_memory
 from .curves import _golden_max
 from .stability import STABLE, _leading_vanishes, classify_polynomials, polynomial_root_counts
 
-__all__ = ["Branch", "Cell", "Decomposition", "decompose", "arc_points"]
+__all__ = ["Branch", "Cell", "Decomposition", "StableHull", "decompose", "arc_points",
+           "stable_hull"]
 
 #: Change of the unstable count across each piece (crossing rule); the
 #: window's edges are labelled ``"window"``.
@@ -185,6 +186,10 @@ class Decomposition:
         The largest sag of the sampled arc's chords on a stable cell's
         boundary (chord length times turn over 8), as a fraction of the
         cell's thinner extent (:func:`decompose` keeps it below 1e-3).
+    hull : StableHull or None
+        The proved enclosure of the stable set the window was chosen from
+        (:meth:`symstab.Loop.region`); when it is empty the decomposition has
+        no cells: no point of the plane is stable, and none was sampled.
     """
 
     x: str
@@ -197,6 +202,7 @@ class Decomposition:
     unbounded: tuple
     polynomial: tuple = dataclasses.field(default=(), compare=False)
     resolution: float = 0.0
+    hull: object = dataclasses.field(default=None, compare=False)
 
     @property
     def stable(self):
@@ -307,10 +313,12 @@ class Decomposition:
 
     def __repr__(self):
         counts = sorted({c.count for c in self.cells})
-        return (f"Decomposition({self.x} in [{self.x_range[0]:.6g}, {self.x_range[1]:.6g}], "
-                f"{self.y} in [{self.y_range[0]:.6g}, {self.y_range[1]:.6g}]: "
-                f"{len(self.cells)} cells, counts {counts}, {len(self.stable)} stable, "
-                f"stable area {self.area:.6g})")
+        where = (f"Decomposition({self.x} in [{self.x_range[0]:.6g}, {self.x_range[1]:.6g}], "
+                 f"{self.y} in [{self.y_range[0]:.6g}, {self.y_range[1]:.6g}]: ")
+        if self.hull is not None and self.hull.empty and not self.cells:
+            return where + "no point of the plane is stable)"
+        return where + (f"{len(self.cells)} cells, counts {counts}, {len(self.stable)} stable, "
+                        f"stable area {self.area:.6g})")
 
 
 # --------------------------------------------------------------------------
@@ -397,6 +405,12 @@ def _sample_arc(base, ax, ay, to_unit, theta=None, fine=1.0):
         n = len(base) - 1
         m = max(1024, 32 * (n + 4))
         theta = np.pi * np.arange(1, m) / m
+        # The chords to the exact ends (theta = 0, pi), added by _pieces, are
+        # never split: angles closing in on both ends geometrically keep them
+        # short (from theta = 0 to pi / m the arc can cross a good part of a
+        # small stable cell at its corner).
+        near = theta[0] * np.geomspace(1e-6, 1.0, 20, endpoint=False)
+        theta = np.concatenate([near, theta, np.pi - near[::-1]])
     for _ in range(_ROUNDS):
         xs, ys, det = arc_points(base, ax, ay, theta)
         u, v = to_unit(xs, ys)
@@ -731,6 +745,267 @@ def _interior_point(rings):
         if lo <= best[1] <= hi:
             return (u, 0.5 * (lo + hi))
     return best
+
+
+# --------------------------------------------------------------------------
+# Where a stable point can be
+
+
+@dataclasses.dataclass(frozen=True, repr=False)
+class StableHull:
+    """Convex polygons that hold every stable point of the plane (the necessary condition of :func:`stable_hull`).
+
+    Attributes
+    ----------
+    polygons : tuple of ndarray, shape (k, 2)
+        The bounded polygons' vertices, counter-clockwise (one polygon when
+        the leading coefficient keeps its sign over the plane); empty when
+        no point is stable or when a polygon is unbounded.
+    bounded : bool
+        False when the condition leaves an unbounded part of the plane
+        (then :attr:`polygons` is empty and says nothing).
+    reason : str
+        Why no point is stable, when that is proved; else empty.
+    """
+
+    polygons: tuple
+    bounded: bool
+    reason: str = ""
+
+    @property
+    def empty(self):
+        """True when no point of the plane is stable (proved, exactly)."""
+        return bool(self.reason)
+
+    def box(self, pad=0.05):
+        """``(x_range, y_range)`` around the polygons, ``pad`` of their span added each side (None if unbounded or empty)."""
+        if not self.bounded or not self.polygons:
+            return None
+        points = np.vstack(self.polygons)
+        out = []
+        for column in points.T:
+            lo, hi = float(column.min()), float(column.max())
+            # The vertices are exact rationals rounded once: a few ulps out is enough,
+            # the pad keeps the stable set's edges off the window's.
+            margin = pad * (hi - lo) + 8 * np.spacing(max(abs(lo), abs(hi), 1e-300))
+            out.append((float(lo - margin), float(hi + margin)))
+        return tuple(out)
+
+    def __repr__(self):
+        if self.empty:
+            return f"StableHull(empty: {self.reason})"
+        if not self.bounded:
+            return "StableHull(unbounded)"
+        return f"StableHull({len(self.polygons)} polygon(s), box {self.box(0.0)})"
+
+
+def _exact_rows(rows):
+    """Float rows as Python integers with one common power of two (exact)."""
+    ratios = [[float(v).as_integer_ratio() for v in row] for row in rows]
+    shift = max(den.bit_length() for row in ratios for _, den in row)
+    return [[num << (shift - den.bit_length()) for num, den in row] for row in ratios]
+
+
+def _taylor_shift(p):
+    """``p(t + 1)`` for exact coefficients ``p`` (highest first): n passes of partial sums."""
+    p = np.array(p, dtype=object)
+    for stop in range(len(p), 1, -1):
+        p[:stop] = np.cumsum(p[:stop])
+    return p
+
+
+def _bilinear(c):
+    """Coefficients ``q_k`` (``q[k]`` of ``w**k``) of ``(w - 1)**n c((w + 1) / (w - 1))``, exactly.
+
+    ``c`` holds Python integers, highest power first.  ``c(1 + 2 t)``, read
+    backwards in ``u = 1 / t``, is ``u**n c(1 + 2 / u)``; then ``u = w - 1``.
+    """
+    n = len(c) - 1
+    shifted = _taylor_shift(c)                                   # c(1 + t)
+    r = [v << (n - j) for j, v in enumerate(shifted)]            # c(1 + 2 t)
+    u = r[::-1]                                                   # u**n c(1 + 2/u), highest first
+    sign = [1 if (n - j) % 2 == 0 else -1 for j in range(n + 1)]
+    # p(w - 1) = f(1 - w) with f(v) = p(-v): flip the odd powers, shift, flip back.
+    flipped = _taylor_shift([s * v for s, v in zip(sign, u)])
+    return [s * v for s, v in zip(sign, flipped)][::-1]          # lowest power first
+
+
+def _approximate(rows):
+    """Integer rows as floats, each row scaled by its own power of two (the same half-plane)."""
+    out = np.empty((len(rows), 3))
+    for k, row in enumerate(rows):
+        shift = max(max(abs(v).bit_length() for v in row) - 60, 0)
+        out[k] = [float(v >> shift) if v >= 0 else -float(-v >> shift) for v in row]
+    return out
+
+
+def _tightest(lines, approximate, i):
+    """Indices of the rows to try first on line ``i``: those that bound it tightest in floats."""
+    a, b, c = approximate[i]
+    A, B, C = approximate.T
+    norm = b * b + c * c
+    with np.errstate(all="ignore"):
+        g = A - a * (B * b + C * c) / norm
+        h = C * b - B * c
+        t = -g / h
+    order = []
+    for rising in (True, False):
+        index = np.flatnonzero(((h > 0) if rising else (h < 0)) & np.isfinite(t))
+        if index.size:
+            order.append(int(index[np.argmax(t[index]) if rising else np.argmin(t[index])]))
+    parallel = np.flatnonzero(np.abs(h) <= 1e-12 * (np.abs(C * b) + np.abs(B * c)))
+    if parallel.size:
+        order.append(int(parallel[np.argmin(g[parallel])]))
+    return order
+
+
+def _line_interval(lines, i, order):
+    """The exact feasible interval of ``t`` on line ``i``: (lo, hi) as (numerator, denominator) or None.
+
+    ``order`` lists rows to intersect first, so an empty interval is found
+    after a few; ``False`` when it is empty.
+    """
+    a, b, c = lines[i]
+    norm = b * b + c * c
+    lo = hi = None           # (numerator, positive denominator) of t
+    seen = set()
+    for j in list(order) + list(range(len(lines))):
+        if j in seen:
+            continue
+        seen.add(j)
+        aj, bj, cj = lines[j]
+        # p(t) = p0 + t (-c, b), p0 = -a (b, c) / norm; row j there is
+        # (a_j norm - a (b_j b + c_j c)) / norm + t (c_j b - b_j c).
+        g = aj * norm - a * (bj * b + cj * c)
+        h = (cj * b - bj * c) * norm
+        if h == 0:
+            if g < 0:
+                return False
+            continue
+        bound = (-g, h) if h > 0 else (g, -h)
+        if h > 0 and (lo is None or bound[0] * lo[1] > lo[0] * bound[1]):
+            lo = bound
+        if h < 0 and (hi is None or bound[0] * hi[1] < hi[0] * bound[1]):
+            hi = bound
+        if lo is not None and hi is not None and lo[0] * hi[1] >= hi[0] * lo[1]:
+            return False
+    return lo, hi
+
+
+def _half_plane_polygon(rows):
+    """The polygon ``{a + b x + c y >= 0 for every row}`` with exact integer rows.
+
+    Returns ``(vertices, bounded, interior)``: the vertices as Fractions,
+    counter-clockwise (empty when unbounded), whether it is bounded, and
+    whether its interior is non-empty.  Each line's feasible interval is
+    the intersection of the others' half-lines on it (a one-dimensional
+    programme per line, in exact rationals); the rows that bound it
+    tightest in floating point are tried first, so a line that is no edge
+    is dismissed after a few exact products.
+    """
+    from fractions import Fraction
+
+    constant = [r for r in rows if r[1] == 0 and r[2] == 0]
+    if any(a <= 0 for a, _, _ in constant):
+        return [], True, False
+    lines = [r for r in rows if r[1] != 0 or r[2] != 0]
+    if not lines:
+        return [], False, True
+    approximate = _approximate(lines)
+    vertices, bounded = [], True
+    for i, (a, b, c) in enumerate(lines):
+        interval = _line_interval(lines, i, _tightest(lines, approximate, i))
+        if interval is False:
+            continue
+        lo, hi = interval
+        if lo is None or hi is None:
+            bounded = False
+            continue
+        norm = b * b + c * c
+        for t in (Fraction(*lo), Fraction(*hi)):
+            vertices.append((Fraction(-a * b, norm) - t * c, Fraction(-a * c, norm) + t * b))
+    if not bounded:
+        return [], False, True
+    vertices = list(set(vertices))
+    if len(vertices) < 3:
+        return [], True, False
+    cx = sum(v[0] for v in vertices) / len(vertices)
+    cy = sum(v[1] for v in vertices) / len(vertices)
+    # The mean of the vertices is inside unless the polygon is flat (a segment).
+    interior = all(a + b * cx + c * cy > 0 for a, b, c in rows)
+    vertices.sort(key=lambda v: math.atan2(float(v[1] - cy), float(v[0] - cx)))
+    return vertices, True, interior
+
+
+def stable_hull(base, ax, ay):
+    """Where a stable point of ``chi = base + x ax + y ay`` can be: a proved convex enclosure.
+
+    If every root of ``chi`` (degree ``n``, leading coefficient nonzero)
+    lies inside the unit circle, the bilinear map ``z = (w + 1) / (w - 1)``
+    takes them into the open left half-plane, so ``q(w) = (w - 1)**n
+    chi((w + 1) / (w - 1))`` is a Hurwitz polynomial of degree ``n``
+    (its leading coefficient is ``chi(1)``, nonzero) and all its ``n + 1``
+    coefficients are nonzero and of one sign (Stodola's necessary
+    condition).  Each ``q_k`` is affine in ``(x, y)``, so the stable set
+    lies inside ``{s q_k(x, y) > 0 for every k}`` for ``s = 1`` or ``s =
+    -1``: at most two convex polygons.  (``q_n = chi(1)`` and ``q_0 = (-1)**n
+    chi(-1)`` are the z = +-1 conditions; ``2**-n q`` are the barycentric
+    coordinates of ``chi`` over ``(z + 1)**k (z - 1)**(n - k)``, whose convex
+    hull is that of the Schur-stable polynomials: no linear necessary
+    condition is sharper.)
+
+    Exact for the coefficients as given: they are turned into integers and
+    the transform and the polygons are computed in exact arithmetic, so an
+    empty enclosure proves that no point is stable.
+
+    Parameters
+    ----------
+    base, ax, ay : array_like, shape (n + 1,)
+        Coefficients (highest power first) of ``A0``, ``Ax`` and ``Ay``.
+
+    Returns
+    -------
+    StableHull
+
+    Examples
+    --------
+    ``z**2 + x z + y``: the hull is the stable triangle ``|x| < 1 + y < 2``.
+
+    >>> hull = stable_hull([1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0])
+    >>> hull.polygons[0].tolist()
+    [[0.0, -1.0], [2.0, 1.0], [-2.0, 1.0]]
+
+    ``z**2 + x z + 3`` is never stable (the product of its roots is 3):
+
+    >>> stable_hull([1.0, 0.0, 3.0], [0.0, 1.0, 0.0], [0.0, 0.0, 0.0]).empty
+    True
+    """
+    rows = np.array([base, ax, ay], dtype=float)
+    if rows.ndim != 2 or not np.all(np.isfinite(rows)):
+        raise ValueError("base, ax and ay must be finite coefficient rows of one length")
+    # Leading zeros shared by all three are not part of the polynomial.
+    keep = np.flatnonzero(np.any(rows != 0, axis=0))
+    if keep.size == 0:
+        return StableHull((), True, "the polynomial is 0 everywhere in the plane: no point is stable")
+    rows = rows[:, keep[0]:]
+    exact = _exact_rows(rows)
+    q = [_bilinear(row) for row in exact]
+    polygons, bounded = [], True
+    for s in (1, -1):
+        half_planes = [(s * q0, s * qx, s * qy) for q0, qx, qy in zip(*q)]
+        vertices, side_bounded, interior = _half_plane_polygon(half_planes)
+        if not side_bounded:
+            bounded = False
+        elif interior:
+            polygons.append(np.array([[float(u), float(v)] for u, v in vertices]))
+    if not bounded:
+        return StableHull((), False)
+    if not polygons:
+        return StableHull((), True, "the coefficients of (w - 1)**n chi((w + 1)/(w - 1)) are "
+                                    "never all of one sign in the plane (Stodola's necessary "
+                                    "condition for the roots inside the unit circle): no point "
+                                    "is stable")
+    return StableHull(tuple(polygons), True)
 
 
 # --------------------------------------------------------------------------

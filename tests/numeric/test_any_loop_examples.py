@@ -428,6 +428,108 @@ def test_stable_intervals_agree_with_bisection(path, examples):
 
 
 # --------------------------------------------------------------------------
+# Issue 18: the stable oracle points Loop.region missed in the actuator lag
+# --------------------------------------------------------------------------
+
+ACTUATOR_LAG = REPO / "examples" / "loops" / "actuator_lag.toml"
+
+
+def _oracle_radii(example, K, B, d, M):
+    """The oracle's spectral radius at many points (batched companion eigenvalues).
+
+    The polynomial of :meth:`Example.poles`, ``z**d Ve_d P_d + Ve_n P_n``,
+    from the same python-control pulse transfer function, a row per point.
+    """
+    num, den = example.oracle.environment(dict(example.values, M=M), K, B)
+
+    def times(rows, p):
+        out = np.zeros(rows.shape[:-1] + (rows.shape[-1] + len(p) - 1,))
+        for k, c in enumerate(p):
+            out[..., k:k + rows.shape[-1]] += c * rows
+        return out
+
+    delayed = np.concatenate([times(den, example.p_den), np.zeros(den.shape[:-1] + (d,))], axis=-1)
+    direct = times(num, example.p_num)
+    chi = delayed
+    chi[..., -direct.shape[-1]:] += direct
+    chi = chi.reshape(-1, chi.shape[-1])
+    chi = chi / chi[:, :1]
+    n = chi.shape[1] - 1
+    companion = np.zeros((len(chi), n, n))
+    companion[:, 0, :] = -chi[:, 1:]
+    companion[:, np.arange(1, n), np.arange(n - 1)] = 1.0
+    return np.max(np.abs(np.linalg.eigvals(companion)), axis=1).reshape(np.shape(K))
+
+
+def test_actuator_lag_misses_no_stable_point_at_the_corner(examples):
+    """At the arc's exact end (B = -b, K = 0) the region held every oracle-stable point.
+
+    The user's example, B = -0.0324, K = 1.1e-4 at M = -0.0125, d = 2, is
+    unstable (python-control: radius 1.0000157); stable points 1e-5 to its
+    right were missed: the chord from the arc's exact end at theta = 0 to
+    its first sample (pi / 1024) was never refined, and the stable set's
+    corner lay between that chord and the arc.  Now none is missed.
+    """
+    example = examples(ACTUATOR_LAG)
+    values = dict(d=2, M=-0.0125)
+    region = example.loop.region(**values)
+    B, K = np.meshgrid(np.linspace(-0.03245, -0.03235, 201), np.linspace(3e-4 / 200, 3e-4, 200))
+    radius = _oracle_radii(example, K, B, **values)
+    stable = radius < 1 - SKIP_BAND
+    assert stable.sum() > 10_000
+    inside = region.contains(B, K)
+    missed = np.flatnonzero(stable & ~inside)
+    assert missed.size == 0, [(B.flat[i], K.flat[i], radius.flat[i]) for i in missed[:5]]
+    assert not np.any(inside & (radius > 1 + SKIP_BAND))
+    assert float(_oracle_radii(example, np.array(1.1e-4), np.array(-0.0324), **values)) > 1.0
+    assert not region.contains(-0.0324, 1.1e-4)
+
+
+@pytest.mark.parametrize("M, d", [(0.0128, 2), (0.0128, 3), (-0.0128, 2), (-0.0125, 2)])
+def test_actuator_lag_points_the_region_misses_are_boundary_pixels(examples, M, d):
+    """Every oracle-stable point outside the region lies between a chord of the arc and the arc.
+
+    On a 120 x 120 grid over the stable set, a stable point the region
+    leaves out is next to its boundary: the oracle's own boundary, found by
+    bisection along the nearest edge's outward normal, lies beyond the
+    point by less than the decomposition's stated chord sag
+    (``resolution`` times the cell's thinner extent): a boundary pixel
+    within the sampled arc's chord error, not a missing sliver.
+    """
+    example = examples(ACTUATOR_LAG)
+    region = example.loop.region(d=d, M=M)
+    (cell,) = region.stable
+    lo, hi = cell.outer.min(axis=0), cell.outer.max(axis=0)
+    B, K = np.meshgrid(np.linspace(lo[0], hi[0], 120), np.linspace(lo[1], hi[1], 120)[1:])
+    radius = _oracle_radii(example, K, B, d, M)
+    stable = radius < 1 - SKIP_BAND
+    missed = np.flatnonzero(stable & ~region.contains(B, K))
+    assert missed.size <= 10, missed.size
+    scale = np.array([region.x_range[1] - region.x_range[0], region.y_range[1] - region.y_range[0]])
+    ring = cell.outer / scale
+    sag = region.resolution * float(np.min(np.ptp(ring, axis=0)))
+    a, b = ring, np.roll(ring, -1, axis=0)
+    for i in missed:
+        p = np.array([B.flat[i], K.flat[i]]) / scale
+        t = np.clip(np.sum((p - a) * (b - a), axis=1) / np.sum((b - a) ** 2, axis=1), 0, 1)
+        gap = np.hypot(*(p - a - t[:, None] * (b - a)).T)
+        k = int(np.argmin(gap))
+        edge = b[k] - a[k]
+        outward = np.array([edge[1], -edge[0]]) / np.hypot(*edge)    # the ring is counter-clockwise
+        inner, outer = 0.0, 4 * sag
+        at = lambda s: (p + s * outward) * scale    # noqa: E731
+        assert _oracle_radii(example, np.array(at(outer)[1]), np.array(at(outer)[0]), d, M) > 1
+        for _ in range(40):
+            middle = 0.5 * (inner + outer)
+            q = at(middle)
+            if _oracle_radii(example, np.array(q[1]), np.array(q[0]), d, M) < 1:
+                inner = middle
+            else:
+                outer = middle
+        assert gap[k] + inner <= 2 * sag, (B.flat[i], K.flat[i], gap[k], inner, sag)
+
+
+# --------------------------------------------------------------------------
 # Acceptance: what is refused, and how it is said
 # --------------------------------------------------------------------------
 
