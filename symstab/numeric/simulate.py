@@ -40,6 +40,13 @@ decaying or bounded run is stable, including a limit cycle at the
 resolution of the encoder.  The default horizon grows with the delay; near
 the boundary the modes have ``|z|`` close to 1 and any finite horizon
 leaves a band of undecidable cells, which the tests count.
+
+The theory to compare a run with (:func:`linear_theory`) is that of the loop
+simulated: its linear part, the velocity filter and the actuator lag
+included (a :class:`symstab.Loop`), quantization and friction left out.  On
+the README's grid (d = 10, K_w in [0, 70], B_w in [-0.1, 2], 100 x 100) with
+a 100 Hz filter the simulation agrees with it on all 9918 cells it decides
+(with the ideal loop's count it differed on 1163).
 """
 
 import dataclasses
