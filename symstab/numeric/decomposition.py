@@ -753,7 +753,7 @@ def _interior_point(rings):
 
 @dataclasses.dataclass(frozen=True, repr=False)
 class StableHull:
-    """Convex polygons that hold every stable point of the plane (the necessary condition of :func:`stable_hull`).
+    """Convex polygons that hold every stable point of a plane (see :func:`stable_hull`).
 
     Attributes
     ----------
@@ -778,7 +778,10 @@ class StableHull:
         return bool(self.reason)
 
     def box(self, pad=0.05):
-        """``(x_range, y_range)`` around the polygons, ``pad`` of their span added each side (None if unbounded or empty)."""
+        """``(x_range, y_range)`` around the polygons, ``pad`` of their span added on each side.
+
+        None when the hull is unbounded or empty.
+        """
         if not self.bounded or not self.polygons:
             return None
         points = np.vstack(self.polygons)
@@ -951,8 +954,8 @@ def stable_hull(base, ax, ay):
     -1``: at most two convex polygons.  (``q_n = chi(1)`` and ``q_0 = (-1)**n
     chi(-1)`` are the z = +-1 conditions; ``2**-n q`` are the barycentric
     coordinates of ``chi`` over ``(z + 1)**k (z - 1)**(n - k)``, whose convex
-    hull is that of the Schur-stable polynomials: no linear necessary
-    condition is sharper.)
+    hull is that of the Schur-stable polynomials of degree ``n``: no
+    condition linear in the coefficients is sharper.)
 
     Exact for the coefficients as given: they are turned into integers and
     the transform and the polygons are computed in exact arithmetic, so an
