@@ -21,7 +21,11 @@ expression it came from (``srepr`` equal), so a derivation from the cache
 is the derivation.  A file that is not valid JSON, names another key, fails
 its checksum or holds a node outside the allow-list is ignored and derived
 again (and rewritten); where the folder cannot be written, nothing is
-cached.
+cached.  Nor is a well-formed entry trusted blindly: the loop checks each
+polynomial it reads at one point against an independent computation (the
+ZOH by the matrix exponential at 30 digits, the environment as parsed, the
+loop polynomial as their product; ``LoopModel._derived``) and derives again
+what disagrees.  The affine decisions are protected by the checksum only.
 """
 
 import functools

@@ -439,13 +439,75 @@ class LoopModel:
         return DerivationCache(self.plant, self.environment,
                                dict(self._symbols, s=model.s, z=model.z))
 
-    def _derived(self, name, derive):
-        """``derive()``, or what an earlier derivation of this loop stored under ``name``."""
+    def _derived(self, name, derive, agrees=None):
+        """``derive()``, or what an earlier derivation of this loop stored under ``name``.
+
+        ``agrees(value)`` checks a stored value against an independent
+        computation at numbers (:meth:`_check_point`): one that disagrees,
+        or cannot be evaluated, is derived again, not trusted.
+        """
         value = self._derivation.get(name)
+        if value is not DerivationCache.MISSING and agrees is not None:
+            try:
+                trusted = agrees(value)
+            except (ArithmeticError, TypeError, ValueError):
+                trusted = False
+            if not trusted:
+                value = DerivationCache.MISSING
         if value is DerivationCache.MISSING:
             value = derive()
             self._derivation.put(name, value)
         return value
+
+    #: The point z0 on which cached polynomials are checked (off the unit circle
+    #: and the real axis, where poles and their cancellations live).
+    _CHECK_Z = complex(1.3, 0.4)
+
+    @functools.cached_property
+    def _check_point(self):
+        """Parameter values (none 0, 1 or equal to another) for checking cached parts."""
+        point = {model.T: sp.Float("0.0213", _DPS)}
+        others = [n for n in self._symbols if n != "T"]
+        for k, name in enumerate(others):
+            point[self._symbols[name]] = sp.Float(repr(1 + 0.3183098861837907 * (k + 1)), _DPS)
+        return point
+
+    def _at_check_point(self, coefficients):
+        """A polynomial (coefficients highest first) at :attr:`_CHECK_Z` and :meth:`_check_point`."""
+        total = 0j
+        for c in coefficients:
+            total = total * self._CHECK_Z + complex(sp.N(c.xreplace(self._check_point), _DPS))
+        return total
+
+    @staticmethod
+    def _close(a, b):
+        return bool(abs(a - b) <= 1e-9 * max(abs(a), abs(b)) and np.isfinite(abs(a)))
+
+    def _environment_agrees(self, parts):
+        at = {**self._check_point, model.z: sp.Float("1.3", _DPS) + sp.I * sp.Float("0.4", _DPS)}
+        expected = complex(sp.N(self.environment.xreplace(at), _DPS))
+        return self._close(self._at_check_point(parts[0]) / self._at_check_point(parts[1]),
+                           expected)
+
+    def _pulse_agrees(self, parts):
+        """Whether (P_n, P_d) give the matrix exponential's Z[ZOH G] at the check point."""
+        point = self._check_point
+        num, den = sp.fraction(sp.together(self.plant.xreplace(point)))
+        with mpmath.workdps(_DPS):
+            num, den = ([mpmath.mpf(sp.Float(c, _DPS)) for c in sp.Poly(p, model.s).all_coeffs()]
+                        for p in (num, den))
+            p_n, p_d = numeric_zoh(num, den, mpmath.mpf(point[model.T]), dps=_DPS)
+            z0 = mpmath.mpc(self._CHECK_Z.real, self._CHECK_Z.imag)
+            expected = complex(mpmath.polyval(p_n, z0) / mpmath.polyval(p_d, z0))
+        return self._close(self._at_check_point(parts[0]) / self._at_check_point(parts[1]),
+                           expected)
+
+    def _parts_agree(self, parts):
+        """Whether the delayed and direct parts are Ve_d P_d and Ve_n P_n at the check point."""
+        (ve_n, ve_d), (p_n, p_d) = self._environment_parts, self._plant_parts
+        at = self._at_check_point
+        return (self._close(at(parts[0]), at(ve_d) * at(p_d))
+                and self._close(at(parts[1]), at(ve_n) * at(p_n)))
 
     @functools.cached_property
     def _environment_parts(self):
@@ -453,7 +515,7 @@ class LoopModel:
             num, den = sp.fraction(sp.cancel(sp.together(self.environment)))
             return poly_coeffs(num, model.z), poly_coeffs(den, model.z)
 
-        return self._derived("environment_parts", derive)
+        return self._derived("environment_parts", derive, self._environment_agrees)
 
     @functools.cached_property
     def _plant_parts(self):
@@ -466,7 +528,7 @@ class LoopModel:
             num, den = sp.fraction(sp.cancel(pulse))
             return poly_coeffs(num, model.z), poly_coeffs(den, model.z)
 
-        return self._derived("plant_parts", derive)
+        return self._derived("plant_parts", derive, self._pulse_agrees)
 
     def pulse_transfer_function(self):
         """``Z[ZOH G](z)`` as a SymPy rational function of ``z``.
@@ -542,7 +604,7 @@ class LoopModel:
     @functools.cached_property
     def _parts(self):
         """Delayed and direct coefficient lists (symbolic path only)."""
-        return self._derived("parts", self._symbolic_parts)
+        return self._derived("parts", self._symbolic_parts, self._parts_agree)
 
     def affine_parameters(self):
         """Names of the parameters in which the characteristic polynomial is affine.
