@@ -600,6 +600,16 @@ class Loop(LoopModel):
                 break
         if found is None:
             raise refused
+        if not found.stable and not _covers(found, enclosure, free):
+            # Nothing stable in the windows tried, and they do not hold every
+            # point that can be stable: to call the set empty would be a guess.
+            if refused is not None:
+                raise refused
+            raise ValueError(
+                f"no stable point in the {x}, {y} windows tried, and the necessary condition "
+                f"for stability leaves an unbounded part of the plane (the leading coefficient "
+                f"of the loop's polynomial changes in it, say), so a stable set outside them is "
+                f"not excluded: give x_range and y_range")
         # Widen the free sides a stable cell reaches (never past the enclosure,
         # which holds the whole stable set); once it reaches none, fit them to
         # the stable set, a quarter of its extent around it.
@@ -724,6 +734,16 @@ class Loop(LoopModel):
         _, ve_d = self._environment_arrays(values, shape)
         num = np.concatenate([self._convolve(ve_d, p_n), np.zeros(d)])
         return control.tf(num, chi, float(values["T"]))
+
+
+def _covers(found, enclosure, free):
+    """Whether the window of ``found`` reaches ``enclosure`` on every free side."""
+    if enclosure is None:
+        return not any(free.values())
+    window = (*found.x_range, *found.y_range)
+    bound = (*enclosure[0], *enclosure[1])
+    return all(not free[side] or (window[k] <= bound[k] if k % 2 == 0 else window[k] >= bound[k])
+               for k, side in enumerate(("x_min", "x_max", "y_min", "y_max")))
 
 
 def _empty_reason(found):

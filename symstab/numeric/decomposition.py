@@ -780,7 +780,15 @@ class StableHull:
     def box(self, pad=0.05):
         """``(x_range, y_range)`` around the polygons, ``pad`` of their span added on each side.
 
-        None when the hull is unbounded or empty.
+        Parameters
+        ----------
+        pad : float
+            Fraction of the polygons' span added on each side.
+
+        Returns
+        -------
+        tuple of (float, float) or None
+            None when the hull is unbounded or empty.
         """
         if not self.bounded or not self.polygons:
             return None

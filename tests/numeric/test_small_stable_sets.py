@@ -182,3 +182,24 @@ def _outside_by(polygon, x, y, margin):
     cross = ((b[:, 0] - a[:, 0])[:, None] * (y[None, :] - a[:, 1, None])
              - (b[:, 1] - a[:, 1])[:, None] * (x[None, :] - a[:, 0, None])) / length
     return np.any(cross < -margin * np.max(np.abs(polygon)), axis=0)
+
+
+def test_without_a_bounded_enclosure_nothing_found_is_not_called_empty(paper_file_loop,
+                                                                       monkeypatch):
+    """No stable cell in windows that need not hold the set is an error, not "empty".
+
+    gamma = 2.1 at d = 1 is empty (|chi(0)| > its leading coefficient), but
+    with the enclosure taken away the windows tried are only the curves'
+    extent: before, ``limits`` answered "no stable point found" (empty) from
+    them; a set outside them was not excluded.
+    """
+    import symstab.numeric.any_loop as any_loop
+    from symstab.numeric.decomposition import StableHull
+
+    assert paper_file_loop.limits(d=1, M=2.1 * M).empty
+    monkeypatch.setattr(any_loop, "stable_hull", lambda *rows: StableHull((), False))
+    with pytest.raises(ValueError, match="not excluded: give x_range and y_range"):
+        paper_file_loop.limits(d=1, M=2.1 * M)
+    # A window given is answered for that window.
+    lim = paper_file_loop.limits(d=1, M=2.1 * M, x_range=(-1.0, 1.0), y_range=(-10.0, 10.0))
+    assert lim.empty and "every cell of the window" in lim.reason
