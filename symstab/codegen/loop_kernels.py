@@ -145,8 +145,6 @@ def load_numpy_kernels(kernels, *, title):
     h = hashlib.sha256(_LAYOUT.encode())
     h.update(data)
     name = f"symstab_loop_{h.hexdigest()[:20]}"
-    if name in sys.modules:
-        return sys.modules[name]
     folder = cache_dir() / "loops"
     path = folder / f"{name}.py"
     try:
@@ -166,11 +164,16 @@ def load_numpy_kernels(kernels, *, title):
                 raise
         except OSError:
             path = None
-    module = type(sys)(name)
-    module.__file__ = None if path is None else str(path)
-    exec(compile(text, module.__file__ or f"<{name}>", "exec"), module.__dict__)
-    module.__symstab_digest__ = _digest(kernels)
-    sys.modules[name] = module
+    where = None if path is None else str(path)
+    # Compiled once per process and cache folder: the same name is the same
+    # text, so a module compiled earlier is as good as a new one.
+    module = sys.modules.get(name)
+    if module is None or getattr(module, "__file__", None) != where:
+        module = type(sys)(name)
+        module.__file__ = where
+        exec(compile(text, where or f"<{name}>", "exec"), module.__dict__)
+        module.__symstab_digest__ = _digest(kernels)
+        sys.modules[name] = module
     return module
 
 
