@@ -42,7 +42,7 @@ import re
 import numpy as np
 import sympy as sp
 
-__all__ = ["unit_registry", "UnitInfo", "unit_info", "dimension_name", "FileValue", "Bound", "FileParameters",
+__all__ = ["unit_registry", "ALLOWED_UNITS", "UnitInfo", "unit_info", "dimension_name", "FileValue", "Bound", "FileParameters",
            "read_parameters", "check_loop_units", "convert", "check_bounds", "SAMPLE_UNITS"]
 
 #: The only units of the delay ``d``, a whole number of samples.
@@ -69,6 +69,46 @@ _SI_NAMES = {
 #: or 10**10**10, would make pint compute for ever).
 _EXPONENT = re.compile(r"(\*\*|\^)\s*(\(\s*)?[+-]?\d{1,2}(\.\d{1,3})?(\s*/\s*\d{1,2})?\s*\)?")
 _POWER = re.compile(r"\*\*|\^")
+#: A unit's names: a letter, then letters, digits or ``_``.
+_NAME = re.compile(r"[^\W\d_]\w*")
+#: What may stand between the names (and exponents) of a unit.
+_JOINERS = re.compile(r"[\s*/()\u00b7]*")
+#: The units a loop file may name, by pint's canonical name, each with any
+#: decimal SI prefix (and pint's plural ``s``).  pint knows far more names,
+#: and some of them would scale a value silently: ``%`` (percent), ``alpha``
+#: (the fine-structure constant), ``c`` (the speed of light), ``Nm`` (a
+#: "number meter"); a name outside this list is refused instead.
+ALLOWED_UNITS = frozenset({
+    "meter", "inch", "foot", "gram", "pound", "ounce", "second", "minute", "hour",
+    "newton", "force_pound", "force_ounce", "force_kilogram", "force_gram", "hertz",
+    "radian", "degree", "turn", "arcminute", "arcsecond", "joule", "watt", "ampere",
+    "volt", "ohm", "kelvin",
+})
+_PREFIXES = frozenset({"", "yocto", "zepto", "atto", "femto", "pico", "nano", "micro", "milli",
+                       "centi", "deci", "deca", "hecto", "kilo", "mega", "giga", "tera", "peta",
+                       "exa", "zetta", "yotta"})
+
+
+def _check_names(text, registry):
+    """Refuse a unit with anything but allowed names, exponents, ``1``, spaces, ``*``, ``/``, brackets."""
+    bare = re.sub(r"(?<![\w.])1(?![\w.])", " ", _EXPONENT.sub(" ", text))
+    names = _NAME.findall(bare)
+    rest = _NAME.sub(" ", bare)
+    if not _JOINERS.fullmatch(rest):
+        odd = "".join(dict.fromkeys(re.sub(r"[\s*/()\u00b7]", "", rest)))
+        what = ("a number belongs in 'value', not in the unit" if odd.isdigit() or odd == "."
+                else f"{odd!r} has no place in a unit")
+        raise ValueError(f"unit {text!r} is not a unit a loop file may name: {what} (a unit is "
+                         f"names of units joined by spaces, '*' and '/', with exponents such as "
+                         f"'^2' or '**-1', or 1 alone)")
+    for name in names:
+        readings = registry.parse_unit_name(name)
+        prefix, unit, suffix = readings[0] if readings else ("", None, "")
+        if unit not in ALLOWED_UNITS or prefix not in _PREFIXES or suffix not in ("", "s"):
+            what = f"pint reads {name!r} as {prefix}{unit}" if unit else f"pint does not know {name!r}"
+            raise ValueError(f"unit {text!r} is not a unit a loop file may name: {what}; allowed: "
+                             f"m, g, s, N, Hz, rad, J, W, A, V, ohm and K with any SI prefix, "
+                             f"and in, ft, lb, oz, lbf, ozf, kgf, min, h, deg, turn, arcmin, arcsec")
 
 
 @functools.lru_cache(maxsize=None)
@@ -162,6 +202,7 @@ def unit_info(text):
         raise ValueError(f"unit {text!r}: an exponent must be a number of at most two digits, "
                          f"and no power may be raised to a power")
     registry = unit_registry()
+    _check_names(text, registry)
     try:
         quantity = registry.parse_expression(text)
         if not isinstance(quantity, registry.Quantity):

@@ -134,8 +134,9 @@ def test_milliseconds_give_the_si_files_K_max():
      r"parameter 'K' has unit 'N/m'.* needs N m/rad there"),
     # unknown to pint, an offset unit, an angular frequency
     (dict(K='{ value = 2.0, unit = "Nm_per_furlong" }'), r"parameter 'K': unit 'Nm_per_furlong' is not a "
-                                                         r"unit pint knows"),
-    (dict(K='{ value = 2.0, unit = "degC" }'), r"parameter 'K': unit 'degC' has an offset"),
+                                                         r"unit a loop file may name"),
+    (dict(K='{ value = 2.0, unit = "degC" }'), r"parameter 'K': unit 'degC' is not a unit a loop "
+                                               r"file may name: pint reads 'degC' as degree_Celsius"),
     (dict(K='{ value = 2.0, unit = "" }'), r"parameter 'K'.*empty"),
     (dict(K='{ value = 2.0, unit = "m**10**10" }'), r"parameter 'K'.*exponent"),
 ])
@@ -271,13 +272,29 @@ def test_every_unit_of_every_example_file_is_converted(path):
 FACTORS.update({"us": 1e-6, "N mm/rad": 1e-3, "lbf/in": 4.4482216152605 / 0.0254})
 
 
+@pytest.mark.parametrize("unit, why", [
+    ("N/m%", "'%' has no place"),                       # pint: percent, K / 100
+    ("N/m $alpha$", "'\\$' has no place"),                # LaTeX: pint would read the constant
+    ("N/m # a comment", "'#' has no place"),          # pint: the rest is a comment
+    ("N/m alpha", "pint reads 'alpha' as fine_structure_constant"),
+    ("Nm", "pint reads 'Nm' as number_meter"),
+    ("c", "pint reads 'c' as speed_of_light"),
+    ("1000 N/m", "a number belongs in 'value'"),
+])
+def test_a_unit_pint_would_read_as_a_silent_factor_is_refused(unit, why):
+    """pint reads these as N/m (or no unit) times a number; taken, K = 2 would become 0.02, 0.0146, ..."""
+    with pytest.raises(ValueError, match=rf"parameter 'K': unit '{re.escape(unit)}' is not a unit "
+                                         rf"a loop file may name: {why}"):
+        parse_loop_text(_paper(K=f'{{ value = 2.0, unit = "{unit}" }}'))
+
+
 def test_every_unit_in_the_readme_is_converted_or_said_to_be_refused():
     readme = (REPO / "README.md").read_text(encoding="utf-8")
     units = set(re.findall(r'unit = "([^"]*)"', readme))
     assert {"ms", "g", "N/mm"} <= units
     refused = set(re.findall(r'unit = "([^"]*)"[^\n]*# refused', readme))
     assert {"kg", "degC", "rad/s"} <= refused
-    listed = re.search(r"any unit pint\s+knows — (.*?) — is converted", readme, re.S).group(1)
+    listed = re.search(r"exponents \(`\^2`, `\*\*-1`\) — (.*?) — is converted", readme, re.S).group(1)
     named = set(re.findall(r"`([^`]+)`", listed))
     assert len(named) >= 10
     for unit in sorted((units | named) - refused - {"samples"}):
