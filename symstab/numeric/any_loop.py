@@ -152,10 +152,14 @@ class Loop(LoopModel):
     values : dict, optional
         Default values of parameters (used where a call does not give one).
     name : str, optional
-        A label for reprs and generated files.
+        A word for reprs and generated files (ASCII letters, digits, ``_``,
+        ``-``, ``.``).
     units : dict, optional
-        Unit of each parameter, as text (shown by the CLI), e.g.
-        ``{"K": "N/m"}``.
+        The SI unit of each parameter, as text (shown by the CLI), e.g.
+        ``{"K": "N/m"}``.  The loop computes with its values as given, so a
+        unit that is not SI (``"ms"``) is refused, and so are units whose
+        dimensions do not fit the loop; a loop file's units are converted
+        (:func:`symstab.load_loop`).
     description : str, optional
         One line on what the loop is.
     plane : (str, str), optional
@@ -166,7 +170,8 @@ class Loop(LoopModel):
     ------
     TypeError, ValueError
         If the plant or the environment is not a proper rational function
-        of its variable, or uses ``d`` (the delay is the loop's).
+        of its variable, or uses ``d`` (the delay is the loop's); if a unit
+        is not SI or does not fit the loop.
 
     Examples
     --------
@@ -178,6 +183,31 @@ class Loop(LoopModel):
     >>> bool(loop.is_stable(K=300.0, B=0.5, m=0.0128, b=0.0324, T=1e-3, d=0))
     True
     """
+
+    def __init__(self, plant, environment, *, values=None, name=None, units=None,
+                 description="", plane=None):
+        super().__init__(plant, environment, values=values, name=name, units=units,
+                         description=description, plane=plane)
+        if self.units:
+            self._check_units()
+
+    def _check_units(self):
+        # A unit here names the unit of values the loop computes with as they
+        # are: one that is not SI would be a label on a wrong number.
+        from .loop_units import check_loop_units, convert
+
+        given = {}
+        for key, unit in self.units.items():
+            item = convert(key, 1, unit, where="units")
+            if item.si_value != 1:
+                raise ValueError(f"units: {key!r} is given in {unit!r}, which is "
+                                 f"{float(item.si_value):g} {item.si_unit}: Loop takes its values "
+                                 f"in SI, so give {key} in {item.si_unit} (a loop file's units are "
+                                 f"converted: symstab.load_loop)")
+            given[key] = convert(key, self.defaults.get(key, 1), unit, where="units")
+        for key, value in self.defaults.items():
+            given.setdefault(key, convert(key, value, None, where="values"))
+        check_loop_units(self, given, [], source="units")
 
     def kernels(self):
         """The loop's generated kernels, as :class:`symstab.codegen.generator.Kernel` objects.

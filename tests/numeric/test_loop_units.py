@@ -20,6 +20,7 @@ if sys.version_info >= (3, 11):
 else:   # pragma: no cover - Python 3.10
     import tomli as tomllib
 
+from symstab import Loop
 from symstab.numeric.loop_files import load_loop, parse_loop_text
 from symstab.numeric.loop_units import check_bounds, unit_info
 
@@ -315,3 +316,21 @@ def test_the_readmes_loop_file_is_read_as_its_comments_say():
     assert loop.units == {"m": "kg", "b": "N s/m", "T": "s", "d": "samples", "K": "N/m"}
     with pytest.raises(ValueError, match=r"K must be a finite real number >= 0, got -1\.0"):
         check_bounds(loop.file_parameters, dict(loop.defaults, K=-1.0), where="--set")
+
+
+@pytest.mark.parametrize("units, match", [
+    ({"T": "ms"}, r"units: 'T' is given in 'ms', which is 0.001 s: Loop takes its values in SI"),
+    ({"K": "N/mm"}, r"units: 'K' is given in 'N/mm', which is 1000 N/m"),
+    ({"K": "kg"}, r"parameter 'K' has unit 'kg', which does not fit the loop"),
+    ({"T": "deg"}, r"parameter 'T' has unit 'deg'.*a time"),
+])
+def test_the_python_loop_refuses_a_unit_it_would_only_print(units, match):
+    """Loop(units=) computes with its values as given: a non-SI unit would label a wrong number."""
+    with pytest.raises(ValueError, match=match):
+        Loop("1/(m*s**2 + b*s)", "K + B*(z - 1)/(T*z)", values=dict(T=1e-3, K=2.0), units=units)
+
+
+def test_the_python_loop_keeps_si_units():
+    loop = Loop("1/(m*s**2 + b*s)", "K + B*(z - 1)/(T*z)", values=dict(T=1e-3),
+                units={"K": "N/m", "T": "s", "m": "kg"})
+    assert loop.units == {"K": "N/m", "T": "s", "m": "kg"}
