@@ -566,7 +566,8 @@ def _limits_rows(setup, lim):
 
 def _limits_notes(setup, lim):
     if lim.empty:
-        return [f"no stable point found in the ({setup.x}, {setup.y}) plane at these values"]
+        return [f"no stable point in the ({setup.x}, {setup.y}) plane at these values: "
+                f"{lim.reason or 'no cell of the window has every root inside the unit circle'}"]
     if math.isinf(lim.y_max) or math.isinf(lim.area):
         return [f"the stable set is unbounded in the ({setup.x}, {setup.y}) plane"]
     return []

@@ -389,3 +389,12 @@ def test_the_map_help_example_frames_the_stable_set(capsys, tmp_path, monkeypatc
         stable = f["stable"]
         # The stable set does not touch the window's left, right or top edge.
         assert not stable[0].any() and not stable[-1].any() and not stable[:, -1].any()
+
+
+def test_limits_says_why_a_stable_set_is_empty(capsys):
+    """M = 2m is beyond |gamma| >= 2.0034, where no point is stable (proved): the CLI says why."""
+    status, out, _ = run(capsys, "limits", "--loop", PAPER,
+                             "--set", "M=0.0256", "--d", 40)
+    assert status == 0
+    note = next(line for line in out.splitlines() if line.startswith("no stable point"))
+    assert "necessary condition" in note and "no point is stable" in note
