@@ -257,3 +257,38 @@ def theta_max_box_sample(seed, n):
         if gamma + 1 + delta * (d + 1) > 0:
             points.append((gamma, d, delta))
     return points
+
+
+def simulated_loop_radius(K, B, *, d, f_c=None, f_a=None, M=0.0, m=None, b=None, T=None):
+    """Spectral radius of the simulated linear loop, by python-control.
+
+    The velocity estimate is the backward difference ``(x[k] - x[k-1])/T``,
+    filtered by ``v_f[k] = a v_f[k-1] + (1 - a) v[k]`` with ``a = exp(-2 pi
+    f_c T)``; the force is ``K x + B v_f + M (v_f[k] - v_f[k-1])/T`` (the
+    simulator's :meth:`_Loop._command`, written here as transfer functions).
+    The actuator is ``1/(tau s + 1)`` with ``tau = 1/(2 pi f_a)``, before the
+    plant, inside the hold.
+    """
+    import control
+
+    from symstab.numeric.units import PAPER_DEVICE
+
+    m = PAPER_DEVICE.m if m is None else m
+    b = PAPER_DEVICE.b if b is None else b
+    T = PAPER_DEVICE.T if T is None else T
+
+    plant = control.tf([1], [m, b, 0])
+    if f_a is not None:
+        plant = plant * control.tf([1], [1 / (2 * math.pi * f_a), 1])
+    G = control.c2d(plant, T, "zoh")
+    z = control.tf([1, 0], [1], T)
+    difference = (z - 1) / (T * z)
+    if f_c is None:
+        VE = K + B * difference + M * difference * difference
+    else:
+        a = math.exp(-2 * math.pi * f_c * T)
+        velocity = (1 - a) * z / (z - a) * difference
+        VE = K + B * velocity + M * difference * velocity
+    delay = control.tf([1], [1] + [0] * d, T)
+    poles = control.poles(control.feedback(G, VE * delay))
+    return float(np.max(np.abs(poles)))

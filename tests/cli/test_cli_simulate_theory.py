@@ -8,8 +8,6 @@ the environment built from the simulator's difference equations as transfer
 functions, the delay, and the closed loop's poles.
 """
 
-import math
-
 import numpy as np
 import pytest
 
@@ -17,6 +15,7 @@ from symstab.numeric.stability import MARGINAL, STABLE
 from symstab.numeric.units import PAPER_DEVICE
 
 from conftest import run_cli
+from oracles import simulated_loop_radius as oracle_radius
 
 DEV = PAPER_DEVICE
 #: The window of the README's map (d = 10), on a small grid.
@@ -26,35 +25,6 @@ GRID = ["--Td", "0.01", "--Kw", "0,70,16", "--Bw=-0.1,2,16"]
 @pytest.fixture(autouse=True)
 def _kernels_in_a_temporary_folder(loop_cache_dir):
     """The filtered and lagged loops' kernels are generated: never into ~/.cache."""
-
-
-def oracle_radius(K, B, *, d, f_c=None, f_a=None, M=0.0, m=DEV.m, b=DEV.b, T=DEV.T):
-    """Spectral radius of the simulated linear loop, by python-control.
-
-    The velocity estimate is the backward difference ``(x[k] - x[k-1])/T``,
-    filtered by ``v_f[k] = a v_f[k-1] + (1 - a) v[k]`` with ``a = exp(-2 pi
-    f_c T)``; the force is ``K x + B v_f + M (v_f[k] - v_f[k-1])/T`` (the
-    simulator's :meth:`_Loop._command`, written here as transfer functions).
-    The actuator is ``1/(tau s + 1)`` with ``tau = 1/(2 pi f_a)``, before the
-    plant, inside the hold.
-    """
-    import control
-
-    plant = control.tf([1], [m, b, 0])
-    if f_a is not None:
-        plant = plant * control.tf([1], [1 / (2 * math.pi * f_a), 1])
-    G = control.c2d(plant, T, "zoh")
-    z = control.tf([1, 0], [1], T)
-    difference = (z - 1) / (T * z)
-    if f_c is None:
-        VE = K + B * difference + M * difference * difference
-    else:
-        a = math.exp(-2 * math.pi * f_c * T)
-        velocity = (1 - a) * z / (z - a) * difference
-        VE = K + B * velocity + M * difference * velocity
-    delay = control.tf([1], [1] + [0] * d, T)
-    poles = control.poles(control.feedback(G, VE * delay))
-    return float(np.max(np.abs(poles)))
 
 
 def _radius(text):

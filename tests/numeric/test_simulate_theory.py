@@ -5,8 +5,6 @@ simulator's filter written as transfer functions) and the loop file of the
 same device, ``examples/loops/lowpass_velocity.toml``.
 """
 
-import math
-
 import numpy as np
 import pytest
 
@@ -15,6 +13,7 @@ from symstab.numeric.simulate import Nonidealities, linear_theory
 from symstab.numeric.stability import MARGINAL, STABLE, UNSTABLE
 
 from conftest import REPO
+from oracles import simulated_loop_radius as oracle_radius
 
 DEV = symstab.PAPER_DEVICE
 
@@ -22,26 +21,6 @@ DEV = symstab.PAPER_DEVICE
 @pytest.fixture(autouse=True)
 def _kernels_in_a_temporary_folder(loop_cache_dir):
     """The linear loops' kernels are generated: never into ~/.cache."""
-
-
-def oracle_radius(K, B, *, d, f_c=None, f_a=None, M=0.0, m=DEV.m, b=DEV.b, T=DEV.T):
-    """Spectral radius by python-control (see tests/cli/test_cli_simulate_theory.py)."""
-    import control
-
-    plant = control.tf([1], [m, b, 0])
-    if f_a is not None:
-        plant = plant * control.tf([1], [1 / (2 * math.pi * f_a), 1])
-    G = control.c2d(plant, T, "zoh")
-    z = control.tf([1, 0], [1], T)
-    difference = (z - 1) / (T * z)
-    if f_c is None:
-        VE = K + B * difference + M * difference * difference
-    else:
-        a = math.exp(-2 * math.pi * f_c * T)
-        velocity = (1 - a) * z / (z - a) * difference
-        VE = K + B * velocity + M * difference * velocity
-    delay = control.tf([1], [1] + [0] * d, T)
-    return float(np.max(np.abs(control.poles(control.feedback(G, VE * delay)))))
 
 
 def test_the_filter_is_the_loop_files_filter():
