@@ -25,7 +25,7 @@ for the loop (:mod:`symstab.codegen.loop_kernels`, cached on disk); the plant's
 pulse transfer function is evaluated at 30 digits for each distinct set of
 plant values (its closed form cancels badly in floating point when
 ``b T / m`` is small) and rounded once.  Classification is
-:func:`symstab.numeric.stability.classify_polynomials` (float Schur-Cohn where its
+:func:`symstab.numeric.roots.classify_polynomials` (float Schur-Cohn where its
 margin is safe, the certified root count elsewhere).  The boundary of a
 parameter plane is the D-decomposition: on ``z = exp(j theta)`` the two real
 equations ``Re chi = Im chi = 0`` are linear in the plane's parameters
@@ -42,13 +42,13 @@ import sympy as sp
 
 from .._resources import check_memory
 from .._validate import check_array, check_count, check_delay, check_window
-from ..symbolic.loop_assembly import _DPS, LoopModel, parse_environment, parse_plant
+from ..symbolic.loop_assembly import _DPS, LoopModel, parse_environment, parse_plant, shift_to_one
 from ..codegen.loop_kernels import environment_kernels, load_numpy_kernels
 from .decomposition import Decomposition, arc_points, decompose, stable_hull
 from .passivity import passive_region
 from .decomposition import lines as _lines
-from .stability import (MARGINAL, STABLE, _leading_vanishes, classify_polynomials,
-                        polynomial_root_counts, polynomial_spectral_radius)
+from .polynomial import DelayedPolynomial
+from .roots import MARGINAL, STABLE, classify_polynomials, root_counts, spectral_radius
 
 __all__ = ["Loop", "LoopLimits", "LoopBoundary", "parse_plant", "parse_environment"]
 
@@ -265,7 +265,7 @@ class Loop(LoopModel):
         return out, d
 
     def _plant_arrays(self, values, shape):
-        """(P_n, P_d, ends) per point, shape ``shape + (k,)``, one 30-digit evaluation per distinct row."""
+        """(P_n, P_d, ends, P_d in z - 1) per point, shape ``shape + (k,)``, one 30-digit evaluation per distinct row."""
         names = self._plant_names + ("T",)
         if all(np.ndim(values[n]) == 0 for n in names):
             # One plant for every point: the common case of a plane sweep.
@@ -275,11 +275,11 @@ class Loop(LoopModel):
         columns = np.stack([np.broadcast_to(values[n], shape).ravel() for n in names], axis=-1)
         unique, inverse = np.unique(columns, axis=0, return_inverse=True)
         parts = [self._numeric_plant(tuple(row[:-1]), float(row[-1])) for row in unique]
-        p_n = np.array([p[0] for p in parts])[inverse.ravel()]
-        p_d = np.array([p[1] for p in parts])[inverse.ravel()]
-        ends = np.array([p[2] for p in parts])[inverse.ravel()]
-        return (p_n.reshape(shape + p_n.shape[-1:]), p_d.reshape(shape + p_d.shape[-1:]),
-                ends.reshape(shape + (4,)))
+        out = []
+        for k in range(4):
+            part = np.array([p[k] for p in parts])[inverse.ravel()]
+            out.append(part.reshape(shape + part.shape[-1:]))
+        return tuple(out)
 
     def _environment_arrays(self, values, shape, slope=None):
         module, names, n_num, n_den = self._kernels
@@ -289,13 +289,6 @@ class Loop(LoopModel):
         out = [np.broadcast_to(np.asarray(c, dtype=float), shape) for c in out]
         return np.stack(out[:n_num], axis=-1), np.stack(out[n_num:], axis=-1)
 
-    def _dense(self, delayed, direct, d):
-        n = d + delayed.shape[-1] - 1
-        out = np.zeros(delayed.shape[:-1] + (n + 1,))
-        out[..., : delayed.shape[-1]] += delayed
-        out[..., n + 1 - direct.shape[-1]:] += direct
-        return out
-
     @staticmethod
     def _convolve(a, b):
         out = np.zeros(np.broadcast_shapes(a.shape[:-1], b.shape[:-1]) + (a.shape[-1] + b.shape[-1] - 1,))
@@ -303,20 +296,34 @@ class Loop(LoopModel):
             out[..., i:i + b.shape[-1]] += a[..., i, None] * b
         return out
 
-    def _coefficients(self, values, d, shape, *, slope=None, plant=None):
+    def _polynomial(self, values, d, shape, *, slope=None, plant=None):
+        """``chi = z**d Ve_d P_d + Ve_n P_n`` (or its slope in one parameter), structured.
+
+        The delayed part comes also in powers of ``z - 1`` (the plant's at 30
+        digits, the environment's shifted in double precision with a bound
+        on that rounding), for the root count's accuracy next to ``z = 1``;
+        a plant parameter's slope has none.
+        """
         if plant is None:
             plant = self._plant_arrays(values, shape)
-        p_n, p_d = plant[:2]
+        p_n, p_d, _, p_d_one = plant
         if slope is None or slope in self._environment_names:
             ve_n, ve_d = self._environment_arrays(values, shape, slope)
-            delayed, direct = self._convolve(ve_d, p_d), self._convolve(ve_n, p_n)
-        else:
-            # A plant parameter: the slope of P_n, P_d (30 digits) by the
-            # exact derivative of their symbolic coefficients.
-            ve_n, ve_d = self._environment_arrays(values, shape)
-            dp_n, dp_d = self._plant_slope(values, shape, slope)
-            delayed, direct = self._convolve(ve_d, dp_d), self._convolve(ve_n, dp_n)
-        return self._dense(delayed, direct, d)
+            ve_one, ve_error = _shift_to_one(ve_d)
+            near_one = (self._convolve(ve_one, p_d_one),
+                        self._convolve(ve_error, np.abs(p_d_one))
+                        + 4 * ve_d.shape[-1] * 2.0**-53 * self._convolve(np.abs(ve_one),
+                                                                         np.abs(p_d_one)))
+            return DelayedPolynomial(self._convolve(ve_d, p_d), self._convolve(ve_n, p_n), d,
+                                     near_one=near_one)
+        # A plant parameter: the slope of P_n, P_d (30 digits) by the exact
+        # derivative of their symbolic coefficients.
+        ve_n, ve_d = self._environment_arrays(values, shape)
+        dp_n, dp_d = self._plant_slope(values, shape, slope)
+        return DelayedPolynomial(self._convolve(ve_d, dp_d), self._convolve(ve_n, dp_n), d)
+
+    def _coefficients(self, values, d, shape, *, slope=None, plant=None):
+        return self._polynomial(values, d, shape, slope=slope, plant=plant).dense()
 
     def _end_values(self, values, d, shape, *, slope=None, plant):
         """``chi(1)`` and ``chi(-1)`` (or their slopes), from the plant's 30-digit end values."""
@@ -369,6 +376,9 @@ class Loop(LoopModel):
     def coefficients(self, **values):
         """Coefficients of ``chi(z)`` (highest power first), divided by ``P_d``'s leading one.
 
+        Dense: for short delays and for comparisons; the loop's own
+        computations keep ``chi`` structured (:meth:`polynomial`).
+
         Parameters
         ----------
         **values
@@ -380,10 +390,29 @@ class Loop(LoopModel):
         ndarray
             Shape ``broadcast_shape + (degree + 1,)``.
         """
+        return self.polynomial(**values).dense()
+
+    def polynomial(self, **values):
+        """``chi(z) = z**d D(z) + N(z)`` as a :class:`~symstab.numeric.polynomial.DelayedPolynomial`.
+
+        ``D = Ve_d P_d`` and ``N = Ve_n P_n``, divided by ``P_d``'s leading
+        coefficient, one polynomial per point; what :meth:`classify`,
+        :meth:`unstable_root_counts` and :meth:`spectral_radius` work on, in
+        O(d) per point.
+
+        Parameters
+        ----------
+        **values
+            Every parameter (:attr:`parameters`), or its default; arrays
+            broadcast; ``d`` is an integer.
+        """
         values, d, shape = self._prepare(values)
         size = int(np.prod(shape))
-        check_memory("the loop's coefficients", 8 * size * (d + 16))
-        return self._finite(self._coefficients(values, d, shape), values)
+        check_memory("the loop's polynomial", 8 * size * 64)
+        with np.errstate(all="ignore"):     # an overflow is the ValueError of _finite
+            chi = self._polynomial(values, d, shape)
+        self._finite(np.concatenate([chi.delayed, chi.direct], axis=-1), values)
+        return chi
 
     @staticmethod
     def _finite(c, values):
@@ -399,7 +428,11 @@ class Loop(LoopModel):
         return c
 
     def spectral_radius(self, **values):
-        """Largest modulus of the closed-loop poles (batched eigenvalues).
+        """Largest modulus of the closed-loop poles.
+
+        :func:`symstab.numeric.roots.spectral_radius`: companion eigenvalues
+        up to degree 128, certified counts on circles and Newton steps on
+        the structured polynomial above.
 
         Parameters
         ----------
@@ -412,14 +445,13 @@ class Loop(LoopModel):
         float or ndarray
             Of the broadcast shape.
         """
-        c = self.coefficients(**values)
-        r = polynomial_spectral_radius(c.reshape(-1, c.shape[-1])).reshape(c.shape[:-1])
+        r = spectral_radius(self.polynomial(**values))
         return float(r) if r.ndim == 0 else r
 
     def classify(self, **values):
         """Stable (1), marginal (0) or unstable (-1) at each point.
 
-        Certified as :func:`symstab.numeric.stability.classify_polynomials` is: for
+        Certified as :func:`symstab.numeric.roots.classify_polynomials` is: for
         the polynomial with the coefficients as computed (each within an ulp
         or so of the exact value: the plant at 30 digits, the environment in
         double precision).
@@ -434,8 +466,7 @@ class Loop(LoopModel):
         -------
         int or ndarray of int8
         """
-        c = self.coefficients(**values)
-        codes = classify_polynomials(c)
+        codes = classify_polynomials(self.polynomial(**values))
         return int(codes) if codes.ndim == 0 else codes
 
     def is_stable(self, **values):
@@ -457,8 +488,9 @@ class Loop(LoopModel):
     def unstable_root_counts(self, **values):
         """Certified number of closed-loop poles outside the unit circle (-1: marginal).
 
-        -1 also where a root is at infinity to within rounding (an ill-posed
-        loop), as in :meth:`classify`.
+        :func:`symstab.numeric.roots.root_counts`, O(d) per point; -1 also
+        where a root is at infinity to within rounding (an ill-posed loop),
+        as in :meth:`classify`.
 
         Parameters
         ----------
@@ -466,12 +498,7 @@ class Loop(LoopModel):
             Every parameter (:attr:`parameters`) or its default; arrays
             broadcast; ``d`` is an integer.
         """
-        c = self.coefficients(**values)
-        rows = c.reshape(-1, c.shape[-1])
-        counts = polynomial_root_counts(rows)
-        # A root at infinity (vanishing leading coefficient) is marginal, as in classify.
-        counts[_leading_vanishes(rows)] = -1
-        counts = counts.reshape(c.shape[:-1])
+        counts = root_counts(self.polynomial(**values))
         return int(counts) if counts.ndim == 0 else counts
 
     def _basis(self, names, given):
@@ -766,6 +793,17 @@ class Loop(LoopModel):
         return control.tf(num, chi, float(values["T"]))
 
 
+def _shift_to_one(c):
+    """Coefficients of ``p(w + 1)`` (``w = z - 1``) from float rows ``c``, with a bound on their rounding.
+
+    Each shifted coefficient is a sum of ``binom(j, k) c_j``; its rounding,
+    and the few ulps of the given coefficients, are bounded by a multiple of
+    the same sum of ``|c_j|`` (the shift of ``|c|``).
+    """
+    return (shift_to_one(c, dtype=float),
+            (4 * c.shape[-1] + 8) * 2.0**-53 * shift_to_one(np.abs(c), dtype=float))
+
+
 def _covers(found, enclosure, free):
     """Whether the window of ``found`` reaches ``enclosure`` on every free side."""
     if enclosure is None:
@@ -981,8 +1019,7 @@ def _line_intervals(a0, a1, a0_ends, a1_ends):
     rows = a0[None, :] + tests[:, None] * a1[None, :]
 
     def count(index):
-        c = polynomial_root_counts(rows[index])
-        return np.where(_leading_vanishes(rows[index]), -1, c)
+        return root_counts(DelayedPolynomial.from_dense(rows[index]))
 
     counts = np.full(len(tests), -2, dtype=np.int64)     # -2: not known
     known = np.zeros(len(tests), dtype=bool)

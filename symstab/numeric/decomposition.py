@@ -28,7 +28,7 @@ the pieces with each other and with the window's edges, builds the planar
 graph and walks its faces: each bounded face is a :class:`Cell` (a polygon,
 with holes where another piece floats inside it).  Each cell's count of
 unstable roots is the certified argument-principle count
-(:func:`symstab.numeric.stability.polynomial_root_counts`) at one interior
+(:func:`symstab.numeric.roots.root_counts`) at one interior
 point, and every edge shared by two cells is checked against the crossing
 rule: across the arc the count changes by 2 (a complex pair), across
 ``z = +-1`` by 1 and across the leading line by 0.  The stable set is the
@@ -43,7 +43,9 @@ import numpy as np
 
 from .._resources import check_memory
 from .curves import _golden_max
-from .stability import STABLE, _leading_vanishes, classify_polynomials, polynomial_root_counts
+from ..symbolic.loop_assembly import shift_to_one
+from .polynomial import DelayedPolynomial
+from .roots import STABLE, classify_polynomials, leading_vanishes, root_counts
 
 __all__ = ["Branch", "Cell", "Decomposition", "StableHull", "decompose", "arc_points",
            "stable_hull"]
@@ -817,14 +819,6 @@ def _exact_rows(rows):
     return [[num << (shift - den.bit_length()) for num, den in row] for row in ratios]
 
 
-def _taylor_shift(p):
-    """``p(t + 1)`` for exact coefficients ``p`` (highest first): n passes of partial sums."""
-    p = np.array(p, dtype=object)
-    for stop in range(len(p), 1, -1):
-        p[:stop] = np.cumsum(p[:stop])
-    return p
-
-
 def _bilinear(c):
     """Coefficients ``q_k`` (``q[k]`` of ``w**k``) of ``(w - 1)**n c((w + 1) / (w - 1))``, exactly.
 
@@ -832,12 +826,12 @@ def _bilinear(c):
     backwards in ``u = 1 / t``, is ``u**n c(1 + 2 / u)``; then ``u = w - 1``.
     """
     n = len(c) - 1
-    shifted = _taylor_shift(c)                                   # c(1 + t)
+    shifted = shift_to_one(c, dtype=object)                                   # c(1 + t)
     r = [v << (n - j) for j, v in enumerate(shifted)]            # c(1 + 2 t)
     u = r[::-1]                                                   # u**n c(1 + 2/u), highest first
     sign = [1 if (n - j) % 2 == 0 else -1 for j in range(n + 1)]
     # p(w - 1) = f(1 - w) with f(v) = p(-v): flip the odd powers, shift, flip back.
-    flipped = _taylor_shift([s * v for s, v in zip(sign, u)])
+    flipped = shift_to_one([s * v for s, v in zip(sign, u)], dtype=object)
     return [s * v for s, v in zip(sign, flipped)][::-1]          # lowest power first
 
 
@@ -1208,8 +1202,9 @@ def _decompose(base, ax, ay, ends, *, x_range, y_range, names, fine):
             points.append(pt)
         points = from_unit(np.array(points).reshape(-1, 2))
         rows = base[None, :] + points[:, :1] * ax[None, :] + points[:, 1:] * ay[None, :]
-        counts = polynomial_root_counts(rows) if len(rows) else np.zeros(0, dtype=np.int64)
-        infinite = _leading_vanishes(rows)
+        counts = (root_counts(DelayedPolynomial.from_dense(rows)) if len(rows)
+                  else np.zeros(0, dtype=np.int64))
+        infinite = leading_vanishes(rows)
         counts[infinite] = -1
         # Where the count's bounds cannot be closed in double precision (long
         # delays: thousands of roots near the circle), the float Schur-Cohn

@@ -45,7 +45,9 @@ import numpy as np
 from .._resources import CHUNK_BYTES, check_memory, chunk_slices
 from .._validate import check_array, check_loop, check_real
 from .curves import bracketed_root
-from .stability import _horner, _leading_vanishes, _polish, loop_coefficients
+from .polynomial import horner
+from .roots import leading_vanishes, polish_roots
+from .stability import loop_coefficients
 
 __all__ = ["Locus", "Crossing", "locus", "paper_locus", "ON_CIRCLE"]
 
@@ -330,7 +332,7 @@ def _roots(c):
     out = np.empty((rows, n), dtype=complex)
     if n == 0:
         return out
-    infinite = _leading_vanishes(c)
+    infinite = leading_vanishes(c)
     regular = np.flatnonzero(~infinite)
     for part in chunk_slices(len(regular), 8 * n * n, _EIG_BATCH_BYTES):
         index = regular[part]
@@ -338,7 +340,7 @@ def _roots(c):
         companion = np.zeros((len(index), n, n))
         companion[:, 0, :] = -rows_c[:, 1:] / rows_c[:, :1]
         companion[:, np.arange(1, n), np.arange(n - 1)] = 1.0
-        out[index] = _polish(rows_c, np.linalg.eigvals(companion).astype(complex))
+        out[index] = polish_roots(rows_c, np.linalg.eigvals(companion).astype(complex))
     for k in np.flatnonzero(infinite):
         finite = np.roots(c[k]) if np.any(c[k]) else np.empty(0)
         out[k, :finite.size] = finite
@@ -524,7 +526,7 @@ def _roots_along(c):
         return _roots(c)
     out = np.empty((rows, n), dtype=complex)
     out[0] = _roots(c[:1])[0]
-    infinite = _leading_vanishes(c)
+    infinite = leading_vanishes(c)
     for i in range(1, rows):
         z = None if infinite[i] or not np.all(np.isfinite(out[i - 1])) else \
             _continued(c[i], out[i - 1])
@@ -542,7 +544,7 @@ def _roots_near(c, start):
     if c.shape[1] - 1 < _CONTINUATION_DEGREE:
         return _roots(c)
     out = np.empty(start.shape, dtype=complex)
-    infinite = _leading_vanishes(c)
+    infinite = leading_vanishes(c)
     for i in range(len(c)):
         z = None if infinite[i] or not np.all(np.isfinite(start[i])) else \
             _continued(c[i], start[i])
@@ -556,7 +558,7 @@ def _continued(c, start):
     z = start.copy()
     with np.errstate(all="ignore"):
         for _ in range(_CONTINUATION_STEPS):
-            value, slope = _horner(row, z[None, :])
+            value, slope = horner(row, z[None, :])
             step = value[0] / slope[0]
             z = z - step
             if not np.all(np.isfinite(z)):
@@ -605,7 +607,7 @@ def _crossings(p, tracked, coefficients):
         """
         guess = za[index] + (x - pa[index]) / (pb[index] - pa[index]) * (zb[index] - za[index])
         c = coefficients(x)
-        return _polish(c, guess[:, None], steps=_NEWTON_STEPS)[:, 0]
+        return polish_roots(c, guess[:, None], steps=_NEWTON_STEPS)[:, 0]
 
     def excess(x, index):
         return np.abs(pole(x, index)) - 1.0

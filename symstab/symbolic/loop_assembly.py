@@ -58,6 +58,26 @@ _PARAMETER_PATTERN = re.compile(r"[A-Za-z][A-Za-z0-9_]{0,39}")
 _TEXT_LIMITS = {"description": 200, "unit": 60}
 
 
+def shift_to_one(coefficients, dtype=None):
+    """Coefficients of ``p(w + 1)`` in ``w`` from those of ``p(z)`` (both highest first).
+
+    ``n`` passes of partial sums along the last axis (Horner's scheme of the
+    shift): exact for integers and fractions (``dtype=object``), in the
+    working precision for mpmath numbers, and with rounding of at most a few
+    ulps of the shift of ``|p|`` for floats.  Rows (leading axes) are shifted
+    together.
+
+    Examples
+    --------
+    >>> shift_to_one([1, -3, 3, -1], dtype=object).tolist()    # (z - 1)**3 = w**3
+    [1, 0, 0, 0]
+    """
+    p = np.array(coefficients, dtype=dtype)
+    for stop in range(p.shape[-1], 1, -1):
+        p[..., :stop] = np.cumsum(p[..., :stop], axis=-1)
+    return p
+
+
 def _real_floats(values):
     """Floats of mpmath numbers that are real up to rounding.
 
@@ -586,8 +606,8 @@ class LoopModel:
             if need:
                 raise ValueError(f"the plant is discretised numerically: give "
                                  f"{', '.join(need)} to get its polynomial")
-            p_n, p_d, _ = self._numeric_plant(tuple(float(values[n]) for n in self._plant_names),
-                                           float(values["T"]))
+            p_n, p_d = self._numeric_plant(tuple(float(values[n]) for n in self._plant_names),
+                                           float(values["T"]))[:2]
             p_n = [sp.Float(str(c), _DPS) for c in p_n]
             p_d = [sp.Float(str(c), _DPS) for c in p_d]
         else:
@@ -672,12 +692,15 @@ class LoopModel:
 
     @functools.lru_cache(maxsize=4096)
     def _plant_cache(self, plant_values, T):
-        """(P_n, P_d, ends) as float arrays, monic P_d, evaluated at 30 digits.
+        """(P_n, P_d, ends, P_d in z - 1) as float arrays, monic P_d, evaluated at 30 digits.
 
         ``ends`` is ``(P_n(1), P_d(1), P_n(-1), P_d(-1))``, summed at 30
         digits: a pole at z = 1 then gives ``P_d(1)`` of 1e-30, not of the
         coefficients' rounding, and the line z = 1 of a plane comes out
-        where it is.
+        where it is.  The last part is ``P_d(w + 1)``'s coefficients in
+        ``w = z - 1`` (highest first), shifted at 30 digits: a pole
+        ``exp(p T)`` near 1 gives a small coefficient with its own digits,
+        which the root count needs next to ``z = 1``.
         """
         with mpmath.workdps(_DPS):
             point = [mpmath.mpf(float(v)) for v in plant_values]
@@ -709,5 +732,7 @@ class LoopModel:
             # 1000 ulps of its terms is that zero.
             ends = [mpmath.mpf(0) if abs(end) <= mpmath.mpf(10)**(3 - _DPS) * sum(abs(c) for c in part)
                     else end for end, part in zip(ends, (p_n, p_d, p_n, p_d))]
-            return tuple(np.array(_real_floats([c / lead for c in part]))
-                         for part in (p_n, p_d, ends))
+            monic = [c / lead for c in p_d]
+            near_one = list(shift_to_one(monic, dtype=object))
+            return tuple(np.array(_real_floats(part)) for part in
+                         ([c / lead for c in p_n], monic, [c / lead for c in ends], near_one))
