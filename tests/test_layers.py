@@ -8,6 +8,11 @@ From the bottom: the private base (``_project``, ``_resources``,
 ``figures``, ``reproduce``).  ``paper_checks`` sits between the library and
 the front ends: the front ends may import it, the library may not.  Imports
 are read from the source (static, lazy ones inside functions included).
+
+Besides the layers: no import cycle (strongly connected components of the
+module graph of symstab and of paper_checks), no private name imported
+from another module (:data:`PRIVATE_IMPORTS_ALLOWED` lists the few left, each
+with its reason), and the command line one module per command.
 """
 
 import ast
@@ -356,3 +361,24 @@ def test_no_private_name_is_imported_across_modules():
     stale = sorted(set(PRIVATE_IMPORTS_ALLOWED) - {(i, f"{s}.{n}") for i, _, s, n in found})
     assert stale == [], f"allowlist entries no longer needed: {stale}"
     assert offenders == [], f"{len(offenders)} private name(s) imported across modules"
+
+
+def test_the_cli_is_one_module_per_command_over_shared_modules():
+    """Each command is a module with ``register`` and ``run``; none imports another command.
+
+    ``symstab.cli.commands`` builds the parser from :data:`~symstab.cli.commands.COMMANDS`;
+    what two commands share lives in a shared module of ``symstab/cli/``.
+    """
+    from symstab.cli import commands
+
+    names = {module.__name__ for module in commands.COMMANDS}
+    assert len(names) == len(commands.COMMANDS)
+    for module in commands.COMMANDS:
+        assert callable(module.register) and callable(module.run), module.__name__
+    parser_commands = set(commands.build_parser()._subparsers._group_actions[0].choices)
+    assert parser_commands == {name.rpartition(".")[2] for name in names}
+    crossing = sorted(f"{name} imports {target} (line {line})"
+                      for name in names
+                      for line, target, _, _ in _imports_of(name, MODULE_NAMES[name])
+                      if target in names and target != name)
+    assert crossing == [], crossing

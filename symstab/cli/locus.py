@@ -17,8 +17,8 @@ import sys
 
 import numpy as np
 
-from .loop_options import (DEVICE_OPTIONS, EXAMPLE, POINT_OPTIONS, LoopSetup, convert_sets,
-                           load_loop_file, loop_echo, parse_number, split_unit)
+from .loop_options import (DEVICE_OPTIONS, EXAMPLE, LINEAR_WITH_LOOP, POINT_OPTIONS, LoopSetup,
+                           convert_sets, load_loop_file, loop_echo, parse_number, split_unit)
 from .options import add_command, add_model_options, resolve
 from .output import check_outputs, emit, interval_texts, png_bytes, write_output
 from .units import tex_unit
@@ -226,9 +226,7 @@ def _loop(args):
             raise ValueError(f"{flag} is an option of the paper's device; with --loop use "
                              f"{instead}")
     if args.linear:
-        raise ValueError("--linear names the units of the paper's device options (rotary by "
-                         "default, linear with --linear: the same numbers); with --loop every "
-                         "value is in the units of the loop file, converted to SI: drop --linear")
+        raise ValueError(LINEAR_WITH_LOOP)
     sets, path = {}, None
     for text in args.set_values or ():
         flag = f"--set {text}"

@@ -31,7 +31,7 @@ import numpy as np
 
 from .._resources import check_memory
 
-__all__ = ["DEVICE_OPTIONS", "POINT_OPTIONS", "EXAMPLE", "add_loop_options", "uses_loop",
+__all__ = ["DEVICE_OPTIONS", "POINT_OPTIONS", "EXAMPLE", "LINEAR_WITH_LOOP", "add_loop_options", "uses_loop",
            "split_unit", "parse_number", "convert_sets", "LoopSetup", "value_text", "loop_echo",
            "load_loop_file", "resolve_loop", "point_count", "broadcast"]
 
@@ -175,14 +175,17 @@ def uses_loop(args):
 # Inputs
 
 
+#: Why ``--linear`` is refused with ``--loop``.
+LINEAR_WITH_LOOP = ("--linear names the units of the paper's device options (rotary by default, "
+                    "linear with --linear: the same numbers); with --loop every value is in the "
+                    "units of the loop file, converted to SI: drop --linear")
+
+
 def _refuse_device_options(args):
     for flag, dest, default, instead in args.loop_refused:
         if getattr(args, dest, default) != default:
             if flag == "--linear":
-                raise ValueError("--linear names the units of the paper's device options (rotary "
-                                 "by default, linear with --linear: the same numbers); with "
-                                 "--loop every value is in the units of the loop file, "
-                                 "converted to SI: drop --linear")
+                raise ValueError(LINEAR_WITH_LOOP)
             if instead is None:
                 raise ValueError(f"{flag} is an option of the paper's device simulation; "
                                  f"map --loop classifies the loop by its roots and takes no "

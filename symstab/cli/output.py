@@ -129,6 +129,7 @@ def write_output(path, data, flag):
 
 
 def number_text(x):
+    """A cell of a table or CSV: "" for None, integers as such, floats to 10 digits, "nan"."""
     if x is None:
         return ""
     if isinstance(x, (int, np.integer)) and not isinstance(x, bool):
