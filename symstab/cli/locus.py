@@ -18,7 +18,8 @@ import sys
 import numpy as np
 
 from .loop_options import (DEVICE_OPTIONS, EXAMPLE, LINEAR_WITH_LOOP, POINT_OPTIONS, LoopSetup,
-                           convert_sets, load_loop_file, loop_echo, parse_number, split_unit)
+                           add_delay, check_names, convert_sets, load_loop_file, loop_echo,
+                           loop_values, parse_number, split_unit)
 from .options import add_command, add_model_options, resolve
 from .output import check_outputs, emit, interval_texts, png_bytes, write_output
 from .units import tex_unit
@@ -248,33 +249,14 @@ def _loop(args):
             sets[name] = (parse_number(name, value, flag, lists=False), unit)
     if path is None:
         raise ValueError("give the path as one --set NAME=LOW:HIGH[:N], e.g. --set K=0:30")
-    if args.d is not None:
-        if "d" in sets:
-            raise ValueError("give the delay once: --d or --set d=...")
-        sets["d"] = (args.d, None)
+    add_delay(args, sets)
     loop = load_loop_file(args.loop)
-    for name in list(sets) + [path[0]]:
-        if name not in loop.parameters:
-            raise ValueError(f"--set {name}: {name!r} is not a parameter of the loop in "
-                             f"{args.loop} (parameters: {', '.join(loop.parameters)})")
+    check_names(args, loop, list(sets) + [path[0]])
     # In the file's units, as every --set (symstab.cli.loop_options): to SI here.
     sets, written = convert_sets(loop, sets)
     ends = convert_sets(loop, {path[0]: ([path[1][0], path[1][-1]], None)})[0][path[0]]
     path = (path[0], np.linspace(ends[0], ends[1], path[1].size))
-    values = {n: v for n, v in loop.defaults.items() if n != path[0]}
-    values.update(sets)
-    missing = [n for n in loop.parameters if n not in values and n != path[0]]
-    if missing:
-        raise ValueError(f"no value for {', '.join(missing)}: the loop file {args.loop} gives "
-                         f"none; add --set {missing[0]}=VALUE")
-    known = getattr(loop, "file_parameters", None)
-    if known is not None:
-        from ..numeric.loop_units import check_bounds
-
-        check_bounds(known, values, skip=(path[0],), where=lambda names: (
-            ", ".join(f"--set {n}=..." for n in sets if n in names) or str(args.loop)))
-        written = {**{n: (v.value, v.unit, v.si_unit) for n, v in known.values.items()
-                      if v.converted}, **written}
+    values, written = loop_values(args, loop, sets, written, skip=(path[0],))
     name, given = path
     _announce(loop.coefficients(**values, **{name: given[0]}).shape[-1] - 1, given.size)
     result = track(loop, name, given, **values)

@@ -31,9 +31,10 @@ import numpy as np
 
 from .._resources import check_memory
 
-__all__ = ["DEVICE_OPTIONS", "POINT_OPTIONS", "EXAMPLE", "LINEAR_WITH_LOOP", "add_loop_options", "uses_loop",
-           "split_unit", "parse_number", "convert_sets", "LoopSetup", "value_text", "loop_echo",
-           "load_loop_file", "resolve_loop", "point_count", "broadcast"]
+__all__ = ["DEVICE_OPTIONS", "POINT_OPTIONS", "EXAMPLE", "LINEAR_WITH_LOOP", "add_loop_options",
+           "uses_loop", "split_unit", "parse_number", "convert_sets", "LoopSetup", "value_text",
+           "loop_echo", "load_loop_file", "add_delay", "check_names", "loop_values", "resolve_loop",
+           "point_count", "broadcast"]
 
 
 #: The paper's device options every numeric command has, with the ``--set``
@@ -395,6 +396,53 @@ def _plane(args, loop):
     return x, y
 
 
+def add_delay(args, sets):
+    """Add ``--d`` to ``sets`` (``{name: (value, unit)}`` of the ``--set`` options), once."""
+    if getattr(args, "d", None) is not None:
+        if "d" in sets:
+            raise ValueError("give the delay once: --d or --set d=...")
+        sets["d"] = (args.d, None)
+    return sets
+
+
+def check_names(args, loop, names):
+    """Refuse the first of ``names`` (given with ``--set``) that is not a parameter of ``loop``."""
+    unknown = [n for n in names if n not in loop.parameters]
+    if unknown:
+        raise ValueError(f"--set {unknown[0]}: {unknown[0]!r} is not a parameter of the loop in "
+                         f"{args.loop} (parameters: {', '.join(loop.parameters)})")
+
+
+def loop_values(args, loop, sets, written_sets, *, skip=()):
+    """``(values, written)``: the file's defaults but ``skip``, changed by ``sets``, checked.
+
+    ``sets`` are the ``--set`` values in SI (:func:`convert_sets`, which also
+    gives ``written_sets``); a parameter without a value, or a value outside
+    the bounds the file declares, is a ValueError.  ``written`` is what the
+    file or a ``--set`` wrote where it differs from the SI value used
+    (:attr:`LoopSetup.written`).
+    """
+    values = {n: v for n, v in loop.defaults.items() if n not in skip}
+    values.update(sets)
+    missing = [n for n in loop.parameters if n not in values and n not in skip]
+    if missing:
+        raise ValueError(f"no value for {', '.join(missing)}: the loop file {args.loop} gives "
+                         f"none; add --set {missing[0]}=VALUE")
+    known = getattr(loop, "file_parameters", None)
+    written = {}
+    if known is not None:
+        from ..numeric.loop_units import check_bounds
+
+        written = {n: (v.value, v.unit, v.si_unit) for n, v in known.values.items()
+                   if v.converted}
+        # The bounds the file declares hold at the --set values too (the
+        # file's own were checked when it was read).
+        check_bounds(known, values, skip=skip, where=lambda names: (
+            ", ".join(f"--set {n}=..." for n in sets if n in names) or str(args.loop)))
+    written.update(written_sets)
+    return values, written
+
+
 def resolve_loop(args, *, plane=True, lists=False):
     """Check every input of a loop command and return its :class:`LoopSetup`.
 
@@ -404,15 +452,9 @@ def resolve_loop(args, *, plane=True, lists=False):
     """
     _refuse_device_options(args)
     sets = _parse_sets(args.set_values, lists=lists)
-    if getattr(args, "d", None) is not None:
-        if "d" in sets:
-            raise ValueError("give the delay once: --d or --set d=...")
-        sets["d"] = (args.d, None)
+    add_delay(args, sets)
     loop = load_loop_file(args.loop)
-    unknown = [n for n in sets if n not in loop.parameters]
-    if unknown:
-        raise ValueError(f"--set {unknown[0]}: {unknown[0]!r} is not a parameter of the loop in "
-                         f"{args.loop} (parameters: {', '.join(loop.parameters)})")
+    check_names(args, loop, sets)
     sets, written_sets = convert_sets(loop, sets)
     x = y = None
     axes = ()
@@ -429,24 +471,7 @@ def resolve_loop(args, *, plane=True, lists=False):
                         if axis == "x" and hasattr(args, "at") else "")
                 raise ValueError(f"--set {name}: {name} is the plane's {axis} axis and takes no "
                                  f"single value here{hint}")
-    values = {n: v for n, v in loop.defaults.items() if n not in axes}
-    values.update(sets)
-    missing = [n for n in loop.parameters if n not in values and n not in axes]
-    if missing:
-        raise ValueError(f"no value for {', '.join(missing)}: the loop file {args.loop} gives "
-                         f"none; add --set {missing[0]}=VALUE")
-    known = getattr(loop, "file_parameters", None)
-    written = {}
-    if known is not None:
-        from ..numeric.loop_units import check_bounds
-
-        written = {n: (v.value, v.unit, v.si_unit) for n, v in known.values.items()
-                   if v.converted}
-        # The bounds the file declares hold at the --set values too (the
-        # file's own were checked when it was read).
-        check_bounds(known, values, skip=axes, where=lambda names: (
-            ", ".join(f"--set {n}=..." for n in sets if n in names) or str(args.loop)))
-    written.update({n: w for n, w in written_sets.items()})
+    values, written = loop_values(args, loop, sets, written_sets, skip=axes)
     if plane:
         loop.boundary(x=x, y=y, n=2, **values)   # checks the plane (affine) and the values
         point = {**values, x: 0.0, y: 0.0}
