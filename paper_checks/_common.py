@@ -6,7 +6,7 @@ import sympy as sp
 
 from symstab.proof.identity import check_identity
 
-from .audit import Outcome
+from .outcome import Outcome
 from .printed import C, PRINTED_COEFFICIENTS, printed, section_of
 
 __all__ = ["where", "place", "with_printed_coefficients", "prove", "compare",

@@ -38,12 +38,13 @@ import importlib
 import json
 import sys
 
+from .outcome import VERDICTS, Outcome
+
 __all__ = [
     "VERDICTS", "Outcome", "Finding", "check", "registered", "run_audit",
     "render_report", "to_json", "CHECK_MODULES", "warm_caches",
 ]
 
-VERDICTS = ("confirmed", "erratum", "approximation", "not-reproduced", "not-checkable")
 
 #: Modules whose import registers checks, in report order.
 CHECK_MODULES = (
@@ -54,21 +55,6 @@ CHECK_MODULES = (
     "paper_checks.claims",
     "paper_checks.open_questions",
 )
-
-
-@dataclasses.dataclass(frozen=True)
-class Outcome:
-    """What a check found: a verdict, one or two lines of evidence, a fix."""
-
-    verdict: str
-    evidence: str
-    corrected: str = ""
-
-    def __post_init__(self):
-        if self.verdict not in VERDICTS:
-            raise ValueError(f"verdict must be one of {VERDICTS}, got {self.verdict!r}")
-        if self.verdict == "erratum" and not self.corrected:
-            raise ValueError("an erratum must state the corrected form")
 
 
 @dataclasses.dataclass(frozen=True)

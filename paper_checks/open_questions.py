@@ -119,7 +119,7 @@ def curve_counts(gamma, d, delta=PAPER_DEVICE.delta):
     """
     arc = boundary_curve(gamma=gamma, d=d, delta=delta, n=_ARC_SAMPLES, segments=False)
     b, a = arc.beta, arc.alpha
-    polygon = regions._closed_polygon(b, a)
+    polygon = regions.closed_polygon(b, a)
     span = np.array([max(np.ptp(b), 1e-300), max(np.ptp(a), 1e-300)])
     # Every candidate probe at once: (fraction, offset, side) -> a point.
     points = []
@@ -131,7 +131,7 @@ def curve_counts(gamma, d, delta=PAPER_DEVICE.delta):
             for sign in (1.0, -1.0):
                 points.append(np.array([b[i], a[i]]) + sign * offset * normal * span)
     points = np.array(points)
-    inside = regions._inside_even_odd(points, polygon)
+    inside = regions.inside_even_odd(points, polygon)
     certified = np.atleast_1d(unstable_root_counts(alpha=points[:, 1], beta=points[:, 0],
                                                    gamma=gamma, d=d, delta=delta))
     by_numpy = _numpy_counts(points[:, 1], points[:, 0], gamma, d, delta)

@@ -55,6 +55,7 @@ __all__ = [
     "InitialDirection", "initial_direction", "side",
     "Probe", "RegionResult", "classify",
     "PaperClaim", "FIGURE_CASES", "LIMIT_CASES", "compare", "format_table",
+    "closed_polygon", "inside_even_odd",
 ]
 
 _DPS = 30
@@ -170,13 +171,35 @@ def side(gamma, d, delta=PAPER_DEVICE.delta):
 # The closed curve the arc forms with alpha = 0
 
 
-def _closed_polygon(betas, alphas):
-    """Arc followed by the alpha = 0 segment back to the start."""
+def closed_polygon(betas, alphas):
+    """The arc followed by the alpha = 0 segment back to its start, as a closed polygon.
+
+    Parameters
+    ----------
+    betas, alphas : ndarray
+        The arc's points, in order.
+
+    Returns
+    -------
+    ndarray of shape (n + 2, 2)
+        ``(beta, alpha)`` vertices: the arc, then ``(betas[-1], 0)`` and ``(betas[0], 0)``.
+    """
     return np.vstack([np.column_stack([betas, alphas]), [[betas[-1], 0.0], [betas[0], 0.0]]])
 
 
-def _inside_even_odd(points, polygon):
-    """Even-odd point-in-polygon (the arc may cross itself)."""
+def inside_even_odd(points, polygon):
+    """Which points are inside ``polygon`` by the even-odd rule (the arc may cross itself).
+
+    Parameters
+    ----------
+    points : ndarray of shape (k, 2)
+    polygon : ndarray of shape (n, 2)
+        Vertices of a closed polygon (:func:`closed_polygon`).
+
+    Returns
+    -------
+    ndarray of bool, shape (k,)
+    """
     x, y = points[:, 0][:, None], points[:, 1][:, None]
     x0, y0 = polygon[:-1, 0], polygon[:-1, 1]
     x1, y1 = polygon[1:, 0], polygon[1:, 1]
@@ -412,7 +435,7 @@ def classify(gamma, d, delta=PAPER_DEVICE.delta, *, n_beta=41, arc_points=None,
         else int(200 + 20 * d * t_end)
     arc = boundary_curve(gamma=gamma, d=d, delta=delta, n=n_arc + 1, segments=False)
     arc_b, arc_a = arc.beta, arc.alpha
-    polygon = _closed_polygon(arc_b, arc_a)
+    polygon = closed_polygon(arc_b, arc_a)
     top = int(np.argmax(arc_a))
     alpha_top, beta_top = float(arc_a[top]), float(arc_b[top])
     b_lo, b_hi = float(arc_b.min()), float(arc_b.max())
@@ -434,7 +457,7 @@ def classify(gamma, d, delta=PAPER_DEVICE.delta, *, n_beta=41, arc_points=None,
     points = np.array([(b, a) for b, r in zip(lines, runs) for lo, hi in r
                        for a in np.linspace(lo, hi, 5)]).reshape(-1, 2)
     if len(points):
-        inside = _inside_even_odd(points, polygon)
+        inside = inside_even_odd(points, polygon)
         outside = 0.0
         if not np.all(inside):
             scale = np.array([max(width, np.finfo(float).tiny), alpha_top])

@@ -1,7 +1,7 @@
 """``symstab locus``: the closed-loop poles along a path of the stiffness or the damping.
 
 The paper's loop takes the device and delay options of the numeric
-commands (:mod:`symstab.cli.numeric`) and a path: one of the stiffness
+commands (:mod:`symstab.cli.options`) and a path: one of the stiffness
 (``--Kw``/``--alpha``) and the damping (``--Bw``/``--beta``) as a range
 ``LOW:HIGH[:N]``, the other as one value.  A loop file takes ``--loop FILE``
 and ``--set NAME=VALUE``, one of the ``--set`` values a range.  The
@@ -12,16 +12,20 @@ input is checked before the work; the PNG is written atomically.
 """
 
 import dataclasses
-import io
 import math
 import sys
 
 import numpy as np
 
-from . import loop as cli_loop
-from .numeric import _add_model_options, _emit, _resolve, interval_texts
+from .loop_options import (DEVICE_OPTIONS, EXAMPLE, LINEAR_WITH_LOOP, POINT_OPTIONS, LoopSetup,
+                           add_delay, check_names, convert_sets, load_loop_file, loop_echo,
+                           loop_values, parse_number, split_unit)
+from .options import add_command, add_model_options, resolve
+from .output import check_outputs, emit, interval_texts, png_bytes, write_output
+from .units import tex_unit
 
-__all__ = ["add_commands"]
+__all__ = ["register", "run"]
+
 
 #: Points of a path given as LOW:HIGH, and the most a path may have.
 DEFAULT_POINTS = 401
@@ -30,24 +34,21 @@ MAX_POINTS = 100_000
 _PLANE_LIMIT = 3.0
 #: The paper's options refused with --loop, and what replaces each (those of
 #: the other numeric commands, but --linear, which locus does not have).
-_DEVICE_OPTIONS = tuple(option for option in cli_loop._DEVICE_OPTIONS
-                        if option[0] != "--linear") + cli_loop._POINT_OPTIONS
-_EXAMPLE_LOOP = "examples/loops/paper.toml"
+_DEVICE_OPTIONS = tuple(option for option in DEVICE_OPTIONS
+                        if option[0] != "--linear") + POINT_OPTIONS
 
 
-def add_commands(sub):
-    """Register ``symstab locus`` on an argparse sub-parser set."""
-    from .commands import add_command
-
+def register(subparsers):
+    """Add ``symstab locus`` to the sub-commands."""
     p = add_command(
-        sub, "locus", help="the closed-loop poles along a path of the stiffness or the damping",
+        subparsers, "locus", help="the closed-loop poles along a path of the stiffness or the damping",
         description="Track every closed-loop pole as the stiffness (or the damping) runs "
                     "along a range, the other fixed, and list where a pole crosses the unit "
                     "circle: a complex pair (the boundary arc, at the angle theta, oscillating "
                     "at theta / (2 pi T)) or a real pole at z = 1 or z = -1; --png draws the "
                     "poles in the z-plane and their largest modulus along the path.",
-        example="symstab locus --Td 0.04 --Bw 0.1 --Kw 0:30 --png locus.png", func=_cmd_locus)
-    _add_model_options(p)
+        example="symstab locus --Td 0.04 --Bw 0.1 --Kw 0:30 --png locus.png", func=run)
+    add_model_options(p)
     g = p.add_argument_group(
         "the path (one option a range LOW:HIGH or LOW:HIGH:N, default N = "
         f"{DEFAULT_POINTS}; a negative LOW needs '=', e.g. --Kw=-5:30)")
@@ -58,9 +59,9 @@ def add_commands(sub):
     p.add_argument("--png", metavar="FILE", help="also draw the locus as PNG")
     g = p.add_argument_group(
         "any loop (instead of the device and path options above)",
-        f"A loop file (TOML, see {_EXAMPLE_LOOP}); --set NAME=VALUE changes a value in its "
+        f"A loop file (TOML, see {EXAMPLE}); --set NAME=VALUE changes a value in its "
         "units, and one --set gives the path as a range, e.g. --set K=0:30.  --d still sets "
-        f"the delay.\nexample: symstab locus --loop {_EXAMPLE_LOOP} --set B=0.1 --set K=0:30 "
+        f"the delay.\nexample: symstab locus --loop {EXAMPLE} --set B=0.1 --set K=0:30 "
         "--png locus.png")
     g.add_argument("--loop", metavar="FILE", help="loop file (TOML)")
     g.add_argument("--set", metavar="NAME=VALUE", action="append", dest="set_values",
@@ -135,13 +136,12 @@ class _View:
 def _paper(args):
     """The paper's loop: resolve the options, run :func:`paper_locus`; return a :class:`_View`."""
     from ..numeric.locus import paper_locus
-    from .simulate import _tex_unit
 
     for flag, dest in (("--set", "set_values"),):
         if getattr(args, dest) is not None:
             raise ValueError(f"{flag} needs a loop file: give --loop FILE "
-                             f"(e.g. --loop {_EXAMPLE_LOOP})")
-    setup = _resolve(args)
+                             f"(e.g. --loop {EXAMPLE})")
+    setup = resolve(args)
     stiffness = [(f, getattr(args, d)) for f, d in (("--alpha", "alpha"), ("--Kw", "Kw"))
                  if getattr(args, d) is not None]
     damping = [(f, getattr(args, d)) for f, d in (("--beta", "beta"), ("--Bw", "Bw"))
@@ -184,10 +184,10 @@ def _paper(args):
     T = dev.T if setup.physical else None
     if path_flag == "--Kw":
         show, name, unit = dev.stiffness, "K_w", setup.units["K_w"]
-        tex = f"$K_w$ [{_tex_unit(unit)}]"
+        tex = f"$K_w$ [{tex_unit(unit)}]"
     elif path_flag == "--Bw":
         show, name, unit = dev.damping, "B_w", setup.units["B_w"]
-        tex = f"$B_w$ [{_tex_unit(unit)}]"
+        tex = f"$B_w$ [{tex_unit(unit)}]"
     else:
         show, name, unit = np.asarray, parameter, ""
         tex = r"$\alpha = K_w T^2 / m$" if parameter == "alpha" else r"$\beta = B_w T / m$"
@@ -227,9 +227,7 @@ def _loop(args):
             raise ValueError(f"{flag} is an option of the paper's device; with --loop use "
                              f"{instead}")
     if args.linear:
-        raise ValueError("--linear names the units of the paper's device options (rotary by "
-                         "default, linear with --linear: the same numbers); with --loop every "
-                         "value is in the units of the loop file, converted to SI: drop --linear")
+        raise ValueError(LINEAR_WITH_LOOP)
     sets, path = {}, None
     for text in args.set_values or ():
         flag = f"--set {text}"
@@ -247,48 +245,27 @@ def _loop(args):
                 raise ValueError(f"{flag}: the delay d is a whole number of samples, not a path")
             path = (name, _path(value, flag))
         else:
-            value, unit = cli_loop._split_unit(value, flag)
-            sets[name] = (cli_loop._parse_number(name, value, flag, lists=False), unit)
+            value, unit = split_unit(value, flag)
+            sets[name] = (parse_number(name, value, flag, lists=False), unit)
     if path is None:
         raise ValueError("give the path as one --set NAME=LOW:HIGH[:N], e.g. --set K=0:30")
-    if args.d is not None:
-        if "d" in sets:
-            raise ValueError("give the delay once: --d or --set d=...")
-        sets["d"] = (args.d, None)
-    loop = cli_loop._load(args.loop)
-    for name in list(sets) + [path[0]]:
-        if name not in loop.parameters:
-            raise ValueError(f"--set {name}: {name!r} is not a parameter of the loop in "
-                             f"{args.loop} (parameters: {', '.join(loop.parameters)})")
-    # In the file's units, as every --set (symstab.cli.loop): to SI here.
-    sets, written = cli_loop._convert_sets(loop, sets)
-    ends = cli_loop._convert_sets(loop, {path[0]: ([path[1][0], path[1][-1]], None)})[0][path[0]]
+    add_delay(args, sets)
+    loop = load_loop_file(args.loop)
+    check_names(args, loop, list(sets) + [path[0]])
+    # In the file's units, as every --set (symstab.cli.loop_options): to SI here.
+    sets, written = convert_sets(loop, sets)
+    ends = convert_sets(loop, {path[0]: ([path[1][0], path[1][-1]], None)})[0][path[0]]
     path = (path[0], np.linspace(ends[0], ends[1], path[1].size))
-    values = {n: v for n, v in loop.defaults.items() if n != path[0]}
-    values.update(sets)
-    missing = [n for n in loop.parameters if n not in values and n != path[0]]
-    if missing:
-        raise ValueError(f"no value for {', '.join(missing)}: the loop file {args.loop} gives "
-                         f"none; add --set {missing[0]}=VALUE")
-    known = getattr(loop, "file_parameters", None)
-    if known is not None:
-        from ..numeric.loop_units import check_bounds
-
-        check_bounds(known, values, skip=(path[0],), where=lambda names: (
-            ", ".join(f"--set {n}=..." for n in sets if n in names) or str(args.loop)))
-        written = {**{n: (v.value, v.unit, v.si_unit) for n, v in known.values.items()
-                      if v.converted}, **written}
+    values, written = loop_values(args, loop, sets, written, skip=(path[0],))
     name, given = path
     _announce(loop.coefficients(**values, **{name: given[0]}).shape[-1] - 1, given.size)
     result = track(loop, name, given, **values)
-    setup = cli_loop.LoopSetup(str(args.loop), loop, values, tuple(sets), written=written)
+    setup = LoopSetup(str(args.loop), loop, values, tuple(sets), written=written)
     unit = setup.unit(name)
-    setup = dataclasses.replace(setup, echo=cli_loop._echo(setup) + (
+    setup = dataclasses.replace(setup, echo=loop_echo(setup) + (
         f"path: {name} from {given[0]:.10g} to {given[-1]:.10g}{' ' + unit if unit else ''} "
         f"({given.size} points)",))
-    from .simulate import _tex_unit
-
-    tex = f"{name} [{_tex_unit(unit)}]" if unit else name
+    tex = f"{name} [{tex_unit(unit)}]" if unit else name
     T = values.get("T") if "T" in loop.parameters else None
     return _View(setup, result, name, unit, tex, lambda v: np.asarray(v, dtype=float),
                  None if T is None else float(T), given=given)
@@ -442,9 +419,8 @@ def _json(view, stretches, certified):
                                            | (locus.unstable_counts() < 0) | (certified < 0)))}
 
 
-def _cmd_locus(args):
-    from .commands import check_outputs, write_output
-
+def run(args):
+    """Run ``symstab locus``; return the exit status."""
     png = None
     if args.png is not None:
         png = check_outputs([("--png", args.png, "file")])["--png"]
@@ -458,8 +434,8 @@ def _cmd_locus(args):
     if image is not None:
         write_output(png, image, "--png")
         notes.append(f"wrote {png}")
-    _emit(view.setup, args.format, columns, rows, result=_json(view, stretches, certified),
-          notes=notes, json_rows=False)
+    emit(view.setup, args.format, columns, rows, result=_json(view, stretches, certified),
+         notes=notes, json_rows=False)
     return 0
 
 
@@ -622,10 +598,7 @@ def _png(view, stretches):
     place = zx.get_position()
     bar = fig.colorbar(dots, cax=fig.add_axes([0.91, place.y0, 0.015, place.height]))
     bar.set_label("pole colour: " + view.tex)
-    buf = io.BytesIO()
-    fig.savefig(buf, format="png", metadata={"Software": None})
-    plt.close(fig)
-    return buf.getvalue()
+    return png_bytes(plt, fig)
 
 
 def _title(view):
@@ -644,10 +617,9 @@ def _title(view):
             where = f"$B_w$ = {float(dev.damping(fixed)):g} {units['B_w']}"
         else:
             where = f"$K_w$ = {float(dev.stiffness(fixed)):g} {units['K_w']}"
-        from .simulate import _tex_unit
         return (f"root locus at {where}, $T_d$ = {dev.delay(setup.d) * 1e3:g} ms "
                 f"($d$ = {setup.d}), $M_w$ = {float(dev.mass(setup.gamma)):g} "
-                f"{_tex_unit(units['M_w'])}")
+                f"{tex_unit(units['M_w'])}")
     symbol = r"\beta" if other == "beta" else r"\alpha"
     return (f"root locus at ${symbol}$ = {fixed:g}, $\\gamma$ = {setup.gamma:g}, $d$ = {setup.d}, "
             f"$\\delta$ = {setup.delta:g}")

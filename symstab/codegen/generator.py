@@ -33,6 +33,7 @@ __all__ = [
     "Kernel", "kernels", "NumPyKernelPrinter", "CKernelPrinter",
     "numpy_module", "c_source", "c_header", "generated_files",
     "COMMAND", "C_PREFIX", "OWNED", "one_line", "comment_text", "docstring_text",
+    "python_function", "c_signature", "c_comment", "c_function",
 ]
 
 #: The command that regenerates the files, named in their headers.
@@ -264,7 +265,15 @@ def _header_lines(comment, what):
             f"{comment} approximations exact to the last bit below their switch.", ""]
 
 
-def _python_function(kernel, printer):
+def python_function(kernel, printer):
+    """The text of one NumPy kernel: a ``def`` with a numpydoc docstring and the CSE'd body.
+
+    Parameters
+    ----------
+    kernel : Kernel
+    printer : NumPyKernelPrinter
+        Prints each expression (the paper's or a loop file's kernel module).
+    """
     replacements, reduced = kernel.cse()
     args = [str(symbol) for symbol, _, _ in kernel.args]
     doc = textwrap.wrap(docstring_text(kernel.doc), 72, break_long_words=False)
@@ -300,11 +309,17 @@ def numpy_module():
              "import numpy", "",
              f"__all__ = {names!r}", ""]
     for kernel in kernels():
-        parts += ["", _python_function(kernel, printer), ""]
+        parts += ["", python_function(kernel, printer), ""]
     return "\n".join(parts).rstrip("\n") + "\n"
 
 
-def _c_signature(kernel):
+def c_signature(kernel):
+    """The C prototype of ``kernel``, without ``;``: returns a double, or writes its outputs.
+
+    Parameters
+    ----------
+    kernel : Kernel
+    """
     params = [f"{ctype} {symbol}" for symbol, ctype, _ in kernel.args]
     if len(kernel.outputs) == 1:
         return f"double {C_PREFIX}{kernel.name}({', '.join(params)})"
@@ -312,7 +327,13 @@ def _c_signature(kernel):
     return f"void {C_PREFIX}{kernel.name}({', '.join(params)})"
 
 
-def _c_comment(kernel):
+def c_comment(kernel):
+    """The ``/* ... */`` comment above a C kernel: what it computes, each argument and output.
+
+    Parameters
+    ----------
+    kernel : Kernel
+    """
     doc = textwrap.wrap(comment_text(kernel.doc, "c"), 72, break_long_words=False)
     lines = ["/*"] + [f" * {line}" for line in doc] + [" *"]
     for symbol, _, description in kernel.args:
@@ -324,9 +345,16 @@ def _c_comment(kernel):
     return "\n".join(lines)
 
 
-def _c_function(kernel, printer):
+def c_function(kernel, printer):
+    """The text of one C kernel: its comment, its signature and the CSE'd body.
+
+    Parameters
+    ----------
+    kernel : Kernel
+    printer : CKernelPrinter
+    """
     replacements, reduced = kernel.cse()
-    lines = [_c_comment(kernel), _c_signature(kernel), "{"]
+    lines = [c_comment(kernel), c_signature(kernel), "{"]
     for symbol, expr in replacements:
         lines.append(f"    const double {symbol} = {printer.doprint(expr)};")
     if len(reduced) == 1:
@@ -345,7 +373,7 @@ def c_header():
     lines += [f"#ifndef {guard}", f"#define {guard}", "", "#ifdef __cplusplus",
               'extern "C" {', "#endif", ""]
     for kernel in kernels():
-        lines += [_c_comment(kernel), _c_signature(kernel) + ";", ""]
+        lines += [c_comment(kernel), c_signature(kernel) + ";", ""]
     lines += ["#ifdef __cplusplus", "}", "#endif", "", f"#endif /* {guard} */"]
     return "\n".join(lines) + "\n"
 
@@ -356,7 +384,7 @@ def c_source():
     lines = _header_lines("//", "C99 kernels; they need only <math.h> (link with -lm).")
     lines += ['#include <math.h>', '#include "symstab_kernels.h"', ""]
     for kernel in kernels():
-        lines += [_c_function(kernel, printer), ""]
+        lines += [c_function(kernel, printer), ""]
     return "\n".join(lines).rstrip("\n") + "\n"
 
 

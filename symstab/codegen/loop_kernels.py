@@ -31,8 +31,8 @@ import tempfile
 import sympy as sp
 
 from ..symbolic import model
-from .generator import (CKernelPrinter, Kernel, NumPyKernelPrinter, _c_function,
-                        _python_function, comment_text)
+from .generator import (CKernelPrinter, Kernel, NumPyKernelPrinter, c_function,
+                        python_function, comment_text)
 from ..symbolic.derivation_cache import CACHE_ENV, cache_dir
 from ..symbolic.loop_assembly import is_affine
 
@@ -84,7 +84,7 @@ def numpy_source(kernels, *, title, command="symstab.Loop"):
     parts = ["\n".join(header("python", title, command)), repr(str(title)), "",
              "import numpy", "", f"__all__ = {names!r}", ""]
     for kernel in kernels:
-        parts += ["", _python_function(kernel, printer), ""]
+        parts += ["", python_function(kernel, printer), ""]
     return "\n".join(parts).rstrip("\n") + "\n"
 
 
@@ -106,7 +106,7 @@ def c_source(kernels, *, title, prefix, command):
     printer = CKernelPrinter()
     lines = header("c", title, command) + ["#include <math.h>", ""]
     for kernel in kernels:
-        text = _c_function(kernel, printer)
+        text = c_function(kernel, printer)
         lines += [text.replace(" symstab_", f" {prefix}"), ""]
     return "\n".join(lines).rstrip("\n") + "\n"
 

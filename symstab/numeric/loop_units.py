@@ -494,7 +494,7 @@ def check_loop_units(loop, file_values, raw_bounds, *, source):
         number or an expression of the loop's parameters of the
         parameter's dimension, or a value is outside its bounds.
     """
-    from ..symbolic.loop_assembly import _parse
+    from ..symbolic.loop_assembly import parse_expression
 
     bounds = []
     for name, kind, raw in raw_bounds:
@@ -503,7 +503,7 @@ def check_loop_units(loop, file_values, raw_bounds, *, source):
             raise ValueError(f"{what} must be a number (in the unit of {name}) or an expression "
                              f"of the loop's parameters, e.g. \"1/(2*T)\"")
         if isinstance(raw, str):
-            expr = _parse(raw, what)
+            expr = parse_expression(raw, what)
             names = {str(s) for s in expr.free_symbols}
             bad = sorted(names - set(loop.parameters))
             if bad:

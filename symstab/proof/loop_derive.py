@@ -20,7 +20,7 @@ import re
 import sympy as sp
 
 from ..symbolic import model
-from ..codegen.generator import _c_comment, _c_signature, comment_text
+from ..codegen.generator import c_comment, c_signature, comment_text
 from ..codegen.loop_kernels import c_source, header, kernel, numpy_source
 
 __all__ = ["COMMAND", "OWNED", "MARKER", "PAPER_PLANT", "PAPER_ENVIRONMENT", "delay_parts",
@@ -138,7 +138,7 @@ def _c_header(kernels, *, title, prefix, guard):
     lines = header("c", title, COMMAND) + [f"#ifndef {guard}", f"#define {guard}", "",
                                            "#ifdef __cplusplus", 'extern "C" {', "#endif", ""]
     for k in kernels:
-        lines += [_c_comment(k), _c_signature(k).replace(" symstab_", f" {prefix}") + ";", ""]
+        lines += [c_comment(k), c_signature(k).replace(" symstab_", f" {prefix}") + ";", ""]
     lines += ["#ifdef __cplusplus", "}", "#endif", "", f"#endif /* {guard} */"]
     return "\n".join(lines) + "\n"
 
@@ -241,7 +241,7 @@ def derivation_steps(loop):
     -------
     list of symstab.proof.derive.Step
     """
-    from .derive import Step
+    from .steps import Step
 
     z, d = model.z, model.d
     ve_n, ve_d = (_poly_expr(c) for c in loop._environment_parts)
@@ -347,7 +347,7 @@ def loop_files(loop):
     ValueError
         If a parameter's name cannot be printed in the kernels (:func:`check_names`).
     """
-    from .derive import render
+    from .steps import render
 
     files = render(derivation_steps(loop), command=COMMAND)
     files.update(kernel_files(loop))

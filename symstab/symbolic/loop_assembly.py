@@ -32,8 +32,9 @@ from .._validate import check_delay
 from .derivation_cache import DerivationCache
 from .discretize import numeric_zoh, written_poles, zoh_pulse_transfer_function
 
-__all__ = ["LoopModel", "parse_plant", "parse_environment", "check_parameter_name",
-           "check_loop_name", "check_text_line", "NAME_PATTERN", "is_affine", "poly_coeffs"]
+__all__ = ["LoopModel", "parse_plant", "parse_environment", "parse_expression",
+           "check_parameter_name", "check_loop_name", "check_text_line", "NAME_PATTERN",
+           "is_affine", "poly_coeffs"]
 
 #: Names with a fixed meaning in every loop.
 RESERVED = ("s", "z", "T", "d")
@@ -203,7 +204,7 @@ _BINARY = {ast.Add: sp.Add, ast.Mult: sp.Mul,
 _FUNCTIONS = {"exp": sp.exp, "sqrt": sp.sqrt}
 
 
-def _parse(text, what):
+def parse_expression(text, what):
     """A SymPy expression from arithmetic text, built from its syntax tree, never evaluated.
 
     Only numbers, names, ``+ - * / **`` (or ``^``), brackets and calls of
@@ -212,6 +213,18 @@ def _parse(text, what):
     from a loop file cannot run code.  A literal exponent is at most
     :data:`MAX_ORDER` and an exponent holds no power (``2**(10**10)`` would
     take SymPy forever).
+
+    Parameters
+    ----------
+    text : str
+        The expression as written (a plant, an environment, a loop file's bound).
+    what : str
+        What it is, for the error message (``"plant"``, ``"paper.toml: bound min of 'T'"``).
+
+    Raises
+    ------
+    ValueError
+        Naming ``what`` and ``text``: a syntax error or a construct that is not allowed.
     """
     try:
         tree = ast.parse(text.replace("^", "**"), mode="eval")
@@ -319,7 +332,7 @@ def parse_plant(plant):
         If it is not rational in ``s``, not proper, zero, or uses ``z`` or ``d``.
     """
     if isinstance(plant, str):
-        expr = _parse(plant, "plant")
+        expr = parse_expression(plant, "plant")
     elif isinstance(plant, sp.Basic):
         expr = sp.sympify(plant)
     elif hasattr(plant, "num") and hasattr(plant, "den") and hasattr(plant, "dt"):
@@ -344,7 +357,7 @@ def parse_environment(environment):
         ``s`` or ``d``.
     """
     if isinstance(environment, str):
-        expr = _parse(environment, "environment")
+        expr = parse_expression(environment, "environment")
     elif isinstance(environment, sp.Basic):
         expr = sp.sympify(environment)
     else:

@@ -82,7 +82,7 @@ def test_paper_device_interval_is_open_and_names_its_marginal_ends(capsys):
 
 
 def test_interval_texts_open_infinite_and_unstable_ends():
-    from symstab.cli.numeric import interval_texts
+    from symstab.cli.output import interval_texts
 
     text, note, kinds = interval_texts([(-np.inf, -0.0), (1.5, 2.0), (3.0, np.inf)],
                                        [(None, MARGINAL), (UNSTABLE, STABLE), (MARGINAL, None)],

@@ -139,7 +139,7 @@ def test_locus_takes_its_set_and_its_path_in_the_files_units(capsys, tmp_path):
 
 def test_one_rule_for_the_units_of_the_device_options_in_the_help_and_the_readme(capsys):
     """--m 0.2 echoed kg m^2 while the README called the device's K N/m: the rule is stated once."""
-    from symstab.cli.numeric import UNITS_RULE
+    from symstab.cli.options import UNITS_RULE
 
     status, out, _ = run(capsys, "limits", "--help")
     assert status == 0 and " ".join(UNITS_RULE.split()) in " ".join(out.split())

@@ -1,0 +1,106 @@
+"""``symstab boundary``: the paper's stability boundary, or a loop file's D-decomposition.
+
+The paper's loop: the arc alpha(theta), beta(theta) of eq. (7) for one
+virtual mass, delay and device, with K_w and B_w in physical units, and
+the straight segments that close the region.  A loop file (``--loop``):
+the (x, y) at which z = exp(j theta) is a closed-loop pole, and the lines
+on which a pole is at z = 1, z = -1 or infinity.
+"""
+
+import dataclasses
+import math
+
+from .._resources import check_memory
+from .loop_options import add_loop_options, resolve_loop, uses_loop
+from .options import add_command, add_model_options, resolve
+from .output import BYTES_PER_ROW, emit
+from .units import physical_columns
+
+__all__ = ["register", "run"]
+
+
+def register(subparsers):
+    """Add ``symstab boundary`` to the sub-commands."""
+    p = add_command(
+        subparsers, "boundary", help="the stability boundary alpha(theta), beta(theta)",
+        description="Compute the stability boundary arc alpha(theta), beta(theta) of the "
+                    "paper's eq. (7) for one virtual mass, delay and device, with K_w and B_w "
+                    "in physical units, and the straight segments that close the region.",
+        example="symstab boundary --Td 0.01 --n 11", func=run)
+    add_model_options(p)
+    p.add_argument("--n", type=int, default=101, help="points on the arc (default 101)")
+    add_loop_options(p, "boundary")
+
+
+def run(args):
+    """Run ``symstab boundary`` (on the loop file of ``--loop``, else the paper's loop)."""
+    return _loop(args) if uses_loop(args) else _paper(args)
+
+
+def _paper(args):
+    """The paper's boundary arc and its closing segments."""
+    from ..numeric.region import boundary_curve
+
+    setup = resolve(args)
+    check_memory(f"--n {args.n} boundary points", args.n * BYTES_PER_ROW)
+    curve = boundary_curve(gamma=setup.gamma, d=setup.d, delta=setup.delta, n=args.n)
+    columns = ["theta [rad]", "alpha", "beta"]
+    rows = list(zip(curve.theta, curve.alpha, curve.beta))
+    if setup.physical:
+        columns += physical_columns(setup, ["K_w", "B_w"])
+        rows = [r + (setup.device.stiffness(r[1]), setup.device.damping(r[2])) for r in rows]
+    notes = [curve.message] if curve.empty else [f"theta_max = {curve.theta_max:.15g} rad"]
+    for seg in curve.segments:
+        notes.append(f"boundary segment ({seg.root}): (beta, alpha) from ({seg.beta0:.10g}, "
+                     f"{seg.alpha0:.10g}) to ({seg.beta1:.10g}, {seg.alpha1:.10g})")
+    result = {"theta_max": curve.theta_max, "message": curve.message,
+              "segments": [dataclasses.asdict(s) for s in curve.segments]}
+    emit(setup, args.format, columns, rows, result=result, notes=notes)
+    return 0
+
+
+def _loop(args):
+    """A loop file's D-decomposition in its plane: the arc and the lines."""
+    from .._validate import check_count
+
+    setup = resolve_loop(args)
+    n = check_count("n", args.n, 2)
+    check_memory(f"--n {n} boundary points", n * BYTES_PER_ROW)
+    curve = setup.loop.boundary(x=setup.x, y=setup.y, n=n, **setup.values)
+    columns = ["theta [rad]", setup.label(setup.x), setup.label(setup.y)]
+    rows = list(zip(curve.theta, curve.x_values, curve.y_values))
+    notes = [f"D-decomposition: z = exp(j theta) is a closed-loop pole at ({setup.x}, {setup.y}) "
+             "(nan: the 2 x 2 system is singular at that theta)"]
+    notes += [_line_text(setup, label, line) for label, line in curve.lines.items()]
+    if not curve.lines:
+        notes.append("no real-root or leading-coefficient line crosses this plane")
+    result = {"lines": {label: dict(zip(("c0", "cx", "cy"), line))
+                        for label, line in curve.lines.items()}}
+    emit(setup, args.format, columns, rows, result=result, notes=notes)
+    return 0
+
+
+def _signed(terms):
+    """``"a + b x - c y"`` from ``[(a, ""), (b, "x"), (c, "y")]`` (the first term keeps its sign).
+
+    Terms that are exactly 0 are left out ("K = 0", not "K = 0 + 0 B"): the
+    lines' coefficients are exact zeros where the loop makes them so.
+    """
+    terms = [(value, name) for value, name in terms if value != 0] or [(0.0, "")]
+    text = ""
+    for k, (value, name) in enumerate(terms):
+        number = f"{abs(value) if k else value:.10g}" + (f" {name}" if name else "")
+        text += number if k == 0 else f" {'-' if math.copysign(1.0, value) < 0 else '+'} {number}"
+    return text
+
+
+def _line_text(setup, label, line):
+    """``z = 1: c0 + cx x + cy y = 0``, and solved for y (or x) when it can be."""
+    c0, cx, cy = line
+    x, y = setup.x, setup.y
+    text = f"line {label}: {_signed([(c0, ''), (cx, x), (cy, y)])} = 0"
+    if cy != 0:
+        text += f", i.e. {y} = {_signed([(-c0 / cy + 0.0, ''), (-cx / cy + 0.0, x)])}"
+    elif cx != 0:
+        text += f", i.e. {x} = {-c0 / cx + 0.0:.10g}"
+    return text

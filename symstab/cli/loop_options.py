@@ -1,0 +1,499 @@
+"""``--loop FILE`` and ``--set NAME=VALUE``: the options of the commands on any loop.
+
+``boundary``, ``limits``, ``classify``, ``design`` and ``map`` take a loop
+file (:func:`symstab.load_loop`) instead of the paper's device options; the
+file's default values are changed with ``--set NAME=VALUE`` (repeatable) and
+the parameter plane is the file's ``plane`` unless ``--x``/``--y`` name
+another.  The file's values are converted to SI when it is read
+(:mod:`symstab.numeric.loop_units`); a ``--set`` value is in the file's unit
+for that parameter, or in the unit it gives (``--set T=0.5ms``), converted
+the same way and checked against the file's bounds.  Everything else on the
+command line (``--at``, ``--x-range``, ``--y-range``) and every result is in
+the SI unit the labels show, and every value used is echoed with its unit
+(as written, then as used where they differ).
+
+The paper's device options (``--m --b --T --Td --delta --gamma --Mw`` and
+the stiffness and damping options) are refused with ``--loop`` (one line
+saying which ``--set`` replaces them); ``--d`` is the one that keeps its
+meaning and sets the delay ``d``.  Everything is checked before the work:
+the ``--set`` syntax, the file, the names, the plane, the values (the loop
+evaluated once at the given point) and the output paths.  The caller
+(:func:`symstab.cli.commands.main`) turns ``ValueError``/``TypeError`` into one line
+``symstab <command>: error: ...`` and exit status 2.
+"""
+
+import dataclasses
+import math
+import re
+import textwrap
+
+import numpy as np
+
+from .._resources import check_memory
+
+__all__ = ["DEVICE_OPTIONS", "POINT_OPTIONS", "EXAMPLE", "LINEAR_WITH_LOOP", "add_loop_options",
+           "uses_loop", "split_unit", "parse_number", "convert_sets", "LoopSetup", "value_text",
+           "loop_echo", "load_loop_file", "add_delay", "check_names", "loop_values", "resolve_loop",
+           "point_count", "broadcast"]
+
+
+#: The paper's device options every numeric command has, with the ``--set``
+#: that replaces each under ``--loop`` (None: nothing does, as for the simulation options).
+DEVICE_OPTIONS = (
+    ("--m", "m", "--set m=..."), ("--b", "b", "--set b=..."), ("--T", "T", "--set T=..."),
+    ("--Td", "Td", "--set d=... (the delay in samples)"),
+    ("--delta", "delta", "--set with the loop's own parameters"),
+    ("--gamma", "gamma", "--set with the loop's virtual mass, e.g. --set M=..."),
+    ("--Mw", "Mw", "--set with the loop's virtual mass, e.g. --set M=..."),
+    ("--linear", "linear", None),
+)
+
+#: Stiffness and damping options: points (classify, limits) and grids (map).
+POINT_OPTIONS = (
+    ("--alpha", "alpha", "--set with the loop's parameters, e.g. --set K=..."),
+    ("--beta", "beta", "--set with the loop's parameters, e.g. --set B=..."),
+    ("--Kw", "Kw", "--set with the loop's parameters, e.g. --set K=..."),
+    ("--Bw", "Bw", "--set with the loop's parameters, e.g. --set B=..."),
+)
+
+_GRID_OPTIONS = tuple((flag, dest, "--x-range/--y-range (the plane is --x/--y)")
+                      for flag, dest, _ in POINT_OPTIONS)
+
+#: The simulation options of ``map``: a general loop has no simulator.
+_SIMULATION_OPTIONS = tuple(
+    (flag, dest, None) for flag, dest in (
+        ("--encoder-resolution", "encoder_resolution"), ("--paper-encoder", "paper_encoder"),
+        ("--velocity-cutoff", "velocity_cutoff"), ("--coulomb", "coulomb"),
+        ("--stiction", "stiction"), ("--friction-compensation", "friction_compensation"),
+        ("--actuator-bandwidth", "actuator_bandwidth"), ("--substeps", "substeps"),
+        ("--steps", "steps"), ("--x0", "x0")))
+
+#: The options each command refuses with ``--loop``.
+_REFUSED = {
+    "boundary": DEVICE_OPTIONS,
+    "limits": DEVICE_OPTIONS + (("--beta", "beta", "--at X (the stable y at x = X)"),
+                                ("--Bw", "Bw", "--at X (the stable y at x = X)")),
+    "classify": DEVICE_OPTIONS + POINT_OPTIONS,
+    "design": DEVICE_OPTIONS,
+    "map": DEVICE_OPTIONS + _GRID_OPTIONS + _SIMULATION_OPTIONS,
+}
+
+#: The options that only mean something with ``--loop``, per command.
+_LOOP_ONLY = {
+    "boundary": ("set_values", "x", "y"),
+    "limits": ("set_values", "x", "y", "at"),
+    "classify": ("set_values",),
+    "design": ("set_values", "x", "y", "at"),
+    "map": ("set_values", "x", "y", "x_range", "y_range"),
+}
+
+_FLAGS = {"set_values": "--set", "x": "--x", "y": "--y", "at": "--at",
+          "x_range": "--x-range", "y_range": "--y-range"}
+
+
+EXAMPLE = "examples/loops/paper.toml"
+
+
+#: What each command gives for a loop file, for its --help.
+_WHAT = {
+    "boundary": "boundary --loop gives the D-decomposition of the plane: the (x, y) at which "
+                "z = exp(j theta) is a closed-loop pole, and the lines c0 + cx x + cy y = 0 "
+                "on which a pole is at z = 1, z = -1 or infinity (leading coefficient 0).",
+    "limits": "limits --loop gives the largest stable y, the x where it is reached, the x "
+              "extent and the area of the stable set in the plane (with --at X the stable "
+              "intervals of y at x = X).",
+    "classify": "classify --loop gives the verdict, the spectral radius and the certified "
+                "number of closed-loop poles outside the unit circle at the file's values "
+                "changed by --set (comma lists: several points).",
+    "design": "design --loop gives the largest stable y, the x where it is reached, and the "
+              "stable intervals of y at that x (or at --at X).",
+    "map": "map --loop classifies every cell of an x-y grid by its root count (no "
+           "simulation) and draws the D-decomposition over it.",
+}
+#: The example of each command with a loop file.
+_LOOP_EXAMPLES = {
+    "boundary": f"symstab boundary --loop {EXAMPLE} --set d=10 --n 11",
+    "limits": f"symstab limits --loop {EXAMPLE} --set M=0.0128 --at 0.3",
+    "classify": f"symstab classify --loop {EXAMPLE} --set K=1,3,10 --set B=0.2",
+    "design": f"symstab design --loop {EXAMPLE} --set d=10",
+    "map": f"symstab map --loop {EXAMPLE} --x-range=-0.1,0.6,141 --y-range=0,6,121 "
+           "--out map.npz",
+}
+
+
+def add_loop_options(p, command):
+    """Add ``--loop``, ``--set`` (and the plane options) of ``command`` to parser ``p``.
+
+    Call it after the command's other options: the refused ones are recorded
+    with their defaults, so that a refused option is recognised when given.
+    """
+    g = p.add_argument_group(
+        "any loop (instead of the device options above)",
+        textwrap.fill(f"A loop file (TOML, see {EXAMPLE}) names the plant, the environment, the "
+                      "default values and their units, converted to SI when the file is read; "
+                      "--set changes a value, in the file's unit for it or in the unit it "
+                      "gives.  --at, the ranges and the results are in the SI units shown.  "
+                      f"{_WHAT[command]}  With --loop the paper's device options are refused "
+                      "(--d still sets the delay d).", 77)
+        + f"\nexample: {_LOOP_EXAMPLES[command]}")
+    g.add_argument("--loop", metavar="FILE", help="loop file (TOML)")
+    many = " (classify: a comma-separated list, one point per entry)" if command == "classify" else ""
+    g.add_argument("--set", metavar="NAME=VALUE", action="append", dest="set_values",
+                   help="set a parameter of the loop: VALUE is in the unit the file gives NAME "
+                        "(SI where the file gives a bare number), or in the unit written after "
+                        "it (--set T=0.5ms, --set \"K=3 N/mm\"), of the same dimension; "
+                        "converted to SI and checked against the file's bounds; repeatable; d "
+                        f"is a whole number of samples{many}")
+    if command != "classify":
+        g.add_argument("--x", metavar="NAME", help="horizontal parameter of the plane "
+                                                   "(default: the file's plane)")
+        g.add_argument("--y", metavar="NAME", help="vertical parameter of the plane "
+                                                   "(default: the file's plane)")
+    if command in ("limits", "design"):
+        g.add_argument("--at", type=float, metavar="X",
+                       help="also give the stable intervals of y at x = X"
+                            + (" (default: the x of the largest y)" if command == "design" else ""))
+    if command == "map":
+        g.add_argument("--x-range", metavar="LOW,HIGH,N", help="grid of x (--x-range=-0.1,0.6,200)")
+        g.add_argument("--y-range", metavar="LOW,HIGH,N", help="grid of y (--y-range=0,6,200)")
+    refused = tuple((flag, dest, p.get_default(dest), instead)
+                    for flag, dest, instead in _REFUSED[command])
+    p.set_defaults(loop_command=command, loop_refused=refused)
+
+
+def uses_loop(args):
+    """True when the command runs on a loop file; refuses loop options without one."""
+    if getattr(args, "loop", None) is not None:
+        return True
+    for dest in _LOOP_ONLY[args.loop_command]:
+        if getattr(args, dest, None) is not None:
+            raise ValueError(f"{_FLAGS[dest]} needs a loop file: give --loop FILE "
+                             f"(e.g. --loop {EXAMPLE})")
+    return False
+
+
+# --------------------------------------------------------------------------
+# Inputs
+
+
+#: Why ``--linear`` is refused with ``--loop``.
+LINEAR_WITH_LOOP = ("--linear names the units of the paper's device options (rotary by default, "
+                    "linear with --linear: the same numbers); with --loop every value is in the "
+                    "units of the loop file, converted to SI: drop --linear")
+
+
+def _refuse_device_options(args):
+    for flag, dest, default, instead in args.loop_refused:
+        if getattr(args, dest, default) != default:
+            if flag == "--linear":
+                raise ValueError(LINEAR_WITH_LOOP)
+            if instead is None:
+                raise ValueError(f"{flag} is an option of the paper's device simulation; "
+                                 f"map --loop classifies the loop by its roots and takes no "
+                                 f"simulation options")
+            raise ValueError(f"{flag} is an option of the paper's device; with --loop use "
+                             f"{instead}")
+
+
+#: A number at the start of a --set value, before its unit (0.25ms, 1e-3 s, 3 1/s).
+_LEADING_NUMBER = re.compile(r"[+-]?(?:\d+(?:\.\d*)?|\.\d+)(?:[eE][+-]?\d+)?")
+
+
+def split_unit(text, flag):
+    """``("0.25", "ms")`` from ``"0.25ms"`` or ``"0.25 ms"``; ``(text, None)`` without a unit.
+
+    A list takes one unit, after its last value (``1,3,10 N/mm``).
+    """
+    head, comma, last = text.rpartition(",")
+    last = last.strip()
+    try:
+        float(last)
+        return text, None
+    except ValueError:
+        pass
+    number = _LEADING_NUMBER.match(last)
+    unit = last[number.end():].strip() if number else ""
+    if not number or not unit:
+        return text, None   # not a number: said so by parse_number
+    if "," in unit:
+        raise ValueError(f"{flag}: give the unit once, after the last value")
+    return head + comma + number.group(), unit
+
+
+def parse_number(name, text, flag, *, lists):
+    """The value(s) of one ``--set``: a float, d an integer; a list where allowed."""
+    items = [t.strip() for t in text.split(",")]
+    if len(items) > 1 and not lists:
+        raise ValueError(f"{flag}: {name} takes one value here (lists are for classify)")
+    if not all(items):
+        raise ValueError(f"{flag}: VALUE must be a number"
+                         + (" or a comma-separated list without empty items" if lists else ""))
+    values = []
+    for item in items:
+        try:
+            value = float(item)
+        except ValueError:
+            raise ValueError(f"{flag}: {item!r} is not a number") from None
+        if not math.isfinite(value):
+            raise ValueError(f"{flag}: {name} must be a finite number, got {item!r}")
+        if name == "d":
+            from .._validate import check_delay
+            try:
+                value = check_delay(value)
+            except ValueError as exc:
+                raise ValueError(f"{flag}: {exc}") from None
+        values.append(value)
+    if name == "d" and len(values) > 1:
+        raise ValueError(f"{flag}: d takes one value (run classify once per delay)")
+    return values if len(values) > 1 else values[0]
+
+
+def _parse_sets(texts, *, lists):
+    """``{name: (value, unit)}`` of the ``--set NAME=VALUE [UNIT]`` options, in the order given.
+
+    ``unit`` is None where the option gives none (the file's unit is meant).
+    """
+    out = {}
+    for text in texts or ():
+        flag = f"--set {text}"
+        name, eq, value = text.partition("=")
+        name = name.strip()
+        if not eq or not name:
+            raise ValueError(f"{flag}: expected NAME=VALUE, e.g. --set K=300")
+        if name in out:
+            raise ValueError(f"--set {name} is given twice; give each parameter once")
+        value, unit = split_unit(value, flag)
+        out[name] = (parse_number(name, value, flag, lists=lists), unit)
+    return out
+
+
+def convert_sets(loop, sets):
+    """The ``--set`` values in SI: (values, written), converted as the file's own.
+
+    A value without a unit is in the file's unit for that parameter (SI where
+    the file gives a bare number); one with a unit is converted from it,
+    which must have the dimension of the parameter (from the file's unit, or
+    implied by the loop).  ``written`` keeps what was typed, for the echo.
+    """
+    from ..numeric.loop_units import FileParameters, convert
+
+    known = getattr(loop, "file_parameters", None) or FileParameters({})
+    values, written = {}, {}
+    for name, (value, unit) in sets.items():
+        flag = f"--set {name}"
+        file_unit = known.file_unit(name)
+        if unit is None:
+            unit = file_unit
+        many = isinstance(value, list)
+        items = [convert(name, v, unit, where=flag) for v in (value if many else [value])]
+        info = items[0].info
+        expected = (known.values[name].info.dimensions if file_unit is not None and name != "d"
+                    else known.dimensions.get(name))
+        if info is not None and expected is not None and info.dimensions != tuple(expected):
+            from ..numeric.loop_units import dimension_name
+            raise ValueError(f"{flag}: unit {unit!r} is {dimension_name(info.dimensions)}, and "
+                             f"{name} is in {dimension_name(expected)}"
+                             + (f" (the file gives it in {file_unit!r})" if file_unit else ""))
+        values[name] = [i.si_value for i in items] if many else items[0].si_value
+        written[name] = (value, items[0].unit, items[0].si_unit)
+    return values, written
+
+
+@dataclasses.dataclass(frozen=True)
+class LoopSetup:
+    """The resolved inputs of a loop command: what :func:`symstab.cli.output.emit` prints."""
+
+    path: str
+    loop: object          # symstab.Loop
+    values: dict          # every value used, axes excluded
+    given: tuple          # names set on the command line
+    x: str = None
+    y: str = None
+    echo: tuple = ()
+    #: What the file or a --set wrote where it differs from the SI value used:
+    #: {name: (value as written, unit as written, SI unit)}.
+    written: dict = dataclasses.field(default_factory=dict)
+
+    def unit(self, name):
+        return self.loop.units.get(name, "")
+
+    def label(self, name):
+        """``"K [N/m]"``, or the bare name when the file gives no unit."""
+        unit = self.unit(name)
+        return f"{name} [{unit}]" if unit else name
+
+    def as_dict(self):
+        loop = self.loop
+        out = {"loop": self.path, "name": loop.name, "plant": str(loop.plant),
+               "environment": str(loop.environment), "zoh": loop.zoh_method,
+               "values": {k: (v.tolist() if isinstance(v, np.ndarray) else v)
+                          for k, v in self.values.items()},
+               "set": list(self.given)}
+        if self.x is not None:
+            out["plane"] = {"x": self.x, "y": self.y}
+        out["units"] = {k: loop.units[k] for k in loop.parameters if k in loop.units}
+        written = {k: {"value": v, "unit": u} for k, (v, u, _) in self.written.items()
+                   if k in self.values}
+        if written:
+            out["as_written"] = written   # converted to "values", in "units"
+        return out
+
+
+def _quantity_text(name, value):
+    if isinstance(value, (list, tuple, np.ndarray)):
+        return f"{name} = [" + ", ".join(f"{v:.10g}" for v in value) + "]"
+    return f"{name} = {value:.10g}" if isinstance(value, float) else f"{name} = {value}"
+
+
+def value_text(setup, name, value):
+    """``"K = 300 N/m"``, ``"K = [1, 3] N/m"``, ``"d = 40 samples"``, ``"T = 0.25 ms (0.00025 s)"``.
+
+    A value the file or a ``--set`` gave in another unit is shown as written
+    and, in brackets, as used (SI).
+    """
+    unit = setup.unit(name) or ("samples" if name == "d" else "")
+    if unit == "samples" and value == 1:
+        unit = "sample"
+    text = _quantity_text(name, value) + (f" {unit}" if unit else "")
+    if name in setup.written and name != "d":
+        given, given_unit, _ = setup.written[name]
+        shown = _quantity_text(name, given) + f" {given_unit}"
+        if shown != text:
+            return f"{shown} ({text.partition(' = ')[2]})"
+    return text
+
+
+def loop_echo(setup):
+    """The lines that echo a loop command's inputs: the loop, every value used, the plane."""
+    loop = setup.loop
+    lines = [f"loop {loop.name} ({setup.path}): G(s) = {loop.plant}, VE(z) = {loop.environment}"
+             f"; ZOH by {loop.zoh_method}"]
+    parts = [value_text(setup, n, setup.values[n]) + (" (--set)" if n in setup.given else "")
+             for n in loop.parameters if n in setup.values]
+    lines.append("values: " + ", ".join(parts))
+    if setup.x is not None:
+        lines.append(f"plane: x = {setup.label(setup.x)}, y = {setup.label(setup.y)}")
+    return tuple(lines)
+
+
+def load_loop_file(path):
+    """The :class:`symstab.Loop` of the loop file at ``path`` (:func:`symstab.load_loop`)."""
+    from ..numeric.loop_files import load_loop
+
+    return load_loop(path)
+
+
+def _plane(args, loop):
+    x, y = args.x, args.y
+    if (x is None) != (y is None):
+        raise ValueError("give the plane as both --x NAME and --y NAME, or neither "
+                         "(the file's plane)")
+    if x is None:
+        if loop.plane is None:
+            raise ValueError(f"the loop file {args.loop} names no plane: give --x NAME --y NAME "
+                             f"(affine parameters: {', '.join(loop.affine_parameters()) or 'none'})")
+        x, y = loop.plane
+    return x, y
+
+
+def add_delay(args, sets):
+    """Add ``--d`` to ``sets`` (``{name: (value, unit)}`` of the ``--set`` options), once."""
+    if getattr(args, "d", None) is not None:
+        if "d" in sets:
+            raise ValueError("give the delay once: --d or --set d=...")
+        sets["d"] = (args.d, None)
+    return sets
+
+
+def check_names(args, loop, names):
+    """Refuse the first of ``names`` (given with ``--set``) that is not a parameter of ``loop``."""
+    unknown = [n for n in names if n not in loop.parameters]
+    if unknown:
+        raise ValueError(f"--set {unknown[0]}: {unknown[0]!r} is not a parameter of the loop in "
+                         f"{args.loop} (parameters: {', '.join(loop.parameters)})")
+
+
+def loop_values(args, loop, sets, written_sets, *, skip=()):
+    """``(values, written)``: the file's defaults but ``skip``, changed by ``sets``, checked.
+
+    ``sets`` are the ``--set`` values in SI (:func:`convert_sets`, which also
+    gives ``written_sets``); a parameter without a value, or a value outside
+    the bounds the file declares, is a ValueError.  ``written`` is what the
+    file or a ``--set`` wrote where it differs from the SI value used
+    (:attr:`LoopSetup.written`).
+    """
+    values = {n: v for n, v in loop.defaults.items() if n not in skip}
+    values.update(sets)
+    missing = [n for n in loop.parameters if n not in values and n not in skip]
+    if missing:
+        raise ValueError(f"no value for {', '.join(missing)}: the loop file {args.loop} gives "
+                         f"none; add --set {missing[0]}=VALUE")
+    known = getattr(loop, "file_parameters", None)
+    written = {}
+    if known is not None:
+        from ..numeric.loop_units import check_bounds
+
+        written = {n: (v.value, v.unit, v.si_unit) for n, v in known.values.items()
+                   if v.converted}
+        # The bounds the file declares hold at the --set values too (the
+        # file's own were checked when it was read).
+        check_bounds(known, values, skip=skip, where=lambda names: (
+            ", ".join(f"--set {n}=..." for n in sets if n in names) or str(args.loop)))
+    written.update(written_sets)
+    return values, written
+
+
+def resolve_loop(args, *, plane=True, lists=False):
+    """Check every input of a loop command and return its :class:`LoopSetup`.
+
+    Raises ValueError (one line for the user) before any long work: the
+    values are checked by evaluating the loop once (the plane's D-
+    decomposition at two angles, or the polynomial at the given points).
+    """
+    _refuse_device_options(args)
+    sets = _parse_sets(args.set_values, lists=lists)
+    add_delay(args, sets)
+    loop = load_loop_file(args.loop)
+    check_names(args, loop, sets)
+    sets, written_sets = convert_sets(loop, sets)
+    x = y = None
+    axes = ()
+    if plane:
+        x, y = _plane(args, loop)
+        for name in (x, y):
+            if name not in loop.parameters:
+                raise ValueError(f"{'--x' if name == x else '--y'} {name}: not a parameter of the "
+                                 f"loop in {args.loop} (parameters: {', '.join(loop.parameters)})")
+        axes = (x, y)
+        for axis, name in (("x", x), ("y", y)):
+            if name in sets:
+                hint = ("; use --at for the stable intervals at one x"
+                        if axis == "x" and hasattr(args, "at") else "")
+                raise ValueError(f"--set {name}: {name} is the plane's {axis} axis and takes no "
+                                 f"single value here{hint}")
+    values, written = loop_values(args, loop, sets, written_sets, skip=axes)
+    if plane:
+        loop.boundary(x=x, y=y, n=2, **values)   # checks the plane (affine) and the values
+        point = {**values, x: 0.0, y: 0.0}
+    else:
+        check_memory("the points' coefficients", 8 * point_count(values) * (values["d"] + 64))
+        point = broadcast(values)
+    # An overflow in the plant's pulse transfer function (exp(-b T / m) at
+    # T = 1e300, say) is a ValueError of the loop's, here before the work.
+    loop.coefficients(**point)
+    setup = LoopSetup(str(args.loop), loop, values, tuple(sets), x, y, written=written)
+    return dataclasses.replace(setup, echo=loop_echo(setup))
+
+
+def point_count(values):
+    """The number of points given: the length of the longest ``--set`` list, else 1."""
+    return max((len(v) for v in values.values() if isinstance(v, list)), default=1)
+
+
+def broadcast(values):
+    """The values as arrays of one length (lists of one length or single values)."""
+    lengths = {n: len(v) for n, v in values.items() if isinstance(v, list)}
+    if len(set(lengths.values())) > 1:
+        text = ", ".join(f"{n} has {k}" for n, k in lengths.items())
+        raise ValueError(f"--set lists must have the same length or one value: {text}")
+    return {n: (np.array(v, dtype=float) if isinstance(v, list) else v) for n, v in values.items()}

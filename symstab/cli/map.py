@@ -1,0 +1,344 @@
+"""``symstab map``: the stability of a stiffness-damping grid; CSV or NPZ, and a PNG.
+
+The paper's loop is simulated at every cell (with the non-idealities of
+:mod:`symstab.cli.simulation`), its root count beside; a loop file
+(``--loop``) has no simulator yet, and every cell is classified by its root
+count, with the D-decomposition drawn over the map.  The output paths are
+checked before the work and the files written atomically.
+"""
+
+import io
+import pathlib
+import textwrap
+
+import numpy as np
+
+from .._resources import CHUNK_BYTES, check_memory, chunk_slices
+from .loop_options import add_loop_options, resolve_loop, uses_loop, value_text
+from .options import add_command, add_model_options, resolve, stiffness_and_damping
+from .output import check_files, draw_lines, png_bytes, pyplot_or_none, visible, write_output
+from .simulation import add_nonideal_options, nonideal_text, resolve_nonideal, simulated_theory
+from .units import tex_unit
+
+__all__ = ["register", "run", "MAX_GRID", "map_outputs"]
+
+#: Bytes per map cell in the CSV and NPZ written, with the Python objects
+#: that build them (generous).
+_MAP_CELL_BYTES = 300
+
+
+#: Memory per classified point of a map, per coefficient: the coefficients,
+#: the environment's and the plant's arrays and the classifier's working
+#: copies (generous).
+_BYTES_PER_COEFFICIENT = 64
+
+
+def register(subparsers):
+    """Add ``symstab map`` to the sub-commands."""
+    p = add_command(
+        subparsers, "map", help="stability of a grid by simulation; write CSV or NPZ and a PNG",
+        description="Simulate every point of a stiffness-damping grid and write which are "
+                    "stable (CSV or NPZ, with the root count of the loop simulated beside, its "
+                    "linear part with the filter and the actuator lag) and a PNG of the map with "
+                    "that loop's boundary, in the units of the grid.",
+        example="symstab map --Td 0.01 --Kw 0,50,100 --Bw=-0.1,1.8,100 --paper-encoder "
+                "--velocity-cutoff 50 --out map.npz",
+        func=run)
+    add_model_options(p)
+    add_nonideal_options(p)
+    p.add_argument("--alpha", metavar="LOW,HIGH,N", help="alpha grid (write --alpha=LOW,... "
+                                                           "when LOW is negative)")
+    p.add_argument("--beta", metavar="LOW,HIGH,N", help="beta grid (--beta=-0.01,0.3,100)")
+    p.add_argument("--Kw", metavar="LOW,HIGH,N", help="K_w grid (physical)")
+    p.add_argument("--Bw", metavar="LOW,HIGH,N", help="B_w grid (physical; --Bw=-0.1,3,100)")
+    p.add_argument("--out", required=True, help="output file, .csv or .npz")
+    p.add_argument("--png", help="PNG file (default: --out with .png)")
+    p.add_argument("--no-png", action="store_true", help="do not draw the PNG")
+    add_loop_options(p, "map")
+
+
+def run(args):
+    """Run ``symstab map`` (on the loop file of ``--loop``, else the paper's loop)."""
+    return _loop(args) if uses_loop(args) else _paper(args)
+
+
+#: Largest number of grid points along one axis of ``symstab map``.
+MAX_GRID = 2000
+
+
+def _grid(text, name):
+    parts = text.split(",")
+    if len(parts) != 3:
+        raise ValueError(f"{name} must be LOW,HIGH,N, got {text!r}")
+    try:
+        lo, hi, n = float(parts[0]), float(parts[1]), int(parts[2])
+    except ValueError:
+        raise ValueError(f"{name} must be LOW,HIGH,N with a whole N, got {text!r}") from None
+    # HIGH - LOW must be finite too: linspace takes it (1e308 - -1e308 is inf).
+    if not (np.isfinite(lo) and np.isfinite(hi) and lo < hi and np.isfinite(hi - lo)
+            and 2 <= n <= MAX_GRID):
+        raise ValueError(f"{name} must have finite LOW < HIGH (and HIGH - LOW finite) and "
+                         f"2 <= N <= {MAX_GRID}, got {text!r}")
+    return np.linspace(lo, hi, n)
+
+
+def map_outputs(args):
+    """``(out, png)`` paths of ``map``, checked before any work (png None with --no-png).
+
+    ``--out`` must be a .csv or .npz file; the PNG defaults to ``--out``
+    with the suffix .png.
+    """
+    if not args.out.endswith((".csv", ".npz")):
+        raise ValueError(f"--out must end in .csv or .npz, got {args.out}")
+    if args.no_png and args.png is not None:
+        raise ValueError("give --png or --no-png, not both")
+    png = None if args.no_png else (
+        str(pathlib.Path(args.out).with_suffix(".png")) if args.png is None else args.png)
+    paths = check_files([("--out", args.out), ("--png", png)])
+    return paths["--out"], paths.get("--png")
+
+
+def _paper(args):
+    """The paper's loop simulated at every cell of the grid."""
+    from ..numeric.simulate import check_steps, progress_printer, stability_map
+    from ..numeric.stability import MARGINAL, STABLE
+
+    setup = resolve(args)
+    nonideal, x0 = resolve_nonideal(args, setup)
+    given = {}  # the grids as the user gave them, by flag: the PNG is drawn in their units
+
+    def grid(text, flag):
+        given[flag] = _grid(text, flag)
+        return given[flag]
+
+    alpha, beta = (np.atleast_1d(x) for x in stiffness_and_damping(args, setup, grid))
+    out, png_path = map_outputs(args)
+    check_memory(f"a map of {alpha.size} x {beta.size} cells", alpha.size * beta.size * _MAP_CELL_BYTES)
+    steps = check_steps(args.steps, setup.d)
+    # The loop simulated, classified by its roots before the simulation (a
+    # refusal then costs no run): its linear part, filter and lag included.
+    theory = simulated_theory(setup, nonideal)
+    A, B = np.meshgrid(alpha, beta, indexing="ij")
+    code = theory.classify(A, B)
+    for line in setup.echo:
+        print(line)
+    result = stability_map(alpha=alpha, beta=beta, gamma=setup.gamma, d=setup.d,
+                           delta=None if setup.physical else setup.delta, steps=steps, x0=x0,
+                           device=setup.device, nonideal=nonideal,
+                           progress=progress_printer("simulating", steps))
+    exact = code == STABLE
+    physical = {}  # K_w and B_w beside alpha and beta, in the units of the echo
+    if setup.physical:
+        dev = setup.device
+        physical = {"K_w": given.get("--Kw", np.atleast_1d(dev.stiffness(alpha))),
+                    "B_w": given.get("--Bw", np.atleast_1d(dev.damping(beta)))}
+    if out.suffix == ".npz":
+        buf = io.BytesIO()
+        units = {f"{name}_unit": np.array(setup.units[name]) for name in physical}
+        np.savez(buf, alpha=alpha, beta=beta, **physical, **units, stable=result.stable,
+                 growth=result.growth, exact_stable=exact, exact_code=code, gamma=setup.gamma,
+                 d=setup.d, delta=setup.delta, steps=steps,
+                 nonidealities=np.array(nonideal_text(nonideal, args)),
+                 theory=np.array(theory.description))
+        data = buf.getvalue()
+    else:
+        buf = io.StringIO()
+        columns = ["alpha", "beta"] + [f"{name} [{setup.units[name]}]" for name in physical]
+        buf.write(",".join(columns + ["stable", "exact_stable", "growth"]) + "\n")
+        cells = [A.ravel(), B.ravel()]
+        if physical:
+            K, Bw = np.meshgrid(physical["K_w"], physical["B_w"], indexing="ij")
+            cells += [K.ravel(), Bw.ravel()]
+        for *values, s, e, g in zip(*cells, result.stable.ravel(), exact.ravel(),
+                                    result.growth.ravel()):
+            buf.write(",".join(f"{v:.12g}" for v in values) + f",{int(s)},{int(e)},{g:.6g}\n")
+        data = buf.getvalue().encode()
+    png = _paper_png(args, setup, result, nonideal, given, theory) if png_path is not None else None
+    write_output(out, data, "--out")
+    written = [str(out)]
+    if png is not None:
+        write_output(png_path, png, "--png")
+        written.append(str(png_path))
+    decided = code != MARGINAL
+    differ = int(np.count_nonzero((result.stable != exact) & decided))
+    print(f"{int(result.stable.sum())} of {result.stable.size} cells stable by simulation "
+          f"({steps} periods); {differ} of the {int(decided.sum())} cells that are not marginal "
+          f"differ from the root-counting classification of the {theory.description}")
+    print("wrote " + ", ".join(written))
+    return 0
+
+
+def _keep_nan(convert):
+    """``convert`` (a Device's, which refuses NaN) applied to the finite entries only."""
+    def apply(values):
+        values = np.asarray(values, dtype=float)
+        out = np.full(values.shape, np.nan)
+        finite = np.isfinite(values)
+        out[finite] = convert(values[finite])
+        return out
+    return apply
+
+
+def _map_axes(setup, given, result):
+    """``(x, y, x label, y label, to_x, to_y)`` in the units of the grids the user gave.
+
+    ``to_x``/``to_y`` convert beta/alpha (the boundary curve) to the axes,
+    keeping the NaN that break a curve between its branches.
+    """
+    dev, units = setup.device, setup.units
+    if "--Bw" in given:
+        x, xlabel, to_x = given["--Bw"], f"$B_w$ [{tex_unit(units['B_w'])}]", _keep_nan(dev.damping)
+    else:
+        x, xlabel, to_x = result.beta, r"$\beta = B_w T / m$", np.asarray
+    if "--Kw" in given:
+        y, ylabel, to_y = given["--Kw"], f"$K_w$ [{tex_unit(units['K_w'])}]", _keep_nan(dev.stiffness)
+    else:
+        y, ylabel, to_y = result.alpha, r"$\alpha = K_w T^2 / m$", np.asarray
+    return x, y, xlabel, ylabel, to_x, to_y
+
+
+def _map_title(setup, nonideal, args, steps_text):
+    if setup.physical:
+        dev, units = setup.device, setup.units
+        loop = (f"$T_d$ = {dev.delay(setup.d) * 1e3:g} ms (d = {setup.d}), "
+                f"$M_w$ = {float(dev.mass(setup.gamma)):g} {tex_unit(units['M_w'])}")
+    else:
+        loop = f"$\\delta$ = {setup.delta:g}, d = {setup.d}, $\\gamma$ = {setup.gamma:g}"
+    return (f"stable by simulation (green, {steps_text}); {loop}\n"
+            f"{nonideal_text(nonideal, args)}")
+
+
+def _paper_png(args, setup, result, nonideal, given, theory):
+    """The map as PNG bytes, or None without matplotlib.
+
+    Drawn in the units of the grids the user gave (K_w, B_w or alpha, beta),
+    with the non-idealities of the simulation in the title and the boundary
+    of the loop simulated (its linear part, ``theory``) over it.
+    """
+    plt = pyplot_or_none()
+    if plt is None:
+        return None
+    from matplotlib.colors import ListedColormap
+
+    x, y, xlabel, ylabel, to_x, to_y = _map_axes(setup, given, result)
+    fig, ax = plt.subplots(figsize=(6.4, 4.8), dpi=120)
+    ax.pcolormesh(x, y, result.stable.astype(float), shading="nearest",
+                  cmap=ListedColormap(["white", "#7fc97f"]), vmin=0, vmax=1)
+    arc_beta, arc_alpha, lines = theory.boundary(n=4000 if theory.loop is not None else 2000)
+    arc_beta = visible(arc_beta, result.beta[0], result.beta[-1])
+    arc_alpha = visible(arc_alpha, result.alpha[0], result.alpha[-1])
+    arc_beta[np.isnan(arc_alpha)] = np.nan
+    drawn = []
+    if np.any(np.isfinite(arc_beta)):
+        name = ("the ideal loop, eq. (7)" if theory.loop is None
+                else f"the {theory.label} (D-decomposition)")
+        drawn += ax.plot(to_x(arc_beta), to_y(arc_alpha), "k-", lw=1.2,
+                         label=f"boundary of {name}")
+    drawn += draw_lines(ax, lines, result.beta, result.alpha, to_x, to_y)
+    ax.set_xlim(x[0], x[-1])
+    ax.set_ylim(y[0], y[-1])
+    ax.set_xlabel(xlabel)
+    ax.set_ylabel(ylabel)
+    ax.set_title(_map_title(setup, nonideal, args, f"{result.steps} periods"), fontsize=10)
+    if drawn:
+        ax.legend(handles=drawn, loc="upper right", fontsize=9)
+    fig.tight_layout()
+    return png_bytes(plt, fig)
+
+
+def _loop(args):
+    """A loop file classified by its root counts at every cell of the grid."""
+    from ..numeric.simulate import progress_printer
+    from ..numeric.stability import MARGINAL, STABLE
+
+    setup = resolve_loop(args)
+    if args.x_range is None or args.y_range is None:
+        raise ValueError("map --loop needs the grid: --x-range LOW,HIGH,N and --y-range LOW,HIGH,N")
+    xs, ys = _grid(args.x_range, "--x-range"), _grid(args.y_range, "--y-range")
+    out, png_path = map_outputs(args)
+    loop, values = setup.loop, setup.values
+    degree = loop.coefficients(**{setup.x: 0.0, setup.y: 0.0}, **values).shape[-1]
+    # The cells are classified a chunk of x at a time; what stays is the codes
+    # and the file's text.
+    check_memory(f"a map of {xs.size} x {ys.size} cells",
+                 xs.size * ys.size * _MAP_CELL_BYTES
+                 + max(CHUNK_BYTES, ys.size * _BYTES_PER_COEFFICIENT * degree))
+    for line in setup.echo:
+        print(line)
+    code = np.empty((xs.size, ys.size), dtype=np.int8)
+    progress = progress_printer("classifying", xs.size)
+    for part in chunk_slices(xs.size, ys.size * _BYTES_PER_COEFFICIENT * degree, CHUNK_BYTES):
+        X, Y = np.meshgrid(xs[part], ys, indexing="ij")
+        code[part] = loop.classify(**{setup.x: X, setup.y: Y}, **values)
+        progress(part.stop)
+    stable = code == STABLE
+    if out.suffix == ".npz":
+        buf = io.BytesIO()
+        np.savez(buf, x=xs, y=ys, x_name=np.array(setup.x), y_name=np.array(setup.y),
+                 x_unit=np.array(setup.unit(setup.x)), y_unit=np.array(setup.unit(setup.y)),
+                 code=code, stable=stable,
+                 values=np.array([value_text(setup, n, values[n]) for n in loop.parameters
+                                  if n in values]),
+                 loop=np.array(str(setup.path)))
+        data = buf.getvalue()
+    else:
+        X, Y = np.meshgrid(xs, ys, indexing="ij")
+        buf = io.StringIO()
+        buf.write(f"{setup.label(setup.x)},{setup.label(setup.y)},code,stable\n")
+        for xv, yv, c in zip(X.ravel(), Y.ravel(), code.ravel()):
+            buf.write(f"{xv:.12g},{yv:.12g},{int(c)},{int(c == STABLE)}\n")
+        data = buf.getvalue()
+    image = _loop_png(setup, xs, ys, code) if png_path is not None else None
+    write_output(out, data, "--out")
+    written = [str(out)]
+    if image is not None:
+        write_output(png_path, image, "--png")
+        written.append(str(png_path))
+    print(f"{int(stable.sum())} of {code.size} cells stable, {int((code == MARGINAL).sum())} "
+          f"marginal (code 1 stable, 0 marginal, -1 unstable; certified root counts)")
+    print("wrote " + ", ".join(written))
+    return 0
+
+
+def _loop_png(setup, xs, ys, code):
+    """The map as PNG bytes (None without matplotlib), with the D-decomposition drawn over it."""
+    from ..numeric.stability import MARGINAL, STABLE
+
+    plt = pyplot_or_none()
+    if plt is None:
+        return None
+    from matplotlib.colors import ListedColormap
+    from matplotlib.patches import Patch
+
+    loop, x, y = setup.loop, setup.x, setup.y
+    fig, ax = plt.subplots(figsize=(6.4, 4.8), dpi=120)
+    shade = np.where(code == STABLE, 2, np.where(code == MARGINAL, 1, 0)).T
+    ax.pcolormesh(xs, ys, shade, shading="nearest", vmin=0, vmax=2,
+                  cmap=ListedColormap(["white", "#bdbdbd", "#7fc97f"]))
+    curve = loop.boundary(x=x, y=y, n=4000, **setup.values)
+    bx, by = visible(curve.x_values, xs[0], xs[-1]), visible(curve.y_values, ys[0], ys[-1])
+    bx[np.isnan(by)] = np.nan
+    handles = [Patch(facecolor="#7fc97f", label="stable")]
+    if np.any(code == MARGINAL):
+        handles.append(Patch(facecolor="#bdbdbd", label="marginal"))
+    if np.any(np.isfinite(bx)):
+        handles += ax.plot(bx, by, "k-", lw=1.2, label=r"$z = e^{j\theta}$ root (D-decomposition)")
+    handles += draw_lines(ax, curve.lines, xs, ys)
+    ax.set_xlim(xs[0], xs[-1])
+    ax.set_ylim(ys[0], ys[-1])
+
+    def axis_label(name):
+        unit = setup.unit(name)
+        return f"{name} [{tex_unit(unit)}]" if unit else name
+
+    ax.set_xlabel(axis_label(x))
+    ax.set_ylabel(axis_label(y))
+    # Wrapped to the width of the figure (a two-mass device has eight values),
+    # between values only: no-break spaces inside each.
+    fixed = ", ".join(value_text(setup, n, setup.values[n]).replace(" ", "\u00a0")
+                      for n in loop.parameters if n in setup.values)
+    ax.set_title("\n".join([f"loop {loop.name}: stable set in the ({x}, {y}) plane (root counts)"]
+                           + textwrap.wrap(fixed, 90)), fontsize=9)
+    ax.legend(handles=handles, loc="best", fontsize=8, framealpha=0.9)
+    fig.tight_layout()
+    return png_bytes(plt, fig)

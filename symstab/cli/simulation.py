@@ -1,0 +1,78 @@
+"""The paper's device simulation, shared by ``simulate`` and ``map``: its options and theory.
+
+The non-idealities are given in physical units and need the physical
+device options (the default device is the paper's);
+:func:`simulated_theory` is the linear part of the loop simulated (filter
+and actuator lag included), whose root count each simulation is compared with.
+"""
+
+__all__ = ["add_nonideal_options", "resolve_nonideal", "simulated_theory", "nonideal_text"]
+
+
+def add_nonideal_options(p):
+    """Add the non-idealities (encoder, velocity filter, friction, actuator lag), --steps and --x0."""
+    g = p.add_argument_group("non-idealities (physical units; each off by default)")
+    g.add_argument("--encoder-resolution", type=float, metavar="Q",
+                   help="position quantum, m or rad (the paper's: 3 arc seconds = 1.454e-5 rad)")
+    g.add_argument("--paper-encoder", action="store_true",
+                   help="use the paper's encoder resolution (3 arc seconds)")
+    g.add_argument("--velocity-cutoff", type=float, metavar="HZ",
+                   help="first-order low-pass filter on the velocity, Hz (the paper's: 50)")
+    g.add_argument("--coulomb", type=float, metavar="F", help="Coulomb friction, N or N m")
+    g.add_argument("--stiction", type=float, metavar="F", help="breakaway force (default: --coulomb)")
+    g.add_argument("--friction-compensation", action="store_true",
+                   help="add the Coulomb friction times sign(estimated velocity) to the command")
+    g.add_argument("--actuator-bandwidth", type=float, metavar="HZ", help="first-order lag, Hz")
+    g.add_argument("--substeps", type=int, default=20,
+                   help="sub-steps per period for friction and the actuator lag (default 20)")
+    p.add_argument("--steps", type=int, help="periods to simulate (default 12000 + 800 d)")
+    p.add_argument("--x0", type=float, default=None,
+                   help="initial position, m or rad (default 1; 0.01 with non-idealities)")
+
+
+def resolve_nonideal(args, setup):
+    """``(Nonidealities, x0)`` of the parsed options, checked before any work (raises ValueError)."""
+    from ..numeric.simulate import PAPER_ENCODER_RESOLUTION, Nonidealities, check_x0
+
+    resolution = args.encoder_resolution
+    if args.paper_encoder:
+        if resolution is not None:
+            raise ValueError("give --encoder-resolution or --paper-encoder, not both")
+        resolution = PAPER_ENCODER_RESOLUTION
+    nonideal = Nonidealities(encoder_resolution=resolution, velocity_cutoff=args.velocity_cutoff,
+                             coulomb_friction=args.coulomb, stiction=args.stiction,
+                             friction_compensation=args.friction_compensation,
+                             actuator_bandwidth=args.actuator_bandwidth, substeps=args.substeps)
+    if not nonideal.ideal and not setup.physical:
+        raise ValueError("non-idealities are in physical units: use --m --b --T --Td (or their "
+                         "defaults), not --delta")
+    if setup.physical:
+        nonideal.check(setup.device.T)
+    # Checked here, not only by the simulator, so that nothing is printed before the error.
+    x0 = check_x0(args.x0) if args.x0 is not None else (1.0 if nonideal.ideal else 0.01)
+    return nonideal, x0
+
+
+def simulated_theory(setup, nonideal):
+    """The :class:`symstab.numeric.simulate.LinearTheory` of the loop simulated."""
+    from ..numeric.simulate import linear_theory
+
+    return linear_theory(gamma=setup.gamma, d=setup.d, delta=setup.delta,
+                         device=setup.device, nonideal=nonideal)
+
+
+def nonideal_text(nonideal, args):
+    """The non-idealities of a run in one line, for the PNG title and the NPZ."""
+    position, force = ("m", "N") if args.linear else ("rad", "N m")
+    parts = []
+    if nonideal.encoder_resolution is not None:
+        parts.append(f"encoder quantum {nonideal.encoder_resolution:.4g} {position}")
+    if nonideal.velocity_cutoff is not None:
+        parts.append(f"velocity filter {nonideal.velocity_cutoff:g} Hz")
+    if nonideal.coulomb_friction is not None:
+        parts.append(f"Coulomb friction {nonideal.coulomb_friction:g} {force}"
+                     + (f" (stiction {nonideal.stiction:g})" if nonideal.stiction is not None else "")
+                     + (", compensated" if nonideal.friction_compensation else ""))
+    if nonideal.actuator_bandwidth is not None:
+        parts.append(f"actuator lag {nonideal.actuator_bandwidth:g} Hz")
+    return ", ".join(parts) if parts else "ideal loop: no quantization, filter, friction or lag"
