@@ -160,30 +160,7 @@ def test_every_public_name_still_works():
 #: Private names a module may still take from another module of symstab or
 #: paper_checks: ``{(importer, "source.name"): reason}``.  Keep it short: a
 #: name another module needs is public, with a docstring, in one home.
-PRIVATE_IMPORTS_ALLOWED = {
-    ("symstab.numeric.any_loop", "symstab.symbolic.loop_assembly._DPS"):
-        "numeric engine rewrite in progress (issue 19)",
-    ("symstab.numeric.any_loop", "symstab.numeric.stability._leading_vanishes"):
-        "numeric engine rewrite in progress (issue 19)",
-    ("symstab.numeric.decomposition", "symstab.numeric.curves._golden_max"):
-        "numeric engine rewrite in progress (issue 19)",
-    ("symstab.numeric.decomposition", "symstab.numeric.stability._leading_vanishes"):
-        "numeric engine rewrite in progress (issue 19)",
-    ("symstab.numeric.locus", "symstab.numeric.stability._horner"):
-        "numeric engine rewrite in progress (issue 19)",
-    ("symstab.numeric.locus", "symstab.numeric.stability._leading_vanishes"):
-        "numeric engine rewrite in progress (issue 19)",
-    ("symstab.numeric.locus", "symstab.numeric.stability._polish"):
-        "numeric engine rewrite in progress (issue 19)",
-    ("symstab.numeric.passivity", "symstab.numeric.curves._golden_max"):
-        "numeric engine rewrite in progress (issue 19)",
-    ("symstab.numeric.region", "symstab.numeric.curves._KERNEL_BYTES_PER_POINT"):
-        "numeric engine rewrite in progress (issue 19)",
-    ("symstab.numeric.region", "symstab.numeric.curves._KERNEL_CHUNK_BYTES"):
-        "numeric engine rewrite in progress (issue 19)",
-    ("symstab.numeric.region", "symstab.numeric.curves._golden_max"):
-        "numeric engine rewrite in progress (issue 19)",
-}
+PRIVATE_IMPORTS_ALLOWED = {}
 
 _ROOTS = {"symstab": PACKAGE, "paper_checks": PACKAGE.parent / "paper_checks"}
 

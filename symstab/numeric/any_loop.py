@@ -42,7 +42,7 @@ import sympy as sp
 
 from .._resources import check_memory
 from .._validate import check_array, check_count, check_delay, check_window
-from ..symbolic.loop_assembly import _DPS, LoopModel, parse_environment, parse_plant, shift_to_one
+from ..symbolic.loop_assembly import PLANT_DIGITS, LoopModel, parse_environment, parse_plant, shift_to_one
 from ..codegen.loop_kernels import environment_kernels, load_numpy_kernels
 from .decomposition import Decomposition, arc_points, decompose, stable_hull
 from .passivity import passive_region
@@ -357,10 +357,10 @@ class Loop(LoopModel):
         unique, inverse = np.unique(columns, axis=0, return_inverse=True)
         rows = []
         for row in unique:
-            sub = {self._symbols[n]: sp.Float(repr(float(v)), _DPS) for n, v in zip(names, row)}
-            lead = den[0].subs(sub).evalf(_DPS)
-            rows.append(([float(sp.diff(c, symbol).subs(sub).evalf(_DPS) / lead) for c in num],
-                         [float(sp.diff(c, symbol).subs(sub).evalf(_DPS) / lead) for c in den]))
+            sub = {self._symbols[n]: sp.Float(repr(float(v)), PLANT_DIGITS) for n, v in zip(names, row)}
+            lead = den[0].subs(sub).evalf(PLANT_DIGITS)
+            rows.append(([float(sp.diff(c, symbol).subs(sub).evalf(PLANT_DIGITS) / lead) for c in num],
+                         [float(sp.diff(c, symbol).subs(sub).evalf(PLANT_DIGITS) / lead) for c in den]))
         dp_n = np.array([r[0] for r in rows])[inverse.ravel()].reshape(shape + (len(num),))
         dp_d = np.array([r[1] for r in rows])[inverse.ravel()].reshape(shape + (len(den),))
         return dp_n, dp_d

@@ -27,7 +27,7 @@ from .._validate import check_loop
 from ..symbolic.theta_max import first_sign_change, reduced_curvature, reduced_qr, reduced_value_slope
 
 __all__ = ["arc_end_angle", "minus_one_line", "BoundaryCurve", "Segment", "scan_grid",
-           "bracketed_root"]
+           "bracketed_root", "golden_max", "KERNEL_BYTES_PER_POINT", "KERNEL_CHUNK_BYTES"]
 
 
 def scan_grid(d, *, n=None, upper=np.pi):
@@ -201,8 +201,8 @@ def minus_one_line(*, gamma, d, delta):
 #: Working set of the boundary kernel per point (tracemalloc measured 16
 #: floats per point at its peak; twice that as a margin), and the chunk it
 #: is run in.
-_KERNEL_BYTES_PER_POINT = 8 * 32
-_KERNEL_CHUNK_BYTES = 32 * 2**20
+KERNEL_BYTES_PER_POINT = 8 * 32
+KERNEL_CHUNK_BYTES = 32 * 2**20
 
 
 @dataclasses.dataclass(frozen=True)
@@ -266,7 +266,7 @@ class BoundaryCurve:
                 f"{len(self.segments)} straight segment{'s' if len(self.segments) != 1 else ''})")
 
 
-def _golden_max(f, a, b, iterations=80):
+def golden_max(f, a, b, iterations=80):
     """Vectorised golden-section search for the maximum of f on [a, b]."""
     ratio = (math.sqrt(5) - 1) / 2
     a, b = np.array(a, dtype=float), np.array(b, dtype=float)

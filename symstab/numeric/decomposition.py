@@ -42,7 +42,7 @@ import math
 import numpy as np
 
 from .._resources import check_memory
-from .curves import _golden_max
+from .curves import golden_max
 from ..symbolic.loop_assembly import shift_to_one
 from .polynomial import DelayedPolynomial
 from .roots import STABLE, classify_polynomials, leading_vanishes, root_counts
@@ -307,7 +307,7 @@ class Decomposition:
             xy = arc_points(base, ax, ay, np.atleast_1d(t))[:2]
             return sense * xy[k]
 
-        t = float(np.atleast_1d(_golden_max(f, float(theta[0]), float(theta[1]), iterations=60))[0])
+        t = float(np.atleast_1d(golden_max(f, float(theta[0]), float(theta[1]), iterations=60))[0])
         xy = [float(v[0]) for v in arc_points(base, ax, ay, np.array([t]))[:2]]
         if sense * xy[k] >= sense * value:
             return xy[k], xy[1 - k]

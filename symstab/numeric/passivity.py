@@ -85,7 +85,7 @@ import numpy as np
 import sympy as sp
 
 from .._validate import check_delay, check_loop, check_real
-from .curves import _golden_max
+from .curves import golden_max
 
 __all__ = ["PassiveRegion", "passive_region", "paper_passive_region"]
 
@@ -428,7 +428,7 @@ def _worst(plane, grid, table, vx, vy):
         valid = np.isfinite(top_values)
         lo, hi, px, py = lo[valid], hi[valid], px[valid], py[valid]
         # 40 steps shrink a bracket of two grid steps to 1e-8 of itself.
-        theta = _golden_max(lambda t: plane.at(t, px, py), lo, hi, iterations=40)
+        theta = golden_max(lambda t: plane.at(t, px, py), lo, hi, iterations=40)
         refined = np.full(top.shape, -np.inf)
         refined[valid] = plane.at(theta, px, py)
         angles = np.full(top.shape, np.nan)

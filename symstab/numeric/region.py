@@ -40,8 +40,8 @@ import numpy as np
 from .._generated import kernels
 from .._resources import CHUNK_BYTES, check_memory, chunk_slices
 from .._validate import check_array, check_count, check_loop, check_real, check_window
-from .curves import (_KERNEL_BYTES_PER_POINT, _KERNEL_CHUNK_BYTES, BoundaryCurve, Segment,
-                     _golden_max, arc_end_angle, bracketed_root, minus_one_line, scan_grid)
+from .curves import (KERNEL_BYTES_PER_POINT, KERNEL_CHUNK_BYTES, BoundaryCurve, Segment,
+                     golden_max, arc_end_angle, bracketed_root, minus_one_line, scan_grid)
 from .decomposition import decompose
 from .stability import MARGINAL, STABLE, UNSTABLE, classify, loop_coefficients
 
@@ -244,7 +244,7 @@ class StabilityRegion:
             i = np.flatnonzero(peak & np.isfinite(inner)) + 1
             if i.size:
                 sign = np.where(v[i] > v[i - 1], 1.0, -1.0)
-                out.append(_golden_max(lambda t, k=index, s=sign: s * kernels.boundary(
+                out.append(golden_max(lambda t, k=index, s=sign: s * kernels.boundary(
                     t, self.gamma, self.d, self.delta)[k], theta[i - 1], theta[i + 1]))
         return np.concatenate(out) if out else np.empty(0)
 
@@ -1175,7 +1175,7 @@ def boundary_curve(*, gamma, d, delta, n=1000, segments=True):
     gamma, d, delta = check_loop(gamma, d, delta)
     n = check_count("n", n, 2)
     # theta, alpha and beta are kept; the kernel's temporaries are chunked.
-    check_memory(f"boundary_curve with n = {n} points", 3 * 8 * n + _KERNEL_CHUNK_BYTES)
+    check_memory(f"boundary_curve with n = {n} points", 3 * 8 * n + KERNEL_CHUNK_BYTES)
     t_end = arc_end_angle(gamma=gamma, d=d, delta=delta)
     if not np.isfinite(t_end):
         empty = np.empty(0)
@@ -1184,7 +1184,7 @@ def boundary_curve(*, gamma, d, delta, n=1000, segments=True):
                              "enters alpha > 0 (1 + gamma + (d + 1) delta <= 0 or close to it)")
     theta = np.linspace(0.0, t_end, n)
     alpha, beta = np.empty(n), np.empty(n)
-    for part in chunk_slices(n, _KERNEL_BYTES_PER_POINT, _KERNEL_CHUNK_BYTES):
+    for part in chunk_slices(n, KERNEL_BYTES_PER_POINT, KERNEL_CHUNK_BYTES):
         alpha[part], beta[part] = kernels.boundary(theta[part], gamma, d, delta)
     # The ends are exact: the arc starts at (-delta, 0) and ends on alpha = 0.
     alpha[0], beta[0] = 0.0, -delta

@@ -34,11 +34,12 @@ from .discretize import numeric_zoh, written_poles, zoh_pulse_transfer_function
 
 __all__ = ["LoopModel", "parse_plant", "parse_environment", "parse_expression",
            "check_parameter_name", "check_loop_name", "check_text_line", "NAME_PATTERN",
-           "is_affine", "poly_coeffs"]
+           "is_affine", "poly_coeffs", "shift_to_one", "PLANT_DIGITS"]
 
 #: Names with a fixed meaning in every loop.
 RESERVED = ("s", "z", "T", "d")
-_DPS = 30
+#: Working digits of the plant's pulse transfer function (rounded once to float).
+PLANT_DIGITS = 30
 #: Parameter names the generated NumPy and C kernels cannot take.
 _C_KEYWORDS = frozenset(
     "auto break case char const continue default do double else enum extern float for goto if "
@@ -499,17 +500,17 @@ class LoopModel:
     @functools.cached_property
     def _check_point(self):
         """Parameter values (none 0, 1 or equal to another) for checking cached parts."""
-        point = {model.T: sp.Float("0.0213", _DPS)}
+        point = {model.T: sp.Float("0.0213", PLANT_DIGITS)}
         others = [n for n in self._symbols if n != "T"]
         for k, name in enumerate(others):
-            point[self._symbols[name]] = sp.Float(repr(1 + 0.3183098861837907 * (k + 1)), _DPS)
+            point[self._symbols[name]] = sp.Float(repr(1 + 0.3183098861837907 * (k + 1)), PLANT_DIGITS)
         return point
 
     def _at_check_point(self, coefficients):
         """A polynomial (coefficients highest first) at :attr:`_CHECK_Z` and :meth:`_check_point`."""
         total = 0j
         for c in coefficients:
-            total = total * self._CHECK_Z + complex(sp.N(c.xreplace(self._check_point), _DPS))
+            total = total * self._CHECK_Z + complex(sp.N(c.xreplace(self._check_point), PLANT_DIGITS))
         return total
 
     @staticmethod
@@ -517,8 +518,8 @@ class LoopModel:
         return bool(abs(a - b) <= 1e-9 * max(abs(a), abs(b)) and np.isfinite(abs(a)))
 
     def _environment_agrees(self, parts):
-        at = {**self._check_point, model.z: sp.Float("1.3", _DPS) + sp.I * sp.Float("0.4", _DPS)}
-        expected = complex(sp.N(self.environment.xreplace(at), _DPS))
+        at = {**self._check_point, model.z: sp.Float("1.3", PLANT_DIGITS) + sp.I * sp.Float("0.4", PLANT_DIGITS)}
+        expected = complex(sp.N(self.environment.xreplace(at), PLANT_DIGITS))
         return self._close(self._at_check_point(parts[0]) / self._at_check_point(parts[1]),
                            expected)
 
@@ -526,10 +527,10 @@ class LoopModel:
         """Whether (P_n, P_d) give the matrix exponential's Z[ZOH G] at the check point."""
         point = self._check_point
         num, den = sp.fraction(sp.together(self.plant.xreplace(point)))
-        with mpmath.workdps(_DPS):
-            num, den = ([mpmath.mpf(sp.Float(c, _DPS)) for c in sp.Poly(p, model.s).all_coeffs()]
+        with mpmath.workdps(PLANT_DIGITS):
+            num, den = ([mpmath.mpf(sp.Float(c, PLANT_DIGITS)) for c in sp.Poly(p, model.s).all_coeffs()]
                         for p in (num, den))
-            p_n, p_d = numeric_zoh(num, den, mpmath.mpf(point[model.T]), dps=_DPS)
+            p_n, p_d = numeric_zoh(num, den, mpmath.mpf(point[model.T]), dps=PLANT_DIGITS)
             z0 = mpmath.mpc(self._CHECK_Z.real, self._CHECK_Z.imag)
             expected = complex(mpmath.polyval(p_n, z0) / mpmath.polyval(p_d, z0))
         return self._close(self._at_check_point(parts[0]) / self._at_check_point(parts[1]),
@@ -621,8 +622,8 @@ class LoopModel:
                                  f"{', '.join(need)} to get its polynomial")
             p_n, p_d = self._numeric_plant(tuple(float(values[n]) for n in self._plant_names),
                                            float(values["T"]))[:2]
-            p_n = [sp.Float(str(c), _DPS) for c in p_n]
-            p_d = [sp.Float(str(c), _DPS) for c in p_d]
+            p_n = [sp.Float(str(c), PLANT_DIGITS) for c in p_n]
+            p_d = [sp.Float(str(c), PLANT_DIGITS) for c in p_d]
         else:
             p_n, p_d = self._plant_parts
         z = model.z
@@ -715,15 +716,15 @@ class LoopModel:
         ``exp(p T)`` near 1 gives a small coefficient with its own digits,
         which the root count needs next to ``z = 1``.
         """
-        with mpmath.workdps(_DPS):
+        with mpmath.workdps(PLANT_DIGITS):
             point = [mpmath.mpf(float(v)) for v in plant_values]
             if self._plant_parts is None:
-                sub = {self._symbols[n]: sp.Float(float(v), _DPS)
+                sub = {self._symbols[n]: sp.Float(float(v), PLANT_DIGITS)
                        for n, v in zip(self._plant_names, plant_values)}
                 num, den = sp.fraction(sp.together(self.plant.subs(sub)))
-                num = [mpmath.mpf(sp.Float(c, _DPS)) for c in sp.Poly(num, model.s).all_coeffs()]
-                den = [mpmath.mpf(sp.Float(c, _DPS)) for c in sp.Poly(den, model.s).all_coeffs()]
-                p_n, p_d = numeric_zoh(num, den, mpmath.mpf(float(T)), dps=_DPS)
+                num = [mpmath.mpf(sp.Float(c, PLANT_DIGITS)) for c in sp.Poly(num, model.s).all_coeffs()]
+                den = [mpmath.mpf(sp.Float(c, PLANT_DIGITS)) for c in sp.Poly(den, model.s).all_coeffs()]
+                p_n, p_d = numeric_zoh(num, den, mpmath.mpf(float(T)), dps=PLANT_DIGITS)
             else:
                 try:
                     p_n, p_d = self._plant_functions(*point, mpmath.mpf(float(T)))
@@ -743,7 +744,7 @@ class LoopModel:
             # keeps the 30-digit rounding of its terms (1e-30 of them: K =
             # 6e-25 N/m for the z = 1 line at T = 0.25 ms); an end within
             # 1000 ulps of its terms is that zero.
-            ends = [mpmath.mpf(0) if abs(end) <= mpmath.mpf(10)**(3 - _DPS) * sum(abs(c) for c in part)
+            ends = [mpmath.mpf(0) if abs(end) <= mpmath.mpf(10)**(3 - PLANT_DIGITS) * sum(abs(c) for c in part)
                     else end for end, part in zip(ends, (p_n, p_d, p_n, p_d))]
             monic = [c / lead for c in p_d]
             near_one = list(shift_to_one(monic, dtype=object))
