@@ -26,7 +26,10 @@ the :class:`Nonidealities` of a real device).
 
 Any other loop -- the user's own plant and virtual environment -- is a
 :class:`Loop` (:mod:`~symstab.numeric.any_loop`), derived and classified the same
-way, and can be read from a TOML loop file (:func:`load_loop`).
+way, and can be read from a TOML loop file (:func:`load_loop`).  The paper's
+loop is one of them: ``PAPER_LOOP`` (:mod:`~symstab.numeric.paper_loop`, built
+on first use), on the same root engine (:mod:`~symstab.numeric.roots`) as the
+dimensionless functions above.
 """
 
 from .symbolic.boundary import boundary, coefficients
@@ -62,7 +65,7 @@ __all__ = [
     "BoundaryCurve", "arc_end_angle", "boundary_curve",
     "STABLE", "MARGINAL", "UNSTABLE", "classify", "is_stable", "spectral_radius",
     "StabilityRegion", "Limits", "limits", "BestVirtualMass", "best_virtual_mass",
-    "Loop", "LoopBoundary", "LoopLimits", "load_loop",
+    "Loop", "LoopBoundary", "LoopLimits", "load_loop", "PAPER_LOOP",
     "Decomposition", "Cell", "Branch",
     "PassiveRegion", "passive_region", "paper_passive_region",
     "Locus", "Crossing", "locus", "paper_locus",
@@ -70,3 +73,12 @@ __all__ = [
     "theta_max_approx",
     "Nonidealities", "Simulation", "simulate", "StabilityMap", "stability_map",
 ]
+
+
+def __getattr__(name):
+    # PAPER_LOOP is derived on first use, not on import (about a second).
+    if name == "PAPER_LOOP":
+        from .numeric.paper_loop import paper_loop
+
+        return paper_loop()
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")

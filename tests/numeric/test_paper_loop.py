@@ -1,0 +1,71 @@
+"""PAPER_LOOP: the paper's loop as a Loop, on the same engine as the dimensionless functions.
+
+Oracles: python-control's poles of the sampled loop (c2d of the plant,
+the delay as z**-d, eq. (1) as a transfer function in z).
+"""
+
+import numpy as np
+import pytest
+
+import symstab
+from symstab.numeric.paper_loop import paper_loop
+
+
+def _control_count(K, B, M, d, m=0.0128, b=0.0324, T=1e-3):
+    control = pytest.importorskip("control")
+    plant = control.c2d(control.tf([1.0], [m, b, 0.0]), T, "zoh")
+    z = control.tf([1.0, 0.0], [1.0], T)
+    env = K + B * (z - 1) / (T * z) + M * (z - 1) ** 2 / (T**2 * z**2)
+    delay = control.tf([1.0], [1.0] + [0.0] * d, T)
+    return int(np.sum(np.abs(control.poles(control.feedback(plant * delay * env, 1))) > 1))
+
+
+def test_paper_loop_is_a_loop_of_the_paper_device():
+    loop = symstab.PAPER_LOOP
+    assert isinstance(loop, symstab.Loop)
+    assert loop is paper_loop()
+    assert loop.plane == ("B", "K")
+    device = symstab.PAPER_DEVICE
+    assert (loop.defaults["m"], loop.defaults["b"], loop.defaults["T"]) == (device.m, device.b, device.T)
+    assert loop.units["K"] == device.units(rotary=True)["K_w"]
+    assert "PAPER_LOOP" in symstab.__all__
+
+
+@pytest.mark.parametrize("d, K, B, M", [(0, 300.0, 0.5, 0.0), (5, 40.0, 0.05, 0.002),
+                                        (40, 3.0, 0.01, 0.0), (40, 6.0, 0.01, 0.0),
+                                        (40, 2.0, 0.1, 0.001)])
+def test_counts_match_python_control_and_the_dimensionless_path(d, K, B, M):
+    expected = _control_count(K, B, M, d)
+    loop = symstab.PAPER_LOOP
+    assert loop.unstable_root_counts(K=K, B=B, M=M, d=d) == expected
+    device = symstab.PAPER_DEVICE
+    dimensionless = symstab.numeric.stability.unstable_root_counts(
+        alpha=device.alpha(K), beta=device.beta(B), gamma=device.gamma(M), d=d, delta=device.delta)
+    assert dimensionless == expected
+    assert loop.classify(K=K, B=B, M=M, d=d) == (symstab.STABLE if expected == 0 else symstab.UNSTABLE)
+
+
+def test_spectral_radius_matches_50_digit_roots_of_the_symbolic_polynomial():
+    """python-control's poles are off by 1.4e-8 here (degree 44); the oracle is mpmath at 50 digits
+    on the coefficients of the symbolic characteristic polynomial evaluated at 30 digits."""
+    mpmath = pytest.importorskip("mpmath")
+    from symstab.numeric.stability import coefficients_at
+
+    device = symstab.PAPER_DEVICE
+    for d, K, B in [(40, 3.0, 0.01), (3, 100.0, 0.2)]:
+        c = coefficients_at(alpha=device.alpha(K), beta=device.beta(B), gamma=0.0, d=d,
+                            delta=device.delta)
+        with mpmath.workdps(50):
+            expected = max(abs(r) for r in mpmath.polyroots([mpmath.mpf(x) for x in c],
+                                                            maxsteps=500, extraprec=500))
+        got = symstab.PAPER_LOOP.spectral_radius(K=K, B=B, d=d)
+        assert abs(got - float(expected)) < 1e-12
+
+
+def test_k_max_sits_between_a_stable_and_an_unstable_point():
+    limits = symstab.PAPER_LOOP.limits(d=40)
+    K, B = limits.y_max, limits.x_at_y_max
+    # 1e-3 either side: python-control's poles are accurate to about 1e-8
+    # here, and the radius moves by 1e-5 over that step.
+    assert _control_count(K * (1 - 1e-3), B, 0.0, 40) == 0
+    assert _control_count(K * (1 + 1e-3), B, 0.0, 40) > 0
