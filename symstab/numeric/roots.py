@@ -491,7 +491,9 @@ def classify_polynomials(chi, *, refine=True):
         Re-decide the polynomials the float test does not decide safely (the
         default).  With ``False`` the Schur-Cohn verdict is returned as it
         is (only a margin of exactly 0 is marginal): faster where a wrong
-        verdict next to the boundary does no harm.
+        verdict next to the boundary does no harm.  From degree 52 on, a
+        structured polynomial (short parts) gets the certified count's
+        verdict either way.
 
     Returns
     -------
@@ -508,7 +510,11 @@ def classify_polynomials(chi, *, refine=True):
     if n == 0:
         out[live] = STABLE
         return out.reshape(shape)
-    if refine and n >= _COUNT_ALL_FROM_DEGREE:
+    short = max(rows.delayed.shape[1], rows.direct.shape[1]) <= _HORNER_TERMS
+    if n >= _COUNT_ALL_FROM_DEGREE and (refine or short):
+        # The count of a structured polynomial is O(n) where Schur-Cohn is
+        # O(n**2): from this degree on it is the faster test as well as the
+        # certified one (dense rows without refinement keep Schur-Cohn).
         close = live
     else:
         close = []
@@ -524,7 +530,7 @@ def classify_polynomials(chi, *, refine=True):
             else:
                 close.append(index[margin < _SCHUR_COHN_SAFE])
         close = np.concatenate(close) if close else np.empty(0, dtype=np.int64)
-    if refine and len(close):
+    if len(close):
         counts = root_counts(rows.take(close))
         out[close] = np.where(counts < 0, MARGINAL, np.where(counts == 0, STABLE, UNSTABLE))
     return out.reshape(shape)

@@ -1,0 +1,84 @@
+"""The one root engine: structured against dense, the paper's loop through Loop against the paper's path.
+
+    python benchmarks/bench_engine.py [--runs 3] [--points 500]
+
+Every row is one run on the same machine state, medians of ``--runs``:
+
+1. Certified root counts (:func:`symstab.numeric.roots.root_counts`) of the
+   paper's loop at d = 10, 100, 1000 for ``--points`` random (K, B) points:
+   ``symstab.PAPER_LOOP.unstable_root_counts`` (the Loop path: plant at 30
+   digits, environment kernel, structured chi) against the dimensionless
+   path (``symstab.numeric.stability.unstable_root_counts``: generated
+   kernel, structured chi), and against the obvious alternative, the same
+   counter on the dense coefficients (O(d) per angle: O(d**2) per point,
+   what Loop did before the structured polynomial).
+2. ``classify`` the same way (Loop against the dimensionless path).
+3. ``spectral_radius`` at d = 2000 of one point: the structured radius
+   (counts on circles, Newton on chi) against companion eigenvalues of the
+   dense polynomial (``numpy.linalg.eigvals``, O(d**3)).
+
+Targets (issue 19): the Loop path within 1.3x of the paper's; the radius at
+d = 2000 under 1 s.  BLAS threads on a busy 2-core machine distort short
+products badly: run with ``OPENBLAS_NUM_THREADS=1`` for stable numbers.
+"""
+
+import argparse
+import statistics
+
+import numpy as np
+
+import symstab
+from symstab.numeric import roots, stability
+from symstab.numeric.polynomial import DelayedPolynomial
+
+from _timing import fmt, timed_runs
+
+
+def _median(fn, runs):
+    return statistics.median(timed_runs(fn, runs))
+
+
+def main(argv=None):
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--runs", type=int, default=3)
+    parser.add_argument("--points", type=int, default=500)
+    args = parser.parse_args(argv)
+    loop, device = symstab.PAPER_LOOP, symstab.PAPER_DEVICE
+    rng = np.random.default_rng(0)
+    K, B = rng.uniform(0.0, 6.0, args.points), rng.uniform(0.0, 0.5, args.points)
+    alpha, beta = device.alpha(K), device.beta(B)
+    print(f"{'what':<34} {'d':>5} {'Loop':>9} {'paper':>9} {'ratio':>6} {'dense':>9} {'dense/structured':>17}")
+    for d in (10, 100, 1000):
+        paper = dict(alpha=alpha, beta=beta, gamma=0.0, d=d, delta=device.delta)
+        t_loop = _median(lambda: loop.unstable_root_counts(K=K, B=B, d=d), args.runs)
+        t_paper = _median(lambda: stability.unstable_root_counts(**paper), args.runs)
+        dense = DelayedPolynomial.from_dense(stability.loop_coefficients(**paper))
+        runs = args.runs if d < 1000 else 1
+        t_dense = _median(lambda: roots.root_counts(dense), runs)
+        agree = np.array_equal(loop.unstable_root_counts(K=K, B=B, d=d), stability.unstable_root_counts(**paper))
+        print(f"{'certified counts (' + str(args.points) + ' pts)':<34} {d:>5} {fmt(t_loop):>9} "
+              f"{fmt(t_paper):>9} {t_loop / t_paper:>6.2f} {fmt(t_dense):>9} {t_dense / t_paper:>17.1f}"
+              f"{'' if agree else '  COUNTS DIFFER'}")
+        t_loop = _median(lambda: loop.classify(K=K, B=B, d=d), args.runs)
+        t_paper = _median(lambda: stability.classify(**paper), args.runs)
+        print(f"{'classify':<34} {d:>5} {fmt(t_loop):>9} {fmt(t_paper):>9} {t_loop / t_paper:>6.2f}")
+    d = 2000
+    chi = stability.paper_polynomial(alpha=device.alpha(3.0), beta=device.beta(0.01), gamma=0.0, d=d,
+                                     delta=device.delta)
+    t_structured = _median(lambda: roots.spectral_radius(chi), args.runs)
+    dense = chi.dense()
+
+    def eigenvalues():
+        companion = np.zeros((d + 4, d + 4))
+        companion[0, :] = -dense[1:] / dense[0]
+        companion[np.arange(1, d + 4), np.arange(d + 3)] = 1.0
+        return float(np.max(np.abs(np.linalg.eigvals(companion))))
+
+    t_eig = _median(eigenvalues, 1)
+    r_structured, r_eig = float(roots.spectral_radius(chi)), eigenvalues()
+    print(f"spectral radius d = {d}: structured {fmt(t_structured)}, eigenvalues {fmt(t_eig)} "
+          f"(ratio {t_eig / t_structured:.0f}); radii {r_structured:.15f} and {r_eig:.15f}")
+
+
+if __name__ == "__main__":
+    main()
