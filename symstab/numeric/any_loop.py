@@ -307,8 +307,14 @@ class Loop(LoopModel):
         if plant is None:
             plant = self._plant_arrays(values, shape)
         p_n, p_d, _, p_d_one = plant
+        # A power of z that divides Ve_d (the backward differences' 1/z**k)
+        # joins the delay: chi = z**(d + k) (Ve_d / z**k) P_d + Ve_n P_n keeps
+        # the delayed part short (the paper's z**(d+2) (z - 1)(z - r)).
+        k = self._delay_of_environment
+        d = d + k
         if slope is None or slope in self._environment_names:
             ve_n, ve_d = self._environment_arrays(values, shape, slope)
+            ve_d = ve_d[..., :ve_d.shape[-1] - k]
             ve_one, ve_error = _shift_to_one(ve_d)
             near_one = (self._convolve(ve_one, p_d_one),
                         self._convolve(ve_error, np.abs(p_d_one))
@@ -319,8 +325,18 @@ class Loop(LoopModel):
         # A plant parameter: the slope of P_n, P_d (30 digits) by the exact
         # derivative of their symbolic coefficients.
         ve_n, ve_d = self._environment_arrays(values, shape)
+        ve_d = ve_d[..., :ve_d.shape[-1] - k]
         dp_n, dp_d = self._plant_slope(values, shape, slope)
         return DelayedPolynomial(self._convolve(ve_d, dp_d), self._convolve(ve_n, dp_n), d)
+
+    @functools.cached_property
+    def _delay_of_environment(self):
+        """How many trailing coefficients of the symbolic ``Ve_d`` are 0 (``z**k`` divides it)."""
+        ve_d = self._environment_parts[1]
+        k = 0
+        while k < len(ve_d) - 1 and sp.simplify(ve_d[len(ve_d) - 1 - k]) == 0:
+            k += 1
+        return k
 
     def _coefficients(self, values, d, shape, *, slope=None, plant=None):
         return self._polynomial(values, d, shape, slope=slope, plant=plant).dense()
