@@ -501,17 +501,29 @@ class Loop(LoopModel):
         counts = root_counts(self.polynomial(**values))
         return int(counts) if counts.ndim == 0 else counts
 
-    def _basis(self, names, given):
-        """(A0, A_x[, A_y]) coefficient rows with the named parameters set to 0."""
+    def _basis(self, names, given, *, structured=False):
+        """(A0, A_x[, A_y]) coefficient rows with the named parameters set to 0.
+
+        With ``structured``, A0 and the slopes are
+        :class:`~symstab.numeric.polynomial.DelayedPolynomial` (one
+        polynomial each, a common shift) instead of dense rows.
+        """
         self._check_plane(names)
         values, d, shape = self._prepare(given, scalar=self.parameters, drop=names)
         for name in names:
             values[name] = np.asarray(0.0)
         plant = self._plant_arrays(values, shape)
+
+        def part(slope=None):
+            chi = self._polynomial(values, d, shape, slope=slope, plant=plant)
+            if structured:
+                self._finite(np.concatenate([chi.delayed, chi.direct], axis=-1), values)
+                return chi
+            return self._finite(chi.dense(), values)
+
         with np.errstate(all="ignore"):     # an overflow is the ValueError of _finite
-            base = self._finite(self._coefficients(values, d, shape, plant=plant), values)
-            slopes = [self._finite(self._coefficients(values, d, shape, slope=n, plant=plant),
-                                   values) for n in names]
+            base = part()
+            slopes = [part(n) for n in names]
         ends = [self._end_values(values, d, shape, plant=plant)] + [
             self._end_values(values, d, shape, slope=n, plant=plant) for n in names]
         return base, slopes, ends
