@@ -44,6 +44,7 @@ from .._resources import check_memory
 from .._validate import check_array, check_count, check_delay, check_window
 from ..symbolic.loop_assembly import PLANT_DIGITS, LoopModel, parse_environment, parse_plant, shift_to_one
 from ..codegen.loop_kernels import environment_kernels, load_numpy_kernels
+from .arcs import CramerArc
 from .decomposition import Decomposition, arc_points, decompose, stable_hull
 from .passivity import passive_region
 from .decomposition import lines as _lines
@@ -588,9 +589,10 @@ class Loop(LoopModel):
         x, y = self._plane(x, y)
         n = check_count("n", n, 2)
         check_memory("the boundary", 64 * n)
-        base, (ax, ay), ends = self._basis((x, y), values)
+        structured, slopes, ends = self._basis((x, y), values, structured=True)
+        base, ax, ay = (p.dense().reshape(-1) for p in (structured, *slopes))
         theta = np.pi * (np.arange(1, n + 1) - 0.5) / n
-        xs, ys, _ = arc_points(base, ax, ay, theta)
+        xs, ys, _ = CramerArc(structured, *slopes)(theta)
         lines = {label: c for label, c in _lines(base, ax, ay, ends).items() if c[1] or c[2]}
         return LoopBoundary(x=x, y=y, theta=theta, x_values=xs, y_values=ys, lines=lines)
 
@@ -640,12 +642,15 @@ class Loop(LoopModel):
         x, y = self._plane(x, y)
         given = {key: None if window is None else check_window(key, window)
                  for key, window in (("x_range", x_range), ("y_range", y_range))}
-        base, (ax, ay), ends = self._basis((x, y), values)
+        structured, slopes, ends = self._basis((x, y), values, structured=True)
+        base, ax, ay = (p.dense().reshape(-1) for p in (structured, *slopes))
+        arc = CramerArc(structured, *slopes)
         free = {"x_min": given["x_range"] is None, "x_max": given["x_range"] is None,
                 "y_min": given["y_range"] is None, "y_max": given["y_range"] is None}
 
         def run(box):
-            return decompose(base, ax, ay, ends, x_range=box[:2], y_range=box[2:], names=(x, y))
+            return decompose(base, ax, ay, ends, x_range=box[:2], y_range=box[2:], names=(x, y),
+                             arc=arc)
 
         # Where a stable point can be at all (exact): an empty enclosure is the
         # answer, a bounded one caps every window a free side may take.

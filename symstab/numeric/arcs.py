@@ -29,10 +29,6 @@ Two arc sources share one interface, ``source(theta) -> (x, y, det)``:
   closed form (the generated kernel :func:`symstab._generated.kernels.boundary`,
   ``x = beta``, ``y = alpha``), with the determinant's sign from the
   structured solve.
-
-:func:`crossing_change` is the one crossing-direction rule: how the number of
-roots outside the circle changes when a parameter moves through a point
-where a root is on the circle.
 """
 
 import fractions
@@ -44,9 +40,10 @@ import numpy as np
 from .._generated import kernels
 from .._validate import check_loop
 from .polynomial import DelayedPolynomial
+from .stability import paper_polynomial
 
-__all__ = ["ArcSource", "CramerArc", "ClosedFormArc", "sine_ratio", "SINGULAR", "END_ANGLE",
-           "EXACT_TERMS"]
+__all__ = ["ArcSource", "CramerArc", "ClosedFormArc", "sine_ratio",
+           "SINGULAR", "END_ANGLE", "EXACT_TERMS"]
 
 #: The determinant is called singular (the arc is at infinity, x and y NaN)
 #: where it is at most this fraction of the rounding scale of its sine
@@ -470,8 +467,6 @@ class ClosedFormArc(ArcSource):
     """
 
     def __init__(self, *, gamma, d, delta):
-        from .stability import paper_polynomial
-
         self.gamma, self.d, self.delta = check_loop(gamma, d, delta)
         at = {(a, b): paper_polynomial(alpha=a, beta=b, gamma=self.gamma, d=self.d, delta=self.delta)
               for a, b in ((0.0, 0.0), (0.0, 1.0), (1.0, 0.0))}
@@ -489,3 +484,4 @@ class ClosedFormArc(ArcSource):
         alpha = np.broadcast_to(np.asarray(alpha, dtype=float), theta.shape).copy()
         beta = np.broadcast_to(np.asarray(beta, dtype=float), theta.shape).copy()
         return beta, alpha, det
+

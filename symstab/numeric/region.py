@@ -42,6 +42,7 @@ from .._resources import CHUNK_BYTES, check_memory, chunk_slices
 from .._validate import check_array, check_count, check_loop, check_real, check_window
 from .curves import (KERNEL_BYTES_PER_POINT, KERNEL_CHUNK_BYTES, BoundaryCurve, Segment,
                      golden_max, arc_end_angle, bracketed_root, minus_one_line, scan_grid)
+from .arcs import ClosedFormArc
 from .decomposition import decompose
 from .stability import MARGINAL, STABLE, UNSTABLE, classify, loop_coefficients
 
@@ -226,8 +227,10 @@ class StabilityRegion:
             values = np.array([np.sum(c), np.sum(c * signs)])
             values[np.abs(values) <= 64 * np.finfo(float).eps * np.sum(np.abs(c))] = 0.0
             ends.append(values)
+        # The paper's arc source is its closed form (the generated kernel).
+        arc = ClosedFormArc(gamma=self.gamma, d=self.d, delta=self.delta)
         return decompose(base, ax, ay, ends, x_range=x_range, y_range=y_range,
-                         names=("beta", "alpha"))
+                         names=("beta", "alpha"), arc=arc)
 
     def _extrema(self, theta):
         """The angles of the local extrema of alpha(theta) and beta(theta).

@@ -142,3 +142,11 @@ def test_bad_input():
         CramerArc(DelayedPolynomial([1.0], [1.0], 3), DelayedPolynomial([1.0], [0.0], 2),
                   DelayedPolynomial([0.0], [1.0], 3))
 
+
+@pytest.mark.parametrize("make", BASES)
+def test_arc_points_of_dense_rows_match_the_50_digit_solve(make):
+    # decomposition.arc_points (the plane's public arc) takes its arc from arcs.py.
+    polynomials = make()
+    reference = oracle(polynomials, THETA)
+    xs, ys, _ = decomposition.arc_points(*(p.dense().reshape(-1) for p in polynomials), THETA)
+    assert relative_error(xs, ys, reference) <= TOLERANCE
