@@ -44,7 +44,7 @@ from .._resources import check_memory
 from .._validate import check_array, check_count, check_delay, check_window
 from ..symbolic.loop_assembly import PLANT_DIGITS, LoopModel, parse_environment, parse_plant, shift_to_one
 from ..codegen.loop_kernels import environment_kernels, load_numpy_kernels
-from .arcs import CramerArc
+from .arcs import CramerArc, crossing_change
 from .decomposition import Decomposition, arc_points, decompose, stable_hull
 from .passivity import passive_region
 from .decomposition import lines as _lines
@@ -978,19 +978,14 @@ def _circle_candidates(a0, a1, a0_ends, a1_ends):
 def _crossing_changes(a0, a1, p, theta):
     """Change of the number of roots outside the circle as ``p`` increases through each crossing.
 
-    At a crossing the root ``z = exp(j theta)`` of ``a0 + p a1`` moves with
-    ``dz/dp = -a1(z) / chi'(z)``; outward (``Re(conj(z) dz/dp) > 0``) adds
-    two roots outside (a complex pair) or one (``z = +-1``).  NaN where the
-    crossing is tangential or the root is multiple: undecided.
+    The crossing rule of :func:`symstab.numeric.arcs.crossing_change` for
+    the polynomials ``a0 + p a1`` (dense rows): +-2 for a pair, +-1 at
+    ``z = +-1``, NaN where the crossing is tangential or the root is
+    multiple: undecided.
     """
-    z = np.exp(1j * theta)
-    chi_slope = _on_circle(np.polyder(a0), theta) + p * _on_circle(np.polyder(a1), theta)
-    with np.errstate(all="ignore"):
-        velocity = -_on_circle(a1, theta) / chi_slope
-        radial = (np.conj(z) * velocity).real
-    size = np.where((theta == 0) | (theta == np.pi), 1.0, 2.0)
-    clear = np.isfinite(radial) & (np.abs(radial) > 1e-8 * np.abs(velocity))
-    return np.where(clear, size * np.sign(radial), np.nan)
+    p = np.asarray(p, dtype=float)
+    chi = DelayedPolynomial.from_dense(a0[None, :] + p[:, None] * a1[None, :])
+    return crossing_change(chi, DelayedPolynomial.from_dense(a1), theta)
 
 
 class _Unresolved(ArithmeticError):

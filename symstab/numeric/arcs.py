@@ -29,6 +29,10 @@ Two arc sources share one interface, ``source(theta) -> (x, y, det)``:
   closed form (the generated kernel :func:`symstab._generated.kernels.boundary`,
   ``x = beta``, ``y = alpha``), with the determinant's sign from the
   structured solve.
+
+:func:`crossing_change` is the one crossing-direction rule: how the number of
+roots outside the circle changes when a parameter moves through a point
+where a root is on the circle.
 """
 
 import fractions
@@ -42,7 +46,7 @@ from .._validate import check_loop
 from .polynomial import DelayedPolynomial
 from .stability import paper_polynomial
 
-__all__ = ["ArcSource", "CramerArc", "ClosedFormArc", "sine_ratio",
+__all__ = ["ArcSource", "CramerArc", "ClosedFormArc", "sine_ratio", "crossing_change",
            "SINGULAR", "END_ANGLE", "EXACT_TERMS"]
 
 #: The determinant is called singular (the arc is at infinity, x and y NaN)
@@ -485,3 +489,80 @@ class ClosedFormArc(ArcSource):
         beta = np.broadcast_to(np.asarray(beta, dtype=float), theta.shape).copy()
         return beta, alpha, det
 
+
+def _part_slope(c, z):
+    """``P(z)`` and ``z P'(z)`` for rows ``c`` (highest first) at points ``z`` (one per row)."""
+    value = np.zeros(z.shape, dtype=complex)
+    slope = np.zeros(z.shape, dtype=complex)
+    for k in range(c.shape[-1]):
+        slope = slope * z + value
+        value = value * z + c[..., k]
+    return value, slope * z
+
+
+def _sizes(c, shift):
+    """``sum_k |c_k| (shift + k)`` and ``sum_k |c_k|`` of rows ``c`` (highest first)."""
+    powers = shift + np.arange(c.shape[-1] - 1, -1, -1, dtype=float)
+    return np.sum(np.abs(c) * powers, axis=-1), np.sum(np.abs(c), axis=-1)
+
+
+def crossing_change(chi, slope, theta):
+    """How the number of roots outside the unit circle changes through crossings.
+
+    The one crossing-direction rule.  At a crossing the polynomial ``chi``
+    (of a family ``chi(s)``) has the root ``z = exp(j theta)``; as the
+    parameter ``s`` increases the root moves with ``dz/ds = -chi_s(z) /
+    chi'(z)`` and leaves the circle where ``Re(conj(z) dz/ds) > 0``, that
+    is where ``-Re(chi_s(z) conj(z chi'(z))) > 0``: a complex pair (``0 <
+    theta < pi``) adds 2 roots outside, a real root (``theta = 0, pi``) 1.
+    The powers of ``z`` come from the angle (``z**shift = exp(j shift
+    theta)``), not from a rounded ``z``.
+
+    Parameters
+    ----------
+    chi : DelayedPolynomial
+        One polynomial per crossing (shape ``(N,)``), at the crossing's
+        parameter value.
+    slope : DelayedPolynomial
+        ``d chi / ds``, the same shift and part lengths; its rows broadcast
+        against ``chi``'s.
+    theta : array_like, shape (N,)
+        The crossings' angles in [0, pi].
+
+    Returns
+    -------
+    ndarray
+        ``+-2`` (a pair), ``+-1`` (``z = +-1``), NaN where the radial
+        velocity is within its rounding (``2e-15 (1 + degree theta)`` times
+        the sizes of ``z chi'`` and ``chi_s``: the phases ``k theta`` carry
+        an absolute error of ``k theta`` ulps): a tangency, a corner or a
+        multiple root, undecided.
+    """
+    theta = np.asarray(theta, dtype=float).ravel()
+    rows = chi.flat()
+    moving = DelayedPolynomial(slope.delayed, slope.direct, slope.shift)
+    shape = (len(theta),)
+    if moving.shape != shape:
+        moving = DelayedPolynomial(np.broadcast_to(moving.delayed, shape + moving.delayed.shape[-1:]),
+                                   np.broadcast_to(moving.direct, shape + moving.direct.shape[-1:]),
+                                   moving.shift)
+    if rows.shape != shape or moving.shift != rows.shift:
+        raise ValueError(f"chi must have one polynomial per angle ({len(theta)}) and slope "
+                         f"chi's shift, got {rows.shape} and shift {moving.shift} vs {rows.shift}")
+    s = rows.shift
+    z = np.exp(1j * theta)
+    power = np.exp(1j * s * theta)
+    d_value, d_slope = _part_slope(rows.delayed, z)
+    n_value, n_slope = _part_slope(rows.direct, z)
+    z_chi_slope = power * (s * d_value + d_slope) + n_slope
+    m_d, _ = _part_slope(moving.delayed, z)
+    m_n, _ = _part_slope(moving.direct, z)
+    partial = power * m_d + m_n
+    radial = -np.real(partial * np.conj(z_chi_slope))
+    chi_size = _sizes(rows.delayed, s)[0] + _sizes(rows.direct, 0)[0]
+    moving_size = _sizes(moving.delayed, s)[1] + _sizes(moving.direct, 0)[1]
+    noise = 2e-15 * (1.0 + rows.degree * theta) * chi_size * moving_size
+    multiplicity = np.where((theta > 0) & (theta < np.pi), 2.0, 1.0)
+    with np.errstate(invalid="ignore"):
+        clear = np.isfinite(radial) & (np.abs(radial) > noise)
+    return np.where(clear, multiplicity * np.sign(radial), np.nan)
