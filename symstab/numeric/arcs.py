@@ -366,11 +366,23 @@ class CramerArc(ArcSource):
         a0, cx, cy = range(3)
         # x = [A0, Ay] / [Ay, Ax], y = [Ax, A0] / [Ay, Ax].
         pairs = ((a0, cy), (cx, a0), (cy, cx))
-        self._series = tuple(_bracket(terms[i], terms[j]) for i, j in pairs)
+        series = [_bracket(terms[i], terms[j]) for i, j in pairs]
+        # One table of sin(m theta) / sin(theta) for the frequencies of all three.
+        self._frequencies = np.unique(np.concatenate([m for m, _ in series]))
+        self._coefficients = np.zeros((3, len(self._frequencies)))
+        for row, (m, e) in zip(self._coefficients, series):
+            row[np.searchsorted(self._frequencies, m)] = e
         longest = max(max(len(p[0]), len(p[1])) for p in parts)
         self._ends = None
         if longest <= EXACT_TERMS:
-            self._ends = tuple(self._end_forms(parts[i], parts[j]) for i, j in pairs)
+            # (bracket, form, power of u) at theta = 0 and at pi, lowest power first.
+            forms = [self._end_forms(parts[i], parts[j]) for i, j in pairs]
+            size = max(len(f) for bracket in forms for end in bracket for f in end)
+            self._ends = np.zeros((2, 3, 3, size))
+            for b, bracket in enumerate(forms):
+                for end, three in enumerate(bracket):
+                    for f, c in enumerate(three):
+                        self._ends[end, b, f, :len(c)] = c
 
     def _end_forms(self, p, q):
         """The three polynomials in ``u`` of a bracket, at theta = 0 and at pi."""
@@ -389,50 +401,51 @@ class CramerArc(ArcSource):
         return tuple(out)
 
     def _middle(self, theta):
-        """Each bracket over sin(theta) by its sine series, with its rounding scale."""
-        out = []
-        for m, e in self._series:
-            if m.size == 0:
-                out.append((np.zeros(theta.shape), np.zeros(theta.shape)))
-                continue
-            ratio = sine_ratio(m[None, :], theta[:, None])
-            terms = ratio * e[None, :]
-            out.append((np.sum(terms, axis=1), np.sum(np.abs(terms), axis=1)))
-        return out
+        """The brackets over sin(theta) by their sine series (M, 3), and the determinant's rounding scale (M,)."""
+        if self._frequencies.size == 0:
+            return np.zeros((len(theta), 3)), np.zeros(len(theta))
+        ratio = sine_ratio(self._frequencies[None, :], theta[:, None])
+        # Sums over the frequencies as elementwise products (see _at_end).
+        value = np.stack([np.sum(ratio * e, axis=1) for e in self._coefficients], axis=1)
+        return value, np.sum(np.abs(ratio) * np.abs(self._coefficients[2]), axis=1)
 
     def _at_end(self, theta, mirror):
-        """Each bracket over sin(theta) by its polynomials in u, with its rounding scale."""
+        """The brackets over sin(theta) by their polynomials in u (M, 3), and the determinant's rounding scale (M,)."""
         half = 0.5 * np.where(mirror, (np.pi - theta) + _PI_LOW, theta)
         u = np.sin(half) ** 2
-        ratio, cosine = _multiple(self.shift, theta) if self.shift else (0.0 * u, 0.0 * u)
-        out = []
-        for forms in self._ends:
-            g, cr, ci = forms[1 if mirror else 0]
-            value, scale = 0.0, 0.0
-            for coefficients, factor in ((g, 1.0), (cr, ratio), (ci, cosine)):
-                if coefficients.size == 0:
-                    continue
-                v = np.polynomial.polynomial.polyval(u, coefficients)
-                a = np.polynomial.polynomial.polyval(u, np.abs(coefficients))
-                value = value + factor * v
-                scale = scale + np.abs(factor) * a
-            out.append((value + 0.0 * u, scale + 0.0 * u))
-        return out
+        # Horner's scheme on (M, 9) arrays: a matrix product this skinny
+        # costs more in BLAS's threads than it computes.
+        forms = self._ends[1 if mirror else 0].reshape(9, -1)
+        # The rounding scale is wanted of the determinant (the last bracket) only.
+        size = np.abs(forms[6:])
+        value = np.zeros((len(u), 9))
+        scale = np.zeros((len(u), 3))
+        column = u[:, None]
+        for k in range(forms.shape[-1] - 1, -1, -1):
+            value = value * column + forms[:, k]
+            scale = scale * column + size[:, k]
+        if self.shift:
+            ratio, cosine = _multiple(self.shift, theta)
+        else:
+            ratio = cosine = np.zeros(theta.shape)
+        factor = np.stack([np.ones(theta.shape), ratio, cosine], axis=-1)
+        value = np.sum(value.reshape(-1, 3, 3) * factor[:, None, :], axis=-1)
+        return value, np.sum(scale * np.abs(factor), axis=-1)
 
     def _sums(self, theta):
+        """The three brackets over sin(theta) (M, 3) and the determinant's rounding scale (M,)."""
         if self._ends is None:
             return self._middle(theta)
-        out = [(np.empty(theta.shape), np.empty(theta.shape)) for _ in range(3)]
+        value, scale = np.empty((len(theta), 3)), np.empty(len(theta))
         low = theta < END_ANGLE
         high = theta > np.pi - END_ANGLE
         middle = ~low & ~high
-        for where, parts in ((low, lambda t: self._at_end(t, False)),
-                             (high, lambda t: self._at_end(t, True)),
-                             (middle, self._middle)):
+        for where, evaluate in ((low, lambda t: self._at_end(t, False)),
+                                (high, lambda t: self._at_end(t, True)),
+                                (middle, self._middle)):
             if where.any():
-                for (value, scale), (v, a) in zip(out, parts(theta[where])):
-                    value[where], scale[where] = v, a
-        return out
+                value[where], scale[where] = evaluate(theta[where])
+        return value, scale
 
     def __call__(self, theta):
         """``(x, y, det)`` at angles ``theta`` in (0, pi), each of ``theta``'s shape.
@@ -443,11 +456,12 @@ class CramerArc(ArcSource):
         theta = np.asarray(theta, dtype=float)
         shape = theta.shape
         theta = theta.ravel()
-        chunk = max(1, 2**20 // max(1, max(len(m) for m, _ in self._series)))
+        chunk = max(1, 2**20 // max(1, len(self._frequencies)))
         xs, ys, det = (np.empty(theta.shape) for _ in range(3))
         for start in range(0, len(theta), chunk):
             part = slice(start, start + chunk)
-            (nx, _), (ny, _), (dv, scale) = self._sums(theta[part])
+            value, scale = self._sums(theta[part])
+            nx, ny, dv = value[:, 0], value[:, 1], value[:, 2]
             with np.errstate(all="ignore"):
                 singular = ~(np.abs(dv) > SINGULAR * scale)
                 xs[part] = np.where(singular, np.nan, nx / dv)

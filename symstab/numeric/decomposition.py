@@ -392,11 +392,12 @@ def _arc_ends(base, ax, ay, ends):
 
 
 def _sample_arc(arc, n, to_unit, theta=None, fine=1.0):
-    """Angles and points of the arc ``arc`` (an arc source), refined until every chord inside the window is short.
+    """Angles and points of the arc, refined until every chord inside the window is short.
 
-    ``n`` is the polynomial's degree.  Returns the angles, the points and
-    the determinant's sign; the caller splits the arc where the sign
-    changes (through infinity).
+    ``arc`` is the arc source, ``n`` the polynomial's degree.  Each round
+    evaluates the new angles only.  Returns the angles, the points and the
+    determinant's sign; the caller splits the arc where the sign changes
+    (through infinity).
     """
     if theta is None:
         m = max(1024, 32 * (n + 4))
@@ -407,8 +408,8 @@ def _sample_arc(arc, n, to_unit, theta=None, fine=1.0):
         # small stable cell at its corner).
         near = theta[0] * np.geomspace(1e-6, 1.0, 20, endpoint=False)
         theta = np.concatenate([near, theta, np.pi - near[::-1]])
+    xs, ys, det = arc(theta)
     for _ in range(_ROUNDS):
-        xs, ys, det = arc(theta)
         u, v = to_unit(xs, ys)
         finite = np.isfinite(u) & np.isfinite(v)
         du, dv = np.diff(u), np.diff(v)
@@ -435,8 +436,9 @@ def _sample_arc(arc, n, to_unit, theta=None, fine=1.0):
         if len(theta) + int(split.sum()) > _MAX_ARC_POINTS:
             break
         mids = 0.5 * (theta[1:] + theta[:-1])[split]
-        theta = np.sort(np.concatenate([theta, mids]))
-    xs, ys, det = arc(theta)
+        order = np.argsort(np.concatenate([theta, mids]), kind="stable")
+        theta, xs, ys, det = (np.concatenate([a, b])[order]
+                              for a, b in zip((theta, xs, ys, det), (mids, *arc(mids))))
     return theta, xs, ys, np.sign(det)
 
 
