@@ -44,6 +44,7 @@ from .._resources import check_memory
 from .._validate import check_array, check_count, check_delay, check_window
 from ..symbolic.loop_assembly import PLANT_DIGITS, LoopModel, parse_environment, parse_plant, shift_to_one
 from ..codegen.loop_kernels import environment_kernels, load_numpy_kernels
+from .arcs import CramerArc, crossing_change
 from .decomposition import Decomposition, arc_points, decompose, stable_hull
 from .passivity import passive_region
 from .decomposition import lines as _lines
@@ -517,17 +518,29 @@ class Loop(LoopModel):
         counts = root_counts(self.polynomial(**values))
         return int(counts) if counts.ndim == 0 else counts
 
-    def _basis(self, names, given):
-        """(A0, A_x[, A_y]) coefficient rows with the named parameters set to 0."""
+    def _basis(self, names, given, *, structured=False):
+        """(A0, A_x[, A_y]) coefficient rows with the named parameters set to 0.
+
+        With ``structured``, A0 and the slopes are
+        :class:`~symstab.numeric.polynomial.DelayedPolynomial` (one
+        polynomial each, a common shift) instead of dense rows.
+        """
         self._check_plane(names)
         values, d, shape = self._prepare(given, scalar=self.parameters, drop=names)
         for name in names:
             values[name] = np.asarray(0.0)
         plant = self._plant_arrays(values, shape)
+
+        def part(slope=None):
+            chi = self._polynomial(values, d, shape, slope=slope, plant=plant)
+            if structured:
+                self._finite(np.concatenate([chi.delayed, chi.direct], axis=-1), values)
+                return chi
+            return self._finite(chi.dense(), values)
+
         with np.errstate(all="ignore"):     # an overflow is the ValueError of _finite
-            base = self._finite(self._coefficients(values, d, shape, plant=plant), values)
-            slopes = [self._finite(self._coefficients(values, d, shape, slope=n, plant=plant),
-                                   values) for n in names]
+            base = part()
+            slopes = [part(n) for n in names]
         ends = [self._end_values(values, d, shape, plant=plant)] + [
             self._end_values(values, d, shape, slope=n, plant=plant) for n in names]
         return base, slopes, ends
@@ -592,9 +605,10 @@ class Loop(LoopModel):
         x, y = self._plane(x, y)
         n = check_count("n", n, 2)
         check_memory("the boundary", 64 * n)
-        base, (ax, ay), ends = self._basis((x, y), values)
+        structured, slopes, ends = self._basis((x, y), values, structured=True)
+        base, ax, ay = (p.dense().reshape(-1) for p in (structured, *slopes))
         theta = np.pi * (np.arange(1, n + 1) - 0.5) / n
-        xs, ys, _ = arc_points(base, ax, ay, theta)
+        xs, ys, _ = CramerArc(structured, *slopes)(theta)
         lines = {label: c for label, c in _lines(base, ax, ay, ends).items() if c[1] or c[2]}
         return LoopBoundary(x=x, y=y, theta=theta, x_values=xs, y_values=ys, lines=lines)
 
@@ -644,12 +658,15 @@ class Loop(LoopModel):
         x, y = self._plane(x, y)
         given = {key: None if window is None else check_window(key, window)
                  for key, window in (("x_range", x_range), ("y_range", y_range))}
-        base, (ax, ay), ends = self._basis((x, y), values)
+        structured, slopes, ends = self._basis((x, y), values, structured=True)
+        base, ax, ay = (p.dense().reshape(-1) for p in (structured, *slopes))
+        arc = CramerArc(structured, *slopes)
         free = {"x_min": given["x_range"] is None, "x_max": given["x_range"] is None,
                 "y_min": given["y_range"] is None, "y_max": given["y_range"] is None}
 
         def run(box):
-            return decompose(base, ax, ay, ends, x_range=box[:2], y_range=box[2:], names=(x, y))
+            return decompose(base, ax, ay, ends, x_range=box[:2], y_range=box[2:], names=(x, y),
+                             arc=arc)
 
         # Where a stable point can be at all (exact): an empty enclosure is the
         # answer, a bounded one caps every window a free side may take.
@@ -977,19 +994,14 @@ def _circle_candidates(a0, a1, a0_ends, a1_ends):
 def _crossing_changes(a0, a1, p, theta):
     """Change of the number of roots outside the circle as ``p`` increases through each crossing.
 
-    At a crossing the root ``z = exp(j theta)`` of ``a0 + p a1`` moves with
-    ``dz/dp = -a1(z) / chi'(z)``; outward (``Re(conj(z) dz/dp) > 0``) adds
-    two roots outside (a complex pair) or one (``z = +-1``).  NaN where the
-    crossing is tangential or the root is multiple: undecided.
+    The crossing rule of :func:`symstab.numeric.arcs.crossing_change` for
+    the polynomials ``a0 + p a1`` (dense rows): +-2 for a pair, +-1 at
+    ``z = +-1``, NaN where the crossing is tangential or the root is
+    multiple: undecided.
     """
-    z = np.exp(1j * theta)
-    chi_slope = _on_circle(np.polyder(a0), theta) + p * _on_circle(np.polyder(a1), theta)
-    with np.errstate(all="ignore"):
-        velocity = -_on_circle(a1, theta) / chi_slope
-        radial = (np.conj(z) * velocity).real
-    size = np.where((theta == 0) | (theta == np.pi), 1.0, 2.0)
-    clear = np.isfinite(radial) & (np.abs(radial) > 1e-8 * np.abs(velocity))
-    return np.where(clear, size * np.sign(radial), np.nan)
+    p = np.asarray(p, dtype=float)
+    chi = DelayedPolynomial.from_dense(a0[None, :] + p[:, None] * a1[None, :])
+    return crossing_change(chi, DelayedPolynomial.from_dense(a1), theta)
 
 
 class _Unresolved(ArithmeticError):

@@ -42,6 +42,7 @@ import math
 import numpy as np
 
 from .._resources import check_memory
+from .arcs import CramerArc
 from .curves import golden_max
 from ..symbolic.loop_assembly import shift_to_one
 from .polynomial import DelayedPolynomial
@@ -192,6 +193,9 @@ class Decomposition:
         The proved enclosure of the stable set the window was chosen from
         (:meth:`symstab.Loop.region`); when it is empty the decomposition has
         no cells: no point of the plane is stable, and none was sampled.
+    arc : symstab.numeric.arcs.ArcSource or None
+        The source the arc was sampled from (None: the structured Cramer
+        solve of :attr:`polynomial`).
     """
 
     x: str
@@ -205,6 +209,7 @@ class Decomposition:
     polynomial: tuple = dataclasses.field(default=(), compare=False)
     resolution: float = 0.0
     hull: object = dataclasses.field(default=None, compare=False)
+    arc: object = dataclasses.field(default=None, compare=False)
 
     @property
     def stable(self):
@@ -301,14 +306,14 @@ class Decomposition:
         on_ring = [np.min(np.hypot(*((ring_of - q) / scale).T)) < 1e-9 for q in neighbours]
         if not all(on_ring):
             return value, other
-        base, ax, ay = self.polynomial
+        arc = self.arc if self.arc is not None else CramerArc(*self.polynomial)
 
         def f(t):
-            xy = arc_points(base, ax, ay, np.atleast_1d(t))[:2]
+            xy = arc(np.atleast_1d(t))[:2]
             return sense * xy[k]
 
         t = float(np.atleast_1d(golden_max(f, float(theta[0]), float(theta[1]), iterations=60))[0])
-        xy = [float(v[0]) for v in arc_points(base, ax, ay, np.array([t]))[:2]]
+        xy = [float(v[0]) for v in arc(np.array([t]))[:2]]
         if sense * xy[k] >= sense * value:
             return xy[k], xy[1 - k]
         return value, other
@@ -327,42 +332,31 @@ class Decomposition:
 # The pieces
 
 
-def _on_circle(c, theta):
-    """Values of the polynomial ``c`` (highest first) at ``exp(j theta)``."""
-    z = np.exp(1j * np.asarray(theta, dtype=float))
-    out = np.zeros_like(z)
-    for ck in c:
-        out = out * z + ck
-    return out
-
-
 def arc_points(base, ax, ay, theta):
     """The arc: the ``(x, y)`` at which ``exp(j theta)`` is a root, and the system's determinant.
 
     ``base + x ax + y ay`` vanishes there: its real and imaginary parts are
-    two linear equations in ``(x, y)``, solved by Cramer's rule; NaN where
-    they are singular (the arc runs off to infinity).
+    two linear equations in ``(x, y)``, solved by Cramer's rule with the
+    factor ``sin(theta)`` of every determinant divided out exactly
+    (:class:`symstab.numeric.arcs.CramerArc`, accurate to about 1e-13 also
+    next to ``theta = 0`` and ``pi``).  NaN where the system is singular
+    (the arc runs off to infinity).
 
     Parameters
     ----------
-    base, ax, ay : ndarray
-        Coefficient rows of ``A0``, ``Ax``, ``Ay`` (highest power first).
+    base, ax, ay : ndarray or DelayedPolynomial
+        Coefficient rows of ``A0``, ``Ax``, ``Ay`` (highest power first),
+        or the structured polynomials of a loop's plane (a common shift).
     theta : array_like
         Angles in (0, pi).
 
     Returns
     -------
     x, y, det : ndarray
+        ``det`` is the determinant over ``sin(theta)`` (its sign, which
+        tells the branches apart, is the determinant's on (0, pi)).
     """
-    a0, cx, cy = (_on_circle(c, theta) for c in (base, ax, ay))
-    with np.errstate(all="ignore"):
-        det = cx.real * cy.imag - cy.real * cx.imag
-        xs = (-a0.real * cy.imag + cy.real * a0.imag) / det
-        ys = (-cx.real * a0.imag + a0.real * cx.imag) / det
-        singular = ~(np.abs(det) > 1e-12 * np.abs(cx) * np.abs(cy))
-    xs[singular] = np.nan
-    ys[singular] = np.nan
-    return xs, ys, det
+    return CramerArc(base, ax, ay)(theta)
 
 
 def lines(base, ax, ay, ends):
@@ -397,14 +391,15 @@ def _arc_ends(base, ax, ay, ends):
     return out
 
 
-def _sample_arc(base, ax, ay, to_unit, theta=None, fine=1.0):
+def _sample_arc(arc, n, to_unit, theta=None, fine=1.0):
     """Angles and points of the arc, refined until every chord inside the window is short.
 
-    Returns the angles, the points and the determinant's sign; the caller
-    splits the arc where the sign changes (through infinity).
+    ``arc`` is the arc source, ``n`` the polynomial's degree.  Each round
+    evaluates the new angles only.  Returns the angles, the points and the
+    determinant's sign; the caller splits the arc where the sign changes
+    (through infinity).
     """
     if theta is None:
-        n = len(base) - 1
         m = max(1024, 32 * (n + 4))
         theta = np.pi * np.arange(1, m) / m
         # The chords to the exact ends (theta = 0, pi), added by _pieces, are
@@ -413,8 +408,8 @@ def _sample_arc(base, ax, ay, to_unit, theta=None, fine=1.0):
         # small stable cell at its corner).
         near = theta[0] * np.geomspace(1e-6, 1.0, 20, endpoint=False)
         theta = np.concatenate([near, theta, np.pi - near[::-1]])
+    xs, ys, det = arc(theta)
     for _ in range(_ROUNDS):
-        xs, ys, det = arc_points(base, ax, ay, theta)
         u, v = to_unit(xs, ys)
         finite = np.isfinite(u) & np.isfinite(v)
         du, dv = np.diff(u), np.diff(v)
@@ -441,8 +436,9 @@ def _sample_arc(base, ax, ay, to_unit, theta=None, fine=1.0):
         if len(theta) + int(split.sum()) > _MAX_ARC_POINTS:
             break
         mids = 0.5 * (theta[1:] + theta[:-1])[split]
-        theta = np.sort(np.concatenate([theta, mids]))
-    xs, ys, det = arc_points(base, ax, ay, theta)
+        order = np.argsort(np.concatenate([theta, mids]), kind="stable")
+        theta, xs, ys, det = (np.concatenate([a, b])[order]
+                              for a, b in zip((theta, xs, ys, det), (mids, *arc(mids))))
     return theta, xs, ys, np.sign(det)
 
 
@@ -1017,7 +1013,7 @@ def stable_hull(base, ax, ay):
 # The decomposition
 
 
-def decompose(base, ax, ay, ends, *, x_range, y_range, names=("x", "y")):
+def decompose(base, ax, ay, ends, *, x_range, y_range, names=("x", "y"), arc=None):
     """The D-decomposition of ``chi = base + x ax + y ay`` inside a window.
 
     Parameters
@@ -1032,6 +1028,12 @@ def decompose(base, ax, ay, ends, *, x_range, y_range, names=("x", "y")):
         The window, ``lo < hi``, finite.
     names : (str, str)
         The plane's parameter names.
+    arc : symstab.numeric.arcs.ArcSource, optional
+        Where the arc's points come from: by default the structured Cramer
+        solve of ``base, ax, ay`` (:class:`symstab.numeric.arcs.CramerArc`);
+        the paper's plane passes its closed form
+        (:class:`symstab.numeric.arcs.ClosedFormArc`), a loop its structured
+        polynomials' solve.
 
     Returns
     -------
@@ -1055,15 +1057,17 @@ def decompose(base, ax, ay, ends, *, x_range, y_range, names=("x", "y")):
     >>> sorted(cell.count for cell in found.cells), round(found.area, 12)
     ([0, 1, 1, 2, 2], 4.0)
     """
+    if arc is None:
+        arc = CramerArc(*(np.asarray(c, dtype=float) for c in (base, ax, ay)))
     found = _decompose(base, ax, ay, ends, x_range=x_range, y_range=y_range, names=names,
-                       fine=1.0)
+                       fine=1.0, arc=arc)
     if found.mismatches or found.resolution > _RESOLUTION:
         # A stable cell small for its window: the arc sampled finer (not
         # beyond 64 times: a window that needs more is refused below).
         fine = max(min(0.125, 0.5 * _RESOLUTION / max(found.resolution, 1e-300)), 1 / 64)
         fine = 1 / 64 if math.isinf(found.resolution) else fine
         found = _decompose(base, ax, ay, ends, x_range=x_range, y_range=y_range, names=names,
-                           fine=fine)
+                           fine=fine, arc=arc)
     if found.resolution > _RESOLUTION:
         raise ValueError(
             f"the stable set is too small to be resolved in the window {found.x} in "
@@ -1080,7 +1084,7 @@ def decompose(base, ax, ay, ends, *, x_range, y_range, names=("x", "y")):
     return found
 
 
-def _decompose(base, ax, ay, ends, *, x_range, y_range, names, fine):
+def _decompose(base, ax, ay, ends, *, x_range, y_range, names, fine, arc):
     """:func:`decompose` with the arc's chords ``fine`` times the usual length."""
     base, ax, ay = (np.asarray(c, dtype=float) for c in (base, ax, ay))
     x0, x1 = (float(v) for v in x_range)
@@ -1098,7 +1102,7 @@ def _decompose(base, ax, ay, ends, *, x_range, y_range, names, fine):
 
     theta = None
     for _ in range(_CROSSING_ROUNDS):
-        theta, xs, ys, sign = _sample_arc(base, ax, ay, to_unit, theta, fine)
+        theta, xs, ys, sign = _sample_arc(arc, len(base) - 1, to_unit, theta, fine)
         polylines, branches = _pieces(base, ax, ay, ends, theta, xs, ys, sign, to_unit, from_unit,
                                       (x0, x1, y0, y1))
         p, q, owner, position = _segments(polylines)
@@ -1286,7 +1290,7 @@ def _decompose(base, ax, ay, ends, *, x_range, y_range, names, fine):
     return Decomposition(x=names[0], y=names[1], x_range=(x0, x1), y_range=(y0, y1),
                          branches=tuple(branches), cells=tuple(cells),
                          mismatches=tuple(mismatches), unbounded=unbounded,
-                         polynomial=(base, ax, ay), resolution=resolution)
+                         polynomial=(base, ax, ay), resolution=resolution, arc=arc)
 
 
 def _components(n, edges):

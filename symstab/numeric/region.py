@@ -42,8 +42,10 @@ from .._resources import CHUNK_BYTES, check_memory, chunk_slices
 from .._validate import check_array, check_count, check_loop, check_real, check_window
 from .curves import (KERNEL_BYTES_PER_POINT, KERNEL_CHUNK_BYTES, BoundaryCurve, Segment,
                      golden_max, arc_end_angle, bracketed_root, minus_one_line, scan_grid)
+from .arcs import ClosedFormArc, crossing_change
 from .decomposition import decompose
-from .stability import MARGINAL, STABLE, UNSTABLE, classify, loop_coefficients
+from .polynomial import DelayedPolynomial
+from .stability import MARGINAL, STABLE, UNSTABLE, classify, loop_coefficients, paper_polynomial
 
 __all__ = ["StabilityRegion", "Limits", "limits", "BestVirtualMass", "best_virtual_mass",
            "boundary_curve"]
@@ -64,15 +66,14 @@ def _ranges(start, stop):
     return owner, np.repeat(start, counts) + offsets
 
 
-def _loop_basis(gamma, d, delta):
-    """chi = P(z) + alpha A(z) + beta B(z): the powers of z that occur and their
-    coefficients in P, A and B (from :func:`symstab.numeric.stability.loop_coefficients`;
-    chi is affine in alpha and beta, so three evaluations give it all)."""
-    base = loop_coefficients(alpha=0.0, beta=0.0, gamma=gamma, d=d, delta=delta)
-    d_alpha = loop_coefficients(alpha=1.0, beta=0.0, gamma=gamma, d=d, delta=delta) - base
-    d_beta = loop_coefficients(alpha=0.0, beta=1.0, gamma=gamma, d=d, delta=delta) - base
-    used = np.flatnonzero((base != 0) | (d_alpha != 0) | (d_beta != 0))
-    return (d + 4 - used).astype(float), base[used], d_alpha[used], d_beta[used]
+def _structured_basis(gamma, d, delta):
+    """chi = A0 + alpha A_alpha + beta A_beta as structured polynomials (A0, A_alpha, A_beta)."""
+    at = {(a, b): paper_polynomial(alpha=a, beta=b, gamma=gamma, d=d, delta=delta)
+          for a, b in ((0.0, 0.0), (1.0, 0.0), (0.0, 1.0))}
+    base = at[0.0, 0.0]
+    slopes = [DelayedPolynomial(at[k].delayed - base.delayed, at[k].direct - base.direct, base.shift)
+              for k in ((1.0, 0.0), (0.0, 1.0))]
+    return DelayedPolynomial(base.delayed, base.direct, base.shift), *slopes
 
 
 def _count(owner, change, low, high, n_lines):
@@ -183,7 +184,7 @@ class StabilityRegion:
         segment[np.searchsorted(theta, poles) - 1] = False
         self._segments = np.flatnonzero(segment)
         self.minus_one = minus_one_line(gamma=self.gamma, d=self.d, delta=self.delta)
-        self._basis = _loop_basis(self.gamma, self.d, self.delta)
+        self._structured = _structured_basis(self.gamma, self.d, self.delta)
 
     def decomposition(self, x_range, y_range):
         """The complete D-decomposition of a window of the (beta, alpha) plane.
@@ -226,8 +227,10 @@ class StabilityRegion:
             values = np.array([np.sum(c), np.sum(c * signs)])
             values[np.abs(values) <= 64 * np.finfo(float).eps * np.sum(np.abs(c))] = 0.0
             ends.append(values)
+        # The paper's arc source is its closed form (the generated kernel).
+        arc = ClosedFormArc(gamma=self.gamma, d=self.d, delta=self.delta)
         return decompose(base, ax, ay, ends, x_range=x_range, y_range=y_range,
-                         names=("beta", "alpha"))
+                         names=("beta", "alpha"), arc=arc)
 
     def _extrema(self, theta):
         """The angles of the local extrema of alpha(theta) and beta(theta).
@@ -329,35 +332,16 @@ class StabilityRegion:
         """How N (roots outside the circle) changes across each crossing.
 
         Moving along the line in the increasing direction of its free
-        coordinate s (alpha on ``beta = b``, beta on ``alpha = a``), the
-        root ``z = exp(i theta)`` moves with ``dz/ds = -chi_s(z) / chi'(z)``
-        and leaves the circle where ``Re(conj(z) dz/ds) > 0``.  Returns
-        +-2 on the arc, +-1 at z = +-1, and 0 where the radial velocity is
-        lost in rounding (a tangency or a corner).
+        coordinate s (alpha on ``beta = b``, beta on ``alpha = a``):
+        :func:`symstab.numeric.arcs.crossing_change`, +-2 on the arc, +-1 at
+        z = +-1, and 0 where the radial velocity is lost in rounding (a
+        tangency or a corner).
         """
-        powers, base, d_alpha, d_beta = self._basis
-        c = base + alpha[:, None] * d_alpha + beta[:, None] * d_beta
-        moving = d_alpha if axis == "beta" else d_beta
-        # z**p on the circle from the angle (no powers of a rounded z); the
-        # powers come in two runs (0..3 and d + 1..d + 4), so two exponentials
-        # and products by z give them all.
-        z = np.exp(1j * theta)
-        high = powers > 3
-        start = powers[high].min() if high.any() else 0.0
-        near = powers - np.where(high, start, 0.0)
-        z_power = np.where(high, np.exp(1j * theta * start)[:, None], 1.0)
-        for k in range(1, int(near.max()) + 1):
-            z_power = np.where(near >= k, z_power * z[:, None], z_power)
-        z_slope = np.sum(c * powers * z_power, axis=1)          # z chi'(z)
-        partial = np.sum(moving * z_power, axis=1)               # chi_s(z)
-        radial = -np.real(partial * np.conj(z_slope))
-        # Rounding: a few ulps of the largest terms, and the phases p theta
-        # carry an absolute error of about p theta ulps.
-        scale = np.sum(np.abs(c * powers), axis=1) * np.sum(np.abs(moving))
-        noise = 2e-15 * (1.0 + powers.max() * theta) * scale
-        sign = np.where(np.abs(radial) > noise, np.sign(radial), 0.0)
-        multiplicity = np.where((theta > 0) & (theta < np.pi), 2.0, 1.0)
-        return multiplicity * sign
+        base, d_alpha, d_beta = self._structured
+        chi = base.combine([np.asarray(alpha, dtype=float), np.asarray(beta, dtype=float)],
+                           [d_alpha, d_beta])
+        change = crossing_change(chi, d_alpha if axis == "beta" else d_beta, theta)
+        return np.where(np.isnan(change), 0.0, change)
 
     def _cuts(self, axis, values, precise=True):
         """Every crossing of the boundary with the lines ``axis = value``.

@@ -1,0 +1,152 @@
+"""The arc sources of symstab.numeric.arcs against a 50-digit mpmath solve.
+
+The oracle solves Re chi = Im chi = 0 for (x, y) at z = exp(j theta) with
+mpmath at 50 digits on the same float coefficients the source is given (so
+the comparison measures the source's arithmetic, not the rounding of the
+coefficients), for the paper's loop and every example loop's default plane.
+"""
+
+import glob
+import os
+
+import mpmath
+import numpy as np
+import pytest
+
+import symstab
+from symstab.numeric import decomposition
+from symstab.numeric.arcs import ClosedFormArc, CramerArc, sine_ratio
+from symstab.numeric.polynomial import DelayedPolynomial
+from symstab.numeric.stability import paper_polynomial
+
+EXAMPLES = sorted(glob.glob(os.path.join(os.path.dirname(__file__), "..", "..", "examples",
+                                         "loops", "*.toml")))
+#: The acceptance test of issue 19: angles in [1e-6, pi - 1e-6].
+THETA = np.unique(np.concatenate([np.geomspace(1e-6, 0.1, 25),
+                                  np.linspace(0.1, np.pi - 0.1, 60),
+                                  np.pi - np.geomspace(1e-6, 0.1, 25)]))
+TOLERANCE = 1e-12
+
+
+def _terms(p):
+    flat = p.flat()
+    delayed, direct = flat.delayed[0], flat.direct[0]
+    return ([(p.shift + len(delayed) - 1 - i, c) for i, c in enumerate(delayed)]
+            + [(len(direct) - 1 - i, c) for i, c in enumerate(direct)])
+
+
+def oracle(polynomials, theta):
+    """(x, y, det / sin theta) at each angle, 50 digits, from the float coefficients."""
+    terms = [_terms(p) for p in polynomials]
+    out = []
+    with mpmath.workdps(50):
+        for t in theta:
+            t = mpmath.mpf(float(t))
+            z = mpmath.expj(t)
+            a0, cx, cy = (sum(mpmath.mpf(float(c)) * z**k for k, c in tt) for tt in terms)
+            det = cx.real * cy.imag - cy.real * cx.imag
+            x = (-a0.real * cy.imag + cy.real * a0.imag) / det
+            y = (-cx.real * a0.imag + a0.real * cx.imag) / det
+            out.append((x, y, det / mpmath.sin(t)))
+    return out
+
+
+def relative_error(xs, ys, reference):
+    """max |(x, y) - reference| / max(|x_ref|, |y_ref|) over the angles (norm-wise)."""
+    worst = 0.0
+    for x, y, (rx, ry, _) in zip(xs, ys, reference):
+        scale = max(abs(rx), abs(ry))
+        worst = max(worst, float(max(abs(x - rx), abs(y - ry)) / scale))
+    return worst
+
+
+def paper_basis(gamma, d, delta):
+    """The paper's (beta, alpha) plane as structured polynomials: base, d/d beta, d/d alpha."""
+    at = [paper_polynomial(alpha=a, beta=b, gamma=gamma, d=d, delta=delta)
+          for a, b in ((0.0, 0.0), (0.0, 1.0), (1.0, 0.0))]
+    base = at[0]
+    return (base,) + tuple(DelayedPolynomial(p.delayed - base.delayed, p.direct - base.direct,
+                                             base.shift) for p in at[1:])
+
+
+def loop_basis(path):
+    loop = symstab.load_loop(path)
+    base, (ax, ay), _ = loop._basis(loop.plane, {}, structured=True)
+    return base, ax, ay
+
+
+BASES = [pytest.param(lambda p=p: loop_basis(p), id=os.path.basename(p)) for p in EXAMPLES] + [
+    pytest.param(lambda g=g, d=d, dl=dl: paper_basis(g, d, dl), id=f"paper-gamma{g}-d{d}-delta{dl}")
+    for g, d, dl in ((0.0, 10, 0.00253125), (1.5, 0, 0.00253125), (-0.5, 100, 0.01))]
+
+
+@pytest.mark.parametrize("make", BASES)
+def test_cramer_arc_matches_the_50_digit_solve(make):
+    polynomials = make()
+    reference = oracle(polynomials, THETA)
+    xs, ys, det = CramerArc(*polynomials)(THETA)
+    assert relative_error(xs, ys, reference) <= TOLERANCE
+    # The determinant with sin(theta) divided out, too.
+    worst = max(float(abs(v - r[2]) / abs(r[2])) for v, r in zip(det, reference))
+    assert worst <= TOLERANCE
+
+
+@pytest.mark.parametrize("make", BASES)
+def test_dense_rows_give_the_same_arc(make):
+    # A dense row is one part (shift 0): the same accuracy, more terms per angle.
+    polynomials = make()
+    reference = oracle(polynomials, THETA)
+    xs, ys, _ = CramerArc(*(p.dense().reshape(-1) for p in polynomials))(THETA)
+    assert relative_error(xs, ys, reference) <= TOLERANCE
+
+
+def test_sine_ratio_against_mpmath():
+    m = np.array([1, 2, 3, 7, 40, 41, 1001, 5004])
+    with mpmath.workdps(50):
+        for t in (1e-9, 1e-6, 1e-3, 0.7, 1.5, 1.6, np.pi - 1e-3, np.pi - 1e-6, np.pi - 1e-9):
+            got = sine_ratio(m, t)
+            tt = mpmath.mpf(float(t))
+            want = [mpmath.sin(int(k) * tt) / mpmath.sin(tt) for k in m]
+            for g, w in zip(got, want):
+                assert abs(g - w) <= 4e-16 * (1 + abs(int(m[-1]) * tt)) * max(1, abs(w)), (t, g, w)
+
+
+def test_closed_form_is_the_paper_arc():
+    # The closed form (alpha, beta from the generated kernel) is the same arc
+    # as the structured solve of the paper's polynomial; the two differ by
+    # the rounding of the coefficients, so to 1e-9 here.
+    gamma, d, delta = 0.0, 10, 0.00253125
+    theta = THETA[(THETA > 1e-3) & (THETA < 3.0)]
+    bx, ay_, det = ClosedFormArc(gamma=gamma, d=d, delta=delta)(theta)
+    cx, cy, cdet = CramerArc(*paper_basis(gamma, d, delta))(theta)
+    assert np.array_equal(det, cdet)
+    scale = np.maximum(np.abs(cx), np.abs(cy))
+    assert np.max(np.maximum(np.abs(bx - cx), np.abs(ay_ - cy)) / scale) < 1e-9
+
+
+def test_singular_determinant_gives_nan():
+    # ax and ay proportional: the system is singular at every angle.
+    base = np.array([1.0, 0.3, 0.2])
+    ax = np.array([0.0, 1.0, 0.5])
+    xs, ys, det = CramerArc(base, ax, 2 * ax)(np.array([0.1, 1.0, 3.0]))
+    assert np.all(np.isnan(xs)) and np.all(np.isnan(ys))
+    assert np.all(det == 0)
+
+
+def test_bad_input():
+    with pytest.raises(ValueError, match="finite"):
+        CramerArc(np.array([1.0, np.nan]), np.array([1.0, 0.0]), np.array([0.0, 1.0]))
+    with pytest.raises(ValueError, match="one non-empty row"):
+        CramerArc(np.ones((2, 2)), np.array([1.0, 0.0]), np.array([0.0, 1.0]))
+    with pytest.raises(ValueError, match="common shift"):
+        CramerArc(DelayedPolynomial([1.0], [1.0], 3), DelayedPolynomial([1.0], [0.0], 2),
+                  DelayedPolynomial([0.0], [1.0], 3))
+
+
+@pytest.mark.parametrize("make", BASES)
+def test_arc_points_of_dense_rows_match_the_50_digit_solve(make):
+    # decomposition.arc_points (the plane's public arc) takes its arc from arcs.py.
+    polynomials = make()
+    reference = oracle(polynomials, THETA)
+    xs, ys, _ = decomposition.arc_points(*(p.dense().reshape(-1) for p in polynomials), THETA)
+    assert relative_error(xs, ys, reference) <= TOLERANCE
