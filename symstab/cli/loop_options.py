@@ -83,12 +83,13 @@ _LOOP_ONLY = {
     "boundary": ("set_values", "x", "y"),
     "limits": ("set_values", "x", "y", "at"),
     "classify": ("set_values",),
-    "design": ("set_values", "x", "y", "at"),
+    "design": ("set_values", "x", "y", "at", "over", "search_range"),
     "map": ("set_values", "x", "y", "x_range", "y_range"),
 }
 
 _FLAGS = {"set_values": "--set", "x": "--x", "y": "--y", "at": "--at",
-          "x_range": "--x-range", "y_range": "--y-range"}
+          "x_range": "--x-range", "y_range": "--y-range", "over": "--over",
+          "search_range": "--range"}
 
 
 EXAMPLE = "examples/loops/paper.toml"
@@ -153,6 +154,17 @@ def add_loop_options(p, command):
         g.add_argument("--at", type=float, metavar="X",
                        help="also give the stable intervals of y at x = X"
                             + (" (default: the x of the largest y)" if command == "design" else ""))
+    if command == "design":
+        g.add_argument("--over", metavar="NAME",
+                       help="the parameter searched for the largest stable y (default: the "
+                            "environment's mass term, a parameter of it in kg or kg m^2 "
+                            "outside the plane)")
+        g.add_argument("--range", metavar="LO:HI", dest="search_range",
+                       help="the values of --over searched, in its SI unit (default: design's "
+                            "gamma range, -1 - (d + 1) delta + 0.001 to 3, times the device's "
+                            "mass: the sum of the plant's parameters in the unit of the mass "
+                            "term, with delta = b T / mass where the loop has a damping b, "
+                            "else 0)")
     if command == "map":
         g.add_argument("--x-range", metavar="LOW,HIGH,N", help="grid of x (--x-range=-0.1,0.6,200)")
         g.add_argument("--y-range", metavar="LOW,HIGH,N", help="grid of y (--y-range=0,6,200)")

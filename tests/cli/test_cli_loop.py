@@ -139,24 +139,6 @@ def test_boundary_lies_on_the_derived_curve_and_names_its_lines(capsys):
     assert any(n.startswith("line z = -1: ") and n.endswith(" B") for n in data["notes"])
 
 
-def test_design_gives_K_max_and_the_stable_K_at_its_damping(capsys):
-    design = run_json(capsys, "design", "--loop", PAPER, "--set", "d=10")
-    paper = run_json(capsys, "limits", "--d", "10", "--linear")["limits"]
-    assert design["limits"]["y_max"] == pytest.approx(stiffness(paper["alpha_max"]), rel=1e-6)
-    b_best = design["limits"]["x_at_y_max"]
-    assert b_best == pytest.approx(damping(paper["beta_at_alpha_max"]), rel=1e-6)
-    (lo, hi), = design["at"]["intervals"]
-    assert design["at"]["x"] == b_best
-    assert abs(lo) < 1e-9 and hi == pytest.approx(stiffness(paper["alpha_max"]), rel=1e-6)
-    # --at: today's `limits --Bw` intervals.
-    design = run_json(capsys, "design", "--loop", PAPER, "--set", "d=10", "--at", "1.5")
-    today = run_json(capsys, "limits", "--d", "10", "--linear", "--Bw", "1.5")
-    (lo, hi), = design["at"]["intervals"]
-    (alo, ahi), = today["alpha_intervals"]["intervals"]
-    assert hi == pytest.approx(stiffness(ahi), rel=1e-6)
-    assert lo == pytest.approx(stiffness(alo), abs=1e-9)
-
-
 def test_map_is_todays_root_count_classification(capsys, tmp_path):
     grid_k, grid_b = "0,2500,9", "-2,12,8"
     out = tmp_path / "loop.npz"
