@@ -106,10 +106,14 @@ _WHAT = {
     "classify": "classify --loop gives the verdict, the spectral radius and the certified "
                 "number of closed-loop poles outside the unit circle at the file's values "
                 "changed by --set (comma lists: several points).",
-    "design": "design --loop gives the largest stable y, the x where it is reached, and the "
-              "stable intervals of y at that x (or at --at X).",
-    "map": "map --loop classifies every cell of an x-y grid by its root count (no "
-           "simulation) and draws the D-decomposition over it.",
+    "design": "design --loop searches a third parameter (--over NAME, default the "
+              "environment's mass term, e.g. M) for the largest stable y, as design searches "
+              "the virtual mass, and gives the best value, y_max there and at the nominal "
+              "value, the x where it is reached and the stable intervals of y at that x (or "
+              "at --at X).",
+    "map": "map --loop classifies every cell of an x-y grid by its certified root count "
+           "(no simulation yet for a loop file: its first line says so) and draws the "
+           "D-decomposition over it.",
 }
 #: The example of each command with a loop file.
 _LOOP_EXAMPLES = {

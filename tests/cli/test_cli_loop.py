@@ -146,10 +146,14 @@ def test_map_is_todays_root_count_classification(capsys, tmp_path):
                             f"--y-range={grid_k}", "--out", out, "--no-png")
     assert status == 0, err
     assert "wrote " + str(out) in text
+    # It counts roots where map of the paper's loop simulates: its first line says so.
+    assert text.splitlines()[0] == ("map --loop: root counts of the linear loop (no simulation "
+                                    "yet for a loop file)")
     paper = tmp_path / "paper.npz"
-    status, _, err = run(capsys, "map", "--d", "1", "--linear", f"--Kw={grid_k}", f"--Bw={grid_b}",
-                         "--steps", "20", "--out", paper, "--no-png")
+    status, simulated, err = run(capsys, "map", "--d", "1", "--linear", f"--Kw={grid_k}",
+                                 f"--Bw={grid_b}", "--steps", "20", "--out", paper, "--no-png")
     assert status == 0, err
+    assert "root counts" not in simulated.splitlines()[0]
     with np.load(out) as f, np.load(paper) as g:
         assert (str(f["x_name"]), str(f["y_name"]), str(f["y_unit"])) == ("B", "K", "N m/rad")
         np.testing.assert_array_equal(f["x"], g["B_w"])
