@@ -83,12 +83,13 @@ _LOOP_ONLY = {
     "boundary": ("set_values", "x", "y"),
     "limits": ("set_values", "x", "y", "at"),
     "classify": ("set_values",),
-    "design": ("set_values", "x", "y", "at"),
+    "design": ("set_values", "x", "y", "at", "over", "search_range"),
     "map": ("set_values", "x", "y", "x_range", "y_range"),
 }
 
 _FLAGS = {"set_values": "--set", "x": "--x", "y": "--y", "at": "--at",
-          "x_range": "--x-range", "y_range": "--y-range"}
+          "x_range": "--x-range", "y_range": "--y-range", "over": "--over",
+          "search_range": "--range"}
 
 
 EXAMPLE = "examples/loops/paper.toml"
@@ -105,10 +106,14 @@ _WHAT = {
     "classify": "classify --loop gives the verdict, the spectral radius and the certified "
                 "number of closed-loop poles outside the unit circle at the file's values "
                 "changed by --set (comma lists: several points).",
-    "design": "design --loop gives the largest stable y, the x where it is reached, and the "
-              "stable intervals of y at that x (or at --at X).",
-    "map": "map --loop classifies every cell of an x-y grid by its root count (no "
-           "simulation) and draws the D-decomposition over it.",
+    "design": "design --loop searches a third parameter (--over NAME, default the "
+              "environment's mass term, e.g. M) for the largest stable y, as design searches "
+              "the virtual mass, and gives the best value, y_max there and at the nominal "
+              "value, the x where it is reached and the stable intervals of y at that x (or "
+              "at --at X).",
+    "map": "map --loop classifies every cell of an x-y grid by its certified root count "
+           "(no simulation yet for a loop file: its first line says so) and draws the "
+           "D-decomposition over it.",
 }
 #: The example of each command with a loop file.
 _LOOP_EXAMPLES = {
@@ -153,6 +158,17 @@ def add_loop_options(p, command):
         g.add_argument("--at", type=float, metavar="X",
                        help="also give the stable intervals of y at x = X"
                             + (" (default: the x of the largest y)" if command == "design" else ""))
+    if command == "design":
+        g.add_argument("--over", metavar="NAME",
+                       help="the parameter searched for the largest stable y (default: the "
+                            "environment's mass term, a parameter of it in kg or kg m^2 "
+                            "outside the plane)")
+        g.add_argument("--range", metavar="LO:HI", dest="search_range",
+                       help="the values of --over searched, in its SI unit (default: design's "
+                            "gamma range, -1 - (d + 1) delta + 0.001 to 3, times the device's "
+                            "mass: the sum of the plant's parameters in the unit of the mass "
+                            "term, with delta = b T / mass where the loop has a damping b, "
+                            "else 0)")
     if command == "map":
         g.add_argument("--x-range", metavar="LOW,HIGH,N", help="grid of x (--x-range=-0.1,0.6,200)")
         g.add_argument("--y-range", metavar="LOW,HIGH,N", help="grid of y (--y-range=0,6,200)")

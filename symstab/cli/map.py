@@ -20,7 +20,12 @@ from .output import check_files, draw_lines, png_bytes, pyplot_or_none, visible,
 from .simulation import add_nonideal_options, nonideal_text, resolve_nonideal, simulated_theory
 from .units import tex_unit
 
-__all__ = ["register", "run", "MAX_GRID", "map_outputs"]
+__all__ = ["register", "run", "MAX_GRID", "map_outputs", "LOOP_MAP_HEADLINE"]
+
+#: The first line of ``map --loop``: what it computes, since ``map`` of the
+#: paper's loop simulates (a loop file has no simulator yet).
+LOOP_MAP_HEADLINE = ("map --loop: root counts of the linear loop (no simulation yet for a "
+                     "loop file)")
 
 #: Bytes per map cell in the CSV and NPZ written, with the Python objects
 #: that build them (generous).
@@ -263,6 +268,7 @@ def _loop(args):
     check_memory(f"a map of {xs.size} x {ys.size} cells",
                  xs.size * ys.size * _MAP_CELL_BYTES
                  + max(CHUNK_BYTES, ys.size * _BYTES_PER_COEFFICIENT * degree))
+    print(LOOP_MAP_HEADLINE)
     for line in setup.echo:
         print(line)
     code = np.empty((xs.size, ys.size), dtype=np.int8)

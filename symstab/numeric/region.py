@@ -48,7 +48,7 @@ from .polynomial import DelayedPolynomial
 from .stability import MARGINAL, STABLE, UNSTABLE, classify, loop_coefficients, paper_polynomial
 
 __all__ = ["StabilityRegion", "Limits", "limits", "BestVirtualMass", "best_virtual_mass",
-           "boundary_curve"]
+           "scan_maximum", "boundary_curve"]
 
 #: Largest number of vertical lines in the scan that finds where the region is.
 _SCAN_LINES = 512
@@ -1050,6 +1050,81 @@ def _check_gamma_range(gamma_range):
     return low, high
 
 
+def scan_maximum(f, low, high, n=17, *, rtol=1e-6, scale=1.0):
+    """The x of [low, high] that maximises a scalar f: a scan, then golden section.
+
+    ``f`` is evaluated on ``n`` evenly spaced points of ``[low, high]``; the
+    best scan point is refined by a golden-section search between its
+    neighbours until the bracket is narrower than ``rtol * max(scale, |x|)``.
+    The search of :func:`best_virtual_mass` (over gamma, ``scale = 1``) and
+    of ``symstab design --loop`` (over a loop's parameter, ``scale`` its
+    reference value): one routine.
+
+    Parameters
+    ----------
+    f : callable
+        ``f(x) -> float``; ``-inf`` (or NaN) where there is nothing to
+        maximise (no stable region at x).
+    low, high : float
+        The interval searched, ``low < high``.
+    n : int
+        Points of the scan, ``n >= 3``.
+    rtol : float
+        Relative width of the final bracket, ``> 0``.
+    scale : float
+        The size of x below which ``rtol`` is taken absolute (times
+        ``scale``), ``> 0``.
+
+    Returns
+    -------
+    (float, float) or None
+        ``(x, f(x))`` at the best point seen (scan or search), or None when
+        ``f`` is not finite at any scan point.
+
+    Raises
+    ------
+    ValueError
+        For ``low >= high``, ``n < 3`` or a non-positive ``rtol`` or ``scale``.
+
+    Examples
+    --------
+    >>> x, value = scan_maximum(lambda x: -(x - 0.3)**2, 0.0, 1.0)
+    >>> round(x, 5), value <= 0
+    (0.3, True)
+    """
+    low, high = check_real("low", low), check_real("high", high)
+    if not low < high:
+        raise ValueError(f"the interval searched must have low < high, got [{low!r}, {high!r}]")
+    n = check_count("n", n, 3)
+    for name, value in (("rtol", rtol), ("scale", scale)):
+        if not (check_real(name, value) > 0):
+            raise ValueError(f"{name} must be a real number > 0, got {value!r}")
+    xs = np.linspace(low, high, n)
+    values = [f(x) for x in xs]
+    if not np.isfinite(values).any():
+        return None
+    k = int(np.nanargmax(np.where(np.isnan(values), -np.inf, values)))
+    a, b = xs[max(k - 1, 0)], xs[min(k + 1, n - 1)]
+    ratio = (math.sqrt(5) - 1) / 2
+    x1, x2 = b - ratio * (b - a), a + ratio * (b - a)
+    f1, f2 = f(x1), f(x2)
+    while b - a > rtol * max(scale, abs(a)):
+        if f1 < f2:
+            a, x1, f1 = x1, x2, f2
+            x2 = a + ratio * (b - a)
+            f2 = f(x2)
+        else:
+            b, x2, f2 = x2, x1, f1
+            x1 = b - ratio * (b - a)
+            f1 = f(x1)
+    # The best point seen: at the edge where the region vanishes the middle
+    # of the last bracket may already have no region.
+    candidates = [(value, x) for value, x in ((values[k], xs[k]), (f1, x1), (f2, x2))
+                  if not math.isnan(value)]
+    value, x = max(candidates)
+    return float(x), float(value)
+
+
 def best_virtual_mass(*, d, delta, gamma_range=None, n=17):
     """The gamma (and beta) that maximise alpha_max, and the gain over gamma = 0.
 
@@ -1091,29 +1166,11 @@ def best_virtual_mass(*, d, delta, gamma_range=None, n=17):
     if gamma_range is None:
         gamma_range = (-1.0 - (d + 1) * delta + 1e-3, 3.0)
     g_lo, g_hi = _check_gamma_range(gamma_range)
-    gammas = np.linspace(g_lo, g_hi, n)
-    values = [_alpha_max(g, d, delta)[0] for g in gammas]
-    if not np.isfinite(values).any():
+    found = scan_maximum(lambda g: _alpha_max(g, d, delta)[0], g_lo, g_hi, n)
+    if found is None:
         return BestVirtualMass(d, delta, None, None, None, None, None, 0.0,
                                f"no gamma in [{g_lo:g}, {g_hi:g}] has a stable region at d = {d}")
-    k = int(np.argmax(values))
-    a, b = gammas[max(k - 1, 0)], gammas[min(k + 1, n - 1)]
-    ratio = (math.sqrt(5) - 1) / 2
-    x1, x2 = b - ratio * (b - a), a + ratio * (b - a)
-    f1, f2 = _alpha_max(x1, d, delta)[0], _alpha_max(x2, d, delta)[0]
-    while b - a > 1e-6 * max(1.0, abs(a)):
-        if f1 < f2:
-            a, x1, f1 = x1, x2, f2
-            x2 = a + ratio * (b - a)
-            f2 = _alpha_max(x2, d, delta)[0]
-        else:
-            b, x2, f2 = x2, x1, f1
-            x1 = b - ratio * (b - a)
-            f1 = _alpha_max(x1, d, delta)[0]
-    # The best point seen: at the edge where the region vanishes the middle
-    # of the last bracket may already have no region.
-    candidates = [(values[k], gammas[k]), (f1, x1), (f2, x2)]
-    _, best_gamma = max(candidates)
+    best_gamma, _ = found
     region = StabilityRegion(gamma=best_gamma, d=d, delta=delta)
     best = region.limits(n_beta=201)
     alpha_zero = _alpha_max(0.0, d, delta)[0]

@@ -44,12 +44,12 @@ def test_loop_interval_is_open_with_an_exact_zero_end(capsys, T, d):
                                "--set", f"d={d}", "--at", "0.5")
     assert status == 0, err
     (line,) = [line for line in out.splitlines() if line.startswith("stable K at B = 0.5")]
-    found = re.fullmatch(r"stable K at B = 0\.5 N s/m: \(0, ([0-9.]+)\) N/m", line)
+    found = re.fullmatch(r"stable K at B = 0\.5 N m s/rad: \(0, ([0-9.]+)\) N m/rad", line)
     assert found, line
     top = float(found.group(1))
     assert python_control_radius(top, 0.5, T=float(T), d=d) == pytest.approx(1, abs=1e-7)
     assert (f"open intervals: their ends are not stable; marginal (a pole on the unit circle) "
-            f"at K = 0 and {found.group(1)} N/m") in out
+            f"at K = 0 and {found.group(1)} N m/rad") in out
     data = json.loads(run_cli(capsys, "limits", "--loop", PAPER, "--set", f"T={T}", "--set",
                               f"d={d}", "--at", "0.5", "--format", "json")[1])
     assert data["limits"]["y_max"] > 0

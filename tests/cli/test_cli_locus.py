@@ -24,7 +24,7 @@ pytestmark = pytest.mark.usefixtures("loop_cache_dir")
 def test_the_example_finds_K_max_of_the_D_decomposition(capsys):
     """`symstab locus --Td 0.04 --Bw 0.1 --Kw 0:30`: one pair out at the top of the stable K."""
     data = run_json(capsys, "locus", "--Td", "0.04", "--Bw", "0.1", "--Kw", "0:30")
-    loop = symstab.load_loop(PAPER)      # linear units: the same numbers as the rotary default
+    loop = symstab.load_loop(PAPER)      # rotary units, as the device options
     (_, top), = loop.stable_intervals("K", B=0.1, d=40)
     crossings = data["crossings"]
     assert [(c["kind"], c["direction"]) for c in crossings] == [("pair", "out")]

@@ -1,8 +1,8 @@
 """``--loop FILE`` and ``--set NAME=VALUE`` on boundary, limits, classify, design and map.
 
-The paper's loop file (``examples/loops/paper.toml``, linear units: kg,
-N s/m, N/m) must give the numbers of today's paper commands run with
-``--linear`` (converted from alpha, beta by K_w = alpha m / T^2 and
+The paper's loop file (``examples/loops/paper.toml``, rotary units: kg m^2,
+N m s/rad, N m/rad, as the paper's device options) must give the numbers of
+today's paper commands (converted from alpha, beta by K_w = alpha m / T^2 and
 B_w = beta m / T); the boundary is checked against the derivation's
 alpha(theta), beta(theta) at 30 digits and the root counts against
 python-control's poles.  Bad input is one line ``symstab <cmd>: error:`` and
@@ -44,7 +44,7 @@ def test_limits_of_the_paper_file_are_todays_K_max(capsys):
     paper = run_json(capsys, "limits", "--Td", "40e-3", "--linear")["limits"]
     lim = loop["limits"]
     assert (lim["x"], lim["y"]) == ("B", "K")
-    assert loop["inputs"]["values"]["d"] == 40 and loop["inputs"]["units"]["K"] == "N/m"
+    assert loop["inputs"]["values"]["d"] == 40 and loop["inputs"]["units"]["K"] == "N m/rad"
     assert lim["y_max"] == pytest.approx(stiffness(paper["alpha_max"]), rel=1e-6)
     assert lim["x_at_y_max"] == pytest.approx(damping(paper["beta_at_alpha_max"]), rel=1e-6)
     assert lim["x_max"] == pytest.approx(damping(paper["beta_right"]), rel=1e-6)
@@ -60,12 +60,12 @@ def test_limits_of_the_paper_file_are_todays_K_max(capsys):
 def test_limits_text_names_the_units_of_the_file(capsys):
     status, out, _ = run(capsys, "limits", "--loop", PAPER, "--d", "10", "--at", "0.3")
     assert status == 0
-    assert "d = 10 samples (--set)" in out and "plane: x = B [N s/m], y = K [N/m]" in out
+    assert "d = 10 samples (--set)" in out and "plane: x = B [N m s/rad], y = K [N m/rad]" in out
     line = next(line for line in out.splitlines() if line.strip().startswith("K_max"))
     k_max = stiffness(symstab.limits(gamma=0.0, d=10, delta=PAPER_DELTA).alpha_max)
-    assert float(line.split()[1]) == pytest.approx(k_max, rel=1e-6) and "N/m" in line
+    assert float(line.split()[1]) == pytest.approx(k_max, rel=1e-6) and "N m/rad" in line
     # Open at both ends: each end has a pole on the unit circle.
-    assert "stable K at B = 0.3 N s/m: (0, " in out
+    assert "stable K at B = 0.3 N m s/rad: (0, " in out
 
 
 def test_classify_gives_todays_radius_and_python_controls_pole_count(capsys):
@@ -77,7 +77,7 @@ def test_classify_gives_todays_radius_and_python_controls_pole_count(capsys):
     assert len(loop["rows"]) == 4
     verdicts = set()
     for row, today, k, b in zip(loop["rows"], paper["rows"], kw, bw):
-        assert (row["K [N/m]"], row["B [N s/m]"]) == (k, b)
+        assert (row["K [N m/rad]"], row["B [N m s/rad]"]) == (k, b)
         assert row["spectral radius"] == pytest.approx(today["spectral radius"], rel=1e-6)
         assert row["verdict"] == today["verdict"]
         poles = python_control_closed_loop(alpha=k * PAPER_T**2 / PAPER_M,
@@ -91,7 +91,7 @@ def test_classify_gives_todays_radius_and_python_controls_pole_count(capsys):
 def test_classify_one_point_echoes_every_value_with_its_unit(capsys):
     status, out, _ = run(capsys, "classify", "--loop", PAPER, "--set", "K=300", "--d", "0")
     assert status == 0
-    assert "K = 300 N/m (--set)" in out and "m = 0.0128 kg" in out and "d = 0 samples" in out
+    assert "K = 300 N m/rad (--set)" in out and "m = 0.0128 kg m^2" in out and "d = 0 samples" in out
     radius = symstab.spectral_radius(alpha=300 * PAPER_T**2 / PAPER_M, beta=0.1 * PAPER_T / PAPER_M,
                                      gamma=0.0, d=0, delta=PAPER_DELTA)
     row = out.split("\n\n")[1].splitlines()[2].split()
@@ -118,7 +118,7 @@ def test_boundary_lies_on_the_derived_curve_and_names_its_lines(capsys):
     assert len(rows) == 40
     checked = 0
     for row in rows:
-        theta, b, k = row["theta [rad]"], row["B [N s/m]"], row["K [N/m]"]
+        theta, b, k = row["theta [rad]"], row["B [N m s/rad]"], row["K [N m/rad]"]
         if b is None:
             continue
         alpha, beta = boundary_point(theta, gamma=0.0, d=10, delta=PAPER_DELTA)
@@ -130,31 +130,13 @@ def test_boundary_lies_on_the_derived_curve_and_names_its_lines(capsys):
     # z = 1: K = 0 (a pole at z = 1 whenever the spring is off).
     one = lines["z = 1"]
     assert one["cx"] == 0 and abs(one["c0"] / one["cy"]) < 1e-9
-    # z = -1: alpha + 2 beta = c of the derivation, in N/m and N s/m.
+    # z = -1: alpha + 2 beta = c of the derivation, in N m/rad and N m s/rad.
     c0, cx, cy = (lines["z = -1"][k] for k in ("c0", "cx", "cy"))
     # alpha + 2 beta = c is K + (2 / T) B = c m / T**2.
     assert cx / cy == pytest.approx(2 / PAPER_T, rel=1e-9)
     c = minus_one_line(gamma=0.0, d=10, delta=PAPER_DELTA)
     assert -c0 / cy == pytest.approx(stiffness(c), rel=1e-6)
     assert any(n.startswith("line z = -1: ") and n.endswith(" B") for n in data["notes"])
-
-
-def test_design_gives_K_max_and_the_stable_K_at_its_damping(capsys):
-    design = run_json(capsys, "design", "--loop", PAPER, "--set", "d=10")
-    paper = run_json(capsys, "limits", "--d", "10", "--linear")["limits"]
-    assert design["limits"]["y_max"] == pytest.approx(stiffness(paper["alpha_max"]), rel=1e-6)
-    b_best = design["limits"]["x_at_y_max"]
-    assert b_best == pytest.approx(damping(paper["beta_at_alpha_max"]), rel=1e-6)
-    (lo, hi), = design["at"]["intervals"]
-    assert design["at"]["x"] == b_best
-    assert abs(lo) < 1e-9 and hi == pytest.approx(stiffness(paper["alpha_max"]), rel=1e-6)
-    # --at: today's `limits --Bw` intervals.
-    design = run_json(capsys, "design", "--loop", PAPER, "--set", "d=10", "--at", "1.5")
-    today = run_json(capsys, "limits", "--d", "10", "--linear", "--Bw", "1.5")
-    (lo, hi), = design["at"]["intervals"]
-    (alo, ahi), = today["alpha_intervals"]["intervals"]
-    assert hi == pytest.approx(stiffness(ahi), rel=1e-6)
-    assert lo == pytest.approx(stiffness(alo), abs=1e-9)
 
 
 def test_map_is_todays_root_count_classification(capsys, tmp_path):
@@ -164,12 +146,16 @@ def test_map_is_todays_root_count_classification(capsys, tmp_path):
                             f"--y-range={grid_k}", "--out", out, "--no-png")
     assert status == 0, err
     assert "wrote " + str(out) in text
+    # It counts roots where map of the paper's loop simulates: its first line says so.
+    assert text.splitlines()[0] == ("map --loop: root counts of the linear loop (no simulation "
+                                    "yet for a loop file)")
     paper = tmp_path / "paper.npz"
-    status, _, err = run(capsys, "map", "--d", "1", "--linear", f"--Kw={grid_k}", f"--Bw={grid_b}",
-                         "--steps", "20", "--out", paper, "--no-png")
+    status, simulated, err = run(capsys, "map", "--d", "1", "--linear", f"--Kw={grid_k}",
+                                 f"--Bw={grid_b}", "--steps", "20", "--out", paper, "--no-png")
     assert status == 0, err
+    assert "root counts" not in simulated.splitlines()[0]
     with np.load(out) as f, np.load(paper) as g:
-        assert (str(f["x_name"]), str(f["y_name"]), str(f["y_unit"])) == ("B", "K", "N/m")
+        assert (str(f["x_name"]), str(f["y_name"]), str(f["y_unit"])) == ("B", "K", "N m/rad")
         np.testing.assert_array_equal(f["x"], g["B_w"])
         np.testing.assert_array_equal(f["y"], g["K_w"])
         code, today = f["code"], g["exact_code"].T   # today's map is (K_w, B_w)
@@ -197,7 +183,7 @@ def test_map_csv_and_png_in_the_units_of_the_file(capsys, tmp_path, monkeypatch)
                          "--y-range=0,2500,4", "--out", out)
     assert status == 0, err
     lines = out.read_text().splitlines()
-    assert lines[0] == "B [N s/m],K [N/m],code,stable" and len(lines) == 21
+    assert lines[0] == "B [N m s/rad],K [N m/rad],code,stable" and len(lines) == 21
     rows = np.array([[float(v) for v in line.split(",")] for line in lines[1:]])
     code = symstab.classify(alpha=rows[:, 1] * PAPER_T**2 / PAPER_M,
                             beta=rows[:, 0] * PAPER_T / PAPER_M, gamma=0.0, d=1, delta=PAPER_DELTA)
@@ -205,7 +191,7 @@ def test_map_csv_and_png_in_the_units_of_the_file(capsys, tmp_path, monkeypatch)
     np.testing.assert_array_equal(rows[decided, 2], code[decided])
     assert (tmp_path / "m.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
     (xlabel, ylabel, xlim, ylim, legend), = seen
-    assert (xlabel, ylabel) == ("B [N s/m]", "K [N/m]")
+    assert (xlabel, ylabel) == ("B [N m s/rad]", "K [N m/rad]")
     assert xlim == pytest.approx((-2, 12)) and ylim == pytest.approx((0, 2500))
     assert "stable" in legend and any("D-decomposition" in t for t in legend)
 

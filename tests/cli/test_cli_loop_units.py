@@ -48,9 +48,9 @@ def test_set_is_in_the_files_unit(capsys, paper_ms):
 @pytest.mark.parametrize("given, si", [
     (["--set", "T=0.5ms"], ["--set", "T=5e-4"]),
     (["--set", "T=500 us"], ["--set", "T=5e-4"]),
-    (["--set", "K=1,3,10 N/mm"], ["--set", "K=1000,3000,10000"]),
-    (["--set", "B=20 g/s"], ["--set", "B=0.02"]),
-    (["--set", "M=6.4 g"], ["--set", "M=0.0064"]),
+    (["--set", "K=1,3,10 kN m/rad"], ["--set", "K=1000,3000,10000"]),
+    (["--set", "B=20 N mm s/rad"], ["--set", "B=0.02"]),
+    (["--set", "M=64 kg cm^2"], ["--set", "M=0.0064"]),
 ])
 def test_set_with_a_unit_is_converted(capsys, given, si):
     base = ["--loop", PAPER, "--set", "d=4"]
@@ -62,17 +62,17 @@ def test_set_with_a_unit_is_converted(capsys, given, si):
 
 def test_the_echo_shows_the_value_as_written_and_as_used(capsys, paper_ms):
     status, out, err = run(capsys, "classify", "--loop", paper_ms, "--set", "K=2,3",
-                           "--set", "B=0.3 kN s/km")
+                           "--set", "B=0.3 kN mm s/rad")
     assert status == 0, err
     values = next(line for line in out.splitlines() if line.startswith("values: "))
     assert "T = 1 ms (0.001 s)" in values
-    assert "B = 0.3 kN s/km (0.3 N s/m) (--set)" in values
-    assert "K = [2, 3] N/m (--set)" in values      # already in SI: shown once
+    assert "B = 0.3 kN mm s/rad (0.3 N m s/rad) (--set)" in values
+    assert "K = [2, 3] N m/rad (--set)" in values      # already in SI: shown once
 
 
 @pytest.mark.parametrize("setting, match", [
     ("T=3kg", r"--set T: parameter 'T' has unit 'kg'.*a time"),
-    ("K=3 kg", r"--set K: unit 'kg' is kg, and K is in N/m"),
+    ("K=3 kg", r"--set K: unit 'kg' is kg, and K is in N m/rad"),
     ("K=3 furlongs_per_parsec", r"--set K: parameter 'K': unit 'furlongs_per_parsec' is not a unit "
                                 r"a loop file may name"),
     ("d=4 ms", r"--set d: parameter 'd' has unit 'ms'"),
@@ -119,21 +119,21 @@ def test_the_help_says_what_set_does_with_units(capsys):
 
 
 def test_locus_takes_its_set_and_its_path_in_the_files_units(capsys, tmp_path):
-    """K in N/mm: --set K=0:0.03 is the SI file's K = 0:30 N/m, and T = 1 ms is 0.001 s."""
+    """K in kN m/rad: --set K=0:0.03 is the SI file's K = 0:30 N m/rad, and T = 1 ms is 0.001 s."""
     text = PAPER.read_text(encoding="utf-8")
     for old, new in (('T = { value = 1e-3, unit = "s" }', 'T = { value = 1, unit = "ms" }'),
-                     ('K = { value = 2.0, unit = "N/m" }', 'K = { value = 2.0, unit = "N/mm" }')):
+                     ('K = { value = 2.0, unit = "N m/rad" }', 'K = { value = 2.0, unit = "kN m/rad" }')):
         assert old in text
         text = text.replace(old, new)
     path = tmp_path / "paper_mm.toml"
     path.write_text(text, encoding="utf-8")
-    status, ours, err = run(capsys, "locus", "--loop", path, "--set", "B=100 g/s", "--set",
+    status, ours, err = run(capsys, "locus", "--loop", path, "--set", "B=100 N mm s/rad", "--set",
                             "K=0:0.03:50", "--set", "d=4")
     assert status == 0, err
     status, reference, err = run(capsys, "locus", "--loop", PAPER, "--set", "B=0.1", "--set",
                                  "K=0:30:50", "--set", "d=4")
     assert status == 0, err
-    assert "path: K from 0 to 30 N/m (50 points)" in ours
+    assert "path: K from 0 to 30 N m/rad (50 points)" in ours
     assert ours.split("\npath: ", 1)[1] == reference.split("\npath: ", 1)[1]
 
 
@@ -152,3 +152,28 @@ def test_one_rule_for_the_units_of_the_device_options_in_the_help_and_the_readme
     assert status == 0 and "m = 0.2 kg m^2" in out and "N m/rad" in out
     status, out, _ = run(capsys, "limits", "--m", "0.2", "--linear")
     assert status == 0 and "m = 0.2 kg," in out and "N m/rad" not in out and "N/m" in out
+
+
+def test_the_paper_loop_file_and_the_device_options_label_the_same_quantities_alike(capsys):
+    """The same device, given as paper.toml or by the paper's options: the same units and numbers.
+
+    K_max printed N/m from paper.toml and N m/rad from ``symstab limits``;
+    the file now gives the paddle's rotary units (Section IV), as
+    :data:`symstab.PAPER_LOOP` does.
+    """
+    status, loop, err = run(capsys, "limits", "--loop", PAPER)
+    assert status == 0, err
+    status, paper, err = run(capsys, "limits", "--Td", "0.04")
+    assert status == 0, err
+    for loop_name, paper_name, unit in (("K_max", "K_max", "N m/rad"),
+                                        ("B at K_max", "B_w at K_max", "N m s/rad"),
+                                        ("B_min", "B_left", "N m s/rad"),
+                                        ("B_max", "B_right", "N m s/rad")):
+        found = re.search(rf"(?m)^\s*{re.escape(loop_name)}\s+(\S+)\s+(.+?)\s{{2,}}", loop)
+        assert found and found.group(2) == unit, (loop_name, loop)
+        ours = float(found.group(1))
+        found = re.search(rf"(?m)\s{re.escape(paper_name)}\s+(\S+)\s+(.+?)\s*$", paper)
+        assert found and found.group(2) == unit, (paper_name, paper)
+        assert ours == pytest.approx(float(found.group(1)), rel=1e-6, abs=1e-9)
+    assert "plane: x = B [N m s/rad], y = K [N m/rad]" in loop
+    assert "m = 0.0128 kg m^2" in loop and "m = 0.0128 kg m^2" in paper

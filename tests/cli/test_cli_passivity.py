@@ -60,7 +60,7 @@ def test_loop_limits_give_the_passive_y_max(capsys):
     assert passive["area"] == pytest.approx(2 * b**2 / T, rel=1e-9) and passive["bounded"]
     status, out, _ = run(capsys, "limits", "--loop", path, "--set", "d=0", "--set", "M=0")
     line = next(line for line in out.splitlines() if line.startswith("passive K_max"))
-    assert "N/m at B =" in line and "stable K_max =" in line
+    assert "N m/rad at B =" in line and "stable K_max =" in line
 
 
 def test_loop_the_theorem_does_not_cover_is_a_note_not_an_error(capsys):

@@ -1,0 +1,111 @@
+"""``symstab design --loop``: the search of a third parameter, as ``design`` searches the virtual mass.
+
+Oracles: an independent dense scan of :meth:`symstab.Loop.limits` over the
+parameter (nested grids, no golden section), and, on the paper's
+loop file, ``symstab design`` of the paper's options at the same device
+(the optimum M = gamma m).  Bad input is one line and exit status 2 before
+the search.
+"""
+
+import math
+
+import numpy as np
+import pytest
+
+import symstab
+
+from conftest import PAPER_DELTA, PAPER_M, PAPER_T, REPO, run_cli as run, run_cli_json as run_json
+
+LOOPS = REPO / "examples" / "loops"
+
+pytestmark = pytest.mark.usefixtures("loop_cache_dir")
+
+
+def dense_scan(loop, name, low, high, **values):
+    """The largest y_max over ``name`` in [low, high]: seven nested 11-point grids.
+
+    The optimum may be a kink (the stable set shrinks to a sliver and
+    vanishes): the last grid's step, 2e-5 of the first's, keeps a steep
+    side within 1e-4.
+
+    A plane the decomposition does not resolve is skipped (as design skips it).
+    """
+    def y_max(value):
+        try:
+            lim = loop.limits(**{**values, name: value})
+        except ValueError:
+            return -math.inf
+        return -math.inf if lim.empty else lim.y_max
+
+    best_value, best = -math.inf, None
+    for _ in range(7):
+        grid = np.linspace(low, high, 11)
+        found = [y_max(v) for v in grid]
+        k = int(np.argmax(found))
+        if found[k] > best_value:
+            best_value, best = found[k], grid[k]
+        step = grid[1] - grid[0]
+        low, high = best - step, best + step
+    return best, best_value
+
+
+@pytest.mark.parametrize("file, extra", [("paper.toml", ["--set", "d=10"]),
+                                         ("frictionless.toml", [])])
+def test_design_finds_the_best_mass_of_a_dense_scan(capsys, file, extra):
+    out = run_json(capsys, "design", "--loop", LOOPS / file, *extra)
+    search = out["search"]
+    assert search["over"] == "M" and search["nominal"] == 0.0
+    loop = symstab.load_loop(LOOPS / file)
+    values = {**out["inputs"]["values"]}
+    low, high = search["range"]
+    at, value = dense_scan(loop, "M", low, high, **values)
+    assert search["y_max"] == pytest.approx(value, rel=1e-4)
+    assert search["y_max"] >= value * (1 - 1e-6)       # the search is no worse than the scan
+    nominal = loop.limits(**values).y_max
+    assert search["y_max_nominal"] == pytest.approx(nominal, rel=1e-9)
+    assert search["gain"] == pytest.approx(search["y_max"] / nominal, rel=1e-12)
+    assert out["limits"]["y_max"] == search["y_max"]
+
+
+def test_design_of_the_paper_file_is_the_paper_design_at_the_same_device(capsys):
+    """paper.toml at d = 10: the best M is gamma m of ``symstab design --d 10`` and K_max the same."""
+    loop = run_json(capsys, "design", "--loop", LOOPS / "paper.toml", "--set", "d=10")
+    paper = run_json(capsys, "design", "--d", "10")["best"]
+    search = loop["search"]
+    # design's gamma range times m: the same scan points, the same search.
+    assert search["range"] == pytest.approx([PAPER_M * (-1 - 11 * PAPER_DELTA + 1e-3), 3 * PAPER_M],
+                                            rel=1e-12)
+    assert search["best"] == pytest.approx(paper["gamma"] * PAPER_M, rel=1e-5)
+    assert search["y_max"] == pytest.approx(paper["alpha_max"] * PAPER_M / PAPER_T**2, rel=1e-6)
+    assert search["gain"] == pytest.approx(paper["gain"], rel=1e-6)
+
+
+def test_the_table_names_the_optimum_the_value_there_and_at_the_nominal_value(capsys):
+    status, out, err = run(capsys, "design", "--loop", LOOPS / "paper.toml", "--set", "d=10",
+                           "--set", "M=0.005")
+    assert status == 0, err
+    assert "searching M in [" in err and "kg m^2" in err
+    rows = {line.strip().split("  ")[0]: line for line in out.splitlines() if "  " in line.strip()}
+    assert "M (best)" in rows and "kg m^2" in rows["M (best)"]
+    assert "K_max" in rows and "N m/rad" in rows["K_max"]
+    assert "K_max at M = 0.005" in rows and "gain" in rows
+
+
+@pytest.mark.parametrize("args, needle", [
+    (["--loop", LOOPS / "lowpass_velocity.toml"], "no mass term: give --over NAME"),
+    (["--loop", LOOPS / "lowpass_velocity.toml", "--over", "f_c"], "give --range LO:HI"),
+    (["--loop", LOOPS / "paper.toml", "--over", "Q"], "--over Q: not a parameter"),
+    (["--loop", LOOPS / "paper.toml", "--over", "d"], "whole number of samples"),
+    (["--loop", LOOPS / "paper.toml", "--over", "K"], "axis"),
+    (["--loop", LOOPS / "paper.toml", "--range", "1"], "--range must be LO:HI"),
+    (["--loop", LOOPS / "paper.toml", "--range", "a:b"], "--range must be LO:HI"),
+    (["--loop", LOOPS / "paper.toml", "--range", "0:inf"], "--range must be LO:HI"),
+    (["--loop", LOOPS / "paper.toml", "--range=0.02:0.01"], "LO < HI"),
+    (["--over", "M"], "--over needs a loop file"),
+    (["--range", "0:1"], "--range needs a loop file"),
+])
+def test_bad_search_input_is_one_line_before_the_search(capsys, args, needle):
+    status, out, err = run(capsys, "design", *args)
+    assert status == 2 and out == "", err
+    assert err.count("\n") == 1 and needle in err, err
+    assert "searching" not in err
