@@ -100,13 +100,27 @@ def test_classify_one_point_echoes_every_value_with_its_unit(capsys):
 
 
 def test_a_marginal_verdict_gives_no_pole_count(capsys):
-    """K = 1e300: the leading coefficient is lost in rounding (a pole at infinity).
-
-    The verdict is marginal; the count beside it was 41 (the polynomial's
-    roots with its leading coefficient as rounded), which contradicted it.
-    """
-    (row,) = run_json(capsys, "classify", "--loop", PAPER, "--set", "K=1e300")["rows"]
+    """K = 0: a pole at z = 1 exactly; the verdict is marginal and no count is printed beside it."""
+    (row,) = run_json(capsys, "classify", "--loop", PAPER, "--set", "K=0")["rows"]
     assert row["verdict"] == "marginal" and row["unstable poles"] is None
+
+
+def test_a_huge_stiffness_is_decided_not_lost_in_rounding(capsys):
+    """K = 1e300: the delayed part's leading 1 is exact against its own part (chi kept structured).
+
+    The dense polynomial called it a pole at infinity (marginal); the
+    structured count gives 41 poles outside, which 60-digit roots of the
+    same coefficients confirm.
+    """
+    mpmath = pytest.importorskip("mpmath")
+    (row,) = run_json(capsys, "classify", "--loop", PAPER, "--set", "K=1e300")["rows"]
+    loop = symstab.load_loop(PAPER)
+    coefficients = loop.coefficients(K=1e300)
+    with mpmath.workdps(60):
+        moduli = [abs(r) for r in mpmath.polyroots([mpmath.mpf(float(c)) for c in coefficients],
+                                                   maxsteps=3000, extraprec=3000)]
+    assert row["verdict"] == "unstable"
+    assert row["unstable poles"] == sum(1 for m in moduli if m > 1) == 41
 
 
 def test_boundary_lies_on_the_derived_curve_and_names_its_lines(capsys):
