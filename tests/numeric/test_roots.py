@@ -24,8 +24,8 @@ def _exact_moduli(chi):
             row.pop()
             zeros += 1
         with mpmath.workdps(50):
-            r = mpmath.polyroots([mpmath.mpf(float(c)) for c in row], maxsteps=2000,
-                                 extraprec=2000) if len(row) > 1 else []
+            r = mpmath.polyroots([mpmath.mpf(float(c)) for c in row], maxsteps=400,
+                                 extraprec=600) if len(row) > 1 else []
             out.append(sorted([abs(x) for x in r] + [mpmath.mpf(0)] * zeros, reverse=True))
     return out
 
@@ -37,16 +37,19 @@ def _count_oracle(moduli, gap=1e-8):
     return sum(1 for m in moduli if m > 1)
 
 
+# Coefficients 0 or of modulus >= 1e-3 (a 1e-255 coefficient puts a root at
+# 1e-255, where a relative test of the radius means nothing).
+coefficient = st.floats(-3, 3, allow_nan=False).map(lambda c: 0.0 if abs(c) < 1e-3 else c)
 structured = st.builds(
     lambda s, d, n, scale: DelayedPolynomial(d, [c * scale for c in n], s),
     st.integers(0, 40),
-    st.lists(st.floats(-3, 3, allow_nan=False), min_size=1, max_size=5).filter(lambda c: abs(c[0]) > 1e-3),
-    st.lists(st.floats(-3, 3, allow_nan=False), min_size=1, max_size=5),
+    st.lists(coefficient, min_size=1, max_size=5).filter(lambda c: c[0] != 0),
+    st.lists(coefficient, min_size=1, max_size=5),
     st.sampled_from([1e-3, 0.1, 1.0, 10.0]),
 ).filter(lambda chi: chi.shift + chi.delayed.shape[-1] > chi.direct.shape[-1])
 
 
-@settings(max_examples=60, deadline=None)
+@settings(max_examples=25, deadline=None)
 @given(structured)
 def test_root_counts_match_50_digit_roots(chi):
     moduli = _exact_moduli(chi)[0]
@@ -58,14 +61,14 @@ def test_root_counts_match_50_digit_roots(chi):
         assert got == expected
 
 
-@settings(max_examples=40, deadline=None)
+@settings(max_examples=25, deadline=None)
 @given(structured)
 def test_spectral_radius_matches_50_digit_roots(chi):
     expected = float(_exact_moduli(chi)[0][0])
     assert abs(float(roots.spectral_radius(chi)) - expected) <= 1e-9 * expected
 
 
-@pytest.mark.parametrize("d", [150, 400, 2000])
+@pytest.mark.parametrize("d", [150, 400])
 def test_long_delay_radius_without_eigenvalues(d):
     """The structured radius (degree > 128) against polished 50-digit roots near the largest."""
     chi = paper_polynomial(alpha=2e-5, beta=0.004, gamma=0.3, d=d, delta=0.00253125)
@@ -73,11 +76,7 @@ def test_long_delay_radius_without_eigenvalues(d):
     # The largest root by Newton steps at 50 digits from numpy's roots (only
     # for the start; the dense coefficients are exact as floats).
     c = chi.flat().dense()[0]
-    start = np.roots(c) if d <= 400 else None
-    if start is None:
-        # d = 2000: numpy's roots are O(d**3); polish the engine's own angle
-        # instead and check with an independent count of mpmath's values.
-        pytest.skip("covered by the benchmark against eigenvalues")
+    start = np.roots(c)
     z0 = start[np.argmax(np.abs(start))]
     with mpmath.workdps(50):
         z = mpmath.mpc(complex(z0))
