@@ -862,15 +862,6 @@ def _empty_reason(found):
     return f"every cell of the window {where} has a root outside the unit circle"
 
 
-def _on_circle(c, theta):
-    """Values of the polynomial rows ``c`` (highest first) at ``exp(j theta)``."""
-    z = np.exp(1j * np.asarray(theta))
-    out = np.zeros_like(z)
-    for ck in c:
-        out = out * z + ck
-    return out
-
-
 #: Largest table of cos(k theta), sin(k theta) on the scan kept per degree (bytes).
 _SCAN_TABLE_BYTES = 4 * 2**20
 
@@ -953,7 +944,7 @@ def _circle_candidates(a0, a1, a0_ends, a1_ends):
     # g vanishes at 0 and pi, so the scan approaches both geometrically.
     grid, cos_k, sin_k = _scan_table(n)
     if cos_k is None:
-        v = _on_circle(np.stack([a0, a1], axis=-1), grid[:, None])
+        v = np.polyval(np.stack([a0, a1], axis=-1), np.exp(1j * grid[:, None]))
         values = (v[:, 0] * np.conj(v[:, 1])).imag
     else:
         # The values of a0, a1 on the scan as products with the table.
@@ -976,7 +967,8 @@ def _circle_candidates(a0, a1, a0_ends, a1_ends):
             if np.min(np.abs(found - a)) > 1e-6 and (not extra or a - extra[-1] > 1e-6):
                 extra.append(a)
     angles = np.unique(np.clip(np.concatenate([found, extra]), 0.0, np.pi))
-    v0, v1 = _on_circle(a0, angles), _on_circle(a1, angles)
+    z = np.exp(1j * np.asarray(angles))
+    v0, v1 = np.polyval(a0, z), np.polyval(a1, z)
     # At z = +-1 exactly: exp(j pi) has an imaginary part of 1e-16.
     for index, end in enumerate((0.0, np.pi)):
         v0[angles == end] = a0_ends[index]
