@@ -4,6 +4,7 @@ Oracles: python-control's poles of the sampled loop (c2d of the plant,
 the delay as z**-d, eq. (1) as a transfer function in z).
 """
 
+import mpmath
 import numpy as np
 import pytest
 
@@ -48,7 +49,6 @@ def test_counts_match_python_control_and_the_dimensionless_path(d, K, B, M):
 def test_spectral_radius_matches_50_digit_roots_of_the_symbolic_polynomial():
     """python-control's poles are off by 1.4e-8 here (degree 44); the oracle is mpmath at 50 digits
     on the coefficients of the symbolic characteristic polynomial evaluated at 30 digits."""
-    mpmath = pytest.importorskip("mpmath")
     from symstab.numeric.stability import coefficients_at
 
     device = symstab.PAPER_DEVICE
@@ -65,7 +65,6 @@ def test_spectral_radius_matches_50_digit_roots_of_the_symbolic_polynomial():
 def _exact_count(K, B, d):
     """Roots outside at 50 digits of the symbolic polynomial evaluated at 30 digits (an oracle
     independent of the kernels and of the root engine)."""
-    mpmath = pytest.importorskip("mpmath")
     from symstab.numeric.stability import coefficients_at
 
     device = symstab.PAPER_DEVICE
