@@ -16,9 +16,15 @@ Every row is one run on the same machine state, medians of ``--runs``:
 3. ``spectral_radius`` at d = 2000 of one point: the structured radius
    (counts on circles, Newton on chi) against companion eigenvalues of the
    dense polynomial (``numpy.linalg.eigvals``, O(d**3)).
+4. The stable set's limits at ``--limits-delays`` (default 200, 1000,
+   5000): ``symstab.PAPER_LOOP.limits`` (the D-decomposition on the
+   structured polynomial, its window from the exact stable hull) against
+   the paper's path ``symstab.limits`` (crossings counted along lines,
+   :mod:`symstab.numeric.region`), and K_max from both.  One run each from
+   d = 1000 on.
 
 Targets (issue 19): the Loop path within 1.3x of the paper's; the radius at
-d = 2000 under 1 s.  BLAS threads on a busy 2-core machine distort short
+d = 2000 under 1 s; Loop limits under 2 s at d = 1000 and 20 s at d = 5000.  BLAS threads on a busy 2-core machine distort short
 products badly: run with ``OPENBLAS_NUM_THREADS=1`` for stable numbers.
 """
 
@@ -42,6 +48,7 @@ def main(argv=None):
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--runs", type=int, default=3)
     parser.add_argument("--points", type=int, default=500)
+    parser.add_argument("--limits-delays", default="200,1000,5000")
     args = parser.parse_args(argv)
     loop, device = symstab.PAPER_LOOP, symstab.PAPER_DEVICE
     rng = np.random.default_rng(0)
@@ -78,6 +85,19 @@ def main(argv=None):
     r_structured, r_eig = float(roots.spectral_radius(chi)), eigenvalues()
     print(f"spectral radius d = {d}: structured {fmt(t_structured)}, eigenvalues {fmt(t_eig)} "
           f"(ratio {t_eig / t_structured:.0f}); radii {r_structured:.15f} and {r_eig:.15f}")
+    print()
+    print(f"{'limits':<8} {'d':>5} {'Loop':>9} {'paper':>9} {'paper/Loop':>11}  K_max (N/m): Loop, paper")
+    for d in (int(v) for v in args.limits_delays.split(",")):
+        runs, warmup = (args.runs, 1) if d < 1000 else (1, 0)
+        found = {}
+        t_loop = statistics.median(timed_runs(
+            lambda: found.update(loop=loop.limits(d=d)), runs, warmup))
+        t_paper = statistics.median(timed_runs(
+            lambda: found.update(paper=symstab.limits(gamma=0.0, d=d, delta=device.delta)),
+            runs, warmup))
+        ours, theirs = found["loop"].y_max, float(device.stiffness(found["paper"].alpha_max))
+        print(f"{'':<8} {d:>5} {fmt(t_loop):>9} {fmt(t_paper):>9} {t_paper / t_loop:>11.2f}  "
+              f"{ours:.9g}, {theirs:.9g}")
 
 
 if __name__ == "__main__":

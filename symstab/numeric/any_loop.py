@@ -666,7 +666,7 @@ class Loop(LoopModel):
 
         def run(box):
             return decompose(base, ax, ay, ends, x_range=box[:2], y_range=box[2:], names=(x, y),
-                             arc=arc)
+                             arc=arc, family=(structured, *slopes))
 
         # Where a stable point can be at all (exact): an empty enclosure is the
         # answer, a bounded one caps every window a free side may take.
@@ -679,7 +679,7 @@ class Loop(LoopModel):
                                  branches=(), cells=(), mismatches=(), unbounded=(),
                                  polynomial=(base, ax, ay), hull=hull)
         found, refused = None, None
-        for auto in _start_windows(base, ax, ay, ends, enclosure):
+        for auto in _start_windows((structured, *slopes), base, ax, ay, ends, hull):
             box = [*(given["x_range"] or auto[0]), *(given["y_range"] or auto[1])]
             try:
                 found = run(box)
@@ -1074,13 +1074,15 @@ def _line_intervals(a0, a1, a0_ends, a1_ends):
     return out
 
 
-def _start_windows(base, ax, ay, ends, enclosure=None):
+def _start_windows(family, base, ax, ay, ends, hull=None):
     """First windows for :meth:`Loop.region`, tried in turn until one holds a stable cell.
 
     First the extent of stable points next to the curves (a few steps off
-    the arc's points and the lines' crossings, classified at once): it is
-    on the scale of the stable set however far the arc runs.  Then, when
-    the stable set has a bounded ``enclosure`` (``(x_range, y_range)`` from
+    the arc's points and the lines' crossings, classified at once on the
+    structured ``family`` ``(A0, Ax, Ay)``, and only where the ``hull``
+    holds them: a point outside it is proved unstable): it is on the scale
+    of the stable set however far the arc runs.  Then, when the stable set
+    has a bounded enclosure (the box of the
     :func:`symstab.numeric.decomposition.stable_hull`), the enclosure
     itself, which holds every stable point: a stable set too small for the
     steps is found there, and one that is not found there is empty.
@@ -1089,6 +1091,7 @@ def _start_windows(base, ax, ay, ends, enclosure=None):
     quarter of the span is added on each side, and each window is cut to
     the enclosure.
     """
+    enclosure = hull.box() if hull is not None else None
     xs, ys, _ = _curve_points(base, ax, ay, ends, per_degree=4, first_lobe=64)
     candidates = []
     if xs.size:
@@ -1102,9 +1105,10 @@ def _start_windows(base, ax, ay, ends, enclosure=None):
                 px.append(xs + ux * step * sx)
                 py.append(ys + uy * step * sy)
         px, py = np.concatenate(px), np.concatenate(py)
-        check_memory("the stable points that start a region's window", 8 * len(px) * len(base))
-        codes = classify_polynomials(
-            base[None, :] + px[:, None] * ax[None, :] + py[:, None] * ay[None, :], refine=False)
+        if hull is not None:
+            held = hull.holds(px, py)
+            px, py = px[held], py[held]
+        codes = classify_polynomials(family[0].combine((px, py), family[1:]), refine=False)
         candidates.append((px[codes == STABLE], py[codes == STABLE], 0.0))
     out = _extent_windows(candidates, enclosure)
     if enclosure is not None:

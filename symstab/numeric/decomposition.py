@@ -41,10 +41,9 @@ import math
 
 import numpy as np
 
-from .._resources import check_memory
+from .._resources import check_memory, chunk_slices
 from .arcs import CramerArc
 from .curves import golden_max
-from ..symbolic.loop_assembly import shift_to_one
 from .polynomial import DelayedPolynomial
 from .roots import STABLE, classify_polynomials, leading_vanishes, root_counts
 
@@ -800,6 +799,43 @@ class StableHull:
             out.append((float(lo - margin), float(hi + margin)))
         return tuple(out)
 
+    def holds(self, x, y):
+        """Whether each point ``(x, y)`` may be stable: False proves it unstable.
+
+        True everywhere when the hull is unbounded, False everywhere when it
+        is empty.  The vertices are the exact ones rounded once, so a point
+        within ``1e-9`` of a polygon's span outside an edge still counts as
+        held (the answer errs on the side of "may be stable").
+
+        Parameters
+        ----------
+        x, y : array_like
+            Points of the plane (broadcast together).
+
+        Returns
+        -------
+        ndarray of bool
+        """
+        x, y = np.broadcast_arrays(np.asarray(x, dtype=float), np.asarray(y, dtype=float))
+        if self.empty:
+            return np.zeros(x.shape, dtype=bool)
+        if not self.bounded:
+            return np.ones(x.shape, dtype=bool)
+        px, py = x.ravel(), y.ravel()
+        out = np.zeros(px.shape, dtype=bool)
+        for polygon in self.polygons:
+            span = float(np.max(np.ptp(polygon, axis=0))) or 1.0
+            start = polygon
+            edge = np.roll(polygon, -1, axis=0) - start
+            slack = -1e-9 * span * np.hypot(edge[:, 0], edge[:, 1])[:, None]
+            # Counter-clockwise: inside is to the left of every edge.
+            for part in chunk_slices(len(px), 8 * len(polygon)):
+                with np.errstate(invalid="ignore"):
+                    cross = (edge[:, 0, None] * (py[None, part] - start[:, 1, None])
+                             - edge[:, 1, None] * (px[None, part] - start[:, 0, None]))
+                out[part] |= np.all(cross >= slack, axis=0)
+        return out.reshape(x.shape)
+
     def __repr__(self):
         if self.empty:
             return f"StableHull(empty: {self.reason})"
@@ -815,20 +851,37 @@ def _exact_rows(rows):
     return [[num << (shift - den.bit_length()) for num, den in row] for row in ratios]
 
 
+def _plus_minus(n, j):
+    """Coefficients (lowest power first) of ``(w + 1)**j (w - 1)**(n - j)``, exact integers.
+
+    From ``(w**2 - 1) f' = (n w + n - 2 j) f``: ``(m + 1) a[m + 1] = (m - 1 -
+    n) a[m - 1] - (n - 2 j) a[m]``, with ``a[0] = (-1)**(n - j)``; O(n)
+    products (the division is exact).
+    """
+    a = [0] * (n + 1)
+    a[0] = -1 if (n - j) % 2 else 1
+    previous = 0
+    for m in range(n):
+        a[m + 1] = ((m - 1 - n) * previous - (n - 2 * j) * a[m]) // (m + 1)
+        previous = a[m]
+    return a
+
+
 def _bilinear(c):
     """Coefficients ``q_k`` (``q[k]`` of ``w**k``) of ``(w - 1)**n c((w + 1) / (w - 1))``, exactly.
 
-    ``c`` holds Python integers, highest power first.  ``c(1 + 2 t)``, read
-    backwards in ``u = 1 / t``, is ``u**n c(1 + 2 / u)``; then ``u = w - 1``.
+    ``c`` holds Python integers, highest power first, so ``q = sum_i c[i]
+    (w + 1)**(n - i) (w - 1)**i``: one O(n) recurrence
+    (:func:`_plus_minus`) per nonzero coefficient.  A loop's rows are
+    nonzero only next to their ends (``z**d D(z) + N(z)``), so a long delay
+    costs O(n) big-integer products per row, not the O(n**2) of a shift.
     """
     n = len(c) - 1
-    shifted = shift_to_one(c, dtype=object)                                   # c(1 + t)
-    r = [v << (n - j) for j, v in enumerate(shifted)]            # c(1 + 2 t)
-    u = r[::-1]                                                   # u**n c(1 + 2/u), highest first
-    sign = [1 if (n - j) % 2 == 0 else -1 for j in range(n + 1)]
-    # p(w - 1) = f(1 - w) with f(v) = p(-v): flip the odd powers, shift, flip back.
-    flipped = shift_to_one([s * v for s, v in zip(sign, u)], dtype=object)
-    return [s * v for s, v in zip(sign, flipped)][::-1]          # lowest power first
+    q = [0] * (n + 1)
+    for i, v in enumerate(c):
+        if v:
+            q = [acc + v * t for acc, t in zip(q, _plus_minus(n, n - i))]
+    return q
 
 
 def _approximate(rows):
@@ -893,6 +946,77 @@ def _line_interval(lines, i, order):
     return lo, hi
 
 
+def _float_candidates(approximate):
+    """Lines whose feasible interval is not empty in floating point, with a wide slack.
+
+    A first guess of the polygon's edges, O(lines**2) float operations in
+    chunks; :func:`_half_plane_polygon` proves or rejects it exactly.  Also
+    returns, per line, the two rows that bound its interval tightest from
+    below and from above (``-1`` where none): with the line, the triples to
+    try for a proof that nothing is feasible (:func:`_infeasible_triple`).
+    """
+    a, b, c = approximate.T
+    norm = b * b + c * c
+    keep = np.zeros(len(approximate), dtype=bool)
+    below = np.full(len(approximate), -1)
+    above = np.full(len(approximate), -1)
+    for part in chunk_slices(len(approximate), 8 * 4 * len(approximate)):
+        ai, bi, ci, ni = (v[part, None] for v in (a, b, c, norm))
+        with np.errstate(all="ignore"):
+            g = a[None, :] - ai * (b[None, :] * bi + c[None, :] * ci) / ni
+            h = c[None, :] * bi - b[None, :] * ci
+            t = -g / h
+            rising, falling = np.where(h > 0, t, -np.inf), np.where(h < 0, t, np.inf)
+            below[part], above[part] = np.argmax(rising, axis=1), np.argmin(falling, axis=1)
+            lo, hi = np.max(rising, axis=1), np.min(falling, axis=1)
+            below[part] = np.where(np.isfinite(lo), below[part], -1)
+            above[part] = np.where(np.isfinite(hi), above[part], -1)
+            scale = np.abs(g) + np.abs(a[None, :])
+            # Parallel rows that exclude the line by far.
+            parallel = np.abs(h) <= 1e-9 * (np.abs(c[None, :] * bi) + np.abs(b[None, :] * ci))
+            excluded = np.any(parallel & (g < -1e-6 * scale), axis=1)
+            width = np.maximum(np.abs(lo), np.abs(hi))
+            keep[part] = ~excluded & ~(hi - lo < -1e-6 * np.where(np.isfinite(width), width, 0))
+    return np.flatnonzero(keep), below, above
+
+
+def _infeasible_triple(lines, triple):
+    """Whether three exact rows prove that no point is inside all of them (Farkas, exactly).
+
+    With ``l_1 = [r_2, r_3]``, ``l_2 = [r_3, r_1]``, ``l_3 = [r_1, r_2]``
+    (the 2 x 2 determinants of the rows' ``(b, c)``), ``sum l_j (b_j, c_j)
+    = 0``; when every ``l_j`` has one sign ``s`` and ``s sum l_j a_j <=
+    0``, the rows' weighted sum is a constant ``<= 0`` that an interior
+    point would make positive.  By Helly's theorem an empty intersection of
+    half-planes has such a triple; this only checks the one given.
+    """
+    (a1, b1, c1), (a2, b2, c2), (a3, b3, c3) = (lines[k] for k in triple)
+    weights = (b2 * c3 - b3 * c2, b3 * c1 - b1 * c3, b1 * c2 - b2 * c1)
+    total = weights[0] * a1 + weights[1] * a2 + weights[2] * a3
+    if all(w >= 0 for w in weights) and any(weights):
+        return total <= 0
+    if all(w <= 0 for w in weights) and any(weights):
+        return total >= 0
+    return False
+
+
+def _closed_cycle(edges):
+    """Whether the edges' exact end points, sorted around their mean, are joined by those edges.
+
+    ``edges`` are ``(vertex, vertex)`` pairs of Fractions.  True proves that
+    the convex polygon of the vertices is the whole feasible set: each side
+    lies on a constraint's line, with the feasible set on its inner side.
+    """
+    vertices = sorted({v for edge in edges for v in edge})
+    if len(vertices) < 3:
+        return False
+    cx = sum(v[0] for v in vertices) / len(vertices)
+    cy = sum(v[1] for v in vertices) / len(vertices)
+    vertices.sort(key=lambda v: math.atan2(float(v[1] - cy), float(v[0] - cx)))
+    sides = {frozenset(edge) for edge in edges if edge[0] != edge[1]}
+    return all(frozenset((u, v)) in sides for u, v in zip(vertices, vertices[1:] + vertices[:1]))
+
+
 def _half_plane_polygon(rows):
     """The polygon ``{a + b x + c y >= 0 for every row}`` with exact integer rows.
 
@@ -902,7 +1026,11 @@ def _half_plane_polygon(rows):
     the intersection of the others' half-lines on it (a one-dimensional
     programme per line, in exact rationals); the rows that bound it
     tightest in floating point are tried first, so a line that is no edge
-    is dismissed after a few exact products.
+    is dismissed after a few exact products.  The lines that are edges in
+    floating point go first: when their exact sides close into a polygon
+    (:func:`_closed_cycle`), that is the answer, and the other lines are
+    never solved exactly (O(lines) exact products instead of
+    O(lines**2)); otherwise every line is.
     """
     from fractions import Fraction
 
@@ -913,18 +1041,32 @@ def _half_plane_polygon(rows):
     if not lines:
         return [], False, True
     approximate = _approximate(lines)
-    vertices, bounded = [], True
-    for i, (a, b, c) in enumerate(lines):
-        interval = _line_interval(lines, i, _tightest(lines, approximate, i))
-        if interval is False:
-            continue
-        lo, hi = interval
-        if lo is None or hi is None:
-            bounded = False
-            continue
-        norm = b * b + c * c
-        for t in (Fraction(*lo), Fraction(*hi)):
-            vertices.append((Fraction(-a * b, norm) - t * c, Fraction(-a * c, norm) + t * b))
+    first, below, above = _float_candidates(approximate)
+    if first.size == 0:
+        # Empty in floating point: look for an exact proof among the lines'
+        # own witnesses before solving every line.
+        for i in range(len(lines)):
+            if below[i] >= 0 and above[i] >= 0 and _infeasible_triple(
+                    lines, (i, int(below[i]), int(above[i]))):
+                return [], True, False
+    for group in (first, None):
+        vertices, edges, bounded = [], [], True
+        for i in (first if group is not None else range(len(lines))):
+            a, b, c = lines[i]
+            interval = _line_interval(lines, i, _tightest(lines, approximate, i))
+            if interval is False:
+                continue
+            lo, hi = interval
+            if lo is None or hi is None:
+                bounded = False          # a feasible ray: proved unbounded either way
+                break
+            norm = b * b + c * c
+            ends = tuple((Fraction(-a * b, norm) - t * c, Fraction(-a * c, norm) + t * b)
+                         for t in (Fraction(*lo), Fraction(*hi)))
+            vertices.extend(ends)
+            edges.append(ends)
+        if not bounded or group is None or _closed_cycle(edges):
+            break
     if not bounded:
         return [], False, True
     vertices = list(set(vertices))
@@ -1013,7 +1155,7 @@ def stable_hull(base, ax, ay):
 # The decomposition
 
 
-def decompose(base, ax, ay, ends, *, x_range, y_range, names=("x", "y"), arc=None):
+def decompose(base, ax, ay, ends, *, x_range, y_range, names=("x", "y"), arc=None, family=None):
     """The D-decomposition of ``chi = base + x ax + y ay`` inside a window.
 
     Parameters
@@ -1034,6 +1176,10 @@ def decompose(base, ax, ay, ends, *, x_range, y_range, names=("x", "y"), arc=Non
         the paper's plane passes its closed form
         (:class:`symstab.numeric.arcs.ClosedFormArc`), a loop its structured
         polynomials' solve.
+    family : (DelayedPolynomial, DelayedPolynomial, DelayedPolynomial), optional
+        ``A0``, ``Ax`` and ``Ay`` again in their structure (one polynomial
+        each, a common shift): the cells' root counts are taken on it,
+        O(d) per cell where the dense rows cost O(d**2).
 
     Returns
     -------
@@ -1060,14 +1206,14 @@ def decompose(base, ax, ay, ends, *, x_range, y_range, names=("x", "y"), arc=Non
     if arc is None:
         arc = CramerArc(*(np.asarray(c, dtype=float) for c in (base, ax, ay)))
     found = _decompose(base, ax, ay, ends, x_range=x_range, y_range=y_range, names=names,
-                       fine=1.0, arc=arc)
+                       fine=1.0, arc=arc, family=family)
     if found.mismatches or found.resolution > _RESOLUTION:
         # A stable cell small for its window: the arc sampled finer (not
         # beyond 64 times: a window that needs more is refused below).
         fine = max(min(0.125, 0.5 * _RESOLUTION / max(found.resolution, 1e-300)), 1 / 64)
         fine = 1 / 64 if math.isinf(found.resolution) else fine
         found = _decompose(base, ax, ay, ends, x_range=x_range, y_range=y_range, names=names,
-                           fine=fine, arc=arc)
+                           fine=fine, arc=arc, family=family)
     if found.resolution > _RESOLUTION:
         raise ValueError(
             f"the stable set is too small to be resolved in the window {found.x} in "
@@ -1084,7 +1230,7 @@ def decompose(base, ax, ay, ends, *, x_range, y_range, names=("x", "y"), arc=Non
     return found
 
 
-def _decompose(base, ax, ay, ends, *, x_range, y_range, names, fine, arc):
+def _decompose(base, ax, ay, ends, *, x_range, y_range, names, fine, arc, family=None):
     """:func:`decompose` with the arc's chords ``fine`` times the usual length."""
     base, ax, ay = (np.asarray(c, dtype=float) for c in (base, ax, ay))
     x0, x1 = (float(v) for v in x_range)
@@ -1205,22 +1351,25 @@ def _decompose(base, ax, ay, ends, *, x_range, y_range, names, fine, arc):
             keep.append(f)
             points.append(pt)
         points = from_unit(np.array(points).reshape(-1, 2))
-        rows = base[None, :] + points[:, :1] * ax[None, :] + points[:, 1:] * ay[None, :]
-        counts = (root_counts(DelayedPolynomial.from_dense(rows)) if len(rows)
-                  else np.zeros(0, dtype=np.int64))
-        infinite = leading_vanishes(rows)
+        if family is not None:
+            chi = family[0].combine((points[:, 0], points[:, 1]), family[1:])
+        else:
+            chi = DelayedPolynomial.from_dense(
+                base[None, :] + points[:, :1] * ax[None, :] + points[:, 1:] * ay[None, :])
+        counts = root_counts(chi) if len(points) else np.zeros(0, dtype=np.int64)
+        infinite = leading_vanishes(chi)
         counts[infinite] = -1
         # Where the count's bounds cannot be closed in double precision (long
         # delays: thousands of roots near the circle), the float Schur-Cohn
         # test with its safe margin can still tell a stable cell.
         open_ = np.flatnonzero((counts == -1) & ~infinite)
         if len(open_):
-            counts[open_[classify_polynomials(rows[open_]) == STABLE]] = 0
+            counts[open_[classify_polynomials(chi.take(open_)) == STABLE]] = 0
             open_ = np.flatnonzero((counts == -1) & ~infinite)
         if len(open_):
             p = points[open_[0]]
             raise ValueError(
-                f"the unstable roots of {len(open_)} of the {len(rows)} cells cannot be counted in "
+                f"the unstable roots of {len(open_)} of the {len(points)} cells cannot be counted in "
                 f"double precision (degree {len(base) - 1}; e.g. at {names[0]} = {p[0]:.6g}, "
                 f"{names[1]} = {p[1]:.6g}): roots too close to the unit circle for the "
                 f"certified count")

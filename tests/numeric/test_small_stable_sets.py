@@ -203,3 +203,68 @@ def test_without_a_bounded_enclosure_nothing_found_is_not_called_empty(paper_fil
     # A window given is answered for that window.
     lim = paper_file_loop.limits(d=1, M=2.1 * M, x_range=(-1.0, 1.0), y_range=(-10.0, 10.0))
     assert lim.empty and "every cell of the window" in lim.reason
+
+
+@pytest.mark.parametrize("n", [1, 2, 7, 16])
+def test_the_bilinear_transform_is_sympys(n):
+    """``_bilinear`` (a recurrence per nonzero coefficient) against SymPy's expansion of its definition."""
+    import random
+
+    import sympy
+
+    from symstab.numeric.decomposition import _bilinear
+
+    w = sympy.Symbol("w")
+    rng = random.Random(n)
+    for _ in range(4):
+        # Sparse rows like a delayed loop's: nonzero next to the ends, zeros between.
+        c = [rng.randint(-10**18, 10**18) if (i < 3 or i > n - 3) and rng.random() < 0.8 else 0
+             for i in range(n + 1)]
+        p = sum(v * w ** (n - i) for i, v in enumerate(c))
+        expanded = sympy.Poly(sympy.cancel((w - 1) ** n * p.subs(w, (w + 1) / (w - 1))), w)
+        want = [int(expanded.coeff_monomial(w ** k)) for k in range(n + 1)]
+        assert _bilinear(c) == want, c
+
+
+def test_hull_holds_exactly_its_polygons():
+    """``StableHull.holds``: True inside the triangle |x| < 1 + y < 2, False a little outside it."""
+    hull = stable_hull([1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0])
+    x = np.array([0.0, 1.9, -1.9, 0.0, 2.1, 0.0, 1.0])
+    y = np.array([0.0, 0.95, 0.95, -0.99, 1.0, 1.01, -0.01])
+    assert hull.holds(x, y).tolist() == [True, True, True, True, False, False, False]
+    assert hull.holds(np.zeros((2, 3)), 0.0).shape == (2, 3)
+    empty = stable_hull([1.0, 0.0, 3.0], [0.0, 1.0, 0.0], [0.0, 0.0, 0.0])
+    assert not empty.holds(0.0, 0.0)
+
+
+@pytest.mark.parametrize("seed", range(3))
+def test_the_hull_does_not_trust_its_float_guess(seed, monkeypatch):
+    """With the float guess of the edges wrong (none, or one edge left out) the hull is the same.
+
+    The exact sides are checked to close into a polygon before the other
+    lines are skipped; when they do not, every line is solved exactly.
+    """
+    import symstab.numeric.decomposition as decomposition
+
+    rng = np.random.default_rng(200 + seed)
+    n = int(rng.integers(3, 7))
+    centre = np.real(np.poly(rng.uniform(-0.8, 0.8, n)))
+    ax, ay = 0.3 * rng.normal(size=n + 1), 0.3 * rng.normal(size=n + 1)
+    ax[0] = ay[0] = 0.0
+    want = stable_hull(centre, ax, ay)
+    guess = decomposition._float_candidates
+
+    def none(rows):
+        _, below, above = guess(rows)
+        return np.arange(0), below, above
+
+    def one_left_out(rows):
+        first, below, above = guess(rows)
+        return first[1:], below, above
+
+    for wrong in (none, one_left_out):
+        monkeypatch.setattr(decomposition, "_float_candidates", wrong)
+        got = stable_hull(centre, ax, ay)
+        assert got.bounded == want.bounded and len(got.polygons) == len(want.polygons)
+        for p, q in zip(got.polygons, want.polygons):
+            assert np.array_equal(p, q)
