@@ -44,7 +44,8 @@ from .numeric.units import PAPER_DEVICE, Device
 from .numeric.curves import BoundaryCurve, arc_end_angle
 from .numeric.region import boundary_curve
 from .numeric.stability import MARGINAL, STABLE, UNSTABLE, classify, is_stable, spectral_radius
-from .numeric.region import BestVirtualMass, Limits, StabilityRegion, best_virtual_mass, limits
+from .numeric.region import BestVirtualMass, StabilityRegion, best_virtual_mass, limits
+from .numeric.results import Limits
 from .numeric.any_loop import Loop, LoopBoundary, LoopLimits
 from .numeric.loop_files import load_loop
 from .numeric.decomposition import Branch, Cell, Decomposition

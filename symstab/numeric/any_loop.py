@@ -50,60 +50,14 @@ from .passivity import passive_region
 from .decomposition import lines as _lines
 from .polynomial import DelayedPolynomial
 from .roots import MARGINAL, STABLE, classify_polynomials, root_counts, spectral_radius
+from .results import Limits
 
 __all__ = ["Loop", "LoopLimits", "LoopBoundary", "parse_plant", "parse_environment"]
 
 
 
-@dataclasses.dataclass(frozen=True)
-class LoopLimits:
-    """Extent of the stable set of a loop in an ``(x, y)`` parameter plane.
-
-    Attributes
-    ----------
-    x, y : str
-        The plane's parameters.
-    y_max : float
-        Largest ``y`` of a stable point (``inf`` if unbounded, ``nan`` if the
-        set is empty).
-    x_at_y_max : float
-        The ``x`` where it is reached.
-    x_min, x_max : float
-        Extent of the stable set in ``x``.
-    area : float
-        Area of the stable set (the Z-width when ``x, y`` are damping and
-        stiffness), from the stable cells' polygons.
-    cells : int
-        The stable cells of :meth:`Loop.region` (the stable set's
-        connected pieces).
-    reason : str
-        When the set is empty, why: no point of the plane passes the
-        necessary condition of
-        :func:`symstab.numeric.decomposition.stable_hull`, or every cell of
-        a window holding every point that does has a root outside the unit
-        circle (or, with a window given, every cell of that window).
-    """
-
-    x: str
-    y: str
-    y_max: float
-    x_at_y_max: float
-    x_min: float
-    x_max: float
-    area: float
-    cells: int
-    reason: str = ""
-
-    @property
-    def empty(self):
-        """True when the stable set is empty (in the window, when one was given): see :attr:`reason`."""
-        return math.isnan(self.y_max)
-
-    def __repr__(self):
-        if self.empty:
-            return f"LoopLimits({self.x}, {self.y}: empty, {self.reason or 'no stable point'})"
-        return (f"LoopLimits({self.y}_max={self.y_max:.6g} at {self.x}={self.x_at_y_max:.6g}, "
-                f"{self.x} in [{self.x_min:.6g}, {self.x_max:.6g}], area={self.area:.6g})")
+#: Older name of :class:`symstab.numeric.results.Limits`, the one result type of ``limits``.
+LoopLimits = Limits
 
 
 @dataclasses.dataclass(frozen=True)
@@ -752,15 +706,15 @@ class Loop(LoopModel):
 
         Returns
         -------
-        LoopLimits
-            Empty (``y_max`` NaN, ``area`` 0, :attr:`LoopLimits.reason` says
-            why) when no point is stable: proved, not a failure to find one
-            (see :meth:`region`).
+        symstab.numeric.results.Limits
+            Empty (``y_max`` None, ``area`` 0, :attr:`~symstab.numeric.results.Limits.reason`
+            says why) when no point is stable: proved, not a failure to find
+            one (see :meth:`region`).
         """
         found = self.region(x, y, **values)
+        at = {k: v for k, v in values.items() if k not in ("x_range", "y_range")}
         if not found.stable:
-            return LoopLimits(found.x, found.y, np.nan, np.nan, np.nan, np.nan, 0.0, 0,
-                              _empty_reason(found))
+            return Limits.empty_set(found.x, found.y, _empty_reason(found), cells=0, at=at)
         (y_max, x_at), (x_min, _), (x_max, _) = (found.extreme(*which) for which in
                                                   (("y", 1), ("x", -1), ("x", 1)))
         sides = set(found.unbounded)
@@ -768,8 +722,8 @@ class Loop(LoopModel):
         x_min = -np.inf if "x_min" in sides else x_min
         x_max = np.inf if "x_max" in sides else x_max
         area = np.inf if sides else found.area
-        return LoopLimits(found.x, found.y, float(y_max), float(x_at), float(x_min), float(x_max),
-                          float(area), len(found.stable))
+        return Limits(found.x, found.y, float(y_max), float(x_at), float(x_min), float(x_max),
+                      float(area), cells=len(found.stable), at=at)
 
     def passive_region(self, x=None, y=None, *, damping="b", x_range=None, y_range=None, **values):
         """The passive set of the environment behind the loop's delay, in the ``(x, y)`` plane.

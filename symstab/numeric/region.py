@@ -44,10 +44,11 @@ from .curves import (KERNEL_BYTES_PER_POINT, KERNEL_CHUNK_BYTES, BoundaryCurve, 
                      golden_max, arc_end_angle, bracketed_root, minus_one_line, scan_grid)
 from .arcs import ClosedFormArc, crossing_change
 from .decomposition import decompose
+from .results import PAPER_PLANE, Limits
 from .polynomial import DelayedPolynomial
 from .stability import MARGINAL, STABLE, UNSTABLE, classify, loop_coefficients, paper_polynomial
 
-__all__ = ["StabilityRegion", "Limits", "limits", "BestVirtualMass", "best_virtual_mass",
+__all__ = ["StabilityRegion", "limits", "BestVirtualMass", "best_virtual_mass",
            "scan_maximum", "boundary_curve"]
 
 #: Largest number of vertical lines in the scan that finds where the region is.
@@ -849,111 +850,21 @@ class StabilityRegion:
         """
         beta_range = self.beta_range()
         top = self.alpha_max() if beta_range else None
+        paper = dict(region=self, at={"gamma": self.gamma, "d": self.d, "delta": self.delta})
         if top is None:
-            return Limits.empty_region(self, "no stable point next to the boundary arc: "
-                                             "the stable region is empty")
+            return Limits.empty_set(*PAPER_PLANE, "no stable point next to the boundary arc: "
+                                                  "the stable region is empty", **paper)
         alpha_max, beta_at = top
         if not (math.isfinite(alpha_max) and all(map(math.isfinite, beta_range))):
-            return Limits(self, alpha_max, math.nan, beta_range[1], beta_range[0], math.inf,
-                          "the stable region is unbounded")
+            return Limits(*PAPER_PLANE, alpha_max, math.nan, beta_range[0], beta_range[1],
+                          math.inf, reason="the stable region is unbounded", **paper)
         # beta_at lies on a stable interval at alpha_max: a point of the
         # region, so the range holds it (the searches for the extremes of
         # beta stop a few ulps short where a corner cannot be counted).
         if math.isfinite(beta_at):
             beta_range = (min(beta_range[0], beta_at), max(beta_range[1], beta_at))
-        return Limits(self, alpha_max, beta_at, beta_range[1], beta_range[0],
-                      self.z_width(*beta_range, n_beta=n_beta), "")
-
-
-@dataclasses.dataclass(frozen=True)
-class Limits:
-    """What one ``(gamma, d, delta)`` lets a device render.
-
-    Attributes
-    ----------
-    region : StabilityRegion
-        The region these numbers describe (its intervals on any line).
-    alpha_max : float or None
-        Largest stable alpha (the renderable stiffness ``K_w T**2 / m``).
-    beta_at_alpha_max : float or None
-        The beta at which alpha_max is reached.
-    beta_right, beta_left : float or None
-        The ends of the stable region's beta range.  ``beta_left`` is not
-        the paper's beta_min = -delta (where the boundary arc starts) unless
-        the region reaches that corner; ``beta_max`` and ``beta_min`` are
-        older names of the same two numbers.
-    z_width : float
-        Area of the stable region in the (beta, alpha) plane (0 when empty).
-    message : str
-        Empty, or why the region is empty or unbounded.
-    """
-
-    region: StabilityRegion
-    alpha_max: float
-    beta_at_alpha_max: float
-    beta_right: float
-    beta_left: float
-    z_width: float
-    message: str = ""
-
-    @property
-    def beta_max(self):
-        """Older name of :attr:`beta_right`."""
-        return self.beta_right
-
-    @property
-    def beta_min(self):
-        """Older name of :attr:`beta_left`."""
-        return self.beta_left
-
-    def __repr__(self):
-        where = (f"gamma={self.region.gamma:g}, d={self.region.d}, "
-                 f"delta={self.region.delta:g}")
-        if self.empty:
-            return f"Limits({where}: empty, {self.message!r})"
-        text = (f"Limits({where}: alpha_max={self.alpha_max:.6g} at "
-                f"beta={self.beta_at_alpha_max:.6g}, beta from {self.beta_left:.6g} "
-                f"to {self.beta_right:.6g}, z_width={self.z_width:.6g}")
-        return text + (f", {self.message!r})" if self.message else ")")
-
-    @classmethod
-    def empty_region(cls, region, message):
-        return cls(region, None, None, None, None, 0.0, message)
-
-    @property
-    def empty(self):
-        """True when no parameter point is stable."""
-        return self.alpha_max is None
-
-    def alpha_interval(self, beta):
-        """The stable alpha intervals at ``beta``; see :meth:`StabilityRegion.alpha_intervals`.
-
-        Parameters
-        ----------
-        beta : float
-            Dimensionless damping.
-        """
-        return self.region.alpha_intervals(beta)
-
-    def minimum_stiffness(self, beta):
-        """The smallest stable alpha at ``beta`` (0 unless a minimum stiffness is needed).
-
-        ``None`` when nothing is stable at ``beta``.
-
-        Parameters
-        ----------
-        beta : float
-            Dimensionless damping.
-        """
-        runs = self.region.alpha_intervals(beta)
-        return runs[0][0] if runs else None
-
-    def as_dict(self):
-        """The numbers, for tables and JSON."""
-        return {"gamma": self.region.gamma, "d": self.region.d, "delta": self.region.delta,
-                "alpha_max": self.alpha_max, "beta_at_alpha_max": self.beta_at_alpha_max,
-                "beta_left": self.beta_left, "beta_right": self.beta_right,
-                "z_width": self.z_width, "message": self.message}
+        return Limits(*PAPER_PLANE, alpha_max, beta_at, beta_range[0], beta_range[1],
+                      self.z_width(*beta_range, n_beta=n_beta), **paper)
 
 
 def limits(*, gamma, d, delta, n_beta=801):

@@ -1,0 +1,172 @@
+"""One result type per question, for every loop.
+
+:class:`Limits` answers "what does this plane's stable set let a device
+render": the largest ``y`` of a stable point, where it is reached, the
+extent in ``x`` and the area.  A :class:`symstab.Loop` gives it for any
+plane (:meth:`symstab.Loop.limits`), the paper's dimensionless functions for
+the plane ``(beta, alpha)`` of Table I (:func:`symstab.limits`,
+:meth:`symstab.StabilityRegion.limits`); there, and only there, the paper's
+names are aliases of the fields (``alpha_max`` is ``y_max``, ``z_width`` is
+``area``, ...).
+"""
+
+import dataclasses
+import math
+
+__all__ = ["Limits"]
+
+#: The paper's names (Table I) of the fields, in its (beta, alpha) plane.
+PAPER_NAMES = {"alpha_max": "y_max", "beta_at_alpha_max": "x_at_y_max", "beta_left": "x_min",
+               "beta_min": "x_min", "beta_right": "x_max", "beta_max": "x_max",
+               "z_width": "area"}
+#: The paper's dimensionless plane: x = beta (damping), y = alpha (stiffness).
+PAPER_PLANE = ("beta", "alpha")
+
+
+def _paper_alias(name, field):
+    def get(self):
+        if (self.x, self.y) != PAPER_PLANE:
+            raise AttributeError(
+                f"{name} is the paper's name in its (beta, alpha) plane; these limits are in "
+                f"the ({self.x}, {self.y}) plane: use {field}")
+        return getattr(self, field)
+
+    get.__name__ = name
+    get.__doc__ = f"The paper's name of :attr:`{field}` (the (beta, alpha) plane only)."
+    return property(get)
+
+
+@dataclasses.dataclass(frozen=True, repr=False)
+class Limits:
+    """The extent and area of the stable set in an ``(x, y)`` parameter plane.
+
+    Attributes
+    ----------
+    x, y : str
+        The plane's parameters (``"beta"``, ``"alpha"`` for the paper's
+        dimensionless plane).
+    y_max : float or None
+        Largest ``y`` of a stable point (``inf`` if unbounded; None when no
+        point is stable).
+    x_at_y_max : float or None
+        The ``x`` where it is reached (NaN when the set is unbounded there).
+    x_min, x_max : float or None
+        Extent of the stable set in ``x``.
+    area : float
+        Area of the stable set in the plane (the Z-width when ``x`` and
+        ``y`` are damping and stiffness); 0 when empty, ``inf`` when
+        unbounded.
+    cells : int or None
+        The stable cells of the D-decomposition the numbers were read from
+        (the set's connected pieces), where one was made.
+    reason : str
+        Why the set is empty or unbounded; else empty.
+    region : object
+        What the numbers describe: the paper's
+        :class:`~symstab.numeric.region.StabilityRegion` (its intervals on
+        any line), or None.
+    at : dict
+        The values of the other parameters, as given.
+
+    Notes
+    -----
+    In the paper's plane the names of Table I are aliases:
+    ``alpha_max`` (``y_max``), ``beta_at_alpha_max`` (``x_at_y_max``),
+    ``beta_left`` and ``beta_min`` (``x_min``), ``beta_right`` and
+    ``beta_max`` (``x_max``), ``z_width`` (``area``); ``message`` is
+    ``reason`` in every plane.  Elsewhere those names raise
+    :class:`AttributeError` rather than answer for another plane.
+    """
+
+    x: str
+    y: str
+    y_max: object
+    x_at_y_max: object
+    x_min: object
+    x_max: object
+    area: float
+    cells: object = None
+    reason: str = ""
+    region: object = None
+    at: dict = dataclasses.field(default_factory=dict)
+
+    alpha_max = _paper_alias("alpha_max", "y_max")
+    beta_at_alpha_max = _paper_alias("beta_at_alpha_max", "x_at_y_max")
+    beta_left = _paper_alias("beta_left", "x_min")
+    beta_min = _paper_alias("beta_min", "x_min")
+    beta_right = _paper_alias("beta_right", "x_max")
+    beta_max = _paper_alias("beta_max", "x_max")
+    z_width = _paper_alias("z_width", "area")
+
+    @property
+    def message(self):
+        """Another name of :attr:`reason`."""
+        return self.reason
+
+    @property
+    def empty(self):
+        """True when no point of the plane is stable (see :attr:`reason`)."""
+        return self.y_max is None
+
+    @classmethod
+    def empty_set(cls, x, y, reason, **fields):
+        """Limits of an empty stable set (``y_max`` None, ``area`` 0)."""
+        return cls(x, y, None, None, None, None, 0.0, reason=reason, **fields)
+
+    def _where(self):
+        return ", ".join(f"{k}={v:g}" if isinstance(v, float) else f"{k}={v}"
+                         for k, v in self.at.items())
+
+    def __repr__(self):
+        where = self._where()
+        head = f"Limits({where}: " if where else f"Limits({self.x}, {self.y}: "
+        if self.empty:
+            return head + f"empty, {self.reason or 'no stable point'})"
+        if (self.x, self.y) == PAPER_PLANE:
+            text = (f"alpha_max={self.y_max:.6g} at beta={self.x_at_y_max:.6g}, beta from "
+                    f"{self.x_min:.6g} to {self.x_max:.6g}, z_width={self.area:.6g}")
+        else:
+            text = (f"{self.y}_max={self.y_max:.6g} at {self.x}={self.x_at_y_max:.6g}, "
+                    f"{self.x} in [{self.x_min:.6g}, {self.x_max:.6g}], area={self.area:.6g}")
+        return head + text + (f", {self.reason!r})" if self.reason else ")")
+
+    def as_dict(self):
+        """The numbers, for tables and JSON (the paper's names in its plane)."""
+        if (self.x, self.y) == PAPER_PLANE:
+            return {**self.at, "alpha_max": self.y_max, "beta_at_alpha_max": self.x_at_y_max,
+                    "beta_left": self.x_min, "beta_right": self.x_max, "z_width": self.area,
+                    "message": self.reason}
+        return {**self.at, "x": self.x, "y": self.y, "y_max": self.y_max,
+                "x_at_y_max": self.x_at_y_max, "x_min": self.x_min, "x_max": self.x_max,
+                "area": self.area, "cells": self.cells, "reason": self.reason}
+
+    # The paper's line questions, answered by its region.
+
+    def _paper_region(self, what):
+        if self.region is None or not hasattr(self.region, "alpha_intervals"):
+            raise AttributeError(f"{what} needs the paper's StabilityRegion; these limits of the "
+                                 f"({self.x}, {self.y}) plane do not carry one")
+        return self.region
+
+    def alpha_interval(self, beta):
+        """The stable alpha intervals at ``beta``; see :meth:`StabilityRegion.alpha_intervals`.
+
+        Parameters
+        ----------
+        beta : float
+            Dimensionless damping.
+        """
+        return self._paper_region("alpha_interval").alpha_intervals(beta)
+
+    def minimum_stiffness(self, beta):
+        """The smallest stable alpha at ``beta`` (0 unless a minimum stiffness is needed).
+
+        ``None`` when nothing is stable at ``beta``.
+
+        Parameters
+        ----------
+        beta : float
+            Dimensionless damping.
+        """
+        runs = self._paper_region("minimum_stiffness").alpha_intervals(beta)
+        return runs[0][0] if runs else None

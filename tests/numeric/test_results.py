@@ -1,0 +1,81 @@
+"""One ``Limits`` for every loop: the paper's dimensionless limits and a Loop's are one type.
+
+Oracles: the two engines that fill it are different algorithms on different
+polynomial kernels (crossings counted along lines in the paper's plane,
+:mod:`symstab.numeric.region`; the D-decomposition of the loop's structured
+polynomial, :mod:`symstab.numeric.decomposition`), so their agreement after
+the change of units is a check of both; python-control's closed-loop poles
+decide the points on either side of the top.
+"""
+
+import numpy as np
+import pytest
+
+import symstab
+from oracles import python_control_closed_loop
+from symstab.numeric.results import Limits
+from symstab.numeric.units import PAPER_DEVICE
+
+control = pytest.importorskip("control")
+
+
+@pytest.mark.parametrize("d", [0, 5, 40])
+def test_the_paper_and_its_loop_give_one_type_that_agrees(d):
+    """symstab.limits and PAPER_LOOP.limits: the same type, the same set after the change of units."""
+    paper = symstab.limits(gamma=0.0, d=d, delta=PAPER_DEVICE.delta)
+    loop = symstab.PAPER_LOOP.limits(d=d)
+    assert type(paper) is type(loop) is Limits is symstab.Limits is symstab.LoopLimits
+    assert (paper.x, paper.y, loop.x, loop.y) == ("beta", "alpha", "B", "K")
+    # Table I names are the fields in the paper's plane.
+    assert (paper.alpha_max, paper.beta_left, paper.beta_right, paper.z_width) == (
+        paper.y_max, paper.x_min, paper.x_max, paper.area)
+    assert loop.y_max == pytest.approx(float(PAPER_DEVICE.stiffness(paper.y_max)), rel=1e-6)
+    assert loop.x_min == pytest.approx(float(PAPER_DEVICE.damping(paper.x_min)), rel=1e-6)
+    assert loop.x_max == pytest.approx(float(PAPER_DEVICE.damping(paper.x_max)), rel=1e-6)
+    # The two areas: polygons against the 801-line rule (low by up to 1e-4).
+    scale = float(PAPER_DEVICE.stiffness(1.0) * PAPER_DEVICE.damping(1.0))
+    assert loop.area == pytest.approx(paper.area * scale, rel=1e-4)
+
+
+def test_the_top_is_the_top_by_python_control():
+    """Just below PAPER_LOOP's K_max at its B the loop is stable, just above unstable (poles)."""
+    d = 5
+    lim = symstab.PAPER_LOOP.limits(d=d)
+    beta, m, T = float(PAPER_DEVICE.beta(lim.x_at_y_max)), PAPER_DEVICE.m, PAPER_DEVICE.T
+    radii = []
+    for factor in (1 - 1e-6, 1 + 1e-6):
+        closed = python_control_closed_loop(alpha=float(PAPER_DEVICE.alpha(factor * lim.y_max)),
+                                            beta=beta, gamma=0.0, d=d, delta=PAPER_DEVICE.delta,
+                                            m=m, T=T)
+        radii.append(float(np.max(np.abs(closed.poles()))))
+    assert radii[0] < 1 < radii[1]
+
+
+def test_paper_names_are_refused_outside_the_paper_plane():
+    """alpha_max of a (B, K) result would be K_max in N/m under a dimensionless name: refused."""
+    lim = symstab.PAPER_LOOP.limits(d=5)
+    for name, field in (("alpha_max", "y_max"), ("z_width", "area"), ("beta_left", "x_min")):
+        with pytest.raises(AttributeError, match=rf"{name} is the paper's name .* use {field}"):
+            getattr(lim, name)
+    with pytest.raises(AttributeError, match="StabilityRegion"):
+        lim.alpha_interval(0.1)
+
+
+def test_an_empty_set_reads_the_same_from_both():
+    """Proved empty sets: y_max None, area 0, a reason, from the paper's engine and from a Loop."""
+    paper = symstab.limits(gamma=2.1, d=40, delta=PAPER_DEVICE.delta)
+    loop = symstab.PAPER_LOOP.limits(d=1, M=2.1 * PAPER_DEVICE.m)
+    for lim in (paper, loop):
+        assert lim.empty and lim.y_max is None and lim.area == 0.0 and lim.reason
+        assert lim.message == lim.reason
+        assert "empty" in repr(lim)
+
+
+def test_json_keys_of_the_paper_plane_are_table_one():
+    """as_dict keeps the paper's keys in its plane and the plane's own names elsewhere."""
+    paper = symstab.limits(gamma=0.0, d=1, delta=PAPER_DEVICE.delta).as_dict()
+    assert list(paper) == ["gamma", "d", "delta", "alpha_max", "beta_at_alpha_max", "beta_left",
+                           "beta_right", "z_width", "message"]
+    loop = symstab.PAPER_LOOP.limits(d=1).as_dict()
+    assert {"y_max", "x_at_y_max", "x_min", "x_max", "area", "cells"} <= set(loop)
+    assert loop["d"] == 1 and loop["x"] == "B"
