@@ -50,7 +50,7 @@ from .passivity import passive_region
 from .decomposition import lines as _lines
 from .polynomial import DelayedPolynomial
 from .roots import MARGINAL, STABLE, classify_polynomials, root_counts, spectral_radius
-from .results import Limits
+from .results import Boundary, Limits
 
 __all__ = ["Loop", "LoopLimits", "LoopBoundary", "parse_plant", "parse_environment"]
 
@@ -60,37 +60,9 @@ __all__ = ["Loop", "LoopLimits", "LoopBoundary", "parse_plant", "parse_environme
 LoopLimits = Limits
 
 
-@dataclasses.dataclass(frozen=True)
-class LoopBoundary:
-    """The D-decomposition of an ``(x, y)`` plane.
+#: Older name of :class:`symstab.numeric.results.Boundary`, the one result type of a boundary.
+LoopBoundary = Boundary
 
-    Attributes
-    ----------
-    x, y : str
-        The plane's parameters.
-    theta : ndarray
-        Angles in (0, pi).
-    x_values, y_values : ndarray
-        The point of the plane at which ``z = exp(j theta)`` is a root (NaN
-        where the 2 x 2 system is singular).
-    lines : dict
-        ``{"z = 1": (c0, cx, cy), "z = -1": ..., "leading": ...}``: the line
-        ``c0 + cx x + cy y = 0`` on which that real root (or a root at
-        infinity) appears; a line whose ``cx`` and ``cy`` are both 0 is left
-        out.
-    """
-
-    x: str
-    y: str
-    theta: np.ndarray
-    x_values: np.ndarray
-    y_values: np.ndarray
-    lines: dict
-
-    def __repr__(self):
-        finite = np.isfinite(self.x_values) & np.isfinite(self.y_values)
-        return (f"LoopBoundary({self.x}, {self.y}: {int(finite.sum())} arc points, "
-                f"lines {', '.join(self.lines) or 'none'})")
 
 class Loop(LoopModel):
     """A sampled haptic loop: plant, zero-order hold, delay and virtual environment.
@@ -554,7 +526,7 @@ class Loop(LoopModel):
 
         Returns
         -------
-        LoopBoundary
+        symstab.numeric.results.Boundary
         """
         x, y = self._plane(x, y)
         n = check_count("n", n, 2)
@@ -564,7 +536,7 @@ class Loop(LoopModel):
         theta = np.pi * (np.arange(1, n + 1) - 0.5) / n
         xs, ys, _ = CramerArc(structured, *slopes)(theta)
         lines = {label: c for label, c in _lines(base, ax, ay, ends).items() if c[1] or c[2]}
-        return LoopBoundary(x=x, y=y, theta=theta, x_values=xs, y_values=ys, lines=lines)
+        return Boundary(x, y, theta, xs, ys, lines=lines, at=dict(values))
 
     def region(self, x=None, y=None, *, x_range=None, y_range=None, **values):
         """The complete D-decomposition of the ``(x, y)`` plane: cells, root counts, stable set.

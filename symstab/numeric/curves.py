@@ -9,7 +9,7 @@ where the arc ends:
   (0, pi], isolated with a bound on R'' so that no root is stepped over
   and refined by regula falsi to a few ulps (the float counterpart of the
   30-digit :func:`symstab.symbolic.theta_max.theta_max`);
-* :class:`BoundaryCurve` -- the arc from theta = 0 to theta_max, with the
+* :class:`BoundaryCurve` (:class:`symstab.numeric.results.Boundary`) -- the arc from theta = 0 to theta_max, with the
   other pieces of the boundary of the stable region (z = 1 and z = -1,
   straight lines in the alpha-beta plane) where they bound it; built by
   :func:`symstab.numeric.region.boundary_curve`, which finds those pieces in
@@ -25,6 +25,7 @@ import numpy as np
 from .._generated import kernels
 from .._validate import check_loop
 from ..symbolic.theta_max import first_sign_change, reduced_curvature, reduced_qr, reduced_value_slope
+from .results import Boundary
 
 __all__ = ["arc_end_angle", "minus_one_line", "BoundaryCurve", "Segment", "scan_grid",
            "bracketed_root", "golden_max", "KERNEL_BYTES_PER_POINT", "KERNEL_CHUNK_BYTES"]
@@ -220,50 +221,8 @@ class Segment:
     alpha1: float
 
 
-@dataclasses.dataclass(frozen=True)
-class BoundaryCurve:
-    """The boundary arc and the straight pieces that close the stable region.
-
-    Attributes
-    ----------
-    gamma, d, delta
-        The parameters.
-    theta, alpha, beta : ndarray
-        The arc from theta = 0 (alpha = 0, beta = -delta) to theta_max; empty
-        when there is no arc.
-    theta_max : float
-        End of the arc (``nan`` when there is none).
-    segments : tuple of Segment
-        The pieces of the lines z = 1 (alpha = 0) and z = -1 that bound the
-        stable region, found from the region itself
-        (:class:`symstab.numeric.region.StabilityRegion`).
-    message : str
-        Empty, or why there is no arc.
-    """
-
-    gamma: float
-    d: int
-    delta: float
-    theta: np.ndarray
-    alpha: np.ndarray
-    beta: np.ndarray
-    theta_max: float
-    segments: tuple = ()
-    message: str = ""
-
-    @property
-    def empty(self):
-        """True when there is no arc."""
-        return self.theta.size == 0
-
-    def __repr__(self):
-        where = f"gamma={self.gamma:g}, d={self.d}, delta={self.delta:g}"
-        if self.empty:
-            return f"BoundaryCurve({where}: no arc, {self.message!r})"
-        return (f"BoundaryCurve({where}: {self.theta.size} points, theta_max={self.theta_max:.6g}, "
-                f"alpha up to {float(np.max(self.alpha)):.6g}, beta from "
-                f"{float(np.min(self.beta)):.6g} to {float(np.max(self.beta)):.6g}, "
-                f"{len(self.segments)} straight segment{'s' if len(self.segments) != 1 else ''})")
+#: Older name of :class:`symstab.numeric.results.Boundary`, the one result type of a boundary.
+BoundaryCurve = Boundary
 
 
 def golden_max(f, a, b, iterations=80):

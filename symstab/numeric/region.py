@@ -40,11 +40,11 @@ import numpy as np
 from .._generated import kernels
 from .._resources import CHUNK_BYTES, check_memory, chunk_slices
 from .._validate import check_array, check_count, check_loop, check_real, check_window
-from .curves import (KERNEL_BYTES_PER_POINT, KERNEL_CHUNK_BYTES, BoundaryCurve, Segment,
+from .curves import (KERNEL_BYTES_PER_POINT, KERNEL_CHUNK_BYTES, Segment,
                      golden_max, arc_end_angle, bracketed_root, minus_one_line, scan_grid)
 from .arcs import ClosedFormArc, crossing_change
 from .decomposition import decompose
-from .results import PAPER_PLANE, Limits
+from .results import PAPER_PLANE, Boundary, Limits
 from .polynomial import DelayedPolynomial
 from .stability import MARGINAL, STABLE, UNSTABLE, classify, loop_coefficients, paper_polynomial
 
@@ -1110,7 +1110,9 @@ def boundary_curve(*, gamma, d, delta, n=1000, segments=True):
 
     Returns
     -------
-    BoundaryCurve
+    symstab.numeric.results.Boundary
+        In the paper's plane: ``alpha`` and ``beta`` (aliases of
+        ``y_values`` and ``x_values``), ``theta_max``, ``segments``.
 
     Raises
     ------
@@ -1129,11 +1131,18 @@ def boundary_curve(*, gamma, d, delta, n=1000, segments=True):
     # theta, alpha and beta are kept; the kernel's temporaries are chunked.
     check_memory(f"boundary_curve with n = {n} points", 3 * 8 * n + KERNEL_CHUNK_BYTES)
     t_end = arc_end_angle(gamma=gamma, d=d, delta=delta)
+    at = {"gamma": gamma, "d": d, "delta": delta}
+    # c0 + c_beta beta + c_alpha alpha = 0: z = 1 is alpha = 0, z = -1 is alpha + 2 beta = c.
+    lines = {"z = 1": (0.0, 0.0, 1.0)}
+    c = minus_one_line(gamma=gamma, d=d, delta=delta)
+    if math.isfinite(c):
+        lines["z = -1"] = (-c, 2.0, 1.0)
     if not np.isfinite(t_end):
         empty = np.empty(0)
-        return BoundaryCurve(gamma, d, delta, empty, empty, empty, t_end, (),
-                             "no boundary arc: alpha < 0 just after theta = 0, so the arc never "
-                             "enters alpha > 0 (1 + gamma + (d + 1) delta <= 0 or close to it)")
+        return Boundary(*PAPER_PLANE, empty, empty, empty, lines=lines, theta_max=t_end,
+                        reason="no boundary arc: alpha < 0 just after theta = 0, so the arc "
+                               "never enters alpha > 0 (1 + gamma + (d + 1) delta <= 0 or close "
+                               "to it)", at=at)
     theta = np.linspace(0.0, t_end, n)
     alpha, beta = np.empty(n), np.empty(n)
     for part in chunk_slices(n, KERNEL_BYTES_PER_POINT, KERNEL_CHUNK_BYTES):
@@ -1145,4 +1154,5 @@ def boundary_curve(*, gamma, d, delta, n=1000, segments=True):
     pieces = ()
     if segments:
         pieces = StabilityRegion(gamma=gamma, d=d, delta=delta).line_segments()
-    return BoundaryCurve(gamma, d, delta, theta, alpha, beta, t_end, pieces)
+    return Boundary(*PAPER_PLANE, theta, beta, alpha, lines=lines, segments=pieces, theta_max=t_end,
+                    at=at)

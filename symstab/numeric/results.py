@@ -2,18 +2,21 @@
 
 :class:`Limits` answers "what does this plane's stable set let a device
 render": the largest ``y`` of a stable point, where it is reached, the
-extent in ``x`` and the area.  A :class:`symstab.Loop` gives it for any
+extent in ``x`` and the area.  :class:`Boundary` answers "where can a root
+cross the unit circle": the arc (a root at ``exp(j theta)``) and the lines of
+the real roots and of a root at infinity.  A :class:`symstab.Loop` gives it for any
 plane (:meth:`symstab.Loop.limits`), the paper's dimensionless functions for
 the plane ``(beta, alpha)`` of Table I (:func:`symstab.limits`,
 :meth:`symstab.StabilityRegion.limits`); there, and only there, the paper's
 names are aliases of the fields (``alpha_max`` is ``y_max``, ``z_width`` is
-``area``, ...).
+``area``, a boundary's ``alpha`` is its ``y_values``, ...).
 """
 
 import dataclasses
-import math
 
-__all__ = ["Limits"]
+import numpy as np
+
+__all__ = ["Limits", "Boundary"]
 
 #: The paper's names (Table I) of the fields, in its (beta, alpha) plane.
 PAPER_NAMES = {"alpha_max": "y_max", "beta_at_alpha_max": "x_at_y_max", "beta_left": "x_min",
@@ -27,12 +30,24 @@ def _paper_alias(name, field):
     def get(self):
         if (self.x, self.y) != PAPER_PLANE:
             raise AttributeError(
-                f"{name} is the paper's name in its (beta, alpha) plane; these limits are in "
+                f"{name} is the paper's name in its (beta, alpha) plane; this result is in "
                 f"the ({self.x}, {self.y}) plane: use {field}")
         return getattr(self, field)
 
     get.__name__ = name
     get.__doc__ = f"The paper's name of :attr:`{field}` (the (beta, alpha) plane only)."
+    return property(get)
+
+
+def _paper_parameter(name):
+    def get(self):
+        if (self.x, self.y) != PAPER_PLANE or name not in self.at:
+            raise AttributeError(f"{name} is a parameter of the paper's (beta, alpha) plane; "
+                                 f"this result is in the ({self.x}, {self.y}) plane: see at")
+        return self.at[name]
+
+    get.__name__ = name
+    get.__doc__ = f"The paper's ``{name}`` (``at[{name!r}]``; the (beta, alpha) plane only)."
     return property(get)
 
 
@@ -170,3 +185,89 @@ class Limits:
         """
         runs = self._paper_region("minimum_stiffness").alpha_intervals(beta)
         return runs[0][0] if runs else None
+
+
+
+@dataclasses.dataclass(frozen=True, repr=False)
+class Boundary:
+    """Where a root of the characteristic polynomial crosses the unit circle, in an ``(x, y)`` plane.
+
+    Attributes
+    ----------
+    x, y : str
+        The plane's parameters (``"beta"``, ``"alpha"`` for the paper's
+        dimensionless plane).
+    theta : ndarray
+        Angles of the arc's points: ``z = exp(j theta)`` is a root at
+        ``(x_values, y_values)``.  A loop's boundary samples all of (0, pi);
+        the paper's :func:`symstab.boundary_curve` the stable region's arc,
+        from theta = 0 to :attr:`theta_max`.  Empty when there is no arc.
+    x_values, y_values : ndarray
+        The arc's points (NaN where the 2 x 2 system is singular: the arc is
+        at infinity there).
+    lines : dict
+        ``{"z = 1": (c0, cx, cy), "z = -1": ..., "leading": ...}``: the line
+        ``c0 + cx x + cy y = 0`` on which that real root (or a root at
+        infinity) appears; a line that does not exist in the plane is left
+        out.
+    segments : tuple of symstab.numeric.curves.Segment
+        The pieces of those lines that bound the stable region, where they
+        were found (the paper's :func:`symstab.boundary_curve`).
+    theta_max : float
+        Where the stable region's arc ends (the paper's plane; NaN else).
+    reason : str
+        Why there is no arc, when there is none.
+    at : dict
+        The values of the other parameters, as given.
+
+    Notes
+    -----
+    In the paper's plane ``alpha`` and ``beta`` are aliases of
+    :attr:`y_values` and :attr:`x_values`, and ``gamma``, ``d``, ``delta``
+    read :attr:`at`; ``message`` is :attr:`reason` in every plane.
+    """
+
+    x: str
+    y: str
+    theta: np.ndarray
+    x_values: np.ndarray
+    y_values: np.ndarray
+    lines: dict = dataclasses.field(default_factory=dict)
+    segments: tuple = ()
+    theta_max: float = float("nan")
+    reason: str = ""
+    at: dict = dataclasses.field(default_factory=dict)
+
+    alpha = _paper_alias("alpha", "y_values")
+    beta = _paper_alias("beta", "x_values")
+    gamma = _paper_parameter("gamma")
+    d = _paper_parameter("d")
+    delta = _paper_parameter("delta")
+
+    @property
+    def message(self):
+        """Another name of :attr:`reason`."""
+        return self.reason
+
+    @property
+    def empty(self):
+        """True when there is no arc."""
+        return self.theta.size == 0
+
+    def __repr__(self):
+        where = ", ".join(f"{k}={v:g}" if isinstance(v, float) else f"{k}={v}"
+                          for k, v in self.at.items())
+        head = f"Boundary({where}: " if where else f"Boundary({self.x}, {self.y}: "
+        if self.empty:
+            return head + f"no arc, {self.reason!r})"
+        finite = np.isfinite(self.x_values) & np.isfinite(self.y_values)
+        if (self.x, self.y) == PAPER_PLANE and self.segments is not None and np.isfinite(
+                self.theta_max):
+            n = len(self.segments)
+            return head + (f"{self.theta.size} points, theta_max={self.theta_max:.6g}, alpha up to "
+                           f"{float(np.max(self.y_values)):.6g}, beta from "
+                           f"{float(np.min(self.x_values)):.6g} to "
+                           f"{float(np.max(self.x_values)):.6g}, {n} straight "
+                           f"segment{'s' if n != 1 else ''})")
+        return head + (f"{int(finite.sum())} arc points, lines "
+                       f"{', '.join(self.lines) or 'none'})")

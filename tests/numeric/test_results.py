@@ -12,7 +12,7 @@ import numpy as np
 import pytest
 
 import symstab
-from oracles import python_control_closed_loop
+from oracles import first_principles_chi, python_control_closed_loop
 from symstab.numeric.results import Limits
 from symstab.numeric.units import PAPER_DEVICE
 
@@ -79,3 +79,39 @@ def test_json_keys_of_the_paper_plane_are_table_one():
     loop = symstab.PAPER_LOOP.limits(d=1).as_dict()
     assert {"y_max", "x_at_y_max", "x_min", "x_max", "area", "cells"} <= set(loop)
     assert loop["d"] == 1 and loop["x"] == "B"
+
+
+@pytest.mark.parametrize("gamma, d", [(0.0, 0), (0.5, 3), (-0.5, 10)])
+def test_the_papers_boundary_lines_are_where_a_real_root_is_on_the_circle(gamma, d):
+    """Points of boundary_curve's z = +-1 lines make chi(+-1) vanish (30-digit printed-equation chi)."""
+    import mpmath
+
+    delta = PAPER_DEVICE.delta
+    curve = symstab.boundary_curve(gamma=gamma, d=d, delta=delta, n=16, segments=False)
+    assert type(curve) is symstab.BoundaryCurve
+    assert (curve.gamma, curve.d, curve.delta) == (gamma, d, delta)
+    assert set(curve.lines) == {"z = 1", "z = -1"}
+    with mpmath.workdps(30):
+        for label, z in (("z = 1", 1), ("z = -1", -1)):
+            c0, cb, ca = curve.lines[label]
+            for beta in (0.01, 0.3):
+                alpha = -(c0 + cb * beta) / ca
+                chi = first_principles_chi(alpha, beta, gamma, d, delta)
+                value = mpmath.polyval(chi, z)
+                scale = sum(abs(c) for c in chi)
+                assert abs(value) < 1e-12 * scale, (label, beta)
+
+
+def test_a_loops_boundary_is_the_same_type_with_the_planes_names():
+    """Loop.boundary and boundary_curve: one Boundary; the paper's names only in its plane."""
+    loop = symstab.PAPER_LOOP.boundary(d=5, n=64)
+    paper = symstab.boundary_curve(gamma=0.0, d=5, delta=PAPER_DEVICE.delta, n=64, segments=False)
+    assert type(loop) is type(paper) is symstab.LoopBoundary is symstab.BoundaryCurve
+    assert (loop.x, loop.y) == ("B", "K") and set(loop.lines) >= {"z = 1", "z = -1"}
+    with pytest.raises(AttributeError, match="use y_values"):
+        loop.alpha
+    with pytest.raises(AttributeError, match="paper's"):
+        loop.gamma
+    # The arc starts at (beta, alpha) = (-delta, 0): the names are not swapped.
+    assert (paper.beta[0], paper.alpha[0]) == (-PAPER_DEVICE.delta, 0.0)
+    assert (paper.x_values[0], paper.y_values[0]) == (-PAPER_DEVICE.delta, 0.0)
