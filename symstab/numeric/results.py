@@ -51,6 +51,15 @@ def _paper_parameter(name):
     return property(get)
 
 
+def _head(kind, result):
+    """``Limits(gamma=0, d=5, delta=0.00253: `` in the paper's plane, ``Limits(B, K at d=5: `` else."""
+    where = ", ".join(f"{k}={v:g}" if isinstance(v, float) else f"{k}={v}"
+                      for k, v in result.at.items())
+    if (result.x, result.y) == PAPER_PLANE and where:
+        return f"{kind}({where}: "
+    return f"{kind}({result.x}, {result.y}{' at ' + where if where else ''}: "
+
+
 @dataclasses.dataclass(frozen=True, repr=False)
 class Limits:
     """The extent and area of the stable set in an ``(x, y)`` parameter plane.
@@ -128,13 +137,8 @@ class Limits:
         """Limits of an empty stable set (``y_max`` None, ``area`` 0)."""
         return cls(x, y, None, None, None, None, 0.0, reason=reason, **fields)
 
-    def _where(self):
-        return ", ".join(f"{k}={v:g}" if isinstance(v, float) else f"{k}={v}"
-                         for k, v in self.at.items())
-
     def __repr__(self):
-        where = self._where()
-        head = f"Limits({where}: " if where else f"Limits({self.x}, {self.y}: "
+        head = _head("Limits", self)
         if self.empty:
             return head + f"empty, {self.reason or 'no stable point'})"
         if (self.x, self.y) == PAPER_PLANE:
@@ -255,9 +259,7 @@ class Boundary:
         return self.theta.size == 0
 
     def __repr__(self):
-        where = ", ".join(f"{k}={v:g}" if isinstance(v, float) else f"{k}={v}"
-                          for k, v in self.at.items())
-        head = f"Boundary({where}: " if where else f"Boundary({self.x}, {self.y}: "
+        head = _head("Boundary", self)
         if self.empty:
             return head + f"no arc, {self.reason!r})"
         finite = np.isfinite(self.x_values) & np.isfinite(self.y_values)
