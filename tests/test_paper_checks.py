@@ -426,7 +426,7 @@ def test_gamma2_claims_do_not_hang_on_one_sample(monkeypatch):
 
     def raised(**kw):
         arc = curve(**kw)
-        return dataclasses.replace(arc, alpha=arc.alpha * (1 + 1e-11))
+        return dataclasses.replace(arc, y_values=arc.y_values * (1 + 1e-11))   # alpha
 
     monkeypatch.setattr(regions, "boundary_curve", raised)
     for memo in (claims._classify, claims._limits):
