@@ -155,14 +155,19 @@ def _stodola_holds(c):
     return all(v > 0 for v in q) or all(v < 0 for v in q)
 
 
+def _real_root_family(rng, n):
+    """A stable monic centre of degree ``n`` (real roots in (-0.8, 0.8)) and two random slopes."""
+    centre = np.real(np.poly(rng.uniform(-0.8, 0.8, n)))
+    ax, ay = 0.3 * rng.normal(size=n + 1), 0.3 * rng.normal(size=n + 1)
+    ax[0] = ay[0] = 0.0
+    return centre, ax, ay
+
+
 @pytest.mark.parametrize("seed", range(4))
 def test_the_hull_is_the_set_where_stodolas_condition_holds(seed):
     """Inside a hull polygon exactly where every transformed coefficient has one sign (both ways)."""
     rng = np.random.default_rng(100 + seed)
-    n = int(rng.integers(2, 6))
-    centre = np.real(np.poly(rng.uniform(-0.8, 0.8, n)))
-    ax, ay = 0.3 * rng.normal(size=n + 1), 0.3 * rng.normal(size=n + 1)
-    ax[0] = ay[0] = 0.0
+    centre, ax, ay = _real_root_family(rng, int(rng.integers(2, 6)))
     hull = stable_hull(centre, ax, ay)
     assert hull.bounded and len(hull.polygons) == 1
     (x0, x1), (y0, y1) = hull.box(0.5)
@@ -247,10 +252,7 @@ def test_the_hull_does_not_trust_its_float_guess(seed, monkeypatch):
     import symstab.numeric.decomposition as decomposition
 
     rng = np.random.default_rng(200 + seed)
-    n = int(rng.integers(3, 7))
-    centre = np.real(np.poly(rng.uniform(-0.8, 0.8, n)))
-    ax, ay = 0.3 * rng.normal(size=n + 1), 0.3 * rng.normal(size=n + 1)
-    ax[0] = ay[0] = 0.0
+    centre, ax, ay = _real_root_family(rng, int(rng.integers(3, 7)))
     want = stable_hull(centre, ax, ay)
     guess = decomposition._float_candidates
 
