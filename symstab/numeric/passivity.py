@@ -78,6 +78,7 @@ along it) becomes many short edges.
 """
 
 import dataclasses
+import functools
 import math
 
 import numpy as np
@@ -176,18 +177,6 @@ class PassiveRegion:
             # _Plane.rows); a relative slack of 1e-12 absorbs the rounding
             # of a point on an edge.
             out &= c0 + cx * x + cy * y <= 1e-12 * (abs(c0) + abs(cx * x) + abs(cy * y))
-        return out
-
-    def renamed(self, x, y):
-        """The same region with the plane's parameters called ``x`` and ``y``.
-
-        Parameters
-        ----------
-        x, y : str
-            The new names.
-        """
-        out = dataclasses.replace(self, x=x, y=y)
-        object.__setattr__(out, "_halfplanes", self._halfplanes)
         return out
 
     def __repr__(self):
@@ -608,6 +597,18 @@ def _check_stable_denominator(den, what):
 # The paper's normalised loop
 
 
+@functools.lru_cache(maxsize=1)
+def _paper_parts():
+    """``T**2 VE / m`` as ``(N, D)`` coefficient lists in z, from the derivation."""
+    from ..symbolic import model
+    from ..symbolic.loop import dimensionless_environment
+
+    num, den = sp.fraction(sp.together(dimensionless_environment()))
+    num = sp.Poly(sp.expand(num), model.z).all_coeffs()
+    den = sp.Poly(sp.expand(den), model.z).all_coeffs()
+    return num, den
+
+
 def paper_passive_region(*, gamma, d, delta, x_range=None, y_range=None):
     """The passive set of the paper's loop in the ``(beta, alpha)`` plane.
 
@@ -618,11 +619,8 @@ def paper_passive_region(*, gamma, d, delta, x_range=None, y_range=None):
         delta > 1/(2 (1 - cos theta)) Re{(1 - e^{-j theta}) h(theta) e^{-j theta d}}
 
     with ``h = alpha + beta (1 - e^{-j theta}) + gamma (1 - e^{-j theta})**2``
-    (``T**2 VE / m``), for ``theta`` in [0, pi]; and ``alpha >= 0`` (no
-    negative static stiffness).  That is :func:`passive_region` of
-    :data:`symstab.PAPER_LOOP` with ``m = T = 1``, ``b = delta`` and ``M =
-    gamma``, where ``(B, K)`` are ``(beta, alpha)``: this function is that
-    call, with the plane's names changed.
+    (``T**2 VE / m``, taken from :func:`symstab.symbolic.loop.dimensionless_environment`),
+    for ``theta`` in [0, pi]; and ``alpha >= 0`` (no negative static stiffness).
 
     Parameters
     ----------
@@ -657,12 +655,23 @@ def paper_passive_region(*, gamma, d, delta, x_range=None, y_range=None):
     gamma, d, delta = check_loop(gamma, d, delta)
     if delta <= 0:
         raise ValueError(f"delta must be > 0 for a passive set with an interior, got {delta!r}")
-    from .paper_loop import PAPER_LOOP
+    x_range, y_range = _windows(x_range, y_range)
+    from ..symbolic import model
 
-    # With m = T = 1 and b = delta, the paper's (B, K) plane is its (beta, alpha) plane.
-    found = PAPER_LOOP.passive_region(x_range=x_range, y_range=y_range, m=1.0, T=1.0, b=delta,
-                                      M=gamma, d=d)
-    return found.renamed("beta", "alpha")
+    num, den = _paper_parts()
+    sub = {model.gamma: sp.Float(repr(gamma), 30)}
+
+    def numbers(coefficients, **at):
+        values = {model.alpha: 0, model.beta: 0, **sub}
+        values.update({getattr(model, k): v for k, v in at.items()})
+        return np.array([float(sp.sympify(c).subs(values)) for c in coefficients])
+
+    base = numbers(num)
+    slope_x = numbers(num, beta=1) - base
+    slope_y = numbers(num, alpha=1) - base
+    den_values = numbers(den)
+    plane = _prepare_plane(base, slope_x, slope_y, den_values, d, 0.5, delta, None)
+    return _solve(plane, "beta", "alpha", x_range, y_range)
 
 
 def _prepare_plane(base, slope_x, slope_y, den, d, scale, damping, damping_axis):
