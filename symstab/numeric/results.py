@@ -18,10 +18,6 @@ import numpy as np
 
 __all__ = ["Limits", "Boundary"]
 
-#: The paper's names (Table I) of the fields, in its (beta, alpha) plane.
-PAPER_NAMES = {"alpha_max": "y_max", "beta_at_alpha_max": "x_at_y_max", "beta_left": "x_min",
-               "beta_min": "x_min", "beta_right": "x_max", "beta_max": "x_max",
-               "z_width": "area"}
 #: The paper's dimensionless plane: x = beta (damping), y = alpha (stiffness).
 PAPER_PLANE = ("beta", "alpha")
 
