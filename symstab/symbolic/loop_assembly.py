@@ -40,6 +40,9 @@ __all__ = ["LoopModel", "parse_plant", "parse_environment", "parse_expression",
 RESERVED = ("s", "z", "T", "d")
 #: Working digits of the plant's pulse transfer function (rounded once to float).
 PLANT_DIGITS = 30
+#: The most digits a plant's closed form is evaluated with (it cancels for a
+#: pole near z = 1; :meth:`LoopModel._closed_form_plant`).
+PLANT_MAX_DIGITS = 5000
 #: Parameter names the generated NumPy and C kernels cannot take.
 _C_KEYWORDS = frozenset(
     "auto break case char const continue default do double else enum extern float for goto if "
@@ -704,6 +707,43 @@ class LoopModel:
         num, den = self._plant_parts
         return sp.lambdify(args, [list(num), list(den)], modules="mpmath")
 
+    def _closed_form_plant(self, point, T):
+        """P_n, P_d of the derived closed form at ``point``, to :data:`PLANT_DIGITS` digits.
+
+        The closed form cancels: ``1/(m s**2 + b s)`` has ``(exp(-b T/m) - 1
+        + b T/m) m / b**2``, whose leading terms' difference loses ``2
+        log10(m / (b T))`` digits (28 at ``b T/m = 1e-14``; at 1e-300 every
+        digit of any fixed precision, so that two precisions agree on a wrong
+        value).  The working digits therefore start above the loss that
+        extreme values can cause -- the plant's order times the decades of
+        the values and ``T`` away from 1 -- and are doubled until two
+        evaluations agree to ``PLANT_DIGITS`` digits of each part's largest
+        coefficient (not beyond :data:`PLANT_MAX_DIGITS`); the more precise
+        one is kept.
+        """
+        order = len(self._plant_parts[1]) - 1
+        decades = sum(abs(mpmath.log10(abs(v))) for v in (*point, T) if v != 0)
+        digits, before = PLANT_DIGITS + order * int(mpmath.ceil(decades)), None
+        while digits <= PLANT_MAX_DIGITS:
+            with mpmath.workdps(digits):
+                try:
+                    parts = self._plant_functions(*point, T)
+                except ZeroDivisionError:
+                    return [mpmath.nan], [mpmath.mpf(0)]
+                parts = [[mpmath.mpmathify(c) for c in part] for part in parts]
+            if not all(mpmath.isfinite(c) for part in parts for c in part):
+                return parts
+            if before is not None and all(
+                    max(abs(a - b) for a, b in zip(old, new))
+                    <= mpmath.mpf(10) ** -PLANT_DIGITS * max(abs(c) for c in new)
+                    for old, new in zip(before, parts)):
+                return parts
+            before, digits = parts, 2 * digits
+        given = ", ".join(f"{n} = {float(v):g}" for n, v in zip(self._plant_names, point))
+        raise ValueError(f"the plant's pulse transfer function at {given}, T = {float(T):g} "
+                         f"cancels beyond {PLANT_MAX_DIGITS} digits: a parameter is too small "
+                         f"or too large for its closed form")
+
     @functools.lru_cache(maxsize=4096)
     def _plant_cache(self, plant_values, T):
         """(P_n, P_d, ends, P_d in z - 1) as float arrays, monic P_d, evaluated at 30 digits.
@@ -726,12 +766,7 @@ class LoopModel:
                 den = [mpmath.mpf(sp.Float(c, PLANT_DIGITS)) for c in sp.Poly(den, model.s).all_coeffs()]
                 p_n, p_d = numeric_zoh(num, den, mpmath.mpf(float(T)), dps=PLANT_DIGITS)
             else:
-                try:
-                    p_n, p_d = self._plant_functions(*point, mpmath.mpf(float(T)))
-                except ZeroDivisionError:
-                    p_n, p_d = [mpmath.nan], [mpmath.mpf(0)]
-                p_n = [mpmath.mpmathify(c) for c in p_n]
-                p_d = [mpmath.mpmathify(c) for c in p_d]
+                p_n, p_d = self._closed_form_plant(point, mpmath.mpf(float(T)))
             lead = p_d[0]
             if lead == 0 or not all(mpmath.isfinite(c) for c in p_n + p_d):
                 given = ", ".join(f"{n} = {float(v):g}" for n, v in zip(self._plant_names, plant_values))

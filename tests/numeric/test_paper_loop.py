@@ -81,3 +81,19 @@ def test_k_max_sits_between_a_stable_and_an_unstable_point():
     K, B = limits.y_max, limits.x_at_y_max
     assert _exact_count(K * (1 - 1e-6), B, 40) == 0
     assert _exact_count(K * (1 + 1e-6), B, 40) > 0
+
+
+@pytest.mark.parametrize("delta", [1e-6, 1e-10, 1e-14, 1e-18, 1e-300])
+def test_coefficients_at_a_tiny_damping_match_the_first_principles_polynomial(delta):
+    """The plant's closed form cancels 2 log10(1 / delta) digits (its (exp(-delta) - 1 + delta) /
+    delta**2): at 30 fixed digits delta = 1e-14 gave P_n = (0.49895, 0.50093), not (0.5, 0.5),
+    and limits 2.5e-3 off.  Oracle: eqs. (1), (2), (4) at 60 digits (tests/oracles.py)."""
+    from oracles import first_principles_chi
+
+    from symstab.numeric.paper_loop import paper_point
+
+    loop, values = paper_point(gamma=0.3, d=2, delta=delta)
+    got = loop.coefficients(K=0.4, B=0.7, **values)
+    with mpmath.workdps(60):
+        expected = np.array([float(c) for c in first_principles_chi(0.4, 0.7, 0.3, 2, delta)])
+    assert np.max(np.abs(got - expected)) <= 4e-16 * np.max(np.abs(expected)), (got, expected)
