@@ -774,7 +774,11 @@ def _covers(found, enclosure, free):
 
 
 def _empty_reason(found):
-    """Why the decomposition ``found`` (of :meth:`Loop.region`) has no stable cell."""
+    """``"the stable set is empty: "`` and why the decomposition ``found`` (of :meth:`Loop.region`) has no stable cell."""
+    return "the stable set is empty: " + _why_empty(found)
+
+
+def _why_empty(found):
     hull = found.hull
     if hull is not None and hull.empty:
         return hull.reason
