@@ -379,7 +379,7 @@ def _window(gammas, d):
     """A common ``((beta0, beta1), (alpha0, alpha1))`` window for the stable regions of ``gammas`` at delay ``d``."""
     tops, lows, highs = [], [], []
     for g in gammas:
-        lim = _region(g, d).limits(n_beta=101)
+        lim = _region(g, d).limits()
         if not lim.empty:
             tops.append(lim.alpha_max)
             lows.append(lim.beta_left)
@@ -508,7 +508,7 @@ def _fig_overlay(name, title, suptitle, gammas, n, paper, claimed, extra_row=Non
               for g, d, v, _, _ in verdicts if claimed[(g, d)] != v]
     verdict = ("every verdict agrees with the paper" if not differ
                else "differs from the paper at " + "; ".join(differ))
-    counted = {(g, d): "U" if _region(g, d).limits(n_beta=21).empty else "S"
+    counted = {(g, d): "U" if _region(g, d).limits().empty else "S"
                for g, d, _, _, _ in verdicts}
     split = [f"gamma {g:g}, d {d}" for g, d, v, _, _ in verdicts if counted[(g, d)] != v]
     check = ("root counting (symstab.limits) gives the same verdicts" if not split
@@ -609,7 +609,7 @@ def fig7():
     ax.axhline(0.0, zorder=2, **_Z_ONE)
     loops = {}
     for g, color in zip(gammas, _COLORS):
-        lim = limits(gamma=g, d=0, delta=DELTA, n_beta=101)
+        lim = limits(gamma=g, d=0, delta=DELTA)
         tag = "U" if lim.empty else ("S, a thin sliver" if lim.z_width < 0.05 else "S")
         _fill_stable(ax, g, 0, window, color)
         first, _ = _draw_boundary(ax, g, 0, window, color)
@@ -779,14 +779,24 @@ def _vanishing_gamma(d, inside, outside, tol=5e-5):
 
     Bisection between ``inside`` (a gamma with a region) and ``outside``
     (one without) on the certified emptiness of :func:`symstab.limits`,
-    until the two are ``tol`` apart.
+    until the two are ``tol`` apart.  Next to the vanishing point the set
+    can be too small to decide (alpha_max below about 1e-12, where two
+    roots meet at z = 1, and the engine refuses): such a gamma moves
+    neither end, and the search goes on between it and ``outside``; the
+    bracket returned is always a decided pair.
     """
-    while abs(outside - inside) > tol:
-        middle = 0.5 * (inside + outside)
-        if limits(gamma=middle, d=d, delta=DELTA, n_beta=3).empty:
+    probe = inside
+    while abs(outside - inside) > tol and abs(outside - probe) > tol:
+        middle = 0.5 * (probe + outside)
+        try:
+            empty = limits(gamma=middle, d=d, delta=DELTA).empty
+        except ValueError:
+            probe = middle
+            continue
+        if empty:
             outside = middle
         else:
-            inside = middle
+            inside = probe = middle
     return inside, outside
 
 
@@ -808,7 +818,7 @@ def _fig_limits(name, title, suptitle, gammas, paper, note):
     fig, axes = plt.subplots(2, 4, figsize=(16, 8.6), sharex=True)
     summary, facts = [], []
     for column, d in enumerate(DELAYS):
-        rows = [limits(gamma=g, d=d, delta=DELTA, n_beta=101) for g in gammas]
+        rows = [limits(gamma=g, d=d, delta=DELTA) for g in gammas]
         empty = np.array([r.empty for r in rows])
         have = np.flatnonzero(~empty)
         right = gammas[0] >= 0  # Fig. 12: the region ends on the right
@@ -819,7 +829,7 @@ def _fig_limits(name, title, suptitle, gammas, paper, note):
             vanish = _vanishing_gamma(d, gammas[edge], gammas[beyond])
             # A few points between the last grid gamma and the vanishing one,
             # closer and closer, show how the Z-width goes to zero.
-            edge_rows = [(g, limits(gamma=g, d=d, delta=DELTA, n_beta=101)) for g in
+            edge_rows = [(g, limits(gamma=g, d=d, delta=DELTA)) for g in
                          (vanish[0] + (gammas[edge] - vanish[0]) * s for s in (0.3, 0.1, 0.0))]
         g_edge = [g for g, _ in edge_rows]
         z_edge = [r.z_width for _, r in edge_rows]

@@ -100,6 +100,19 @@ def first_principles_chi_float(alpha, beta, gamma, d, delta, dps=30):
         return np.array([float(c) for c in first_principles_chi(alpha, beta, gamma, d, delta)])
 
 
+def first_principles_radius(alpha, beta, gamma, d, delta, dps=40):
+    """Largest root modulus of :func:`first_principles_chi`, by ``mpmath.polyroots`` at ``dps`` digits.
+
+    For points on the edge of a region where two roots meet (a double root
+    at z = 1 at a sliver's corner), ``np.roots`` of rounded coefficients is
+    ``sqrt(eps)``, about 1e-8, off; this is not.
+    """
+    with mpmath.workdps(dps):
+        coefficients = first_principles_chi(alpha, beta, gamma, d, delta)
+        roots = mpmath.polyroots(coefficients, maxsteps=100, extraprec=2 * dps)
+        return float(max(abs(r) for r in roots))
+
+
 def delta_of_z(z, *, alpha, beta, gamma, d, delta):
     """Eq. (2): Delta(z) = 1 + VE(z) z^-d Z[ZOH G] in Table I's variables."""
     A, B, C = loop_gain_parts(z, d, delta)

@@ -14,14 +14,17 @@ the same engine as any loop of the user's.
 not on ``import symstab``.
 """
 
+import dataclasses
 import functools
 
 import sympy as sp
 
+from .._validate import check_loop
 from ..symbolic import model
+from .results import PAPER_PLANE
 from .units import PAPER_DEVICE
 
-__all__ = ["PAPER_LOOP", "paper_loop", "PAPER_NAMES"]
+__all__ = ["PAPER_LOOP", "paper_loop", "PAPER_NAMES", "paper_point", "paper_limits"]
 
 #: Names of the environment's parameters in the loop: ``K_w, B_w, M_w`` of
 #: the model are ``K, B, M`` (as in ``examples/loops/paper.toml``).
@@ -60,6 +63,62 @@ def paper_loop():
                 "K": 2.0, "B": 0.1, "M": 0.0},
         units={"m": "kg m^2", "b": "N m s/rad", "T": "s",
                "K": units["K_w"], "B": units["B_w"], "M": units["M_w"]})
+
+
+@functools.lru_cache(maxsize=1)
+def frictionless_paper_loop():
+    """The paper's loop with ``b = 0``: plant ``1/(m s**2)`` (``delta = 0``).
+
+    :class:`~symstab.Loop` refuses ``1/(m s**2 + b s)`` at ``b = 0`` (its
+    pulse transfer function has a double pole at z = 1 there, not the
+    limit of the simple ones), so the frictionless device is its own loop.
+    """
+    from .any_loop import Loop
+
+    rename = {getattr(model, name): sp.Symbol(new) for name, new in PAPER_NAMES.items()}
+    environment = model.virtual_environment().subs(rename)
+    return Loop(model.plant().subs(model.b, 0), environment, name="paper-frictionless",
+                plane=("B", "K"), values={"m": 1.0, "T": 1.0, "d": 0, "K": 0.0, "B": 0.0, "M": 0.0})
+
+
+def paper_point(*, gamma, d, delta):
+    """The loop and values that are the paper's dimensionless point ``(gamma, d, delta)``.
+
+    With ``m = T = 1`` Table I's variables are the loop's own parameters:
+    ``alpha = K T**2/m = K``, ``beta = B T/m = B``, ``gamma = M/m = M`` and
+    ``delta = b T/m = b``; the plane ``(B, K)`` is the paper's
+    ``(beta, alpha)``.
+
+    Returns
+    -------
+    (Loop, dict)
+        :func:`paper_loop` (or :func:`frictionless_paper_loop` at
+        ``delta = 0``) and the values of its parameters other than ``B, K``.
+    """
+    gamma, d, delta = check_loop(gamma, d, delta)
+    if delta == 0:
+        return frictionless_paper_loop(), {"m": 1.0, "T": 1.0, "M": gamma, "d": d}
+    return paper_loop(), {"m": 1.0, "T": 1.0, "b": delta, "M": gamma, "d": d}
+
+
+def paper_limits(*, gamma, d, delta, region=None):
+    """:meth:`Loop.limits <symstab.Loop.limits>` of the paper's loop, in Table I's plane.
+
+    The limits of the ``(B, K)`` plane of :func:`paper_point`, renamed
+    ``(beta, alpha)``, with ``at`` the paper's ``gamma, d, delta`` and
+    ``region`` the :class:`~symstab.numeric.region.StabilityRegion` given
+    (for its line questions), so Table I's names apply.
+
+    Examples
+    --------
+    >>> lim = paper_limits(gamma=0.0, d=0, delta=0.00253125)
+    >>> round(lim.alpha_max, 4), round(lim.beta_right, 4)
+    (0.6897, 2.0034)
+    """
+    loop, values = paper_point(gamma=gamma, d=d, delta=delta)
+    found = loop.limits("B", "K", **values)
+    return dataclasses.replace(found, x=PAPER_PLANE[0], y=PAPER_PLANE[1], region=region,
+                               at={"gamma": values["M"], "d": values["d"], "delta": float(delta)})
 
 
 def __getattr__(name):

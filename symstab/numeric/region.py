@@ -34,6 +34,7 @@ import collections.abc
 import dataclasses
 import functools
 import math
+import warnings
 
 import numpy as np
 
@@ -44,15 +45,14 @@ from .curves import (KERNEL_BYTES_PER_POINT, KERNEL_CHUNK_BYTES, Segment,
                      golden_max, arc_end_angle, bracketed_root, minus_one_line, scan_grid)
 from .arcs import ClosedFormArc, crossing_change
 from .decomposition import decompose
-from .results import PAPER_PLANE, Boundary, Limits
+from .paper_loop import paper_limits
+from .results import PAPER_PLANE, Boundary
 from .polynomial import DelayedPolynomial
 from .stability import MARGINAL, STABLE, UNSTABLE, classify, loop_coefficients, paper_polynomial
 
 __all__ = ["StabilityRegion", "limits", "BestVirtualMass", "best_virtual_mass",
            "scan_maximum", "boundary_curve"]
 
-#: Largest number of vertical lines in the scan that finds where the region is.
-_SCAN_LINES = 512
 #: Working bytes per crossing of a line with the boundary (positions, angles,
 #: the terms of the crossing direction); lines are processed in chunks of
 #: :data:`symstab._resources.CHUNK_BYTES` of crossings.
@@ -606,94 +606,9 @@ class StabilityRegion:
     # -- where the region is ----------------------------------------------
 
     @functools.cached_property
-    def _scan(self):
-        """Vertical lines between the arc's samples, and their stable intervals.
-
-        Every piece of arc that bounds the region has samples on it, so
-        lines between consecutive sample betas meet every part of the region
-        wider than the samples' spacing (down to the thinnest slivers: at
-        d = 0 every gap between samples has its line).  At large d the lines
-        are thinned to :data:`_SCAN_LINES`, keeping all those of the first
-        lobe of the arc (theta up to where alpha first falls to 0), where the
-        region lies.
-        """
-        ok = np.isfinite(self._beta) & (np.abs(self._beta) < 1e6) & np.isfinite(self._alpha)
-        betas = np.unique(self._beta[ok])
-        if len(betas) > _SCAN_LINES:
-            # The lobe ends where alpha first falls to 0: arc_end_angle, which
-            # a grid of alpha could step over (a dip narrower than its step).
-            stop = arc_end_angle(gamma=self.gamma, d=self.d, delta=self.delta)
-            end = (int(np.searchsorted(self._theta, stop)) + 1 if np.isfinite(stop)
-                   else len(self._theta))
-            lobe = np.unique(self._beta[:end][ok[:end]])
-            keep = np.linspace(0, len(betas) - 1, max(_SCAN_LINES - len(lobe), 2)).astype(int)
-            betas = np.union1d(betas[keep], lobe)
-        lines = 0.5 * (betas[1:] + betas[:-1])
-        # Lines through the corner (-delta, 0), where the samples near
-        # theta = 0 crowd, meet the region on nothing wider than rounding.
-        lines = lines[np.abs(lines + self.delta) > 1e-9 * self.delta]
-        # A line that cannot be counted is left out, not classified gap by
-        # gap: the scan only has to find the region, and a neighbour does.
-        runs = self._intervals("beta", lines, fallback=False)
-        known = [i for i, r in enumerate(runs) if r is not None]
-        return lines[known], [runs[i] for i in known]
-
-    def _last_meeting(self, axis, inside, outside, rounds=14, fan=16):
-        """The boundary between ``inside`` (a line meeting the region) and ``outside``.
-
-        A ``fan``-ary search: each round tests ``fan`` lines at once.
-        Returns the last line found to meet the region and its intervals
-        (``None`` when no trial line met it: ``inside`` itself was the best).
-        """
-        runs_inside = None
-        for _ in range(rounds):
-            trial = np.linspace(inside, outside, fan + 2)[1:-1]
-            runs = self._intervals(axis, trial, fallback=False)
-            if any(r is None for r in runs):
-                # Lines this close to a corner (within about 1e-8 relative
-                # at d = 200) cannot be counted; classifying every gap on
-                # them would cost O(d**3) for the last digits.  The extreme
-                # is then the corner, when one lies in the bracket.
-                corner = self._corners_between(axis, inside, outside)
-                if corner is not None:
-                    inside = corner
-                break
-            k = np.flatnonzero([bool(r) for r in runs])
-            j = k[-1] + 1 if k.size else 0
-            if j > 0:
-                inside, runs_inside = trial[j - 1], runs[j - 1]
-            outside = trial[j] if j < fan else outside
-            if abs(outside - inside) <= 4 * np.spacing(max(abs(inside), abs(outside))):
-                break
-        return inside, runs_inside
-
-    def _missing_line(self, axis, inside, step):
-        """A line beyond ``inside`` (by multiples of ``step``) that misses the region."""
-        outside = inside + step
-        for _ in range(60):
-            if not self._intervals(axis, [outside])[0]:
-                return outside
-            step *= 4
-            outside = inside + step
-            if not math.isfinite(outside):
-                break
-        return None
-
-    def _corners_between(self, axis, inside, outside):
-        """The corner nearest to ``inside`` in ``[inside, outside]``, or None.
-
-        Corners are where the boundary pieces meet on alpha = 0: the arc's
-        start (-delta, 0), the arc's other ends and z = -1 (beta = c / 2);
-        only vertical lines (``axis == "beta"``) are snapped.
-        """
-        if axis != "beta":
-            return None
-        corners = np.concatenate([self._corners(), [self.minus_one / 2]])
-        lo, hi = min(inside, outside), max(inside, outside)
-        near = corners[(corners >= lo) & (corners <= hi)]
-        if near.size == 0:
-            return None
-        return float(near[np.argmin(np.abs(near - inside))])
+    def _limits(self):
+        """The limits of this region, from the one engine (:func:`~symstab.numeric.paper_loop.paper_limits`)."""
+        return paper_limits(gamma=self.gamma, d=self.d, delta=self.delta, region=self)
 
     def _corners(self):
         """beta of the points where the arc meets alpha = 0 (exact corners)."""
@@ -774,101 +689,42 @@ class StabilityRegion:
         return b[np.isfinite(residual) & (residual <= np.maximum(np.abs(g0), np.abs(g1)))]
 
     def alpha_max(self):
-        """``(alpha_max, beta at alpha_max)``, or ``None`` when the region is empty.
-
-        The highest stable point on the scan's vertical lines brackets
-        alpha_max from below; a k-ary search for the last horizontal line
-        that meets the region settles it.
-        """
-        lines, runs = self._scan
-        tops = [(r[-1][1], r[-1][0]) for r in runs if r]
-        if not tops:
-            return None
-        top, bottom = max(tops)
-        inside = top - 0.25 * (top - bottom)
-        if not self._intervals("alpha", [inside])[0]:
-            k = int(np.argmax([r[-1][1] if r else -np.inf for r in runs]))
-            return float(top), float(lines[k])
-        outside = self._missing_line("alpha", inside, 2 * (top - inside) + 1e-300)
-        if outside is None:
-            return math.inf, math.nan
-        alpha_max, at_top = self._last_meeting("alpha", inside, outside)
-        at_top = at_top or self._intervals("alpha", [alpha_max], closure=True)[0]
-        if not at_top:
-            return float(alpha_max), math.nan
-        # The run the search ended on touches the top: its middle is the
-        # top's beta, a stable point (the run was counted).
-        return float(alpha_max), float(0.5 * (at_top[0][0] + at_top[-1][1]))
+        """``(alpha_max, beta at alpha_max)``, or ``None`` when the region is empty (see :meth:`limits`)."""
+        lim = self._limits
+        return None if lim.empty else (lim.y_max, lim.x_at_y_max)
 
     def beta_range(self):
-        """``(beta_min, beta_max)`` of the stable region, or ``None`` when it is empty."""
-        lines, runs = self._scan
-        k = np.flatnonzero([bool(r) for r in runs])
-        if k.size == 0:
-            return None
-        spacing = max(np.max(np.diff(lines)) if len(lines) > 1 else 0.0, self.delta)
-        ends = []
-        for i, toward in ((k[0], k[0] - 1), (k[-1], k[-1] + 1)):
-            if 0 <= toward < len(lines):
-                outside = lines[toward]
-            else:
-                outside = self._missing_line("beta", lines[i], (toward - i) * spacing)
-                if outside is None:
-                    outside = math.copysign(math.inf, toward - i)
-                    ends.append(outside)
-                    continue
-            ends.append(float(self._last_meeting("beta", lines[i], outside)[0]))
-        return ends[0], ends[1]
+        """``(beta_min, beta_max)`` of the stable region, or ``None`` when it is empty (see :meth:`limits`)."""
+        lim = self._limits
+        return None if lim.empty else (lim.x_min, lim.x_max)
 
-    def z_width(self, beta_min, beta_max, n_beta=801):
-        """Area of the stable region: the stable length on verticals, trapezoid rule.
-
-        Parameters
-        ----------
-        beta_min, beta_max : float
-            The region's extent in beta.
-        n_beta : int
-            Vertical lines (the two ends included).
-        """
-        betas = np.linspace(beta_min, beta_max, n_beta)
-        # No boundary piece is vertical (the arc is vertical at points only,
-        # the lines z = +-1 are not), so the stable length is 0 at the two
-        # extreme betas; their lines run through corners, where counting
-        # fails.
-        lengths = np.zeros(n_beta)
-        runs = self._intervals("beta", betas[1:-1])
-        lengths[1:-1] = [sum(h - l for l, h in r) for r in runs]
-        return float(np.sum(0.5 * (lengths[1:] + lengths[:-1]) * np.diff(betas)))
-
-    def limits(self, *, n_beta=801):
+    def limits(self, *, n_beta=None):
         """alpha_max, the beta range and the Z-width (see :func:`limits`).
 
         Parameters
         ----------
-        n_beta : int
-            Vertical lines for the Z-width.
+        n_beta : None
+            Deprecated and ignored: the Z-width is the area of the stable
+            polygons, not an integral over ``n_beta`` vertical lines.
         """
-        beta_range = self.beta_range()
-        top = self.alpha_max() if beta_range else None
-        paper = dict(region=self, at={"gamma": self.gamma, "d": self.d, "delta": self.delta})
-        if top is None:
-            return Limits.empty_set(*PAPER_PLANE, "no stable point next to the boundary arc: "
-                                                  "the stable region is empty", **paper)
-        alpha_max, beta_at = top
-        if not (math.isfinite(alpha_max) and all(map(math.isfinite, beta_range))):
-            return Limits(*PAPER_PLANE, alpha_max, math.nan, beta_range[0], beta_range[1],
-                          math.inf, reason="the stable region is unbounded", **paper)
-        # beta_at lies on a stable interval at alpha_max: a point of the
-        # region, so the range holds it (the searches for the extremes of
-        # beta stop a few ulps short where a corner cannot be counted).
-        if math.isfinite(beta_at):
-            beta_range = (min(beta_range[0], beta_at), max(beta_range[1], beta_at))
-        return Limits(*PAPER_PLANE, alpha_max, beta_at, beta_range[0], beta_range[1],
-                      self.z_width(*beta_range, n_beta=n_beta), **paper)
+        _deprecated_n_beta(n_beta)
+        return self._limits
 
 
-def limits(*, gamma, d, delta, n_beta=801):
+def _deprecated_n_beta(n_beta):
+    if n_beta is not None:
+        warnings.warn("n_beta is deprecated and ignored: the Z-width is now the area of the "
+                      "stable polygons of the D-decomposition (no line integration)",
+                      DeprecationWarning, stacklevel=3)
+
+
+def limits(*, gamma, d, delta, n_beta=None):
     """Renderable limits of one virtual mass, delay and device.
+
+    The paper's loop in Table I's plane, on the engine of every loop
+    (:meth:`symstab.Loop.limits`, :func:`~symstab.numeric.paper_loop.paper_limits`):
+    the stable cells of the D-decomposition of the (beta, alpha) plane, their
+    extreme vertices (refined along the arc) and the area of their polygons.
 
     Parameters
     ----------
@@ -878,10 +734,9 @@ def limits(*, gamma, d, delta, n_beta=801):
         Delay in samples, ``d >= 0``.
     delta : float
         ``b T / m > 0``.
-    n_beta : int
-        Vertical lines for the Z-width, ``n_beta >= 3`` (trapezoid rule; its
-        error is about ``1 / n_beta**2`` of the width where the region's
-        edges are smooth).
+    n_beta : None
+        Deprecated and ignored (the Z-width was a trapezoid rule over
+        ``n_beta`` vertical lines; it is now the polygons' area).
 
     Returns
     -------
@@ -897,9 +752,8 @@ def limits(*, gamma, d, delta, n_beta=801):
     >>> lim  # doctest: +ELLIPSIS
     Limits(gamma=0, d=0, delta=0.00253125: alpha_max=0.68967 at beta=0.827933, beta from ...)
     """
-    n_beta = check_count("n_beta", n_beta, 3)
-    check_memory(f"limits with n_beta = {n_beta} vertical lines", 4 * 8 * n_beta)
-    return StabilityRegion(gamma=gamma, d=d, delta=delta).limits(n_beta=n_beta)
+    _deprecated_n_beta(n_beta)
+    return StabilityRegion(gamma=gamma, d=d, delta=delta).limits()
 
 
 @dataclasses.dataclass(frozen=True)
@@ -941,8 +795,8 @@ class BestVirtualMass:
 
 
 def _alpha_max(gamma, d, delta):
-    top = StabilityRegion(gamma=gamma, d=d, delta=delta).alpha_max()
-    return (-math.inf, math.nan) if top is None else top
+    lim = paper_limits(gamma=gamma, d=d, delta=delta)
+    return (-math.inf, math.nan) if lim.empty else (lim.y_max, lim.x_at_y_max)
 
 
 def _check_gamma_range(gamma_range):
@@ -1083,7 +937,7 @@ def best_virtual_mass(*, d, delta, gamma_range=None, n=17):
                                f"no gamma in [{g_lo:g}, {g_hi:g}] has a stable region at d = {d}")
     best_gamma, _ = found
     region = StabilityRegion(gamma=best_gamma, d=d, delta=delta)
-    best = region.limits(n_beta=201)
+    best = region.limits()
     alpha_zero = _alpha_max(0.0, d, delta)[0]
     return BestVirtualMass(d, delta, float(best_gamma), best.beta_at_alpha_max, best.alpha_max,
                            float(alpha_zero), float(best.alpha_max / alpha_zero), best.z_width)

@@ -216,8 +216,8 @@ def test_z_width_closes_to_zero_where_the_region_vanishes(drawn, name, right):
         vanish = g[end]
         # The end is where the region vanishes: none there, one 1e-4 inside.
         inward = -1e-4 if right else 1e-4
-        assert limits(gamma=vanish, d=d, delta=DELTA, n_beta=3).empty
-        assert not limits(gamma=vanish + inward, d=d, delta=DELTA, n_beta=3).empty
+        assert limits(gamma=vanish, d=d, delta=DELTA).empty
+        assert not limits(gamma=vanish + inward, d=d, delta=DELTA).empty
         # The "no stable region" band starts there: no unclassified gap.
         band, = [p for p in ax.patches if p.get_facecolor()[0] == 1.0 and p.get_facecolor()[1] == 0.0]
         x0, x1 = band.get_x(), band.get_x() + band.get_width()

@@ -35,9 +35,15 @@ def test_limits_at_large_delta_bracket_python_controls_edge(delta, d):
     lim = symstab.limits(gamma=0.0, d=d, delta=delta)
     assert not lim.empty, lim.message
     assert math.isfinite(lim.alpha_max) and lim.alpha_max > 0
-    beta = lim.beta_at_alpha_max
-    assert _python_control_stable(lim.alpha_max * (1 - 1e-3), beta, 0.0, d, delta)
-    assert not _python_control_stable(lim.alpha_max * (1 + 1e-3), beta, 0.0, d, delta)
+    # Just below the top, the middle of the widest stable beta run is stable
+    # (straight below the top is no probe: at delta = 1e4, d = 0 the top is
+    # the corner on beta = -delta, and the line below it runs along the edge);
+    # just above, nothing is.
+    below = lim.alpha_max * (1 - 1e-3)
+    lo, hi = max(lim.region.beta_intervals(below), key=lambda run: run[1] - run[0])
+    assert _python_control_stable(below, 0.5 * (lo + hi), 0.0, d, delta)
+    for beta in (lim.beta_at_alpha_max, 0.5 * (lo + hi)):
+        assert not _python_control_stable(lim.alpha_max * (1 + 1e-3), beta, 0.0, d, delta)
 
 
 @pytest.mark.parametrize("delta", [0.0, 400.0, 710.0, 1e4])

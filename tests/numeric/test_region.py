@@ -43,7 +43,7 @@ from symstab import (PAPER_DEVICE, STABLE, Device, StabilityRegion, arc_end_angl
 from symstab.numeric.evaluate import alpha_max_on_arc, boundary_point
 
 from conftest import PAPER_DELTA, assert_message_names
-from oracles import (first_principles_boundary_point, first_principles_chi_float,
+from oracles import (first_principles_boundary_point, first_principles_chi_float, first_principles_radius,
                      theta_max_box_sample)
 
 
@@ -536,7 +536,6 @@ def test_limits_at_d_200_agree_with_the_30_digit_interval_scan():
 COUNT_CALLS = {
     "boundary_curve n": (lambda v: boundary_curve(gamma=0.0, d=0, delta=PAPER_DELTA, n=v,
                                                   segments=False), "n", 2),
-    "limits n_beta": (lambda v: limits(gamma=0.0, d=0, delta=PAPER_DELTA, n_beta=v), "n_beta", 3),
     "best_virtual_mass n": (lambda v: best_virtual_mass(d=0, delta=PAPER_DELTA, n=v), "n", 3),
 }
 
@@ -555,6 +554,16 @@ def test_every_count_parameter_follows_one_rule(call, value, error):
     assert_message_names(excinfo, name)
     if error is ValueError:
         assert f">= {low}" in str(excinfo.value)
+
+
+def test_n_beta_is_deprecated_and_changes_nothing():
+    """The Z-width is the polygons' area now: ``n_beta`` (the old line count) warns and is ignored."""
+    plain = limits(gamma=0.0, d=2, delta=PAPER_DELTA)
+    with pytest.warns(DeprecationWarning, match="n_beta"):
+        old = limits(gamma=0.0, d=2, delta=PAPER_DELTA, n_beta=101)
+    with pytest.warns(DeprecationWarning, match="n_beta"):
+        StabilityRegion(gamma=0.0, d=2, delta=PAPER_DELTA).limits(n_beta=101)
+    assert old.as_dict() == plain.as_dict()
 
 
 @pytest.mark.parametrize("gamma_range, error", [
@@ -648,8 +657,14 @@ def test_best_virtual_mass_is_a_maximiser(request, gamma0_limits, which, d, othe
         other = limits(gamma=g, d=d, delta=PAPER_DELTA).alpha_max
         if other is not None:
             assert other <= best.alpha_max * (1 + 1e-12), (g, other, best.alpha_max)
-    # the reported top is a stable point of the first-principles loop (or on its edge)
-    assert oracle_radius(best.alpha_max, best.beta, best.gamma, d, PAPER_DELTA) < 1 + 1e-9
+    # The reported top is on the edge of the first-principles region: within
+    # 4 ulps below it the largest root is on the unit circle to 1e-9.  (At
+    # d = 0 the top is a corner where two roots meet, so the radius moves by
+    # about 3e-9 per ulp of alpha, and np.roots of rounded coefficients is
+    # off by 1e-8: 40-digit roots.)
+    below = [best.alpha_max - k * np.spacing(best.alpha_max) for k in range(5)]
+    radii = [first_principles_radius(a, best.beta, best.gamma, d, PAPER_DELTA) for a in below]
+    assert min(radii) < 1 + 1e-9, radii
 
 
 @pytest.mark.parametrize("which, d", [("best_d0", 0), ("best_d40", 40)])
