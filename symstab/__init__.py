@@ -49,8 +49,10 @@ from .numeric.results import Limits
 from .numeric.any_loop import Loop, LoopBoundary, LoopLimits
 from .numeric.loop_files import load_loop
 from .numeric.decomposition import Branch, Cell, Decomposition
-from .numeric.passivity import PassiveRegion, paper_passive_region, passive_region
-from .numeric.locus import Crossing, Locus, locus, paper_locus
+from .numeric.passivity import PassiveRegion, passive_region
+from .numeric.paper_loop import paper_passive_region
+from .numeric.locus import Crossing, Locus, locus
+from .numeric.paper_loop import paper_locus
 from .numeric.simulate import Nonidealities, Simulation, StabilityMap, simulate, stability_map
 from .numeric.theta_bounds import (ThetaMaxEnclosure, certify_theta_max, theta_max_approx,
                                    theta_max_enclosure)

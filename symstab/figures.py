@@ -30,7 +30,7 @@ import numpy as np
 from ._generated import kernels
 from .numeric.curves import arc_end_angle
 from .numeric.region import boundary_curve
-from .numeric.passivity import paper_passive_region
+from .numeric.paper_loop import paper_passive_region
 from .numeric.region import StabilityRegion, limits
 from .numeric.simulate import PAPER_ENCODER_RESOLUTION, Nonidealities, stability_map
 from .numeric.stability import unstable_root_counts

@@ -93,9 +93,9 @@ def _passive(setup, lim):
     """The passive set beside the stable region: (notes, json), one line per fact.
 
     Colgate and Schenkel's condition with the device's friction and the
-    delay (:func:`symstab.numeric.passivity.paper_passive_region`).
+    delay (:func:`symstab.numeric.paper_loop.paper_passive_region`).
     """
-    from ..numeric.passivity import paper_passive_region
+    from ..numeric.paper_loop import paper_passive_region
 
     if setup.delta == 0:
         return (["passive set (Colgate-Schenkel): none, the device has no damping (delta = 0)"],

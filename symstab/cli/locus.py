@@ -135,7 +135,7 @@ class _View:
 
 def _paper(args):
     """The paper's loop: resolve the options, run :func:`paper_locus`; return a :class:`_View`."""
-    from ..numeric.locus import paper_locus
+    from ..numeric.paper_loop import paper_locus
 
     for flag, dest in (("--set", "set_values"),):
         if getattr(args, dest) is not None:

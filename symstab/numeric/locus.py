@@ -1,7 +1,7 @@
 """Root locus: the closed-loop poles tracked along a path of one parameter.
 
-:func:`locus` (any :class:`symstab.Loop`) and :func:`paper_locus` (the
-paper's normalised loop) follow every root of the characteristic
+:func:`locus` (any :class:`symstab.Loop`; the paper's normalised loop is
+:func:`symstab.numeric.paper_loop.paper_locus`, a use of it) follows every root of the characteristic
 polynomial as one parameter runs through a list of values, the others
 fixed -- for example the stiffness ``K`` at a fixed damping ``B``, a
 vertical line of the paper's ``(beta, alpha)`` plane -- and find where a
@@ -43,13 +43,12 @@ import dataclasses
 import numpy as np
 
 from .._resources import CHUNK_BYTES, check_memory, chunk_slices
-from .._validate import check_array, check_loop, check_real
+from .._validate import check_array, check_real
 from .curves import bracketed_root
 from .polynomial import horner
 from .roots import leading_vanishes, polish_roots
-from .stability import loop_coefficients
 
-__all__ = ["Locus", "Crossing", "locus", "paper_locus", "ON_CIRCLE"]
+__all__ = ["Locus", "Crossing", "locus", "ON_CIRCLE"]
 
 #: A pole whose modulus is within this of 1 is on the circle (a marginal point).
 ON_CIRCLE = 1e-10
@@ -240,66 +239,6 @@ def locus(loop, parameter, values, **fixed):
         return loop.coefficients(**used, **{parameter: np.asarray(p, dtype=float)})
 
     return _locus(parameter, values, dict(used), coefficients)
-
-
-_PAPER_PATHS = ("alpha", "beta")
-
-
-def paper_locus(*, parameter, values, gamma, d, delta, alpha=None, beta=None):
-    """The closed-loop poles of the paper's loop along a line of the (beta, alpha) plane.
-
-    Parameters
-    ----------
-    parameter : {"alpha", "beta"}
-        The parameter that varies.
-    values : array_like, shape (n,)
-        Its values, ``n >= 2``, strictly increasing or strictly decreasing.
-    gamma : float
-        ``M_w / m``.
-    d : int
-        Delay in samples.
-    delta : float
-        ``b T / m``.
-    alpha, beta : float, optional
-        The fixed one of the two (the other is ``parameter``).
-
-    Returns
-    -------
-    Locus
-        ``fixed`` holds the other of alpha, beta and gamma, d, delta.
-
-    Raises
-    ------
-    TypeError, ValueError
-        For an out-of-range value, a missing or doubly given parameter, or
-        a locus that would not fit in the memory limit.
-
-    Examples
-    --------
-    >>> path = paper_locus(parameter="alpha", values=[0.0001, 0.001], beta=0.0078,
-    ...                    gamma=0.0, d=40, delta=0.0025)
-    >>> [(c.kind, c.direction) for c in path.crossings]
-    [('pair', 'out')]
-    """
-    if parameter not in _PAPER_PATHS:
-        raise ValueError(f"parameter must be 'alpha' or 'beta', got {parameter!r}")
-    other = "beta" if parameter == "alpha" else "alpha"
-    given = {"alpha": alpha, "beta": beta}
-    if given[parameter] is not None:
-        raise ValueError(f"{parameter} is the path's parameter: give its values as values, "
-                         f"not as {parameter}=")
-    if given[other] is None:
-        raise TypeError(f"paper_locus along {parameter} needs the fixed {other}=")
-    gamma, d, delta = check_loop(gamma, d, delta)
-    fixed_value = check_real(other, given[other])
-    values = _path(parameter, values)
-    fixed = {other: fixed_value, "gamma": gamma, "d": d, "delta": delta}
-
-    def coefficients(p):
-        return loop_coefficients(**{parameter: np.asarray(p, dtype=float), other: fixed_value},
-                                 gamma=gamma, d=d, delta=delta)
-
-    return _locus(parameter, values, fixed, coefficients)
 
 
 def _path(parameter, values):

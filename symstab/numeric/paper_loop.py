@@ -19,12 +19,13 @@ import functools
 
 import sympy as sp
 
-from .._validate import check_loop
+from .._validate import check_loop, check_real
 from ..symbolic import model
 from .results import PAPER_PLANE
 from .units import PAPER_DEVICE
 
-__all__ = ["PAPER_LOOP", "paper_loop", "PAPER_NAMES", "paper_point", "paper_limits"]
+__all__ = ["PAPER_LOOP", "paper_loop", "PAPER_NAMES", "paper_point", "paper_limits",
+           "paper_passive_region", "paper_locus"]
 
 #: Names of the environment's parameters in the loop: ``K_w, B_w, M_w`` of
 #: the model are ``K, B, M`` (as in ``examples/loops/paper.toml``).
@@ -119,6 +120,121 @@ def paper_limits(*, gamma, d, delta, region=None):
     found = loop.limits("B", "K", **values)
     return dataclasses.replace(found, x=PAPER_PLANE[0], y=PAPER_PLANE[1], region=region,
                                at={"gamma": values["M"], "d": values["d"], "delta": float(delta)})
+
+
+def paper_passive_region(*, gamma, d, delta, x_range=None, y_range=None):
+    """The passive set of the paper's loop in the ``(beta, alpha)`` plane.
+
+    In Table I's units (``alpha = K_w T**2 / m``, ``beta = B_w T / m``,
+    ``gamma = M_w / m``, ``delta = b T / m``) Colgate and Schenkel's
+    condition (:mod:`symstab.numeric.passivity`) multiplied by ``T / m`` reads
+
+        delta > 1/(2 (1 - cos theta)) Re{(1 - e^{-j theta}) h(theta) e^{-j theta d}}
+
+    with ``h = alpha + beta (1 - e^{-j theta}) + gamma (1 - e^{-j theta})**2``
+    (``T**2 VE / m``), for ``theta`` in [0, pi]; and ``alpha >= 0`` (no
+    negative static stiffness).  That is :meth:`Loop.passive_region
+    <symstab.Loop.passive_region>` of :func:`paper_point`'s loop and values,
+    with the plane's names changed.
+
+    Parameters
+    ----------
+    gamma : float
+        ``M_w / m``.
+    d : int
+        Delay in samples.
+    delta : float
+        ``b T / m``, > 0 (with no damping the passive set has no interior).
+    x_range, y_range : (float, float), optional
+        The window of beta and alpha; by default the polygon's bounding box
+        with a 5 % margin (an unbounded set: its finite vertices' box grown
+        by its own size).
+
+    Returns
+    -------
+    symstab.numeric.passivity.PassiveRegion
+        ``x = "beta"``, ``y = "alpha"``; ``y_max`` is the passive
+        ``alpha_max``.
+
+    Raises
+    ------
+    TypeError, ValueError
+        If a parameter is of the wrong kind or out of range.
+
+    Examples
+    --------
+    >>> r = paper_passive_region(gamma=0.0, d=0, delta=0.002)
+    >>> round(r.y_max, 12), round(r.area, 12)     # alpha <= 2 delta, |beta| <= delta
+    (0.004, 8e-06)
+    """
+    gamma, d, delta = check_loop(gamma, d, delta)
+    if delta <= 0:
+        raise ValueError(f"delta must be > 0 for a passive set with an interior, got {delta!r}")
+    loop, values = paper_point(gamma=gamma, d=d, delta=delta)
+    found = loop.passive_region("B", "K", x_range=x_range, y_range=y_range, **values)
+    return found.renamed(*PAPER_PLANE)
+
+
+#: The paper's locus paths, and the loop parameter each is (with ``m = T = 1``).
+_PAPER_PATHS = {"alpha": "K", "beta": "B"}
+
+
+def paper_locus(*, parameter, values, gamma, d, delta, alpha=None, beta=None):
+    """The closed-loop poles of the paper's loop along a line of the (beta, alpha) plane.
+
+    :func:`~symstab.numeric.locus.locus` of :func:`paper_point`'s loop along
+    ``K`` (alpha) or ``B`` (beta), with the path and the fixed values named
+    in Table I's variables.
+
+    Parameters
+    ----------
+    parameter : {"alpha", "beta"}
+        The parameter that varies.
+    values : array_like, shape (n,)
+        Its values, ``n >= 2``, strictly increasing or strictly decreasing.
+    gamma : float
+        ``M_w / m``.
+    d : int
+        Delay in samples.
+    delta : float
+        ``b T / m``.
+    alpha, beta : float, optional
+        The fixed one of the two (the other is ``parameter``).
+
+    Returns
+    -------
+    symstab.numeric.locus.Locus
+        ``fixed`` holds the other of alpha, beta and gamma, d, delta.
+
+    Raises
+    ------
+    TypeError, ValueError
+        For an out-of-range value, a missing or doubly given parameter, or
+        a locus that would not fit in the memory limit.
+
+    Examples
+    --------
+    >>> path = paper_locus(parameter="alpha", values=[0.0001, 0.001], beta=0.0078,
+    ...                    gamma=0.0, d=40, delta=0.0025)
+    >>> [(c.kind, c.direction) for c in path.crossings]
+    [('pair', 'out')]
+    """
+    from .locus import locus
+
+    if parameter not in _PAPER_PATHS:
+        raise ValueError(f"parameter must be 'alpha' or 'beta', got {parameter!r}")
+    other = "beta" if parameter == "alpha" else "alpha"
+    given = {"alpha": alpha, "beta": beta}
+    if given[parameter] is not None:
+        raise ValueError(f"{parameter} is the path's parameter: give its values as values, "
+                         f"not as {parameter}=")
+    if given[other] is None:
+        raise TypeError(f"paper_locus along {parameter} needs the fixed {other}=")
+    fixed_value = check_real(other, given[other])
+    loop, point = paper_point(gamma=gamma, d=d, delta=delta)
+    found = locus(loop, _PAPER_PATHS[parameter], values, **point, **{_PAPER_PATHS[other]: fixed_value})
+    fixed = {other: fixed_value, "gamma": point["M"], "d": point["d"], "delta": float(delta)}
+    return dataclasses.replace(found, parameter=parameter, fixed=fixed)
 
 
 def __getattr__(name):

@@ -78,16 +78,15 @@ along it) becomes many short edges.
 """
 
 import dataclasses
-import functools
 import math
 
 import numpy as np
 import sympy as sp
 
-from .._validate import check_delay, check_loop, check_real
+from .._validate import check_delay, check_real
 from .curves import golden_max
 
-__all__ = ["PassiveRegion", "passive_region", "paper_passive_region"]
+__all__ = ["PassiveRegion", "passive_region"]
 
 #: Relative tolerance of the condition at the polygon's vertices (of the damping).
 _RTOL = 1e-6
@@ -177,6 +176,18 @@ class PassiveRegion:
             # _Plane.rows); a relative slack of 1e-12 absorbs the rounding
             # of a point on an edge.
             out &= c0 + cx * x + cy * y <= 1e-12 * (abs(c0) + abs(cx * x) + abs(cy * y))
+        return out
+
+    def renamed(self, x, y):
+        """The same region with the plane's parameters called ``x`` and ``y``.
+
+        Parameters
+        ----------
+        x, y : str
+            The new names.
+        """
+        out = dataclasses.replace(self, x=x, y=y)
+        object.__setattr__(out, "_halfplanes", self._halfplanes)
         return out
 
     def __repr__(self):
@@ -591,87 +602,6 @@ def _check_stable_denominator(den, what):
     if roots.size and np.max(np.abs(roots)) >= 1 - 1e-12:
         raise ValueError(f"{what} has a pole at |z| = {np.max(np.abs(roots)):.6g} >= 1: "
                          f"Colgate and Schenkel's condition needs a stable H(z)")
-
-
-# --------------------------------------------------------------------------
-# The paper's normalised loop
-
-
-@functools.lru_cache(maxsize=1)
-def _paper_parts():
-    """``T**2 VE / m`` as ``(N, D)`` coefficient lists in z, from the derivation."""
-    from ..symbolic import model
-    from ..symbolic.loop import dimensionless_environment
-
-    num, den = sp.fraction(sp.together(dimensionless_environment()))
-    num = sp.Poly(sp.expand(num), model.z).all_coeffs()
-    den = sp.Poly(sp.expand(den), model.z).all_coeffs()
-    return num, den
-
-
-def paper_passive_region(*, gamma, d, delta, x_range=None, y_range=None):
-    """The passive set of the paper's loop in the ``(beta, alpha)`` plane.
-
-    In Table I's units (``alpha = K_w T**2 / m``, ``beta = B_w T / m``,
-    ``gamma = M_w / m``, ``delta = b T / m``) Colgate and Schenkel's
-    condition (module docstring) multiplied by ``T / m`` reads
-
-        delta > 1/(2 (1 - cos theta)) Re{(1 - e^{-j theta}) h(theta) e^{-j theta d}}
-
-    with ``h = alpha + beta (1 - e^{-j theta}) + gamma (1 - e^{-j theta})**2``
-    (``T**2 VE / m``, taken from :func:`symstab.symbolic.loop.dimensionless_environment`),
-    for ``theta`` in [0, pi]; and ``alpha >= 0`` (no negative static stiffness).
-
-    Parameters
-    ----------
-    gamma : float
-        ``M_w / m``.
-    d : int
-        Delay in samples.
-    delta : float
-        ``b T / m``, > 0 (with no damping the passive set has no interior).
-    x_range, y_range : (float, float), optional
-        The window of beta and alpha; by default the polygon's bounding box
-        with a 5 % margin (an unbounded set: its finite vertices' box grown
-        by its own size).
-
-    Returns
-    -------
-    PassiveRegion
-        ``x = "beta"``, ``y = "alpha"``; ``y_max`` is the passive
-        ``alpha_max``.
-
-    Raises
-    ------
-    TypeError, ValueError
-        If a parameter is of the wrong kind or out of range.
-
-    Examples
-    --------
-    >>> r = paper_passive_region(gamma=0.0, d=0, delta=0.002)
-    >>> round(r.y_max, 12), round(r.area, 12)     # alpha <= 2 delta, |beta| <= delta
-    (0.004, 8e-06)
-    """
-    gamma, d, delta = check_loop(gamma, d, delta)
-    if delta <= 0:
-        raise ValueError(f"delta must be > 0 for a passive set with an interior, got {delta!r}")
-    x_range, y_range = _windows(x_range, y_range)
-    from ..symbolic import model
-
-    num, den = _paper_parts()
-    sub = {model.gamma: sp.Float(repr(gamma), 30)}
-
-    def numbers(coefficients, **at):
-        values = {model.alpha: 0, model.beta: 0, **sub}
-        values.update({getattr(model, k): v for k, v in at.items()})
-        return np.array([float(sp.sympify(c).subs(values)) for c in coefficients])
-
-    base = numbers(num)
-    slope_x = numbers(num, beta=1) - base
-    slope_y = numbers(num, alpha=1) - base
-    den_values = numbers(den)
-    plane = _prepare_plane(base, slope_x, slope_y, den_values, d, 0.5, delta, None)
-    return _solve(plane, "beta", "alpha", x_range, y_range)
 
 
 def _prepare_plane(base, slope_x, slope_y, den, d, scale, damping, damping_axis):

@@ -16,7 +16,8 @@ import pytest
 
 import symstab
 from symstab.numeric import locus as locus_module
-from symstab.numeric.locus import ON_CIRCLE, locus, paper_locus
+from symstab.numeric.locus import ON_CIRCLE, locus
+from symstab.numeric.paper_loop import paper_locus
 from symstab.numeric.stability import unstable_root_counts
 
 from conftest import PAPER_DELTA, REPO

@@ -22,7 +22,8 @@ import numpy as np
 import pytest
 
 import symstab
-from symstab.numeric.passivity import PassiveRegion, paper_passive_region, passive_region
+from symstab.numeric.paper_loop import paper_passive_region
+from symstab.numeric.passivity import PassiveRegion, passive_region
 
 from conftest import PAPER_B, PAPER_DELTA, PAPER_M, PAPER_T, REPO
 
