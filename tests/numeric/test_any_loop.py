@@ -351,9 +351,12 @@ def test_a_loop_string_cannot_run_code(tmp_path):
 
 
 def test_values_beyond_double_precision_are_an_error_not_an_empty_set(paper_loop):
-    # At T = 1e-30 the plant's numerator cancels to nothing even at 30 digits.
-    with pytest.raises(ValueError, match="cannot be resolved in double precision|underflows"):
-        paper_loop.limits("B", "K", M=0.0, m=PAPER_M, b=PAPER_B, T=1e-30, d=0)
+    # At T = 1e-30 the plant's closed form cancels 60 digits (it was refused at 30 fixed
+    # digits); with the digits it needs, K_max is the dimensionless alpha_max times m / T**2.
+    found = paper_loop.limits("B", "K", M=0.0, m=PAPER_M, b=PAPER_B, T=1e-30, d=0)
+    reference = symstab.limits(gamma=0.0, d=0, delta=PAPER_B * 1e-30 / PAPER_M)
+    assert found.y_max == pytest.approx(reference.alpha_max * PAPER_M / 1e-60, rel=1e-12)
+    assert found.area == pytest.approx(reference.z_width * PAPER_M**2 / 1e-90, rel=1e-9)
     with pytest.raises(ValueError, match="overflows or underflows"):
         paper_loop.stable_intervals("K", B=0.1, M=0.0, m=PAPER_M, b=PAPER_B, T=1e-300, d=0)
     with pytest.raises(ValueError, match="overflows or underflows"):
