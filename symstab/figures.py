@@ -20,33 +20,27 @@ otherwise.
 
 import dataclasses
 import functools
-import io
 import math
 import pathlib
 import time
 
 import numpy as np
 
-from ._generated import kernels
-from .numeric.curves import arc_end_angle
+from .drawing import LEGEND_SIZE, PANEL_TITLE_SIZE, SUPTITLE_SIZE, label_log_axis, png_bytes, pyplot
+from .numeric.curves import arc_end_angle, arc_polylines
 from .numeric.region import boundary_curve
 from .numeric.paper_loop import paper_passive_region
-from .numeric.region import StabilityRegion, limits
+from .numeric.region import StabilityRegion, limits, vanishing_gamma
 from .numeric.simulate import PAPER_ENCODER_RESOLUTION, Nonidealities, stability_map
 from .numeric.stability import unstable_root_counts
 from .numeric.units import PAPER_DEVICE
 
-__all__ = ["FigureResult", "FIGURES", "make_figures", "pyplot", "require_matplotlib"]
+__all__ = ["FigureResult", "FIGURES", "make_figures"]
 
 DELTA = PAPER_DEVICE.delta
 #: The delays of Figs. 6, 8, 11 and 12.
 DELAYS = (0, 1, 5, 10)
 _COLORS = ("#1f77b4", "#d62728", "#2ca02c", "#ff7f0e", "#9467bd", "#8c564b", "#e377c2")
-#: Font sizes (pt).  A figure's own title sits above its panels' titles, so it
-#: is the largest; legends stay readable at the saved 110 dpi (6-7 pt was not).
-SUPTITLE_SIZE = 13
-PANEL_TITLE_SIZE = 11
-LEGEND_SIZE = 8
 #: Legend of the arc's end angle in Figs. 3 and 4, in words rather than in
 #: the derivation's terms ("first root of alpha").
 _THETA_MAX_EXACT = r"exact: where the arc ends, $\alpha(\theta_{\max}) = 0$"
@@ -61,42 +55,6 @@ class FigureResult:
     figure: object
     paper: str
     symstab: str
-
-
-def require_matplotlib():
-    """Raise a one-line ValueError when matplotlib is missing (it is an extra)."""
-    try:
-        import matplotlib  # noqa: F401
-    except ImportError:
-        raise ValueError("the figures need matplotlib: pip install 'symstab[figures]' "
-                         "(or pip install matplotlib)") from None
-
-
-def pyplot():
-    """matplotlib.pyplot with the Agg backend and the figures' style."""
-    require_matplotlib()
-    import matplotlib
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-    plt.rcParams.update({"font.size": 10, "axes.grid": True, "grid.alpha": 0.3,
-                         "savefig.dpi": 110, "figure.dpi": 110})
-    return plt
-
-
-def _label_log_axis(ax):
-    """Label 1-2-5 steps on a log y axis that spans less than three decades.
-
-    Over so few decades matplotlib labels only the powers of ten -- two or
-    three ticks; the steps between them are written as plain numbers.  Call
-    it after plotting, so the limits are the data's.
-    """
-    from matplotlib import ticker
-
-    lo, hi = ax.get_ylim()
-    if math.log10(hi / lo) < 3:
-        ax.yaxis.set_major_locator(ticker.LogLocator(base=10.0, subs=(1.0, 2.0, 5.0)))
-        ax.yaxis.set_major_formatter(ticker.FuncFormatter(lambda v, _: f"{v:g}"))
-        ax.yaxis.set_minor_formatter(ticker.NullFormatter())
 
 
 def _labels(ax, physical=False):
@@ -149,21 +107,18 @@ def fig3():
 
 def fig4():
     """theta_max versus d, gamma = 0: exact and the Newton form (12)."""
-    plt = pyplot()
-    import sympy as sp
-    from .symbolic import model
-    from .symbolic.theta_max import newton_form_gamma0
+    from .symbolic.theta_max import theta_max_newton
 
+    plt = pyplot()
     ds = np.arange(0, 101)
     exact = np.array([arc_end_angle(gamma=0.0, d=int(d), delta=DELTA) for d in ds])
-    form = sp.lambdify((model.d, model.delta, model.Gamma), newton_form_gamma0().theta_newton, "mpmath")
-    newton = np.array([float(form(int(d), DELTA, math.exp(DELTA))) if d > 0 else np.nan for d in ds])
+    newton = np.array([theta_max_newton(d=int(d), delta=DELTA) if d > 0 else np.nan for d in ds])
     fig, ax = plt.subplots(figsize=(6, 4))
     ax.semilogy(ds, exact, "-", color=_COLORS[0], lw=2, label=_THETA_MAX_EXACT)
     ax.semilogy(ds[1:], newton[1:], "--", color=_COLORS[1], lw=1.5, label="one Newton step, eq. (12)")
     ax.set_xlabel(r"delay $d = T_d / T$ (samples)")
     ax.set_ylabel(r"$\theta_{\max}$ (rad)")
-    _label_log_axis(ax)  # theta_max spans two decades, 1.6 to 0.017 rad
+    label_log_axis(ax)  # theta_max spans two decades, 1.6 to 0.017 rad
     ax.set_title(r"Fig. 4: $\theta_{\max}$ versus $d$, $\gamma = 0$")
     ax.legend()
     err = np.abs(newton[1:] - exact[1:]) / exact[1:]
@@ -228,38 +183,6 @@ _COUNTS_NOTE = ("numbers: closed-loop poles outside the unit circle in that cell
 def _region(gamma, d):
     """The stable region of ``(gamma, d)``, kept: the panels, fills and verdicts share its scan."""
     return StabilityRegion(gamma=gamma, d=d, delta=DELTA)
-
-
-def _arc_pieces(gamma, d, window):
-    """The whole boundary arc, 0 < theta < pi, for drawing in ``window``.
-
-    Returns ``(first, beyond)``, each an ``(n, 2)`` array of ``(beta, alpha)``
-    rows: the arc of eq. (7) from theta = 0 to theta_max, and the rest up to
-    pi (empty when there is no theta_max).  Rows of NaN cut the curve where
-    it runs far from the window -- through a pole it goes to infinity and
-    comes back from the other side, and a straight line across would be
-    drawn.  The samples resolve the arc's turns: sin(d theta) has d / 2
-    periods on the way, so 400 samples a period.
-    """
-    (b0, b1), (a0, a1) = window
-    t_max = arc_end_angle(gamma=gamma, d=d, delta=DELTA)
-    theta = np.linspace(0.0, np.pi, 4000 + 400 * d + 1)[1:-1]
-    if np.isfinite(t_max):
-        theta = np.union1d(theta, [t_max])
-    alpha, beta = kernels.boundary(theta, gamma, d, DELTA)
-    span_b, span_a = b1 - b0, a1 - a0
-    with np.errstate(invalid="ignore"):
-        far = ~(np.isfinite(alpha) & np.isfinite(beta)) \
-            | (beta < b0 - 5 * span_b) | (beta > b1 + 5 * span_b) \
-            | (alpha < a0 - 5 * span_a) | (alpha > a1 + 5 * span_a)
-    points = np.column_stack([beta, alpha])
-    points[far] = np.nan
-    # The arc starts exactly at the corner (-delta, 0), the z = 1 root's line.
-    points = np.vstack([[-DELTA, 0.0], points])
-    if not np.isfinite(t_max):
-        return np.empty((0, 2)), points
-    k = int(np.searchsorted(theta, t_max)) + 1
-    return points[: k + 1], points[k:]
 
 
 @functools.lru_cache(maxsize=64)
@@ -352,7 +275,7 @@ def _write_counts(ax, gamma, d, window, scale=(1.0, 1.0), room=9.0):
 
 def _draw_boundary(ax, gamma, d, window, color, scale=(1.0, 1.0), beyond=True):
     """Draw the arc of eq. (7) (solid) and, with ``beyond``, the rest of the arc up to pi (dashed)."""
-    first, rest = _arc_pieces(gamma, d, window)
+    first, rest = arc_polylines(gamma=gamma, d=d, delta=DELTA, window=window)
     sx, sy = scale
     if len(first):
         ax.plot(first[:, 0] * sx, first[:, 1] * sy, color=color, zorder=3, **_ARC)
@@ -774,32 +697,6 @@ def fig10(n=40):
 # Limits versus gamma
 
 
-def _vanishing_gamma(d, inside, outside, tol=5e-5):
-    """Where the stable region vanishes: ``(last gamma with a region, first without)``.
-
-    Bisection between ``inside`` (a gamma with a region) and ``outside``
-    (one without) on the certified emptiness of :func:`symstab.limits`,
-    until the two are ``tol`` apart.  Next to the vanishing point the set
-    can be too small to decide (alpha_max below about 1e-12, where two
-    roots meet at z = 1, and the engine refuses): such a gamma moves
-    neither end, and the search goes on between it and ``outside``; the
-    bracket returned is always a decided pair.
-    """
-    probe = inside
-    while abs(outside - inside) > tol and abs(outside - probe) > tol:
-        middle = 0.5 * (probe + outside)
-        try:
-            empty = limits(gamma=middle, d=d, delta=DELTA).empty
-        except ValueError:
-            probe = middle
-            continue
-        if empty:
-            outside = middle
-        else:
-            inside = probe = middle
-    return inside, outside
-
-
 def _fig_limits(name, title, suptitle, gammas, paper, note):
     """beta_max, alpha_max and the Z-width versus ``gammas``, one column per delay.
 
@@ -826,7 +723,7 @@ def _fig_limits(name, title, suptitle, gammas, paper, note):
         beyond = edge + 1 if right else edge - 1
         vanish, edge_rows = None, []
         if 0 <= beyond < len(gammas) and empty[beyond]:
-            vanish = _vanishing_gamma(d, gammas[edge], gammas[beyond])
+            vanish = vanishing_gamma(d=d, delta=DELTA, inside=gammas[edge], outside=gammas[beyond])
             # A few points between the last grid gamma and the vanishing one,
             # closer and closer, show how the Z-width goes to zero.
             edge_rows = [(g, limits(gamma=g, d=d, delta=DELTA)) for g in
@@ -873,7 +770,7 @@ def _fig_limits(name, title, suptitle, gammas, paper, note):
         lin.set_xlabel(r"$\gamma = M_w/m$")
         ax.set_ylabel("dimensionless, log scale")
         lin.set_ylabel("Z-width, linear scale")
-        _label_log_axis(ax)
+        label_log_axis(ax)
         ax.set_title(f"$d = {d}$", fontsize=PANEL_TITLE_SIZE)
         k = int(np.nanargmax(am))
         facts.append(dict(d=d, am=am, bm=bm, zw=zw, edge=edge, empty=empty, vanish=vanish,
@@ -950,10 +847,7 @@ def make_figures(out_dir, progress=None):
     for make in FIGURES:
         start = time.perf_counter()
         result = make()
-        buf = io.BytesIO()
-        result.figure.savefig(buf, format="png", metadata={"Software": None})
-        plt.close(result.figure)
-        write_bytes(out / f"{result.name}.png", buf.getvalue())
+        write_bytes(out / f"{result.name}.png", png_bytes(plt, result.figure))
         result.figure = None
         results.append(result)
         if progress is not None:

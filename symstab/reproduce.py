@@ -22,7 +22,6 @@ and exit with status 130 and 143 (128 + the signal number).
 
 import concurrent.futures
 import contextlib
-import io
 import os
 import pathlib
 import signal
@@ -43,15 +42,14 @@ _ORDER = ("fig12", "fig11", "fig10", "fig8", "fig6", "fig7", "fig4", "fig5", "fi
 
 def _figure_task(name):
     from . import figures
+    from .drawing import png_bytes, pyplot
 
-    plt = figures.pyplot()
+    plt = pyplot()
     start = time.perf_counter()
     result = getattr(figures, name)()
-    buf = io.BytesIO()
-    result.figure.savefig(buf, format="png", metadata={"Software": None})
-    plt.close(result.figure)
+    data = png_bytes(plt, result.figure)
     result.figure = None
-    return result, buf.getvalue(), time.perf_counter() - start
+    return result, data, time.perf_counter() - start
 
 
 def _derive(out, log):
@@ -176,7 +174,7 @@ def reproduce(out_dir, *, workers=2, log=None):
     ends the program with status 130 or 143 (128 + the signal number), as
     the command line promises.
     """
-    from .figures import require_matplotlib
+    from .drawing import require_matplotlib
 
     log = log or (lambda line: print(line, file=sys.stderr, flush=True))
     out = pathlib.Path(out_dir)

@@ -27,7 +27,7 @@ PACKAGE = pathlib.Path(symstab.__file__).resolve().parent
 #: Rank of each layer; a module may import its own rank or lower.
 RANK = {"base": 0, "symbolic": 1, "codegen": 2, "proof": 3, "numeric": 4, "front": 5}
 _BASE = {"_project", "_resources", "_validate", "_workers", "_generated"}
-_FRONT = {"cli", "figures", "reproduce", "__main__"}
+_FRONT = {"cli", "drawing", "figures", "reproduce", "__main__"}
 
 
 def _layer(parts):

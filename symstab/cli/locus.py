@@ -21,7 +21,8 @@ from .loop_options import (DEVICE_OPTIONS, EXAMPLE, LINEAR_WITH_LOOP, POINT_OPTI
                            add_delay, check_names, convert_sets, load_loop_file, loop_echo,
                            loop_values, parse_number, split_unit)
 from .options import add_command, add_model_options, resolve
-from .output import check_outputs, emit, interval_texts, png_bytes, write_output
+from ..drawing import png_bytes
+from .output import check_outputs, emit, interval_texts, write_output
 from .units import tex_unit
 
 __all__ = ["register", "run"]
@@ -424,7 +425,7 @@ def run(args):
     png = None
     if args.png is not None:
         png = check_outputs([("--png", args.png, "file")])["--png"]
-        from ..figures import require_matplotlib
+        from ..drawing import require_matplotlib
         require_matplotlib()
     view = _loop(args) if args.loop is not None else _paper(args)
     certified = _certified(view)
@@ -530,7 +531,7 @@ def _plane(ax, view, norm, limit, window=None):
 
 def _png(view, stretches):
     """The locus as PNG bytes: the z-plane, a zoom on where the poles cross, the largest modulus."""
-    from ..figures import LEGEND_SIZE, PANEL_TITLE_SIZE, SUPTITLE_SIZE, pyplot
+    from ..drawing import LEGEND_SIZE, PANEL_TITLE_SIZE, SUPTITLE_SIZE, pyplot
 
     plt = pyplot()
     from matplotlib.colors import Normalize

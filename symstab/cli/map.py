@@ -16,7 +16,8 @@ import numpy as np
 from .._resources import CHUNK_BYTES, check_memory, chunk_slices
 from .loop_options import add_loop_options, resolve_loop, uses_loop, value_text
 from .options import add_command, add_model_options, resolve, stiffness_and_damping
-from .output import check_files, draw_lines, png_bytes, pyplot_or_none, visible, write_output
+from ..drawing import draw_lines, png_bytes, pyplot_or_none, visible
+from .output import check_files, write_output
 from .simulation import add_nonideal_options, nonideal_text, resolve_nonideal, simulated_theory
 from .units import tex_unit
 

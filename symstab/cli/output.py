@@ -19,7 +19,7 @@ import tempfile
 import numpy as np
 
 __all__ = ["FORMATS", "BYTES_PER_ROW", "check_outputs", "check_files", "write_output", "emit",
-           "number_text", "interval_texts", "pyplot_or_none", "png_bytes", "visible", "draw_lines"]
+           "number_text", "interval_texts"]
 
 
 FORMATS = ("table", "csv", "json")
@@ -271,57 +271,3 @@ def _plain(x):
     if isinstance(x, float) and not math.isfinite(x):
         return None if math.isnan(x) else ("inf" if x > 0 else "-inf")
     return x
-
-
-# --------------------------------------------------------------------------
-# PNG
-
-
-def pyplot_or_none():
-    """matplotlib's pyplot, or None (said on stderr) where matplotlib is not installed."""
-    from ..figures import pyplot
-
-    try:
-        return pyplot()
-    except ValueError:
-        print("matplotlib is not installed: no PNG", file=sys.stderr)
-        return None
-
-
-def png_bytes(plt, fig):
-    """The figure as PNG bytes (no software tag: the bytes depend on the drawing only); closes it."""
-    buf = io.BytesIO()
-    fig.savefig(buf, format="png", metadata={"Software": None})
-    plt.close(fig)
-    return buf.getvalue()
-
-
-def visible(values, lo, hi):
-    """``values`` with NaN where far outside [lo, hi], so that a line breaks there."""
-    span = hi - lo
-    out = np.array(values, dtype=float)
-    out[~((out > lo - 2 * span) & (out < hi + 2 * span))] = np.nan
-    return out
-
-
-def draw_lines(ax, lines, xs, ys, to_x=np.asarray, to_y=np.asarray):
-    """Draw the D-decomposition's lines ``c0 + cx x + cy y = 0`` across a window; return the handles.
-
-    ``xs`` and ``ys`` are the window's grids in the lines' plane; ``to_x`` and
-    ``to_y`` take that plane's coordinates to the axes' (a map drawn in
-    other units).
-    """
-    styles = {"z = 1": ("C0", "--"), "z = -1": ("C3", "--"), "leading": ("C1", ":")}
-    handles = []
-    for label, (c0, cx, cy) in lines.items():
-        color, style = styles.get(label, ("C4", "-."))
-        if cy != 0:
-            px, py = xs[[0, -1]], -(c0 + cx * xs[[0, -1]]) / cy
-        else:
-            px, py = np.full(2, -c0 / cx), ys[[0, -1]]
-        if np.all(py < ys[0]) or np.all(py > ys[-1]) or np.all(px < xs[0]) or np.all(px > xs[-1]):
-            continue   # the line misses the window
-        handles += ax.plot(to_x(px), to_y(py), color=color, ls=style, lw=1.2,
-                           label=label.replace("leading", "leading coefficient 0")
-                           .replace("z = 1", "root z = 1").replace("z = -1", "root z = -1"))
-    return handles

@@ -50,7 +50,7 @@ from .results import PAPER_PLANE, Boundary
 from .polynomial import DelayedPolynomial
 from .stability import MARGINAL, STABLE, UNSTABLE, classify, loop_coefficients, paper_polynomial
 
-__all__ = ["StabilityRegion", "limits", "BestVirtualMass", "best_virtual_mass",
+__all__ = ["StabilityRegion", "limits", "vanishing_gamma", "BestVirtualMass", "best_virtual_mass",
            "scan_maximum", "boundary_curve"]
 
 #: Working bytes per crossing of a line with the boundary (positions, angles,
@@ -754,6 +754,69 @@ def limits(*, gamma, d, delta, n_beta=None):
     """
     _deprecated_n_beta(n_beta)
     return StabilityRegion(gamma=gamma, d=d, delta=delta).limits()
+
+
+def vanishing_gamma(*, d, delta, inside, outside, tol=5e-5):
+    """Where the stable region vanishes along gamma: ``(last gamma with a region, first without)``.
+
+    Bisection between ``inside`` (a gamma with a stable region) and
+    ``outside`` (one without) on the certified emptiness of :func:`limits`,
+    until the two are ``tol`` apart.  Next to the vanishing point the set
+    can be too small to decide (alpha_max below about 1e-12, where two
+    roots meet at z = 1, and the engine refuses): such a gamma moves neither
+    end, and the search goes on between it and ``outside``.  The bracket
+    returned is always a decided pair, wider than ``tol`` when the search
+    ran into such gammas.
+
+    Parameters
+    ----------
+    d : int
+        Delay in samples.
+    delta : float
+        ``b T / m``.
+    inside, outside : float
+        The two ends; either may be the larger.
+    tol : float
+        Width of the bracket to stop at, > 0.
+
+    Returns
+    -------
+    (float, float)
+        ``(inside, outside)``, moved towards each other.
+
+    Raises
+    ------
+    ValueError
+        If ``inside`` has no stable region or ``outside`` has one.
+
+    Examples
+    --------
+    A region exists while gamma > -1 - (d + 1) delta:
+
+    >>> lo, hi = vanishing_gamma(d=0, delta=0.00253125, inside=-0.5, outside=-1.5, tol=1e-3)
+    >>> hi <= -1.00253125 <= lo
+    True
+    """
+    _, d, delta = check_loop(0.0, d, delta)
+    inside, outside = check_real("inside", inside), check_real("outside", outside)
+    tol = check_real("tol", tol, low=0.0, low_open=True)
+    if limits(gamma=inside, d=d, delta=delta).empty:
+        raise ValueError(f"inside = {inside!r} must be a gamma with a stable region (d = {d})")
+    if not limits(gamma=outside, d=d, delta=delta).empty:
+        raise ValueError(f"outside = {outside!r} must be a gamma without a stable region (d = {d})")
+    probe = inside
+    while abs(outside - inside) > tol and abs(outside - probe) > tol:
+        middle = 0.5 * (probe + outside)
+        try:
+            empty = limits(gamma=middle, d=d, delta=delta).empty
+        except ValueError:
+            probe = middle
+            continue
+        if empty:
+            outside = middle
+        else:
+            inside = probe = middle
+    return inside, outside
 
 
 @dataclasses.dataclass(frozen=True)

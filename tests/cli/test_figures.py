@@ -17,7 +17,7 @@ pytest.importorskip("matplotlib")
 import matplotlib.legend  # noqa: E402
 import matplotlib.text  # noqa: E402
 
-from symstab import figures  # noqa: E402
+from symstab import drawing, figures  # noqa: E402
 
 # Small grids and gamma scans: the text is the same as at full size.
 _SMALL = {"fig3": {}, "fig4": {}, "fig5": {}, "fig6": {"n": 4}, "fig7": {}, "fig8": {"n": 4},
@@ -28,7 +28,7 @@ _PANELLED = ("fig6", "fig8", "fig10", "fig11", "fig12")
 @pytest.fixture(scope="module")
 def drawn():
     """Figures by name, built when a test first asks (each xdist worker builds its own)."""
-    plt = figures.pyplot()
+    plt = drawing.pyplot()
     made = {}
 
     class Lazy(dict):

@@ -788,3 +788,46 @@ def test_boundary_curve_prints_a_summary_not_its_arrays():
     assert "array(" not in text and "1000 points" in text
     assert f"theta_max={curve.theta_max:.6g}" in text
     assert "no arc" in repr(symstab.boundary_curve(gamma=-3.0, d=0, delta=PAPER_DELTA, n=10))
+
+
+@pytest.mark.parametrize("d", [0, 5, 10])
+def test_vanishing_gamma_brackets_the_derived_end_of_the_arc(d):
+    """The region shrinks to nothing where the arc's start vanishes, gamma* = -1 - (d + 1) delta
+    (REPORT.md, claim:no_region_gamma_le_-1): the bisection's decided bracket holds it."""
+    from symstab.numeric.region import vanishing_gamma
+
+    star = -1.0 - (d + 1) * PAPER_DELTA
+    inside, outside = vanishing_gamma(d=d, delta=PAPER_DELTA, inside=-0.9, outside=-1.2, tol=1e-4)
+    assert outside <= star <= inside and inside - outside <= 1e-4
+    assert limits(gamma=outside, d=d, delta=PAPER_DELTA).empty
+    assert not limits(gamma=inside, d=d, delta=PAPER_DELTA).empty
+
+
+def test_vanishing_gamma_refuses_ends_on_the_wrong_side():
+    from symstab.numeric.region import vanishing_gamma
+
+    with pytest.raises(ValueError, match="inside"):
+        vanishing_gamma(d=0, delta=PAPER_DELTA, inside=-1.2, outside=-1.3)
+    with pytest.raises(ValueError, match="outside"):
+        vanishing_gamma(d=0, delta=PAPER_DELTA, inside=-0.5, outside=0.0)
+    with pytest.raises(ValueError, match="tol"):
+        vanishing_gamma(d=0, delta=PAPER_DELTA, inside=-0.5, outside=-1.2, tol=0.0)
+
+
+@pytest.mark.parametrize("gamma, d", [(0.0, 0), (0.5, 5), (1.0, 10)])
+def test_arc_polylines_lie_on_the_boundary_by_python_control(gamma, d):
+    """Every drawn arc point has a closed-loop pole on the unit circle (python-control's poles of
+    the sampled loop); the first piece starts at the corner (-delta, 0) and ends on alpha = 0."""
+    from oracles import python_control_closed_loop
+    from symstab.numeric.curves import arc_polylines
+
+    window = ((-0.5, 2.5), (-0.1, 4.0))
+    first, beyond = arc_polylines(gamma=gamma, d=d, delta=PAPER_DELTA, window=window)
+    assert tuple(first[0]) == (-PAPER_DELTA, 0.0)
+    assert abs(first[-1][1]) <= 1e-9 and np.array_equal(first[-1], beyond[0])
+    points = np.vstack([first, beyond])
+    points = points[np.all(np.isfinite(points), axis=1)]
+    for beta, alpha in points[np.linspace(1, len(points) - 1, 12).astype(int)]:
+        poles = python_control_closed_loop(alpha=alpha, beta=beta, gamma=gamma, d=d,
+                                           delta=PAPER_DELTA, m=1.0, T=1.0).poles()
+        assert np.min(np.abs(np.abs(poles) - 1.0)) <= 1e-7, (beta, alpha)
