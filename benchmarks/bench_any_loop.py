@@ -424,8 +424,9 @@ def bench_limits(args):
             print(f"  {d:>3} {M_w:>7g} {fmt(t_loop):>12} {fmt(t_paper):>15} {t_loop / t_paper:>6.1f}x "
                   f"{fmt(t_int):>17} {fmt(t_ref_int):>16}  {lim.y_max:<12.6g}  "
                   + ", ".join(f"{k} {v:.1e}" for k, v in diffs.items()))
-    print(f"   Loop vs symstab.limits: largest relative difference {worst_all:.1e} (Loop.limits' "
-          f"area is its stable polygons', symstab.limits' a trapezoid rule over 801 lines)")
+    print(f"   Loop vs symstab.limits: largest relative difference {worst_all:.1e} (one engine: "
+          f"symstab.limits is Loop.limits at m = T = 1; the difference is the units' rounding, "
+          f"and the K intervals come from two line engines)")
 
 
 def main():

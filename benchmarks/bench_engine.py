@@ -18,10 +18,11 @@ Every row is one run on the same machine state, medians of ``--runs``:
    dense polynomial (``numpy.linalg.eigvals``, O(d**3)).
 4. The stable set's limits at ``--limits-delays`` (default 200, 1000,
    5000): ``symstab.PAPER_LOOP.limits`` (the D-decomposition on the
-   structured polynomial, its window from the exact stable hull) against
-   the paper's path ``symstab.limits`` (crossings counted along lines,
-   :mod:`symstab.numeric.region`), and K_max from both.  One run each from
-   d = 1000 on.
+   structured polynomial, its window from the exact stable hull) in the
+   device's units against ``symstab.limits`` in Table I's, which is the
+   same engine at m = T = 1 (the paper's own line integration is gone): the
+   ratio is what the dimensionless adapter costs, and K_max from both.
+   One run each from d = 1000 on.
 
 Targets (issue 19): the Loop path within 1.3x of the paper's; the radius at
 d = 2000 under 1 s; Loop limits under 2 s at d = 1000 and 20 s at d = 5000.  BLAS threads on a busy 2-core machine distort short

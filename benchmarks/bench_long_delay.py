@@ -5,8 +5,8 @@
 For each delay d (gamma = 0.5, delta = 1e-4):
 
 1. ``symstab.boundary_curve(n=64)`` with its default segments, and
-   ``symstab.limits`` (the region found by counting crossings along lines,
-   :mod:`symstab.numeric.region`): median wall time of ``--runs``.
+   ``symstab.limits`` (the D-decomposition of the paper's loop,
+   :meth:`symstab.Loop.limits`): median wall time of ``--runs``.
 2. The obvious alternative, side by side in the same run: classify a
    beta x alpha grid with ``symstab.classify`` at the resolution that gives
    alpha_max and the beta range to 1e-3 (1e-3 of alpha_max and of the beta
