@@ -32,7 +32,6 @@ from .numeric.region import boundary_curve
 from .numeric.paper_loop import paper_passive_region
 from .numeric.region import StabilityRegion, limits, vanishing_gamma
 from .numeric.simulate import PAPER_ENCODER_RESOLUTION, Nonidealities, stability_map
-from .numeric.stability import unstable_root_counts
 from .numeric.units import PAPER_DEVICE
 
 __all__ = ["FigureResult", "FIGURES", "make_figures"]
@@ -503,12 +502,13 @@ def fig8(n=100):
                         "2.2 unstable.", claimed, extra_row=_fig8_second_row(gammas))
 
 
-def _loop_counts(gamma, first, beta):
+def _loop_counts(gamma, first, beta, window):
     """Root counts inside and just outside a thin loop of the arc, on the vertical ``beta``.
 
     ``first`` is the arc of eq. (7) as ``(beta, alpha)`` rows; it runs up
-    to its tip and back, so it meets the vertical twice.  Returns
-    ``(inside, outside, alpha_tip, beta_tip)``.
+    to its tip and back, so it meets the vertical twice.  The counts are the
+    certified ones of the D-decomposition's cells at a point between the two
+    and one above.  Returns ``(inside, outside, alpha_tip, beta_tip)``.
     """
     ok = np.all(np.isfinite(first), axis=1)
     b, a = first[ok, 0], first[ok, 1]
@@ -518,8 +518,7 @@ def _loop_counts(gamma, first, beta):
         order = np.argsort(b[half])
         heights.append(np.interp(beta, b[half][order], a[half][order]))
     lo, hi = sorted(heights)
-    inside, outside = unstable_root_counts(alpha=np.array([0.5 * (lo + hi), hi + 0.25]),
-                                           beta=np.array([beta, beta]), gamma=gamma, d=0, delta=DELTA)
+    inside, outside = _decomposition(gamma, 0, window).count_at([beta, beta], [0.5 * (lo + hi), hi + 0.25])
     return int(inside), int(outside), float(a[tip]), float(b[tip])
 
 
@@ -538,7 +537,7 @@ def fig7():
         first, _ = _draw_boundary(ax, g, 0, window, color)
         ax.plot([], [], color=color, lw=2.5, label=fr"$\gamma = {g:g}$ ({tag})")
         if lim.empty:
-            loops[g] = (_loop_counts(g, first, -1.5), color)
+            loops[g] = (_loop_counts(g, first, -1.5, window), color)
     points = []
     lim0 = limits(gamma=0.0, d=0, delta=DELTA)
     points.append((1, lim0.beta_at_alpha_max, lim0.alpha_max))
