@@ -119,11 +119,13 @@ class PassiveRegion:
         The window.
     area : float
         Area of the polygon (inside the window).
-    y_max : float
+    y_max : float or None
         Largest ``y`` of a passive point (``inf`` if the set is unbounded
-        upwards, ``nan`` if it is empty), e.g. the passive ``K_max``.
-    x_at_y_max : float
-        The ``x`` where it is reached (the middle of a horizontal top edge).
+        upwards, None if it is empty, as in :class:`~symstab.numeric.results.Limits`),
+        e.g. the passive ``K_max``.
+    x_at_y_max : float or None
+        The ``x`` where it is reached (the middle of a horizontal top edge;
+        None if the set is empty).
     """
 
     x: str
@@ -133,8 +135,8 @@ class PassiveRegion:
     x_range: tuple
     y_range: tuple
     area: float
-    y_max: float
-    x_at_y_max: float
+    y_max: object
+    x_at_y_max: object
     # The half-planes c0 + cx x + cy y <= 0 whose intersection the polygon
     # is (before the window): set by _solve, read by contains().
     _halfplanes: np.ndarray = dataclasses.field(default=None, init=False, repr=False,
@@ -543,7 +545,7 @@ def _solve(plane, x, y, x_range, y_range, hints=(0.0, 0.0)):
     halfplanes = rows * np.array([1.0, 1.0 / plane.sx, 1.0 / plane.sy])
     if len(polygon) == 0:
         return _with_halfplanes(PassiveRegion(x, y, np.zeros((0, 2)), True, tuple(window[0]),
-                                              tuple(window[1]), 0.0, math.nan, math.nan),
+                                              tuple(window[1]), 0.0, None, None),
                                 halfplanes)
     full = polygon * unscale + 0.0     # no -0.0
     (x0, x1), (y0, y1) = window

@@ -308,7 +308,8 @@ def test_empty_set():
     # gives alpha/2 - beta <= delta; their sum and alpha >= 0 need gamma <= delta.
     region = paper_passive_region(gamma=0.5, d=0, delta=PAPER_DELTA)
     assert region.empty and region.polygon.shape == (0, 2) and region.area == 0.0
-    assert math.isnan(region.y_max) and "no passive point" in repr(region)
+    # None, as an empty Limits says (it was NaN)
+    assert region.y_max is None and region.x_at_y_max is None and "no passive point" in repr(region)
     assert not region.contains(0.0, 0.0)
 
 
