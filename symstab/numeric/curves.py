@@ -253,6 +253,8 @@ def arc_polylines(*, gamma, d, delta, window):
         theta) has d / 2 periods on the way, so 400 samples a period.
     """
     gamma, d, delta = check_loop(gamma, d, delta)
+    if isinstance(window, (str, bytes)) or not hasattr(window, "__len__") or len(window) != 2:
+        raise TypeError(f"window must be ((beta0, beta1), (alpha0, alpha1)), got {window!r}")
     (b0, b1), (a0, a1) = (check_window("window[0]", window[0]), check_window("window[1]", window[1]))
     check_memory("the arc's polylines", 64 * (4000 + 400 * d))
     t_max = arc_end_angle(gamma=gamma, d=d, delta=delta)

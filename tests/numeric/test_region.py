@@ -32,6 +32,7 @@ test_alpha_max_at_the_best_gamma_is_the_top_of_the_region guards it.
 
 import functools
 import math
+import re
 
 import mpmath
 import numpy as np
@@ -831,3 +832,14 @@ def test_arc_polylines_lie_on_the_boundary_by_python_control(gamma, d):
         poles = python_control_closed_loop(alpha=alpha, beta=beta, gamma=gamma, d=d,
                                            delta=PAPER_DELTA, m=1.0, T=1.0).poles()
         assert np.min(np.abs(np.abs(poles) - 1.0)) <= 1e-7, (beta, alpha)
+
+
+@pytest.mark.parametrize("window, error, name", [(1.0, TypeError, "window"), ("ab", TypeError, "window"),
+                                                 (((0, 1),), TypeError, "window"),
+                                                 (((1, 0), (0, 1)), ValueError, "window[0]"),
+                                                 (((0, 1), (0, np.nan)), ValueError, "window[1]")])
+def test_arc_polylines_refuses_a_bad_window_naming_it(window, error, name):
+    from symstab.numeric.curves import arc_polylines
+
+    with pytest.raises(error, match=re.escape(name)):
+        arc_polylines(gamma=0.0, d=0, delta=PAPER_DELTA, window=window)
