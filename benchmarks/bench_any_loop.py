@@ -426,7 +426,8 @@ def bench_limits(args):
                   + ", ".join(f"{k} {v:.1e}" for k, v in diffs.items()))
     print(f"   Loop vs symstab.limits: largest relative difference {worst_all:.1e} (one engine: "
           f"symstab.limits is Loop.limits at m = T = 1; the difference is the units' rounding, "
-          f"and the K intervals come from two line engines)")
+          f"amplified to about sqrt(eps) in B at K_max, the argmax of a flat top; the K intervals "
+          f"come from two line engines)")
 
 
 def main():
