@@ -719,7 +719,7 @@ class LoopModel:
         the values and ``T`` away from 1 -- and are doubled until two
         evaluations agree to ``PLANT_DIGITS`` digits of each part's largest
         coefficient (not beyond :data:`PLANT_MAX_DIGITS`); the more precise
-        one is kept.
+        one is kept, and returned with its digits ``(P_n, P_d, digits)``.
         """
         order = len(self._plant_parts[1]) - 1
         decades = sum(abs(mpmath.log10(abs(v))) for v in (*point, T) if v != 0)
@@ -729,15 +729,15 @@ class LoopModel:
                 try:
                     parts = self._plant_functions(*point, T)
                 except ZeroDivisionError:
-                    return [mpmath.nan], [mpmath.mpf(0)]
+                    return [mpmath.nan], [mpmath.mpf(0)], digits
                 parts = [[mpmath.mpmathify(c) for c in part] for part in parts]
             if not all(mpmath.isfinite(c) for part in parts for c in part):
-                return parts
+                return (*parts, digits)
             if before is not None and all(
                     max(abs(a - b) for a, b in zip(old, new))
                     <= mpmath.mpf(10) ** -PLANT_DIGITS * max(abs(c) for c in new)
                     for old, new in zip(before, parts)):
-                return parts
+                return (*parts, digits)
             before, digits = parts, 2 * digits
         given = ", ".join(f"{n} = {float(v):g}" for n, v in zip(self._plant_names, point))
         raise ValueError(f"the plant's pulse transfer function at {given}, T = {float(T):g} "
@@ -754,8 +754,11 @@ class LoopModel:
         where it is.  The last part is ``P_d(w + 1)``'s coefficients in
         ``w = z - 1`` (highest first), shifted at 30 digits: a pole
         ``exp(p T)`` near 1 gives a small coefficient with its own digits,
-        which the root count needs next to ``z = 1``.
+        which the root count needs next to ``z = 1``.  Where the closed form
+        needed more digits (:meth:`_closed_form_plant`), all of this is done
+        at those: a pole ``exp(-1e-30)`` keeps its ``1e-30`` after the shift.
         """
+        digits = PLANT_DIGITS
         with mpmath.workdps(PLANT_DIGITS):
             point = [mpmath.mpf(float(v)) for v in plant_values]
             if self._plant_parts is None:
@@ -766,7 +769,8 @@ class LoopModel:
                 den = [mpmath.mpf(sp.Float(c, PLANT_DIGITS)) for c in sp.Poly(den, model.s).all_coeffs()]
                 p_n, p_d = numeric_zoh(num, den, mpmath.mpf(float(T)), dps=PLANT_DIGITS)
             else:
-                p_n, p_d = self._closed_form_plant(point, mpmath.mpf(float(T)))
+                p_n, p_d, digits = self._closed_form_plant(point, mpmath.mpf(float(T)))
+        with mpmath.workdps(digits):
             lead = p_d[0]
             if lead == 0 or not all(mpmath.isfinite(c) for c in p_n + p_d):
                 given = ", ".join(f"{n} = {float(v):g}" for n, v in zip(self._plant_names, plant_values))

@@ -97,3 +97,18 @@ def test_coefficients_at_a_tiny_damping_match_the_first_principles_polynomial(de
     with mpmath.workdps(60):
         expected = np.array([float(c) for c in first_principles_chi(0.4, 0.7, 0.3, 2, delta)])
     assert np.max(np.abs(got - expected)) <= 4e-16 * np.max(np.abs(expected)), (got, expected)
+
+
+@pytest.mark.parametrize("delta", [1e-6, 1e-14, 1e-30, 1e-100])
+def test_the_pole_next_to_z_1_keeps_its_digits_in_powers_of_z_minus_1(delta):
+    """P_d(w + 1) = w (w + 1 - exp(-delta)) at m = T = 1: its middle coefficient is 1 - exp(-delta),
+    the pole's distance from z = 1 that the root count needs.  Shifted at a fixed 30 digits it was
+    1.4e-2 off at delta = 1e-30 and 0 (a double pole at z = 1) from 1e-35 on.  Oracle: mpmath's
+    expm1."""
+    from symstab.numeric.paper_loop import paper_point
+
+    loop, _ = paper_point(gamma=0.0, d=0, delta=delta)
+    names = dict(b=delta, m=1.0)
+    near_one = loop._plant_cache(tuple(names[n] for n in loop._plant_names), 1.0)[3]
+    assert near_one[0] == 1.0
+    assert near_one[1] == pytest.approx(float(-mpmath.expm1(-mpmath.mpf(delta))), rel=1e-15, abs=0)
