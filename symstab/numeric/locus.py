@@ -48,7 +48,7 @@ from .curves import bracketed_root
 from .polynomial import horner
 from .roots import leading_vanishes, polish_roots
 
-__all__ = ["Locus", "Crossing", "locus", "ON_CIRCLE"]
+__all__ = ["Locus", "Crossing", "locus", "check_path", "ON_CIRCLE"]
 
 #: A pole whose modulus is within this of 1 is on the circle (a marginal point).
 ON_CIRCLE = 1e-10
@@ -226,7 +226,7 @@ def locus(loop, parameter, values, **fixed):
     if unknown:
         raise TypeError(f"unknown parameter(s) {', '.join(unknown)}; parameters of this loop: "
                         f"{', '.join(loop.parameters)}")
-    values = _path(parameter, values)
+    values = check_path(parameter, values)
     used = {n: v for n, v in loop.defaults.items() if n != parameter}
     used.update(fixed)
     for name, value in used.items():
@@ -241,8 +241,26 @@ def locus(loop, parameter, values, **fixed):
     return _locus(parameter, values, dict(used), coefficients)
 
 
-def _path(parameter, values):
-    """The path's values as a strictly monotonic float array of at least two."""
+def check_path(parameter, values):
+    """The path's values as a strictly monotonic float array of at least two.
+
+    Parameters
+    ----------
+    parameter : str
+        The path's parameter, as the caller named it (for the messages).
+    values : array_like
+        Its values.
+
+    Returns
+    -------
+    ndarray
+        One-dimensional, strictly increasing or strictly decreasing.
+
+    Raises
+    ------
+    TypeError, ValueError
+        Naming ``values (of parameter)``.
+    """
     values = check_array(f"values (of {parameter})", values)
     if values.ndim != 1 or values.size < 2:
         raise ValueError(f"values (of {parameter}) must be a list of at least two numbers, got "

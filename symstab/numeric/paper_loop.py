@@ -219,7 +219,7 @@ def paper_locus(*, parameter, values, gamma, d, delta, alpha=None, beta=None):
     >>> [(c.kind, c.direction) for c in path.crossings]
     [('pair', 'out')]
     """
-    from .locus import locus
+    from .locus import check_path, locus
 
     if parameter not in _PAPER_PATHS:
         raise ValueError(f"parameter must be 'alpha' or 'beta', got {parameter!r}")
@@ -231,6 +231,7 @@ def paper_locus(*, parameter, values, gamma, d, delta, alpha=None, beta=None):
     if given[other] is None:
         raise TypeError(f"paper_locus along {parameter} needs the fixed {other}=")
     fixed_value = check_real(other, given[other])
+    values = check_path(parameter, values)      # errors name alpha or beta, not K or B
     loop, point = paper_point(gamma=gamma, d=d, delta=delta)
     found = locus(loop, _PAPER_PATHS[parameter], values, **point, **{_PAPER_PATHS[other]: fixed_value})
     fixed = {other: fixed_value, "gamma": point["M"], "d": point["d"], "delta": float(delta)}

@@ -384,3 +384,10 @@ def test_continuation_falls_back_where_roots_collide():
     assert locus_module._continued(c, np.array([0.5, 0.52, -0.3])) is None
     z = locus_module._continued(np.poly([0.5, 0.7, -0.3]), np.array([0.49, 0.71, -0.31]))
     np.testing.assert_allclose(np.sort_complex(z), [-0.3, 0.5, 0.7], atol=1e-14)
+
+
+@pytest.mark.parametrize("values", [[0.2, 0.1, 0.3], [0.1], "ab"])
+def test_paper_locus_errors_name_the_papers_parameter(values):
+    """paper_locus runs on the loop's K and B; its errors still say alpha or beta."""
+    with pytest.raises((TypeError, ValueError), match=r"values \(of alpha\)"):
+        paper_locus(parameter="alpha", values=values, beta=0.1, gamma=0.0, d=0, delta=0.1)
