@@ -788,8 +788,14 @@ def _why_empty(found):
     if box is not None and all(w[0] <= b[0] and b[1] <= w[1]
                                for w, b in zip((found.x_range, found.y_range), box)):
         return (f"every cell of the window {where}, which holds every point that passes the "
-                f"necessary condition of the roots inside the unit circle, has a root outside it")
-    return f"every cell of the window {where} has a root outside the unit circle"
+                f"necessary condition of the roots inside the unit circle, has a root outside it"
+                f"{_UNRESOLVED}")
+    return f"every cell of the window {where} has a root outside the unit circle{_UNRESOLVED}"
+
+
+#: What an empty decomposition does not exclude (the hull, when empty, is a proof).
+_UNRESOLVED = (" (a stable sliver too thin for the sampled arc to draw, as next to a point "
+               "where the set vanishes, is not excluded)")
 
 
 #: Largest table of cos(k theta), sin(k theta) on the scan kept per degree (bytes).

@@ -713,6 +713,7 @@ class StabilityRegion:
 
 def _deprecated_n_beta(n_beta):
     if n_beta is not None:
+        check_count("n_beta", n_beta, 3)    # still refused as before, while it is deprecated
         warnings.warn("n_beta is deprecated and ignored: the Z-width is now the area of the "
                       "stable polygons of the D-decomposition (no line integration)",
                       DeprecationWarning, stacklevel=3)
@@ -765,8 +766,10 @@ def vanishing_gamma(*, d, delta, inside, outside, tol=5e-5):
     can be too small to decide (alpha_max below about 1e-12, where two
     roots meet at z = 1, and the engine refuses): such a gamma moves neither
     end, and the search goes on between it and ``outside``.  The bracket
-    returned is always a decided pair, wider than ``tol`` when the search
-    ran into such gammas.
+    returned is a pair the engine decided, wider than ``tol`` when the
+    search ran into such gammas; an "empty" next to the vanishing point can
+    be a sliver thinner than the engine resolves (:meth:`symstab.Loop.limits`
+    says so in its reason).
 
     Parameters
     ----------
