@@ -34,6 +34,12 @@ PAPER_NAMES = {"K_w": "K", "B_w": "B", "M_w": "M"}
 _PAPER_DELAY = 40
 
 
+def _environment():
+    """Eq. (1)'s VE(z) with ``K_w, B_w, M_w`` named ``K, B, M`` (:data:`PAPER_NAMES`)."""
+    rename = {getattr(model, name): sp.Symbol(new) for name, new in PAPER_NAMES.items()}
+    return model.virtual_environment().subs(rename)
+
+
 @functools.lru_cache(maxsize=1)
 def paper_loop():
     """The paper's loop as a :class:`~symstab.Loop` (built once, then shared).
@@ -53,8 +59,7 @@ def paper_loop():
     """
     from .any_loop import Loop
 
-    rename = {getattr(model, name): sp.Symbol(new) for name, new in PAPER_NAMES.items()}
-    environment = model.virtual_environment().subs(rename)
+    environment = _environment()
     device = PAPER_DEVICE
     units = device.units(rotary=True)
     return Loop(
@@ -76,8 +81,7 @@ def frictionless_paper_loop():
     """
     from .any_loop import Loop
 
-    rename = {getattr(model, name): sp.Symbol(new) for name, new in PAPER_NAMES.items()}
-    environment = model.virtual_environment().subs(rename)
+    environment = _environment()
     return Loop(model.plant().subs(model.b, 0), environment, name="paper-frictionless",
                 plane=("B", "K"), values={"m": 1.0, "T": 1.0, "d": 0, "K": 0.0, "B": 0.0, "M": 0.0})
 
