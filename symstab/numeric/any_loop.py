@@ -44,11 +44,12 @@ from .._resources import check_memory
 from .._validate import check_array, check_count, check_delay, check_window
 from ..symbolic.loop_assembly import PLANT_DIGITS, LoopModel, parse_environment, parse_plant, shift_to_one
 from ..codegen.loop_kernels import environment_kernels, load_numpy_kernels
-from .arcs import CramerArc, crossing_change
+from .arcs import CramerArc
 from .decomposition import Decomposition, arc_points, decompose, stable_hull
 from .passivity import passive_region
 from .decomposition import lines as _lines
 from .polynomial import DelayedPolynomial
+from .intervals import Unresolved, line_intervals
 from .roots import MARGINAL, STABLE, classify_polynomials, root_counts, spectral_radius
 from .results import Boundary, Limits
 
@@ -494,10 +495,10 @@ class Loop(LoopModel):
             Stable intervals ``(lo, hi)``, increasing; ``lo`` may be
             ``-inf`` and ``hi`` ``inf``.  Endpoints are unstable or marginal.
         """
-        base, (slope,), (base_ends, slope_ends) = self._basis((name,), values)
+        base, (slope,), (base_ends, slope_ends) = self._basis((name,), values, structured=True)
         try:
-            return _line_intervals(base, slope, base_ends, slope_ends)
-        except _Unresolved:
+            return line_intervals(base, slope, (tuple(base_ends), tuple(slope_ends)))
+        except Unresolved:
             fixed = ", ".join(f"{k} = {v:g}" for k, v in values.items() if k != "d")
             raise ValueError(f"the loop's polynomial along {name} cannot be resolved in double "
                              f"precision at {fixed}, d = {values.get('d', self.defaults.get('d'))}: "
@@ -796,218 +797,6 @@ def _why_empty(found):
 #: What an empty decomposition does not exclude (the hull, when empty, is a proof).
 _UNRESOLVED = (" (a stable sliver too thin for the sampled arc to draw, as next to a point "
                "where the set vanishes, is not excluded)")
-
-
-#: Largest table of cos(k theta), sin(k theta) on the scan kept per degree (bytes).
-_SCAN_TABLE_BYTES = 4 * 2**20
-
-
-@functools.lru_cache(maxsize=4)
-def _scan_table(n):
-    """The sign scan of :func:`_circle_candidates` for degree ``n``: ``(grid, cos, sin)``.
-
-    ``cos``, ``sin`` are ``cos(k theta)``, ``sin(k theta)`` for ``k = n ..
-    0`` (shape ``(n + 1, len(grid))``), or None where they would take more
-    than ``_SCAN_TABLE_BYTES``; all read-only.
-    """
-    from .curves import scan_grid
-
-    grid = scan_grid(n, n=max(256, 16 * (n + 1)))[:-1]
-    grid = np.concatenate([grid, np.pi - (grid[:40][::-1])])
-    out = [grid, None, None]
-    if 16 * (n + 1) * len(grid) <= _SCAN_TABLE_BYTES:
-        angles = np.multiply.outer(np.arange(n, -1, -1, dtype=float), grid)
-        out[1:] = np.cos(angles), np.sin(angles)
-    for part in out:
-        if part is not None:
-            part.flags.writeable = False
-    return tuple(out)
-
-
-def _sine_series_angles(h):
-    """Angles in [0, pi] of the roots of the anti-palindromic ``h`` within 1e-4 of the circle.
-
-    ``h`` (degree ``2 n``, highest first, ``rev(h) = -h``) is ``z**n`` times
-    ``sum_k -h[n + k] (z**k - z**-k)``, that is ``2j z**n sin(theta) q(cos
-    theta)`` on the circle with ``q = sum_k -h[n + k] U_{k-1}`` (Chebyshev
-    polynomials of the second kind).  The roots of ``q`` (degree ``n - 1``,
-    from its Chebyshev series: a colleague matrix of half the size of
-    ``h``'s companion, an eighth of the work) are ``w = (z + 1/z) / 2`` for
-    the root pairs ``z, 1/z`` of ``h`` other than ``+-1``.
-    """
-    n = (len(h) - 1) // 2
-    u = -np.asarray(h[n + 1:], dtype=float)       # u[m]: coefficient of U_m
-    if n < 1 or not np.any(u):
-        return np.empty(0)
-    # U_m = 2 (T_m + T_{m-2} + ...), with T_0 counted once: Chebyshev
-    # coefficient j sums 2 u[m] over m >= j of j's parity.
-    t = np.zeros(n)
-    for parity in (0, 1):
-        t[parity::2] = 2 * np.cumsum(u[parity::2][::-1])[::-1]
-    t[0] -= np.sum(u[0::2])
-    with np.errstate(all="ignore"):
-        w = np.polynomial.chebyshev.chebroots(t).astype(complex)
-        z = w + np.sqrt(w * w - 1)
-        keep = np.isfinite(z) & (np.abs(np.abs(z) - 1) < 1e-4)
-    return np.abs(np.angle(z[keep]))
-
-
-def _circle_candidates(a0, a1, a0_ends, a1_ends):
-    """Parameter values ``p`` at which ``a0 + p a1`` has a root on the unit circle.
-
-    Angles where ``Im(a0 conj a1) = 0``: the sign changes on a scan of the
-    angle (refined by the root bracketer) and the ends ``theta = 0, pi``,
-    joined with the unit-circle roots of the polynomial
-    ``a0 rev(a1) - rev(a0) a1`` that the scan missed.  Returns ``(p,
-    theta)``, the crossings' parameter values and angles.
-    """
-    from .curves import bracketed_root
-
-    n = len(a0) - 1
-    h = np.convolve(a0, a1[::-1]) - np.convolve(a0[::-1], a1)
-    sine = -h[n + 1:]
-    multiples = np.arange(1, n + 1, dtype=float)
-
-    def g(theta, index=None):
-        # g = sum_k sine[k-1] sin(k theta) (see _sine_series_angles): for
-        # the few brackets one vectorised step, cheaper than n steps of
-        # Horner's scheme on both polynomials, and rounding no worse (k
-        # theta carries the error that Horner's powers of z accumulate).
-        return np.sin(np.multiply.outer(theta, multiples)) @ sine
-
-    # The sign scan, refined to a few ulps, finds every crossing whose
-    # neighbours on the scan are apart; theta = 0 and pi are always there.
-    # g vanishes at 0 and pi, so the scan approaches both geometrically.
-    grid, cos_k, sin_k = _scan_table(n)
-    if cos_k is None:
-        v = np.polyval(np.stack([a0, a1], axis=-1), np.exp(1j * grid[:, None]))
-        values = (v[:, 0] * np.conj(v[:, 1])).imag
-    else:
-        # The values of a0, a1 on the scan as products with the table.
-        re, im = np.stack([a0, a1]) @ cos_k, np.stack([a0, a1]) @ sin_k
-        values = im[0] * re[1] - re[0] * im[1]
-    change = np.flatnonzero(np.sign(values[:-1]) * np.sign(values[1:]) < 0)
-    found = [0.0, np.pi]
-    if change.size:
-        found += list(bracketed_root(g, grid[change], grid[change + 1], indexed=True))
-    found = np.array(found)
-    # The unit-circle roots of the polynomial h = a0 rev(a1) - rev(a0) a1
-    # (z**n (2j) g on the circle) add those the scan cannot see (a close
-    # pair between two scan points, a double root); near a scanned angle
-    # they are the same crossing, less accurately.
-    extra = []
-    near = _sine_series_angles(h)
-    if near.size:
-        for a in np.sort(near):
-            # Conjugates and the pairs z, 1/conj(z) of h give each angle twice.
-            if np.min(np.abs(found - a)) > 1e-6 and (not extra or a - extra[-1] > 1e-6):
-                extra.append(a)
-    angles = np.unique(np.clip(np.concatenate([found, extra]), 0.0, np.pi))
-    z = np.exp(1j * np.asarray(angles))
-    v0, v1 = np.polyval(a0, z), np.polyval(a1, z)
-    # At z = +-1 exactly: exp(j pi) has an imaginary part of 1e-16.
-    for index, end in enumerate((0.0, np.pi)):
-        v0[angles == end] = a0_ends[index]
-        v1[angles == end] = a1_ends[index]
-    with np.errstate(all="ignore"):
-        p = -(v0 * np.conj(v1)).real / np.abs(v1) ** 2
-        residual = np.abs(v0 + p * v1)
-    # Rounding of a0 + p a1 on the circle is relative to the sums of the
-    # coefficients' moduli, not to |a0(z)|, which cancels near a root.
-    scale = np.sum(np.abs(a0)) + np.abs(p) * np.sum(np.abs(a1))
-    keep = np.isfinite(p) & (residual <= 1e-6 * np.where(scale > 0, scale, 1.0))
-    return p[keep], angles[keep]
-
-
-def _crossing_changes(a0, a1, p, theta):
-    """Change of the number of roots outside the circle as ``p`` increases through each crossing.
-
-    The crossing rule of :func:`symstab.numeric.arcs.crossing_change` for
-    the polynomials ``a0 + p a1`` (dense rows): +-2 for a pair, +-1 at
-    ``z = +-1``, NaN where the crossing is tangential or the root is
-    multiple: undecided.
-    """
-    p = np.asarray(p, dtype=float)
-    chi = DelayedPolynomial.from_dense(a0[None, :] + p[:, None] * a1[None, :])
-    return crossing_change(chi, DelayedPolynomial.from_dense(a1), theta)
-
-
-class _Unresolved(ArithmeticError):
-    """Every stretch of a line has a root on the unit circle to within rounding."""
-
-
-def _line_intervals(a0, a1, a0_ends, a1_ends):
-    """Stable intervals of ``p`` for the polynomial ``a0 + p a1`` (rows, highest first).
-
-    ``a0_ends``, ``a1_ends`` are the polynomials' values at ``z = 1`` and
-    ``z = -1``, computed more accurately than from the coefficients.
-
-    The number of roots outside the circle is counted (certified) at the
-    first test point and carried across each crossing by its direction
-    (:func:`_crossing_changes`); every test point the bookkeeping calls
-    stable, and every one after an undecided crossing, is counted afresh,
-    and a disagreement sends every test point to the certified count.
-    """
-    a0, a1 = np.asarray(a0, dtype=float), np.asarray(a1, dtype=float)
-    p, theta = _circle_candidates(a0, a1, a0_ends, a1_ends)
-    changes = list(_crossing_changes(a0, a1, p, theta))
-    p = list(p)
-    if a1[0] != 0:
-        # The leading coefficient vanishes: a root passes through infinity,
-        # outside on both sides.
-        p.append(-a0[0] / a1[0])
-        changes.append(0.0)
-    p, changes = np.array(p, dtype=float), np.array(changes, dtype=float)
-    keep = np.isfinite(p)
-    p, changes = p[keep], changes[keep]
-    order = np.argsort(p, kind="stable")
-    p, changes = p[order], changes[order]
-    # Crossings at the same p add up.
-    candidates, at = np.unique(p, return_inverse=True)
-    summed = np.zeros(len(candidates))
-    np.add.at(summed, at, changes)
-    if candidates.size == 0:
-        tests = np.array([0.0])
-    else:
-        pad = max(1.0, float(np.max(np.abs(candidates))))
-        tests = np.concatenate([[candidates[0] - pad], 0.5 * (candidates[1:] + candidates[:-1]),
-                                [candidates[-1] + pad]])
-    rows = a0[None, :] + tests[:, None] * a1[None, :]
-
-    def count(index):
-        return root_counts(DelayedPolynomial.from_dense(rows[index]))
-
-    counts = np.full(len(tests), -2, dtype=np.int64)     # -2: not known
-    known = np.zeros(len(tests), dtype=bool)
-    first = count(np.array([0]))[0]
-    counts[0], known[0] = first, True
-    for k in range(1, len(tests)):
-        step = summed[k - 1]
-        if counts[k - 1] >= 0 and np.isfinite(step):
-            counts[k] = counts[k - 1] + int(step)
-        else:
-            counts[k] = count(np.array([k]))[0]
-            known[k] = True
-    claim = np.flatnonzero(~known & (counts <= 0))
-    if claim.size:
-        fresh = count(claim)
-        if np.any(fresh != counts[claim]):
-            counts = count(np.arange(len(tests)))
-        else:
-            counts[claim] = fresh
-    if np.all(counts == -1):
-        raise _Unresolved
-    edges = np.concatenate([[-np.inf], candidates, [np.inf]])
-    out = []
-    for k, c in enumerate(counts):
-        if c != 0:
-            continue
-        lo, hi = float(edges[k]) + 0.0, float(edges[k + 1]) + 0.0     # no -0.0
-        if out and out[-1][1] == lo:
-            out[-1] = (out[-1][0], hi)
-        else:
-            out.append((lo, hi))
-    return out
 
 
 def _start_windows(family, base, ax, ay, ends, hull=None):

@@ -46,7 +46,7 @@ from .._validate import check_loop
 from .polynomial import DelayedPolynomial
 from .stability import paper_polynomial
 
-__all__ = ["ArcSource", "CramerArc", "ClosedFormArc", "sine_ratio", "crossing_change",
+__all__ = ["ArcSource", "Brackets", "CramerArc", "ClosedFormArc", "sine_ratio", "crossing_change",
            "SINGULAR", "END_ANGLE", "EXACT_TERMS"]
 
 #: The determinant is called singular (the arc is at infinity, x and y NaN)
@@ -307,6 +307,154 @@ class ArcSource:
         raise NotImplementedError
 
 
+class Brackets:
+    """Brackets ``[P, Q] / sin(theta)`` of real polynomials, accurate at both ends of (0, pi).
+
+    ``[P, Q] = Im(P(z) conj Q(z))`` at ``z = exp(j theta)`` carries a factor
+    ``sin(theta)``; here it is divided out analytically (see the module
+    notes and :class:`CramerArc`): the sine series ``sum_m e_m sin(m theta)
+    / sin(theta)`` with exact ``e_m`` in the middle, and next to ``0`` and
+    ``pi`` polynomials in ``u = sin(theta/2)**2`` (``cos(theta/2)**2``)
+    with exactly computed coefficients.  The one evaluator of brackets:
+    :class:`CramerArc` solves its 2 x 2 system with three of them, the line
+    engine (:mod:`symstab.numeric.intervals`) finds the crossings of a line
+    from one.
+
+    Parameters
+    ----------
+    polynomials : sequence of DelayedPolynomial or ndarray
+        One polynomial each, real and finite: :class:`DelayedPolynomial`
+        rows of one polynomial with a common shift, or 1-D dense
+        coefficient rows (highest power first; split at their longest run
+        of zeros).
+    pairs : sequence of (int, int)
+        The brackets ``[polynomials[i], polynomials[j]]`` wanted.
+
+    Examples
+    --------
+    >>> b = Brackets([np.array([1.0, 0.0]), np.array([0.0, 1.0])], [(0, 1)])   # [z, 1]
+    >>> value, scale = b(np.array([1e-9]))
+    >>> float(value[0, 0])                 # Im(z) / sin(theta)
+    1.0
+    """
+
+    def __init__(self, polynomials, pairs):
+        polynomials = list(polynomials)
+        if not all(isinstance(p, DelayedPolynomial) for p in polynomials):
+            polynomials = _split_dense([p.dense().reshape(-1) if isinstance(p, DelayedPolynomial)
+                                        else p for p in polynomials])
+        parts = [_parts(p) for p in polynomials]
+        shifts = {p[2] for p in parts}
+        if len(shifts) != 1:
+            raise ValueError(f"the polynomials of a bracket must have a common shift, got "
+                             f"{sorted(shifts)}")
+        self.shift = shifts.pop()
+        self.pairs = tuple((int(i), int(j)) for i, j in pairs)
+        terms = [_terms(p) for p in parts]
+        series = [_bracket(terms[i], terms[j]) for i, j in self.pairs]
+        # One table of sin(m theta) / sin(theta) for the frequencies of all brackets.
+        self._frequencies = np.unique(np.concatenate([m for m, _ in series]))
+        self._coefficients = np.zeros((len(series), len(self._frequencies)))
+        for row, (m, e) in zip(self._coefficients, series):
+            row[np.searchsorted(self._frequencies, m)] = e
+        longest = max(max(len(p[0]), len(p[1])) for p in parts)
+        self._ends = None
+        if longest <= EXACT_TERMS:
+            # (bracket, form, power of u) at theta = 0 and at pi, lowest power first.
+            forms = [self._end_forms(parts[i], parts[j]) for i, j in self.pairs]
+            size = max(len(f) for bracket in forms for end in bracket for f in end)
+            self._ends = np.zeros((2, len(series), 3, size))
+            for b, bracket in enumerate(forms):
+                for end, three in enumerate(bracket):
+                    for f, c in enumerate(three):
+                        self._ends[end, b, f, :len(c)] = c
+
+    @property
+    def frequencies(self):
+        """How many frequencies the sine series have together: the cost of one angle."""
+        return len(self._frequencies)
+
+    def _end_forms(self, p, q):
+        """The three polynomials in ``u`` of a bracket, at theta = 0 and at pi."""
+        (dp, np_, s), (dq, nq, _) = p, q
+        if s == 0:
+            whole = [np.polyadd(dp, np_), np.polyadd(dq, nq)]
+            l0, c = _laurent(*whole), {}
+        else:
+            l0 = _add(_laurent(dp, dq), _laurent(np_, nq))
+            c = _add(_laurent(dp, nq), _laurent(dq, np_), -1)
+        out = []
+        for mirror in (False, True):
+            g = _end_series(l0, mirror)[1]
+            cr, ci = _end_series(c, mirror)
+            out.append((g, cr, ci))
+        return tuple(out)
+
+    def _middle(self, theta):
+        """The brackets by their sine series, and their rounding scales: both (M, k)."""
+        k = len(self.pairs)
+        if self._frequencies.size == 0:
+            return np.zeros((len(theta), k)), np.zeros((len(theta), k))
+        ratio = sine_ratio(self._frequencies[None, :], theta[:, None])
+        # Sums over the frequencies as elementwise products (see _at_end).
+        value = np.stack([np.sum(ratio * e, axis=1) for e in self._coefficients], axis=1)
+        size = np.abs(ratio)
+        scale = np.stack([np.sum(size * np.abs(e), axis=1) for e in self._coefficients], axis=1)
+        return value, scale
+
+    def _at_end(self, theta, mirror):
+        """The brackets by their polynomials in u, and their rounding scales: both (M, k)."""
+        k = len(self.pairs)
+        half = 0.5 * np.where(mirror, (np.pi - theta) + _PI_LOW, theta)
+        u = np.sin(half) ** 2
+        # Horner's scheme on (M, 3 k) arrays: a matrix product this skinny
+        # costs more in BLAS's threads than it computes.
+        forms = self._ends[1 if mirror else 0].reshape(3 * k, -1)
+        size = np.abs(forms)
+        value = np.zeros((len(u), 3 * k))
+        scale = np.zeros((len(u), 3 * k))
+        column = u[:, None]
+        for power in range(forms.shape[-1] - 1, -1, -1):
+            value = value * column + forms[:, power]
+            scale = scale * column + size[:, power]
+        if self.shift:
+            ratio, cosine = _multiple(self.shift, theta)
+        else:
+            ratio = cosine = np.zeros(theta.shape)
+        factor = np.stack([np.ones(theta.shape), ratio, cosine], axis=-1)
+        value = np.sum(value.reshape(-1, k, 3) * factor[:, None, :], axis=-1)
+        scale = np.sum(scale.reshape(-1, k, 3) * np.abs(factor)[:, None, :], axis=-1)
+        return value, scale
+
+    def __call__(self, theta):
+        """The brackets over sin(theta) and their rounding scales at angles in (0, pi): (M, k) each.
+
+        The scale is the sum of the moduli of the terms summed, the size of
+        a bracket's rounding error in units of the precision.
+        """
+        theta = np.asarray(theta, dtype=float).ravel()
+        k = len(self.pairs)
+        value, scale = np.empty((len(theta), k)), np.empty((len(theta), k))
+        chunk = max(1, 2**20 // max(1, len(self._frequencies)))
+        for start in range(0, len(theta), chunk):
+            part = slice(start, start + chunk)
+            t = theta[part]
+            if self._ends is None:
+                value[part], scale[part] = self._middle(t)
+                continue
+            v, c = np.empty((len(t), k)), np.empty((len(t), k))
+            low = t < END_ANGLE
+            high = t > np.pi - END_ANGLE
+            middle = ~low & ~high
+            for where, evaluate in ((low, lambda x: self._at_end(x, False)),
+                                    (high, lambda x: self._at_end(x, True)),
+                                    (middle, self._middle)):
+                if where.any():
+                    v[where], c[where] = evaluate(t[where])
+            value[part], scale[part] = v, c
+        return value, scale
+
+
 class CramerArc(ArcSource):
     """The arc of ``A0 + x Ax + y Ay`` by Cramer's rule with sin(theta) divided out analytically.
 
@@ -353,99 +501,9 @@ class CramerArc(ArcSource):
     """
 
     def __init__(self, base, ax, ay):
-        polynomials = (base, ax, ay)
-        if not all(isinstance(p, DelayedPolynomial) for p in polynomials):
-            polynomials = _split_dense([p.dense().reshape(-1) if isinstance(p, DelayedPolynomial)
-                                        else p for p in polynomials])
-        parts = [_parts(p) for p in polynomials]
-        shifts = {p[2] for p in parts}
-        if len(shifts) != 1:
-            raise ValueError(f"base, ax and ay must have a common shift, got {sorted(shifts)}")
-        self.shift = shifts.pop()
-        terms = [_terms(p) for p in parts]
-        a0, cx, cy = range(3)
         # x = [A0, Ay] / [Ay, Ax], y = [Ax, A0] / [Ay, Ax].
-        pairs = ((a0, cy), (cx, a0), (cy, cx))
-        series = [_bracket(terms[i], terms[j]) for i, j in pairs]
-        # One table of sin(m theta) / sin(theta) for the frequencies of all three.
-        self._frequencies = np.unique(np.concatenate([m for m, _ in series]))
-        self._coefficients = np.zeros((3, len(self._frequencies)))
-        for row, (m, e) in zip(self._coefficients, series):
-            row[np.searchsorted(self._frequencies, m)] = e
-        longest = max(max(len(p[0]), len(p[1])) for p in parts)
-        self._ends = None
-        if longest <= EXACT_TERMS:
-            # (bracket, form, power of u) at theta = 0 and at pi, lowest power first.
-            forms = [self._end_forms(parts[i], parts[j]) for i, j in pairs]
-            size = max(len(f) for bracket in forms for end in bracket for f in end)
-            self._ends = np.zeros((2, 3, 3, size))
-            for b, bracket in enumerate(forms):
-                for end, three in enumerate(bracket):
-                    for f, c in enumerate(three):
-                        self._ends[end, b, f, :len(c)] = c
-
-    def _end_forms(self, p, q):
-        """The three polynomials in ``u`` of a bracket, at theta = 0 and at pi."""
-        (dp, np_, s), (dq, nq, _) = p, q
-        if s == 0:
-            whole = [np.polyadd(dp, np_), np.polyadd(dq, nq)]
-            l0, c = _laurent(*whole), {}
-        else:
-            l0 = _add(_laurent(dp, dq), _laurent(np_, nq))
-            c = _add(_laurent(dp, nq), _laurent(dq, np_), -1)
-        out = []
-        for mirror in (False, True):
-            g = _end_series(l0, mirror)[1]
-            cr, ci = _end_series(c, mirror)
-            out.append((g, cr, ci))
-        return tuple(out)
-
-    def _middle(self, theta):
-        """The brackets over sin(theta) by their sine series (M, 3), and the determinant's rounding scale (M,)."""
-        if self._frequencies.size == 0:
-            return np.zeros((len(theta), 3)), np.zeros(len(theta))
-        ratio = sine_ratio(self._frequencies[None, :], theta[:, None])
-        # Sums over the frequencies as elementwise products (see _at_end).
-        value = np.stack([np.sum(ratio * e, axis=1) for e in self._coefficients], axis=1)
-        return value, np.sum(np.abs(ratio) * np.abs(self._coefficients[2]), axis=1)
-
-    def _at_end(self, theta, mirror):
-        """The brackets over sin(theta) by their polynomials in u (M, 3), and the determinant's rounding scale (M,)."""
-        half = 0.5 * np.where(mirror, (np.pi - theta) + _PI_LOW, theta)
-        u = np.sin(half) ** 2
-        # Horner's scheme on (M, 9) arrays: a matrix product this skinny
-        # costs more in BLAS's threads than it computes.
-        forms = self._ends[1 if mirror else 0].reshape(9, -1)
-        # The rounding scale is wanted of the determinant (the last bracket) only.
-        size = np.abs(forms[6:])
-        value = np.zeros((len(u), 9))
-        scale = np.zeros((len(u), 3))
-        column = u[:, None]
-        for k in range(forms.shape[-1] - 1, -1, -1):
-            value = value * column + forms[:, k]
-            scale = scale * column + size[:, k]
-        if self.shift:
-            ratio, cosine = _multiple(self.shift, theta)
-        else:
-            ratio = cosine = np.zeros(theta.shape)
-        factor = np.stack([np.ones(theta.shape), ratio, cosine], axis=-1)
-        value = np.sum(value.reshape(-1, 3, 3) * factor[:, None, :], axis=-1)
-        return value, np.sum(scale * np.abs(factor), axis=-1)
-
-    def _sums(self, theta):
-        """The three brackets over sin(theta) (M, 3) and the determinant's rounding scale (M,)."""
-        if self._ends is None:
-            return self._middle(theta)
-        value, scale = np.empty((len(theta), 3)), np.empty(len(theta))
-        low = theta < END_ANGLE
-        high = theta > np.pi - END_ANGLE
-        middle = ~low & ~high
-        for where, evaluate in ((low, lambda t: self._at_end(t, False)),
-                                (high, lambda t: self._at_end(t, True)),
-                                (middle, self._middle)):
-            if where.any():
-                value[where], scale[where] = evaluate(theta[where])
-        return value, scale
+        self._brackets = Brackets((base, ax, ay), ((0, 2), (1, 0), (2, 1)))
+        self.shift = self._brackets.shift
 
     def __call__(self, theta):
         """``(x, y, det)`` at angles ``theta`` in (0, pi), each of ``theta``'s shape.
@@ -455,19 +513,13 @@ class CramerArc(ArcSource):
         """
         theta = np.asarray(theta, dtype=float)
         shape = theta.shape
-        theta = theta.ravel()
-        chunk = max(1, 2**20 // max(1, len(self._frequencies)))
-        xs, ys, det = (np.empty(theta.shape) for _ in range(3))
-        for start in range(0, len(theta), chunk):
-            part = slice(start, start + chunk)
-            value, scale = self._sums(theta[part])
-            nx, ny, dv = value[:, 0], value[:, 1], value[:, 2]
-            with np.errstate(all="ignore"):
-                singular = ~(np.abs(dv) > SINGULAR * scale)
-                xs[part] = np.where(singular, np.nan, nx / dv)
-                ys[part] = np.where(singular, np.nan, ny / dv)
-            det[part] = dv
-        return xs.reshape(shape), ys.reshape(shape), det.reshape(shape)
+        value, scale = self._brackets(theta.ravel())
+        nx, ny, dv = value[:, 0], value[:, 1], value[:, 2]
+        with np.errstate(all="ignore"):
+            singular = ~(np.abs(dv) > SINGULAR * scale[:, 2])
+            xs = np.where(singular, np.nan, nx / dv)
+            ys = np.where(singular, np.nan, ny / dv)
+        return xs.reshape(shape), ys.reshape(shape), dv.reshape(shape)
 
 
 class ClosedFormArc(ArcSource):

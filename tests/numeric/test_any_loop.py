@@ -397,22 +397,53 @@ def test_arrays_broadcast(paper_loop):
 
 # -- the line engine's pieces ------------------------------------------------------
 
-def test_sine_series_angles_are_the_unit_circle_roots_of_h():
-    """The Chebyshev route to h's unit-circle roots against numpy.roots of h itself."""
-    from symstab.numeric.any_loop import _sine_series_angles
+def _numpy_unstable(coefficients):
+    """Roots outside the unit circle by numpy.roots (the companion matrix's eigenvalues)."""
+    return int(np.sum(np.abs(np.roots(coefficients)) > 1))
+
+
+def test_line_engine_on_random_lines_agrees_with_numpy_roots():
+    """Stable intervals of a0 + p a1: stable inside (numpy.roots), unstable just outside each end."""
+    from symstab.numeric.intervals import line_intervals
 
     rng = np.random.default_rng(17)
-    for degree in (2, 5, 12, 30, 44):
-        a0, a1 = rng.normal(size=degree + 1), rng.normal(size=degree + 1)
-        h = np.polysub(np.polymul(a0, a1[::-1]), np.polymul(a0[::-1], a1))
-        roots = np.roots(h)
-        on_circle = roots[np.abs(np.abs(roots) - 1) < 1e-6]
-        # +-1 are roots of every such h; the Chebyshev series leaves them out.
-        expected = np.sort(np.unique(np.round(np.abs(np.angle(on_circle)), 7)))
-        expected = expected[(expected > 1e-6) & (expected < np.pi - 1e-6)]
-        got = np.sort(np.unique(np.round(_sine_series_angles(h), 7)))
-        got = got[(got > 1e-6) & (got < np.pi - 1e-6)]
-        np.testing.assert_allclose(got, expected, atol=1e-6)
+    checked = 0
+    for degree in (1, 2, 5, 12, 30):
+        for _ in range(6):
+            a0 = rng.normal(size=degree + 1)
+            a1 = rng.normal(size=degree + 1)
+            a0[0] = abs(a0[0]) + 3.0          # a leading coefficient that stays away from 0
+            a1[0] = 0.0
+            runs = line_intervals(a0, a1)
+            for lo, hi in runs:
+                for p in np.linspace(lo, hi, 7)[1:-1] if np.isfinite(lo + hi) else []:
+                    assert _numpy_unstable(a0 + p * a1) == 0, (degree, p, runs)
+                    checked += 1
+                for end, side in ((lo, -1), (hi, 1)):
+                    if np.isfinite(end):
+                        step = 1e-6 * max(1.0, abs(end))
+                        outside = end + side * step
+                        if not any(a < outside < b for a, b in runs):
+                            assert _numpy_unstable(a0 + outside * a1) > 0, (degree, end, runs)
+                            checked += 1
+    assert checked > 50
+
+
+def test_loop_line_at_a_long_delay_is_right():
+    """The low-pass loop at d = 1000: stable K in (0, 0.0507...) by numpy.roots.
+
+    The dense line engine this replaced called the line empty here (in 43
+    s): a stable stretch missed, silently.
+    """
+    loop = symstab.load_loop(os.path.join(os.path.dirname(__file__), "..", "..", "examples",
+                                          "loops", "lowpass_velocity.toml"))
+    runs = loop.stable_intervals("K", B=0.02, d=1000)
+    assert len(runs) == 1
+    lo, hi = runs[0]
+    assert lo == pytest.approx(0.0, abs=1e-12)
+    for k in (0.25 * hi, 0.5 * hi, hi * (1 - 1e-4)):
+        assert _numpy_unstable(loop.coefficients(K=k, B=0.02, d=1000)) == 0
+    assert _numpy_unstable(loop.coefficients(K=hi * (1 + 1e-4), B=0.02, d=1000)) > 0
 
 
 def test_root_counts_next_to_the_circle_are_right_or_marginal():

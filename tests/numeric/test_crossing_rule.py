@@ -4,7 +4,8 @@
 ``StabilityRegion._crossing_change`` and ``any_loop._crossing_changes`` as
 they were before the rule moved to arcs.py (commit abfdc40), kept here as
 references: on their own cases (the crossings of the paper's region with
-lines, the crossings of every example loop's lines) the new rule gives the
+lines, the crossings the line engine finds on every example loop's lines,
+:mod:`symstab.numeric.intervals`) the new rule gives the
 same verdict wherever the old one decided, and decides where it did.
 """
 
@@ -15,7 +16,9 @@ import numpy as np
 import pytest
 
 import symstab
-from symstab.numeric import any_loop
+from symstab.numeric import intervals
+from symstab.numeric.arcs import crossing_change
+from symstab.numeric.polynomial import DelayedPolynomial
 from symstab.numeric.region import StabilityRegion
 from symstab.numeric.stability import loop_coefficients
 
@@ -88,9 +91,12 @@ def test_loop_rule_is_the_old_one(path):
     decided = 0
     for name in loop.plane:
         base, (slope,), (base_ends, slope_ends) = loop._basis((name,), {})
-        p, theta = any_loop._circle_candidates(base, slope, base_ends, slope_ends)
+        p, theta = intervals._crossings(*(DelayedPolynomial.from_dense(r[None, :])
+                                          for r in (base, slope)),
+                                        (tuple(base_ends), tuple(slope_ends)), (base, slope))
         old = old_loop_rule(base, slope, p, theta)
-        new = any_loop._crossing_changes(base, slope, p, theta)
+        new = crossing_change(DelayedPolynomial.from_dense(base[None, :] + p[:, None] * slope),
+                              DelayedPolynomial.from_dense(slope), theta)
         both = np.isfinite(old) & np.isfinite(new)
         np.testing.assert_array_equal(new[both], old[both])
         # Decided by one and not the other only within the old rule's
