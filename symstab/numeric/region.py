@@ -169,6 +169,24 @@ class StabilityRegion:
 
     def __init__(self, *, gamma, d, delta):
         self.gamma, self.d, self.delta = check_loop(gamma, d, delta)
+        self.minus_one = minus_one_line(gamma=self.gamma, d=self.d, delta=self.delta)
+        self._structured = _structured_basis(self.gamma, self.d, self.delta)
+
+    # The sampled arc, taken on first use: the limits (the one engine's)
+    # do not need it, only the line questions do.
+
+    @functools.cached_property
+    def _samples(self):
+        """``(theta, alpha, beta, segments)`` of the sampled arc (see :meth:`_sample`)."""
+        return self._sample()
+
+    _theta = property(lambda self: self._samples[0])
+    _alpha = property(lambda self: self._samples[1])
+    _beta = property(lambda self: self._samples[2])
+    _segments = property(lambda self: self._samples[3])
+
+    def _sample(self):
+        """The arc on the scan grid, with its extrema and a few ulps either side of each pole."""
         theta = np.concatenate([[0.0], scan_grid(self.d, upper=np.pi * (1 - 1e-9))])
         theta = np.union1d(theta, self._extrema(theta))
         poles = self._poles(theta)
@@ -179,13 +197,10 @@ class StabilityRegion:
                                                   poles + 4 * np.spacing(poles)]))
         alpha, beta = kernels.boundary(theta, self.gamma, self.d, self.delta)
         alpha[0], beta[0] = 0.0, -self.delta
-        self._theta, self._alpha, self._beta = theta, alpha, beta
         finite = np.isfinite(alpha) & np.isfinite(beta)
         segment = finite[:-1] & finite[1:]
         segment[np.searchsorted(theta, poles) - 1] = False
-        self._segments = np.flatnonzero(segment)
-        self.minus_one = minus_one_line(gamma=self.gamma, d=self.d, delta=self.delta)
-        self._structured = _structured_basis(self.gamma, self.d, self.delta)
+        return theta, alpha, beta, np.flatnonzero(segment)
 
     def decomposition(self, x_range, y_range):
         """The complete D-decomposition of a window of the (beta, alpha) plane.
