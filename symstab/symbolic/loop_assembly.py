@@ -720,10 +720,19 @@ class LoopModel:
         evaluations agree to ``PLANT_DIGITS`` digits of each part's largest
         coefficient (not beyond :data:`PLANT_MAX_DIGITS`); the more precise
         one is kept, and returned with its digits ``(P_n, P_d, digits)``.
+
+        The loss comes from the plant's poles ``p`` in ``s`` (``exp(p T) -
+        1`` and its Taylor terms cancel when ``|p T|`` is small, ``exp(p_i
+        T) - exp(p_j T)`` when ``|p_i - p_j| T`` is), not from the size of
+        the values: ``m = b = 1e300`` is the benign ``b T / m = T``.  So the
+        start is the plant's order times the decades of ``|p T|`` and
+        ``|p_i - p_j| T`` below 1, from the poles at the point.
         """
         order = len(self._plant_parts[1]) - 1
-        decades = sum(abs(mpmath.log10(abs(v))) for v in (*point, T) if v != 0)
-        digits, before = PLANT_DIGITS + order * int(mpmath.ceil(decades)), None
+        digits = PLANT_DIGITS + order * self._cancelled_decades(point, T)
+        if digits > PLANT_MAX_DIGITS:
+            self._refuse_plant(point, T)
+        before = None
         while digits <= PLANT_MAX_DIGITS:
             with mpmath.workdps(digits):
                 try:
@@ -739,10 +748,56 @@ class LoopModel:
                     for old, new in zip(before, parts)):
                 return (*parts, digits)
             before, digits = parts, 2 * digits
+        self._refuse_plant(point, T)
+
+    def _refuse_plant(self, point, T):
         given = ", ".join(f"{n} = {float(v):g}" for n, v in zip(self._plant_names, point))
         raise ValueError(f"the plant's pulse transfer function at {given}, T = {float(T):g} "
                          f"cancels beyond {PLANT_MAX_DIGITS} digits: a parameter is too small "
                          f"or too large for its closed form")
+
+    @functools.cached_property
+    def _plant_pole_factors(self):
+        """mpmath function of (plant values..., T): coefficients of the denominator's factors in ``s``.
+
+        The closed-form path has factors of degree 2 at most, so each
+        factor's poles come from the quadratic formula (in its stable form)
+        rather than from a root finder, which would round ``s + 1e-300`` to
+        ``s``.
+        """
+        args = [self._symbols[n] for n in self._plant_names] + [model.T]
+        _, den = sp.fraction(sp.cancel(sp.together(self.plant)))
+        factors = [poly_coeffs(f, model.s) for f, _ in sp.factor_list(den, model.s)[1]]
+        return sp.lambdify(args, factors, modules="mpmath")
+
+    def _cancelled_decades(self, point, T):
+        """Decades of ``|p T|`` and ``|p_i - p_j| T`` below 1 over the plant's poles ``p`` at ``point``."""
+        poles = []
+        with mpmath.workdps(PLANT_DIGITS):
+            try:
+                factors = self._plant_pole_factors(*point, T)
+            except (ZeroDivisionError, TypeError, ValueError):
+                return 0
+            for factor in factors:
+                c = [mpmath.mpmathify(x) for x in factor]
+                if not all(mpmath.isfinite(x) for x in c):
+                    return 0
+                while c and c[0] == 0:
+                    c.pop(0)
+                if len(c) == 2:
+                    poles.append(-c[1] / c[0])
+                elif len(c) == 3:
+                    a, b, k = c
+                    root = mpmath.sqrt(b * b - 4 * a * k)
+                    q = -(b + (root if b >= 0 else -root)) / 2 if b != 0 else root / 2
+                    poles += [q / a, k / q] if q != 0 else [mpmath.mpf(0), mpmath.mpf(0)]
+            T = mpmath.mpf(T)
+            sizes = [abs(p) * T for p in poles]
+            # An integrator's pole at 0 is exact: its distance to p is |p| again.
+            poles = [p for p in poles if p != 0]
+            sizes += [abs(a - b) * T for i, a in enumerate(poles) for b in poles[i + 1:]]
+            total = sum(-mpmath.log10(x) for x in sizes if 0 < x < 1)
+        return int(mpmath.ceil(total))
 
     @functools.lru_cache(maxsize=4096)
     def _plant_cache(self, plant_values, T):

@@ -364,6 +364,25 @@ def test_values_beyond_double_precision_are_an_error_not_an_empty_set(paper_loop
 
 
 
+def test_huge_values_of_a_benign_plant_need_no_extra_digits(paper_loop):
+    """m = b = 1e100 is b T / m = T: K_max scales with m exactly (eq. (4): alpha = K T**2 / m).
+
+    The plant's working digits used to start from the decades of the values
+    (at m = b = 1e300: 2400 digits, then 4800, 12 s per plant); they start
+    from the poles' |p T| now (30 digits here).  The scaled limits must be
+    those at m = b = 1 to rounding.
+    """
+    from symstab.numeric.any_loop import Loop
+
+    loop = Loop(paper_loop.plant, paper_loop.environment, plane=("B", "K"))
+    assert loop._cancelled_decades((1e300, 1e300), 1e-3) in (3, 4)      # |p T| = 1e-3
+    assert loop._cancelled_decades((1e-14, 1.0), 1.0) in (14, 15)       # (b, m): |p T| = 1e-14
+    found = paper_loop.limits("B", "K", M=0.0, m=1e100, b=1e100, T=1e-3, d=3)
+    reference = paper_loop.limits("B", "K", M=0.0, m=1.0, b=1.0, T=1e-3, d=3)
+    assert found.y_max == pytest.approx(reference.y_max * 1e100, rel=1e-12)
+    assert found.x_at_y_max == pytest.approx(reference.x_at_y_max * 1e100, rel=1e-6)
+
+
 def test_bad_calls_name_the_parameter(paper_loop):
     with pytest.raises(TypeError, match="missing value.*M"):
         paper_loop.classify(K=1.0, B=0.1, d=0, **DEVICE)
