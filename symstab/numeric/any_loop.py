@@ -477,10 +477,12 @@ class Loop(LoopModel):
 
         The polynomial is ``A0(z) + p A1(z)`` in the parameter ``p``, so a
         root crosses the unit circle only at the ``p`` where ``A0 + p A1``
-        vanishes at some ``z = exp(j theta)``: where ``Im(A0 conj A1) = 0``
-        (found as roots of a polynomial and by a sign scan, then refined),
-        at ``z = +-1``, and where the leading coefficient vanishes.  Each
-        stretch between those values is classified at its midpoint.
+        vanishes at some ``z = exp(j theta)``: where ``Im(A0 conj A1) = 0``,
+        at ``z = +-1``, and where the leading coefficient vanishes.  The
+        one line engine (:func:`symstab.numeric.intervals.line_intervals`)
+        finds them on the structured polynomial (O(d) per angle and per
+        certified count, whatever the delay) and counts the roots outside
+        the circle between them.
 
         Parameters
         ----------

@@ -118,7 +118,7 @@ def _angles(base, slope, given):
     if change.size:
         found.append(bracketed_root(g, grid[change], grid[change + 1], indexed=True))
     # A zero of g within its rounding at a sample: a tangency, kept as it is.
-    found.append(grid[np.abs(value) <= 64 * np.finfo(float).eps * scale])
+    found.append(grid[(scale > 0) & (np.abs(value) <= 64 * np.finfo(float).eps * scale)])
     # A close pair of zeros between two samples shows as a local minimum of
     # |g| with both neighbours of one sign: look for the extremum itself.
     size = np.abs(value)
