@@ -65,6 +65,11 @@ LoopLimits = Limits
 LoopBoundary = Boundary
 
 
+#: Largest coordinate of a window of :meth:`Loop.region`: products of two
+#: coordinates (areas, cross products of the cells' edges) stay finite.
+LARGEST_COORDINATE = 1e150
+
+
 class Loop(LoopModel):
     """A sampled haptic loop: plant, zero-order hold, delay and virtual environment.
 
@@ -594,6 +599,12 @@ class Loop(LoopModel):
                 "y_min": given["y_range"] is None, "y_max": given["y_range"] is None}
 
         def run(box):
+            if not all(abs(v) <= LARGEST_COORDINATE for v in box):
+                raise ValueError(
+                    f"the {x}, {y} window {x} in [{box[0]:.3g}, {box[1]:.3g}], {y} in "
+                    f"[{box[2]:.3g}, {box[3]:.3g}] goes beyond {LARGEST_COORDINATE:g}, where "
+                    f"the cells' areas overflow double precision: give the loop's values in "
+                    f"units that keep the plane's numbers smaller")
             return decompose(base, ax, ay, ends, x_range=box[:2], y_range=box[2:], names=(x, y),
                              arc=arc, family=(structured, *slopes))
 

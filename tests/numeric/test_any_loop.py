@@ -381,6 +381,10 @@ def test_huge_values_of_a_benign_plant_need_no_extra_digits(paper_loop):
     reference = paper_loop.limits("B", "K", M=0.0, m=1.0, b=1.0, T=1e-3, d=3)
     assert found.y_max == pytest.approx(reference.y_max * 1e100, rel=1e-12)
     assert found.x_at_y_max == pytest.approx(reference.x_at_y_max * 1e100, rel=1e-6)
+    # At m = b = 1e300 the plane's window reaches K = 6e305 and its area 1e607: the set was
+    # called empty (a silent wrong answer); it is refused, naming the limit.
+    with pytest.raises(ValueError, match="beyond 1e\\+150.*overflow double precision"):
+        paper_loop.limits("B", "K", M=0.0, m=1e300, b=1e300, T=1e-3, d=3)
 
 
 def test_bad_calls_name_the_parameter(paper_loop):
