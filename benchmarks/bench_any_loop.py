@@ -427,7 +427,7 @@ def bench_limits(args):
     print(f"   Loop vs symstab.limits: largest relative difference {worst_all:.1e} (one engine: "
           f"symstab.limits is Loop.limits at m = T = 1; the difference is the units' rounding, "
           f"amplified to about sqrt(eps) in B at K_max, the argmax of a flat top; the K intervals "
-          f"come from two line engines)")
+          f"come from the one line engine in both units)")
 
 
 def main():

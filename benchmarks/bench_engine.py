@@ -23,6 +23,11 @@ Every row is one run on the same machine state, medians of ``--runs``:
    same engine at m = T = 1 (the paper's own line integration is gone): the
    ratio is what the dimensionless adapter costs, and K_max from both.
    One run each from d = 1000 on.
+5. Stable K intervals on ``--lines`` vertical lines across the stable B
+   range at d = 10, 100, 1000: one family
+   (``PAPER_LOOP.stable_intervals("K", B=array)``, the lines' brackets
+   scanned, refined and counted together) against the obvious alternative,
+   a loop of single lines; and that both give the same intervals.
 
 Targets (issue 19): the Loop path within 1.3x of the paper's; the radius at
 d = 2000 under 1 s; Loop limits under 2 s at d = 1000 and 20 s at d = 5000.  BLAS threads on a busy 2-core machine distort short
@@ -50,6 +55,7 @@ def main(argv=None):
     parser.add_argument("--runs", type=int, default=3)
     parser.add_argument("--points", type=int, default=500)
     parser.add_argument("--limits-delays", default="200,1000,5000")
+    parser.add_argument("--lines", type=int, default=40)
     args = parser.parse_args(argv)
     loop, device = symstab.PAPER_LOOP, symstab.PAPER_DEVICE
     rng = np.random.default_rng(0)
@@ -99,6 +105,20 @@ def main(argv=None):
         ours, theirs = found["loop"].y_max, float(device.stiffness(found["paper"].alpha_max))
         print(f"{'':<8} {d:>5} {fmt(t_loop):>9} {fmt(t_paper):>9} {t_paper / t_loop:>11.2f}  "
               f"{ours:.9g}, {theirs:.9g}")
+    print()
+    print(f"{'K intervals on ' + str(args.lines) + ' lines':<26} {'d':>5} {'family':>9} "
+          f"{'one by one':>11} {'ratio':>6}  same intervals")
+    for d in (10, 100, 1000):
+        lim = loop.limits(d=d)
+        dampings = np.linspace(lim.x_min, lim.x_max, args.lines + 2)[1:-1]
+        runs = args.runs if d < 1000 else 1
+        found = {}
+        t_family = _median(lambda: found.update(family=loop.stable_intervals("K", B=dampings, d=d)),
+                           runs)
+        t_single = _median(lambda: found.update(single=[loop.stable_intervals("K", B=b, d=d)
+                                                        for b in dampings]), runs)
+        print(f"{'':<26} {d:>5} {fmt(t_family):>9} {fmt(t_single):>11} "
+              f"{t_single / t_family:>6.1f}  {found['family'] == found['single']}")
 
 
 if __name__ == "__main__":

@@ -49,7 +49,7 @@ from .decomposition import Decomposition, arc_points, decompose, stable_hull
 from .passivity import passive_region
 from .decomposition import lines as _lines
 from .polynomial import DelayedPolynomial
-from .intervals import Unresolved, line_intervals
+from .intervals import family_intervals
 from .roots import MARGINAL, STABLE, classify_polynomials, root_counts, spectral_radius
 from .results import Boundary, Limits
 
@@ -484,7 +484,7 @@ class Loop(LoopModel):
         root crosses the unit circle only at the ``p`` where ``A0 + p A1``
         vanishes at some ``z = exp(j theta)``: where ``Im(A0 conj A1) = 0``,
         at ``z = +-1``, and where the leading coefficient vanishes.  The
-        one line engine (:func:`symstab.numeric.intervals.line_intervals`)
+        one line engine (:func:`symstab.numeric.intervals.family_intervals`)
         finds them on the structured polynomial (O(d) per angle and per
         certified count, whatever the delay) and counts the roots outside
         the circle between them.
@@ -494,23 +494,64 @@ class Loop(LoopModel):
         name : str
             A parameter in :meth:`affine_parameters`.
         **values
-            Single values of every other parameter (``d`` included).
+            Single values of every other parameter (``d`` included).  One
+            other parameter of :meth:`affine_parameters` may be given a 1-D
+            array instead: a family of parallel lines, one per value,
+            scanned and counted together.
 
         Returns
         -------
         list of (float, float)
             Stable intervals ``(lo, hi)``, increasing; ``lo`` may be
             ``-inf`` and ``hi`` ``inf``.  Endpoints are unstable or marginal.
+            A line on which every value has a root exactly at ``z = 1`` or
+            ``z = -1`` has none.  For a family, one such list per value.
+
+        Raises
+        ------
+        ValueError
+            For more than one array, and where a line cannot be resolved in
+            double precision (every stretch of it has a root on the unit
+            circle to within rounding).
         """
-        base, (slope,), (base_ends, slope_ends) = self._basis((name,), values, structured=True)
-        try:
-            return line_intervals(base, slope, (tuple(base_ends), tuple(slope_ends)))
-        except Unresolved:
-            fixed = ", ".join(f"{k} = {v:g}" for k, v in values.items() if k != "d")
-            raise ValueError(f"the loop's polynomial along {name} cannot be resolved in double "
-                             f"precision at {fixed}, d = {values.get('d', self.defaults.get('d'))}: "
-                             f"every stretch has a root on the unit circle to within rounding "
-                             f"(a value far outside the loop's usual range?)") from None
+        arrays = [k for k, v in values.items() if k != "d" and np.ndim(v) > 0]
+        if len(arrays) > 1:
+            raise ValueError(f"at most one parameter may be an array (a family of lines), got "
+                             f"{', '.join(arrays)}")
+        across = arrays[0] if arrays else None
+        family = across is not None
+        if not family and self.plane is not None and name in self.plane:
+            # One line of the plane's family: the base polynomial then has
+            # both plane parameters at 0, so a value that vanishes there
+            # (chi(1) with K = 0) is exactly 0, as on every line of a family.
+            other = self.plane[1 - self.plane.index(name)]
+            if other in self.defaults or other in values:
+                across = other
+        at = np.zeros(1)
+        if across is not None:
+            at = check_array(across, values.get(across, self.defaults.get(across)))
+            if at.ndim > 1:
+                raise ValueError(f"{across} must be a single value or a 1-D array of values, "
+                                 f"got shape {at.shape}")
+            at = at.reshape(-1)
+            values = {k: v for k, v in values.items() if k != across}
+        names = (name,) if across is None else (name, across)
+        base, slopes, ends = self._basis(names, values, structured=True)
+        runs = family_intervals(base, slopes[1] if across else None, slopes[0], at,
+                                (tuple(ends[0]), tuple(ends[-1]), tuple(ends[1])))
+        if across is not None and not family:
+            values = {**values, across: float(at[0])}
+        for value, r in zip(at, runs):
+            if r is None:
+                fixed = ", ".join(f"{k} = {v:g}" for k, v in values.items() if k != "d")
+                if family:
+                    fixed = f"{across} = {value:g}" + (", " + fixed if fixed else "")
+                raise ValueError(
+                    f"the loop's polynomial along {name} cannot be resolved in double precision "
+                    f"at {fixed}, d = {values.get('d', self.defaults.get('d'))}: every stretch "
+                    f"has a root on the unit circle to within rounding (a value far outside "
+                    f"the loop's usual range?)")
+        return runs if family else runs[0]
 
     def _plane(self, x, y):
         if x is None and y is None and self.plane is not None:

@@ -1,33 +1,20 @@
-"""The stable region in the (beta, alpha) plane, and what it lets a user render.
+"""The paper's stable region in Table I's (beta, alpha) plane, and what it lets a user render.
 
-For fixed ``(gamma, d, delta)`` the characteristic polynomial is affine in
-alpha and in beta, so along any vertical line ``beta = b`` (or horizontal
-line ``alpha = a``) a root can cross the unit circle only where the line
-meets
+The paper's loop is :data:`~symstab.numeric.paper_loop.PAPER_LOOP`; at the
+dimensionless point ``(gamma, d, delta)`` it is that loop with ``m = T =
+1`` (:func:`~symstab.numeric.paper_loop.paper_point`), whose plane ``(B,
+K)`` is the paper's ``(beta, alpha)``.  Everything here is the one engine
+of every loop in the paper's names:
 
-* the boundary arc ``(beta(theta), alpha(theta))``, ``0 < theta < pi``
-  (a pair of complex roots on the circle), from the generated kernel;
-* the line ``alpha = 0`` (a root at z = 1);
-* the line ``alpha + 2 beta = c`` (a root at z = -1,
-  :func:`symstab.numeric.curves.minus_one_line`).
-
-Between two consecutive crossings the number N of roots outside the unit
-circle is constant, and across a crossing it changes by +-2 (the arc) or +-1
-(z = +-1) with the sign of the crossing root's radial velocity; at the two
-ends of a line N is known in closed form.  So N in every gap follows by
-counting, with no classification and no probe near the boundary: the stable
-intervals along a line are the gaps with N = 0, exact up to the root-finding
-of the crossings (to the last bit, by :func:`symstab.numeric.curves.bracketed_root`),
-with no scan of alpha.  A line whose count fails its consistency check is
-decided gap by gap with :func:`symstab.numeric.stability.classify`.  The cost per
-line is O(d) kernel evaluations, not the O(d**2) of a Schur-Cohn test or the
-O(d**3) of eigenvalues, so d in the thousands stays interactive.
-
-:class:`StabilityRegion` does this for many lines at once; :func:`limits`
-builds on it (a scan of vertical lines between the arc's samples finds the
-region, then alpha_max and the beta range by a k-ary search for the last
-line that still meets it, and the Z-width by integrating the stable length
-over beta), and :func:`best_virtual_mass` maximises alpha_max over gamma.
+* :class:`StabilityRegion` -- the stable intervals on any vertical or
+  horizontal line (:meth:`symstab.Loop.stable_intervals`, the one line
+  engine :func:`symstab.numeric.intervals.family_intervals`), the complete
+  D-decomposition of a window, and the pieces of ``z = +-1`` that bound the
+  region (for :func:`boundary_curve`);
+* :func:`limits` -- alpha_max, the beta range and the Z-width
+  (:meth:`symstab.Loop.limits`, the polygons of the stable cells);
+* :func:`best_virtual_mass` -- the gamma that maximises alpha_max;
+* :func:`boundary_curve` -- the arc of eq. (7) from its generated kernel.
 """
 
 import collections.abc
@@ -39,114 +26,34 @@ import warnings
 import numpy as np
 
 from .._generated import kernels
-from .._resources import CHUNK_BYTES, check_memory, chunk_slices
+from .._resources import check_memory, chunk_slices
 from .._validate import check_array, check_count, check_loop, check_real, check_window
 from .curves import (KERNEL_BYTES_PER_POINT, KERNEL_CHUNK_BYTES, Segment,
                      golden_max, arc_end_angle, bracketed_root, minus_one_line, scan_grid)
-from .arcs import ClosedFormArc, crossing_change
+from .arcs import ClosedFormArc
 from .decomposition import decompose
-from .paper_loop import paper_limits
+from .paper_loop import paper_limits, paper_point
 from .results import PAPER_PLANE, Boundary
-from .polynomial import DelayedPolynomial
-from .stability import MARGINAL, STABLE, UNSTABLE, classify, loop_coefficients, paper_polynomial
+from .stability import loop_coefficients
 
 __all__ = ["StabilityRegion", "limits", "vanishing_gamma", "BestVirtualMass", "best_virtual_mass",
            "scan_maximum", "boundary_curve"]
 
-#: Working bytes per crossing of a line with the boundary (positions, angles,
-#: the terms of the crossing direction); lines are processed in chunks of
-#: :data:`symstab._resources.CHUNK_BYTES` of crossings.
-_BYTES_PER_CROSSING = 640
-
-
-def _ranges(start, stop):
-    """Concatenate ``arange(start[i], stop[i])``; also return the owner i of each."""
-    counts = stop - start
-    owner = np.repeat(np.arange(len(start)), counts)
-    offsets = np.arange(counts.sum()) - np.repeat(np.cumsum(counts) - counts, counts)
-    return owner, np.repeat(start, counts) + offsets
-
-
-def _structured_basis(gamma, d, delta):
-    """chi = A0 + alpha A_alpha + beta A_beta as structured polynomials (A0, A_alpha, A_beta)."""
-    at = {(a, b): paper_polynomial(alpha=a, beta=b, gamma=gamma, d=d, delta=delta)
-          for a, b in ((0.0, 0.0), (1.0, 0.0), (0.0, 1.0))}
-    base = at[0.0, 0.0]
-    slopes = [DelayedPolynomial(at[k].delayed - base.delayed, at[k].direct - base.direct, base.shift)
-              for k in ((1.0, 0.0), (0.0, 1.0))]
-    return DelayedPolynomial(base.delayed, base.direct, base.shift), *slopes
-
-
-def _count(owner, change, low, high, n_lines):
-    """N just above each cut (sorted by line, then position), and the lines whose count fails.
-
-    ``low``/``high`` are N at the two ends of each line.  One crossing
-    whose direction was lost (``change == 0``) is filled in from the ends;
-    a line fails when more are lost, when the count from the low end does
-    not arrive at the high end's value, or when it goes below 0.
-    """
-    unknown = change == 0
-    n_unknown = np.bincount(owner, weights=unknown, minlength=n_lines)
-    known_sum = np.bincount(owner, weights=change, minlength=n_lines)
-    missing = (high - low - known_sum)[owner]
-    fill = unknown & (n_unknown[owner] == 1) & (np.abs(missing) <= 2)
-    change = np.where(fill, missing, change)
-    n_cuts = np.bincount(owner, minlength=n_lines)
-    first = np.r_[True, owner[1:] != owner[:-1]] if owner.size else np.zeros(0, dtype=bool)
-    running = np.cumsum(change)
-    offset = np.repeat(running[first] - change[first], n_cuts[n_cuts > 0])
-    above = low[owner] + running - offset
-    bad = np.zeros(n_lines, dtype=bool)
-    np.logical_or.at(bad, owner, (unknown & ~fill) | (above < 0))
-    bad |= (low < 0) | (low + np.bincount(owner, weights=change, minlength=n_lines) != high)
-    return above, bad
-
-
-@dataclasses.dataclass
-class _Crossings:
-    """Crossings of a family of lines with the boundary (parallel arrays)."""
-
-    axis: str
-    owner: np.ndarray
-    segment: np.ndarray
-    target: np.ndarray
-    theta: np.ndarray
-    other: np.ndarray
-    low: np.ndarray
-    high: np.ndarray
-    exact: np.ndarray
-    change: np.ndarray = None
-
-    _FIELDS = ("owner", "segment", "target", "theta", "other", "low", "high", "exact", "change")
-
-    def take(self, index):
-        return _Crossings(self.axis, *(None if getattr(self, f) is None else getattr(self, f)[index]
-                                       for f in self._FIELDS))
-
-    def join(self, more):
-        return _Crossings(self.axis, *(np.concatenate([getattr(self, f), getattr(more, f)])
-                                       for f in self._FIELDS[:-1]))
-
-    def alpha_beta(self):
-        """(alpha, beta) of each crossing."""
-        return (self.other, self.target) if self.axis == "beta" else (self.target, self.other)
-
+#: An end of a stable interval within this many ulps of its terms' size
+#: from a line z = +-1 lies on it (:meth:`StabilityRegion.line_segments`).
+_LINE_ULPS = 16
 
 class StabilityRegion:
     """The stable set of one ``(gamma, d, delta)`` in the (beta, alpha) plane.
 
-    On a line ``beta = b`` (or ``alpha = a``) the number N of roots outside
-    the unit circle changes only where the line crosses the boundary: by 2
-    on the arc (a pair of roots), by 1 on z = 1 and z = -1, with the sign
-    of the radial velocity of the crossing root, ``-Re(conj(z) chi_s /
-    chi'(z))``.  At the ends of the line N is known in closed form (see
-    :meth:`_end_counts`), so N in every gap between crossings follows by
-    counting, with no classification and no probe next to the boundary; the
-    stable gaps are those with N = 0.  Each line is checked: the count from
-    one end must arrive at the other end's value and never go below 0.  A
-    line that fails the check (a crossing whose direction rounding cannot
-    tell, at a corner or a tangency) is decided gap by gap with
-    :func:`symstab.numeric.stability.classify` instead.
+    Its line questions are those of :data:`~symstab.numeric.paper_loop.PAPER_LOOP`
+    at :func:`~symstab.numeric.paper_loop.paper_point` (``alpha`` is its
+    ``K``, ``beta`` its ``B``), answered by the one line engine: the
+    crossings of a line with the unit circle (the arc, ``z = +-1`` and the
+    leading coefficient's zero), the certified count of roots outside the
+    circle at one point and the crossing rule between them, every stable
+    stretch counted afresh.  Its limits are the loop's
+    (:func:`~symstab.numeric.paper_loop.paper_limits`).
 
     Parameters
     ----------
@@ -170,10 +77,9 @@ class StabilityRegion:
     def __init__(self, *, gamma, d, delta):
         self.gamma, self.d, self.delta = check_loop(gamma, d, delta)
         self.minus_one = minus_one_line(gamma=self.gamma, d=self.d, delta=self.delta)
-        self._structured = _structured_basis(self.gamma, self.d, self.delta)
 
-    # The sampled arc, taken on first use: the limits (the one engine's)
-    # do not need it, only the line questions do.
+    # The sampled arc, taken on first use: only the pieces of z = +-1 that
+    # bound the region (line_segments) need it.
 
     @functools.cached_property
     def _samples(self):
@@ -280,292 +186,8 @@ class StabilityRegion:
         pole = ~np.isfinite(value) | (value > np.maximum(np.abs(beta[s]), np.abs(beta[s + 1])))
         return root[pole]
 
-    # -- crossings of the boundary with a family of lines -----------------
-
-    def _arc_point(self, theta):
-        return kernels.boundary(theta, self.gamma, self.d, self.delta)
-
-    def _arc_crossings(self, axis, values, precise=True):
-        """Arc points where ``axis`` (``"beta"`` or ``"alpha"``) equals each value.
-
-        Returns a :class:`_Crossings`: for every crossing the index into
-        ``values``, its arc segment, angle and other coordinate.  Each arc
-        segment is half-open, so a value met exactly at a sample is found
-        once.  Without ``precise`` the angle and the other coordinate are
-        interpolated in the segment, and ``low``/``high`` bound the other
-        coordinate (the segments are monotone); :meth:`_refine` settles
-        those it is asked to.
-        """
-        coord = self._beta if axis == "beta" else self._alpha
-        other = self._alpha if axis == "beta" else self._beta
-        order = np.argsort(values)
-        sorted_values = values[order]
-        c0, c1 = coord[self._segments], coord[self._segments + 1]
-        rising = c1 > c0
-        start = np.where(rising, np.searchsorted(sorted_values, c0, "left"),
-                         np.searchsorted(sorted_values, c1, "right"))
-        stop = np.where(rising, np.searchsorted(sorted_values, c1, "left"),
-                        np.searchsorted(sorted_values, c0, "right"))
-        stop = np.maximum(stop, start)
-        segment, k = _ranges(start, stop)
-        segment = self._segments[segment]
-        target = sorted_values[k]
-        c0, c1 = coord[segment], coord[segment + 1]
-        o0, o1 = other[segment], other[segment + 1]
-        with np.errstate(divide="ignore", invalid="ignore"):
-            frac = np.clip((target - c0) / (c1 - c0), 0.0, 1.0)
-        frac = np.where(c0 == target, 0.0, frac)
-        t0, t1 = self._theta[segment], self._theta[segment + 1]
-        found = _Crossings(axis=axis, owner=order[k], segment=segment, target=target,
-                           theta=t0 + frac * (t1 - t0), other=o0 + frac * (o1 - o0),
-                           low=np.minimum(o0, o1), high=np.maximum(o0, o1),
-                           exact=c0 == target)
-        found.other[found.exact] = o0[found.exact]
-        found.low[found.exact] = found.high[found.exact] = o0[found.exact]
-        if precise:
-            self._refine(found, np.flatnonzero(~found.exact))
-        return found
-
-    def _refine(self, found, which):
-        """Root-find the crossings ``which`` of ``found`` to the last bit (in place)."""
-        which = which[~found.exact[which]]
-        if which.size == 0:
-            return
-        index = 1 if found.axis == "beta" else 0
-        segment, target = found.segment[which], found.target[which]
-
-        def f(t, i):
-            return self._arc_point(t)[index] - target[i]
-
-        root = bracketed_root(f, self._theta[segment], self._theta[segment + 1], indexed=True)
-        other = self._arc_point(root)[1 - index]
-        other = np.where(root == 0.0, 0.0 if found.axis == "beta" else -self.delta, other)
-        found.theta[which], found.other[which] = root, other
-        found.low[which] = found.high[which] = other
-        found.exact[which] = True
-
-    def _crossing_change(self, axis, theta, alpha, beta):
-        """How N (roots outside the circle) changes across each crossing.
-
-        Moving along the line in the increasing direction of its free
-        coordinate s (alpha on ``beta = b``, beta on ``alpha = a``):
-        :func:`symstab.numeric.arcs.crossing_change`, +-2 on the arc, +-1 at
-        z = +-1, and 0 where the radial velocity is lost in rounding (a
-        tangency or a corner).
-        """
-        base, d_alpha, d_beta = self._structured
-        chi = base.combine([np.asarray(alpha, dtype=float), np.asarray(beta, dtype=float)],
-                           [d_alpha, d_beta])
-        change = crossing_change(chi, d_alpha if axis == "beta" else d_beta, theta)
-        return np.where(np.isnan(change), 0.0, change)
-
-    def _cuts(self, axis, values, precise=True):
-        """Every crossing of the boundary with the lines ``axis = value``.
-
-        Returns ``(owner, position, change)`` sorted by line and position:
-        the line's index, the free coordinate of the crossing and the change
-        of N across it (:meth:`_crossing_change`).
-        """
-        cuts = self._all_cuts(axis, values, precise)
-        return cuts.owner, cuts.other, cuts.change
-
-    def _all_cuts(self, axis, values, precise):
-        """The crossings with the arc (:meth:`_arc_crossings`) and with z = +-1, sorted."""
-        found = self._arc_crossings(axis, values, precise)
-        # The arc's start (theta = 0) is the corner with z = 1, counted there.
-        found = found.take(found.theta > 0)
-        lines = np.arange(len(values))
-        if axis == "beta":
-            extra = [(np.zeros(len(values)), 0.0), (self.minus_one - 2 * values, np.pi)]
-        else:
-            extra = [((self.minus_one - values) / 2, np.pi)]
-        for position, theta in extra:
-            keep = np.isfinite(position)
-            n = int(keep.sum())
-            found = found.join(_Crossings(
-                axis=axis, owner=lines[keep], segment=np.full(n, -1), target=values[keep],
-                theta=np.full(n, theta), other=position[keep], low=position[keep],
-                high=position[keep], exact=np.ones(n, dtype=bool)))
-        found = found.take(np.lexsort((found.other, found.owner)))
-        found.change = self._crossing_change(axis, found.theta, *found.alpha_beta())
-        return found
-
-    def _end_counts(self, axis, values):
-        """N at the low and the high end of each line (closed form).
-
-        For |alpha| -> infinity on ``beta = b``, d + 1 roots go to infinity
-        and the other three tend to 0, 0 and ``-zoh_b0 / zoh_b1`` (inside:
-        ``0 < zoh_b0 < zoh_b1`` for delta > 0), so N = d + 1 at both ends.
-        For |beta| -> infinity on ``alpha = a``, d + 1 roots go to infinity
-        and the others tend to 0, ``-zoh_b0 / zoh_b1`` and
-        ``1 - a / beta``: N = d + 1 at the end where ``a / beta > 0`` and
-        d + 2 at the other.  On ``alpha = 0`` z = 1 is a root everywhere:
-        the line is marginal (ends ``-1``, matched by nothing).
-
-        For delta = 0, ``zoh_b0 = zoh_b1`` and the third root tends to -1
-        itself: ``z + 1 ~ -8 (-1)**d / alpha`` on a vertical line and
-        ``-4 (-1)**d / beta`` on a horizontal one (chi(-1) = 4 (-1)**d), one
-        more root outside at one end (checked against 50-digit roots).
-        """
-        n = np.full(len(values), self.d + 1)
-        even = self.d % 2 == 0
-        if axis == "beta":
-            if self.delta == 0:
-                return n + (not even), n + even
-            return n, n
-        low = np.where(values > 0, self.d + 2, self.d + 1)
-        high = np.where(values > 0, self.d + 1, self.d + 2)
-        if self.delta == 0:
-            low, high = low + (not even), high + even
-        low[values == 0] = -1
-        return low, high
-
-    def _line_chunks(self, axis, values):
-        """Slices of ``values`` whose crossings fit in :data:`CHUNK_BYTES` together.
-
-        Most lines cross the boundary about d + 2 times, but a line along
-        which the arc keeps returning (alpha = 0 itself) crosses it up to
-        once per segment, so the crossings are counted first (O(segments)).
-        """
-        if len(values) == 0:
-            return []
-        coord = self._beta if axis == "beta" else self._alpha
-        order = np.argsort(values)
-        c0, c1 = coord[self._segments], coord[self._segments + 1]
-        rising = c1 > c0
-        start = np.where(rising, np.searchsorted(values[order], c0, "left"),
-                         np.searchsorted(values[order], c1, "right"))
-        stop = np.maximum(start, np.where(rising, np.searchsorted(values[order], c1, "left"),
-                                          np.searchsorted(values[order], c0, "right")))
-        step = np.zeros(len(values) + 1)
-        np.add.at(step, start, 1)
-        np.add.at(step, stop, -1)
-        per_line = np.empty(len(values))
-        per_line[order] = np.cumsum(step)[:-1]
-        weight = _BYTES_PER_CROSSING * (per_line + 3)
-        chunks, begin, total = [], 0, 0.0
-        for i, w in enumerate(weight):
-            if i > begin and total + w > CHUNK_BYTES:
-                chunks.append(slice(begin, i))
-                begin, total = i, 0.0
-            total += w
-        chunks.append(slice(begin, len(values)))
-        return chunks
-
-    def _counted_runs(self, axis, values):
-        """Stable intervals on each line by counting; ``None`` where the check fails.
-
-        The crossings start as estimates bounded by their arc segments;
-        those whose bounds overlap a neighbour's (their order is in doubt)
-        and those that end an interval with N = 0 are root-found, until
-        none is left in doubt.
-        """
-        out = [None] * len(values)
-        for part in self._line_chunks(axis, values):
-            chunk = values[part]
-            cuts = self._all_cuts(axis, chunk, precise=False)
-            low, high = self._end_counts(axis, chunk)
-            for _ in range(8):
-                above, bad = _count(cuts.owner, cuts.change, low, high, len(chunk))
-                # Pairs of neighbours on one line: in doubt when their bounds
-                # overlap, or when they end an interval with N = 0.
-                pair = (cuts.owner[1:] == cuts.owner[:-1]) & (
-                    (cuts.high[:-1] >= cuts.low[1:]) | (above[:-1] == 0))
-                doubt = np.zeros(len(cuts.owner), dtype=bool)
-                doubt[:-1] |= pair
-                doubt[1:] |= pair
-                doubt &= ~cuts.exact
-                if not doubt.any():
-                    break
-                which = np.flatnonzero(doubt)
-                self._refine(cuts, which)
-                cuts.change[which] = self._crossing_change(
-                    axis, cuts.theta[which], *(x[which] for x in cuts.alpha_beta()))
-                cuts = cuts.take(np.lexsort((cuts.other, cuts.owner)))
-            else:
-                bad[:] = True
-            for i in np.flatnonzero(~bad):
-                out[part.start + i] = []
-            same = np.zeros(len(cuts.owner), dtype=bool)
-            same[:-1] = cuts.owner[1:] == cuts.owner[:-1]
-            for j in np.flatnonzero((above == 0) & same):
-                runs = out[part.start + cuts.owner[j]]
-                if runs is not None and cuts.other[j + 1] > cuts.other[j]:
-                    runs.append((float(cuts.other[j]), float(cuts.other[j + 1])))
-        return out
-
-    def _classified_runs(self, axis, values, closure):
-        """Stable intervals on each line by one classification per gap (the fallback).
-
-        With ``closure``, gaps whose probe is marginal count too (the
-        searches for the extent of the region run into corners, where the
-        gaps are too short for the classification to tell).
-        """
-        owner, cuts, _ = self._cuts(axis, values)  # precise: the probes go between them
-        first = np.r_[True, owner[1:] != owner[:-1]]
-        last = np.r_[owner[1:] != owner[:-1], True]
-        pad = 1.0 + np.abs(cuts)
-        between = 0.5 * (cuts[:-1] + cuts[1:])
-        probe_owner = np.concatenate([owner[first], owner[:-1][~last[:-1]], owner[last]])
-        probe_at = np.concatenate([cuts[first] - pad[first], between[~last[:-1]],
-                                   cuts[last] + pad[last]])
-        probe_lo = np.concatenate([np.full(first.sum(), -np.inf), cuts[:-1][~last[:-1]], cuts[last]])
-        probe_hi = np.concatenate([cuts[first], cuts[1:][~last[:-1]], np.full(last.sum(), np.inf)])
-        line_value = values[probe_owner]
-        if axis == "beta":
-            code = classify(alpha=probe_at, beta=line_value, gamma=self.gamma, d=self.d, delta=self.delta)
-        else:
-            code = classify(alpha=line_value, beta=probe_at, gamma=self.gamma, d=self.d, delta=self.delta)
-        code = np.atleast_1d(code)
-        stable = (code == STABLE) | (closure & (code == MARGINAL))
-        out = [[] for _ in values]
-        order = np.lexsort((probe_lo, probe_owner))
-        for i in order[stable[order]]:
-            runs = out[probe_owner[i]]
-            if runs and runs[-1][1] == probe_lo[i]:
-                runs[-1] = (runs[-1][0], float(probe_hi[i]))
-            else:
-                runs.append((float(probe_lo[i]), float(probe_hi[i])))
-        return out
-
-    def _intervals(self, axis, values, closure=False, confirm=False, fallback=True):
-        """Stable intervals of the other coordinate on each line ``axis = value``.
-
-        By counting (:meth:`_counted_runs`); lines whose count fails its
-        check, and with ``confirm`` lines where the classification of the
-        middle of a counted interval disagrees, are decided gap by gap
-        (:meth:`_classified_runs`), or left ``None`` without ``fallback``.
-        """
-        values = np.atleast_1d(np.asarray(values, dtype=float))
-        runs = self._counted_runs(axis, values)
-        if confirm:
-            owner = np.array([i for i, r in enumerate(runs) if r for _ in r], dtype=int)
-            middle = np.array([0.5 * (lo + hi) for r in runs if r for lo, hi in r])
-            if owner.size:
-                on_line = values[owner]
-                alpha, beta = (middle, on_line) if axis == "beta" else (on_line, middle)
-                # The float Schur-Cohn verdict (refine=False) is enough here:
-                # "stable" keeps the counted interval, and "unstable" only
-                # sends the line to the gap-by-gap classification, which
-                # certifies its verdicts; a wrong verdict can cost time but
-                # not change the answer.  (At large d every point has roots
-                # within 1e-6 of the circle, and certifying one costs seconds.)
-                code = np.atleast_1d(classify(alpha=alpha, beta=beta, gamma=self.gamma,
-                                              d=self.d, delta=self.delta, refine=False))
-                for i in owner[code == UNSTABLE]:
-                    runs[i] = None
-        redo = [i for i, r in enumerate(runs) if r is None]
-        if redo and fallback:
-            for i, r in zip(redo, self._classified_runs(axis, values[redo], closure)):
-                runs[i] = r
-        return runs
-
     def alpha_intervals(self, beta):
         """The stable alpha intervals at damping ``beta``.
-
-        Each interval found by counting is checked by one Schur-Cohn test
-        (:func:`symstab.numeric.stability.classify`) of its middle; a line where they
-        disagree is classified gap by gap.
 
         Parameters
         ----------
@@ -578,7 +200,7 @@ class StabilityRegion:
             Increasing, disjoint; empty when no alpha is stable.  An interval
             that does not start at 0 shows the minimum stiffness needed.
         """
-        return self._intervals("beta", [check_real("beta", beta)], confirm=True)[0]
+        return self._intervals("beta", [check_real("beta", beta)])[0]
 
     def beta_intervals(self, alpha):
         """The stable beta intervals at stiffness ``alpha`` (as :meth:`alpha_intervals`).
@@ -588,14 +210,15 @@ class StabilityRegion:
         alpha : float
             Dimensionless stiffness.
         """
-        return self._intervals("alpha", [check_real("alpha", alpha)], confirm=True)[0]
+        return self._intervals("alpha", [check_real("alpha", alpha)])[0]
 
     def alpha_intervals_on(self, betas):
         """The stable alpha intervals on many vertical lines at once.
 
         The same intervals as :meth:`alpha_intervals` at each ``beta``, with
-        the crossings of all lines found and counted together: tens of times
-        faster than a loop over the lines when there are many.
+        the lines scanned, refined and counted together (a family of lines
+        of :meth:`symstab.Loop.stable_intervals`): many times faster than a
+        loop over the lines when there are many.
 
         Parameters
         ----------
@@ -616,7 +239,13 @@ class StabilityRegion:
         values = check_array("betas", betas)
         if values.ndim != 1:
             raise ValueError(f"betas must be a one-dimensional sequence, got shape {values.shape}")
-        return self._intervals("beta", values, confirm=True)
+        return self._intervals("beta", values)
+
+    def _intervals(self, axis, values):
+        """The stable intervals of the other coordinate on the lines ``axis = value``."""
+        loop, point = paper_point(gamma=self.gamma, d=self.d, delta=self.delta)
+        free, line = ("K", "B") if axis == "beta" else ("B", "K")
+        return loop.stable_intervals(free, **{line: np.atleast_1d(values)}, **point)
 
     # -- where the region is ----------------------------------------------
 
@@ -626,9 +255,8 @@ class StabilityRegion:
         return paper_limits(gamma=self.gamma, d=self.d, delta=self.delta, region=self)
 
     def _corners(self):
-        """beta of the points where the arc meets alpha = 0 (exact corners)."""
-        ends = self._arc_crossings("alpha", np.array([0.0])).other
-        return np.sort(np.concatenate([ends, [-self.delta]]))
+        """beta of the points where the arc meets alpha = 0: its start ``-delta`` and the others."""
+        return np.union1d(self._arc_roots(lambda a, b: a, start=1), [-self.delta])
 
     def line_segments(self):
         """The pieces of z = 1 (alpha = 0) and z = -1 that bound the stable region.
@@ -681,7 +309,11 @@ class StabilityRegion:
         out = []
         for b0, b1, bm, r in zip(ends[:-1], ends[1:], middle, runs):
             a = line_alpha(bm)
-            if b1 > b0 and any(lo == a or hi == a for lo, hi in r):
+            # An end of a stable interval on the line: the same point from
+            # the polynomial's end values and from the line's closed form,
+            # rounded differently (a few ulps of the terms).
+            near = _LINE_ULPS * np.finfo(float).eps * (abs(a) + 2 * abs(bm) + abs(self.minus_one))
+            if b1 > b0 and any(abs(lo - a) <= near or abs(hi - a) <= near for lo, hi in r):
                 if out and out[-1][1] == b0:
                     out[-1] = (out[-1][0], b1)
                 else:
@@ -689,9 +321,16 @@ class StabilityRegion:
         return [Segment(root, float(b0), float(line_alpha(b0)), float(b1), float(line_alpha(b1)))
                 for b0, b1 in out]
 
-    def _arc_roots(self, g):
-        """beta of the arc points where ``g(alpha, beta)`` changes sign (poles left out)."""
-        s = self._segments
+    def _arc_point(self, theta):
+        return kernels.boundary(theta, self.gamma, self.d, self.delta)
+
+    def _arc_roots(self, g, start=0):
+        """beta of the arc points where ``g(alpha, beta)`` changes sign (poles left out).
+
+        Segments from the ``start``-th sample on (the first, from theta = 0,
+        starts at the corner ``(-delta, 0)`` itself).
+        """
+        s = self._segments[self._segments >= start]
         g0 = g(self._alpha[s], self._beta[s])
         g1 = g(self._alpha[s + 1], self._beta[s + 1])
         change = np.sign(g0) != np.sign(g1)

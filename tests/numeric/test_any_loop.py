@@ -398,8 +398,13 @@ def test_bad_calls_name_the_parameter(paper_loop):
         paper_loop.classify(K=1.0, B=0.1, M=0.0, d=1.5, **DEVICE)
     with pytest.raises(ValueError, match="'m' does not enter .* affinely"):
         paper_loop.stable_intervals("m", K=1.0, B=0.1, M=0.0, d=0, b=PAPER_B, T=PAPER_T)
-    with pytest.raises(ValueError, match="single value"):
-        paper_loop.stable_intervals("K", B=[0.1, 0.2], M=0.0, d=0, **DEVICE)
+    with pytest.raises(ValueError, match="'m' does not enter .* affinely"):
+        paper_loop.stable_intervals("K", B=0.1, M=0.0, d=0, m=[PAPER_M, 2 * PAPER_M],
+                                    b=PAPER_B, T=PAPER_T)
+    with pytest.raises(ValueError, match="at most one parameter may be an array.*B, M"):
+        paper_loop.stable_intervals("K", B=[0.1, 0.2], M=[0.0, 0.1], d=0, **DEVICE)
+    with pytest.raises(ValueError, match="B must be a single value or a 1-D array"):
+        paper_loop.stable_intervals("K", B=[[0.1, 0.2]], M=0.0, d=0, **DEVICE)
     squared = Loop(PLANT, "K**2 + B*(z - 1)/(T*z)")
     with pytest.raises(ValueError, match="'K' does not enter"):
         squared.limits("B", "K", d=0, **DEVICE)
@@ -450,6 +455,50 @@ def test_line_engine_on_random_lines_agrees_with_numpy_roots():
                             assert _numpy_unstable(a0 + outside * a1) > 0, (degree, end, runs)
                             checked += 1
     assert checked > 50
+
+
+def test_a_family_of_lines_is_its_lines_one_by_one():
+    """Lines scanned and counted together give each line's own intervals (and numpy.roots agrees)."""
+    from symstab.numeric.intervals import family_intervals, line_intervals
+
+    rng = np.random.default_rng(29)
+    checked = 0
+    for degree in (1, 3, 8, 20):
+        for _ in range(4):
+            a0, across, a1 = rng.normal(size=(3, degree + 1))
+            a0[0] = abs(a0[0]) + 3.0
+            across[0] = a1[0] = 0.0
+            at = np.linspace(-1.5, 1.5, 9)
+            together = family_intervals(a0, across, a1, at)
+            for v, runs in zip(at, together):
+                alone = line_intervals(a0 + v * across, a1)
+                assert len(runs) == len(alone), (degree, v, runs, alone)
+                for got, want in zip(runs, alone):
+                    np.testing.assert_allclose(got, want, rtol=1e-9, atol=1e-12)
+                for lo, hi in runs:
+                    if np.isfinite(lo + hi):
+                        p = 0.5 * (lo + hi)
+                        assert _numpy_unstable(a0 + v * across + p * a1) == 0
+                        checked += 1
+    assert checked > 20
+
+
+def test_loop_family_of_lines_equals_its_single_lines():
+    """``stable_intervals`` with one parameter an array: the paper's vertical lines at d = 40."""
+    loop = symstab.PAPER_LOOP
+    values = {"M": 0.0064, "d": 40}
+    dampings = np.array([-0.01, 0.0, 0.05, 0.2, 0.6])
+    together = loop.stable_intervals("K", B=dampings, **values)
+    assert len(together) == len(dampings)
+    for B, runs in zip(dampings, together):
+        # One line is a family of one: the same arithmetic.
+        assert runs == loop.stable_intervals("K", B=float(B), **values)
+        assert runs == loop.stable_intervals("K", B=np.array([B]), **values)[0]
+        for lo, hi in runs:
+            assert lo == 0.0      # chi(1) = 0 at K = 0, exactly
+            assert _numpy_unstable(loop.coefficients(K=0.5 * hi, B=B, **values)) == 0
+    # K = 0 puts a root exactly at z = 1 for every B: no stable B (not an error).
+    assert loop.stable_intervals("B", K=np.array([0.0, 1.0]), **values)[0] == []
 
 
 def test_loop_line_at_a_long_delay_is_right():

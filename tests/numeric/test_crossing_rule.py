@@ -3,10 +3,10 @@
 ``old_region_rule`` and ``old_loop_rule`` are the bodies of
 ``StabilityRegion._crossing_change`` and ``any_loop._crossing_changes`` as
 they were before the rule moved to arcs.py (commit abfdc40), kept here as
-references: on their own cases (the crossings of the paper's region with
-lines, the crossings the line engine finds on every example loop's lines,
-:mod:`symstab.numeric.intervals`) the new rule gives the
-same verdict wherever the old one decided, and decides where it did.
+references: on the crossings the one line engine
+(:mod:`symstab.numeric.intervals`) finds on the paper's lines and on every
+example loop's lines, the new rule gives the same verdict wherever the old
+one decided, and decides where it did.
 """
 
 import glob
@@ -19,7 +19,7 @@ import symstab
 from symstab.numeric import intervals
 from symstab.numeric.arcs import crossing_change
 from symstab.numeric.polynomial import DelayedPolynomial
-from symstab.numeric.region import StabilityRegion
+from symstab.numeric.paper_loop import paper_point
 from symstab.numeric.stability import loop_coefficients
 
 EXAMPLES = sorted(glob.glob(os.path.join(os.path.dirname(__file__), "..", "..", "examples",
@@ -75,14 +75,20 @@ def old_loop_rule(a0, a1, p, theta):
                                              (0.0, 10, 0.00253125), (-0.5, 40, 0.01)])
 @pytest.mark.parametrize("axis", ["beta", "alpha"])
 def test_region_rule_is_the_old_one(gamma, d, delta, axis):
-    region = StabilityRegion(gamma=gamma, d=d, delta=delta)
+    """The crossings of the paper's lines (the line engine's, on PAPER_LOOP) decided as before."""
+    loop, point = paper_point(gamma=gamma, d=d, delta=delta)
     values = np.linspace(-0.2, 0.8, 23) if axis == "beta" else np.linspace(-0.5, 3.0, 23)
-    cuts = region._all_cuts(axis, values, precise=True)
-    alpha, beta = cuts.alpha_beta()
-    old = old_region_rule(gamma, d, delta, axis, cuts.theta, alpha, beta)
-    new = region._crossing_change(axis, cuts.theta, alpha, beta)
+    free, across = ("K", "B") if axis == "beta" else ("B", "K")
+    base, (slope, sideways), ends = loop._basis((free, across), point, structured=True)
+    base, sideways, slope = polynomials = tuple(x.flat() for x in (base, sideways, slope))
+    line, p, theta = intervals._crossings(polynomials, values, (ends[0], ends[2], ends[1]),
+                                          polynomials)
+    on_line = values[line]
+    alpha, beta = (p, on_line) if axis == "beta" else (on_line, p)
+    old = old_region_rule(gamma, d, delta, axis, theta, alpha, beta)
+    new = crossing_change(base.combine([on_line, p], [sideways, slope]), slope, theta)
     assert len(new) > 20
-    np.testing.assert_array_equal(new, old)
+    np.testing.assert_array_equal(np.where(np.isnan(new), 0.0, new), old)
 
 
 @pytest.mark.parametrize("path", EXAMPLES, ids=os.path.basename)
@@ -91,9 +97,11 @@ def test_loop_rule_is_the_old_one(path):
     decided = 0
     for name in loop.plane:
         base, (slope,), (base_ends, slope_ends) = loop._basis((name,), {})
-        p, theta = intervals._crossings(*(DelayedPolynomial.from_dense(r[None, :])
-                                          for r in (base, slope)),
-                                        (tuple(base_ends), tuple(slope_ends)), (base, slope))
+        zero = np.zeros_like(base)
+        polynomials = tuple(DelayedPolynomial.from_dense(r[None, :]) for r in (base, zero, slope))
+        _, p, theta = intervals._crossings(polynomials, np.zeros(1),
+                                           (tuple(base_ends), (0.0, 0.0), tuple(slope_ends)),
+                                           (base, zero, slope))
         old = old_loop_rule(base, slope, p, theta)
         new = crossing_change(DelayedPolynomial.from_dense(base[None, :] + p[:, None] * slope),
                               DelayedPolynomial.from_dense(slope), theta)
