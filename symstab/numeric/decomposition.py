@@ -390,15 +390,16 @@ def _arc_ends(base, ax, ay, ends):
     return out
 
 
-def _sample_arc(arc, n, to_unit, theta=None, fine=1.0):
+def _sample_arc(arc, n, to_unit, samples=None, fine=1.0):
     """Angles and points of the arc, refined until every chord inside the window is short.
 
-    ``arc`` is the arc source, ``n`` the polynomial's degree.  Each round
-    evaluates the new angles only.  Returns the angles, the points and the
-    determinant's sign; the caller splits the arc where the sign changes
-    (through infinity).
+    ``arc`` is the arc source, ``n`` the polynomial's degree, ``samples``
+    the ``(theta, x, y, det)`` of a previous call with more angles added
+    (NaN where not yet evaluated).  Each round evaluates the new angles
+    only.  Returns the angles, the points and the determinant (the caller
+    splits the arc where its sign changes: through infinity).
     """
-    if theta is None:
+    if samples is None:
         m = max(1024, 32 * (n + 4))
         theta = np.pi * np.arange(1, m) / m
         # The chords to the exact ends (theta = 0, pi), added by _pieces, are
@@ -407,7 +408,12 @@ def _sample_arc(arc, n, to_unit, theta=None, fine=1.0):
         # small stable cell at its corner).
         near = theta[0] * np.geomspace(1e-6, 1.0, 20, endpoint=False)
         theta = np.concatenate([near, theta, np.pi - near[::-1]])
-    xs, ys, det = arc(theta)
+        xs, ys, det = arc(theta)
+    else:
+        theta, xs, ys, det = (np.array(a, dtype=float) for a in samples)
+        new = np.isnan(det)
+        if new.any():
+            xs[new], ys[new], det[new] = arc(theta[new])
     for _ in range(_ROUNDS):
         u, v = to_unit(xs, ys)
         finite = np.isfinite(u) & np.isfinite(v)
@@ -438,7 +444,7 @@ def _sample_arc(arc, n, to_unit, theta=None, fine=1.0):
         order = np.argsort(np.concatenate([theta, mids]), kind="stable")
         theta, xs, ys, det = (np.concatenate([a, b])[order]
                               for a, b in zip((theta, xs, ys, det), (mids, *arc(mids))))
-    return theta, xs, ys, np.sign(det)
+    return theta, xs, ys, det
 
 
 def _pieces(base, ax, ay, ends, theta, xs, ys, sign, to_unit, from_unit, box):
@@ -1246,9 +1252,11 @@ def _decompose(base, ax, ay, ends, *, x_range, y_range, names, fine, arc, family
     def from_unit(uv):
         return np.column_stack([x0 + sx * uv[:, 0], y0 + sy * uv[:, 1]])
 
-    theta = None
+    samples = None
     for _ in range(_CROSSING_ROUNDS):
-        theta, xs, ys, sign = _sample_arc(arc, len(base) - 1, to_unit, theta, fine)
+        samples = _sample_arc(arc, len(base) - 1, to_unit, samples, fine)
+        theta, xs, ys, det = samples
+        sign = np.sign(det)
         polylines, branches = _pieces(base, ax, ay, ends, theta, xs, ys, sign, to_unit, from_unit,
                                       (x0, x1, y0, y1))
         p, q, owner, position = _segments(polylines)
@@ -1270,7 +1278,13 @@ def _decompose(base, ax, ay, ends, *, x_range, y_range, names, fine, arc, family
                     hot.extend([max(a_, middle - (b_ - a_) / 64), min(b_, middle + (b_ - a_) / 64)])
         if not hot:
             break
-        theta = np.unique(np.concatenate([theta, hot]))
+        # The angles added are evaluated by the next round's sampling, the
+        # others are kept.
+        hot = np.setdiff1d(hot, theta)
+        order = np.argsort(np.concatenate([theta, hot]), kind="stable")
+        unknown = np.full(len(hot), np.nan)
+        samples = tuple(np.concatenate([a, b])[order] for a, b in
+                        zip(samples, (hot, unknown, unknown, unknown)))
     n_segments = len(p)
     check_memory(f"the D-decomposition's {n_segments} segments", 64 * n_segments * 64)
 
