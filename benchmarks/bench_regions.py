@@ -1,14 +1,15 @@
 """Every example loop's ``Loop.region`` here against an earlier revision, side by side (run by hand).
 
-    python benchmarks/bench_regions.py [--against d0d1e0a] [--runs 3] [--delays 0,10,100]
+    python benchmarks/bench_regions.py [--against d0d1e0a] [--runs 10] [--delays 0,10,100]
 
 For each loop file in ``examples/loops`` and each delay of ``--delays``
 (``d`` set on the file's defaults), ``Loop.region()`` in its default plane
 is timed in this checkout and in ``--against`` (default ``d0d1e0a``, main
 on the day issue 19 was filed: the target is "every example loop's region
 no slower than today"), each in its own Python process with its own empty
-kernel cache, one warm-up run (the loop's kernels are generated then) and
-the median of ``--runs``.  The earlier revision is checked out with ``git
+kernel cache and one BLAS thread, one warm-up run (the loop's kernels are
+generated then) and the median of ``--runs`` of the process's CPU time
+(less disturbed by other work on the machine than the wall time).  The earlier revision is checked out with ``git
 worktree`` into a temporary folder, removed at the end.  Rows alternate
 between the two revisions loop by loop, so a load on the machine hits both.
 
@@ -41,9 +42,9 @@ d, runs = int(sys.argv[3]), int(sys.argv[4])
 found = loop.region(d=d)
 times = []
 for _ in range(runs):
-    start = time.perf_counter()
+    start = time.process_time()
     found = loop.region(d=d)
-    times.append(time.perf_counter() - start)
+    times.append(time.process_time() - start)
 print(json.dumps({"time": statistics.median(times), "cells": len(found.stable),
                   "area": float(found.area)}))
 """
@@ -62,7 +63,7 @@ def _probe(root, path, d, runs):
 def main(argv=None):
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--against", default="d0d1e0a", help="the earlier revision (default d0d1e0a)")
-    parser.add_argument("--runs", type=int, default=3)
+    parser.add_argument("--runs", type=int, default=10)
     parser.add_argument("--delays", default="0,10,100")
     args = parser.parse_args(argv)
     delays = [int(v) for v in args.delays.split(",")]
