@@ -42,7 +42,7 @@ from .curves import bracketed_root, scan_grid, zoom_max
 from .polynomial import DelayedPolynomial, horner
 from .roots import root_counts
 
-__all__ = ["line_intervals", "family_intervals", "Unresolved", "RESIDUAL"]
+__all__ = ["line_intervals", "family_intervals", "circle_crossings", "Unresolved", "RESIDUAL"]
 
 #: A candidate crossing is kept where ``|A0 + p A1|`` at its angle is at
 #: most this fraction of the rounding scale ``sum |a0_k| + |p| sum |a1_k|``.
@@ -209,6 +209,55 @@ def _crossings(polynomials, at, ends, given):
     return line[keep], p[keep], theta[keep]
 
 
+def circle_crossings(base, slope, ends=None):
+    """Where the line ``base + p slope`` has a root on the unit circle: ``(p, theta)``.
+
+    The crossings :func:`line_intervals` counts across (the leading
+    coefficient's zero left out), sorted by angle: on a plane, where the
+    line meets the arc (``0 < theta < pi``) and the lines ``z = +-1``.
+    A line along which ``z = 1`` (or ``-1``) is a root for every ``p`` has
+    no crossing there.
+
+    Parameters
+    ----------
+    base, slope, ends
+        As for :func:`line_intervals`.
+
+    Returns
+    -------
+    (ndarray, ndarray)
+        ``p`` and ``theta`` in [0, pi] of each crossing.
+
+    Examples
+    --------
+    >>> p, theta = circle_crossings(np.array([1.0, -0.5, 0.0]), np.array([0.0, 0.0, 1.0]))
+    >>> p.round(12).tolist(), np.cos(theta).round(12).tolist()     # z**2 - z/2 + p
+    ([-0.5, 1.0, -1.5], [1.0, 0.25, -1.0])
+    """
+    given = (base, None, slope)
+    polynomials, given, ends = _prepared(given, ends)
+    _, p, theta = _crossings(polynomials, np.zeros(1), ends, given)
+    return p + 0.0, theta
+
+
+def _prepared(given, ends):
+    """The three polynomials of a family (a zero ``across`` for None), as given and structured, and their ends."""
+    base, across, slope = given
+    if across is None:
+        across = _one(base, "base")
+        across = DelayedPolynomial(np.zeros_like(across.delayed), np.zeros_like(across.direct),
+                                   across.shift)
+        if ends is not None:
+            ends = (ends[0], (0.0, 0.0), ends[-1])
+    given = (base, across, slope)
+    polynomials = _common([_one(p, name) for p, name in zip(given, ("base", "across", "slope"))])
+    if all(isinstance(x, DelayedPolynomial) for x in given):
+        given = polynomials
+    if ends is None:
+        ends = [_end_values(chi) for chi in polynomials]
+    return polynomials, given, ends
+
+
 def _carry(counts, steps, first):
     """Counts carried across the crossings from each known one (in place); -2 where unknown.
 
@@ -267,18 +316,7 @@ def family_intervals(base, across, slope, at, ends=None):
     [[(-1.0, 1.0)], [(-1.5, 0.5)]]
     """
     at = np.asarray(at, dtype=float).ravel()
-    if across is None:
-        across = _one(base, "base")
-        across = DelayedPolynomial(np.zeros_like(across.delayed), np.zeros_like(across.direct),
-                                   across.shift)
-        if ends is not None:
-            ends = (ends[0], (0.0, 0.0), ends[2])
-    given = (base, across, slope)
-    polynomials = _common([_one(p, name) for p, name in zip(given, ("base", "across", "slope"))])
-    if all(isinstance(x, DelayedPolynomial) for x in given):
-        given = polynomials
-    if ends is None:
-        ends = [_end_values(chi) for chi in polynomials]
+    polynomials, given, ends = _prepared((base, across, slope), ends)
     base, across, slope = polynomials
     line, p, theta = _crossings(polynomials, at, ends, given)
     with np.errstate(all="ignore"):

@@ -28,10 +28,11 @@ import numpy as np
 from .._generated import kernels
 from .._resources import check_memory, chunk_slices
 from .._validate import check_array, check_count, check_loop, check_real, check_window
-from .curves import (KERNEL_BYTES_PER_POINT, KERNEL_CHUNK_BYTES, Segment,
-                     golden_max, arc_end_angle, bracketed_root, minus_one_line, scan_grid)
+from .curves import (KERNEL_BYTES_PER_POINT, KERNEL_CHUNK_BYTES, Segment, arc_end_angle,
+                     minus_one_line)
 from .arcs import ClosedFormArc
 from .decomposition import decompose
+from .intervals import circle_crossings
 from .paper_loop import paper_limits, paper_point
 from .results import PAPER_PLANE, Boundary
 from .stability import loop_coefficients
@@ -40,7 +41,7 @@ __all__ = ["StabilityRegion", "limits", "vanishing_gamma", "BestVirtualMass", "b
            "scan_maximum", "boundary_curve"]
 
 #: An end of a stable interval within this many ulps of its terms' size
-#: from a line z = +-1 lies on it (:meth:`StabilityRegion.line_segments`).
+#: from the line z = -1 lies on it (:meth:`StabilityRegion.line_segments`).
 _LINE_ULPS = 16
 
 class StabilityRegion:
@@ -77,36 +78,6 @@ class StabilityRegion:
     def __init__(self, *, gamma, d, delta):
         self.gamma, self.d, self.delta = check_loop(gamma, d, delta)
         self.minus_one = minus_one_line(gamma=self.gamma, d=self.d, delta=self.delta)
-
-    # The sampled arc, taken on first use: only the pieces of z = +-1 that
-    # bound the region (line_segments) need it.
-
-    @functools.cached_property
-    def _samples(self):
-        """``(theta, alpha, beta, segments)`` of the sampled arc (see :meth:`_sample`)."""
-        return self._sample()
-
-    _theta = property(lambda self: self._samples[0])
-    _alpha = property(lambda self: self._samples[1])
-    _beta = property(lambda self: self._samples[2])
-    _segments = property(lambda self: self._samples[3])
-
-    def _sample(self):
-        """The arc on the scan grid, with its extrema and a few ulps either side of each pole."""
-        theta = np.concatenate([[0.0], scan_grid(self.d, upper=np.pi * (1 - 1e-9))])
-        theta = np.union1d(theta, self._extrema(theta))
-        poles = self._poles(theta)
-        # Samples a few ulps either side of each pole: every other segment
-        # is then monotone in alpha and in beta, so a crossing lies between
-        # its segment's ends, without root-finding.
-        theta = np.union1d(theta, np.concatenate([poles - 4 * np.spacing(poles),
-                                                  poles + 4 * np.spacing(poles)]))
-        alpha, beta = kernels.boundary(theta, self.gamma, self.d, self.delta)
-        alpha[0], beta[0] = 0.0, -self.delta
-        finite = np.isfinite(alpha) & np.isfinite(beta)
-        segment = finite[:-1] & finite[1:]
-        segment[np.searchsorted(theta, poles) - 1] = False
-        return theta, alpha, beta, np.flatnonzero(segment)
 
     def decomposition(self, x_range, y_range):
         """The complete D-decomposition of a window of the (beta, alpha) plane.
@@ -153,38 +124,6 @@ class StabilityRegion:
         arc = ClosedFormArc(gamma=self.gamma, d=self.d, delta=self.delta)
         return decompose(base, ax, ay, ends, x_range=x_range, y_range=y_range,
                          names=("beta", "alpha"), arc=arc)
-
-    def _extrema(self, theta):
-        """The angles of the local extrema of alpha(theta) and beta(theta).
-
-        With them among the samples, alpha and beta are monotone on every
-        segment of the sampled arc, so a line that meets a segment twice
-        (near the top of the arc, say) cannot slip through unnoticed.
-        """
-        out = []
-        values = kernels.boundary(theta, self.gamma, self.d, self.delta)
-        for index, v in enumerate(values):
-            inner = v[1:-1]
-            peak = (inner >= v[:-2]) & (inner > v[2:]) | (inner <= v[:-2]) & (inner < v[2:])
-            i = np.flatnonzero(peak & np.isfinite(inner)) + 1
-            if i.size:
-                sign = np.where(v[i] > v[i - 1], 1.0, -1.0)
-                out.append(golden_max(lambda t, k=index, s=sign: s * kernels.boundary(
-                    t, self.gamma, self.d, self.delta)[k], theta[i - 1], theta[i + 1]))
-        return np.concatenate(out) if out else np.empty(0)
-
-    def _poles(self, theta):
-        """Angles where the arc goes to infinity (alpha and beta change sign there)."""
-        beta = kernels.boundary(theta, self.gamma, self.d, self.delta)[1]
-        s = np.flatnonzero(np.isfinite(beta[:-1]) & np.isfinite(beta[1:])
-                           & (beta[:-1] * beta[1:] < 0))
-        if s.size == 0:
-            return np.empty(0)
-        root = bracketed_root(lambda t, i: kernels.boundary(t, self.gamma, self.d, self.delta)[1],
-                              theta[s], theta[s + 1], indexed=True)
-        value = np.abs(kernels.boundary(root, self.gamma, self.d, self.delta)[1])
-        pole = ~np.isfinite(value) | (value > np.maximum(np.abs(beta[s]), np.abs(beta[s + 1])))
-        return root[pole]
 
     def alpha_intervals(self, beta):
         """The stable alpha intervals at damping ``beta``.
@@ -254,9 +193,25 @@ class StabilityRegion:
         """The limits of this region, from the one engine (:func:`~symstab.numeric.paper_loop.paper_limits`)."""
         return paper_limits(gamma=self.gamma, d=self.d, delta=self.delta, region=self)
 
-    def _corners(self):
-        """beta of the points where the arc meets alpha = 0: its start ``-delta`` and the others."""
-        return np.union1d(self._arc_roots(lambda a, b: a, start=1), [-self.delta])
+    def _corners(self, c):
+        """beta of the points where the arc meets a line ``alpha = c - k beta`` (``k`` 0 or 2).
+
+        The crossings of that line with the unit circle at ``0 < theta <
+        pi`` (the one line engine's,
+        :func:`~symstab.numeric.intervals.circle_crossings`): on ``alpha =
+        0`` (``c = 0``, ``k = 0``) and on ``z = -1`` (``alpha + 2 beta =
+        c``) a real root is on the circle everywhere, the arc's corners are
+        where a pair joins it.
+        """
+        loop, point = paper_point(gamma=self.gamma, d=self.d, delta=self.delta)
+        base, (d_beta, d_alpha), ends = loop._basis(("B", "K"), point, structured=True)
+        k = 0.0 if c == 0 else 2.0
+        line = base.combine([c], [d_alpha]).flat()
+        slope = d_beta.combine([-k], [d_alpha]).flat()
+        line_ends = tuple(ends[0] + c * ends[2])
+        slope_ends = tuple(ends[1] - k * ends[2])
+        beta, theta = circle_crossings(line, slope, (line_ends, slope_ends))
+        return beta[(theta > 0) & (theta < np.pi)]
 
     def line_segments(self):
         """The pieces of z = 1 (alpha = 0) and z = -1 that bound the stable region.
@@ -288,13 +243,13 @@ class StabilityRegion:
 
         # z = 1: alpha = 0; the region borders a piece when a stable interval
         # of the vertical line through its middle starts or ends at 0.
-        ends = self._corners()
+        ends = np.union1d(self._corners(0.0), [-self.delta])
         if math.isfinite(c):
             ends = np.union1d(ends, [c / 2])
         out += self._bordering_pieces("z=1", within(ends), lambda b: 0.0)
         if math.isfinite(c):
             # z = -1: alpha + 2 beta = c, cut where the arc crosses it and at alpha = 0.
-            ends = np.union1d(self._arc_roots(lambda a, b: a + 2 * b - c), [c / 2])
+            ends = np.union1d(self._corners(c), [c / 2])
             out += self._bordering_pieces("z=-1", within(ends), lambda b: c - 2 * b)
         return tuple(out)
 
@@ -309,10 +264,11 @@ class StabilityRegion:
         out = []
         for b0, b1, bm, r in zip(ends[:-1], ends[1:], middle, runs):
             a = line_alpha(bm)
-            # An end of a stable interval on the line: the same point from
-            # the polynomial's end values and from the line's closed form,
-            # rounded differently (a few ulps of the terms).
-            near = _LINE_ULPS * np.finfo(float).eps * (abs(a) + 2 * abs(bm) + abs(self.minus_one))
+            # An end of a stable interval on z = -1: the same point from the
+            # polynomial's end values and from the line's closed form, rounded
+            # differently (a few ulps of the terms).  On z = 1 both are 0.
+            near = 0.0 if root == "z=1" else \
+                _LINE_ULPS * np.finfo(float).eps * (abs(a) + 2 * abs(bm) + abs(self.minus_one))
             if b1 > b0 and any(abs(lo - a) <= near or abs(hi - a) <= near for lo, hi in r):
                 if out and out[-1][1] == b0:
                     out[-1] = (out[-1][0], b1)
@@ -320,27 +276,6 @@ class StabilityRegion:
                     out.append((b0, b1))
         return [Segment(root, float(b0), float(line_alpha(b0)), float(b1), float(line_alpha(b1)))
                 for b0, b1 in out]
-
-    def _arc_point(self, theta):
-        return kernels.boundary(theta, self.gamma, self.d, self.delta)
-
-    def _arc_roots(self, g, start=0):
-        """beta of the arc points where ``g(alpha, beta)`` changes sign (poles left out).
-
-        Segments from the ``start``-th sample on (the first, from theta = 0,
-        starts at the corner ``(-delta, 0)`` itself).
-        """
-        s = self._segments[self._segments >= start]
-        g0 = g(self._alpha[s], self._beta[s])
-        g1 = g(self._alpha[s + 1], self._beta[s + 1])
-        change = np.sign(g0) != np.sign(g1)
-        s, g0, g1 = s[change], g0[change], g1[change]
-        if s.size == 0:
-            return np.empty(0)
-        root = bracketed_root(lambda t: g(*self._arc_point(t)), self._theta[s], self._theta[s + 1])
-        a, b = self._arc_point(root)
-        residual = np.abs(g(a, b))
-        return b[np.isfinite(residual) & (residual <= np.maximum(np.abs(g0), np.abs(g1)))]
 
     def alpha_max(self):
         """``(alpha_max, beta at alpha_max)``, or ``None`` when the region is empty (see :meth:`limits`)."""
