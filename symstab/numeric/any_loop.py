@@ -98,6 +98,13 @@ class Loop(LoopModel):
     plane : (str, str), optional
         The default ``(x, y)`` plane of :meth:`boundary` and :meth:`limits`
         (for example ``("B", "K")``); checked to be jointly affine.
+    arc : callable, optional
+        The loop's arc in closed form, where SymPy derived one:
+        ``arc(x, y, values)`` gives ``theta -> (x, y)``, the point of the
+        ``(x, y)`` plane where ``exp(j theta)`` is a root at the other
+        ``values`` (NaN where the closed form does not keep its digits), or
+        None for a plane it does not cover.  The line engine refines its
+        crossings on it (the paper's loop: eq. (7)'s kernel).
 
     Raises
     ------
@@ -118,9 +125,12 @@ class Loop(LoopModel):
     """
 
     def __init__(self, plant, environment, *, values=None, name=None, units=None,
-                 description="", plane=None):
+                 description="", plane=None, arc=None):
         super().__init__(plant, environment, values=values, name=name, units=units,
                          description=description, plane=plane)
+        if arc is not None and not callable(arc):
+            raise TypeError(f"arc must be callable, got {type(arc).__name__}")
+        self._arc = arc
         if self.units:
             self._check_units()
 
@@ -538,7 +548,8 @@ class Loop(LoopModel):
         names = (name,) if across is None else (name, across)
         base, slopes, ends = self._basis(names, values, structured=True)
         runs = family_intervals(base, slopes[1] if across else None, slopes[0], at,
-                                (tuple(ends[0]), tuple(ends[-1]), tuple(ends[1])))
+                                (tuple(ends[0]), tuple(ends[-1]), tuple(ends[1])),
+                                arc=self._closed_form(across, name, values))
         if across is not None and not family:
             values = {**values, across: float(at[0])}
         for value, r in zip(at, runs):
@@ -552,6 +563,12 @@ class Loop(LoopModel):
                     f"has a root on the unit circle to within rounding (a value far outside "
                     f"the loop's usual range?)")
         return runs if family else runs[0]
+
+    def _closed_form(self, x, y, values):
+        """``theta -> (x, y)`` of the arc in closed form, or None (see the ``arc`` parameter)."""
+        if self._arc is None or x is None:
+            return None
+        return self._arc(x, y, {**self.defaults, **values})
 
     def _plane(self, x, y):
         if x is None and y is None and self.plane is not None:

@@ -51,6 +51,10 @@ RESIDUAL = 1e-6
 #: about sqrt(eps), below which the values next to a smooth minimum differ
 #: by less than their rounding.
 _DIP_RTOL = 1e-9
+#: A crossing is re-found on an accurate arc source within this relative
+#: distance of the angle the coefficients gave (they are good to about
+#: 1e-11 where they cancel next to z = 1).
+_POLISH = 1e-9
 
 
 class Unresolved(ArithmeticError):
@@ -209,7 +213,35 @@ def _crossings(polynomials, at, ends, given):
     return line[keep], p[keep], theta[keep]
 
 
-def circle_crossings(base, slope, ends=None):
+def _polished(line, p, theta, at, arc):
+    """The crossings at ``0 < theta < pi`` refined on an arc source where it has them.
+
+    ``arc(theta) -> (value, position)``: the line value of the arc's point
+    at ``theta`` and its position along the line (NaN where the source has
+    nothing better to offer).  Each crossing's angle is re-found as the
+    root of ``value(theta) - v`` within ``1e-9`` of its own; where the
+    source has no sign change there, the crossing stays as it was.
+    """
+    inner = np.flatnonzero((theta > 0) & (theta < np.pi))
+    if arc is None or inner.size == 0:
+        return p, theta
+    lo = np.maximum(theta[inner] * (1 - _POLISH), np.finfo(float).tiny)
+    hi = np.minimum(theta[inner] * (1 + _POLISH), np.pi * (1 - np.finfo(float).eps))
+    target = at[line[inner]]
+    f_lo, f_hi = arc(lo)[0] - target, arc(hi)[0] - target
+    ok = np.isfinite(f_lo) & np.isfinite(f_hi) & (np.sign(f_lo) * np.sign(f_hi) < 0)
+    if not ok.any():
+        return p, theta
+    which, target = inner[ok], target[ok]
+    root = bracketed_root(lambda t, i: arc(t)[0] - target[i], lo[ok], hi[ok], indexed=True)
+    position = arc(root)[1]
+    good = np.isfinite(position)
+    p, theta = p.copy(), theta.copy()
+    p[which[good]], theta[which[good]] = position[good], root[good]
+    return p, theta
+
+
+def circle_crossings(base, slope, ends=None, *, arc=None):
     """Where the line ``base + p slope`` has a root on the unit circle: ``(p, theta)``.
 
     The crossings :func:`line_intervals` counts across (the leading
@@ -222,6 +254,8 @@ def circle_crossings(base, slope, ends=None):
     ----------
     base, slope, ends
         As for :func:`line_intervals`.
+    arc : callable, optional
+        As for :func:`family_intervals` (with ``v = 0``).
 
     Returns
     -------
@@ -236,7 +270,8 @@ def circle_crossings(base, slope, ends=None):
     """
     given = (base, None, slope)
     polynomials, given, ends = _prepared(given, ends)
-    _, p, theta = _crossings(polynomials, np.zeros(1), ends, given)
+    line, p, theta = _crossings(polynomials, np.zeros(1), ends, given)
+    p, theta = _polished(line, p, theta, np.zeros(1), arc)
     return p + 0.0, theta
 
 
@@ -280,7 +315,7 @@ def _carry(counts, steps, first):
     return np.array(need, dtype=np.int64)
 
 
-def family_intervals(base, across, slope, at, ends=None):
+def family_intervals(base, across, slope, at, ends=None, *, arc=None):
     """Stable intervals of ``p`` on each line ``base + v across + p slope``, ``v`` in ``at``.
 
     The lines of a family share their brackets and are scanned, refined and
@@ -299,6 +334,12 @@ def family_intervals(base, across, slope, at, ends=None):
         where the caller knows them better than the sums of the coefficients
         (a loop's plant at 30 digits, a value known to vanish exactly);
         ``across``'s pair is not read when ``across`` is None.
+    arc : callable, optional
+        ``arc(theta) -> (v, p)``: the point where ``exp(j theta)`` is a
+        root, as the value ``v`` of its line and its position ``p`` on it,
+        from a source more accurate than the coefficients (a closed form;
+        NaN where it is not).  Each crossing at ``0 < theta < pi`` is then
+        re-found on it (:data:`_POLISH`).
 
     Returns
     -------
@@ -319,6 +360,7 @@ def family_intervals(base, across, slope, at, ends=None):
     polynomials, given, ends = _prepared((base, across, slope), ends)
     base, across, slope = polynomials
     line, p, theta = _crossings(polynomials, at, ends, given)
+    p, theta = _polished(line, p, theta, at, arc)
     with np.errstate(all="ignore"):
         chi = base.combine([at[line], p], [across, slope])
     changes = crossing_change(chi, slope, theta) if p.size else np.empty(0)

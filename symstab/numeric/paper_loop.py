@@ -17,14 +17,16 @@ not on ``import symstab``.
 import dataclasses
 import functools
 
+import numpy as np
 import sympy as sp
 
+from .._generated import kernels
 from .._validate import check_loop, check_real
 from ..symbolic import model
 from .results import PAPER_PLANE
 from .units import PAPER_DEVICE
 
-__all__ = ["PAPER_LOOP", "paper_loop", "PAPER_NAMES", "paper_point", "paper_limits",
+__all__ = ["PAPER_LOOP", "paper_loop", "PAPER_NAMES", "paper_point", "closed_form_arc", "paper_limits",
            "paper_passive_region", "paper_locus"]
 
 #: Names of the environment's parameters in the loop: ``K_w, B_w, M_w`` of
@@ -38,6 +40,45 @@ def _environment():
     """Eq. (1)'s VE(z) with ``K_w, B_w, M_w`` named ``K, B, M`` (:data:`PAPER_NAMES`)."""
     rename = {getattr(model, name): sp.Symbol(new) for name, new in PAPER_NAMES.items()}
     return model.virtual_environment().subs(rename)
+
+
+def closed_form_arc(x, y, values):
+    """Eq. (7)'s arc in the plane ``(B, K)`` (either way round): ``theta -> (x, y)``.
+
+    The generated kernel (:func:`symstab._generated.kernels.boundary`) at
+    ``gamma = M/m``, ``delta = b T/m``, scaled by ``K = alpha m/T**2``,
+    ``B = beta m/T``.  It keeps its digits from theta = 0 on, where the
+    loop's coefficients cancel (``z = 1`` is a root of the plant's
+    denominator and of the environment's terms in B and M); past pi/2 its
+    ``tan(theta/2)`` times a vanishing sum loses them (2e-12 at pi - 1e-6,
+    d = 10), and there it gives NaN: the coefficients are the better source.
+
+    Parameters
+    ----------
+    x, y : str
+        The plane (``"B", "K"`` or ``"K", "B"``).
+    values : dict
+        ``m``, ``T``, ``d``, ``M`` and (but for the frictionless loop) ``b``.
+
+    Returns
+    -------
+    callable or None
+        ``theta -> (x, y)``; None for another plane.
+    """
+    if {x, y} != {"B", "K"}:
+        return None
+    m, T, d = float(values["m"]), float(values["T"]), int(values["d"])
+    gamma, delta = float(values["M"]) / m, float(values.get("b", 0.0)) * T / m
+
+    def arc(theta):
+        theta = np.asarray(theta, dtype=float)
+        alpha, beta = kernels.boundary(theta, gamma, d, delta)
+        far = theta > 0.5 * np.pi
+        B = np.where(far, np.nan, beta * (m / T))
+        K = np.where(far, np.nan, alpha * (m / T**2))
+        return (B, K) if x == "B" else (K, B)
+
+    return arc
 
 
 @functools.lru_cache(maxsize=1)
@@ -68,7 +109,8 @@ def paper_loop():
         values={"m": device.m, "b": device.b, "T": device.T, "d": _PAPER_DELAY,
                 "K": 2.0, "B": 0.1, "M": 0.0},
         units={"m": "kg m^2", "b": "N m s/rad", "T": "s",
-               "K": units["K_w"], "B": units["B_w"], "M": units["M_w"]})
+               "K": units["K_w"], "B": units["B_w"], "M": units["M_w"]},
+        arc=closed_form_arc)
 
 
 @functools.lru_cache(maxsize=1)
@@ -83,7 +125,8 @@ def frictionless_paper_loop():
 
     environment = _environment()
     return Loop(model.plant().subs(model.b, 0), environment, name="paper-frictionless",
-                plane=("B", "K"), values={"m": 1.0, "T": 1.0, "d": 0, "K": 0.0, "B": 0.0, "M": 0.0})
+                plane=("B", "K"), values={"m": 1.0, "T": 1.0, "d": 0, "K": 0.0, "B": 0.0, "M": 0.0},
+                arc=closed_form_arc)
 
 
 def paper_point(*, gamma, d, delta):

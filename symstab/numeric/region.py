@@ -33,7 +33,7 @@ from .curves import (KERNEL_BYTES_PER_POINT, KERNEL_CHUNK_BYTES, Segment, arc_en
 from .arcs import ClosedFormArc
 from .decomposition import decompose
 from .intervals import circle_crossings
-from .paper_loop import paper_limits, paper_point
+from .paper_loop import closed_form_arc, paper_limits, paper_point
 from .results import PAPER_PLANE, Boundary
 from .stability import loop_coefficients
 
@@ -198,10 +198,10 @@ class StabilityRegion:
 
         The crossings of that line with the unit circle at ``0 < theta <
         pi`` (the one line engine's,
-        :func:`~symstab.numeric.intervals.circle_crossings`): on ``alpha =
-        0`` (``c = 0``, ``k = 0``) and on ``z = -1`` (``alpha + 2 beta =
-        c``) a real root is on the circle everywhere, the arc's corners are
-        where a pair joins it.
+        :func:`~symstab.numeric.intervals.circle_crossings`, refined on the
+        closed form): on ``alpha = 0`` (``c = 0``, ``k = 0``) and on ``z =
+        -1`` (``alpha + 2 beta = c``) a real root is on the circle
+        everywhere, the arc's corners are where a pair joins it.
         """
         loop, point = paper_point(gamma=self.gamma, d=self.d, delta=self.delta)
         base, (d_beta, d_alpha), ends = loop._basis(("B", "K"), point, structured=True)
@@ -210,7 +210,13 @@ class StabilityRegion:
         slope = d_beta.combine([-k], [d_alpha]).flat()
         line_ends = tuple(ends[0] + c * ends[2])
         slope_ends = tuple(ends[1] - k * ends[2])
-        beta, theta = circle_crossings(line, slope, (line_ends, slope_ends))
+        closed = closed_form_arc("B", "K", {**point, "B": 0.0, "K": 0.0})
+
+        def arc(theta):        # the arc point's distance along alpha from the line, and its beta
+            beta, alpha = closed(theta)
+            return alpha + k * beta - c, beta
+
+        beta, theta = circle_crossings(line, slope, (line_ends, slope_ends), arc=arc)
         return beta[(theta > 0) & (theta < np.pi)]
 
     def line_segments(self):

@@ -317,6 +317,56 @@ def test_alpha_intervals_on_many_lines_match_a_brute_force_scan(gamma, d, delta)
         _assert_runs_match_a_brute_force_scan(r, gamma, d, delta, beta, starts_at_zero)
 
 
+def _arc_point_at_beta(gamma, d, delta, beta, near_alpha):
+    """The 40-digit arc point (alpha, beta) of the first principles with this beta, next to near_alpha."""
+    from symstab._generated import kernels
+
+    theta = np.linspace(1e-7, np.pi - 1e-7, 200_001)
+    alpha_f, beta_f = kernels.boundary(theta, gamma, d, delta)
+    g = beta_f - beta
+    k = np.flatnonzero(np.isfinite(g[:-1]) & np.isfinite(g[1:]) & (np.sign(g[:-1]) != np.sign(g[1:]))
+                       & (np.abs(g[:-1] - g[1:]) < 1.0))          # not a pole
+    k = k[np.argmin(np.abs(alpha_f[k] - near_alpha))]
+    with mpmath.workdps(40):
+        t = mpmath.findroot(lambda t: first_principles_boundary_point(t, gamma, d, delta)[1] - beta,
+                            (theta[k], theta[k + 1]), solver="anderson")
+        return float(first_principles_boundary_point(t, gamma, d, delta)[0]), float(t)
+
+
+@pytest.mark.parametrize("gamma, d, delta, betas", [
+    (0.5, 40, PAPER_DELTA, [0.001, 0.0076, 0.0208, 0.0405]),
+    (0.0, 10, PAPER_DELTA, [0.001, 0.034, 0.067, 0.134])])
+def test_interval_ends_keep_the_closed_forms_digits(gamma, d, delta, betas):
+    """The top of each stable alpha interval is the arc point on the line, to 1e-13 (40-digit oracle).
+
+    Next to theta = 0 the loop's coefficients cancel (z = 1 is a root of the
+    plant's denominator and of the environment's B and M terms) and the
+    crossings they give are 1e-12 off (6e-13 at gamma = 0.5, d = 40, theta
+    = 0.009); refined on eq. (7)'s closed form they are not.
+    """
+    runs = StabilityRegion(gamma=gamma, d=d, delta=delta).alpha_intervals_on(betas)
+    for beta, r in zip(betas, runs):
+        top = r[-1][1]
+        want, theta = _arc_point_at_beta(gamma, d, delta, beta, top)
+        assert top == pytest.approx(want, rel=1e-13, abs=0), (beta, theta)
+
+
+def test_a_corner_of_the_arc_with_alpha_zero_keeps_its_digits():
+    """Where the arc meets alpha = 0 (the z = 1 segment's end at gamma = -1.001, d = 0), to 1e-13.
+
+    The corner is ill-conditioned on the coefficients (alpha is flat there:
+    an absolute 1e-16 in alpha moves it by 1.6e-11); on the closed form it
+    is not.
+    """
+    gamma, d, delta = -1.001, 0, PAPER_DELTA
+    (segment,) = boundary_curve(gamma=gamma, d=d, delta=delta, n=3).segments
+    with mpmath.workdps(40):
+        t = mpmath.findroot(lambda t: first_principles_boundary_point(t, gamma, d, delta)[0],
+                            (0.07, 0.09), solver="anderson")
+        want = float(first_principles_boundary_point(t, gamma, d, delta)[1])
+    assert segment.beta1 == pytest.approx(want, rel=1e-13, abs=0)
+
+
 @pytest.mark.parametrize("betas, error", [
     ([[0.1, 0.2]], ValueError), ([0.1, np.nan], ValueError), (["a"], TypeError), ([True], TypeError)])
 def test_alpha_intervals_on_refuses_bad_lines(betas, error):
