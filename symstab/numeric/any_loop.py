@@ -41,7 +41,7 @@ import numpy as np
 import sympy as sp
 
 from .._resources import check_memory
-from .._validate import check_array, check_count, check_delay, check_window
+from .._validate import check_array, check_count, check_delay, check_real, check_window
 from ..symbolic.loop_assembly import PLANT_DIGITS, LoopModel, parse_environment, parse_plant, shift_to_one
 from ..codegen.loop_kernels import environment_kernels, load_numpy_kernels
 from .arcs import CramerArc
@@ -133,6 +133,13 @@ class Loop(LoopModel):
         self._arc = arc
         if self.units:
             self._check_units()
+
+    def __reduce__(self):
+        # Rebuilt from its definition (the kernels are compiled again on first
+        # use): a loop, and a result that refers to it, travel to a worker process.
+        return (_rebuilt, (self.plant, self.environment, {
+            "values": dict(self.defaults), "name": self.name, "units": dict(self.units),
+            "description": self.description, "plane": self.plane, "arc": self._arc}))
 
     def _check_units(self):
         # A unit here names the unit of values the loop computes with as they
@@ -757,8 +764,10 @@ class Loop(LoopModel):
         """
         found = self.region(x, y, **values)
         at = {k: v for k, v in values.items() if k not in ("x_range", "y_range")}
+        line = functools.partial(_stable_intervals_at, self, found.x, found.y, at)
         if not found.stable:
-            return Limits.empty_set(found.x, found.y, _empty_reason(found), cells=0, at=at)
+            return Limits.empty_set(found.x, found.y, _empty_reason(found), cells=0, at=at,
+                                    line=line)
         (y_max, x_at), (x_min, _), (x_max, _) = (found.extreme(*which) for which in
                                                   (("y", 1), ("x", -1), ("x", 1)))
         sides = set(found.unbounded)
@@ -767,7 +776,7 @@ class Loop(LoopModel):
         x_max = np.inf if "x_max" in sides else x_max
         area = np.inf if sides else found.area
         return Limits(found.x, found.y, float(y_max), float(x_at), float(x_min), float(x_max),
-                      float(area), cells=len(found.stable), at=at)
+                      float(area), cells=len(found.stable), at=at, line=line)
 
     def passive_region(self, x=None, y=None, *, damping="b", x_range=None, y_range=None, **values):
         """The passive set of the environment behind the loop's delay, in the ``(x, y)`` plane.
@@ -822,6 +831,28 @@ class Loop(LoopModel):
         _, ve_d = self._environment_arrays(values, shape)
         num = np.concatenate([self._convolve(ve_d, p_n), np.zeros(d)])
         return control.tf(num, chi, float(values["T"]))
+
+
+def _rebuilt(plant, environment, options):
+    """A :class:`Loop` from its pickled definition (:meth:`Loop.__reduce__`).
+
+    One loop per definition and process: the results that refer to one
+    loop (every Limits of a sweep, say) share it, and its derivation.
+    """
+    key = (sp.srepr(plant), sp.srepr(environment),
+           *(tuple(sorted(v.items())) if isinstance(v, dict) else v for v in options.values()))
+    if key not in _REBUILT:
+        _REBUILT[key] = Loop(plant, environment, **options)
+    return _REBUILT[key]
+
+
+#: The loops rebuilt in this process from pickles, by definition.
+_REBUILT = {}
+
+
+def _stable_intervals_at(loop, x, y, values, at):
+    """The stable ``y`` intervals of ``loop`` at ``x = at`` (:attr:`Limits.line`)."""
+    return loop.stable_intervals(y, **{x: check_real(x, at)}, **values)
 
 
 def _shift_to_one(c):

@@ -16,6 +16,8 @@ import dataclasses
 
 import numpy as np
 
+from .._validate import check_real
+
 __all__ = ["Limits", "Boundary"]
 
 #: The paper's dimensionless plane: x = beta (damping), y = alpha (stiffness).
@@ -83,10 +85,12 @@ class Limits:
         Why the set is empty or unbounded; else empty.
     region : object
         What the numbers describe: the paper's
-        :class:`~symstab.numeric.region.StabilityRegion` (its intervals on
-        any line), or None.
+        :class:`~symstab.numeric.region.StabilityRegion`, or None.
     at : dict
         The values of the other parameters, as given.
+    line : callable or None
+        ``line(x) -> [(lo, hi), ...]``: the stable intervals of ``y`` at
+        ``x`` (:meth:`intervals_at`), where the limits came from a loop.
 
     Notes
     -----
@@ -109,6 +113,7 @@ class Limits:
     reason: str = ""
     region: object = None
     at: dict = dataclasses.field(default_factory=dict)
+    line: object = dataclasses.field(default=None, compare=False)
 
     alpha_max = _paper_alias("alpha_max", "y_max")
     beta_at_alpha_max = _paper_alias("beta_at_alpha_max", "x_at_y_max")
@@ -155,23 +160,44 @@ class Limits:
                 "x_at_y_max": self.x_at_y_max, "x_min": self.x_min, "x_max": self.x_max,
                 "area": self.area, "cells": self.cells, "reason": self.reason}
 
-    # The paper's line questions, answered by its region.
+    # The line questions, answered by the one line engine of the loop.
 
-    def _paper_region(self, what):
-        if self.region is None or not hasattr(self.region, "alpha_intervals"):
-            raise AttributeError(f"{what} needs the paper's StabilityRegion; these limits of the "
-                                 f"({self.x}, {self.y}) plane do not carry one")
-        return self.region
+    def intervals_at(self, x):
+        """The stable ``y`` intervals at ``x``: :meth:`symstab.Loop.stable_intervals` on this plane.
+
+        Parameters
+        ----------
+        x : float
+            The value of the plane's ``x``.
+
+        Returns
+        -------
+        list of (float, float)
+            Increasing, disjoint; empty when no ``y`` is stable.
+
+        Raises
+        ------
+        AttributeError
+            For limits that did not come from a loop (no :attr:`line`).
+        """
+        if self.line is None:
+            raise AttributeError(f"these limits of the ({self.x}, {self.y}) plane did not come "
+                                 f"from a loop: no line engine to ask")
+        return self.line(x)
 
     def alpha_interval(self, beta):
-        """The stable alpha intervals at ``beta``; see :meth:`StabilityRegion.alpha_intervals`.
+        """The stable alpha intervals at ``beta`` (the paper's name of :meth:`intervals_at`).
 
         Parameters
         ----------
         beta : float
             Dimensionless damping.
         """
-        return self._paper_region("alpha_interval").alpha_intervals(beta)
+        if (self.x, self.y) != PAPER_PLANE:
+            raise AttributeError(f"alpha_interval is the paper's name in its (beta, alpha) plane; "
+                                 f"this result is in the ({self.x}, {self.y}) plane: use "
+                                 f"intervals_at")
+        return self.intervals_at(check_real("beta", beta))
 
     def minimum_stiffness(self, beta):
         """The smallest stable alpha at ``beta`` (0 unless a minimum stiffness is needed).
@@ -183,9 +209,8 @@ class Limits:
         beta : float
             Dimensionless damping.
         """
-        runs = self._paper_region("minimum_stiffness").alpha_intervals(beta)
+        runs = self.alpha_interval(beta)
         return runs[0][0] if runs else None
-
 
 
 @dataclasses.dataclass(frozen=True, repr=False)

@@ -57,8 +57,41 @@ def test_paper_names_are_refused_outside_the_paper_plane():
     for name, field in (("alpha_max", "y_max"), ("z_width", "area"), ("beta_left", "x_min")):
         with pytest.raises(AttributeError, match=rf"{name} is the paper's name .* use {field}"):
             getattr(lim, name)
-    with pytest.raises(AttributeError, match="StabilityRegion"):
+    with pytest.raises(AttributeError, match="alpha_interval is the paper's name .* intervals_at"):
         lim.alpha_interval(0.1)
+
+
+def test_every_loops_limits_answer_the_line_question():
+    """intervals_at(x) of a loop's limits is its stable_intervals (python-control on both sides of
+    the top); in the paper's plane alpha_interval is the same question in Table I's names."""
+    loop = symstab.PAPER_LOOP
+    lim = loop.limits(d=5)
+    (lo, hi), = lim.intervals_at(lim.x_at_y_max)
+    assert (lo, hi) == tuple(loop.stable_intervals("K", B=lim.x_at_y_max, d=5)[0])
+    assert hi == pytest.approx(lim.y_max, rel=1e-6)
+    beta = float(PAPER_DEVICE.beta(lim.x_at_y_max))
+    radii = [float(np.max(np.abs(python_control_closed_loop(
+        alpha=float(PAPER_DEVICE.alpha(k)), beta=beta, gamma=0.0, d=5, delta=PAPER_DEVICE.delta,
+        m=PAPER_DEVICE.m, T=PAPER_DEVICE.T).poles()))) for k in (hi * (1 - 1e-6), hi * (1 + 1e-6))]
+    assert radii[0] < 1 < radii[1]
+    paper = symstab.limits(gamma=1.5, d=0, delta=PAPER_DEVICE.delta)
+    assert paper.alpha_interval(-0.5) == paper.region.alpha_intervals(-0.5)
+    assert 1 < paper.minimum_stiffness(-0.5) < 1.3          # Fig. 7's circle 6
+    with pytest.raises(TypeError, match="beta"):
+        paper.alpha_interval("a")
+
+
+def test_limits_and_their_loop_pickle():
+    """A Limits travels to another process with its loop: the same numbers, the same line answers."""
+    import pickle
+
+    lim = symstab.PAPER_LOOP.limits(d=5)
+    back = pickle.loads(pickle.dumps(lim))
+    assert back == lim and back.as_dict() == lim.as_dict()
+    assert back.intervals_at(lim.x_at_y_max) == lim.intervals_at(lim.x_at_y_max)
+    loop = pickle.loads(pickle.dumps(symstab.PAPER_LOOP))
+    assert loop.units == symstab.PAPER_LOOP.units and loop.plane == ("B", "K")
+    assert loop.limits(d=5) == lim
 
 
 def test_an_empty_set_reads_the_same_from_both():
