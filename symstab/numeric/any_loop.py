@@ -743,7 +743,7 @@ class Loop(LoopModel):
 
         Read from :meth:`region`: the stable cells' polygons give the area
         (exact up to the chords of the sampled arc), and their extreme
-        vertices the extent, refined along the arc by golden-section search
+        vertices the extent, refined along the arc by a zooming grid search
         where the extreme is a smooth turn of the arc rather than a corner.
 
         Parameters

@@ -18,7 +18,6 @@ where the arc ends:
 
 import dataclasses
 import fractions
-import math
 
 import numpy as np
 
@@ -29,7 +28,7 @@ from ..symbolic.theta_max import first_sign_change, reduced_curvature, reduced_q
 from .results import Boundary
 
 __all__ = ["arc_end_angle", "minus_one_line", "BoundaryCurve", "Segment", "scan_grid",
-           "bracketed_root", "golden_max", "zoom_max", "arc_polylines", "KERNEL_BYTES_PER_POINT",
+           "bracketed_root", "zoom_max", "arc_polylines", "KERNEL_BYTES_PER_POINT",
            "KERNEL_CHUNK_BYTES"]
 
 
@@ -280,21 +279,6 @@ def arc_polylines(*, gamma, d, delta, window):
     return points[: k + 1], points[k:]
 
 
-def golden_max(f, a, b, iterations=80):
-    """Vectorised golden-section search for the maximum of f on [a, b]."""
-    ratio = (math.sqrt(5) - 1) / 2
-    a, b = np.array(a, dtype=float), np.array(b, dtype=float)
-    x1, x2 = b - ratio * (b - a), a + ratio * (b - a)
-    f1, f2 = f(x1), f(x2)
-    for _ in range(iterations):
-        left = f1 < f2
-        a = np.where(left, x1, a)
-        b = np.where(left, b, x2)
-        x1, x2 = np.where(left, x2, b - ratio * (b - a)), np.where(left, a + ratio * (b - a), x1)
-        f1, f2 = np.where(left, f2, f(x1)), np.where(left, f(x2), f1)
-    return 0.5 * (a + b)
-
-
 def zoom_max(f, a, b, *, rtol, points=33, enough=None):
     """Vectorised search for the maximum of f on each [a, b] by zooming grids.
 
@@ -312,7 +296,7 @@ def zoom_max(f, a, b, *, rtol, points=33, enough=None):
         The brackets, ``a < b``.
     rtol : float
         A bracket stops when narrower than ``rtol`` times its larger end's
-        modulus.  Next to a smooth maximum the values of two points ``h``
+        modulus (or than ``rtol`` times its first width, next to 0).  Next to a smooth maximum the values of two points ``h``
         apart differ by ``f'' h**2``, below their rounding once ``h`` is
         about ``sqrt(eps)`` of the scale: a finer grid compares noise.
     points : int
@@ -335,6 +319,8 @@ def zoom_max(f, a, b, *, rtol, points=33, enough=None):
     """
     a, b = np.array(a, dtype=float).ravel(), np.array(b, dtype=float).ravel()
     best = 0.5 * (a + b)
+    # Next to 0 the relative width is taken of the first bracket's width.
+    floor = rtol * (b - a)
     active = np.arange(a.size)
     grid = np.linspace(0.0, 1.0, points)
     while active.size:
@@ -353,6 +339,7 @@ def zoom_max(f, a, b, *, rtol, points=33, enough=None):
         a[active] = x[rows, np.maximum(k - 1, 0)]
         b[active] = x[rows, np.minimum(k + 1, points - 1)]
         width = b[active] - a[active]
-        done |= width <= rtol * np.maximum(np.abs(a[active]), np.abs(b[active]))
+        done |= width <= np.maximum(rtol * np.maximum(np.abs(a[active]), np.abs(b[active])),
+                                    floor[active])
         active = active[~done]
     return best

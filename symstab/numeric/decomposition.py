@@ -43,7 +43,7 @@ import numpy as np
 
 from .._resources import check_memory, chunk_slices
 from .arcs import CramerArc
-from .curves import golden_max
+from .curves import zoom_max
 from .polynomial import DelayedPolynomial
 from .roots import STABLE, classify_polynomials, leading_vanishes, root_counts
 
@@ -79,6 +79,9 @@ _MAX_PAIRS = 20_000_000
 #: Smallest area of a cell, as a fraction of the window's (a cycle of the
 #: graph with less is a path walked there and back, not a cell).
 _AREA = 1e-24
+#: Relative width in theta to which an extreme of the arc is searched: the
+#: extreme's value is then exact to rounding (it is flat there).
+_EXTREME_RTOL = 1e-12
 #: Tolerance on the segment parameters of an intersection.
 _ENDS = 1e-9
 
@@ -263,7 +266,7 @@ class Decomposition:
 
         The extreme vertex of the stable cells; where it is a smooth turn of
         the arc (its neighbours along the arc are on the same cell's
-        boundary), refined along the arc by golden-section search in theta.
+        boundary), refined along the arc by a zooming grid in theta (curves.zoom_max).
 
         Parameters
         ----------
@@ -307,11 +310,10 @@ class Decomposition:
             return value, other
         arc = self.arc if self.arc is not None else CramerArc(*self.polynomial)
 
-        def f(t):
-            xy = arc(np.atleast_1d(t))[:2]
-            return sense * xy[k]
+        def f(t, _):
+            return sense * arc(t.ravel())[k].reshape(t.shape)
 
-        t = float(np.atleast_1d(golden_max(f, float(theta[0]), float(theta[1]), iterations=60))[0])
+        t = float(zoom_max(f, [theta[0]], [theta[1]], rtol=_EXTREME_RTOL)[0])
         xy = [float(v[0]) for v in arc(np.array([t]))[:2]]
         if sense * xy[k] >= sense * value:
             return xy[k], xy[1 - k]

@@ -67,7 +67,7 @@ must not depend on them), so each ``theta`` gives a half-plane and the passive
 set is their intersection: a convex set.  It is computed as a polygon by
 cutting planes: the half-planes of a grid of ``theta`` (16 points per period
 of the highest harmonic, at least 1024) cut a large box; then, at every
-vertex, the worst ``theta`` is found (the grid, then a golden-section search
+vertex, the worst ``theta`` is found (the grid, then a zooming-grid search
 around each of the best local maxima) and its half-plane cuts the vertex off
 when the condition fails there by more than ``1e-6 b``.  When no vertex
 fails, every vertex satisfies the condition with ``b (1 + 1e-6)``, so by
@@ -84,7 +84,7 @@ import numpy as np
 import sympy as sp
 
 from .._validate import check_delay, check_real
-from .curves import golden_max
+from .curves import zoom_max
 
 __all__ = ["PassiveRegion", "passive_region"]
 
@@ -415,8 +415,8 @@ def _worst(plane, grid, table, vx, vy):
     """``(value, theta)``: the largest ``a`` over ``theta`` in [0, pi] at each scaled point.
 
     The grid (``table`` holds ``a0, ax, ay`` on it) gives the best local
-    maxima, and a golden-section search between each one's neighbours
-    refines them.
+    maxima, and a zooming-grid search (:func:`~symstab.numeric.curves.zoom_max`)
+    between each one's neighbours refines them.
     """
     a0, ax, ay = table
     best = np.empty(len(vx))
@@ -440,8 +440,8 @@ def _worst(plane, grid, table, vx, vy):
         py = np.broadcast_to(vy[sl, None], top.shape)
         valid = np.isfinite(top_values)
         lo, hi, px, py = lo[valid], hi[valid], px[valid], py[valid]
-        # 40 steps shrink a bracket of two grid steps to 1e-8 of itself.
-        theta = golden_max(lambda t: plane.at(t, px, py), lo, hi, iterations=40)
+        # Down to 1e-9 of the angle: the maximum's value is then exact to rounding.
+        theta = zoom_max(lambda t, i: plane.at(t, px[i, None], py[i, None]), lo, hi, rtol=1e-9)
         refined = np.full(top.shape, -np.inf)
         refined[valid] = plane.at(theta, px, py)
         angles = np.full(top.shape, np.nan)
