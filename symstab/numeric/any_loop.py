@@ -555,7 +555,8 @@ class Loop(LoopModel):
         names = (name,) if across is None else (name, across)
         base, slopes, ends = self._basis(names, values, structured=True)
         runs = family_intervals(base, slopes[1] if across else None, slopes[0], at,
-                                (tuple(ends[0]), tuple(ends[-1]), tuple(ends[1])),
+                                (tuple(ends[0]), tuple(ends[2]) if across else None,
+                                 tuple(ends[1])),
                                 arc=self._closed_form(across, name, values))
         if across is not None and not family:
             values = {**values, across: float(at[0])}

@@ -387,14 +387,17 @@ def family_intervals(base, across, slope, at, ends=None, *, arc=None):
     edges_lo = np.full(first[-1], -np.inf)
     edges_hi = np.full(first[-1], np.inf)
     steps = np.full(first[-1], np.nan)
+    # The candidates are sorted by line, then p: each line's are one slice.
+    start = np.cumsum(per_line) - per_line
     for i in np.flatnonzero(per_line):
-        c = candidates[candidate_line == i]
+        mine = slice(start[i], start[i] + per_line[i])
+        c = candidates[mine]
         s = slice(first[i], first[i + 1])
         pad = max(1.0, float(np.max(np.abs(c))))
         tests[s] = np.concatenate([[c[0] - pad], 0.5 * (c[1:] + c[:-1]), [c[-1] + pad]])
         edges_lo[s][1:] = c
         edges_hi[s][:-1] = c
-        steps[s][:-1] = summed[candidate_line == i]
+        steps[s][:-1] = summed[mine]
 
     def count(index):
         return root_counts(base.combine([at[test_line[index]], tests[index]], [across, slope]))
