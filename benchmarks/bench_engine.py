@@ -6,8 +6,10 @@ Every row is one run on the same machine state, medians of ``--runs``:
 
 1. Certified root counts (:func:`symstab.numeric.roots.root_counts`) of the
    paper's loop at d = 10, 100, 1000 for ``--points`` random (K, B) points:
-   ``symstab.PAPER_LOOP.unstable_root_counts`` (the Loop path: plant at 30
-   digits, environment kernel, structured chi) against the dimensionless
+   the loop of ``examples/loops/paper.toml`` (the Loop path of a user's
+   loop: plant at 30 digits, environment kernel, structured chi; the same
+   loop as ``symstab.PAPER_LOOP``, which counts the roots of eq. (5)'s
+   closed form instead) against the dimensionless
    path (``symstab.numeric.stability.unstable_root_counts``: generated
    kernel, structured chi), and against the obvious alternative, the same
    counter on the dense coefficients (O(d) per angle: O(d**2) per point,
@@ -35,6 +37,7 @@ products badly: run with ``OPENBLAS_NUM_THREADS=1`` for stable numbers.
 """
 
 import argparse
+import pathlib
 import statistics
 
 import numpy as np
@@ -58,22 +61,23 @@ def main(argv=None):
     parser.add_argument("--lines", type=int, default=40)
     args = parser.parse_args(argv)
     loop, device = symstab.PAPER_LOOP, symstab.PAPER_DEVICE
+    own = symstab.load_loop(pathlib.Path(__file__).parent.parent / "examples" / "loops" / "paper.toml")
     rng = np.random.default_rng(0)
     K, B = rng.uniform(0.0, 6.0, args.points), rng.uniform(0.0, 0.5, args.points)
     alpha, beta = device.alpha(K), device.beta(B)
     print(f"{'what':<34} {'d':>5} {'Loop':>9} {'paper':>9} {'ratio':>6} {'dense':>9} {'dense/structured':>17}")
     for d in (10, 100, 1000):
         paper = dict(alpha=alpha, beta=beta, gamma=0.0, d=d, delta=device.delta)
-        t_loop = _median(lambda: loop.unstable_root_counts(K=K, B=B, d=d), args.runs)
+        t_loop = _median(lambda: own.unstable_root_counts(K=K, B=B, d=d), args.runs)
         t_paper = _median(lambda: stability.unstable_root_counts(**paper), args.runs)
         dense = DelayedPolynomial.from_dense(stability.loop_coefficients(**paper))
         runs = args.runs if d < 1000 else 1
         t_dense = _median(lambda: roots.root_counts(dense), runs)
-        agree = np.array_equal(loop.unstable_root_counts(K=K, B=B, d=d), stability.unstable_root_counts(**paper))
+        agree = np.array_equal(own.unstable_root_counts(K=K, B=B, d=d), stability.unstable_root_counts(**paper))
         print(f"{'certified counts (' + str(args.points) + ' pts)':<34} {d:>5} {fmt(t_loop):>9} "
               f"{fmt(t_paper):>9} {t_loop / t_paper:>6.2f} {fmt(t_dense):>9} {t_dense / t_paper:>17.1f}"
               f"{'' if agree else '  COUNTS DIFFER'}")
-        t_loop = _median(lambda: loop.classify(K=K, B=B, d=d), args.runs)
+        t_loop = _median(lambda: own.classify(K=K, B=B, d=d), args.runs)
         t_paper = _median(lambda: stability.classify(**paper), args.runs)
         print(f"{'classify':<34} {d:>5} {fmt(t_loop):>9} {fmt(t_paper):>9} {t_loop / t_paper:>6.2f}")
     d = 2000

@@ -105,6 +105,15 @@ class Loop(LoopModel):
         ``values`` (NaN where the closed form does not keep its digits), or
         None for a plane it does not cover.  The line engine refines its
         crossings on it (the paper's loop: eq. (7)'s kernel).
+    polynomial : callable, optional
+        The loop's characteristic polynomial in closed form, where SymPy
+        derived one: ``polynomial(values, d)`` gives a
+        :class:`~symstab.numeric.polynomial.DelayedPolynomial` with the
+        roots of ``chi`` (any nonzero scale) at the broadcast ``values``
+        (arrays, ``d`` apart).  :meth:`classify`,
+        :meth:`unstable_root_counts` and :meth:`spectral_radius` count its
+        roots (the paper's loop: eq. (5)'s kernel, exact next to ``z = 1``
+        and from ``b T/m = 0`` to 1e6); :meth:`polynomial` stays the loop's own.
 
     Raises
     ------
@@ -125,12 +134,14 @@ class Loop(LoopModel):
     """
 
     def __init__(self, plant, environment, *, values=None, name=None, units=None,
-                 description="", plane=None, arc=None):
+                 description="", plane=None, arc=None, polynomial=None):
         super().__init__(plant, environment, values=values, name=name, units=units,
                          description=description, plane=plane)
-        if arc is not None and not callable(arc):
-            raise TypeError(f"arc must be callable, got {type(arc).__name__}")
+        for option, hook in (("arc", arc), ("polynomial", polynomial)):
+            if hook is not None and not callable(hook):
+                raise TypeError(f"{option} must be callable, got {type(hook).__name__}")
         self._arc = arc
+        self._closed_polynomial = polynomial
         if self.units:
             self._check_units()
 
@@ -139,7 +150,8 @@ class Loop(LoopModel):
         # use): a loop, and a result that refers to it, travel to a worker process.
         return (_rebuilt, (self.plant, self.environment, {
             "values": dict(self.defaults), "name": self.name, "units": dict(self.units),
-            "description": self.description, "plane": self.plane, "arc": self._arc}))
+            "description": self.description, "plane": self.plane, "arc": self._arc,
+            "polynomial": self._closed_polynomial}))
 
     def _check_units(self):
         # A unit here names the unit of values the loop computes with as they
@@ -393,6 +405,14 @@ class Loop(LoopModel):
                              f"parameter is too large or too small for double precision")
         return c
 
+    def _root_polynomial(self, values):
+        """The polynomial whose roots are counted: the closed form where the loop has one."""
+        if self._closed_polynomial is None:
+            return self.polynomial(**values)
+        values, d, shape = self._prepare(values)
+        check_memory("the loop's polynomial", 8 * int(np.prod(shape)) * 64)
+        return self._closed_polynomial({n: np.broadcast_to(v, shape) for n, v in values.items()}, d)
+
     def spectral_radius(self, **values):
         """Largest modulus of the closed-loop poles.
 
@@ -411,7 +431,7 @@ class Loop(LoopModel):
         float or ndarray
             Of the broadcast shape.
         """
-        r = spectral_radius(self.polynomial(**values))
+        r = spectral_radius(self._root_polynomial(values))
         return float(r) if r.ndim == 0 else r
 
     def classify(self, **values):
@@ -432,7 +452,7 @@ class Loop(LoopModel):
         -------
         int or ndarray of int8
         """
-        codes = classify_polynomials(self.polynomial(**values))
+        codes = classify_polynomials(self._root_polynomial(values))
         return int(codes) if codes.ndim == 0 else codes
 
     def is_stable(self, **values):
@@ -464,7 +484,7 @@ class Loop(LoopModel):
             Every parameter (:attr:`parameters`) or its default; arrays
             broadcast; ``d`` is an integer.
         """
-        counts = root_counts(self.polynomial(**values))
+        counts = root_counts(self._root_polynomial(values))
         return int(counts) if counts.ndim == 0 else counts
 
     def _basis(self, names, given, *, structured=False):

@@ -26,7 +26,8 @@ from ..symbolic import model
 from .results import PAPER_PLANE
 from .units import PAPER_DEVICE
 
-__all__ = ["PAPER_LOOP", "paper_loop", "PAPER_NAMES", "paper_point", "closed_form_arc", "paper_limits",
+__all__ = ["PAPER_LOOP", "paper_loop", "PAPER_NAMES", "paper_point", "closed_form_arc",
+           "closed_form_polynomial", "paper_limits",
            "paper_passive_region", "paper_locus"]
 
 #: Names of the environment's parameters in the loop: ``K_w, B_w, M_w`` of
@@ -81,6 +82,38 @@ def closed_form_arc(x, y, values):
     return arc
 
 
+def closed_form_polynomial(values, d):
+    """Eq. (5)'s chi in Table I's variables: the roots of the paper's loop at ``values``.
+
+    :func:`~symstab.numeric.stability.paper_polynomial` at ``alpha = K T**2/m``,
+    ``beta = B T/m``, ``gamma = M/m``, ``delta = b T/m`` (0 for the
+    frictionless loop): the generated kernel, divided by ``delta**2
+    exp(delta)``, exact next to ``z = 1`` and finite up to ``delta = 1e6``,
+    which the loop's own coefficients are not (``exp(-b T/m)`` underflows).
+    A value out of Table I's ranges is a ValueError in Table I's names.
+
+    Parameters
+    ----------
+    values : dict of ndarray
+        ``K, B, M, m, T`` and (but for the frictionless loop) ``b``, of one shape.
+    d : int
+        The delay in samples.
+    """
+    from .stability import paper_polynomial
+
+    m, T = values["m"], values["T"]
+    with np.errstate(over="ignore", under="ignore"):
+        table_one = dict(alpha=values["K"] * (T**2 / m), beta=values["B"] * (T / m),
+                         gamma=values["M"] / m, delta=values.get("b", np.zeros_like(m)) * (T / m))
+    try:
+        return paper_polynomial(**table_one, d=d)
+    except ValueError as exc:
+        if np.all(m == 1.0) and np.all(T == 1.0):
+            raise       # paper_point: the values are Table I's variables themselves
+        raise ValueError(f"{exc} (the paper's loop in Table I's variables: alpha = K T^2/m, "
+                         f"beta = B T/m, gamma = M/m, delta = b T/m)") from None
+
+
 @functools.lru_cache(maxsize=1)
 def paper_loop():
     """The paper's loop as a :class:`~symstab.Loop` (built once, then shared).
@@ -110,7 +143,7 @@ def paper_loop():
                 "K": 2.0, "B": 0.1, "M": 0.0},
         units={"m": "kg m^2", "b": "N m s/rad", "T": "s",
                "K": units["K_w"], "B": units["B_w"], "M": units["M_w"]},
-        arc=closed_form_arc)
+        arc=closed_form_arc, polynomial=closed_form_polynomial)
 
 
 @functools.lru_cache(maxsize=1)
@@ -126,7 +159,7 @@ def frictionless_paper_loop():
     environment = _environment()
     return Loop(model.plant().subs(model.b, 0), environment, name="paper-frictionless",
                 plane=("B", "K"), values={"m": 1.0, "T": 1.0, "d": 0, "K": 0.0, "B": 0.0, "M": 0.0},
-                arc=closed_form_arc)
+                arc=closed_form_arc, polynomial=closed_form_polynomial)
 
 
 def paper_point(*, gamma, d, delta):

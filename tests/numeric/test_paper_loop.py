@@ -112,3 +112,21 @@ def test_the_pole_next_to_z_1_keeps_its_digits_in_powers_of_z_minus_1(delta):
     near_one = loop._plant_cache(tuple(names[n] for n in loop._plant_names), 1.0)[3]
     assert near_one[0] == 1.0
     assert near_one[1] == pytest.approx(float(-mpmath.expm1(-mpmath.mpf(delta))), rel=1e-15, abs=0)
+
+
+def test_counts_are_eq_5s_closed_form_and_refuse_out_of_range_values_in_table_one_names():
+    # PAPER_LOOP counts the roots of eq. (5)'s kernel (Loop(polynomial=...)):
+    # a value beyond Table I's ranges is refused naming both systems.
+    with pytest.raises(ValueError, match=r"alpha must be .*alpha = K T\^2/m"):
+        symstab.PAPER_LOOP.classify(K=1e300, B=0.1, d=0)
+    with pytest.raises(TypeError, match="polynomial must be callable"):
+        symstab.Loop("1/(m*s**2 + b*s)", "K", polynomial=3.0)
+
+
+def test_a_pickled_paper_loop_keeps_its_closed_form():
+    import pickle
+
+    again = pickle.loads(pickle.dumps(symstab.PAPER_LOOP))
+    with pytest.raises(ValueError, match=r"alpha = K T\^2/m"):
+        again.classify(K=1e300, B=0.1, d=0)
+    assert int(again.unstable_root_counts(K=6.0, B=0.01, d=40)) == _control_count(6.0, 0.01, 0.0, 40)
