@@ -34,7 +34,7 @@ from .._resources import check_memory
 __all__ = ["DEVICE_OPTIONS", "POINT_OPTIONS", "EXAMPLE", "LINEAR_WITH_LOOP", "add_loop_options",
            "uses_loop", "split_unit", "parse_number", "convert_sets", "LoopSetup", "value_text",
            "loop_echo", "load_loop_file", "add_delay", "check_names", "loop_values", "resolve_loop",
-           "point_count", "broadcast"]
+           "resolve_setup", "TABLE_ONE", "point_count", "broadcast"]
 
 
 #: The paper's device options every numeric command has, with the ``--set``
@@ -93,6 +93,9 @@ _FLAGS = {"set_values": "--set", "x": "--x", "y": "--y", "at": "--at",
 
 
 EXAMPLE = "examples/loops/paper.toml"
+
+#: The paper's loop's parameters in Table I's variables (with m = T = 1).
+TABLE_ONE = {"K": "alpha", "B": "beta", "M": "gamma", "b": "delta"}
 
 
 #: What each command gives for a loop file, for its --help.
@@ -329,16 +332,24 @@ class LoopSetup:
     #: What the file or a --set wrote where it differs from the SI value used:
     #: {name: (value as written, unit as written, SI unit)}.
     written: dict = dataclasses.field(default_factory=dict)
+    #: The paper's device options (a :class:`symstab.cli.options.Setup`) where
+    #: they gave the loop: ``loop`` is then the paper's loop in Table I's
+    #: variables (:func:`symstab.numeric.paper_loop.paper_point`).
+    paper: object = None
 
     def unit(self, name):
-        return self.loop.units.get(name, "")
+        return "" if self.paper is not None else self.loop.units.get(name, "")
 
     def label(self, name):
-        """``"K [N/m]"``, or the bare name when the file gives no unit."""
+        """``"K [N/m]"``, or the bare name when the file gives no unit (Table I's for the paper)."""
+        if self.paper is not None:
+            return TABLE_ONE.get(name, name)
         unit = self.unit(name)
         return f"{name} [{unit}]" if unit else name
 
     def as_dict(self):
+        if self.paper is not None:
+            return self.paper.as_dict()
         loop = self.loop
         out = {"loop": self.path, "name": loop.name, "plant": str(loop.plant),
                "environment": str(loop.environment), "zoh": loop.zoh_method,
@@ -499,6 +510,26 @@ def resolve_loop(args, *, plane=True, lists=False):
     loop.coefficients(**point)
     setup = LoopSetup(str(args.loop), loop, values, tuple(sets), x, y, written=written)
     return dataclasses.replace(setup, echo=loop_echo(setup))
+
+
+def resolve_setup(args, *, plane=True, lists=False):
+    """The :class:`LoopSetup` of a command: the loop file of ``--loop``, else the paper's options.
+
+    The paper's device options (:func:`symstab.cli.options.resolve`) are
+    shorthand for the paper's loop: :func:`~symstab.numeric.paper_loop.paper_point`
+    at their ``gamma, d, delta``, whose plane ``(B, K)`` is Table I's
+    ``(beta, alpha)``, with :attr:`LoopSetup.paper` the device for the
+    physical columns and the echo.
+    """
+    if uses_loop(args):
+        return resolve_loop(args, plane=plane, lists=lists)
+    from ..numeric.paper_loop import paper_point
+    from .options import resolve
+
+    paper = resolve(args)
+    loop, values = paper_point(gamma=paper.gamma, d=paper.d, delta=paper.delta)
+    x, y = ("B", "K") if plane else (None, None)
+    return LoopSetup("", loop, values, (), x, y, echo=paper.echo, paper=paper)
 
 
 def point_count(values):

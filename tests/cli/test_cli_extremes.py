@@ -10,6 +10,7 @@ shows (warnings on stderr, signals, memory of a long delay) runs in a
 subprocess.
 """
 
+import json
 import os
 import pathlib
 import resource
@@ -324,12 +325,12 @@ def test_a_signal_stops_a_long_map_with_one_line_and_no_file(tmp_path, signum, s
 
 def test_interrupted_in_process_returns_130(capsys, monkeypatch):
     """Ctrl-C inside a command: one line and 130 from main(), not a KeyboardInterrupt."""
-    from symstab.numeric import stability
+    from symstab import Loop
 
-    def interrupted(**kwargs):
+    def interrupted(self, **kwargs):
         raise KeyboardInterrupt
 
-    monkeypatch.setattr(stability, "classify", interrupted)
+    monkeypatch.setattr(Loop, "classify", interrupted)
     status, out, err = _main(capsys, "classify", *DIMENSIONLESS)
     assert status == 130
     assert err.strip() == "symstab classify: interrupted"
@@ -357,9 +358,14 @@ def test_huge_stiffness_is_one_line_not_an_assertion(capsys):
     _assert_one_line_error(status, err, "classify", "alpha", "1e+150")
 
 
-def test_classify_at_d_5000_gives_verdicts_without_the_cubic_radius(capsys):
+def test_classify_at_d_5000_gives_the_verdicts_and_the_radius(capsys):
+    # The radius was left out above d = 1000 (eigenvalues of a 5004-square
+    # matrix a point); the structured radius costs O(d) a step.  Its side of
+    # 1 is the certified verdict's.
     status, out, err = _main(capsys, "classify", "--d", "5000", "--delta", "0.0025",
-                             "--alpha", "1e-7,1e-5", "--beta", "1e-5")
+                             "--alpha", "1e-7,1e-5", "--beta", "1e-5", "--format", "json")
     assert status == 0, err
-    assert "stable" in out and "unstable" in out
-    assert "spectral radius not computed for d > 1000" in out
+    rows = json.loads(out)["rows"]
+    assert [r["verdict"] for r in rows] == ["stable", "unstable"]
+    assert rows[0]["spectral radius"] < 1 < rows[1]["spectral radius"]
+    assert rows[1]["unstable poles"] >= 1
