@@ -12,9 +12,9 @@ import sys
 import textwrap
 
 from .loop_limits import limits_notes, limits_result, limits_rows, stable_intervals_at
-from .loop_options import add_loop_options, resolve_loop, uses_loop
-from .options import add_command, add_model_options, resolve
-from .output import emit, interval_texts, number_text
+from .loop_options import add_loop_options, resolve_loop, resolve_setup, uses_loop
+from .options import add_command, add_model_options
+from .output import emit, number_text
 
 __all__ = ["register", "run"]
 
@@ -125,7 +125,8 @@ def _paper(args):
     """The paper's limits, the stable intervals at --beta/--Bw, the passive set."""
     from ..numeric.region import limits
 
-    setup = resolve(args)
+    loop_setup = resolve_setup(args)
+    setup = loop_setup.paper
     lim = limits(gamma=setup.gamma, d=setup.d, delta=setup.delta)
     columns, rows = _limits_rows(setup, lim)
     notes = [lim.message] if lim.message else []
@@ -134,7 +135,6 @@ def _paper(args):
                      f"the paper's beta_min = -delta = {-setup.delta:.10g} is where the boundary "
                      "arc starts (theta = 0)")
     result = {"limits": _limits_json(lim)}
-    damping = None
     if args.beta is not None or args.Bw is not None:
         if args.Bw is not None:
             if not setup.physical:
@@ -142,32 +142,9 @@ def _paper(args):
             damping = float(setup.device.beta(args.Bw))
         else:
             damping = args.beta
-        from .._validate import check_real
-        damping = check_real("beta", damping)
-        runs = [] if lim.empty else lim.alpha_interval(damping)
-        from ..numeric.stability import classify
-
-        codes = [tuple(int(classify(alpha=end, beta=damping, gamma=setup.gamma, d=setup.d,
-                                    delta=setup.delta)) if math.isfinite(end) else None
-                       for end in run) for run in runs]
-        text, ends, kinds = interval_texts(runs, codes, "alpha")
-        notes.append(f"stable alpha at beta = {damping:.10g}: {text}")
-        if setup.physical and runs:
-            dev = setup.device
-
-            def stiffness(alpha):
-                return alpha if math.isinf(alpha) else float(dev.stiffness(alpha))
-
-            physical = [tuple(stiffness(end) for end in run) for run in runs]
-            text, ends, _ = interval_texts(physical, codes, "K_w", setup.units["K_w"])
-            notes.append(f"stable K_w at B_w = {float(dev.damping(damping)):.10g} "
-                         f"{setup.units['B_w']}: {text}")
-        if ends:
-            notes.append(ends)
-        if runs and runs[0][0] > 0:
-            notes.append(f"a minimum stiffness is needed: alpha > {runs[0][0]:.10g}")
-        result["alpha_intervals"] = {"beta": damping, "intervals": [list(r) for r in runs],
-                                     "ends": kinds}
+        more, at = stable_intervals_at(loop_setup, damping)
+        notes += more
+        result["alpha_intervals"] = {"beta": at["x"], "intervals": at["intervals"], "ends": at["ends"]}
     more, result["passive"] = _passive(setup, lim)
     notes += more
     emit(setup, args.format, columns, rows, result=result, notes=notes, json_rows=False)

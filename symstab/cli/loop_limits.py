@@ -13,23 +13,35 @@ __all__ = ["stable_intervals_at", "limits_rows", "limits_notes", "limits_result"
 
 
 def stable_intervals_at(setup, at):
-    """The stable intervals of y at x = ``at``: (notes, json)."""
+    """The stable intervals of y at x = ``at``, their ends classified: (notes, json).
+
+    For the paper's device options (``setup.paper``) in Table I's names,
+    and in the device's units too where it is physical.
+    """
     from .._validate import check_real
 
-    at = check_real(f"--at ({setup.x})", at)
+    x, y = setup.name(setup.x), setup.name(setup.y)
+    at = check_real(f"--at ({x})" if setup.paper is None else x, at)
     runs = setup.loop.stable_intervals(setup.y, **{setup.x: at}, **setup.values)
     unit_x = f" {setup.unit(setup.x)}" if setup.unit(setup.x) else ""
     unit_y = f" {setup.unit(setup.y)}" if setup.unit(setup.y) else ""
     codes = [tuple(setup.loop.classify(**{setup.x: at, setup.y: end}, **setup.values)
                    if math.isfinite(end) else None for end in run) for run in runs]
-    text, ends, kinds = interval_texts(runs, codes, setup.y, setup.unit(setup.y))
-    notes = [f"stable {setup.y} at {setup.x} = {at:.10g}{unit_x}: {text}"]
+    text, ends, kinds = interval_texts(runs, codes, y, setup.unit(setup.y))
+    notes = [f"stable {y} at {x} = {at:.10g}{unit_x}: {text}"]
+    if setup.paper is not None and setup.paper.physical and runs:
+        device, units = setup.paper.device, setup.paper.units
+        physical = [tuple(end if math.isinf(end) else float(device.stiffness(end)) for end in run)
+                    for run in runs]
+        # The ends' note in the units the device was given in.
+        text, ends, _ = interval_texts(physical, codes, "K_w", units["K_w"])
+        notes.append(f"stable K_w at B_w = {float(device.damping(at)):.10g} {units['B_w']}: {text}")
     if ends:
         notes.append(ends)
     # The z = 1 line of a loop with an integrator lies at y = 0 up to rounding
     # (1e-12 of the interval): no minimum worth naming.
     if runs and runs[0][0] > 1e-9 * (runs[0][1] - runs[0][0]):
-        notes.append(f"a minimum is needed: {setup.y} > {runs[0][0]:.10g}{unit_y}")
+        notes.append(f"a minimum is needed: {y} > {runs[0][0]:.10g}{unit_y}")
     return notes, {"x": at, "intervals": [list(r) for r in runs], "ends": kinds}
 
 

@@ -340,6 +340,10 @@ class LoopSetup:
     def unit(self, name):
         return "" if self.paper is not None else self.loop.units.get(name, "")
 
+    def name(self, name):
+        """A parameter's name as printed: Table I's for the paper's device options."""
+        return TABLE_ONE.get(name, name) if self.paper is not None else name
+
     def label(self, name):
         """``"K [N/m]"``, or the bare name when the file gives no unit (Table I's for the paper)."""
         if self.paper is not None:
