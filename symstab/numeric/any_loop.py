@@ -109,8 +109,8 @@ class Loop(LoopModel):
         The loop's characteristic polynomial in closed form, where SymPy
         derived one: ``polynomial(values, d)`` gives a
         :class:`~symstab.numeric.polynomial.DelayedPolynomial` with the
-        roots of ``chi`` (any nonzero scale) at the broadcast ``values``
-        (arrays, ``d`` apart).  :meth:`classify`,
+        roots of ``chi`` (any nonzero scale) at ``values`` (arrays that
+        broadcast together, ``d`` apart), of their broadcast shape.  :meth:`classify`,
         :meth:`unstable_root_counts` and :meth:`spectral_radius` count its
         roots (the paper's loop: eq. (5)'s kernel, exact next to ``z = 1``
         and from ``b T/m = 0`` to 1e6); :meth:`polynomial` stays the loop's own.
@@ -411,7 +411,8 @@ class Loop(LoopModel):
             return self.polynomial(**values)
         values, d, shape = self._prepare(values)
         check_memory("the loop's polynomial", 8 * int(np.prod(shape)) * 64)
-        return self._closed_polynomial({n: np.broadcast_to(v, shape) for n, v in values.items()}, d)
+        # As given (a single value stays one): the closed form broadcasts.
+        return self._closed_polynomial(values, d)
 
     def spectral_radius(self, **values):
         """Largest modulus of the closed-loop poles.
@@ -487,12 +488,28 @@ class Loop(LoopModel):
         counts = root_counts(self._root_polynomial(values))
         return int(counts) if counts.ndim == 0 else counts
 
-    def _basis(self, names, given, *, structured=False):
-        """(A0, A_x[, A_y]) coefficient rows with the named parameters set to 0.
+    def affine_parts(self, names, given, *, structured=False):
+        """``chi = A0 + x A_x (+ y A_y)`` in the affine parameters ``names``: the parts and their ends.
 
-        With ``structured``, A0 and the slopes are
-        :class:`~symstab.numeric.polynomial.DelayedPolynomial` (one
-        polynomial each, a common shift) instead of dense rows.
+        What the line engine, the D-decomposition and the arc sources work
+        on: the characteristic polynomial with the named parameters set to
+        0, its slope in each, and their values at ``z = 1`` and ``z = -1``
+        from the plant's 30-digit end values.
+
+        Parameters
+        ----------
+        names : tuple of str
+            One or two parameters in which ``chi`` is jointly affine.
+        given : dict
+            Single values of the other parameters (defaults for the rest).
+        structured : bool
+            :class:`~symstab.numeric.polynomial.DelayedPolynomial` parts
+            (one polynomial each, a common shift) instead of dense rows.
+
+        Returns
+        -------
+        (A0, [A_x, A_y], [ends of A0, of A_x, of A_y])
+            Each end an array ``(chi(1), chi(-1))``.
         """
         self._check_plane(names)
         values, d, shape = self._prepare(given, scalar=self.parameters, drop=names)
@@ -573,7 +590,7 @@ class Loop(LoopModel):
             at = at.reshape(-1)
             values = {k: v for k, v in values.items() if k != across}
         names = (name,) if across is None else (name, across)
-        base, slopes, ends = self._basis(names, values, structured=True)
+        base, slopes, ends = self.affine_parts(names, values, structured=True)
         runs = family_intervals(base, slopes[1] if across else None, slopes[0], at,
                                 (tuple(ends[0]), tuple(ends[2]) if across else None,
                                  tuple(ends[1])),
@@ -625,7 +642,7 @@ class Loop(LoopModel):
         x, y = self._plane(x, y)
         n = check_count("n", n, 2)
         check_memory("the boundary", 64 * n)
-        structured, slopes, ends = self._basis((x, y), values, structured=True)
+        structured, slopes, ends = self.affine_parts((x, y), values, structured=True)
         base, ax, ay = (p.dense().reshape(-1) for p in (structured, *slopes))
         theta = np.pi * (np.arange(1, n + 1) - 0.5) / n
         xs, ys, _ = CramerArc(structured, *slopes)(theta)
@@ -678,7 +695,7 @@ class Loop(LoopModel):
         x, y = self._plane(x, y)
         given = {key: None if window is None else check_window(key, window)
                  for key, window in (("x_range", x_range), ("y_range", y_range))}
-        structured, slopes, ends = self._basis((x, y), values, structured=True)
+        structured, slopes, ends = self.affine_parts((x, y), values, structured=True)
         base, ax, ay = (p.dense().reshape(-1) for p in (structured, *slopes))
         arc = CramerArc(structured, *slopes)
         free = {"x_min": given["x_range"] is None, "x_max": given["x_range"] is None,

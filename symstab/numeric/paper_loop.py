@@ -95,7 +95,8 @@ def closed_form_polynomial(values, d):
     Parameters
     ----------
     values : dict of ndarray
-        ``K, B, M, m, T`` and (but for the frictionless loop) ``b``, of one shape.
+        ``K, B, M, m, T`` and (but for the frictionless loop) ``b``, arrays
+        that broadcast together.
     d : int
         The delay in samples.
     """
@@ -104,7 +105,7 @@ def closed_form_polynomial(values, d):
     m, T = values["m"], values["T"]
     with np.errstate(over="ignore", under="ignore"):
         table_one = dict(alpha=values["K"] * (T**2 / m), beta=values["B"] * (T / m),
-                         gamma=values["M"] / m, delta=values.get("b", np.zeros_like(m)) * (T / m))
+                         gamma=values["M"] / m, delta=values.get("b", 0.0) * (T / m))
     try:
         return paper_polynomial(**table_one, d=d)
     except ValueError as exc:

@@ -204,7 +204,7 @@ class StabilityRegion:
         everywhere, the arc's corners are where a pair joins it.
         """
         loop, point = paper_point(gamma=self.gamma, d=self.d, delta=self.delta)
-        base, (d_beta, d_alpha), ends = loop._basis(("B", "K"), point, structured=True)
+        base, (d_beta, d_alpha), ends = loop.affine_parts(("B", "K"), point, structured=True)
         k = 0.0 if c == 0 else 2.0
         line = base.combine([c], [d_alpha]).flat()
         slope = d_beta.combine([-k], [d_alpha]).flat()

@@ -71,7 +71,7 @@ def paper_basis(gamma, d, delta):
 
 def loop_basis(path):
     loop = symstab.load_loop(path)
-    base, (ax, ay), _ = loop._basis(loop.plane, {}, structured=True)
+    base, (ax, ay), _ = loop.affine_parts(loop.plane, {}, structured=True)
     return base, ax, ay
 
 

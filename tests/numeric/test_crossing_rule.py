@@ -79,7 +79,7 @@ def test_region_rule_is_the_old_one(gamma, d, delta, axis):
     loop, point = paper_point(gamma=gamma, d=d, delta=delta)
     values = np.linspace(-0.2, 0.8, 23) if axis == "beta" else np.linspace(-0.5, 3.0, 23)
     free, across = ("K", "B") if axis == "beta" else ("B", "K")
-    base, (slope, sideways), ends = loop._basis((free, across), point, structured=True)
+    base, (slope, sideways), ends = loop.affine_parts((free, across), point, structured=True)
     base, sideways, slope = polynomials = tuple(x.flat() for x in (base, sideways, slope))
     line, p, theta = intervals._crossings(polynomials, values, (ends[0], ends[2], ends[1]),
                                           polynomials)
@@ -96,7 +96,7 @@ def test_loop_rule_is_the_old_one(path):
     loop = symstab.load_loop(path)
     decided = 0
     for name in loop.plane:
-        base, (slope,), (base_ends, slope_ends) = loop._basis((name,), {})
+        base, (slope,), (base_ends, slope_ends) = loop.affine_parts((name,), {})
         zero = np.zeros_like(base)
         polynomials = tuple(DelayedPolynomial.from_dense(r[None, :]) for r in (base, zero, slope))
         _, p, theta = intervals._crossings(polynomials, np.zeros(1),

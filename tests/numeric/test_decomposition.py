@@ -279,5 +279,5 @@ def test_a_window_with_too_many_crossings_is_refused_quickly():
 def _paper_basis(gamma, d):
     """The (B, K) basis of the paper's loop file (as Loop.region builds it)."""
     loop = load_loop(os.path.join(ROOT, "examples", "loops", "paper.toml"))
-    base, (ax, ay), ends = loop._basis(("B", "K"), {"d": d, "M": gamma * M})
+    base, (ax, ay), ends = loop.affine_parts(("B", "K"), {"d": d, "M": gamma * M})
     return base, ax, ay, ends
