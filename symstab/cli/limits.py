@@ -12,7 +12,7 @@ import sys
 import textwrap
 
 from .loop_limits import limits_notes, limits_result, limits_rows, stable_intervals_at
-from .loop_options import add_loop_options, resolve_loop, resolve_setup, uses_loop
+from .loop_options import add_loop_options, resolve_setup
 from .options import add_command, add_model_options
 from .output import emit, number_text
 
@@ -39,8 +39,64 @@ def register(subparsers):
 
 
 def run(args):
-    """Run ``symstab limits`` (on the loop file of ``--loop``, else the paper's loop)."""
-    return _loop(args) if uses_loop(args) else _paper(args)
+    """Run ``symstab limits``: a loop file's plane (``--loop``), else the paper's; one flow.
+
+    The paper's device options are the paper's loop in Table I's variables
+    (:func:`symstab.cli.loop_options.resolve_setup`); its table keeps Table
+    I's names (alpha_max, ..., z_width) with the device's units beside them.
+    """
+    from ..numeric.region import limits
+
+    setup = resolve_setup(args)
+    at = _line(args, setup)         # checked before the work
+    if setup.paper is None:
+        # Seconds at long delays (the plane's D-decomposition, and the passive set): say what runs.
+        print(f"scanning the ({setup.x}, {setup.y}) plane for the extent of the stable set ...",
+              file=sys.stderr, flush=True)
+        lim = setup.loop.limits(x=setup.x, y=setup.y, **setup.values)
+        columns, rows = ["quantity", "value", "unit", "meaning"], limits_rows(setup, lim)
+        notes, result = limits_notes(setup, lim), limits_result(lim)
+    else:
+        paper = setup.paper
+        lim = limits(gamma=paper.gamma, d=paper.d, delta=paper.delta)
+        columns, rows = _limits_rows(paper, lim)
+        notes, result = _paper_notes(paper, lim), {"limits": _limits_json(lim)}
+    if at is not None:
+        more, line = stable_intervals_at(setup, at)
+        notes += more
+        if setup.paper is None:
+            result["at"] = line
+        else:
+            result["alpha_intervals"] = {"beta": line["x"], "intervals": line["intervals"],
+                                         "ends": line["ends"]}
+    more, result["passive"] = (_loop_passive(setup, lim) if setup.paper is None
+                               else _passive(setup.paper, lim))
+    notes += more
+    emit(setup, args.format, columns, rows, result=result, notes=notes, json_rows=False)
+    return 0
+
+
+def _line(args, setup):
+    """The x of the stable intervals asked for (--at X, or the paper's --beta/--Bw), or None."""
+    from .._validate import check_real
+
+    if setup.paper is None:
+        return None if args.at is None else check_real(f"--at ({setup.x})", args.at)
+    if args.Bw is not None:
+        if not setup.paper.physical:
+            raise ValueError("--Bw needs a physical device; use --beta with --delta")
+        return check_real("beta", float(setup.paper.device.beta(args.Bw)))
+    return None if args.beta is None else check_real("beta", args.beta)
+
+
+def _paper_notes(setup, lim):
+    """Why the paper's region is empty, or that its leftmost beta is not the paper's beta_min."""
+    notes = [lim.message] if lim.message else []
+    if not lim.empty and not math.isclose(lim.beta_left, -setup.delta, rel_tol=1e-9, abs_tol=1e-12):
+        notes.append(f"beta_left = {lim.beta_left:.10g} is the leftmost beta of the stable region; "
+                     f"the paper's beta_min = -delta = {-setup.delta:.10g} is where the boundary "
+                     "arc starts (theta = 0)")
+    return notes
 
 
 #: The quantities of ``symstab limits``: (name in the table and the JSON, attribute of
@@ -121,36 +177,6 @@ def _passive(setup, lim):
     return notes, out
 
 
-def _paper(args):
-    """The paper's limits, the stable intervals at --beta/--Bw, the passive set."""
-    from ..numeric.region import limits
-
-    loop_setup = resolve_setup(args)
-    setup = loop_setup.paper
-    lim = limits(gamma=setup.gamma, d=setup.d, delta=setup.delta)
-    columns, rows = _limits_rows(setup, lim)
-    notes = [lim.message] if lim.message else []
-    if not lim.empty and not math.isclose(lim.beta_left, -setup.delta, rel_tol=1e-9, abs_tol=1e-12):
-        notes.append(f"beta_left = {lim.beta_left:.10g} is the leftmost beta of the stable region; "
-                     f"the paper's beta_min = -delta = {-setup.delta:.10g} is where the boundary "
-                     "arc starts (theta = 0)")
-    result = {"limits": _limits_json(lim)}
-    if args.beta is not None or args.Bw is not None:
-        if args.Bw is not None:
-            if not setup.physical:
-                raise ValueError("--Bw needs a physical device; use --beta with --delta")
-            damping = float(setup.device.beta(args.Bw))
-        else:
-            damping = args.beta
-        more, at = stable_intervals_at(loop_setup, damping)
-        notes += more
-        result["alpha_intervals"] = {"beta": at["x"], "intervals": at["intervals"], "ends": at["ends"]}
-    more, result["passive"] = _passive(setup, lim)
-    notes += more
-    emit(setup, args.format, columns, rows, result=result, notes=notes, json_rows=False)
-    return 0
-
-
 def _loop_passive(setup, lim):
     """The passive set beside the stable one: (notes, json), one line per fact.
 
@@ -186,26 +212,3 @@ def _loop_passive(setup, lim):
                      f"[{region.x_range[0]:.6g}, {region.x_range[1]:.6g}], {y} in "
                      f"[{region.y_range[0]:.6g}, {region.y_range[1]:.6g}] is {region.area:.10g}")
     return notes, out
-
-
-def _loop(args):
-    """A loop file's limits in its plane, the intervals at --at, the passive set."""
-    setup = resolve_loop(args)
-    if args.at is not None:
-        from .._validate import check_real
-        check_real(f"--at ({setup.x})", args.at)
-    # Seconds at long delays (the plane's D-decomposition, and the passive set): say what runs.
-    print(f"scanning the ({setup.x}, {setup.y}) plane for the extent of the stable set ...",
-          file=sys.stderr, flush=True)
-    lim = setup.loop.limits(x=setup.x, y=setup.y, **setup.values)
-    rows = limits_rows(setup, lim)
-    notes = limits_notes(setup, lim)
-    result = limits_result(lim)
-    if args.at is not None:
-        more, result["at"] = stable_intervals_at(setup, args.at)
-        notes += more
-    more, result["passive"] = _loop_passive(setup, lim)
-    notes += more
-    emit(setup, args.format, ["quantity", "value", "unit", "meaning"], rows, result=result,
-         notes=notes, json_rows=False)
-    return 0
