@@ -11,8 +11,8 @@ import dataclasses
 import math
 
 from .._resources import check_memory
-from .loop_options import add_loop_options, resolve_loop, uses_loop
-from .options import add_command, add_model_options, resolve
+from .loop_options import add_loop_options, resolve_setup
+from .options import add_command, add_model_options
 from .output import BYTES_PER_ROW, emit
 from .units import physical_columns
 
@@ -33,49 +33,44 @@ def register(subparsers):
 
 
 def run(args):
-    """Run ``symstab boundary`` (on the loop file of ``--loop``, else the paper's loop)."""
-    return _loop(args) if uses_loop(args) else _paper(args)
+    """Run ``symstab boundary``: a loop file's D-decomposition (``--loop``), else the paper's arc.
 
-
-def _paper(args):
-    """The paper's boundary arc and its closing segments."""
+    The paper's device options are the paper's loop in Table I's variables
+    (:func:`symstab.cli.loop_options.resolve_setup`); for them the rows are
+    eq. (7)'s arc up to theta_max and the segments that close the stable
+    region, for a loop file the whole arc and the z = +-1 lines.
+    """
+    from .._validate import check_count
     from ..numeric.region import boundary_curve
 
-    setup = resolve(args)
-    check_memory(f"--n {args.n} boundary points", args.n * BYTES_PER_ROW)
-    curve = boundary_curve(gamma=setup.gamma, d=setup.d, delta=setup.delta, n=args.n)
-    columns = ["theta [rad]", "alpha", "beta"]
-    rows = list(zip(curve.theta, curve.alpha, curve.beta))
-    if setup.physical:
-        columns += physical_columns(setup, ["K_w", "B_w"])
-        rows = [r + (setup.device.stiffness(r[1]), setup.device.damping(r[2])) for r in rows]
-    notes = [curve.message] if curve.empty else [f"theta_max = {curve.theta_max:.15g} rad"]
-    for seg in curve.segments:
-        notes.append(f"boundary segment ({seg.root}): (beta, alpha) from ({seg.beta0:.10g}, "
-                     f"{seg.alpha0:.10g}) to ({seg.beta1:.10g}, {seg.alpha1:.10g})")
-    result = {"theta_max": curve.theta_max, "message": curve.message,
-              "segments": [dataclasses.asdict(s) for s in curve.segments]}
-    emit(setup, args.format, columns, rows, result=result, notes=notes)
-    return 0
-
-
-def _loop(args):
-    """A loop file's D-decomposition in its plane: the arc and the lines."""
-    from .._validate import check_count
-
-    setup = resolve_loop(args)
+    setup = resolve_setup(args)
     n = check_count("n", args.n, 2)
     check_memory(f"--n {n} boundary points", n * BYTES_PER_ROW)
-    curve = setup.loop.boundary(x=setup.x, y=setup.y, n=n, **setup.values)
-    columns = ["theta [rad]", setup.label(setup.x), setup.label(setup.y)]
-    rows = list(zip(curve.theta, curve.x_values, curve.y_values))
-    notes = [f"D-decomposition: z = exp(j theta) is a closed-loop pole at ({setup.x}, {setup.y}) "
-             "(nan: the 2 x 2 system is singular at that theta)"]
-    notes += [_line_text(setup, label, line) for label, line in curve.lines.items()]
-    if not curve.lines:
-        notes.append("no real-root or leading-coefficient line crosses this plane")
-    result = {"lines": {label: dict(zip(("c0", "cx", "cy"), line))
-                        for label, line in curve.lines.items()}}
+    paper = setup.paper
+    if paper is None:
+        curve = setup.loop.boundary(x=setup.x, y=setup.y, n=n, **setup.values)
+        columns = ["theta [rad]", setup.label(setup.x), setup.label(setup.y)]
+        rows = list(zip(curve.theta, curve.x_values, curve.y_values))
+        notes = [f"D-decomposition: z = exp(j theta) is a closed-loop pole at ({setup.x}, "
+                 f"{setup.y}) (nan: the 2 x 2 system is singular at that theta)"]
+        notes += [_line_text(setup, label, line) for label, line in curve.lines.items()]
+        if not curve.lines:
+            notes.append("no real-root or leading-coefficient line crosses this plane")
+        result = {"lines": {label: dict(zip(("c0", "cx", "cy"), line))
+                            for label, line in curve.lines.items()}}
+    else:
+        curve = boundary_curve(gamma=paper.gamma, d=paper.d, delta=paper.delta, n=n)
+        columns = ["theta [rad]", "alpha", "beta"]
+        rows = list(zip(curve.theta, curve.alpha, curve.beta))
+        if paper.physical:
+            columns += physical_columns(paper, ["K_w", "B_w"])
+            rows = [r + (paper.device.stiffness(r[1]), paper.device.damping(r[2])) for r in rows]
+        notes = [curve.message] if curve.empty else [f"theta_max = {curve.theta_max:.15g} rad"]
+        notes += [f"boundary segment ({seg.root}): (beta, alpha) from ({seg.beta0:.10g}, "
+                  f"{seg.alpha0:.10g}) to ({seg.beta1:.10g}, {seg.alpha1:.10g})"
+                  for seg in curve.segments]
+        result = {"theta_max": curve.theta_max, "message": curve.message,
+                  "segments": [dataclasses.asdict(s) for s in curve.segments]}
     emit(setup, args.format, columns, rows, result=result, notes=notes)
     return 0
 
