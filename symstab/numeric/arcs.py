@@ -260,7 +260,10 @@ def _multiple(m, theta):
     cosine = cos_m - err * sin_m
     denominator = np.sin(hi) + lo * np.cos(hi)
     odd = np.mod(m, 2.0) == 1
-    return (np.where(mirror & ~odd, -1.0, 1.0) * numerator / denominator,
+    # At theta = 0 exactly (pi is mirrored onto lo != 0) the ratio is its limit m.
+    with np.errstate(invalid="ignore", divide="ignore"):
+        ratio = np.where(denominator == 0, m, numerator / denominator)
+    return (np.where(mirror & ~odd, -1.0, 1.0) * ratio,
             np.where(mirror & odd, -1.0, 1.0) * cosine)
 
 
@@ -278,7 +281,7 @@ def sine_ratio(m, theta):
     m : array_like
         Positive integers (as floats or ints), below ``2**26``.
     theta : array_like
-        Angles in (0, pi); broadcast against ``m``.
+        Angles in [0, pi]; broadcast against ``m``.
 
     Returns
     -------
@@ -290,6 +293,8 @@ def sine_ratio(m, theta):
     3.0
     >>> float(sine_ratio(2, np.pi - 1e-9))
     -2.0
+    >>> float(sine_ratio(5, 0.0))                # the limit
+    5.0
     """
     return _multiple(m, theta)[0]
 

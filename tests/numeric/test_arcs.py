@@ -111,6 +111,14 @@ def test_sine_ratio_against_mpmath():
                 assert abs(g - w) <= 4e-16 * (1 + abs(int(m[-1]) * tt)) * max(1, abs(w)), (t, g, w)
 
 
+def test_sine_ratio_at_the_ends_is_its_limit():
+    # sin(m theta)/sin(theta) -> m at 0 and (-1)**(m + 1) m at pi (U_{m-1}(+-1));
+    # at theta = 0 the quotient was 0/0 = NaN with a RuntimeWarning.
+    m = np.array([1, 2, 3, 40, 41])
+    assert sine_ratio(m, 0.0).tolist() == [1, 2, 3, 40, 41]
+    assert sine_ratio(m, np.pi).tolist() == [1, -2, 3, -40, 41]
+
+
 def test_closed_form_is_the_paper_arc():
     # The closed form (alpha, beta from the generated kernel) is the same arc
     # as the structured solve of the paper's polynomial; the two differ by
