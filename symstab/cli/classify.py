@@ -7,6 +7,8 @@ lists: several points) or at stiffness-damping points of the paper's loop,
 whose device options are shorthand for it (one computation either way).
 """
 
+import sys
+
 import numpy as np
 
 from .._resources import check_memory
@@ -16,6 +18,10 @@ from .output import emit
 from .units import physical_columns
 
 __all__ = ["register", "run"]
+
+#: From this many points times the degree on, the radius takes seconds
+#: (0.3 s a point at d = 5000): ``classify`` says on stderr what runs.
+_ANNOUNCE_WORK = 100_000
 
 
 def register(subparsers):
@@ -59,6 +65,10 @@ def run(args):
     loop = setup.loop
     code = loop.classify(**values)
     counts = loop.unstable_root_counts(**values)
+    if n * (values["d"] + 4) >= _ANNOUNCE_WORK:
+        # The radius costs about ten verdicts (counts on circles, Newton steps): say what runs.
+        print(f"computing the spectral radius of {n} point(s) at delay d = {values['d']} ...",
+              file=sys.stderr, flush=True)
     radius = loop.spectral_radius(**values)
     columns = [setup.label(m) for m in names]
     rows = [tuple(float(values[m][k]) for m in names) for k in range(n)]
