@@ -2,13 +2,26 @@
 # NumPy kernels, vectorised over theta, gamma, delta, alpha, beta (arrays broadcast); d is an int.
 # Every expression is proved equal to the derivation by `symstab derive` (step 07_proofs),
 # except the Taylor branches of zoh_b1, zoh_b0, zoh_gap, decay_mean,
-# approximations exact to the last bit below their switch.
+# approximations exact to the last bit below their switch, and the error-free
+# products of sin_multiple, cos_multiple.
 
 """Generated NumPy kernels of symstab (see symstab.codegen.generator)."""
 
 import numpy
 
-__all__ = ['zoh_b1', 'zoh_b0', 'zoh_gap', 'decay_mean', 'boundary', 'loop_coefficients', 'plant_step_coefficients', 'plant_step', 'environment_force']
+__all__ = ['zoh_b1', 'zoh_b0', 'zoh_gap', 'decay_mean', 'sin_multiple', 'cos_multiple', 'boundary', 'loop_coefficients', 'plant_step_coefficients', 'plant_step', 'environment_force']
+
+
+def _exact_product(k, x):
+    """k x = hi + lo exactly (Dekker's product; Veltkamp's split in halves of 26 bits)."""
+    hi = k*x
+    c = 134217729.0*k
+    k_hi = c - (c - k)
+    k_lo = k - k_hi
+    c = 134217729.0*x
+    x_hi = c - (c - x)
+    x_lo = x - x_hi
+    return hi, ((k_hi*x_hi - hi) + k_hi*x_lo + k_lo*x_hi) + k_lo*x_lo
 
 
 def zoh_b1(delta):
@@ -90,6 +103,48 @@ def decay_mean(delta):
     return numpy.where(numpy.less(delta, 1), delta*(delta*(delta*(delta*(delta*(delta*(delta*(delta*(delta*(delta*(delta*(delta*(delta*(delta*(delta*(delta*(1/355687428096000 - 1/6402373705728000*delta) - 1/20922789888000) + 1/1307674368000) - 1/87178291200) + 1/6227020800) - 1/479001600) + 1/39916800) - 1/3628800) + 1/362880) - 1/40320) + 1/5040) - 1/720) + 1/120) - 1/24) + 1/6) - 1/2) + 1, -numpy.expm1(-x0)/x0)
 
 
+def sin_multiple(k, x):
+    """sin(k x) for an integer k, with the product k x carried exactly as hi +
+    lo, so the value keeps its relative accuracy where k x is large and
+    sin(k x) small; sin(hi + lo) = sin(hi) + lo cos(hi) to within lo^2.
+
+    Parameters
+    ----------
+    k : int
+        the integer multiple
+    x : float or ndarray
+        the angle (rad)
+
+    Returns
+    -------
+    sin_multiple : float or ndarray
+        sin(k x)
+    """
+    hi, lo = _exact_product(k, x)
+    return numpy.sin(hi) + lo*numpy.cos(hi)
+
+
+def cos_multiple(k, x):
+    """cos(k x) for an integer k, with the product k x carried exactly as hi +
+    lo, so the value keeps its relative accuracy where k x is large and
+    cos(k x) small; cos(hi + lo) = cos(hi) - lo sin(hi) to within lo^2.
+
+    Parameters
+    ----------
+    k : int
+        the integer multiple
+    x : float or ndarray
+        the angle (rad)
+
+    Returns
+    -------
+    cos_multiple : float or ndarray
+        cos(k x)
+    """
+    hi, lo = _exact_product(k, x)
+    return numpy.cos(hi) - lo*numpy.sin(hi)
+
+
 def boundary(theta, gamma, d, delta):
     """The stability boundary alpha(theta), beta(theta): the (alpha, beta) at
     which z = exp(j theta) is a root of the characteristic polynomial.
@@ -119,16 +174,16 @@ def boundary(theta, gamma, d, delta):
     x4 = zoh_b1(delta)
     x5 = numpy.cos(x0)
     x6 = (delta**2*zoh_gap(delta)**2 + 4*x3*x4*x5**2)**(-1.0)
-    x7 = theta*(d + 1)
+    x7 = d + 1
     x8 = numpy.sin(theta)
     x9 = x3 + x4*numpy.cos(theta)
     x10 = -2*x1 - numpy.expm1(-delta)
     x11 = x10*x9 + x4*x8**2
     x12 = -x10*x4*x8 + x8*x9
-    x13 = x0*(2*d + 1)
+    x13 = 2*d + 1
     return (
-        x2 + 2*x6*(x11*numpy.sin(x7) + x12*numpy.cos(x7))*numpy.tan(x0),
-        -x2 + x6*(-x11*numpy.cos(x13) + x12*numpy.sin(x13))/x5,
+        x2 + 2*x6*(x11*sin_multiple(x7, theta) + x12*cos_multiple(x7, theta))*numpy.tan(x0),
+        -x2 + x6*(-x11*cos_multiple(x13, x0) + x12*sin_multiple(x13, x0))/x5,
     )
 
 

@@ -2,7 +2,8 @@
 // C99 kernels; they need only <math.h> (link with -lm).
 // Every expression is proved equal to the derivation by `symstab derive` (step 07_proofs),
 // except the Taylor branches of zoh_b1, zoh_b0, zoh_gap, decay_mean,
-// approximations exact to the last bit below their switch.
+// approximations exact to the last bit below their switch, and the error-free
+// products of sin_multiple, cos_multiple.
 
 #include <math.h>
 #include "symstab_kernels.h"
@@ -87,6 +88,38 @@ double symstab_decay_mean(double delta)
 }
 
 /*
+ * sin(k x) for an integer k, with the product k x carried exactly as hi +
+ * lo, so the value keeps its relative accuracy where k x is large and
+ * sin(k x) small; sin(hi + lo) = sin(hi) + lo cos(hi) to within lo^2.
+ *
+ * k: the integer multiple
+ * x: the angle (rad)
+ * returns: sin(k x)
+ */
+double symstab_sin_multiple(int k, double x)
+{
+    const double hi = k * x;
+    const double lo = fma((double)k, x, -hi);
+    return sin(hi) + lo * cos(hi);
+}
+
+/*
+ * cos(k x) for an integer k, with the product k x carried exactly as hi +
+ * lo, so the value keeps its relative accuracy where k x is large and
+ * cos(k x) small; cos(hi + lo) = cos(hi) - lo sin(hi) to within lo^2.
+ *
+ * k: the integer multiple
+ * x: the angle (rad)
+ * returns: cos(k x)
+ */
+double symstab_cos_multiple(int k, double x)
+{
+    const double hi = k * x;
+    const double lo = fma((double)k, x, -hi);
+    return cos(hi) - lo * sin(hi);
+}
+
+/*
  * The stability boundary alpha(theta), beta(theta): the (alpha, beta) at
  * which z = exp(j theta) is a root of the characteristic polynomial.
  *
@@ -106,15 +139,15 @@ void symstab_boundary(double theta, double gamma, int d, double delta, double *a
     const double x4 = symstab_zoh_b1(delta);
     const double x5 = cos(x0);
     const double x6 = 1.0/(pow(delta, 2)*pow(symstab_zoh_gap(delta), 2) + 4*x3*x4*pow(x5, 2));
-    const double x7 = theta*(d + 1);
+    const int x7 = d + 1;
     const double x8 = sin(theta);
     const double x9 = x3 + x4*cos(theta);
     const double x10 = -2*x1 - expm1(-delta);
     const double x11 = x10*x9 + x4*pow(x8, 2);
     const double x12 = -x10*x4*x8 + x8*x9;
-    const double x13 = x0*(2*d + 1);
-    *alpha = x2 + 2*x6*(x11*sin(x7) + x12*cos(x7))*tan(x0);
-    *beta = -x2 + x6*(-x11*cos(x13) + x12*sin(x13))/x5;
+    const int x13 = 2*d + 1;
+    *alpha = x2 + 2*x6*(x11*symstab_sin_multiple(x7, theta) + x12*symstab_cos_multiple(x7, theta))*tan(x0);
+    *beta = -x2 + x6*(-x11*symstab_cos_multiple(x13, x0) + x12*symstab_sin_multiple(x13, x0))/x5;
 }
 
 /*

@@ -2,7 +2,8 @@
 // C99 kernels; they need only <math.h> (link with -lm).
 // Every expression is proved equal to the derivation by `symstab derive` (step 07_proofs),
 // except the Taylor branches of zoh_b1, zoh_b0, zoh_gap, decay_mean,
-// approximations exact to the last bit below their switch.
+// approximations exact to the last bit below their switch, and the error-free
+// products of sin_multiple, cos_multiple.
 
 #ifndef SYMSTAB_KERNELS_H
 #define SYMSTAB_KERNELS_H
@@ -51,6 +52,28 @@ double symstab_zoh_gap(double delta);
  * returns: (1 - exp(-delta)) / delta
  */
 double symstab_decay_mean(double delta);
+
+/*
+ * sin(k x) for an integer k, with the product k x carried exactly as hi +
+ * lo, so the value keeps its relative accuracy where k x is large and
+ * sin(k x) small; sin(hi + lo) = sin(hi) + lo cos(hi) to within lo^2.
+ *
+ * k: the integer multiple
+ * x: the angle (rad)
+ * returns: sin(k x)
+ */
+double symstab_sin_multiple(int k, double x);
+
+/*
+ * cos(k x) for an integer k, with the product k x carried exactly as hi +
+ * lo, so the value keeps its relative accuracy where k x is large and
+ * cos(k x) small; cos(hi + lo) = cos(hi) - lo sin(hi) to within lo^2.
+ *
+ * k: the integer multiple
+ * x: the angle (rad)
+ * returns: cos(k x)
+ */
+double symstab_cos_multiple(int k, double x);
 
 /*
  * The stability boundary alpha(theta), beta(theta): the (alpha, beta) at

@@ -32,7 +32,12 @@ sin(theta/2)**2``, ``em = -expm1(-delta) = 1 - r``), ``H = b1 z + b0`` and
     alpha = 2 tan(theta/2) Im(exp(j (d+1) theta) M) / |H|**2 + 4 gamma sin(theta/2)**2
     beta  = -Re(exp(j (d+1/2) theta) M) / (cos(theta/2) |H|**2) - 4 gamma sin(theta/2)**2
 
-with ``|H|**2 = delta**2 gap**2 + 4 b1 b0 cos(theta/2)**2``.  Every form is
+with ``|H|**2 = delta**2 gap**2 + 4 b1 b0 cos(theta/2)**2``.  The sines and
+cosines of ``(d+1) theta`` and ``(2d+1) theta/2`` are :class:`sin_multiple`
+and :class:`cos_multiple`: the product of the integer and the angle is
+carried exactly, so they keep their relative accuracy next to ``theta =
+pi``, where ``(d+1) theta`` is large and its sine small (rounding the
+product first cost up to 1e-9 of alpha there).  Every form is
 proved equal to the derivation by the exact checker (:func:`proofs`), with
 the symbols replaced by their definitions in ``Gamma`` and ``delta``; so are
 the closed forms the four functions are evaluated by above their switch.
@@ -52,6 +57,7 @@ from ..symbolic.sampled_plant import dimensionless_step
 
 __all__ = [
     "SeriesFunction", "zoh_b1", "zoh_b0", "zoh_gap", "decay_mean", "SERIES_FUNCTIONS",
+    "MultipleAngle", "sin_multiple", "cos_multiple", "MULTIPLE_ANGLE_FUNCTIONS",
     "r", "em", "b1", "b0", "gap", "mean",
     "boundary_forms", "loop_coefficient_forms",
     "plant_step_forms", "environment_force_form", "position_history",
@@ -198,6 +204,45 @@ class decay_mean(SeriesFunction):
 #: The series-evaluated functions, in the order they are generated.
 SERIES_FUNCTIONS = (zoh_b1, zoh_b0, zoh_gap, decay_mean)
 
+class MultipleAngle(sp.Function):
+    """``f(k x)`` for an integer ``k``, with the product ``k x`` carried exactly.
+
+    ``k x`` is the sum ``hi + lo`` of two doubles (an error-free product),
+    and ``f(hi + lo) = f(hi) + lo f'(hi)`` to within ``lo**2``: the value
+    keeps its relative accuracy where ``k x`` is large and ``f(k x)`` small,
+    as ``sin((d + 1) theta)`` next to ``theta = pi``.  Subclasses give the
+    :attr:`function` (``sp.sin`` or ``sp.cos``); :meth:`definition` is
+    ``function(k x)``, which the proofs substitute (:func:`as_derivation`).
+    The code printers of :mod:`symstab.codegen.generator` print a call of
+    the generated helper of the same name.
+    """
+
+    nargs = 2
+    function = None
+
+    def definition(self):
+        k, x = self.args
+        return self.function(k * x)
+
+    def _latex(self, printer):
+        return printer._print(self.definition())
+
+
+class sin_multiple(MultipleAngle):
+    """``sin(k x)`` for an integer ``k``, with ``k x`` carried exactly."""
+
+    function = sp.sin
+
+
+class cos_multiple(MultipleAngle):
+    """``cos(k x)`` for an integer ``k``, with ``k x`` carried exactly."""
+
+    function = sp.cos
+
+
+#: The multiple-angle functions, in the order they are generated.
+MULTIPLE_ANGLE_FUNCTIONS = (sin_multiple, cos_multiple)
+
 #: Symbols of the forms: ``r = exp(-delta)``, ``em = 1 - r`` and the four
 #: functions above at ``delta``.
 r, em = sp.symbols("r em", positive=True)
@@ -221,16 +266,18 @@ def _circle_parts():
 def boundary_forms():
     """Return ``(alpha, beta)`` on the boundary in the well-conditioned form.
 
-    Expressions in ``theta, gamma, d, delta`` and the symbols :data:`em`,
-    :data:`b1`, :data:`b0`, :data:`gap`.
+    Expressions in ``theta, gamma, d, delta``, the symbols :data:`em`,
+    :data:`b1`, :data:`b0`, :data:`gap` and the multiple-angle functions
+    :class:`sin_multiple`, :class:`cos_multiple`.
     """
     th, d, g = model.theta, model.d, model.gamma
     re_M, im_M, H2 = _circle_parts()
     half = th / 2
-    a = (d + 1) * th
-    b = (2 * d + 1) * th / 2
-    alpha = 2 * sp.tan(half) * (sp.sin(a) * re_M + sp.cos(a) * im_M) / H2 + 4 * g * sp.sin(half) ** 2
-    beta = -(sp.cos(b) * re_M - sp.sin(b) * im_M) / (sp.cos(half) * H2) - 4 * g * sp.sin(half) ** 2
+    # exp(j (d+1) theta) and exp(j (2d+1) theta/2), with the products carried exactly.
+    sin_a, cos_a = sin_multiple(d + 1, th), cos_multiple(d + 1, th)
+    sin_b, cos_b = sin_multiple(2 * d + 1, half), cos_multiple(2 * d + 1, half)
+    alpha = 2 * sp.tan(half) * (sin_a * re_M + cos_a * im_M) / H2 + 4 * g * sp.sin(half) ** 2
+    beta = -(cos_b * re_M - sin_b * im_M) / (sp.cos(half) * H2) - 4 * g * sp.sin(half) ** 2
     return alpha, beta
 
 
@@ -296,7 +343,11 @@ def _definitions():
 
 
 def as_derivation(expr):
-    """Replace the symbols of the forms by their definitions in ``Gamma, delta``."""
+    """Replace the symbols of the forms by their definitions in ``Gamma, delta``.
+
+    The multiple-angle functions become the sines and cosines they evaluate.
+    """
+    expr = expr.replace(lambda e: isinstance(e, MultipleAngle), lambda e: e.definition())
     return expr.subs(_definitions())
 
 

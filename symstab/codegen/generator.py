@@ -59,12 +59,19 @@ class Kernel:
         ``(name, expression, description)``.
     doc : str
         One paragraph for the generated docstring and comment.
+    python_body, c_body : tuple of str
+        Hand-written body lines, for a helper whose floating-point steps
+        SymPy would simplify away (an error-free product); empty for a
+        kernel printed from its outputs.  The outputs then state what the
+        body computes.
     """
 
     name: str
     args: tuple
     outputs: tuple
     doc: str
+    python_body: tuple = ()
+    c_body: tuple = ()
 
     def __post_init__(self):
         allowed = {symbol for symbol, _, _ in self.args}
@@ -97,6 +104,41 @@ _ARG = {
 }
 
 
+#: The integer multiple and the angle of the multiple-angle helpers.
+_K, _X = sp.Symbol("k", integer=True), sp.Symbol("x", real=True)
+
+#: NumPy has no fused multiply-add: the error-free product of the
+#: multiple-angle helpers is Dekker's, with Veltkamp's splits.
+_EXACT_PRODUCT = '''def _exact_product(k, x):
+    """k x = hi + lo exactly (Dekker's product; Veltkamp's split in halves of 26 bits)."""
+    hi = k*x
+    c = 134217729.0*k
+    k_hi = c - (c - k)
+    k_lo = k - k_hi
+    c = 134217729.0*x
+    x_hi = c - (c - x)
+    x_lo = x - x_hi
+    return hi, ((k_hi*x_hi - hi) + k_hi*x_lo + k_lo*x_hi) + k_lo*x_lo'''
+
+
+def _multiple_angle_kernel(function):
+    """The generated helper of a :class:`~symstab.codegen.forms.MultipleAngle` function."""
+    name = function.__name__
+    f = function.function.__name__
+    derivative = {"sin": ("+", "cos"), "cos": ("-", "sin")}[f]
+    return Kernel(
+        name, ((_K, "int", "the integer multiple"), (_X, "double", "the angle (rad)")),
+        ((name, function.function(_K * _X), f"{f}(k x)"),),
+        f"{f}(k x) for an integer k, with the product k x carried exactly as hi + lo, so the "
+        f"value keeps its relative accuracy where k x is large and {f}(k x) small; {f}(hi + lo) "
+        f"= {f}(hi) {derivative[0]} lo {derivative[1]}(hi) to within lo^2.",
+        python_body=("hi, lo = _exact_product(k, x)",
+                     f"return numpy.{f}(hi) {derivative[0]} lo*numpy.{derivative[1]}(hi)"),
+        c_body=("const double hi = k * x;",
+                "const double lo = fma((double)k, x, -hi);",
+                f"return {f}(hi) {derivative[0]} lo * {derivative[1]}(hi);"))
+
+
 @functools.lru_cache(maxsize=None)
 def kernels():
     """Return the kernels, in file order."""
@@ -116,6 +158,7 @@ def kernels():
                  f"{f.formula}: {f.__doc__[0].lower()}{f.__doc__[1:].rstrip('.')}, for delta >= 0; a Taylor "
                  f"polynomial below delta = {f.switch}, exp(-delta) and expm1(-delta) above.")
           for f in kf.SERIES_FUNCTIONS),
+        *(_multiple_angle_kernel(f) for f in kf.MULTIPLE_ANGLE_FUNCTIONS),
         Kernel("boundary", tuple(_ARG[k] for k in ("theta", "gamma", "d", "delta")),
                (("alpha", kf.as_evaluable(alpha), "dimensionless stiffness on the boundary"),
                 ("beta", kf.as_evaluable(beta), "dimensionless damping on the boundary")),
@@ -151,8 +194,8 @@ def kernels():
 class NumPyKernelPrinter(NumPyPrinter):
     """NumPy printer for the kernels.
 
-    The series functions of :mod:`symstab.codegen.forms` print as calls of
-    their generated helpers.
+    The series and multiple-angle functions of :mod:`symstab.codegen.forms`
+    print as calls of their generated helpers.
     """
 
     def __init__(self, settings=None):
@@ -161,8 +204,8 @@ class NumPyKernelPrinter(NumPyPrinter):
     def _print_Function(self, expr):
         # SymPy's printers skip subclass names of a Function's bases, so the
         # series functions are recognised here rather than by _print_<name>.
-        if isinstance(expr, kf.SeriesFunction):
-            return f"{type(expr).__name__}({self._print(expr.args[0])})"
+        if isinstance(expr, (kf.SeriesFunction, kf.MultipleAngle)):
+            return f"{type(expr).__name__}({', '.join(self._print(a) for a in expr.args)})"
         return super()._print_Function(expr)
 
     def _print_Max(self, expr):
@@ -182,14 +225,14 @@ class NumPyKernelPrinter(NumPyPrinter):
 
 
 class CKernelPrinter(C99CodePrinter):
-    """C99 printer for the kernels: series functions call their generated helpers."""
+    """C99 printer for the kernels: series and multiple-angle functions call their generated helpers."""
 
     def __init__(self, settings=None):
         super().__init__(dict({"strict": True}, **(settings or {})))
 
     def _print_Function(self, expr):
-        if isinstance(expr, kf.SeriesFunction):
-            return f"{C_PREFIX}{type(expr).__name__}({self._print(expr.args[0])})"
+        if isinstance(expr, (kf.SeriesFunction, kf.MultipleAngle)):
+            return f"{C_PREFIX}{type(expr).__name__}({', '.join(self._print(a) for a in expr.args)})"
         return super()._print_Function(expr)
 
 
@@ -262,7 +305,8 @@ def _header_lines(comment, what):
             f"{comment} Every expression is proved equal to the derivation by `{COMMAND}`"
             " (step 07_proofs),",
             f"{comment} except the Taylor branches of {', '.join(f.__name__ for f in kf.SERIES_FUNCTIONS)},",
-            f"{comment} approximations exact to the last bit below their switch.", ""]
+            f"{comment} approximations exact to the last bit below their switch, and the error-free",
+            f"{comment} products of {', '.join(f.__name__ for f in kf.MULTIPLE_ANGLE_FUNCTIONS)}.", ""]
 
 
 def python_function(kernel, printer):
@@ -287,6 +331,8 @@ def python_function(kernel, printer):
     for name, _, description in kernel.outputs:
         lines += [f"    {name} : float or ndarray", f"        {docstring_text(description)}"]
     lines.append('    """')
+    if kernel.python_body:
+        return "\n".join(lines + [f"    {line}" for line in kernel.python_body])
     for symbol, expr in replacements:
         lines.append(f"    {symbol} = {printer.doprint(expr)}")
     results = [printer.doprint(expr) for expr in reduced]
@@ -307,7 +353,7 @@ def numpy_module():
                                           "alpha, beta (arrays broadcast); d is an int.")),
              '"""Generated NumPy kernels of symstab (see symstab.codegen.generator)."""', "",
              "import numpy", "",
-             f"__all__ = {names!r}", ""]
+             f"__all__ = {names!r}", "", "", _EXACT_PRODUCT, ""]
     for kernel in kernels():
         parts += ["", python_function(kernel, printer), ""]
     return "\n".join(parts).rstrip("\n") + "\n"
@@ -355,8 +401,12 @@ def c_function(kernel, printer):
     """
     replacements, reduced = kernel.cse()
     lines = [c_comment(kernel), c_signature(kernel), "{"]
+    if kernel.c_body:
+        return "\n".join(lines + [f"    {line}" for line in kernel.c_body] + ["}"])
     for symbol, expr in replacements:
-        lines.append(f"    const double {symbol} = {printer.doprint(expr)};")
+        # An integer temporary (d + 1) stays an int: it is passed as one.
+        ctype = "int" if expr.is_integer else "double"
+        lines.append(f"    const {ctype} {symbol} = {printer.doprint(expr)};")
     if len(reduced) == 1:
         lines.append(f"    return {printer.doprint(reduced[0])};")
     else:

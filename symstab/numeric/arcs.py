@@ -13,9 +13,8 @@ digits of that factor (8 of them at ``theta = 1e-4``).  Here each bracket is
 the sine series ``sum_m e_m sin(m theta)`` with exact coefficients ``e_m``
 (the products ``p_j q_k`` summed without rounding, once per plane), divided
 by ``sin(theta)`` term by term: ``sin(m theta) / sin(theta)`` (Chebyshev's
-``U_{m-1}(cos theta)``) is computed from ``m theta`` carried to the last bit,
-and next to ``pi`` from ``pi - theta`` (``sin(m theta) = (-1)**(m+1) sin(m
-(pi - theta))``), so it keeps its digits at both ends.
+``U_{m-1}(cos theta)``) is computed from ``m theta`` carried exactly (the
+generated ``sin_multiple``), so it keeps its digits at both ends.
 
 A :class:`~symstab.numeric.polynomial.DelayedPolynomial` ``z**s D + N``
 gives each bracket three clusters of frequencies (``D`` with ``D`` and ``N``
@@ -62,8 +61,6 @@ EXACT_TERMS = 64
 _PI_LOW = 1.2246467991473532e-16
 #: Veltkamp's constant, 2**27 + 1: splits a double into two halves of 26 bits.
 _SPLIT = 134217729.0
-#: Largest frequency whose product with a half of theta is exact.
-_MAX_FREQUENCY = 2**26
 
 
 def _parts(polynomial):
@@ -226,60 +223,38 @@ def _bracket(first, second):
     terms = np.concatenate([(sign * hi)[:, None], (sign * lo)[:, None]], axis=1)
     e = np.array([math.fsum(terms[a:b].ravel()) for a, b in zip(start, stop)], dtype=float)
     keep = e != 0
-    if np.any(frequencies >= _MAX_FREQUENCY):
-        raise ValueError(f"an arc source takes polynomials of degree below {_MAX_FREQUENCY}")
     return frequencies[keep].astype(float), e[keep]
 
 
 def _multiple(m, theta):
     """``sin(m theta) / sin(theta)`` and ``cos(m theta)``, accurate at both ends of (0, pi).
 
-    ``m theta`` is carried as an exact sum of two doubles (Veltkamp's split
-    of ``theta``: each half times an integer ``m < 2**26`` is exact), and
-    for ``theta > pi / 2`` the angle is ``phi = pi - theta`` (``np.pi -
-    theta`` is exact there; the low part of pi is added), with ``sin(m
-    theta) = (-1)**(m + 1) sin(m phi)`` and ``cos(m theta) = (-1)**m cos(m
-    phi)``.
+    ``m theta`` is carried exactly by the generated helpers
+    (:func:`symstab._generated.kernels.sin_multiple`, ``cos_multiple``), so
+    ``sin(m theta)`` keeps its relative accuracy next to ``pi`` as
+    ``sin(theta)`` does; at ``theta = 0`` the ratio is its limit ``m``.
     """
     m = np.asarray(m, dtype=float)
     theta = np.asarray(theta, dtype=float)
-    mirror = theta > 0.5 * np.pi
-    # The angle used, as hi + lo: theta itself, or pi - theta near pi.
-    hi = np.where(mirror, np.pi - theta, theta)
-    lo = np.where(mirror, _PI_LOW, 0.0)
-    c = _SPLIT * hi
-    h_big = c - (c - hi)
-    h_small = hi - h_big
-    s, t = m * h_big, m * h_small
-    # s + t exactly (Knuth's two-sum), then the product of m with lo.
-    total = s + t
-    bv = total - s
-    err = (s - (total - bv)) + (t - bv) + m * lo
-    sin_m, cos_m = np.sin(total), np.cos(total)
-    numerator = sin_m + err * cos_m
-    cosine = cos_m - err * sin_m
-    denominator = np.sin(hi) + lo * np.cos(hi)
-    odd = np.mod(m, 2.0) == 1
-    # At theta = 0 exactly (pi is mirrored onto lo != 0) the ratio is its limit m.
+    numerator = kernels.sin_multiple(m, theta)
+    denominator = np.sin(theta)
     with np.errstate(invalid="ignore", divide="ignore"):
         ratio = np.where(denominator == 0, m, numerator / denominator)
-    return (np.where(mirror & ~odd, -1.0, 1.0) * ratio,
-            np.where(mirror & odd, -1.0, 1.0) * cosine)
+    return ratio, kernels.cos_multiple(m, theta)
 
 
 def sine_ratio(m, theta):
     """``sin(m theta) / sin(theta)`` (``U_{m-1}(cos theta)``), accurate at both ends of (0, pi).
 
-    ``m theta`` is carried to the last bit and next to pi the angle is
-    mirrored (``sin(m theta) = (-1)**(m + 1) sin(m (pi - theta))``), so the
-    ratio keeps its relative accuracy as ``theta -> 0`` or ``pi`` (the
+    ``m theta`` is carried to the last bit, so the ratio keeps its relative
+    accuracy as ``theta -> 0`` or ``pi`` (the
     limits ``m`` and ``(-1)**(m+1) m``), where the quotient of two rounded
     sines would not.
 
     Parameters
     ----------
     m : array_like
-        Positive integers (as floats or ints), below ``2**26``.
+        Positive integers (as floats or ints).
     theta : array_like
         Angles in [0, pi]; broadcast against ``m``.
 

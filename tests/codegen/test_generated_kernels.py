@@ -37,7 +37,7 @@ import pytest
 import sympy as sp
 
 from conftest import PAPER_DELTA, REPO, relative_error
-from oracles import first_principles_chi, first_principles_chi_float
+from oracles import first_principles_boundary_point, first_principles_chi, first_principles_chi_float
 import symstab
 from symstab.symbolic import model
 from symstab._generated import kernels as numpy_kernels
@@ -102,6 +102,8 @@ EXPECTED_SIGNATURES = {
     "symstab_zoh_b0": ("double", ["double"]),
     "symstab_zoh_gap": ("double", ["double"]),
     "symstab_decay_mean": ("double", ["double"]),
+    "symstab_sin_multiple": ("double", ["int", "double"]),
+    "symstab_cos_multiple": ("double", ["int", "double"]),
     "symstab_boundary": ("void", ["double", "double", "int", "double"] + ["double *"] * 2),
     "symstab_loop_coefficients": ("void", ["double"] * 4 + ["double *"] * 7),
     "symstab_plant_step_coefficients": ("void", ["double"] + ["double *"] * 4),
@@ -123,6 +125,9 @@ class CKernels:
     def _outputs(n):
         # NaN-initialised, so an output the C code forgets to write is caught.
         return [ctypes.c_double(math.nan) for _ in range(n)]
+
+    def multiple(self, name, k, x):
+        return getattr(self.lib, f"symstab_{name}")(int(k), float(x))
 
     def boundary(self, theta, gamma, d, delta):
         out = self._outputs(2)
@@ -340,6 +345,65 @@ def test_boundary_matches_derivation_at_50_digits(c_kernels, delta, d, gamma):
                     failures.append(f"{kernel} {name} at theta={theta!r}: {float(value)!r} vs "
                                     f"{mpmath.nstr(expected, 17)}, relative error {float(err):.3g}")
     assert not failures, "\n".join(failures)
+
+
+#: Angles of the whole half circle, dense at both ends (issue 19's acceptance).
+CIRCLE = np.unique(np.concatenate([np.geomspace(1e-6, 0.1, 25), np.linspace(0.1, np.pi - 0.1, 40),
+                                   np.pi - np.geomspace(1e-6, 0.1, 25)]))
+#: Norm-wise relative error of (alpha, beta) on the whole half circle.
+CIRCLE_RTOL = 1e-12
+
+
+@pytest.mark.parametrize("gamma, d, delta", [(0.0, 0, 0.1), (-0.5, 1, 2.0), (1.5, 10, 2.0),
+                                             (0.0, 40, 0.1), (-0.5, 200, 0.00253125),
+                                             (1.0, 1000, 20.0), (0.5, 5, 1e-6)])
+def test_boundary_on_the_whole_circle_matches_first_principles(c_kernels, gamma, d, delta):
+    """(alpha, beta) of both kernels to 1e-12 of their size for theta in [1e-6, pi - 1e-6].
+
+    The reference is the first-principles solve of Delta(exp(j theta)) = 0
+    (the printed eqs. (1), (2), (4)) at 50 digits.  Next to pi the sines of
+    (d + 1) theta and (2d + 1) theta / 2 are small and their arguments
+    large: rounding the products before the sine cost up to 1.2e-9 here
+    (gamma = 0, d = 40, delta = 0.1, theta = pi - 1e-6).
+    """
+    failures = []
+    for kernel, f in _kernel_boundaries(c_kernels).items():
+        worst, where = 0.0, None
+        for theta in CIRCLE:
+            alpha, beta = f(float(theta), gamma, d, delta)
+            with mpmath.workdps(50):
+                ra, rb = first_principles_boundary_point(float(theta), gamma, d, delta)
+                err = float(max(abs(alpha - ra), abs(beta - rb)) / max(abs(ra), abs(rb)))
+            if err > worst:
+                worst, where = err, theta
+        if not worst <= CIRCLE_RTOL:
+            failures.append(f"{kernel}: relative error {worst:.3g} at theta = {where!r}")
+    assert not failures, "\n".join(failures)
+
+
+@pytest.mark.parametrize("name", ["sin_multiple", "cos_multiple"])
+def test_multiple_angle_helpers_match_mpmath(c_kernels, name):
+    """sin(k x), cos(k x) of both kernels to 2 ulp of their value (plus 1e-16 k x ulp absolute).
+
+    The helpers carry k x exactly; the naive float product loses the digits
+    of k x's rounding, relative to the value where sin(k x) is small.
+    """
+    function = {"sin_multiple": mpmath.sin, "cos_multiple": mpmath.cos}[name]
+    ks = [1, 2, 7, 41, 2001, 20001]
+    xs = [1e-9, 0.3, 1.5, np.pi / 2 - 1e-7, np.pi - 1e-3, np.pi - 1e-6, np.pi - 1e-9, np.pi]
+    naive = {"sin_multiple": np.sin, "cos_multiple": np.cos}[name]
+    naive_worst = 0.0
+    for k in ks:
+        for x in xs:
+            with mpmath.workdps(50):
+                want = function(k * mpmath.mpf(float(x)))
+            bound = 2 * 2.0**-52 * abs(want) + 1e-32 * k * x
+            for kernel, got in (("numpy", getattr(numpy_kernels, name)(k, x)),
+                                ("C", c_kernels.multiple(name, k, x))):
+                assert abs(got - want) <= bound, (kernel, k, x, got, want)
+            naive_worst = max(naive_worst, float(abs(naive(k * x) - want) / bound))
+    # The check can fail: the naive product misses the bound by orders of magnitude.
+    assert naive_worst > 1e3
 
 
 @pytest.mark.parametrize("delta, d, gamma", GRID, ids=GRID_IDS)
