@@ -43,7 +43,7 @@ import numpy as np
 
 from .._resources import check_memory, chunk_slices
 from .arcs import CramerArc
-from .curves import zoom_max
+from .curves import bracketed_root, zoom_max
 from .polynomial import DelayedPolynomial
 from .roots import STABLE, classify_polynomials, leading_vanishes, root_counts
 
@@ -84,6 +84,11 @@ _AREA = 1e-24
 _EXTREME_RTOL = 1e-12
 #: Tolerance on the segment parameters of an intersection.
 _ENDS = 1e-9
+#: Distance (in units of the window) within which a vertex is on a line and
+#: an arc chord (a corner), and the most a corner may move when re-found on
+#: the arc (a chord's sag is far below it).
+_CORNER = 1e-9
+_CORNER_MOVE = 1e-4
 
 
 @dataclasses.dataclass(frozen=True, repr=False)
@@ -264,9 +269,10 @@ class Decomposition:
     def extreme(self, coordinate, sense=1):
         """The largest (``sense=1``) or smallest (``sense=-1``) coordinate of the stable set.
 
-        The extreme vertex of the stable cells; where it is a smooth turn of
-        the arc (its neighbours along the arc are on the same cell's
-        boundary), refined along the arc by a zooming grid in theta (curves.zoom_max).
+        The extreme vertex of the stable cells; where it is a corner (the arc
+        meets a line), re-found on the arc; where it is a smooth turn of the
+        arc (its neighbours along the arc are on the same cell's boundary),
+        refined along the arc by a zooming grid in theta (curves.zoom_max).
 
         Parameters
         ----------
@@ -297,6 +303,9 @@ class Decomposition:
         if arc is None or not self.polynomial:
             return value, other
         scale = np.array([self.x_range[1] - self.x_range[0], self.y_range[1] - self.y_range[0]])
+        corner = self._corner(arc, best, scale)
+        if corner is not None:
+            return float(corner[k]), float(corner[1 - k])
         near = np.hypot(*((arc.points - best) / scale).T)
         j = int(np.nanargmin(near)) if np.isfinite(near).any() else -1
         if j < 1 or j >= len(arc.points) - 1 or near[j] > 1e-9:
@@ -318,6 +327,56 @@ class Decomposition:
         if sense * xy[k] >= sense * value:
             return xy[k], xy[1 - k]
         return value, other
+
+    def _corner(self, arc, vertex, scale):
+        """A vertex where the arc meets a line, re-found on the arc: ``(x, y)`` or None.
+
+        The chords' crossing is off the curves' by the chord's sag (1e-10
+        to 1e-8 of the window); here the arc's angle between the chord's
+        ends is the root of the line's equation along it (the source's own
+        accuracy, 1e-13).  None where ``vertex`` is not on one line and one
+        arc chord.
+        """
+        unit = vertex / scale
+        for line in self.branches:
+            if line.label == "arc":
+                continue
+            ends = line.points[np.all(np.isfinite(line.points), axis=1)]
+            if len(ends) < 2:
+                continue
+            origin, direction = ends[0] / scale, (ends[-1] - ends[0]) / scale
+            length = float(np.hypot(*direction))
+            if length == 0:
+                continue
+            normal = np.array([-direction[1], direction[0]]) / length
+
+            def side(points):
+                return (points / scale - origin) @ normal
+
+            if abs(float(side(vertex))) > _CORNER:
+                continue
+            # The arc's chords through the vertex that cross the line.
+            g = side(arc.points)
+            a, b = arc.points[:-1] / scale, arc.points[1:] / scale
+            t = np.clip(np.einsum("ij,ij->i", unit - a, b - a)
+                        / np.maximum(np.einsum("ij,ij->i", b - a, b - a), 1e-300), 0.0, 1.0)
+            gap = np.hypot(*(a + t[:, None] * (b - a) - unit).T)
+            crossing = (np.sign(g[:-1]) * np.sign(g[1:]) < 0) & (gap < _CORNER)
+            if not crossing.any():
+                continue
+            j = int(np.flatnonzero(crossing)[np.argmin(gap[crossing])])
+            source = self.arc if self.arc is not None else CramerArc(*self.polynomial)
+
+            def along(theta):
+                xs, ys = source(theta.ravel())[:2]
+                return side(np.column_stack([xs, ys])).reshape(theta.shape)
+
+            root = bracketed_root(along, [arc.theta[j]], [arc.theta[j + 1]])
+            xs, ys = source(root)[:2]
+            point = np.array([float(xs[0]), float(ys[0])])
+            if np.all(np.isfinite(point)) and float(np.hypot(*((point - vertex) / scale))) < _CORNER_MOVE:
+                return point
+        return None
 
     def __repr__(self):
         counts = sorted({c.count for c in self.cells})

@@ -447,7 +447,22 @@ def test_beta_max_at_gamma0_d0_is_the_end_of_the_arc(gamma0_limits):
     lim = gamma0_limits[0]
     t = theta_max_30(0.0, 0, PAPER_DELTA)
     _, b = boundary_point(t, gamma=0.0, d=0, delta=PAPER_DELTA, dps=30)
-    assert abs(lim.beta_max - float(b)) <= 1e-9 * float(b), (lim.beta_max, b)
+    assert abs(lim.beta_max - float(b)) <= 1e-12 * float(b), (lim.beta_max, b)
+
+
+@pytest.mark.parametrize("gamma, d, delta", [(-0.5, 0, 2.0), (0.0, 1, 0.1), (0.0, 5, 1e-4),
+                                             (1.5, 0, 0.1), (0.5, 0, 2.0)])
+def test_beta_max_is_the_corner_of_the_arc_on_alpha_zero(gamma, d, delta):
+    # The region's right end is the corner where the arc ends on alpha = 0
+    # (theta_max).  The polygons' vertex there is where two chords cross, off
+    # the curves by a chord's sag (up to 2e-9 relative); it is re-found on
+    # the arc.  Oracle: the first-principles arc at theta_max, 50 digits.
+    lim = limits(gamma=gamma, d=d, delta=delta)
+    with mpmath.workdps(50):
+        t = mpmath.findroot(lambda t: first_principles_boundary_point(t, gamma, d, delta)[0],
+                            mpmath.mpf(theta_max_30(gamma, d, delta)))
+        b = first_principles_boundary_point(t, gamma, d, delta)[1]
+    assert abs(lim.beta_max - float(b)) <= 1e-12 * abs(float(b)), (lim.beta_max, b)
 
 
 def green_area(gamma, d, delta):
