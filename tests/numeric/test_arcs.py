@@ -124,6 +124,23 @@ def test_sine_ratio_at_the_ends_is_its_limit():
     assert np.all(np.abs(sine_ratio(m, np.pi) - limit) <= 4e-16 * np.abs(limit))
 
 
+@pytest.mark.parametrize("gamma, d, delta", [(0.0, 10, 0.00253125), (-0.5, 40, 0.1),
+                                             (1.5, 1, 2.0), (0.5, 200, 1e-5)])
+def test_paper_loops_closed_form_arc_matches_the_printed_model_on_the_whole_circle(gamma, d, delta):
+    # PAPER_LOOP's arc hook in Table I's variables (m = T = 1: B = beta,
+    # K = alpha), against the 50-digit solve of the printed eqs. (1), (2),
+    # (4): exact coefficients, not the rounded ones the Cramer oracle uses.
+    from oracles import first_principles_boundary_point
+    from symstab.numeric.paper_loop import closed_form_arc, paper_point
+
+    _, values = paper_point(gamma=gamma, d=d, delta=delta)
+    beta, alpha = closed_form_arc("B", "K", values)(THETA)
+    with mpmath.workdps(50):
+        reference = [first_principles_boundary_point(float(t), gamma, d, delta)[::-1] + (None,)
+                     for t in THETA]
+    assert relative_error(beta, alpha, reference) <= TOLERANCE
+
+
 def test_closed_form_is_the_paper_arc():
     # The closed form (alpha, beta from the generated kernel) is the same arc
     # as the structured solve of the paper's polynomial; the two differ by
