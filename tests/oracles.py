@@ -255,6 +255,59 @@ def boundary_point_mp(theta, gamma, d, delta):
     return fa(t, g, d, dl, mpmath.exp(dl)), fb(t, g, d, dl, mpmath.exp(dl))
 
 
+def loop_arc_mp(loop, theta, *, dps=50):
+    """The arc of a :class:`symstab.Loop`'s default plane from its model, at ``dps`` digits.
+
+    ``1 + VE(z) G(z) z**-d = 0`` at ``z = exp(j theta)`` solved for the
+    plane's ``(x, y)`` by Cramer's rule on its real and imaginary parts,
+    with the loop's default values as exact binary numbers: ``G`` from the
+    loop's symbolic pulse transfer function (or, for a plant discretised
+    numerically, the matrix exponential at ``dps`` digits), ``VE`` the
+    environment as written.  Nothing is rounded to doubles: this is the
+    reference the arc's accuracy is measured against, coefficients'
+    rounding included.
+
+    Returns
+    -------
+    list of (mpf, mpf)
+    """
+    from symstab.symbolic.discretize import numeric_zoh
+
+    z = model.z
+    x, y = loop.plane
+    values = dict(loop.defaults)
+    d = int(values.pop("d"))
+    with mpmath.workdps(dps):
+        symbols = {s.name: s for s in loop.environment.free_symbols | loop.plant.free_symbols}
+        exact = {symbols[k]: sp.Rational(float(v)) for k, v in values.items()
+                 if k in symbols and k not in (x, y)}
+        environment = loop.environment.subs(exact)
+        if loop.zoh_method == "residues":
+            pulse = sp.lambdify(z, loop.pulse_transfer_function().subs(exact), "mpmath")
+        else:
+            num, den = sp.fraction(sp.together(loop.plant.subs(exact)))
+            p_n, p_d = numeric_zoh([mpmath.mpf(sp.Rational(c).p) / sp.Rational(c).q
+                                    for c in sp.Poly(num, model.s).all_coeffs()],
+                                   [mpmath.mpf(sp.Rational(c).p) / sp.Rational(c).q
+                                    for c in sp.Poly(den, model.s).all_coeffs()],
+                                   mpmath.mpf(float(values["T"])), dps=dps)
+
+            def pulse(w):
+                return mpmath.polyval(p_n, w) / mpmath.polyval(p_d, w)
+        X, Y = symbols[x], symbols[y]
+        parts = [sp.lambdify(z, e, "mpmath") for e in
+                 (environment.subs({X: 0, Y: 0}), sp.diff(environment, X), sp.diff(environment, Y))]
+        out = []
+        for t in theta:
+            w = mpmath.expj(t if isinstance(t, mpmath.mpf) else mpmath.mpf(float(t)))
+            g = pulse(w) * w**(-d)
+            a0, cx, cy = 1 + parts[0](w) * g, parts[1](w) * g, parts[2](w) * g
+            det = cx.real * cy.imag - cy.real * cx.imag
+            out.append(((-a0.real * cy.imag + cy.real * a0.imag) / det,
+                        (-cx.real * a0.imag + a0.real * cx.imag) / det))
+        return out
+
+
 def theta_max_box_sample(seed, n):
     """Seeded ``(gamma, d, delta)`` with an arc, in the box of issue 12.
 

@@ -34,6 +34,7 @@ leading coefficient give straight lines.
 """
 
 import dataclasses
+import fractions
 import functools
 import math
 
@@ -44,7 +45,7 @@ from .._resources import check_memory
 from .._validate import check_array, check_count, check_delay, check_real, check_window
 from ..symbolic.loop_assembly import PLANT_DIGITS, LoopModel, parse_environment, parse_plant, shift_to_one
 from ..codegen.loop_kernels import environment_kernels, load_numpy_kernels
-from .arcs import CramerArc
+from .arcs import EXACT_TERMS, ClosedFormArc, CramerArc, ExactPolynomial
 from .decomposition import Decomposition, arc_points, decompose, stable_hull
 from .passivity import passive_region
 from .decomposition import lines as _lines
@@ -69,6 +70,16 @@ LoopBoundary = Boundary
 #: coordinates (areas, cross products of the cells' edges) stay finite.
 LARGEST_COORDINATE = 1e150
 
+
+
+def _exact_product(a, b):
+    """The coefficients of the product of two polynomials (rows highest first), as exact Fractions."""
+    a = [fractions.Fraction(float(c)) if not isinstance(c, fractions.Fraction) else c for c in a]
+    out = [fractions.Fraction(0)] * (len(a) + len(b) - 1)
+    for i, x in enumerate(a):
+        for j, y in enumerate(b):
+            out[i + j] += x * y
+    return tuple(out)
 
 class Loop(LoopModel):
     """A sampled haptic loop: plant, zero-order hold, delay and virtual environment.
@@ -622,6 +633,81 @@ class Loop(LoopModel):
             raise TypeError("give the plane's parameters x and y (this loop has no default plane)")
         return x, y
 
+    def arc(self, x=None, y=None, **values):
+        """The arc source of the ``(x, y)`` plane: ``source(theta) -> (x, y, det)``.
+
+        The one source of the loop's arc, which :meth:`boundary`,
+        :meth:`region` and :meth:`limits` sample: the closed form where
+        SymPy derived one (the ``arc`` parameter; the paper's kernel), else
+        Cramer's rule with ``sin(theta)`` divided out
+        (:class:`~symstab.numeric.arcs.CramerArc`) on the loop's
+        characteristic polynomial with its plant's 30-digit coefficients
+        kept exact where the plane's parameters are the environment's (a
+        plant zero next to ``z = -1``, a pole at ``z = 1``: rounded to
+        doubles, those coefficients cost the arc up to 1e-9 of its size
+        there).
+
+        Parameters
+        ----------
+        x, y : str
+            The plane's parameters, jointly affine (default: :attr:`plane`).
+        **values
+            Single values of every other parameter.
+
+        Returns
+        -------
+        symstab.numeric.arcs.ArcSource
+            At angles in (0, pi): the point of the plane where ``exp(j
+            theta)`` is a root (NaN where the arc is at infinity) and the
+            sign-carrying determinant.
+
+        Examples
+        --------
+        >>> loop = Loop("1/(m*s**2 + b*s)", "K + B*(z - 1)/(T*z)",
+        ...             values=dict(m=0.0128, b=0.0324, T=1e-3, d=10))
+        >>> B, K, det = loop.arc("B", "K")(np.array([0.05]))
+        >>> bool(K[0] > 0)
+        True
+        """
+        x, y = self._plane(x, y)
+        structured, slopes, _ = self.affine_parts((x, y), values, structured=True)
+        return self._arc_source(x, y, values, (structured, *slopes))
+
+    def _arc_source(self, x, y, values, parts):
+        """:meth:`arc` on the plane's structured parts, computed by the caller."""
+        exact = self._exact_parts((x, y), values)
+        cramer = CramerArc(*(exact or parts))
+        closed = self._closed_form(x, y, values)
+        return cramer if closed is None else ClosedFormArc(closed, cramer)
+
+    def _exact_parts(self, names, given):
+        """``(A0, A_x, A_y)`` as :class:`~symstab.numeric.arcs.ExactPolynomial`, or None.
+
+        The plant's coefficients exact at their 30 digits, the
+        environment's doubles as they are, multiplied in rational
+        arithmetic.  None where a plane parameter is also the plant's (its
+        slope is not computed exactly) or a part is longer than the arc's
+        exact sums take.
+        """
+        if any(n not in self._environment_names or n in self._plant_names or n == "T"
+               for n in names):
+            return None
+        values, d, shape = self._prepare(given, scalar=self.parameters, drop=names)
+        for name in names:
+            values[name] = np.asarray(0.0)
+        p_n, p_d = self._exact_plant(tuple(float(values[n]) for n in self._plant_names),
+                                     float(values["T"]))
+        k = self._delay_of_environment
+        out = []
+        for slope in (None, *names):
+            ve_n, ve_d = (part.reshape(-1) for part in self._environment_arrays(values, shape, slope))
+            ve_d = ve_d[:len(ve_d) - k]
+            delayed, direct = _exact_product(ve_d, p_d), _exact_product(ve_n, p_n)
+            if max(len(delayed), len(direct)) > EXACT_TERMS:
+                return None
+            out.append(ExactPolynomial(delayed, direct, d + k))
+        return tuple(out)
+
     def boundary(self, x=None, y=None, n=1000, **values):
         """The D-decomposition of the ``(x, y)`` plane.
 
@@ -645,7 +731,7 @@ class Loop(LoopModel):
         structured, slopes, ends = self.affine_parts((x, y), values, structured=True)
         base, ax, ay = (p.dense().reshape(-1) for p in (structured, *slopes))
         theta = np.pi * (np.arange(1, n + 1) - 0.5) / n
-        xs, ys, _ = CramerArc(structured, *slopes)(theta)
+        xs, ys, _ = self._arc_source(x, y, values, (structured, *slopes))(theta)
         lines = {label: c for label, c in _lines(base, ax, ay, ends).items() if c[1] or c[2]}
         return Boundary(x, y, theta, xs, ys, lines=lines, at=dict(values))
 
@@ -697,7 +783,7 @@ class Loop(LoopModel):
                  for key, window in (("x_range", x_range), ("y_range", y_range))}
         structured, slopes, ends = self.affine_parts((x, y), values, structured=True)
         base, ax, ay = (p.dense().reshape(-1) for p in (structured, *slopes))
-        arc = CramerArc(structured, *slopes)
+        arc = self._arc_source(x, y, values, (structured, *slopes))
         free = {"x_min": given["x_range"] is None, "x_max": given["x_range"] is None,
                 "y_min": given["y_range"] is None, "y_max": given["y_range"] is None}
 

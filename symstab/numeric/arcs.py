@@ -24,8 +24,8 @@ angle whatever the delay.
 Two arc sources share one interface, ``source(theta) -> (x, y, det)``:
 
 * :class:`CramerArc` -- the solve above, for any loop;
-* :class:`ClosedFormArc` -- the paper's loop, whose arc SymPy derived in
-  closed form (the generated kernel :func:`symstab._generated.kernels.boundary`,
+* :class:`ClosedFormArc` -- a loop whose arc SymPy derived in closed form
+  (the paper's: the generated kernel :func:`symstab._generated.kernels.boundary`,
   ``x = beta``, ``y = alpha``), with the determinant's sign from the
   structured solve.
 
@@ -34,6 +34,7 @@ roots outside the circle changes when a parameter moves through a point
 where a root is on the circle.
 """
 
+import dataclasses
 import fractions
 import functools
 import math
@@ -45,8 +46,8 @@ from .._validate import check_loop
 from .polynomial import DelayedPolynomial
 from .stability import paper_polynomial
 
-__all__ = ["ArcSource", "Brackets", "CramerArc", "ClosedFormArc", "sine_ratio", "crossing_change",
-           "SINGULAR", "END_ANGLE", "EXACT_TERMS"]
+__all__ = ["ArcSource", "Brackets", "CramerArc", "ClosedFormArc", "ExactPolynomial", "sine_ratio",
+           "crossing_change", "SINGULAR", "END_ANGLE", "EXACT_TERMS"]
 
 #: The determinant is called singular (the arc is at infinity, x and y NaN)
 #: where it is at most this fraction of the rounding scale of its sine
@@ -63,12 +64,46 @@ _PI_LOW = 1.2246467991473532e-16
 _SPLIT = 134217729.0
 
 
+@dataclasses.dataclass(frozen=True)
+class ExactPolynomial:
+    """One real polynomial ``z**shift D(z) + N(z)`` with exact rational coefficients.
+
+    What an arc source needs where rounding the coefficients to doubles
+    would cost the arc its digits: a plant zero or pole next to ``z = 1``
+    or ``z = -1`` makes the brackets cancel there, and the coefficients'
+    rounding (1e-16 of them) is then 1e-9 of the arc (a loop's plant at
+    30 digits, :meth:`symstab.Loop.arc`).
+
+    Attributes
+    ----------
+    delayed, direct : tuple of fractions.Fraction
+        The coefficients of ``D`` and ``N``, highest power first.
+    shift : int
+        The power of ``z`` on the delayed part.
+    """
+
+    delayed: tuple
+    direct: tuple
+    shift: int
+
+
+def _exact(x):
+    """``x`` as a Fraction, exactly (a double is its binary value)."""
+    return x if isinstance(x, fractions.Fraction) else fractions.Fraction(float(x))
+
+
 def _parts(polynomial):
     """``(D, N, shift)`` of one real polynomial ``z**shift D(z) + N(z)`` (rows highest first).
 
     ``polynomial`` is a :class:`DelayedPolynomial` of one row or a 1-D row of
     dense coefficients (taken as ``N``, ``shift = 0``).
     """
+    if isinstance(polynomial, ExactPolynomial):
+        rows = [np.array([_exact(c) for c in part], dtype=object)
+                for part in (polynomial.delayed, polynomial.direct)]
+        if not all(len(r) for r in rows):
+            raise ValueError("delayed and direct must have at least one coefficient each")
+        return rows[0], rows[1], int(polynomial.shift)
     if isinstance(polynomial, DelayedPolynomial):
         if len(polynomial) != 1:
             raise ValueError(f"an arc source takes one polynomial per part, got {len(polynomial)}")
@@ -117,7 +152,7 @@ def _terms(parts):
     powers = np.concatenate([shift + np.arange(len(delayed) - 1, -1, -1),
                              np.arange(len(direct) - 1, -1, -1)])
     coefficients = np.concatenate([delayed, direct])
-    keep = coefficients != 0
+    keep = np.array([c != 0 for c in coefficients], dtype=bool)
     return powers[keep].astype(np.int64), coefficients[keep]
 
 
@@ -132,7 +167,7 @@ def _laurent(a, b):
             if y == 0:
                 continue
             k = (pa - i) - (pb - j)
-            out[k] = out.get(k, 0) + fractions.Fraction(float(x)) * fractions.Fraction(float(y))
+            out[k] = out.get(k, 0) + _exact(x) * _exact(y)
     return out
 
 
@@ -209,6 +244,17 @@ def _bracket(first, second):
     ``e_m`` is that sum of exact products rounded once (``math.fsum``).
     """
     (pj, p), (qk, q) = first, second
+    if p.dtype == object or q.dtype == object:
+        # Exact coefficients: the sums in rational arithmetic, rounded once.
+        sums = {}
+        for j, a in zip(pj.tolist(), p):
+            for k, b in zip(qk.tolist(), q):
+                if j != k:
+                    term = _exact(a) * _exact(b)
+                    sums[abs(j - k)] = sums.get(abs(j - k), 0) + (term if j > k else -term)
+        frequencies = sorted(m for m, e in sums.items() if e != 0)
+        return (np.array(frequencies, dtype=float),
+                np.array([float(sums[m]) for m in frequencies], dtype=float))
     m = np.subtract.outer(pj, qk).ravel()
     hi, lo = _two_product(np.multiply.outer(p, np.ones_like(q)).ravel(),
                           np.multiply.outer(np.ones_like(p), q).ravel())
@@ -302,9 +348,11 @@ class Brackets:
 
     Parameters
     ----------
-    polynomials : sequence of DelayedPolynomial or ndarray
+    polynomials : sequence of DelayedPolynomial, ExactPolynomial or ndarray
         One polynomial each, real and finite: :class:`DelayedPolynomial`
-        rows of one polynomial with a common shift, or 1-D dense
+        rows of one polynomial or :class:`ExactPolynomial` (exact
+        coefficients: each bracket's coefficients summed in rational
+        arithmetic, rounded once), with a common shift; or 1-D dense
         coefficient rows (highest power first; split at their longest run
         of zeros).
     pairs : sequence of (int, int)
@@ -320,7 +368,7 @@ class Brackets:
 
     def __init__(self, polynomials, pairs):
         polynomials = list(polynomials)
-        if not all(isinstance(p, DelayedPolynomial) for p in polynomials):
+        if not all(isinstance(p, (DelayedPolynomial, ExactPolynomial)) for p in polynomials):
             polynomials = _split_dense([p.dense().reshape(-1) if isinstance(p, DelayedPolynomial)
                                         else p for p in polynomials])
         parts = [_parts(p) for p in polynomials]
@@ -440,11 +488,11 @@ class CramerArc(ArcSource):
 
     Parameters
     ----------
-    base, ax, ay : DelayedPolynomial or ndarray
+    base, ax, ay : DelayedPolynomial, ExactPolynomial or ndarray
         One polynomial each: :class:`DelayedPolynomial` rows of one
-        polynomial with a common shift (the structured basis of a loop's
-        plane), or 1-D dense coefficient rows (highest power first).  Real
-        and finite.
+        polynomial or :class:`ExactPolynomial`, with a common shift (the
+        structured basis of a loop's plane), or 1-D dense coefficient rows
+        (highest power first).  Real and finite.
 
     Notes
     -----
@@ -503,37 +551,63 @@ class CramerArc(ArcSource):
 
 
 class ClosedFormArc(ArcSource):
-    """The paper's arc in its plane ``(x, y) = (beta, alpha)``, from the closed form.
-
-    ``alpha(theta)``, ``beta(theta)`` come from the generated kernel
-    (SymPy's closed form, sin(theta) divided out symbolically); the
-    determinant (its sign marks the branches through infinity) from the
-    structured :class:`CramerArc` of the paper's polynomial.
+    """An arc in closed form, with the determinant's sign from a Cramer solve.
 
     Parameters
     ----------
-    gamma, d, delta
-        The paper's loop (:func:`symstab._validate.check_loop`).
+    points : callable
+        ``theta -> (x, y)``: the closed form (SymPy's, sin(theta) divided
+        out symbolically), for angles in (0, pi).
+    determinant : ArcSource
+        The source whose determinant (its sign marks the branches through
+        infinity) goes with the points: the :class:`CramerArc` of the same
+        plane.
+
+    Examples
+    --------
+    The paper's arc in its plane ``(x, y) = (beta, alpha)``:
+
+    >>> arc = ClosedFormArc.paper(gamma=0.0, d=0, delta=0.00253125)
+    >>> beta, alpha, det = arc(np.array([1.0]))
+    >>> round(float(alpha[0]), 6) > 0
+    True
     """
 
-    def __init__(self, *, gamma, d, delta):
-        self.gamma, self.d, self.delta = check_loop(gamma, d, delta)
-        at = {(a, b): paper_polynomial(alpha=a, beta=b, gamma=self.gamma, d=self.d, delta=self.delta)
+    def __init__(self, points, determinant):
+        if not callable(points) or not isinstance(determinant, ArcSource):
+            raise TypeError("points must be callable and determinant an ArcSource")
+        self._points, self._determinant = points, determinant
+
+    @classmethod
+    def paper(cls, *, gamma, d, delta):
+        """The paper's arc in ``(beta, alpha)``: the generated kernel, the paper's polynomial's det.
+
+        ``alpha(theta)``, ``beta(theta)`` come from
+        :func:`symstab._generated.kernels.boundary`; ``gamma, d, delta`` are
+        checked by :func:`symstab._validate.check_loop`.
+        """
+        gamma, d, delta = check_loop(gamma, d, delta)
+        at = {(a, b): paper_polynomial(alpha=a, beta=b, gamma=gamma, d=d, delta=delta)
               for a, b in ((0.0, 0.0), (0.0, 1.0), (1.0, 0.0))}
         base = at[0.0, 0.0]
         # chi is affine in alpha and beta: the slopes are differences.
         slopes = [DelayedPolynomial(at[k].delayed - base.delayed, at[k].direct - base.direct,
                                     base.shift) for k in ((0.0, 1.0), (1.0, 0.0))]
-        self._cramer = CramerArc(base, *slopes)
+
+        def points(theta):
+            alpha, beta = kernels.boundary(theta, gamma, d, delta)
+            return beta, alpha
+
+        return cls(points, CramerArc(base, *slopes))
 
     def __call__(self, theta):
-        """``(beta, alpha, det)`` at angles ``theta`` in (0, pi)."""
+        """``(x, y, det)`` at angles ``theta`` in (0, pi)."""
         theta = np.asarray(theta, dtype=float)
-        alpha, beta = kernels.boundary(theta, self.gamma, self.d, self.delta)
-        det = self._cramer(theta)[2]
-        alpha = np.broadcast_to(np.asarray(alpha, dtype=float), theta.shape).copy()
-        beta = np.broadcast_to(np.asarray(beta, dtype=float), theta.shape).copy()
-        return beta, alpha, det
+        x, y = self._points(theta)
+        det = self._determinant(theta)[2]
+        x = np.broadcast_to(np.asarray(x, dtype=float), theta.shape).copy()
+        y = np.broadcast_to(np.asarray(y, dtype=float), theta.shape).copy()
+        return x, y, det
 
 
 def _part_slope(c, z):

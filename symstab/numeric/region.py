@@ -121,7 +121,7 @@ class StabilityRegion:
             values[np.abs(values) <= 64 * np.finfo(float).eps * np.sum(np.abs(c))] = 0.0
             ends.append(values)
         # The paper's arc source is its closed form (the generated kernel).
-        arc = ClosedFormArc(gamma=self.gamma, d=self.d, delta=self.delta)
+        arc = ClosedFormArc.paper(gamma=self.gamma, d=self.d, delta=self.delta)
         return decompose(base, ax, ay, ends, x_range=x_range, y_range=y_range,
                          names=("beta", "alpha"), arc=arc)
 

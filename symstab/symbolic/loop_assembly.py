@@ -19,6 +19,7 @@ axes a parameter plane may have) and evaluates the plant's polynomials at
 """
 
 import ast
+import fractions
 import functools
 import keyword
 import re
@@ -81,6 +82,16 @@ def shift_to_one(coefficients, dtype=None):
     for stop in range(p.shape[-1], 1, -1):
         p[..., :stop] = np.cumsum(p[..., :stop], axis=-1)
     return p
+
+
+def _fraction(value):
+    """An mpmath number that is real up to rounding, as the exact Fraction of its binary value."""
+    if isinstance(value, mpmath.mpc):
+        value = value.real
+    value = mpmath.mpf(value)
+    man, exp = value.man_exp            # the mantissa's magnitude
+    exact = fractions.Fraction(int(man)) * fractions.Fraction(2) ** int(exp)
+    return -exact if value < 0 else exact
 
 
 def _real_floats(values):
@@ -800,18 +811,11 @@ class LoopModel:
         return int(mpmath.ceil(total))
 
     @functools.lru_cache(maxsize=4096)
-    def _plant_cache(self, plant_values, T):
-        """(P_n, P_d, ends, P_d in z - 1) as float arrays, monic P_d, evaluated at 30 digits.
+    def _plant_digits(self, plant_values, T):
+        """``(P_n, P_d, digits)``: the pulse transfer function's coefficients as mpmath numbers.
 
-        ``ends`` is ``(P_n(1), P_d(1), P_n(-1), P_d(-1))``, summed at 30
-        digits: a pole at z = 1 then gives ``P_d(1)`` of 1e-30, not of the
-        coefficients' rounding, and the line z = 1 of a plane comes out
-        where it is.  The last part is ``P_d(w + 1)``'s coefficients in
-        ``w = z - 1`` (highest first), shifted at 30 digits: a pole
-        ``exp(p T)`` near 1 gives a small coefficient with its own digits,
-        which the root count needs next to ``z = 1``.  Where the closed form
-        needed more digits (:meth:`_closed_form_plant`), all of this is done
-        at those: a pole ``exp(-1e-30)`` keeps its ``1e-30`` after the shift.
+        At :data:`PLANT_DIGITS` digits, or more where the closed form needs
+        them (:meth:`_closed_form_plant`); refused where it is not defined.
         """
         digits = PLANT_DIGITS
         with mpmath.workdps(PLANT_DIGITS):
@@ -832,6 +836,37 @@ class LoopModel:
                 raise ValueError(f"the plant's pulse transfer function is not defined at "
                                  f"{given}, T = {float(T):g} (a pole cancels a parameter, "
                                  f"e.g. b = 0 in 1/(m s**2 + b s)? write that plant with b = 0)")
+        return p_n, p_d, digits
+
+    def _exact_plant(self, plant_values, T):
+        """``(P_n, P_d)`` with monic ``P_d``, as exact Fractions of their 30-digit values.
+
+        For the arc's brackets (:class:`symstab.numeric.arcs.CramerArc`):
+        rounded to doubles, the coefficients of a plant with a zero or a
+        pole next to ``z = +-1`` lose what the arc needs there.
+        """
+        p_n, p_d, digits = self._plant_digits(tuple(plant_values), T)
+        with mpmath.workdps(digits):
+            lead = p_d[0]
+            return tuple(tuple(_fraction(c / lead) for c in part) for part in (p_n, p_d))
+
+    @functools.lru_cache(maxsize=4096)
+    def _plant_cache(self, plant_values, T):
+        """(P_n, P_d, ends, P_d in z - 1) as float arrays, monic P_d, evaluated at 30 digits.
+
+        ``ends`` is ``(P_n(1), P_d(1), P_n(-1), P_d(-1))``, summed at 30
+        digits: a pole at z = 1 then gives ``P_d(1)`` of 1e-30, not of the
+        coefficients' rounding, and the line z = 1 of a plane comes out
+        where it is.  The last part is ``P_d(w + 1)``'s coefficients in
+        ``w = z - 1`` (highest first), shifted at 30 digits: a pole
+        ``exp(p T)`` near 1 gives a small coefficient with its own digits,
+        which the root count needs next to ``z = 1``.  Where the closed form
+        needed more digits (:meth:`_closed_form_plant`), all of this is done
+        at those: a pole ``exp(-1e-30)`` keeps its ``1e-30`` after the shift.
+        """
+        p_n, p_d, digits = self._plant_digits(tuple(plant_values), T)
+        with mpmath.workdps(digits):
+            lead = p_d[0]
             ends = [sum(c * sign**k for k, c in enumerate(reversed(part)))
                     for sign in (1, -1) for part in (p_n, p_d)]
             # A pole at z = 1 (an integrator) makes P_d(1) vanish, but the sum
