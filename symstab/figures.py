@@ -27,7 +27,8 @@ import time
 import numpy as np
 
 from .drawing import LEGEND_SIZE, PANEL_TITLE_SIZE, SUPTITLE_SIZE, label_log_axis, png_bytes, pyplot
-from .numeric.curves import arc_end_angle, arc_polylines
+from .numeric.curves import arc_end_angle
+from .numeric.region import arc_polylines
 from .numeric.region import boundary_curve
 from .numeric.paper_loop import paper_passive_region
 from .numeric.region import StabilityRegion, limits, vanishing_gamma

@@ -26,8 +26,8 @@ Two arc sources share one interface, ``source(theta) -> (x, y, det)``:
 * :class:`CramerArc` -- the solve above, for any loop;
 * :class:`ClosedFormArc` -- a loop whose arc SymPy derived in closed form
   (the paper's: the generated kernel :func:`symstab._generated.kernels.boundary`,
-  ``x = beta``, ``y = alpha``), with the determinant's sign from the
-  structured solve.
+  :func:`symstab.numeric.paper_loop.paper_arc`), with the determinant's sign
+  from the structured solve.
 
 :func:`crossing_change` is the one crossing-direction rule: how the number of
 roots outside the circle changes when a parameter moves through a point
@@ -42,9 +42,7 @@ import math
 import numpy as np
 
 from .._generated import kernels
-from .._validate import check_loop
 from .polynomial import DelayedPolynomial
-from .stability import paper_polynomial
 
 __all__ = ["ArcSource", "Brackets", "CramerArc", "ClosedFormArc", "ExactPolynomial", "sine_ratio",
            "crossing_change", "SINGULAR", "END_ANGLE", "EXACT_TERMS"]
@@ -565,40 +563,18 @@ class ClosedFormArc(ArcSource):
 
     Examples
     --------
-    The paper's arc in its plane ``(x, y) = (beta, alpha)``:
-
-    >>> arc = ClosedFormArc.paper(gamma=0.0, d=0, delta=0.00253125)
-    >>> beta, alpha, det = arc(np.array([1.0]))
-    >>> round(float(alpha[0]), 6) > 0
-    True
+    >>> cramer = CramerArc(np.array([1.0, 0.0, 0.0]), np.array([0.0, 1.0, 0.0]),
+    ...                    np.array([0.0, 0.0, 1.0]))            # z**2 + x z + y
+    >>> arc = ClosedFormArc(lambda t: (-2 * np.cos(t), np.ones_like(t)), cramer)
+    >>> x, y, det = arc(np.array([np.pi / 3]))
+    >>> round(float(x[0]), 12), float(y[0])
+    (-1.0, 1.0)
     """
 
     def __init__(self, points, determinant):
         if not callable(points) or not isinstance(determinant, ArcSource):
             raise TypeError("points must be callable and determinant an ArcSource")
         self._points, self._determinant = points, determinant
-
-    @classmethod
-    def paper(cls, *, gamma, d, delta):
-        """The paper's arc in ``(beta, alpha)``: the generated kernel, the paper's polynomial's det.
-
-        ``alpha(theta)``, ``beta(theta)`` come from
-        :func:`symstab._generated.kernels.boundary`; ``gamma, d, delta`` are
-        checked by :func:`symstab._validate.check_loop`.
-        """
-        gamma, d, delta = check_loop(gamma, d, delta)
-        at = {(a, b): paper_polynomial(alpha=a, beta=b, gamma=gamma, d=d, delta=delta)
-              for a, b in ((0.0, 0.0), (0.0, 1.0), (1.0, 0.0))}
-        base = at[0.0, 0.0]
-        # chi is affine in alpha and beta: the slopes are differences.
-        slopes = [DelayedPolynomial(at[k].delayed - base.delayed, at[k].direct - base.direct,
-                                    base.shift) for k in ((0.0, 1.0), (1.0, 0.0))]
-
-        def points(theta):
-            alpha, beta = kernels.boundary(theta, gamma, d, delta)
-            return beta, alpha
-
-        return cls(points, CramerArc(base, *slopes))
 
     def __call__(self, theta):
         """``(x, y, det)`` at angles ``theta`` in (0, pi)."""

@@ -22,13 +22,12 @@ import fractions
 import numpy as np
 
 from .._generated import kernels
-from .._resources import check_memory
-from .._validate import check_loop, check_window
+from .._validate import check_loop
 from ..symbolic.theta_max import first_sign_change, reduced_curvature, reduced_qr, reduced_value_slope
 from .results import Boundary
 
 __all__ = ["arc_end_angle", "minus_one_line", "BoundaryCurve", "Segment", "scan_grid",
-           "bracketed_root", "zoom_max", "arc_polylines", "KERNEL_BYTES_PER_POINT",
+           "bracketed_root", "zoom_max", "KERNEL_BYTES_PER_POINT",
            "KERNEL_CHUNK_BYTES"]
 
 
@@ -227,56 +226,6 @@ class Segment:
 
 #: Older name of :class:`symstab.numeric.results.Boundary`, the one result type of a boundary.
 BoundaryCurve = Boundary
-
-
-def arc_polylines(*, gamma, d, delta, window):
-    """The whole boundary arc, 0 < theta < pi, as polylines to draw in ``window``.
-
-    Parameters
-    ----------
-    gamma : float
-        ``M_w / m``.
-    d : int
-        Delay in samples.
-    delta : float
-        ``b T / m``.
-    window : ((float, float), (float, float))
-        ``((beta0, beta1), (alpha0, alpha1))``, the part of the plane drawn.
-
-    Returns
-    -------
-    (ndarray, ndarray)
-        ``(first, beyond)``, each an ``(n, 2)`` array of ``(beta, alpha)``
-        rows: the arc of eq. (7) from theta = 0 to theta_max, and the rest up
-        to pi (empty when there is no theta_max).  Rows of NaN cut the curve
-        where it runs far from the window -- through a pole it goes to
-        infinity and comes back from the other side, and a straight line
-        across would be drawn.  The samples resolve the arc's turns: sin(d
-        theta) has d / 2 periods on the way, so 400 samples a period.
-    """
-    gamma, d, delta = check_loop(gamma, d, delta)
-    if isinstance(window, (str, bytes)) or not hasattr(window, "__len__") or len(window) != 2:
-        raise TypeError(f"window must be ((beta0, beta1), (alpha0, alpha1)), got {window!r}")
-    (b0, b1), (a0, a1) = (check_window("window[0]", window[0]), check_window("window[1]", window[1]))
-    check_memory("the arc's polylines", 64 * (4000 + 400 * d))
-    t_max = arc_end_angle(gamma=gamma, d=d, delta=delta)
-    theta = np.linspace(0.0, np.pi, 4000 + 400 * d + 1)[1:-1]
-    if np.isfinite(t_max):
-        theta = np.union1d(theta, [t_max])
-    alpha, beta = kernels.boundary(theta, gamma, d, delta)
-    span_b, span_a = b1 - b0, a1 - a0
-    with np.errstate(invalid="ignore"):
-        far = ~(np.isfinite(alpha) & np.isfinite(beta)) \
-            | (beta < b0 - 5 * span_b) | (beta > b1 + 5 * span_b) \
-            | (alpha < a0 - 5 * span_a) | (alpha > a1 + 5 * span_a)
-    points = np.column_stack([beta, alpha])
-    points[far] = np.nan
-    # The arc starts exactly at the corner (-delta, 0), the z = 1 root's line.
-    points = np.vstack([[-delta, 0.0], points])
-    if not np.isfinite(t_max):
-        return np.empty((0, 2)), points
-    k = int(np.searchsorted(theta, t_max)) + 1
-    return points[: k + 1], points[k:]
 
 
 def zoom_max(f, a, b, *, rtol, points=33, enough=None):

@@ -26,7 +26,7 @@ from ..symbolic import model
 from .results import PAPER_PLANE
 from .units import PAPER_DEVICE
 
-__all__ = ["PAPER_LOOP", "paper_loop", "PAPER_NAMES", "paper_point", "closed_form_arc",
+__all__ = ["PAPER_LOOP", "paper_loop", "PAPER_NAMES", "paper_point", "paper_arc", "closed_form_arc",
            "closed_form_polynomial", "paper_limits",
            "paper_passive_region", "paper_locus"]
 
@@ -180,6 +180,24 @@ def paper_point(*, gamma, d, delta):
     if delta == 0:
         return frictionless_paper_loop(), {"m": 1.0, "T": 1.0, "M": gamma, "d": d}
     return paper_loop(), {"m": 1.0, "T": 1.0, "b": delta, "M": gamma, "d": d}
+
+
+def paper_arc(*, gamma, d, delta):
+    """The paper's arc in Table I's plane: ``source(theta) -> (beta, alpha, det)``.
+
+    :meth:`Loop.arc <symstab.Loop.arc>` of :func:`paper_point`'s loop in
+    the plane ``(B, K) = (beta, alpha)``: eq. (7)'s closed form (the
+    generated kernel, :func:`closed_form_arc`), with the determinant's sign
+    from the loop's Cramer solve.
+
+    Examples
+    --------
+    >>> beta, alpha, det = paper_arc(gamma=0.0, d=0, delta=0.00253125)(np.array([1.0]))
+    >>> bool(alpha[0] > 0)
+    True
+    """
+    loop, values = paper_point(gamma=gamma, d=d, delta=delta)
+    return loop.arc("B", "K", **values)
 
 
 def paper_limits(*, gamma, d, delta, region=None):

@@ -25,20 +25,18 @@ import warnings
 
 import numpy as np
 
-from .._generated import kernels
 from .._resources import check_memory, chunk_slices
 from .._validate import check_array, check_count, check_loop, check_real, check_window
 from .curves import (KERNEL_BYTES_PER_POINT, KERNEL_CHUNK_BYTES, Segment, arc_end_angle,
                      minus_one_line)
-from .arcs import ClosedFormArc
 from .decomposition import decompose
 from .intervals import circle_crossings
-from .paper_loop import closed_form_arc, paper_limits, paper_point
+from .paper_loop import closed_form_arc, paper_arc, paper_limits, paper_point
 from .results import PAPER_PLANE, Boundary
 from .stability import loop_coefficients
 
 __all__ = ["StabilityRegion", "limits", "vanishing_gamma", "BestVirtualMass", "best_virtual_mass",
-           "scan_maximum", "boundary_curve"]
+           "scan_maximum", "boundary_curve", "arc_polylines"]
 
 #: An end of a stable interval within this many ulps of its terms' size
 #: from the line z = -1 lies on it (:meth:`StabilityRegion.line_segments`).
@@ -121,7 +119,7 @@ class StabilityRegion:
             values[np.abs(values) <= 64 * np.finfo(float).eps * np.sum(np.abs(c))] = 0.0
             ends.append(values)
         # The paper's arc source is its closed form (the generated kernel).
-        arc = ClosedFormArc.paper(gamma=self.gamma, d=self.d, delta=self.delta)
+        arc = paper_arc(gamma=self.gamma, d=self.d, delta=self.delta)
         return decompose(base, ax, ay, ends, x_range=x_range, y_range=y_range,
                          names=("beta", "alpha"), arc=arc)
 
@@ -660,8 +658,9 @@ def boundary_curve(*, gamma, d, delta, n=1000, segments=True):
                                "to it)", at=at)
     theta = np.linspace(0.0, t_end, n)
     alpha, beta = np.empty(n), np.empty(n)
+    arc = paper_arc(gamma=gamma, d=d, delta=delta)
     for part in chunk_slices(n, KERNEL_BYTES_PER_POINT, KERNEL_CHUNK_BYTES):
-        alpha[part], beta[part] = kernels.boundary(theta[part], gamma, d, delta)
+        beta[part], alpha[part], _ = arc(theta[part])
     # The ends are exact: the arc starts at (-delta, 0) and ends on alpha = 0.
     alpha[0], beta[0] = 0.0, -delta
     if t_end < np.pi:
@@ -671,3 +670,53 @@ def boundary_curve(*, gamma, d, delta, n=1000, segments=True):
         pieces = StabilityRegion(gamma=gamma, d=d, delta=delta).line_segments()
     return Boundary(*PAPER_PLANE, theta, beta, alpha, lines=lines, segments=pieces, theta_max=t_end,
                     at=at)
+
+
+def arc_polylines(*, gamma, d, delta, window):
+    """The whole boundary arc, 0 < theta < pi, as polylines to draw in ``window``.
+
+    Parameters
+    ----------
+    gamma : float
+        ``M_w / m``.
+    d : int
+        Delay in samples.
+    delta : float
+        ``b T / m``.
+    window : ((float, float), (float, float))
+        ``((beta0, beta1), (alpha0, alpha1))``, the part of the plane drawn.
+
+    Returns
+    -------
+    (ndarray, ndarray)
+        ``(first, beyond)``, each an ``(n, 2)`` array of ``(beta, alpha)``
+        rows: the arc of eq. (7) from theta = 0 to theta_max, and the rest up
+        to pi (empty when there is no theta_max).  Rows of NaN cut the curve
+        where it runs far from the window -- through a pole it goes to
+        infinity and comes back from the other side, and a straight line
+        across would be drawn.  The samples resolve the arc's turns: sin(d
+        theta) has d / 2 periods on the way, so 400 samples a period.
+    """
+    gamma, d, delta = check_loop(gamma, d, delta)
+    if isinstance(window, (str, bytes)) or not hasattr(window, "__len__") or len(window) != 2:
+        raise TypeError(f"window must be ((beta0, beta1), (alpha0, alpha1)), got {window!r}")
+    (b0, b1), (a0, a1) = (check_window("window[0]", window[0]), check_window("window[1]", window[1]))
+    check_memory("the arc's polylines", 64 * (4000 + 400 * d))
+    t_max = arc_end_angle(gamma=gamma, d=d, delta=delta)
+    theta = np.linspace(0.0, np.pi, 4000 + 400 * d + 1)[1:-1]
+    if np.isfinite(t_max):
+        theta = np.union1d(theta, [t_max])
+    beta, alpha, _ = paper_arc(gamma=gamma, d=d, delta=delta)(theta)
+    span_b, span_a = b1 - b0, a1 - a0
+    with np.errstate(invalid="ignore"):
+        far = ~(np.isfinite(alpha) & np.isfinite(beta)) \
+            | (beta < b0 - 5 * span_b) | (beta > b1 + 5 * span_b) \
+            | (alpha < a0 - 5 * span_a) | (alpha > a1 + 5 * span_a)
+    points = np.column_stack([beta, alpha])
+    points[far] = np.nan
+    # The arc starts exactly at the corner (-delta, 0), the z = 1 root's line.
+    points = np.vstack([[-delta, 0.0], points])
+    if not np.isfinite(t_max):
+        return np.empty((0, 2)), points
+    k = int(np.searchsorted(theta, t_max)) + 1
+    return points[: k + 1], points[k:]

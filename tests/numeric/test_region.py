@@ -891,7 +891,7 @@ def test_arc_polylines_lie_on_the_boundary_by_python_control(gamma, d):
     """Every drawn arc point has a closed-loop pole on the unit circle (python-control's poles of
     the sampled loop); the first piece starts at the corner (-delta, 0) and ends on alpha = 0."""
     from oracles import python_control_closed_loop
-    from symstab.numeric.curves import arc_polylines
+    from symstab.numeric.region import arc_polylines
 
     window = ((-0.5, 2.5), (-0.1, 4.0))
     first, beyond = arc_polylines(gamma=gamma, d=d, delta=PAPER_DELTA, window=window)
@@ -910,7 +910,7 @@ def test_arc_polylines_lie_on_the_boundary_by_python_control(gamma, d):
                                                  (((1, 0), (0, 1)), ValueError, "window[0]"),
                                                  (((0, 1), (0, np.nan)), ValueError, "window[1]")])
 def test_arc_polylines_refuses_a_bad_window_naming_it(window, error, name):
-    from symstab.numeric.curves import arc_polylines
+    from symstab.numeric.region import arc_polylines
 
     with pytest.raises(error, match=re.escape(name)):
         arc_polylines(gamma=0.0, d=0, delta=PAPER_DELTA, window=window)
