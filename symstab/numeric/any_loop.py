@@ -602,10 +602,12 @@ class Loop(LoopModel):
             values = {k: v for k, v in values.items() if k != across}
         names = (name,) if across is None else (name, across)
         base, slopes, ends = self.affine_parts(names, values, structured=True)
+        # The crossings with the arc are re-found on the loop's arc source
+        # where it is more accurate than the float parts the engine scans.
         runs = family_intervals(base, slopes[1] if across else None, slopes[0], at,
                                 (tuple(ends[0]), tuple(ends[2]) if across else None,
                                  tuple(ends[1])),
-                                arc=self._closed_form(across, name, values))
+                                arc=None if across is None else self._arc_points(across, name, values))
         if across is not None and not family:
             values = {**values, across: float(at[0])}
         for value, r in zip(at, runs):
@@ -675,10 +677,20 @@ class Loop(LoopModel):
 
     def _arc_source(self, x, y, values, parts):
         """:meth:`arc` on the plane's structured parts, computed by the caller."""
-        exact = self._exact_parts((x, y), values)
-        cramer = CramerArc(*(exact or parts))
+        cramer = CramerArc(*(self._exact_parts((x, y), values) or parts))
         closed = self._closed_form(x, y, values)
         return cramer if closed is None else ClosedFormArc(closed, cramer)
+
+    def _arc_points(self, x, y, values):
+        """``theta -> (x, y)`` of :meth:`arc` where it beats Cramer on the float parts, else None."""
+        closed = self._closed_form(x, y, values)
+        if closed is not None:
+            return closed
+        exact = self._exact_parts((x, y), values)
+        if exact is None:
+            return None
+        cramer = CramerArc(*exact)
+        return lambda theta: cramer(theta)[:2]
 
     def _exact_parts(self, names, given):
         """``(A0, A_x, A_y)`` as :class:`~symstab.numeric.arcs.ExactPolynomial`, or None.

@@ -110,6 +110,29 @@ def test_loop_arc_matches_the_model_with_exact_coefficients(path):
     assert relative_error(xs, ys, reference) <= TOLERANCE
 
 
+@pytest.mark.parametrize("name", ["lowpass_velocity.toml", "paper.toml"])
+def test_stable_interval_ends_on_the_arc_match_the_model(name):
+    # Where the line B = const leaves the stable set across the arc (at
+    # theta of about 0.01 for these loops at d = 40), the line engine's
+    # crossing is re-found on Loop.arc: 9e-12 off the model before, found on
+    # the float parts.  Oracle: the crossing of the 40-digit arc of the model.
+    from oracles import loop_arc_mp
+
+    loop = symstab.load_loop(os.path.join(os.path.dirname(EXAMPLES[0]), name))
+    x, y = loop.plane
+    lim = loop.limits()
+    at = lim.x_min + 0.1 * (lim.x_max - lim.x_min)
+    top = max(hi for _, hi in loop.stable_intervals(y, **{x: at}))
+    theta = np.linspace(1e-4, 0.2, 2001)
+    xs = loop.arc()(theta)[0] - at
+    i = int(np.flatnonzero(np.sign(xs[1:]) * np.sign(xs[:-1]) < 0)[0])
+    with mpmath.workdps(40):
+        t = mpmath.findroot(lambda t: loop_arc_mp(loop, [t], dps=40)[0][0] - at,
+                            (mpmath.mpf(theta[i]), mpmath.mpf(theta[i + 1])), solver="anderson")
+        want = loop_arc_mp(loop, [t], dps=40)[0][1]
+    assert abs(top - want) <= 1e-13 * abs(want), (top, want)
+
+
 @pytest.mark.parametrize("make", BASES)
 def test_dense_rows_give_the_same_arc(make):
     # A dense row is one part (shift 0): the same accuracy, more terms per angle.
