@@ -45,7 +45,7 @@ from .._resources import check_memory
 from .._validate import check_array, check_count, check_delay, check_real, check_window
 from ..symbolic.loop_assembly import PLANT_DIGITS, LoopModel, parse_environment, parse_plant, shift_to_one
 from ..codegen.loop_kernels import environment_kernels, load_numpy_kernels
-from .arcs import EXACT_TERMS, ClosedFormArc, CramerArc, ExactPolynomial
+from .arcs import END_ANGLE, EXACT_TERMS, ClosedFormArc, CramerArc, ExactPolynomial
 from .decomposition import Decomposition, arc_points, decompose, stable_hull
 from .passivity import passive_region
 from .decomposition import lines as _lines
@@ -682,7 +682,14 @@ class Loop(LoopModel):
         return cramer if closed is None else ClosedFormArc(closed, cramer)
 
     def _arc_points(self, x, y, values):
-        """``theta -> (x, y)`` of :meth:`arc` where it beats Cramer on the float parts, else None."""
+        """``theta -> (x, y)`` of :meth:`arc` where it beats Cramer on the float parts, else None.
+
+        The exact Cramer solve gives NaN (nothing better) between
+        :data:`~symstab.numeric.arcs.END_ANGLE` and ``pi`` less it: the
+        float parts lose their digits only next to ``z = +-1``, and a
+        family of lines at a long delay crosses the arc thousands of times
+        in between.
+        """
         closed = self._closed_form(x, y, values)
         if closed is not None:
             return closed
@@ -690,7 +697,16 @@ class Loop(LoopModel):
         if exact is None:
             return None
         cramer = CramerArc(*exact)
-        return lambda theta: cramer(theta)[:2]
+
+        def points(theta):
+            theta = np.asarray(theta, dtype=float)
+            xs, ys = np.full(theta.shape, np.nan), np.full(theta.shape, np.nan)
+            near = (theta < END_ANGLE) | (theta > np.pi - END_ANGLE)
+            if near.any():
+                xs[near], ys[near] = cramer(theta[near])[:2]
+            return xs, ys
+
+        return points
 
     def _exact_parts(self, names, given):
         """``(A0, A_x, A_y)`` as :class:`~symstab.numeric.arcs.ExactPolynomial`, or None.
