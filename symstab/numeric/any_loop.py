@@ -71,15 +71,18 @@ LoopBoundary = Boundary
 LARGEST_COORDINATE = 1e150
 
 
-
 def _exact_product(a, b):
-    """The coefficients of the product of two polynomials (rows highest first), as exact Fractions."""
-    a = [fractions.Fraction(float(c)) if not isinstance(c, fractions.Fraction) else c for c in a]
+    """The coefficients of the product of two polynomials (rows highest first), as exact Fractions.
+
+    ``a`` holds doubles (each taken as its binary value), ``b`` Fractions.
+    """
     out = [fractions.Fraction(0)] * (len(a) + len(b) - 1)
     for i, x in enumerate(a):
+        x = fractions.Fraction(float(x))
         for j, y in enumerate(b):
             out[i + j] += x * y
     return tuple(out)
+
 
 class Loop(LoopModel):
     """A sampled haptic loop: plant, zero-order hold, delay and virtual environment.
