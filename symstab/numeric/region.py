@@ -602,6 +602,16 @@ def best_virtual_mass(*, d, delta, gamma_range=None, n=17):
                            float(alpha_zero), float(best.alpha_max / alpha_zero), best.z_width)
 
 
+def _arc_points(gamma, d, delta):
+    """``theta -> (beta, alpha)``: the paper's arc source's points, without its determinant.
+
+    The curves drawn need no determinant (a Cramer solve per angle, three
+    times the closed form's cost).
+    """
+    _, values = paper_point(gamma=gamma, d=d, delta=delta)
+    return closed_form_arc("B", "K", values)
+
+
 def boundary_curve(*, gamma, d, delta, n=1000, segments=True):
     """Sample the boundary arc from theta = 0 to theta_max.
 
@@ -658,9 +668,9 @@ def boundary_curve(*, gamma, d, delta, n=1000, segments=True):
                                "to it)", at=at)
     theta = np.linspace(0.0, t_end, n)
     alpha, beta = np.empty(n), np.empty(n)
-    arc = paper_arc(gamma=gamma, d=d, delta=delta)
+    points = _arc_points(gamma, d, delta)
     for part in chunk_slices(n, KERNEL_BYTES_PER_POINT, KERNEL_CHUNK_BYTES):
-        beta[part], alpha[part], _ = arc(theta[part])
+        beta[part], alpha[part] = points(theta[part])
     # The ends are exact: the arc starts at (-delta, 0) and ends on alpha = 0.
     alpha[0], beta[0] = 0.0, -delta
     if t_end < np.pi:
@@ -706,7 +716,7 @@ def arc_polylines(*, gamma, d, delta, window):
     theta = np.linspace(0.0, np.pi, 4000 + 400 * d + 1)[1:-1]
     if np.isfinite(t_max):
         theta = np.union1d(theta, [t_max])
-    beta, alpha, _ = paper_arc(gamma=gamma, d=d, delta=delta)(theta)
+    beta, alpha = _arc_points(gamma, d, delta)(theta)
     span_b, span_a = b1 - b0, a1 - a0
     with np.errstate(invalid="ignore"):
         far = ~(np.isfinite(alpha) & np.isfinite(beta)) \
