@@ -16,7 +16,6 @@ where the arc ends:
   the region (so this module does not import the region engine).
 """
 
-import dataclasses
 import fractions
 
 import numpy as np
@@ -26,8 +25,8 @@ from .._validate import check_loop
 from ..symbolic.theta_max import first_sign_change, reduced_curvature, reduced_qr, reduced_value_slope
 from .results import Boundary
 
-__all__ = ["arc_end_angle", "minus_one_line", "BoundaryCurve", "Segment", "scan_grid",
-           "bracketed_root", "zoom_max", "KERNEL_BYTES_PER_POINT",
+__all__ = ["arc_end_angle", "minus_one_line", "BoundaryCurve", "scan_grid",
+           "bracketed_root", "refit_root", "zoom_max", "KERNEL_BYTES_PER_POINT",
            "KERNEL_CHUNK_BYTES"]
 
 
@@ -114,6 +113,43 @@ def bracketed_root(f, lo, hi, iterations=64, *, indexed=False):
         fhi[active] = np.where(same_as_lo, fb, fx)
         side[active] = np.where(same_as_lo, 1, -1)
     return (0.5 * (lo + hi)).reshape(shape)
+
+
+def refit_root(f, root, half_width, points=17):
+    """A root of ``f`` re-found as the zero of a straight line fitted around it.
+
+    Where ``f`` is computed with an absolute error floor (a difference of
+    larger terms), it is exactly 0, or of either sign, over a stretch of
+    arguments around its root, and :func:`bracketed_root` stops anywhere in
+    it.  The least-squares line through ``points`` values on ``[root -
+    half_width, root + half_width]`` (wide enough for ``f`` to rise above
+    its floor there, narrow enough for ``f`` to be straight) averages the
+    floor out.  ``root`` is kept where the line is flat or its zero is not
+    inside that stretch.
+
+    Parameters
+    ----------
+    f : callable
+        ``f(x)`` for a 1-D array ``x``.
+    root : float
+        The root to re-find.
+    half_width : float
+        Half the stretch fitted.
+    points : int
+        Values fitted (odd, so ``root`` is the middle one).
+
+    Returns
+    -------
+    float
+    """
+    step = np.linspace(-half_width, half_width, points)
+    values = np.asarray(f(root + step), dtype=float)
+    if not np.all(np.isfinite(values)):
+        return root
+    slope, intercept = np.polyfit(step, values, 1)
+    if slope == 0 or not abs(intercept / slope) < half_width:
+        return root
+    return root - intercept / slope
 
 
 def arc_end_angle(*, gamma, d, delta):
@@ -207,21 +243,6 @@ def minus_one_line(*, gamma, d, delta):
 #: is run in.
 KERNEL_BYTES_PER_POINT = 8 * 32
 KERNEL_CHUNK_BYTES = 32 * 2**20
-
-
-@dataclasses.dataclass(frozen=True)
-class Segment:
-    """A straight piece of the boundary: from ``(beta0, alpha0)`` to ``(beta1, alpha1)``.
-
-    ``root`` says which real root crosses the unit circle on it: ``"z=1"``
-    (the line alpha = 0) or ``"z=-1"``.
-    """
-
-    root: str
-    beta0: float
-    alpha0: float
-    beta1: float
-    alpha1: float
 
 
 #: Older name of :class:`symstab.numeric.results.Boundary`, the one result type of a boundary.

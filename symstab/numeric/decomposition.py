@@ -43,11 +43,12 @@ import numpy as np
 
 from .._resources import check_memory, chunk_slices
 from .arcs import CramerArc
-from .curves import bracketed_root, zoom_max
+from .curves import bracketed_root, refit_root, zoom_max
 from .polynomial import DelayedPolynomial
+from .results import Segment
 from .roots import STABLE, classify_polynomials, leading_vanishes, root_counts
 
-__all__ = ["Branch", "Cell", "Decomposition", "StableHull", "decompose", "arc_points",
+__all__ = ["Branch", "Cell", "Decomposition", "StableHull", "decompose", "arc_points", "sample_arc",
            "stable_hull"]
 
 #: Change of the unstable count across each piece (crossing rule); the
@@ -203,6 +204,11 @@ class Decomposition:
     arc : symstab.numeric.arcs.ArcSource or None
         The source the arc was sampled from (None: the structured Cramer
         solve of :attr:`polynomial`).
+    segments : tuple of symstab.numeric.results.Segment
+        The pieces of the z = 1 and z = -1 lines that bound the stable set
+        (a stable cell's edges on them: across such a line the count
+        changes, so the other side is unstable), joined where they meet,
+        each end where the arc meets the line re-found on the arc.
     """
 
     x: str
@@ -217,6 +223,7 @@ class Decomposition:
     resolution: float = 0.0
     hull: object = dataclasses.field(default=None, compare=False)
     arc: object = dataclasses.field(default=None, compare=False)
+    segments: tuple = ()
 
     @property
     def stable(self):
@@ -291,11 +298,11 @@ class Decomposition:
             raise ValueError(f"coordinate must be 'x' or 'y' and sense 1 or -1, got "
                              f"{coordinate!r}, {sense!r}")
         k = 0 if coordinate == "x" else 1
-        best, ring_of = None, None
+        best, cell_of = None, None
         for cell in self.stable:
             i = int(np.argmax(sense * cell.outer[:, k]))
             if best is None or sense * cell.outer[i, k] > sense * best[k]:
-                best, ring_of = cell.outer[i], cell.outer
+                best, cell_of = cell.outer[i], cell
         if best is None:
             return math.nan, math.nan
         arc = next((b for b in self.branches if b.label == "arc"), None)
@@ -314,7 +321,7 @@ class Decomposition:
         theta = arc.theta[[j - 1, j + 1]]
         if not np.all(np.isfinite(theta)):
             return value, other
-        on_ring = [np.min(np.hypot(*((ring_of - q) / scale).T)) < 1e-9 for q in neighbours]
+        on_ring = [np.min(np.hypot(*((cell_of.outer - q) / scale).T)) < 1e-9 for q in neighbours]
         if not all(on_ring):
             return value, other
         arc = self.arc if self.arc is not None else CramerArc(*self.polynomial)
@@ -324,20 +331,15 @@ class Decomposition:
 
         t = float(zoom_max(f, [theta[0]], [theta[1]], rtol=_EXTREME_RTOL)[0])
         xy = [float(v[0]) for v in arc(np.array([t]))[:2]]
-        if sense * xy[k] >= sense * value:
+        # The arc's own extreme, if it is not cut off by a line the cell is on one side of.
+        beside = all(side(np.array(xy)) * side(np.array(cell_of.point)) >= 0
+                     or abs(side(np.array(xy))) <= _CORNER for _, side in self._sides(scale))
+        if sense * xy[k] >= sense * value and beside:
             return xy[k], xy[1 - k]
         return value, other
 
-    def _corner(self, arc, vertex, scale):
-        """A vertex where the arc meets a line, re-found on the arc: ``(x, y)`` or None.
-
-        The chords' crossing is off the curves' by the chord's sag (1e-10
-        to 1e-8 of the window); here the arc's angle between the chord's
-        ends is the root of the line's equation along it (the source's own
-        accuracy, 1e-13).  None where ``vertex`` is not on one line and one
-        arc chord.
-        """
-        unit = vertex / scale
+    def _sides(self, scale):
+        """``(branch, side)`` per line: ``side(points)``, the signed distance in window units."""
         for line in self.branches:
             if line.label == "arc":
                 continue
@@ -349,10 +351,27 @@ class Decomposition:
             if length == 0:
                 continue
             normal = np.array([-direction[1], direction[0]]) / length
+            yield line, (lambda points, origin=origin, normal=normal:
+                         (points / scale - origin) @ normal)
 
-            def side(points):
-                return (points / scale - origin) @ normal
+    def _corner(self, arc, vertex, scale):
+        """A vertex where the arc meets a line, re-found on the arc: ``(x, y)`` or None.
 
+        The chords' crossing is off the curves' by the chord's sag (1e-10
+        to 1e-8 of the window); here the arc's angle between the chord's
+        ends is the root of the line's equation along it (the source's own
+        accuracy, 1e-13).  A vertex at an end of the arc (``theta = 0`` or
+        ``pi``, on ``z = +-1``) is that end, from the arc source.  None where
+        ``vertex`` is neither on one line and one arc chord nor at an end.
+        """
+        # The arc's ends (theta = 0, pi) are on z = +-1, and exact.
+        at_end = np.flatnonzero(np.isin(arc.theta, (0.0, np.pi)))
+        if at_end.size:
+            gap = np.hypot(*((arc.points[at_end] - vertex) / scale).T)
+            if gap.min() < _CORNER:
+                return arc.points[at_end[int(np.argmin(gap))]].copy()
+        unit = vertex / scale
+        for _, side in self._sides(scale):
             if abs(float(side(vertex))) > _CORNER:
                 continue
             # The arc's chords through the vertex that cross the line.
@@ -371,12 +390,51 @@ class Decomposition:
                 xs, ys = source(theta.ravel())[:2]
                 return side(np.column_stack([xs, ys])).reshape(theta.shape)
 
-            root = bracketed_root(along, [arc.theta[j]], [arc.theta[j + 1]])
-            xs, ys = source(root)[:2]
+            root = bracketed_root(along, [arc.theta[j]], [arc.theta[j + 1]])[0]
+            # The line's equation along the arc is a difference of larger
+            # terms next to a flat corner: fitted over a thousandth of the
+            # chord, its rounding floor averages out.
+            width = max(1e-3 * (arc.theta[j + 1] - arc.theta[j]), 64 * np.spacing(root))
+            root = refit_root(along, root, width)
+            xs, ys = source(np.array([root]))[:2]
             point = np.array([float(xs[0]), float(ys[0])])
             if np.all(np.isfinite(point)) and float(np.hypot(*((point - vertex) / scale))) < _CORNER_MOVE:
                 return point
         return None
+
+    def renamed(self, x, y):
+        """The same decomposition with the plane's parameters called ``x`` and ``y``.
+
+        Parameters
+        ----------
+        x, y : str
+            The new names.
+        """
+        segments = tuple(dataclasses.replace(g, x=x, y=y) for g in self.segments)
+        return dataclasses.replace(self, x=x, y=y, segments=segments)
+
+    def _segment(self, label, line, ends):
+        """The :class:`~symstab.numeric.results.Segment` of ``line`` between two cell vertices.
+
+        An end where the arc meets the line is re-found on the arc
+        (:meth:`_corner`); every end is then put on the line exactly (``y``
+        from ``x``, or ``x`` from ``y`` for a steep line), so a piece of
+        ``y = 0`` has ``y`` 0, not a rounding of it.
+        """
+        arc = next((b for b in self.branches if b.label == "arc"), None)
+        scale = np.array([self.x_range[1] - self.x_range[0], self.y_range[1] - self.y_range[0]])
+        c0, cx, cy = line
+        points = []
+        for end in ends:
+            corner = self._corner(arc, end, scale) if arc is not None else None
+            u, v = (float(w) for w in (end if corner is None else corner))
+            if abs(cy) >= abs(cx):
+                v = -(c0 + cx * u) / cy + 0.0
+            else:
+                u = -(c0 + cy * v) / cx + 0.0
+            points.append((u, v))
+        (u0, v0), (u1, v1) = sorted(points)
+        return Segment(label.replace(" ", ""), u0, v0, u1, v1, self.x, self.y)
 
     def __repr__(self):
         counts = sorted({c.count for c in self.cells})
@@ -431,34 +489,35 @@ def lines(base, ax, ay, ends):
     return out
 
 
-def _arc_ends(base, ax, ay, ends):
-    """The arc's exact ends: ``chi(+-1) = chi'(+-1) = 0``, or None where singular."""
-    out = []
-    n = len(base) - 1
-    powers = np.arange(n, -1, -1, dtype=float)
-    for index, sign in ((0, 1.0), (1, -1.0)):
-        # chi'(sign) = sum_k k c_k sign**(k - 1)
-        slope = [float(np.sum(powers * c * sign ** np.maximum(powers - 1, 0))) for c in (base, ax, ay)]
-        value = [float(e[index]) for e in ends]
-        det = value[1] * slope[2] - value[2] * slope[1]
-        scale = max(abs(value[1] * slope[2]), abs(value[2] * slope[1]), 1e-300)
-        if abs(det) <= 1e-12 * scale:
-            out.append(None)
-            continue
-        x = (-value[0] * slope[2] + value[2] * slope[0]) / det
-        y = (-value[1] * slope[0] + value[0] * slope[1]) / det
-        out.append((x, y))
-    return out
+def sample_arc(arc, n, to_unit, samples=None, fine=1.0):
+    """The arc's adaptive samples: refined until every chord near the window is short and straight.
 
+    The one sampler of an arc in a window (the D-decomposition's, the
+    figures'): a grid of ``max(1024, 32 (n + 4))`` angles, closing in on
+    ``theta = 0`` and ``pi`` geometrically, then halved where a chord near
+    the window is longer than 2e-3 of it, turns by more than 0.05 rad
+    from the next, or passes through infinity (the determinant changes
+    sign), up to 400 000 angles.
 
-def _sample_arc(arc, n, to_unit, samples=None, fine=1.0):
-    """Angles and points of the arc, refined until every chord inside the window is short.
+    Parameters
+    ----------
+    arc : symstab.numeric.arcs.ArcSource
+        ``arc(theta) -> (x, y, det)``.
+    n : int
+        The polynomial's degree.
+    to_unit : callable
+        ``to_unit(x, y) -> (u, v)``: window units, the window being [0, 1]**2.
+    samples : tuple, optional
+        The ``(theta, x, y, det)`` of a previous call with more angles
+        added (NaN where not yet evaluated): only those are evaluated.
+    fine : float
+        The chord and turn limits' factor.
 
-    ``arc`` is the arc source, ``n`` the polynomial's degree, ``samples``
-    the ``(theta, x, y, det)`` of a previous call with more angles added
-    (NaN where not yet evaluated).  Each round evaluates the new angles
-    only.  Returns the angles, the points and the determinant (the caller
-    splits the arc where its sign changes: through infinity).
+    Returns
+    -------
+    theta, x, y, det : ndarray
+        Increasing angles in (0, pi) and the arc there (split the arc where
+        ``det`` changes sign: through infinity).
     """
     if samples is None:
         m = max(1024, 32 * (n + 4))
@@ -508,17 +567,21 @@ def _sample_arc(arc, n, to_unit, samples=None, fine=1.0):
     return theta, xs, ys, det
 
 
-def _pieces(base, ax, ay, ends, theta, xs, ys, sign, to_unit, from_unit, box):
+def _pieces(base, ax, ay, ends, arc, theta, xs, ys, sign, to_unit, from_unit, box):
     """The branches (in the plane's units) and the polylines to intersect (in window units).
 
     Each polyline is ``(points, label, theta)`` (``theta`` None for a line
     and for the window's edges), cut to the runs of segments that reach the
-    window.
+    window.  The arc's ends at ``theta = 0`` and ``pi`` are the arc
+    source's (there its equations are ``chi(+-1) = chi'(+-1) = 0``), None
+    where that system is singular.
     """
     polylines, branches = [], []
     u, v = to_unit(xs, ys)
     finite = np.isfinite(u) & np.isfinite(v)
-    ends_xy = _arc_ends(base, ax, ay, ends)
+    end_x, end_y, _ = arc(np.array([0.0, np.pi]))
+    ends_xy = [(x, y) if math.isfinite(x) and math.isfinite(y) else None
+               for x, y in zip(end_x.tolist(), end_y.tolist())]
     cut = np.flatnonzero((sign[1:] != sign[:-1]) | ~finite[1:] | ~finite[:-1]) + 1
     arc_rows, arc_theta = [], []
     for part in np.split(np.arange(len(theta)), cut):
@@ -527,14 +590,18 @@ def _pieces(base, ax, ay, ends, theta, xs, ys, sign, to_unit, from_unit, box):
             continue
         pts = np.column_stack([u[part], v[part]])
         th = theta[part]
-        # The exact ends at theta = 0 and pi, when this part reaches them.
+        # The exact ends at theta = 0 and pi, when this part reaches them
+        # (kept as they are in the branch, not taken back from window units).
+        rows = from_unit(pts)
         if part[0] == 0 and ends_xy[0] is not None:
             pts = np.vstack([np.column_stack(to_unit(*ends_xy[0])), pts])
+            rows = np.vstack([ends_xy[0], rows])
             th = np.concatenate([[0.0], th])
         if part[-1] == len(theta) - 1 and ends_xy[1] is not None:
             pts = np.vstack([pts, np.column_stack(to_unit(*ends_xy[1]))])
+            rows = np.vstack([rows, ends_xy[1]])
             th = np.concatenate([th, [np.pi]])
-        arc_rows.append(from_unit(pts))
+        arc_rows.append(rows)
         arc_theta.append(th)
         if len(pts) >= 2:
             polylines.append((pts, "arc", th))
@@ -1315,11 +1382,11 @@ def _decompose(base, ax, ay, ends, *, x_range, y_range, names, fine, arc, family
 
     samples = None
     for _ in range(_CROSSING_ROUNDS):
-        samples = _sample_arc(arc, len(base) - 1, to_unit, samples, fine)
+        samples = sample_arc(arc, len(base) - 1, to_unit, samples, fine)
         theta, xs, ys, det = samples
         sign = np.sign(det)
-        polylines, branches = _pieces(base, ax, ay, ends, theta, xs, ys, sign, to_unit, from_unit,
-                                      (x0, x1, y0, y1))
+        polylines, branches = _pieces(base, ax, ay, ends, arc, theta, xs, ys, sign, to_unit,
+                                      from_unit, (x0, x1, y0, y1))
         p, q, owner, position = _segments(polylines)
         labels = [label for _, label, _ in polylines]
         hits = _intersections(p, q, owner, position)
@@ -1485,6 +1552,8 @@ def _decompose(base, ax, ay, ends, *, x_range, y_range, names, fine, arc, family
                     touched.add("x_min" if u < 1e-6 else "x_max" if u > 1 - 1e-6
                                 else "y_min" if v < 1e-6 else "y_max")
         unbounded = tuple(side for side in ("x_min", "x_max", "y_min", "y_max") if side in touched)
+        sides = _line_sides([cycles[f] for n, f in enumerate(keep) if counts[n] == 0],
+                            src, dst, half_label)
         # How finely the arc draws each stable cell.
         resolution = 0.0
         for n, f in enumerate(keep):
@@ -1509,12 +1578,41 @@ def _decompose(base, ax, ay, ends, *, x_range, y_range, names, fine, arc, family
                 sag = np.maximum(length, np.roll(length, 1)) * phi / 8
                 resolution = max(resolution, float(np.max(sag[both])) / extent)
     else:
-        unbounded = ()
+        unbounded, sides = (), []
         resolution = 0.0
-    return Decomposition(x=names[0], y=names[1], x_range=(x0, x1), y_range=(y0, y1),
-                         branches=tuple(branches), cells=tuple(cells),
-                         mismatches=tuple(mismatches), unbounded=unbounded,
-                         polynomial=(base, ax, ay), resolution=resolution, arc=arc)
+    found = Decomposition(x=names[0], y=names[1], x_range=(x0, x1), y_range=(y0, y1),
+                          branches=tuple(branches), cells=tuple(cells),
+                          mismatches=tuple(mismatches), unbounded=unbounded,
+                          polynomial=(base, ax, ay), resolution=resolution, arc=arc)
+    coefficients = lines(base, ax, ay, ends)
+    segments = [found._segment(label, coefficients[label], from_unit(xy[[a, b]]))
+                for label, a, b in sides]
+    segments.sort(key=lambda g: (g.root, g.x0))
+    return dataclasses.replace(found, segments=tuple(segments))
+
+
+def _line_sides(rings, src, dst, half_label):
+    """``(label, first node, last node)`` of each run of the rings' half-edges on z = +-1.
+
+    A stable cell's boundary runs counter-clockwise, so two stable cells
+    that meet on one line (at an arc's touch or the leading line) continue
+    each other's run head to tail.
+    """
+    step = {}
+    for ring in rings:
+        for h in ring:
+            if half_label[h] in ("z = 1", "z = -1"):
+                step[half_label[h], int(src[h])] = int(dst[h])
+    heads = {key[1] for key in step}
+    out = []
+    for (label, a), b in sorted(step.items()):
+        if (label, a) not in step or any(step.get((label, p)) == a for p in heads):
+            continue            # not the first half-edge of a run (or already walked)
+        del step[label, a]
+        while (label, b) in step:
+            b = step.pop((label, b))
+        out.append((label, a, b))
+    return out
 
 
 def _components(n, edges):

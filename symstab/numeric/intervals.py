@@ -42,7 +42,7 @@ from .curves import bracketed_root, scan_grid, zoom_max
 from .polynomial import DelayedPolynomial, horner
 from .roots import root_counts
 
-__all__ = ["line_intervals", "family_intervals", "circle_crossings", "Unresolved", "RESIDUAL"]
+__all__ = ["line_intervals", "family_intervals", "Unresolved", "RESIDUAL"]
 
 #: A candidate crossing is kept where ``|A0 + p A1|`` at its angle is at
 #: most this fraction of the rounding scale ``sum |a0_k| + |p| sum |a1_k|``.
@@ -239,40 +239,6 @@ def _polished(line, p, theta, at, arc):
     p, theta = p.copy(), theta.copy()
     p[which[good]], theta[which[good]] = position[good], root[good]
     return p, theta
-
-
-def circle_crossings(base, slope, ends=None, *, arc=None):
-    """Where the line ``base + p slope`` has a root on the unit circle: ``(p, theta)``.
-
-    The crossings :func:`line_intervals` counts across (the leading
-    coefficient's zero left out), sorted by angle: on a plane, where the
-    line meets the arc (``0 < theta < pi``) and the lines ``z = +-1``.
-    A line along which ``z = 1`` (or ``-1``) is a root for every ``p`` has
-    no crossing there.
-
-    Parameters
-    ----------
-    base, slope, ends
-        As for :func:`line_intervals`.
-    arc : callable, optional
-        As for :func:`family_intervals` (with ``v = 0``).
-
-    Returns
-    -------
-    (ndarray, ndarray)
-        ``p`` and ``theta`` in [0, pi] of each crossing.
-
-    Examples
-    --------
-    >>> p, theta = circle_crossings(np.array([1.0, -0.5, 0.0]), np.array([0.0, 0.0, 1.0]))
-    >>> p.round(12).tolist(), np.cos(theta).round(12).tolist()     # z**2 - z/2 + p
-    ([-0.5, 1.0, -1.5], [1.0, 0.25, -1.0])
-    """
-    given = (base, None, slope)
-    polynomials, given, ends = _prepared(given, ends)
-    line, p, theta = _crossings(polynomials, np.zeros(1), ends, given)
-    p, theta = _polished(line, p, theta, np.zeros(1), arc)
-    return p + 0.0, theta
 
 
 def _prepared(given, ends):

@@ -27,20 +27,13 @@ import numpy as np
 
 from .._resources import check_memory, chunk_slices
 from .._validate import check_array, check_count, check_loop, check_real, check_window
-from .curves import (KERNEL_BYTES_PER_POINT, KERNEL_CHUNK_BYTES, Segment, arc_end_angle,
-                     minus_one_line)
-from .decomposition import decompose
-from .intervals import circle_crossings
+from .curves import KERNEL_BYTES_PER_POINT, KERNEL_CHUNK_BYTES, arc_end_angle, minus_one_line
+from .decomposition import sample_arc
 from .paper_loop import closed_form_arc, paper_arc, paper_limits, paper_point
 from .results import PAPER_PLANE, Boundary
-from .stability import loop_coefficients
 
 __all__ = ["StabilityRegion", "limits", "vanishing_gamma", "BestVirtualMass", "best_virtual_mass",
            "scan_maximum", "boundary_curve", "arc_polylines"]
-
-#: An end of a stable interval within this many ulps of its terms' size
-#: from the line z = -1 lies on it (:meth:`StabilityRegion.line_segments`).
-_LINE_ULPS = 16
 
 class StabilityRegion:
     """The stable set of one ``(gamma, d, delta)`` in the (beta, alpha) plane.
@@ -75,7 +68,6 @@ class StabilityRegion:
 
     def __init__(self, *, gamma, d, delta):
         self.gamma, self.d, self.delta = check_loop(gamma, d, delta)
-        self.minus_one = minus_one_line(gamma=self.gamma, d=self.d, delta=self.delta)
 
     def decomposition(self, x_range, y_range):
         """The complete D-decomposition of a window of the (beta, alpha) plane.
@@ -83,7 +75,7 @@ class StabilityRegion:
         Every branch of eq. (7) over all of (0, pi) -- not only the first
         arc, up to theta_max --, the z = 1 line (alpha = 0) and the z = -1
         line, the cells they cut the window into and each cell's certified
-        count of unstable roots (:func:`symstab.numeric.decomposition.decompose`).
+        count of unstable roots (:meth:`symstab.Loop.region` of the paper's loop).
 
         Parameters
         ----------
@@ -106,22 +98,9 @@ class StabilityRegion:
         """
         x_range = check_window("x_range", x_range)
         y_range = check_window("y_range", y_range)
-        coefficients = [loop_coefficients(alpha=a, beta=b, gamma=self.gamma, d=self.d,
-                                          delta=self.delta)
-                        for a, b in ((0.0, 0.0), (0.0, 1.0), (1.0, 0.0))]
-        base = coefficients[0]
-        ax, ay = coefficients[1] - base, coefficients[2] - base
-        signs = (-1.0) ** np.arange(len(base) - 1, -1, -1)
-        ends = []
-        for c in (base, ax, ay):
-            # chi(+-1): a sum below its own rounding is 0 (alpha = 0 is exactly z = 1).
-            values = np.array([np.sum(c), np.sum(c * signs)])
-            values[np.abs(values) <= 64 * np.finfo(float).eps * np.sum(np.abs(c))] = 0.0
-            ends.append(values)
-        # The paper's arc source is its closed form (the generated kernel).
-        arc = paper_arc(gamma=self.gamma, d=self.d, delta=self.delta)
-        return decompose(base, ax, ay, ends, x_range=x_range, y_range=y_range,
-                         names=("beta", "alpha"), arc=arc)
+        loop, point = paper_point(gamma=self.gamma, d=self.d, delta=self.delta)
+        found = loop.region("B", "K", x_range=x_range, y_range=y_range, **point)
+        return found.renamed(*PAPER_PLANE)
 
     def alpha_intervals(self, beta):
         """The stable alpha intervals at damping ``beta``.
@@ -191,95 +170,26 @@ class StabilityRegion:
         """The limits of this region, from the one engine (:func:`~symstab.numeric.paper_loop.paper_limits`)."""
         return paper_limits(gamma=self.gamma, d=self.d, delta=self.delta, region=self)
 
-    def _corners(self, c):
-        """beta of the points where the arc meets a line ``alpha = c - k beta`` (``k`` 0 or 2).
-
-        The crossings of that line with the unit circle at ``0 < theta <
-        pi`` (the one line engine's,
-        :func:`~symstab.numeric.intervals.circle_crossings`, refined on the
-        closed form): on ``alpha = 0`` (``c = 0``, ``k = 0``) and on ``z =
-        -1`` (``alpha + 2 beta = c``) a real root is on the circle
-        everywhere, the arc's corners are where a pair joins it.
-        """
+    @functools.cached_property
+    def _region(self):
+        """The D-decomposition around the stable region (:meth:`symstab.Loop.region`)."""
         loop, point = paper_point(gamma=self.gamma, d=self.d, delta=self.delta)
-        base, (d_beta, d_alpha), ends = loop.affine_parts(("B", "K"), point, structured=True)
-        k = 0.0 if c == 0 else 2.0
-        line = base.combine([c], [d_alpha]).flat()
-        slope = d_beta.combine([-k], [d_alpha]).flat()
-        line_ends = tuple(ends[0] + c * ends[2])
-        slope_ends = tuple(ends[1] - k * ends[2])
-        closed = closed_form_arc("B", "K", {**point, "B": 0.0, "K": 0.0})
-
-        def arc(theta):        # the arc point's distance along alpha from the line, and its beta
-            beta, alpha = closed(theta)
-            return alpha + k * beta - c, beta
-
-        beta, theta = circle_crossings(line, slope, (line_ends, slope_ends), arc=arc)
-        return beta[(theta > 0) & (theta < np.pi)]
+        return loop.region("B", "K", **point)
 
     def line_segments(self):
         """The pieces of z = 1 (alpha = 0) and z = -1 that bound the stable region.
 
-        Along each line the corners (where the arc or the other line meets
-        it) cut it into pieces; one vertical line through the middle of a
-        piece tells whether the region borders it.
+        The stable cells' edges on those lines
+        (:attr:`symstab.numeric.decomposition.Decomposition.segments`),
+        joined where they meet; an end where the arc meets the line is
+        re-found on the arc.
 
         Returns
         -------
-        tuple of :class:`symstab.numeric.curves.Segment`
+        tuple of :class:`symstab.numeric.results.Segment`
+            In the (beta, alpha) plane.
         """
-        extent = self.beta_range()
-        if extent is None:
-            return ()
-        c = self.minus_one
-        out = []
-
-        def within(ends):
-            # Only pieces inside the region's beta range can border it (at
-            # large d the arc meets alpha = 0 thousands of times elsewhere).
-            # The searches for the extremes may stop an ulp-scale step short
-            # of a corner: a corner that close stands for the extreme.
-            tol = 1e-9 * (extent[1] - extent[0])
-            ends = ends[(ends >= extent[0] - tol) & (ends <= extent[1] + tol)]
-            extra = [b for b in extent if math.isfinite(b)
-                     and (ends.size == 0 or np.min(np.abs(ends - b)) > tol)]
-            return np.union1d(ends, extra)
-
-        # z = 1: alpha = 0; the region borders a piece when a stable interval
-        # of the vertical line through its middle starts or ends at 0.
-        ends = np.union1d(self._corners(0.0), [-self.delta])
-        if math.isfinite(c):
-            ends = np.union1d(ends, [c / 2])
-        out += self._bordering_pieces("z=1", within(ends), lambda b: 0.0)
-        if math.isfinite(c):
-            # z = -1: alpha + 2 beta = c, cut where the arc crosses it and at alpha = 0.
-            ends = np.union1d(self._corners(c), [c / 2])
-            out += self._bordering_pieces("z=-1", within(ends), lambda b: c - 2 * b)
-        return tuple(out)
-
-    def _bordering_pieces(self, root, ends, line_alpha):
-        """Segments of a line (alpha = line_alpha(beta)) between consecutive ``ends``
-        that border the stable region, merged where they meet."""
-        ends = ends[np.isfinite(ends)]
-        if ends.size < 2:
-            return []
-        middle = 0.5 * (ends[1:] + ends[:-1])
-        runs = self._intervals("beta", middle)
-        out = []
-        for b0, b1, bm, r in zip(ends[:-1], ends[1:], middle, runs):
-            a = line_alpha(bm)
-            # An end of a stable interval on z = -1: the same point from the
-            # polynomial's end values and from the line's closed form, rounded
-            # differently (a few ulps of the terms).  On z = 1 both are 0.
-            near = 0.0 if root == "z=1" else \
-                _LINE_ULPS * np.finfo(float).eps * (abs(a) + 2 * abs(bm) + abs(self.minus_one))
-            if b1 > b0 and any(abs(lo - a) <= near or abs(hi - a) <= near for lo, hi in r):
-                if out and out[-1][1] == b0:
-                    out[-1] = (out[-1][0], b1)
-                else:
-                    out.append((b0, b1))
-        return [Segment(root, float(b0), float(line_alpha(b0)), float(b1), float(line_alpha(b1)))
-                for b0, b1 in out]
+        return self._region.renamed(*PAPER_PLANE).segments
 
     def alpha_max(self):
         """``(alpha_max, beta at alpha_max)``, or ``None`` when the region is empty (see :meth:`limits`)."""
@@ -704,20 +614,25 @@ def arc_polylines(*, gamma, d, delta, window):
         to pi (empty when there is no theta_max).  Rows of NaN cut the curve
         where it runs far from the window -- through a pole it goes to
         infinity and comes back from the other side, and a straight line
-        across would be drawn.  The samples resolve the arc's turns: sin(d
-        theta) has d / 2 periods on the way, so 400 samples a period.
+        across would be drawn.  The arc is sampled as the D-decomposition
+        samples it (:func:`symstab.numeric.decomposition.sample_arc`):
+        inside the window no chord is longer than 2e-3 of it nor turns by
+        more than 0.05 rad from the next.
     """
     gamma, d, delta = check_loop(gamma, d, delta)
     if isinstance(window, (str, bytes)) or not hasattr(window, "__len__") or len(window) != 2:
         raise TypeError(f"window must be ((beta0, beta1), (alpha0, alpha1)), got {window!r}")
     (b0, b1), (a0, a1) = (check_window("window[0]", window[0]), check_window("window[1]", window[1]))
-    check_memory("the arc's polylines", 64 * (4000 + 400 * d))
-    t_max = arc_end_angle(gamma=gamma, d=d, delta=delta)
-    theta = np.linspace(0.0, np.pi, 4000 + 400 * d + 1)[1:-1]
-    if np.isfinite(t_max):
-        theta = np.union1d(theta, [t_max])
-    beta, alpha = _arc_points(gamma, d, delta)(theta)
     span_b, span_a = b1 - b0, a1 - a0
+    arc = paper_arc(gamma=gamma, d=d, delta=delta)
+    theta, beta, alpha, _ = sample_arc(
+        arc, d + 4, lambda x, y: ((np.asarray(x) - b0) / span_b, (np.asarray(y) - a0) / span_a))
+    t_max = arc_end_angle(gamma=gamma, d=d, delta=delta)
+    if np.isfinite(t_max):
+        k = int(np.searchsorted(theta, t_max))
+        end_beta, _, _ = arc(np.array([t_max]))
+        theta, beta, alpha = (np.insert(v, k, w) for v, w in
+                              ((theta, t_max), (beta, end_beta[0]), (alpha, 0.0)))
     with np.errstate(invalid="ignore"):
         far = ~(np.isfinite(alpha) & np.isfinite(beta)) \
             | (beta < b0 - 5 * span_b) | (beta > b1 + 5 * span_b) \
@@ -728,5 +643,5 @@ def arc_polylines(*, gamma, d, delta, window):
     points = np.vstack([[-delta, 0.0], points])
     if not np.isfinite(t_max):
         return np.empty((0, 2)), points
-    k = int(np.searchsorted(theta, t_max)) + 1
+    k += 1
     return points[: k + 1], points[k:]

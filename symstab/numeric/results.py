@@ -18,7 +18,7 @@ import numpy as np
 
 from .._validate import check_real
 
-__all__ = ["Limits", "Boundary"]
+__all__ = ["Limits", "Boundary", "Segment"]
 
 #: The paper's dimensionless plane: x = beta (damping), y = alpha (stiffness).
 PAPER_PLANE = ("beta", "alpha")
@@ -213,6 +213,40 @@ class Limits:
         return runs[0][0] if runs else None
 
 
+@dataclasses.dataclass(frozen=True)
+class Segment:
+    """A straight piece of the stable set's boundary, from ``(x0, y0)`` to ``(x1, y1)``.
+
+    Attributes
+    ----------
+    root : str
+        Which real root is on the unit circle along it: ``"z=1"`` or
+        ``"z=-1"``.
+    x0, y0, x1, y1 : float
+        Its ends, ``x0 <= x1``.
+    x, y : str
+        The plane's parameters.
+
+    Notes
+    -----
+    In the paper's plane ``beta0``, ``alpha0``, ``beta1``, ``alpha1`` are
+    aliases of the ends.
+    """
+
+    root: str
+    x0: float
+    y0: float
+    x1: float
+    y1: float
+    x: str = "x"
+    y: str = "y"
+
+    beta0 = _paper_alias("beta0", "x0")
+    alpha0 = _paper_alias("alpha0", "y0")
+    beta1 = _paper_alias("beta1", "x1")
+    alpha1 = _paper_alias("alpha1", "y1")
+
+
 @dataclasses.dataclass(frozen=True, repr=False)
 class Boundary:
     """Where a root of the characteristic polynomial crosses the unit circle, in an ``(x, y)`` plane.
@@ -235,9 +269,10 @@ class Boundary:
         ``c0 + cx x + cy y = 0`` on which that real root (or a root at
         infinity) appears; a line that does not exist in the plane is left
         out.
-    segments : tuple of symstab.numeric.curves.Segment
-        The pieces of those lines that bound the stable region, where they
-        were found (the paper's :func:`symstab.boundary_curve`).
+    segments : tuple of Segment
+        The pieces of those lines that bound the stable set, where they
+        were found (the paper's :func:`symstab.boundary_curve`, from the
+        stable cells of its D-decomposition).
     theta_max : float
         Where the stable region's arc ends (the paper's plane; NaN else).
     reason : str

@@ -310,6 +310,29 @@ def test_limits_find_the_stable_region(path, examples):
     assert below and not above, f"{lim}: oracle stable below {below}, above {above}"
 
 
+@pytest.mark.parametrize("path", EXAMPLES, ids=_ids(EXAMPLES))
+def test_region_segments_bound_the_stable_set(path, examples):
+    """Each z = +-1 piece of the region's boundary has the oracle's stable set on one side only.
+
+    A tenth and nine tenths along each segment, a step of 1e-6 of the
+    window off the line: stable (python-control's poles) on one side,
+    unstable on the other.  Every example loop has the integrator's z = 1
+    line among its pieces (at K = 0).
+    """
+    example = examples(path)
+    region = example.loop.region(d=1)
+    assert any(s.root == "z=1" for s in region.segments), region.segments
+    span = np.array([np.ptp(region.x_range), np.ptp(region.y_range)])
+    for s in region.segments:
+        a, b = np.array([s.x0, s.y0]), np.array([s.x1, s.y1])
+        direction = (b - a) / span
+        normal = np.array([-direction[1], direction[0]]) / np.hypot(*direction) * span
+        for t in (0.1, 0.9):
+            point = a + t * (b - a)
+            sides = [example.stable(*(point + k * 1e-6 * normal), 1) for k in (1, -1)]
+            assert sides[0] != sides[1], (s, t, sides)
+
+
 # --------------------------------------------------------------------------
 # Acceptance: is_stable on random points
 # --------------------------------------------------------------------------
