@@ -46,7 +46,7 @@ from .._validate import check_array, check_count, check_delay, check_real, check
 from ..symbolic.loop_assembly import PLANT_DIGITS, LoopModel, parse_environment, parse_plant, shift_to_one
 from ..codegen.loop_kernels import environment_kernels, load_numpy_kernels
 from .arcs import END_ANGLE, EXACT_TERMS, ClosedFormArc, CramerArc, ExactPolynomial
-from .decomposition import Decomposition, arc_points, decompose, stable_hull
+from .decomposition import Decomposition, decompose, stable_hull
 from .passivity import passive_region
 from .decomposition import lines as _lines
 from .polynomial import DelayedPolynomial
@@ -833,13 +833,13 @@ class Loop(LoopModel):
         hull = stable_hull(base, ax, ay) if any(free.values()) else None
         enclosure = hull.box() if hull is not None else None
         if hull is not None and hull.empty:
-            auto = _curve_windows(base, ax, ay, ends)[-1]
+            auto = _curve_windows(arc, base, ax, ay, ends)[-1]
             box = [*(given["x_range"] or auto[0]), *(given["y_range"] or auto[1])]
             return Decomposition(x=x, y=y, x_range=tuple(box[:2]), y_range=tuple(box[2:]),
                                  branches=(), cells=(), mismatches=(), unbounded=(),
                                  polynomial=(base, ax, ay), hull=hull)
         found, refused = None, None
-        for auto in _start_windows((structured, *slopes), base, ax, ay, ends, hull):
+        for auto in _start_windows(arc, (structured, *slopes), base, ax, ay, ends, hull):
             box = [*(given["x_range"] or auto[0]), *(given["y_range"] or auto[1])]
             try:
                 found = run(box)
@@ -1056,7 +1056,7 @@ _UNRESOLVED = (" (a stable sliver too thin for the sampled arc to draw, as next 
                "where the set vanishes, is not excluded)")
 
 
-def _start_windows(family, base, ax, ay, ends, hull=None):
+def _start_windows(arc, family, base, ax, ay, ends, hull=None):
     """First windows for :meth:`Loop.region`, tried in turn until one holds a stable cell.
 
     First the extent of stable points next to the curves (a few steps off
@@ -1074,7 +1074,7 @@ def _start_windows(family, base, ax, ay, ends, hull=None):
     the enclosure.
     """
     enclosure = hull.box() if hull is not None else None
-    xs, ys, _ = _curve_points(base, ax, ay, ends, per_degree=4, first_lobe=64)
+    xs, ys, _ = _curve_points(arc, base, ax, ay, ends, per_degree=4, first_lobe=64)
     candidates = []
     if xs.size:
         # Steps on each point's own scale: its size and the distance to its
@@ -1096,13 +1096,13 @@ def _start_windows(family, base, ax, ay, ends, hull=None):
     if enclosure is not None:
         out.append(tuple(enclosure))
     else:
-        out += [w for w in _curve_windows(base, ax, ay, ends) if w not in out]
+        out += [w for w in _curve_windows(arc, base, ax, ay, ends) if w not in out]
     return out or [((-1.0, 1.0), (-1.0, 1.0))]
 
 
-def _curve_windows(base, ax, ay, ends):
+def _curve_windows(arc, base, ax, ay, ends):
     """The extent of the arc and the lines' crossings: without the outer 2 % on each side, then all."""
-    xs, ys, _ = _curve_points(base, ax, ay, ends)
+    xs, ys, _ = _curve_points(arc, base, ax, ay, ends)
     return _extent_windows([(xs, ys, 0.02), (xs, ys, 0.0)]) or [((-1.0, 1.0), (-1.0, 1.0))]
 
 
@@ -1130,8 +1130,8 @@ def _extent_windows(candidates, enclosure=None):
     return out
 
 
-def _curve_points(base, ax, ay, ends, per_degree=16, first_lobe=0):
-    """Points of the arc (finite ones) and the lines' crossings.
+def _curve_points(arc, base, ax, ay, ends, per_degree=16, first_lobe=0):
+    """Points of the arc (finite ones, from the loop's arc source ``arc``) and the lines' crossings.
 
     The arc at ``per_degree (n + 4)`` angles, plus ``first_lobe`` more below
     ``8 pi / (n + 4)``, where at long delays the stable set's arc lies, and
@@ -1148,7 +1148,7 @@ def _curve_points(base, ax, ay, ends, per_degree=16, first_lobe=0):
         lobe = 8 * np.pi / (n + 4) * np.arange(1, first_lobe + 1) / first_lobe
         near = theta[0] * np.geomspace(1e-6, 1.0, 24, endpoint=False)
         theta = np.union1d(theta, np.concatenate([lobe, near, np.pi - near]))
-    xs, ys, _ = arc_points(base, ax, ay, theta)
+    xs, ys, _ = arc(theta)
     lines = list(_lines(base, ax, ay, ends).values())
     for i in range(len(lines)):
         for j in range(i + 1, len(lines)):
