@@ -3,12 +3,13 @@
 The paper's loop: the arc alpha(theta), beta(theta) of eq. (7) for one
 virtual mass, delay and device, with K_w and B_w in physical units, and
 the straight segments that close the region.  A loop file (``--loop``):
-the (x, y) at which z = exp(j theta) is a closed-loop pole, and the lines
-on which a pole is at z = 1, z = -1 or infinity.
+the (x, y) at which z = exp(j theta) is a closed-loop pole, the lines on
+which a pole is at z = 1, z = -1 or infinity, and the pieces of them that
+close the stable set (from its D-decomposition, :meth:`symstab.Loop.region`).
 """
 
-import dataclasses
 import math
+import sys
 
 from .._resources import check_memory
 from .loop_options import add_loop_options, resolve_setup
@@ -37,8 +38,9 @@ def run(args):
 
     The paper's device options are the paper's loop in Table I's variables
     (:func:`symstab.cli.loop_options.resolve_setup`); for them the rows are
-    eq. (7)'s arc up to theta_max and the segments that close the stable
-    region, for a loop file the whole arc and the z = +-1 lines.
+    eq. (7)'s arc up to theta_max, for a loop file the whole arc and the
+    z = +-1 lines; for both the segments of those lines that close the
+    stable set (:attr:`symstab.numeric.decomposition.Decomposition.segments`).
     """
     from .._validate import check_count
     from ..numeric.region import boundary_curve
@@ -58,6 +60,14 @@ def run(args):
             notes.append("no real-root or leading-coefficient line crosses this plane")
         result = {"lines": {label: dict(zip(("c0", "cx", "cy"), line))
                             for label, line in curve.lines.items()}}
+        # The stable set's straight pieces: its D-decomposition (seconds at long delays).
+        print(f"finding the ({setup.x}, {setup.y}) plane's stable set for the segments that "
+              f"close it ...", file=sys.stderr, flush=True)
+        try:
+            segments = setup.loop.region(setup.x, setup.y, **setup.values).segments
+        except ValueError as exc:
+            segments = ()
+            notes.append(f"the segments that close the stable set were not found: {exc}")
     else:
         curve = boundary_curve(gamma=paper.gamma, d=paper.d, delta=paper.delta, n=n)
         columns = ["theta [rad]", "alpha", "beta"]
@@ -66,11 +76,14 @@ def run(args):
             columns += physical_columns(paper, ["K_w", "B_w"])
             rows = [r + (paper.device.stiffness(r[1]), paper.device.damping(r[2])) for r in rows]
         notes = [curve.message] if curve.empty else [f"theta_max = {curve.theta_max:.15g} rad"]
-        notes += [f"boundary segment ({seg.root}): (beta, alpha) from ({seg.beta0:.10g}, "
-                  f"{seg.alpha0:.10g}) to ({seg.beta1:.10g}, {seg.alpha1:.10g})"
-                  for seg in curve.segments]
-        result = {"theta_max": curve.theta_max, "message": curve.message,
-                  "segments": [dataclasses.asdict(s) for s in curve.segments]}
+        result = {"theta_max": curve.theta_max, "message": curve.message}
+        segments = curve.segments
+    x, y = setup.name(setup.x), setup.name(setup.y)
+    plane = f"({setup.label(setup.x)}, {setup.label(setup.y)})"
+    notes += [f"boundary segment ({g.root}): {plane} from ({g.x0:.10g}, {g.y0:.10g}) to "
+              f"({g.x1:.10g}, {g.y1:.10g})" for g in segments]
+    result["segments"] = [{"root": g.root, f"{x}0": g.x0, f"{y}0": g.y0, f"{x}1": g.x1,
+                           f"{y}1": g.y1} for g in segments]
     emit(setup, args.format, columns, rows, result=result, notes=notes)
     return 0
 

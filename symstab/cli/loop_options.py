@@ -101,8 +101,9 @@ TABLE_ONE = {"K": "alpha", "B": "beta", "M": "gamma", "b": "delta"}
 #: What each command gives for a loop file, for its --help.
 _WHAT = {
     "boundary": "boundary --loop gives the D-decomposition of the plane: the (x, y) at which "
-                "z = exp(j theta) is a closed-loop pole, and the lines c0 + cx x + cy y = 0 "
-                "on which a pole is at z = 1, z = -1 or infinity (leading coefficient 0).",
+                "z = exp(j theta) is a closed-loop pole, the lines c0 + cx x + cy y = 0 "
+                "on which a pole is at z = 1, z = -1 or infinity (leading coefficient 0), "
+                "and the pieces of them that close the stable set.",
     "limits": "limits --loop gives the largest stable y, the x where it is reached, the x "
               "extent and the area of the stable set in the plane (with --at X the stable "
               "intervals of y at x = X).",

@@ -151,6 +151,18 @@ def test_boundary_lies_on_the_derived_curve_and_names_its_lines(capsys):
     c = minus_one_line(gamma=0.0, d=10, delta=PAPER_DELTA)
     assert -c0 / cy == pytest.approx(stiffness(c), rel=1e-6)
     assert any(n.startswith("line z = -1: ") and n.endswith(" B") for n in data["notes"])
+    # The piece of K = 0 that closes the stable set: from the arc's start at
+    # beta = -delta (B = -b) to where the first-principles arc returns to alpha = 0.
+    from oracles import first_principles_boundary_point, first_principles_theta_max
+
+    (segment,) = data["segments"]
+    assert segment["root"] == "z=1" and segment["K0"] == segment["K1"] == 0
+    assert segment["B0"] == pytest.approx(damping(-PAPER_DELTA), rel=1e-12)
+    theta_max = first_principles_theta_max(0.0, 10, PAPER_DELTA)
+    beta_end = first_principles_boundary_point(theta_max, 0.0, 10, PAPER_DELTA)[1]
+    assert segment["B1"] == pytest.approx(damping(float(beta_end)), rel=1e-9)
+    assert any(n.startswith("boundary segment (z=1): (B [N m s/rad], K [N m/rad]) from ")
+               for n in data["notes"])
 
 
 def test_map_is_todays_root_count_classification(capsys, tmp_path):
