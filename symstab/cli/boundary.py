@@ -50,24 +50,25 @@ def run(args):
     check_memory(f"--n {n} boundary points", n * BYTES_PER_ROW)
     paper = setup.paper
     if paper is None:
-        curve = setup.loop.boundary(x=setup.x, y=setup.y, n=n, **setup.values)
+        # The stable set's straight pieces: its D-decomposition (seconds at long delays).
+        print(f"finding the ({setup.x}, {setup.y}) plane's stable set for the segments that "
+              f"close it ...", file=sys.stderr, flush=True)
+        try:
+            curve = setup.loop.boundary(x=setup.x, y=setup.y, n=n, segments=True, **setup.values)
+        except ValueError as exc:
+            curve = setup.loop.boundary(x=setup.x, y=setup.y, n=n, **setup.values)
+            notes = [f"the segments that close the stable set were not found: {exc}"]
+        else:
+            notes = []
         columns = ["theta [rad]", setup.label(setup.x), setup.label(setup.y)]
         rows = list(zip(curve.theta, curve.x_values, curve.y_values))
-        notes = [f"D-decomposition: z = exp(j theta) is a closed-loop pole at ({setup.x}, "
-                 f"{setup.y}) (nan: the 2 x 2 system is singular at that theta)"]
+        notes.insert(0, f"D-decomposition: z = exp(j theta) is a closed-loop pole at ({setup.x}, "
+                        f"{setup.y}) (nan: the 2 x 2 system is singular at that theta)")
         notes += [_line_text(setup, label, line) for label, line in curve.lines.items()]
         if not curve.lines:
             notes.append("no real-root or leading-coefficient line crosses this plane")
         result = {"lines": {label: dict(zip(("c0", "cx", "cy"), line))
                             for label, line in curve.lines.items()}}
-        # The stable set's straight pieces: its D-decomposition (seconds at long delays).
-        print(f"finding the ({setup.x}, {setup.y}) plane's stable set for the segments that "
-              f"close it ...", file=sys.stderr, flush=True)
-        try:
-            segments = setup.loop.region(setup.x, setup.y, **setup.values).segments
-        except ValueError as exc:
-            segments = ()
-            notes.append(f"the segments that close the stable set were not found: {exc}")
     else:
         curve = boundary_curve(gamma=paper.gamma, d=paper.d, delta=paper.delta, n=n)
         columns = ["theta [rad]", "alpha", "beta"]
@@ -77,7 +78,7 @@ def run(args):
             rows = [r + (paper.device.stiffness(r[1]), paper.device.damping(r[2])) for r in rows]
         notes = [curve.message] if curve.empty else [f"theta_max = {curve.theta_max:.15g} rad"]
         result = {"theta_max": curve.theta_max, "message": curve.message}
-        segments = curve.segments
+    segments = curve.segments
     x, y = setup.name(setup.x), setup.name(setup.y)
     plane = f"({setup.label(setup.x)}, {setup.label(setup.y)})"
     notes += [f"boundary segment ({g.root}): {plane} from ({g.x0:.10g}, {g.y0:.10g}) to "

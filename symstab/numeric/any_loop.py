@@ -739,7 +739,7 @@ class Loop(LoopModel):
             out.append(ExactPolynomial(delayed, direct, d + k))
         return tuple(out)
 
-    def boundary(self, x=None, y=None, n=1000, **values):
+    def boundary(self, x=None, y=None, n=1000, *, segments=False, **values):
         """The D-decomposition of the ``(x, y)`` plane.
 
         Parameters
@@ -749,6 +749,9 @@ class Loop(LoopModel):
             (default: the loop's :attr:`plane`).
         n : int
             Angles in (0, pi).
+        segments : bool
+            Also find the pieces of the z = +-1 lines that close the stable
+            set (from :meth:`region`: seconds at long delays).
         **values
             Single values of every other parameter.
 
@@ -764,7 +767,8 @@ class Loop(LoopModel):
         theta = np.pi * (np.arange(1, n + 1) - 0.5) / n
         xs, ys, _ = self._arc_source(x, y, values, (structured, *slopes))(theta)
         lines = {label: c for label, c in _lines(base, ax, ay, ends).items() if c[1] or c[2]}
-        return Boundary(x, y, theta, xs, ys, lines=lines, at=dict(values))
+        pieces = self.region(x, y, **values).segments if segments else ()
+        return Boundary(x, y, theta, xs, ys, lines=lines, segments=pieces, at=dict(values))
 
     def region(self, x=None, y=None, *, x_range=None, y_range=None, **values):
         """The complete D-decomposition of the ``(x, y)`` plane: cells, root counts, stable set.
