@@ -117,9 +117,11 @@ def _single(text, flag):
 class _View:
     """What the output needs: the inputs' echo, the locus and how to show its parameter."""
 
-    def __init__(self, setup, locus, name, unit, tex, show, T, dimensionless=None, given=None):
+    def __init__(self, setup, locus, count, name, unit, tex, show, T, dimensionless=None,
+                 given=None):
         self.setup = setup          # has .echo and .as_dict() (numeric.Setup or loop.LoopSetup)
         self.locus = locus
+        self.count = count          # path values -> certified unstable counts (the loop's)
         self.name = name            # "K_w", "alpha", "K"
         self.unit = unit
         self.tex = tex              # the axis label, mathtext
@@ -136,7 +138,7 @@ class _View:
 
 def _paper(args):
     """The paper's loop: resolve the options, run :func:`paper_locus`; return a :class:`_View`."""
-    from ..numeric.paper_loop import paper_locus
+    from ..numeric.paper_loop import paper_locus, paper_point
 
     for flag, dest in (("--set", "set_values"),):
         if getattr(args, dest) is not None:
@@ -193,8 +195,15 @@ def _paper(args):
         show, name, unit = np.asarray, parameter, ""
         tex = r"$\alpha = K_w T^2 / m$" if parameter == "alpha" else r"$\beta = B_w T / m$"
     dimensionless = parameter if path_flag in ("--Kw", "--Bw") else None
-    return _View(setup, locus, name, unit, tex, lambda v: np.asarray(show(v), dtype=float), T,
-                 dimensionless, given)
+    # The certified counts: the paper's loop at m = T = 1, whose (B, K) is (beta, alpha).
+    loop, point = paper_point(gamma=setup.gamma, d=setup.d, delta=setup.delta)
+    plane = {"alpha": "K", "beta": "B"}
+
+    def count(v):
+        return loop.unstable_root_counts(**point, **{plane[other]: fixed_value, plane[parameter]: v})
+
+    return _View(setup, locus, count, name, unit, tex,
+                 lambda v: np.asarray(show(v), dtype=float), T, dimensionless, given)
 
 
 #: From this many poles on, say on stderr what runs (some seconds: 8 s for
@@ -268,7 +277,10 @@ def _loop(args):
         f"({given.size} points)",))
     tex = f"{name} [{tex_unit(unit)}]" if unit else name
     T = values.get("T") if "T" in loop.parameters else None
-    return _View(setup, result, name, unit, tex, lambda v: np.asarray(v, dtype=float),
+    def count(v):
+        return loop.unstable_root_counts(**values, **{name: v})
+
+    return _View(setup, result, count, name, unit, tex, lambda v: np.asarray(v, dtype=float),
                  None if T is None else float(T), given=given)
 
 
@@ -306,15 +318,8 @@ def _stretches(view):
 
 
 def _certified(view):
-    """Certified root counts at the path's points, or None where not available."""
-    locus = view.locus
-    if view.setup.__class__.__name__ == "LoopSetup":
-        return np.atleast_1d(view.setup.loop.unstable_root_counts(
-            **view.setup.values, **{locus.parameter: locus.values}))
-    from ..numeric.stability import unstable_root_counts
-
-    fixed = dict(locus.fixed)
-    return np.atleast_1d(unstable_root_counts(**fixed, **{locus.parameter: locus.values}))
+    """Certified root counts at the path's points (:meth:`symstab.Loop.unstable_root_counts`)."""
+    return np.atleast_1d(view.count(view.locus.values))
 
 
 #: A crossing value within this fraction of the path's span from 0 is
