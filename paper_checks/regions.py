@@ -48,7 +48,8 @@ from symstab._validate import check_count, check_loop, check_real
 from symstab.symbolic.small_theta import small_theta_limits
 from symstab.numeric.curves import arc_end_angle, minus_one_line
 from symstab.numeric.region import StabilityRegion, boundary_curve
-from symstab.numeric.stability import stable_alpha_intervals, unstable_root_counts
+from symstab.numeric.stability import unstable_root_counts
+from symstab.symbolic.loop import characteristic_polynomial
 from symstab.numeric.units import PAPER_DEVICE
 
 __all__ = [
@@ -56,6 +57,7 @@ __all__ = [
     "Probe", "RegionResult", "classify",
     "PaperClaim", "FIGURE_CASES", "LIMIT_CASES", "compare", "format_table",
     "closed_polygon", "inside_even_odd",
+    "coefficients_at", "unstable_root_count", "stable_alpha_intervals",
 ]
 
 _DPS = 30
@@ -306,7 +308,7 @@ class RegionResult:
     library_check : dict
         Empty, or with ``cross_check``: the vertical through the arc's top
         re-scanned with the 30-digit reference
-        :func:`symstab.numeric.stability.stable_alpha_intervals`, both
+        :func:`stable_alpha_intervals`, both
         interval lists (``reference``, ``counted``) and ``agrees``.
     seconds : float
         Wall time of the call.
@@ -396,7 +398,7 @@ def classify(gamma, d, delta=PAPER_DEVICE.delta, *, n_beta=41, arc_points=None,
         stable intervals lie on the arc itself.
     cross_check : bool, optional
         Re-scan the vertical through the arc's top with the 30-digit
-        reference :func:`symstab.numeric.stability.stable_alpha_intervals`
+        reference :func:`stable_alpha_intervals`
         (about 0.2 s) and compare.
 
     Returns
@@ -716,3 +718,72 @@ def main(processes=2):
 
 if __name__ == "__main__":
     main()
+
+
+# --------------------------------------------------------------------------
+# The audit's reference per point: symstab's derivation at 30 digits and
+# numpy's roots (slow; independent of the generated kernels and of the
+# root engine it checks)
+
+
+def coefficients_at(*, alpha, beta, gamma, d, delta):
+    """Coefficients of chi(z), highest power first, as floats (30-digit evaluation)."""
+    return characteristic_polynomial().numeric_coeffs(
+        alpha=alpha, beta=beta, gamma=gamma, d=d, delta=delta)
+
+
+def unstable_root_count(*, alpha, beta, gamma, d, delta, marginal_tol=1e-12):
+    """Number of roots with modulus > 1, or ``None`` when one is marginal."""
+    roots = np.roots(coefficients_at(alpha=alpha, beta=beta, gamma=gamma, d=d, delta=delta))
+    mod = np.abs(roots)
+    if np.any(np.abs(mod - 1.0) <= marginal_tol):
+        return None
+    return int(np.count_nonzero(mod > 1.0))
+
+
+def stable_alpha_intervals(*, beta, gamma, d, delta, alpha_low=-1.0, alpha_high=6.0,
+                           n=600, xtol=1e-10):
+    """The stable alpha intervals at fixed beta, by a scan and bisection.
+
+    ``alpha`` is scanned on ``n`` points of ``[alpha_low, alpha_high]``;
+    each change of stability is refined by bisection on the spectral radius
+    (roots of the 30-digit coefficients) to ``xtol``.  It is slow and
+    independent of the generated kernels;
+    :meth:`symstab.StabilityRegion.alpha_intervals` finds the same intervals
+    with the line engine, fast and without a scan.
+
+    Returns
+    -------
+    list of (float, float)
+        The stable intervals, in increasing order; empty when none.
+    """
+    def rho(a):
+        # The 30-digit coefficients and numpy's roots, not the generated
+        # kernels: the audit uses this as a reference independent of them.
+        coeffs = coefficients_at(alpha=float(a), beta=beta, gamma=gamma, d=d, delta=delta)
+        return float(np.max(np.abs(np.roots(coeffs)))) - 1.0
+
+    grid = np.linspace(alpha_low, alpha_high, n)
+    stable = [rho(a) < 0 for a in grid]
+    edges = []
+    for k in range(1, n):
+        if stable[k] != stable[k - 1]:
+            lo, hi = grid[k - 1], grid[k]
+            while hi - lo > xtol:
+                mid = 0.5 * (lo + hi)
+                if (rho(mid) < 0) == stable[k - 1]:
+                    lo = mid
+                else:
+                    hi = mid
+            edges.append(0.5 * (lo + hi))
+    intervals = []
+    start = grid[0] if stable[0] else None
+    for edge in edges:
+        if start is None:
+            start = edge
+        else:
+            intervals.append((float(start), float(edge)))
+            start = None
+    if start is not None:
+        intervals.append((float(start), float(grid[-1])))
+    return intervals

@@ -15,7 +15,11 @@ And a reference that is *not* independent: symstab's own derivation
 evaluated with mpmath numbers at the caller's precision
 (:func:`loop_coefficients_mp`, :func:`boundary_point_mp`, :func:`chi_mp`),
 the 30- to 60-digit reference for the float kernels, here so that every test
-evaluates it the same way (always mpmath numbers, never Python floats).
+evaluates it the same way (always mpmath numbers, never Python floats); and
+per point its 30-digit coefficients with numpy's roots
+(:func:`coefficients_at`, :func:`unstable_root_count`,
+:func:`stable_alpha_intervals`: the audit's reference, from
+:mod:`paper_checks.regions`), the slow reference of the root engine.
 
 Fixtures, shared command runs and assertion helpers are in ``conftest.py``.
 Both modules are imported by name (``from oracles import ...``) from every
@@ -29,6 +33,7 @@ import mpmath
 import numpy as np
 import sympy as sp
 
+from paper_checks.regions import coefficients_at, stable_alpha_intervals, unstable_root_count  # noqa: F401
 from symstab.symbolic import model
 from symstab.symbolic.boundary import boundary
 from symstab.symbolic.loop import characteristic_polynomial

@@ -15,11 +15,6 @@ hand it to the one root engine, :mod:`symstab.numeric.roots`, that every
 * :func:`classify` -- stable, unstable or marginal;
 * :func:`is_stable` -- the same as a masked boolean array (masked where
   marginal), or ``True``/``False``/``None`` for a single point.
-
-The per-point functions at the end (:func:`coefficients_at`,
-:func:`unstable_root_count`, :func:`stable_alpha_intervals`) evaluate the
-coefficients at 30 digits through mpmath; they are the slow reference the
-audit was built on.
 """
 
 import numpy as np
@@ -27,7 +22,6 @@ import numpy as np
 from .._generated import kernels
 from .._resources import check_memory
 from .._validate import DELTA_MAX, PARAMETER_MAX, check_array, check_delay
-from ..symbolic.loop import characteristic_polynomial
 from . import roots
 from .polynomial import DelayedPolynomial
 from .roots import MARGINAL, STABLE, UNSTABLE, classify_polynomials, schur_cohn
@@ -35,9 +29,7 @@ from .roots import MARGINAL, STABLE, UNSTABLE, classify_polynomials, schur_cohn
 __all__ = [
     "STABLE", "MARGINAL", "UNSTABLE",
     "loop_coefficients", "paper_polynomial", "spectral_radius", "schur_cohn",
-    "unstable_root_counts", "classify", "is_stable",
-    "coefficients_at", "unstable_root_count", "stable_alpha_intervals",
-    "polynomial_root_counts", "classify_polynomials", "polynomial_spectral_radius",
+    "unstable_root_counts", "classify", "is_stable", "classify_polynomials",
 ]
 
 
@@ -245,21 +237,6 @@ def classify(*, alpha, beta, gamma, d, delta, refine=True):
     return _shaped(codes, shape)
 
 
-def polynomial_root_counts(coefficients, *, coefficient_ulps=roots.COEFFICIENT_ULPS):
-    """Certified number of roots outside the unit circle of dense real polynomials.
-
-    :func:`symstab.numeric.roots.root_counts` of the rows (highest power
-    first, shape ``(N, n + 1)``); -1 where marginal.
-    """
-    return roots.root_counts(DelayedPolynomial.from_dense(coefficients),
-                             coefficient_ulps=coefficient_ulps)
-
-
-def polynomial_spectral_radius(coefficients):
-    """Largest root modulus of dense real polynomials: :func:`symstab.numeric.roots.spectral_radius`."""
-    return roots.spectral_radius(DelayedPolynomial.from_dense(coefficients))
-
-
 def _shaped(codes, shape):
     codes = codes.reshape(shape)
     return int(codes) if codes.ndim == 0 else codes
@@ -292,70 +269,3 @@ def is_stable(*, alpha, beta, gamma, d, delta):
     if code.ndim == 0:
         return None if code == MARGINAL else bool(code == STABLE)
     return np.ma.MaskedArray(code == STABLE, mask=code == MARGINAL)
-
-
-# --------------------------------------------------------------------------
-# Per-point reference at 30 digits (the audit's)
-
-
-def coefficients_at(*, alpha, beta, gamma, d, delta):
-    """Coefficients of chi(z), highest power first, as floats (30-digit evaluation)."""
-    return characteristic_polynomial().numeric_coeffs(
-        alpha=alpha, beta=beta, gamma=gamma, d=d, delta=delta)
-
-
-def unstable_root_count(*, alpha, beta, gamma, d, delta, marginal_tol=1e-12):
-    """Number of roots with modulus > 1, or ``None`` when one is marginal."""
-    roots = np.roots(coefficients_at(alpha=alpha, beta=beta, gamma=gamma, d=d, delta=delta))
-    mod = np.abs(roots)
-    if np.any(np.abs(mod - 1.0) <= marginal_tol):
-        return None
-    return int(np.count_nonzero(mod > 1.0))
-
-
-def stable_alpha_intervals(*, beta, gamma, d, delta, alpha_low=-1.0, alpha_high=6.0,
-                           n=600, xtol=1e-10):
-    """The stable alpha intervals at fixed beta, by a scan and bisection.
-
-    ``alpha`` is scanned on ``n`` points of ``[alpha_low, alpha_high]``;
-    each change of stability is refined by bisection on the spectral radius
-    (roots of the 30-digit coefficients) to ``xtol``.  It is slow and
-    independent of the generated kernels;
-    :meth:`symstab.numeric.region.StabilityRegion.alpha_intervals` finds the same
-    intervals from the boundary curves, fast and without a scan.
-
-    Returns
-    -------
-    list of (float, float)
-        The stable intervals, in increasing order; empty when none.
-    """
-    def rho(a):
-        # The 30-digit coefficients and numpy's roots, not the generated
-        # kernels: the audit uses this as a reference independent of them.
-        coeffs = coefficients_at(alpha=float(a), beta=beta, gamma=gamma, d=d, delta=delta)
-        return float(np.max(np.abs(np.roots(coeffs)))) - 1.0
-
-    grid = np.linspace(alpha_low, alpha_high, n)
-    stable = [rho(a) < 0 for a in grid]
-    edges = []
-    for k in range(1, n):
-        if stable[k] != stable[k - 1]:
-            lo, hi = grid[k - 1], grid[k]
-            while hi - lo > xtol:
-                mid = 0.5 * (lo + hi)
-                if (rho(mid) < 0) == stable[k - 1]:
-                    lo = mid
-                else:
-                    hi = mid
-            edges.append(0.5 * (lo + hi))
-    intervals = []
-    start = grid[0] if stable[0] else None
-    for edge in edges:
-        if start is None:
-            start = edge
-        else:
-            intervals.append((float(start), float(edge)))
-            start = None
-    if start is not None:
-        intervals.append((float(start), float(grid[-1])))
-    return intervals

@@ -17,8 +17,9 @@ import symstab
 from symstab.symbolic import model
 from symstab.numeric.any_loop import Loop
 from symstab.symbolic.discretize import numeric_zoh, zoh_pulse_transfer_function
-from symstab.numeric.stability import (MARGINAL, STABLE, UNSTABLE, classify_polynomials,
-                               polynomial_root_counts, polynomial_spectral_radius)
+from symstab.numeric.polynomial import DelayedPolynomial
+from symstab.numeric.roots import root_counts, spectral_radius
+from symstab.numeric.stability import MARGINAL, STABLE, UNSTABLE, classify_polynomials
 
 from conftest import PAPER_B, PAPER_M, PAPER_T, assert_rel_close
 from oracles import python_control_closed_loop
@@ -241,7 +242,7 @@ def _mp_outside(coefficients):
         return sum(1 for r in roots if abs(r) > 1), min(abs(abs(r) - 1) for r in roots)
 
 
-def test_polynomial_root_counts_against_mpmath():
+def test_dense_root_counts_against_mpmath():
     """Never a wrong count; marginal only where the coefficients cannot decide.
 
     Degree 40 from random roots has coefficients up to 1e10 times its values
@@ -256,7 +257,7 @@ def test_polynomial_root_counts_against_mpmath():
             outside, gap = _mp_outside(c)
             if gap < 1e-9:
                 continue
-            count = polynomial_root_counts(c[None, :])[0]
+            count = root_counts(DelayedPolynomial.from_dense(c[None, :]))[0]
             code = classify_polynomials(c)
             expected = STABLE if outside == 0 else UNSTABLE
             if count == -1:
@@ -266,7 +267,7 @@ def test_polynomial_root_counts_against_mpmath():
                 continue
             assert count == outside
             assert code == expected
-            r = polynomial_spectral_radius(c[None, :])[0]
+            r = spectral_radius(DelayedPolynomial.from_dense(c[None, :]))[0]
             with mpmath.workdps(40):
                 exact = max(abs(x) for x in mpmath.polyroots([mpmath.mpf(float(v)) for v in c],
                                                              maxsteps=200, extraprec=200))
@@ -277,7 +278,7 @@ def test_polynomial_root_counts_against_mpmath():
 
 def test_a_root_on_the_circle_is_marginal():
     c = np.real(np.poly([np.exp(0.7j), np.exp(-0.7j), 0.5]))
-    assert polynomial_root_counts(c[None, :])[0] == -1
+    assert root_counts(DelayedPolynomial.from_dense(c[None, :]))[0] == -1
     assert classify_polynomials(c) == MARGINAL
     # A vanishing leading coefficient is a root at infinity: marginal too.
     assert classify_polynomials([0.0, 1.0, 0.2]) == MARGINAL
@@ -529,7 +530,7 @@ def test_root_counts_next_to_the_circle_are_right_or_marginal():
         roots = radius * np.exp(1j * rng.uniform(0.01, np.pi - 0.01, degree))
         c = np.real(np.poly(np.concatenate([roots, np.conj(roots)])))
         outside, nearest = _mp_outside(c)
-        count = polynomial_root_counts(c[None, :])[0]
+        count = root_counts(DelayedPolynomial.from_dense(c[None, :]))[0]
         if count == -1:
             marginal += 1
             continue

@@ -49,7 +49,7 @@ def test_counts_match_python_control_and_the_dimensionless_path(d, K, B, M):
 def test_spectral_radius_matches_50_digit_roots_of_the_symbolic_polynomial():
     """python-control's poles are off by 1.4e-8 here (degree 44); the oracle is mpmath at 50 digits
     on the coefficients of the symbolic characteristic polynomial evaluated at 30 digits."""
-    from symstab.numeric.stability import coefficients_at
+    from oracles import coefficients_at
 
     device = symstab.PAPER_DEVICE
     for d, K, B in [(40, 3.0, 0.01), (3, 100.0, 0.2)]:
@@ -65,7 +65,7 @@ def test_spectral_radius_matches_50_digit_roots_of_the_symbolic_polynomial():
 def _exact_count(K, B, d):
     """Roots outside at 50 digits of the symbolic polynomial evaluated at 30 digits (an oracle
     independent of the kernels and of the root engine)."""
-    from symstab.numeric.stability import coefficients_at
+    from oracles import coefficients_at
 
     device = symstab.PAPER_DEVICE
     c = coefficients_at(alpha=device.alpha(K), beta=device.beta(B), gamma=0.0, d=d, delta=device.delta)

@@ -45,7 +45,7 @@ from symstab.numeric.evaluate import alpha_max_on_arc, boundary_point
 
 from conftest import PAPER_DELTA, assert_message_names
 from oracles import (first_principles_boundary_point, first_principles_chi_float, first_principles_radius,
-                     theta_max_box_sample)
+                     stable_alpha_intervals, theta_max_box_sample)
 
 
 #: The first-principles polynomial of eqs. (1), (2), (4) (tests/oracles.py),
@@ -579,7 +579,7 @@ def test_long_delay_alpha_interval_matches_first_principles(gamma, d, delta, bet
 
 def test_limits_at_d_200_agree_with_the_30_digit_interval_scan():
     """limits() at d = 200: the interval at beta_at_alpha_max reaches alpha_max, and the
-    slow 30-digit reference scan (stability.stable_alpha_intervals, roots of the
+    slow 30-digit reference scan (oracles.stable_alpha_intervals, roots of the
     30-digit coefficients) finds the same interval at another beta."""
     gamma, d, delta, beta = 0.5, 200, 1e-4, 0.003
     lim = limits(gamma=gamma, d=d, delta=delta)
@@ -588,7 +588,7 @@ def test_limits_at_d_200_agree_with_the_30_digit_interval_scan():
     assert top and top[-1][1] == pytest.approx(lim.alpha_max, rel=1e-6)
     (lo, hi), = lim.alpha_interval(beta)
     # three scan points (-0.3, 0.45, 1.2 of the top) and bisection to 1e-6: ~45 root finds
-    ref = symstab.numeric.stability.stable_alpha_intervals(beta=beta, gamma=gamma, d=d, delta=delta,
+    ref = stable_alpha_intervals(beta=beta, gamma=gamma, d=d, delta=delta,
                                                    alpha_low=-0.3 * hi, alpha_high=1.2 * hi,
                                                    n=3, xtol=1e-6 * hi)
     assert len(ref) == 1

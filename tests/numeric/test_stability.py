@@ -1,14 +1,14 @@
-"""symstab.numeric.stability: root counting against python-control's poles."""
+"""symstab.numeric.stability, and the 30-digit per-point oracles, against python-control's poles."""
 
 import numpy as np
 import pytest
 
 from symstab.numeric.evaluate import boundary_point
-from symstab.numeric.stability import (coefficients_at, spectral_radius, stable_alpha_intervals,
-                               unstable_root_count)
+from symstab.numeric.stability import spectral_radius
 
 from conftest import PAPER_DELTA
-from oracles import dimensionless, python_control_closed_loop, random_loop_points
+from oracles import (coefficients_at, dimensionless, python_control_closed_loop,
+                     random_loop_points, stable_alpha_intervals, unstable_root_count)
 
 
 @pytest.mark.parametrize("point", random_loop_points(seed=7, n=20, delta_range=(1e-3, 1.0)))
