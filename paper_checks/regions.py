@@ -698,28 +698,6 @@ def _classify_or_none(point):
         return None
 
 
-def main(processes=2):
-    """Classify every case, print the table and each disagreement's evidence."""
-    import multiprocessing
-
-    claims = FIGURE_CASES + LIMIT_CASES
-    unique = list(dict.fromkeys((c.gamma, c.d) for c in claims))
-    started = time.perf_counter()
-    with multiprocessing.Pool(processes) as pool:
-        results = dict(zip(unique, pool.map(_classify_or_none, unique)))
-    rows = [(c, results[(c.gamma, c.d)]) for c in claims]
-    print(format_table(rows))
-    print(f"\n{len(unique)} parameter points in {time.perf_counter() - started:.1f} s")
-    for claim, result in rows:
-        if result is not None and compare(claim, result) is not True:
-            print(f"\n[{claim.figure} lines {claim.lines}] paper: {claim.claim}\n"
-                  + result.evidence())
-
-
-if __name__ == "__main__":
-    main()
-
-
 # --------------------------------------------------------------------------
 # The audit's reference per point: symstab's derivation at 30 digits and
 # numpy's roots (slow; independent of the generated kernels and of the
@@ -787,3 +765,25 @@ def stable_alpha_intervals(*, beta, gamma, d, delta, alpha_low=-1.0, alpha_high=
     if start is not None:
         intervals.append((float(start), float(grid[-1])))
     return intervals
+
+
+def main(processes=2):
+    """Classify every case, print the table and each disagreement's evidence."""
+    import multiprocessing
+
+    claims = FIGURE_CASES + LIMIT_CASES
+    unique = list(dict.fromkeys((c.gamma, c.d) for c in claims))
+    started = time.perf_counter()
+    with multiprocessing.Pool(processes) as pool:
+        results = dict(zip(unique, pool.map(_classify_or_none, unique)))
+    rows = [(c, results[(c.gamma, c.d)]) for c in claims]
+    print(format_table(rows))
+    print(f"\n{len(unique)} parameter points in {time.perf_counter() - started:.1f} s")
+    for claim, result in rows:
+        if result is not None and compare(claim, result) is not True:
+            print(f"\n[{claim.figure} lines {claim.lines}] paper: {claim.claim}\n"
+                  + result.evidence())
+
+
+if __name__ == "__main__":
+    main()

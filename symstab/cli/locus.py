@@ -277,6 +277,7 @@ def _loop(args):
         f"({given.size} points)",))
     tex = f"{name} [{tex_unit(unit)}]" if unit else name
     T = values.get("T") if "T" in loop.parameters else None
+
     def count(v):
         return loop.unstable_root_counts(**values, **{name: v})
 

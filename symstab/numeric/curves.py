@@ -17,15 +17,16 @@ where the arc ends:
 """
 
 import fractions
+import math
 
 import numpy as np
 
 from .._generated import kernels
 from .._validate import check_loop
 from ..symbolic.theta_max import first_sign_change, reduced_curvature, reduced_qr, reduced_value_slope
-from .results import Boundary
+from .results import Boundary, Segment  # noqa: F401  (Segment: its home before results)
 
-__all__ = ["arc_end_angle", "minus_one_line", "BoundaryCurve", "scan_grid",
+__all__ = ["arc_end_angle", "minus_one_line", "BoundaryCurve", "Segment", "scan_grid",
            "bracketed_root", "refit_root", "zoom_max", "KERNEL_BYTES_PER_POINT",
            "KERNEL_CHUNK_BYTES"]
 
@@ -124,8 +125,10 @@ def refit_root(f, root, half_width, points=17):
     it.  The least-squares line through ``points`` values on ``[root -
     half_width, root + half_width]`` (wide enough for ``f`` to rise above
     its floor there, narrow enough for ``f`` to be straight) averages the
-    floor out.  ``root`` is kept where the line is flat or its zero is not
-    inside that stretch.
+    floor out.  ``root`` is kept where the line is flat, where ``f`` is not
+    straight there (the values stray from the line by more than 1e-2 of
+    its rise over ``half_width``), or where its zero is not inside that
+    stretch.
 
     Parameters
     ----------
@@ -146,10 +149,14 @@ def refit_root(f, root, half_width, points=17):
     values = np.asarray(f(root + step), dtype=float)
     if not np.all(np.isfinite(values)):
         return root
-    slope, intercept = np.polyfit(step, values, 1)
-    if slope == 0 or not abs(intercept / slope) < half_width:
+    (slope, intercept), residuals = np.polyfit(step, values, 1, full=True)[:2]
+    rms = math.sqrt(float(residuals[0]) / points) if len(residuals) else 0.0
+    # Only a straight f (what is left beside the line is a floor of
+    # rounding, not a curve) has the line's zero for its root.
+    if slope == 0 or rms > 1e-2 * abs(slope) * half_width \
+            or not abs(intercept / slope) < half_width:
         return root
-    return root - intercept / slope
+    return float(root - intercept / slope)
 
 
 def arc_end_angle(*, gamma, d, delta):

@@ -208,7 +208,9 @@ class Decomposition:
         The pieces of the z = 1 and z = -1 lines that bound the stable set
         (a stable cell's edges on them: across such a line the count
         changes, so the other side is unstable), joined where they meet,
-        each end where the arc meets the line re-found on the arc.
+        each end where the arc meets the line re-found on the arc.  An end
+        on a side of the window in :attr:`unbounded` is where the window
+        cuts the piece, not where it ends.
     """
 
     x: str
@@ -392,8 +394,8 @@ class Decomposition:
 
             root = bracketed_root(along, [arc.theta[j]], [arc.theta[j + 1]])[0]
             # The line's equation along the arc is a difference of larger
-            # terms next to a flat corner: fitted over a thousandth of the
-            # chord, its rounding floor averages out.
+            # terms next to a flat corner: fitted over 2e-3 of the chord
+            # around the root, its rounding floor averages out.
             width = max(1e-3 * (arc.theta[j + 1] - arc.theta[j]), 64 * np.spacing(root))
             root = refit_root(along, root, width)
             xs, ys = source(np.array([root]))[:2]
@@ -413,26 +415,33 @@ class Decomposition:
         segments = tuple(dataclasses.replace(g, x=x, y=y) for g in self.segments)
         return dataclasses.replace(self, x=x, y=y, segments=segments)
 
-    def _segment(self, label, line, ends):
-        """The :class:`~symstab.numeric.results.Segment` of ``line`` between two cell vertices.
+    def _segment(self, label, lines, ends):
+        """The :class:`~symstab.numeric.results.Segment` of line ``label`` between two cell vertices.
 
         An end where the arc meets the line is re-found on the arc
-        (:meth:`_corner`); every end is then put on the line exactly (``y``
-        from ``x``, or ``x`` from ``y`` for a steep line), so a piece of
-        ``y = 0`` has ``y`` 0, not a rounding of it.
+        (:meth:`_corner`), one where the other of z = +-1 crosses it is the
+        two lines' crossing; every end is then put on the line exactly
+        (``y`` from ``x``, or ``x`` from ``y`` for a line steep in the
+        window), so a piece of ``y = 0`` has ``y`` 0, not a rounding of it.
+        ``lines`` holds each line's ``(c0, cx, cy)``.
         """
         arc = next((b for b in self.branches if b.label == "arc"), None)
-        scale = np.array([self.x_range[1] - self.x_range[0], self.y_range[1] - self.y_range[0]])
-        c0, cx, cy = line
+        sx, sy = self.x_range[1] - self.x_range[0], self.y_range[1] - self.y_range[0]
+        c0, cx, cy = lines[label]
         points = []
         for end in ends:
-            corner = self._corner(arc, end, scale) if arc is not None else None
+            corner = self._corner(arc, end, np.array([sx, sy])) if arc is not None else None
             u, v = (float(w) for w in (end if corner is None else corner))
-            if abs(cy) >= abs(cx):
-                v = -(c0 + cx * u) / cy + 0.0
+            other = lines["z = 1" if label == "z = -1" else "z = -1"]
+            e0, ex, ey = other
+            det = cx * ey - cy * ex
+            if det != 0 and abs(e0 + ex * u + ey * v) <= _CORNER * math.hypot(ex * sx, ey * sy):
+                u, v = (-c0 * ey + cy * e0) / det, (-cx * e0 + c0 * ex) / det
+            elif abs(cy) * sy >= abs(cx) * sx:
+                v = -(c0 + cx * u) / cy
             else:
-                u = -(c0 + cy * v) / cx + 0.0
-            points.append((u, v))
+                u = -(c0 + cy * v) / cx
+            points.append((u + 0.0, v + 0.0))
         (u0, v0), (u1, v1) = sorted(points)
         return Segment(label.replace(" ", ""), u0, v0, u1, v1, self.x, self.y)
 
@@ -1585,9 +1594,9 @@ def _decompose(base, ax, ay, ends, *, x_range, y_range, names, fine, arc, family
                           mismatches=tuple(mismatches), unbounded=unbounded,
                           polynomial=(base, ax, ay), resolution=resolution, arc=arc)
     coefficients = lines(base, ax, ay, ends)
-    segments = [found._segment(label, coefficients[label], from_unit(xy[[a, b]]))
+    segments = [found._segment(label, coefficients, from_unit(xy[[a, b]]))
                 for label, a, b in sides]
-    segments.sort(key=lambda g: (g.root, g.x0))
+    segments.sort(key=lambda g: (g.root != "z=1", g.x0))
     return dataclasses.replace(found, segments=tuple(segments))
 
 
@@ -1595,18 +1604,18 @@ def _line_sides(rings, src, dst, half_label):
     """``(label, first node, last node)`` of each run of the rings' half-edges on z = +-1.
 
     A stable cell's boundary runs counter-clockwise, so two stable cells
-    that meet on one line (at an arc's touch or the leading line) continue
-    each other's run head to tail.
+    that meet on one line (where an arc touches it) continue each other's
+    run head to tail.
     """
     step = {}
     for ring in rings:
         for h in ring:
             if half_label[h] in ("z = 1", "z = -1"):
                 step[half_label[h], int(src[h])] = int(dst[h])
-    heads = {key[1] for key in step}
+    tails = {(label, b) for (label, _), b in step.items()}
     out = []
     for (label, a), b in sorted(step.items()):
-        if (label, a) not in step or any(step.get((label, p)) == a for p in heads):
+        if (label, a) not in step or (label, a) in tails:
             continue            # not the first half-edge of a run (or already walked)
         del step[label, a]
         while (label, b) in step:

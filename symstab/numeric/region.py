@@ -68,6 +68,9 @@ class StabilityRegion:
 
     def __init__(self, *, gamma, d, delta):
         self.gamma, self.d, self.delta = check_loop(gamma, d, delta)
+        #: ``c`` of the z = -1 line ``alpha + 2 beta = c``
+        #: (:func:`~symstab.numeric.curves.minus_one_line`).
+        self.minus_one = minus_one_line(gamma=self.gamma, d=self.d, delta=self.delta)
 
     def decomposition(self, x_range, y_range):
         """The complete D-decomposition of a window of the (beta, alpha) plane.

@@ -170,6 +170,24 @@ def test_crossing_rule_holds_and_the_stable_set_is_closed(case):
     assert len(found.stable) >= 1
 
 
+def test_segments_of_the_schur_cohn_triangle_are_exact():
+    """z**2 + x z + y: stable on the triangle |y| < 1, |x| < 1 + y (Jury's conditions).
+
+    Its sides on z = 1 (1 + x + y = 0) and z = -1 (1 - x + y = 0) meet at
+    (0, -1), a corner of the two lines (their crossing, not two roundings
+    of it), and reach the arc y = 1 at x = -2 and 2.
+    """
+    ends = [np.array([1.0, 1.0]), np.array([1.0, -1.0]), np.array([1.0, 1.0])]
+    found = decompose([1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0], ends,
+                      x_range=(-3.0, 3.0), y_range=(-2.0, 2.0))
+    one, minus_one = found.segments
+    assert (one.root, one.x1, one.y1) == ("z=1", 0.0, -1.0)           # the lines' crossing
+    assert (minus_one.root, minus_one.x0, minus_one.y0) == ("z=-1", 0.0, -1.0)
+    near = dict(abs=1e-15)                                            # on the arc
+    assert (one.x0, one.y0) == (pytest.approx(-2.0, **near), pytest.approx(1.0, **near))
+    assert (minus_one.x1, minus_one.y1) == (pytest.approx(2.0, **near), pytest.approx(1.0, **near))
+
+
 def test_paper_limits_from_the_region_match_the_line_engine():
     """Loop.limits, now read from the polygons, against the paper's independent line engine."""
     import symstab

@@ -367,6 +367,34 @@ def test_a_corner_of_the_arc_with_alpha_zero_keeps_its_digits():
     assert segment.beta1 == pytest.approx(want, rel=1e-13, abs=0)
 
 
+def test_refit_root_averages_a_rounding_floor_and_leaves_a_curve_alone():
+    """A straight f rounded to a quantum: the fitted zero is the true one; a curved f keeps its root.
+
+    f(x) = s (x - r) rounded to q = 2**-60 (as alpha next to the flat corner
+    above) is exactly 0 over a stretch q / s wide, where the bracketer
+    stops anywhere; the line through values around it has its zero at r.
+    Next to a double root, (x - 1)**2 - w**2 is no straight line over the
+    fitted stretch, and the bracketed root stays.
+    """
+    from symstab.numeric.curves import bracketed_root, refit_root
+
+    r, s, q = 0.0782554498112388, 2.4e-3, 2.0**-60
+
+    def f(x):
+        return q * np.round(s * (np.asarray(x) - r) / q)
+
+    plateau = q / s
+    lo, hi = r - 7e-10, r + 3e-10
+    found = bracketed_root(f, [lo], [hi])[0]
+    assert abs(found - r) > 0.1 * plateau               # somewhere on the stretch of zeros
+    assert abs(refit_root(f, found, 1e-3 * (hi - lo)) - r) < 0.01 * plateau
+
+    def g(x):
+        return (np.asarray(x) - 1.0) ** 2 - 2e-4 ** 2
+
+    assert refit_root(g, 1.0002, 1e-3) == 1.0002
+
+
 @pytest.mark.parametrize("betas, error", [
     ([[0.1, 0.2]], ValueError), ([0.1, np.nan], ValueError), (["a"], TypeError), ([True], TypeError)])
 def test_alpha_intervals_on_refuses_bad_lines(betas, error):
