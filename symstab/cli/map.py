@@ -322,7 +322,7 @@ def _loop_png(setup, xs, ys, code):
     shade = np.where(code == STABLE, 2, np.where(code == MARGINAL, 1, 0)).T
     ax.pcolormesh(xs, ys, shade, shading="nearest", vmin=0, vmax=2,
                   cmap=ListedColormap(["white", "#bdbdbd", "#7fc97f"]))
-    curve = loop.boundary(x=x, y=y, n=4000, **setup.values)
+    curve = loop.boundary(x=x, y=y, window=((xs[0], xs[-1]), (ys[0], ys[-1])), **setup.values)
     bx, by = visible(curve.x_values, xs[0], xs[-1]), visible(curve.y_values, ys[0], ys[-1])
     bx[np.isnan(by)] = np.nan
     handles = [Patch(facecolor="#7fc97f", label="stable")]

@@ -46,7 +46,7 @@ from .._validate import check_array, check_count, check_delay, check_real, check
 from ..symbolic.loop_assembly import PLANT_DIGITS, LoopModel, parse_environment, parse_plant, shift_to_one
 from ..codegen.loop_kernels import environment_kernels, load_numpy_kernels
 from .arcs import END_ANGLE, EXACT_TERMS, ClosedFormArc, CramerArc, ExactPolynomial
-from .decomposition import Decomposition, decompose, stable_hull
+from .decomposition import Decomposition, decompose, stable_hull, window_arc
 from .passivity import passive_region
 from .decomposition import lines as _lines
 from .polynomial import DelayedPolynomial
@@ -739,7 +739,7 @@ class Loop(LoopModel):
             out.append(ExactPolynomial(delayed, direct, d + k))
         return tuple(out)
 
-    def boundary(self, x=None, y=None, n=1000, *, segments=False, **values):
+    def boundary(self, x=None, y=None, n=1000, *, window=None, segments=False, **values):
         """The D-decomposition of the ``(x, y)`` plane.
 
         Parameters
@@ -748,7 +748,11 @@ class Loop(LoopModel):
             Two parameters entering the polynomial jointly affinely
             (default: the loop's :attr:`plane`).
         n : int
-            Angles in (0, pi).
+            Angles in (0, pi), evenly spaced (without ``window``).
+        window : ((float, float), (float, float)), optional
+            ``(x_range, y_range)``: the arc sampled to be drawn there instead,
+            adaptively (:func:`symstab.numeric.decomposition.window_arc`: no
+            chord in the window longer than 2e-3 of it, NaN far from it).
         segments : bool
             Also find the pieces of the z = +-1 lines that close the stable
             set (from :meth:`region`: seconds at long delays).
@@ -764,8 +768,16 @@ class Loop(LoopModel):
         check_memory("the boundary", 64 * n)
         structured, slopes, ends = self.affine_parts((x, y), values, structured=True)
         base, ax, ay = (p.dense().reshape(-1) for p in (structured, *slopes))
-        theta = np.pi * (np.arange(1, n + 1) - 0.5) / n
-        xs, ys, _ = self._arc_source(x, y, values, (structured, *slopes))(theta)
+        arc = self._arc_source(x, y, values, (structured, *slopes))
+        if window is None:
+            theta = np.pi * (np.arange(1, n + 1) - 0.5) / n
+            xs, ys, _ = arc(theta)
+        else:
+            if isinstance(window, (str, bytes)) or not hasattr(window, "__len__") \
+                    or len(window) != 2:
+                raise TypeError(f"window must be ((x0, x1), (y0, y1)), got {window!r}")
+            box = check_window("window[0]", window[0]), check_window("window[1]", window[1])
+            theta, xs, ys = window_arc(arc, len(base) - 1, *box)
         lines = {label: c for label, c in _lines(base, ax, ay, ends).items() if c[1] or c[2]}
         pieces = self.region(x, y, **values).segments if segments else ()
         return Boundary(x, y, theta, xs, ys, lines=lines, segments=pieces, at=dict(values))

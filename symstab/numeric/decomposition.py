@@ -49,6 +49,7 @@ from .results import Segment
 from .roots import STABLE, classify_polynomials, leading_vanishes, root_counts
 
 __all__ = ["Branch", "Cell", "Decomposition", "StableHull", "decompose", "arc_points", "sample_arc",
+           "window_arc",
            "stable_hull"]
 
 #: Change of the unstable count across each piece (crossing rule); the
@@ -574,6 +575,45 @@ def sample_arc(arc, n, to_unit, samples=None, fine=1.0):
         theta, xs, ys, det = (np.concatenate([a, b])[order]
                               for a, b in zip((theta, xs, ys, det), (mids, *arc(mids))))
     return theta, xs, ys, det
+
+
+def window_arc(arc, n, x_range, y_range, *, angles=()):
+    """The arc to draw in a window: :func:`sample_arc`'s angles, NaN far from the window.
+
+    Parameters
+    ----------
+    arc : symstab.numeric.arcs.ArcSource
+        ``arc(theta) -> (x, y, det)``.
+    n : int
+        The polynomial's degree.
+    x_range, y_range : (float, float)
+        The window.
+    angles : sequence of float
+        More angles to have among the samples (an end of a piece to draw).
+
+    Returns
+    -------
+    theta, x, y : ndarray
+        Increasing angles in (0, pi) and the arc there; NaN where it is not
+        finite or more than five window widths away (through a pole the arc
+        runs to infinity and comes back from the other side: a straight
+        chord across would be drawn).
+    """
+    (x0, x1), (y0, y1) = x_range, y_range
+    sx, sy = x1 - x0, y1 - y0
+    theta, xs, ys, _ = sample_arc(arc, n, lambda x, y: ((np.asarray(x) - x0) / sx,
+                                                        (np.asarray(y) - y0) / sy))
+    extra = np.setdiff1d(np.asarray(angles, dtype=float), theta)
+    if extra.size:
+        order = np.argsort(np.concatenate([theta, extra]), kind="stable")
+        more = arc(extra)
+        theta, xs, ys = (np.concatenate([a, b])[order] for a, b in
+                         zip((theta, xs, ys), (extra, more[0], more[1])))
+    with np.errstate(invalid="ignore"):
+        far = ~(np.isfinite(xs) & np.isfinite(ys)) \
+            | (xs < x0 - 5 * sx) | (xs > x1 + 5 * sx) | (ys < y0 - 5 * sy) | (ys > y1 + 5 * sy)
+    xs, ys = np.where(far, np.nan, xs), np.where(far, np.nan, ys)
+    return theta, xs, ys
 
 
 def _pieces(base, ax, ay, ends, arc, theta, xs, ys, sign, to_unit, from_unit, box):

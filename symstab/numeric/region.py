@@ -28,7 +28,7 @@ import numpy as np
 from .._resources import check_memory, chunk_slices
 from .._validate import check_array, check_count, check_loop, check_real, check_window
 from .curves import KERNEL_BYTES_PER_POINT, KERNEL_CHUNK_BYTES, arc_end_angle, minus_one_line
-from .decomposition import sample_arc
+from .decomposition import window_arc
 from .paper_loop import closed_form_arc, paper_arc, paper_limits, paper_point
 from .results import PAPER_PLANE, Boundary
 
@@ -618,7 +618,7 @@ def arc_polylines(*, gamma, d, delta, window):
         where it runs far from the window -- through a pole it goes to
         infinity and comes back from the other side, and a straight line
         across would be drawn.  The arc is sampled as the D-decomposition
-        samples it (:func:`symstab.numeric.decomposition.sample_arc`):
+        samples it (:func:`symstab.numeric.decomposition.window_arc`):
         inside the window no chord is longer than 2e-3 of it nor turns by
         more than 0.05 rad from the next.
     """
@@ -626,25 +626,15 @@ def arc_polylines(*, gamma, d, delta, window):
     if isinstance(window, (str, bytes)) or not hasattr(window, "__len__") or len(window) != 2:
         raise TypeError(f"window must be ((beta0, beta1), (alpha0, alpha1)), got {window!r}")
     (b0, b1), (a0, a1) = (check_window("window[0]", window[0]), check_window("window[1]", window[1]))
-    span_b, span_a = b1 - b0, a1 - a0
-    arc = paper_arc(gamma=gamma, d=d, delta=delta)
-    theta, beta, alpha, _ = sample_arc(
-        arc, d + 4, lambda x, y: ((np.asarray(x) - b0) / span_b, (np.asarray(y) - a0) / span_a))
     t_max = arc_end_angle(gamma=gamma, d=d, delta=delta)
-    if np.isfinite(t_max):
-        k = int(np.searchsorted(theta, t_max))
-        end_beta, _, _ = arc(np.array([t_max]))
-        theta, beta, alpha = (np.insert(v, k, w) for v, w in
-                              ((theta, t_max), (beta, end_beta[0]), (alpha, 0.0)))
-    with np.errstate(invalid="ignore"):
-        far = ~(np.isfinite(alpha) & np.isfinite(beta)) \
-            | (beta < b0 - 5 * span_b) | (beta > b1 + 5 * span_b) \
-            | (alpha < a0 - 5 * span_a) | (alpha > a1 + 5 * span_a)
+    theta, beta, alpha = window_arc(paper_arc(gamma=gamma, d=d, delta=delta), d + 4, (b0, b1),
+                                    (a0, a1), angles=[t_max] if np.isfinite(t_max) else [])
     points = np.column_stack([beta, alpha])
-    points[far] = np.nan
     # The arc starts exactly at the corner (-delta, 0), the z = 1 root's line.
     points = np.vstack([[-delta, 0.0], points])
     if not np.isfinite(t_max):
         return np.empty((0, 2)), points
-    k += 1
+    k = int(np.searchsorted(theta, t_max)) + 1
+    if np.isfinite(points[k, 1]):
+        points[k, 1] = 0.0              # theta_max is where the arc meets alpha = 0
     return points[: k + 1], points[k:]
