@@ -15,7 +15,7 @@ import dataclasses
 import math
 import sys
 
-from .loop_limits import limits_notes, limits_result, limits_rows, stable_intervals_at
+from .loop_limits import limits_notes, limits_table, named, stable_intervals_at
 from .loop_options import add_loop_options, resolve_loop, uses_loop
 from .options import add_command, add_model_options, resolve
 from .output import emit
@@ -203,12 +203,12 @@ def _loop(args):
     search.update(best=best, y_max=lim.y_max, x_at_y_max=lim.x_at_y_max, gain=gain)
     rows = [(f"{name} (best)", best, unit, f"the {name} that maximises {y}_max"),
             (f"{y}_max", lim.y_max, uy, f"largest stable {y} at the best {name}"),
-            *limits_rows(setup, lim)[1:2],
+            limits_table(setup, lim)[1][1],
             (f"{y}_max at {name} = {nominal:.6g}", search["y_max_nominal"], uy,
              f"largest stable {y} at the nominal {name} (the file's or --set)"),
             ("gain", gain, "", f"{y}_max at the best {name} over that at the nominal one")]
     notes = limits_notes(setup, lim)
-    result = {"search": search, **limits_result(lim)}
+    result = {"search": search, "limits": named(setup, lim).as_dict()}
     at_best = dataclasses.replace(setup, values={**setup.values, name: best})
     at = args.at
     if at is None and not lim.empty and math.isfinite(lim.x_at_y_max):

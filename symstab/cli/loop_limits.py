@@ -1,15 +1,18 @@
-"""A loop file's stable set in its plane, as rows and notes: shared by ``limits`` and ``design``.
+"""The stable set in a plane, as rows and notes: shared by ``limits`` and ``design``.
 
-:func:`limits_rows`, :func:`limits_notes` and :func:`limits_result` show a
-:meth:`symstab.Loop.limits`; :func:`stable_intervals_at` the stable
-intervals of y at one x, their ends classified.
+:func:`limits_table` and :func:`limits_notes` show a
+:meth:`symstab.Loop.limits` (a loop file's, or the paper's loop in Table
+I's names for the paper's device options), :func:`passive_notes` the
+passive set beside it, :func:`stable_intervals_at` the stable intervals of
+y at one x, their ends classified.
 """
 
+import dataclasses
 import math
 
-from .output import interval_texts
+from .output import interval_texts, number_text
 
-__all__ = ["stable_intervals_at", "limits_rows", "limits_notes", "limits_result"]
+__all__ = ["LIMITS", "stable_intervals_at", "named", "limits_table", "limits_notes", "passive_notes"]
 
 
 def stable_intervals_at(setup, at):
@@ -45,30 +48,136 @@ def stable_intervals_at(setup, at):
     return notes, {"x": at, "intervals": [list(r) for r in runs], "ends": kinds}
 
 
-def limits_rows(setup, lim):
-    """The rows (quantity, value, unit, meaning) of a loop's limits in the plane of ``setup``."""
+#: The quantities of ``limits``: (field of :class:`~symstab.numeric.results.Limits`,
+#: name in the plane ``(x, y)``, the paper's name in Table I's plane, meaning, what
+#: its unit is).  The paper's names say what each is: ``beta_left``/``beta_right``
+#: are the ends of the stable set's beta range, which a reader of the paper would
+#: otherwise take for its beta_min = -delta, the damping where the boundary arc starts.
+LIMITS = (
+    ("y_max", "{y}_max", "alpha_max", "largest stable {y}", "y"),
+    ("x_at_y_max", "{x} at {y}_max", "beta_at_alpha_max", "the {x} at which {y}_max is reached",
+     "x"),
+    ("x_min", "{x}_min", "beta_left", "leftmost {x} of the stable set", "x"),
+    ("x_max", "{x}_max", "beta_right", "rightmost {x} of the stable set", "x"),
+    ("area", "area", "z_width", "area of the stable set in the ({x}, {y}) plane", "area"),
+)
+
+
+def _units(setup, physical=False):
+    """The units of x, y and the area: the loop's; none in Table I's plane, the device's if ``physical``."""
     ux, uy = setup.unit(setup.x), setup.unit(setup.y)
-    area_unit = f"({ux})({uy})" if ux and uy else (ux or uy)
-    x, y = setup.x, setup.y
-    return [(f"{y}_max", lim.y_max, uy, f"largest stable {y}"),
-            (f"{x} at {y}_max", lim.x_at_y_max, ux, f"the {x} where it is reached"),
-            (f"{x}_min", lim.x_min, ux, f"leftmost {x} of the stable set"),
-            (f"{x}_max", lim.x_max, ux, f"rightmost {x} of the stable set"),
-            ("area", lim.area, area_unit, f"area of the stable set in the ({x}, {y}) plane")]
+    if physical:
+        ux, uy = setup.paper.units["B_w"], setup.paper.units["K_w"]
+    return {"x": ux, "y": uy, "area": f"({ux})({uy})" if ux and uy else (ux or uy)}
+
+
+def _physical(setup, kind, value):
+    """A value of Table I's plane in the paper's device's units (``kind`` x, y or area)."""
+    device = setup.paper.device
+    if value is None:
+        return None
+    if kind == "y":
+        return float(device.stiffness(value))
+    if kind == "x":
+        return float(device.damping(value))
+    return value * (device.m / device.T) * (device.m / device.T**2)
+
+
+def named(setup, lim):
+    """``lim`` in the plane's printed names (Table I's for the paper's device options)."""
+    return dataclasses.replace(lim, x=setup.name(setup.x), y=setup.name(setup.y), at={})
+
+
+def limits_table(setup, lim):
+    """``(columns, rows)`` of the limits ``lim`` of the plane of ``setup``.
+
+    A loop's rows are ``(quantity, value, unit, meaning)`` in its units;
+    the paper's device options give Table I's names and values, and for a
+    physical device the same quantity in the device's units beside them
+    (named as ``limits --loop examples/loops/paper.toml`` names it).
+    """
+    x, y = setup.name(setup.x), setup.name(setup.y)
+    paper = setup.paper
+    physical = paper is not None and paper.physical
+    units = _units(setup, physical)
+    rows = []
+    for field, name, paper_name, meaning, kind in LIMITS:
+        value = getattr(lim, field)
+        if paper is None:
+            row = (name.format(x=x, y=y), value, units[kind])
+        elif physical:
+            row = (paper_name, value, name.format(x=setup.x, y=setup.y),
+                   _physical(setup, kind, value), units[kind])
+        else:
+            row = (paper_name, value)
+        rows.append(row + (meaning.format(x=x, y=y),))
+    columns = (["quantity", "value"] + (["unit"] if paper is None else [])
+               + (["physical", "physical value", "unit"] if physical else []) + ["meaning"])
+    return columns, rows
 
 
 def limits_notes(setup, lim):
-    """The notes on a loop's limits: why the stable set is empty, or that it is unbounded."""
+    """The notes on limits: why the stable set is empty or unbounded, the paper's beta_min."""
+    x, y = setup.name(setup.x), setup.name(setup.y)
     if lim.empty:
-        return [f"no stable point in the ({setup.x}, {setup.y}) plane at these values: "
+        return [f"no stable point in the ({x}, {y}) plane at these values: "
                 f"{lim.reason or 'no cell of the window has every root inside the unit circle'}"]
     if math.isinf(lim.y_max) or math.isinf(lim.area):
-        return [f"the stable set is unbounded in the ({setup.x}, {setup.y}) plane"]
+        return [f"the stable set is unbounded in the ({x}, {y}) plane"]
+    delta = None if setup.paper is None else setup.paper.delta
+    if delta is not None and not math.isclose(lim.x_min, -delta, rel_tol=1e-9, abs_tol=1e-12):
+        return [f"beta_left = {lim.x_min:.10g} is the leftmost beta of the stable region; "
+                f"the paper's beta_min = -delta = {-delta:.10g} is where the boundary arc "
+                "starts (theta = 0)"]
     return []
 
 
-def limits_result(lim):
-    """The ``limits`` object of the JSON output of a loop's limits."""
-    out = {"x": lim.x, "y": lim.y, "y_max": lim.y_max, "x_at_y_max": lim.x_at_y_max,
-           "x_min": lim.x_min, "x_max": lim.x_max, "area": lim.area, "cells": lim.cells}
-    return {"limits": out}
+def passive_notes(setup, lim):
+    """The passive set beside the stable one: (notes, json), one line per fact.
+
+    Colgate and Schenkel's condition with the device's friction ``b`` and
+    the delay (:func:`symstab.numeric.passivity.passive_region`).  A loop
+    it does not cover (no ``b``, a plant other than ``1/(m s**2 + b s)``)
+    gets a note saying why, not an error: the stable limits stand on their
+    own.
+    """
+    from ..numeric.passivity import passive_region
+
+    x, y = setup.name(setup.x), setup.name(setup.y)
+    damping = "delta" if setup.paper is not None else "b"
+    b = setup.paper.delta if setup.paper is not None else setup.values.get("b")
+    if b == 0:
+        return ([f"passive set (Colgate-Schenkel): none, the device has no damping "
+                 f"({damping} = 0)"], {"y_max": None, "area": 0.0})
+    try:
+        region = passive_region(setup.loop, x=setup.x, y=setup.y, **setup.values).renamed(x, y)
+    except (ValueError, TypeError, ArithmeticError) as exc:
+        return [f"passive set (Colgate-Schenkel) not computed: {exc}"], {"error": str(exc)}
+    ux, uy, ua = (f" {u}" if u else "" for u in _units(setup).values())
+    out = {"x": x, "y": y, "y_max": region.y_max, "x_at_y_max": region.x_at_y_max,
+           "area": region.area, "bounded": region.bounded,
+           "x_range": list(region.x_range), "y_range": list(region.y_range)}
+    if setup.paper is not None:      # Table I's names, as the stable limits have them
+        out.update(alpha_max=region.y_max, beta_at_alpha_max=region.x_at_y_max)
+    if region.empty:
+        unit = f" {setup.unit('b')}" if setup.unit("b") else ""
+        return [f"passive set (Colgate-Schenkel, with the delay): no passive point in the "
+                f"({x}, {y}) plane at {damping} = {b:.10g}{unit}"], out
+    notes = [f"passive {y}_max = {region.y_max:.10g}{uy} at {x} = {region.x_at_y_max:.10g}{ux} "
+             f"(Colgate-Schenkel with the delay; stable {y}_max = "
+             f"{number_text(lim.y_max) or 'none'})"]
+    if setup.paper is not None and setup.paper.physical:
+        units = _units(setup, physical=True)
+        k_max, b_at = (_physical(setup, k, v) for k, v in (("y", region.y_max),
+                                                           ("x", region.x_at_y_max)))
+        out.update(K_max=k_max, B_w_at_K_max=b_at)
+        notes.append(f"passive {setup.y}_max = {k_max:.10g} {units['y']} at {setup.x} = "
+                     f"{b_at:.10g} {units['x']}")
+    if region.bounded:
+        notes.append(f"passive area = {region.area:.10g}{ua} in the "
+                     f"({x}, {y}) plane (stable area = {number_text(lim.area) or 'none'})")
+    else:
+        notes.append(f"the passive set is unbounded; its area inside {x} in "
+                     f"[{region.x_range[0]:.6g}, {region.x_range[1]:.6g}], {y} in "
+                     f"[{region.y_range[0]:.6g}, {region.y_range[1]:.6g}] is {region.area:.10g}")
+    return notes, out
