@@ -19,7 +19,7 @@ import numpy as np
 
 from .loop_options import (DEVICE_OPTIONS, EXAMPLE, LINEAR_WITH_LOOP, POINT_OPTIONS, LoopSetup,
                            add_delay, check_names, convert_sets, load_loop_file, loop_echo,
-                           loop_values, parse_number, split_unit)
+                           loop_values, paper_setup, parse_number, split_unit)
 from .options import add_command, add_model_options, resolve
 from ..drawing import png_bytes
 from .output import check_outputs, emit, interval_texts, write_output
@@ -117,11 +117,10 @@ def _single(text, flag):
 class _View:
     """What the output needs: the inputs' echo, the locus and how to show its parameter."""
 
-    def __init__(self, setup, locus, count, name, unit, tex, show, T, dimensionless=None,
-                 given=None):
-        self.setup = setup          # has .echo and .as_dict() (numeric.Setup or loop.LoopSetup)
+    def __init__(self, setup, locus, name, unit, tex, show, T, dimensionless=None, given=None,
+                 fixed=None):
+        self.setup = setup          # a LoopSetup (setup.paper: the paper's device options)
         self.locus = locus
-        self.count = count          # path values -> certified unstable counts (the loop's)
         self.name = name            # "K_w", "alpha", "K"
         self.unit = unit
         self.tex = tex              # the axis label, mathtext
@@ -129,22 +128,27 @@ class _View:
         self.T = T                  # sample period (s) or None
         self.dimensionless = dimensionless   # "alpha" or "beta" beside a physical value
         self.given = given          # the path as the user gave it (in the shown units)
+        self.fixed = fixed          # the paper's options: (name, value) of the fixed one of alpha, beta
         self.symbol = {"K_w": "$K_w$", "B_w": "$B_w$", "alpha": r"$\alpha$",
                        "beta": r"$\beta$"}.get(name, name)
 
     def label(self):
         return f"{self.name} [{self.unit}]" if self.unit else self.name
 
+    def count(self, values):
+        """Certified unstable root counts along the path (:meth:`symstab.Loop.unstable_root_counts`)."""
+        setup, locus = self.setup, self.locus
+        return setup.loop.unstable_root_counts(**locus.fixed, **{locus.parameter: values})
+
 
 def _paper(args):
-    """The paper's loop: resolve the options, run :func:`paper_locus`; return a :class:`_View`."""
-    from ..numeric.paper_loop import paper_locus, paper_point
-
+    """The paper's options: the paper's loop (:func:`paper_setup`), its path ``K`` or ``B``."""
     for flag, dest in (("--set", "set_values"),):
         if getattr(args, dest) is not None:
             raise ValueError(f"{flag} needs a loop file: give --loop FILE "
                              f"(e.g. --loop {EXAMPLE})")
-    setup = resolve(args)
+    setup = paper_setup(resolve(args), plane=False)
+    paper = setup.paper
     stiffness = [(f, getattr(args, d)) for f, d in (("--alpha", "alpha"), ("--Kw", "Kw"))
                  if getattr(args, d) is not None]
     damping = [(f, getattr(args, d)) for f, d in (("--beta", "beta"), ("--Bw", "Bw"))
@@ -158,52 +162,45 @@ def _paper(args):
                          f"(the path), the other one value; got {s_flag} {s_text} and "
                          f"{d_flag} {d_text}")
     for flag in (s_flag, d_flag):
-        if flag in ("--Kw", "--Bw") and not setup.physical:
+        if flag in ("--Kw", "--Bw") and not paper.physical:
             raise ValueError(f"{flag} needs a physical device; use --alpha and --beta with "
                              f"--delta")
     path_flag, path_text, fixed_flag, fixed_text = (
         (s_flag, s_text, d_flag, d_text) if _is_range(s_text) else (d_flag, d_text, s_flag, s_text))
     given = _path(path_text, path_flag)
     fixed = _single(fixed_text, fixed_flag)
-    dev = setup.device
+    dev = paper.device
     to_dimensionless = {"--alpha": np.asarray, "--beta": np.asarray,
                         "--Kw": (lambda v: dev.alpha(v)), "--Bw": (lambda v: dev.beta(v))}
     parameter = "alpha" if path_flag in ("--alpha", "--Kw") else "beta"
     other = "beta" if parameter == "alpha" else "alpha"
     values = np.asarray(to_dimensionless[path_flag](given), dtype=float)
     fixed_value = float(to_dimensionless[fixed_flag](fixed))
-    _announce(setup.d + 4, values.size)
-    locus = paper_locus(parameter=parameter, values=values, gamma=setup.gamma, d=setup.d,
-                        delta=setup.delta, **{other: fixed_value})
     fixed_name = fixed_flag[2:]
     unit_of = {"Kw": "K_w", "Bw": "B_w"}
-    fixed_text = (f"{unit_of[fixed_name]} = {fixed:.10g} {setup.units[unit_of[fixed_name]]}"
+    fixed_text = (f"{unit_of[fixed_name]} = {fixed:.10g} {paper.units[unit_of[fixed_name]]}"
                   if fixed_name in unit_of else f"{fixed_name} = {fixed:.10g}")
     if fixed_name in unit_of:
         fixed_text += f" ({other} = {fixed_value:.10g})"
-    names = {"Kw": "K_w", "Bw": "B_w"}
-    setup = _with_echo(setup, f"path: {names.get(path_flag[2:], path_flag[2:])} from {given[0]:.10g} to {given[-1]:.10g} "
-                              f"({given.size} points) at {fixed_text}")
-    T = dev.T if setup.physical else None
+    setup = _with_echo(setup, f"path: {unit_of.get(path_flag[2:], path_flag[2:])} from "
+                              f"{given[0]:.10g} to {given[-1]:.10g} ({given.size} points) at "
+                              f"{fixed_text}")
     if path_flag == "--Kw":
-        show, name, unit = dev.stiffness, "K_w", setup.units["K_w"]
+        show, name, unit = dev.stiffness, "K_w", paper.units["K_w"]
         tex = f"$K_w$ [{tex_unit(unit)}]"
     elif path_flag == "--Bw":
-        show, name, unit = dev.damping, "B_w", setup.units["B_w"]
+        show, name, unit = dev.damping, "B_w", paper.units["B_w"]
         tex = f"$B_w$ [{tex_unit(unit)}]"
     else:
         show, name, unit = np.asarray, parameter, ""
         tex = r"$\alpha = K_w T^2 / m$" if parameter == "alpha" else r"$\beta = B_w T / m$"
-    dimensionless = parameter if path_flag in ("--Kw", "--Bw") else None
-    # The certified counts: the paper's loop at m = T = 1, whose (B, K) is (beta, alpha).
-    loop, point = paper_point(gamma=setup.gamma, d=setup.d, delta=setup.delta)
+    # The paper's loop at m = T = 1, whose (B, K) is (beta, alpha).
     plane = {"alpha": "K", "beta": "B"}
-
-    def count(v):
-        return loop.unstable_root_counts(**point, **{plane[other]: fixed_value, plane[parameter]: v})
-
-    return _View(setup, locus, count, name, unit, tex,
-                 lambda v: np.asarray(show(v), dtype=float), T, dimensionless, given)
+    return _track(setup, plane[parameter], values, {plane[other]: fixed_value}, name=name,
+                  unit=unit, tex=tex, show=lambda v: np.asarray(show(v), dtype=float),
+                  T=dev.T if paper.physical else None,
+                  dimensionless=parameter if path_flag in ("--Kw", "--Bw") else None,
+                  given=given, fixed=(other, fixed_value))
 
 
 #: From this many poles on, say on stderr what runs (some seconds: 8 s for
@@ -211,17 +208,21 @@ def _paper(args):
 _ANNOUNCE_DEGREE = 150
 
 
-def _announce(degree, n):
-    """Refuse a locus that cannot fit, then say on stderr what runs (long ones only).
+def _track(setup, parameter, path, others, **shown):
+    """Track the poles of ``setup.loop`` along ``parameter`` (``path``), ``others`` fixed: a :class:`_View`.
 
-    The memory is decided first so that a refusal is the one error line.
+    The memory is decided first, so that a refusal is the one error line;
+    a long run says on stderr what runs.
     """
-    from ..numeric.locus import check_locus_memory
+    from ..numeric.locus import check_locus_memory, locus
 
-    check_locus_memory(n, degree)
+    values = {**setup.values, **others}
+    degree = setup.loop.coefficients(**values, **{parameter: path[0]}).shape[-1] - 1
+    check_locus_memory(path.size, degree)
     if degree >= _ANNOUNCE_DEGREE:
-        print(f"tracking {degree} closed-loop poles at {n}+ points ...", file=sys.stderr,
+        print(f"tracking {degree} closed-loop poles at {path.size}+ points ...", file=sys.stderr,
               flush=True)
+    return _View(setup, locus(setup.loop, parameter, path, **values), **shown)
 
 
 def _with_echo(setup, line):
@@ -229,9 +230,7 @@ def _with_echo(setup, line):
 
 
 def _loop(args):
-    """A loop file: resolve ``--loop``/``--set``, run :func:`locus`; return a :class:`_View`."""
-    from ..numeric.locus import locus as track
-
+    """A loop file: resolve ``--loop``/``--set``, the path one ``--set NAME=LOW:HIGH``."""
     for flag, dest, instead in _DEVICE_OPTIONS:
         if getattr(args, dest) is not None:
             raise ValueError(f"{flag} is an option of the paper's device; with --loop use "
@@ -268,21 +267,16 @@ def _loop(args):
     path = (path[0], np.linspace(ends[0], ends[1], path[1].size))
     values, written = loop_values(args, loop, sets, written, skip=(path[0],))
     name, given = path
-    _announce(loop.coefficients(**values, **{name: given[0]}).shape[-1] - 1, given.size)
-    result = track(loop, name, given, **values)
     setup = LoopSetup(str(args.loop), loop, values, tuple(sets), written=written)
     unit = setup.unit(name)
-    setup = dataclasses.replace(setup, echo=loop_echo(setup) + (
-        f"path: {name} from {given[0]:.10g} to {given[-1]:.10g}{' ' + unit if unit else ''} "
-        f"({given.size} points)",))
-    tex = f"{name} [{tex_unit(unit)}]" if unit else name
+    setup = _with_echo(dataclasses.replace(setup, echo=loop_echo(setup)),
+                       f"path: {name} from {given[0]:.10g} to {given[-1]:.10g}"
+                       f"{' ' + unit if unit else ''} ({given.size} points)")
     T = values.get("T") if "T" in loop.parameters else None
-
-    def count(v):
-        return loop.unstable_root_counts(**values, **{name: v})
-
-    return _View(setup, result, count, name, unit, tex, lambda v: np.asarray(v, dtype=float),
-                 None if T is None else float(T), given=given)
+    return _track(setup, name, given, {}, name=name, unit=unit,
+                  tex=f"{name} [{tex_unit(unit)}]" if unit else name,
+                  show=lambda v: np.asarray(v, dtype=float), T=None if T is None else float(T),
+                  given=given)
 
 
 # --------------------------------------------------------------------------
@@ -610,23 +604,22 @@ def _png(view, stretches):
 
 def _title(view):
     setup = view.setup
-    if setup.__class__.__name__ == "LoopSetup":
+    if setup.paper is None:
         fixed = ", ".join(f"{n} = {v:g}" + (f" {setup.unit(n)}" if setup.unit(n) else "")
                           for n, v in setup.values.items() if n != "d")
         return (f"root locus of the loop {setup.loop.name} along {view.name}: {fixed}, "
                 f"d = {setup.values['d']}")
-    locus = view.locus
-    other = "beta" if locus.parameter == "alpha" else "alpha"
-    fixed = locus.fixed[other]
-    if setup.physical:
-        dev, units = setup.device, setup.units
+    paper = setup.paper
+    other, fixed = view.fixed
+    if paper.physical:
+        dev, units = paper.device, paper.units
         if other == "beta":
             where = f"$B_w$ = {float(dev.damping(fixed)):g} {units['B_w']}"
         else:
             where = f"$K_w$ = {float(dev.stiffness(fixed)):g} {units['K_w']}"
-        return (f"root locus at {where}, $T_d$ = {dev.delay(setup.d) * 1e3:g} ms "
-                f"($d$ = {setup.d}), $M_w$ = {float(dev.mass(setup.gamma)):g} "
+        return (f"root locus at {where}, $T_d$ = {dev.delay(paper.d) * 1e3:g} ms "
+                f"($d$ = {paper.d}), $M_w$ = {float(dev.mass(paper.gamma)):g} "
                 f"{tex_unit(units['M_w'])}")
     symbol = r"\beta" if other == "beta" else r"\alpha"
-    return (f"root locus at ${symbol}$ = {fixed:g}, $\\gamma$ = {setup.gamma:g}, $d$ = {setup.d}, "
-            f"$\\delta$ = {setup.delta:g}")
+    return (f"root locus at ${symbol}$ = {fixed:g}, $\\gamma$ = {paper.gamma:g}, $d$ = {paper.d}, "
+            f"$\\delta$ = {paper.delta:g}")

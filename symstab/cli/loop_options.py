@@ -34,7 +34,7 @@ from .._resources import check_memory
 __all__ = ["DEVICE_OPTIONS", "POINT_OPTIONS", "EXAMPLE", "LINEAR_WITH_LOOP", "add_loop_options",
            "uses_loop", "split_unit", "parse_number", "convert_sets", "LoopSetup", "value_text",
            "loop_echo", "load_loop_file", "add_delay", "check_names", "loop_values", "resolve_loop",
-           "resolve_setup", "TABLE_ONE", "point_count", "broadcast"]
+           "resolve_setup", "paper_setup", "TABLE_ONE", "point_count", "broadcast"]
 
 
 #: The paper's device options every numeric command has, with the ``--set``
@@ -528,10 +528,20 @@ def resolve_setup(args, *, plane=True, lists=False):
     """
     if uses_loop(args):
         return resolve_loop(args, plane=plane, lists=lists)
-    from ..numeric.paper_loop import paper_point
     from .options import resolve
 
-    paper = resolve(args)
+    return paper_setup(resolve(args), plane=plane)
+
+
+def paper_setup(paper, *, plane=True):
+    """The :class:`LoopSetup` of the paper's device options ``paper`` (a resolved ``Setup``).
+
+    The paper's loop at ``m = T = 1``
+    (:func:`~symstab.numeric.paper_loop.paper_point`): its parameters are
+    Table I's variables, its plane ``(B, K)`` is ``(beta, alpha)``.
+    """
+    from ..numeric.paper_loop import paper_point
+
     loop, values = paper_point(gamma=paper.gamma, d=paper.d, delta=paper.delta)
     x, y = ("B", "K") if plane else (None, None)
     return LoopSetup("", loop, values, (), x, y, echo=paper.echo, paper=paper)
