@@ -178,3 +178,11 @@ def check_window(name, value):
     if not lo < hi:
         raise ValueError(f"{name} must be (lo, hi) with lo < hi, got ({lo:g}, {hi:g})")
     return lo, hi
+
+
+def check_box(name, value, names=("x", "y")):
+    """Return a drawing window ``((x0, x1), (y0, y1))``, each pair as :func:`check_window`."""
+    if isinstance(value, (str, bytes)) or not hasattr(value, "__len__") or len(value) != 2:
+        x, y = names
+        raise TypeError(f"{name} must be (({x}0, {x}1), ({y}0, {y}1)), got {value!r}")
+    return check_window(f"{name}[0]", value[0]), check_window(f"{name}[1]", value[1])

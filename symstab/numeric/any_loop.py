@@ -42,7 +42,7 @@ import numpy as np
 import sympy as sp
 
 from .._resources import check_memory
-from .._validate import check_array, check_count, check_delay, check_real, check_window
+from .._validate import check_array, check_box, check_count, check_delay, check_real, check_window
 from ..symbolic.loop_assembly import PLANT_DIGITS, LoopModel, parse_environment, parse_plant, shift_to_one
 from ..codegen.loop_kernels import environment_kernels, load_numpy_kernels
 from .arcs import END_ANGLE, EXACT_TERMS, ClosedFormArc, CramerArc, ExactPolynomial
@@ -773,11 +773,7 @@ class Loop(LoopModel):
             theta = np.pi * (np.arange(1, n + 1) - 0.5) / n
             xs, ys, _ = arc(theta)
         else:
-            if isinstance(window, (str, bytes)) or not hasattr(window, "__len__") \
-                    or len(window) != 2:
-                raise TypeError(f"window must be ((x0, x1), (y0, y1)), got {window!r}")
-            box = check_window("window[0]", window[0]), check_window("window[1]", window[1])
-            theta, xs, ys = window_arc(arc, len(base) - 1, *box)
+            theta, xs, ys = window_arc(arc, len(base) - 1, *check_box("window", window))
         lines = {label: c for label, c in _lines(base, ax, ay, ends).items() if c[1] or c[2]}
         pieces = self.region(x, y, **values).segments if segments else ()
         return Boundary(x, y, theta, xs, ys, lines=lines, segments=pieces, at=dict(values))
@@ -935,19 +931,8 @@ class Loop(LoopModel):
         """
         found = self.region(x, y, **values)
         at = {k: v for k, v in values.items() if k not in ("x_range", "y_range")}
-        line = functools.partial(_stable_intervals_at, self, found.x, found.y, at)
-        if not found.stable:
-            return Limits.empty_set(found.x, found.y, _empty_reason(found), cells=0, at=at,
-                                    line=line)
-        (y_max, x_at), (x_min, _), (x_max, _) = (found.extreme(*which) for which in
-                                                  (("y", 1), ("x", -1), ("x", 1)))
-        sides = set(found.unbounded)
-        y_max = np.inf if "y_max" in sides else y_max
-        x_min = -np.inf if "x_min" in sides else x_min
-        x_max = np.inf if "x_max" in sides else x_max
-        area = np.inf if sides else found.area
-        return Limits(found.x, found.y, float(y_max), float(x_at), float(x_min), float(x_max),
-                      float(area), cells=len(found.stable), at=at, line=line)
+        return found.limits(at=at, line=functools.partial(_stable_intervals_at, self, found.x,
+                                                          found.y, at))
 
     def passive_region(self, x=None, y=None, *, damping="b", x_range=None, y_range=None, **values):
         """The passive set of the environment behind the loop's delay, in the ``(x, y)`` plane.
@@ -1045,31 +1030,6 @@ def _covers(found, enclosure, free):
     bound = (*enclosure[0], *enclosure[1])
     return all(not free[side] or (window[k] <= bound[k] if k % 2 == 0 else window[k] >= bound[k])
                for k, side in enumerate(("x_min", "x_max", "y_min", "y_max")))
-
-
-def _empty_reason(found):
-    """``"the stable set is empty: "`` and why the decomposition ``found`` (of :meth:`Loop.region`) has no stable cell."""
-    return "the stable set is empty: " + _why_empty(found)
-
-
-def _why_empty(found):
-    hull = found.hull
-    if hull is not None and hull.empty:
-        return hull.reason
-    where = (f"{found.x} in [{found.x_range[0]:.6g}, {found.x_range[1]:.6g}], {found.y} in "
-             f"[{found.y_range[0]:.6g}, {found.y_range[1]:.6g}]")
-    box = hull.box(0.0) if hull is not None else None
-    if box is not None and all(w[0] <= b[0] and b[1] <= w[1]
-                               for w, b in zip((found.x_range, found.y_range), box)):
-        return (f"every cell of the window {where}, which holds every point that passes the "
-                f"necessary condition of the roots inside the unit circle, has a root outside it"
-                f"{_UNRESOLVED}")
-    return f"every cell of the window {where} has a root outside the unit circle{_UNRESOLVED}"
-
-
-#: What an empty decomposition does not exclude (the hull, when empty, is a proof).
-_UNRESOLVED = (" (a stable sliver too thin for the sampled arc to draw, as next to a point "
-               "where the set vanishes, is not excluded)")
 
 
 def _start_windows(arc, family, base, ax, ay, ends, hull=None):

@@ -45,7 +45,7 @@ from .._resources import check_memory, chunk_slices
 from .arcs import CramerArc
 from .curves import bracketed_root, refit_root, zoom_max
 from .polynomial import DelayedPolynomial
-from .results import Segment
+from .results import Limits, Segment
 from .roots import STABLE, classify_polynomials, leading_vanishes, root_counts
 
 __all__ = ["Branch", "Cell", "Decomposition", "StableHull", "decompose", "arc_points", "sample_arc",
@@ -168,6 +168,11 @@ class Cell:
         for hole in self.holes:
             inside &= ~_inside(hole, x, y)
         return inside
+
+
+#: What an empty decomposition does not exclude (the hull, when empty, is a proof).
+_UNRESOLVED = (" (a stable sliver too thin for the sampled arc to draw, as next to a point "
+               "where the set vanishes, is not excluded)")
 
 
 @dataclasses.dataclass(frozen=True, repr=False)
@@ -404,6 +409,56 @@ class Decomposition:
             if np.all(np.isfinite(point)) and float(np.hypot(*((point - vertex) / scale))) < _CORNER_MOVE:
                 return point
         return None
+
+    def limits(self, *, at=None, line=None):
+        """The extent and area of the stable set, read from this decomposition.
+
+        The stable cells' polygons give the area (exact up to the chords of
+        the sampled arc), their extreme vertices the extent (:meth:`extreme`,
+        refined along the arc where the extreme is a smooth turn of it); a
+        side in :attr:`unbounded` makes its extreme, and the area, infinite.
+
+        Parameters
+        ----------
+        at : dict, optional
+            The values of the other parameters (:attr:`Limits.at`).
+        line : callable, optional
+            ``line(x) -> [(lo, hi), ...]``, the stable intervals of ``y`` at
+            ``x`` (:attr:`Limits.line`).
+
+        Returns
+        -------
+        symstab.numeric.results.Limits
+            Empty, with the reason, when no cell is stable.
+        """
+        at = {} if at is None else at
+        if not self.stable:
+            return Limits.empty_set(self.x, self.y, "the stable set is empty: " + self._why_empty(),
+                                    cells=0, at=at, line=line)
+        (y_max, x_at), (x_min, _), (x_max, _) = (self.extreme(*which) for which in
+                                                  (("y", 1), ("x", -1), ("x", 1)))
+        sides = set(self.unbounded)
+        y_max = np.inf if "y_max" in sides else y_max
+        x_min = -np.inf if "x_min" in sides else x_min
+        x_max = np.inf if "x_max" in sides else x_max
+        area = np.inf if sides else self.area
+        return Limits(self.x, self.y, float(y_max), float(x_at), float(x_min), float(x_max),
+                      float(area), cells=len(self.stable), at=at, line=line)
+
+    def _why_empty(self):
+        """Why no cell is stable: the hull's proof, or what the window held."""
+        hull = self.hull
+        if hull is not None and hull.empty:
+            return hull.reason
+        where = (f"{self.x} in [{self.x_range[0]:.6g}, {self.x_range[1]:.6g}], {self.y} in "
+                 f"[{self.y_range[0]:.6g}, {self.y_range[1]:.6g}]")
+        box = hull.box(0.0) if hull is not None else None
+        if box is not None and all(w[0] <= b[0] and b[1] <= w[1]
+                                   for w, b in zip((self.x_range, self.y_range), box)):
+            return (f"every cell of the window {where}, which holds every point that passes the "
+                    f"necessary condition of the roots inside the unit circle, has a root "
+                    f"outside it{_UNRESOLVED}")
+        return f"every cell of the window {where} has a root outside the unit circle{_UNRESOLVED}"
 
     def renamed(self, x, y):
         """The same decomposition with the plane's parameters called ``x`` and ``y``.

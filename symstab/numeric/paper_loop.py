@@ -200,13 +200,12 @@ def paper_arc(*, gamma, d, delta):
     return loop.arc("B", "K", **values)
 
 
-def paper_limits(*, gamma, d, delta, region=None):
+def paper_limits(*, gamma, d, delta):
     """:meth:`Loop.limits <symstab.Loop.limits>` of the paper's loop, in Table I's plane.
 
     The limits of the ``(B, K)`` plane of :func:`paper_point`, renamed
-    ``(beta, alpha)``, with ``at`` the paper's ``gamma, d, delta`` and
-    ``region`` the :class:`~symstab.numeric.region.StabilityRegion` given
-    (for its line questions), so Table I's names apply.
+    ``(beta, alpha)``, with ``at`` the paper's ``gamma, d, delta``, so
+    Table I's names apply.
 
     Examples
     --------
@@ -216,7 +215,7 @@ def paper_limits(*, gamma, d, delta, region=None):
     """
     loop, values = paper_point(gamma=gamma, d=d, delta=delta)
     found = loop.limits("B", "K", **values)
-    return dataclasses.replace(found, x=PAPER_PLANE[0], y=PAPER_PLANE[1], region=region,
+    return dataclasses.replace(found, x=PAPER_PLANE[0], y=PAPER_PLANE[1],
                                at={"gamma": values["M"], "d": values["d"], "delta": float(delta)})
 
 

@@ -26,7 +26,7 @@ import warnings
 import numpy as np
 
 from .._resources import check_memory, chunk_slices
-from .._validate import check_array, check_count, check_loop, check_real, check_window
+from .._validate import check_array, check_box, check_count, check_loop, check_real, check_window
 from .curves import KERNEL_BYTES_PER_POINT, KERNEL_CHUNK_BYTES, arc_end_angle, minus_one_line
 from .decomposition import window_arc
 from .paper_loop import closed_form_arc, paper_arc, paper_limits, paper_point
@@ -71,6 +71,11 @@ class StabilityRegion:
         #: ``c`` of the z = -1 line ``alpha + 2 beta = c``
         #: (:func:`~symstab.numeric.curves.minus_one_line`).
         self.minus_one = minus_one_line(gamma=self.gamma, d=self.d, delta=self.delta)
+
+    def __getstate__(self):
+        # The cached decomposition holds its arc source (closures of the
+        # generated kernel): a copy in another process makes its own on use.
+        return {k: v for k, v in self.__dict__.items() if k not in ("_region", "_limits")}
 
     def decomposition(self, x_range, y_range):
         """The complete D-decomposition of a window of the (beta, alpha) plane.
@@ -170,8 +175,10 @@ class StabilityRegion:
 
     @functools.cached_property
     def _limits(self):
-        """The limits of this region, from the one engine (:func:`~symstab.numeric.paper_loop.paper_limits`)."""
-        return paper_limits(gamma=self.gamma, d=self.d, delta=self.delta, region=self)
+        """The limits of this region, read from its D-decomposition (:meth:`Decomposition.limits`)."""
+        found = self._region.limits(at={"gamma": self.gamma, "d": self.d, "delta": self.delta},
+                                    line=self.alpha_intervals)
+        return dataclasses.replace(found, x=PAPER_PLANE[0], y=PAPER_PLANE[1], region=self)
 
     @functools.cached_property
     def _region(self):
@@ -623,9 +630,7 @@ def arc_polylines(*, gamma, d, delta, window):
         more than 0.05 rad from the next.
     """
     gamma, d, delta = check_loop(gamma, d, delta)
-    if isinstance(window, (str, bytes)) or not hasattr(window, "__len__") or len(window) != 2:
-        raise TypeError(f"window must be ((beta0, beta1), (alpha0, alpha1)), got {window!r}")
-    (b0, b1), (a0, a1) = (check_window("window[0]", window[0]), check_window("window[1]", window[1]))
+    (b0, b1), (a0, a1) = check_box("window", window, PAPER_PLANE)
     t_max = arc_end_angle(gamma=gamma, d=d, delta=delta)
     theta, beta, alpha = window_arc(paper_arc(gamma=gamma, d=d, delta=delta), d + 4, (b0, b1),
                                     (a0, a1), angles=[t_max] if np.isfinite(t_max) else [])

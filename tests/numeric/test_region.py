@@ -942,3 +942,5 @@ def test_arc_polylines_refuses_a_bad_window_naming_it(window, error, name):
 
     with pytest.raises(error, match=re.escape(name)):
         arc_polylines(gamma=0.0, d=0, delta=PAPER_DELTA, window=window)
+    with pytest.raises(error, match=re.escape(name)):
+        symstab.PAPER_LOOP.boundary(d=0, window=window)

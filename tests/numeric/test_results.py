@@ -92,6 +92,13 @@ def test_limits_and_their_loop_pickle():
     loop = pickle.loads(pickle.dumps(symstab.PAPER_LOOP))
     assert loop.units == symstab.PAPER_LOOP.units and loop.plane == ("B", "K")
     assert loop.limits(d=5) == lim
+    # The paper's limits carry their region, whose decomposition (closures
+    # of the generated kernel) is made again where it is needed.
+    region = symstab.StabilityRegion(gamma=0.0, d=5, delta=PAPER_DEVICE.delta)
+    segments, paper = region.line_segments(), region.limits()
+    back = pickle.loads(pickle.dumps(paper))
+    assert back.as_dict() == paper.as_dict() and back.region.line_segments() == segments
+    assert back.alpha_interval(0.05) == paper.alpha_interval(0.05)
 
 
 def test_an_empty_set_reads_the_same_from_both():
