@@ -1,22 +1,22 @@
 """``symstab design``: the virtual mass that maximises the renderable stiffness.
 
-The paper's loop: the virtual mass gamma = M_w / m that maximises the
-largest stable stiffness for one delay and device, with that stiffness,
-its damping and the gain over no virtual mass.  A loop file (``--loop``):
-the same search over a third parameter (``--over NAME``, default the
-environment's mass term) in the range ``--range LO:HI`` (default design's
-gamma range times the device's mass), with the same routine
-(:func:`symstab.numeric.region.scan_maximum`): the best value, the largest
-stable y there and at the nominal value, the x where it is reached, and the
-stable intervals of y there (or at --at X).
+One search for both inputs (:func:`symstab.numeric.region.scan_maximum` of
+:meth:`symstab.Loop.limits`, as :func:`symstab.best_virtual_mass` does):
+the paper's options search the virtual mass gamma = M_w / m of the paper's
+loop from no virtual mass, a loop file (``--loop``) a third parameter
+(``--over NAME``, default the environment's mass term) in the range
+``--range LO:HI`` (default design's gamma range times the device's mass)
+from its nominal value.  Printed: the best value, the largest stable y
+there and at the nominal value, the gain, the x where it is reached and
+the stable intervals of y there (or at --at X).
 """
 
 import dataclasses
 import math
 import sys
 
-from .loop_limits import limits_notes, limits_table, named, stable_intervals_at
-from .loop_options import add_loop_options, resolve_loop, uses_loop
+from .loop_limits import limits_notes, named, plane_table, stable_intervals_at
+from .loop_options import add_loop_options, paper_setup, resolve_loop, uses_loop
 from .options import add_command, add_model_options, resolve
 from .output import emit
 
@@ -36,39 +36,24 @@ def register(subparsers):
 
 
 def run(args):
-    """Run ``symstab design`` (on the loop file of ``--loop``, else the paper's loop)."""
-    return _loop(args) if uses_loop(args) else _paper(args)
+    """Run ``symstab design`` on a loop file (``--loop``) or the paper's loop: one search.
 
-
-def _paper(args):
-    """The best virtual mass of the paper's loop for one delay and device."""
-    from ..numeric.region import best_virtual_mass, limits
-
-    setup = resolve(args, mass=False)
-    print("searching gamma for the largest renderable stiffness ...", file=sys.stderr, flush=True)
-    best = best_virtual_mass(d=setup.d, delta=setup.delta)
-    rows = [("gamma (best)", best.gamma), ("beta at alpha_max", best.beta),
-            ("alpha_max", best.alpha_max), ("alpha_max at gamma = 0", best.alpha_max_gamma0),
-            ("gain", best.gain), ("Z-width at the best gamma", best.z_width)]
-    columns = ["quantity", "value"]
-    if setup.physical:
-        dev, u = setup.device, setup.units
-        area = dev.m**2 / dev.T**3
-        physical = [(dev.mass(best.gamma), "M_w", u["M_w"]), (dev.damping(best.beta), "B_w", u["B_w"]),
-                    (dev.stiffness(best.alpha_max), "K_max", u["K_w"]),
-                    (dev.stiffness(best.alpha_max_gamma0), "K_max (M_w = 0)", u["K_w"]),
-                    (best.gain, "gain", ""),
-                    (best.z_width * area, "Z-width", f"({u['B_w']})({u['K_w']})")]
-        columns += ["physical", "physical value", "unit"]
-        rows = [r + (label, value, unit) for r, (value, label, unit) in zip(rows, physical)]
-    result = {"best": {k: v for k, v in dataclasses.asdict(best).items() if k not in ("d", "delta")}}
-    notes = ["the virtual mass argument --gamma/--Mw is ignored: design searches over it"] \
-        if (args.gamma is not None or args.Mw is not None) else []
-    if best.z_width < 0.05 * limits(gamma=0.0, d=setup.d, delta=setup.delta).z_width:
-        notes.append("the best gamma lies where the stable region is a thin sliver: the gain "
-                     "needs very precise tuning of the virtual mass and damping")
-    emit(setup, args.format, columns, rows, result=result, notes=notes, json_rows=False)
-    return 0
+    The paper's device options are the paper's loop in Table I's variables
+    (:func:`symstab.cli.loop_options.paper_setup`), searched over its
+    virtual mass ``M`` (gamma, with ``m = 1``) from no virtual mass; its
+    table keeps Table I's names with the device's units beside them, and
+    its JSON the ``best`` of :func:`symstab.best_virtual_mass`.
+    """
+    if uses_loop(args):
+        setup = resolve_loop(args)
+        name = _search_parameter(args, setup)
+        notes = []
+    else:
+        setup = paper_setup(resolve(args, mass=False))
+        name = "M"
+        notes = (["the virtual mass argument --gamma/--Mw is ignored: design searches over it"]
+                 if (args.gamma is not None or args.Mw is not None) else [])
+    return _search(args, setup, name, notes)
 
 
 #: The SI units of a mass term (linear, rotary) and of the matching damping.
@@ -108,6 +93,8 @@ def _device_mass(setup, name):
     ``m1 + m2`` for two masses), and the loop's ``b`` where it has one in
     the matching damping unit (else 0).
     """
+    if setup.paper is not None:
+        return 1.0, setup.paper.delta       # Table I: masses in units of m, delta = b T / m
     unit = setup.unit(name)
     if unit not in _MASS_UNITS:
         return None
@@ -149,20 +136,24 @@ def _search_range(args, setup, name):
     return mass * (-1.0 - (setup.values["d"] + 1) * delta + 1e-3), mass * 3.0, mass
 
 
-def _loop(args):
-    """A loop file: the value of a third parameter that maximises the largest stable y."""
+def _search(args, setup, name, notes):
+    """The value of ``name`` that maximises the largest stable y of the plane of ``setup``.
+
+    One :func:`~symstab.numeric.region.scan_maximum` of :meth:`symstab.Loop.limits`
+    over the range (:func:`_search_range`); a value whose plane cannot be
+    resolved is skipped, said in a note.
+    """
     from ..numeric.region import scan_maximum
 
-    setup = resolve_loop(args)
-    name = _search_parameter(args, setup)
     low, high, scale = _search_range(args, setup, name)
     if args.at is not None:
         from .._validate import check_real
         check_real(f"--at ({setup.x})", args.at)
+    p, x, y = setup.name(name), setup.name(setup.x), setup.name(setup.y)
     unit = setup.unit(name)
     suffix = f" {unit}" if unit else ""
-    print(f"searching {name} in [{low:.6g}, {high:.6g}]{suffix} for the largest stable "
-          f"{setup.y} of the ({setup.x}, {setup.y}) plane ...", file=sys.stderr, flush=True)
+    print(f"searching {p} in [{low:.6g}, {high:.6g}]{suffix} for the largest stable "
+          f"{y} of the ({x}, {y}) plane ...", file=sys.stderr, flush=True)
 
     def limits_at(value):
         return setup.loop.limits(x=setup.x, y=setup.y, **{**setup.values, name: value})
@@ -183,61 +174,81 @@ def _loop(args):
     found = scan_maximum(y_max, low, high, rtol=1e-6, scale=scale)
     nominal = setup.values[name]
     nominal_lim = limits_at(nominal)
-    uy = setup.unit(setup.y)
-    x, y = setup.x, setup.y
-    search = {"over": name, "range": [low, high], "unit": unit, "nominal": nominal,
+    search = {"over": p, "range": [low, high], "unit": unit, "nominal": nominal,
               "y_max_nominal": None if nominal_lim.empty else nominal_lim.y_max}
+    at_nominal = (f"{{y}}_max at {{p}} = {nominal:.6g}", search["y_max_nominal"], "y",
+                  "largest stable {y} at the nominal {p}")
     if found is None:
-        rows = [(f"{y}_max at {name} = {nominal:.6g}", search["y_max_nominal"], uy,
-                 f"largest stable {y} at the nominal {name}")]
-        notes = [f"no {name} in [{low:.6g}, {high:.6g}]{suffix} has a stable point in the "
-                 f"({x}, {y}) plane"] + limits_notes(setup, nominal_lim)
+        notes += [f"no {p} in [{low:.6g}, {high:.6g}]{suffix} has a stable point in the "
+                  f"({x}, {y}) plane"] + limits_notes(setup, nominal_lim)
         search.update(best=None, y_max=None, x_at_y_max=None, gain=None)
-        emit(setup, args.format, ["quantity", "value", "unit", "meaning"], rows,
-             result={"search": search}, notes=notes, json_rows=False)
+        columns, rows = plane_table(setup, [at_nominal], over=name)
+        emit(setup, args.format, columns, rows, result=_result(setup, search, nominal_lim),
+             notes=notes, json_rows=False)
         return 0
     best, _ = found
     lim = limits_at(best)
     gain = lim.y_max / nominal_lim.y_max if not nominal_lim.empty and nominal_lim.y_max > 0 \
         else None
     search.update(best=best, y_max=lim.y_max, x_at_y_max=lim.x_at_y_max, gain=gain)
-    rows = [(f"{name} (best)", best, unit, f"the {name} that maximises {y}_max"),
-            (f"{y}_max", lim.y_max, uy, f"largest stable {y} at the best {name}"),
-            limits_table(setup, lim)[1][1],
-            (f"{y}_max at {name} = {nominal:.6g}", search["y_max_nominal"], uy,
-             f"largest stable {y} at the nominal {name} (the file's or --set)"),
-            ("gain", gain, "", f"{y}_max at the best {name} over that at the nominal one")]
-    notes = limits_notes(setup, lim)
-    result = {"search": search, "limits": named(setup, lim).as_dict()}
+    rows = [("{p} (best)", best, "p", "the {p} that maximises {y}_max"),
+            ("{y}_max", lim.y_max, "y", "largest stable {y} at the best {p}"),
+            ("{x} at {y}_max", lim.x_at_y_max, "x", "the {x} at which {y}_max is reached"),
+            at_nominal,
+            ("gain", gain, None, "{y}_max at the best {p} over that at the nominal one"),
+            ("area at the best {p}", lim.area, "area", "area of the stable set (the Z-width "
+             "where {x} is a damping and {y} a stiffness)")]
+    notes += limits_notes(setup, lim)
     at_best = dataclasses.replace(setup, values={**setup.values, name: best})
     at = args.at
     if at is None and not lim.empty and math.isfinite(lim.x_at_y_max):
         at = lim.x_at_y_max
+    line = None
     if at is not None:
-        more, result["at"] = stable_intervals_at(at_best, at)
-        notes += [f"at the best {name} = {best:.10g}{suffix}: {line}" if k == 0 else line
-                  for k, line in enumerate(more)]
-        runs = result["at"]["intervals"]
+        more, line = stable_intervals_at(at_best, at)
+        notes += [f"at the best {p} = {best:.10g}{suffix}: {text}" if k == 0 else text
+                  for k, text in enumerate(more)]
+        runs = line["intervals"]
         if runs:
             lo, hi = runs[-1]
-            rows.append((f"{y} range at {x} = {at:.6g}", hi - lo, uy,
-                         f"width of the top stable interval of {y} at that {x}"))
+            rows.append(("{y} range at the {x} of {y}_max" if args.at is None else
+                         f"{{y}} range at {{x}} = {at:.6g}", hi - lo, "y",
+                         "width of the top stable interval of {y} at that {x}"))
         if args.at is None and (not runs or runs[-1][1] - runs[-1][0] < 0.05 * lim.y_max):
             notes.append(f"{y}_max is reached at the tip of a thin sliver of the stable "
-                         f"set: it needs precise tuning of {x}; give --at X for the "
-                         f"stable {y} at another {x}")
+                         f"set: it needs precise tuning of {x}"
+                         + ("; give --at X for the stable {y} at another {x}"
+                            if setup.paper is None else ""))
     if not nominal_lim.empty and math.isfinite(nominal_lim.area) \
             and lim.area < 0.05 * nominal_lim.area:
-        notes.append(f"the best {name} lies where the stable set is a thin sliver (area "
-                     f"{lim.area:.3g} against {nominal_lim.area:.3g} at the nominal {name}): "
-                     f"the gain needs very precise tuning of {name} and {x}")
+        notes.append(f"the best {p} lies where the stable set is a thin sliver (area "
+                     f"{lim.area:.3g} against {nominal_lim.area:.3g} at the nominal {p}): "
+                     f"the gain needs very precise tuning of {p} and {x}")
     if failed:
         where = ", ".join(f"{v:.10g}" for v, _ in failed[:3]) + (", ..." if len(failed) > 3 else "")
-        notes.append(f"the limits could not be computed at {len(failed)} value(s) of {name} "
-                     f"({where}{suffix}): {failed[0][1]}; the best {name} is the best of the "
+        notes.append(f"the limits could not be computed at {len(failed)} value(s) of {p} "
+                     f"({where}{suffix}): {failed[0][1]}; the best {p} is the best of the "
                      f"others")
     if best - low < 1e-3 * (high - low) or high - best < 1e-3 * (high - low):
-        notes.append(f"the best {name} is at an end of the range searched: widen --range")
-    emit(setup, args.format, ["quantity", "value", "unit", "meaning"], rows, result=result,
-         notes=notes, json_rows=False)
+        notes.append(f"the best {p} is at an end of the range searched"
+                     + (": widen --range" if setup.paper is None else ""))
+    columns, rows = plane_table(setup, rows, over=name)
+    result = _result(setup, search, lim)
+    if line is not None:
+        result["at"] = line
+    emit(setup, args.format, columns, rows, result=result, notes=notes, json_rows=False)
     return 0
+
+
+def _result(setup, search, lim):
+    """The JSON: the search and the limits at its best value; for the paper's options also
+    ``best`` under :class:`symstab.numeric.region.BestVirtualMass`'s names."""
+    out = {"search": search, "limits": named(setup, lim).as_dict()}
+    if setup.paper is not None:
+        out["best"] = {"gamma": search["best"], "beta": search["x_at_y_max"],
+                       "alpha_max": search["y_max"], "alpha_max_gamma0": search["y_max_nominal"],
+                       "gain": search["gain"], "z_width": lim.area if search["best"] is not None
+                       else 0.0, "message": "" if search["best"] is not None else
+                       f"no gamma in [{search['range'][0]:g}, {search['range'][1]:g}] has a "
+                       f"stable region at d = {setup.paper.d}"}
+    return out

@@ -7,6 +7,7 @@ the range of damping over the stable region and its area (Z-width), with
 Both give the passive set (Colgate-Schenkel) beside the stable one.
 """
 
+import math
 import sys
 import textwrap
 
@@ -62,6 +63,11 @@ def run(args):
     lim = named(setup, setup.loop.limits(x=setup.x, y=setup.y, **setup.values))
     columns, rows = limits_table(setup, lim)
     notes, result = limits_notes(setup, lim), {"limits": lim.as_dict()}
+    delta = None if setup.paper is None or lim.empty else setup.paper.delta
+    if delta is not None and not math.isclose(lim.x_min, -delta, rel_tol=1e-9, abs_tol=1e-12):
+        notes.append(f"beta_left = {lim.x_min:.10g} is the leftmost beta of the stable region; "
+                     f"the paper's beta_min = -delta = {-delta:.10g} is where the boundary arc "
+                     "starts (theta = 0)")
     if at is not None:
         more, line = stable_intervals_at(setup, at)
         notes += more

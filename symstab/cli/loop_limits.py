@@ -12,7 +12,8 @@ import math
 
 from .output import interval_texts, number_text
 
-__all__ = ["LIMITS", "stable_intervals_at", "named", "limits_table", "limits_notes", "passive_notes"]
+__all__ = ["LIMITS", "stable_intervals_at", "named", "plane_table", "limits_table", "limits_notes",
+           "passive_notes"]
 
 
 def stable_intervals_at(setup, at):
@@ -63,23 +64,30 @@ LIMITS = (
 )
 
 
-def _units(setup, physical=False):
-    """The units of x, y and the area: the loop's; none in Table I's plane, the device's if ``physical``."""
+def _units(setup, physical=False, over=None):
+    """The unit of each kind of quantity: the loop's; none in Table I's plane, the device's if ``physical``.
+
+    Kinds: ``x``, ``y``, ``area`` and ``p``, the parameter ``over`` (design's).
+    """
     ux, uy = setup.unit(setup.x), setup.unit(setup.y)
+    up = setup.unit(over) if over else ""
     if physical:
-        ux, uy = setup.paper.units["B_w"], setup.paper.units["K_w"]
-    return {"x": ux, "y": uy, "area": f"({ux})({uy})" if ux and uy else (ux or uy)}
+        ux, uy, up = (setup.paper.units[k] for k in ("B_w", "K_w", "M_w"))
+    return {"x": ux, "y": uy, "p": up, "area": f"({ux})({uy})" if ux and uy else (ux or uy),
+            None: ""}
 
 
 def _physical(setup, kind, value):
-    """A value of Table I's plane in the paper's device's units (``kind`` x, y or area)."""
+    """A value of Table I's plane in the paper's device's units (``kind`` as :func:`_units`)."""
     device = setup.paper.device
-    if value is None:
-        return None
+    if value is None or kind is None:
+        return value
     if kind == "y":
         return float(device.stiffness(value))
     if kind == "x":
         return float(device.damping(value))
+    if kind == "p":
+        return float(device.mass(value))
     return value * (device.m / device.T) * (device.m / device.T**2)
 
 
@@ -88,47 +96,53 @@ def named(setup, lim):
     return dataclasses.replace(lim, x=setup.name(setup.x), y=setup.name(setup.y), at={})
 
 
-def limits_table(setup, lim):
-    """``(columns, rows)`` of the limits ``lim`` of the plane of ``setup``.
+def plane_table(setup, rows, *, over=None):
+    """``(columns, rows)`` of quantities of the plane of ``setup``, for :func:`symstab.cli.output.emit`.
 
-    A loop's rows are ``(quantity, value, unit, meaning)`` in its units;
-    the paper's device options give Table I's names and values, and for a
-    physical device the same quantity in the device's units beside them
-    (named as ``limits --loop examples/loops/paper.toml`` names it).
+    ``rows`` are ``(name, value, kind, meaning)``: ``name`` and ``meaning``
+    templates in ``{x}``, ``{y}`` and ``{p}`` (the parameter ``over``),
+    ``kind`` that of :func:`_units`, and ``name`` a pair ``(name, Table
+    I's name)`` where the paper's name is not the template's.  A loop's
+    rows are ``(quantity, value, unit, meaning)`` in its units; the paper's
+    device options give Table I's names and values, and for a physical
+    device the same quantity in the device's units beside them, named as
+    ``examples/loops/paper.toml`` names it.
     """
-    x, y = setup.name(setup.x), setup.name(setup.y)
+    names = {"x": setup.name(setup.x), "y": setup.name(setup.y),
+             "p": setup.name(over) if over else ""}
+    raw = {"x": setup.x, "y": setup.y, "p": over or ""}
     paper = setup.paper
     physical = paper is not None and paper.physical
-    units = _units(setup, physical)
-    rows = []
-    for field, name, paper_name, meaning, kind in LIMITS:
-        value = getattr(lim, field)
+    units = _units(setup, physical, over)
+    out = []
+    for name, value, kind, meaning in rows:
+        name, table_one = name if isinstance(name, tuple) else (name, None)
         if paper is None:
-            row = (name.format(x=x, y=y), value, units[kind])
-        elif physical:
-            row = (paper_name, value, name.format(x=setup.x, y=setup.y),
-                   _physical(setup, kind, value), units[kind])
+            row = (name.format(**names), value, units[kind])
         else:
-            row = (paper_name, value)
-        rows.append(row + (meaning.format(x=x, y=y),))
+            row = (table_one or name.format(**names), value)
+            if physical:
+                row += (name.format(**raw), _physical(setup, kind, value), units[kind])
+        out.append(row + (meaning.format(**names),))
     columns = (["quantity", "value"] + (["unit"] if paper is None else [])
                + (["physical", "physical value", "unit"] if physical else []) + ["meaning"])
-    return columns, rows
+    return columns, out
+
+
+def limits_table(setup, lim):
+    """``(columns, rows)`` of the limits ``lim`` of the plane of ``setup`` (:func:`plane_table`)."""
+    return plane_table(setup, [((name, paper_name), getattr(lim, field), kind, meaning)
+                               for field, name, paper_name, meaning, kind in LIMITS])
 
 
 def limits_notes(setup, lim):
-    """The notes on limits: why the stable set is empty or unbounded, the paper's beta_min."""
+    """The notes on limits: why the stable set is empty, or that it is unbounded."""
     x, y = setup.name(setup.x), setup.name(setup.y)
     if lim.empty:
         return [f"no stable point in the ({x}, {y}) plane at these values: "
                 f"{lim.reason or 'no cell of the window has every root inside the unit circle'}"]
     if math.isinf(lim.y_max) or math.isinf(lim.area):
         return [f"the stable set is unbounded in the ({x}, {y}) plane"]
-    delta = None if setup.paper is None else setup.paper.delta
-    if delta is not None and not math.isclose(lim.x_min, -delta, rel_tol=1e-9, abs_tol=1e-12):
-        return [f"beta_left = {lim.x_min:.10g} is the leftmost beta of the stable region; "
-                f"the paper's beta_min = -delta = {-delta:.10g} is where the boundary arc "
-                "starts (theta = 0)"]
     return []
 
 
@@ -153,7 +167,8 @@ def passive_notes(setup, lim):
         region = passive_region(setup.loop, x=setup.x, y=setup.y, **setup.values).renamed(x, y)
     except (ValueError, TypeError, ArithmeticError) as exc:
         return [f"passive set (Colgate-Schenkel) not computed: {exc}"], {"error": str(exc)}
-    ux, uy, ua = (f" {u}" if u else "" for u in _units(setup).values())
+    units = _units(setup)
+    ux, uy, ua = (f" {units[k]}" if units[k] else "" for k in ("x", "y", "area"))
     out = {"x": x, "y": y, "y_max": region.y_max, "x_at_y_max": region.x_at_y_max,
            "area": region.area, "bounded": region.bounded,
            "x_range": list(region.x_range), "y_range": list(region.y_range)}
