@@ -230,10 +230,8 @@ def _paper_png(args, setup, result, nonideal, given, theory):
     fig, ax = plt.subplots(figsize=(6.4, 4.8), dpi=120)
     ax.pcolormesh(x, y, result.stable.astype(float), shading="nearest",
                   cmap=ListedColormap(["white", "#7fc97f"]), vmin=0, vmax=1)
-    arc_beta, arc_alpha, lines = theory.boundary(n=4000 if theory.loop is not None else 2000)
-    arc_beta = visible(arc_beta, result.beta[0], result.beta[-1])
-    arc_alpha = visible(arc_alpha, result.alpha[0], result.alpha[-1])
-    arc_beta[np.isnan(arc_alpha)] = np.nan
+    arc_beta, arc_alpha, lines = theory.boundary(((result.beta[0], result.beta[-1]),
+                                                  (result.alpha[0], result.alpha[-1])))
     drawn = []
     if np.any(np.isfinite(arc_beta)):
         name = ("the ideal loop, eq. (7)" if theory.loop is None

@@ -60,7 +60,7 @@ import numpy as np
 from .._generated import kernels
 from .._resources import MAX_STEPS_ENV, check_memory, chunk_slices
 from .._resources import max_steps as _max_steps_setting
-from .._validate import check_array, check_delay, check_loop, check_real
+from .._validate import check_array, check_box, check_delay, check_loop, check_real
 
 __all__ = ["Nonidealities", "Simulation", "simulate", "StabilityMap", "stability_map",
            "default_horizon", "check_steps", "check_x0", "max_steps", "progress_printer", "PAPER_ENCODER_RESOLUTION",
@@ -697,7 +697,7 @@ class LinearTheory:
     them (``alpha``, ``beta``; ``gamma`` and ``d`` are fixed here).  Without
     a velocity filter or an actuator lag the linear part is the paper's loop
     and the paper's functions answer (:func:`symstab.numeric.stability.classify`,
-    :func:`symstab.numeric.region.boundary_curve`); with either, a
+    the boundary of :func:`~symstab.numeric.paper_loop.paper_point`'s loop); with either, a
     :class:`symstab.Loop` of the paper's plant (with the lag) and the
     environment on the filtered velocity, in the device's physical units.
 
@@ -788,39 +788,41 @@ class LinearTheory:
                                          delta=self.delta))
         return float(self.loop.spectral_radius(**self._physical(alpha, beta), **self.values))
 
-    def boundary(self, n=2000):
-        """The theory's boundary in the ``(beta, alpha)`` plane.
+    def boundary(self, window):
+        """The theory's D-decomposition in the ``(beta, alpha)`` plane, to draw in ``window``.
+
+        The loop's arc sampled for the window
+        (:meth:`symstab.Loop.boundary`, :func:`~symstab.numeric.decomposition.window_arc`)
+        and its lines; the paper's loop, without a filter or a lag, is
+        :func:`~symstab.numeric.paper_loop.paper_point`'s, in Table I's
+        variables.
 
         Parameters
         ----------
-        n : int
-            Points along the arc.
+        window : ((float, float), (float, float))
+            ``((beta0, beta1), (alpha0, alpha1))``.
 
         Returns
         -------
         (beta, alpha, lines)
-            The arc's points (NaN between branches) and the straight lines
-            ``{"z = 1": (c0, c_beta, c_alpha), ...}`` of the D-decomposition
-            (``c0 + c_beta beta + c_alpha alpha = 0``; none for the paper's
-            loop, whose drawn boundary is the curve of eq. (7)).
+            The arc's points (NaN between branches and far from the window)
+            and the straight lines ``{"z = 1": (c0, c_beta, c_alpha), ...}``
+            (``c0 + c_beta beta + c_alpha alpha = 0``).
         """
+        (b0, b1), (a0, a1) = check_box("window", window, ("beta", "alpha"))
         if self.loop is None:
-            from .region import boundary_curve
+            from .paper_loop import paper_point
 
-            curve = boundary_curve(gamma=self.gamma, d=self.d, delta=self.delta, n=n,
-                                   segments=False)
-            return np.asarray(curve.beta), np.asarray(curve.alpha), {}
-        curve = self.loop.boundary(x="B", y="K", n=n, **self.values)
+            loop, point = paper_point(gamma=self.gamma, d=self.d, delta=self.delta)
+            curve = loop.boundary(x="B", y="K", window=((b0, b1), (a0, a1)), **point)
+            return curve.x_values, curve.y_values, curve.lines
         dev = self.device
         # B = beta m / T and K = alpha m / T**2: the lines' slopes scale alike.
-        lines = {label: (c0, cb * dev.m / dev.T, ck * dev.m / dev.T**2)
-                 for label, (c0, cb, ck) in curve.lines.items()}
-        finite = np.isfinite(curve.x_values) & np.isfinite(curve.y_values)
-        beta, alpha = np.full(finite.shape, np.nan), np.full(finite.shape, np.nan)
-        # The Device's conversions refuse NaN, which marks the arc's breaks.
-        beta[finite] = dev.beta(curve.x_values[finite])
-        alpha[finite] = dev.alpha(curve.y_values[finite])
-        return beta, alpha, lines
+        sx, sy = dev.m / dev.T, dev.m / dev.T**2
+        curve = self.loop.boundary(x="B", y="K", window=((b0 * sx, b1 * sx), (a0 * sy, a1 * sy)),
+                                   **self.values)
+        lines = {label: (c0, cb * sx, ck * sy) for label, (c0, cb, ck) in curve.lines.items()}
+        return curve.x_values / sx, curve.y_values / sy, lines
 
 
 def linear_theory(*, gamma, d, delta=None, device=None, nonideal=None):

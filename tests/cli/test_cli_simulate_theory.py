@@ -137,3 +137,24 @@ def test_ideal_map_still_names_the_ideal_loop(tmp_path, capsys):
                                 "--steps", "400", "--out", tmp_path / "m.csv", "--no-png")
     assert status == 0, err
     assert "differ from the root-counting classification of the ideal loop" in text
+
+
+def test_ideal_map_draws_the_paper_loops_boundary_and_its_z_equal_one_line(tmp_path, capsys,
+                                                                            drawn):
+    """The ideal map's boundary is the paper's loop's (python-control: a pole on the circle)."""
+    from oracles import python_control_closed_loop
+
+    delta = PAPER_DEVICE.delta
+    status, _, err = run_cli(capsys, "map", "--delta", str(delta), "--d", "5",
+                             "--alpha", "0,0.05,12", "--beta=-0.01,0.3,12", "--steps", "400",
+                             "--out", tmp_path / "m.npz")
+    assert status == 0, err
+    (lines,) = drawn
+    assert "root z = 1" in lines                 # alpha = 0, drawn as for any loop
+    x, y = lines["boundary of the ideal loop, eq. (7)"]
+    inside = np.flatnonzero(np.isfinite(x) & (y > 1e-3) & (y < 0.05) & (x > -0.01) & (x < 0.3))
+    assert inside.size > 50
+    for k in inside[:: max(1, inside.size // 20)]:
+        poles = python_control_closed_loop(alpha=float(y[k]), beta=float(x[k]), gamma=0.0, d=5,
+                                           delta=delta, m=1.0, T=1.0).poles()
+        assert np.min(np.abs(np.abs(poles) - 1.0)) <= 1e-7, (x[k], y[k])
