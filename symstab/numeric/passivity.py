@@ -203,56 +203,49 @@ class PassiveRegion:
 
 
 # --------------------------------------------------------------------------
-# The condition as cosine polynomials
+# The condition, term by term in Dirichlet kernels
 
 
-def _cosine_series(num, den, d):
-    """Cosine coefficients ``q`` of ``|D|**2 [Re H - cot(theta/2) Im H]`` for ``H = N z**-d / D``.
+def _laurent(num, den, d):
+    """``(p, lowest)``: ``P(z) = N(z) D(1/z) z**-d = sum_i p[i] z**(lowest + i)``.
 
-    ``num`` and ``den`` are real coefficients, highest power first.  The
-    Laurent polynomial ``P = N(z) D(1/z) z**-d`` has the coefficient ``p_k``
-    of ``z**k``; its term contributes ``p_k`` times the Dirichlet kernel
-    ``D_{-k}`` (``k <= 0``) or ``-D_{k-1}`` (``k >= 1``), see the module
-    docstring.
+    ``num`` and ``den`` are real coefficients, highest power first; ``p``
+    is short (``len(num) + len(den) - 1`` terms) whatever the delay.
     """
     ascending = np.asarray(num, dtype=float)[::-1]
     # den highest first is D(1/z) in ascending powers from z**-(len(den) - 1).
-    p = np.convolve(ascending, np.asarray(den, dtype=float))
-    lowest = -(len(den) - 1) - d
-    powers = lowest + np.arange(len(p))
-    orders = np.where(powers <= 0, -powers, powers - 1)
-    signs = np.where(powers <= 0, 1.0, -1.0)
-    q = np.zeros(int(orders.max()) + 1)
-    # D_m = 1 + 2 (cos theta + ... + cos m theta): q_i gets 2 p for every
-    # term whose kernel reaches i (a cumulative sum from the top).
-    weights = np.zeros(len(q))
-    np.add.at(weights, orders, signs * p)
-    q[0] = weights.sum()
-    q[1:] = 2 * np.cumsum(weights[::-1])[::-1][1:]
-    return q
+    return np.convolve(ascending, np.asarray(den, dtype=float)), -(len(den) - 1) - d
 
 
-def _autocorrelation(den):
-    """Cosine coefficients of ``|D(exp(j theta))|**2``."""
-    den = np.asarray(den, dtype=float)
-    c = np.convolve(den, den[::-1])
-    n = len(den) - 1
-    return np.concatenate([[c[n]], 2 * c[n + 1:]])
+def _kernels(orders, theta):
+    """Dirichlet kernels ``D_m(theta) = sin((m + 1/2) theta) / sin(theta/2)`` (``2 m + 1`` at 0).
+
+    Shape ``theta.shape + orders.shape``; ``theta`` in [0, pi].
+    """
+    theta = np.asarray(theta, dtype=float)[..., None]
+    half = np.sin(0.5 * theta)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        values = np.sin((orders + 0.5) * theta) / half
+    return np.where(half == 0, 2.0 * orders + 1.0, values)
 
 
 @dataclasses.dataclass
 class _Plane:
     """The condition ``a0(theta) + x ax(theta) + y ay(theta) <= 0`` of a plane, in damping units.
 
-    ``a = scale (C0 + x Cx + y Cy) / R - damping`` with cosine series
-    ``C`` (:func:`_cosine_series`) and ``R = |D|**2``; ``damping_axis`` is 0 or
-    1 when the damping itself is the plane's x or y (then ``damping`` is 0
-    and the axis carries ``-1``).  ``static`` is ``(h0, hx, hy)``: ``H(1)``,
-    which must be ``>= 0``.  ``sx, sy`` scale the plane to order one.
+    ``a = scale (C0 + x Cx + y Cy) / R - damping`` with ``C = |D|**2 [Re H
+    - cot(theta/2) Im H]`` of the three numerators (the base and the two
+    slopes) and ``R = |D|**2``.  Each ``C`` is a short sum of Dirichlet
+    kernels (see the module docstring), evaluated in closed form: a point
+    costs the same at any delay.  ``damping_axis`` is 0 or 1 when the
+    damping itself is the plane's x or y (then ``damping`` is 0 and the axis
+    carries ``-1``).  ``static`` is ``(h0, hx, hy)``: ``H(1)``, which must
+    be ``>= 0``.  ``sx, sy`` scale the plane to order one.
     """
 
-    series: np.ndarray         # (n + 1, 3): columns C0, Cx, Cy
-    r: np.ndarray              # cosine series of |D|**2
+    weights: np.ndarray        # (n, 3): each numerator's p_k times the kernel's sign
+    orders: np.ndarray         # (n,): the order m of each term's kernel
+    den: np.ndarray            # D, highest power first
     scale: float
     damping: float
     damping_axis: object
@@ -260,11 +253,16 @@ class _Plane:
     sx: float = 1.0
     sy: float = 1.0
 
+    @property
+    def harmonic(self):
+        """The highest harmonic of ``cos(k theta)`` in the condition (the grid's resolution)."""
+        return int(max(self.orders.max(), len(self.den) - 1))
+
     def terms(self, theta):
         """``(a0, ax, ay)`` at the angles ``theta`` (each of ``theta``'s shape), unscaled axes."""
-        c = np.cos(theta)
-        values = np.polynomial.chebyshev.chebval(c, self.series)    # (3,) + shape
-        r = np.polynomial.chebyshev.chebval(c, self.r)
+        theta = np.asarray(theta, dtype=float)
+        values = np.moveaxis(_kernels(self.orders, theta) @ self.weights, -1, 0)   # (3,) + shape
+        r = np.abs(np.polyval(self.den, np.exp(1j * theta)))**2
         a = self.scale * values / r
         a[0] = a[0] - self.damping
         if self.damping_axis is not None:
@@ -466,8 +464,7 @@ def _solve(plane, x, y, x_range, y_range, hints=(0.0, 0.0)):
     ``hints`` are sizes of the axes (the loop's defaults) used only where
     the condition gives no scale of its own (no line crosses that axis).
     """
-    n_series = plane.series.shape[0] - 1
-    grid = _grid(max(n_series, len(plane.r) - 1))
+    grid = _grid(plane.harmonic)
     table = plane.terms(grid)
 
     # The plane's natural scale: where the grid's lines cross the axes.
@@ -489,24 +486,26 @@ def _solve(plane, x, y, x_range, y_range, hints=(0.0, 0.0)):
     plane.sx, plane.sy = scales
     tolerance = _RTOL * (plane.damping if plane.damping_axis is None else scales[plane.damping_axis])
 
-    rows = np.concatenate([plane.static_row(), plane.rows(grid)])
-    polygon = _clip_all(_box(_BOX, _BOX), rows)
-    for _ in range(_MAX_ROUNDS):
-        if len(polygon) == 0:
-            break
-        value, theta = _worst(plane, grid, table, polygon[:, 0], polygon[:, 1])
-        failing = value > tolerance
-        if not failing.any():
-            break
-        new = plane.rows(np.unique(theta[failing]))
-        rows = np.concatenate([rows, new])
-        polygon = _clip_all(polygon, new)
-        if len(polygon) > _MAX_VERTICES:
-            raise ArithmeticError(f"the passive set's boundary needs more than {_MAX_VERTICES} "
-                                  f"vertices to meet the tolerance")
-    else:
+    def cut(polygon, rows):
+        """Cutting planes until every vertex meets the condition to ``tolerance``."""
+        for _ in range(_MAX_ROUNDS):
+            if len(polygon) == 0:
+                return polygon, rows
+            value, theta = _worst(plane, grid, table, polygon[:, 0], polygon[:, 1])
+            failing = value > tolerance
+            if not failing.any():
+                return polygon, rows
+            new = plane.rows(np.unique(theta[failing]))
+            rows = np.concatenate([rows, new])
+            polygon = _clip_all(polygon, new)
+            if len(polygon) > _MAX_VERTICES:
+                raise ArithmeticError(f"the passive set's boundary needs more than "
+                                      f"{_MAX_VERTICES} vertices to meet the tolerance")
         raise ArithmeticError(f"the passive set did not converge in {_MAX_ROUNDS} rounds of "
                               f"cutting planes")
+
+    rows = np.concatenate([plane.static_row(), plane.rows(grid)])
+    polygon, rows = cut(_clip_all(_box(_BOX, _BOX), rows), rows)
 
     # The far box: a vertex on it means the set runs off to infinity.
     on_box = np.abs(polygon) >= _BOX * (1 - 1e-9)
@@ -514,10 +513,14 @@ def _solve(plane, x, y, x_range, y_range, hints=(0.0, 0.0)):
         polygon) else (False, False)
     if len(polygon) and not (unbounded_x or unbounded_y):
         # Redo the cuts in a box fitted to the set: its vertices then carry
-        # the rounding of its own size, not of the far box's.
+        # the rounding of its own size, not of the far box's, which merged
+        # vertices closer than 1e-9 of its span, and a polished corner has
+        # moved: every vertex is checked again (at d = 300 one was 2.3e-6 b
+        # outside).
         lo, hi = polygon.min(axis=0), polygon.max(axis=0)
         half = np.maximum(hi - lo, 1e-300)
         polygon = _polish(_clip_all(_box(half[0], half[1], (lo + hi) / 2), rows), rows)
+        polygon, rows = cut(polygon, rows)
         on_box = np.zeros(polygon.shape, dtype=bool)
 
     unscale = np.array([plane.sx, plane.sy])
@@ -609,13 +612,16 @@ def _check_stable_denominator(den, what):
 def _prepare_plane(base, slope_x, slope_y, den, d, scale, damping, damping_axis):
     length = max(len(base), len(slope_x), len(slope_y))
     pad = [np.pad(np.asarray(c, dtype=float), (length - len(c), 0)) for c in (base, slope_x, slope_y)]
-    series = [_cosine_series(c, den, d) for c in pad]
-    n = max(len(s) for s in series)
-    series = np.stack([np.pad(s, (0, n - len(s))) for s in series], axis=1)
+    terms = [_laurent(c, den, d) for c in pad]     # one length and lowest power for the three
+    p = np.stack([t[0] for t in terms], axis=1)
+    powers = terms[0][1] + np.arange(len(p))
+    # A term p z**k contributes p D_{-k} (k <= 0) or -p D_{k-1} (k >= 1).
+    orders = np.where(powers <= 0, -powers, powers - 1)
+    weights = np.where(powers <= 0, 1.0, -1.0)[:, None] * p
     at_one = float(np.sum(den))
     static = tuple(float(np.sum(c)) / at_one for c in pad)
-    return _Plane(series, _autocorrelation(den), scale, 0.0 if damping_axis is not None else damping,
-                  damping_axis, static)
+    return _Plane(weights, orders.astype(float), np.asarray(den, dtype=float), scale,
+                  0.0 if damping_axis is not None else damping, damping_axis, static)
 
 
 # --------------------------------------------------------------------------
