@@ -176,8 +176,8 @@ def _search(args, setup, name, notes):
     nominal_lim = limits_at(nominal)
     search = {"over": p, "range": [low, high], "unit": unit, "nominal": nominal,
               "y_max_nominal": None if nominal_lim.empty else nominal_lim.y_max}
-    at_nominal = (f"{{y}}_max at {{p}} = {nominal:.6g}", search["y_max_nominal"], "y",
-                  "largest stable {y} at the nominal {p}")
+    at_nominal = ((f"{{y}}_max at {{p}} = {nominal:.6g}", None, "K_max at M_w = 0"),
+                  search["y_max_nominal"], "y", "largest stable {y} at the nominal {p}")
     if found is None:
         notes += [f"no {p} in [{low:.6g}, {high:.6g}]{suffix} has a stable point in the "
                   f"({x}, {y}) plane"] + limits_notes(setup, nominal_lim)
@@ -192,12 +192,13 @@ def _search(args, setup, name, notes):
         else None
     search.update(best=best, y_max=lim.y_max, x_at_y_max=lim.x_at_y_max, gain=gain)
     rows = [("{p} (best)", best, "p", "the {p} that maximises {y}_max"),
-            ("{y}_max", lim.y_max, "y", "largest stable {y} at the best {p}"),
-            ("{x} at {y}_max", lim.x_at_y_max, "x", "the {x} at which {y}_max is reached"),
+            (("{y}_max", None, "K_max"), lim.y_max, "y", "largest stable {y} at the best {p}"),
+            (("{x} at {y}_max", None, "B_w at K_max"), lim.x_at_y_max, "x",
+             "the {x} at which {y}_max is reached"),
             at_nominal,
             ("gain", gain, None, "{y}_max at the best {p} over that at the nominal one"),
-            ("area at the best {p}", lim.area, "area", "area of the stable set (the Z-width "
-             "where {x} is a damping and {y} a stiffness)")]
+            (("area at the best {p}", None, "Z-width at the best M_w"), lim.area, "area",
+             "area of the stable set (the Z-width where {x} is a damping and {y} a stiffness)")]
     notes += limits_notes(setup, lim)
     at_best = dataclasses.replace(setup, values={**setup.values, name: best})
     at = args.at
@@ -206,9 +207,12 @@ def _search(args, setup, name, notes):
     line = None
     if at is not None:
         more, line = stable_intervals_at(at_best, at)
-        notes += [f"at the best {p} = {best:.10g}{suffix}: {text}" if k == 0 else text
-                  for k, text in enumerate(more)]
         runs = line["intervals"]
+        # At a corner of the stable set the line through the x of y_max only
+        # touches it: no interval to show (the note on the sliver says why).
+        if runs or args.at is not None:
+            notes += [f"at the best {p} = {best:.10g}{suffix}: {text}" if k == 0 else text
+                      for k, text in enumerate(more)]
         if runs:
             lo, hi = runs[-1]
             rows.append(("{y} range at the {x} of {y}_max" if args.at is None else
@@ -217,7 +221,7 @@ def _search(args, setup, name, notes):
         if args.at is None and (not runs or runs[-1][1] - runs[-1][0] < 0.05 * lim.y_max):
             notes.append(f"{y}_max is reached at the tip of a thin sliver of the stable "
                          f"set: it needs precise tuning of {x}"
-                         + ("; give --at X for the stable {y} at another {x}"
+                         + (f"; give --at X for the stable {y} at another {x}"
                             if setup.paper is None else ""))
     if not nominal_lim.empty and math.isfinite(nominal_lim.area) \
             and lim.area < 0.05 * nominal_lim.area:

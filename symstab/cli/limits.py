@@ -39,7 +39,7 @@ def register(subparsers):
                 + "\n".join(textwrap.fill(meaning.format(x="beta", y="alpha"), 79,
                                          initial_indent=f"  {name:<18} ",
                                          subsequent_indent=" " * 21)
-                            for _, _, name, meaning, _ in LIMITS) + "\n\n" + p.epilog)
+                            for _, _, (name, _), meaning, _ in LIMITS) + "\n\n" + p.epilog)
     add_model_options(p)
     x = p.add_mutually_exclusive_group()
     x.add_argument("--beta", type=float, help="also give the stable alpha interval(s) at this beta")
@@ -58,7 +58,7 @@ def run(args):
     at = _line(args, setup)         # checked before the work
     if setup.values["d"] >= _ANNOUNCE_DELAY:
         # Seconds at long delays (the plane's D-decomposition, and the passive set): say what runs.
-            print(f"scanning the ({setup.name(setup.x)}, {setup.name(setup.y)}) plane for the "
+        print(f"scanning the ({setup.name(setup.x)}, {setup.name(setup.y)}) plane for the "
               "extent of the stable set ...", file=sys.stderr, flush=True)
     lim = named(setup, setup.loop.limits(x=setup.x, y=setup.y, **setup.values))
     columns, rows = limits_table(setup, lim)

@@ -50,17 +50,19 @@ def stable_intervals_at(setup, at):
 
 
 #: The quantities of ``limits``: (field of :class:`~symstab.numeric.results.Limits`,
-#: name in the plane ``(x, y)``, the paper's name in Table I's plane, meaning, what
-#: its unit is).  The paper's names say what each is: ``beta_left``/``beta_right``
-#: are the ends of the stable set's beta range, which a reader of the paper would
-#: otherwise take for its beta_min = -delta, the damping where the boundary arc starts.
+#: name in the plane ``(x, y)``, the paper's name in Table I's plane and in the
+#: device's units, meaning, what its unit is).  The paper's names say what each is:
+#: ``beta_left``/``beta_right`` are the ends of the stable set's beta range, which a
+#: reader of the paper would otherwise take for its beta_min = -delta, the damping
+#: where the boundary arc starts.
 LIMITS = (
-    ("y_max", "{y}_max", "alpha_max", "largest stable {y}", "y"),
-    ("x_at_y_max", "{x} at {y}_max", "beta_at_alpha_max", "the {x} at which {y}_max is reached",
-     "x"),
-    ("x_min", "{x}_min", "beta_left", "leftmost {x} of the stable set", "x"),
-    ("x_max", "{x}_max", "beta_right", "rightmost {x} of the stable set", "x"),
-    ("area", "area", "z_width", "area of the stable set in the ({x}, {y}) plane", "area"),
+    ("y_max", "{y}_max", ("alpha_max", "K_max"), "largest stable {y}", "y"),
+    ("x_at_y_max", "{x} at {y}_max", ("beta_at_alpha_max", "B_w at K_max"),
+     "the {x} at which {y}_max is reached", "x"),
+    ("x_min", "{x}_min", ("beta_left", "B_left"), "leftmost {x} of the stable set", "x"),
+    ("x_max", "{x}_max", ("beta_right", "B_right"), "rightmost {x} of the stable set", "x"),
+    ("area", "area", ("z_width", "Z-width"), "area of the stable set in the ({x}, {y}) plane",
+     "area"),
 )
 
 
@@ -101,28 +103,30 @@ def plane_table(setup, rows, *, over=None):
 
     ``rows`` are ``(name, value, kind, meaning)``: ``name`` and ``meaning``
     templates in ``{x}``, ``{y}`` and ``{p}`` (the parameter ``over``),
-    ``kind`` that of :func:`_units`, and ``name`` a pair ``(name, Table
-    I's name)`` where the paper's name is not the template's.  A loop's
-    rows are ``(quantity, value, unit, meaning)`` in its units; the paper's
-    device options give Table I's names and values, and for a physical
-    device the same quantity in the device's units beside them, named as
-    ``examples/loops/paper.toml`` names it.
+    ``kind`` that of :func:`_units`, and ``name`` a tuple ``(name, Table
+    I's name, physical name)`` where the paper's names are not the
+    template's (None: the template's).  A loop's rows are ``(quantity,
+    value, unit, meaning)`` in its units; the paper's device options give
+    Table I's names and values, and for a physical device the same quantity
+    in the device's units beside them (``K_w``, ``B_w``, ``M_w``).
     """
     names = {"x": setup.name(setup.x), "y": setup.name(setup.y),
              "p": setup.name(over) if over else ""}
-    raw = {"x": setup.x, "y": setup.y, "p": over or ""}
+    physical_names = {"x": "B_w", "y": "K_w", "p": "M_w"}
     paper = setup.paper
     physical = paper is not None and paper.physical
     units = _units(setup, physical, over)
     out = []
     for name, value, kind, meaning in rows:
-        name, table_one = name if isinstance(name, tuple) else (name, None)
+        name, table_one, label = (name + (None, None))[:3] if isinstance(name, tuple) else (
+            name, None, None)
         if paper is None:
             row = (name.format(**names), value, units[kind])
         else:
             row = (table_one or name.format(**names), value)
             if physical:
-                row += (name.format(**raw), _physical(setup, kind, value), units[kind])
+                row += (label or name.format(**physical_names), _physical(setup, kind, value),
+                        units[kind])
         out.append(row + (meaning.format(**names),))
     columns = (["quantity", "value"] + (["unit"] if paper is None else [])
                + (["physical", "physical value", "unit"] if physical else []) + ["meaning"])
@@ -131,16 +135,17 @@ def plane_table(setup, rows, *, over=None):
 
 def limits_table(setup, lim):
     """``(columns, rows)`` of the limits ``lim`` of the plane of ``setup`` (:func:`plane_table`)."""
-    return plane_table(setup, [((name, paper_name), getattr(lim, field), kind, meaning)
-                               for field, name, paper_name, meaning, kind in LIMITS])
+    return plane_table(setup, [((name, *paper_names), getattr(lim, field), kind, meaning)
+                               for field, name, paper_names, meaning, kind in LIMITS])
 
 
 def limits_notes(setup, lim):
     """The notes on limits: why the stable set is empty, or that it is unbounded."""
     x, y = setup.name(setup.x), setup.name(setup.y)
     if lim.empty:
-        return [f"no stable point in the ({x}, {y}) plane at these values: "
-                f"{lim.reason or 'no cell of the window has every root inside the unit circle'}"]
+        why = lim.reason.removeprefix("the stable set is empty: ") or \
+            "no cell of the window has every root inside the unit circle"
+        return [f"the stable set of the ({x}, {y}) plane is empty at these values: {why}"]
     if math.isinf(lim.y_max) or math.isinf(lim.area):
         return [f"the stable set is unbounded in the ({x}, {y}) plane"]
     return []
@@ -158,11 +163,13 @@ def passive_notes(setup, lim):
     from ..numeric.passivity import passive_region
 
     x, y = setup.name(setup.x), setup.name(setup.y)
-    damping = "delta" if setup.paper is not None else "b"
-    b = setup.paper.delta if setup.paper is not None else setup.values.get("b")
-    if b == 0:
-        return ([f"passive set (Colgate-Schenkel): none, the device has no damping "
-                 f"({damping} = 0)"], {"y_max": None, "area": 0.0})
+    paper = setup.paper
+    if paper is not None and paper.delta == 0:
+        # The frictionless paper's loop has no b: no passive set with an interior.
+        out = {"x": x, "y": y, "y_max": None, "x_at_y_max": None, "area": 0.0,
+               "alpha_max": None, "beta_at_alpha_max": None}
+        return ["passive set (Colgate-Schenkel): none, the device has no damping "
+                "(delta = 0)"], out
     try:
         region = passive_region(setup.loop, x=setup.x, y=setup.y, **setup.values).renamed(x, y)
     except (ValueError, TypeError, ArithmeticError) as exc:
@@ -172,12 +179,15 @@ def passive_notes(setup, lim):
     out = {"x": x, "y": y, "y_max": region.y_max, "x_at_y_max": region.x_at_y_max,
            "area": region.area, "bounded": region.bounded,
            "x_range": list(region.x_range), "y_range": list(region.y_range)}
-    if setup.paper is not None:      # Table I's names, as the stable limits have them
+    if paper is not None:      # Table I's names, as the stable limits have them
         out.update(alpha_max=region.y_max, beta_at_alpha_max=region.x_at_y_max)
     if region.empty:
-        unit = f" {setup.unit('b')}" if setup.unit("b") else ""
+        where = (f"gamma = {paper.gamma:.6g}, d = {paper.d}, delta = {paper.delta:.6g}"
+                 if paper is not None else
+                 f"b = {setup.values.get('b', math.nan):.10g}"
+                 + (f" {setup.unit('b')}" if setup.unit("b") else ""))
         return [f"passive set (Colgate-Schenkel, with the delay): no passive point in the "
-                f"({x}, {y}) plane at {damping} = {b:.10g}{unit}"], out
+                f"({x}, {y}) plane at {where}"], out
     notes = [f"passive {y}_max = {region.y_max:.10g}{uy} at {x} = {region.x_at_y_max:.10g}{ux} "
              f"(Colgate-Schenkel with the delay; stable {y}_max = "
              f"{number_text(lim.y_max) or 'none'})"]
@@ -186,8 +196,8 @@ def passive_notes(setup, lim):
         k_max, b_at = (_physical(setup, k, v) for k, v in (("y", region.y_max),
                                                            ("x", region.x_at_y_max)))
         out.update(K_max=k_max, B_w_at_K_max=b_at)
-        notes.append(f"passive {setup.y}_max = {k_max:.10g} {units['y']} at {setup.x} = "
-                     f"{b_at:.10g} {units['x']}")
+        notes.append(f"passive K_max = {k_max:.10g} {units['y']} at B_w = {b_at:.10g} "
+                     f"{units['x']}")
     if region.bounded:
         notes.append(f"passive area = {region.area:.10g}{ua} in the "
                      f"({x}, {y}) plane (stable area = {number_text(lim.area) or 'none'})")

@@ -44,8 +44,9 @@ class StabilityRegion:
     crossings of a line with the unit circle (the arc, ``z = +-1`` and the
     leading coefficient's zero), the certified count of roots outside the
     circle at one point and the crossing rule between them, every stable
-    stretch counted afresh.  Its limits are the loop's
-    (:func:`~symstab.numeric.paper_loop.paper_limits`).
+    stretch counted afresh.  Its limits are read from the loop's D-decomposition
+    (:meth:`symstab.numeric.decomposition.Decomposition.limits`), made once
+    for them and for :meth:`line_segments`.
 
     Parameters
     ----------
@@ -236,7 +237,7 @@ def limits(*, gamma, d, delta, n_beta=None):
     """Renderable limits of one virtual mass, delay and device.
 
     The paper's loop in Table I's plane, on the engine of every loop
-    (:meth:`symstab.Loop.limits`, :func:`~symstab.numeric.paper_loop.paper_limits`):
+    (:meth:`symstab.Loop.limits`, through :meth:`StabilityRegion.limits`):
     the stable cells of the D-decomposition of the (beta, alpha) plane, their
     extreme vertices (refined along the arc) and the area of their polygons.
 

@@ -165,14 +165,16 @@ def test_the_paper_loop_file_and_the_device_options_label_the_same_quantities_al
     assert status == 0, err
     status, paper, err = run(capsys, "limits", "--Td", "0.04")
     assert status == 0, err
-    # The device options' physical column names each quantity as the file's plane does.
-    for name, unit in (("K_max", "N m/rad"), ("B at K_max", "N m s/rad"),
-                       ("B_min", "N m s/rad"), ("B_max", "N m s/rad")):
-        found = re.search(rf"(?m)^\s*{re.escape(name)}\s+(\S+)\s+(.+?)\s{{2,}}", loop)
-        assert found and found.group(2) == unit, (name, loop)
+    for loop_name, paper_name, unit in (("K_max", "K_max", "N m/rad"),
+                                        ("B at K_max", "B_w at K_max", "N m s/rad"),
+                                        ("B_min", "B_left", "N m s/rad"),
+                                        ("B_max", "B_right", "N m s/rad")):
+        found = re.search(rf"(?m)^\s*{re.escape(loop_name)}\s+(\S+)\s+(.+?)\s{{2,}}", loop)
+        assert found and found.group(2) == unit, (loop_name, loop)
         ours = float(found.group(1))
-        found = re.search(rf"(?m)\s{re.escape(name)}\s+(\S+)\s+(.+?)\s{{2,}}", paper)
-        assert found and found.group(2) == unit, (name, paper)
+        # The meaning column follows the unit.
+        found = re.search(rf"(?m)\s{re.escape(paper_name)}\s+(\S+)\s+(.+?)\s{{2,}}", paper)
+        assert found and found.group(2) == unit, (paper_name, paper)
         assert ours == pytest.approx(float(found.group(1)), rel=1e-6, abs=1e-9)
     assert "plane: x = B [N m s/rad], y = K [N m/rad]" in loop
     assert "m = 0.0128 kg m^2" in loop and "m = 0.0128 kg m^2" in paper
