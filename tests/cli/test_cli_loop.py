@@ -408,5 +408,6 @@ def test_limits_says_why_a_stable_set_is_empty(capsys):
     status, out, _ = run(capsys, "limits", "--loop", PAPER,
                              "--set", "M=0.0256", "--d", 40)
     assert status == 0
-    note = next(line for line in out.splitlines() if line.startswith("no stable point"))
+    note = next(line for line in out.splitlines()
+                if line.startswith("the stable set of the (B, K) plane is empty"))
     assert "necessary condition" in note and "no point is stable" in note
