@@ -714,9 +714,24 @@ class LoopModel:
     @functools.cached_property
     def _plant_functions(self):
         """mpmath functions of (plant values..., T) giving P_n and P_d (symbolic path)."""
-        args = [self._symbols[n] for n in self._plant_names] + [model.T]
         num, den = self._plant_parts
-        return sp.lambdify(args, [list(num), list(den)], modules="mpmath")
+        return self._plant_function([list(num), list(den)])
+
+    def _plant_function(self, exprs):
+        """An mpmath function of (plant values..., T) giving ``exprs``.
+
+        The arguments are dummies: a parameter named like an mpmath name
+        (``e``, ``exp``) would otherwise shadow it in the generated function
+        (``e`` for Euler's number), and ``T`` in the plant would be an
+        argument twice.  The plant's own ``T``, when it has one, is given
+        the same value by the caller as the last argument.
+        """
+        names = [self._symbols[n] for n in self._plant_names]
+        args = [sp.Dummy(n) for n in self._plant_names] + [sp.Dummy("T")]
+        rename = dict(zip(names, args))
+        rename.setdefault(model.T, args[-1])
+        exprs = [[sp.sympify(c).xreplace(rename) for c in part] for part in exprs]
+        return sp.lambdify(args, exprs, modules="mpmath")
 
     def _closed_form_plant(self, point, T):
         """P_n, P_d of the derived closed form at ``point``, to :data:`PLANT_DIGITS` digits.
@@ -776,10 +791,9 @@ class LoopModel:
         rather than from a root finder, which would round ``s + 1e-300`` to
         ``s``.
         """
-        args = [self._symbols[n] for n in self._plant_names] + [model.T]
         _, den = sp.fraction(sp.cancel(sp.together(self.plant)))
-        factors = [poly_coeffs(f, model.s) for f, _ in sp.factor_list(den, model.s)[1]]
-        return sp.lambdify(args, factors, modules="mpmath")
+        return self._plant_function([poly_coeffs(f, model.s)
+                                     for f, _ in sp.factor_list(den, model.s)[1]])
 
     def _cancelled_decades(self, point, T):
         """Decades of ``|p T|`` and ``|p_i - p_j| T`` below 1 over the plant's poles ``p`` at ``point``."""

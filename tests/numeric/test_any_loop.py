@@ -124,6 +124,25 @@ def test_a_quadratic_factor_by_residues(k_h):
         assert loop.spectral_radius(K=K, B=B, d=d, **values) == pytest.approx(oracle, rel=1e-8)
 
 
+@pytest.mark.parametrize("name", ["e", "exp"])
+def test_a_parameter_named_like_an_mpmath_name_keeps_its_value(name):
+    """``e`` once shadowed Euler's number in the plant's mpmath function (K_max of a gain-49 plant for 7 e)."""
+    loop = Loop(f"exp(1)*{name}/(m*s**2 + b*s)", "K + B*(z - 1)/(T*z)")
+    values = dict(m=PAPER_M, b=PAPER_B, T=PAPER_T, **{name: 7.0})
+    for K, B, d in ((0.5, 0.01, 0), (3.0, 0.02, 2), (0.2, 0.005, 10)):
+        oracle = _python_control_radius([PAPER_M / (7 * np.e), PAPER_B / (7 * np.e), 0], K, B, d)
+        assert loop.spectral_radius(K=K, B=B, d=d, **values) == pytest.approx(oracle, rel=1e-8)
+
+
+def test_the_sample_period_in_the_plant():
+    """``T`` in the plant (a lag of one sample period) was an argument twice: a SyntaxError."""
+    loop = Loop("1/(m*s*(T*s + 1))", "K + B*(z - 1)/(T*z)")
+    for K, B, d in ((30.0, 0.5, 0), (200.0, 2.0, 2), (5.0, 0.1, 10)):
+        oracle = _python_control_radius([PAPER_M * PAPER_T, PAPER_M, 0], K, B, d)
+        assert loop.spectral_radius(K=K, B=B, d=d, m=PAPER_M, T=PAPER_T) == \
+            pytest.approx(oracle, rel=1e-8)
+
+
 def test_numeric_path_for_a_cubic_factor():
     """An irreducible cubic is left to the matrix exponential, and says so."""
     loop = Loop("1/(m*s**3 + b*s**2 + k*s + c)", "K + B*(z - 1)/(T*z)")
