@@ -142,14 +142,12 @@ def run_audit(ids=None, progress=None, *, workers=None, executor=None):
         Run the checks in this pool (whose workers are shared with other
         work, as in ``symstab reproduce``) instead of a new one.
     """
-    from symstab._workers import default_workers, worker_pool
+    from symstab._workers import check_workers, default_workers, worker_pool
 
     checks = _selected(ids)
     if executor is not None:
         return _run_parallel(checks, progress, executor)
-    workers = default_workers() if workers is None else workers
-    if isinstance(workers, bool) or not isinstance(workers, int) or workers < 1:
-        raise ValueError(f"workers must be an integer >= 1, got {workers!r}")
+    workers = default_workers() if workers is None else check_workers(workers)
     if workers == 1 or len(checks) < 2:
         findings = []
         for n, (cid, entry) in enumerate(checks.items(), 1):

@@ -11,7 +11,7 @@ import os
 import signal
 import time
 
-__all__ = ["default_workers", "worker_pool"]
+__all__ = ["default_workers", "check_workers", "worker_pool"]
 
 
 def default_workers():
@@ -21,6 +21,26 @@ def default_workers():
     and duplicated symbolic work.
     """
     return max(1, min(2, os.cpu_count() or 1))
+
+
+def max_workers():
+    """The most worker processes a run may ask for: four per core, at least 8.
+
+    Each worker imports SymPy and holds its caches (about 200 MB); a
+    million of them once filled the memory and left thousands behind.
+    """
+    return max(8, 4 * (os.cpu_count() or 1))
+
+
+def check_workers(workers):
+    """``workers`` if it is a whole number from 1 to :func:`max_workers`, else a clear error."""
+    if isinstance(workers, bool) or not isinstance(workers, int):
+        raise TypeError(f"workers must be an integer, got {type(workers).__name__} {workers!r}")
+    limit = max_workers()
+    if not 1 <= workers <= limit:
+        raise ValueError(f"workers must be from 1 to {limit} (four per core, at least 8), "
+                         f"got {workers}")
+    return workers
 
 
 def _worker_init():

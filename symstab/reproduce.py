@@ -30,7 +30,7 @@ import tempfile
 import threading
 import time
 
-from ._workers import default_workers, worker_pool
+from ._workers import check_workers, default_workers, worker_pool
 
 __all__ = ["reproduce", "render_index", "worker_pool", "default_workers"]
 
@@ -180,8 +180,7 @@ def reproduce(out_dir, *, workers=2, log=None):
     out = pathlib.Path(out_dir)
     if out.exists() and not out.is_dir():
         raise ValueError(f"--out must be a directory, got file {out}")
-    if isinstance(workers, bool) or not isinstance(workers, int) or workers < 1:
-        raise ValueError(f"workers must be an integer >= 1, got {workers!r}")
+    check_workers(workers)
     require_matplotlib()
     try:
         import paper_checks.audit  # noqa: F401

@@ -61,7 +61,7 @@ def check_outputs(outputs):
     Raises
     ------
     ValueError
-        Naming the flag and the user's path: a file that is a directory, a
+        Naming the flag and the user's path: a file that is a directory or a device, a
         directory that is a file, a missing or unwritable folder, or two
         outputs that name the same file (after resolving ``..`` and links).
     """
@@ -75,6 +75,9 @@ def check_outputs(outputs):
         if kind == "file":
             if path.is_dir():
                 raise ValueError(f"{flag} {path} is a directory, expected a file name")
+            if path.exists() and not path.is_file():
+                raise ValueError(f"{flag} {path} is not a regular file (a device or a pipe): "
+                                 f"the atomic write would replace it; give a file name")
             folder = path.parent
             if not folder.exists():
                 raise ValueError(f"{flag} {path}: folder {folder} does not exist")

@@ -49,6 +49,10 @@ from .loop_units import check_loop_units, read_parameters
 
 __all__ = ["load_loop", "parse_loop_text"]
 
+#: The largest loop file read (a loop file is a few hundred bytes; this
+#: stops ``/dev/zero`` or a wrong path from filling the memory).
+MAX_FILE_BYTES = 1 << 20
+
 _KEYS = {"name", "description", "plant", "environment", "plane", "parameters"}
 
 
@@ -124,7 +128,12 @@ def load_loop(path):
     """
     path = pathlib.Path(path)
     try:
-        text = path.read_text(encoding="utf-8")
+        with open(path, "rb") as fh:
+            data = fh.read(MAX_FILE_BYTES + 1)
+        if len(data) > MAX_FILE_BYTES:
+            raise ValueError(f"loop file {str(path)!r} is larger than {MAX_FILE_BYTES} bytes: "
+                             f"not a loop file")
+        text = data.decode("utf-8")
     except OSError as exc:
         raise ValueError(f"cannot read loop file {str(path)!r}: {exc.strerror or exc}") from None
     except UnicodeDecodeError:

@@ -66,6 +66,11 @@ __all__ = ["Nonidealities", "Simulation", "simulate", "StabilityMap", "stability
            "default_horizon", "check_steps", "check_x0", "max_steps", "progress_printer", "PAPER_ENCODER_RESOLUTION",
            "MAX_STEPS_ENV", "LinearTheory", "linear_theory"]
 
+#: The most sub-steps per period: each multiplies the simulation's time (a
+#: billion once hung it), and the held-mean approximation they refine is
+#: second order in ``1/substeps``, so a thousand is far past any use.
+MAX_SUBSTEPS = 1000
+
 #: The paper's encoder: better than 3 arc seconds after quadrature and gear
 #: train (Section VI), in rad.
 PAPER_ENCODER_RESOLUTION = math.radians(3 / 3600)
@@ -104,7 +109,8 @@ class Nonidealities:
     actuator_bandwidth : float
         First-order lag of the applied force (Hz), > 0.
     substeps : int
-        Sub-steps per period for friction and the actuator lag, >= 1.
+        Sub-steps per period for friction and the actuator lag, 1 to
+        :data:`MAX_SUBSTEPS`.
     """
 
     encoder_resolution: float = None
@@ -140,8 +146,9 @@ class Nonidealities:
                 not isinstance(self.substeps, (int, np.integer)):
             raise TypeError(f"substeps must be an integer >= 1, got "
                             f"{type(self.substeps).__name__} {self.substeps!r}")
-        if self.substeps < 1:
-            raise ValueError(f"substeps must be an integer >= 1, got {self.substeps!r}")
+        if not 1 <= self.substeps <= MAX_SUBSTEPS:
+            raise ValueError(f"substeps must be an integer from 1 to {MAX_SUBSTEPS}, "
+                             f"got {self.substeps!r}")
 
     def check(self, T):
         """Validate against the sample period ``T``; raise ValueError naming the field.

@@ -37,6 +37,10 @@ __all__ = ["LoopModel", "parse_plant", "parse_environment", "parse_expression",
            "check_parameter_name", "check_loop_name", "check_text_line", "NAME_PATTERN",
            "is_affine", "poly_coeffs", "shift_to_one", "PLANT_DIGITS"]
 
+#: The longest plant, environment or bound expression read (a loop file's
+#: physics fits in a few hundred characters; a long chain of + or * nests
+#: the parser and SymPy as deep as it is long).
+MAX_EXPRESSION_LENGTH = 2000
 #: Names with a fixed meaning in every loop.
 RESERVED = ("s", "z", "T", "d")
 #: Working digits of the plant's pulse transfer function (rounded once to float).
@@ -241,10 +245,15 @@ def parse_expression(text, what):
     ValueError
         Naming ``what`` and ``text``: a syntax error or a construct that is not allowed.
     """
+    if len(text) > MAX_EXPRESSION_LENGTH:
+        raise ValueError(f"{what} is {len(text)} characters long, above the limit of "
+                         f"{MAX_EXPRESSION_LENGTH}")
     try:
         tree = ast.parse(text.replace("^", "**"), mode="eval")
     except SyntaxError as exc:
         raise ValueError(f"{what} {text!r} is not a valid expression: {exc.msg}") from None
+    except (RecursionError, MemoryError):
+        raise ValueError(f"{what} is nested too deeply to parse") from None
     fixed = {"s": model.s, "z": model.z, "T": model.T, "pi": sp.pi}
 
     def build(node, in_exponent=False):
@@ -279,6 +288,9 @@ def parse_expression(text, what):
         if isinstance(exc, ValueError) and str(exc).startswith(what):
             raise
         raise ValueError(f"{what} {text!r} is not a valid expression: {exc}") from None
+    except RecursionError:
+        raise ValueError(f"{what} is nested too deeply to build (a long chain of + or *, "
+                         f"say)") from None
     if not isinstance(expr, sp.Expr):
         raise ValueError(f"{what} {text!r} is not an expression")
     return expr

@@ -85,6 +85,11 @@ REFUSED = [
     # alpha = K_w T^2 / m underflows to 0; K_w = alpha m / T^2 overflows (Device).
     (["classify", "--T", "1e-300", "--Kw", "1", "--Bw", "0.5"], ["alpha = K_w T^2 / m", "T"]),
     (["boundary", "--T", "1e-300"], ["K_w = alpha m / T^2", "T"]),
+    # A billion sub-steps hung; a million workers filled the memory; /dev/zero as a loop file too.
+    (["simulate", "--Kw", "30", "--Bw", "1", "--actuator-bandwidth", "100", "--substeps",
+      "1000000000"], ["substeps", "1000"]),
+    (["reproduce", "--workers", "1000000", "--out", "rr"], ["workers", "1000000", "four per core"]),
+    (["classify", "--loop", "/dev/zero"], ["/dev/zero", "larger than"]),
 ]
 
 
@@ -211,6 +216,30 @@ def test_map_refuses_png_and_out_naming_the_same_file(capsys, tmp_path, monkeypa
                              "--beta", "0,0.3,3", "--steps", "100", "--out", "m.npz", "--png", png)
     _assert_one_line_error(status, err, "map", "--out", "--png", "same file")
     assert sorted(p.name for p in tmp_path.iterdir()) == ["sub"]
+
+
+def test_an_output_that_is_a_device_or_a_pipe_is_refused_before_the_work(capsys, tmp_path,
+                                                                        monkeypatch):
+    """--png /dev/null was replaced by a regular file (the atomic rename); a pipe likewise."""
+    from symstab.numeric import locus
+
+    pipe = tmp_path / "pipe"
+    os.mkfifo(pipe)
+    _forbid(monkeypatch, locus, "locus", "the locus")
+    status, _, err = _main(capsys, "locus", "--Bw", "0.1", "--Kw", "0:30", "--png", str(pipe))
+    _assert_one_line_error(status, err, "locus", "--png", "not a regular file")
+    assert pipe.is_fifo()
+
+
+def test_an_output_behind_a_link_replaces_the_target_not_the_link(tmp_path):
+    from symstab.proof.derive import write_bytes
+
+    target = tmp_path / "target.txt"
+    target.write_text("old")
+    link = tmp_path / "link.txt"
+    link.symlink_to(target)
+    write_bytes(link, b"new")
+    assert link.is_symlink() and target.read_text() == "new"
 
 
 def _unwritable_folder(tmp_path):

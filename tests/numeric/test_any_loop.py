@@ -350,6 +350,10 @@ def test_unwritable_cache_compiles_in_memory(tmp_path, monkeypatch):
     # Sizes SymPy would take forever on are refused before any algebra.
     ("1/s**1000", ENVIRONMENT, "above the limit 100"),
     (PLANT, "K*2**(10**10)", "power inside an exponent"),
+    # A RecursionError traceback: chains as deep as they are long.
+    ("1+" * 5000 + PLANT, ENVIRONMENT, "above the limit of 2000"),
+    ("-" * 1900 + PLANT, ENVIRONMENT, "nested too deeply"),
+    ("1+" * 980 + PLANT, ENVIRONMENT, "nested too deeply"),
     # Names that Loop's methods take as arguments.
     (PLANT, "K + x_range", "argument of Loop's methods"),
     (PLANT, "K + x*B", "argument of Loop's methods"),
