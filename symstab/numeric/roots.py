@@ -22,6 +22,7 @@ The paper's dimensionless functions (:mod:`symstab.numeric.stability`) and
 """
 
 import functools
+import math
 
 import numpy as np
 
@@ -536,18 +537,27 @@ def classify_polynomials(chi, *, refine=True):
     return out.reshape(shape)
 
 
-def polish_roots(c, roots, steps=3):
+#: The largest relative move of a Newton polish of eigenvalues: they are off
+#: by about sqrt(eps) (1e-8) at a double root, far less elsewhere.
+_POLISH_STEP = 1e-6
+
+
+def polish_roots(c, roots, steps=3, max_step=math.inf):
     """Newton steps on dense coefficients ``c`` (rows), kept only where they shrink ``|p|``.
 
     Companion eigenvalues carry errors of a few 1e-12 near other roots (at
     alpha = 0 the root z = 1 came out as 1 - 4e-12); a few Newton steps on
-    the coefficients bring them to the accuracy the coefficients allow.
+    the coefficients bring them to the accuracy the coefficients allow.  A
+    step longer than ``max_step`` times ``max(|z|, 1)`` is not taken (for
+    eigenvalues, which are close already: from a double root at z = 1 a step
+    once jumped to the root 0).
     """
     for _ in range(steps):
         with np.errstate(all="ignore"):
             value, slope = horner(c, roots)
             trial = roots - value / slope
-            better = np.isfinite(trial) & (np.abs(horner(c, trial)[0]) < np.abs(value))
+            better = (np.isfinite(trial) & (np.abs(horner(c, trial)[0]) < np.abs(value))
+                      & (np.abs(trial - roots) <= max_step * np.maximum(np.abs(roots), 1.0)))
         roots = np.where(better, trial, roots)
     return roots
 
@@ -565,7 +575,7 @@ def _eigen_radius(coefficients):
         companion[:, np.arange(1, n), np.arange(n - 1)] = 1.0
         roots = np.linalg.eigvals(companion)
         top = np.argsort(-np.abs(roots), axis=-1)[:, :min(2, n)]
-        largest = polish_roots(c, np.take_along_axis(roots, top, axis=-1))
+        largest = polish_roots(c, np.take_along_axis(roots, top, axis=-1), max_step=_POLISH_STEP)
         out[start:start + batch] = np.max(np.abs(largest), axis=-1)
     return out
 
@@ -650,11 +660,10 @@ def _structured_radius(chi):
         _bisect(chi, lo, hi, todo, tolerance)
         z = _newton_in_bracket(chi.take(todo), lo[todo], hi[todo])
         modulus = np.abs(z)
-        # Accepted when no root lies outside a circle just above it: then
-        # it is the largest to within that margin.
         landed = np.isfinite(modulus) & (modulus >= lo[todo]) & (modulus <= hi[todo])
-        # Accepted when no root lies outside a circle just above it (then it
-        # is the largest to within that margin); a count that is marginal
+        # Accepted when no root lies outside a circle just above it and one
+        # lies outside or on a circle just below (then it is the largest to
+        # within that margin); a count that is marginal
         # there (the root itself within rounding of that circle) is tried
         # again a little farther out.  A root outside: the bracket moves up.
         accepted = np.zeros(todo.size, dtype=bool)
@@ -664,7 +673,13 @@ def _structured_radius(chi):
                 break
             above = modulus[check] * (1 + margin)
             counts = _outside(chi.take(todo[check]), above)
-            accepted[check[counts == 0]] = True
+            # Newton's last iterate need not be a root: it is the radius
+            # only if a root is also outside (or on) a circle just below it.
+            inside = np.flatnonzero(counts == 0)
+            below = modulus[check[inside]] * (1 - margin)
+            none_below = _outside(chi.take(todo[check[inside]]), below) == 0
+            accepted[check[inside[~none_below]]] = True
+            hi[todo[check[inside[none_below]]]] = below[none_below]
             up = (counts > 0) & (above < hi[todo[check]])
             lo[todo[check[up]]] = above[up]
             check = check[counts < 0]

@@ -68,13 +68,12 @@ def test_spectral_radius_matches_50_digit_roots(chi):
     assert abs(float(roots.spectral_radius(chi)) - expected) <= 1e-9 * expected
 
 
-@pytest.mark.parametrize("d", [150, 400])
-def test_long_delay_radius_without_eigenvalues(d):
-    """The structured radius (degree > 128) against polished 50-digit roots near the largest."""
-    chi = paper_polynomial(alpha=2e-5, beta=0.004, gamma=0.3, d=d, delta=0.00253125)
-    got = float(roots.spectral_radius(chi))
-    # The largest root by Newton steps at 50 digits from numpy's roots (only
-    # for the start; the dense coefficients are exact as floats).
+def _largest_root_mp(chi):
+    """|z| of the largest root: Newton steps at 50 digits from numpy's roots.
+
+    numpy's roots serve only as the start; the dense coefficients are exact
+    as floats.
+    """
     c = chi.flat().dense()[0]
     start = np.roots(c)
     z0 = start[np.argmax(np.abs(start))]
@@ -84,8 +83,34 @@ def test_long_delay_radius_without_eigenvalues(d):
         for _ in range(8):
             value, slope = mpmath.polyval(coeffs, z, derivative=True)
             z -= value / slope
-        expected = abs(z)
-    assert abs(got - float(expected)) <= 1e-12 * float(expected)
+        return float(abs(z))
+
+
+@pytest.mark.parametrize("d", [150, 400])
+def test_long_delay_radius_without_eigenvalues(d):
+    """The structured radius (degree > 128) against polished 50-digit roots near the largest."""
+    chi = paper_polynomial(alpha=2e-5, beta=0.004, gamma=0.3, d=d, delta=0.00253125)
+    expected = _largest_root_mp(chi)
+    assert abs(float(roots.spectral_radius(chi)) - expected) <= 1e-12 * expected
+
+
+def test_the_structured_radius_is_a_root_not_newtons_last_step():
+    """A largest root next to z = 1 at a small angle (T = 10 us, d = 129).
+
+    Newton's last iterate was accepted with only "no root outside it"
+    checked: 1.0000162 for a radius of 1.000000000002.  Evaluating chi in
+    double precision so close to z = 1 leaves about 1e-10.
+    """
+    m, b, T, B, K = 0.0128, 0.0324, 1e-5, 0.02, 40.45783066836089
+    chi = paper_polynomial(alpha=K * T**2 / m, beta=B * T / m, gamma=0.0, d=129, delta=b * T / m)
+    expected = _largest_root_mp(chi)
+    assert abs(float(roots.spectral_radius(chi)) - expected) <= 1e-9 * expected
+
+
+def test_a_polish_does_not_jump_from_a_double_root_to_another():
+    """[1, -2, 1, -5e-37, 0]: Newton from the double root at 1 jumped to the root 0 (radius 0)."""
+    chi = np.array([[1.0, -2.0, 1.0, -5e-37, 0.0]])
+    assert float(roots.spectral_radius(chi)[0]) == pytest.approx(1.0, abs=1e-7)
 
 
 def test_near_one_form_keeps_counts_next_to_z_equal_1():
