@@ -591,7 +591,12 @@ def spectral_radius(chi):
     to 1e-7, then the largest root itself is found by Newton steps on the
     structured polynomial from the smallest ``|chi|`` on the bracket's upper
     circle and accepted where it lands in the bracket (to about 1e-14 where
-    it is simple; otherwise the bracket's middle, to 1e-7).
+    it is simple; otherwise the bracket's middle, to 1e-7).  The root is
+    accepted only with certified counts on both sides of it (none outside a
+    circle just above, one outside or on a circle just below).  Next to
+    ``z = 1`` at short sample periods the values of ``chi`` in double
+    precision limit the radius to about 1e-10 to 1e-9 (measured against 50
+    digits: 7.6e-11 at ``T`` = 10 us, d = 129).
 
     Parameters
     ----------
