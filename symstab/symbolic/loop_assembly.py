@@ -261,8 +261,21 @@ def parse_expression(text, what):
             exponent = isinstance(node.op, ast.Pow)
             if exponent and in_exponent:
                 raise ValueError(f"{what} {text!r}: a power inside an exponent is not allowed")
-            return _BINARY[type(node.op)](build(node.left, in_exponent),
-                                          build(node.right, in_exponent or exponent))
+            left, right = build(node.left, in_exponent), build(node.right, in_exponent or exponent)
+            # An exponent written as a product (2**(10*10)), and powers of
+            # powers (((s + 1)**100)**100, which SymPy joins), are checked
+            # before and after the power is taken.
+            if exponent and right.is_Number and abs(right) > MAX_ORDER:
+                raise ValueError(f"{what} {text!r}: exponent {right} is above the limit "
+                                 f"{MAX_ORDER}")
+            built = _BINARY[type(node.op)](left, right)
+            if exponent:
+                top = max((abs(p.exp) for p in sp.sympify(built).atoms(sp.Pow) if p.exp.is_Number),
+                          default=0)
+                if top > MAX_ORDER:
+                    raise ValueError(f"{what} {text!r}: exponent {top} is above the limit "
+                                     f"{MAX_ORDER}")
+            return built
         if isinstance(node, ast.UnaryOp) and isinstance(node.op, (ast.UAdd, ast.USub)):
             value = build(node.operand, in_exponent)
             return -value if isinstance(node.op, ast.USub) else value
@@ -277,7 +290,12 @@ def parse_expression(text, what):
             return fixed.get(node.id) or sp.Symbol(node.id)
         if (isinstance(node, ast.Call) and isinstance(node.func, ast.Name)
                 and node.func.id in _FUNCTIONS and len(node.args) == 1 and not node.keywords):
-            return _FUNCTIONS[node.func.id](build(node.args[0], in_exponent))
+            inner = node.args[0]
+            if node.func.id == "exp" and any(isinstance(n, ast.Call) and
+                                             getattr(n.func, "id", None) == "exp"
+                                             for n in ast.walk(inner)):
+                raise ValueError(f"{what} {text!r}: exp() inside exp() is not allowed")
+            return _FUNCTIONS[node.func.id](build(inner, in_exponent))
         shown = ast.get_source_segment(text.replace("^", "**"), node) or type(node).__name__
         raise ValueError(f"{what} {text!r}: {shown!r} is not allowed (numbers, names, + - * / **, "
                          f"brackets, exp() and sqrt() only)")

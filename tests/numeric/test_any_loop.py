@@ -350,6 +350,10 @@ def test_unwritable_cache_compiles_in_memory(tmp_path, monkeypatch):
     # Sizes SymPy would take forever on are refused before any algebra.
     ("1/s**1000", ENVIRONMENT, "above the limit 100"),
     (PLANT, "K*2**(10**10)", "power inside an exponent"),
+    # Exponents past the limit by a product or by powers of powers: hours of algebra.
+    ("(s + 1)**(100*100)/(m*s**2 + b*s)", ENVIRONMENT, "exponent 10000 is above the limit"),
+    (PLANT, "K + B*(((z - 1)/z)**100)**100", "exponent 10000 is above the limit"),
+    ("exp(exp(exp(exp(exp(exp(0))))))/(m*s**2 + b*s)", ENVIRONMENT, "exp\\(\\) inside exp"),
     # A RecursionError traceback: chains as deep as they are long.
     ("1+" * 5000 + PLANT, ENVIRONMENT, "above the limit of 2000"),
     ("-" * 1900 + PLANT, ENVIRONMENT, "nested too deeply"),
