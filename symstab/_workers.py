@@ -34,12 +34,10 @@ def max_workers():
 
 def check_workers(workers):
     """``workers`` if it is a whole number from 1 to :func:`max_workers`, else a clear error."""
-    if isinstance(workers, bool) or not isinstance(workers, int):
-        raise TypeError(f"workers must be an integer, got {type(workers).__name__} {workers!r}")
     limit = max_workers()
-    if not 1 <= workers <= limit:
-        raise ValueError(f"workers must be from 1 to {limit} (four per core, at least 8), "
-                         f"got {workers}")
+    if isinstance(workers, bool) or not isinstance(workers, int) or not 1 <= workers <= limit:
+        raise ValueError(f"workers must be an integer from 1 to {limit} (four per core, at "
+                         f"least 8), got {workers!r}")
     return workers
 
 
