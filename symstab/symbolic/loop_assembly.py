@@ -256,6 +256,10 @@ def parse_expression(text, what):
         raise ValueError(f"{what} is nested too deeply to parse") from None
     fixed = {"s": model.s, "z": model.z, "T": model.T, "pi": sp.pi}
 
+    def check_exponent(value):
+        if abs(value) > MAX_ORDER:
+            raise ValueError(f"{what} {text!r}: exponent {value} is above the limit {MAX_ORDER}")
+
     def build(node, in_exponent=False):
         if isinstance(node, ast.BinOp) and type(node.op) in _BINARY:
             exponent = isinstance(node.op, ast.Pow)
@@ -265,24 +269,19 @@ def parse_expression(text, what):
             # An exponent written as a product (2**(10*10)), and powers of
             # powers (((s + 1)**100)**100, which SymPy joins), are checked
             # before and after the power is taken.
-            if exponent and right.is_Number and abs(right) > MAX_ORDER:
-                raise ValueError(f"{what} {text!r}: exponent {right} is above the limit "
-                                 f"{MAX_ORDER}")
+            if exponent and right.is_Number:
+                check_exponent(right)
             built = _BINARY[type(node.op)](left, right)
             if exponent:
-                top = max((abs(p.exp) for p in sp.sympify(built).atoms(sp.Pow) if p.exp.is_Number),
-                          default=0)
-                if top > MAX_ORDER:
-                    raise ValueError(f"{what} {text!r}: exponent {top} is above the limit "
-                                     f"{MAX_ORDER}")
+                check_exponent(max((abs(p.exp) for p in sp.sympify(built).atoms(sp.Pow)
+                                    if p.exp.is_Number), default=0))
             return built
         if isinstance(node, ast.UnaryOp) and isinstance(node.op, (ast.UAdd, ast.USub)):
             value = build(node.operand, in_exponent)
             return -value if isinstance(node.op, ast.USub) else value
         if isinstance(node, ast.Constant) and type(node.value) in (int, float):
-            if in_exponent and abs(node.value) > MAX_ORDER:
-                raise ValueError(f"{what} {text!r}: exponent {node.value} is above the limit "
-                                 f"{MAX_ORDER}")
+            if in_exponent:
+                check_exponent(node.value)
             if isinstance(node.value, int):
                 return sp.Integer(node.value)
             return sp.Float(repr(node.value))
