@@ -14,7 +14,7 @@ import sys
 import numpy as np
 
 __all__ = ["require_matplotlib", "pyplot", "pyplot_or_none", "png_bytes", "visible",
-           "draw_lines", "label_log_axis", "SUPTITLE_SIZE", "PANEL_TITLE_SIZE", "LEGEND_SIZE"]
+           "draw_lines", "label_log_axis", "design_figure", "SUPTITLE_SIZE", "PANEL_TITLE_SIZE", "LEGEND_SIZE"]
 
 #: Font sizes (pt).  A figure's own title sits above its panels' titles, so it
 #: is the largest; legends stay readable at the saved 110 dpi (6-7 pt was not).
@@ -105,3 +105,72 @@ def label_log_axis(ax):
         ax.yaxis.set_major_locator(ticker.LogLocator(base=10.0, subs=(1.0, 2.0, 5.0)))
         ax.yaxis.set_major_formatter(ticker.FuncFormatter(lambda v, _: f"{v:g}"))
         ax.yaxis.set_minor_formatter(ticker.NullFormatter())
+
+
+def design_figure(plt, found, labels, target_label):
+    """A :class:`~symstab.numeric.design.Design` drawn: its target against the parameter(s) searched.
+
+    One parameter: the target at every value evaluated (a line through the
+    scan and the refinement), the values with no stable point marked at the
+    bottom, the optimum and the nominal value marked.  Two: the evaluations
+    coloured by the target, the same marks.
+
+    Parameters
+    ----------
+    plt : module
+        :func:`pyplot`.
+    found : symstab.numeric.design.Design
+    labels : list of str
+        The axis label of each parameter searched.
+    target_label : str
+        The target's label, with its unit.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
+    samples = found.samples
+    names = list(found.over)
+    value = samples[:, -1]
+    good = np.isfinite(value)
+    none = value == -np.inf
+    fig, ax = plt.subplots(figsize=(6.4, 4.4))
+    what = {"y_max": "maximise the largest stable y", "area": "maximise the area",
+            "passive": "maximise the largest passive y"}[found.target]
+    if len(names) == 1:
+        order = np.argsort(samples[:, 0])
+        u, v = samples[order, 0], value[order]
+        ax.plot(u[np.isfinite(v)], v[np.isfinite(v)], "-o", color="C0", ms=3, lw=1.2,
+                label=f"{target_label.split(' [')[0]} ({int(good.sum())} evaluations)")
+        if none.any():
+            floor = np.min(value[good]) if good.any() else 0.0
+            ax.plot(samples[none, 0], np.full(int(none.sum()), floor), "x", color="0.5",
+                    label="no stable point")
+        if found.nominal:
+            ax.axvline(found.nominal[names[0]], color="C2", ls="--", lw=1,
+                       label=f"nominal {names[0]} = {found.nominal[names[0]]:.4g}")
+        if found.best is not None:
+            ax.plot([found.best[names[0]]], [found.value], "*", color="C3", ms=12,
+                    label=f"best {names[0]} = {found.best[names[0]]:.6g}")
+        ax.set_xlabel(labels[0])
+        ax.set_ylabel(target_label)
+    else:
+        if good.any():
+            dots = ax.scatter(samples[good, 0], samples[good, 1], c=value[good], s=18,
+                              cmap="viridis")
+            fig.colorbar(dots, ax=ax, label=target_label)
+        if none.any():
+            ax.plot(samples[none, 0], samples[none, 1], "x", color="0.6", ms=4,
+                    label="no stable point")
+        if found.nominal:
+            ax.plot([found.nominal[names[0]]], [found.nominal[names[1]]], "o", mfc="none",
+                    color="C2", ms=9, label="nominal")
+        if found.best is not None:
+            ax.plot([found.best[names[0]]], [found.best[names[1]]], "*", color="C3", ms=14,
+                    label="best " + ", ".join(f"{k} = {v:.4g}" for k, v in found.best.items()))
+        ax.set_xlabel(labels[0])
+        ax.set_ylabel(labels[1])
+    ax.set_title(f"design: {what} over {' and '.join(names)}", fontsize=PANEL_TITLE_SIZE)
+    ax.legend(fontsize=LEGEND_SIZE, loc="best")
+    fig.tight_layout()
+    return fig

@@ -1,14 +1,17 @@
-"""``symstab design``: the virtual mass that maximises the renderable stiffness.
+"""``symstab design``: the parameter values that maximise K_max, the Z-width or the passive K_max.
 
-One search for both inputs (:func:`symstab.numeric.region.scan_maximum` of
-:meth:`symstab.Loop.limits`, as :func:`symstab.best_virtual_mass` does):
-the paper's options search the virtual mass gamma = M_w / m of the paper's
-loop from no virtual mass, a loop file (``--loop``) a third parameter
-(``--over NAME``, default the environment's mass term) in the range
-``--range LO:HI`` (default design's gamma range times the device's mass)
-from its nominal value.  Printed: the best value, the largest stable y
-there and at the nominal value, the gain, the x where it is reached and
-the stable intervals of y there (or at --at X).
+One search for both inputs (:meth:`symstab.Loop.design`, as
+:func:`symstab.best_virtual_mass` does): the paper's options search the
+virtual mass gamma = M_w / m of the paper's loop from no virtual mass; a loop
+file (``--loop``) one or two parameters outside the plane (``--over
+NAME=LO:HI``, repeatable; default the environment's mass term over design's
+gamma range times the device's mass) from their nominal values.
+``--maximize`` picks the target: the largest stable y (``K_max``, the
+default), the area of the stable set (``area``, the Z-width) or the largest
+passive y (``passive``).  Printed: the best values, the target there and at
+the nominal values, the gain, the x where y_max is reached and the stable
+intervals of y there (or at --at X); ``--png`` draws the target against the
+parameter(s) searched.
 """
 
 import dataclasses
@@ -16,22 +19,41 @@ import math
 import sys
 
 from .loop_limits import limits_notes, named, plane_table, stable_intervals_at
-from .loop_options import add_loop_options, paper_setup, resolve_loop, uses_loop
+from .loop_options import add_loop_options, paper_setup, resolve_loop, split_unit, uses_loop
 from .options import add_command, add_model_options, resolve
-from .output import emit
+from .output import check_outputs, emit, write_output
 
 __all__ = ["register", "run"]
+
+#: ``--maximize``'s words: the target of :meth:`symstab.Loop.design` each names
+#: (``{y}_max``, e.g. ``K_max``, is ``y_max`` too).
+_TARGET_WORDS = {"y_max": "y_max", "K_max": "y_max", "area": "area", "Z-width": "area",
+                 "z_width": "area", "passive": "passive"}
+#: The scan's points per parameter at most: each is a certified region.
+MAX_POINTS = 201
 
 
 def register(subparsers):
     """Add ``symstab design`` to the sub-commands."""
     p = add_command(
-        subparsers, "design", help="the virtual mass that maximises the renderable stiffness",
-        description="Search the virtual mass gamma = M_w / m that maximises the largest stable "
-                    "stiffness for one delay and device, and report that stiffness, its damping "
-                    "and the gain over no virtual mass.",
+        subparsers, "design", help="the virtual mass (or any parameter) that maximises K_max",
+        description="Search the virtual mass gamma = M_w / m (with --loop: one or two "
+                    "parameters of the loop) that maximises the largest stable stiffness, the "
+                    "Z-width or the passive stiffness for one delay and device, and report "
+                    "the optimum, the target there and at the nominal value, and the gain.",
         example="symstab design --Td 0.04", func=run)
     add_model_options(p)
+    g = p.add_argument_group("the search")
+    g.add_argument("--maximize", metavar="TARGET", default="K_max",
+                   help="what to maximise: K_max (the largest stable y of the plane; also "
+                        "y_max or the plane's {y}_max), area (the area of the stable set, the "
+                        "Z-width; also Z-width) or passive (the largest passive y, "
+                        "Colgate-Schenkel with the delay) (default: K_max)")
+    g.add_argument("--points", metavar="N", type=int,
+                   help=f"scan points per parameter before the refinement, 3 to {MAX_POINTS} "
+                        f"(default 17 for one parameter, 9 for two)")
+    g.add_argument("--png", metavar="FILE", help="also draw the target against the parameter(s) "
+                                                 "searched as PNG")
     add_loop_options(p, "design")
 
 
@@ -44,34 +66,120 @@ def run(args):
     table keeps Table I's names with the device's units beside them, and
     its JSON the ``best`` of :func:`symstab.best_virtual_mass`.
     """
+    target = _target(args.maximize)
+    if args.points is not None and not 3 <= args.points <= MAX_POINTS:
+        raise ValueError(f"--points must be an integer from 3 to {MAX_POINTS}, got {args.points}")
+    png = check_outputs([("--png", args.png, "file")]).get("--png")
     if uses_loop(args):
         setup = resolve_loop(args)
-        name = _search_parameter(args, setup)
+        over = _search_over(args, setup)
         notes = []
     else:
         setup = paper_setup(resolve(args, mass=False))
-        name = "M"
+        d, delta = setup.paper.d, setup.paper.delta
+        over = {"M": (-1.0 - (d + 1) * delta + 1e-3, 3.0)}    # best_virtual_mass's range
         notes = (["the virtual mass argument --gamma/--Mw is ignored: design searches over it"]
                  if (args.gamma is not None or args.Mw is not None) else [])
-    return _search(args, setup, name, notes)
+    if target == "passive" and setup.paper is not None and setup.paper.delta == 0:
+        raise ValueError("--maximize passive: the device has no damping (delta = 0), so no "
+                         "point is passive")
+    if args.at is not None:
+        from .._validate import check_real
+        check_real(f"--at ({setup.x})", args.at)
+    return _search(args, setup, over, target, notes, png)
+
+
+def _target(word):
+    """The target of :meth:`symstab.Loop.design` that ``--maximize`` names."""
+    target = _TARGET_WORDS.get(word)
+    if target is None and word.endswith("_max") and word[:-4].isidentifier():
+        target = "y_max"      # the plane's {y}_max, checked against the plane in _search
+    if target is None:
+        raise ValueError(f"--maximize must be K_max (or y_max, or the plane's {{y}}_max), area "
+                         f"(or Z-width) or passive, got {word!r}")
+    return target
 
 
 #: The SI units of a mass term (linear, rotary) and of the matching damping.
 _MASS_UNITS = {"kg": "N s/m", "kg m^2": "N m s/rad"}
 
 
-def _search_parameter(args, setup):
+def _search_over(args, setup):
+    """``{name: (low, high)}`` of ``--over`` (and ``--range``), checked before the search."""
+    texts = args.over or [None]
+    if len(texts) > 2:
+        raise ValueError(f"--over is given {len(texts)} times: design searches one or two "
+                         f"parameters")
+    over = {}
+    for text in texts:
+        name, window = (None, None) if text is None else _over_text(text)
+        name = _search_parameter(args, setup, name)
+        if name in over:
+            raise ValueError(f"--over {name} is given twice; give each parameter once")
+        if window is None and args.search_range is not None:
+            if len(texts) > 1:
+                raise ValueError("--range is the range of a single --over NAME: with two "
+                                 "parameters give --over NAME=LO:HI for each")
+            window = _range_text(args.search_range, "--range", None)
+        elif window is not None and args.search_range is not None:
+            raise ValueError(f"--over {text} gives its range: drop --range {args.search_range}")
+        if window is None:
+            window = _default_range(setup, name)
+        else:
+            window = _converted(setup, name, *window)
+        over[name] = window
+    return over
+
+
+def _over_text(text):
+    """``(name, (low, high, unit) or None)`` of one ``--over NAME[=LO:HI [UNIT]]``."""
+    name, eq, window = text.partition("=")
+    name = name.strip()
+    if not name:
+        raise ValueError(f"--over {text}: expected NAME or NAME=LO:HI, e.g. --over M=0:0.03")
+    return name, (_range_text(window, f"--over {name}", name) if eq else None)
+
+
+def _range_text(text, flag, name):
+    """``(low, high, unit)`` of ``LO:HI`` with an optional unit after HI."""
+    from .._validate import check_real
+
+    head, colon, tail = text.partition(":")
+    tail, unit = split_unit(tail.strip(), flag)
+    try:
+        if not colon:
+            raise ValueError
+        low, high = (check_real(flag, float(v)) for v in (head, tail))
+    except (ValueError, TypeError):
+        raise ValueError(f"{flag} must be LO:HI, two finite numbers (a unit may follow), "
+                         f"got {text!r}") from None
+    if not low < high:
+        raise ValueError(f"{flag}: LO:HI must have LO < HI, got {text!r}")
+    return low, high, unit
+
+
+def _converted(setup, name, low, high, unit):
+    """``(low, high)`` in SI: converted from ``unit`` as a ``--set`` value is (None: SI)."""
+    if unit is None:
+        return low, high
+    from .loop_options import convert_sets
+
+    values, _ = convert_sets(setup.loop, {name: ([low, high], unit)}, flag="--over")
+    low, high = values[name]
+    return float(low), float(high)
+
+
+def _search_parameter(args, setup, name):
     """The parameter ``--over`` names, or the environment's mass term (refused if none)."""
     loop = setup.loop
     others = [n for n in loop.parameters if n not in (setup.x, setup.y, "d")]
-    name = args.over
     if name is None:
         names = {str(s) for s in loop.environment.free_symbols}
         masses = [n for n in others if n in names and setup.unit(n) in _MASS_UNITS]
         if len(masses) != 1:
             why = "no mass term" if not masses else f"several mass terms ({', '.join(masses)})"
             raise ValueError(f"design --loop: the environment of {args.loop} has {why}: give "
-                             f"--over NAME, the parameter to search (candidates: "
+                             f"--over NAME=LO:HI, the parameter to search (candidates: "
                              f"{', '.join(others)})")
         return masses[0]
     if name not in loop.parameters:
@@ -93,8 +201,6 @@ def _device_mass(setup, name):
     ``m1 + m2`` for two masses), and the loop's ``b`` where it has one in
     the matching damping unit (else 0).
     """
-    if setup.paper is not None:
-        return 1.0, setup.paper.delta       # Table I: masses in units of m, delta = b T / m
     unit = setup.unit(name)
     if unit not in _MASS_UNITS:
         return None
@@ -107,148 +213,180 @@ def _device_mass(setup, name):
     return float(sum(masses)), float(damping)
 
 
-def _search_range(args, setup, name):
-    """``(low, high, scale)``: the values searched and the size below which tolerances are absolute."""
+def _default_range(setup, name):
+    """design's gamma range times the device's mass, for a mass term; else refused."""
     device = _device_mass(setup, name)
-    if args.search_range is not None:
-        from .._validate import check_real
-
-        text = args.search_range
-        parts = text.split(":")
-        try:
-            if len(parts) != 2:
-                raise ValueError
-            low, high = (check_real("--range", float(v)) for v in parts)
-        except (ValueError, TypeError):
-            raise ValueError(f"--range must be LO:HI, two finite numbers, got {text!r}") from None
-        if not low < high:
-            raise ValueError(f"--range LO:HI must have LO < HI, got {text!r}")
-        scale = device[0] if device else max(abs(low), abs(high))
-        return low, high, scale
     if device is None:
         unit = setup.unit(name)
-        raise ValueError(f"--over {name}: give --range LO:HI{f' (in {unit})' if unit else ''}; "
-                         f"the default range is design's gamma range times the device's mass, "
-                         f"for a mass term of a loop whose plant has a mass in its unit")
+        raise ValueError(f"--over {name}: give its range, --over {name}=LO:HI"
+                         f"{f' (in {unit})' if unit else ''}; the default range is design's "
+                         f"gamma range times the device's mass, for a mass term of a loop "
+                         f"whose plant has a mass in its unit")
     mass, damping = device
     delta = damping * setup.values["T"] / mass
-    # design's gamma range (best_virtual_mass), times the mass.
-    return mass * (-1.0 - (setup.values["d"] + 1) * delta + 1e-3), mass * 3.0, mass
+    return mass * (-1.0 - (setup.values["d"] + 1) * delta + 1e-3), mass * 3.0
 
 
-def _search(args, setup, name, notes):
-    """The value of ``name`` that maximises the largest stable y of the plane of ``setup``.
+#: ``(row name, Table I's name, physical name)`` and meaning of each target.
+_TARGET_ROWS = {
+    "y_max": (("{y}_max", None, "K_max"), "largest stable {y}"),
+    "area": (("area", "z_width", "Z-width"), "area of the stable set (the Z-width where {x} "
+             "is a damping and {y} a stiffness)"),
+    "passive": (("passive {y}_max", "passive alpha_max", "passive K_max"),
+                "largest passive {y} (Colgate-Schenkel with the delay)"),
+}
 
-    One :func:`~symstab.numeric.region.scan_maximum` of :meth:`symstab.Loop.limits`
-    over the range (:func:`_search_range`); a value whose plane cannot be
-    resolved is skipped, said in a note.
-    """
-    from ..numeric.region import scan_maximum
 
-    low, high, scale = _search_range(args, setup, name)
-    if args.at is not None:
-        from .._validate import check_real
-        check_real(f"--at ({setup.x})", args.at)
-    p, x, y = setup.name(name), setup.name(setup.x), setup.name(setup.y)
-    unit = setup.unit(name)
-    suffix = f" {unit}" if unit else ""
-    print(f"searching {p} in [{low:.6g}, {high:.6g}]{suffix} for the largest stable "
-          f"{y} of the ({x}, {y}) plane ...", file=sys.stderr, flush=True)
+def _search(args, setup, over, target, notes, png):
+    """The values of ``over`` that maximise ``target`` in the plane of ``setup``: one design."""
+    from ..numeric.simulate import progress_printer
 
-    def limits_at(value):
-        return setup.loop.limits(x=setup.x, y=setup.y, **{**setup.values, name: value})
-
-    failed = []
-
-    def y_max(value):
-        # A plane the decomposition cannot resolve (a stable set shrinking to
-        # a sliver) is a point without an answer, said in a note: not the end
-        # of a search that has others.
-        try:
-            lim = limits_at(value)
-        except ValueError as exc:
-            failed.append((value, str(exc)))
-            return math.nan
-        return -math.inf if lim.empty else lim.y_max
-
-    found = scan_maximum(y_max, low, high, rtol=1e-6, scale=scale)
-    nominal = setup.values[name]
-    nominal_lim = limits_at(nominal)
-    search = {"over": p, "range": [low, high], "unit": unit, "nominal": nominal,
-              "y_max_nominal": None if nominal_lim.empty else nominal_lim.y_max}
-    at_nominal = ((f"{{y}}_max at {{p}} = {nominal:.6g}", None, "K_max at M_w = 0"),
-                  search["y_max_nominal"], "y", "largest stable {y} at the nominal {p}")
-    if found is None:
-        notes += [f"no {p} in [{low:.6g}, {high:.6g}]{suffix} has a stable point in the "
-                  f"({x}, {y}) plane"] + limits_notes(setup, nominal_lim)
-        search.update(best=None, y_max=None, x_at_y_max=None, gain=None)
-        columns, rows = plane_table(setup, [at_nominal], over=name)
-        emit(setup, args.format, columns, rows, result=_result(setup, search, nominal_lim),
+    names = tuple(over)
+    y_word = setup.name(setup.y)
+    if args.maximize.endswith("_max") and args.maximize not in ("y_max", "K_max") \
+            and args.maximize != f"{y_word}_max":
+        raise ValueError(f"--maximize {args.maximize}: the plane's y is {y_word}; give "
+                         f"{y_word}_max (or y_max), area or passive")
+    x, y = setup.name(setup.x), y_word
+    units = {n: setup.unit(n) for n in names}
+    ranges = ", ".join(f"{setup.name(n)} in [{lo:.6g}, {hi:.6g}]"
+                       + (f" {units[n]}" if units[n] else "") for n, (lo, hi) in over.items())
+    what = {"y_max": f"the largest stable {y}", "area": "the largest area of the stable set",
+            "passive": f"the largest passive {y}"}[target]
+    print(f"searching {ranges} for {what} of the ({x}, {y}) plane ...", file=sys.stderr,
+          flush=True)
+    n = args.points or (17 if len(names) == 1 else 9)
+    progress = progress_printer("design", n**len(names) + 40)
+    found = setup.loop.design(over=over, maximize=target, x=setup.x, y=setup.y, n=n,
+                              progress=lambda k: progress(min(k, n**len(names) + 39)),
+                              **{k: v for k, v in setup.values.items()})
+    progress(n**len(names) + 40)
+    label, meaning = _TARGET_ROWS[target]
+    nominal_text = ", ".join(f"{{{k}}} = {setup.values[name]:.6g}"
+                             for k, name in zip("pq", names))
+    value_nominal = found.value_nominal
+    at_nominal = (((label[0] + f" at {nominal_text}"),
+                   None if setup.paper is None else
+                   f"{label[1] or label[0].format(y=y)} at gamma = 0",
+                   f"{label[2]} at M_w = 0"),
+                  value_nominal if value_nominal is None or value_nominal > -math.inf else None,
+                  "area" if target == "area" else "y", f"{meaning} at the nominal "
+                  + " and ".join(f"{{{k}}}" for k in "pq"[:len(names)]))
+    search = _search_json(setup, found, names)
+    if found.best is None:
+        notes += [found.message] + limits_notes(setup, _limits(setup, names, found.nominal))
+        columns, rows = plane_table(setup, [at_nominal], over=names)
+        _write_png(png, setup, found, notes)
+        emit(setup, args.format, columns, rows, result=_result(setup, search, None),
              notes=notes, json_rows=False)
         return 0
-    best, _ = found
-    lim = limits_at(best)
-    gain = lim.y_max / nominal_lim.y_max if not nominal_lim.empty and nominal_lim.y_max > 0 \
-        else None
-    search.update(best=best, y_max=lim.y_max, x_at_y_max=lim.x_at_y_max, gain=gain)
-    rows = [("{p} (best)", best, "p", "the {p} that maximises {y}_max"),
-            (("{y}_max", None, "K_max"), lim.y_max, "y", "largest stable {y} at the best {p}"),
-            (("{x} at {y}_max", None, "B_w at K_max"), lim.x_at_y_max, "x",
-             "the {x} at which {y}_max is reached"),
-            at_nominal,
-            ("gain", gain, None, "{y}_max at the best {p} over that at the nominal one"),
-            (("area at the best {p}", None, "Z-width at the best M_w"), lim.area, "area",
-             "area of the stable set (the Z-width where {x} is a damping and {y} a stiffness)")]
+    lim = found.limits if target != "passive" else _limits(setup, names, found.best)
+    kind = "area" if target == "area" else "y"
+    rows = [(f"{{{k}}} (best)", found.best[name], k, f"the {{{k}}} that maximises {label[0]}")
+            for k, name in zip("pq", names)]
+    rows.append((label, found.value, kind, f"{meaning} at the best "
+                 + " and ".join(f"{{{k}}}" for k in "pq"[:len(names)])))
+    if target != "y_max" and not lim.empty:
+        rows.append((("{y}_max", None, "K_max"), lim.y_max, "y", "largest stable {y} there"))
+    if not lim.empty:
+        rows.append((("{x} at {y}_max", None, "B_w at K_max"), lim.x_at_y_max, "x",
+                     "the {x} at which {y}_max is reached"))
+    rows += [at_nominal, ("gain", found.gain, None, f"{label[0]} at the best over that at "
+                          f"the nominal value")]
+    if target != "area":
+        rows.append((("area at the best {p}" if len(names) == 1 else "area there", None,
+                      "Z-width at the best M_w"), lim.area, "area",
+                     "area of the stable set (the Z-width where {x} is a damping and {y} a "
+                     "stiffness)"))
     notes += limits_notes(setup, lim)
-    at_best = dataclasses.replace(setup, values={**setup.values, name: best})
+    at_best = dataclasses.replace(setup, values={**setup.values, **found.best})
     at = args.at
     if at is None and not lim.empty and math.isfinite(lim.x_at_y_max):
         at = lim.x_at_y_max
     line = None
+    best_text = ", ".join(f"{setup.name(k)} = {v:.10g}" + (f" {units[k]}" if units[k] else "")
+                          for k, v in found.best.items())
     if at is not None:
         more, line = stable_intervals_at(at_best, at)
         runs = line["intervals"]
         # At a corner of the stable set the line through the x of y_max only
         # touches it: no interval to show (the note on the sliver says why).
         if runs or args.at is not None:
-            notes += [f"at the best {p} = {best:.10g}{suffix}: {text}" if k == 0 else text
+            notes += [f"at the best {best_text}: {text}" if k == 0 else text
                       for k, text in enumerate(more)]
         if runs:
             lo, hi = runs[-1]
             rows.append(("{y} range at the {x} of {y}_max" if args.at is None else
                          f"{{y}} range at {{x}} = {at:.6g}", hi - lo, "y",
                          "width of the top stable interval of {y} at that {x}"))
-        if args.at is None and (not runs or runs[-1][1] - runs[-1][0] < 0.05 * lim.y_max):
+        if args.at is None and target == "y_max" and \
+                (not runs or runs[-1][1] - runs[-1][0] < 0.05 * lim.y_max):
             notes.append(f"{y}_max is reached at the tip of a thin sliver of the stable "
                          f"set: it needs precise tuning of {x}"
                          + (f"; give --at X for the stable {y} at another {x}"
                             if setup.paper is None else ""))
-    if not nominal_lim.empty and math.isfinite(nominal_lim.area) \
+    nominal_lim = _limits(setup, names, found.nominal) if found.nominal else None
+    if nominal_lim is not None and not nominal_lim.empty and math.isfinite(nominal_lim.area) \
             and lim.area < 0.05 * nominal_lim.area:
-        notes.append(f"the best {p} lies where the stable set is a thin sliver (area "
-                     f"{lim.area:.3g} against {nominal_lim.area:.3g} at the nominal {p}): "
-                     f"the gain needs very precise tuning of {p} and {x}")
-    if failed:
-        where = ", ".join(f"{v:.10g}" for v, _ in failed[:3]) + (", ..." if len(failed) > 3 else "")
-        notes.append(f"the limits could not be computed at {len(failed)} value(s) of {p} "
-                     f"({where}{suffix}): {failed[0][1]}; the best {p} is the best of the "
-                     f"others")
-    if best - low < 1e-3 * (high - low) or high - best < 1e-3 * (high - low):
-        notes.append(f"the best {p} is at an end of the range searched"
-                     + (": widen --range" if setup.paper is None else ""))
-    columns, rows = plane_table(setup, rows, over=name)
+        notes.append(f"the best {best_text} lies where the stable set is a thin sliver (area "
+                     f"{lim.area:.3g} against {nominal_lim.area:.3g} at the nominal values): "
+                     f"the gain needs very precise tuning of {', '.join(names)} and {x}")
+    if found.failed:
+        where = "; ".join(", ".join(f"{k} = {v:.10g}" for k, v in point.items())
+                          for point, _ in found.failed[:3]) + ("; ..." if len(found.failed) > 3
+                                                                else "")
+        notes.append(f"the {'limits' if target != 'passive' else 'passive set'} could not be "
+                     f"computed at {len(found.failed)} value(s) ({where}): "
+                     f"{found.failed[0][1]}; the best is the best of the others")
+    for name in found.at_edge:
+        notes.append(f"the best {setup.name(name)} is at an end of the range searched"
+                     + (f": widen --over {name}=LO:HI" if setup.paper is None else ""))
+    columns, rows = plane_table(setup, rows, over=names)
     result = _result(setup, search, lim)
     if line is not None:
         result["at"] = line
+    _write_png(png, setup, found, notes)
     emit(setup, args.format, columns, rows, result=result, notes=notes, json_rows=False)
     return 0
+
+
+def _limits(setup, names, point):
+    """:meth:`symstab.Loop.limits` of the plane at ``point`` of the searched parameters."""
+    return setup.loop.limits(x=setup.x, y=setup.y, **{**setup.values, **point})
+
+
+def _search_json(setup, found, names):
+    """The search for JSON: one parameter as numbers, two as ``{name: ...}``."""
+    one = len(names) == 1
+    lim = found.limits
+    y_max = None
+    if found.best is not None:
+        y_max = found.value if found.target == "y_max" else (
+            None if lim is None or lim.y_max is None else lim.y_max)
+    out = {"over": setup.name(names[0]) if one else [setup.name(n) for n in names],
+           "maximize": found.target,
+           "range": list(found.over[names[0]]) if one else {n: list(r) for n, r in
+                                                             found.over.items()},
+           "unit": setup.unit(names[0]) if one else {n: setup.unit(n) for n in names},
+           "nominal": (found.nominal.get(names[0]) if one else found.nominal or None),
+           "value_nominal": found.value_nominal,
+           "best": None if found.best is None else (found.best[names[0]] if one else found.best),
+           "value": found.value, "gain": found.gain,
+           "evaluations": int(found.samples.shape[0]),
+           "spacing": found.spacing[names[0]] if one else found.spacing}
+    if found.target == "y_max":
+        out["y_max_nominal"] = (found.value_nominal if found.value_nominal is not None
+                                and found.value_nominal > -math.inf else None)
+    out["y_max"] = y_max
+    out["x_at_y_max"] = None if found.best is None or lim is None else lim.x_at_y_max
+    return out
 
 
 def _result(setup, search, lim):
     """The JSON: the search and the limits at its best value; for the paper's options also
     ``best`` under :class:`symstab.numeric.region.BestVirtualMass`'s names."""
-    out = {"search": search, "limits": named(setup, lim).as_dict()}
-    if setup.paper is not None:
+    out = {"search": search, "limits": None if lim is None else named(setup, lim).as_dict()}
+    if setup.paper is not None and search["maximize"] == "y_max":
         out["best"] = {"gamma": search["best"], "beta": search["x_at_y_max"],
                        "alpha_max": search["y_max"], "alpha_max_gamma0": search["y_max_nominal"],
                        "gain": search["gain"], "z_width": lim.area if search["best"] is not None
@@ -256,3 +394,23 @@ def _result(setup, search, lim):
                        f"no gamma in [{search['range'][0]:g}, {search['range'][1]:g}] has a "
                        f"stable region at d = {setup.paper.d}"}
     return out
+
+
+def _write_png(png, setup, found, notes):
+    """Draw the target against the searched parameter(s) into ``png`` (if given)."""
+    if png is None:
+        return
+    from ..drawing import design_figure, png_bytes, pyplot
+
+    plt = pyplot()
+    names = tuple(found.over)
+    labels = [setup.label(n) for n in names]
+    label, _ = _TARGET_ROWS[found.target]
+    y = setup.name(setup.y)
+    unit = {"y_max": setup.unit(setup.y), "passive": setup.unit(setup.y)}.get(
+        found.target, f"({setup.unit(setup.x)})({setup.unit(setup.y)})"
+        if setup.unit(setup.x) and setup.unit(setup.y) else "")
+    target_label = label[0].format(y=y) + (f" [{unit}]" if unit else "")
+    fig = design_figure(plt, found, labels, target_label)
+    write_output(png, png_bytes(plt, fig), "--png")
+    notes.append(f"wrote {png}")

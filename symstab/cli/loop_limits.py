@@ -69,14 +69,21 @@ LIMITS = (
 def _units(setup, physical=False, over=None):
     """The unit of each kind of quantity: the loop's; none in Table I's plane, the device's if ``physical``.
 
-    Kinds: ``x``, ``y``, ``area`` and ``p``, the parameter ``over`` (design's).
+    Kinds: ``x``, ``y``, ``area``, and ``p`` and ``q``, the parameters
+    ``over`` (design's: a name or a pair of names).
     """
     ux, uy = setup.unit(setup.x), setup.unit(setup.y)
-    up = setup.unit(over) if over else ""
+    up, uq = (setup.unit(name) for name in _searched(over))
     if physical:
         ux, uy, up = (setup.paper.units[k] for k in ("B_w", "K_w", "M_w"))
-    return {"x": ux, "y": uy, "p": up, "area": f"({ux})({uy})" if ux and uy else (ux or uy),
-            None: ""}
+    return {"x": ux, "y": uy, "p": up, "q": uq,
+            "area": f"({ux})({uy})" if ux and uy else (ux or uy), None: ""}
+
+
+def _searched(over):
+    """``(p, q)``: design's searched parameters (a name, a pair or None), "" where none."""
+    names = (over,) if isinstance(over, str) else tuple(over or ())
+    return (names + ("", ""))[:2]
 
 
 def _physical(setup, kind, value):
@@ -102,7 +109,7 @@ def plane_table(setup, rows, *, over=None):
     """``(columns, rows)`` of quantities of the plane of ``setup``, for :func:`symstab.cli.output.emit`.
 
     ``rows`` are ``(name, value, kind, meaning)``: ``name`` and ``meaning``
-    templates in ``{x}``, ``{y}`` and ``{p}`` (the parameter ``over``),
+    templates in ``{x}``, ``{y}``, ``{p}`` and ``{q}`` (the parameters ``over``),
     ``kind`` that of :func:`_units`, and ``name`` a tuple ``(name, Table
     I's name, physical name)`` where the paper's names are not the
     template's (None: the template's).  A loop's rows are ``(quantity,
@@ -111,7 +118,7 @@ def plane_table(setup, rows, *, over=None):
     in the device's units beside them (``K_w``, ``B_w``, ``M_w``).
     """
     names = {"x": setup.name(setup.x), "y": setup.name(setup.y),
-             "p": setup.name(over) if over else ""}
+             **{k: setup.name(n) if n else "" for k, n in zip("pq", _searched(over))}}
     physical_names = {"x": "B_w", "y": "K_w", "p": "M_w"}
     paper = setup.paper
     physical = paper is not None and paper.physical

@@ -110,11 +110,12 @@ _WHAT = {
     "classify": "classify --loop gives the verdict, the spectral radius and the certified "
                 "number of closed-loop poles outside the unit circle at the file's values "
                 "changed by --set (comma lists: several points).",
-    "design": "design --loop searches a third parameter (--over NAME, default the "
-              "environment's mass term, e.g. M) for the largest stable y, as design searches "
-              "the virtual mass, and gives the best value, y_max there and at the nominal "
-              "value, the x where it is reached and the stable intervals of y at that x (or "
-              "at --at X).",
+    "design": "design --loop searches one or two parameters outside the plane (--over "
+              "NAME=LO:HI, default the environment's mass term, e.g. M) for the largest "
+              "stable y, area or passive y (--maximize), as design searches the virtual "
+              "mass, and gives the best values, the target there and at the nominal values, "
+              "the x where y_max is reached and the stable intervals of y at that x (or at "
+              "--at X).",
     "map": "map --loop classifies every cell of an x-y grid by its certified root count "
            "(no simulation yet for a loop file: its first line says so) and draws the "
            "D-decomposition over it.",
@@ -163,16 +164,17 @@ def add_loop_options(p, command):
                        help="also give the stable intervals of y at x = X"
                             + (" (default: the x of the largest y)" if command == "design" else ""))
     if command == "design":
-        g.add_argument("--over", metavar="NAME",
-                       help="the parameter searched for the largest stable y (default: the "
-                            "environment's mass term, a parameter of it in kg or kg m^2 "
-                            "outside the plane)")
+        g.add_argument("--over", metavar="NAME[=LO:HI]", action="append",
+                       help="a parameter searched, with its range in its SI unit or in the "
+                            "unit written after it (--over \"f_c=20:400 Hz\"); repeat for two "
+                            "parameters (default: the environment's mass term, a parameter of "
+                            "it in kg or kg m^2 outside the plane)")
         g.add_argument("--range", metavar="LO:HI", dest="search_range",
-                       help="the values of --over searched, in its SI unit (default: design's "
-                            "gamma range, -1 - (d + 1) delta + 0.001 to 3, times the device's "
-                            "mass: the sum of the plant's parameters in the unit of the mass "
-                            "term, with delta = b T / mass where the loop has a damping b, "
-                            "else 0)")
+                       help="the range of a single --over NAME given without one (default "
+                            "for a mass term: design's gamma range, -1 - (d + 1) delta + 0.001 "
+                            "to 3, times the device's mass: the sum of the plant's parameters "
+                            "in the unit of the mass term, with delta = b T / mass where the "
+                            "loop has a damping b, else 0)")
     if command == "map":
         g.add_argument("--x-range", metavar="LOW,HIGH,N", help="grid of x (--x-range=-0.1,0.6,200)")
         g.add_argument("--y-range", metavar="LOW,HIGH,N", help="grid of y (--y-range=0,6,200)")
@@ -287,20 +289,22 @@ def _parse_sets(texts, *, lists):
     return out
 
 
-def convert_sets(loop, sets):
+def convert_sets(loop, sets, flag="--set"):
     """The ``--set`` values in SI: (values, written), converted as the file's own.
 
     A value without a unit is in the file's unit for that parameter (SI where
     the file gives a bare number); one with a unit is converted from it,
     which must have the dimension of the parameter (from the file's unit, or
     implied by the loop).  ``written`` keeps what was typed, for the echo.
+    Messages name ``flag NAME`` (``--over`` for design's ranges).
     """
     from ..numeric.loop_units import FileParameters, convert
 
     known = getattr(loop, "file_parameters", None) or FileParameters({})
     values, written = {}, {}
+    option = flag
     for name, (value, unit) in sets.items():
-        flag = f"--set {name}"
+        flag = f"{option} {name}"
         file_unit = known.file_unit(name)
         if unit is None:
             unit = file_unit

@@ -960,6 +960,65 @@ class Loop(LoopModel):
         return passive_region(self, x, y, damping=damping, x_range=x_range, y_range=y_range,
                               **values)
 
+    def design(self, *, over, maximize="y_max", x=None, y=None, n=None, rtol=1e-6, damping="b",
+               progress=None, **values):
+        """The value of one or two parameters that maximises K_max, the Z-width or the passive K_max.
+
+        Each evaluation is a certified answer at one value of the searched
+        parameters (:meth:`limits`, or :meth:`passive_region` for
+        ``maximize="passive"``); the search is a coarse scan, then
+        ``scipy.optimize`` (:mod:`symstab.numeric.design` says how, and
+        what it can miss).
+
+        Parameters
+        ----------
+        over : dict
+            ``{name: (low, high)}``, one or two parameters outside the plane
+            (not ``d``), e.g. ``{"M": (0.0, 0.04)}``.
+        maximize : str
+            ``"y_max"`` (the largest stable ``y``, K_max), ``"area"`` (the
+            Z-width) or ``"passive"`` (the passive K_max).
+        x, y : str, optional
+            The plane (default: the loop's :attr:`plane`).
+        n : int, optional
+            Scan points per parameter, ``>= 3`` (default 17 for one
+            parameter, 9 for two).
+        rtol : float
+            Relative accuracy of the optimum.
+        damping : str
+            The device's viscous friction, for ``maximize="passive"``.
+        progress : callable, optional
+            Called with the number of evaluations so far.
+        **values
+            Single values of the other parameters; the searched ones' values
+            here (or defaults) are the nominal point the gain is measured
+            against.
+
+        Returns
+        -------
+        symstab.numeric.design.Design
+
+        Raises
+        ------
+        TypeError, ValueError
+            For a parameter that is unknown, the delay, an axis of the
+            plane, a range that is not ``(low, high)`` with ``low < high``,
+            or an unknown target.
+
+        Examples
+        --------
+        >>> loop = Loop("1/(m*s**2 + b*s)", "K + B*(z - 1)/(T*z) + M*(z - 1)**2/(T**2*z**2)",
+        ...             plane=("B", "K"))
+        >>> best = loop.design(over={"M": (0.0, 0.03)}, m=0.0128, b=0.0324, T=1e-3, d=1,
+        ...                    M=0.0, B=0.0, K=0.0)
+        >>> 0.006 < best.best["M"] < 0.02 and best.gain > 2
+        True
+        """
+        from .design import design
+
+        return design(self, over=over, maximize=maximize, x=x, y=y, n=n, rtol=rtol,
+                      damping=damping, progress=progress, **values)
+
     def closed_loop(self, **values):
         """The closed loop from a force at the plant's input to the position.
 

@@ -13,7 +13,8 @@ of every loop in the paper's names:
   region (for :func:`boundary_curve`);
 * :func:`limits` -- alpha_max, the beta range and the Z-width
   (:meth:`symstab.Loop.limits`, the polygons of the stable cells);
-* :func:`best_virtual_mass` -- the gamma that maximises alpha_max;
+* :func:`best_virtual_mass` -- the gamma that maximises alpha_max
+  (:meth:`symstab.Loop.design` over the loop's ``M``);
 * :func:`boundary_curve` -- the arc of eq. (7) from its generated kernel.
 """
 
@@ -29,11 +30,11 @@ from .._resources import check_memory, chunk_slices
 from .._validate import check_array, check_box, check_count, check_loop, check_real, check_window
 from .curves import KERNEL_BYTES_PER_POINT, KERNEL_CHUNK_BYTES, arc_end_angle, minus_one_line
 from .decomposition import window_arc
-from .paper_loop import closed_form_arc, paper_arc, paper_limits, paper_point
+from .paper_loop import closed_form_arc, paper_arc, paper_point
 from .results import PAPER_PLANE, Boundary
 
 __all__ = ["StabilityRegion", "limits", "vanishing_gamma", "BestVirtualMass", "best_virtual_mass",
-           "scan_maximum", "boundary_curve", "arc_polylines"]
+           "boundary_curve", "arc_polylines"]
 
 class StabilityRegion:
     """The stable set of one ``(gamma, d, delta)`` in the (beta, alpha) plane.
@@ -374,11 +375,6 @@ class BestVirtualMass:
     message: str = ""
 
 
-def _alpha_max(gamma, d, delta):
-    lim = paper_limits(gamma=gamma, d=d, delta=delta)
-    return (-math.inf, math.nan) if lim.empty else (lim.y_max, lim.x_at_y_max)
-
-
 def _check_gamma_range(gamma_range):
     """``(low, high)``: two finite reals with ``low < high``."""
     if isinstance(gamma_range, (str, bytes)) or not isinstance(gamma_range, collections.abc.Sequence) \
@@ -395,88 +391,15 @@ def _check_gamma_range(gamma_range):
     return low, high
 
 
-def scan_maximum(f, low, high, n=17, *, rtol=1e-6, scale=1.0):
-    """The x of [low, high] that maximises a scalar f: a scan, then golden section.
-
-    ``f`` is evaluated on ``n`` evenly spaced points of ``[low, high]``; the
-    best scan point is refined by a golden-section search between its
-    neighbours until the bracket is narrower than ``rtol * max(scale, |x|)``.
-    The search of :func:`best_virtual_mass` (over gamma, ``scale = 1``) and
-    of ``symstab design --loop`` (over a loop's parameter, ``scale`` its
-    reference value): one routine.
-
-    Parameters
-    ----------
-    f : callable
-        ``f(x) -> float``; ``-inf`` (or NaN) where there is nothing to
-        maximise (no stable region at x).
-    low, high : float
-        The interval searched, ``low < high``.
-    n : int
-        Points of the scan, ``n >= 3``.
-    rtol : float
-        Relative width of the final bracket, ``> 0``.
-    scale : float
-        The size of x below which ``rtol`` is taken absolute (times
-        ``scale``), ``> 0``.
-
-    Returns
-    -------
-    (float, float) or None
-        ``(x, f(x))`` at the best point seen (scan or search), or None when
-        ``f`` is not finite at any scan point.
-
-    Raises
-    ------
-    ValueError
-        For ``low >= high``, ``n < 3`` or a non-positive ``rtol`` or ``scale``.
-
-    Examples
-    --------
-    >>> x, value = scan_maximum(lambda x: -(x - 0.3)**2, 0.0, 1.0)
-    >>> round(x, 5), value <= 0
-    (0.3, True)
-    """
-    low, high = check_real("low", low), check_real("high", high)
-    if not low < high:
-        raise ValueError(f"the interval searched must have low < high, got [{low!r}, {high!r}]")
-    n = check_count("n", n, 3)
-    for name, value in (("rtol", rtol), ("scale", scale)):
-        if not (check_real(name, value) > 0):
-            raise ValueError(f"{name} must be a real number > 0, got {value!r}")
-    xs = np.linspace(low, high, n)
-    values = [f(x) for x in xs]
-    if not np.isfinite(values).any():
-        return None
-    k = int(np.nanargmax(np.where(np.isnan(values), -np.inf, values)))
-    a, b = xs[max(k - 1, 0)], xs[min(k + 1, n - 1)]
-    ratio = (math.sqrt(5) - 1) / 2
-    x1, x2 = b - ratio * (b - a), a + ratio * (b - a)
-    f1, f2 = f(x1), f(x2)
-    while b - a > rtol * max(scale, abs(a)):
-        if f1 < f2:
-            a, x1, f1 = x1, x2, f2
-            x2 = a + ratio * (b - a)
-            f2 = f(x2)
-        else:
-            b, x2, f2 = x2, x1, f1
-            x1 = b - ratio * (b - a)
-            f1 = f(x1)
-    # The best point seen: at the edge where the region vanishes the middle
-    # of the last bracket may already have no region.
-    candidates = [(value, x) for value, x in ((values[k], xs[k]), (f1, x1), (f2, x2))
-                  if not math.isnan(value)]
-    value, x = max(candidates)
-    return float(x), float(value)
-
-
 def best_virtual_mass(*, d, delta, gamma_range=None, n=17):
     """The gamma (and beta) that maximise alpha_max, and the gain over gamma = 0.
 
-    alpha_max(gamma) is scanned on ``n`` points of ``gamma_range`` (default
-    from just above ``-1 - (d + 1) delta``, below which no arc exists, to 3)
-    and the best scan point is refined by a golden-section search between
-    its neighbours, to 1e-6 in gamma.
+    :meth:`symstab.Loop.design` of the paper's loop in Table I's variables
+    (:func:`~symstab.numeric.paper_loop.paper_point`) over its virtual mass
+    ``M = gamma``: alpha_max(gamma) is scanned on ``n`` points of
+    ``gamma_range`` (default from just above ``-1 - (d + 1) delta``, below
+    which no arc exists, to 3) and the best scan point is refined by Brent's
+    bounded search between its neighbours (:mod:`symstab.numeric.design`).
 
     Parameters
     ----------
@@ -511,16 +434,14 @@ def best_virtual_mass(*, d, delta, gamma_range=None, n=17):
     if gamma_range is None:
         gamma_range = (-1.0 - (d + 1) * delta + 1e-3, 3.0)
     g_lo, g_hi = _check_gamma_range(gamma_range)
-    found = scan_maximum(lambda g: _alpha_max(g, d, delta)[0], g_lo, g_hi, n)
-    if found is None:
+    loop, values = paper_point(gamma=0.0, d=d, delta=delta)
+    found = loop.design(over={"M": (g_lo, g_hi)}, x="B", y="K", n=n, **values)
+    if found.best is None:
         return BestVirtualMass(d, delta, None, None, None, None, None, 0.0,
                                f"no gamma in [{g_lo:g}, {g_hi:g}] has a stable region at d = {d}")
-    best_gamma, _ = found
-    region = StabilityRegion(gamma=best_gamma, d=d, delta=delta)
-    best = region.limits()
-    alpha_zero = _alpha_max(0.0, d, delta)[0]
-    return BestVirtualMass(d, delta, float(best_gamma), best.beta_at_alpha_max, best.alpha_max,
-                           float(alpha_zero), float(best.alpha_max / alpha_zero), best.z_width)
+    best = found.limits
+    return BestVirtualMass(d, delta, found.best["M"], best.x_at_y_max, best.y_max,
+                           float(found.value_nominal), found.gain, best.area)
 
 
 def _arc_points(gamma, d, delta):

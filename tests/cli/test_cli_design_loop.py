@@ -8,6 +8,7 @@ the search.
 """
 
 import math
+import re
 
 import numpy as np
 import pytest
@@ -92,8 +93,8 @@ def test_the_table_names_the_optimum_the_value_there_and_at_the_nominal_value(ca
 
 
 @pytest.mark.parametrize("args, needle", [
-    (["--loop", LOOPS / "lowpass_velocity.toml"], "no mass term: give --over NAME"),
-    (["--loop", LOOPS / "lowpass_velocity.toml", "--over", "f_c"], "give --range LO:HI"),
+    (["--loop", LOOPS / "lowpass_velocity.toml"], "no mass term: give --over NAME=LO:HI"),
+    (["--loop", LOOPS / "lowpass_velocity.toml", "--over", "f_c"], "give its range, --over f_c=LO:HI (in Hz)"),
     (["--loop", LOOPS / "paper.toml", "--over", "Q"], "--over Q: not a parameter"),
     (["--loop", LOOPS / "paper.toml", "--over", "d"], "whole number of samples"),
     (["--loop", LOOPS / "paper.toml", "--over", "K"], "axis"),
@@ -103,9 +104,52 @@ def test_the_table_names_the_optimum_the_value_there_and_at_the_nominal_value(ca
     (["--loop", LOOPS / "paper.toml", "--range=0.02:0.01"], "LO < HI"),
     (["--over", "M"], "--over needs a loop file"),
     (["--range", "0:1"], "--range needs a loop file"),
+    (["--loop", LOOPS / "paper.toml", "--over", "M=0:1 s"], "--over M: unit 's' is"),
+    (["--loop", LOOPS / "paper.toml", "--over", "M=0:1", "--range", "0:2"], "drop --range"),
+    (["--loop", LOOPS / "paper.toml", "--over", "M", "--over", "b", "--range", "0:2"],
+     "--range is the range of a single --over"),
+    (["--loop", LOOPS / "paper.toml", "--over", "M=0:1", "--over", "M=1:2"], "given twice"),
+    (["--loop", LOOPS / "paper.toml", "--over", "M=0:1", "--over", "b=1:2", "--over", "m=1:2"],
+     "one or two parameters"),
+    (["--maximize", "speed"], "--maximize must be K_max"),
+    (["--loop", LOOPS / "paper.toml", "--maximize", "B_max"], "the plane's y is K"),
+    (["--points", "2"], "--points must be an integer from 3"),
+    (["--png", "/nonexistent/x.png"], "--png"),
 ])
 def test_bad_search_input_is_one_line_before_the_search(capsys, args, needle):
     status, out, err = run(capsys, "design", *args)
     assert status == 2 and out == "", err
     assert err.count("\n") == 1 and needle in err, err
     assert "searching" not in err
+
+
+def test_a_wide_range_finds_the_narrow_band_of_stable_masses(capsys):
+    """actuator_lag over M in [-1, 10] kg: it said "no M in [-1, 10] kg has a stable point"
+    while its own table showed K_max at M = 0 (the 17-point scan stepped over the band of
+    stable masses, about (-0.013, 0.017) kg).  Now the optimum is the default range's."""
+    wide = run_json(capsys, "design", "--loop", LOOPS / "actuator_lag.toml", "--range=-1:10")
+    default = run_json(capsys, "design", "--loop", LOOPS / "actuator_lag.toml")
+    assert wide["search"]["best"] is not None, wide.get("notes")
+    assert wide["search"]["y_max"] == pytest.approx(default["search"]["y_max"], rel=1e-4)
+    assert wide["search"]["best"] == pytest.approx(default["search"]["best"], rel=1e-4)
+
+
+def test_over_takes_a_range_with_a_unit_and_two_parameters(capsys, tmp_path):
+    """--over f_c=0.02:0.2 kHz is f_c in [20, 200] Hz; a second --over searches a box; --png
+    draws the evaluations; --maximize area is the Z-width."""
+    common = ["design", "--loop", LOOPS / "lowpass_velocity.toml", "--set", "d=2"]
+    hertz = run_json(capsys, *common, "--over", "f_c=20:200", "--points", "5")
+    kilohertz = run_json(capsys, *common, "--over", "f_c=0.02:0.2 kHz", "--points", "5")
+    assert kilohertz["search"]["range"] == pytest.approx([20.0, 200.0], rel=1e-12)
+    assert kilohertz["search"]["best"] == pytest.approx(hertz["search"]["best"], rel=1e-9)
+    png = tmp_path / "design.png"
+    loop = symstab.load_loop(LOOPS / "lowpass_velocity.toml")
+    status, out, err = run(capsys, *common, "--over", "f_c=20:200", "--over", "b=0.01:0.05",
+                           "--points", "3", "--maximize", "area", "--png", png)
+    assert status == 0, err
+    assert png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    rows = {cells[0]: cells[1:] for cells in (re.split(r"\s{2,}", line.strip())
+                                              for line in out.splitlines()) if len(cells) > 2}
+    assert "f_c (best)" in rows and "b (best)" in rows and "area" in rows
+    best_f_c, best_b, area = (float(rows[k][0]) for k in ("f_c (best)", "b (best)", "area"))
+    assert loop.limits(d=2, f_c=best_f_c, b=best_b).area == pytest.approx(area, rel=1e-6)

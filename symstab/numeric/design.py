@@ -1,0 +1,452 @@
+"""The design search: the value of one or two loop parameters that maximises a target.
+
+:meth:`symstab.Loop.design` asks: which virtual mass (filter cut-off, sample
+period, ...) gives the largest renderable stiffness, the largest Z-width or
+the largest passive stiffness?  Each evaluation is a certified answer of the
+one engine at one value of the searched parameters:
+
+* ``"y_max"`` -- :attr:`Limits.y_max <symstab.numeric.results.Limits.y_max>`
+  of :meth:`symstab.Loop.limits` (``K_max`` in the plane ``(B, K)``);
+* ``"area"`` -- :attr:`Limits.area <symstab.numeric.results.Limits.area>`,
+  the Z-width where ``x`` is a damping and ``y`` a stiffness;
+* ``"passive"`` -- ``y_max`` of :meth:`symstab.Loop.passive_region` (the
+  passive ``K_max``).
+
+A value where no point is stable has no target (``-inf``); one the engine
+cannot resolve (a stable set shrinking to a sliver it refuses) is skipped
+and reported in :attr:`Design.failed`.
+
+The search (:func:`maximize_scalar`, :func:`maximize_box`) is a coarse scan
+first, so that a second maximum is not missed, then ``scipy.optimize``
+from the best scan point: a bounded scalar search (Brent's method,
+:func:`scipy.optimize.minimize_scalar`) in one parameter, Nelder-Mead with
+bounds (:func:`scipy.optimize.minimize`) in two.  The scan includes the
+nominal value, and zooms into a run of stable values that holds fewer than
+five scan points (a narrow band of stable values, such as the virtual
+masses of a loop with a fast device, is resolved before the refinement
+rather than missed).  A band that holds neither a scan point nor the
+nominal value can still be missed: :attr:`Design.spacing` says the scan's
+step, and ``n`` makes it finer.
+"""
+
+import dataclasses
+import math
+
+import numpy as np
+
+from .._validate import check_count, check_real, check_window
+
+__all__ = ["TARGETS", "Design", "design", "maximize_scalar", "maximize_box"]
+
+#: What a design maximises, with what it is.
+TARGETS = {
+    "y_max": "the largest stable y (K_max in the (B, K) plane)",
+    "area": "the area of the stable set (the Z-width in the (B, K) plane)",
+    "passive": "the largest passive y (the passive K_max in the (B, K) plane)",
+}
+#: A run of stable scan values shorter than this is zoomed into before refining.
+_MIN_RUN = 5
+#: Zooms at most (each divides the step by about n / 2).
+_MAX_ZOOMS = 8
+#: Evaluations of the local refinement at most.
+_MAX_REFINE = 200
+
+
+@dataclasses.dataclass(frozen=True)
+class Design:
+    """What :meth:`symstab.Loop.design` found.
+
+    Attributes
+    ----------
+    target : str
+        What was maximised: a key of :data:`TARGETS`.
+    x, y : str
+        The plane whose stable (or passive) set the target measures.
+    over : dict
+        ``{name: (low, high)}``: the parameters searched and their ranges.
+    best : dict or None
+        ``{name: value}`` at the optimum; None when no value searched has a
+        stable point (:attr:`message` says so).
+    value : float or None
+        The target there.
+    nominal : dict
+        ``{name: value}`` of the searched parameters as given or defaulted
+        (empty when one has no value).
+    value_nominal : float or None
+        The target at the nominal values (None where there are none; ``-inf``
+        when no point is stable there).
+    limits : object or None
+        At the optimum: the :class:`~symstab.numeric.results.Limits` of the
+        plane (targets ``y_max``, ``area``) or the
+        :class:`~symstab.numeric.passivity.PassiveRegion` (``passive``).
+    samples : ndarray
+        Every evaluation, ``(k, len(over) + 1)``: the parameters' values,
+        then the target (``-inf`` no stable point, NaN not resolved), in
+        the order evaluated.
+    spacing : dict
+        ``{name: step}`` of the first scan: a band of stable values
+        narrower than this that holds no scan point can be missed.
+    failed : tuple of (dict, str)
+        The values the engine could not resolve, with its message.
+    values : dict
+        The other parameters' values, as given.
+    message : str
+        Why there is no optimum; else empty.
+    """
+
+    target: str
+    x: str
+    y: str
+    over: dict
+    best: object
+    value: object
+    nominal: dict
+    value_nominal: object
+    limits: object
+    samples: np.ndarray
+    spacing: dict
+    failed: tuple = ()
+    values: dict = dataclasses.field(default_factory=dict)
+    message: str = ""
+
+    @property
+    def gain(self):
+        """:attr:`value` over :attr:`value_nominal`, where both are finite and positive; else None."""
+        if self.value is None or self.value_nominal is None:
+            return None
+        if not (math.isfinite(self.value) and math.isfinite(self.value_nominal)
+                and self.value_nominal > 0):
+            return None
+        return self.value / self.value_nominal
+
+    @property
+    def at_edge(self):
+        """The searched parameters whose optimum lies within 1e-3 of the range's width of an end."""
+        if self.best is None:
+            return ()
+        return tuple(name for name, (lo, hi) in self.over.items()
+                     if min(self.best[name] - lo, hi - self.best[name]) < 1e-3 * (hi - lo))
+
+    def __repr__(self):
+        over = ", ".join(f"{n} in [{lo:.6g}, {hi:.6g}]" for n, (lo, hi) in self.over.items())
+        if self.best is None:
+            return f"Design({self.target} over {over}: {self.message})"
+        best = ", ".join(f"{n}={v:.6g}" for n, v in self.best.items())
+        gain = f", gain {self.gain:.4g}" if self.gain is not None else ""
+        return f"Design({self.target} over {over}: {best}, {self.target}={self.value:.6g}{gain})"
+
+    def as_dict(self):
+        """The numbers, for tables and JSON."""
+        return {"target": self.target, "x": self.x, "y": self.y,
+                "over": {n: list(r) for n, r in self.over.items()}, "best": self.best,
+                "value": self.value, "nominal": self.nominal,
+                "value_nominal": self.value_nominal, "gain": self.gain,
+                "evaluations": int(self.samples.shape[0]), "spacing": self.spacing,
+                "failed": len(self.failed), "message": self.message}
+
+
+class _Evaluations:
+    """The target at points of the searched box, each evaluated once and remembered."""
+
+    def __init__(self, f, progress):
+        self.f, self.progress = f, progress
+        self.seen = {}
+
+    def __call__(self, point):
+        key = tuple(float(v) for v in np.atleast_1d(point))
+        if key not in self.seen:
+            value = float(self.f(key))
+            self.seen[key] = -math.inf if value == -math.inf else value
+            if self.progress is not None:
+                self.progress(len(self.seen))
+        return self.seen[key]
+
+    def best(self):
+        """``(point, value)`` of the largest finite (or +inf) value seen, or None."""
+        found = [(v, p) for p, v in self.seen.items() if not math.isnan(v) and v > -math.inf]
+        if not found:
+            return None
+        value, point = max(found)
+        return point, value
+
+    def penalised(self, point):
+        """The value to minimise: minus the target, and past the worst value where there is none."""
+        value = self(point)
+        if math.isnan(value) or value == -math.inf:
+            finite = [v for v in self.seen.values() if math.isfinite(v)]
+            worst = min(finite, default=0.0)
+            return -(worst - abs(worst) - 1.0)
+        return -value
+
+
+def maximize_scalar(f, low, high, n=17, *, include=(), rtol=1e-6, progress=None):
+    """The x of [low, high] that maximises a scalar ``f``: a scan, then Brent's method.
+
+    ``f`` is evaluated on ``n`` evenly spaced points of ``[low, high]`` and
+    at the values ``include`` that lie inside; a run of finite values that
+    holds the best one and fewer than five points is scanned again between
+    its infeasible neighbours (up to eight times).  The best point is then
+    refined by :func:`scipy.optimize.minimize_scalar` (``method="bounded"``)
+    between its neighbours, to ``rtol`` times the larger of ``|x|`` and the
+    bracket's width.
+
+    Parameters
+    ----------
+    f : callable
+        ``f(x) -> float``; ``-inf`` where there is nothing to maximise (no
+        stable point), NaN where it could not be evaluated.
+    low, high : float
+        The interval searched, ``low < high``.
+    n : int
+        Points of the scan, ``n >= 3``.
+    include : iterable of float
+        Points evaluated with the scan (the nominal value).
+    rtol : float
+        Relative accuracy of the optimum, ``> 0``.
+    progress : callable, optional
+        Called with the number of evaluations so far.
+
+    Returns
+    -------
+    (float, float, list) or (None, None, list)
+        The best point seen and ``f`` there (None when ``f`` has no finite
+        value at any point evaluated), and every evaluation ``[(x, f(x)), ...]``.
+
+    Examples
+    --------
+    >>> x, value, _ = maximize_scalar(lambda x: -(x - 0.3)**2, 0.0, 1.0)
+    >>> round(x, 5), value <= 0
+    (0.3, True)
+    """
+    from scipy.optimize import minimize_scalar
+
+    low, high = check_window("the interval searched", (low, high))
+    n = check_count("n", n, 3)
+    rtol = check_real("rtol", rtol, low=0.0, low_open=True)
+    evaluate = _Evaluations(lambda p: f(p[0]), progress)
+    xs = sorted(set(np.linspace(low, high, n).tolist())
+                | {float(v) for v in include if low <= v <= high})
+    for x in xs:
+        evaluate(x)
+    for _ in range(_MAX_ZOOMS):
+        found = evaluate.best()
+        if found is None or not math.isfinite(found[1]):
+            break
+        xs = sorted(p[0] for p in evaluate.seen)
+        ok = [math.isfinite(evaluate.seen[(x,)]) for x in xs]
+        k = xs.index(found[0][0])
+        i, j = k, k
+        while i > 0 and ok[i - 1]:
+            i -= 1
+        while j < len(xs) - 1 and ok[j + 1]:
+            j += 1
+        if j - i + 1 >= _MIN_RUN:
+            break
+        a, b = xs[max(i - 1, 0)], xs[min(j + 1, len(xs) - 1)]
+        for x in np.linspace(a, b, n):
+            evaluate(float(x))
+    found = evaluate.best()
+    if found is None:
+        return None, None, [(p[0], v) for p, v in evaluate.seen.items()]
+    (x_best,), value = found
+    if math.isfinite(value):
+        xs = sorted(p[0] for p in evaluate.seen)
+        k = xs.index(x_best)
+        a, b = xs[max(k - 1, 0)], xs[min(k + 1, len(xs) - 1)]
+        if a < b:
+            minimize_scalar(lambda x: evaluate.penalised(x), bounds=(a, b), method="bounded",
+                            options={"xatol": rtol * max(abs(x_best), b - a),
+                                     "maxiter": _MAX_REFINE})
+        (x_best,), value = evaluate.best()
+    return x_best, value, [(p[0], v) for p, v in evaluate.seen.items()]
+
+
+def maximize_box(f, box, n=9, *, include=(), rtol=1e-6, progress=None):
+    """The point of a 2-D box that maximises ``f``: a grid, then Nelder-Mead with bounds.
+
+    ``f`` is evaluated on an ``n x n`` grid of the box and at the points
+    ``include`` inside it; while fewer than four grid points have a finite
+    value, the grid is laid again over the box those points and their
+    neighbours span (up to eight times).  The best point is refined by
+    :func:`scipy.optimize.minimize` (``method="Nelder-Mead"``, bounded by
+    the box) from a simplex one grid step wide, in coordinates scaled to the
+    box, to ``rtol`` of the box's width.
+
+    Parameters
+    ----------
+    f : callable
+        ``f((u, v)) -> float``; ``-inf`` where there is nothing to maximise,
+        NaN where it could not be evaluated.
+    box : ((float, float), (float, float))
+        The ranges of the two parameters.
+    n : int
+        Grid points per parameter, ``n >= 3``.
+    include : iterable of (float, float)
+        Points evaluated with the grid (the nominal values).
+    rtol : float
+        Relative accuracy of the optimum, ``> 0``.
+    progress : callable, optional
+        Called with the number of evaluations so far.
+
+    Returns
+    -------
+    (tuple, float, list) or (None, None, list)
+        As :func:`maximize_scalar`, with points ``(u, v)``.
+
+    Examples
+    --------
+    >>> p, value, _ = maximize_box(lambda p: -(p[0] - 0.3)**2 - (p[1] + 1)**2,
+    ...                            ((0.0, 1.0), (-2.0, 2.0)))
+    >>> round(p[0], 4), round(p[1], 4)
+    (0.3, -1.0)
+    """
+    from scipy.optimize import minimize
+
+    (u0, u1), (v0, v1) = (check_window(f"box[{k}]", r) for k, r in enumerate(box))
+    n = check_count("n", n, 3)
+    rtol = check_real("rtol", rtol, low=0.0, low_open=True)
+    evaluate = _Evaluations(f, progress)
+    for p in include:
+        if u0 <= p[0] <= u1 and v0 <= p[1] <= v1:
+            evaluate((float(p[0]), float(p[1])))
+    step = ((u1 - u0) / (n - 1), (v1 - v0) / (n - 1))
+    grid = ((u0, u1), (v0, v1))
+    for _ in range(_MAX_ZOOMS + 1):
+        us, vs = np.linspace(*grid[0], n), np.linspace(*grid[1], n)
+        for u in us:
+            for v in vs:
+                evaluate((float(u), float(v)))
+        finite = [p for p in evaluate.seen if math.isfinite(evaluate.seen[p])]
+        if len(finite) >= 4 or not finite:
+            break
+        du, dv = (us[1] - us[0]), (vs[1] - vs[0])
+        pu, pv = [p[0] for p in finite], [p[1] for p in finite]
+        grid = ((max(u0, min(pu) - du), min(u1, max(pu) + du)),
+                (max(v0, min(pv) - dv), min(v1, max(pv) + dv)))
+        if not (grid[0][0] < grid[0][1] and grid[1][0] < grid[1][1]):
+            break
+        step = (du, dv)
+    found = evaluate.best()
+    if found is None:
+        return None, None, list(evaluate.seen.items())
+    point, value = found
+    if math.isfinite(value):
+        width = np.array([u1 - u0, v1 - v0])
+        origin = np.array([u0, v0])
+        start = (np.array(point) - origin) / width
+        cell = np.array(step) / width
+
+        def scaled(q):
+            q = np.clip(q, 0.0, 1.0)
+            return evaluate.penalised(tuple((origin + q * width).tolist()))
+
+        simplex = np.array([start, start + [cell[0], 0.0], start + [0.0, cell[1]]])
+        # A simplex vertex past the box is reflected inside it.
+        simplex = np.where(simplex > 1.0, 2 * start - simplex, simplex).clip(0.0, 1.0)
+        minimize(scaled, start, method="Nelder-Mead", bounds=[(0.0, 1.0), (0.0, 1.0)],
+                 options={"initial_simplex": simplex, "xatol": rtol, "fatol": rtol * abs(value),
+                          "maxfev": _MAX_REFINE})
+        point, value = evaluate.best()
+    return point, value, list(evaluate.seen.items())
+
+
+def _check_over(loop, over, x, y):
+    """``{name: (low, high)}``: one or two parameters of the loop, outside the plane."""
+    if not isinstance(over, dict) or not 1 <= len(over) <= 2:
+        raise TypeError(f"over must be a dict of one or two {{name: (low, high)}}, got {over!r}")
+    out = {}
+    others = [p for p in loop.parameters if p not in (x, y, "d")]
+    for name, window in over.items():
+        if name not in loop.parameters:
+            raise ValueError(f"over: {name!r} is not a parameter of the loop (candidates: "
+                             f"{', '.join(others)})")
+        if name == "d":
+            raise ValueError("over: the delay d is a whole number of samples; design once per delay")
+        if name in (x, y):
+            raise ValueError(f"over: {name} is an axis of the ({x}, {y}) plane; search another "
+                             f"parameter (candidates: {', '.join(others)})")
+        out[name] = check_window(f"over[{name!r}]", window)
+    return out
+
+
+def design(loop, *, over, maximize="y_max", x=None, y=None, n=None, rtol=1e-6, damping="b",
+           progress=None, **values):
+    """The value of one or two parameters of ``loop`` that maximises a target.
+
+    See :meth:`symstab.Loop.design`, which calls this.
+    """
+    if maximize not in TARGETS:
+        raise ValueError(f"maximize must be one of {', '.join(map(repr, TARGETS))}, "
+                         f"got {maximize!r}")
+    if x is None or y is None:
+        if loop.plane is None:
+            raise ValueError("give the plane: x and y (the loop has no default plane)")
+        x, y = (x or loop.plane[0]), (y or loop.plane[1])
+    over = _check_over(loop, over, x, y)
+    names = tuple(over)
+    n = (17 if len(names) == 1 else 9) if n is None else check_count("n", n, 3)
+    if progress is not None and not callable(progress):
+        raise TypeError(f"progress must be a callable taking the number of evaluations, or None, "
+                        f"got {type(progress).__name__}")
+    merged = {**loop.defaults, **values}
+    nominal = {name: float(merged[name]) for name in names if name in merged}
+    if len(nominal) != len(names):
+        nominal = {}
+    failed = []
+
+    def answer(point):
+        return _answer(loop, maximize, x, y, damping, {**values, **dict(zip(names, point))})
+
+    def target(point):
+        try:
+            return _target(maximize, answer(point))
+        except ValueError as exc:
+            failed.append((dict(zip(names, point)), str(exc)))
+            return math.nan
+
+    include = [tuple(nominal[n_] for n_ in names)] if nominal else []
+    if len(names) == 1:
+        best, value, seen = maximize_scalar(lambda v: target((v,)), *over[names[0]], n,
+                                            include=[p[0] for p in include], rtol=rtol,
+                                            progress=progress)
+        best = None if best is None else (best,)
+        seen = [((p,), v) for p, v in seen]
+    else:
+        best, value, seen = maximize_box(target, tuple(over[k] for k in names), n,
+                                         include=include, rtol=rtol, progress=progress)
+    samples = np.array([[*p, v] for p, v in seen], dtype=float).reshape(-1, len(names) + 1)
+    spacing = {k: (hi - lo) / (n - 1) for k, (lo, hi) in over.items()}
+    value_nominal = None
+    if nominal:
+        key = tuple(nominal[k] for k in names)
+        hits = [v for p, v in seen if tuple(p) == key]
+        value_nominal = hits[0] if hits else target(key)
+        if value_nominal is not None and math.isnan(value_nominal):
+            value_nominal = None
+    common = dict(target=maximize, x=x, y=y, over=over, nominal=nominal,
+                  value_nominal=value_nominal, samples=samples, spacing=spacing,
+                  failed=tuple(failed), values=dict(values))
+    if best is None:
+        ranges = ", ".join(f"{k} in [{lo:.6g}, {hi:.6g}]" for k, (lo, hi) in over.items())
+        what = "passive" if maximize == "passive" else "stable"
+        return Design(best=None, value=None, limits=None,
+                      message=f"no value of {ranges} has a {what} point in the ({x}, {y}) plane "
+                              f"(scanned in steps of "
+                              f"{', '.join(f'{s:.3g}' for s in spacing.values())}; "
+                              f"{len(samples)} evaluations)", **common)
+    return Design(best=dict(zip(names, (float(v) for v in best))), value=float(value),
+                  limits=answer(best), **common)
+
+
+def _answer(loop, maximize, x, y, damping, values):
+    """The engine's answer whose number is the target: Limits or PassiveRegion."""
+    if maximize == "passive":
+        return loop.passive_region(x, y, damping=damping, **values)
+    return loop.limits(x, y, **values)
+
+
+def _target(maximize, answer):
+    """The target's number of an answer; ``-inf`` where no point is stable (passive)."""
+    if answer.y_max is None:
+        return -math.inf
+    return float(answer.area if maximize == "area" else answer.y_max)
