@@ -59,14 +59,17 @@ POINT_OPTIONS = (
 _GRID_OPTIONS = tuple((flag, dest, "--x-range/--y-range (the plane is --x/--y)")
                       for flag, dest, _ in POINT_OPTIONS)
 
-#: The simulation options of ``map``: a general loop has no simulator.
-_SIMULATION_OPTIONS = tuple(
-    (flag, dest, None) for flag, dest in (
-        ("--encoder-resolution", "encoder_resolution"), ("--paper-encoder", "paper_encoder"),
-        ("--velocity-cutoff", "velocity_cutoff"), ("--coulomb", "coulomb"),
-        ("--stiction", "stiction"), ("--friction-compensation", "friction_compensation"),
-        ("--actuator-bandwidth", "actuator_bandwidth"), ("--substeps", "substeps"),
-        ("--steps", "steps"), ("--x0", "x0")))
+#: The simulation options of the paper's device that a general loop has not:
+#: what inside the period its simulator does not model (its filter and lag
+#: are the loop's own environment and plant).
+_SIMULATION_OPTIONS = (
+    ("--velocity-cutoff", "velocity_cutoff",
+     "a velocity filter written into the loop file's environment (examples/loops/"
+     "lowpass_velocity.toml)"),
+    ("--actuator-bandwidth", "actuator_bandwidth",
+     "an actuator lag written into the loop file's plant (examples/loops/actuator_lag.toml)"),
+    ("--coulomb", "coulomb", None), ("--stiction", "stiction", None),
+    ("--friction-compensation", "friction_compensation", None), ("--substeps", "substeps", None))
 
 #: The options each command refuses with ``--loop``.
 _REFUSED = {
@@ -76,6 +79,7 @@ _REFUSED = {
     "classify": DEVICE_OPTIONS + POINT_OPTIONS,
     "design": DEVICE_OPTIONS,
     "map": DEVICE_OPTIONS + _GRID_OPTIONS + _SIMULATION_OPTIONS,
+    "simulate": DEVICE_OPTIONS + POINT_OPTIONS + _SIMULATION_OPTIONS,
 }
 
 #: The options that only mean something with ``--loop``, per command.
@@ -84,12 +88,13 @@ _LOOP_ONLY = {
     "limits": ("set_values", "x", "y", "at"),
     "classify": ("set_values",),
     "design": ("set_values", "x", "y", "at", "over", "search_range"),
-    "map": ("set_values", "x", "y", "x_range", "y_range"),
+    "map": ("set_values", "x", "y", "x_range", "y_range", "simulate"),
+    "simulate": ("set_values",),
 }
 
 _FLAGS = {"set_values": "--set", "x": "--x", "y": "--y", "at": "--at",
           "x_range": "--x-range", "y_range": "--y-range", "over": "--over",
-          "search_range": "--range"}
+          "search_range": "--range", "simulate": "--simulate"}
 
 
 EXAMPLE = "examples/loops/paper.toml"
@@ -116,9 +121,13 @@ _WHAT = {
               "mass, and gives the best values, the target there and at the nominal values, "
               "the x where y_max is reached and the stable intervals of y at that x (or at "
               "--at X).",
+    "simulate": "simulate --loop runs the loop at the file's values changed by --set (the "
+                "plant's exact ZOH step, the environment's difference equation, the delay "
+                "line; encoder quantization and force saturation in the loop's SI "
+                "units) and compares the verdict with its certified root count.",
     "map": "map --loop classifies every cell of an x-y grid by its certified root count "
-           "(no simulation yet for a loop file: its first line says so) and draws the "
-           "D-decomposition over it.",
+           "and draws the D-decomposition over it; with --simulate it also simulates every "
+           "cell and compares.",
 }
 #: The example of each command with a loop file.
 _LOOP_EXAMPLES = {
@@ -126,6 +135,7 @@ _LOOP_EXAMPLES = {
     "limits": f"symstab limits --loop {EXAMPLE} --set M=0.0128 --at 0.3",
     "classify": f"symstab classify --loop {EXAMPLE} --set K=1,3,10 --set B=0.2",
     "design": f"symstab design --loop {EXAMPLE} --set d=10",
+    "simulate": f"symstab simulate --loop {EXAMPLE} --set K=3 --set B=0.2 --out trajectory.csv",
     "map": f"symstab map --loop {EXAMPLE} --x-range=-0.1,0.6,141 --y-range=0,6,121 "
            "--out map.npz",
 }
@@ -154,7 +164,7 @@ def add_loop_options(p, command):
                         "it (--set T=0.5ms, --set \"K=3 N/mm\"), of the same dimension; "
                         "converted to SI and checked against the file's bounds; repeatable; d "
                         f"is a whole number of samples{many}")
-    if command != "classify":
+    if command not in ("classify", "simulate"):
         g.add_argument("--x", metavar="NAME", help="horizontal parameter of the plane "
                                                    "(default: the file's plane)")
         g.add_argument("--y", metavar="NAME", help="vertical parameter of the plane "
@@ -176,6 +186,11 @@ def add_loop_options(p, command):
                             "in the unit of the mass term, with delta = b T / mass where the "
                             "loop has a damping b, else 0)")
     if command == "map":
+        g.add_argument("--simulate", action="store_true", default=None,
+                       help="also simulate every cell (the plant's exact ZOH step, the "
+                            "environment's difference equation, the delay line; with "
+                            "--steps, --x0, --encoder-resolution, --force-limit in the "
+                            "loop's SI units)")
         g.add_argument("--x-range", metavar="LOW,HIGH,N", help="grid of x (--x-range=-0.1,0.6,200)")
         g.add_argument("--y-range", metavar="LOW,HIGH,N", help="grid of y (--y-range=0,6,200)")
     refused = tuple((flag, dest, p.get_default(dest), instead)
@@ -210,9 +225,9 @@ def _refuse_device_options(args):
             if flag == "--linear":
                 raise ValueError(LINEAR_WITH_LOOP)
             if instead is None:
-                raise ValueError(f"{flag} is an option of the paper's device simulation; "
-                                 f"map --loop classifies the loop by its roots and takes no "
-                                 f"simulation options")
+                raise ValueError(f"{flag} is an option of the paper's device simulation: "
+                                 f"Coulomb friction needs the plant's velocity, which a loop "
+                                 f"file's simulator does not model yet")
             raise ValueError(f"{flag} is an option of the paper's device; with --loop use "
                              f"{instead}")
 

@@ -2,8 +2,10 @@
 
 The paper's loop is simulated at every cell (with the non-idealities of
 :mod:`symstab.cli.simulation`), its root count beside; a loop file
-(``--loop``) has no simulator yet, and every cell is classified by its root
-count, with the D-decomposition drawn over the map.  The output paths are
+(``--loop``) is classified by its root count at every cell, with the
+D-decomposition drawn over the map, and with ``--simulate`` also simulated
+(:meth:`symstab.Loop.stability_map`: encoder quantization and force
+saturation on the samples).  The output paths are
 checked before the work and the files written atomically.
 """
 
@@ -18,15 +20,20 @@ from .loop_options import add_loop_options, resolve_loop, uses_loop, value_text
 from .options import add_command, add_model_options, resolve, stiffness_and_damping
 from ..drawing import draw_lines, png_bytes, pyplot_or_none, visible
 from .output import check_files, write_output
-from .simulation import add_nonideal_options, nonideal_text, resolve_nonideal, simulated_theory
+from .simulation import (add_nonideal_options, loop_nonideal_text, nonideal_text, resolve_nonideal,
+                         simulated_theory)
 from .units import tex_unit
 
-__all__ = ["register", "run", "MAX_GRID", "map_outputs", "LOOP_MAP_HEADLINE"]
+__all__ = ["register", "run", "MAX_GRID", "map_outputs", "LOOP_MAP_HEADLINE",
+           "LOOP_SIMULATE_HEADLINE"]
 
 #: The first line of ``map --loop``: what it computes, since ``map`` of the
-#: paper's loop simulates (a loop file has no simulator yet).
-LOOP_MAP_HEADLINE = ("map --loop: root counts of the linear loop (no simulation yet for a "
-                     "loop file)")
+#: paper's loop simulates (a loop file with --simulate).
+LOOP_MAP_HEADLINE = ("map --loop: root counts of the linear loop (add --simulate to simulate "
+                     "every cell)")
+#: The first line of ``map --loop --simulate``.
+LOOP_SIMULATE_HEADLINE = ("map --loop --simulate: every cell simulated, the loop's certified "
+                          "root count beside")
 
 #: Bytes per map cell in the CSV and NPZ written, with the Python objects
 #: that build them (generous).
@@ -250,9 +257,16 @@ def _paper_png(args, setup, result, nonideal, given, theory):
     return png_bytes(plt, fig)
 
 
+#: The simulation options ``map --loop`` takes with ``--simulate`` only.
+_LOOP_SIMULATION_OPTIONS = (("--steps", "steps"), ("--x0", "x0"),
+                            ("--encoder-resolution", "encoder_resolution"),
+                            ("--paper-encoder", "paper_encoder"),
+                            ("--force-limit", "force_limit"))
+
+
 def _loop(args):
-    """A loop file classified by its root counts at every cell of the grid."""
-    from ..numeric.simulate import progress_printer
+    """A loop file classified by its root counts at every cell of the grid (and simulated)."""
+    from ..numeric.simulate import check_steps, progress_printer
     from ..numeric.stability import MARGINAL, STABLE
 
     setup = resolve_loop(args)
@@ -261,13 +275,23 @@ def _loop(args):
     xs, ys = _grid(args.x_range, "--x-range"), _grid(args.y_range, "--y-range")
     out, png_path = map_outputs(args)
     loop, values = setup.loop, setup.values
+    simulate = bool(args.simulate)
+    if not simulate:
+        for flag, dest in _LOOP_SIMULATION_OPTIONS:
+            if getattr(args, dest) not in (None, False):
+                raise ValueError(f"{flag} is an option of the simulation: add --simulate")
+    else:
+        nonideal, x0 = resolve_nonideal(args, None)
+        steps = check_steps(args.steps, values["d"])
+        # The difference equations at one cell: a plant they cannot step is refused now.
+        loop.difference_equations(**{setup.x: xs[0], setup.y: ys[0]}, **values)
     degree = loop.coefficients(**{setup.x: 0.0, setup.y: 0.0}, **values).shape[-1]
     # The cells are classified a chunk of x at a time; what stays is the codes
     # and the file's text.
     check_memory(f"a map of {xs.size} x {ys.size} cells",
                  xs.size * ys.size * _MAP_CELL_BYTES
                  + max(CHUNK_BYTES, ys.size * _BYTES_PER_COEFFICIENT * degree))
-    print(LOOP_MAP_HEADLINE)
+    print(LOOP_SIMULATE_HEADLINE if simulate else LOOP_MAP_HEADLINE)
     for line in setup.echo:
         print(line)
     code = np.empty((xs.size, ys.size), dtype=np.int8)
@@ -277,11 +301,20 @@ def _loop(args):
         code[part] = loop.classify(**{setup.x: X, setup.y: Y}, **values)
         progress(part.stop)
     stable = code == STABLE
+    simulated = None
+    if simulate:
+        simulated = loop.stability_map(xs, ys, x=setup.x, y=setup.y, steps=steps, x0=x0,
+                                       nonideal=nonideal,
+                                       progress=progress_printer("simulating", steps),
+                                       **{k: v for k, v in values.items()})
     if out.suffix == ".npz":
         buf = io.BytesIO()
+        extra = {} if simulated is None else {
+            "simulated_stable": simulated.stable.T, "growth": simulated.growth.T,
+            "steps": steps, "x0": x0, "nonidealities": np.array(loop_nonideal_text(nonideal))}
         np.savez(buf, x=xs, y=ys, x_name=np.array(setup.x), y_name=np.array(setup.y),
                  x_unit=np.array(setup.unit(setup.x)), y_unit=np.array(setup.unit(setup.y)),
-                 code=code, stable=stable,
+                 code=code, stable=stable, **extra,
                  values=np.array([value_text(setup, n, values[n]) for n in loop.parameters
                                   if n in values]),
                  loop=np.array(str(setup.path)))
@@ -289,11 +322,19 @@ def _loop(args):
     else:
         X, Y = np.meshgrid(xs, ys, indexing="ij")
         buf = io.StringIO()
-        buf.write(f"{setup.label(setup.x)},{setup.label(setup.y)},code,stable\n")
-        for xv, yv, c in zip(X.ravel(), Y.ravel(), code.ravel()):
-            buf.write(f"{xv:.12g},{yv:.12g},{int(c)},{int(c == STABLE)}\n")
+        buf.write(f"{setup.label(setup.x)},{setup.label(setup.y)},code,stable"
+                  + (",simulated_stable,growth" if simulated is not None else "") + "\n")
+        columns = [X.ravel(), Y.ravel(), code.ravel()]
+        if simulated is not None:
+            columns += [simulated.stable.T.ravel(), simulated.growth.T.ravel()]
+        for xv, yv, c, *sim in zip(*columns):
+            row = f"{xv:.12g},{yv:.12g},{int(c)},{int(c == STABLE)}"
+            if sim:
+                row += f",{int(sim[0])},{sim[1]:.6g}"
+            buf.write(row + "\n")
         data = buf.getvalue()
-    image = _loop_png(setup, xs, ys, code) if png_path is not None else None
+    image = (_loop_png(setup, xs, ys, code, None if simulated is None else simulated.stable.T)
+             if png_path is not None else None)
     write_output(out, data, "--out")
     written = [str(out)]
     if image is not None:
@@ -301,12 +342,23 @@ def _loop(args):
         written.append(str(png_path))
     print(f"{int(stable.sum())} of {code.size} cells stable, {int((code == MARGINAL).sum())} "
           f"marginal (code 1 stable, 0 marginal, -1 unstable; certified root counts)")
+    if simulated is not None:
+        decided = code != MARGINAL
+        differ = int(np.count_nonzero((simulated.stable.T != stable) & decided))
+        print(f"{int(simulated.stable.sum())} of {code.size} cells stable by simulation "
+              f"({steps} periods; {loop_nonideal_text(nonideal)}); {differ} of the "
+              f"{int(decided.sum())} cells that are not marginal differ from the root counts")
     print("wrote " + ", ".join(written))
     return 0
 
 
-def _loop_png(setup, xs, ys, code):
-    """The map as PNG bytes (None without matplotlib), with the D-decomposition drawn over it."""
+def _loop_png(setup, xs, ys, code, simulated=None):
+    """The map as PNG bytes (None without matplotlib), with the D-decomposition drawn over it.
+
+    Shaded by the root counts, or by the simulation (``simulated``, stable
+    cells by ``(x, y)``) where one ran: the D-decomposition drawn over it is
+    the root counts' boundary.
+    """
     from ..numeric.stability import MARGINAL, STABLE
 
     plt = pyplot_or_none()
@@ -317,14 +369,16 @@ def _loop_png(setup, xs, ys, code):
 
     loop, x, y = setup.loop, setup.x, setup.y
     fig, ax = plt.subplots(figsize=(6.4, 4.8), dpi=120)
-    shade = np.where(code == STABLE, 2, np.where(code == MARGINAL, 1, 0)).T
+    shade = (np.where(code == STABLE, 2, np.where(code == MARGINAL, 1, 0)) if simulated is None
+             else np.where(simulated, 2, 0)).T
     ax.pcolormesh(xs, ys, shade, shading="nearest", vmin=0, vmax=2,
                   cmap=ListedColormap(["white", "#bdbdbd", "#7fc97f"]))
     curve = loop.boundary(x=x, y=y, window=((xs[0], xs[-1]), (ys[0], ys[-1])), **setup.values)
     bx, by = visible(curve.x_values, xs[0], xs[-1]), visible(curve.y_values, ys[0], ys[-1])
     bx[np.isnan(by)] = np.nan
-    handles = [Patch(facecolor="#7fc97f", label="stable")]
-    if np.any(code == MARGINAL):
+    handles = [Patch(facecolor="#7fc97f", label="stable" if simulated is None
+                     else "stable by simulation")]
+    if simulated is None and np.any(code == MARGINAL):
         handles.append(Patch(facecolor="#bdbdbd", label="marginal"))
     if np.any(np.isfinite(bx)):
         handles += ax.plot(bx, by, "k-", lw=1.2, label=r"$z = e^{j\theta}$ root (D-decomposition)")
@@ -342,8 +396,9 @@ def _loop_png(setup, xs, ys, code):
     # between values only: no-break spaces inside each.
     fixed = ", ".join(value_text(setup, n, setup.values[n]).replace(" ", "\u00a0")
                       for n in loop.parameters if n in setup.values)
-    ax.set_title("\n".join([f"loop {loop.name}: stable set in the ({x}, {y}) plane (root counts)"]
-                           + textwrap.wrap(fixed, 90)), fontsize=9)
+    how = "root counts" if simulated is None else "simulated; lines: root counts"
+    ax.set_title("\n".join([f"loop {loop.name}: stable set in the ({x}, {y}) plane ({how})"]
+                           + textwrap.wrap(fixed, 80)), fontsize=9)
     ax.legend(handles=handles, loc="best", fontsize=8, framealpha=0.9)
     fig.tight_layout()
     return png_bytes(plt, fig)

@@ -1,4 +1,7 @@
-"""``symstab simulate``: simulate the paper's loop at one point; write its trajectory as CSV.
+"""``symstab simulate``: simulate a loop at one point; write its trajectory as CSV.
+
+The paper's loop by default; a loop file with ``--loop`` (its values
+changed by ``--set``), run by :meth:`symstab.Loop.simulate`.
 
 The device and delay options are those of the numeric commands
 (:mod:`symstab.cli.options`), the non-idealities those of
@@ -12,9 +15,10 @@ import io
 import numpy as np
 
 from .._resources import check_memory
+from .loop_options import add_loop_options, resolve_loop, uses_loop, value_text
 from .options import add_command, add_model_options, parse_list, resolve, stiffness_and_damping
 from .output import check_files, write_output
-from .simulation import add_nonideal_options, resolve_nonideal, simulated_theory
+from .simulation import add_nonideal_options, loop_nonideal_text, resolve_nonideal, simulated_theory
 
 __all__ = ["register", "run"]
 
@@ -41,10 +45,13 @@ def register(subparsers):
     p.add_argument("--Kw", help="virtual stiffness (physical)")
     p.add_argument("--Bw", help="virtual damping (physical)")
     p.add_argument("--out", help="CSV file for the trajectory (k, t, x)")
+    add_loop_options(p, "simulate")
 
 
 def run(args):
     """Run ``symstab simulate``; return the exit status."""
+    if uses_loop(args):
+        return _loop(args)
     from ..numeric.simulate import simulate
     from ..numeric.stability import MARGINAL, STABLE, UNSTABLE
     from ..numeric.simulate import check_steps, progress_printer
@@ -85,6 +92,45 @@ def run(args):
                   + ("x [rad]" if setup.physical and not args.linear else
                      "x [m]" if setup.physical else "x") + "\n")
         np.savetxt(buf, np.column_stack([k, t, run.positions]), delimiter=",", fmt=["%d", "%.9g", "%.17g"])
+        write_output(args.out, buf.getvalue(), "--out")
+        print(f"wrote the trajectory to {args.out}")
+    return 0
+
+
+def _loop(args):
+    """A loop file simulated at its values changed by ``--set``, its root count beside."""
+    from ..numeric.simulate import check_steps, progress_printer
+    from ..numeric.stability import MARGINAL, STABLE, UNSTABLE
+
+    setup = resolve_loop(args, plane=False)
+    loop, values = setup.loop, setup.values
+    nonideal, x0 = resolve_nonideal(args, None)
+    check_files([("--out", args.out)])
+    steps = check_steps(args.steps, values["d"])
+    record = args.out is not None
+    if record:
+        check_memory(f"the --out trajectory of {steps} periods", (steps + 1) * _TRAJECTORY_ROW_BYTES)
+    loop.difference_equations(**values)        # a plant it cannot step is refused before the run
+    code = int(loop.classify(**values))
+    radius = float(loop.spectral_radius(**values))
+    run = loop.simulate(steps=steps, x0=x0, nonideal=nonideal, record=record,
+                        progress=progress_printer("simulating", steps), **values)
+    for line in setup.echo:
+        print(line)
+    verdict = "diverged (unstable)" if run.diverged else ("stable" if run.stable else "unstable")
+    if run.stable and run.amplitude[3] > 0.25 * run.amplitude[0]:
+        verdict = (f"bounded, not decaying (a limit cycle of amplitude {run.amplitude[3]:.4g}: "
+                   f"the verdict compares the last two quarters)")
+    print(f"simulated {run.steps} periods from x0 = {x0:g} ({loop_nonideal_text(nonideal)}): "
+          f"{verdict}; max |x| per quarter: " + ", ".join(f"{a:.4g}" for a in run.amplitude))
+    print(f"theory (the loop's certified root count): spectral radius {radius:.12g} -> "
+          + {STABLE: "stable", MARGINAL: "marginal", UNSTABLE: "unstable"}[code])
+    if record:
+        k = np.arange(run.steps + 1)
+        buf = io.StringIO()
+        buf.write(f"k,t [s],x (SI; {value_text(setup, 'T', values['T'])})\n")
+        np.savetxt(buf, np.column_stack([k, k * float(values["T"]), run.positions]),
+                   delimiter=",", fmt=["%d", "%.9g", "%.17g"])
         write_output(args.out, buf.getvalue(), "--out")
         print(f"wrote the trajectory to {args.out}")
     return 0

@@ -6,7 +6,8 @@ device options (the default device is the paper's);
 and actuator lag included), whose root count each simulation is compared with.
 """
 
-__all__ = ["add_nonideal_options", "resolve_nonideal", "simulated_theory", "nonideal_text"]
+__all__ = ["add_nonideal_options", "resolve_nonideal", "simulated_theory", "nonideal_text",
+           "loop_nonideal_text"]
 
 
 def add_nonideal_options(p):
@@ -23,8 +24,11 @@ def add_nonideal_options(p):
     g.add_argument("--friction-compensation", action="store_true",
                    help="add the Coulomb friction times sign(estimated velocity) to the command")
     g.add_argument("--actuator-bandwidth", type=float, metavar="HZ", help="first-order lag, Hz")
-    g.add_argument("--substeps", type=int, default=20,
-                   help="sub-steps per period for friction and the actuator lag (default 20)")
+    g.add_argument("--substeps", type=int,
+                   help="sub-steps per period for friction and the actuator lag (default 20; "
+                        "only with --coulomb or --actuator-bandwidth)")
+    g.add_argument("--force-limit", type=float, metavar="F",
+                   help="largest force command, N or N m (the amplifier's saturation)")
     p.add_argument("--steps", type=int, help="periods to simulate (default 12000 + 800 d)")
     p.add_argument("--x0", type=float, default=None,
                    help="initial position, m or rad (default 1; 0.01 with non-idealities)")
@@ -39,14 +43,21 @@ def resolve_nonideal(args, setup):
         if resolution is not None:
             raise ValueError("give --encoder-resolution or --paper-encoder, not both")
         resolution = PAPER_ENCODER_RESOLUTION
+    if args.substeps is not None and args.coulomb is None and args.actuator_bandwidth is None:
+        raise ValueError("--substeps divides the period for Coulomb friction and the actuator "
+                         "lag: give --coulomb or --actuator-bandwidth, or drop --substeps")
     nonideal = Nonidealities(encoder_resolution=resolution, velocity_cutoff=args.velocity_cutoff,
                              coulomb_friction=args.coulomb, stiction=args.stiction,
                              friction_compensation=args.friction_compensation,
-                             actuator_bandwidth=args.actuator_bandwidth, substeps=args.substeps)
-    if not nonideal.ideal and not setup.physical:
+                             actuator_bandwidth=args.actuator_bandwidth,
+                             substeps=20 if args.substeps is None else args.substeps,
+                             force_limit=args.force_limit)
+    if setup is None:       # a loop file: its values are physical (SI)
+        pass
+    elif not nonideal.ideal and not setup.physical:
         raise ValueError("non-idealities are in physical units: use --m --b --T --Td (or their "
                          "defaults), not --delta")
-    if setup.physical:
+    if setup is not None and setup.physical:
         nonideal.check(setup.device.T)
     # Checked here, not only by the simulator, so that nothing is printed before the error.
     x0 = check_x0(args.x0) if args.x0 is not None else (1.0 if nonideal.ideal else 0.01)
@@ -54,8 +65,8 @@ def resolve_nonideal(args, setup):
 
 
 def simulated_theory(setup, nonideal):
-    """The :class:`symstab.numeric.simulate.LinearTheory` of the loop simulated."""
-    from ..numeric.simulate import linear_theory
+    """The :class:`symstab.numeric.simulate_theory.LinearTheory` of the loop simulated."""
+    from ..numeric.simulate_theory import linear_theory
 
     return linear_theory(gamma=setup.gamma, d=setup.d, delta=setup.delta,
                          device=setup.device, nonideal=nonideal)
@@ -75,4 +86,16 @@ def nonideal_text(nonideal, args):
                      + (", compensated" if nonideal.friction_compensation else ""))
     if nonideal.actuator_bandwidth is not None:
         parts.append(f"actuator lag {nonideal.actuator_bandwidth:g} Hz")
+    if nonideal.force_limit is not None:
+        parts.append(f"force limit {nonideal.force_limit:g} {force}")
     return ", ".join(parts) if parts else "ideal loop: no quantization, filter, friction or lag"
+
+
+def loop_nonideal_text(nonideal):
+    """A loop file's non-idealities in one line (its SI units: position m or rad, force N or N m)."""
+    parts = []
+    if nonideal.encoder_resolution is not None:
+        parts.append(f"encoder quantum {nonideal.encoder_resolution:.4g}")
+    if nonideal.force_limit is not None:
+        parts.append(f"force limit {nonideal.force_limit:g}")
+    return ("ideal loop" if not parts else ", ".join(parts) + " (SI units of the loop file)")

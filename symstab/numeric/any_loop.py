@@ -960,6 +960,123 @@ class Loop(LoopModel):
         return passive_region(self, x, y, damping=damping, x_range=x_range, y_range=y_range,
                               **values)
 
+    def difference_equations(self, **values):
+        """The loop's difference equations per point: ``(a, b, c, e)``, ``d`` and the shape.
+
+        The plant's sampled step ``P_d(z) y = P_n(z) u`` and the environment
+        ``Ve_d(z) f = Ve_n(z) x_s``, both divided by their leading
+        coefficient: ``y[k] = sum_i (b[i] u[k-1-i] - a[i] y[k-1-i])`` and
+        ``f[k] = e[0] x_s[k] + sum_i (e[i+1] x_s[k-1-i] - c[i] f[k-1-i])``.
+        The loop is closed by ``u[k] = -f[k - d]``, so that its
+        characteristic polynomial is :meth:`polynomial`'s ``chi``.
+
+        Parameters
+        ----------
+        **values
+            Every parameter (or its default); arrays broadcast.
+
+        Returns
+        -------
+        ((ndarray, ndarray, ndarray, ndarray), int, tuple)
+            ``a`` and ``b`` of length ``deg P_d``, ``c`` of length ``deg
+            Ve_d`` and ``e`` one longer, each of shape ``shape + (k,)``;
+            the delay; the broadcast shape.
+
+        Raises
+        ------
+        ValueError
+            For a plant with direct feed-through (``P_n`` as high as ``P_d``),
+            a leading coefficient 0, or values that overflow.
+        """
+        values, d, shape = self._prepare(values)
+        p_n, p_d, _, _ = self._plant_arrays(values, shape)
+        ve_n, ve_d = self._environment_arrays(values, shape)
+        n, m = p_d.shape[-1] - 1, ve_d.shape[-1] - 1
+        p_n = np.concatenate([np.zeros(shape + (n + 1 - p_n.shape[-1],)), p_n], axis=-1)
+        ve_n = np.concatenate([np.zeros(shape + (m + 1 - ve_n.shape[-1],)), ve_n], axis=-1)
+        with np.errstate(all="ignore"):
+            if np.any(p_n[..., 0] != 0):
+                raise ValueError("the plant has direct feed-through (G(s) is not strictly "
+                                 "proper): the sampled position would depend on the force of "
+                                 "the same instant; not simulated")
+            lead_p, lead_e = p_d[..., :1], ve_d[..., :1]
+            if np.any(lead_p == 0) or np.any(lead_e == 0):
+                raise ValueError("the leading coefficient of P_d or Ve_d is 0 at these values")
+            parts = (p_d[..., 1:] / lead_p, p_n[..., 1:] / lead_p, ve_d[..., 1:] / lead_e,
+                     ve_n / lead_e)
+        self._finite(np.concatenate(parts, axis=-1), values)
+        return parts, d, shape
+
+    def simulate(self, *, steps=None, x0=1.0, v0=None, nonideal=None, record=False,
+                 progress=None, **values):
+        """Run the loop in time for every parameter point at once.
+
+        The plant's exact ZOH step on the samples, the environment's
+        difference equation and the delay line
+        (:func:`symstab.numeric.simulate.simulate_loop` says how, and which
+        non-idealities a loop has); stable when the last quarter of the run
+        does not outgrow the third.
+
+        Parameters
+        ----------
+        steps : int, optional
+            Periods (default: 12000 + 800 d).
+        x0, v0 : float
+            Initial position and its change per period (default ``x0 / 100``).
+        nonideal : symstab.numeric.simulate.Nonidealities, optional
+            Encoder quantization and force saturation.
+        record : bool
+            Keep every position.
+        progress : callable, optional
+            Called with the number of steps done.
+        **values
+            The loop's parameters (or their defaults); arrays broadcast.
+
+        Returns
+        -------
+        symstab.numeric.simulate.Simulation
+
+        Examples
+        --------
+        >>> loop = Loop("1/(m*s**2 + b*s)", "K + B*(z - 1)/(T*z)")
+        >>> run = loop.simulate(K=[100.0, 3000.0], B=0.5, m=0.0128, b=0.0324, T=1e-3, d=1,
+        ...                     steps=4000)
+        >>> run.stable.tolist()
+        [True, False]
+        """
+        from .simulate import simulate_loop
+
+        return simulate_loop(self, steps=steps, x0=x0, v0=v0, nonideal=nonideal, record=record,
+                             progress=progress, **values)
+
+    def stability_map(self, x_values, y_values, *, x=None, y=None, steps=None, x0=1.0, v0=None,
+                      nonideal=None, progress=None, **values):
+        """Stable cells of an ``(x, y)`` grid by simulation (:meth:`simulate` on every cell).
+
+        Parameters
+        ----------
+        x_values, y_values : array_like
+            1-D grids.
+        x, y : str, optional
+            The plane (default: :attr:`plane`).
+        steps, x0, v0, nonideal
+            As in :meth:`simulate`.
+        progress : callable or True
+            ``True`` draws a progress bar on stderr for runs over 2 s.
+        **values
+            Single values of the other parameters.
+
+        Returns
+        -------
+        symstab.numeric.simulate.StabilityMap
+            ``stable`` of shape ``(len(y_values), len(x_values))``.
+        """
+        from .simulate import loop_stability_map
+
+        x, y = self._plane(x, y)
+        return loop_stability_map(self, x_values, y_values, x=x, y=y, steps=steps, x0=x0, v0=v0,
+                                  nonideal=nonideal, progress=progress, **values)
+
     def design(self, *, over, maximize="y_max", x=None, y=None, n=None, rtol=1e-6, damping="b",
                progress=None, **values):
         """The value of one or two parameters that maximises K_max, the Z-width or the passive K_max.

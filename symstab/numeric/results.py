@@ -24,7 +24,8 @@ __all__ = ["Limits", "Boundary", "Segment"]
 PAPER_PLANE = ("beta", "alpha")
 
 
-def _paper_alias(name, field):
+def paper_alias(name, field):
+    """A property ``name`` of a result in the paper's (beta, alpha) plane: ``field`` there, else AttributeError."""
     def get(self):
         if (self.x, self.y) != PAPER_PLANE:
             raise AttributeError(
@@ -37,7 +38,8 @@ def _paper_alias(name, field):
     return property(get)
 
 
-def _paper_parameter(name):
+def paper_parameter(name):
+    """A property ``name``: the paper's parameter ``at[name]`` of a result in its (beta, alpha) plane."""
     def get(self):
         if (self.x, self.y) != PAPER_PLANE or name not in self.at:
             raise AttributeError(f"{name} is a parameter of the paper's (beta, alpha) plane; "
@@ -115,13 +117,13 @@ class Limits:
     at: dict = dataclasses.field(default_factory=dict)
     line: object = dataclasses.field(default=None, compare=False)
 
-    alpha_max = _paper_alias("alpha_max", "y_max")
-    beta_at_alpha_max = _paper_alias("beta_at_alpha_max", "x_at_y_max")
-    beta_left = _paper_alias("beta_left", "x_min")
-    beta_min = _paper_alias("beta_min", "x_min")
-    beta_right = _paper_alias("beta_right", "x_max")
-    beta_max = _paper_alias("beta_max", "x_max")
-    z_width = _paper_alias("z_width", "area")
+    alpha_max = paper_alias("alpha_max", "y_max")
+    beta_at_alpha_max = paper_alias("beta_at_alpha_max", "x_at_y_max")
+    beta_left = paper_alias("beta_left", "x_min")
+    beta_min = paper_alias("beta_min", "x_min")
+    beta_right = paper_alias("beta_right", "x_max")
+    beta_max = paper_alias("beta_max", "x_max")
+    z_width = paper_alias("z_width", "area")
 
     @property
     def message(self):
@@ -241,10 +243,10 @@ class Segment:
     x: str = "x"
     y: str = "y"
 
-    beta0 = _paper_alias("beta0", "x0")
-    alpha0 = _paper_alias("alpha0", "y0")
-    beta1 = _paper_alias("beta1", "x1")
-    alpha1 = _paper_alias("alpha1", "y1")
+    beta0 = paper_alias("beta0", "x0")
+    alpha0 = paper_alias("alpha0", "y0")
+    beta1 = paper_alias("beta1", "x1")
+    alpha1 = paper_alias("alpha1", "y1")
 
 
 @dataclasses.dataclass(frozen=True, repr=False)
@@ -298,11 +300,11 @@ class Boundary:
     reason: str = ""
     at: dict = dataclasses.field(default_factory=dict)
 
-    alpha = _paper_alias("alpha", "y_values")
-    beta = _paper_alias("beta", "x_values")
-    gamma = _paper_parameter("gamma")
-    d = _paper_parameter("d")
-    delta = _paper_parameter("delta")
+    alpha = paper_alias("alpha", "y_values")
+    beta = paper_alias("beta", "x_values")
+    gamma = paper_parameter("gamma")
+    d = paper_parameter("d")
+    delta = paper_parameter("delta")
 
     @property
     def message(self):

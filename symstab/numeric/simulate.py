@@ -13,6 +13,9 @@ Non-idealities (:class:`Nonidealities`, physical units, each off by
 default) need a :class:`symstab.numeric.units.Device`:
 
 * ``encoder_resolution`` -- the sampled position is rounded to this step;
+* ``force_limit`` -- the force command is clipped to this size (the
+  amplifier's saturation: an unstable linear loop then grows into a bounded
+  limit cycle, which the verdict calls bounded, not growing);
 * ``velocity_cutoff`` -- the velocity used by the damper and mass terms is
   the backward difference passed through a first-order low-pass filter
   (pole ``exp(-2 pi f_c T)``, unit DC gain); the mass term differences the
@@ -41,7 +44,14 @@ resolution of the encoder.  The default horizon grows with the delay; near
 the boundary the modes have ``|z|`` close to 1 and any finite horizon
 leaves a band of undecidable cells, which the tests count.
 
-The theory to compare a run with (:func:`linear_theory`) is that of the loop
+Any :class:`symstab.Loop` runs the same way (:func:`simulate_loop`,
+:meth:`symstab.Loop.simulate`, :meth:`symstab.Loop.stability_map`): its
+plant's exact ZOH step on the samples, its environment's difference
+equation, the delay line, the same verdict; its theory is its own root
+count.
+
+The theory to compare a run with
+(:func:`~symstab.numeric.simulate_theory.linear_theory`) is that of the loop
 simulated: its linear part, the velocity filter and the actuator lag
 included (a :class:`symstab.Loop`), quantization and friction left out.  On
 the README's grid (d = 10, K_w in [0, 70], B_w in [-0.1, 2], 100 x 100) with
@@ -50,7 +60,6 @@ a 100 Hz filter the simulation agrees with it on all 9918 cells it decides
 """
 
 import dataclasses
-import functools
 import math
 import sys
 import time
@@ -60,11 +69,12 @@ import numpy as np
 from .._generated import kernels
 from .._resources import MAX_STEPS_ENV, check_memory, chunk_slices
 from .._resources import max_steps as _max_steps_setting
-from .._validate import check_array, check_box, check_delay, check_loop, check_real
+from .._validate import check_array, check_delay, check_loop, check_real
+from .results import PAPER_PLANE, paper_alias, paper_parameter
 
 __all__ = ["Nonidealities", "Simulation", "simulate", "StabilityMap", "stability_map",
            "default_horizon", "check_steps", "check_x0", "max_steps", "progress_printer", "PAPER_ENCODER_RESOLUTION",
-           "MAX_STEPS_ENV", "LinearTheory", "linear_theory"]
+           "MAX_STEPS_ENV", "simulate_loop", "loop_stability_map"]
 
 #: The most sub-steps per period: each multiplies the simulation's time (a
 #: billion once hung it), and the held-mean approximation they refine is
@@ -111,6 +121,8 @@ class Nonidealities:
     substeps : int
         Sub-steps per period for friction and the actuator lag, 1 to
         :data:`MAX_SUBSTEPS`.
+    force_limit : float
+        Largest force command (N or N m), > 0: the command is clipped to it.
     """
 
     encoder_resolution: float = None
@@ -120,6 +132,7 @@ class Nonidealities:
     friction_compensation: bool = False
     actuator_bandwidth: float = None
     substeps: int = 20
+    force_limit: float = None
 
     def __post_init__(self):
         # Checked at construction, so that a wrong kind never reaches a run:
@@ -142,6 +155,8 @@ class Nonidealities:
             raise ValueError("friction_compensation needs coulomb_friction")
         if self.actuator_bandwidth is not None:
             check_real("actuator_bandwidth", self.actuator_bandwidth, low=0.0, low_open=True)
+        if self.force_limit is not None:
+            check_real("force_limit", self.force_limit, low=0.0, low_open=True)
         if isinstance(self.substeps, (bool, np.bool_)) or \
                 not isinstance(self.substeps, (int, np.integer)):
             raise TypeError(f"substeps must be an integer >= 1, got "
@@ -173,7 +188,8 @@ class Nonidealities:
     @property
     def ideal(self):
         return (self.encoder_resolution is None and self.velocity_cutoff is None
-                and self.coulomb_friction is None and self.actuator_bandwidth is None)
+                and self.coulomb_friction is None and self.actuator_bandwidth is None
+                and self.force_limit is None)
 
     @property
     def needs_substeps(self):
@@ -404,13 +420,7 @@ def simulate(*, alpha, beta, gamma, d, delta, steps=None, x0=1.0, v0=None, devic
         _run(run, steps, amplitude[:, part], None if positions is None else positions[:, part],
              progress, report, number, len(chunks))
         diverged[part] = run.diverged
-    amplitude[:, diverged] = np.inf
-    floor = 4 * nonideal.encoder_resolution if nonideal.encoder_resolution else 0.0
-    stable = ~diverged & (amplitude[3] <= np.maximum(amplitude[2], floor))
-    return Simulation(
-        positions=None if positions is None else positions.reshape((steps + 1,) + shape),
-        amplitude=amplitude.reshape((4,) + shape),
-        diverged=diverged.reshape(shape), stable=stable.reshape(shape), steps=steps)
+    return _verdict(amplitude, diverged, positions, shape, steps, nonideal)
 
 
 def _run(run, steps, amplitude, positions, progress, report, chunk, n_chunks):
@@ -467,9 +477,12 @@ class _Loop:
                 self.lag_mean = -math.expm1(-h) / h   # mean of exp(-t) over [0, h]
             else:
                 self.lag = None
+            self.force_limit = (None if nonideal.force_limit is None
+                                else nonideal.force_limit * force_scale)
         else:
             self.coulomb = self.stiction = 0.0
             self.filter_pole = self.lag = None
+            self.force_limit = None
         self.v_hat = np.zeros(n)          # filtered velocity estimate (times T)
         self.applied = np.zeros(n)        # actuator output
         self.ideal = nonideal.ideal and not nonideal.friction_compensation
@@ -548,6 +561,8 @@ class _Loop:
     def _step_general(self):
         xs = self._sample(self.x)
         command = self._command(xs)
+        if self.force_limit is not None:
+            command = np.clip(command, -self.force_limit, self.force_limit)
         self.history[1][...] = self.history[0]
         self.history[0][...] = xs
         slot = self.k % (self.d + 1)
@@ -608,28 +623,44 @@ class _Loop:
 
 @dataclasses.dataclass(frozen=True)
 class StabilityMap:
-    """Stability by simulation on a grid.
+    """Stability by simulation on a grid of the ``(x, y)`` plane.
 
     Attributes
     ----------
-    alpha, beta : ndarray
+    y_values, x_values : ndarray
         The 1-D grids.
     stable : ndarray of bool
-        Shape ``(len(alpha), len(beta))``.
+        Shape ``(len(y_values), len(x_values))``.
     growth : ndarray
         Last quarter's amplitude over the third's (``inf`` when diverged).
-    gamma, d, delta, steps
-        The run's parameters.
+    steps : int
+        Periods simulated.
+    x, y : str
+        The plane (``"beta"``, ``"alpha"``: the paper's, Table I's variables).
+    at : dict
+        The other parameters' values (the paper's ``gamma``, ``d``, ``delta``).
+
+    Notes
+    -----
+    In the paper's plane ``alpha`` and ``beta`` are aliases of the grids and
+    ``gamma``, ``d``, ``delta`` of :attr:`at`, as in
+    :class:`~symstab.numeric.results.Limits`.
     """
 
-    alpha: np.ndarray
-    beta: np.ndarray
+    y_values: np.ndarray
+    x_values: np.ndarray
     stable: np.ndarray
     growth: np.ndarray
-    gamma: float
-    d: int
-    delta: float
     steps: int
+    x: str = PAPER_PLANE[0]
+    y: str = PAPER_PLANE[1]
+    at: dict = dataclasses.field(default_factory=dict)
+
+    alpha = paper_alias("alpha", "y_values")
+    beta = paper_alias("beta", "x_values")
+    gamma = paper_parameter("gamma")
+    d = paper_parameter("d")
+    delta = paper_parameter("delta")
 
 
 def stability_map(*, alpha, beta, gamma, d, delta, steps=None, x0=1.0, v0=None, device=None,
@@ -672,248 +703,224 @@ def stability_map(*, alpha, beta, gamma, d, delta, steps=None, x0=1.0, v0=None, 
                    device=device, nonideal=nonideal, progress=progress)
     with np.errstate(divide="ignore", invalid="ignore"):
         growth = np.where(run.diverged, np.inf, run.amplitude[3] / run.amplitude[2])
-    return StabilityMap(alpha, beta, run.stable, growth, gamma, d,
-                        float(delta if delta is not None else device.delta), run.steps)
+    return StabilityMap(alpha, beta, run.stable, growth, run.steps, at={
+        "gamma": gamma, "d": d, "delta": float(delta if delta is not None else device.delta)})
 
 
 # --------------------------------------------------------------------------
-# The theory of the loop simulated
-
-#: The simulated loop's linear part as loop expressions, in physical units.
-#: The environment is the simulator's force law (:meth:`_Loop._command`):
-#: the damper and the mass act on the backward difference
-#: ``(z - 1)/(T z)`` passed through the filter ``v_f[k] = a v_f[k-1] +
-#: (1 - a) v[k]``, i.e. ``(1 - a) z/(z - a)`` with ``a = exp(-2 pi f_c T)``
-#: (the environment of ``examples/loops/lowpass_velocity.toml``, with the mass
-#: term differencing the filtered velocity as the simulator does).  The
-#: actuator's first-order lag is part of the plant, ``tau = 1/(2 pi f_a)``.
-_IDEAL_ENVIRONMENT = "K + B*(z - 1)/(T*z) + M*(z - 1)**2/(T**2*z**2)"
-_FILTERED_ENVIRONMENT = ("K + (B + M*(z - 1)/(T*z))*(1 - exp(-2*pi*f_c*T))*(z - 1)"
-                         "/(T*(z - exp(-2*pi*f_c*T)))")
-#: The device, with and without viscous friction (b = 0 cancels a pole of
-#: 1/(m s**2 + b s), so the frictionless plant is its own expression).
-_PLANTS = {(False, False): "1/(m*s**2 + b*s)", (False, True): "1/(m*s**2)",
-           (True, False): "1/((tau*s + 1)*(m*s**2 + b*s))", (True, True): "1/((tau*s + 1)*m*s**2)"}
+# Any loop: its plant's pulse transfer function and its environment, stepped
 
 
-@dataclasses.dataclass(frozen=True)
-class LinearTheory:
-    """The root-counting theory of the loop :func:`simulate` runs: its linear part.
-
-    Built by :func:`linear_theory`.  Points are given as the simulator takes
-    them (``alpha``, ``beta``; ``gamma`` and ``d`` are fixed here).  Without
-    a velocity filter or an actuator lag the linear part is the paper's loop
-    and the paper's functions answer (:func:`symstab.numeric.stability.classify`,
-    the boundary of :func:`~symstab.numeric.paper_loop.paper_point`'s loop); with either, a
-    :class:`symstab.Loop` of the paper's plant (with the lag) and the
-    environment on the filtered velocity, in the device's physical units.
-
-    Attributes
-    ----------
-    loop : symstab.Loop or None
-        The linear loop (None: the paper's loop, answered in closed form).
-    values : dict
-        The loop's values besides its plane ``(B, K)`` (physical units).
-    device : symstab.numeric.units.Device or None
-    gamma, d, delta
-        The point's virtual mass ratio, delay and ``b T / m``.
-    label : str
-        What the theory is of, e.g. "linear loop with the 100 Hz velocity filter".
-    left_out : tuple of str
-        The non-linear elements of the simulation the theory leaves out
-        (encoder quantization, Coulomb friction, friction compensation).
-    """
-
-    loop: object
-    values: dict
-    device: object
-    gamma: float
-    d: int
-    delta: float
-    label: str
-    left_out: tuple
-
-    @property
-    def description(self):
-        """:attr:`label`, and when non-linear elements are on, that they are left out.
-
-        For example "linear loop with the 50 Hz velocity filter; its linear
-        part only: encoder quantization and Coulomb friction left out".
-        """
-        if not self.left_out:
-            return self.label
-        names = list(self.left_out)
-        names = ", ".join(names[:-1]) + " and " + names[-1] if len(names) > 1 else names[0]
-        return f"{self.label}; its linear part only: {names} left out"
-
-    def _physical(self, alpha, beta):
-        return {"K": np.asarray(self.device.stiffness(alpha), dtype=float),
-                "B": np.asarray(self.device.damping(beta), dtype=float)}
-
-    def classify(self, alpha, beta):
-        """Stable (1), marginal (0) or unstable (-1) at each ``(alpha, beta)``, certified.
-
-        Parameters
-        ----------
-        alpha, beta : float or array_like
-            Broadcast together.
-
-        Returns
-        -------
-        int or ndarray of int8
-        """
-        from .stability import classify
-
-        if self.loop is None:
-            return classify(alpha=alpha, beta=beta, gamma=self.gamma, d=self.d, delta=self.delta)
-        alpha, beta = np.broadcast_arrays(check_array("alpha", alpha), check_array("beta", beta))
-        if alpha.ndim == 0:
-            return self.loop.classify(**self._physical(alpha, beta), **self.values)
-        flat_alpha, flat_beta = alpha.ravel(), beta.ravel()
-        out = np.empty(flat_alpha.size, dtype=np.int8)
-        # A chunk at a time: a point's coefficients take 8 (d + 16) bytes.
-        for part in chunk_slices(flat_alpha.size, 64 * (self.d + 16)):
-            out[part] = self.loop.classify(**self._physical(flat_alpha[part], flat_beta[part]),
-                                           **self.values)
-        return out.reshape(alpha.shape)
-
-    def spectral_radius(self, alpha, beta):
-        """Largest modulus of the closed-loop poles at one ``(alpha, beta)``.
-
-        Parameters
-        ----------
-        alpha, beta : float
-
-        Returns
-        -------
-        float
-        """
-        from .stability import spectral_radius
-
-        if self.loop is None:
-            return float(spectral_radius(alpha=alpha, beta=beta, gamma=self.gamma, d=self.d,
-                                         delta=self.delta))
-        return float(self.loop.spectral_radius(**self._physical(alpha, beta), **self.values))
-
-    def boundary(self, window):
-        """The theory's D-decomposition in the ``(beta, alpha)`` plane, to draw in ``window``.
-
-        The loop's arc sampled for the window
-        (:meth:`symstab.Loop.boundary`, :func:`~symstab.numeric.decomposition.window_arc`)
-        and its lines; the paper's loop, without a filter or a lag, is
-        :func:`~symstab.numeric.paper_loop.paper_point`'s, in Table I's
-        variables.
-
-        Parameters
-        ----------
-        window : ((float, float), (float, float))
-            ``((beta0, beta1), (alpha0, alpha1))``.
-
-        Returns
-        -------
-        (beta, alpha, lines)
-            The arc's points (NaN between branches and far from the window)
-            and the straight lines ``{"z = 1": (c0, c_beta, c_alpha), ...}``
-            (``c0 + c_beta beta + c_alpha alpha = 0``).
-        """
-        (b0, b1), (a0, a1) = check_box("window", window, ("beta", "alpha"))
-        if self.loop is None:
-            from .paper_loop import paper_point
-
-            loop, point = paper_point(gamma=self.gamma, d=self.d, delta=self.delta)
-            curve = loop.boundary(x="B", y="K", window=((b0, b1), (a0, a1)), **point)
-            return curve.x_values, curve.y_values, curve.lines
-        dev = self.device
-        # B = beta m / T and K = alpha m / T**2: the lines' slopes scale alike.
-        sx, sy = dev.m / dev.T, dev.m / dev.T**2
-        curve = self.loop.boundary(x="B", y="K", window=((b0 * sx, b1 * sx), (a0 * sy, a1 * sy)),
-                                   **self.values)
-        lines = {label: (c0, cb * sx, ck * sy) for label, (c0, cb, ck) in curve.lines.items()}
-        return curve.x_values / sx, curve.y_values / sy, lines
+#: Floats held per point besides the delay line and the histories: the
+#: position, the sampled position, the force and about five temporaries.
+_ANY_LOOP_FLOATS = 8
 
 
-def linear_theory(*, gamma, d, delta=None, device=None, nonideal=None):
-    """The linear part of the loop :func:`simulate` runs, to compare a run with.
+def simulate_loop(loop, *, steps=None, x0=1.0, v0=None, nonideal=None, record=False,
+                  progress=None, **values):
+    """Run a :class:`symstab.Loop` for every parameter point at once (:meth:`symstab.Loop.simulate`).
 
-    The velocity filter and the actuator lag are linear: they are in the
-    theory exactly as the simulator has them (the filter's difference
-    equation is the simulator's; the lag is the continuous first-order lag,
-    which the simulator integrates on its sub-steps to second order in
-    ``1/substeps``).  Encoder quantization, Coulomb friction and its
-    compensation are not linear: they are left out and named in
-    :attr:`LinearTheory.left_out`.
+    The plant is its exact ZOH step on the samples: the difference equation
+    of ``P(z) = Z[ZOH G] = P_n / P_d``, whose coefficients the loop derives
+    (by residues, or the matrix exponential at 30 digits where there is no
+    closed form), ``P_d(z) y = P_n(z) u``.  The environment is its
+    difference equation ``Ve_d(z) f = Ve_n(z) x_s`` on the sampled position
+    ``x_s``, and the force waits ``d`` samples: ``u[k] = -f[k - d]``, the
+    loop whose characteristic polynomial is ``chi = z**d Ve_d P_d + Ve_n
+    P_n`` (:meth:`symstab.Loop.polynomial`).  The run starts from the
+    position ``x0``, earlier positions ``x0 - k v0``, the sampled history at
+    ``x0``, no force and an empty delay line; the verdict is
+    :func:`simulate`'s.
+
+    Non-idealities on the samples (:class:`Nonidealities`, physical units):
+    ``encoder_resolution`` rounds the sampled position and ``force_limit``
+    clips the force command (a saturated
+    unstable loop may settle into a bounded limit cycle, which the verdict
+    calls bounded, not growing).  A velocity filter or an actuator lag is
+    part of a loop's own environment or plant; Coulomb friction needs the
+    plant's velocity state and is not simulated for a general loop yet.
 
     Parameters
     ----------
-    gamma, d, delta, device, nonideal
-        As in :func:`simulate` (``delta`` may be None with a device).
+    loop : symstab.Loop
+    steps, x0, v0, record, progress
+        As in :func:`simulate` (``v0`` is a position change per period,
+        default ``x0 / 100``).
+    nonideal : Nonidealities, optional
+        Only the fields above.
+    **values
+        The loop's parameters (or their defaults); arrays broadcast, ``d``
+        one integer.
 
     Returns
     -------
-    LinearTheory
+    Simulation
+        Of the broadcast shape of the values.
 
     Raises
     ------
     TypeError, ValueError
-        As :func:`simulate` for the same arguments.
-
-    Examples
-    --------
-    >>> from symstab import PAPER_DEVICE
-    >>> theory = linear_theory(gamma=0.0, d=10, device=PAPER_DEVICE,
-    ...                        nonideal=Nonidealities(velocity_cutoff=100.0))
-    >>> theory.label
-    'linear loop with the 100 Hz velocity filter'
+        For a value of the wrong kind or out of range, a non-ideality a
+        general loop does not have, a plant with direct feed-through (its
+        ``P_n`` as high as ``P_d``: the sampled position would depend on the
+        force of the same instant), or a run that does not fit in memory.
     """
-    from .units import Device
-
     nonideal = Nonidealities() if nonideal is None else nonideal
     if not isinstance(nonideal, Nonidealities):
         raise TypeError(f"nonideal must be a symstab.numeric.simulate.Nonidealities or None, "
                         f"got {type(nonideal).__name__}")
-    if device is not None and not isinstance(device, Device):
-        raise TypeError(f"device must be a symstab.Device or None, got {type(device).__name__}")
-    gamma = check_real("gamma", gamma)
-    if device is None:
-        if not nonideal.ideal:
-            raise ValueError("nonideal needs a device (physical units)")
-        if delta is None:
-            raise TypeError("delta must be a real number (or None with a device), got None")
-        gamma, d, delta = check_loop(gamma, d, delta)
+    for field, instead in (("velocity_cutoff", "write the filter into the loop's environment"),
+                           ("actuator_bandwidth", "write the lag into the loop's plant"),
+                           ("coulomb_friction", "not simulated for a general loop yet")):
+        if getattr(nonideal, field) is not None:
+            raise ValueError(f"nonideal.{field}: {instead} (the paper's simulator, "
+                             f"symstab.simulate, has it)")
+    if progress is not None and not callable(progress):
+        raise TypeError(f"progress must be a callable taking the number of steps done, or None, "
+                        f"got {type(progress).__name__}")
+    parts, d, shape = loop.difference_equations(**values)
+    steps = check_steps(steps, d)
+    x0 = check_x0(x0)
+    v0 = x0 / 100 if v0 is None else check_real("v0", v0, low=-X0_MAX, high=X0_MAX)
+    parts = [np.broadcast_to(p, shape + p.shape[-1:]).reshape(-1, p.shape[-1]) for p in parts]
+    n_points = parts[0].shape[0]
+    orders = parts[1].shape[-1] + parts[3].shape[-1]
+    point_bytes = 8 * (d + 1 + 2 * orders + sum(p.shape[-1] for p in parts) + _ANY_LOOP_FLOATS)
+    if record:
+        check_memory(f"recording {steps} periods of {n_points} point(s) at d = {d}",
+                     8 * (steps + 1) * n_points + point_bytes * n_points)
     else:
-        nonideal.check(device.T)
-        d = check_delay(d)
-        delta = device.delta
-    left_out = tuple(name for name, on in (
-        ("encoder quantization", nonideal.encoder_resolution is not None),
-        ("Coulomb friction", nonideal.coulomb_friction is not None),
-        ("friction compensation", nonideal.friction_compensation)) if on)
-    filtered = nonideal.velocity_cutoff is not None
-    lagged = nonideal.actuator_bandwidth is not None
-    if not (filtered or lagged):
-        return LinearTheory(None, {}, device, gamma, d, delta, "ideal loop", left_out)
-    parts = []
-    if filtered:
-        parts.append(f"the {nonideal.velocity_cutoff:g} Hz velocity filter")
-    if lagged:
-        parts.append(f"the {nonideal.actuator_bandwidth:g} Hz actuator lag")
-    values = {"m": device.m, "T": device.T, "d": d, "M": float(device.mass(gamma))}
-    if device.b != 0:
-        values["b"] = device.b
-    if filtered:
-        values["f_c"] = float(nonideal.velocity_cutoff)
-    if lagged:
-        values["tau"] = 1.0 / (2 * math.pi * nonideal.actuator_bandwidth)
-    loop = _linear_loop(filtered, lagged, device.b == 0)
-    return LinearTheory(loop, values, device, gamma, d, delta,
-                        "linear loop with " + " and ".join(parts), left_out)
+        check_memory(f"simulating {n_points} point(s)", 8 * 6 * n_points)
+    chunks = [slice(0, n_points)] if record else chunk_slices(n_points, point_bytes)
+    amplitude = np.zeros((4, n_points))
+    diverged = np.zeros(n_points, dtype=bool)
+    positions = np.empty((steps + 1, n_points)) if record else None
+    report = max(1, steps // 100)
+    for number, part in enumerate(chunks):
+        run = _AnyLoop([p[part] for p in parts], d, x0, v0, nonideal)
+        run.check_every = 1 if record else _CHECK_EVERY
+        _run(run, steps, amplitude[:, part], None if positions is None else positions[:, part],
+             progress, report, number, len(chunks))
+        diverged[part] = run.diverged
+    return _verdict(amplitude, diverged, positions, shape, steps, nonideal)
 
 
-@functools.lru_cache(maxsize=None)
-def _linear_loop(filtered, lagged, frictionless):
-    """The :class:`symstab.Loop` of a linear part, derived once per process."""
-    from .any_loop import Loop
+def _verdict(amplitude, diverged, positions, shape, steps, nonideal):
+    """The :class:`Simulation` of a run: unstable when the last quarter outgrows the third."""
+    amplitude[:, diverged] = np.inf
+    floor = 4 * nonideal.encoder_resolution if nonideal.encoder_resolution else 0.0
+    stable = ~diverged & (amplitude[3] <= np.maximum(amplitude[2], floor))
+    return Simulation(
+        positions=None if positions is None else positions.reshape((steps + 1,) + shape),
+        amplitude=amplitude.reshape((4,) + shape),
+        diverged=diverged.reshape(shape), stable=stable.reshape(shape), steps=steps)
 
-    return Loop(_PLANTS[lagged, frictionless],
-                _FILTERED_ENVIRONMENT if filtered else _IDEAL_ENVIRONMENT,
-                name="simulated_linear_part", plane=("B", "K"))
+
+class _AnyLoop:
+    """A loop's samples for N points: :meth:`step` advances one period.
+
+    ``a``, ``b``: the plant's ``P_d`` (monic, without its leading 1) and
+    ``P_n`` (its coefficients of ``z**(n-1) .. 1``); ``c``, ``e``: the
+    environment's ``Ve_d`` (monic, without its leading 1) and ``Ve_n``
+    (``z**m .. 1``).  Histories are lists, newest first, rotated (no copies).
+    """
+
+    def __init__(self, parts, d, x0, v0, nonideal):
+        a, b, c, e = parts
+        n_points = a.shape[0]
+        self.a, self.b, self.c, self.e = (np.ascontiguousarray(p.T) for p in (a, b, c, e))
+        self.d = d
+        self.quantum = nonideal.encoder_resolution
+        self.force_limit = nonideal.force_limit
+        n, m = a.shape[1], c.shape[1]
+        self.x = np.full(n_points, float(x0))
+        # y[k-1], y[k-2], ... before the start: x0 - k v0; no force applied yet.
+        self.y_past = [np.full(n_points, x0 - k * v0) for k in range(1, n + 1)]
+        self.u_past = [np.zeros(n_points) for _ in range(n)]
+        sampled = self._sample(self.x)
+        self.s_past = [np.array(sampled) for _ in range(m)]
+        self.f_past = [np.zeros(n_points) for _ in range(m)]
+        self.forces = np.zeros((d + 1, n_points))
+        self.k = 0
+        self.diverged = np.zeros(n_points, dtype=bool)
+        self.check_every = _CHECK_EVERY
+
+    def _sample(self, x):
+        q = self.quantum
+        return x if not q else q * np.round(x / q)
+
+    def step(self):
+        # The environment's force from the sampled position of this instant.
+        sampled = self._sample(self.x)
+        force = self.e[0] * sampled
+        for k in range(len(self.f_past)):
+            force += self.e[k + 1] * self.s_past[k] - self.c[k] * self.f_past[k]
+        self.s_past = [sampled if self.quantum else sampled.copy()] + self.s_past[:-1]
+        self.f_past = [force] + self.f_past[:-1]
+        command = force
+        if self.force_limit is not None:
+            command = np.clip(command, -self.force_limit, self.force_limit)
+        self.forces[self.k % (self.d + 1)] = command
+        held = -self.forces[(self.k - self.d) % (self.d + 1)]
+        self.k += 1
+        # The plant's next sample: P_d(z) y = P_n(z) u.
+        self.y_past = [self.x] + self.y_past[:-1]
+        self.u_past = [held] + self.u_past[:-1]
+        x = np.zeros_like(self.x)
+        for k in range(len(self.y_past)):
+            x += self.b[k] * self.u_past[k] - self.a[k] * self.y_past[k]
+        self.x = x
+        if self.k % self.check_every == 0:
+            self.freeze_diverged()
+
+    def freeze_diverged(self):
+        """Mark the points whose state left [-1e100, 1e100] or is not finite; zero them."""
+        bad = ~(np.abs(self.x) < _OVERFLOW)
+        for history in (self.y_past, self.u_past, self.f_past):
+            for value in history:
+                bad |= ~np.isfinite(value)
+        if bad.any():
+            self.diverged |= bad
+            self.x[bad] = 0.0
+            self.forces[:, bad] = 0.0
+            for history in (self.y_past, self.u_past, self.s_past, self.f_past):
+                for value in history:
+                    value[bad] = 0.0
+
+
+def loop_stability_map(loop, x_values, y_values, *, x=None, y=None, steps=None, x0=1.0, v0=None,
+                       nonideal=None, progress=None, **values):
+    """Stable cells of an ``(x, y)`` grid of a loop by simulation (:meth:`symstab.Loop.stability_map`).
+
+    Parameters
+    ----------
+    loop : symstab.Loop
+    x_values, y_values : array_like
+        1-D grids of the plane's parameters.
+    x, y : str, optional
+        The plane (default: the loop's :attr:`~symstab.Loop.plane`).
+    steps, x0, v0, nonideal, progress
+        As in :func:`simulate_loop` (``progress=True`` draws a bar).
+    **values
+        Single values of the other parameters.
+
+    Returns
+    -------
+    StabilityMap
+    """
+    x_values, y_values = check_array(x, x_values), check_array(y, y_values)
+    if x_values.ndim != 1 or y_values.ndim != 1:
+        raise ValueError(f"the grids of {x} and {y} must be 1-D")
+    for name in (x, y):
+        if name in values:
+            raise TypeError(f"{name} is an axis of the map: give its grid, not a value")
+    if progress is True:
+        progress = progress_printer("simulating", check_steps(
+            steps, check_delay(values.get("d", loop.defaults.get("d", 0)))))
+    Y, X = np.meshgrid(y_values, x_values, indexing="ij")
+    run = simulate_loop(loop, steps=steps, x0=x0, v0=v0, nonideal=nonideal, progress=progress,
+                        **{x: X, y: Y}, **values)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        growth = np.where(run.diverged, np.inf, run.amplitude[3] / run.amplitude[2])
+    at = {k: v for k, v in {**loop.defaults, **values}.items() if k not in (x, y)}
+    return StabilityMap(y_values, x_values, run.stable, growth, run.steps, x=x, y=y, at=at)

@@ -173,8 +173,8 @@ def test_map_is_todays_root_count_classification(capsys, tmp_path):
     assert status == 0, err
     assert "wrote " + str(out) in text
     # It counts roots where map of the paper's loop simulates: its first line says so.
-    assert text.splitlines()[0] == ("map --loop: root counts of the linear loop (no simulation "
-                                    "yet for a loop file)")
+    assert text.splitlines()[0] == ("map --loop: root counts of the linear loop (add --simulate "
+                                    "to simulate every cell)")
     paper = tmp_path / "paper.npz"
     status, simulated, err = run(capsys, "map", "--d", "1", "--linear", f"--Kw={grid_k}",
                                  f"--Bw={grid_b}", "--steps", "20", "--out", paper, "--no-png")

@@ -1,4 +1,4 @@
-"""The theory of the loop the simulator runs (:func:`symstab.numeric.simulate.linear_theory`).
+"""The theory of the loop the simulator runs (:func:`symstab.numeric.simulate_theory.linear_theory`).
 
 Oracles: python-control (the plant through ``c2d(..., "zoh")``, the
 simulator's filter written as transfer functions) and the loop file of the
@@ -9,7 +9,8 @@ import numpy as np
 import pytest
 
 import symstab
-from symstab.numeric.simulate import Nonidealities, linear_theory
+from symstab.numeric.simulate import Nonidealities
+from symstab.numeric.simulate_theory import linear_theory
 from symstab.numeric.stability import MARGINAL, STABLE, UNSTABLE
 
 from conftest import REPO

@@ -1,0 +1,90 @@
+"""``simulate --loop`` and ``map --loop --simulate``: a loop file run in time.
+
+Oracles: the loop's certified root counts (``symstab classify --loop``, the
+same cells), python-control's closed-loop poles for the growth of one
+trajectory, and the paper's own simulator (``symstab map`` of the paper's
+device options) on the same grid.  Bad input is one line, exit status 2,
+before the run.
+"""
+
+import numpy as np
+import pytest
+
+import symstab
+
+from conftest import REPO, run_cli as run
+
+LOOPS = REPO / "examples" / "loops"
+PAPER = LOOPS / "paper.toml"
+
+pytestmark = pytest.mark.usefixtures("loop_cache_dir")
+
+
+def test_map_simulate_agrees_with_the_root_counts_and_the_paper_simulator(capsys, tmp_path):
+    grid_k, grid_b = "0.5,40,8", "-0.05,1.2,9"
+    out = tmp_path / "loop.npz"
+    status, text, err = run(capsys, "map", "--loop", PAPER, "--set", "d=10", "--simulate",
+                            f"--x-range={grid_b}", f"--y-range={grid_k}", "--out", out)
+    assert status == 0, err
+    assert text.splitlines()[0].startswith("map --loop --simulate: every cell simulated")
+    assert "0 of the 72 cells that are not marginal differ from the root counts" in text
+    paper = tmp_path / "paper.npz"
+    status, _, err = run(capsys, "map", "--d", "10", f"--Kw={grid_k}", f"--Bw={grid_b}",
+                         "--out", paper, "--no-png")
+    assert status == 0, err
+    with np.load(out) as f, np.load(paper) as g:
+        simulated, code = f["simulated_stable"], f["code"]     # (B, K)
+        assert 0 < simulated.sum() < simulated.size
+        np.testing.assert_array_equal(simulated, code == symstab.STABLE)
+        np.testing.assert_array_equal(simulated, g["stable"].T)  # the paper's map is (K_w, B_w)
+        assert int(f["steps"]) == 12000 + 800 * 10
+    assert (tmp_path / "loop.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+
+
+def test_simulate_loop_prints_the_verdict_and_the_root_count_and_writes_the_trajectory(
+        capsys, tmp_path):
+    out = tmp_path / "t.csv"
+    status, text, err = run(capsys, "simulate", "--loop", LOOPS / "operator_arm.toml",
+                            "--set", "K=1500", "--steps", "3000", "--out", out)
+    assert status == 0, err
+    loop = symstab.load_loop(LOOPS / "operator_arm.toml")
+    radius = loop.spectral_radius(K=1500.0)
+    assert radius > 1
+    assert "simulated 3000 periods from x0 = 1 (ideal loop): unstable" in text
+    assert f"spectral radius {radius:.12g} -> unstable" in text
+    rows = np.loadtxt(out, delimiter=",", skiprows=1)
+    assert rows.shape == (3001, 3) and rows[1, 1] == pytest.approx(1e-3)
+    late, early = np.abs(rows[2600:, 2]).max(), np.abs(rows[1100:1500, 2]).max()
+    assert (late / early) ** (1 / 1500) == pytest.approx(radius, abs=1e-4)
+
+
+def test_a_saturated_unstable_loop_is_called_bounded_not_stable(capsys):
+    status, text, err = run(capsys, "simulate", "--loop", LOOPS / "operator_arm.toml",
+                            "--set", "K=3000", "--force-limit", "5", "--steps", "4000")
+    assert status == 0, err
+    assert "force limit 5" in text and "bounded, not decaying (a limit cycle" in text
+    assert "-> unstable" in text
+
+
+@pytest.mark.parametrize("args, needle", [
+    (["simulate", "--loop", PAPER, "--velocity-cutoff", "50"],
+     "a velocity filter written into the loop file's environment"),
+    (["simulate", "--loop", PAPER, "--coulomb", "0.01"], "Coulomb friction needs the plant's"),
+    (["simulate", "--loop", PAPER, "--Kw", "3"], "--Kw is an option of the paper's device"),
+    (["simulate", "--loop", PAPER, "--steps", "3"], "steps"),
+    (["simulate", "--loop", PAPER, "--force-limit", "-1"], "force_limit"),
+    (["simulate", "--Kw", "3", "--Bw", "0.1", "--substeps", "5"], "drop --substeps"),
+    (["map", "--loop", PAPER, "--x-range=0,1,3", "--y-range=0,1,3", "--out", "m.npz",
+      "--steps", "100"], "--steps is an option of the simulation: add --simulate"),
+    (["map", "--loop", PAPER, "--x-range=0,1,3", "--y-range=0,1,3", "--out", "m.npz",
+      "--simulate", "--actuator-bandwidth", "100"], "written into the loop file's plant"),
+    (["map", "--simulate", "--Kw=0,1,3", "--Bw=0,1,3", "--out", "m.npz"],
+     "--simulate needs a loop file"),
+])
+def test_bad_simulation_input_is_one_line_before_the_run(capsys, tmp_path, monkeypatch, args,
+                                                         needle):
+    monkeypatch.chdir(tmp_path)
+    status, out, err = run(capsys, *args)
+    assert status == 2 and err.count("\n") == 1 and needle in err, err
+    assert "simulated" not in out
+    assert list(tmp_path.iterdir()) == []
