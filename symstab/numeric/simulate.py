@@ -816,6 +816,21 @@ def _verdict(amplitude, diverged, positions, shape, steps, nonideal):
         diverged=diverged.reshape(shape), stable=stable.reshape(shape), steps=steps)
 
 
+def _terms(columns):
+    """``[(k, coefficient), ...]`` of the nonzero columns of ``(N, k)`` coefficients.
+
+    A column equal at every point is a float (a scalar product is faster).
+    """
+    out = []
+    for k in range(columns.shape[1]):
+        column = columns[:, k]
+        if np.all(column == 0):
+            continue
+        out.append((k, float(column[0]) if np.all(column == column[0]) else
+                    np.ascontiguousarray(column)))
+    return out
+
+
 class _AnyLoop:
     """A loop's samples for N points: :meth:`step` advances one period.
 
@@ -828,7 +843,12 @@ class _AnyLoop:
     def __init__(self, parts, d, x0, v0, nonideal):
         a, b, c, e = parts
         n_points = a.shape[0]
-        self.a, self.b, self.c, self.e = (np.ascontiguousarray(p.T) for p in (a, b, c, e))
+        # Each sum keeps its nonzero terms only (a backward difference's Ve_d
+        # is z**k: no force feedback at all), with a float coefficient where
+        # every point has the same (the plant of a plane of the environment).
+        self.a, self.b, self.c = (_terms(p) for p in (a, b, c))
+        self.e0, self.e = e[:, 0], _terms(e[:, 1:])
+        self.e0 = float(self.e0[0]) if np.all(self.e0 == self.e0[0]) else self.e0
         self.d = d
         self.quantum = nonideal.encoder_resolution
         self.force_limit = nonideal.force_limit
@@ -841,6 +861,7 @@ class _AnyLoop:
         self.s_past = [np.array(sampled) for _ in range(m)]
         self.f_past = [np.zeros(n_points) for _ in range(m)]
         self.forces = np.zeros((d + 1, n_points))
+        self._scratch = np.empty(n_points)
         self.k = 0
         self.diverged = np.zeros(n_points, dtype=bool)
         self.check_every = _CHECK_EVERY
@@ -849,26 +870,36 @@ class _AnyLoop:
         q = self.quantum
         return x if not q else q * np.round(x / q)
 
+    def _sum(self, out, terms, history, sign):
+        tmp = self._scratch
+        for k, coefficient in terms:
+            np.multiply(coefficient, history[k], out=tmp)
+            if sign > 0:
+                out += tmp
+            else:
+                out -= tmp
+
     def step(self):
         # The environment's force from the sampled position of this instant.
+        # (self.x is a new array every period, so the histories may keep it.)
         sampled = self._sample(self.x)
-        force = self.e[0] * sampled
-        for k in range(len(self.f_past)):
-            force += self.e[k + 1] * self.s_past[k] - self.c[k] * self.f_past[k]
-        self.s_past = [sampled if self.quantum else sampled.copy()] + self.s_past[:-1]
-        self.f_past = [force] + self.f_past[:-1]
-        command = force
+        force = np.multiply(self.e0, sampled)
+        self._sum(force, self.e, self.s_past, 1)
+        self._sum(force, self.c, self.f_past, -1)
+        if self.s_past:
+            self.s_past = [sampled] + self.s_past[:-1]
+            self.f_past = [force] + self.f_past[:-1]
         if self.force_limit is not None:
-            command = np.clip(command, -self.force_limit, self.force_limit)
-        self.forces[self.k % (self.d + 1)] = command
-        held = -self.forces[(self.k - self.d) % (self.d + 1)]
+            np.clip(force, -self.force_limit, self.force_limit, out=force)
+        self.forces[self.k % (self.d + 1)] = force
+        held = np.negative(self.forces[(self.k - self.d) % (self.d + 1)])
         self.k += 1
         # The plant's next sample: P_d(z) y = P_n(z) u.
         self.y_past = [self.x] + self.y_past[:-1]
         self.u_past = [held] + self.u_past[:-1]
-        x = np.zeros_like(self.x)
-        for k in range(len(self.y_past)):
-            x += self.b[k] * self.u_past[k] - self.a[k] * self.y_past[k]
+        x = np.zeros_like(held)
+        self._sum(x, self.b, self.u_past, 1)
+        self._sum(x, self.a, self.y_past, -1)
         self.x = x
         if self.k % self.check_every == 0:
             self.freeze_diverged()
