@@ -403,6 +403,13 @@ def c_function(kernel, printer):
     lines = [c_comment(kernel), c_signature(kernel), "{"]
     if kernel.c_body:
         return "\n".join(lines + [f"    {line}" for line in kernel.c_body] + ["}"])
+    # An argument the kernel does not use (a slope kernel shares its
+    # environment's signature) is cast to void: the C compiles warning-free
+    # under -Wextra, whose -Wunused-parameter would flag it.
+    used = set().union(*(e.free_symbols for _, e in replacements), *(e.free_symbols
+                                                                      for e in reduced))
+    lines += [f"    (void){symbol};" for symbol, _, _ in kernel.args
+              if isinstance(symbol, sp.Symbol) and symbol not in used]
     for symbol, expr in replacements:
         # An integer temporary (d + 1) stays an int: it is passed as one.
         ctype = "int" if expr.is_integer else "double"

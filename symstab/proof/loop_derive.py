@@ -23,7 +23,7 @@ from ..symbolic import model
 from ..codegen.generator import c_comment, c_signature, comment_text
 from ..codegen.loop_kernels import c_source, header, kernel, numpy_source
 
-__all__ = ["COMMAND", "OWNED", "MARKER", "PAPER_PLANT", "PAPER_ENVIRONMENT", "delay_parts",
+__all__ = ["COMMAND", "OWNED", "MARKER", "PAPER_PLANT", "PAPER_ENVIRONMENT", "delay_parts", "step_source", "step_orders",
            "plant_kernel", "c_name",
            "derivation_steps", "kernel_files", "file_names", "loop_files", "is_generated",
            "unit_circle_system", "paper_loop_proofs"]
@@ -117,6 +117,83 @@ def plant_kernel(loop):
                   f"at 30 digits instead.")
 
 
+def step_orders(loop):
+    """``(n, m)``: the degrees of the plant's ``P_d`` and the environment's ``Ve_d`` in ``z``.
+
+    The lengths of :meth:`symstab.Loop.difference_equations`' ``a`` and
+    ``c``, read from the symbols (no value is needed): ``P_d`` has one root
+    per pole of ``G(s)``.
+    """
+    if loop.zoh_method == "residues":
+        n = len(loop.pulse_transfer_function().as_numer_denom()[1].as_poly(model.z).all_coeffs()) - 1
+    else:
+        n = sp.degree(sp.fraction(sp.cancel(sp.together(loop.plant)))[1], model.s)
+    # The environment kernel gives Ve_n's coefficients (num...), then Ve_d's (den...).
+    m = sum(1 for name, _, _ in loop.kernels()[0].outputs if name.startswith("den")) - 1
+    return int(n), m
+
+
+def step_source(loop, prefix):
+    """C99 text of the loop's step on its samples: the environment's and the plant's difference equations.
+
+    ``<prefix>environment_step`` computes the force of this sample from the
+    sampled position and the histories, ``<prefix>plant_step`` the next
+    sample of the position from the force held over the period: the
+    difference equations of :meth:`symstab.Loop.difference_equations`, in
+    the order :meth:`symstab.Loop.simulate` sums them, for every loop (the
+    coefficients are arguments: :func:`plant_kernel`'s and the environment
+    kernel's where SymPy printed them, :meth:`symstab.Loop.difference_equations`
+    at 30 digits for any plant, complex poles and the matrix exponential
+    included).  The caller keeps the delay line (``u[k] = -force[k - d]``),
+    the quantization and the saturation.
+
+    Parameters
+    ----------
+    loop : symstab.Loop
+    prefix : str
+        The C symbols' prefix.
+
+    Returns
+    -------
+    (str, str)
+        The functions' text and their prototypes with comments.
+    """
+    n, m = step_orders(loop)
+    environment_doc = (
+        f"/* One sample of the environment's difference equation, Ve_d(z) f = Ve_n(z) x_s:\n"
+        f" * force = e[0] x_s + sum_i (e[i+1] s_past[i] - c[i] f_past[i]), i < {m};\n"
+        f" * c ({m} values): Ve_d over its leading coefficient, without the leading 1;\n"
+        f" * e ({m + 1} values): Ve_n over Ve_d's leading coefficient, highest power first;\n"
+        f" * s_past, f_past ({m} values, newest first) are shifted in place. */")
+    plant_doc = (
+        f"/* One period of the plant's exact ZOH step on the samples, P_d(z) y = P_n(z) u:\n"
+        f" * the histories shift in place (y_past[0] = x, u_past[0] = u), then\n"
+        f" * x_next = sum_i (b[i] u_past[i] - a[i] y_past[i]), i < {n};\n"
+        f" * a ({n} values): P_d over its leading coefficient, without the leading 1;\n"
+        f" * b ({n} values): P_n's coefficients of z^{n - 1} .. 1 over P_d's leading one;\n"
+        f" * u is the force held over the period: minus the force of d samples ago. */")
+    environment = (f"void {prefix}environment_step(const double *c, const double *e, "
+                   f"double *s_past, double *f_past, double x_s, double *force)")
+    plant = (f"void {prefix}plant_step(const double *a, const double *b, double *y_past, "
+             f"double *u_past, double x, double u, double *x_next)")
+    body = [environment_doc, environment, "{", "    double f = e[0] * x_s;"]
+    body += [f"    f += e[{i + 1}] * s_past[{i}];" for i in range(m)]
+    body += [f"    f -= c[{i}] * f_past[{i}];" for i in range(m)]
+    for name, first in (("s_past", "x_s"), ("f_past", "f")):
+        body += [f"    {name}[{i}] = {name}[{i - 1}];" for i in range(m - 1, 0, -1)]
+        body += [f"    {name}[0] = {first};"] if m else []
+    body += ["    *force = f;", "}", "", plant_doc, plant, "{"]
+    for name, first in (("y_past", "x"), ("u_past", "u")):
+        body += [f"    {name}[{i}] = {name}[{i - 1}];" for i in range(n - 1, 0, -1)]
+        body += [f"    {name}[0] = {first};"]
+    body += ["    double y = 0.0;"]
+    body += [f"    y += b[{i}] * u_past[{i}];" for i in range(n)]
+    body += [f"    y -= a[{i}] * y_past[{i}];" for i in range(n)]
+    body += ["    *x_next = y;", "}"]
+    prototypes = [environment_doc, environment + ";", "", plant_doc, plant + ";", ""]
+    return "\n".join(body) + "\n", prototypes
+
+
 def c_name(loop):
     """The loop's name as a C identifier (used in file names and C symbols).
 
@@ -134,11 +211,12 @@ def c_name(loop):
     return name if not name[0].isdigit() else f"loop_{name}"
 
 
-def _c_header(kernels, *, title, prefix, guard):
+def _c_header(kernels, *, title, prefix, guard, more=()):
     lines = header("c", title, COMMAND) + [f"#ifndef {guard}", f"#define {guard}", "",
                                            "#ifdef __cplusplus", 'extern "C" {', "#endif", ""]
     for k in kernels:
         lines += [c_comment(k), c_signature(k).replace(" symstab_", f" {prefix}") + ";", ""]
+    lines += list(more)
     lines += ["#ifdef __cplusplus", "}", "#endif", "", f"#endif /* {guard} */"]
     return "\n".join(lines) + "\n"
 
@@ -147,7 +225,8 @@ def kernel_files(loop):
     """``{filename: text}`` of the loop's NumPy module and C99 source and header.
 
     The NumPy module holds :meth:`symstab.Loop.kernels` (what the loop runs
-    on); the C files add :func:`plant_kernel` on the residue path.  C
+    on); the C files add :func:`plant_kernel` on the residue path and the
+    loop's step on its samples (:func:`step_source`) for every loop.  C
     symbols are ``symstab_<name>_<kernel>``.
 
     Parameters
@@ -177,7 +256,9 @@ def kernel_files(loop):
                   if loop.zoh_method != "residues" else
                   "; the plant's pulse transfer function (poles with square roots) is not "
                   "printed in C: symstab.Loop evaluates it at 30 digits."))
-    source = c_source(c_kernels, title=c_title, prefix=prefix, command=COMMAND)
+    steps, step_prototypes = step_source(loop, prefix)
+    c_title += " The loop's step on its samples (any plant: coefficients as arguments)."
+    source = c_source(c_kernels, title=c_title, prefix=prefix, command=COMMAND) + "\n" + steps
     # SymPy's C99 printer writes pi as M_PI, which <math.h> defines only
     # outside strict C99 (POSIX): define it where the compiler does not.
     pi = ("#ifndef M_PI\n#define M_PI 3.14159265358979323846264338327950288\n#endif\n"
@@ -189,7 +270,8 @@ def kernel_files(loop):
                                            command=COMMAND),
         f"{stem}_kernels.c": source,
         f"{stem}_kernels.h": _c_header(c_kernels, title=c_title, prefix=prefix,
-                                       guard=f"SYMSTAB_{stem.upper()}_KERNELS_H"),
+                                       guard=f"SYMSTAB_{stem.upper()}_KERNELS_H",
+                                       more=step_prototypes),
     }
 
 
