@@ -989,6 +989,8 @@ class Loop(LoopModel):
             a leading coefficient 0, or values that overflow.
         """
         values, d, shape = self._prepare(values)
+        # The coefficients and their working copies, about 64 floats a point.
+        check_memory("the loop's difference equations", 8 * int(np.prod(shape)) * 64)
         p_n, p_d, _, _ = self._plant_arrays(values, shape)
         ve_n, ve_d = self._environment_arrays(values, shape)
         n, m = p_d.shape[-1] - 1, ve_d.shape[-1] - 1

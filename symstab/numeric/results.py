@@ -249,8 +249,24 @@ class Segment:
     alpha1 = paper_alias("alpha1", "y1")
 
 
+class PaperGridNames:
+    """The paper's names of a result over the plane's ``x_values``, ``y_values`` and ``at``.
+
+    In the paper's (beta, alpha) plane ``alpha`` and ``beta`` are the grids
+    (``y_values``, ``x_values``) and ``gamma``, ``d``, ``delta`` the values
+    in ``at``; elsewhere they raise :class:`AttributeError`.  Shared by
+    :class:`Boundary` and :class:`symstab.numeric.simulate.StabilityMap`.
+    """
+
+    alpha = paper_alias("alpha", "y_values")
+    beta = paper_alias("beta", "x_values")
+    gamma = paper_parameter("gamma")
+    d = paper_parameter("d")
+    delta = paper_parameter("delta")
+
+
 @dataclasses.dataclass(frozen=True, repr=False)
-class Boundary:
+class Boundary(PaperGridNames):
     """Where a root of the characteristic polynomial crosses the unit circle, in an ``(x, y)`` plane.
 
     Attributes
@@ -300,11 +316,6 @@ class Boundary:
     reason: str = ""
     at: dict = dataclasses.field(default_factory=dict)
 
-    alpha = paper_alias("alpha", "y_values")
-    beta = paper_alias("beta", "x_values")
-    gamma = paper_parameter("gamma")
-    d = paper_parameter("d")
-    delta = paper_parameter("delta")
 
     @property
     def message(self):

@@ -70,7 +70,7 @@ from .._generated import kernels
 from .._resources import MAX_STEPS_ENV, check_memory, chunk_slices
 from .._resources import max_steps as _max_steps_setting
 from .._validate import check_array, check_delay, check_loop, check_real
-from .results import PAPER_PLANE, paper_alias, paper_parameter
+from .results import PAPER_PLANE, PaperGridNames
 
 __all__ = ["Nonidealities", "Simulation", "simulate", "StabilityMap", "stability_map",
            "default_horizon", "check_steps", "check_x0", "max_steps", "progress_printer", "PAPER_ENCODER_RESOLUTION",
@@ -400,8 +400,21 @@ def simulate(*, alpha, beta, gamma, d, delta, steps=None, x0=1.0, v0=None, devic
     steps = check_steps(steps, d)
     x0 = check_x0(x0)
     v0 = x0 / 100 if v0 is None else check_real("v0", v0, low=-X0_MAX, high=X0_MAX)
-    n_points = alpha.size
-    point_bytes = 8 * (d + 1 + _FLOATS_PER_POINT)
+    return _run_chunks(
+        lambda part: _Loop(alpha[part], beta[part], gamma[part], d, delta, x0, v0, device,
+                           nonideal),
+        alpha.size, 8 * (d + 1 + _FLOATS_PER_POINT), steps=steps, d=d, record=record,
+        progress=progress, nonideal=nonideal, shape=shape)
+
+
+def _run_chunks(make_run, n_points, point_bytes, *, steps, d, record, progress, nonideal, shape):
+    """Run ``n_points`` in chunks of about :data:`~symstab._resources.CHUNK_BYTES`; the :class:`Simulation`.
+
+    The one driver of both simulators: ``make_run(part)`` builds the state
+    of the points ``part`` (a :class:`_Loop` or an :class:`_AnyLoop`) of
+    ``point_bytes`` each.  Recording keeps every position, so it runs in
+    one chunk and its memory is checked first.
+    """
     if record:
         check_memory(f"recording {steps} periods of {n_points} point(s) at d = {d}",
                      8 * (steps + 1) * n_points + point_bytes * n_points)
@@ -414,7 +427,7 @@ def simulate(*, alpha, beta, gamma, d, delta, steps=None, x0=1.0, v0=None, devic
     positions = np.empty((steps + 1, n_points)) if record else None
     report = max(1, steps // 100)
     for number, part in enumerate(chunks):
-        run = _Loop(alpha[part], beta[part], gamma[part], d, delta, x0, v0, device, nonideal)
+        run = make_run(part)
         # Recorded positions must never hold an overflowed value: check every period then.
         run.check_every = 1 if record else _CHECK_EVERY
         _run(run, steps, amplitude[:, part], None if positions is None else positions[:, part],
@@ -622,7 +635,7 @@ class _Loop:
 
 
 @dataclasses.dataclass(frozen=True)
-class StabilityMap:
+class StabilityMap(PaperGridNames):
     """Stability by simulation on a grid of the ``(x, y)`` plane.
 
     Attributes
@@ -655,12 +668,6 @@ class StabilityMap:
     x: str = PAPER_PLANE[0]
     y: str = PAPER_PLANE[1]
     at: dict = dataclasses.field(default_factory=dict)
-
-    alpha = paper_alias("alpha", "y_values")
-    beta = paper_alias("beta", "x_values")
-    gamma = paper_parameter("gamma")
-    d = paper_parameter("d")
-    delta = paper_parameter("delta")
 
 
 def stability_map(*, alpha, beta, gamma, d, delta, steps=None, x0=1.0, v0=None, device=None,
@@ -783,26 +790,11 @@ def simulate_loop(loop, *, steps=None, x0=1.0, v0=None, nonideal=None, record=Fa
     x0 = check_x0(x0)
     v0 = x0 / 100 if v0 is None else check_real("v0", v0, low=-X0_MAX, high=X0_MAX)
     parts = [np.broadcast_to(p, shape + p.shape[-1:]).reshape(-1, p.shape[-1]) for p in parts]
-    n_points = parts[0].shape[0]
     orders = parts[1].shape[-1] + parts[3].shape[-1]
     point_bytes = 8 * (d + 1 + 2 * orders + sum(p.shape[-1] for p in parts) + _ANY_LOOP_FLOATS)
-    if record:
-        check_memory(f"recording {steps} periods of {n_points} point(s) at d = {d}",
-                     8 * (steps + 1) * n_points + point_bytes * n_points)
-    else:
-        check_memory(f"simulating {n_points} point(s)", 8 * 6 * n_points)
-    chunks = [slice(0, n_points)] if record else chunk_slices(n_points, point_bytes)
-    amplitude = np.zeros((4, n_points))
-    diverged = np.zeros(n_points, dtype=bool)
-    positions = np.empty((steps + 1, n_points)) if record else None
-    report = max(1, steps // 100)
-    for number, part in enumerate(chunks):
-        run = _AnyLoop([p[part] for p in parts], d, x0, v0, nonideal)
-        run.check_every = 1 if record else _CHECK_EVERY
-        _run(run, steps, amplitude[:, part], None if positions is None else positions[:, part],
-             progress, report, number, len(chunks))
-        diverged[part] = run.diverged
-    return _verdict(amplitude, diverged, positions, shape, steps, nonideal)
+    return _run_chunks(lambda part: _AnyLoop([p[part] for p in parts], d, x0, v0, nonideal),
+                       parts[0].shape[0], point_bytes, steps=steps, d=d, record=record,
+                       progress=progress, nonideal=nonideal, shape=shape)
 
 
 def _verdict(amplitude, diverged, positions, shape, steps, nonideal):
