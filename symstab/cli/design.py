@@ -272,15 +272,17 @@ def _search(args, setup, over, target, notes, png):
                   value_nominal if value_nominal is None or value_nominal > -math.inf else None,
                   "area" if target == "area" else "y", f"{meaning} at the nominal "
                   + " and ".join(f"{{{k}}}" for k in "pq"[:len(names)]))
-    search = _search_json(setup, found, names)
     if found.best is None:
-        notes += [found.message] + limits_notes(setup, _limits(setup, names, found.nominal))
+        search = _search_json(setup, found, names, None)
+        notes += ([found.message] + _failed_notes(found)
+                  + limits_notes(setup, _limits(setup, names, found.nominal)))
         columns, rows = plane_table(setup, [at_nominal], over=names)
         _write_png(png, setup, found, notes)
         emit(setup, args.format, columns, rows, result=_result(setup, search, None),
              notes=notes, json_rows=False)
         return 0
     lim = found.limits if target != "passive" else _limits(setup, names, found.best)
+    search = _search_json(setup, found, names, lim)
     kind = "area" if target == "area" else "y"
     rows = [(f"{{{k}}} (best)", found.best[name], k, f"the {{{k}}} that maximises {label[0]}")
             for k, name in zip("pq", names)]
@@ -331,13 +333,7 @@ def _search(args, setup, over, target, notes, png):
         notes.append(f"the best {best_text} lies where the stable set is a thin sliver (area "
                      f"{lim.area:.3g} against {nominal_lim.area:.3g} at the nominal values): "
                      f"the gain needs very precise tuning of {', '.join(names)} and {x}")
-    if found.failed:
-        where = "; ".join(", ".join(f"{k} = {v:.10g}" for k, v in point.items())
-                          for point, _ in found.failed[:3]) + ("; ..." if len(found.failed) > 3
-                                                                else "")
-        notes.append(f"the {'limits' if target != 'passive' else 'passive set'} could not be "
-                     f"computed at {len(found.failed)} value(s) ({where}): "
-                     f"{found.failed[0][1]}; the best is the best of the others")
+    notes += _failed_notes(found)
     for name in found.at_edge:
         notes.append(f"the best {setup.name(name)} is at an end of the range searched"
                      + (f": widen --over {name}=LO:HI" if setup.paper is None else ""))
@@ -350,19 +346,30 @@ def _search(args, setup, over, target, notes, png):
     return 0
 
 
+def _failed_notes(found):
+    """A note on the values the engine could not resolve (none when it resolved all)."""
+    if not found.failed:
+        return []
+    where = "; ".join(", ".join(f"{k} = {v:.10g}" for k, v in point.items())
+                      for point, _ in found.failed[:3]) + ("; ..." if len(found.failed) > 3 else "")
+    return [f"the {'limits' if found.target != 'passive' else 'passive set'} could not be "
+            f"computed at {len(found.failed)} value(s) ({where}): {found.failed[0][1]}; the "
+            f"best is the best of the others"]
+
+
 def _limits(setup, names, point):
     """:meth:`symstab.Loop.limits` of the plane at ``point`` of the searched parameters."""
     return setup.loop.limits(x=setup.x, y=setup.y, **{**setup.values, **point})
 
 
-def _search_json(setup, found, names):
-    """The search for JSON: one parameter as numbers, two as ``{name: ...}``."""
+def _search_json(setup, found, names, lim):
+    """The search for JSON: one parameter as numbers, two as ``{name: ...}``.
+
+    ``y_max`` and ``x_at_y_max`` are the stable set's at the optimum (``lim``,
+    the plane's :class:`~symstab.numeric.results.Limits`), whatever the target.
+    """
     one = len(names) == 1
-    lim = found.limits
-    y_max = None
-    if found.best is not None:
-        y_max = found.value if found.target == "y_max" else (
-            None if lim is None or lim.y_max is None else lim.y_max)
+    y_max = None if lim is None or lim.y_max is None else lim.y_max
     out = {"over": setup.name(names[0]) if one else [setup.name(n) for n in names],
            "maximize": found.target,
            "range": list(found.over[names[0]]) if one else {n: list(r) for n, r in
@@ -378,7 +385,7 @@ def _search_json(setup, found, names):
         out["y_max_nominal"] = (found.value_nominal if found.value_nominal is not None
                                 and found.value_nominal > -math.inf else None)
     out["y_max"] = y_max
-    out["x_at_y_max"] = None if found.best is None or lim is None else lim.x_at_y_max
+    out["x_at_y_max"] = None if lim is None else lim.x_at_y_max
     return out
 
 

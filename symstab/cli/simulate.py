@@ -118,7 +118,7 @@ def _loop(args):
     for line in setup.echo:
         print(line)
     verdict = "diverged (unstable)" if run.diverged else ("stable" if run.stable else "unstable")
-    if run.stable and run.amplitude[3] > 0.25 * run.amplitude[0]:
+    if run.stable and not nonideal.ideal and run.amplitude[3] >= 0.9 * run.amplitude[2]:
         verdict = (f"bounded, not decaying (a limit cycle of amplitude {run.amplitude[3]:.4g}: "
                    f"the verdict compares the last two quarters)")
     print(f"simulated {run.steps} periods from x0 = {x0:g} ({loop_nonideal_text(nonideal)}): "

@@ -155,8 +155,7 @@ class _Evaluations:
     def __call__(self, point):
         key = tuple(float(v) for v in np.atleast_1d(point))
         if key not in self.seen:
-            value = float(self.f(key))
-            self.seen[key] = -math.inf if value == -math.inf else value
+            self.seen[key] = float(self.f(key))
             if self.progress is not None:
                 self.progress(len(self.seen))
         return self.seen[key]
@@ -325,7 +324,7 @@ def maximize_box(f, box, n=9, *, include=(), rtol=1e-6, progress=None):
                 (max(v0, min(pv) - dv), min(v1, max(pv) + dv)))
         if not (grid[0][0] < grid[0][1] and grid[1][0] < grid[1][1]):
             break
-        step = (du, dv)
+        step = ((grid[0][1] - grid[0][0]) / (n - 1), (grid[1][1] - grid[1][0]) / (n - 1))
     found = evaluate.best()
     if found is None:
         return None, None, list(evaluate.seen.items())
@@ -344,7 +343,8 @@ def maximize_box(f, box, n=9, *, include=(), rtol=1e-6, progress=None):
         # A simplex vertex past the box is reflected inside it.
         simplex = np.where(simplex > 1.0, 2 * start - simplex, simplex).clip(0.0, 1.0)
         minimize(scaled, start, method="Nelder-Mead", bounds=[(0.0, 1.0), (0.0, 1.0)],
-                 options={"initial_simplex": simplex, "xatol": rtol, "fatol": rtol * abs(value),
+                 options={"initial_simplex": simplex, "xatol": rtol,
+                          "fatol": rtol * abs(value) if value else rtol,
                           "maxfev": _MAX_REFINE})
         point, value = evaluate.best()
     return point, value, list(evaluate.seen.items())
@@ -388,10 +388,22 @@ def design(loop, *, over, maximize="y_max", x=None, y=None, n=None, rtol=1e-6, d
     if progress is not None and not callable(progress):
         raise TypeError(f"progress must be a callable taking the number of evaluations, or None, "
                         f"got {type(progress).__name__}")
+    for axis, name in (("x", x), ("y", y)) + ((("damping", damping),) if maximize == "passive"
+                                                 else ()):
+        if name not in loop.parameters:
+            raise ValueError(f"{axis}: {name!r} is not a parameter of the loop (parameters: "
+                             f"{', '.join(loop.parameters)})")
+    for name in (x, y):
+        if name in values:
+            raise TypeError(f"{name} is an axis of the ({x}, {y}) plane: it takes no value here")
     merged = {**loop.defaults, **values}
     nominal = {name: float(merged[name]) for name in names if name in merged}
     if len(nominal) != len(names):
         nominal = {}
+    # The values are checked once, before the scan: a wrong one is the caller's
+    # error, not a value of the searched parameter without an answer.
+    loop.polynomial(**{**values, x: 0.0, y: 0.0,
+                       **{k: 0.5 * (lo + hi) for k, (lo, hi) in over.items()}})
     failed = []
 
     def answer(point):
@@ -426,6 +438,10 @@ def design(loop, *, over, maximize="y_max", x=None, y=None, n=None, rtol=1e-6, d
     common = dict(target=maximize, x=x, y=y, over=over, nominal=nominal,
                   value_nominal=value_nominal, samples=samples, spacing=spacing,
                   failed=tuple(failed), values=dict(values))
+    if best is None and failed and not np.any(samples[:, -1] == -np.inf):
+        raise ValueError(f"the {'passive set' if maximize == 'passive' else 'limits'} could not "
+                         f"be computed at any of the {len(samples)} values searched: "
+                         f"{failed[0][1]}")
     if best is None:
         ranges = ", ".join(f"{k} in [{lo:.6g}, {hi:.6g}]" for k, (lo, hi) in over.items())
         what = "passive" if maximize == "passive" else "stable"

@@ -789,11 +789,13 @@ def simulate_loop(loop, *, steps=None, x0=1.0, v0=None, nonideal=None, record=Fa
     steps = check_steps(steps, d)
     x0 = check_x0(x0)
     v0 = x0 / 100 if v0 is None else check_real("v0", v0, low=-X0_MAX, high=X0_MAX)
-    parts = [np.broadcast_to(p, shape + p.shape[-1:]).reshape(-1, p.shape[-1]) for p in parts]
+    n_points = int(np.prod(shape))
+    parts = [np.broadcast_to(p, shape + p.shape[-1:]).reshape(n_points, p.shape[-1])
+             for p in parts]
     orders = parts[1].shape[-1] + parts[3].shape[-1]
     point_bytes = 8 * (d + 1 + 2 * orders + sum(p.shape[-1] for p in parts) + _ANY_LOOP_FLOATS)
     return _run_chunks(lambda part: _AnyLoop([p[part] for p in parts], d, x0, v0, nonideal),
-                       parts[0].shape[0], point_bytes, steps=steps, d=d, record=record,
+                       n_points, point_bytes, steps=steps, d=d, record=record,
                        progress=progress, nonideal=nonideal, shape=shape)
 
 
@@ -881,9 +883,10 @@ class _AnyLoop:
         if self.s_past:
             self.s_past = [sampled] + self.s_past[:-1]
             self.f_past = [force] + self.f_past[:-1]
-        if self.force_limit is not None:
-            np.clip(force, -self.force_limit, self.force_limit, out=force)
-        self.forces[self.k % (self.d + 1)] = force
+        # The environment keeps its own force; the command sent is clipped.
+        command = (force if self.force_limit is None
+                   else np.clip(force, -self.force_limit, self.force_limit))
+        self.forces[self.k % (self.d + 1)] = command
         held = np.negative(self.forces[(self.k - self.d) % (self.d + 1)])
         self.k += 1
         # The plant's next sample: P_d(z) y = P_n(z) u.

@@ -176,7 +176,10 @@ def step_source(loop, prefix):
                    f"double *s_past, double *f_past, double x_s, double *force)")
     plant = (f"void {prefix}plant_step(const double *a, const double *b, double *y_past, "
              f"double *u_past, double x, double u, double *x_next)")
-    body = [environment_doc, environment, "{", "    double f = e[0] * x_s;"]
+    body = [environment_doc, environment, "{"]
+    if m == 0:      # a static environment: no history (the arguments keep one signature)
+        body += ["    (void)c;", "    (void)s_past;", "    (void)f_past;"]
+    body += ["    double f = e[0] * x_s;"]
     body += [f"    f += e[{i + 1}] * s_past[{i}];" for i in range(m)]
     body += [f"    f -= c[{i}] * f_past[{i}];" for i in range(m)]
     for name, first in (("s_past", "x_s"), ("f_past", "f")):

@@ -98,8 +98,10 @@ def test_two_parameters_find_the_optimum_of_a_dense_scan():
     assert found.at_edge == ("f_c",) and found.best["f_c"] == pytest.approx(200.0, rel=1e-6)
     _, value = dense_maximum(target_of(loop, "y_max", "M", f_c=200.0), *box["M"])
     assert found.value == pytest.approx(value, rel=1e-4)
-    # ... and no point of the first grid is better.
-    assert found.value >= np.max(found.samples[:26, -1])
+    # ... and no point of an independent 4 x 4 grid of the box is better.
+    grid = [target_of(loop, "y_max", "M", f_c=v)(u)
+            for u in np.linspace(*box["M"], 4) for v in np.linspace(*box["f_c"], 4)]
+    assert found.value >= max(grid)
 
 
 def test_best_virtual_mass_keeps_its_published_numbers():
@@ -135,6 +137,22 @@ def test_the_box_search_finds_an_interior_maximum():
     p, value, _ = maximize_box(lambda p: -(p[0] - 0.31)**2 - 3 * (p[1] + 1.2)**2,
                                ((0.0, 1.0), (-2.0, 2.0)))
     assert p[0] == pytest.approx(0.31, abs=1e-5) and p[1] == pytest.approx(-1.2, abs=1e-5)
+
+
+def test_bad_values_are_an_error_not_a_design_without_a_stable_point():
+    """T = -1 ms, an unknown axis or a damping the loop has not were each reported as "no
+    value has a stable point" (every evaluation failed and was skipped)."""
+    loop = symstab.load_loop(LOOPS / "paper.toml")
+    with pytest.raises(ValueError) as excinfo:
+        loop.design(over={"M": (0.0, 0.03)}, n=3, T=-1e-3)
+    assert_message_names(excinfo, "T")
+    with pytest.raises(ValueError) as excinfo:
+        loop.design(over={"M": (0.0, 0.03)}, n=3, x="B", y="Q")
+    assert_message_names(excinfo, "Q")
+    frictionless = symstab.load_loop(LOOPS / "frictionless.toml")
+    with pytest.raises(ValueError) as excinfo:
+        frictionless.design(over={"M": (0.0, 0.03)}, n=3, maximize="passive")
+    assert_message_names(excinfo, "damping")
 
 
 @pytest.mark.parametrize("kwargs, error, name", [

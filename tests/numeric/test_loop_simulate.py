@@ -132,6 +132,34 @@ def test_a_force_limit_holds_an_unstable_paper_loop_and_a_loose_one_changes_noth
     assert not symstab.simulate(**unstable, nonideal=Nonidealities(force_limit=0.01)).diverged
 
 
+def test_a_force_limit_clips_the_command_not_the_environment_s_own_force():
+    """An environment that feeds its force back (a low-pass, VE = K z/(z - r)) keeps
+    Ve_d(z) f = Ve_n(z) x_s with the limit on: only the command sent is clipped.  The
+    reference is written here from the difference equations, with python-control's
+    c2d for the plant."""
+    control = pytest.importorskip("control")
+    m, b, T, K, r, limit, d = 0.0128, 0.0324, 1e-3, 40.0, 0.6, 5.0, 1
+    loop = symstab.Loop("1/(m*s**2 + b*s)", "K*z/(z - r)",
+                        values={"m": m, "b": b, "T": T, "K": K, "r": r, "d": d})
+    steps = 300
+    run = loop.simulate(steps=steps, record=True, nonideal=Nonidealities(force_limit=limit))
+    sampled = control.c2d(control.tf([1.0], [m, b, 0.0]), T, "zoh")
+    num = np.trim_zeros(np.asarray(sampled.num[0][0], dtype=float), "f")
+    den = np.asarray(sampled.den[0][0], dtype=float)
+    b1, b2 = num / den[0]
+    a1, a2 = den[1:] / den[0]
+    x = [1.0 - 2 * 0.01, 1.0 - 0.01, 1.0]        # y[-2], y[-1], y[0]
+    u = [0.0, 0.0]                                # u[-2], u[-1]
+    f_prev, line = 0.0, [0.0] * (d + 1)
+    for k in range(steps):
+        f = K * x[-1] + r * f_prev                # f[k] = K x[k] + r f[k-1]
+        f_prev = f
+        line[k % (d + 1)] = min(max(f, -limit), limit)
+        u.append(-line[(k - d) % (d + 1)])
+        x.append(b1 * u[-1] + b2 * u[-2] - a1 * x[-1] - a2 * x[-2])
+    np.testing.assert_allclose(run.positions, x[2:], rtol=1e-9, atol=1e-12)
+
+
 def test_a_loop_map_has_no_paper_names():
     loop = symstab.load_loop(LOOPS / "frictionless.toml")
     found = loop.stability_map([0.05], [20.0], steps=100)
