@@ -31,6 +31,8 @@ _TARGET_WORDS = {"y_max": "y_max", "K_max": "y_max", "area": "area", "Z-width": 
                  "z_width": "area", "passive": "passive"}
 #: The scan's points per parameter at most: each is a certified region.
 MAX_POINTS = 201
+#: The scan's points in all at most (two parameters: ``--points`` squared).
+MAX_EVALUATIONS = 2000
 
 
 def register(subparsers):
@@ -75,17 +77,24 @@ def run(args):
         over = _search_over(args, setup)
         notes = []
     else:
+        if args.gamma is not None or args.Mw is not None:
+            raise ValueError(f"{'--gamma' if args.gamma is not None else '--Mw'}: design "
+                             f"searches the virtual mass, from no virtual mass (gamma = 0) to "
+                             f"the best; drop it")
         setup = paper_setup(resolve(args, mass=False))
         d, delta = setup.paper.d, setup.paper.delta
         over = {"M": (-1.0 - (d + 1) * delta + 1e-3, 3.0)}    # best_virtual_mass's range
-        notes = (["the virtual mass argument --gamma/--Mw is ignored: design searches over it"]
-                 if (args.gamma is not None or args.Mw is not None) else [])
+        notes = []
     if target == "passive" and setup.paper is not None and setup.paper.delta == 0:
         raise ValueError("--maximize passive: the device has no damping (delta = 0), so no "
                          "point is passive")
     if args.at is not None:
         from .._validate import check_real
         check_real(f"--at ({setup.x})", args.at)
+    if args.points is not None and args.points ** len(over) > MAX_EVALUATIONS:
+        raise ValueError(f"--points {args.points} with {len(over)} parameters is "
+                         f"{args.points ** len(over)} scan points, above {MAX_EVALUATIONS} (each "
+                         f"is a certified region, about 0.1 to 1 s): give fewer --points")
     return _search(args, setup, over, target, notes, png)
 
 
@@ -128,7 +137,27 @@ def _search_over(args, setup):
         else:
             window = _converted(setup, name, *window)
         over[name] = window
+    _check_ends(setup, over)
     return over
+
+
+def _check_ends(setup, over):
+    """Every corner of the searched box within the file's bounds and the loop's domain."""
+    from ..numeric.loop_units import FileParameters, check_bounds
+
+    known = getattr(setup.loop, "file_parameters", None) or FileParameters({})
+    corners = [{}]
+    for name, ends in over.items():
+        corners = [{**c, name: v} for c in corners for v in ends]
+    flags = " ".join(f"--over {n}" for n in over)
+    for corner in corners:
+        values = {**setup.values, **corner}
+        check_bounds(known, values, skip=(setup.x, setup.y), where=lambda names: flags)
+        try:
+            setup.loop.polynomial(**{**values, setup.x: 0.0, setup.y: 0.0})
+        except (TypeError, ValueError) as exc:
+            at = ", ".join(f"{k} = {v:.6g}" for k, v in corner.items())
+            raise ValueError(f"{flags}: at {at}: {exc}") from None
 
 
 def _over_text(text):
@@ -155,6 +184,8 @@ def _range_text(text, flag, name):
                          f"got {text!r}") from None
     if not low < high:
         raise ValueError(f"{flag}: LO:HI must have LO < HI, got {text!r}")
+    if not math.isfinite(high - low):
+        raise ValueError(f"{flag}: HI - LO must be finite (below 1.8e308), got {text!r}")
     return low, high, unit
 
 
@@ -243,8 +274,9 @@ def _search(args, setup, over, target, notes, png):
 
     names = tuple(over)
     y_word = setup.name(setup.y)
-    if args.maximize.endswith("_max") and args.maximize not in ("y_max", "K_max") \
-            and args.maximize != f"{y_word}_max":
+    # K_max names the plane's y_max where y is the stiffness (K, or the paper's alpha).
+    allowed = {"y_max", f"{y_word}_max"} | ({"K_max"} if y_word in ("K", "alpha") else set())
+    if args.maximize.endswith("_max") and args.maximize not in allowed:
         raise ValueError(f"--maximize {args.maximize}: the plane's y is {y_word}; give "
                          f"{y_word}_max (or y_max), area or passive")
     x, y = setup.name(setup.x), y_word
@@ -253,13 +285,19 @@ def _search(args, setup, over, target, notes, png):
                        + (f" {units[n]}" if units[n] else "") for n, (lo, hi) in over.items())
     what = {"y_max": f"the largest stable {y}", "area": "the largest area of the stable set",
             "passive": f"the largest passive {y}"}[target]
-    print(f"searching {ranges} for {what} of the ({x}, {y}) plane ...", file=sys.stderr,
-          flush=True)
     n = args.points or (17 if len(names) == 1 else 9)
     progress = progress_printer("design", n**len(names) + 40)
+
+    def evaluated(k):
+        # Said at the first evaluation: the design checks its inputs before, and a
+        # refusal there is one line.
+        if k == 1:
+            print(f"searching {ranges} for {what} of the ({x}, {y}) plane ...",
+                  file=sys.stderr, flush=True)
+        progress(min(k, n**len(names) + 39))
+
     found = setup.loop.design(over=over, maximize=target, x=setup.x, y=setup.y, n=n,
-                              progress=lambda k: progress(min(k, n**len(names) + 39)),
-                              **{k: v for k, v in setup.values.items()})
+                              progress=evaluated, **{k: v for k, v in setup.values.items()})
     progress(n**len(names) + 40)
     label, meaning = _TARGET_ROWS[target]
     nominal_text = ", ".join(f"{{{k}}} = {setup.values[name]:.6g}"

@@ -72,6 +72,9 @@ def register(subparsers):
 
 def run(args):
     """Run ``symstab map`` (on the loop file of ``--loop``, else the paper's loop)."""
+    if args.format != "table":
+        raise ValueError(f"--format {args.format}: map writes its cells with --out (.csv or "
+                         f".npz)")
     return _loop(args) if uses_loop(args) else _paper(args)
 
 

@@ -50,6 +50,9 @@ def register(subparsers):
 
 def run(args):
     """Run ``symstab simulate``; return the exit status."""
+    if args.format != "table":
+        raise ValueError(f"--format {args.format}: simulate prints its verdict as text and "
+                         f"writes the trajectory as CSV with --out")
     if uses_loop(args):
         return _loop(args)
     from ..numeric.simulate import simulate

@@ -39,6 +39,10 @@ def resolve_nonideal(args, setup):
     from ..numeric.simulate import PAPER_ENCODER_RESOLUTION, Nonidealities, check_x0
 
     resolution = args.encoder_resolution
+    if args.paper_encoder and setup is None:
+        raise ValueError("--paper-encoder is the paper's encoder, 3 arc seconds in rad; a loop "
+                         "file's position may be in m: give --encoder-resolution Q in the unit "
+                         "of its position")
     if args.paper_encoder:
         if resolution is not None:
             raise ValueError("give --encoder-resolution or --paper-encoder, not both")

@@ -1128,8 +1128,7 @@ class Loop(LoopModel):
         --------
         >>> loop = Loop("1/(m*s**2 + b*s)", "K + B*(z - 1)/(T*z) + M*(z - 1)**2/(T**2*z**2)",
         ...             plane=("B", "K"))
-        >>> best = loop.design(over={"M": (0.0, 0.03)}, m=0.0128, b=0.0324, T=1e-3, d=1,
-        ...                    M=0.0, B=0.0, K=0.0)
+        >>> best = loop.design(over={"M": (0.0, 0.03)}, m=0.0128, b=0.0324, T=1e-3, d=1, M=0.0)
         >>> 0.006 < best.best["M"] < 0.02 and best.gain > 2
         True
         """

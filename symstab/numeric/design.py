@@ -391,8 +391,10 @@ def design(loop, *, over, maximize="y_max", x=None, y=None, n=None, rtol=1e-6, d
     for axis, name in (("x", x), ("y", y)) + ((("damping", damping),) if maximize == "passive"
                                                  else ()):
         if name not in loop.parameters:
-            raise ValueError(f"{axis}: {name!r} is not a parameter of the loop (parameters: "
-                             f"{', '.join(loop.parameters)})")
+            need = (": maximize='passive' needs the device's viscous friction"
+                    if axis == "damping" else "")
+            raise ValueError(f"{axis}: {name!r} is not a parameter of the loop{need} "
+                             f"(parameters: {', '.join(loop.parameters)})")
     for name in (x, y):
         if name in values:
             raise TypeError(f"{name} is an axis of the ({x}, {y}) plane: it takes no value here")
@@ -402,8 +404,11 @@ def design(loop, *, over, maximize="y_max", x=None, y=None, n=None, rtol=1e-6, d
         nominal = {}
     # The values are checked once, before the scan: a wrong one is the caller's
     # error, not a value of the searched parameter without an answer.
-    loop.polynomial(**{**values, x: 0.0, y: 0.0,
-                       **{k: 0.5 * (lo + hi) for k, (lo, hi) in over.items()}})
+    middle = {k: 0.5 * (lo + hi) for k, (lo, hi) in over.items()}
+    loop.polynomial(**{**values, x: 0.0, y: 0.0, **middle})
+    if maximize == "passive":
+        # A plant the passivity theorem does not cover is refused here, once.
+        loop.passive_region(x, y, damping=damping, **{**values, **middle})
     failed = []
 
     def answer(point):

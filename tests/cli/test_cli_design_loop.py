@@ -114,6 +114,17 @@ def test_the_table_names_the_optimum_the_value_there_and_at_the_nominal_value(ca
     (["--maximize", "speed"], "--maximize must be K_max"),
     (["--loop", LOOPS / "paper.toml", "--maximize", "B_max"], "the plane's y is K"),
     (["--points", "2"], "--points must be an integer from 3"),
+    # From an attack on the inputs: each ran a search and exited 0, or failed after it.
+    (["--loop", LOOPS / "two_mass.toml", "--maximize", "passive"], "passive"),
+    (["--loop", LOOPS / "paper.toml", "--over", "T=-1:0"], "--over T"),
+    (["--loop", LOOPS / "lowpass_velocity.toml", "--over", "f_c=10:1000 Hz"], "f_c"),
+    (["--loop", LOOPS / "lowpass_velocity.toml", "--over", "T=1:20 ms"], "f_c"),
+    (["--loop", LOOPS / "paper.toml", "--over", "M=-1e308:1e308"], "HI - LO must be finite"),
+    (["--loop", LOOPS / "paper.toml", "--over", "M=0:1", "--over", "b=0.01:1", "--points", "50"],
+     "2500 scan points, above 2000"),
+    (["--loop", LOOPS / "paper.toml", "--x", "K", "--y", "B", "--maximize", "K_max"],
+     "the plane's y is B"),
+    (["--gamma", "1"], "--gamma: design searches the virtual mass"),
     (["--png", "/nonexistent/x.png"], "--png"),
 ])
 def test_bad_search_input_is_one_line_before_the_search(capsys, args, needle):

@@ -202,11 +202,15 @@ def test_design_does_not_echo_a_virtual_mass_it_searches_over(capsys):
     assert "Td = 0.01 s (d = 10)" in echo
     assert "M_w" not in echo and "gamma" not in echo, echo
     status, out, _ = _main(capsys, "design", "--delta", str(PAPER_DELTA), "--d", "10",
-                           "--gamma", "1", "--format", "json")
+                           "--format", "json")
     data = json.loads(out)
     assert "gamma" not in data["inputs"] and "M_w" not in data["inputs"]
     assert data["inputs"]["d"] == 10
-    assert any("ignored" in note for note in data["notes"])
+    # --gamma 1 was "ignored" in a note while the nominal row showed alpha_max at gamma = 1
+    # under the label "gamma = 0" (gain 1.87 instead of 5.82): it is refused now.
+    status, out, err = _main(capsys, "design", "--delta", str(PAPER_DELTA), "--d", "10",
+                             "--gamma", "1")
+    assert status == 2 and out == "" and "--gamma: design searches the virtual mass" in err
 
 
 # --------------------------------------------------------------------------

@@ -80,6 +80,11 @@ def test_a_saturated_unstable_loop_is_called_bounded_not_stable(capsys):
       "--simulate", "--actuator-bandwidth", "100"], "written into the loop file's plant"),
     (["map", "--simulate", "--Kw=0,1,3", "--Bw=0,1,3", "--out", "m.npz"],
      "--simulate needs a loop file"),
+    (["simulate", "--loop", LOOPS / "frictionless.toml", "--paper-encoder"],
+     "--paper-encoder is the paper's encoder"),
+    (["simulate", "--loop", PAPER, "--format", "json"], "--format json"),
+    (["map", "--loop", PAPER, "--x-range=0,1,3", "--y-range=0,1,3", "--out", "m.npz",
+      "--format", "csv"], "--format csv"),
 ])
 def test_bad_simulation_input_is_one_line_before_the_run(capsys, tmp_path, monkeypatch, args,
                                                          needle):
