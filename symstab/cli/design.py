@@ -91,6 +91,9 @@ def run(args):
     if args.at is not None:
         from .._validate import check_real
         check_real(f"--at ({setup.x})", args.at)
+        # The line at x = --at is asked again at the best values: tried once now, so
+        # that an x the line engine refuses is refused before the search.
+        setup.loop.stable_intervals(setup.y, **{setup.x: args.at}, **setup.values)
     if args.points is not None and args.points ** len(over) > MAX_EVALUATIONS:
         raise ValueError(f"--points {args.points} with {len(over)} parameters is "
                          f"{args.points ** len(over)} scan points, above {MAX_EVALUATIONS} (each "
@@ -207,6 +210,11 @@ def _search_parameter(args, setup, name):
     if name is None:
         names = {str(s) for s in loop.environment.free_symbols}
         masses = [n for n in others if n in names and setup.unit(n) in _MASS_UNITS]
+        axes = [n for n in (setup.x, setup.y) if n in names and setup.unit(n) in _MASS_UNITS]
+        if not masses and axes:
+            raise ValueError(f"design --loop: the environment's mass term {axes[0]} is an axis "
+                             f"of the ({setup.x}, {setup.y}) plane: give --over NAME=LO:HI, the "
+                             f"parameter to search (candidates: {', '.join(others)})")
         if len(masses) != 1:
             why = "no mass term" if not masses else f"several mass terms ({', '.join(masses)})"
             raise ValueError(f"design --loop: the environment of {args.loop} has {why}: give "

@@ -62,7 +62,7 @@ def run(args):
     setup = resolve(args)
     alpha, beta = _point(args, setup)
     nonideal, x0 = resolve_nonideal(args, setup)
-    check_files([("--out", args.out)])
+    _check_out(args.out)
     steps = check_steps(args.steps, setup.d)
     record = args.out is not None
     if record:
@@ -108,7 +108,7 @@ def _loop(args):
     setup = resolve_loop(args, plane=False)
     loop, values = setup.loop, setup.values
     nonideal, x0 = resolve_nonideal(args, None)
-    check_files([("--out", args.out)])
+    _check_out(args.out)
     steps = check_steps(args.steps, values["d"])
     record = args.out is not None
     if record:
@@ -137,6 +137,13 @@ def _loop(args):
         write_output(args.out, buf.getvalue(), "--out")
         print(f"wrote the trajectory to {args.out}")
     return 0
+
+
+def _check_out(out):
+    """``--out``: a .csv file in a writable folder (the trajectory is CSV), checked first."""
+    if out is not None and not str(out).endswith(".csv"):
+        raise ValueError(f"--out must end in .csv (the trajectory is written as CSV), got {out}")
+    check_files([("--out", out)])
 
 
 def _single(text, name):

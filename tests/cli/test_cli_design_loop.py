@@ -125,6 +125,8 @@ def test_the_table_names_the_optimum_the_value_there_and_at_the_nominal_value(ca
     (["--loop", LOOPS / "paper.toml", "--x", "K", "--y", "B", "--maximize", "K_max"],
      "the plane's y is B"),
     (["--gamma", "1"], "--gamma: design searches the virtual mass"),
+    (["--loop", LOOPS / "paper.toml", "--x", "B", "--y", "M"], "mass term M is an axis"),
+    (["--loop", LOOPS / "frictionless.toml", "--at", "1e300"], "1e+300"),
     (["--png", "/nonexistent/x.png"], "--png"),
 ])
 def test_bad_search_input_is_one_line_before_the_search(capsys, args, needle):

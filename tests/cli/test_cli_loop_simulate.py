@@ -83,6 +83,7 @@ def test_a_saturated_unstable_loop_is_called_bounded_not_stable(capsys):
     (["simulate", "--loop", LOOPS / "frictionless.toml", "--paper-encoder"],
      "--paper-encoder is the paper's encoder"),
     (["simulate", "--loop", PAPER, "--format", "json"], "--format json"),
+    (["simulate", "--loop", PAPER, "--out", "t.npz"], "--out must end in .csv"),
     (["map", "--loop", PAPER, "--x-range=0,1,3", "--y-range=0,1,3", "--out", "m.npz",
       "--format", "csv"], "--format csv"),
 ])
