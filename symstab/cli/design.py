@@ -56,6 +56,11 @@ def register(subparsers):
                         f"(default 17 for one parameter, 9 for two)")
     g.add_argument("--png", metavar="FILE", help="also draw the target against the parameter(s) "
                                                  "searched as PNG")
+    g.add_argument("--delay", metavar="TIME",
+                   help="with --loop: hold the loop delay at TIME (s, or with a unit: 5ms) "
+                        "while the sample period is searched (--over T=...): d = ceil(TIME / "
+                        "T) samples at each T, the whole samples that cover it, instead of the "
+                        "file's d")
     add_loop_options(p, "design")
 
 
@@ -72,9 +77,11 @@ def run(args):
     if args.points is not None and not 3 <= args.points <= MAX_POINTS:
         raise ValueError(f"--points must be an integer from 3 to {MAX_POINTS}, got {args.points}")
     png = check_outputs([("--png", args.png, "file")]).get("--png")
+    delay = None
     if uses_loop(args):
         setup = resolve_loop(args)
         over = _search_over(args, setup)
+        delay = _delay(args, setup)
         notes = []
     else:
         if args.gamma is not None or args.Mw is not None:
@@ -98,7 +105,23 @@ def run(args):
         raise ValueError(f"--points {args.points} with {len(over)} parameters is "
                          f"{args.points ** len(over)} scan points, above {MAX_EVALUATIONS} (each "
                          f"is a certified region, about 0.1 to 1 s): give fewer --points")
-    return _search(args, setup, over, target, notes, png)
+    return _search(args, setup, over, target, notes, png, delay)
+
+
+def _delay(args, setup):
+    """``--delay`` in seconds (converted as a ``--set T=...`` value is), or None."""
+    if args.delay is None:
+        return None
+    if "d" in setup.given:
+        raise ValueError("--delay holds the delay in seconds as T varies: drop --d / --set d")
+    from .loop_options import convert_sets, parse_number
+
+    text, unit = split_unit(args.delay.strip(), "--delay")
+    value = parse_number("T", text, "--delay", lists=False)
+    values, _ = convert_sets(setup.loop, {"T": (value, unit)}, flag="--delay")
+    from .._validate import check_real
+
+    return check_real("--delay", values["T"], low=0.0)
 
 
 def _target(word):
@@ -276,7 +299,7 @@ _TARGET_ROWS = {
 }
 
 
-def _search(args, setup, over, target, notes, png):
+def _search(args, setup, over, target, notes, png, delay=None):
     """The values of ``over`` that maximise ``target`` in the plane of ``setup``: one design."""
     from ..numeric.simulate import progress_printer
 
@@ -305,7 +328,9 @@ def _search(args, setup, over, target, notes, png):
         progress(min(k, n**len(names) + 39))
 
     found = setup.loop.design(over=over, maximize=target, x=setup.x, y=setup.y, n=n,
-                              progress=evaluated, **{k: v for k, v in setup.values.items()})
+                              progress=evaluated, delay=delay,
+                              **{k: v for k, v in setup.values.items()
+                                 if not (delay is not None and k == "d")})
     progress(n**len(names) + 40)
     label, meaning = _TARGET_ROWS[target]
     nominal_text = ", ".join(f"{{{k}}} = {setup.values[name]:.6g}"
@@ -321,13 +346,13 @@ def _search(args, setup, over, target, notes, png):
     if found.best is None:
         search = _search_json(setup, found, names, None)
         notes += ([found.message] + _failed_notes(found)
-                  + limits_notes(setup, _limits(setup, names, found.nominal)))
+                  + limits_notes(setup, _limits(setup, found.nominal, delay)))
         columns, rows = plane_table(setup, [at_nominal], over=names)
         _write_png(png, setup, found, notes)
         emit(setup, args.format, columns, rows, result=_result(setup, search, None),
              notes=notes, json_rows=False)
         return 0
-    lim = found.limits if target != "passive" else _limits(setup, names, found.best)
+    lim = found.limits if target != "passive" else _limits(setup, found.best, delay)
     search = _search_json(setup, found, names, lim)
     kind = "area" if target == "area" else "y"
     rows = [(f"{{{k}}} (best)", found.best[name], k, f"the {{{k}}} that maximises {label[0]}")
@@ -347,7 +372,12 @@ def _search(args, setup, over, target, notes, png):
                      "area of the stable set (the Z-width where {x} is a damping and {y} a "
                      "stiffness)"))
     notes += limits_notes(setup, lim)
-    at_best = dataclasses.replace(setup, values={**setup.values, **found.best})
+    at_best = dataclasses.replace(setup, values=_at(setup, found.best, delay))
+    if delay is not None:
+        T = at_best.values["T"]
+        notes.append(f"the delay is held at {delay:.6g} s: d = ceil({delay:.6g} s / T) "
+                     f"samples; at the best T = {T:.6g} s, d = {found.best_d} "
+                     f"({found.best_d * T:.6g} s)")
     at = args.at
     if at is None and not lim.empty and math.isfinite(lim.x_at_y_max):
         at = lim.x_at_y_max
@@ -373,7 +403,7 @@ def _search(args, setup, over, target, notes, png):
                          f"set: it needs precise tuning of {x}"
                          + (f"; give --at X for the stable {y} at another {x}"
                             if setup.paper is None else ""))
-    nominal_lim = _limits(setup, names, found.nominal) if found.nominal else None
+    nominal_lim = _limits(setup, found.nominal, delay) if found.nominal else None
     if nominal_lim is not None and not nominal_lim.empty and math.isfinite(nominal_lim.area) \
             and lim.area < 0.05 * nominal_lim.area:
         notes.append(f"the best {best_text} lies where the stable set is a thin sliver (area "
@@ -403,9 +433,19 @@ def _failed_notes(found):
             f"best is the best of the others"]
 
 
-def _limits(setup, names, point):
+def _at(setup, point, delay):
+    """The values at ``point`` of the searched parameters (``d`` held by ``delay`` if given)."""
+    from ..numeric.design import held_delay
+
+    values = {**setup.values, **point}
+    if delay is not None:
+        values["d"] = held_delay(delay, values["T"])
+    return values
+
+
+def _limits(setup, point, delay=None):
     """:meth:`symstab.Loop.limits` of the plane at ``point`` of the searched parameters."""
-    return setup.loop.limits(x=setup.x, y=setup.y, **{**setup.values, **point})
+    return setup.loop.limits(x=setup.x, y=setup.y, **_at(setup, point, delay))
 
 
 def _search_json(setup, found, names, lim):

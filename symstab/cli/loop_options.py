@@ -87,14 +87,14 @@ _LOOP_ONLY = {
     "boundary": ("set_values", "x", "y"),
     "limits": ("set_values", "x", "y", "at"),
     "classify": ("set_values",),
-    "design": ("set_values", "x", "y", "at", "over", "search_range"),
+    "design": ("set_values", "x", "y", "at", "over", "search_range", "delay"),
     "map": ("set_values", "x", "y", "x_range", "y_range", "simulate"),
     "simulate": ("set_values",),
 }
 
 _FLAGS = {"set_values": "--set", "x": "--x", "y": "--y", "at": "--at",
           "x_range": "--x-range", "y_range": "--y-range", "over": "--over",
-          "search_range": "--range", "simulate": "--simulate"}
+          "search_range": "--range", "simulate": "--simulate", "delay": "--delay"}
 
 
 EXAMPLE = "examples/loops/paper.toml"

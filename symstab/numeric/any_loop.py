@@ -1080,7 +1080,7 @@ class Loop(LoopModel):
                                   nonideal=nonideal, progress=progress, **values)
 
     def design(self, *, over, maximize="y_max", x=None, y=None, n=None, rtol=1e-6, damping="b",
-               progress=None, **values):
+               delay=None, progress=None, **values):
         """The value of one or two parameters that maximises K_max, the Z-width or the passive K_max.
 
         Each evaluation is a certified answer at one value of the searched
@@ -1106,6 +1106,11 @@ class Loop(LoopModel):
             Relative accuracy of the optimum.
         damping : str
             The device's viscous friction, for ``maximize="passive"``.
+        delay : float, optional
+            The loop delay in seconds, held while the sample period ``T``
+            is searched: ``d = ceil(delay / T)`` at each value, the whole
+            samples that cover it (instead
+            of ``d``).
         progress : callable, optional
             Called with the number of evaluations so far.
         **values
@@ -1135,7 +1140,7 @@ class Loop(LoopModel):
         from .design import design
 
         return design(self, over=over, maximize=maximize, x=x, y=y, n=n, rtol=rtol,
-                      damping=damping, progress=progress, **values)
+                      damping=damping, delay=delay, progress=progress, **values)
 
     def closed_loop(self, **values):
         """The closed loop from a force at the plant's input to the position.

@@ -36,7 +36,7 @@ import numpy as np
 
 from .._validate import check_count, check_real, check_window
 
-__all__ = ["TARGETS", "Design", "design", "maximize_scalar", "maximize_box"]
+__all__ = ["TARGETS", "Design", "design", "maximize_scalar", "maximize_box", "held_delay"]
 
 #: What a design maximises, with what it is.
 TARGETS = {
@@ -92,6 +92,9 @@ class Design:
         The other parameters' values, as given.
     message : str
         Why there is no optimum; else empty.
+    delay : float or None
+        The loop delay held in seconds while ``T`` varies (``d = ceil(delay
+        / T)`` at each value), or None (``d`` as given).
     """
 
     target: str
@@ -108,6 +111,16 @@ class Design:
     failed: tuple = ()
     values: dict = dataclasses.field(default_factory=dict)
     message: str = ""
+    delay: object = None
+
+    @property
+    def best_d(self):
+        """The delay in samples at the optimum: ``ceil(delay / T)`` where the delay is held in seconds."""
+        if self.best is None:
+            return None
+        if self.delay is None:
+            return self.values.get("d")
+        return held_delay(self.delay, self.best.get("T", self.values.get("T")))
 
     @property
     def gain(self):
@@ -370,7 +383,7 @@ def _check_over(loop, over, x, y):
 
 
 def design(loop, *, over, maximize="y_max", x=None, y=None, n=None, rtol=1e-6, damping="b",
-           progress=None, **values):
+           delay=None, progress=None, **values):
     """The value of one or two parameters of ``loop`` that maximises a target.
 
     See :meth:`symstab.Loop.design`, which calls this.
@@ -398,21 +411,32 @@ def design(loop, *, over, maximize="y_max", x=None, y=None, n=None, rtol=1e-6, d
     for name in (x, y):
         if name in values:
             raise TypeError(f"{name} is an axis of the ({x}, {y}) plane: it takes no value here")
+    if delay is not None:
+        delay = check_real("delay", delay, low=0.0)
+        if "d" in values:
+            raise TypeError("give the delay in seconds (delay) or in samples (d), not both")
     merged = {**loop.defaults, **values}
     nominal = {name: float(merged[name]) for name in names if name in merged}
     if len(nominal) != len(names):
         nominal = {}
     # The values are checked once, before the scan: a wrong one is the caller's
     # error, not a value of the searched parameter without an answer.
-    middle = {k: 0.5 * (lo + hi) for k, (lo, hi) in over.items()}
-    loop.polynomial(**{**values, x: 0.0, y: 0.0, **middle})
+    def at(point):
+        """The values at a point of the search; with ``delay``, d = ceil(delay / T) there."""
+        out = {**values, **dict(zip(names, point))}
+        if delay is not None:
+            out["d"] = held_delay(delay, out.get("T", loop.defaults.get("T")))
+        return out
+
+    middle = tuple(0.5 * (lo + hi) for lo, hi in over.values())
+    loop.polynomial(**{**at(middle), x: 0.0, y: 0.0})
     if maximize == "passive":
         # A plant the passivity theorem does not cover is refused here, once.
-        loop.passive_region(x, y, damping=damping, **{**values, **middle})
+        loop.passive_region(x, y, damping=damping, **at(middle))
     failed = []
 
     def answer(point):
-        return _answer(loop, maximize, x, y, damping, {**values, **dict(zip(names, point))})
+        return _answer(loop, maximize, x, y, damping, at(point))
 
     def target(point):
         try:
@@ -442,7 +466,7 @@ def design(loop, *, over, maximize="y_max", x=None, y=None, n=None, rtol=1e-6, d
             value_nominal = None
     common = dict(target=maximize, x=x, y=y, over=over, nominal=nominal,
                   value_nominal=value_nominal, samples=samples, spacing=spacing,
-                  failed=tuple(failed), values=dict(values))
+                  failed=tuple(failed), values=dict(values), delay=delay)
     if best is None and failed and not np.any(samples[:, -1] == -np.inf):
         raise ValueError(f"the {'passive set' if maximize == 'passive' else 'limits'} could not "
                          f"be computed at any of the {len(samples)} values searched: "
@@ -457,6 +481,18 @@ def design(loop, *, over, maximize="y_max", x=None, y=None, n=None, rtol=1e-6, d
                               f"{len(samples)} evaluations)", **common)
     return Design(best=dict(zip(names, (float(v) for v in best))), value=float(value),
                   limits=answer(best), **common)
+
+
+def held_delay(delay, T):
+    """``d = ceil(delay / T)``: a delay held in seconds, in the whole samples of ``T`` that cover it.
+
+    A force can only be applied at a sample, so a delay of 2.5 periods acts
+    as 3 (rounding down would render a shorter delay than the device has).
+    A quotient within 1e-9 of a whole number is that number.
+    """
+    quotient = delay / float(T)
+    return int(round(quotient)) if abs(quotient - round(quotient)) <= 1e-9 * max(1.0, quotient) \
+        else math.ceil(quotient)
 
 
 def _answer(loop, maximize, x, y, damping, values):

@@ -127,6 +127,10 @@ def test_the_table_names_the_optimum_the_value_there_and_at_the_nominal_value(ca
     (["--gamma", "1"], "--gamma: design searches the virtual mass"),
     (["--loop", LOOPS / "paper.toml", "--x", "B", "--y", "M"], "mass term M is an axis"),
     (["--loop", LOOPS / "frictionless.toml", "--at", "1e300"], "1e+300"),
+    (["--loop", LOOPS / "paper.toml", "--over", "T=0.2:4 ms", "--delay", "10 kg"], "--delay"),
+    (["--loop", LOOPS / "paper.toml", "--over", "T=0.2:4 ms", "--delay", "10ms", "--d", "3"],
+     "drop --d"),
+    (["--delay", "10ms"], "--delay needs a loop file"),
     (["--png", "/nonexistent/x.png"], "--png"),
 ])
 def test_bad_search_input_is_one_line_before_the_search(capsys, args, needle):

@@ -172,3 +172,30 @@ def test_bad_design_input_names_the_parameter(kwargs, error, name):
     with pytest.raises(error) as excinfo:
         loop.design(**kwargs)
     assert_message_names(excinfo, name)
+
+
+def test_the_sample_period_with_the_delay_held_in_seconds():
+    """T searched with a 10 ms delay: d = ceil(10 ms / T) at each T (the whole samples that
+    cover the delay), against a dense scan that holds it the same way."""
+    loop = symstab.load_loop(LOOPS / "paper.toml")
+    delay, window = 0.01, (2e-4, 4e-3)
+    found = loop.design(over={"T": window}, delay=delay, n=9, M=0.0)
+
+    def f(T):
+        d = math.ceil(delay / T - 1e-9)
+        return loop.limits(T=T, d=d, M=0.0).y_max
+
+    at, value = dense_maximum(f, *window, points=9, levels=4)
+    assert found.value == pytest.approx(value, rel=1e-4)
+    assert found.best_d == math.ceil(delay / found.best["T"] - 1e-9)
+    assert found.best_d * found.best["T"] >= delay * (1 - 1e-12)
+    with pytest.raises(TypeError, match="not both"):
+        loop.design(over={"T": window}, delay=delay, d=3)
+
+
+@pytest.mark.parametrize("delay, T, d", [(0.01, 0.001, 10), (0.01, 0.0003, 34), (0.003, 0.001, 3),
+                                         (0.0, 0.001, 0), (0.0025, 0.001, 3)])
+def test_a_held_delay_is_the_whole_samples_that_cover_it(delay, T, d):
+    from symstab.numeric.design import held_delay
+
+    assert held_delay(delay, T) == d
