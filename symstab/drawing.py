@@ -135,8 +135,7 @@ def design_figure(plt, found, labels, target_label):
     good = np.isfinite(value)
     none = value == -np.inf
     fig, ax = plt.subplots(figsize=(6.4, 4.4))
-    what = {"y_max": "maximise the largest stable y", "area": "maximise the area",
-            "passive": "maximise the largest passive y"}[found.target]
+    what = "maximise " + target_label.split(" [")[0]
     if len(names) == 1:
         order = np.argsort(samples[:, 0])
         u, v = samples[order, 0], value[order]
