@@ -1139,6 +1139,7 @@ class Loop(LoopModel):
         """
         from .design import design
 
+        x, y = self._plane(x, y)
         return design(self, over=over, maximize=maximize, x=x, y=y, n=n, rtol=rtol,
                       damping=damping, delay=delay, progress=progress, **values)
 

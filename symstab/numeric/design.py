@@ -386,15 +386,12 @@ def design(loop, *, over, maximize="y_max", x=None, y=None, n=None, rtol=1e-6, d
            delay=None, progress=None, **values):
     """The value of one or two parameters of ``loop`` that maximises a target.
 
-    See :meth:`symstab.Loop.design`, which calls this.
+    See :meth:`symstab.Loop.design`, which calls this with the plane ``x``,
+    ``y`` resolved.
     """
     if maximize not in TARGETS:
         raise ValueError(f"maximize must be one of {', '.join(map(repr, TARGETS))}, "
                          f"got {maximize!r}")
-    if x is None or y is None:
-        if loop.plane is None:
-            raise ValueError("give the plane: x and y (the loop has no default plane)")
-        x, y = (x or loop.plane[0]), (y or loop.plane[1])
     over = _check_over(loop, over, x, y)
     names = tuple(over)
     n = (17 if len(names) == 1 else 9) if n is None else check_count("n", n, 3)
