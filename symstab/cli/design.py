@@ -19,16 +19,22 @@ import math
 import sys
 
 from .loop_limits import limits_notes, named, plane_table, stable_intervals_at
-from .loop_options import add_loop_options, paper_setup, resolve_loop, split_unit, uses_loop
+from .loop_options import (EXAMPLE, add_loop_options, paper_setup, resolve_loop, split_unit,
+                           uses_loop)
 from .options import add_command, add_model_options, resolve
 from .output import check_outputs, emit, write_output
+from .simulation import add_nonideal_options, loop_nonideal_text, resolve_nonideal
 
 __all__ = ["register", "run"]
 
 #: ``--maximize``'s words: the target of :meth:`symstab.Loop.design` each names
 #: (``{y}_max``, e.g. ``K_max``, is ``y_max`` too).
 _TARGET_WORDS = {"y_max": "y_max", "K_max": "y_max", "area": "area", "Z-width": "area",
-                 "z_width": "area", "passive": "passive"}
+                 "z_width": "area", "passive": "passive", "simulated": "simulated"}
+#: The options of the simulated target (``--maximize simulated``) only: flag, dest.
+_SIMULATION_FLAGS = (("--amplitude", "amplitude"), ("--encoder-resolution", "encoder_resolution"),
+                     ("--paper-encoder", "paper_encoder"), ("--force-limit", "force_limit"),
+                     ("--steps", "steps"), ("--x0", "x0"))
 #: The scan's points per parameter at most: each is a certified region.
 MAX_POINTS = 201
 #: The scan's points in all at most (two parameters: ``--points`` squared).
@@ -49,8 +55,10 @@ def register(subparsers):
     g.add_argument("--maximize", metavar="TARGET", default="K_max",
                    help="what to maximise: K_max (the largest stable y of the plane; also "
                         "y_max or the plane's {y}_max), area (the area of the stable set, the "
-                        "Z-width; also Z-width) or passive (the largest passive y, "
-                        "Colgate-Schenkel with the delay) (default: K_max)")
+                        "Z-width; also Z-width), passive (the largest passive y, "
+                        "Colgate-Schenkel with the delay) or simulated (with --loop: the "
+                        "largest y whose simulated run, with the non-idealities given, "
+                        "neither grows nor ends above --amplitude) (default: K_max)")
     g.add_argument("--points", metavar="N", type=int,
                    help=f"scan points per parameter before the refinement, 3 to {MAX_POINTS} "
                         f"(default 17 for one parameter, 9 for two)")
@@ -61,6 +69,11 @@ def register(subparsers):
                         "while the sample period is searched (--over T=...): d = ceil(TIME / "
                         "T) samples at each T, the whole samples that cover it, instead of the "
                         "file's d")
+    g.add_argument("--amplitude", metavar="X", type=float,
+                   help="with --maximize simulated: the largest |x| accepted in the last "
+                        "quarter of a run, in the loop's position unit (m or rad); a limit "
+                        "cycle above it, or a decay not below it by the end, is refused")
+    add_nonideal_options(p)
     add_loop_options(p, "design")
 
 
@@ -74,6 +87,10 @@ def run(args):
     its JSON the ``best`` of :func:`symstab.best_virtual_mass`.
     """
     target = _target(args.maximize)
+    given = [flag for flag, dest in _SIMULATION_FLAGS if getattr(args, dest) not in (None, False)]
+    if target != "simulated" and given:
+        raise ValueError(f"{given[0]} is an option of the simulated target: add --maximize "
+                         f"simulated (with --loop)")
     if args.points is not None and not 3 <= args.points <= MAX_POINTS:
         raise ValueError(f"--points must be an integer from 3 to {MAX_POINTS}, got {args.points}")
     png = check_outputs([("--png", args.png, "file")]).get("--png")
@@ -83,6 +100,9 @@ def run(args):
         over = _search_over(args, setup)
         delay = _delay(args, setup)
         notes = []
+    elif target == "simulated":
+        raise ValueError(f"--maximize simulated simulates a loop file: give --loop FILE (the "
+                         f"paper's device: --loop {EXAMPLE})")
     else:
         if args.gamma is not None or args.Mw is not None:
             raise ValueError(f"{'--gamma' if args.gamma is not None else '--Mw'}: design "
@@ -105,7 +125,24 @@ def run(args):
         raise ValueError(f"--points {args.points} with {len(over)} parameters is "
                          f"{args.points ** len(over)} scan points, above {MAX_EVALUATIONS} (each "
                          f"is a certified region, about 0.1 to 1 s): give fewer --points")
-    return _search(args, setup, over, target, notes, png, delay)
+    simulation = _simulation(args) if target == "simulated" else {}
+    return _search(args, setup, over, target, notes, png, delay, simulation)
+
+
+def _simulation(args):
+    """The settings of the simulated target, checked before the search (``Loop.design``'s)."""
+    from ..numeric.simulate import check_loop_nonideal
+
+    if args.amplitude is None:
+        raise ValueError("--maximize simulated needs --amplitude X: the largest |x| accepted at "
+                         "the end of a run, in the loop's position unit (m or rad)")
+    from .._validate import check_real
+
+    amplitude = check_real("--amplitude", args.amplitude, low=0.0, low_open=True)
+    nonideal, x0 = resolve_nonideal(args, None)
+    # The horizon at each delay searched is checked by Loop.design before its scan.
+    return {"amplitude": amplitude, "nonideal": check_loop_nonideal(nonideal), "x0": x0,
+            "steps": args.steps}
 
 
 def _delay(args, setup):
@@ -296,10 +333,12 @@ _TARGET_ROWS = {
              "is a damping and {y} a stiffness)"),
     "passive": (("passive {y}_max", "passive alpha_max", "passive K_max"),
                 "largest passive {y} (Colgate-Schenkel with the delay)"),
+    "simulated": (("simulated {y}_max", None, "simulated K_max"),
+                  "largest {y} whose simulated run neither grows nor ends above the amplitude"),
 }
 
 
-def _search(args, setup, over, target, notes, png, delay=None):
+def _search(args, setup, over, target, notes, png, delay=None, simulation=None):
     """The values of ``over`` that maximise ``target`` in the plane of ``setup``: one design."""
     from ..numeric.simulate import progress_printer
 
@@ -315,7 +354,9 @@ def _search(args, setup, over, target, notes, png, delay=None):
     ranges = ", ".join(f"{setup.name(n)} in [{lo:.6g}, {hi:.6g}]"
                        + (f" {units[n]}" if units[n] else "") for n, (lo, hi) in over.items())
     what = {"y_max": f"the largest stable {y}", "area": "the largest area of the stable set",
-            "passive": f"the largest passive {y}"}[target]
+            "passive": f"the largest passive {y}",
+            "simulated": f"the largest {y} whose simulated run settles below "
+                         f"{(simulation or {}).get('amplitude', 0):.4g}"}[target]
     n = args.points or (17 if len(names) == 1 else 9)
     progress = progress_printer("design", n**len(names) + 40)
 
@@ -328,7 +369,7 @@ def _search(args, setup, over, target, notes, png, delay=None):
         progress(min(k, n**len(names) + 39))
 
     found = setup.loop.design(over=over, maximize=target, x=setup.x, y=setup.y, n=n,
-                              progress=evaluated, delay=delay,
+                              progress=evaluated, delay=delay, **(simulation or {}),
                               **{k: v for k, v in setup.values.items()
                                  if not (delay is not None and k == "d")})
     progress(n**len(names) + 40)
@@ -352,15 +393,25 @@ def _search(args, setup, over, target, notes, png, delay=None):
         emit(setup, args.format, columns, rows, result=_result(setup, search, None),
              notes=notes, json_rows=False)
         return 0
-    lim = found.limits if target != "passive" else _limits(setup, found.best, delay)
+    # The plane's certified limits at the best values, whatever the target.
+    if target == "passive":
+        lim = _limits(setup, found.best, delay)
+    elif target == "simulated":
+        lim = found.limits.linear
+    else:
+        lim = found.limits
     search = _search_json(setup, found, names, lim)
     kind = "area" if target == "area" else "y"
     rows = [(f"{{{k}}} (best)", found.best[name], k, f"the {{{k}}} that maximises {label[0]}")
             for k, name in zip("pq", names)]
     rows.append((label, found.value, kind, f"{meaning} at the best "
                  + " and ".join(f"{{{k}}}" for k in "pq"[:len(names)])))
+    if target == "simulated":
+        rows.append((("{x} of the simulated {y}_max", None, "B_w of the simulated K_max"),
+                     found.limits.x_at_y_max, "x", "the {x} of the run that reaches it"))
     if target != "y_max" and not lim.empty:
-        rows.append((("{y}_max", None, "K_max"), lim.y_max, "y", "largest stable {y} there"))
+        rows.append((("{y}_max", None, "K_max"), lim.y_max, "y", "largest stable {y} there"
+                     + (" (linear, certified)" if target == "simulated" else "")))
     if not lim.empty:
         rows.append((("{x} at {y}_max", None, "B_w at K_max"), lim.x_at_y_max, "x",
                      "the {x} at which {y}_max is reached"))
@@ -372,6 +423,8 @@ def _search(args, setup, over, target, notes, png, delay=None):
                      "area of the stable set (the Z-width where {x} is a damping and {y} a "
                      "stiffness)"))
     notes += limits_notes(setup, lim)
+    if target == "simulated":
+        notes += _simulation_notes(setup, found.limits, simulation)
     at_best = dataclasses.replace(setup, values=_at(setup, found.best, delay))
     if delay is not None:
         T = at_best.values["T"]
@@ -420,6 +473,20 @@ def _search(args, setup, over, target, notes, png, delay=None):
     _write_png(png, setup, found, notes)
     emit(setup, args.format, columns, rows, result=result, notes=notes, json_rows=False)
     return 0
+
+
+def _simulation_notes(setup, simulated, simulation):
+    """What the simulated target is: the runs, the non-idealities, its resolution."""
+    y = setup.name(setup.y)
+    out = [f"simulated: {loop_nonideal_text(simulation['nonideal'])}, x0 = "
+           f"{simulation['x0']:g}, {simulated.steps} periods per run; a run is accepted when "
+           f"it does not grow and its last quarter's |x| is at most "
+           f"{simulation['amplitude']:.4g} (not certified: simulated {y}_max resolved to "
+           f"{simulated.resolution:.3g})"]
+    if simulated.at_top:
+        out.append(f"the simulated {y}_max is at the top of its window (1.25 times the linear "
+                   f"{y}_max): it may lie higher")
+    return out
 
 
 def _failed_notes(found):
@@ -472,6 +539,13 @@ def _search_json(setup, found, names, lim):
                                 and found.value_nominal > -math.inf else None)
     out["y_max"] = y_max
     out["x_at_y_max"] = None if lim is None else lim.x_at_y_max
+    if found.target == "simulated":
+        simulated = found.limits
+        out["simulated"] = {
+            "x_at_y_max": None if simulated is None else simulated.x_at_y_max,
+            "resolution": None if simulated is None else simulated.resolution,
+            "amplitude": None if simulated is None else simulated.amplitude,
+            "steps": None if simulated is None else simulated.steps}
     return out
 
 
@@ -500,7 +574,8 @@ def _write_png(png, setup, found, notes):
     labels = [setup.label(n) for n in names]
     label, _ = _TARGET_ROWS[found.target]
     y = setup.name(setup.y)
-    unit = {"y_max": setup.unit(setup.y), "passive": setup.unit(setup.y)}.get(
+    unit = {"y_max": setup.unit(setup.y), "passive": setup.unit(setup.y),
+            "simulated": setup.unit(setup.y)}.get(
         found.target, f"({setup.unit(setup.x)})({setup.unit(setup.y)})"
         if setup.unit(setup.x) and setup.unit(setup.y) else "")
     target_label = label[0].format(y=y) + (f" [{unit}]" if unit else "")

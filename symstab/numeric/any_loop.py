@@ -1079,13 +1079,18 @@ class Loop(LoopModel):
         return loop_stability_map(self, x_values, y_values, x=x, y=y, steps=steps, x0=x0, v0=v0,
                                   nonideal=nonideal, progress=progress, **values)
 
-    def design(self, *, over, maximize="y_max", x=None, y=None, n=None, rtol=1e-6, damping="b",
-               delay=None, progress=None, **values):
-        """The value of one or two parameters that maximises K_max, the Z-width or the passive K_max.
+    def design(self, *, over, maximize="y_max", x=None, y=None, n=None, rtol=None, damping="b",
+               delay=None, progress=None, amplitude=None, nonideal=None, x0=None, steps=None,
+               **values):
+        """The value of one or two parameters that maximises K_max, the Z-width, the passive K_max
+        or the simulated K_max.
 
-        Each evaluation is a certified answer at one value of the searched
-        parameters (:meth:`limits`, or :meth:`passive_region` for
-        ``maximize="passive"``); the search is a coarse scan, then
+        Each evaluation of the linear targets is a certified answer at one
+        value of the searched parameters (:meth:`limits`, or
+        :meth:`passive_region` for ``maximize="passive"``); the simulated
+        target is :func:`~symstab.numeric.simulate_limit.simulated_limit`
+        (runs of :meth:`simulate` with the non-idealities given).  The
+        search is a coarse scan, then
         ``scipy.optimize`` (:mod:`symstab.numeric.design` says how, and
         what it can miss).
 
@@ -1096,14 +1101,17 @@ class Loop(LoopModel):
             (not ``d``), e.g. ``{"M": (0.0, 0.04)}``.
         maximize : str
             ``"y_max"`` (the largest stable ``y``, K_max), ``"area"`` (the
-            Z-width) or ``"passive"`` (the passive K_max).
+            Z-width), ``"passive"`` (the passive K_max) or ``"simulated"``
+            (the largest ``y`` whose simulated run neither grows nor ends
+            above ``amplitude``).
         x, y : str, optional
             The plane (default: the loop's :attr:`plane`).
         n : int, optional
             Scan points per parameter, ``>= 3`` (default 17 for one
             parameter, 9 for two).
-        rtol : float
-            Relative accuracy of the optimum.
+        rtol : float, optional
+            Relative accuracy of the optimum (default 1e-6; 1e-3 for
+            ``"simulated"``, which is resolved to its grid).
         damping : str
             The device's viscous friction, for ``maximize="passive"``.
         delay : float, optional
@@ -1113,6 +1121,12 @@ class Loop(LoopModel):
             of ``d``).
         progress : callable, optional
             Called with the number of evaluations so far.
+        amplitude : float
+            ``maximize="simulated"`` only (and needed there): the largest
+            ``|x|`` accepted in the last quarter of a run (the position's
+            unit).
+        nonideal, x0, steps : optional
+            ``maximize="simulated"`` only: as in :meth:`simulate`.
         **values
             Single values of the other parameters; the searched ones' values
             here (or defaults) are the nominal point the gain is measured
@@ -1141,7 +1155,8 @@ class Loop(LoopModel):
 
         x, y = self._plane(x, y)
         return design(self, over=over, maximize=maximize, x=x, y=y, n=n, rtol=rtol,
-                      damping=damping, delay=delay, progress=progress, **values)
+                      damping=damping, delay=delay, progress=progress, amplitude=amplitude,
+                      nonideal=nonideal, x0=x0, steps=steps, **values)
 
     def closed_loop(self, **values):
         """The closed loop from a force at the plant's input to the position.

@@ -10,7 +10,12 @@ one engine at one value of the searched parameters:
 * ``"area"`` -- :attr:`Limits.area <symstab.numeric.results.Limits.area>`,
   the Z-width where ``x`` is a damping and ``y`` a stiffness;
 * ``"passive"`` -- ``y_max`` of :meth:`symstab.Loop.passive_region` (the
-  passive ``K_max``).
+  passive ``K_max``);
+* ``"simulated"`` -- ``y_max`` of
+  :func:`~symstab.numeric.simulate_limit.simulated_limit`: the largest
+  ``y`` whose simulated run, with the non-idealities given, neither grows
+  nor ends above a stated ``amplitude`` (not certified: a simulation,
+  resolved to its grid).
 
 A value where no point is stable has no target (``-inf``); one the engine
 cannot resolve (a stable set shrinking to a sliver it refuses) is skipped
@@ -43,7 +48,11 @@ TARGETS = {
     "y_max": "the largest stable y (K_max in the (B, K) plane)",
     "area": "the area of the stable set (the Z-width in the (B, K) plane)",
     "passive": "the largest passive y (the passive K_max in the (B, K) plane)",
+    "simulated": "the largest y whose simulated run settles below the amplitude given",
 }
+#: The relative accuracy of the search by default: a simulated target is
+#: resolved to its grid, about 1e-4 of its y_max, so finer is wasted.
+_RTOL = {"simulated": 1e-3}
 #: A run of stable scan values shorter than this is zoomed into before refining.
 _MIN_RUN = 5
 #: Zooms at most (each divides the step by about n / 2).
@@ -78,7 +87,9 @@ class Design:
     limits : object or None
         At the optimum: the :class:`~symstab.numeric.results.Limits` of the
         plane (targets ``y_max``, ``area``) or the
-        :class:`~symstab.numeric.passivity.PassiveRegion` (``passive``).
+        :class:`~symstab.numeric.passivity.PassiveRegion` (``passive``) or
+        the :class:`~symstab.numeric.simulate_limit.SimulatedLimit`
+        (``simulated``).
     samples : ndarray
         Every evaluation, ``(k, len(over) + 1)``: the parameters' values,
         then the target (``-inf`` no stable point, NaN not resolved), in
@@ -382,8 +393,9 @@ def _check_over(loop, over, x, y):
     return out
 
 
-def design(loop, *, over, maximize="y_max", x=None, y=None, n=None, rtol=1e-6, damping="b",
-           delay=None, progress=None, **values):
+def design(loop, *, over, maximize="y_max", x=None, y=None, n=None, rtol=None, damping="b",
+           delay=None, progress=None, amplitude=None, nonideal=None, x0=None, steps=None,
+           **values):
     """The value of one or two parameters of ``loop`` that maximises a target.
 
     See :meth:`symstab.Loop.design`, which calls this with the plane ``x``,
@@ -393,6 +405,8 @@ def design(loop, *, over, maximize="y_max", x=None, y=None, n=None, rtol=1e-6, d
         raise ValueError(f"maximize must be one of {', '.join(map(repr, TARGETS))}, "
                          f"got {maximize!r}")
     over = _check_over(loop, over, x, y)
+    simulation = _check_simulation(maximize, amplitude, nonideal, x0, steps)
+    rtol = _RTOL.get(maximize, 1e-6) if rtol is None else rtol
     names = tuple(over)
     n = (17 if len(names) == 1 else 9) if n is None else check_count("n", n, 3)
     if progress is not None and not callable(progress):
@@ -430,10 +444,17 @@ def design(loop, *, over, maximize="y_max", x=None, y=None, n=None, rtol=1e-6, d
     if maximize == "passive":
         # A plant the passivity theorem does not cover is refused here, once.
         loop.passive_region(x, y, damping=damping, **at(middle))
+    if simulation:
+        # The horizon is checked at every corner's delay (held in seconds, d
+        # varies with T), before the scan.
+        from .simulate import check_steps
+
+        for corner in _corners(over):
+            check_steps(steps, at(corner).get("d", loop.defaults.get("d", 0)))
     failed = []
 
     def answer(point):
-        return _answer(loop, maximize, x, y, damping, at(point))
+        return _answer(loop, maximize, x, y, damping, at(point), simulation)
 
     def target(point):
         try:
@@ -465,14 +486,17 @@ def design(loop, *, over, maximize="y_max", x=None, y=None, n=None, rtol=1e-6, d
                   value_nominal=value_nominal, samples=samples, spacing=spacing,
                   failed=tuple(failed), values=dict(values), delay=delay)
     if best is None and failed and not np.any(samples[:, -1] == -np.inf):
-        raise ValueError(f"the {'passive set' if maximize == 'passive' else 'limits'} could not "
+        what = {"passive": "passive set", "simulated": "simulated limit"}.get(maximize, "limits")
+        raise ValueError(f"the {what} could not "
                          f"be computed at any of the {len(samples)} values searched: "
                          f"{failed[0][1]}")
     if best is None:
         ranges = ", ".join(f"{k} in [{lo:.6g}, {hi:.6g}]" for k, (lo, hi) in over.items())
-        what = "passive" if maximize == "passive" else "stable"
+        what = {"passive": "a passive point",
+                "simulated": f"a point whose simulated run settles below "
+                             f"{simulation.get('amplitude', 0):.3g}"}.get(maximize, "a stable point")
         return Design(best=None, value=None, limits=None,
-                      message=f"no value of {ranges} has a {what} point in the ({x}, {y}) plane "
+                      message=f"no value of {ranges} has {what} in the ({x}, {y}) plane "
                               f"(scanned in steps of "
                               f"{', '.join(f'{s:.3g}' for s in spacing.values())}; "
                               f"{len(samples)} evaluations)", **common)
@@ -492,8 +516,39 @@ def held_delay(delay, T):
         else math.ceil(quotient)
 
 
-def _answer(loop, maximize, x, y, damping, values):
-    """The engine's answer whose number is the target: Limits or PassiveRegion."""
+def _check_simulation(maximize, amplitude, nonideal, x0, steps):
+    """The simulation's settings of ``maximize="simulated"`` (checked), else ``{}``."""
+    given = {k: v for k, v in (("amplitude", amplitude), ("nonideal", nonideal), ("x0", x0),
+                               ("steps", steps)) if v is not None}
+    if maximize != "simulated":
+        if given:
+            raise TypeError(f"{', '.join(given)}: only with maximize='simulated' (the other "
+                            f"targets are certified, not simulated)")
+        return {}
+    from .simulate import check_loop_nonideal, check_x0
+
+    if amplitude is None:
+        raise TypeError("maximize='simulated' needs amplitude: the largest |x| accepted at the "
+                        "end of a run (the position's unit)")
+    return {"amplitude": check_real("amplitude", amplitude, low=0.0, low_open=True),
+            "nonideal": check_loop_nonideal(nonideal),
+            "x0": 1.0 if x0 is None else check_x0(x0), "steps": steps}
+
+
+def _corners(over):
+    """The corners of the searched box, as points."""
+    corners = [()]
+    for lo, hi in over.values():
+        corners = [c + (v,) for c in corners for v in (lo, hi)]
+    return corners
+
+
+def _answer(loop, maximize, x, y, damping, values, simulation):
+    """The answer whose number is the target: Limits, PassiveRegion or SimulatedLimit."""
+    if maximize == "simulated":
+        from .simulate_limit import simulated_limit
+
+        return simulated_limit(loop, x=x, y=y, **simulation, **values)
     if maximize == "passive":
         return loop.passive_region(x, y, damping=damping, **values)
     return loop.limits(x, y, **values)

@@ -74,7 +74,7 @@ from .results import PAPER_PLANE, PaperGridNames
 
 __all__ = ["Nonidealities", "Simulation", "simulate", "StabilityMap", "stability_map",
            "default_horizon", "check_steps", "check_x0", "max_steps", "progress_printer", "PAPER_ENCODER_RESOLUTION",
-           "MAX_STEPS_ENV", "simulate_loop", "loop_stability_map"]
+           "MAX_STEPS_ENV", "simulate_loop", "loop_stability_map", "check_loop_nonideal"]
 
 #: The most sub-steps per period: each multiplies the simulation's time (a
 #: billion once hung it), and the held-mean approximation they refine is
@@ -772,16 +772,7 @@ def simulate_loop(loop, *, steps=None, x0=1.0, v0=None, nonideal=None, record=Fa
         ``P_n`` as high as ``P_d``: the sampled position would depend on the
         force of the same instant), or a run that does not fit in memory.
     """
-    nonideal = Nonidealities() if nonideal is None else nonideal
-    if not isinstance(nonideal, Nonidealities):
-        raise TypeError(f"nonideal must be a symstab.numeric.simulate.Nonidealities or None, "
-                        f"got {type(nonideal).__name__}")
-    for field, instead in (("velocity_cutoff", "write the filter into the loop's environment"),
-                           ("actuator_bandwidth", "write the lag into the loop's plant"),
-                           ("coulomb_friction", "not simulated for a general loop yet")):
-        if getattr(nonideal, field) is not None:
-            raise ValueError(f"nonideal.{field}: {instead} (the paper's simulator, "
-                             f"symstab.simulate, has it)")
+    nonideal = check_loop_nonideal(nonideal)
     if progress is not None and not callable(progress):
         raise TypeError(f"progress must be a callable taking the number of steps done, or None, "
                         f"got {type(progress).__name__}")
@@ -797,6 +788,26 @@ def simulate_loop(loop, *, steps=None, x0=1.0, v0=None, nonideal=None, record=Fa
     return _run_chunks(lambda part: _AnyLoop([p[part] for p in parts], d, x0, v0, nonideal),
                        n_points, point_bytes, steps=steps, d=d, record=record,
                        progress=progress, nonideal=nonideal, shape=shape)
+
+
+def check_loop_nonideal(nonideal):
+    """``nonideal`` (None: ideal) as the :class:`Nonidealities` of a general loop, or raise.
+
+    A general loop has encoder quantization and a force limit; the velocity
+    filter and the actuator lag belong in its environment and plant, and
+    Coulomb friction is not simulated for it yet.
+    """
+    nonideal = Nonidealities() if nonideal is None else nonideal
+    if not isinstance(nonideal, Nonidealities):
+        raise TypeError(f"nonideal must be a symstab.numeric.simulate.Nonidealities or None, "
+                        f"got {type(nonideal).__name__}")
+    for field, instead in (("velocity_cutoff", "write the filter into the loop's environment"),
+                           ("actuator_bandwidth", "write the lag into the loop's plant"),
+                           ("coulomb_friction", "not simulated for a general loop yet")):
+        if getattr(nonideal, field) is not None:
+            raise ValueError(f"nonideal.{field}: {instead} (the paper's simulator, "
+                             f"symstab.simulate, has it)")
+    return nonideal
 
 
 def _verdict(amplitude, diverged, positions, shape, steps, nonideal):

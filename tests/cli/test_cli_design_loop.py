@@ -132,6 +132,21 @@ def test_the_table_names_the_optimum_the_value_there_and_at_the_nominal_value(ca
      "drop --d"),
     (["--delay", "10ms"], "--delay needs a loop file"),
     (["--png", "/nonexistent/x.png"], "--png"),
+    # The simulated target: its options only with it, with a loop file, checked first.
+    (["--loop", LOOPS / "paper.toml", "--amplitude", "1e-3"], "add --maximize simulated"),
+    (["--encoder-resolution", "1e-5"], "add --maximize simulated"),
+    (["--maximize", "simulated", "--amplitude", "1e-3"], "give --loop FILE"),
+    (["--loop", LOOPS / "paper.toml", "--maximize", "simulated"], "needs --amplitude"),
+    (["--loop", LOOPS / "paper.toml", "--maximize", "simulated", "--amplitude", "0"],
+     "--amplitude"),
+    (["--loop", LOOPS / "paper.toml", "--maximize", "simulated", "--amplitude", "1e-3",
+      "--paper-encoder"], "--paper-encoder"),
+    (["--loop", LOOPS / "paper.toml", "--maximize", "simulated", "--amplitude", "1e-3",
+      "--velocity-cutoff", "50"], "--velocity-cutoff"),
+    (["--loop", LOOPS / "paper.toml", "--maximize", "simulated", "--amplitude", "1e-3",
+      "--steps", "1000000000"], "steps"),
+    (["--loop", LOOPS / "paper.toml", "--maximize", "simulated", "--amplitude", "1e-3",
+      "--force-limit", "-1"], "force_limit"),
 ])
 def test_bad_search_input_is_one_line_before_the_search(capsys, args, needle):
     status, out, err = run(capsys, "design", *args)
@@ -170,3 +185,28 @@ def test_over_takes_a_range_with_a_unit_and_two_parameters(capsys, tmp_path):
     assert "f_c (best)" in rows and "b (best)" in rows and "area" in rows
     best_f_c, best_b, area = (float(rows[k][0]) for k in ("f_c (best)", "b (best)", "area"))
     assert loop.limits(d=2, f_c=best_f_c, b=best_b).area == pytest.approx(area, rel=1e-6)
+
+
+def test_the_simulated_target_names_what_it_simulated(capsys, tmp_path):
+    """--maximize simulated: the simulated K_max at the best value with the certified one
+    beside it (the simulation accepts less), the runs and the amplitude in a note, a PNG."""
+    png = tmp_path / "design.png"
+    status, out, err = run(capsys, "design", "--loop", LOOPS / "lowpass_velocity.toml",
+                           "--set", "d=2", "--over", "f_c=50:400", "--points", "3",
+                           "--maximize", "simulated", "--amplitude", "1e-3", "--steps", "2000",
+                           "--encoder-resolution", "1e-5", "--png", png)
+    assert status == 0, err
+    assert "whose simulated run settles below 0.001" in err
+    rows = {line.strip().split("  ")[0]: line.split() for line in out.splitlines()
+            if "  " in line.strip()}
+    simulated, linear = float(rows["simulated K_max"][2]), float(rows["K_max"][1])
+    assert 0.9 * linear < simulated < linear
+    assert "encoder quantum 1e-05" in out and "2000 periods per run" in out
+    assert png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    found = run_json(capsys, "design", "--loop", LOOPS / "lowpass_velocity.toml",
+                     "--set", "d=2", "--over", "f_c=50:400", "--points", "3",
+                     "--maximize", "simulated", "--amplitude", "1e-3", "--steps", "2000",
+                     "--encoder-resolution", "1e-5")
+    assert found["search"]["maximize"] == "simulated"
+    assert found["search"]["value"] == pytest.approx(simulated, rel=1e-9)
+    assert found["search"]["simulated"]["steps"] == 2000
