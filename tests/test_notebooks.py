@@ -3,9 +3,11 @@
 Each notebook walks through one derivation step by calling :mod:`symstab`
 and :mod:`paper_checks` (it derives nothing of its own) and asserts the
 audit's verdicts as it goes, so executing it is a test of both the library
-and the narrative; the last one walks one loop of ``examples/loops/``
+and the narrative; ``08`` walks one loop of ``examples/loops/``
 through :class:`symstab.Loop` and asserts its answers against
-python-control's poles.  The notebooks are stored without outputs; these tests
+python-control's poles; ``09`` answers the velocity filter's cut-off
+question (linear model against simulation with the encoder) and asserts
+its answer.  The notebooks are stored without outputs; these tests
 execute them in a fresh ``python3`` kernel with nbclient and fail on any cell
 error.  The execution tests are skipped when nbclient or ipykernel is not
 installed; the storage tests only need the standard library.
@@ -28,6 +30,7 @@ EXPECTED = (
     "06_small_theta_limits.ipynb",
     "07_code_generation.ipynb",
     "08_any_loop.ipynb",
+    "09_cutoff.ipynb",
 )
 
 KERNELSPEC = {"name": "python3", "display_name": "Python 3", "language": "python"}

@@ -424,7 +424,7 @@ def _search(args, setup, over, target, notes, png, delay=None, simulation=None):
                      "stiffness)"))
     notes += limits_notes(setup, lim)
     if target == "simulated":
-        notes += _simulation_notes(setup, found.limits, simulation)
+        notes += _simulation_notes(setup, found, simulation)
     at_best = dataclasses.replace(setup, values=_at(setup, found.best, delay))
     if delay is not None:
         T = at_best.values["T"]
@@ -475,14 +475,28 @@ def _search(args, setup, over, target, notes, png, delay=None, simulation=None):
     return 0
 
 
-def _simulation_notes(setup, simulated, simulation):
-    """What the simulated target is: the runs, the non-idealities, its resolution."""
+#: Values whose simulated target lies within this fraction of the best are ties: near
+#: the limit the accepted set's edge is ragged (quantization limit cycles near the
+#: amplitude), and the target varies by about 1 % between nearby values.
+SIMULATED_TIE = 0.01
+
+
+def _simulation_notes(setup, found, simulation):
+    """What the simulated target is: the runs, the non-idealities, its resolution, the ties."""
     y = setup.name(setup.y)
+    simulated = found.limits
     out = [f"simulated: {loop_nonideal_text(simulation['nonideal'])}, x0 = "
            f"{simulation['x0']:g}, {simulated.steps} periods per run; a run is accepted when "
            f"it does not grow and its last quarter's |x| is at most "
-           f"{simulation['amplitude']:.4g} (not certified: simulated {y}_max resolved to "
-           f"{simulated.resolution:.3g})"]
+           f"{simulation['amplitude']:.4g} (not certified: simulated {y}_max refined to steps "
+           f"of {simulated.resolution:.3g})"]
+    ties = found.samples[found.samples[:, -1] >= (1 - SIMULATED_TIE) * found.value]
+    spans = ", ".join(f"{setup.name(n)} from {ties[:, k].min():.6g} to {ties[:, k].max():.6g}"
+                      for k, n in enumerate(found.over))
+    out.append(f"the edge of the accepted runs is ragged where quantization cycles come near "
+               f"the amplitude, so the simulated {y}_max varies by about 1 % between nearby "
+               f"values: the values searched within {SIMULATED_TIE:.0%} of the best are "
+               f"{spans}")
     if simulated.at_top:
         out.append(f"the simulated {y}_max is at the top of its window (1.25 times the linear "
                    f"{y}_max): it may lie higher")

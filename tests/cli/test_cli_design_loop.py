@@ -202,6 +202,7 @@ def test_the_simulated_target_names_what_it_simulated(capsys, tmp_path):
     simulated, linear = float(rows["simulated K_max"][2]), float(rows["K_max"][1])
     assert 0.9 * linear < simulated < linear
     assert "encoder quantum 1e-05" in out and "2000 periods per run" in out
+    assert "the values searched within 1% of the best are f_c from" in out
     assert png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
     found = run_json(capsys, "design", "--loop", LOOPS / "lowpass_velocity.toml",
                      "--set", "d=2", "--over", "f_c=50:400", "--points", "3",
