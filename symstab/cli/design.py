@@ -35,6 +35,13 @@ _TARGET_WORDS = {"y_max": "y_max", "K_max": "y_max", "area": "area", "Z-width": 
 _SIMULATION_FLAGS = (("--amplitude", "amplitude"), ("--encoder-resolution", "encoder_resolution"),
                      ("--paper-encoder", "paper_encoder"), ("--force-limit", "force_limit"),
                      ("--steps", "steps"), ("--x0", "x0"))
+#: The paper simulator's options (refused with --loop by add_loop_options; without a
+#: loop file design has no simulation for them).
+_PAPER_SIMULATION_FLAGS = (("--velocity-cutoff", "velocity_cutoff"), ("--coulomb", "coulomb"),
+                           ("--stiction", "stiction"),
+                           ("--friction-compensation", "friction_compensation"),
+                           ("--actuator-bandwidth", "actuator_bandwidth"),
+                           ("--substeps", "substeps"))
 #: The scan's points per parameter at most: each is a certified region.
 MAX_POINTS = 201
 #: The scan's points in all at most (two parameters: ``--points`` squared).
@@ -71,8 +78,10 @@ def register(subparsers):
                         "file's d")
     g.add_argument("--amplitude", metavar="X", type=float,
                    help="with --maximize simulated: the largest |x| accepted in the last "
-                        "quarter of a run, in the loop's position unit (m or rad); a limit "
-                        "cycle above it, or a decay not below it by the end, is refused")
+                        "quarter of a run, in the loop's position unit (m or rad), from --x0; "
+                        "a limit cycle above it, or a decay not below it by the end, is "
+                        "refused (--steps counts periods: with --delay and --over T a fixed "
+                        "--steps is a shorter time at a smaller T)")
     add_nonideal_options(p)
     add_loop_options(p, "design")
 
@@ -87,7 +96,16 @@ def run(args):
     its JSON the ``best`` of :func:`symstab.best_virtual_mass`.
     """
     target = _target(args.maximize)
-    given = [flag for flag, dest in _SIMULATION_FLAGS if getattr(args, dest) not in (None, False)]
+    # (0 is a value given: only None, and False for a switch, are "not given".)
+    def given(flags):
+        return [flag for flag, dest in flags
+                if getattr(args, dest) is not None and getattr(args, dest) is not False]
+
+    paper_flags = given(_PAPER_SIMULATION_FLAGS)
+    if args.loop is None and paper_flags:      # with --loop, add_loop_options refuses them
+        raise ValueError(f"{paper_flags[0]}: design simulates only a loop file (--maximize "
+                         f"simulated --loop FILE), whose filter or lag is written in the file")
+    given = given(_SIMULATION_FLAGS)
     if target != "simulated" and given:
         raise ValueError(f"{given[0]} is an option of the simulated target: add --maximize "
                          f"simulated (with --loop)")
@@ -477,7 +495,8 @@ def _search(args, setup, over, target, notes, png, delay=None, simulation=None):
 
 #: Values whose simulated target lies within this fraction of the best are ties: near
 #: the limit the accepted set's edge is ragged (quantization limit cycles near the
-#: amplitude), and the target varies by about 1 % between nearby values.
+#: amplitude); for the paper's device at d = 5 the target varies by about 1 % between
+#: nearby values (measured, symstab/numeric/simulate_limit.py).
 SIMULATED_TIE = 0.01
 
 
@@ -490,13 +509,14 @@ def _simulation_notes(setup, found, simulation):
            f"it does not grow and its last quarter's |x| is at most "
            f"{simulation['amplitude']:.4g} (not certified: simulated {y}_max refined to steps "
            f"of {simulated.resolution:.3g})"]
-    ties = found.samples[found.samples[:, -1] >= (1 - SIMULATED_TIE) * found.value]
-    spans = ", ".join(f"{setup.name(n)} from {ties[:, k].min():.6g} to {ties[:, k].max():.6g}"
-                      for k, n in enumerate(found.over))
-    out.append(f"the edge of the accepted runs is ragged where quantization cycles come near "
-               f"the amplitude, so the simulated {y}_max varies by about 1 % between nearby "
-               f"values: the values searched within {SIMULATED_TIE:.0%} of the best are "
-               f"{spans}")
+    if simulation["nonideal"].encoder_resolution is not None:
+        ties = found.samples[found.samples[:, -1] >= (1 - SIMULATED_TIE) * found.value]
+        spans = ", ".join(f"{setup.name(n)} from {ties[:, k].min():.6g} to "
+                          f"{ties[:, k].max():.6g}" for k, n in enumerate(found.over))
+        out.append(f"the edge of the accepted runs is ragged where quantization cycles come "
+                   f"near the amplitude (for the paper's device the simulated {y}_max varies "
+                   f"by about 1 % between nearby values): the values searched within "
+                   f"{SIMULATED_TIE:.0%} of the best are {spans}")
     if simulated.at_top:
         out.append(f"the simulated {y}_max is at the top of its window (1.25 times the linear "
                    f"{y}_max): it may lie higher")
@@ -555,11 +575,10 @@ def _search_json(setup, found, names, lim):
     out["x_at_y_max"] = None if lim is None else lim.x_at_y_max
     if found.target == "simulated":
         simulated = found.limits
-        out["simulated"] = {
-            "x_at_y_max": None if simulated is None else simulated.x_at_y_max,
-            "resolution": None if simulated is None else simulated.resolution,
-            "amplitude": None if simulated is None else simulated.amplitude,
-            "steps": None if simulated is None else simulated.steps}
+        out["simulated"] = None if simulated is None else {
+            "x_at_y_max": simulated.x_at_y_max, "resolution": simulated.resolution,
+            "amplitude": simulated.amplitude, "steps": simulated.steps, "x0": simulated.x0,
+            "at_top": simulated.at_top, "nonideal": loop_nonideal_text(simulated.nonideal)}
     return out
 
 

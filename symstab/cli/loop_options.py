@@ -117,7 +117,7 @@ _WHAT = {
                 "changed by --set (comma lists: several points).",
     "design": "design --loop searches one or two parameters outside the plane (--over "
               "NAME=LO:HI, default the environment's mass term, e.g. M) for the largest "
-              "stable y, area or passive y (--maximize), as design searches the virtual "
+              "stable y, area, passive y or simulated y (--maximize), as design searches the virtual "
               "mass, and gives the best values, the target there and at the nominal values, "
               "the x where y_max is reached and the stable intervals of y at that x (or at "
               "--at X).",

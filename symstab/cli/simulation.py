@@ -36,7 +36,7 @@ def add_nonideal_options(p):
 
 def resolve_nonideal(args, setup):
     """``(Nonidealities, x0)`` of the parsed options, checked before any work (raises ValueError)."""
-    from ..numeric.simulate import PAPER_ENCODER_RESOLUTION, Nonidealities, check_x0
+    from ..numeric.simulate import PAPER_ENCODER_RESOLUTION, Nonidealities, check_x0, default_x0
 
     resolution = args.encoder_resolution
     if args.paper_encoder and setup is None:
@@ -64,7 +64,7 @@ def resolve_nonideal(args, setup):
     if setup is not None and setup.physical:
         nonideal.check(setup.device.T)
     # Checked here, not only by the simulator, so that nothing is printed before the error.
-    x0 = check_x0(args.x0) if args.x0 is not None else (1.0 if nonideal.ideal else 0.01)
+    x0 = check_x0(args.x0) if args.x0 is not None else default_x0(nonideal)
     return nonideal, x0
 
 

@@ -1126,7 +1126,10 @@ class Loop(LoopModel):
             ``|x|`` accepted in the last quarter of a run (the position's
             unit).
         nonideal, x0, steps : optional
-            ``maximize="simulated"`` only: as in :meth:`simulate`.
+            ``maximize="simulated"`` only: as in :meth:`simulate` (``x0``
+            default 1, or 0.01 with non-idealities, as ``symstab design``;
+            ``steps`` is periods, so with ``delay`` and ``T`` searched a
+            fixed ``steps`` is a shorter time at a smaller ``T``).
         **values
             Single values of the other parameters; the searched ones' values
             here (or defaults) are the nominal point the gain is measured

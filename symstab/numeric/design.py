@@ -525,14 +525,15 @@ def _check_simulation(maximize, amplitude, nonideal, x0, steps):
             raise TypeError(f"{', '.join(given)}: only with maximize='simulated' (the other "
                             f"targets are certified, not simulated)")
         return {}
-    from .simulate import check_loop_nonideal, check_x0
+    from .simulate import check_loop_nonideal, check_x0, default_x0
 
     if amplitude is None:
         raise TypeError("maximize='simulated' needs amplitude: the largest |x| accepted at the "
                         "end of a run (the position's unit)")
+    nonideal = check_loop_nonideal(nonideal)
     return {"amplitude": check_real("amplitude", amplitude, low=0.0, low_open=True),
-            "nonideal": check_loop_nonideal(nonideal),
-            "x0": 1.0 if x0 is None else check_x0(x0), "steps": steps}
+            "nonideal": nonideal, "x0": default_x0(nonideal) if x0 is None else check_x0(x0),
+            "steps": steps}
 
 
 def _corners(over):

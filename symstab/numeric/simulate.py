@@ -74,7 +74,8 @@ from .results import PAPER_PLANE, PaperGridNames
 
 __all__ = ["Nonidealities", "Simulation", "simulate", "StabilityMap", "stability_map",
            "default_horizon", "check_steps", "check_x0", "max_steps", "progress_printer", "PAPER_ENCODER_RESOLUTION",
-           "MAX_STEPS_ENV", "simulate_loop", "loop_stability_map", "check_loop_nonideal"]
+           "MAX_STEPS_ENV", "simulate_loop", "loop_stability_map", "check_loop_nonideal",
+           "default_x0"]
 
 #: The most sub-steps per period: each multiplies the simulation's time (a
 #: billion once hung it), and the held-mean approximation they refine is
@@ -207,6 +208,16 @@ def default_horizon(d):
     longer horizon.
     """
     return 12000 + 800 * check_delay(d)
+
+
+def default_x0(nonideal):
+    """The initial position when none is given: 1, or 0.01 with non-idealities.
+
+    A quantized or saturated run starts within a few hundred encoder counts
+    of the paper's (0.01 rad is 688 of its 3 arc-second counts), where its
+    limit cycles are seen; an ideal loop is linear, so any start will do.
+    """
+    return 1.0 if nonideal is None or nonideal.ideal else 0.01
 
 
 def check_x0(x0):

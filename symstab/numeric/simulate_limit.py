@@ -61,6 +61,10 @@ class SimulatedLimit:
         The ``x`` of that run.
     amplitude : float
         The largest ``|x|`` accepted in the run's last quarter.
+    x0 : float
+        The runs' initial position.
+    nonideal : Nonidealities
+        The runs' non-idealities.
     linear : Limits
         The certified limits of the loop without non-idealities: the window.
     resolution : float
@@ -81,6 +85,8 @@ class SimulatedLimit:
     y_max: object
     x_at_y_max: object
     amplitude: float
+    x0: float
+    nonideal: object
     linear: object
     resolution: object
     runs: int
@@ -101,7 +107,7 @@ class SimulatedLimit:
                 f"amplitude <= {self.amplitude:.3g}, {self.runs} runs)")
 
 
-def simulated_limit(loop, *, x, y, amplitude, nonideal=None, steps=None, x0=1.0, n=(12, 16),
+def simulated_limit(loop, *, x, y, amplitude, nonideal=None, steps=None, x0=None, n=(12, 16),
                     refine=3, progress=None, **values):
     """The largest ``y`` of the plane at which the simulated loop is accepted.
 
@@ -118,7 +124,9 @@ def simulated_limit(loop, *, x, y, amplitude, nonideal=None, steps=None, x0=1.0,
         Encoder quantization and force limit (:func:`~symstab.numeric.
         simulate.simulate_loop`).
     steps, x0 : optional
-        As in :meth:`symstab.Loop.simulate`.
+        As in :meth:`symstab.Loop.simulate`; ``x0`` default 1, or 0.01 with
+        non-idealities (:func:`~symstab.numeric.simulate.default_x0`, as
+        the command line), from which ``amplitude`` is reached.
     n : (int, int)
         The first grid's points in ``x`` and ``y``, each ``>= 3`` (the ``x`` of
         the linear ``y_max`` is added to the grid in ``x``).
@@ -140,14 +148,18 @@ def simulated_limit(loop, *, x, y, amplitude, nonideal=None, steps=None, x0=1.0,
         and for an ``amplitude`` that is not a positive number or a linear
         stable set unbounded in ``x``.
     """
+    from .simulate import check_loop_nonideal, check_x0, default_x0
+
     amplitude = check_real("amplitude", amplitude, low=0.0, low_open=True)
+    nonideal = check_loop_nonideal(nonideal)
+    x0 = default_x0(nonideal) if x0 is None else check_x0(x0)
     n_x, n_y = _grid_size(n)
     refine = check_count("refine", refine, 0)
     for name in (x, y):
         if name in values:
             raise TypeError(f"{name} is an axis of the ({x}, {y}) plane: it takes no value here")
     linear = loop.limits(x, y, **values)
-    common = dict(x=x, y=y, amplitude=amplitude, linear=linear)
+    common = dict(x=x, y=y, amplitude=amplitude, x0=x0, nonideal=nonideal, linear=linear)
     if linear.y_max is None or not linear.y_max > 0:
         why = linear.reason or f"its largest stable {y} is {linear.y_max:.6g}, not above 0"
         return SimulatedLimit(y_max=None, x_at_y_max=None, resolution=None, runs=0, steps=0,

@@ -147,6 +147,14 @@ def test_the_table_names_the_optimum_the_value_there_and_at_the_nominal_value(ca
       "--steps", "1000000000"], "steps"),
     (["--loop", LOOPS / "paper.toml", "--maximize", "simulated", "--amplitude", "1e-3",
       "--force-limit", "-1"], "force_limit"),
+    # From a review: 0 was taken for "not given" and the flag ignored (exit 0); the paper
+    # simulator's options were accepted without a loop file and ignored.
+    (["--loop", LOOPS / "paper.toml", "--x0", "0", "--points", "3"], "--x0"),
+    (["--loop", LOOPS / "paper.toml", "--steps", "0", "--points", "3"], "--steps"),
+    (["--loop", LOOPS / "paper.toml", "--amplitude", "0", "--points", "3"], "--amplitude"),
+    (["--coulomb", "0.1"], "--coulomb"),
+    (["--velocity-cutoff", "50"], "--velocity-cutoff"),
+    (["--friction-compensation", "--coulomb", "0.1"], "--coulomb"),
 ])
 def test_bad_search_input_is_one_line_before_the_search(capsys, args, needle):
     status, out, err = run(capsys, "design", *args)
@@ -211,3 +219,14 @@ def test_the_simulated_target_names_what_it_simulated(capsys, tmp_path):
     assert found["search"]["maximize"] == "simulated"
     assert found["search"]["value"] == pytest.approx(simulated, rel=1e-9)
     assert found["search"]["simulated"]["steps"] == 2000
+    # With non-idealities the runs start at 0.01, as simulate and map --simulate do, and
+    # the library's default is the same start.
+    assert found["search"]["simulated"]["x0"] == 0.01
+    assert found["search"]["simulated"]["at_top"] is False
+    loop = symstab.load_loop(LOOPS / "lowpass_velocity.toml")
+    from symstab.numeric.simulate import Nonidealities
+
+    library = loop.design(over={"f_c": (50.0, 400.0)}, n=3, maximize="simulated",
+                          amplitude=1e-3, steps=2000,
+                          nonideal=Nonidealities(encoder_resolution=1e-5), d=2)
+    assert library.value == pytest.approx(simulated, rel=1e-9)
