@@ -64,6 +64,12 @@ class Kernel:
         SymPy would simplify away (an error-free product); empty for a
         kernel printed from its outputs.  The outputs then state what the
         body computes.
+    complex_arithmetic : bool
+        C only: the temporaries are ``double complex`` (C99's
+        ``<complex.h>``), printed by :class:`CComplexKernelPrinter`, and each
+        output is the real part (:class:`RealPart`) of a complex expression:
+        a plant whose poles are written with square roots that are
+        imaginary for a complex pair.
     """
 
     name: str
@@ -72,6 +78,7 @@ class Kernel:
     doc: str
     python_body: tuple = ()
     c_body: tuple = ()
+    complex_arithmetic: bool = False
 
     def __post_init__(self):
         allowed = {symbol for symbol, _, _ in self.args}
@@ -234,6 +241,45 @@ class CKernelPrinter(C99CodePrinter):
         if isinstance(expr, (kf.SeriesFunction, kf.MultipleAngle)):
             return f"{C_PREFIX}{type(expr).__name__}({', '.join(self._print(a) for a in expr.args)})"
         return super()._print_Function(expr)
+
+
+class RealPart(sp.Function):
+    """The real part of a complex C99 expression, left unevaluated (printed ``creal``).
+
+    SymPy's ``re`` would try to split a large expression of unknown sign
+    into real and imaginary parts symbolically; the C kernel only needs the
+    real part of the number it computes.
+    """
+
+    nargs = 1
+
+
+class CComplexKernelPrinter(CKernelPrinter):
+    """C99 printer in complex arithmetic: ``cexp``, ``csqrt``, ``cpow``, ``creal``.
+
+    For the kernels with ``complex_arithmetic``: a square root of a negative
+    number is the imaginary one (``csqrt``), and the exponentials of complex
+    arguments are C99's ``cexp``.  Any other function is refused (its real
+    C version would be wrong for a complex argument).
+    """
+
+    def _print_exp(self, expr):
+        return f"cexp({self._print(expr.args[0])})"
+
+    def _print_Pow(self, expr):
+        base = self._print(expr.base)
+        if expr.exp == sp.Rational(1, 2):
+            return f"csqrt({base})"
+        if expr.exp == -sp.Rational(1, 2):
+            return f"1.0/csqrt({base})"
+        if expr.exp == -1:
+            return f"1.0/({base})"
+        return f"cpow({base}, {self._print(expr.exp)})"
+
+    def _print_Function(self, expr):
+        if isinstance(expr, RealPart):
+            return f"creal({self._print(expr.args[0])})"
+        raise NotImplementedError(f"{type(expr).__name__} has no complex C99 kernel here")
 
 
 def one_line(text):
@@ -400,6 +446,8 @@ def c_function(kernel, printer):
     printer : CKernelPrinter
     """
     replacements, reduced = kernel.cse()
+    if kernel.complex_arithmetic:
+        printer = CComplexKernelPrinter()
     lines = [c_comment(kernel), c_signature(kernel), "{"]
     if kernel.c_body:
         return "\n".join(lines + [f"    {line}" for line in kernel.c_body] + ["}"])
@@ -412,7 +460,8 @@ def c_function(kernel, printer):
               if isinstance(symbol, sp.Symbol) and symbol not in used]
     for symbol, expr in replacements:
         # An integer temporary (d + 1) stays an int: it is passed as one.
-        ctype = "int" if expr.is_integer else "double"
+        ctype = "int" if expr.is_integer else ("double complex" if kernel.complex_arithmetic
+                                               else "double")
         lines.append(f"    const {ctype} {symbol} = {printer.doprint(expr)};")
     if len(reduced) == 1:
         lines.append(f"    return {printer.doprint(reduced[0])};")

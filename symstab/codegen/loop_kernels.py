@@ -104,7 +104,8 @@ def c_source(kernels, *, title, prefix, command):
     str
     """
     printer = CKernelPrinter()
-    lines = header("c", title, command) + ["#include <math.h>", ""]
+    complex_h = ["#include <complex.h>"] if any(k.complex_arithmetic for k in kernels) else []
+    lines = header("c", title, command) + ["#include <math.h>"] + complex_h + [""]
     for kernel in kernels:
         text = c_function(kernel, printer)
         lines += [text.replace(" symstab_", f" {prefix}"), ""]
@@ -177,14 +178,14 @@ def load_numpy_kernels(kernels, *, title):
     return module
 
 
-def kernel(name, args, outputs, doc):
+def kernel(name, args, outputs, doc, *, complex_arithmetic=False):
     """Shorthand for :class:`symstab.codegen.generator.Kernel` with float arguments.
 
     ``args`` is a sequence of ``(symbol, description)``; ``outputs`` of
     ``(name, expression, description)``.
     """
     return Kernel(name, tuple((symbol, "double", text) for symbol, text in args),
-                  tuple(outputs), doc)
+                  tuple(outputs), doc, complex_arithmetic=complex_arithmetic)
 
 
 def environment_kernels(loop):

@@ -20,7 +20,7 @@ import re
 import sympy as sp
 
 from ..symbolic import model
-from ..codegen.generator import c_comment, c_signature, comment_text
+from ..codegen.generator import RealPart, c_comment, c_signature, comment_text
 from ..codegen.loop_kernels import c_source, header, kernel, numpy_source
 
 __all__ = ["COMMAND", "OWNED", "MARKER", "PAPER_PLANT", "PAPER_ENVIRONMENT", "delay_parts", "step_source", "step_orders",
@@ -90,31 +90,55 @@ def plant_kernel(loop):
     symstab.codegen.generator.Kernel or None
         None when the loop's ZOH is computed numerically
         (``loop.zoh_method == "matrix exponential"``), or when its poles are
-        written with square roots (a complex pair would need complex
-        arithmetic in C).
+        written with square roots and a parameter is named as a macro of
+        ``<complex.h>`` (``I``, ``complex``, ``imaginary``).
+
+    Notes
+    -----
+    Where the residues write the poles with square roots (a quadratic
+    factor of the plant's denominator), the square root is imaginary for a
+    complex pair: the kernel is then computed in C99 complex arithmetic
+    (``<complex.h>``: ``csqrt``, ``cexp``) and returns the real parts of the
+    coefficients divided by ``P_d``'s leading one (``P_d`` monic).  The
+    imaginary parts cancel to rounding, and the same kernel serves real
+    poles (the square root real) and complex ones; a repeated pole (the
+    square root 0) divides by zero.
     """
     if loop.zoh_method != "residues":
         return None
     pulse = loop.pulse_transfer_function()
-    if any(not p.exp.is_integer for p in pulse.atoms(sp.Pow)):
-        # A complex pole pair is written with the square root of a negative
-        # number: a double-precision C kernel would print NaN.
-        return None
     num, den = sp.fraction(pulse)
     z = model.z
     p_n, p_d = sp.Poly(num, z).all_coeffs(), sp.Poly(den, z).all_coeffs()
     args = [(x, f"parameter {x}") for x in _parameter_symbols(loop, loop.plant) if x != model.T]
     args.append((model.T, "sample period T"))
+    roots = any(not p.exp.is_integer for p in pulse.atoms(sp.Pow))
+    if roots:
+        if {str(x) for x, _ in args} & _COMPLEX_MACROS:
+            return None
+        # Divided by P_d's leading coefficient, whose square-root factors are
+        # those of the others: the quotients are real for real parameters.
+        lead = p_d[0]
+        p_n = [RealPart(c / lead) for c in p_n]
+        p_d = [sp.Integer(1)] + [RealPart(c / lead) for c in p_d[1:]]
     outputs = ([(f"pn{k}", c, f"coefficient of z^{len(p_n) - 1 - k} of P_n")
                 for k, c in enumerate(p_n)]
                + [(f"pd{k}", c, f"coefficient of z^{len(p_d) - 1 - k} of P_d")
                   for k, c in enumerate(p_d)])
+    how = ("They are computed in C99 complex arithmetic (the poles' square roots are "
+           "imaginary for a complex pair), P_d made monic, and the real parts returned, "
+           "without a float-safe rewriting" if roots else
+           "They are printed as derived, without a float-safe rewriting")
     return kernel("pulse_transfer_function", args, outputs,
                   f"Numerator P_n and denominator P_d of Z[ZOH G](z) for G(s) = {loop.plant}, "
-                  f"highest power of z first, as derived by residues. They are printed as "
-                  f"derived, without a float-safe rewriting: close poles (such as a small "
-                  f"b T / m) cancel digits in double precision; symstab.Loop evaluates them "
-                  f"at 30 digits instead.")
+                  f"highest power of z first, as derived by residues. {how}: close poles "
+                  f"(such as a small b T / m) cancel digits in double precision; "
+                  f"symstab.Loop evaluates them at 30 digits instead.",
+                  complex_arithmetic=roots)
+
+
+#: Macros of <complex.h> a parameter's name would collide with.
+_COMPLEX_MACROS = {"I", "complex", "imaginary", "_Complex_I", "_Imaginary_I"}
 
 
 def step_orders(loop):
@@ -252,13 +276,18 @@ def kernel_files(loop):
     plant = plant_kernel(loop)
     c_kernels = environment + ([plant] if plant is not None else [])
     prefix = f"symstab_{stem}_"
-    c_title = (f"C99 kernels of the loop {loop.name} (need only <math.h>, link with -lm): "
+    needs = ("<math.h> and <complex.h>" if plant is not None and plant.complex_arithmetic
+             else "<math.h>")
+    c_title = (f"C99 kernels of the loop {loop.name} (need only {needs}, link with -lm): "
                f"VE(z) = {loop.environment}"
-               + (f", and Z[ZOH G] of G(s) = {loop.plant}." if plant is not None else
+               + (f", and Z[ZOH G] of G(s) = {loop.plant}"
+                  + (" (in complex arithmetic)." if plant.complex_arithmetic
+                     else ".") if plant is not None else
                   "; the plant's pulse transfer function is computed numerically."
                   if loop.zoh_method != "residues" else
-                  "; the plant's pulse transfer function (poles with square roots) is not "
-                  "printed in C: symstab.Loop evaluates it at 30 digits."))
+                  "; the plant's pulse transfer function (poles with square roots, a parameter "
+                  "named as a <complex.h> macro) is not printed in C: symstab.Loop evaluates "
+                  "it at 30 digits."))
     steps, step_prototypes = step_source(loop, prefix)
     c_title += " The loop's step on its samples (any plant: coefficients as arguments)."
     source = c_source(c_kernels, title=c_title, prefix=prefix, command=COMMAND) + "\n" + steps
