@@ -33,15 +33,7 @@ _TARGET_WORDS = {"y_max": "y_max", "K_max": "y_max", "area": "area", "Z-width": 
                  "z_width": "area", "passive": "passive", "simulated": "simulated"}
 #: The options of the simulated target (``--maximize simulated``) only: flag, dest.
 _SIMULATION_FLAGS = (("--amplitude", "amplitude"), ("--encoder-resolution", "encoder_resolution"),
-                     ("--paper-encoder", "paper_encoder"), ("--force-limit", "force_limit"),
-                     ("--steps", "steps"), ("--x0", "x0"))
-#: The paper simulator's options (refused with --loop by add_loop_options; without a
-#: loop file design has no simulation for them).
-_PAPER_SIMULATION_FLAGS = (("--velocity-cutoff", "velocity_cutoff"), ("--coulomb", "coulomb"),
-                           ("--stiction", "stiction"),
-                           ("--friction-compensation", "friction_compensation"),
-                           ("--actuator-bandwidth", "actuator_bandwidth"),
-                           ("--substeps", "substeps"))
+                     ("--force-limit", "force_limit"), ("--steps", "steps"), ("--x0", "x0"))
 #: The scan's points per parameter at most: each is a certified region.
 MAX_POINTS = 201
 #: The scan's points in all at most (two parameters: ``--points`` squared).
@@ -82,7 +74,7 @@ def register(subparsers):
                         "a limit cycle above it, or a decay not below it by the end, is "
                         "refused (--steps counts periods: with --delay and --over T a fixed "
                         "--steps is a shorter time at a smaller T)")
-    add_nonideal_options(p)
+    add_nonideal_options(p, loop_only=True)
     add_loop_options(p, "design")
 
 
@@ -96,16 +88,8 @@ def run(args):
     its JSON the ``best`` of :func:`symstab.best_virtual_mass`.
     """
     target = _target(args.maximize)
-    # (0 is a value given: only None, and False for a switch, are "not given".)
-    def given(flags):
-        return [flag for flag, dest in flags
-                if getattr(args, dest) is not None and getattr(args, dest) is not False]
-
-    paper_flags = given(_PAPER_SIMULATION_FLAGS)
-    if args.loop is None and paper_flags:      # with --loop, add_loop_options refuses them
-        raise ValueError(f"{paper_flags[0]}: design simulates only a loop file (--maximize "
-                         f"simulated --loop FILE), whose filter or lag is written in the file")
-    given = given(_SIMULATION_FLAGS)
+    # (0 is a value given: only None is "not given".)
+    given = [flag for flag, dest in _SIMULATION_FLAGS if getattr(args, dest) is not None]
     if target != "simulated" and given:
         raise ValueError(f"{given[0]} is an option of the simulated target: add --maximize "
                          f"simulated (with --loop)")

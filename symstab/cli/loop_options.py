@@ -77,7 +77,7 @@ _REFUSED = {
     "limits": DEVICE_OPTIONS + (("--beta", "beta", "--at X (the stable y at x = X)"),
                                 ("--Bw", "Bw", "--at X (the stable y at x = X)")),
     "classify": DEVICE_OPTIONS + POINT_OPTIONS,
-    "design": DEVICE_OPTIONS + _SIMULATION_OPTIONS,
+    "design": DEVICE_OPTIONS,
     "map": DEVICE_OPTIONS + _GRID_OPTIONS + _SIMULATION_OPTIONS,
     "simulate": DEVICE_OPTIONS + POINT_OPTIONS + _SIMULATION_OPTIONS,
 }

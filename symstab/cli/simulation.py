@@ -10,11 +10,18 @@ __all__ = ["add_nonideal_options", "resolve_nonideal", "simulated_theory", "noni
            "loop_nonideal_text"]
 
 
-def add_nonideal_options(p):
-    """Add the non-idealities (encoder, velocity filter, friction, actuator lag), --steps and --x0."""
+def add_nonideal_options(p, loop_only=False):
+    """Add the non-idealities (encoder, velocity filter, friction, actuator lag), --steps and --x0.
+
+    ``loop_only``: only those of a loop file's simulation (the encoder's quantum,
+    the force limit, --steps, --x0), for a command that simulates loop files only.
+    """
     g = p.add_argument_group("non-idealities (physical units; each off by default)")
     g.add_argument("--encoder-resolution", type=float, metavar="Q",
                    help="position quantum, m or rad (the paper's: 3 arc seconds = 1.454e-5 rad)")
+    if loop_only:
+        _add_limit_and_run(p, g)
+        return
     g.add_argument("--paper-encoder", action="store_true",
                    help="use the paper's encoder resolution (3 arc seconds)")
     g.add_argument("--velocity-cutoff", type=float, metavar="HZ",
@@ -27,6 +34,11 @@ def add_nonideal_options(p):
     g.add_argument("--substeps", type=int,
                    help="sub-steps per period for friction and the actuator lag (default 20; "
                         "only with --coulomb or --actuator-bandwidth)")
+    _add_limit_and_run(p, g)
+
+
+def _add_limit_and_run(p, g):
+    """--force-limit in the group ``g``, --steps and --x0 in ``p``."""
     g.add_argument("--force-limit", type=float, metavar="F",
                    help="largest force command, N or N m (the amplifier's saturation)")
     p.add_argument("--steps", type=int, help="periods to simulate (default 12000 + 800 d)")
@@ -38,23 +50,29 @@ def resolve_nonideal(args, setup):
     """``(Nonidealities, x0)`` of the parsed options, checked before any work (raises ValueError)."""
     from ..numeric.simulate import PAPER_ENCODER_RESOLUTION, Nonidealities, check_x0, default_x0
 
+    # A command with add_nonideal_options(loop_only=True) has not the paper's options.
+    option = {name: getattr(args, name, None) for name in (
+        "paper_encoder", "velocity_cutoff", "coulomb", "stiction", "friction_compensation",
+        "actuator_bandwidth", "substeps")}
     resolution = args.encoder_resolution
-    if args.paper_encoder and setup is None:
+    if option["paper_encoder"] and setup is None:
         raise ValueError("--paper-encoder is the paper's encoder, 3 arc seconds in rad; a loop "
                          "file's position may be in m: give --encoder-resolution Q in the unit "
                          "of its position")
-    if args.paper_encoder:
+    if option["paper_encoder"]:
         if resolution is not None:
             raise ValueError("give --encoder-resolution or --paper-encoder, not both")
         resolution = PAPER_ENCODER_RESOLUTION
-    if args.substeps is not None and args.coulomb is None and args.actuator_bandwidth is None:
+    if option["substeps"] is not None and option["coulomb"] is None \
+            and option["actuator_bandwidth"] is None:
         raise ValueError("--substeps divides the period for Coulomb friction and the actuator "
                          "lag: give --coulomb or --actuator-bandwidth, or drop --substeps")
-    nonideal = Nonidealities(encoder_resolution=resolution, velocity_cutoff=args.velocity_cutoff,
-                             coulomb_friction=args.coulomb, stiction=args.stiction,
-                             friction_compensation=args.friction_compensation,
-                             actuator_bandwidth=args.actuator_bandwidth,
-                             substeps=20 if args.substeps is None else args.substeps,
+    nonideal = Nonidealities(encoder_resolution=resolution,
+                             velocity_cutoff=option["velocity_cutoff"],
+                             coulomb_friction=option["coulomb"], stiction=option["stiction"],
+                             friction_compensation=bool(option["friction_compensation"]),
+                             actuator_bandwidth=option["actuator_bandwidth"],
+                             substeps=20 if option["substeps"] is None else option["substeps"],
                              force_limit=args.force_limit)
     if setup is None:       # a loop file: its values are physical (SI)
         pass
