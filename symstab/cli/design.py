@@ -208,14 +208,12 @@ def _search_over(args, setup):
 
 def _check_ends(setup, over):
     """Every corner of the searched box within the file's bounds and the loop's domain."""
+    from ..numeric.design import box_corners
     from ..numeric.loop_units import FileParameters, check_bounds
 
     known = getattr(setup.loop, "file_parameters", None) or FileParameters({})
-    corners = [{}]
-    for name, ends in over.items():
-        corners = [{**c, name: v} for c in corners for v in ends]
     flags = " ".join(f"--over {n}" for n in over)
-    for corner in corners:
+    for corner in box_corners(over):
         values = {**setup.values, **corner}
         check_bounds(known, values, skip=(setup.x, setup.y), where=lambda names: flags)
         try:

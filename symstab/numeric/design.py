@@ -41,7 +41,8 @@ import numpy as np
 
 from .._validate import check_count, check_real, check_window
 
-__all__ = ["TARGETS", "Design", "design", "maximize_scalar", "maximize_box", "held_delay"]
+__all__ = ["TARGETS", "Design", "design", "maximize_scalar", "maximize_box", "held_delay",
+           "box_corners"]
 
 #: What a design maximises, with what it is.
 TARGETS = {
@@ -449,8 +450,8 @@ def design(loop, *, over, maximize="y_max", x=None, y=None, n=None, rtol=None, d
         # varies with T), before the scan.
         from .simulate import check_steps
 
-        for corner in _corners(over):
-            check_steps(steps, at(corner).get("d", loop.defaults.get("d", 0)))
+        for corner in box_corners(over):
+            check_steps(steps, at(tuple(corner.values())).get("d", loop.defaults.get("d", 0)))
     failed = []
 
     def answer(point):
@@ -536,11 +537,11 @@ def _check_simulation(maximize, amplitude, nonideal, x0, steps):
             "steps": steps}
 
 
-def _corners(over):
-    """The corners of the searched box, as points."""
-    corners = [()]
-    for lo, hi in over.values():
-        corners = [c + (v,) for c in corners for v in (lo, hi)]
+def box_corners(over):
+    """``[{name: value}, ...]``: the corners of the box ``{name: (low, high)}`` searched."""
+    corners = [{}]
+    for name, ends in over.items():
+        corners = [{**c, name: v} for c in corners for v in ends]
     return corners
 
 
