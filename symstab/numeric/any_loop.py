@@ -934,6 +934,52 @@ class Loop(LoopModel):
         return found.limits(at=at, line=functools.partial(_stable_intervals_at, self, found.x,
                                                           found.y, at))
 
+    def simulated_limit(self, x=None, y=None, *, amplitude, nonideal=None, steps=None, x0=None,
+                        progress=None, **values):
+        """The largest ``y`` at which the simulated loop neither grows nor ends above ``amplitude``.
+
+        The simulated counterpart of :meth:`limits`' ``y_max``, with the
+        non-idealities the linear model leaves out (encoder quantization, a
+        force limit): runs of :meth:`simulate` on a grid over the certified
+        stable set, refined in ``y``
+        (:func:`symstab.numeric.simulate_limit.simulated_limit` says how, and
+        how accurate it is).  Not certified.
+
+        Parameters
+        ----------
+        x, y : str, optional
+            The plane (default: :attr:`plane`).
+        amplitude : float
+            The largest ``|x|`` accepted in the last quarter of a run (the
+            position's unit).
+        nonideal, steps, x0 : optional
+            As in :meth:`simulate` (``x0`` default 1, or 0.01 with
+            non-idealities).
+        progress : callable, optional
+            Called with the runs done.
+        **values
+            Single values of the other parameters.
+
+        Returns
+        -------
+        symstab.numeric.simulate_limit.SimulatedLimit
+
+        Examples
+        --------
+        >>> from symstab.numeric.simulate import Nonidealities
+        >>> loop = Loop("1/(m*s**2 + b*s)", "K + B*(z - 1)/(T*z)")
+        >>> found = loop.simulated_limit("B", "K", amplitude=1e-3, steps=3000,
+        ...                              nonideal=Nonidealities(encoder_resolution=1e-5),
+        ...                              m=0.0128, b=0.0324, T=1e-3, d=1)
+        >>> 0.9 * found.linear.y_max < found.y_max < found.linear.y_max
+        True
+        """
+        from .simulate_limit import simulated_limit
+
+        x, y = self._plane(x, y)
+        return simulated_limit(self, x=x, y=y, amplitude=amplitude, nonideal=nonideal,
+                               steps=steps, x0=x0, progress=progress, **values)
+
     def passive_region(self, x=None, y=None, *, damping="b", x_range=None, y_range=None, **values):
         """The passive set of the environment behind the loop's delay, in the ``(x, y)`` plane.
 
