@@ -387,3 +387,62 @@ def dense_maximum(f, low, high, *, points=11, levels=7):
         step = grid[1] - grid[0]
         low, high = max(ends[0], best - step), min(ends[1], best + step)
     return best, best_value
+
+
+def coulomb_friction_run(model, *, K, B, T, d, steps, x0, coulomb, stiction):
+    """Sampled positions of a loop whose mass has Coulomb friction, integrated event by event.
+
+    An independent reference for the simulator's sub-steps: scipy's DOP853
+    at rtol 1e-12 between events, the events located by scipy (the mass's
+    velocity reaching 0; the force on a held mass reaching the stiction
+    force).  ``model`` is the physics written out by hand:
+    ``rhs(state, u, friction)`` (friction on the mass, in the direction of
+    its motion), ``velocity(state)``, ``net(state, u)`` (the force on the
+    mass at rest besides friction), ``stop(state)`` (the state with the
+    mass's velocity 0) and ``start(x0)`` (everything at rest at x0).  The
+    environment is ``K x + B (x[k] - x[k-1]) / T``, the command ``u[k] =
+    -f[k - d]`` held over the period, as in the simulator.
+    """
+    from scipy.integrate import solve_ivp
+
+    state = model["start"](x0)
+    moving, direction = False, 0.0
+    samples, forces = [model["position"](state)], []
+    previous = samples[0]
+    for k in range(steps):
+        x = samples[-1]
+        forces.append(K * x + B * (x - previous) / T)
+        previous = x
+        u = -forces[k - d] if k >= d else 0.0
+        t = 0.0
+        while t < T:
+            if not moving:
+                net = model["net"](state, u)
+                if abs(net) > stiction:
+                    moving, direction = True, math.copysign(1.0, net)
+                    continue
+
+                def slip(_, y, u=u):
+                    return abs(model["net"](y, u)) - stiction
+                slip.terminal, slip.direction = True, 1
+                run = solve_ivp(lambda _, y, u=u: model["rhs"](y, u, model["net"](y, u)),
+                                (t, T), state, method="DOP853", rtol=1e-12, atol=1e-18,
+                                events=slip)
+                state = model["stop"](run.y[:, -1])
+                if run.status == 1:
+                    moving, direction = True, math.copysign(1.0, model["net"](state, u))
+            else:
+                def halt(_, y):
+                    return model["velocity"](y)
+                # Only a crossing against the motion: a breakaway starts at v = 0.
+                halt.terminal, halt.direction = True, -direction
+                run = solve_ivp(lambda _, y, u=u, f=coulomb * direction: model["rhs"](y, u, f),
+                                (t, T), state, method="DOP853", rtol=1e-12, atol=1e-18,
+                                events=halt)
+                state = run.y[:, -1]
+                if run.status == 1:
+                    state = model["stop"](state)
+                    moving = False
+            t = run.t[-1]
+        samples.append(model["position"](state))
+    return np.array(samples)

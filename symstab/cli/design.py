@@ -127,13 +127,12 @@ def run(args):
         raise ValueError(f"--points {args.points} with {len(over)} parameters is "
                          f"{args.points ** len(over)} scan points, above {MAX_EVALUATIONS} (each "
                          f"is a certified region, about 0.1 to 1 s): give fewer --points")
-    simulation = _simulation(args) if target == "simulated" else {}
+    simulation = _simulation(args, setup.loop) if target == "simulated" else {}
     return _search(args, setup, over, target, notes, png, delay, simulation)
 
 
-def _simulation(args):
+def _simulation(args, loop):
     """The settings of the simulated target, checked before the search (``Loop.design``'s)."""
-    from ..numeric.simulate import check_loop_nonideal
 
     if args.amplitude is None:
         raise ValueError("--maximize simulated needs --amplitude X: the largest |x| accepted at "
@@ -141,9 +140,9 @@ def _simulation(args):
     from .._validate import check_real
 
     amplitude = check_real("--amplitude", args.amplitude, low=0.0, low_open=True)
-    nonideal, x0 = resolve_nonideal(args, None)
+    nonideal, x0 = resolve_nonideal(args, None, loop)
     # The horizon at each delay searched is checked by Loop.design before its scan.
-    return {"amplitude": amplitude, "nonideal": check_loop_nonideal(nonideal), "x0": x0,
+    return {"amplitude": amplitude, "nonideal": nonideal, "x0": x0,
             "steps": args.steps}
 
 

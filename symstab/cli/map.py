@@ -4,8 +4,8 @@ The paper's loop is simulated at every cell (with the non-idealities of
 :mod:`symstab.cli.simulation`), its root count beside; a loop file
 (``--loop``) is classified by its root count at every cell, with the
 D-decomposition drawn over the map, and with ``--simulate`` also simulated
-(:meth:`symstab.Loop.stability_map`: encoder quantization and force
-saturation on the samples).  The output paths are
+(:meth:`symstab.Loop.stability_map`: encoder quantization, force
+saturation, and Coulomb friction on the driven mass).  The output paths are
 checked before the work and the files written atomically.
 """
 
@@ -264,7 +264,8 @@ def _paper_png(args, setup, result, nonideal, given, theory):
 _LOOP_SIMULATION_OPTIONS = (("--steps", "steps"), ("--x0", "x0"),
                             ("--encoder-resolution", "encoder_resolution"),
                             ("--paper-encoder", "paper_encoder"),
-                            ("--force-limit", "force_limit"))
+                            ("--force-limit", "force_limit"), ("--coulomb", "coulomb"),
+                            ("--stiction", "stiction"), ("--substeps", "substeps"))
 
 
 def _loop(args):
@@ -284,7 +285,7 @@ def _loop(args):
             if getattr(args, dest) not in (None, False):
                 raise ValueError(f"{flag} is an option of the simulation: add --simulate")
     else:
-        nonideal, x0 = resolve_nonideal(args, None)
+        nonideal, x0 = resolve_nonideal(args, None, loop)
         steps = check_steps(args.steps, values["d"])
         # The difference equations at one cell: a plant they cannot step is refused now.
         loop.difference_equations(**{setup.x: xs[0], setup.y: ys[0]}, **values)

@@ -107,21 +107,25 @@ def _loop(args):
 
     setup = resolve_loop(args, plane=False)
     loop, values = setup.loop, setup.values
-    nonideal, x0 = resolve_nonideal(args, None)
+    nonideal, x0 = resolve_nonideal(args, None, loop)
     _check_out(args.out)
     steps = check_steps(args.steps, values["d"])
     record = args.out is not None
-    if record:
-        check_memory(f"the --out trajectory of {steps} periods", (steps + 1) * _TRAJECTORY_ROW_BYTES)
+    # One point: its trajectory is kept (the verdict tells a mass held by
+    # friction from a limit cycle by it).
+    check_memory(f"the trajectory of {steps} periods", (steps + 1) * _TRAJECTORY_ROW_BYTES)
     loop.difference_equations(**values)        # a plant it cannot step is refused before the run
     code = int(loop.classify(**values))
     radius = float(loop.spectral_radius(**values))
-    run = loop.simulate(steps=steps, x0=x0, nonideal=nonideal, record=record,
+    run = loop.simulate(steps=steps, x0=x0, nonideal=nonideal, record=True,
                         progress=progress_printer("simulating", steps), **values)
     for line in setup.echo:
         print(line)
     verdict = "diverged (unstable)" if run.diverged else ("stable" if run.stable else "unstable")
-    if run.stable and not nonideal.ideal and run.amplitude[3] >= 0.9 * run.amplitude[2]:
+    last = run.positions[-(run.steps // 4):]
+    if run.stable and np.all(last == last[-1]) and nonideal.coulomb_friction is not None:
+        verdict = f"stable (held at rest by friction at x = {last[-1]:.4g})"
+    elif run.stable and not nonideal.ideal and run.amplitude[3] >= 0.9 * run.amplitude[2]:
         verdict = (f"bounded, not decaying (a limit cycle of amplitude {run.amplitude[3]:.4g}: "
                    f"the verdict compares the last two quarters)")
     print(f"simulated {run.steps} periods from x0 = {x0:g} ({loop_nonideal_text(nonideal)}): "

@@ -14,23 +14,25 @@ def add_nonideal_options(p, loop_only=False):
     """Add the non-idealities (encoder, velocity filter, friction, actuator lag), --steps and --x0.
 
     ``loop_only``: only those of a loop file's simulation (the encoder's quantum,
-    the force limit, --steps, --x0), for a command that simulates loop files only.
+    Coulomb friction, the force limit, --steps, --x0), for a command that
+    simulates loop files only.
     """
     g = p.add_argument_group("non-idealities (physical units; each off by default)")
     g.add_argument("--encoder-resolution", type=float, metavar="Q",
                    help="position quantum, m or rad (the paper's: 3 arc seconds = 1.454e-5 rad)")
-    if loop_only:
-        _add_limit_and_run(p, g)
-        return
-    g.add_argument("--paper-encoder", action="store_true",
-                   help="use the paper's encoder resolution (3 arc seconds)")
-    g.add_argument("--velocity-cutoff", type=float, metavar="HZ",
-                   help="first-order low-pass filter on the velocity, Hz (the paper's: 50)")
-    g.add_argument("--coulomb", type=float, metavar="F", help="Coulomb friction, N or N m")
+    if not loop_only:
+        g.add_argument("--paper-encoder", action="store_true",
+                       help="use the paper's encoder resolution (3 arc seconds)")
+        g.add_argument("--velocity-cutoff", type=float, metavar="HZ",
+                       help="first-order low-pass filter on the velocity, Hz (the paper's: 50)")
+    g.add_argument("--coulomb", type=float, metavar="F",
+                   help="Coulomb friction on the driven mass, N or N m (a loop file's: after "
+                        "its actuator)")
     g.add_argument("--stiction", type=float, metavar="F", help="breakaway force (default: --coulomb)")
-    g.add_argument("--friction-compensation", action="store_true",
-                   help="add the Coulomb friction times sign(estimated velocity) to the command")
-    g.add_argument("--actuator-bandwidth", type=float, metavar="HZ", help="first-order lag, Hz")
+    if not loop_only:
+        g.add_argument("--friction-compensation", action="store_true",
+                       help="add the Coulomb friction times sign(estimated velocity) to the command")
+        g.add_argument("--actuator-bandwidth", type=float, metavar="HZ", help="first-order lag, Hz")
     g.add_argument("--substeps", type=int,
                    help="sub-steps per period for friction and the actuator lag (default 20; "
                         "only with --coulomb or --actuator-bandwidth)")
@@ -46,9 +48,14 @@ def _add_limit_and_run(p, g):
                    help="initial position, m or rad (default 1; 0.01 with non-idealities)")
 
 
-def resolve_nonideal(args, setup):
-    """``(Nonidealities, x0)`` of the parsed options, checked before any work (raises ValueError)."""
-    from ..numeric.simulate import PAPER_ENCODER_RESOLUTION, Nonidealities, check_x0, default_x0
+def resolve_nonideal(args, setup, loop=None):
+    """``(Nonidealities, x0)`` of the parsed options, checked before any work (raises ValueError).
+
+    ``setup`` is the paper's device options, or None for a loop file,
+    ``loop``, whose simulation the options are checked against.
+    """
+    from ..numeric.simulate import (PAPER_ENCODER_RESOLUTION, Nonidealities, check_loop_nonideal,
+                                    check_x0, default_x0)
 
     # A command with add_nonideal_options(loop_only=True) has not the paper's options.
     option = {name: getattr(args, name, None) for name in (
@@ -75,7 +82,12 @@ def resolve_nonideal(args, setup):
                              substeps=20 if option["substeps"] is None else option["substeps"],
                              force_limit=args.force_limit)
     if setup is None:       # a loop file: its values are physical (SI)
-        pass
+        if nonideal.coulomb_friction is not None:
+            try:
+                loop.driven_mass
+            except ValueError as exc:
+                raise ValueError(f"--coulomb: {exc}") from None
+        nonideal = check_loop_nonideal(nonideal)
     elif not nonideal.ideal and not setup.physical:
         raise ValueError("non-idealities are in physical units: use --m --b --T --Td (or their "
                          "defaults), not --delta")
@@ -118,6 +130,10 @@ def loop_nonideal_text(nonideal):
     parts = []
     if nonideal.encoder_resolution is not None:
         parts.append(f"encoder quantum {nonideal.encoder_resolution:.4g}")
+    if nonideal.coulomb_friction is not None:
+        stiction = "" if nonideal.stiction is None else f", stiction {nonideal.stiction:g}"
+        parts.append(f"Coulomb friction {nonideal.coulomb_friction:g}{stiction}, "
+                     f"{nonideal.substeps} sub-steps a period")
     if nonideal.force_limit is not None:
         parts.append(f"force limit {nonideal.force_limit:g}")
     return ("ideal loop" if not parts else ", ".join(parts) + " (SI units of the loop file)")

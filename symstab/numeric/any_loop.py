@@ -38,6 +38,7 @@ import fractions
 import functools
 import math
 
+import mpmath
 import numpy as np
 import sympy as sp
 
@@ -128,6 +129,12 @@ class Loop(LoopModel):
         :meth:`unstable_root_counts` and :meth:`spectral_radius` count its
         roots (the paper's loop: eq. (5)'s kernel, exact next to ``z = 1``
         and from ``b T/m = 0`` to 1e6); :meth:`polynomial` stays the loop's own.
+    actuator : str or sympy.Expr, optional
+        ``A(s)``, the factor of the plant from the force command to the
+        force on the driven mass (an amplifier's lag, ``"1/(tau*s + 1)"``);
+        default ``1``.  Coulomb friction acts on the mass, after it
+        (:meth:`simulate`); ``plant / actuator`` must be a mass's force to
+        position (relative degree 2).
 
     Raises
     ------
@@ -148,9 +155,9 @@ class Loop(LoopModel):
     """
 
     def __init__(self, plant, environment, *, values=None, name=None, units=None,
-                 description="", plane=None, arc=None, polynomial=None):
+                 description="", plane=None, arc=None, polynomial=None, actuator=None):
         super().__init__(plant, environment, values=values, name=name, units=units,
-                         description=description, plane=plane)
+                         description=description, plane=plane, actuator=actuator)
         for option, hook in (("arc", arc), ("polynomial", polynomial)):
             if hook is not None and not callable(hook):
                 raise TypeError(f"{option} must be callable, got {type(hook).__name__}")
@@ -165,7 +172,7 @@ class Loop(LoopModel):
         return (_rebuilt, (self.plant, self.environment, {
             "values": dict(self.defaults), "name": self.name, "units": dict(self.units),
             "description": self.description, "plane": self.plane, "arc": self._arc,
-            "polynomial": self._closed_polynomial}))
+            "polynomial": self._closed_polynomial, "actuator": self.actuator}))
 
     def _check_units(self):
         # A unit here names the unit of values the loop computes with as they
@@ -1055,6 +1062,46 @@ class Loop(LoopModel):
         self._finite(np.concatenate(parts, axis=-1), values)
         return parts, d, shape
 
+    def friction_spaces(self, substeps, **values):
+        """The state spaces in which friction acts: ``(spaces, inverse)``.
+
+        One :class:`~symstab.numeric.friction.FrictionSpace` per distinct
+        plant among the points (``values`` broadcast), and the index of
+        each point's (of the broadcast shape).
+
+        Parameters
+        ----------
+        substeps : int
+            Sub-steps per period (:class:`~symstab.numeric.simulate.Nonidealities`).
+        **values
+            The loop's parameters (or their defaults); arrays broadcast.
+
+        Returns
+        -------
+        (list of symstab.numeric.friction.FrictionSpace, ndarray of int)
+
+        Raises
+        ------
+        ValueError
+            When the plant (over :attr:`actuator`) is not a mass's force to
+            position, or its state is not determined by its positions.
+        """
+        values, _, shape = self._prepare(values)
+        names = self._plant_names + ("T",)
+        columns = np.stack([np.broadcast_to(values[n], shape).ravel() for n in names], axis=-1)
+        unique, inverse = np.unique(columns, axis=0, return_inverse=True)
+        spaces = [self._friction_space(tuple(float(v) for v in row[:-1]), float(row[-1]), substeps)
+                  for row in unique]
+        return spaces, inverse.reshape(shape)
+
+    @functools.lru_cache(maxsize=256)
+    def _friction_space(self, plant_values, T, substeps):
+        from .friction import DIGITS, friction_space
+
+        with mpmath.workdps(DIGITS):
+            coefficients = self.driven_mass(*map(mpmath.mpf, plant_values), mpmath.mpf(T))
+        return friction_space(coefficients, T, substeps)
+
     def simulate(self, *, steps=None, x0=1.0, v0=None, nonideal=None, record=False,
                  progress=None, **values):
         """Run the loop in time for every parameter point at once.
@@ -1072,7 +1119,8 @@ class Loop(LoopModel):
         x0, v0 : float
             Initial position and its change per period (default ``x0 / 100``).
         nonideal : symstab.numeric.simulate.Nonidealities, optional
-            Encoder quantization and force saturation.
+            Encoder quantization, force saturation, and Coulomb friction on
+            the driven mass (after :attr:`actuator`).
         record : bool
             Keep every position.
         progress : callable, optional

@@ -406,7 +406,7 @@ def design(loop, *, over, maximize="y_max", x=None, y=None, n=None, rtol=None, d
         raise ValueError(f"maximize must be one of {', '.join(map(repr, TARGETS))}, "
                          f"got {maximize!r}")
     over = _check_over(loop, over, x, y)
-    simulation = _check_simulation(maximize, amplitude, nonideal, x0, steps)
+    simulation = _check_simulation(maximize, amplitude, nonideal, x0, steps, loop)
     rtol = _RTOL.get(maximize, 1e-6) if rtol is None else rtol
     names = tuple(over)
     n = (17 if len(names) == 1 else 9) if n is None else check_count("n", n, 3)
@@ -517,7 +517,7 @@ def held_delay(delay, T):
         else math.ceil(quotient)
 
 
-def _check_simulation(maximize, amplitude, nonideal, x0, steps):
+def _check_simulation(maximize, amplitude, nonideal, x0, steps, loop=None):
     """The simulation's settings of ``maximize="simulated"`` (checked), else ``{}``."""
     given = {k: v for k, v in (("amplitude", amplitude), ("nonideal", nonideal), ("x0", x0),
                                ("steps", steps)) if v is not None}
@@ -531,7 +531,7 @@ def _check_simulation(maximize, amplitude, nonideal, x0, steps):
     if amplitude is None:
         raise TypeError("maximize='simulated' needs amplitude: the largest |x| accepted at the "
                         "end of a run (the position's unit)")
-    nonideal = check_loop_nonideal(nonideal)
+    nonideal = check_loop_nonideal(nonideal, loop)
     return {"amplitude": check_real("amplitude", amplitude, low=0.0, low_open=True),
             "nonideal": nonideal, "x0": default_x0(nonideal) if x0 is None else check_x0(x0),
             "steps": steps}

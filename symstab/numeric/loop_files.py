@@ -7,6 +7,8 @@
     plant = "1/(m*s**2 + b*s)"
     environment = "K + B*(z - 1)/(T*z) + M*(z - 1)**2/(T**2*z**2)"
     plane = ["B", "K"]              # optional: the default (x, y) plane
+    actuator = "1"                  # optional: command to force on the mass
+                                    # (where Coulomb friction acts)
 
     [parameters]
     m = { value = 0.0128, unit = "kg" }
@@ -53,7 +55,7 @@ __all__ = ["load_loop", "parse_loop_text"]
 #: stops ``/dev/zero`` or a wrong path from filling the memory).
 MAX_FILE_BYTES = 1 << 20
 
-_KEYS = {"name", "description", "plant", "environment", "plane", "parameters"}
+_KEYS = {"name", "description", "plant", "environment", "plane", "parameters", "actuator"}
 
 
 def _default_name(source):
@@ -86,7 +88,7 @@ def parse_loop_text(text, *, source="<loop file>"):
     for key in ("plant", "environment"):
         if not isinstance(data.get(key), str):
             raise ValueError(f"{source}: {key!r} must be given as a string")
-    for key in ("name", "description"):
+    for key in ("name", "description", "actuator"):
         if key in data and not isinstance(data[key], str):
             raise ValueError(f"{source}: {key!r} must be a string, got {type(data[key]).__name__}")
     # Every value in SI, each unit read by pint (symstab.numeric.loop_units).
@@ -99,7 +101,8 @@ def parse_loop_text(text, *, source="<loop file>"):
     try:
         loop = Loop(data["plant"], data["environment"], values=values, units=units,
                     name=data.get("name", _default_name(source)),
-                    description=data.get("description", ""), plane=plane)
+                    description=data.get("description", ""), plane=plane,
+                    actuator=data.get("actuator"))
     except (TypeError, ValueError) as exc:
         raise ValueError(f"{source}: {exc}") from None
     # What the file wrote (units, bounds) beside the SI values the loop holds:

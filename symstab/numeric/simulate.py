@@ -46,7 +46,8 @@ leaves a band of undecidable cells, which the tests count.
 
 Any :class:`symstab.Loop` runs the same way (:func:`simulate_loop`,
 :meth:`symstab.Loop.simulate`, :meth:`symstab.Loop.stability_map`): its
-plant's exact ZOH step on the samples, its environment's difference
+plant's exact ZOH step on the samples (with Coulomb friction, on its state
+space, :mod:`symstab.numeric.friction`), its environment's difference
 equation, the delay line, the same verdict; its theory is its own root
 count.
 
@@ -70,6 +71,7 @@ from .._generated import kernels
 from .._resources import MAX_STEPS_ENV, check_memory, chunk_slices
 from .._resources import max_steps as _max_steps_setting
 from .._validate import check_array, check_delay, check_loop, check_real
+from .friction import FrictionPlant, stacked_spaces
 from .results import PAPER_PLANE, PaperGridNames
 
 __all__ = ["Nonidealities", "Simulation", "simulate", "StabilityMap", "stability_map",
@@ -750,13 +752,17 @@ def simulate_loop(loop, *, steps=None, x0=1.0, v0=None, nonideal=None, record=Fa
     ``x0``, no force and an empty delay line; the verdict is
     :func:`simulate`'s.
 
-    Non-idealities on the samples (:class:`Nonidealities`, physical units):
+    Non-idealities (:class:`Nonidealities`, physical units):
     ``encoder_resolution`` rounds the sampled position and ``force_limit``
     clips the force command (a saturated
     unstable loop may settle into a bounded limit cycle, which the verdict
-    calls bounded, not growing).  A velocity filter or an actuator lag is
-    part of a loop's own environment or plant; Coulomb friction needs the
-    plant's velocity state and is not simulated for a general loop yet.
+    calls bounded, not growing).  ``coulomb_friction`` (with ``stiction``
+    and ``substeps``) acts on the loop's driven mass, after its
+    :attr:`~symstab.Loop.actuator`: the plant is then stepped on its
+    continuous state space, ``substeps`` exact sub-steps a period, with the
+    paper's simulator's stick and reversal rules
+    (:mod:`symstab.numeric.friction`).  A velocity filter or an actuator
+    lag is part of a loop's own environment or plant.
 
     Parameters
     ----------
@@ -765,7 +771,7 @@ def simulate_loop(loop, *, steps=None, x0=1.0, v0=None, nonideal=None, record=Fa
         As in :func:`simulate` (``v0`` is a position change per period,
         default ``x0 / 100``).
     nonideal : Nonidealities, optional
-        Only the fields above.
+        Only the fields above (and ``substeps``).
     **values
         The loop's parameters (or their defaults); arrays broadcast, ``d``
         one integer.
@@ -783,7 +789,7 @@ def simulate_loop(loop, *, steps=None, x0=1.0, v0=None, nonideal=None, record=Fa
         ``P_n`` as high as ``P_d``: the sampled position would depend on the
         force of the same instant), or a run that does not fit in memory.
     """
-    nonideal = check_loop_nonideal(nonideal)
+    nonideal = check_loop_nonideal(nonideal, loop)
     if progress is not None and not callable(progress):
         raise TypeError(f"progress must be a callable taking the number of steps done, or None, "
                         f"got {type(progress).__name__}")
@@ -796,17 +802,30 @@ def simulate_loop(loop, *, steps=None, x0=1.0, v0=None, nonideal=None, record=Fa
              for p in parts]
     orders = parts[1].shape[-1] + parts[3].shape[-1]
     point_bytes = 8 * (d + 1 + 2 * orders + sum(p.shape[-1] for p in parts) + _ANY_LOOP_FLOATS)
-    return _run_chunks(lambda part: _AnyLoop([p[part] for p in parts], d, x0, v0, nonideal),
-                       n_points, point_bytes, steps=steps, d=d, record=record,
+    if nonideal.coulomb_friction is None:
+        def make_run(part):
+            return _AnyLoop([p[part] for p in parts], d, x0, v0, nonideal)
+    else:
+        spaces, inverse = loop.friction_spaces(nonideal.substeps, **values)
+        n = spaces[0].phi.shape[0]
+        # The state, its two candidates and their temporaries; per-point matrices.
+        point_bytes += 8 * (6 * n + 4 + (0 if len(spaces) == 1 else 2 * n * n + 10 * n))
+
+        def make_run(part):
+            space = stacked_spaces(spaces, inverse.ravel()[part])
+            return _FrictionLoop([p[part] for p in parts], d, x0, v0, nonideal, space)
+    return _run_chunks(make_run, n_points, point_bytes, steps=steps, d=d, record=record,
                        progress=progress, nonideal=nonideal, shape=shape)
 
 
-def check_loop_nonideal(nonideal):
+def check_loop_nonideal(nonideal, loop=None):
     """``nonideal`` (None: ideal) as the :class:`Nonidealities` of a general loop, or raise.
 
-    A general loop has encoder quantization and a force limit; the velocity
-    filter and the actuator lag belong in its environment and plant, and
-    Coulomb friction is not simulated for it yet.
+    A general loop has encoder quantization, a force limit and Coulomb
+    friction on its driven mass (with ``loop``: checked to have one,
+    :meth:`symstab.Loop.driven_mass`); the velocity filter and the actuator
+    lag belong in its environment and plant, and friction compensation
+    needs the paper's velocity estimate.
     """
     nonideal = Nonidealities() if nonideal is None else nonideal
     if not isinstance(nonideal, Nonidealities):
@@ -814,10 +833,16 @@ def check_loop_nonideal(nonideal):
                         f"got {type(nonideal).__name__}")
     for field, instead in (("velocity_cutoff", "write the filter into the loop's environment"),
                            ("actuator_bandwidth", "write the lag into the loop's plant"),
-                           ("coulomb_friction", "not simulated for a general loop yet")):
-        if getattr(nonideal, field) is not None:
+                           ("friction_compensation", "a general loop has no velocity estimate "
+                            "to compensate with")):
+        if getattr(nonideal, field) not in (None, False):
             raise ValueError(f"nonideal.{field}: {instead} (the paper's simulator, "
                              f"symstab.simulate, has it)")
+    if loop is not None and nonideal.coulomb_friction is not None:
+        try:
+            loop.driven_mass
+        except ValueError as exc:
+            raise ValueError(f"nonideal.coulomb_friction: {exc}") from None
     return nonideal
 
 
@@ -911,15 +936,18 @@ class _AnyLoop:
         self.forces[self.k % (self.d + 1)] = command
         held = np.negative(self.forces[(self.k - self.d) % (self.d + 1)])
         self.k += 1
-        # The plant's next sample: P_d(z) y = P_n(z) u.
+        self.x = self._plant_step(held)
+        if self.k % self.check_every == 0:
+            self.freeze_diverged()
+
+    def _plant_step(self, held):
+        """The plant's next sample under the force ``held``: ``P_d(z) y = P_n(z) u``."""
         self.y_past = [self.x] + self.y_past[:-1]
         self.u_past = [held] + self.u_past[:-1]
         x = np.zeros_like(held)
         self._sum(x, self.b, self.u_past, 1)
         self._sum(x, self.a, self.y_past, -1)
-        self.x = x
-        if self.k % self.check_every == 0:
-            self.freeze_diverged()
+        return x
 
     def freeze_diverged(self):
         """Mark the points whose state left [-1e100, 1e100] or is not finite; zero them."""
@@ -934,6 +962,25 @@ class _AnyLoop:
             for history in (self.y_past, self.u_past, self.s_past, self.f_past):
                 for value in history:
                     value[bad] = 0.0
+
+
+class _FrictionLoop(_AnyLoop):
+    """A loop whose plant is a :class:`~symstab.numeric.friction.FrictionPlant`: Coulomb friction on its mass."""
+
+    def __init__(self, parts, d, x0, v0, nonideal, space):
+        super().__init__(parts, d, x0, v0, nonideal)
+        self.y_past = self.u_past = []      # the state space holds the plant's past
+        self.plant = FrictionPlant(space, x0, v0, self.x.size, nonideal)
+
+    def _plant_step(self, held):
+        return self.plant.step(held)
+
+    def freeze_diverged(self):
+        bad = ~(np.abs(self.x) < _OVERFLOW) | ~np.all(np.isfinite(self.plant.state), axis=0)
+        if bad.any():
+            self.plant.freeze(bad)
+            self.x[bad] = np.inf        # marked diverged below, with everything zeroed
+        super().freeze_diverged()
 
 
 def loop_stability_map(loop, x_values, y_values, *, x=None, y=None, steps=None, x0=1.0, v0=None,

@@ -151,7 +151,7 @@ def simulated_limit(loop, *, x, y, amplitude, nonideal=None, steps=None, x0=None
     from .simulate import check_loop_nonideal, check_x0, default_x0
 
     amplitude = check_real("amplitude", amplitude, low=0.0, low_open=True)
-    nonideal = check_loop_nonideal(nonideal)
+    nonideal = check_loop_nonideal(nonideal, loop)
     x0 = default_x0(nonideal) if x0 is None else check_x0(x0)
     n_x, n_y = _grid_size(n)
     refine = check_count("refine", refine, 0)

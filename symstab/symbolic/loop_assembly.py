@@ -33,7 +33,7 @@ from .._validate import check_delay
 from .derivation_cache import DerivationCache
 from .discretize import numeric_zoh, written_poles, zoh_pulse_transfer_function
 
-__all__ = ["LoopModel", "parse_plant", "parse_environment", "parse_expression",
+__all__ = ["LoopModel", "parse_plant", "parse_environment", "parse_actuator", "parse_expression",
            "check_parameter_name", "check_loop_name", "check_text_line", "NAME_PATTERN",
            "is_affine", "poly_coeffs", "shift_to_one", "PLANT_DIGITS"]
 
@@ -389,6 +389,57 @@ def parse_plant(plant):
     return expr
 
 
+def parse_actuator(actuator, plant):
+    """The actuator ``A(s)`` (force command to the force on the driven mass), checked.
+
+    ``None`` is ``1``: the command acts on the mass itself.  The rest of the
+    plant, ``G / A``, is the driven mass's force to position: a rational,
+    proper function of ``s`` in the plant's parameters whose relative
+    degree is 2 (a force accelerates a mass), so that the mass's velocity
+    is a state, driven by no input directly, on which Coulomb friction acts
+    (:meth:`LoopModel.driven_mass`).
+
+    Raises
+    ------
+    TypeError
+        For another kind than a string or a SymPy expression.
+    ValueError
+        If ``A`` is not rational and proper in ``s``, has a parameter the
+        plant has not, or leaves a ``G / A`` that is not a mass's.
+    """
+    if actuator is None:
+        return None
+    if isinstance(actuator, str):
+        expr = parse_expression(actuator, "actuator")
+    elif isinstance(actuator, sp.Basic):
+        expr = sp.sympify(actuator)
+    else:
+        raise TypeError(f"actuator must be a string or a SymPy expression, "
+                        f"got {type(actuator).__name__}")
+    expr = _real_symbols(expr)
+    _check_rational(expr, model.s, "actuator A(s)", model.z)
+    extra = expr.free_symbols - plant.free_symbols
+    if extra:
+        raise ValueError(f"actuator A(s) = {expr}: {', '.join(sorted(map(str, extra)))} "
+                         f"is not a parameter of the plant (A is a factor of G)")
+    _mass_parts(plant, expr)
+    return expr
+
+
+def _mass_parts(plant, actuator):
+    """``(N, D)`` of the driven mass ``G / A``, or ValueError saying why it is not a mass's."""
+    mass = sp.cancel(sp.together(plant / (1 if actuator is None else actuator)))
+    num, den = sp.fraction(mass)
+    relative = sp.degree(den, model.s) - sp.degree(num, model.s)
+    if relative != 2:
+        where = ("the plant" if actuator is None else f"the plant over the actuator, {mass},")
+        hint = (" (a lag or filter between the command and the mass? give it as the loop's "
+                "actuator, e.g. actuator = \"1/(tau*s + 1)\")" if relative > 2 else "")
+        raise ValueError(f"Coulomb friction acts on the driven mass, whose position per force "
+                         f"has relative degree 2; {where} has relative degree {relative}{hint}")
+    return num, den
+
+
 def parse_environment(environment):
     """The environment ``VE(z)`` as a SymPy expression, checked: rational in ``z`` and proper.
 
@@ -454,6 +505,10 @@ class LoopModel:
         One line of printable text on what the loop is (:func:`check_text_line`).
     plane : (str, str), optional
         The default ``(x, y)`` parameter plane; checked to be jointly affine.
+    actuator : str or sympy.Expr, optional
+        ``A(s)``, the factor of ``G`` from the force command to the force
+        on the driven mass (an amplifier's lag); default ``1``.  It says
+        where Coulomb friction acts (:func:`parse_actuator`).
 
     Raises
     ------
@@ -465,9 +520,10 @@ class LoopModel:
     """
 
     def __init__(self, plant, environment, *, values=None, name=None, units=None,
-                 description="", plane=None):
+                 description="", plane=None, actuator=None):
         self.plant = parse_plant(plant)
         self.environment = parse_environment(environment)
+        self.actuator = parse_actuator(actuator, self.plant)
         self.name = check_loop_name("loop" if name is None else name)
         self.description = check_text_line("description", description)
         symbols = {str(x): x for x in self.plant.free_symbols | self.environment.free_symbols}
@@ -810,6 +866,27 @@ class LoopModel:
         raise ValueError(f"the plant's pulse transfer function at {given}, T = {float(T):g} "
                          f"cancels beyond {PLANT_MAX_DIGITS} digits: a parameter is too small "
                          f"or too large for its closed form")
+
+    @functools.cached_property
+    def driven_mass(self):
+        """mpmath function of (plant values..., T): the actuator's and the driven mass's coefficients.
+
+        ``[A_n, A_d, N, D]`` in ``s``, highest power first: the actuator
+        ``A = A_n / A_d`` and the mass ``G / A = N / D`` (relative degree 2),
+        from which :mod:`symstab.numeric.friction` builds the state space on
+        which Coulomb friction acts.
+
+        Raises
+        ------
+        ValueError
+            When the plant (over the actuator) is not a mass's force to
+            position (:func:`parse_actuator`): said when friction is asked
+            for, the loop itself is fine without it.
+        """
+        actuator = sp.Integer(1) if self.actuator is None else self.actuator
+        num, den = _mass_parts(self.plant, self.actuator)
+        a_num, a_den = sp.fraction(sp.cancel(sp.together(actuator)))
+        return self._plant_function([poly_coeffs(p, model.s) for p in (a_num, a_den, num, den)])
 
     @functools.cached_property
     def _plant_pole_factors(self):

@@ -66,10 +66,54 @@ def test_a_saturated_unstable_loop_is_called_bounded_not_stable(capsys):
     assert "-> unstable" in text
 
 
+def test_friction_holds_the_mass_and_the_verdict_says_so(capsys):
+    """Two masses, friction on the motor: it ends held within stiction / K of zero."""
+    status, text, err = run(capsys, "simulate", "--loop", LOOPS / "two_mass.toml",
+                            "--coulomb", "0.05", "--stiction", "0.08", "--steps", "2000")
+    assert status == 0, err
+    assert "Coulomb friction 0.05, stiction 0.08, 20 sub-steps a period" in text
+    held = float(text.split("held at rest by friction at x = ")[1].split(")")[0])
+    assert 0 < abs(held) <= 0.08 / 100.0
+    assert "-> stable" in text
+
+
+def test_friction_behind_an_undeclared_lag_is_refused_before_the_run(capsys, tmp_path,
+                                                                    monkeypatch):
+    text = (LOOPS / "actuator_lag.toml").read_text()
+    lagged = tmp_path / "lagged.toml"
+    lagged.write_text(text.replace('actuator = "1/(tau*s + 1)"', ""))
+    (tmp_path / "work").mkdir()
+    monkeypatch.chdir(tmp_path / "work")
+    status, out, err = run(capsys, "simulate", "--loop", lagged, "--coulomb", "0.01")
+    assert status == 2 and err.count("\n") == 1, err
+    assert ("--coulomb: Coulomb friction acts on the driven mass, whose position per force has "
+            "relative degree 2; the plant has relative degree 3") in err
+    assert out == "" and list((tmp_path / "work").iterdir()) == []
+
+
+def test_map_simulates_friction_on_the_loop_s_mass(capsys, tmp_path):
+    out = tmp_path / "f.npz"
+    status, text, err = run(capsys, "map", "--loop", LOOPS / "actuator_lag.toml", "--simulate",
+                            "--coulomb", "0.02", "--x-range=0.2,1,3", "--y-range=50,400,3",
+                            "--steps", "3000", "--out", out, "--no-png")
+    assert status == 0, err
+    loop = symstab.load_loop(LOOPS / "actuator_lag.toml")
+    with np.load(out) as f:
+        assert "Coulomb friction 0.02" in str(f["nonidealities"])
+        B, K = np.meshgrid(f["x"], f["y"], indexing="ij")
+        run_ = loop.simulate(B=B, K=K, steps=3000, x0=0.01,
+                             nonideal=symstab.numeric.simulate.Nonidealities(coulomb_friction=0.02))
+        np.testing.assert_array_equal(f["simulated_stable"], run_.stable)
+
+
 @pytest.mark.parametrize("args, needle", [
     (["simulate", "--loop", PAPER, "--velocity-cutoff", "50"],
      "a velocity filter written into the loop file's environment"),
-    (["simulate", "--loop", PAPER, "--coulomb", "0.01"], "Coulomb friction needs the plant's"),
+    (["simulate", "--loop", PAPER, "--coulomb", "0.01", "--friction-compensation"],
+     "a general loop has no velocity estimate"),
+    (["simulate", "--loop", PAPER, "--coulomb", "0.01", "--stiction", "0.005"], "stiction"),
+    (["map", "--loop", PAPER, "--x-range=0,1,3", "--y-range=0,1,3", "--out", "m.npz",
+      "--coulomb", "0.01"], "--coulomb is an option of the simulation: add --simulate"),
     (["simulate", "--loop", PAPER, "--Kw", "3"], "--Kw is an option of the paper's device"),
     (["simulate", "--loop", PAPER, "--steps", "3"], "steps"),
     (["simulate", "--loop", PAPER, "--force-limit", "-1"], "force_limit"),

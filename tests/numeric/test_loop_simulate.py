@@ -170,7 +170,7 @@ def test_a_loop_map_has_no_paper_names():
 @pytest.mark.parametrize("nonideal, name", [
     (Nonidealities(velocity_cutoff=50.0), "velocity_cutoff"),
     (Nonidealities(actuator_bandwidth=100.0), "actuator_bandwidth"),
-    (Nonidealities(coulomb_friction=0.01), "coulomb_friction"),
+    (Nonidealities(coulomb_friction=0.01, friction_compensation=True), "friction_compensation"),
     ("none", "nonideal"),
 ])
 def test_what_a_loop_does_not_model_is_refused_by_name(nonideal, name):

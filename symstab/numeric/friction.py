@@ -1,0 +1,290 @@
+"""Coulomb friction on a loop's driven mass: the state space it acts in.
+
+Friction acts inside the period, on the velocity of the mass the force
+drives, so a loop with friction is stepped on a continuous state space
+rather than on its pulse transfer function.  The plant is split as
+``G = A M``: the actuator ``A`` (the loop's ``actuator``, default 1: force
+command to the force on the mass) and the mass ``M = G / A`` (force to
+position, relative degree 2, :meth:`symstab.Loop.driven_mass`).  Each is
+realised in controllable canonical form and put in series:
+
+    x' = F x + B_u u + B_f (-friction),      y = C x,      v = C_v x = C F x
+
+(``C B_u = C B_f = 0``: the velocity is a state, driven by no input
+directly).  With the friction held over a sub-step of ``h = T / n`` both
+inputs are piecewise constant, so every sub-step is exact:
+``exp([[F, B_u, B_f], [0, 0, 0], [0, 0, 0]] h)`` gives ``Phi``, ``Gamma_u``
+and ``Gamma_f``, at 30 digits (mpmath), rounded once.
+
+At rest, the force on the mass besides friction is ``net = (C_v F x + C_v
+B_u u) / (C_v B_f)`` (its mass times the acceleration it would have); the
+mass stays at rest while ``|net|`` is within the stiction force, and then
+moves by the constrained dynamics ``x' = P (F x + B_u u)`` with ``P = I -
+B_f C_v / (C_v B_f)``, the friction taking exactly ``net`` (for a rigid
+mass: nothing moves; for two masses: the one not held goes on).  A moving
+mass feels ``friction_coulomb sign(v)``; a sub-step that would reverse its
+velocity ends at rest, by the friction's impulse on the mass alone,
+``x -= B_f (C_v x) / (C_v B_f)``.  This is the paper's simulator's model
+(:func:`symstab.numeric.simulate.simulate`: the same sub-steps, stick and
+reversal rules) for any mass with any linear structure around it.
+"""
+
+import dataclasses
+
+import mpmath
+import numpy as np
+
+__all__ = ["FrictionSpace", "friction_space", "stacked_spaces", "FrictionPlant"]
+
+#: Digits of the matrix exponentials (as the plant's pulse transfer function).
+DIGITS = 30
+
+
+@dataclasses.dataclass(frozen=True)
+class FrictionSpace:
+    """The sub-step matrices of one plant (floats), in coordinates whose first two
+    are the mass's position and velocity.
+
+    Attributes
+    ----------
+    phi, gamma_u, gamma_f : ndarray
+        Moving sub-step: ``x <- phi x + gamma_u u - gamma_f friction``
+        (``(n, n)``, ``(n,)``, ``(n,)``).
+    stuck_phi, stuck_gamma : ndarray
+        Sub-step of a mass held at rest.
+    net_state, net_input : ndarray, float
+        ``net = net_state . x + net_input u``, the force on the resting mass.
+    impulse : ndarray
+        ``B_f / (C_v B_f)``: the state change that stops the mass.
+    start_position, start_change : ndarray
+        The state after positions ``x0 - k v0`` (``k = 0, 1, ...``) with no
+        force: ``x0 start_position + v0 start_change``.
+    """
+
+    phi: np.ndarray
+    gamma_u: np.ndarray
+    gamma_f: np.ndarray
+    stuck_phi: np.ndarray
+    stuck_gamma: np.ndarray
+    net_state: np.ndarray
+    net_input: float
+    impulse: np.ndarray
+    start_position: np.ndarray
+    start_change: np.ndarray
+
+
+def _canonical(num, den):
+    """Controllable canonical ``(A, B, C, D)`` of ``num / den`` (mpmath, highest power first)."""
+    while den and den[0] == 0:
+        den = den[1:]
+    lead = den[0]
+    den = [c / lead for c in den]
+    num = [c / lead for c in num]
+    n = len(den) - 1
+    num = [mpmath.mpf(0)] * (n + 1 - len(num)) + list(num)
+    direct = num[0]
+    A = mpmath.zeros(n, n)
+    for j in range(n):
+        A[0, j] = -den[j + 1]
+    for i in range(1, n):
+        A[i, i - 1] = 1
+    B = mpmath.zeros(n, 1)
+    if n:
+        B[0, 0] = 1
+    C = mpmath.matrix([[num[k] - direct * den[k] for k in range(1, n + 1)]]) if n else mpmath.zeros(1, 0)
+    return A, B, C, direct
+
+
+def _exponential(A, inputs, h):
+    """``(Phi, [Gamma_i])`` of ``x' = A x + sum B_i u_i`` over ``h`` with the inputs held."""
+    n, k = A.rows, len(inputs)
+    M = mpmath.zeros(n + k, n + k)
+    M[:n, :n] = A
+    for j, B in enumerate(inputs):
+        M[:n, n + j] = B
+    E = mpmath.expm(M * h)
+    return E[:n, :n], [E[:n, n + j] for j in range(k)]
+
+
+def friction_space(coefficients, T, substeps):
+    """The :class:`FrictionSpace` of one plant from ``[A_n, A_d, N, D]`` (:meth:`symstab.Loop.driven_mass`).
+
+    Raises
+    ------
+    ValueError
+        If the state is not determined by the positions (the actuator's
+        pole cancels a zero of the mass), or the numbers are not finite.
+    """
+    with mpmath.workdps(DIGITS):
+        a_num, a_den, m_num, m_den = ([mpmath.mpf(c) for c in part] for part in coefficients)
+        Aa, Ba, Ca, Da = _canonical(a_num, a_den)
+        Am, Bm, Cm, _ = _canonical(m_num, m_den)
+        na, nm = Aa.rows, Am.rows
+        n = na + nm
+        F = mpmath.zeros(n, n)
+        B_u, B_f, C = mpmath.zeros(n, 1), mpmath.zeros(n, 1), mpmath.zeros(1, n)
+        if na:
+            F[:na, :na] = Aa
+            B_u[:na, 0] = Ba
+            F[na:, :na] = Bm * Ca
+        F[na:, na:] = Am
+        B_u[na:, 0] = Bm * Da
+        B_f[na:, 0] = Bm
+        C[0, na:] = Cm
+        C_v = C * F
+        per_mass = (C_v * B_f)[0, 0]
+        if per_mass == 0:
+            raise ValueError("the driven mass has no velocity state (C F B = 0)")
+        h = mpmath.mpf(T) / substeps
+        phi, (gamma_u, gamma_f) = _exponential(F, [B_u, B_f], h)
+        P = mpmath.eye(n) - B_f * C_v / per_mass
+        stuck_phi, (stuck_gamma,) = _exponential(P * F, [P * B_u], h)
+        # Positions at t = 0, -T, -2T, ... with no force: C exp(-F k T) x.
+        back = mpmath.expm(-F * mpmath.mpf(T))
+        rows, row = mpmath.zeros(n, n), C
+        for k in range(n):
+            rows[k, :] = row
+            row = row * back
+        try:
+            start = [mpmath.lu_solve(rows, mpmath.matrix([f(k) for k in range(n)]))
+                     for f in (lambda k: 1, lambda k: -k)]
+        except ZeroDivisionError:
+            raise ValueError("the plant's state is not determined by its positions (a pole "
+                             "of the actuator cancels a zero of the mass?)") from None
+        # New coordinates whose first two are the mass's position and velocity,
+        # so that a held mass keeps its position to the bit and a stopped one
+        # has velocity 0 exactly (in the canonical form both are sums, and a
+        # held position drifting by an ulp a period reads as growth).
+        S = _with_rows(C, C_v)
+        S_inv = S ** -1
+        out = dict(phi=S * phi * S_inv, gamma_u=S * gamma_u, gamma_f=S * gamma_f,
+                   stuck_phi=S * stuck_phi * S_inv, stuck_gamma=S * stuck_gamma,
+                   net_state=C_v * F * S_inv / per_mass,
+                   net_input=(C_v * B_u)[0, 0] / per_mass, impulse=S * B_f / per_mass,
+                   start_position=S * start[0], start_change=S * start[1])
+        out = {k: np.array(v.tolist(), dtype=float).squeeze() if isinstance(v, mpmath.matrix)
+               else float(v) for k, v in out.items()}
+    for key in ("phi", "stuck_phi"):
+        out[key] = out[key].reshape(n, n)
+    for key, value in out.items():
+        if not np.all(np.isfinite(value)):
+            raise ValueError(f"the friction state space of the plant is not finite ({key})")
+        if key not in ("phi", "stuck_phi", "net_input"):
+            out[key] = np.reshape(value, n)
+    # The impulse stops the mass exactly: its velocity component is 1.
+    out["impulse"][1] = 1.0
+    return FrictionSpace(**out)
+
+
+def _with_rows(*rows):
+    """An invertible matrix whose first rows are ``rows``, completed by unit rows."""
+    n = rows[0].cols
+    S = mpmath.zeros(n, n)
+    for i, row in enumerate(rows):
+        S[i, :] = row
+    filled = len(rows)
+    for j in range(n):
+        if filled == n:
+            break
+        S[filled, :] = mpmath.zeros(1, n)
+        S[filled, j] = 1
+        # Keep the unit row if it is independent of the rows so far.
+        if mpmath.mnorm(_residual(S[:filled + 1, :]), 1) > mpmath.mpf(10) ** (-DIGITS // 2):
+            filled += 1
+    if filled < n:
+        raise ValueError("the mass's position and velocity are not independent states")
+    return S
+
+
+def _residual(rows):
+    """The last row minus its projection on the others (mpmath)."""
+    last = rows[rows.rows - 1, :]
+    if rows.rows == 1:
+        return last
+    basis = rows[:rows.rows - 1, :]
+    gram = basis * basis.T
+    return last - (last * basis.T) * gram ** -1 * basis
+
+
+def stacked_spaces(spaces, inverse):
+    """One :class:`FrictionSpace` for many points: the distinct plants' ``spaces`` indexed by ``inverse``.
+
+    One plant (a plane of the environment) keeps its matrices; several
+    get a last axis of points.
+    """
+    if len(spaces) == 1:
+        return spaces[0]
+    fields = {}
+    for field in dataclasses.fields(FrictionSpace):
+        stacked = np.stack([np.asarray(getattr(s, field.name)) for s in spaces], axis=-1)
+        fields[field.name] = np.ascontiguousarray(stacked[..., inverse])
+    return FrictionSpace(**fields)
+
+
+def _times(matrix, state):
+    """``matrix @ state`` for ``(n, n)`` or per-point ``(n, n, N)`` matrices, state ``(n, N)``."""
+    return matrix @ state if matrix.ndim == 2 else np.einsum("ijp,jp->ip", matrix, state)
+
+
+def _dot(row, state):
+    """``row . state`` per point: ``(N,)``."""
+    return row @ state if row.ndim == 1 else np.einsum("ip,ip->p", row, state)
+
+
+def _column(vector):
+    """A vector of the state as a column that broadcasts over points."""
+    return vector[:, None] if vector.ndim == 1 else vector
+
+
+class FrictionPlant:
+    """The plant's state for N points under Coulomb friction: :meth:`step` advances one period.
+
+    ``state`` is ``(n, N)``; its rows 0 and 1 are the mass's position and
+    velocity.  ``rest`` marks the points whose mass is at rest (held by
+    stiction or stopped by a reversal).
+    """
+
+    def __init__(self, space, x0, v0, n_points, nonideal):
+        self.space = space
+        self.substeps = nonideal.substeps
+        self.coulomb = nonideal.coulomb_friction
+        self.stiction = nonideal.stiction if nonideal.stiction is not None else self.coulomb
+        self.state = (_column(space.start_position) * x0
+                      + _column(space.start_change) * v0) * np.ones(n_points)
+        # A history of one position and no force: the mass (and the rest) at rest.
+        self.rest = np.full(n_points, v0 == 0)
+        self._stop(self.rest)
+
+    def _stop(self, where):
+        """Stop the mass at ``where``: the friction's impulse on the mass alone (velocity 0 exactly)."""
+        if where.any():
+            self.state -= _column(self.space.impulse) * np.where(where, self.state[1], 0.0)
+
+    def step(self, held):
+        """Advance one period under the command ``held`` (per point); the new position."""
+        sp = self.space
+        drive = _column(sp.gamma_u) * held
+        for _ in range(self.substeps):
+            moving = _times(sp.phi, self.state) + drive
+            if self.coulomb == 0 and self.stiction == 0:
+                self.state = moving
+                continue
+            net = _dot(sp.net_state, self.state) + sp.net_input * held
+            direction = np.where(self.rest, np.sign(net), np.sign(self.state[1]))
+            moving -= _column(sp.gamma_f) * (self.coulomb * direction)
+            stuck = self.rest & (np.abs(net) <= self.stiction)
+            # A reversal within the sub-step ends at rest (friction cannot
+            # push the mass backwards); a stuck mass stays where it is.
+            reversed_ = ~self.rest & (direction != 0) & (np.sign(moving[1]) == -direction)
+            if stuck.any():
+                kept = _times(sp.stuck_phi, self.state) + _column(sp.stuck_gamma) * held
+                kept[0] = self.state[0]
+                moving = np.where(stuck, kept, moving)
+            self.state = moving
+            self.rest = reversed_ | stuck
+            self._stop(self.rest)
+        return self.state[0].copy()
+
+    def freeze(self, bad):
+        self.state[:, bad] = 0.0
+        self.rest[bad] = True
