@@ -139,15 +139,19 @@ def friction_space(coefficients, T, substeps):
         phi, (gamma_u, gamma_f) = _exponential(F, [B_u, B_f], h)
         P = mpmath.eye(n) - B_f * C_v / per_mass
         stuck_phi, (stuck_gamma,) = _exponential(P * F, [P * B_u], h)
-        # Positions at t = 0, -T, -2T, ... with no force: C exp(-F k T) x.
-        back = mpmath.expm(-F * mpmath.mpf(T))
+        # Positions at t = -(n-1)T, ..., -T, 0 with no force from the state w
+        # at the first: C exp(F k T) w (forward in time, so a fast stable mode
+        # is a small number, not exp(+|p| T) overflowing); the start is
+        # exp(F (n-1) T) w.
+        period = mpmath.expm(F * mpmath.mpf(T))
         rows, row = mpmath.zeros(n, n), C
         for k in range(n):
             rows[k, :] = row
-            row = row * back
+            row = row * period
         try:
-            start = [mpmath.lu_solve(rows, mpmath.matrix([f(k) for k in range(n)]))
-                     for f in (lambda k: 1, lambda k: -k)]
+            start = [period ** (n - 1) * mpmath.lu_solve(
+                rows, mpmath.matrix([f(n - 1 - k) for k in range(n)]))
+                for f in (lambda k: 1, lambda k: -k)]
         except ZeroDivisionError:
             raise ValueError("the plant's state is not determined by its positions (a pole "
                              "of the actuator cancels a zero of the mass?)") from None
@@ -244,16 +248,27 @@ class FrictionPlant:
     stiction or stopped by a reversal).
     """
 
-    def __init__(self, space, x0, v0, n_points, nonideal):
+    def __init__(self, space, state, rest, *, substeps, coulomb, stiction):
         self.space = space
-        self.substeps = nonideal.substeps
-        self.coulomb = nonideal.coulomb_friction
-        self.stiction = nonideal.stiction if nonideal.stiction is not None else self.coulomb
-        self.state = (_column(space.start_position) * x0
-                      + _column(space.start_change) * v0) * np.ones(n_points)
-        # A history of one position and no force: the mass (and the rest) at rest.
-        self.rest = np.full(n_points, v0 == 0)
+        self.substeps = substeps
+        self.coulomb, self.stiction = coulomb, stiction
+        self.state = state
+        self.rest = rest
         self._stop(self.rest)
+
+    @classmethod
+    def from_history(cls, space, x0, v0, n_points, nonideal):
+        """The plant after positions ``x0 - k v0`` with no force (the loop simulator's start).
+
+        A history of one position is everything at rest.  Friction and
+        stiction in the loop's force unit, from ``nonideal``.
+        """
+        coulomb = nonideal.coulomb_friction
+        state = (_column(space.start_position) * x0
+                 + _column(space.start_change) * v0) * np.ones(n_points)
+        return cls(space, state, np.full(n_points, v0 == 0), substeps=nonideal.substeps,
+                   coulomb=coulomb,
+                   stiction=nonideal.stiction if nonideal.stiction is not None else coulomb)
 
     def _stop(self, where):
         """Stop the mass at ``where``: the friction's impulse on the mass alone (velocity 0 exactly)."""
@@ -266,7 +281,7 @@ class FrictionPlant:
         drive = _column(sp.gamma_u) * held
         for _ in range(self.substeps):
             moving = _times(sp.phi, self.state) + drive
-            if self.coulomb == 0 and self.stiction == 0:
+            if not (self.coulomb or self.stiction):
                 self.state = moving
                 continue
             net = _dot(sp.net_state, self.state) + sp.net_input * held

@@ -24,13 +24,14 @@ default) need a :class:`symstab.numeric.units.Device`:
   equal) -- integrated inside the period on ``substeps`` sub-steps: a moving
   device feels ``-F_c sign(v)``; a sub-step that would reverse the velocity
   ends at rest instead, and a device at rest stays there while the applied
-  force is within the stiction force;
+  force is within the stiction force (:mod:`symstab.numeric.friction`, the
+  model of every loop's friction);
 * ``friction_compensation`` -- the command adds ``F_c sign(v_hat)``, with
   ``v_hat`` the (filtered) velocity estimate;
 * ``actuator_bandwidth`` -- the applied force follows the command through a
-  first-order lag of that bandwidth; each sub-step drives the plant with the
-  lag's exact mean over the sub-step, held (accurate to second order in the
-  sub-step, not exact: the plant sees a constant force per sub-step).
+  first-order lag of that bandwidth: the device behind its lag is stepped
+  exactly on its state space (the lag is the loop's actuator, as in
+  ``examples/loops/actuator_lag.toml``), at any number of sub-steps.
 
 Stability by simulation (:func:`stability_map`): the run starts from the
 position ``x0`` (``1e-100 <= |x0| <= 1e50``, see :func:`simulate`), the history at ``x0`` and a small velocity (``v0 T = x0 /
@@ -61,6 +62,7 @@ a 100 Hz filter the simulation agrees with it on all 9918 cells it decides
 """
 
 import dataclasses
+import functools
 import math
 import sys
 import time
@@ -71,7 +73,7 @@ from .._generated import kernels
 from .._resources import MAX_STEPS_ENV, check_memory, chunk_slices
 from .._resources import max_steps as _max_steps_setting
 from .._validate import check_array, check_delay, check_loop, check_real
-from .friction import FrictionPlant, stacked_spaces
+from .friction import FrictionPlant, friction_space, stacked_spaces
 from .results import PAPER_PLANE, PaperGridNames
 
 __all__ = ["Nonidealities", "Simulation", "simulate", "StabilityMap", "stability_map",
@@ -80,8 +82,8 @@ __all__ = ["Nonidealities", "Simulation", "simulate", "StabilityMap", "stability
            "default_x0"]
 
 #: The most sub-steps per period: each multiplies the simulation's time (a
-#: billion once hung it), and the held-mean approximation they refine is
-#: second order in ``1/substeps``, so a thousand is far past any use.
+#: billion once hung it), and friction's stick and reversal times, which they
+#: resolve, are first order in ``1/substeps``: a thousand is far past any use.
 MAX_SUBSTEPS = 1000
 
 #: The paper's encoder: better than 3 arc seconds after quadrature and gear
@@ -122,8 +124,8 @@ class Nonidealities:
     actuator_bandwidth : float
         First-order lag of the applied force (Hz), > 0.
     substeps : int
-        Sub-steps per period for friction and the actuator lag, 1 to
-        :data:`MAX_SUBSTEPS`.
+        Sub-steps per period, 1 to :data:`MAX_SUBSTEPS`: friction is
+        decided at their ends (the actuator lag is exact at any number).
     force_limit : float
         Largest force command (N or N m), > 0: the command is clipped to it.
     """
@@ -471,6 +473,17 @@ def _run(run, steps, amplitude, positions, progress, report, chunk, n_chunks):
     run.freeze_diverged()
 
 
+@functools.lru_cache(maxsize=64)
+def _paper_space(delta, bandwidth, substeps):
+    """The :class:`~symstab.numeric.friction.FrictionSpace` of the paper's device in Table I's units.
+
+    The mass ``1 / (s**2 + delta s)`` (``m = T = 1``), behind the lag
+    ``bandwidth / (s + bandwidth)`` (``bandwidth = 2 pi f_a T``) when there is one.
+    """
+    actuator = [[bandwidth], [1, bandwidth]] if bandwidth else [[1], [1]]
+    return friction_space(actuator + [[1], [1, delta, 0]], 1, substeps)
+
+
 class _Loop:
     """The loop's state for N points; :meth:`step` advances one period."""
 
@@ -486,31 +499,35 @@ class _Loop:
         self.forces = np.zeros((d + 1, n))  # commands waiting in the delay line
         self.k = 0
         self.diverged = np.zeros(n, dtype=bool)
-        self.inner = nonideal.needs_substeps
-        self.sub = nonideal.substeps if self.inner else 1
-        phi01, phi11, g0, g1 = kernels.plant_step_coefficients(delta / self.sub)
+        phi01, phi11, g0, g1 = kernels.plant_step_coefficients(delta)
         self.phi01, self.phi11, self.g0, self.g1 = (float(c) for c in (phi01, phi11, g0, g1))
+        self.plant = None
         if device is not None:
             force_scale = device.T**2 / device.m   # physical force -> f T^2 / m
             self.coulomb = (nonideal.coulomb_friction or 0.0) * force_scale
-            self.stiction = (nonideal.stiction if nonideal.stiction is not None
-                             else (nonideal.coulomb_friction or 0.0)) * force_scale
             self.filter_pole = (math.exp(-2 * math.pi * nonideal.velocity_cutoff * device.T)
                                 if nonideal.velocity_cutoff else None)
-            if nonideal.actuator_bandwidth:
-                h = 2 * math.pi * nonideal.actuator_bandwidth * device.T / self.sub
-                self.lag = math.exp(-h)
-                self.lag_mean = -math.expm1(-h) / h   # mean of exp(-t) over [0, h]
-            else:
-                self.lag = None
             self.force_limit = (None if nonideal.force_limit is None
                                 else nonideal.force_limit * force_scale)
+            if nonideal.needs_substeps:
+                # Friction and the actuator lag act inside the period: the
+                # device (behind its lag) is stepped on its state space, in
+                # Table I's units (m = T = 1), with the loop simulator's friction.
+                bandwidth = (2 * math.pi * nonideal.actuator_bandwidth * device.T
+                             if nonideal.actuator_bandwidth else None)
+                space = _paper_space(float(delta), bandwidth, nonideal.substeps)
+                state = np.zeros((space.phi.shape[0], n))
+                state[0], state[1] = self.x, self.v
+                stiction = (nonideal.stiction if nonideal.stiction is not None
+                            else (nonideal.coulomb_friction or 0.0)) * force_scale
+                self.plant = FrictionPlant(space, state, self.v == 0,
+                                           substeps=nonideal.substeps, coulomb=self.coulomb,
+                                           stiction=stiction)
         else:
-            self.coulomb = self.stiction = 0.0
-            self.filter_pole = self.lag = None
+            self.coulomb = 0.0
+            self.filter_pole = None
             self.force_limit = None
         self.v_hat = np.zeros(n)          # filtered velocity estimate (times T)
-        self.applied = np.zeros(n)        # actuator output
         self.ideal = nonideal.ideal and not nonideal.friction_compensation
         if self.ideal:
             # The force of eq. (1) is linear in the three sampled positions:
@@ -595,16 +612,19 @@ class _Loop:
         self.forces[slot] = command
         held = self.forces[(self.k - self.d) % (self.d + 1)] if self.k >= self.d else 0.0 * command
         self.k += 1
-        if not self.inner:
+        if self.plant is None:
             x, v = self.x, self.v
             self.x = x + self.phi01 * v + self.g0 * held
             self.v = self.phi11 * v + self.g1 * held
         else:
-            self._substeps(held)
+            self.x = self.plant.step(held)
+            self.v = self.plant.state[1]
 
     def freeze_diverged(self):
         """Mark the points whose state left [-1e100, 1e100] or is not finite; zero them."""
         bad = ~(np.abs(self.x) < _OVERFLOW) | ~np.isfinite(self.v)
+        if self.plant is not None:
+            bad |= ~np.all(np.isfinite(self.plant.state), axis=0)
         if bad.any():
             self.diverged |= bad
             self.x[bad] = 0.0
@@ -613,38 +633,8 @@ class _Loop:
             for sampled in self.history:
                 sampled[bad] = 0.0
             self.v_hat[bad] = 0.0
-            self.applied[bad] = 0.0
-
-    def _substeps(self, held):
-        n = self.sub
-        for _ in range(n):
-            if self.lag is not None:
-                # The lag's exact mean over the sub-step drives the plant (the
-                # held-mean approximation is second order in 1/substeps).
-                start = self.applied
-                self.applied = held + (start - held) * self.lag
-                drive = held + (start - held) * self.lag_mean
-            else:
-                drive = self.applied = held
-            if self.coulomb > 0 or self.stiction > 0:
-                moving = self.v != 0
-                stuck = ~moving & (np.abs(drive) <= self.stiction)
-                direction = np.where(moving, np.sign(self.v), np.sign(drive))
-                total = drive - self.coulomb * direction
-            else:
-                stuck = np.zeros_like(self.v, dtype=bool)
-                direction = None
-                total = drive
-            # Sub-step of length T/n: velocity (v T)/n and force (f T^2/m)/n^2.
-            x_new = self.x + self.phi01 * self.v / n + self.g0 * total / n**2
-            v_new = self.phi11 * self.v + self.g1 * total / n
-            if direction is not None:
-                # A reversal within the sub-step ends at rest (friction cannot
-                # push the device backwards); a stuck device stays put.
-                reversed_ = (direction != 0) & (np.sign(v_new) == -direction) & (self.v != 0)
-                v_new = np.where(reversed_ | stuck, 0.0, v_new)
-                x_new = np.where(stuck, self.x, x_new)
-            self.x, self.v = x_new, v_new
+            if self.plant is not None:
+                self.plant.freeze(bad)
 
 
 @dataclasses.dataclass(frozen=True)
@@ -970,7 +960,7 @@ class _FrictionLoop(_AnyLoop):
     def __init__(self, parts, d, x0, v0, nonideal, space):
         super().__init__(parts, d, x0, v0, nonideal)
         self.y_past = self.u_past = []      # the state space holds the plant's past
-        self.plant = FrictionPlant(space, x0, v0, self.x.size, nonideal)
+        self.plant = FrictionPlant.from_history(space, x0, v0, self.x.size, nonideal)
 
     def _plant_step(self, held):
         return self.plant.step(held)

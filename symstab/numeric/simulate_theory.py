@@ -180,8 +180,7 @@ def linear_theory(*, gamma, d, delta=None, device=None, nonideal=None):
     The velocity filter and the actuator lag are linear: they are in the
     theory exactly as the simulator has them (the filter's difference
     equation is the simulator's; the lag is the continuous first-order lag,
-    which the simulator integrates on its sub-steps to second order in
-    ``1/substeps``).  Encoder quantization, Coulomb friction and its
+    which the simulator steps exactly).  Encoder quantization, Coulomb friction and its
     compensation are not linear: they are left out and named in
     :attr:`LinearTheory.left_out`.
 
