@@ -868,7 +868,9 @@ class _AnyLoop:
     ``a``, ``b``: the plant's ``P_d`` (monic, without its leading 1) and
     ``P_n`` (its coefficients of ``z**(n-1) .. 1``); ``c``, ``e``: the
     environment's ``Ve_d`` (monic, without its leading 1) and ``Ve_n``
-    (``z**m .. 1``).  Histories are lists, newest first, rotated (no copies).
+    (``z**m .. 1``).  Histories are lists, newest first, rotated (no copies);
+    the delay line is a ring of the commands themselves, and the plant's
+    input history keeps the commands ``f`` (its sum has ``-b``: ``u = -f``).
     """
 
     def __init__(self, parts, d, x0, v0, nonideal):
@@ -877,7 +879,8 @@ class _AnyLoop:
         # Each sum keeps its nonzero terms only (a backward difference's Ve_d
         # is z**k: no force feedback at all), with a float coefficient where
         # every point has the same (the plant of a plane of the environment).
-        self.a, self.b, self.c = (_terms(p) for p in (a, b, c))
+        self.a, self.c = _terms(a), _terms(c)
+        self.minus_b = _terms(-b)
         self.e0, self.e = e[:, 0], _terms(e[:, 1:])
         self.e0 = float(self.e0[0]) if np.all(self.e0 == self.e0[0]) else self.e0
         self.d = d
@@ -887,11 +890,11 @@ class _AnyLoop:
         self.x = np.full(n_points, float(x0))
         # y[k-1], y[k-2], ... before the start: x0 - k v0; no force applied yet.
         self.y_past = [np.full(n_points, x0 - k * v0) for k in range(1, n + 1)]
-        self.u_past = [np.zeros(n_points) for _ in range(n)]
+        self.f_past_plant = [np.zeros(n_points) for _ in range(n)]
         sampled = self._sample(self.x)
         self.s_past = [np.array(sampled) for _ in range(m)]
         self.f_past = [np.zeros(n_points) for _ in range(m)]
-        self.forces = np.zeros((d + 1, n_points))
+        self.line = [np.zeros(n_points) for _ in range(d + 1)]
         self._scratch = np.empty(n_points)
         self.k = 0
         self.diverged = np.zeros(n_points, dtype=bool)
@@ -923,33 +926,34 @@ class _AnyLoop:
         # The environment keeps its own force; the command sent is clipped.
         command = (force if self.force_limit is None
                    else np.clip(force, -self.force_limit, self.force_limit))
-        self.forces[self.k % (self.d + 1)] = command
-        held = np.negative(self.forces[(self.k - self.d) % (self.d + 1)])
+        slot = self.k % (self.d + 1)
+        self.line[slot] = command
         self.k += 1
-        self.x = self._plant_step(held)
+        # The command of d periods ago (d = 0: this one) drives the plant.
+        self.x = self._plant_step(self.line[(slot + 1) % (self.d + 1)] if self.d else command)
         if self.k % self.check_every == 0:
             self.freeze_diverged()
 
-    def _plant_step(self, held):
-        """The plant's next sample under the force ``held``: ``P_d(z) y = P_n(z) u``."""
+    def _plant_step(self, command):
+        """The plant's next sample under ``u = -command``: ``P_d(z) y = P_n(z) u``."""
         self.y_past = [self.x] + self.y_past[:-1]
-        self.u_past = [held] + self.u_past[:-1]
-        x = np.zeros_like(held)
-        self._sum(x, self.b, self.u_past, 1)
+        self.f_past_plant = [command] + self.f_past_plant[:-1]
+        (k, first), *rest = self.minus_b
+        x = np.multiply(first, self.f_past_plant[k])
+        self._sum(x, rest, self.f_past_plant, 1)
         self._sum(x, self.a, self.y_past, -1)
         return x
 
     def freeze_diverged(self):
         """Mark the points whose state left [-1e100, 1e100] or is not finite; zero them."""
         bad = ~(np.abs(self.x) < _OVERFLOW)
-        for history in (self.y_past, self.u_past, self.f_past):
+        for history in (self.y_past, self.f_past_plant, self.f_past):
             for value in history:
                 bad |= ~np.isfinite(value)
         if bad.any():
             self.diverged |= bad
             self.x[bad] = 0.0
-            self.forces[:, bad] = 0.0
-            for history in (self.y_past, self.u_past, self.s_past, self.f_past):
+            for history in (self.line, self.y_past, self.f_past_plant, self.s_past, self.f_past):
                 for value in history:
                     value[bad] = 0.0
 
@@ -959,11 +963,11 @@ class _FrictionLoop(_AnyLoop):
 
     def __init__(self, parts, d, x0, v0, nonideal, space):
         super().__init__(parts, d, x0, v0, nonideal)
-        self.y_past = self.u_past = []      # the state space holds the plant's past
+        self.y_past = self.f_past_plant = []      # the state space holds the plant's past
         self.plant = FrictionPlant.from_history(space, x0, v0, self.x.size, nonideal)
 
-    def _plant_step(self, held):
-        return self.plant.step(held)
+    def _plant_step(self, command):
+        return self.plant.step(-command)
 
     def freeze_diverged(self):
         bad = ~(np.abs(self.x) < _OVERFLOW) | ~np.all(np.isfinite(self.plant.state), axis=0)
