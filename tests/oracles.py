@@ -336,7 +336,8 @@ def simulated_loop_radius(K, B, *, d, f_c=None, f_a=None, M=0.0, m=None, b=None,
     The velocity estimate is the backward difference ``(x[k] - x[k-1])/T``,
     filtered by ``v_f[k] = a v_f[k-1] + (1 - a) v[k]`` with ``a = exp(-2 pi
     f_c T)``; the force is ``K x + B v_f + M (v_f[k] - v_f[k-1])/T`` (the
-    simulator's :meth:`_Loop._command`, written here as transfer functions).
+    paper's force law with its velocity filter, written here as transfer
+    functions from the description, not from the simulator's loop).
     The actuator is ``1/(tau s + 1)`` with ``tau = 1/(2 pi f_a)``, before the
     plant, inside the hold.
     """

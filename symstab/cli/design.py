@@ -33,7 +33,9 @@ _TARGET_WORDS = {"y_max": "y_max", "K_max": "y_max", "area": "area", "Z-width": 
                  "z_width": "area", "passive": "passive", "simulated": "simulated"}
 #: The options of the simulated target (``--maximize simulated``) only: flag, dest.
 _SIMULATION_FLAGS = (("--amplitude", "amplitude"), ("--encoder-resolution", "encoder_resolution"),
-                     ("--force-limit", "force_limit"), ("--steps", "steps"), ("--x0", "x0"))
+                     ("--force-limit", "force_limit"), ("--coulomb", "coulomb"),
+                     ("--stiction", "stiction"), ("--substeps", "substeps"),
+                     ("--steps", "steps"), ("--x0", "x0"))
 #: The scan's points per parameter at most: each is a certified region.
 MAX_POINTS = 201
 #: The scan's points in all at most (two parameters: ``--points`` squared).

@@ -1041,6 +1041,27 @@ class Loop(LoopModel):
             For a plant with direct feed-through (``P_n`` as high as ``P_d``),
             a leading coefficient 0, or values that overflow.
         """
+        parts, d, shape = self.difference_parts(values)
+        self._finite(np.concatenate(parts, axis=-1), self._prepare(values)[0])
+        return parts, d, shape
+
+    def difference_parts(self, values):
+        """:meth:`difference_equations` of the dict ``values``, with coefficients that overflow kept.
+
+        The paper's simulator calls a point whose coefficient overflows (``K
+        = 1e308``) a point that diverges at once, as it always has; a loop's
+        own run refuses it (:meth:`difference_equations`).
+
+        Parameters
+        ----------
+        values : dict
+            Every parameter (or its default); arrays broadcast.
+
+        Returns
+        -------
+        ((ndarray, ndarray, ndarray, ndarray), int, tuple)
+            As :meth:`difference_equations`.
+        """
         values, d, shape = self._prepare(values)
         # The coefficients and their working copies, about 64 floats a point.
         check_memory("the loop's difference equations", 8 * int(np.prod(shape)) * 64)
@@ -1057,10 +1078,8 @@ class Loop(LoopModel):
             lead_p, lead_e = p_d[..., :1], ve_d[..., :1]
             if np.any(lead_p == 0) or np.any(lead_e == 0):
                 raise ValueError("the leading coefficient of P_d or Ve_d is 0 at these values")
-            parts = (p_d[..., 1:] / lead_p, p_n[..., 1:] / lead_p, ve_d[..., 1:] / lead_e,
-                     ve_n / lead_e)
-        self._finite(np.concatenate(parts, axis=-1), values)
-        return parts, d, shape
+            return (p_d[..., 1:] / lead_p, p_n[..., 1:] / lead_p, ve_d[..., 1:] / lead_e,
+                    ve_n / lead_e), d, shape
 
     def friction_spaces(self, substeps, **values):
         """The state spaces in which friction acts: ``(spaces, inverse)``.
@@ -1140,7 +1159,7 @@ class Loop(LoopModel):
         >>> run.stable.tolist()
         [True, False]
         """
-        from .simulate import simulate_loop
+        from .loop_simulate import simulate_loop
 
         return simulate_loop(self, steps=steps, x0=x0, v0=v0, nonideal=nonideal, record=record,
                              progress=progress, **values)
@@ -1167,7 +1186,7 @@ class Loop(LoopModel):
         symstab.numeric.simulate.StabilityMap
             ``stable`` of shape ``(len(y_values), len(x_values))``.
         """
-        from .simulate import loop_stability_map
+        from .loop_simulate import loop_stability_map
 
         x, y = self._plane(x, y)
         return loop_stability_map(self, x_values, y_values, x=x, y=y, steps=steps, x0=x0, v0=v0,

@@ -448,7 +448,7 @@ def design(loop, *, over, maximize="y_max", x=None, y=None, n=None, rtol=None, d
     if simulation:
         # The horizon is checked at every corner's delay (held in seconds, d
         # varies with T), before the scan.
-        from .simulate import check_steps
+        from .loop_simulate import check_steps
 
         for corner in box_corners(over):
             check_steps(steps, at(tuple(corner.values())).get("d", loop.defaults.get("d", 0)))
@@ -526,7 +526,7 @@ def _check_simulation(maximize, amplitude, nonideal, x0, steps, loop=None):
             raise TypeError(f"{', '.join(given)}: only with maximize='simulated' (the other "
                             f"targets are certified, not simulated)")
         return {}
-    from .simulate import check_loop_nonideal, check_x0, default_x0
+    from .loop_simulate import check_loop_nonideal, check_x0, default_x0
 
     if amplitude is None:
         raise TypeError("maximize='simulated' needs amplitude: the largest |x| accepted at the "

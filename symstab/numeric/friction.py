@@ -34,7 +34,7 @@ import dataclasses
 import mpmath
 import numpy as np
 
-__all__ = ["FrictionSpace", "friction_space", "stacked_spaces", "FrictionPlant"]
+__all__ = ["FrictionSpace", "friction_space", "stacked_spaces", "StatePlant", "substeps_of"]
 
 #: Digits of the matrix exponentials (as the plant's pulse transfer function).
 DIGITS = 30
@@ -166,6 +166,8 @@ def friction_space(coefficients, T, substeps):
                    net_state=C_v * F * S_inv / per_mass,
                    net_input=(C_v * B_u)[0, 0] / per_mass, impulse=S * B_f / per_mass,
                    start_position=S * start[0], start_change=S * start[1])
+        for key in ("phi", "stuck_phi"):
+            out[key] = _snapped(out[key])
         out = {k: np.array(v.tolist(), dtype=float).squeeze() if isinstance(v, mpmath.matrix)
                else float(v) for k, v in out.items()}
     for key in ("phi", "stuck_phi"):
@@ -178,6 +180,22 @@ def friction_space(coefficients, T, substeps):
     # The impulse stops the mass exactly: its velocity component is 1.
     out["impulse"][1] = 1.0
     return FrictionSpace(**out)
+
+
+def _snapped(matrix):
+    """``matrix`` with the entries at its 30 digits' rounding of 0 set to 0.
+
+    In the position-velocity coordinates a mass's step has exact zeros
+    (the position does not feed the velocity) that the change of
+    coordinates leaves as 1e-40; as zeros, the step skips them.
+    """
+    out = matrix.copy()
+    for i in range(out.rows):
+        size = max(abs(out[i, j]) for j in range(out.cols))
+        for j in range(out.cols):
+            if abs(out[i, j]) <= mpmath.mpf(10) ** (4 - DIGITS) * size:
+                out[i, j] = 0
+    return out
 
 
 def _with_rows(*rows):
@@ -210,6 +228,12 @@ def _residual(rows):
     return last - (last * basis.T) * gram ** -1 * basis
 
 
+def substeps_of(nonideal):
+    """Sub-steps a period for ``nonideal``: its own with friction, else 1 (every step is exact)."""
+    friction = nonideal.coulomb_friction or nonideal.stiction
+    return nonideal.substeps if friction else 1
+
+
 def stacked_spaces(spaces, inverse):
     """One :class:`FrictionSpace` for many points: the distinct plants' ``spaces`` indexed by ``inverse``.
 
@@ -240,21 +264,30 @@ def _column(vector):
     return vector[:, None] if vector.ndim == 1 else vector
 
 
-class FrictionPlant:
-    """The plant's state for N points under Coulomb friction: :meth:`step` advances one period.
+class StatePlant:
+    """A plant on its state space for N points, with Coulomb friction on its mass when given.
 
-    ``state`` is ``(n, N)``; its rows 0 and 1 are the mass's position and
-    velocity.  ``rest`` marks the points whose mass is at rest (held by
-    stiction or stopped by a reversal).
+    :meth:`step` advances one period.  ``state`` is ``(n, N)``; its rows 0
+    and 1 are the mass's position and velocity.  ``rest`` marks the points
+    whose mass is at rest (held by stiction or stopped by a reversal).
+    Without friction each sub-step is summed in place over the nonzero
+    entries of one shared matrix (:func:`substeps_of` gives one a period):
+    the paper's device's step is a few products per point.
     """
 
     def __init__(self, space, state, rest, *, substeps, coulomb, stiction):
         self.space = space
+        self.friction = bool(coulomb or stiction)
         self.substeps = substeps
         self.coulomb, self.stiction = coulomb, stiction
         self.state = state
         self.rest = rest
-        self._stop(self.rest)
+        if self.friction:
+            self._stop(self.rest)
+        if not self.friction and space.phi.ndim == 2:
+            self._terms = [[(j, float(c)) for j, c in enumerate(row) if c != 0]
+                           for row in space.phi]
+            self._scratch = np.empty(state.shape[1])
 
     @classmethod
     def from_history(cls, space, x0, v0, n_points, nonideal):
@@ -266,7 +299,7 @@ class FrictionPlant:
         coulomb = nonideal.coulomb_friction
         state = (_column(space.start_position) * x0
                  + _column(space.start_change) * v0) * np.ones(n_points)
-        return cls(space, state, np.full(n_points, v0 == 0), substeps=nonideal.substeps,
+        return cls(space, state, np.full(n_points, v0 == 0), substeps=substeps_of(nonideal),
                    coulomb=coulomb,
                    stiction=nonideal.stiction if nonideal.stiction is not None else coulomb)
 
@@ -275,15 +308,21 @@ class FrictionPlant:
         if where.any():
             self.state -= _column(self.space.impulse) * np.where(where, self.state[1], 0.0)
 
-    def step(self, held):
-        """Advance one period under the command ``held`` (per point); the new position."""
+    def step(self, force, sign=1.0):
+        """Advance one period under the input ``sign * force`` (per point); the new position.
+
+        (``sign = -1``: the loop's ``u = -f`` without a pass to negate it.)
+        The position is a new array each period (a history may keep it).
+        """
+        if not self.friction:
+            for _ in range(self.substeps):
+                self.state = self._linear(force, sign)
+            return self.state[0]
         sp = self.space
+        held = sign * force
         drive = _column(sp.gamma_u) * held
         for _ in range(self.substeps):
             moving = _times(sp.phi, self.state) + drive
-            if not (self.coulomb or self.stiction):
-                self.state = moving
-                continue
             net = _dot(sp.net_state, self.state) + sp.net_input * held
             direction = np.where(self.rest, np.sign(net), np.sign(self.state[1]))
             moving -= _column(sp.gamma_f) * (self.coulomb * direction)
@@ -299,6 +338,23 @@ class FrictionPlant:
             self.rest = reversed_ | stuck
             self._stop(self.rest)
         return self.state[0].copy()
+
+    def _linear(self, force, sign):
+        """``phi state + gamma_u sign force``: in place over the nonzero entries of a shared ``phi``."""
+        sp = self.space
+        if sp.phi.ndim != 2:
+            return _times(sp.phi, self.state) + _column(sign * sp.gamma_u) * force
+        new, tmp = np.empty_like(self.state), self._scratch
+        for i, terms in enumerate(self._terms):
+            row = new[i]
+            np.multiply(sign * float(sp.gamma_u[i]), force, out=row)
+            for j, c in terms:
+                if c == 1.0:
+                    row += self.state[j]
+                else:
+                    np.multiply(c, self.state[j], out=tmp)
+                    row += tmp
+        return new
 
     def freeze(self, bad):
         self.state[:, bad] = 0.0

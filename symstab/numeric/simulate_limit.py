@@ -148,7 +148,7 @@ def simulated_limit(loop, *, x, y, amplitude, nonideal=None, steps=None, x0=None
         and for an ``amplitude`` that is not a positive number or a linear
         stable set unbounded in ``x``.
     """
-    from .simulate import check_loop_nonideal, check_x0, default_x0
+    from .loop_simulate import check_loop_nonideal, check_x0, default_x0
 
     amplitude = check_real("amplitude", amplitude, low=0.0, low_open=True)
     nonideal = check_loop_nonideal(nonideal, loop)

@@ -16,13 +16,14 @@ import numpy as np
 
 from .._resources import chunk_slices
 from .._validate import check_array, check_box, check_delay, check_loop, check_real
-from .simulate import Nonidealities
+from .loop_simulate import Nonidealities
 
-__all__ = ["LinearTheory", "linear_theory"]
+__all__ = ["LinearTheory", "linear_theory", "paper_simulated_loop"]
 
 
-#: The simulated loop's linear part as loop expressions, in physical units.
-#: The environment is the simulator's force law (:meth:`_Loop._command`):
+#: The simulated loop's linear part as loop expressions, in physical units;
+#: the paper's simulator runs these loops (in Table I's units).
+#: The environment is the paper's force law with its velocity filter:
 #: the damper and the mass act on the backward difference
 #: ``(z - 1)/(T z)`` passed through the filter ``v_f[k] = a v_f[k-1] +
 #: (1 - a) v[k]``, i.e. ``(1 - a) z/(z - a)`` with ``a = exp(-2 pi f_c T)``
@@ -245,16 +246,24 @@ def linear_theory(*, gamma, d, delta=None, device=None, nonideal=None):
         values["f_c"] = float(nonideal.velocity_cutoff)
     if lagged:
         values["tau"] = 1.0 / (2 * math.pi * nonideal.actuator_bandwidth)
-    loop = _linear_loop(filtered, lagged, device.b == 0)
+    loop = paper_simulated_loop(filtered, lagged, device.b == 0)
     return LinearTheory(loop, values, device, gamma, d, delta,
                         "linear loop with " + " and ".join(parts), left_out)
 
 
 @functools.lru_cache(maxsize=None)
-def _linear_loop(filtered, lagged, frictionless):
-    """The :class:`symstab.Loop` of a linear part, derived once per process."""
+def paper_simulated_loop(filtered, lagged, frictionless):
+    """The paper's loop as the simulator runs it: a :class:`symstab.Loop`, derived once per process.
+
+    The device (``frictionless``: ``b = 0``), behind its actuator lag
+    (``lagged``, declared as the loop's actuator, so friction acts after
+    it), with the environment on the filtered velocity (``filtered``).
+    :func:`symstab.numeric.simulate.simulate` runs it in Table I's units;
+    :func:`linear_theory` counts its roots in physical ones.
+    """
     from .any_loop import Loop
 
     return Loop(_PLANTS[lagged, frictionless],
                 _FILTERED_ENVIRONMENT if filtered else _IDEAL_ENVIRONMENT,
-                name="simulated_linear_part", plane=("B", "K"))
+                name="simulated_linear_part", plane=("B", "K"),
+                actuator="1/(tau*s + 1)" if lagged else None)

@@ -153,8 +153,11 @@ def test_the_table_names_the_optimum_the_value_there_and_at_the_nominal_value(ca
     (["--loop", LOOPS / "paper.toml", "--steps", "0", "--points", "3"], "--steps"),
     (["--loop", LOOPS / "paper.toml", "--amplitude", "0", "--points", "3"], "--amplitude"),
     (["--coulomb", "0.1"], "--coulomb"),
+    (["--loop", LOOPS / "paper.toml", "--coulomb", "0.1"], "add --maximize simulated"),
+    (["--loop", LOOPS / "actuator_lag.toml", "--maximize", "simulated", "--amplitude", "1e-3",
+      "--coulomb", "0.1", "--stiction", "0.05"], "stiction"),
     (["--velocity-cutoff", "50"], "--velocity-cutoff"),
-    (["--friction-compensation", "--coulomb", "0.1"], "--coulomb"),
+    (["--friction-compensation", "--coulomb", "0.1"], "--friction-compensation"),
 ])
 def test_bad_search_input_is_one_line_before_the_search(capsys, args, needle):
     status, out, err = run(capsys, "design", *args)

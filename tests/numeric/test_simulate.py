@@ -925,7 +925,7 @@ def test_recording_beyond_the_memory_limit_is_refused_before_running(monkeypatch
 
 def _small_chunks(monkeypatch, budget):
     from symstab import _resources
-    from symstab.numeric import simulate as module
+    from symstab.numeric import loop_simulate as module
 
     monkeypatch.setattr(module, "chunk_slices",
                         lambda n, size: _resources.chunk_slices(n, size, budget=budget))
@@ -956,6 +956,8 @@ def test_chunked_map_memory_does_not_grow_with_the_working_set(monkeypatch):
 
     _small_chunks(monkeypatch, budget=256 * 1024)
     alpha, beta = np.linspace(0.0, 0.01, 100), np.linspace(0.0, 0.2, 100)
+    # Once per process the paper's loop is derived (SymPy, a few MB): not per point.
+    stability_map(alpha=alpha[:2], beta=beta[:2], gamma=0.0, d=40, delta=PAPER_DELTA, steps=48)
     tracemalloc.start()
     try:
         stability_map(alpha=alpha, beta=beta, gamma=0.0, d=40, delta=PAPER_DELTA, steps=48)

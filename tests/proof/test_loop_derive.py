@@ -26,6 +26,7 @@ import subprocess
 import sys
 
 import numpy as np
+import sympy as sp
 import pytest
 
 from conftest import REPO, hash_seed_other_than_ours
@@ -620,10 +621,13 @@ def test_the_c_step_of_every_example_loop_compiles_strictly_and_runs_as_numpy(fi
     n, m = a.shape[-1], c.shape[-1]
     coefficients = [buffer(p) for p in (a, b, c, e)]
     # The start of Loop.simulate: earlier positions x0 - k v0 with v0 = x0 / 100, no
-    # force applied yet, the sampled history at x0, no force computed yet.
+    # force applied yet, the sampled history at x0 and the environment at rest there:
+    # its force VE(1) x0 (VE from the loop's expression, at its values).
     y_past = buffer([x0 - k * x0 / 100 for k in range(1, n + 1)])
     u_past, s_past = buffer(np.zeros(n)), buffer(np.full(m, x0))
-    f_past = buffer(np.zeros(m))
+    at_rest = loop.environment.subs({sp.Symbol(k, real=True): v for k, v in loop.defaults.items()
+                                     if k != "d"}).subs(sp.Symbol("z"), 1)
+    f_past = buffer(np.full(m, float(at_rest) * x0))
     force, x_next = ctypes.c_double(), ctypes.c_double()
     line = np.zeros(d + 1)
     x, positions = x0, [x0]
