@@ -1,22 +1,15 @@
-"""The sampled haptic loop in time: many parameter points at once.
+"""The paper's sampled loop in time: many parameter points at once.
 
-One simulator runs every loop (:func:`simulate_loop`,
-:meth:`symstab.Loop.simulate`): every period ``T`` the position is sampled,
-the virtual environment's difference equation computes a force from the
-sampled positions, the force waits ``d`` samples in the delay line, and a
-zero-order hold applies it to the plant, stepped exactly on the samples by
-its pulse transfer function ``P(z)`` (derived by the loop), or on its
-continuous state space (:mod:`symstab.numeric.friction`) where Coulomb
-friction acts inside the period or the run starts from a state.  All
-points run together as NumPy arrays, one loop over time.
-
-The paper's simulator (:func:`simulate`, :func:`stability_map`) is a use of
-it: the paper's loop in Table I's units (``m = T = 1``, ``b = delta``, ``K
-= alpha``, ``B = beta``, ``M = gamma``; position, ``v T``, force ``f T**2 /
-m``), the velocity filter in its environment and the actuator lag in its
-plant (the loops of :func:`~symstab.numeric.simulate_theory.linear_theory`,
-whose root counts are its theory), the device on its state space from the
-position ``x0`` and velocity ``v0 / T``.
+:func:`simulate` and :func:`stability_map` run the paper's loop on the loop
+simulator (:mod:`symstab.numeric.loop_simulate`, the one engine of every
+:class:`symstab.Loop`): the loop of
+:func:`~symstab.numeric.simulate_theory.paper_simulated_loop` in Table I's
+units (``m = T = 1``, ``b = delta``, ``K = alpha``, ``B = beta``, ``M =
+gamma``; position, ``v T``, force ``f T**2 / m``), the velocity filter in
+its environment and the actuator lag as its actuator, the device on its
+state space from the position ``x0`` and the velocity ``v0 / T``.  The
+engine's names (:class:`Nonidealities`, :class:`Simulation`,
+:func:`simulate_loop`, ...) are importable from here too.
 
 Non-idealities (:class:`Nonidealities`, physical units, each off by
 default) need a :class:`symstab.numeric.units.Device`:
@@ -55,11 +48,6 @@ decaying or bounded run is stable, including a limit cycle at the
 resolution of the encoder.  The default horizon grows with the delay; near
 the boundary the modes have ``|z|`` close to 1 and any finite horizon
 leaves a band of undecidable cells, which the tests count.
-
-A loop's own run (:meth:`symstab.Loop.simulate`,
-:meth:`symstab.Loop.stability_map`) starts from positions ``x0 - k v0``
-before the start, no force and the environment at rest at the sampled
-``x0``; its theory is its own root count.
 
 The theory to compare a run with
 (:func:`~symstab.numeric.simulate_theory.linear_theory`) is that of the loop

@@ -409,15 +409,7 @@ def parse_actuator(actuator, plant):
     """
     if actuator is None:
         return None
-    if isinstance(actuator, str):
-        expr = parse_expression(actuator, "actuator")
-    elif isinstance(actuator, sp.Basic):
-        expr = sp.sympify(actuator)
-    else:
-        raise TypeError(f"actuator must be a string or a SymPy expression, "
-                        f"got {type(actuator).__name__}")
-    expr = _real_symbols(expr)
-    _check_rational(expr, model.s, "actuator A(s)", model.z)
+    expr = _rational(actuator, "actuator", "actuator A(s)", model.s, model.z)
     extra = expr.free_symbols - plant.free_symbols
     if extra:
         raise ValueError(f"actuator A(s) = {expr}: {', '.join(sorted(map(str, extra)))} "
@@ -451,15 +443,20 @@ def parse_environment(environment):
         If it is not rational in ``z``, not proper (not causal), zero, or uses
         ``s`` or ``d``.
     """
-    if isinstance(environment, str):
-        expr = parse_expression(environment, "environment")
-    elif isinstance(environment, sp.Basic):
-        expr = sp.sympify(environment)
+    return _rational(environment, "environment", "environment VE(z)", model.z, model.s)
+
+
+def _rational(value, what, label, variable, other):
+    """``value`` (text or SymPy) as a checked rational function of ``variable`` (:func:`_check_rational`)."""
+    if isinstance(value, str):
+        expr = parse_expression(value, what)
+    elif isinstance(value, sp.Basic):
+        expr = sp.sympify(value)
     else:
-        raise TypeError(f"environment must be a string or a SymPy expression, "
-                        f"got {type(environment).__name__}")
+        raise TypeError(f"{what} must be a string or a SymPy expression, "
+                        f"got {type(value).__name__}")
     expr = _real_symbols(expr)
-    _check_rational(expr, model.z, "environment VE(z)", model.s)
+    _check_rational(expr, variable, label, other)
     return expr
 
 

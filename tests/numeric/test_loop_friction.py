@@ -134,3 +134,17 @@ def test_the_loop_file_s_actuator_is_read_and_travels_with_the_loop():
         'actuator = "1/(tau*s + 1)"', 'actuator = "__import__(\'os\')"')
     with pytest.raises(ValueError, match="actuator"):
         symstab.numeric.loop_files.parse_loop_text(text)
+
+
+def test_points_with_different_plants_run_as_each_alone():
+    """Per-point state spaces (a mass of each size) give each point's own run."""
+    loop = symstab.load_loop(LOOPS / "two_mass.toml")
+    nonideal = Nonidealities(coulomb_friction=0.05, stiction=0.08, substeps=10)
+    m1 = np.array([0.002, 0.004, 0.008])
+    together = loop.simulate(m1=m1, steps=300, x0=0.01, record=True, nonideal=nonideal)
+    for k, value in enumerate(m1):
+        alone = loop.simulate(m1=value, steps=300, x0=0.01, record=True, nonideal=nonideal)
+        scale = np.max(np.abs(alone.positions))
+        np.testing.assert_allclose(together.positions[:, k], alone.positions, rtol=0,
+                                   atol=1e-12 * scale)
+    assert len({together.positions[-1, k] for k in range(3)}) == 3

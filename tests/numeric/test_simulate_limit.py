@@ -122,8 +122,8 @@ def test_design_checks_the_simulation_before_the_scan():
         ({"maximize": "y_max", "amplitude": 1.0}, TypeError, "amplitude"),
         ({"maximize": "area", "nonideal": Nonidealities()}, TypeError, "nonideal"),
         ({"maximize": "simulated", "amplitude": 1.0,
-          "nonideal": Nonidealities(coulomb_friction=0.01)}, ValueError,
-         "nonideal.coulomb_friction"),
+          "nonideal": Nonidealities(coulomb_friction=0.01, friction_compensation=True)},
+         ValueError, "nonideal.friction_compensation"),
         ({"maximize": "simulated", "amplitude": 1.0, "x0": 0.0}, ValueError, "x0"),
         ({"maximize": "simulated", "amplitude": 1.0, "steps": 10**9}, ValueError, "steps"),
     ]
@@ -131,6 +131,16 @@ def test_design_checks_the_simulation_before_the_scan():
         with pytest.raises(error) as excinfo:
             loop.design(over={"M": (0.0, 0.03)}, n=3, progress=calls.append, **kwargs)
         assert_message_names(excinfo, name)
+    # Friction behind a lag the loop does not declare as its actuator.
+    lagged = symstab.Loop("1/((tau*s + 1)*(m*s**2 + b*s))", "K + B*(z - 1)/(T*z)",
+                          values={"m": 0.0128, "b": 0.0324, "tau": 1.6e-4, "T": 1e-3, "d": 1,
+                                  "K": 100.0, "B": 0.5}, plane=("B", "K"))
+    with pytest.raises(ValueError) as excinfo:
+        lagged.design(over={"tau": (1e-4, 1e-3)}, n=3, progress=calls.append,
+                      maximize="simulated", amplitude=1.0,
+                      nonideal=Nonidealities(coulomb_friction=0.01))
+    assert_message_names(excinfo, "nonideal.coulomb_friction")
+    assert "relative degree 3" in str(excinfo.value)
     assert calls == []
 
 
