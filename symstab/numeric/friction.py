@@ -270,9 +270,10 @@ class StatePlant:
     :meth:`step` advances one period.  ``state`` is ``(n, N)``; its rows 0
     and 1 are the mass's position and velocity.  ``rest`` marks the points
     whose mass is at rest (held by stiction or stopped by a reversal).
-    Without friction each sub-step is summed in place over the nonzero
-    entries of one shared matrix (:func:`substeps_of` gives one a period):
-    the paper's device's step is a few products per point.
+    Without friction, with one matrix for every point, the state is kept
+    as its rows and each sub-step sums the nonzero entries into new rows
+    (:func:`substeps_of` gives one a period): the paper's device's step is
+    a few products per point and no copy.
     """
 
     def __init__(self, space, state, rest, *, substeps, coulomb, stiction):
@@ -280,14 +281,22 @@ class StatePlant:
         self.friction = bool(coulomb or stiction)
         self.substeps = substeps
         self.coulomb, self.stiction = coulomb, stiction
-        self.state = state
         self.rest = rest
-        if self.friction:
-            self._stop(self.rest)
+        self._rows = None
         if not self.friction and space.phi.ndim == 2:
             self._terms = [[(j, float(c)) for j, c in enumerate(row) if c != 0]
                            for row in space.phi]
             self._scratch = np.empty(state.shape[1])
+            self._rows = list(state)
+        else:
+            self._state = state
+        if self.friction:
+            self._stop(self.rest)
+
+    @property
+    def state(self):
+        """The ``(n, N)`` state (rows 0 and 1: the mass's position and velocity)."""
+        return self._state if self._rows is None else np.stack(self._rows)
 
     @classmethod
     def from_history(cls, space, x0, v0, n_points, nonideal):
@@ -306,7 +315,7 @@ class StatePlant:
     def _stop(self, where):
         """Stop the mass at ``where``: the friction's impulse on the mass alone (velocity 0 exactly)."""
         if where.any():
-            self.state -= _column(self.space.impulse) * np.where(where, self.state[1], 0.0)
+            self._state -= _column(self.space.impulse) * np.where(where, self._state[1], 0.0)
 
     def step(self, force, sign=1.0):
         """Advance one period under the input ``sign * force`` (per point); the new position.
@@ -314,48 +323,62 @@ class StatePlant:
         (``sign = -1``: the loop's ``u = -f`` without a pass to negate it.)
         The position is a new array each period (a history may keep it).
         """
+        if self._rows is not None:
+            for _ in range(self.substeps):
+                self._rows = self._linear_rows(force, sign)
+            return self._rows[0]
         if not self.friction:
             for _ in range(self.substeps):
-                self.state = self._linear(force, sign)
-            return self.state[0]
+                self._state = _times(self.space.phi, self._state) + (
+                    _column(sign * self.space.gamma_u) * force)
+            return self._state[0]
         sp = self.space
         held = sign * force
         drive = _column(sp.gamma_u) * held
         for _ in range(self.substeps):
-            moving = _times(sp.phi, self.state) + drive
-            net = _dot(sp.net_state, self.state) + sp.net_input * held
-            direction = np.where(self.rest, np.sign(net), np.sign(self.state[1]))
+            moving = _times(sp.phi, self._state) + drive
+            net = _dot(sp.net_state, self._state) + sp.net_input * held
+            direction = np.where(self.rest, np.sign(net), np.sign(self._state[1]))
             moving -= _column(sp.gamma_f) * (self.coulomb * direction)
             stuck = self.rest & (np.abs(net) <= self.stiction)
             # A reversal within the sub-step ends at rest (friction cannot
             # push the mass backwards); a stuck mass stays where it is.
             reversed_ = ~self.rest & (direction != 0) & (np.sign(moving[1]) == -direction)
             if stuck.any():
-                kept = _times(sp.stuck_phi, self.state) + _column(sp.stuck_gamma) * held
-                kept[0] = self.state[0]
+                kept = _times(sp.stuck_phi, self._state) + _column(sp.stuck_gamma) * held
+                kept[0] = self._state[0]
                 moving = np.where(stuck, kept, moving)
-            self.state = moving
+            self._state = moving
             self.rest = reversed_ | stuck
             self._stop(self.rest)
-        return self.state[0].copy()
+        return self._state[0].copy()
 
-    def _linear(self, force, sign):
-        """``phi state + gamma_u sign force``: in place over the nonzero entries of a shared ``phi``."""
-        sp = self.space
-        if sp.phi.ndim != 2:
-            return _times(sp.phi, self.state) + _column(sign * sp.gamma_u) * force
-        new, tmp = np.empty_like(self.state), self._scratch
+    def _linear_rows(self, force, sign):
+        """The rows of ``phi state + gamma_u sign force``: new arrays, summed over ``phi``'s nonzero entries."""
+        rows, tmp, gamma = self._rows, self._scratch, self.space.gamma_u
+        new = []
         for i, terms in enumerate(self._terms):
-            row = new[i]
-            np.multiply(sign * float(sp.gamma_u[i]), force, out=row)
+            row = np.multiply(sign * float(gamma[i]), force)
             for j, c in terms:
                 if c == 1.0:
-                    row += self.state[j]
+                    row += rows[j]
                 else:
-                    np.multiply(c, self.state[j], out=tmp)
+                    np.multiply(c, rows[j], out=tmp)
                     row += tmp
+            new.append(row)
         return new
 
+    def finite(self):
+        """Per point: is every state finite?"""
+        if self._rows is None:
+            return np.all(np.isfinite(self._state), axis=0)
+        ok = np.isfinite(self._rows[0])
+        for row in self._rows[1:]:
+            ok &= np.isfinite(row)
+        return ok
+
     def freeze(self, bad):
-        self.state[:, bad] = 0.0
+        """Zero the points ``bad`` (diverged) and hold them at rest."""
+        for row in (self._state if self._rows is None else self._rows):
+            row[bad] = 0.0
         self.rest[bad] = True

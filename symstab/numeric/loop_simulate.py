@@ -692,7 +692,7 @@ class _FrictionLoop(_AnyLoop):
         return self.plant.step(command, -1.0)
 
     def freeze_diverged(self):
-        bad = ~(np.abs(self.x) < _OVERFLOW) | ~np.all(np.isfinite(self.plant.state), axis=0)
+        bad = ~(np.abs(self.x) < _OVERFLOW) | ~self.plant.finite()
         if bad.any():
             self.plant.freeze(bad)
             self.x[bad] = np.inf        # marked diverged below, with everything zeroed
