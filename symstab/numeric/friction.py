@@ -24,9 +24,11 @@ B_f C_v / (C_v B_f)``, the friction taking exactly ``net`` (for a rigid
 mass: nothing moves; for two masses: the one not held goes on).  A moving
 mass feels ``friction_coulomb sign(v)``; a sub-step that would reverse its
 velocity ends at rest, by the friction's impulse on the mass alone,
-``x -= B_f (C_v x) / (C_v B_f)``.  This is the paper's simulator's model
-(:func:`symstab.numeric.simulate.simulate`: the same sub-steps, stick and
-reversal rules) for any mass with any linear structure around it.
+``x -= B_f (C_v x) / (C_v B_f)``: the paper's simulator's friction model,
+for any mass with any linear structure around it (the paper's device is
+one: :func:`symstab.numeric.simulate.simulate` runs on :class:`StatePlant`).
+Without friction the same state space steps a plant from a given state
+(the paper's device from ``x0`` and ``v0``), exactly, a period at a time.
 """
 
 import dataclasses

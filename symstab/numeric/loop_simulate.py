@@ -494,7 +494,7 @@ def run_loop(parts_of, n_points, *, d, steps, x0, v0, nonideal, record, progress
         point_bytes += 8 * (6 * n + 4 + (0 if len(spaces) == 1 else 2 * n * n + 10 * n))
 
         def make_run(part):
-            return _FrictionLoop(parts_of(part), d, x0, v0, nonideal,
+            return _StateLoop(parts_of(part), d, x0, v0, nonideal,
                                  stacked_spaces(spaces, inverse[part]), state=state,
                                  compensation=compensation)
     return _run_chunks(make_run, n_points, point_bytes, steps=steps, d=d, record=record,
@@ -666,7 +666,7 @@ class _AnyLoop:
             self.v_hat[bad] = 0.0
 
 
-class _FrictionLoop(_AnyLoop):
+class _StateLoop(_AnyLoop):
     """A loop whose plant is a :class:`~symstab.numeric.friction.StatePlant`: on its state space.
 
     With Coulomb friction on its mass, or started from a state: ``state =
