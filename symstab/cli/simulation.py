@@ -72,6 +72,9 @@ def resolve_nonideal(args, setup, loop=None):
         resolution = PAPER_ENCODER_RESOLUTION
     if option["substeps"] is not None and option["coulomb"] is None \
             and option["actuator_bandwidth"] is None:
+        if setup is None:       # a loop file: its lag is in its plant, exact
+            raise ValueError("--substeps divides the period for Coulomb friction: give "
+                             "--coulomb, or drop --substeps")
         raise ValueError("--substeps divides the period for Coulomb friction and the actuator "
                          "lag: give --coulomb or --actuator-bandwidth, or drop --substeps")
     nonideal = Nonidealities(encoder_resolution=resolution,
@@ -82,12 +85,7 @@ def resolve_nonideal(args, setup, loop=None):
                              substeps=20 if option["substeps"] is None else option["substeps"],
                              force_limit=args.force_limit)
     if setup is None:       # a loop file: its values are physical (SI)
-        if nonideal.coulomb_friction is not None:
-            try:
-                loop.driven_mass
-            except ValueError as exc:
-                raise ValueError(f"--coulomb: {exc}") from None
-        nonideal = check_loop_nonideal(nonideal)
+        nonideal = check_loop_nonideal(nonideal, loop, friction_name="--coulomb")
     elif not nonideal.ideal and not setup.physical:
         raise ValueError("non-idealities are in physical units: use --m --b --T --Td (or their "
                          "defaults), not --delta")

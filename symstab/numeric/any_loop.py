@@ -947,7 +947,7 @@ class Loop(LoopModel):
 
         The simulated counterpart of :meth:`limits`' ``y_max``, with the
         non-idealities the linear model leaves out (encoder quantization, a
-        force limit): runs of :meth:`simulate` on a grid over the certified
+        force limit, Coulomb friction): runs of :meth:`simulate` on a grid over the certified
         stable set, refined in ``y``
         (:func:`symstab.numeric.simulate_limit.simulated_limit` says how, and
         how accurate it is).  Not certified.
@@ -1041,8 +1041,9 @@ class Loop(LoopModel):
             For a plant with direct feed-through (``P_n`` as high as ``P_d``),
             a leading coefficient 0, or values that overflow.
         """
-        parts, d, shape = self.difference_parts(values)
-        self._finite(np.concatenate(parts, axis=-1), self._prepare(values)[0])
+        values, d, shape = self._prepare(values)
+        parts = self._difference_parts(values, shape)
+        self._finite(np.concatenate(parts, axis=-1), values)
         return parts, d, shape
 
     def difference_parts(self, values):
@@ -1063,6 +1064,10 @@ class Loop(LoopModel):
             As :meth:`difference_equations`.
         """
         values, d, shape = self._prepare(values)
+        return self._difference_parts(values, shape), d, shape
+
+    def _difference_parts(self, values, shape):
+        """``(a, b, c, e)`` at prepared ``values`` (:meth:`_prepare`) of the broadcast ``shape``."""
         # The coefficients and their working copies, about 64 floats a point.
         check_memory("the loop's difference equations", 8 * int(np.prod(shape)) * 64)
         p_n, p_d, _, _ = self._plant_arrays(values, shape)
@@ -1079,7 +1084,7 @@ class Loop(LoopModel):
             if np.any(lead_p == 0) or np.any(lead_e == 0):
                 raise ValueError("the leading coefficient of P_d or Ve_d is 0 at these values")
             return (p_d[..., 1:] / lead_p, p_n[..., 1:] / lead_p, ve_d[..., 1:] / lead_e,
-                    ve_n / lead_e), d, shape
+                    ve_n / lead_e)
 
     def friction_spaces(self, substeps, **values):
         """The state spaces in which friction acts: ``(spaces, inverse)``.

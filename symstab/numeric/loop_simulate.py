@@ -501,14 +501,15 @@ def run_loop(parts_of, n_points, *, d, steps, x0, v0, nonideal, record, progress
                        progress=progress, nonideal=nonideal, shape=shape)
 
 
-def check_loop_nonideal(nonideal, loop=None):
+def check_loop_nonideal(nonideal, loop=None, friction_name="nonideal.coulomb_friction"):
     """``nonideal`` (None: ideal) as the :class:`Nonidealities` of a general loop, or raise.
 
     A general loop has encoder quantization, a force limit and Coulomb
     friction on its driven mass (with ``loop``: checked to have one,
     :meth:`symstab.Loop.driven_mass`); the velocity filter and the actuator
     lag belong in its environment and plant, and friction compensation
-    needs the paper's velocity estimate.
+    needs the paper's velocity estimate.  ``friction_name`` names the
+    friction in the message (the CLI's ``--coulomb``).
     """
     nonideal = Nonidealities() if nonideal is None else nonideal
     if not isinstance(nonideal, Nonidealities):
@@ -525,7 +526,7 @@ def check_loop_nonideal(nonideal, loop=None):
         try:
             loop.driven_mass
         except ValueError as exc:
-            raise ValueError(f"nonideal.coulomb_friction: {exc}") from None
+            raise ValueError(f"{friction_name}: {exc}") from None
     return nonideal
 
 
