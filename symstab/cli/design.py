@@ -33,7 +33,8 @@ _TARGET_WORDS = {"y_max": "y_max", "K_max": "y_max", "area": "area", "Z-width": 
                  "z_width": "area", "passive": "passive", "simulated": "simulated"}
 #: The options of the simulated target (``--maximize simulated``) only: flag, dest.
 _SIMULATION_FLAGS = (("--amplitude", "amplitude"), ("--encoder-resolution", "encoder_resolution"),
-                     ("--force-limit", "force_limit"), ("--coulomb", "coulomb"),
+                     ("--force-limit", "force_limit"),
+                     ("--force-resolution", "force_resolution"), ("--coulomb", "coulomb"),
                      ("--stiction", "stiction"), ("--substeps", "substeps"),
                      ("--steps", "steps"), ("--x0", "x0"))
 #: The scan's points per parameter at most: each is a certified region.
@@ -492,7 +493,8 @@ def _simulation_notes(setup, found, simulation):
            f"it does not grow and its last quarter's |x| is at most "
            f"{simulation['amplitude']:.4g} (not certified: simulated {y}_max refined to steps "
            f"of {simulated.resolution:.3g})"]
-    if simulation["nonideal"].encoder_resolution is not None:
+    if simulation["nonideal"].encoder_resolution is not None or \
+            simulation["nonideal"].force_resolution is not None:
         ties = found.samples[found.samples[:, -1] >= (1 - SIMULATED_TIE) * found.value]
         spans = ", ".join(f"{setup.name(n)} from {ties[:, k].min():.6g} to "
                           f"{ties[:, k].max():.6g}" for k, n in enumerate(found.over))

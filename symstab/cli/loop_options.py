@@ -189,7 +189,8 @@ def add_loop_options(p, command):
         g.add_argument("--simulate", action="store_true", default=None,
                        help="also simulate every cell (the plant's exact ZOH step, the "
                             "environment's difference equation, the delay line; with "
-                            "--steps, --x0, --encoder-resolution, --force-limit in the "
+                            "--steps, --x0, --encoder-resolution, --force-limit, "
+                            "--force-resolution in the "
                             "loop's SI units)")
         g.add_argument("--x-range", metavar="LOW,HIGH,N", help="grid of x (--x-range=-0.1,0.6,200)")
         g.add_argument("--y-range", metavar="LOW,HIGH,N", help="grid of y (--y-range=0,6,200)")

@@ -264,7 +264,8 @@ def _paper_png(args, setup, result, nonideal, given, theory):
 _LOOP_SIMULATION_OPTIONS = (("--steps", "steps"), ("--x0", "x0"),
                             ("--encoder-resolution", "encoder_resolution"),
                             ("--paper-encoder", "paper_encoder"),
-                            ("--force-limit", "force_limit"), ("--coulomb", "coulomb"),
+                            ("--force-limit", "force_limit"),
+                            ("--force-resolution", "force_resolution"), ("--coulomb", "coulomb"),
                             ("--stiction", "stiction"), ("--substeps", "substeps"))
 
 

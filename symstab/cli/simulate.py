@@ -128,6 +128,10 @@ def _loop(args):
     elif run.stable and not nonideal.ideal and run.amplitude[3] >= 0.9 * run.amplitude[2]:
         verdict = (f"bounded, not decaying (a limit cycle of amplitude {run.amplitude[3]:.4g}: "
                    f"the verdict compares the last two quarters)")
+        if run.amplitude[3] > run.amplitude[2]:
+            verdict = (f"bounded (a limit cycle of amplitude {run.amplitude[3]:.4g}, within "
+                       f"{float(run.floor):.4g}, the most the quantization can move the "
+                       f"position here)")
     print(f"simulated {run.steps} periods from x0 = {x0:g} ({loop_nonideal_text(nonideal)}): "
           f"{verdict}; max |x| per quarter: " + ", ".join(f"{a:.4g}" for a in run.amplitude))
     print(f"theory (the loop's certified root count): spectral radius {radius:.12g} -> "

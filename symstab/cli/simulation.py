@@ -6,15 +6,26 @@ device options (the default device is the paper's);
 and actuator lag included), whose root count each simulation is compared with.
 """
 
+import re
+
 __all__ = ["add_nonideal_options", "resolve_nonideal", "simulated_theory", "nonideal_text",
            "loop_nonideal_text"]
+
+
+#: The option of each field of :class:`~symstab.numeric.simulate.Nonidealities`.
+_OPTION_OF = {"encoder_resolution": "--encoder-resolution", "velocity_cutoff": "--velocity-cutoff",
+              "coulomb_friction": "--coulomb", "stiction": "--stiction",
+              "friction_compensation": "--friction-compensation",
+              "actuator_bandwidth": "--actuator-bandwidth", "substeps": "--substeps",
+              "force_limit": "--force-limit", "force_resolution": "--force-resolution"}
+_FIELD_NAMES = re.compile(r"(?:nonideal\.)?\b(" + "|".join(_OPTION_OF) + r")\b")
 
 
 def add_nonideal_options(p, loop_only=False):
     """Add the non-idealities (encoder, velocity filter, friction, actuator lag), --steps and --x0.
 
     ``loop_only``: only those of a loop file's simulation (the encoder's quantum,
-    Coulomb friction, the force limit, --steps, --x0), for a command that
+    Coulomb friction, the force limit and quantum, --steps, --x0), for a command that
     simulates loop files only.
     """
     g = p.add_argument_group("non-idealities (physical units; each off by default)")
@@ -40,9 +51,12 @@ def add_nonideal_options(p, loop_only=False):
 
 
 def _add_limit_and_run(p, g):
-    """--force-limit in the group ``g``, --steps and --x0 in ``p``."""
+    """--force-limit and --force-resolution in the group ``g``, --steps and --x0 in ``p``."""
     g.add_argument("--force-limit", type=float, metavar="F",
                    help="largest force command, N or N m (the amplifier's saturation)")
+    g.add_argument("--force-resolution", type=float, metavar="Q",
+                   help="force quantum, N or N m (the DAC's step): the command is rounded to "
+                        "it (not with --coulomb)")
     p.add_argument("--steps", type=int, help="periods to simulate (default 12000 + 800 d)")
     p.add_argument("--x0", type=float, default=None,
                    help="initial position, m or rad (default 1; 0.01 with non-idealities)")
@@ -77,20 +91,25 @@ def resolve_nonideal(args, setup, loop=None):
                              "--coulomb, or drop --substeps")
         raise ValueError("--substeps divides the period for Coulomb friction and the actuator "
                          "lag: give --coulomb or --actuator-bandwidth, or drop --substeps")
-    nonideal = Nonidealities(encoder_resolution=resolution,
-                             velocity_cutoff=option["velocity_cutoff"],
-                             coulomb_friction=option["coulomb"], stiction=option["stiction"],
-                             friction_compensation=bool(option["friction_compensation"]),
-                             actuator_bandwidth=option["actuator_bandwidth"],
-                             substeps=20 if option["substeps"] is None else option["substeps"],
-                             force_limit=args.force_limit)
-    if setup is None:       # a loop file: its values are physical (SI)
-        nonideal = check_loop_nonideal(nonideal, loop, friction_name="--coulomb")
-    elif not nonideal.ideal and not setup.physical:
-        raise ValueError("non-idealities are in physical units: use --m --b --T --Td (or their "
-                         "defaults), not --delta")
-    if setup is not None and setup.physical:
-        nonideal.check(setup.device.T)
+    try:
+        nonideal = Nonidealities(encoder_resolution=resolution,
+                                 velocity_cutoff=option["velocity_cutoff"],
+                                 coulomb_friction=option["coulomb"], stiction=option["stiction"],
+                                 friction_compensation=bool(option["friction_compensation"]),
+                                 actuator_bandwidth=option["actuator_bandwidth"],
+                                 substeps=20 if option["substeps"] is None else option["substeps"],
+                                 force_limit=args.force_limit,
+                                 force_resolution=args.force_resolution)
+        if setup is None:       # a loop file: its values are physical (SI)
+            nonideal = check_loop_nonideal(nonideal, loop, friction_name="--coulomb")
+        elif not nonideal.ideal and not setup.physical:
+            raise ValueError("non-idealities are in physical units: use --m --b --T --Td (or "
+                             "their defaults), not --delta")
+        if setup is not None and setup.physical:
+            nonideal.check(setup.device.T)
+    except (TypeError, ValueError) as exc:
+        # The library names its fields; the command line names its options.
+        raise type(exc)(_FIELD_NAMES.sub(lambda m: _OPTION_OF[m.group(1)], str(exc))) from None
     # Checked here, not only by the simulator, so that nothing is printed before the error.
     x0 = check_x0(args.x0) if args.x0 is not None else default_x0(nonideal)
     return nonideal, x0
@@ -120,6 +139,8 @@ def nonideal_text(nonideal, args):
         parts.append(f"actuator lag {nonideal.actuator_bandwidth:g} Hz")
     if nonideal.force_limit is not None:
         parts.append(f"force limit {nonideal.force_limit:g} {force}")
+    if nonideal.force_resolution is not None:
+        parts.append(f"force quantum {nonideal.force_resolution:.4g} {force}")
     return ", ".join(parts) if parts else "ideal loop: no quantization, filter, friction or lag"
 
 
@@ -134,4 +155,6 @@ def loop_nonideal_text(nonideal):
                      f"{nonideal.substeps} sub-steps a period")
     if nonideal.force_limit is not None:
         parts.append(f"force limit {nonideal.force_limit:g}")
+    if nonideal.force_resolution is not None:
+        parts.append(f"force quantum {nonideal.force_resolution:.4g}")
     return ("ideal loop" if not parts else ", ".join(parts) + " (SI units of the loop file)")

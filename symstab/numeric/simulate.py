@@ -18,6 +18,10 @@ default) need a :class:`symstab.numeric.units.Device`:
 * ``force_limit`` -- the force command is clipped to this size (the
   amplifier's saturation: an unstable linear loop then grows into a bounded
   limit cycle, which the verdict calls bounded, not growing);
+* ``force_resolution`` -- the force command is rounded to a multiple of
+  this quantum (the DAC's step) before the clip; where the linear loop is
+  stable the verdict allows the limit cycle the quantum can cause
+  (:func:`~symstab.numeric.loop_simulate.linear_stable`);
 * ``velocity_cutoff`` -- the velocity used by the damper and mass terms is
   the backward difference passed through a first-order low-pass filter
   (pole ``exp(-2 pi f_c T)``, unit DC gain); the mass term differences the
@@ -67,7 +71,8 @@ from .._validate import check_array, check_delay, check_loop, check_real
 from .loop_simulate import (MAX_STEPS_ENV, PAPER_ENCODER_RESOLUTION, X0_MAX, Nonidealities,
                             Simulation, StabilityMap, check_loop_nonideal, check_steps,
                             check_x0, default_horizon, default_x0, loop_stability_map,
-                            max_steps, progress_printer, run_loop, simulate_loop)
+                            linear_stable, max_steps, progress_printer, run_loop,
+                            simulate_loop)
 from .friction import substeps_of
 from .simulate_theory import paper_simulated_loop
 
@@ -179,7 +184,7 @@ def simulate(*, alpha, beta, gamma, d, delta, steps=None, x0=1.0, v0=None, devic
     run_nonideal = dataclasses.replace(
         nonideal, velocity_cutoff=None, actuator_bandwidth=None, friction_compensation=False,
         **{name: None if getattr(nonideal, name) is None else getattr(nonideal, name) * scale
-           for name in ("coulomb_friction", "stiction", "force_limit")})
+           for name in ("coulomb_friction", "stiction", "force_limit", "force_resolution")})
     spaces, _ = loop.friction_spaces(substeps_of(run_nonideal), **dict(values, K=0.0, B=0.0, M=0.0))
     compensation = None
     if nonideal.friction_compensation:
@@ -195,7 +200,8 @@ def simulate(*, alpha, beta, gamma, d, delta, steps=None, x0=1.0, v0=None, devic
     return run_loop(parts_of, alpha.size, d=d, steps=steps, x0=x0, v0=v0, nonideal=run_nonideal,
                     record=record, progress=progress, shape=shape,
                     spaces=(spaces, np.zeros(alpha.size, dtype=int)), state=(x0, v0),
-                    compensation=compensation)
+                    compensation=compensation,
+                    linear_stable=linear_stable(loop, run_nonideal, values, (alpha.size,)))
 
 
 def stability_map(*, alpha, beta, gamma, d, delta, steps=None, x0=1.0, v0=None, device=None,

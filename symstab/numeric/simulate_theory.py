@@ -228,6 +228,8 @@ def linear_theory(*, gamma, d, delta=None, device=None, nonideal=None):
         delta = device.delta
     left_out = tuple(name for name, on in (
         ("encoder quantization", nonideal.encoder_resolution is not None),
+        ("force quantization", nonideal.force_resolution is not None),
+        ("force saturation", nonideal.force_limit is not None),
         ("Coulomb friction", nonideal.coulomb_friction is not None),
         ("friction compensation", nonideal.friction_compensation)) if on)
     filtered = nonideal.velocity_cutoff is not None

@@ -146,7 +146,7 @@ def test_the_table_names_the_optimum_the_value_there_and_at_the_nominal_value(ca
     (["--loop", LOOPS / "paper.toml", "--maximize", "simulated", "--amplitude", "1e-3",
       "--steps", "1000000000"], "steps"),
     (["--loop", LOOPS / "paper.toml", "--maximize", "simulated", "--amplitude", "1e-3",
-      "--force-limit", "-1"], "force_limit"),
+      "--force-limit", "-1"], "--force-limit must be"),
     # From a review: 0 was taken for "not given" and the flag ignored (exit 0); the paper
     # simulator's options were accepted without a loop file and ignored.
     (["--loop", LOOPS / "paper.toml", "--x0", "0", "--points", "3"], "--x0"),
@@ -155,7 +155,7 @@ def test_the_table_names_the_optimum_the_value_there_and_at_the_nominal_value(ca
     (["--coulomb", "0.1"], "--coulomb"),
     (["--loop", LOOPS / "paper.toml", "--coulomb", "0.1"], "add --maximize simulated"),
     (["--loop", LOOPS / "actuator_lag.toml", "--maximize", "simulated", "--amplitude", "1e-3",
-      "--coulomb", "0.1", "--stiction", "0.05"], "stiction"),
+      "--coulomb", "0.1", "--stiction", "0.05"], "--stiction must be"),
     (["--velocity-cutoff", "50"], "--velocity-cutoff"),
     (["--friction-compensation", "--coulomb", "0.1"], "--friction-compensation"),
 ])

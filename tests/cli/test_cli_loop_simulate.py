@@ -66,6 +66,27 @@ def test_a_saturated_unstable_loop_is_called_bounded_not_stable(capsys):
     assert "-> unstable" in text
 
 
+def test_a_force_quantum_s_limit_cycle_is_bounded_and_the_map_agrees_with_the_root_counts(
+        capsys, tmp_path):
+    """A DAC of 1 mN on the 50 Hz filtered loop: a stable point cycles within the quantum's
+    bound; on a map every cell not marginal agrees with the root counts."""
+    status, text, err = run(capsys, "simulate", "--loop", LOOPS / "lowpass_velocity.toml",
+                            "--set", "K=1", "--force-resolution", "0.003", "--steps", "8000")
+    assert status == 0, err
+    assert "(force quantum 0.003 (SI units of the loop file)): bounded" in text
+    assert "-> stable" in text
+    out = tmp_path / "q.npz"
+    status, text, err = run(capsys, "map", "--loop", LOOPS / "lowpass_velocity.toml",
+                            "--simulate", "--force-resolution", "1e-3", "--x-range=0,0.2,5",
+                            "--y-range=0.5,6,5", "--steps", "4000", "--out", out, "--no-png")
+    assert status == 0, err
+    with np.load(out) as f:
+        simulated, code = f["simulated_stable"], f["code"]
+    assert 0 < simulated.sum() < simulated.size
+    np.testing.assert_array_equal(simulated[code != symstab.MARGINAL],
+                                  code[code != symstab.MARGINAL] == symstab.STABLE)
+
+
 def test_friction_holds_the_mass_and_the_verdict_says_so(capsys):
     """Two masses, friction on the motor: it ends held within stiction / K of zero."""
     status, text, err = run(capsys, "simulate", "--loop", LOOPS / "two_mass.toml",
@@ -111,12 +132,16 @@ def test_map_simulates_friction_on_the_loop_s_mass(capsys, tmp_path):
      "a velocity filter written into the loop file's environment"),
     (["simulate", "--loop", PAPER, "--coulomb", "0.01", "--friction-compensation"],
      "a general loop has no velocity estimate"),
-    (["simulate", "--loop", PAPER, "--coulomb", "0.01", "--stiction", "0.005"], "stiction"),
+    (["simulate", "--loop", PAPER, "--coulomb", "0.01", "--stiction", "0.005"],
+     "--stiction must be"),
     (["map", "--loop", PAPER, "--x-range=0,1,3", "--y-range=0,1,3", "--out", "m.npz",
       "--coulomb", "0.01"], "--coulomb is an option of the simulation: add --simulate"),
     (["simulate", "--loop", PAPER, "--Kw", "3"], "--Kw is an option of the paper's device"),
     (["simulate", "--loop", PAPER, "--steps", "3"], "steps"),
-    (["simulate", "--loop", PAPER, "--force-limit", "-1"], "force_limit"),
+    (["simulate", "--loop", PAPER, "--force-limit", "-1"], "--force-limit must be"),
+    (["simulate", "--loop", PAPER, "--force-resolution", "0"], "--force-resolution must be"),
+    (["simulate", "--loop", PAPER, "--force-resolution", "1e-3", "--coulomb", "0.01"],
+     "--force-resolution with --coulomb"),
     (["simulate", "--Kw", "3", "--Bw", "0.1", "--substeps", "5"], "drop --substeps"),
     (["map", "--loop", PAPER, "--x-range=0,1,3", "--y-range=0,1,3", "--out", "m.npz",
       "--steps", "100"], "--steps is an option of the simulation: add --simulate"),

@@ -175,10 +175,12 @@ def test_map_writes_npz_and_png_matching_the_exact_classification(capsys, tmp_pa
 
 
 @pytest.mark.parametrize("args, needle", [
-    (["simulate", "--alpha", "0.1", "--beta", "0.1", "--velocity-cutoff", "600"], "velocity_cutoff"),
-    (["simulate", "--alpha", "0.1", "--beta", "0.1", "--encoder-resolution", "-1"], "encoder_resolution"),
+    (["simulate", "--alpha", "0.1", "--beta", "0.1", "--velocity-cutoff", "600"], "--velocity-cutoff must be"),
+    (["simulate", "--alpha", "0.1", "--beta", "0.1", "--encoder-resolution", "-1"], "--encoder-resolution must be"),
     (["simulate", "--alpha", "0.1", "--beta", "0.1", "--steps", "0"], "steps"),
-    (["simulate", "--alpha", "0.1", "--beta", "0.1", "--coulomb", "0.1", "--stiction", "0.05"], "stiction"),
+    (["simulate", "--alpha", "0.1", "--beta", "0.1", "--coulomb", "0.1", "--stiction", "0.05"], "--stiction must be"),
+    (["simulate", "--alpha", "0.1", "--beta", "0.1", "--force-resolution", "nan"],
+     "--force-resolution must be"),
     (["simulate", "--delta", "0.1", "--alpha", "0.1", "--beta", "0.1", "--paper-encoder"], "physical"),
     (["map", "--alpha", "0,1,10", "--beta", "0,1,10", "--out", "m.txt"], "--out"),
     (["map", "--alpha", "0,1", "--beta", "0,1,10", "--out", "m.csv"], "--alpha"),

@@ -56,8 +56,8 @@ def test_simulated_maps_agree_with_the_root_counts(file):
     assert (found.x, found.y) == (x, y) and found.at["d"] == loop.defaults["d"]
 
 
-def python_control_radius(loop, values):
-    """The largest closed-loop pole modulus, built by python-control from G(s) and VE(z)."""
+def python_control_parts(loop, values):
+    """python-control's ``(P(z), VE(z), z**-d)`` of the loop: G(s) sampled by c2d."""
     control = pytest.importorskip("control")
     s, z = sp.symbols("s z")
     subs = {symbol: values[str(symbol)] for symbol in
@@ -71,6 +71,13 @@ def python_control_radius(loop, values):
     environment = control.tf([float(c) for c in sp.Poly(num, z).all_coeffs()],
                              [float(c) for c in sp.Poly(den, z).all_coeffs()], T)
     delay = control.tf([1.0], [1.0] + [0.0] * int(values["d"]), T)
+    return sampled, environment, delay
+
+
+def python_control_radius(loop, values):
+    """The largest closed-loop pole modulus, built by python-control from G(s) and VE(z)."""
+    control = pytest.importorskip("control")
+    sampled, environment, delay = python_control_parts(loop, values)
     closed = control.feedback(sampled, environment * delay)
     return float(np.max(np.abs(closed.poles())))
 
@@ -132,17 +139,19 @@ def test_a_force_limit_holds_an_unstable_paper_loop_and_a_loose_one_changes_noth
     assert not symstab.simulate(**unstable, nonideal=Nonidealities(force_limit=0.01)).diverged
 
 
-def test_a_force_limit_clips_the_command_not_the_environment_s_own_force():
+@pytest.mark.parametrize("limit, quantum", [(5.0, None), (None, 0.7), (5.0, 0.7)])
+def test_the_dac_rounds_and_clips_the_command_not_the_environment_s_own_force(limit, quantum):
     """An environment that feeds its force back (a low-pass, VE = K z/(z - r)) keeps
-    Ve_d(z) f = Ve_n(z) x_s with the limit on: only the command sent is clipped.  The
-    reference is written here from the difference equations, with python-control's
-    c2d for the plant."""
+    Ve_d(z) f = Ve_n(z) x_s with the DAC on: only the command sent is rounded to the
+    force quantum and clipped to the limit.  The reference is written here from the
+    difference equations, with python-control's c2d for the plant."""
     control = pytest.importorskip("control")
-    m, b, T, K, r, limit, d = 0.0128, 0.0324, 1e-3, 40.0, 0.6, 5.0, 1
+    m, b, T, K, r, d = 0.0128, 0.0324, 1e-3, 40.0, 0.6, 1
     loop = symstab.Loop("1/(m*s**2 + b*s)", "K*z/(z - r)",
                         values={"m": m, "b": b, "T": T, "K": K, "r": r, "d": d})
     steps = 300
-    run = loop.simulate(steps=steps, record=True, nonideal=Nonidealities(force_limit=limit))
+    run = loop.simulate(steps=steps, record=True,
+                        nonideal=Nonidealities(force_limit=limit, force_resolution=quantum))
     sampled = control.c2d(control.tf([1.0], [m, b, 0.0]), T, "zoh")
     num = np.trim_zeros(np.asarray(sampled.num[0][0], dtype=float), "f")
     den = np.asarray(sampled.den[0][0], dtype=float)
@@ -150,14 +159,87 @@ def test_a_force_limit_clips_the_command_not_the_environment_s_own_force():
     a1, a2 = den[1:] / den[0]
     x = [1.0 - 2 * 0.01, 1.0 - 0.01, 1.0]        # y[-2], y[-1], y[0]
     u = [0.0, 0.0]                                # u[-2], u[-1]
-    f_prev, line = 0.0, [0.0] * (d + 1)
+    f_prev, line, sent = K / (1 - r) * 1.0, [0.0] * (d + 1), set()   # at rest at x0 = 1
     for k in range(steps):
         f = K * x[-1] + r * f_prev                # f[k] = K x[k] + r f[k-1]
         f_prev = f
-        line[k % (d + 1)] = min(max(f, -limit), limit)
+        command = f if quantum is None else quantum * round(f / quantum)
+        command = command if limit is None else min(max(command, -limit), limit)
+        sent.add(command)
+        line[k % (d + 1)] = command
         u.append(-line[(k - d) % (d + 1)])
         x.append(b1 * u[-1] + b2 * u[-2] - a1 * x[-1] - a2 * x[-2])
-    np.testing.assert_allclose(run.positions, x[2:], rtol=1e-9, atol=1e-12)
+    # Two computations of the sampled plant (the loop's residues, python-control's
+    # matrix exponential) differ in their last bits; over 300 periods that grows to
+    # 1.3e-12 of max |x| = 1 (measured, with the quantum).
+    np.testing.assert_allclose(run.positions, x[2:], rtol=1e-9, atol=1e-11)
+    # The DAC did act: the commands are its levels, and the run is not the linear one.
+    if limit is not None:
+        assert max(sent) == limit
+    if quantum is not None:
+        assert all(c == quantum * round(c / quantum) or abs(c) == limit for c in sent)
+    linear = loop.simulate(steps=steps, record=True)
+    assert np.max(np.abs(run.positions - linear.positions)) > 1e-3
+
+
+@pytest.mark.parametrize("file, quantum", [("lowpass_velocity.toml", 1e-3),
+                                           ("operator_arm.toml", 0.05),
+                                           ("two_mass.toml", 1e-3)])
+def test_a_force_quantum_moves_a_stable_loop_by_at_most_half_of_it_times_the_pulse_response(
+        file, quantum):
+    """Rounding adds at most q/2 to each command: the quantized run stays within q/2 times
+    the l1 norm of the closed loop's force-pulse response of the unquantized run, which
+    is the verdict's floor.  The response is python-control's: the plant sampled by
+    c2d, the delay and the environment closed by ``feedback``."""
+    control = pytest.importorskip("control")
+    loop = symstab.load_loop(LOOPS / file)
+    values = dict(loop.defaults)
+    assert loop.classify(**values) == 1
+    steps = 3000
+    exact = loop.simulate(steps=steps, x0=0.01, record=True, **values)
+    quantized = loop.simulate(steps=steps, x0=0.01, record=True,
+                              nonideal=Nonidealities(force_resolution=quantum), **values)
+    sampled, environment, delay = python_control_parts(loop, values)
+    # The position per force added to the command sent (before the delay).
+    pulse = control.feedback(sampled * delay, environment)
+    T = float(values["T"])
+    # A unit force for one period (impulse_response would scale it by 1 / T).
+    unit = np.zeros(steps + 1)
+    unit[0] = 1.0
+    h = control.forced_response(pulse, T=np.arange(steps + 1) * T, U=unit).outputs
+    bound = quantum / 2 * np.sum(np.abs(h[1:]))
+    assert float(quantized.floor) == pytest.approx(bound, rel=1e-6)
+    departure = np.max(np.abs(quantized.positions - exact.positions))
+    assert 0 < departure <= bound
+    assert quantized.stable
+
+
+def test_a_force_quantum_map_agrees_with_the_root_counts_away_from_the_boundary():
+    """The floor is given only where the linear loop is stable: an unstable cell's growth
+    is not hidden, and a stable cell's quantization cycle is not called growth (without
+    the floor, 543 of these 1 515 stable cells were: the last quarter of a limit cycle
+    exceeds the third as often as not)."""
+    loop = symstab.load_loop(LOOPS / "paper.toml")
+    bs, ks = np.linspace(-0.02, 0.3, 20), np.linspace(0.0, 6.0, 20)
+    K, B = np.meshgrid(ks, bs, indexing="ij")
+    found = loop.simulate(K=K, B=B, d=5, steps=6000, x0=0.01,
+                          nonideal=Nonidealities(force_resolution=1e-3))
+    code = loop.classify(K=K, B=B, d=5)
+    assert 0 < np.sum(code == 1) < code.size and np.any(code == -1)
+    differ = np.argwhere((code == 1) != found.stable)
+    decided = [(i, j) for i, j in differ
+               if abs(loop.spectral_radius(K=ks[i], B=bs[j], d=5) - 1) > 1e-3]
+    assert decided == []
+    assert np.all(found.stable[code == 1])
+    # Where the linear loop is not stable there is no floor.
+    assert np.all(found.floor[code != 1] == 0) and np.all(found.floor[code == 1] > 0)
+
+
+def test_a_force_quantum_with_friction_is_refused_by_name():
+    with pytest.raises(ValueError) as excinfo:
+        Nonidealities(force_resolution=1e-3, coulomb_friction=0.01)
+    assert_message_names(excinfo, "force_resolution")
+    assert "coulomb_friction" in str(excinfo.value)
 
 
 def test_a_loop_map_has_no_paper_names():
@@ -196,19 +278,34 @@ def test_bad_simulation_input_names_the_parameter(kwargs, name):
     assert_message_names(excinfo, name)
 
 
-def test_the_paper_loop_simulated_as_a_loop_agrees_with_the_paper_simulator():
+@pytest.mark.parametrize("nonideal", [None, Nonidealities(force_resolution=1e-3)])
+def test_the_paper_loop_simulated_as_a_loop_agrees_with_the_paper_simulator(nonideal):
     """PAPER_LOOP's simulation and the paper's simulator (a state-space step of its own)
-    give the same verdicts on a grid across the stable set, away from the boundary."""
+    give the same verdicts on a grid across the stable set, away from the boundary; with
+    a force quantum too (the paper's simulator scales it to its units)."""
     loop = symstab.load_loop(LOOPS / "paper.toml")
     device = symstab.PAPER_DEVICE
     assert device.delta == pytest.approx(PAPER_DELTA, rel=1e-12)
     top = symstab.limits(gamma=0.0, d=10, delta=PAPER_DELTA)
     alpha = np.linspace(0.05, 1.3, 8) * top.alpha_max
     beta = np.linspace(top.beta_left - 0.2 * top.beta_right, 1.2 * top.beta_right, 8)
-    paper = stability_map(alpha=alpha, beta=beta, gamma=0.0, d=10, delta=None, device=device)
-    found = loop.stability_map(device.damping(beta), device.stiffness(alpha), d=10, M=0.0)
+    paper = stability_map(alpha=alpha, beta=beta, gamma=0.0, d=10, delta=None, device=device,
+                          nonideal=nonideal)
+    found = loop.stability_map(device.damping(beta), device.stiffness(alpha), d=10, M=0.0,
+                               nonideal=nonideal)
     assert 0 < found.stable.sum() < found.stable.size
     differ = np.argwhere(paper.stable != found.stable)
     decided = [(i, j) for i, j in differ if abs(symstab.spectral_radius(
         alpha=alpha[i], beta=beta[j], gamma=0.0, d=10, delta=PAPER_DELTA) - 1) > 1e-3]
     assert decided == []
+    if nonideal is not None:
+        # The quantum's floor (rad) is the same in both units: the scaling is right.
+        a, b = alpha[:3], beta[4]
+        assert symstab.classify(alpha=a, beta=b, gamma=0.0, d=10, delta=PAPER_DELTA).tolist() \
+            == [1, 1, 1]
+        paper = symstab.simulate(alpha=a, beta=b, gamma=0.0, d=10, delta=None, device=device,
+                                 nonideal=nonideal, steps=4000)
+        found = loop.simulate(K=device.stiffness(a), B=device.damping(b), d=10, M=0.0,
+                              nonideal=nonideal, steps=4000)
+        assert np.all(paper.floor > 0)
+        np.testing.assert_allclose(paper.floor, found.floor, rtol=1e-9)
