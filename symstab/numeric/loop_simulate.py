@@ -558,18 +558,18 @@ def run_loop(parts_of, n_points, *, d, steps, x0, v0, nonideal, record, progress
         root count of 0); needed with a force quantum, whose verdict floor
         they get (:func:`_verdict`).
     """
-    pulse_of = None
-    if nonideal.force_resolution is not None:
-        if linear_stable is None or np.shape(linear_stable) != (n_points,):
-            raise ValueError("a force quantum's verdict needs linear_stable, one bool a point")
+    def pulse(part):
+        # The linear loop's response to a unit force pulse, at its stable points only.
+        points = np.asarray(linear_stable[part], dtype=bool)
+        if not points.any():
+            return None, points
+        return _AnyLoop([p[points] for p in parts_of(part)], d, 0.0, 0.0, Nonidealities(),
+                        pulse=1.0), points
 
-        def pulse_of(part):
-            # The linear loop's response to a unit force pulse, at its stable points only.
-            points = np.asarray(linear_stable[part], dtype=bool)
-            if not points.any():
-                return None, points
-            return _AnyLoop([p[points] for p in parts_of(part)], d, 0.0, 0.0, Nonidealities(),
-                            pulse=1.0), points
+    if nonideal.force_resolution is not None and (
+            linear_stable is None or np.shape(linear_stable) != (n_points,)):
+        raise ValueError("a force quantum's verdict needs linear_stable, one bool a point")
+    pulse_of = None if nonideal.force_resolution is None else pulse
     point_bytes = 8 * (d + 1 + parts_floats + _ANY_LOOP_FLOATS)
     if spaces is None:
         def make_run(part):
