@@ -262,7 +262,7 @@ class Simulation:
     diverged: np.ndarray
     stable: np.ndarray
     steps: int
-    floor: np.ndarray = 0.0
+    floor: np.ndarray
 
     def __repr__(self):
         stable = np.asarray(self.stable)
@@ -511,10 +511,10 @@ def simulate_loop(loop, *, steps=None, x0=1.0, v0=None, nonideal=None, record=Fa
     return run_loop(lambda part: [p[part] for p in parts], n_points, d=d, steps=steps, x0=x0,
                     v0=v0, nonideal=nonideal, record=record, progress=progress, shape=shape,
                     spaces=spaces, parts_floats=2 * orders + sum(p.shape[-1] for p in parts),
-                    linear_stable=linear_stable(loop, nonideal, values, shape))
+                    linear_stable=linearly_stable(loop, nonideal, values, shape))
 
 
-def linear_stable(loop, nonideal, values, shape):
+def linearly_stable(loop, nonideal, values, shape):
     """Where ``loop``'s linear part is stable at ``values`` (raveled), if ``nonideal`` quantizes the force.
 
     The certified root count (:meth:`symstab.Loop.unstable_root_counts`)

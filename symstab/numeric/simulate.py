@@ -21,7 +21,7 @@ default) need a :class:`symstab.numeric.units.Device`:
 * ``force_resolution`` -- the force command is rounded to a multiple of
   this quantum (the DAC's step) before the clip; where the linear loop is
   stable the verdict allows the limit cycle the quantum can cause
-  (:func:`~symstab.numeric.loop_simulate.linear_stable`);
+  (:func:`~symstab.numeric.loop_simulate.linearly_stable`);
 * ``velocity_cutoff`` -- the velocity used by the damper and mass terms is
   the backward difference passed through a first-order low-pass filter
   (pole ``exp(-2 pi f_c T)``, unit DC gain); the mass term differences the
@@ -71,7 +71,7 @@ from .._validate import check_array, check_delay, check_loop, check_real
 from .loop_simulate import (MAX_STEPS_ENV, PAPER_ENCODER_RESOLUTION, X0_MAX, Nonidealities,
                             Simulation, StabilityMap, check_loop_nonideal, check_steps,
                             check_x0, default_horizon, default_x0, loop_stability_map,
-                            linear_stable, max_steps, progress_printer, run_loop,
+                            linearly_stable, max_steps, progress_printer, run_loop,
                             simulate_loop)
 from .friction import substeps_of
 from .simulate_theory import paper_simulated_loop
@@ -201,7 +201,7 @@ def simulate(*, alpha, beta, gamma, d, delta, steps=None, x0=1.0, v0=None, devic
                     record=record, progress=progress, shape=shape,
                     spaces=(spaces, np.zeros(alpha.size, dtype=int)), state=(x0, v0),
                     compensation=compensation,
-                    linear_stable=linear_stable(loop, run_nonideal, values, (alpha.size,)))
+                    linear_stable=linearly_stable(loop, run_nonideal, values, (alpha.size,)))
 
 
 def stability_map(*, alpha, beta, gamma, d, delta, steps=None, x0=1.0, v0=None, device=None,
