@@ -45,7 +45,7 @@ from .numeric.curves import BoundaryCurve, arc_end_angle
 from .numeric.region import boundary_curve
 from .numeric.stability import MARGINAL, STABLE, UNSTABLE, classify, is_stable, spectral_radius
 from .numeric.region import BestVirtualMass, StabilityRegion, best_virtual_mass, limits
-from .numeric.results import Limits
+from .numeric.results import Limits, StabilityProbability
 from .numeric.any_loop import Loop, LoopBoundary, LoopLimits
 from .numeric.loop_files import load_loop
 from .numeric.decomposition import Branch, Cell, Decomposition
@@ -75,6 +75,7 @@ __all__ = [
     "ThetaMaxEnclosure", "theta_max_enclosure", "certify_theta_max",
     "theta_max_approx",
     "Nonidealities", "Simulation", "simulate", "StabilityMap", "stability_map",
+    "StabilityProbability",
 ]
 
 

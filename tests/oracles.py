@@ -183,6 +183,30 @@ def python_control_closed_loop(*, alpha, beta, gamma, d, delta, m, T):
     return control.feedback(G, VE * delay)
 
 
+def python_control_parts(loop, values):
+    """python-control's ``(P(z), VE(z), z**-d)`` of a :class:`symstab.Loop` at ``values``.
+
+    ``G(s)`` and ``VE(z)`` with the values substituted by SymPy, turned into
+    ``control.tf`` from their coefficients; ``G`` sampled by ``control.c2d(...,
+    "zoh")``.  The closed loop is ``control.feedback(P, VE * delay)``.
+    """
+    import control
+
+    s, z = sp.symbols("s z")
+    subs = {symbol: values[str(symbol)] for symbol in
+            loop.plant.free_symbols | loop.environment.free_symbols if str(symbol) in values}
+    num, den = sp.fraction(sp.together(loop.plant.subs(subs)))
+    plant = control.tf([float(c) for c in sp.Poly(num, s).all_coeffs()],
+                       [float(c) for c in sp.Poly(den, s).all_coeffs()])
+    T = float(values["T"])
+    sampled = control.c2d(plant, T, "zoh")
+    num, den = sp.fraction(sp.together(loop.environment.subs(subs)))
+    environment = control.tf([float(c) for c in sp.Poly(num, z).all_coeffs()],
+                             [float(c) for c in sp.Poly(den, z).all_coeffs()], T)
+    delay = control.tf([1.0], [1.0] + [0.0] * int(values["d"]), T)
+    return sampled, environment, delay
+
+
 # --------------------------------------------------------------------------
 # Points for the oracles
 # --------------------------------------------------------------------------

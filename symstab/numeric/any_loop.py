@@ -1197,6 +1197,53 @@ class Loop(LoopModel):
         return loop_stability_map(self, x_values, y_values, x=x, y=y, steps=steps, x0=x0, v0=v0,
                                   nonideal=nonideal, progress=progress, **values)
 
+    def stability_probability(self, x_values, y_values, *, uncertain, samples=1000, seed=0,
+                              x=None, y=None, progress=None, **values):
+        """The probability that each cell of an ``(x, y)`` grid is stable when parameters are uncertain.
+
+        Monte Carlo over the draws of the uncertain parameters, each cell
+        classified by its certified root count at every draw
+        (:mod:`symstab.numeric.probability`).
+
+        Parameters
+        ----------
+        x_values, y_values : array_like
+            1-D grids.
+        uncertain : dict
+            ``{name: (low, high)}`` (uniform; ``d``: the integers from
+            ``low`` to ``high``) or ``{name: distribution}`` (a frozen
+            :mod:`scipy.stats` distribution, or any object with
+            ``rvs(size=..., random_state=...)``).
+        samples : int
+            Draws (default 1000).
+        seed : int
+            The seed: the same seed gives the same map.
+        x, y : str, optional
+            The plane (default: :attr:`plane`).
+        progress : callable, optional
+            Called with the number of draws done.
+        **values
+            Single values of the other parameters.
+
+        Returns
+        -------
+        symstab.numeric.results.StabilityProbability
+
+        Examples
+        --------
+        >>> loop = Loop("1/(m*s**2 + b*s)", "K + B*(z - 1)/(T*z)", plane=("B", "K"),
+        ...             values={"m": 0.0128, "b": 0.0324, "T": 1e-3, "d": 10})
+        >>> found = loop.stability_probability([-0.03, 0.05], [1.0], samples=200,
+        ...                                    uncertain={"b": (0.0162, 0.0648)})
+        >>> found.probability.tolist(), round(float(found.standard_error[0, 0]), 3)
+        ([[0.57, 1.0]], 0.035)
+        """
+        from .probability import stability_probability
+
+        x, y = self._plane(x, y)
+        return stability_probability(self, x_values, y_values, x=x, y=y, uncertain=uncertain,
+                                     samples=samples, seed=seed, progress=progress, **values)
+
     def design(self, *, over, maximize="y_max", x=None, y=None, n=None, rtol=None, damping="b",
                delay=None, progress=None, amplitude=None, nonideal=None, x0=None, steps=None,
                **values):

@@ -18,7 +18,7 @@ import numpy as np
 
 from .._validate import check_real
 
-__all__ = ["Limits", "Boundary", "Segment"]
+__all__ = ["Limits", "Boundary", "Segment", "StabilityProbability"]
 
 #: The paper's dimensionless plane: x = beta (damping), y = alpha (stiffness).
 PAPER_PLANE = ("beta", "alpha")
@@ -342,3 +342,50 @@ class Boundary(PaperGridNames):
                            f"segment{'s' if n != 1 else ''})")
         return head + (f"{int(finite.sum())} arc points, lines "
                        f"{', '.join(self.lines) or 'none'})")
+
+
+@dataclasses.dataclass(frozen=True, repr=False)
+class StabilityProbability:
+    """The probability that each cell of an ``(x, y)`` grid is stable, over uncertain parameters.
+
+    Attributes
+    ----------
+    y_values, x_values : ndarray
+        The 1-D grids.
+    probability : ndarray
+        ``(len(y_values), len(x_values))``: the fraction of the draws at
+        which the cell is stable (certified root counts).
+    standard_error : ndarray
+        Its Monte Carlo standard error, ``sqrt(p (1 - p) / samples)``.
+    marginal : ndarray of int
+        Draws at which the cell was marginal (counted as not stable).
+    samples, seed : int
+        The draws and the seed of the generator that drew them.
+    uncertain : dict
+        Each uncertain parameter's distribution in words.
+    x, y : str
+        The plane.
+    at : dict
+        The values of the other parameters.
+    """
+
+    y_values: np.ndarray
+    x_values: np.ndarray
+    probability: np.ndarray
+    standard_error: np.ndarray
+    marginal: np.ndarray
+    samples: int
+    seed: int
+    uncertain: dict
+    x: str
+    y: str
+    at: dict = dataclasses.field(default_factory=dict)
+
+    def __repr__(self):
+        p = self.probability
+        drawn = ", ".join(f"{k} ~ {v}" for k, v in self.uncertain.items())
+        return (f"StabilityProbability({self.x} x {self.y}: {p.shape[1]} x {p.shape[0]} cells, "
+                f"{self.samples} draws of {drawn}: {int(np.count_nonzero(p == 1))} always stable, "
+                f"{int(np.count_nonzero((p > 0) & (p < 1)))} sometimes, "
+                f"{int(np.count_nonzero(p == 0))} never; largest standard error "
+                f"{float(np.max(self.standard_error)):.2g})")

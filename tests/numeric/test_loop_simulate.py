@@ -19,12 +19,12 @@ import math
 
 import numpy as np
 import pytest
-import sympy as sp
 
 import symstab
 from symstab.numeric.simulate import Nonidealities, stability_map
 
 from conftest import PAPER_DELTA, REPO, assert_message_names
+from oracles import python_control_parts
 
 LOOPS = REPO / "examples" / "loops"
 EXAMPLES = sorted(path.name for path in LOOPS.glob("*.toml"))
@@ -54,24 +54,6 @@ def test_simulated_maps_agree_with_the_root_counts(file):
                if abs(loop.spectral_radius(**{x: xs[j], y: ys[i]}) - 1) > 1e-3]
     assert decided == [], f"{len(decided)} cells away from the boundary differ"
     assert (found.x, found.y) == (x, y) and found.at["d"] == loop.defaults["d"]
-
-
-def python_control_parts(loop, values):
-    """python-control's ``(P(z), VE(z), z**-d)`` of the loop: G(s) sampled by c2d."""
-    control = pytest.importorskip("control")
-    s, z = sp.symbols("s z")
-    subs = {symbol: values[str(symbol)] for symbol in
-            loop.plant.free_symbols | loop.environment.free_symbols if str(symbol) in values}
-    num, den = sp.fraction(sp.together(loop.plant.subs(subs)))
-    plant = control.tf([float(c) for c in sp.Poly(num, s).all_coeffs()],
-                       [float(c) for c in sp.Poly(den, s).all_coeffs()])
-    T = float(values["T"])
-    sampled = control.c2d(plant, T, "zoh")
-    num, den = sp.fraction(sp.together(loop.environment.subs(subs)))
-    environment = control.tf([float(c) for c in sp.Poly(num, z).all_coeffs()],
-                             [float(c) for c in sp.Poly(den, z).all_coeffs()], T)
-    delay = control.tf([1.0], [1.0] + [0.0] * int(values["d"]), T)
-    return sampled, environment, delay
 
 
 def python_control_radius(loop, values):
