@@ -19,8 +19,8 @@ import math
 import sys
 
 from .loop_limits import limits_notes, named, plane_table, stable_intervals_at
-from .loop_options import (EXAMPLE, add_loop_options, paper_setup, resolve_loop, split_unit,
-                           uses_loop)
+from .loop_options import (EXAMPLE, add_loop_options, check_box, converted_range, paper_setup,
+                           range_text, resolve_loop, split_unit, uses_loop)
 from .options import add_command, add_model_options, resolve
 from .output import check_outputs, emit, write_output
 from .simulation import add_nonideal_options, loop_nonideal_text, resolve_nonideal
@@ -196,33 +196,16 @@ def _search_over(args, setup):
             if len(texts) > 1:
                 raise ValueError("--range is the range of a single --over NAME: with two "
                                  "parameters give --over NAME=LO:HI for each")
-            window = _range_text(args.search_range, "--range", None)
+            window = range_text(args.search_range, "--range")
         elif window is not None and args.search_range is not None:
             raise ValueError(f"--over {text} gives its range: drop --range {args.search_range}")
         if window is None:
             window = _default_range(setup, name)
         else:
-            window = _converted(setup, name, *window)
+            window = converted_range(setup, name, *window, flag="--over")
         over[name] = window
-    _check_ends(setup, over)
+    check_box(setup, over, "--over")
     return over
-
-
-def _check_ends(setup, over):
-    """Every corner of the searched box within the file's bounds and the loop's domain."""
-    from ..numeric.design import box_corners
-    from ..numeric.loop_units import FileParameters, check_bounds
-
-    known = getattr(setup.loop, "file_parameters", None) or FileParameters({})
-    flags = " ".join(f"--over {n}" for n in over)
-    for corner in box_corners(over):
-        values = {**setup.values, **corner}
-        check_bounds(known, values, skip=(setup.x, setup.y), where=lambda names: flags)
-        try:
-            setup.loop.polynomial(**{**values, setup.x: 0.0, setup.y: 0.0})
-        except (TypeError, ValueError) as exc:
-            at = ", ".join(f"{k} = {v:.6g}" for k, v in corner.items())
-            raise ValueError(f"{flags}: at {at}: {exc}") from None
 
 
 def _over_text(text):
@@ -231,38 +214,7 @@ def _over_text(text):
     name = name.strip()
     if not name:
         raise ValueError(f"--over {text}: expected NAME or NAME=LO:HI, e.g. --over M=0:0.03")
-    return name, (_range_text(window, f"--over {name}", name) if eq else None)
-
-
-def _range_text(text, flag, name):
-    """``(low, high, unit)`` of ``LO:HI`` with an optional unit after HI."""
-    from .._validate import check_real
-
-    head, colon, tail = text.partition(":")
-    tail, unit = split_unit(tail.strip(), flag)
-    try:
-        if not colon:
-            raise ValueError
-        low, high = (check_real(flag, float(v)) for v in (head, tail))
-    except (ValueError, TypeError):
-        raise ValueError(f"{flag} must be LO:HI, two finite numbers (a unit may follow), "
-                         f"got {text!r}") from None
-    if not low < high:
-        raise ValueError(f"{flag}: LO:HI must have LO < HI, got {text!r}")
-    if not math.isfinite(high - low):
-        raise ValueError(f"{flag}: HI - LO must be finite (below 1.8e308), got {text!r}")
-    return low, high, unit
-
-
-def _converted(setup, name, low, high, unit):
-    """``(low, high)`` in SI: converted from ``unit`` as a ``--set`` value is (None: SI)."""
-    if unit is None:
-        return low, high
-    from .loop_options import convert_sets
-
-    values, _ = convert_sets(setup.loop, {name: ([low, high], unit)}, flag="--over")
-    low, high = values[name]
-    return float(low), float(high)
+    return name, (range_text(window, f"--over {name}") if eq else None)
 
 
 def _search_parameter(args, setup, name):

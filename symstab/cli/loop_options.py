@@ -34,7 +34,8 @@ from .._resources import check_memory
 __all__ = ["DEVICE_OPTIONS", "POINT_OPTIONS", "EXAMPLE", "LINEAR_WITH_LOOP", "add_loop_options",
            "uses_loop", "split_unit", "parse_number", "convert_sets", "LoopSetup", "value_text",
            "loop_echo", "load_loop_file", "add_delay", "check_names", "loop_values", "resolve_loop",
-           "resolve_setup", "paper_setup", "TABLE_ONE", "point_count", "broadcast"]
+           "resolve_setup", "paper_setup", "TABLE_ONE", "point_count", "broadcast", "range_text",
+           "converted_range", "check_box"]
 
 
 #: The paper's device options every numeric command has, with the ``--set``
@@ -88,13 +89,15 @@ _LOOP_ONLY = {
     "limits": ("set_values", "x", "y", "at"),
     "classify": ("set_values",),
     "design": ("set_values", "x", "y", "at", "over", "search_range", "delay"),
-    "map": ("set_values", "x", "y", "x_range", "y_range", "simulate"),
+    "map": ("set_values", "x", "y", "x_range", "y_range", "simulate", "uncertain", "samples",
+            "seed"),
     "simulate": ("set_values",),
 }
 
 _FLAGS = {"set_values": "--set", "x": "--x", "y": "--y", "at": "--at",
           "x_range": "--x-range", "y_range": "--y-range", "over": "--over",
-          "search_range": "--range", "simulate": "--simulate", "delay": "--delay"}
+          "search_range": "--range", "simulate": "--simulate", "delay": "--delay",
+          "uncertain": "--uncertain", "samples": "--samples", "seed": "--seed"}
 
 
 EXAMPLE = "examples/loops/paper.toml"
@@ -192,6 +195,16 @@ def add_loop_options(p, command):
                             "--steps, --x0, --encoder-resolution, --force-limit, "
                             "--force-resolution in the "
                             "loop's SI units)")
+        g.add_argument("--uncertain", metavar="NAME=LO:HI", action="append",
+                       help="instead of one classification, the probability that each cell is "
+                            "stable when NAME is drawn uniformly from LO:HI (its SI unit, or "
+                            "the unit written after HI: --uncertain \"b=0.02:0.045 N*m*s/rad\"; "
+                            "d: the whole delays LO..HI); repeatable")
+        g.add_argument("--samples", type=int, metavar="N",
+                       help="draws with --uncertain (default 1000)")
+        g.add_argument("--seed", type=int, metavar="S",
+                       help="seed of the draws with --uncertain (default 0: the same map every "
+                            "run)")
         g.add_argument("--x-range", metavar="LOW,HIGH,N", help="grid of x (--x-range=-0.1,0.6,200)")
         g.add_argument("--y-range", metavar="LOW,HIGH,N", help="grid of y (--y-range=0,6,200)")
     refused = tuple((flag, dest, p.get_default(dest), instead)
@@ -389,6 +402,55 @@ class LoopSetup:
         if written:
             out["as_written"] = written   # converted to "values", in "units"
         return out
+
+
+def range_text(text, flag):
+    """``(low, high, unit)`` of ``LO:HI`` with an optional unit after HI (``--over``, ``--uncertain``)."""
+    from .._validate import check_real
+
+    head, colon, tail = text.partition(":")
+    tail, unit = split_unit(tail.strip(), flag)
+    try:
+        if not colon:
+            raise ValueError
+        low, high = (check_real(flag, float(v)) for v in (head, tail))
+    except (ValueError, TypeError):
+        raise ValueError(f"{flag} must be LO:HI, two finite numbers (a unit may follow), "
+                         f"got {text!r}") from None
+    if not low < high:
+        raise ValueError(f"{flag}: LO:HI must have LO < HI, got {text!r}")
+    if not math.isfinite(high - low):
+        raise ValueError(f"{flag}: HI - LO must be finite (below 1.8e308), got {text!r}")
+    return low, high, unit
+
+
+def converted_range(setup, name, low, high, unit, *, flag):
+    """``(low, high)`` in SI: converted from ``unit`` as a ``--set`` value is (None: SI)."""
+    if unit is None:
+        return low, high
+    values, _ = convert_sets(setup.loop, {name: ([low, high], unit)}, flag=flag)
+    low, high = values[name]
+    return float(low), float(high)
+
+
+def check_box(setup, box, flag):
+    """Every corner of the box ``{name: (low, high)}`` within the file's bounds and the loop's domain.
+
+    ``flag`` names the option that gave the box (``--over``, ``--uncertain``).
+    """
+    from ..numeric.design import box_corners
+    from ..numeric.loop_units import FileParameters, check_bounds
+
+    known = getattr(setup.loop, "file_parameters", None) or FileParameters({})
+    flags = " ".join(f"{flag} {n}" for n in box)
+    for corner in box_corners(box):
+        values = {**setup.values, **corner}
+        check_bounds(known, values, skip=(setup.x, setup.y), where=lambda names: flags)
+        try:
+            setup.loop.polynomial(**{**values, setup.x: 0.0, setup.y: 0.0})
+        except (TypeError, ValueError) as exc:
+            at = ", ".join(f"{k} = {v:.6g}" for k, v in corner.items())
+            raise ValueError(f"{flags}: at {at}: {exc}") from None
 
 
 def _quantity_text(name, value):

@@ -16,7 +16,8 @@ import textwrap
 import numpy as np
 
 from .._resources import CHUNK_BYTES, check_memory, chunk_slices
-from .loop_options import add_loop_options, resolve_loop, uses_loop, value_text
+from .loop_options import (add_loop_options, check_box, converted_range, range_text, resolve_loop,
+                           uses_loop, value_text)
 from .options import add_command, add_model_options, resolve, stiffness_and_damping
 from ..drawing import draw_lines, png_bytes, pyplot_or_none, visible
 from .output import check_files, write_output
@@ -31,6 +32,10 @@ __all__ = ["register", "run", "MAX_GRID", "map_outputs", "LOOP_MAP_HEADLINE",
 #: paper's loop simulates (a loop file with --simulate).
 LOOP_MAP_HEADLINE = ("map --loop: root counts of the linear loop (add --simulate to simulate "
                      "every cell)")
+#: The first line of ``map --loop --uncertain``.
+LOOP_PROBABILITY_HEADLINE = ("map --loop --uncertain: the probability that each cell is stable "
+                             "over random draws of the uncertain parameters (a certified root "
+                             "count at every draw)")
 #: The first line of ``map --loop --simulate``.
 LOOP_SIMULATE_HEADLINE = ("map --loop --simulate: every cell simulated, the loop's certified "
                           "root count beside")
@@ -279,6 +284,11 @@ def _loop(args):
         raise ValueError("map --loop needs the grid: --x-range LOW,HIGH,N and --y-range LOW,HIGH,N")
     xs, ys = _grid(args.x_range, "--x-range"), _grid(args.y_range, "--y-range")
     out, png_path = map_outputs(args)
+    if args.uncertain is not None:
+        return _probability(args, setup, xs, ys, out, png_path)
+    for flag, dest in (("--samples", "samples"), ("--seed", "seed")):
+        if getattr(args, dest) is not None:
+            raise ValueError(f"{flag} counts the draws of --uncertain: add --uncertain NAME=LO:HI")
     loop, values = setup.loop, setup.values
     simulate = bool(args.simulate)
     if not simulate:
@@ -313,17 +323,10 @@ def _loop(args):
                                        progress=progress_printer("simulating", steps),
                                        **{k: v for k, v in values.items()})
     if out.suffix == ".npz":
-        buf = io.BytesIO()
         extra = {} if simulated is None else {
             "simulated_stable": simulated.stable.T, "growth": simulated.growth.T,
             "steps": steps, "x0": x0, "nonidealities": np.array(loop_nonideal_text(nonideal))}
-        np.savez(buf, x=xs, y=ys, x_name=np.array(setup.x), y_name=np.array(setup.y),
-                 x_unit=np.array(setup.unit(setup.x)), y_unit=np.array(setup.unit(setup.y)),
-                 code=code, stable=stable, **extra,
-                 values=np.array([value_text(setup, n, values[n]) for n in loop.parameters
-                                  if n in values]),
-                 loop=np.array(str(setup.path)))
-        data = buf.getvalue()
+        data = _loop_npz(setup, xs, ys, values, code=code, stable=stable, **extra)
     else:
         X, Y = np.meshgrid(xs, ys, indexing="ij")
         buf = io.StringIO()
@@ -357,6 +360,147 @@ def _loop(args):
     return 0
 
 
+def _loop_npz(setup, xs, ys, values, **arrays):
+    """A loop map's NPZ bytes: its grid, names, units, fixed values and file, and ``arrays``."""
+    buf = io.BytesIO()
+    np.savez(buf, x=xs, y=ys, x_name=np.array(setup.x), y_name=np.array(setup.y),
+             x_unit=np.array(setup.unit(setup.x)), y_unit=np.array(setup.unit(setup.y)),
+             **arrays, values=np.array([value_text(setup, n, values[n])
+                                        for n in setup.loop.parameters if n in values]),
+             loop=np.array(str(setup.path)))
+    return buf.getvalue()
+
+
+def _uncertain_box(args, setup):
+    """``{name: (low, high)}`` of the ``--uncertain`` options, in SI, checked against the file."""
+    loop = setup.loop
+    others = [n for n in loop.parameters if n not in (setup.x, setup.y)]
+    box = {}
+    for text in args.uncertain:
+        name, eq, window = text.partition("=")
+        name = name.strip()
+        if not eq or not name:
+            raise ValueError(f"--uncertain {text}: expected NAME=LO:HI, e.g. --uncertain "
+                             f"b=0.02:0.045")
+        if name in box:
+            raise ValueError(f"--uncertain {name} is given twice; give each parameter once")
+        if name not in loop.parameters:
+            raise ValueError(f"--uncertain {name}: not a parameter of the loop in {args.loop} "
+                             f"(candidates: {', '.join(others)})")
+        if name in (setup.x, setup.y):
+            raise ValueError(f"--uncertain {name}: {name} is an axis of the ({setup.x}, "
+                             f"{setup.y}) map; draw another parameter (candidates: "
+                             f"{', '.join(others)})")
+        low, high, unit = range_text(window, f"--uncertain {name}")
+        if name == "d":
+            if unit is not None or low != int(low) or high != int(high):
+                raise ValueError(f"--uncertain d: the delay is a whole number of samples: give "
+                                 f"d=LO:HI in samples, got {window!r}")
+            box[name] = (int(low), int(high))
+        else:
+            box[name] = converted_range(setup, name, low, high, unit, flag="--uncertain")
+    check_box(setup, {k: v for k, v in box.items() if k != "d"}, "--uncertain")
+    return box
+
+
+def _probability(args, setup, xs, ys, out, png_path):
+    """``map --loop --uncertain``: the probability of stability of every cell, its files and PNG."""
+    from ..numeric.probability import draw_values
+    from ..numeric.simulate import progress_printer
+
+    if args.simulate:
+        raise ValueError("--uncertain maps the probability of stability by root counts; "
+                         "--simulate simulates the nominal loop: give one of them")
+    loop, x, y = setup.loop, setup.x, setup.y
+    box = _uncertain_box(args, setup)
+    samples = 1000 if args.samples is None else args.samples
+    seed = 0 if args.seed is None else args.seed
+    # Checked now (the counts, the seed, a delay's range), before anything is printed.
+    draw_values(loop, box, samples, seed, axes=(x, y))
+    fixed = {k: v for k, v in setup.values.items() if k not in box}
+    check_memory(f"a map of {xs.size} x {ys.size} cells", xs.size * ys.size * _MAP_CELL_BYTES
+                 + CHUNK_BYTES)
+    print(LOOP_PROBABILITY_HEADLINE)
+    for line in setup.echo:
+        print(line)
+    found = loop.stability_probability(xs, ys, x=x, y=y, uncertain=box, samples=samples,
+                                       seed=seed, progress=progress_printer("drawing", samples),
+                                       **fixed)
+    drawn = [f"{name} ~ {text}" + (f" {setup.unit(name)}" if name != "d" and setup.unit(name)
+                                   else "") for name, text in found.uncertain.items()]
+    p, error, marginal = found.probability.T, found.standard_error.T, found.marginal.T
+    if out.suffix == ".npz":
+        data = _loop_npz(setup, xs, ys, fixed, probability=p, standard_error=error,
+                         marginal=marginal, samples=samples, seed=seed,
+                         uncertain=np.array(drawn))
+    else:
+        X, Y = np.meshgrid(xs, ys, indexing="ij")
+        buf = io.StringIO()
+        buf.write(f"{setup.label(x)},{setup.label(y)},probability,standard_error,marginal\n")
+        for row in zip(X.ravel(), Y.ravel(), p.ravel(), error.ravel(), marginal.ravel()):
+            buf.write(f"{row[0]:.12g},{row[1]:.12g},{row[2]:.6g},{row[3]:.3g},{int(row[4])}\n")
+        data = buf.getvalue()
+    image = _probability_png(setup, found, fixed, drawn) if png_path is not None else None
+    write_output(out, data, "--out")
+    written = [str(out)]
+    if image is not None:
+        write_output(png_path, image, "--png")
+        written.append(str(png_path))
+    between = int(np.count_nonzero((p > 0) & (p < 1)))
+    print(f"{samples} draws of {', '.join(drawn)} (seed {seed}): stable at every draw in "
+          f"{int(np.count_nonzero(p == 1))} of {p.size} cells, at none in "
+          f"{int(np.count_nonzero(p == 0))}, at some in {between} (largest standard error "
+          f"{float(error.max()):.2g}); marginal draws, counted as not stable: "
+          f"{int(marginal.sum())}")
+    print("wrote " + ", ".join(written))
+    return 0
+
+
+def _probability_png(setup, found, fixed, drawn):
+    """The probability map as PNG bytes (None without matplotlib), the nominal boundary over it."""
+    plt = pyplot_or_none()
+    if plt is None:
+        return None
+    xs, ys = found.x_values, found.y_values
+    fig, ax = plt.subplots(figsize=(6.4, 4.8), dpi=120)
+    mesh = ax.pcolormesh(xs, ys, found.probability, shading="nearest", vmin=0.0, vmax=1.0,
+                         cmap="Greens")
+    fig.colorbar(mesh, ax=ax, label="probability of stability")
+    handles = _draw_boundary(ax, setup, xs, ys, "nominal loop: ")
+    _axes(ax, setup, xs, ys)
+    rest = ", ".join(value_text(setup, n, fixed[n]).replace(" ", "\u00a0")
+                     for n in setup.loop.parameters if n in fixed)
+    ax.set_title("\n".join([f"loop {setup.loop.name}: probability of stability, "
+                            f"{found.samples} draws"] + textwrap.wrap(", ".join(drawn), 80)
+                           + textwrap.wrap(rest, 80)), fontsize=8)
+    if handles:
+        ax.legend(handles=handles, loc="best", fontsize=8, framealpha=0.9)
+    fig.tight_layout()
+    return png_bytes(plt, fig)
+
+
+def _draw_boundary(ax, setup, xs, ys, label=""):
+    """The loop's D-decomposition at ``setup.values`` drawn on ``ax``; the legend's handles."""
+    curve = setup.loop.boundary(x=setup.x, y=setup.y, window=((xs[0], xs[-1]), (ys[0], ys[-1])),
+                                **setup.values)
+    bx, by = visible(curve.x_values, xs[0], xs[-1]), visible(curve.y_values, ys[0], ys[-1])
+    bx[np.isnan(by)] = np.nan
+    handles = []
+    if np.any(np.isfinite(bx)):
+        handles += ax.plot(bx, by, "k-", lw=1.2,
+                           label=label + r"$z = e^{j\theta}$ root (D-decomposition)")
+    return handles + draw_lines(ax, curve.lines, xs, ys)
+
+
+def _axes(ax, setup, xs, ys):
+    """The map's limits and its axes' names with their units."""
+    ax.set_xlim(xs[0], xs[-1])
+    ax.set_ylim(ys[0], ys[-1])
+    for name, set_label in ((setup.x, ax.set_xlabel), (setup.y, ax.set_ylabel)):
+        unit = setup.unit(name)
+        set_label(f"{name} [{tex_unit(unit)}]" if unit else name)
+
+
 def _loop_png(setup, xs, ys, code, simulated=None):
     """The map as PNG bytes (None without matplotlib), with the D-decomposition drawn over it.
 
@@ -378,25 +522,12 @@ def _loop_png(setup, xs, ys, code, simulated=None):
              else np.where(simulated, 2, 0)).T
     ax.pcolormesh(xs, ys, shade, shading="nearest", vmin=0, vmax=2,
                   cmap=ListedColormap(["white", "#bdbdbd", "#7fc97f"]))
-    curve = loop.boundary(x=x, y=y, window=((xs[0], xs[-1]), (ys[0], ys[-1])), **setup.values)
-    bx, by = visible(curve.x_values, xs[0], xs[-1]), visible(curve.y_values, ys[0], ys[-1])
-    bx[np.isnan(by)] = np.nan
     handles = [Patch(facecolor="#7fc97f", label="stable" if simulated is None
                      else "stable by simulation")]
     if simulated is None and np.any(code == MARGINAL):
         handles.append(Patch(facecolor="#bdbdbd", label="marginal"))
-    if np.any(np.isfinite(bx)):
-        handles += ax.plot(bx, by, "k-", lw=1.2, label=r"$z = e^{j\theta}$ root (D-decomposition)")
-    handles += draw_lines(ax, curve.lines, xs, ys)
-    ax.set_xlim(xs[0], xs[-1])
-    ax.set_ylim(ys[0], ys[-1])
-
-    def axis_label(name):
-        unit = setup.unit(name)
-        return f"{name} [{tex_unit(unit)}]" if unit else name
-
-    ax.set_xlabel(axis_label(x))
-    ax.set_ylabel(axis_label(y))
+    handles += _draw_boundary(ax, setup, xs, ys)
+    _axes(ax, setup, xs, ys)
     # Wrapped to the width of the figure (a two-mass device has eight values),
     # between values only: no-break spaces inside each.
     fixed = ", ".join(value_text(setup, n, setup.values[n]).replace(" ", "\u00a0")
