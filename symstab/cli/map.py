@@ -373,6 +373,8 @@ def _loop_npz(setup, xs, ys, values, **arrays):
 
 def _uncertain_box(args, setup):
     """``{name: (low, high)}`` of the ``--uncertain`` options, in SI, checked against the file."""
+    from .._validate import check_delay
+
     loop = setup.loop
     others = [n for n in loop.parameters if n not in (setup.x, setup.y)]
     box = {}
@@ -396,7 +398,10 @@ def _uncertain_box(args, setup):
             if unit is not None or low != int(low) or high != int(high):
                 raise ValueError(f"--uncertain d: the delay is a whole number of samples: give "
                                  f"d=LO:HI in samples, got {window!r}")
-            box[name] = (int(low), int(high))
+            try:
+                box[name] = (check_delay(int(low)), check_delay(int(high)))
+            except ValueError as exc:
+                raise ValueError(f"--uncertain d: {exc}") from None
         else:
             box[name] = converted_range(setup, name, low, high, unit, flag="--uncertain")
     check_box(setup, {k: v for k, v in box.items() if k != "d"}, "--uncertain")
@@ -405,7 +410,7 @@ def _uncertain_box(args, setup):
 
 def _probability(args, setup, xs, ys, out, png_path):
     """``map --loop --uncertain``: the probability of stability of every cell, its files and PNG."""
-    from ..numeric.probability import draw_values
+    from ..numeric.probability import MAX_SAMPLES, draw_values
     from ..numeric.simulate import progress_printer
 
     if args.simulate:
@@ -415,6 +420,10 @@ def _probability(args, setup, xs, ys, out, png_path):
     box = _uncertain_box(args, setup)
     samples = 1000 if args.samples is None else args.samples
     seed = 0 if args.seed is None else args.seed
+    if not 1 <= samples <= MAX_SAMPLES:
+        raise ValueError(f"--samples must be an integer from 1 to {MAX_SAMPLES}, got {samples}")
+    if seed < 0:
+        raise ValueError(f"--seed must be a non-negative integer, got {seed}")
     # Checked now (the counts, the seed, a delay's range), before anything is printed.
     draw_values(loop, box, samples, seed, axes=(x, y))
     fixed = {k: v for k, v in setup.values.items() if k not in box}
