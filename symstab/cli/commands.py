@@ -24,14 +24,14 @@ import warnings
 
 from .._project import project_root
 from . import (audit, boundary, classify, derive, design, figures, limits, locus, reproduce,
-               simulate)
+               simulate, sweep)
 from . import map as map_command
 
 __all__ = ["main", "build_parser", "package_version", "project_root", "COMMANDS"]
 
 #: The command modules, in the order of ``symstab --help``.
 COMMANDS = (derive, audit, figures, reproduce, boundary, limits, classify, design, simulate,
-            map_command, locus)
+            map_command, locus, sweep)
 
 
 def package_version():

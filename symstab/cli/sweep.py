@@ -1,0 +1,339 @@
+"""``symstab sweep SPEC.toml``: one question asked of a loop at many parameter points, on Dask.
+
+The spec (TOML) names the loop file (relative to the spec), the question
+(``limits``), optionally the plane, the rows per chunk, and the points:
+either ``[grid]``, every combination of the values given for each parameter
+(a list, or ``{from = LO, to = HI, points = N}``; ``unit = "..."`` converts
+them, else they are in the loop file's unit), or ``[random]``, ``samples``
+rows drawn uniformly from ``NAME = [LO, HI]`` (whole delays for ``d``) with
+``seed``.  Every row's inputs and answers go to one table (CSV or NPZ, the
+units in the header); the chunks are evaluated on a Dask cluster (a
+``LocalCluster`` on this machine's cores, or ``--scheduler ADDRESS``) or,
+with ``--serial``, here, and saved as they finish in ``OUT.parts/``: run
+the same command again after an interruption and the saved chunks are not
+recomputed.  Once the table is written the folder is removed.  The spec is data: nothing in it is run.
+"""
+
+import io
+import logging
+import math
+import os
+import pathlib
+import shutil
+import sys
+
+import numpy as np
+
+from .loop_options import convert_sets, load_loop_file
+from .options import add_command
+from .output import check_files, write_output
+
+__all__ = ["register", "run", "MAX_ROWS"]
+
+#: The most rows a sweep has (each is a certified region, about 0.1 to 1 s).
+MAX_ROWS = 1_000_000
+#: The largest spec read.
+_MAX_SPEC_BYTES = 1 << 20
+_KEYS = {"loop", "question", "plane", "chunk", "grid", "random"}
+#: Rows per chunk by default: a task long enough to hide the cluster's overhead.
+_DEFAULT_CHUNK = 10
+
+
+def register(subparsers):
+    """Add ``symstab sweep`` to the sub-commands."""
+    p = add_command(
+        subparsers, "sweep", help="ask a loop's limits at many parameter points (on Dask)",
+        description="Evaluate the limits of a loop's stable set (K_max, the B where it is "
+                    "reached, the B range, the area) at every row of a grid or of random draws "
+                    "of its parameters, given in a TOML spec; the chunks run on a Dask cluster "
+                    "(pip install '.[sweep]') and are saved as they finish, so a run that is "
+                    "interrupted resumes where it stopped.",
+        example="symstab sweep examples/sweeps/paper_delays.toml --out out/sweep.csv",
+        func=run)
+    p.add_argument("spec", help="the sweep's TOML spec")
+    p.add_argument("--out", required=True, help="the table: .csv or .npz")
+    g = p.add_mutually_exclusive_group()
+    g.add_argument("--scheduler", metavar="ADDRESS",
+                   help="a running Dask scheduler (default: a LocalCluster on this machine)")
+    g.add_argument("--workers", type=int, metavar="N",
+                   help="workers of the LocalCluster (default: the machine's cores)")
+    g.add_argument("--serial", action="store_true", help="evaluate here, one chunk after another")
+
+
+def run(args):
+    out = pathlib.Path(args.out)
+    if out.suffix not in (".csv", ".npz"):
+        raise ValueError(f"--out must end in .csv or .npz, got {args.out!r}")
+    check_files([("--out", out)])
+    if args.workers is not None and not 1 <= args.workers <= 256:
+        raise ValueError(f"--workers must be an integer from 1 to 256, got {args.workers}")
+    plan = read_spec(args.spec)
+    client_of = None if args.serial else _client_factory(args)
+    from ..numeric.sweep import ChunkStore, run_sweep, sweep_key
+    from ..numeric.simulate import progress_printer
+
+    rows, chunk = plan["rows"], plan["chunk"]
+    n_chunks = math.ceil(len(rows) / chunk)
+    parts = out.with_name(out.name + ".parts")
+    key = sweep_key(plan["loop_text"], plan["question"], plan["x"], plan["y"],
+                    ",".join(plan["names"]), rows, chunk)
+    store = ChunkStore(parts, key, n_chunks)
+    loop = plan["loop"]
+    print(f"sweep {args.spec}: {plan['question']} of loop {loop.name} in the ({plan['x']}, "
+          f"{plan['y']}) plane at {len(rows)} points ({plan['how']}), {n_chunks} chunks of "
+          f"{chunk}; saved as they finish in {parts}")
+    client = cluster = None
+    try:
+        if client_of is not None:
+            client, cluster, where = client_of()
+            print(f"on {where}")
+        values, reasons, loaded = run_sweep(
+            loop, plan["question"], plan["x"], plan["y"], plan["names"], rows, chunk=chunk,
+            store=store, client=client, progress=progress_printer("sweeping", n_chunks))
+    except KeyboardInterrupt:
+        saved = len(store.done())
+        print(f"{chr(10) if sys.stderr.isatty() else ''}symstab sweep: interrupted: {saved} of "
+              f"{n_chunks} chunks saved in {parts}; the same command resumes there",
+              file=sys.stderr)
+        return 130
+    finally:
+        if client is not None:
+            client.close()
+        if cluster is not None:
+            cluster.close()
+    if loaded:
+        print(f"resumed: {loaded} of {n_chunks} chunks were saved by an earlier run and not "
+              f"evaluated again")
+    write_output(out, _table(plan, values, reasons, out.suffix), "--out")
+    # The table holds every chunk now: the folder kept for a resume goes.
+    shutil.rmtree(parts, ignore_errors=True)
+    stable = int(np.count_nonzero(np.isfinite(values[:, 0])))
+    print(f"{stable} of {len(rows)} points have a stable set; wrote {out}")
+    return 0
+
+
+def _client_factory(args):
+    """A callable giving ``(client, cluster or None, description)``; refuses a missing Dask now."""
+    import importlib
+
+    try:
+        importlib.import_module("dask.distributed")
+    except ImportError:
+        raise ValueError("symstab sweep runs on Dask: pip install '.[sweep]' (dask.distributed), "
+                         "or give --serial") from None
+
+    def make():
+        from dask.distributed import Client, LocalCluster
+
+        if args.scheduler is not None:
+            return Client(args.scheduler), None, f"the Dask scheduler at {args.scheduler}"
+        n = args.workers or os.cpu_count() or 1
+        # Its workers' log lines (a task cancelled on Ctrl-C ...) are not for the user.
+        cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=True,
+                               dashboard_address=None, silence_logs=logging.ERROR)
+        return Client(cluster), cluster, f"a Dask LocalCluster of {n} worker process(es)"
+
+    return make
+
+
+def read_spec(path):
+    """The sweep of the spec at ``path``: its loop, plane, question, rows (SI) and chunk size."""
+    from ..numeric.loop_files import tomllib
+
+    path = pathlib.Path(path)
+    try:
+        with open(path, "rb") as fh:
+            data = fh.read(_MAX_SPEC_BYTES + 1)
+    except OSError as exc:
+        raise ValueError(f"cannot read the sweep spec {str(path)!r}: {exc.strerror or exc}") from None
+    if len(data) > _MAX_SPEC_BYTES:
+        raise ValueError(f"the sweep spec {str(path)!r} is larger than {_MAX_SPEC_BYTES} bytes")
+    try:
+        spec = tomllib.loads(data.decode("utf-8"))
+    except (UnicodeDecodeError, tomllib.TOMLDecodeError) as exc:
+        raise ValueError(f"the sweep spec {str(path)!r} is not TOML: {exc}") from None
+    unknown = sorted(set(spec) - _KEYS)
+    if unknown:
+        raise ValueError(f"the sweep spec {path}: unknown key {unknown[0]!r} (the keys are "
+                         f"{', '.join(sorted(_KEYS))})")
+    where = f"the sweep spec {path}"
+    if not isinstance(spec.get("loop"), str):
+        raise ValueError(f"{where}: loop = \"FILE\", the loop file (relative to the spec), is "
+                         f"required")
+    loop_path = (path.parent / spec["loop"])
+    loop = load_loop_file(str(loop_path))
+    try:
+        loop_text = loop_path.read_text(encoding="utf-8")
+    except OSError as exc:
+        raise ValueError(f"{where}: cannot read {loop_path}: {exc.strerror or exc}") from None
+    from ..numeric.sweep import QUESTIONS
+
+    question = spec.get("question", "limits")
+    if question not in QUESTIONS:
+        raise ValueError(f"{where}: question must be one of {', '.join(QUESTIONS)}, got "
+                         f"{question!r}")
+    plane = spec.get("plane", loop.plane)
+    if (not isinstance(plane, (list, tuple)) or len(plane) != 2
+            or not all(isinstance(n, str) for n in plane)):
+        raise ValueError(f"{where}: plane must be two parameter names, e.g. [\"B\", \"K\"]")
+    x, y = plane
+    chunk = spec.get("chunk", _DEFAULT_CHUNK)
+    if isinstance(chunk, bool) or not isinstance(chunk, int) or not 1 <= chunk <= 10_000:
+        raise ValueError(f"{where}: chunk must be an integer from 1 to 10000 (rows per task), "
+                         f"got {chunk!r}")
+    if ("grid" in spec) == ("random" in spec):
+        raise ValueError(f"{where}: give the points as [grid] or as [random], one of them")
+    table = spec.get("grid", spec.get("random"))
+    if not isinstance(table, dict):
+        raise ValueError(f"{where}: [grid] or [random] must be a table")
+    if "grid" in spec:
+        names, rows, how = _grid(where, loop, x, y, table)
+    else:
+        names, rows, how = _random(where, loop, x, y, table)
+    if not names:
+        raise ValueError(f"{where}: sweep at least one parameter")
+    # The first row asked of the loop now: a value out of its domain is refused before the run.
+    from ..numeric.loop_units import FileParameters, check_bounds
+
+    known = getattr(loop, "file_parameters", None) or FileParameters({})
+    columns = {n: rows[:, k] for k, n in enumerate(names)}
+    check_bounds(known, {**loop.defaults, **columns}, skip=(x, y),
+                 where=lambda bad: f"{where}: a point's " + ", ".join(bad))
+    # The box's corners asked of the loop now: a value outside its domain is refused before
+    # the run, not in the middle of it.
+    import itertools
+
+    for corner in itertools.product(*[(rows[:, k].min(), rows[:, k].max())
+                                      for k in range(len(names))]):
+        values = {n: int(v) if n == "d" else float(v) for n, v in zip(names, corner)}
+        try:
+            loop.polynomial(**{**values, x: 0.0, y: 0.0})
+        except (TypeError, ValueError) as exc:
+            at = ", ".join(f"{n} = {v:.6g}" for n, v in values.items())
+            raise ValueError(f"{where}: at {at}: {exc}") from None
+    return {"loop": loop, "loop_text": loop_text, "question": question, "x": x, "y": y,
+            "names": tuple(names), "rows": rows, "chunk": chunk, "how": how}
+
+
+def _check_name(where, loop, x, y, name):
+    if name not in loop.parameters:
+        raise ValueError(f"{where}: {name!r} is not a parameter of the loop (its parameters: "
+                         f"{', '.join(loop.parameters)})")
+    if name in (x, y):
+        raise ValueError(f"{where}: {name} is an axis of the ({x}, {y}) plane; the limits are "
+                         f"read in it, not swept")
+
+
+def _si(where, loop, name, values, unit):
+    """``values`` (a list of numbers) in SI: from ``unit``, else from the loop file's unit."""
+    if not all(isinstance(v, (int, float)) and not isinstance(v, bool) for v in values):
+        raise ValueError(f"{where}: {name} must be numbers, got {values!r}")
+    if name == "d":
+        if unit not in (None, "samples") or not all(float(v).is_integer() and v >= 0
+                                                    for v in values):
+            raise ValueError(f"{where}: d counts whole samples, >= 0, got {values!r}")
+        return [float(v) for v in values]
+    if unit is not None and not isinstance(unit, str):
+        raise ValueError(f"{where}: the unit of {name} must be text, got {unit!r}")
+    converted, _ = convert_sets(loop, {name: (list(values), unit)}, flag=where + ":")
+    out = [float(v) for v in converted[name]]
+    if not all(math.isfinite(v) for v in out):
+        raise ValueError(f"{where}: {name} must be finite numbers, got {values!r}")
+    return out
+
+
+def _grid(where, loop, x, y, table):
+    names, axes = [], []
+    for name, spec in table.items():
+        _check_name(where, loop, x, y, name)
+        unit = None
+        if isinstance(spec, dict):
+            extra = sorted(set(spec) - {"from", "to", "points", "unit", "values"})
+            if extra:
+                raise ValueError(f"{where}: [grid] {name}: unknown key {extra[0]!r} (give "
+                                 f"{{from, to, points}} or {{values}}, and unit)")
+            unit = spec.get("unit")
+            if "values" in spec:
+                spec = spec["values"]
+            else:
+                low, high, n = spec.get("from"), spec.get("to"), spec.get("points")
+                if (isinstance(n, bool) or not isinstance(n, int) or n < 1
+                        or not all(isinstance(v, (int, float)) and not isinstance(v, bool)
+                                   for v in (low, high))):
+                    raise ValueError(f"{where}: [grid] {name} = {{from = LO, to = HI, points = N}} "
+                                     f"needs two numbers and a whole N >= 1")
+                spec = list(np.linspace(low, high, n))
+                if name == "d":
+                    spec = sorted({round(v) for v in spec})
+        if not isinstance(spec, list) or not spec:
+            raise ValueError(f"{where}: [grid] {name} must be a non-empty list of values or "
+                             f"{{from, to, points}}")
+        names.append(name)
+        axes.append(_si(f"{where}: [grid]", loop, name, spec, unit))
+    size = math.prod(len(a) for a in axes)
+    if size > MAX_ROWS:
+        raise ValueError(f"{where}: the grid has {size} points, more than {MAX_ROWS}")
+    mesh = np.meshgrid(*[np.asarray(a) for a in axes], indexing="ij")
+    rows = np.column_stack([m.ravel() for m in mesh]) if names else np.empty((0, 0))
+    return names, rows, "a grid of " + " x ".join(f"{len(a)} {n}" for n, a in zip(names, axes))
+
+
+def _random(where, loop, x, y, table):
+    samples, seed = table.get("samples"), table.get("seed", 0)
+    if isinstance(samples, bool) or not isinstance(samples, int) or not 1 <= samples <= MAX_ROWS:
+        raise ValueError(f"{where}: [random] samples must be an integer from 1 to {MAX_ROWS}")
+    if isinstance(seed, bool) or not isinstance(seed, int) or seed < 0:
+        raise ValueError(f"{where}: [random] seed must be a non-negative integer, got {seed!r}")
+    rng = np.random.default_rng(seed)
+    names, columns = [], []
+    for name, spec in table.items():
+        if name in ("samples", "seed"):
+            continue
+        _check_name(where, loop, x, y, name)
+        unit = None
+        if isinstance(spec, dict):
+            extra = sorted(set(spec) - {"range", "unit"})
+            if extra:
+                raise ValueError(f"{where}: [random] {name}: unknown key {extra[0]!r} (give "
+                                 f"[LO, HI] or {{range = [LO, HI], unit = \"...\"}})")
+            unit, spec = spec.get("unit"), spec.get("range")
+        if not isinstance(spec, list) or len(spec) != 2:
+            raise ValueError(f"{where}: [random] {name} must be [LO, HI] (uniform draws)")
+        low, high = _si(f"{where}: [random]", loop, name, spec, unit)
+        if not low < high if name != "d" else not low <= high:
+            raise ValueError(f"{where}: [random] {name} = [LO, HI] needs LO < HI, got {spec!r}")
+        names.append(name)
+        columns.append(rng.integers(int(low), int(high), endpoint=True, size=samples).astype(float)
+                       if name == "d" else rng.uniform(low, high, size=samples))
+    rows = np.column_stack(columns) if columns else np.empty((0, 0))
+    return names, rows, f"{samples} random draws of {', '.join(names)} (seed {seed})"
+
+
+def _table(plan, values, reasons, suffix):
+    """The table's bytes: every row's inputs and answers, the units in the names."""
+    loop, x, y = plan["loop"], plan["x"], plan["y"]
+    units = getattr(loop, "units", {}) or {}
+
+    def label(name):
+        unit = "samples" if name == "d" else units.get(name, "")
+        return f"{name} [{unit}]" if unit else name
+
+    answers = [f"{y}_max", f"{x}_at_{y}_max", f"{x}_min", f"{x}_max", "area"]
+    answer_units = [units.get(y, ""), units.get(x, ""), units.get(x, ""), units.get(x, ""),
+                    f"({units.get(x, '')})({units.get(y, '')})" if units.get(x) else ""]
+    inputs = [label(n) for n in plan["names"]]
+    outputs = [f"{a} [{u}]" if u else a for a, u in zip(answers, answer_units)]
+    if suffix == ".npz":
+        buf = io.BytesIO()
+        np.savez(buf, inputs=plan["rows"], input_names=np.array(inputs),
+                 answers=values, answer_names=np.array(outputs),
+                 reasons=np.array(reasons, dtype=str), question=np.array(plan["question"]),
+                 loop=np.array(loop.name))
+        return buf.getvalue()
+    buf = io.StringIO()
+    buf.write(",".join(inputs + outputs + ["reason"]) + "\n")
+    for row, answer, reason in zip(plan["rows"], values, reasons):
+        cells = [f"{v:.12g}" for v in row] + [f"{v:.12g}" for v in answer]
+        reason = " ".join(reason.split()).replace('"', "'")
+        buf.write(",".join(cells + [f'"{reason}"']) + "\n")
+    return buf.getvalue()

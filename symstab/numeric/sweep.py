@@ -1,0 +1,186 @@
+"""Sweeps: one question asked of a loop at many parameter points, a chunk at a time.
+
+A sweep is a table of rows, each a value of every swept parameter (a
+device family, delays, cut-offs, uncertain values ...), and a question
+asked at every row: today the limits of the stable set in the loop's plane
+(:meth:`symstab.Loop.limits`: the largest ``y``, the ``x`` where it is
+reached, the extent in ``x`` and the area).  The rows are cut into chunks;
+each chunk is evaluated serially or as one task on a Dask cluster
+(:mod:`dask.distributed`, an optional extra), and saved, complete, in a
+folder as soon as it is done (:class:`ChunkStore`): an interrupted sweep
+run again skips the chunks already saved.  Every row is evaluated by the
+same code wherever it runs, so a cluster gives the serial numbers exactly.
+"""
+
+import hashlib
+import json
+import os
+import pathlib
+
+import numpy as np
+
+__all__ = ["QUESTIONS", "evaluate_rows", "ChunkStore", "run_sweep", "sweep_key"]
+
+#: The questions a sweep asks, and the columns each answers (in the plane's names).
+QUESTIONS = {"limits": ("y_max", "x_at_y_max", "x_min", "x_max", "area")}
+
+
+def evaluate_rows(loop, question, x, y, names, rows):
+    """Answer ``question`` at every row: ``(values (n, k), reasons (n,))``.
+
+    Parameters
+    ----------
+    loop : symstab.Loop
+    question : str
+        A key of :data:`QUESTIONS`.
+    x, y : str
+        The plane.
+    names : tuple of str
+        The swept parameters, the columns of ``rows``.
+    rows : ndarray, shape (n, len(names))
+        Their values in SI (``d`` a whole number).
+
+    Returns
+    -------
+    (ndarray, list of str)
+        The answers (NaN where there is none: an empty stable set) and why
+        a set is empty or unbounded (empty text otherwise).
+    """
+    if question not in QUESTIONS:
+        raise ValueError(f"question must be one of {', '.join(QUESTIONS)}, got {question!r}")
+    out = np.full((len(rows), len(QUESTIONS[question])), np.nan)
+    reasons = []
+    for i, row in enumerate(rows):
+        values = {n: int(v) if n == "d" else float(v) for n, v in zip(names, row)}
+        found = loop.limits(x, y, **values)
+        out[i] = [np.nan if v is None else float(v)
+                  for v in (found.y_max, found.x_at_y_max, found.x_min, found.x_max, found.area)]
+        reasons.append(found.reason)
+    return out, reasons
+
+
+def sweep_key(*parts):
+    """A digest of what determines a sweep's numbers (the loop's text, the question, the rows)."""
+    digest = hashlib.sha256()
+    for part in parts:
+        data = part.tobytes() if isinstance(part, np.ndarray) else str(part).encode("utf-8")
+        digest.update(len(data).to_bytes(8, "little") + data)
+    return digest.hexdigest()
+
+
+class ChunkStore:
+    """The finished chunks of one sweep, one complete file each, in ``folder``.
+
+    ``folder/sweep.json`` holds the sweep's key (:func:`sweep_key`); a
+    folder that holds another sweep's chunks is refused, not mixed in.
+    A chunk is written to a temporary name and renamed, so a file there is
+    always whole, also after an interruption.
+    """
+
+    def __init__(self, folder, key, n_chunks):
+        self.folder = pathlib.Path(folder)
+        manifest = self.folder / "sweep.json"
+        if manifest.exists():
+            try:
+                kept = json.loads(manifest.read_text(encoding="utf-8"))
+            except (OSError, ValueError):
+                kept = None
+            if not isinstance(kept, dict) or kept.get("key") != key:
+                raise ValueError(f"{self.folder} holds the chunks of another sweep (or not a "
+                                 f"sweep's): remove it, or write this sweep elsewhere")
+        else:
+            self.folder.mkdir(parents=True, exist_ok=True)
+            _write_atomically(manifest, json.dumps({"key": key, "chunks": n_chunks}).encode())
+        self.n_chunks = n_chunks
+
+    def path(self, index):
+        return self.folder / f"chunk-{index:06d}.npz"
+
+    def done(self):
+        """The indices of the chunks saved."""
+        return {i for i in range(self.n_chunks) if self.path(i).exists()}
+
+    def save(self, index, values, reasons):
+        import io
+
+        buf = io.BytesIO()
+        np.savez(buf, values=values, reasons=np.array(reasons, dtype=str))
+        _write_atomically(self.path(index), buf.getvalue())
+
+    def load(self, index):
+        with np.load(self.path(index)) as f:
+            return f["values"], [str(r) for r in f["reasons"]]
+
+
+def _write_atomically(path, data):
+    tmp = path.with_name(path.name + ".tmp")
+    with open(tmp, "wb") as fh:
+        fh.write(data)
+    os.replace(tmp, path)
+
+
+def run_sweep(loop, question, x, y, names, rows, *, chunk, store, client=None, progress=None):
+    """Evaluate every row, a chunk at a time, serially or on ``client``; the whole table.
+
+    Parameters
+    ----------
+    loop, question, x, y, names, rows
+        As :func:`evaluate_rows`.
+    chunk : int
+        Rows per chunk (a task on the cluster; a file in the store).
+    store : ChunkStore
+        Where finished chunks are saved; those already there are loaded,
+        not evaluated again.
+    client : dask.distributed.Client, optional
+        Evaluate the chunks on its cluster (default: here, one after another).
+    progress : callable, optional
+        Called with the number of chunks finished (saved ones included).
+
+    Returns
+    -------
+    (ndarray, list of str, int)
+        The answers and reasons of every row, in the rows' order, and the
+        number of chunks loaded from the store rather than evaluated.
+    """
+    slices = [slice(i, min(i + chunk, len(rows))) for i in range(0, len(rows), chunk)]
+    values = np.full((len(rows), len(QUESTIONS[question])), np.nan)
+    reasons = [""] * len(rows)
+    done = store.done()
+
+    def keep(index, result):
+        part = slices[index]
+        values[part], reasons[part] = result[0], result[1]
+
+    for index in sorted(done):
+        keep(index, store.load(index))
+    finished = len(done)
+    if progress is not None:
+        progress(finished)
+    todo = [i for i in range(len(slices)) if i not in done]
+    if client is None:
+        for index in todo:
+            result = evaluate_rows(loop, question, x, y, names, rows[slices[index]])
+            store.save(index, *result)
+            keep(index, result)
+            finished += 1
+            if progress is not None:
+                progress(finished)
+    elif todo:
+        from dask.distributed import as_completed
+
+        shared = client.scatter(loop, broadcast=True)
+        futures = {client.submit(evaluate_rows, shared, question, x, y, names, rows[slices[i]],
+                                 pure=False): i for i in todo}
+        try:
+            for future in as_completed(futures):
+                index = futures[future]
+                result = future.result()
+                store.save(index, *result)
+                keep(index, result)
+                finished += 1
+                if progress is not None:
+                    progress(finished)
+        finally:
+            for future in futures:
+                future.cancel()
+    return values, reasons, len(done)

@@ -1,0 +1,172 @@
+"""``symstab sweep SPEC.toml``: many rows of a loop's limits, serially or on a Dask LocalCluster.
+
+Oracles: :meth:`symstab.Loop.limits` at each row's values (converted from
+the spec's units), and the serial run, which a two-worker LocalCluster must
+equal exactly, also after an interruption by SIGINT that it resumes without
+evaluating the saved chunks again.  A bad spec is one line, exit status 2,
+before any work, and nothing is written.
+"""
+
+import signal
+import subprocess
+import sys
+import time
+
+import numpy as np
+import pytest
+
+import symstab
+
+from conftest import REPO, run_cli as run
+
+LOOPS = REPO / "examples" / "loops"
+
+pytestmark = pytest.mark.usefixtures("loop_cache_dir")
+
+
+def spec(tmp_path, text, name="s.toml"):
+    path = tmp_path / name
+    path.write_text(f'loop = "{(LOOPS / "paper.toml").as_posix()}"\n' + text, encoding="utf-8")
+    return path
+
+
+def read_csv(path):
+    lines = path.read_text(encoding="utf-8").splitlines()
+    rows = [line.rsplit(",", 1)[0].split(",") for line in lines[1:]]
+    return lines[0], np.array(rows, dtype=float)
+
+
+def test_each_row_is_the_loop_s_limits_at_its_values_in_si(capsys, tmp_path):
+    path = spec(tmp_path, 'chunk = 2\n[grid]\nd = [5, 12]\n'
+                          'b = { values = [16.2, 48.6], unit = "mN m s/rad" }\n')
+    status, text, err = run(capsys, "sweep", path, "--out", tmp_path / "t.csv", "--serial")
+    assert status == 0, err
+    assert "at 4 points (a grid of 2 d x 2 b), 2 chunks of 2" in text
+    header, rows = read_csv(tmp_path / "t.csv")
+    assert header == ("d [samples],b [N m s/rad],K_max [N m/rad],B_at_K_max [N m s/rad],"
+                      "B_min [N m s/rad],B_max [N m s/rad],area [(N m s/rad)(N m/rad)],reason")
+    loop = symstab.load_loop(LOOPS / "paper.toml")
+    for d, b, y_max, x_at, x_min, x_max, area in rows:
+        found = loop.limits(d=int(d), b=b)
+        assert b in (pytest.approx(0.0162), pytest.approx(0.0486))
+        np.testing.assert_allclose([y_max, x_at, x_min, x_max, area],
+                                   [found.y_max, found.x_at_y_max, found.x_min, found.x_max,
+                                    found.area], rtol=1e-11)
+
+
+def test_random_rows_are_drawn_in_range_and_the_npz_names_them(capsys, tmp_path):
+    path = spec(tmp_path, '[random]\nsamples = 5\nseed = 3\nd = [2, 6]\nb = [0.02, 0.04]\n')
+    status, text, err = run(capsys, "sweep", path, "--out", tmp_path / "t.npz", "--serial")
+    assert status == 0, err
+    with np.load(tmp_path / "t.npz") as f:
+        inputs, answers = f["inputs"], f["answers"]
+        assert list(f["input_names"]) == ["d [samples]", "b [N m s/rad]"]
+        assert inputs.shape == (5, 2) and answers.shape == (5, 5)
+    assert np.all((inputs[:, 0] >= 2) & (inputs[:, 0] <= 6) & (inputs[:, 0] % 1 == 0))
+    assert np.all((inputs[:, 1] >= 0.02) & (inputs[:, 1] <= 0.04))
+    assert np.all(np.isfinite(answers))
+
+
+def test_a_two_worker_cluster_gives_the_serial_table_and_resumes_after_sigint(capsys, tmp_path):
+    pytest.importorskip("dask.distributed")
+    path = spec(tmp_path, 'chunk = 1\n[grid]\nd = { from = 1, to = 30, points = 30 }\n'
+                          'b = [0.0162, 0.0648]\n')
+    status, _, err = run(capsys, "sweep", path, "--out", tmp_path / "serial.npz", "--serial")
+    assert status == 0, err
+    out = tmp_path / "cluster.npz"
+    parts = tmp_path / "cluster.npz.parts"
+    process = subprocess.Popen([sys.executable, "-m", "symstab", "sweep", str(path), "--out",
+                                str(out), "--workers", "2"], stdout=subprocess.PIPE,
+                               stderr=subprocess.PIPE, text=True)
+    deadline = time.monotonic() + 120
+    while time.monotonic() < deadline and process.poll() is None:
+        if parts.exists() and len(list(parts.glob("chunk-*.npz"))) >= 2:
+            break
+        time.sleep(0.02)
+    process.send_signal(signal.SIGINT)
+    _, stderr = process.communicate(timeout=120)
+    assert process.returncode == 130, stderr
+    saved = sorted(parts.glob("chunk-*.npz"))
+    assert 2 <= len(saved) < 60, "the sweep ended before the interruption: make it longer"
+    assert f"interrupted: {len(saved)} of 60 chunks saved in {parts}" in stderr
+    assert not out.exists() and not list(parts.glob("*.tmp"))
+    # A saved chunk is used as saved, not evaluated again: mark one, and the table shows it.
+    marked = int(saved[0].stem.split("-")[1])         # chunk = 1: chunk k is row k
+    with np.load(saved[0]) as f:
+        reasons = f["reasons"]
+    np.savez(saved[0], values=np.full((1, 5), -1.0), reasons=reasons)
+    status, text, err = run(capsys, "sweep", path, "--out", out, "--workers", "2")
+    assert status == 0, err
+    assert f"resumed: {len(saved)} of 60 chunks were saved by an earlier run" in text
+    with np.load(out) as f, np.load(tmp_path / "serial.npz") as g:
+        assert np.array_equal(f["inputs"], g["inputs"]) and f["answers"].shape == (60, 5)
+        assert np.all(f["answers"][marked] == -1.0)
+        others = np.arange(60) != marked
+        # The cluster's numbers are the serial run's, to the last bit.
+        assert np.array_equal(f["answers"][others], g["answers"][others])
+    assert not parts.exists()
+
+
+def test_the_chunks_go_once_the_table_is_written_and_another_sweep_s_are_refused(capsys,
+                                                                                 tmp_path):
+    first = spec(tmp_path, '[grid]\nd = [3]\n', "a.toml")
+    assert run(capsys, "sweep", first, "--out", tmp_path / "t.csv", "--serial")[0] == 0
+    assert (tmp_path / "t.csv").exists() and not (tmp_path / "t.csv.parts").exists()
+    parts = tmp_path / "u.csv.parts"
+    parts.mkdir()
+    (parts / "sweep.json").write_text('{"key": "another sweep"}')
+    status, _, err = run(capsys, "sweep", first, "--out", tmp_path / "u.csv", "--serial")
+    assert status == 2 and "holds the chunks of another sweep" in err
+    assert not (tmp_path / "u.csv").exists() and list(parts.iterdir()) == [parts / "sweep.json"]
+
+
+def test_without_dask_the_message_says_what_to_install(capsys, tmp_path, monkeypatch):
+    monkeypatch.setitem(sys.modules, "dask.distributed", None)
+    status, _, err = run(capsys, "sweep", spec(tmp_path, '[grid]\nd = [3]\n'), "--out",
+                         tmp_path / "t.csv")
+    assert status == 2 and "pip install '.[sweep]'" in err and "--serial" in err
+    assert not (tmp_path / "t.csv").exists()
+
+
+@pytest.mark.parametrize("text, needle", [
+    ('[grid]\nd = [3]\ncolour = "red"\n', "the sweep spec"),
+    ('colour = "red"\n[grid]\nd = [3]\n', "unknown key 'colour'"),
+    ('question = "poles"\n[grid]\nd = [3]\n', "question must be one of limits"),
+    ('chunk = 0\n[grid]\nd = [3]\n', "chunk must be an integer"),
+    ('', "give the points as [grid] or as [random]"),
+    ('[grid]\nd = [3]\n[random]\nsamples = 3\n', "one of them"),
+    ('[grid]\nK = [1, 2]\n', "K is an axis"),
+    ('[grid]\nq = [1, 2]\n', "'q' is not a parameter"),
+    ('[grid]\nd = [1.5]\n', "d counts whole samples"),
+    ('[grid]\nb = { values = [1], unit = "Hz" }\n', "Hz"),
+    ('[grid]\nb = []\n', "non-empty list"),
+    ('[grid]\nb = ["x"]\n', "must be numbers"),
+    ('[grid]\nb = { from = 0, to = 1 }\n', "points = N"),
+    ('[random]\nsamples = 0\nb = [0.01, 0.02]\n', "samples must be an integer"),
+    ('[random]\nsamples = 3\nb = [0.02, 0.01]\n', "LO < HI"),
+    ('[random]\nsamples = 3\nb = [0.01]\n', "[LO, HI]"),
+    ('[random]\nsamples = 3\nseed = -1\nb = [0.01, 0.02]\n', "seed"),
+    ('[grid]\nm = [0]\n', "the sweep spec"),
+])
+def test_a_bad_spec_is_one_line_before_any_work(capsys, tmp_path, monkeypatch, text, needle):
+    path = spec(tmp_path, text)
+    (tmp_path / "work").mkdir()
+    monkeypatch.chdir(tmp_path / "work")
+    status, out, err = run(capsys, "sweep", path, "--out", "t.csv", "--serial")
+    assert status == 2, err
+    assert err.count("\n") == 1 and needle in err, err
+    assert out == "" and list((tmp_path / "work").iterdir()) == []
+
+
+@pytest.mark.parametrize("args, needle", [
+    (["--out", "t.txt"], "--out must end in .csv or .npz"),
+    (["--out", "t.csv", "--workers", "0"], "--workers must be"),
+    (["--out", "t.csv", "--serial", "--workers", "2"], "not allowed with"),
+])
+def test_bad_options_are_one_line(capsys, tmp_path, monkeypatch, args, needle):
+    path = spec(tmp_path, '[grid]\nd = [3]\n')
+    (tmp_path / "work").mkdir()
+    monkeypatch.chdir(tmp_path / "work")
+    status, out, err = run(capsys, "sweep", path, *args)
+    assert status == 2 and needle in err.strip().splitlines()[-1], err
+    assert list((tmp_path / "work").iterdir()) == []
