@@ -77,21 +77,24 @@ def run(args):
     parts = out.with_name(out.name + ".parts")
     key = sweep_key(plan["loop_text"], plan["question"], plan["x"], plan["y"],
                     ",".join(plan["names"]), rows, chunk)
-    store = ChunkStore(parts, key, n_chunks)
     loop = plan["loop"]
-    print(f"sweep {args.spec}: {plan['question']} of loop {loop.name} in the ({plan['x']}, "
-          f"{plan['y']}) plane at {len(rows)} points ({plan['how']}), {n_chunks} chunks of "
-          f"{chunk}; saved as they finish in {parts}")
-    client = cluster = None
+    client = cluster = store = None
     try:
+        # The cluster first: an address that does not answer is refused before a folder is made.
+        where = None
         if client_of is not None:
             client, cluster, where = client_of()
+        store = ChunkStore(parts, key, n_chunks)
+        print(f"sweep {args.spec}: {plan['question']} of loop {loop.name} in the ({plan['x']}, "
+              f"{plan['y']}) plane at {len(rows)} points ({plan['how']}), {n_chunks} chunks of "
+              f"{chunk}; saved as they finish in {parts}")
+        if where is not None:
             print(f"on {where}")
         values, reasons, loaded = run_sweep(
             loop, plan["question"], plan["x"], plan["y"], plan["names"], rows, chunk=chunk,
             store=store, client=client, progress=progress_printer("sweeping", n_chunks))
     except KeyboardInterrupt:
-        saved = len(store.done())
+        saved = len(store.done()) if store is not None else 0
         print(f"{chr(10) if sys.stderr.isatty() else ''}symstab sweep: interrupted: {saved} of "
               f"{n_chunks} chunks saved in {parts}; the same command resumes there",
               file=sys.stderr)
@@ -126,7 +129,8 @@ def _client_factory(args):
         from dask.distributed import Client, LocalCluster
 
         if args.scheduler is not None:
-            return Client(args.scheduler), None, f"the Dask scheduler at {args.scheduler}"
+            return (Client(args.scheduler, timeout=10), None,
+                    f"the Dask scheduler at {args.scheduler}")
         n = args.workers or os.cpu_count() or 1
         # Its workers' log lines (a task cancelled on Ctrl-C ...) are not for the user.
         cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=True,
