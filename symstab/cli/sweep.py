@@ -288,8 +288,7 @@ def _random(where, loop, x, y, table):
         raise ValueError(f"{where}: [random] samples must be an integer from 1 to {MAX_ROWS}")
     if isinstance(seed, bool) or not isinstance(seed, int) or seed < 0:
         raise ValueError(f"{where}: [random] seed must be a non-negative integer, got {seed!r}")
-    rng = np.random.default_rng(seed)
-    names, columns = [], []
+    ranges = {}
     for name, spec in table.items():
         if name in ("samples", "seed"):
             continue
@@ -306,11 +305,15 @@ def _random(where, loop, x, y, table):
         low, high = _si(f"{where}: [random]", loop, name, spec, unit)
         if not low < high if name != "d" else not low <= high:
             raise ValueError(f"{where}: [random] {name} = [LO, HI] needs LO < HI, got {spec!r}")
-        names.append(name)
-        columns.append(rng.integers(int(low), int(high), endpoint=True, size=samples).astype(float)
-                       if name == "d" else rng.uniform(low, high, size=samples))
-    rows = np.column_stack(columns) if columns else np.empty((0, 0))
-    return names, rows, f"{samples} random draws of {', '.join(names)} (seed {seed})"
+        ranges[name] = (int(low), int(high)) if name == "d" else (low, high)
+    if not ranges:
+        return [], np.empty((0, 0)), ""
+    from ..numeric.probability import draw_values
+
+    # The draws of the probability map's: one seeded generator, whole delays for d.
+    draws = draw_values(loop, ranges, samples, seed, axes=(x, y))
+    rows = np.column_stack([draws[n] for n in ranges])
+    return list(ranges), rows, f"{samples} random draws of {', '.join(ranges)} (seed {seed})"
 
 
 def _table(plan, values, reasons, suffix):
