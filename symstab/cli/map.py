@@ -416,6 +416,10 @@ def _probability(args, setup, xs, ys, out, png_path):
     if args.simulate:
         raise ValueError("--uncertain maps the probability of stability by root counts; "
                          "--simulate simulates the nominal loop: give one of them")
+    for flag, dest in _LOOP_SIMULATION_OPTIONS:
+        if getattr(args, dest) not in (None, False):
+            raise ValueError(f"{flag} is an option of the simulation; --uncertain maps root "
+                             f"counts: drop {flag}")
     loop, x, y = setup.loop, setup.x, setup.y
     box = _uncertain_box(args, setup)
     samples = 1000 if args.samples is None else args.samples

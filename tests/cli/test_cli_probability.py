@@ -79,6 +79,7 @@ def test_a_delay_drawn_and_the_csv(capsys, tmp_path):
     (["--loop", PAPER, *GRID, "--uncertain", "b=0.01:0.02", "--seed", "-1"], "seed"),
     (["--loop", PAPER, *GRID, "--samples", "10"], "--samples counts the draws of --uncertain"),
     (["--loop", PAPER, *GRID, "--uncertain", "b=0.01:0.02", "--simulate"], "give one of them"),
+    (["--loop", PAPER, *GRID, "--uncertain", "b=0.01:0.02", "--steps", "100"], "drop --steps"),
     (["--loop", LOOPS / "lowpass_velocity.toml", *GRID, "--uncertain", "f_c=100:600"],
      "--uncertain f_c"),
 ])
