@@ -19,7 +19,7 @@ import time
 import numpy as np
 
 import symstab
-from symstab.numeric.sweep import ChunkStore, run_sweep
+from symstab.numeric.sweep import ChunkStore, Question, run_sweep
 
 from _timing import fmt
 
@@ -45,7 +45,7 @@ def main():
     with tempfile.TemporaryDirectory() as tmp:
         n_chunks = -(-len(rows) // args.chunk)
         start = time.perf_counter()
-        serial, _, _ = run_sweep(loop, "limits", "B", "K", names, rows, chunk=args.chunk,
+        serial, _, _ = run_sweep(loop, Question("limits", "B", "K"), names, rows, chunk=args.chunk,
                                  store=ChunkStore(pathlib.Path(tmp) / "serial", "s", n_chunks))
         t_serial = time.perf_counter() - start
         start = time.perf_counter()
@@ -55,7 +55,7 @@ def main():
         t_start = time.perf_counter() - start
         try:
             start = time.perf_counter()
-            found, _, _ = run_sweep(loop, "limits", "B", "K", names, rows, chunk=args.chunk,
+            found, _, _ = run_sweep(loop, Question("limits", "B", "K"), names, rows, chunk=args.chunk,
                                     store=ChunkStore(pathlib.Path(tmp) / "dask", "d", n_chunks),
                                     client=client)
             t_dask = time.perf_counter() - start

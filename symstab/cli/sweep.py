@@ -1,7 +1,9 @@
 """``symstab sweep SPEC.toml``: one question asked of a loop at many parameter points, on Dask.
 
 The spec (TOML) names the loop file (relative to the spec), the question
-(``limits``), optionally the plane, the rows per chunk, and the points:
+(``limits``, or ``design`` with a ``[design]`` table: ``over = {NAME = [LO,
+HI]}``, one or two parameters, and ``maximize``, K_max, the Z-width or the
+passive K_max), optionally the plane, the rows per chunk, and the points:
 either ``[grid]``, every combination of the values given for each parameter
 (a list, or ``{from = LO, to = HI, points = N}``; ``unit = "..."`` converts
 them, else they are in the loop file's unit), or ``[random]``, ``samples``
@@ -34,7 +36,10 @@ __all__ = ["register", "run", "MAX_ROWS"]
 MAX_ROWS = 1_000_000
 #: The largest spec read.
 _MAX_SPEC_BYTES = 1 << 20
-_KEYS = {"loop", "question", "plane", "chunk", "grid", "random"}
+_KEYS = {"loop", "question", "plane", "chunk", "grid", "random", "design"}
+#: ``[design] maximize``'s words (those of ``symstab design --maximize``).
+_TARGETS = {"y_max": "y_max", "K_max": "y_max", "area": "area", "Z-width": "area",
+            "passive": "passive"}
 #: Rows per chunk by default: a task long enough to hide the cluster's overhead.
 _DEFAULT_CHUNK = 10
 
@@ -75,8 +80,8 @@ def run(args):
     rows, chunk = plan["rows"], plan["chunk"]
     n_chunks = math.ceil(len(rows) / chunk)
     parts = out.with_name(out.name + ".parts")
-    key = sweep_key(plan["loop_text"], plan["question"], plan["x"], plan["y"],
-                    ",".join(plan["names"]), rows, chunk)
+    key = sweep_key(plan["loop_text"], repr(plan["question"]), ",".join(plan["names"]), rows,
+                    chunk)
     loop = plan["loop"]
     client = cluster = store = None
     try:
@@ -85,14 +90,15 @@ def run(args):
         if client_of is not None:
             client, cluster, where = client_of()
         store = ChunkStore(parts, key, n_chunks)
-        print(f"sweep {args.spec}: {plan['question']} of loop {loop.name} in the ({plan['x']}, "
-              f"{plan['y']}) plane at {len(rows)} points ({plan['how']}), {n_chunks} chunks of "
+        question = plan["question"]
+        print(f"sweep {args.spec}: {question.kind} of loop {loop.name} in the ({question.x}, "
+              f"{question.y}) plane at {len(rows)} points ({plan['how']}), {n_chunks} chunks of "
               f"{chunk}; saved as they finish in {parts}")
         if where is not None:
             print(f"on {where}")
         values, reasons, loaded = run_sweep(
-            loop, plan["question"], plan["x"], plan["y"], plan["names"], rows, chunk=chunk,
-            store=store, client=client, progress=progress_printer("sweeping", n_chunks))
+            loop, plan["question"], plan["names"], rows, chunk=chunk, store=store,
+            client=client, progress=progress_printer("sweeping", n_chunks))
     except KeyboardInterrupt:
         saved = len(store.done()) if store is not None else 0
         print(f"{chr(10) if sys.stderr.isatty() else ''}symstab sweep: interrupted: {saved} of "
@@ -110,8 +116,9 @@ def run(args):
     write_output(out, _table(plan, values, reasons, out.suffix), "--out")
     # The table holds every chunk now: the folder kept for a resume goes.
     shutil.rmtree(parts, ignore_errors=True)
-    stable = int(np.count_nonzero(np.isfinite(values[:, 0])))
-    print(f"{stable} of {len(rows)} points have a stable set; wrote {out}")
+    answered = int(np.count_nonzero(np.all(np.isfinite(values), axis=1)))
+    print(f"{answered} of {len(rows)} points answered in full (the others' reasons are in the "
+          f"table); wrote {out}")
     return 0
 
 
@@ -170,17 +177,24 @@ def read_spec(path):
         loop_text = loop_path.read_text(encoding="utf-8")
     except OSError as exc:
         raise ValueError(f"{where}: cannot read {loop_path}: {exc.strerror or exc}") from None
-    from ..numeric.sweep import QUESTIONS
+    from ..numeric.sweep import QUESTIONS, Question
 
-    question = spec.get("question", "limits")
-    if question not in QUESTIONS:
+    kind = spec.get("question", "limits")
+    if kind not in QUESTIONS:
         raise ValueError(f"{where}: question must be one of {', '.join(QUESTIONS)}, got "
-                         f"{question!r}")
+                         f"{kind!r}")
     plane = spec.get("plane", loop.plane)
     if (not isinstance(plane, (list, tuple)) or len(plane) != 2
             or not all(isinstance(n, str) for n in plane)):
         raise ValueError(f"{where}: plane must be two parameter names, e.g. [\"B\", \"K\"]")
     x, y = plane
+    if ("design" in spec) != (kind == "design"):
+        raise ValueError(f"{where}: [design] (over, maximize) goes with question = \"design\", "
+                         f"and only with it")
+    over, maximize = (), "y_max"
+    if kind == "design":
+        over, maximize = _design(where, loop, x, y, spec["design"])
+    question = Question(kind, x, y, over=over, maximize=maximize)
     chunk = spec.get("chunk", _DEFAULT_CHUNK)
     if isinstance(chunk, bool) or not isinstance(chunk, int) or not 1 <= chunk <= 10_000:
         raise ValueError(f"{where}: chunk must be an integer from 1 to 10000 (rows per task), "
@@ -196,6 +210,10 @@ def read_spec(path):
         names, rows, how = _random(where, loop, x, y, table)
     if not names:
         raise ValueError(f"{where}: sweep at least one parameter")
+    searched = [name for name, _, _ in over if name in names]
+    if searched:
+        raise ValueError(f"{where}: {searched[0]} is swept and searched: give it in [grid] or "
+                         f"[random], or in [design] over, not both")
     # The first row asked of the loop now: a value out of its domain is refused before the run.
     from ..numeric.loop_units import FileParameters, check_bounds
 
@@ -207,16 +225,52 @@ def read_spec(path):
     # the run, not in the middle of it.
     import itertools
 
-    for corner in itertools.product(*[(rows[:, k].min(), rows[:, k].max())
-                                      for k in range(len(names))]):
-        values = {n: int(v) if n == "d" else float(v) for n, v in zip(names, corner)}
+    ends = [(n, (rows[:, k].min(), rows[:, k].max())) for k, n in enumerate(names)]
+    ends += [(name, (low, high)) for name, low, high in over]
+    for corner in itertools.product(*[pair for _, pair in ends]):
+        values = {n: int(v) if n == "d" else float(v) for (n, _), v in zip(ends, corner)}
         try:
             loop.polynomial(**{**values, x: 0.0, y: 0.0})
         except (TypeError, ValueError) as exc:
             at = ", ".join(f"{n} = {v:.6g}" for n, v in values.items())
             raise ValueError(f"{where}: at {at}: {exc}") from None
-    return {"loop": loop, "loop_text": loop_text, "question": question, "x": x, "y": y,
+    return {"loop": loop, "loop_text": loop_text, "question": question,
             "names": tuple(names), "rows": rows, "chunk": chunk, "how": how}
+
+
+def _design(where, loop, x, y, table):
+    """``(over, maximize)`` of the spec's ``[design]`` table, the ranges in SI."""
+    if not isinstance(table, dict):
+        raise ValueError(f"{where}: [design] must be a table")
+    extra = sorted(set(table) - {"over", "maximize"})
+    if extra:
+        raise ValueError(f"{where}: [design]: unknown key {extra[0]!r} (over, maximize)")
+    maximize = table.get("maximize", "y_max")
+    if maximize not in _TARGETS:
+        raise ValueError(f"{where}: [design] maximize must be one of {', '.join(_TARGETS)} (the "
+                         f"simulated target is not swept), got {maximize!r}")
+    over = table.get("over")
+    if not isinstance(over, dict) or not 1 <= len(over) <= 2:
+        raise ValueError(f"{where}: [design] over = {{NAME = [LO, HI]}} names one or two "
+                         f"parameters to search")
+    ranges = []
+    for name, spec in over.items():
+        _check_name(where, loop, x, y, name)
+        if name == "d":
+            raise ValueError(f"{where}: [design] over d: the delay is a whole number of "
+                             f"samples; sweep it in [grid] instead")
+        unit = None
+        if isinstance(spec, dict):
+            unit, spec = spec.get("unit"), spec.get("range")
+        if not isinstance(spec, list) or len(spec) != 2:
+            raise ValueError(f"{where}: [design] over {name} must be [LO, HI] or "
+                             f"{{range = [LO, HI], unit = \"...\"}}")
+        low, high = _si(f"{where}: [design] over", loop, name, spec, unit)
+        if not low < high:
+            raise ValueError(f"{where}: [design] over {name} = [LO, HI] needs LO < HI, got "
+                             f"{spec!r}")
+        ranges.append((name, low, high))
+    return tuple(ranges), _TARGETS[maximize]
 
 
 def _check_name(where, loop, x, y, name):
@@ -318,23 +372,28 @@ def _random(where, loop, x, y, table):
 
 def _table(plan, values, reasons, suffix):
     """The table's bytes: every row's inputs and answers, the units in the names."""
-    loop, x, y = plan["loop"], plan["x"], plan["y"]
+    loop, question = plan["loop"], plan["question"]
     units = getattr(loop, "units", {}) or {}
 
-    def label(name):
-        unit = "samples" if name == "d" else units.get(name, "")
+    def unit_of(name):
+        if name == "d":
+            return "samples"
+        if name == "area":
+            ux, uy = units.get(question.x, ""), units.get(question.y, "")
+            return f"({ux})({uy})" if ux and uy else ""
+        return units.get(name, "")
+
+    def label(name, of):
+        unit = unit_of(of)
         return f"{name} [{unit}]" if unit else name
 
-    answers = [f"{y}_max", f"{x}_at_{y}_max", f"{x}_min", f"{x}_max", "area"]
-    answer_units = [units.get(y, ""), units.get(x, ""), units.get(x, ""), units.get(x, ""),
-                    f"({units.get(x, '')})({units.get(y, '')})" if units.get(x) else ""]
-    inputs = [label(n) for n in plan["names"]]
-    outputs = [f"{a} [{u}]" if u else a for a, u in zip(answers, answer_units)]
+    inputs = [label(n, n) for n in plan["names"]]
+    outputs = [label(name, of) for name, of in question.columns()]
     if suffix == ".npz":
         buf = io.BytesIO()
         np.savez(buf, inputs=plan["rows"], input_names=np.array(inputs),
                  answers=values, answer_names=np.array(outputs),
-                 reasons=np.array(reasons, dtype=str), question=np.array(plan["question"]),
+                 reasons=np.array(reasons, dtype=str), question=np.array(question.kind),
                  loop=np.array(loop.name))
         return buf.getvalue()
     buf = io.StringIO()

@@ -2,9 +2,11 @@
 
 A sweep is a table of rows, each a value of every swept parameter (a
 device family, delays, cut-offs, uncertain values ...), and a question
-asked at every row: today the limits of the stable set in the loop's plane
-(:meth:`symstab.Loop.limits`: the largest ``y``, the ``x`` where it is
-reached, the extent in ``x`` and the area).  The rows are cut into chunks;
+asked at every row (:class:`Question`): the limits of the stable set in the
+loop's plane (:meth:`symstab.Loop.limits`: the largest ``y``, the ``x``
+where it is reached, the extent in ``x`` and the area), or the best value
+of one or two parameters for K_max, the Z-width or the passive K_max
+(:meth:`symstab.Loop.design`).  The rows are cut into chunks;
 each chunk is evaluated serially or as one task on a Dask cluster
 (:mod:`dask.distributed`, an optional extra), and saved, complete, in a
 folder as soon as it is done (:class:`ChunkStore`): an interrupted sweep
@@ -12,6 +14,7 @@ run again skips the chunks already saved.  Every row is evaluated by the
 same code wherever it runs, so a cluster gives the serial numbers exactly.
 """
 
+import dataclasses
 import hashlib
 import json
 import os
@@ -19,22 +22,78 @@ import pathlib
 
 import numpy as np
 
-__all__ = ["QUESTIONS", "evaluate_rows", "ChunkStore", "run_sweep", "sweep_key"]
+__all__ = ["QUESTIONS", "Question", "evaluate_rows", "ChunkStore", "run_sweep", "sweep_key"]
 
-#: The questions a sweep asks, and the columns each answers (in the plane's names).
-QUESTIONS = {"limits": ("y_max", "x_at_y_max", "x_min", "x_max", "area")}
+#: The questions a sweep asks.
+QUESTIONS = {
+    "limits": "the limits of the stable set in the plane (Loop.limits)",
+    "design": "the best value of one or two parameters (Loop.design)",
+}
 
 
-def evaluate_rows(loop, question, x, y, names, rows):
+@dataclasses.dataclass(frozen=True)
+class Question:
+    """What a sweep asks at every row, and the columns of its answer.
+
+    Attributes
+    ----------
+    kind : str
+        A key of :data:`QUESTIONS`.
+    x, y : str
+        The plane.
+    over : tuple of (str, float, float)
+        ``design``: the parameters searched and their ranges (SI).
+    maximize : str
+        ``design``: ``"y_max"``, ``"area"`` or ``"passive"``.
+    """
+
+    kind: str
+    x: str
+    y: str
+    over: tuple = ()
+    maximize: str = "y_max"
+
+    def __post_init__(self):
+        if self.kind not in QUESTIONS:
+            raise ValueError(f"question must be one of {', '.join(QUESTIONS)}, got {self.kind!r}")
+        if self.kind == "design" and not 1 <= len(self.over) <= 2:
+            raise ValueError("design searches one or two parameters: give over")
+        if self.kind == "design" and self.maximize not in ("y_max", "area", "passive"):
+            raise ValueError(f"maximize must be y_max, area or passive, got {self.maximize!r}")
+
+    def columns(self):
+        """The answer's columns: ``(name, the parameter whose unit it has, or "area")``."""
+        x, y = self.x, self.y
+        if self.kind == "limits":
+            return ((f"{y}_max", y), (f"{x}_at_{y}_max", x), (f"{x}_min", x), (f"{x}_max", x),
+                    ("area", "area"))
+        target = {"y_max": (f"{y}_max", y), "area": ("area", "area"),
+                  "passive": (f"passive_{y}_max", y)}[self.maximize]
+        return tuple((f"best_{name}", name) for name, _, _ in self.over) + (
+            (target[0] + "_at_best", target[1]), (target[0] + "_at_nominal", target[1]))
+
+    def answer(self, loop, values):
+        """The answer's numbers at one row (NaN: none) and why there is none (or empty)."""
+        if self.kind == "limits":
+            found = loop.limits(self.x, self.y, **values)
+            numbers = (found.y_max, found.x_at_y_max, found.x_min, found.x_max, found.area)
+            return [np.nan if v is None else float(v) for v in numbers], found.reason
+        found = loop.design(over={name: (low, high) for name, low, high in self.over},
+                            maximize=self.maximize, x=self.x, y=self.y, **values)
+        best = [np.nan if found.best is None else float(found.best[name])
+                for name, _, _ in self.over]
+        value = [np.nan if v is None or not np.isfinite(v) else float(v)
+                 for v in (found.value, found.value_nominal)]
+        return best + value, found.message
+
+
+def evaluate_rows(loop, question, names, rows):
     """Answer ``question`` at every row: ``(values (n, k), reasons (n,))``.
 
     Parameters
     ----------
     loop : symstab.Loop
-    question : str
-        A key of :data:`QUESTIONS`.
-    x, y : str
-        The plane.
+    question : Question
     names : tuple of str
         The swept parameters, the columns of ``rows``.
     rows : ndarray, shape (n, len(names))
@@ -44,18 +103,14 @@ def evaluate_rows(loop, question, x, y, names, rows):
     -------
     (ndarray, list of str)
         The answers (NaN where there is none: an empty stable set) and why
-        a set is empty or unbounded (empty text otherwise).
+        (empty text where there is an answer).
     """
-    if question not in QUESTIONS:
-        raise ValueError(f"question must be one of {', '.join(QUESTIONS)}, got {question!r}")
-    out = np.full((len(rows), len(QUESTIONS[question])), np.nan)
+    out = np.full((len(rows), len(question.columns())), np.nan)
     reasons = []
     for i, row in enumerate(rows):
         values = {n: int(v) if n == "d" else float(v) for n, v in zip(names, row)}
-        found = loop.limits(x, y, **values)
-        out[i] = [np.nan if v is None else float(v)
-                  for v in (found.y_max, found.x_at_y_max, found.x_min, found.x_max, found.area)]
-        reasons.append(found.reason)
+        out[i], reason = question.answer(loop, values)
+        reasons.append(reason)
     return out, reasons
 
 
@@ -119,12 +174,12 @@ def _write_atomically(path, data):
     os.replace(tmp, path)
 
 
-def run_sweep(loop, question, x, y, names, rows, *, chunk, store, client=None, progress=None):
+def run_sweep(loop, question, names, rows, *, chunk, store, client=None, progress=None):
     """Evaluate every row, a chunk at a time, serially or on ``client``; the whole table.
 
     Parameters
     ----------
-    loop, question, x, y, names, rows
+    loop, question, names, rows
         As :func:`evaluate_rows`.
     chunk : int
         Rows per chunk (a task on the cluster; a file in the store).
@@ -143,7 +198,7 @@ def run_sweep(loop, question, x, y, names, rows, *, chunk, store, client=None, p
         number of chunks loaded from the store rather than evaluated.
     """
     slices = [slice(i, min(i + chunk, len(rows))) for i in range(0, len(rows), chunk)]
-    values = np.full((len(rows), len(QUESTIONS[question])), np.nan)
+    values = np.full((len(rows), len(question.columns())), np.nan)
     reasons = [""] * len(rows)
     done = store.done()
 
@@ -159,7 +214,7 @@ def run_sweep(loop, question, x, y, names, rows, *, chunk, store, client=None, p
     todo = [i for i in range(len(slices)) if i not in done]
     if client is None:
         for index in todo:
-            result = evaluate_rows(loop, question, x, y, names, rows[slices[index]])
+            result = evaluate_rows(loop, question, names, rows[slices[index]])
             store.save(index, *result)
             keep(index, result)
             finished += 1
@@ -169,7 +224,7 @@ def run_sweep(loop, question, x, y, names, rows, *, chunk, store, client=None, p
         from dask.distributed import as_completed
 
         shared = client.scatter(loop, broadcast=True)
-        futures = {client.submit(evaluate_rows, shared, question, x, y, names, rows[slices[i]],
+        futures = {client.submit(evaluate_rows, shared, question, names, rows[slices[i]],
                                  pure=False): i for i in todo}
         try:
             for future in as_completed(futures):

@@ -54,6 +54,26 @@ def test_each_row_is_the_loop_s_limits_at_its_values_in_si(capsys, tmp_path):
                                     found.area], rtol=1e-11)
 
 
+def test_a_design_sweep_finds_the_best_virtual_mass_at_each_delay(capsys, tmp_path):
+    """The virtual mass M that maximises K_max at d = 0 and d = 40: the gains over M = 0
+    are best_virtual_mass's published 5.82 and 4.14, and each row is Loop.design's."""
+    path = spec(tmp_path, 'question = "design"\n[grid]\nd = [0, 40]\n'
+                          '[design]\nover = { M = { range = [-14.1, 38.4], unit = "g m^2" } }\n'
+                          'maximize = "K_max"\n')
+    status, text, err = run(capsys, "sweep", path, "--out", tmp_path / "t.npz", "--serial")
+    assert status == 0, err
+    assert "design of loop paper in the (B, K) plane at 2 points" in text
+    with np.load(tmp_path / "t.npz") as f:
+        answers, names = f["answers"], list(f["answer_names"])
+    assert names == ["best_M [kg m^2]", "K_max_at_best [N m/rad]", "K_max_at_nominal [N m/rad]"]
+    gains = answers[:, 1] / answers[:, 2]
+    np.testing.assert_allclose(gains, [5.82, 4.14], atol=0.005)
+    loop = symstab.load_loop(LOOPS / "paper.toml")
+    for d, (best, value, nominal) in zip((0, 40), answers):
+        found = loop.design(over={"M": (-0.0141, 0.0384)}, d=d)
+        assert (best, value, nominal) == (found.best["M"], found.value, found.value_nominal)
+
+
 def test_random_rows_are_drawn_in_range_and_the_npz_names_them(capsys, tmp_path):
     path = spec(tmp_path, '[random]\nsamples = 5\nseed = 3\nd = [2, 6]\nb = [0.02, 0.04]\n')
     status, text, err = run(capsys, "sweep", path, "--out", tmp_path / "t.npz", "--serial")
@@ -147,6 +167,16 @@ def test_without_dask_the_message_says_what_to_install(capsys, tmp_path, monkeyp
     ('[random]\nsamples = 3\nb = [0.01]\n', "[LO, HI]"),
     ('[random]\nsamples = 3\nseed = -1\nb = [0.01, 0.02]\n', "seed"),
     ('[grid]\nm = [0]\n', "the sweep spec"),
+    ('question = "design"\n[grid]\nd = [3]\n', "[design] (over, maximize) goes with"),
+    ('[grid]\nd = [3]\n[design]\nover = { M = [0, 1] }\n', "goes with question"),
+    ('question = "design"\n[grid]\nd = [3]\n[design]\nover = { d = [0, 1] }\n',
+     "whole number"),
+    ('question = "design"\n[grid]\nM = [0]\n[design]\nover = { M = [0, 0.01] }\n',
+     "swept and searched"),
+    ('question = "design"\n[grid]\nd = [3]\n[design]\nover = { M = [0, 0.01] }\n'
+     'maximize = "simulated"\n', "maximize must be one of"),
+    ('question = "design"\n[grid]\nd = [3]\n[design]\nover = { M = [0.01, 0] }\n',
+     "LO < HI"),
 ])
 def test_a_bad_spec_is_one_line_before_any_work(capsys, tmp_path, monkeypatch, text, needle):
     path = spec(tmp_path, text)
