@@ -30,7 +30,7 @@ from .loop_options import convert_sets, load_loop_file
 from .options import add_command
 from .output import check_files, write_output
 
-__all__ = ["register", "run", "MAX_ROWS"]
+__all__ = ["register", "run", "MAX_ROWS", "local_cluster", "read_spec"]
 
 #: The most rows a sweep has (each is a certified region, about 0.1 to 1 s).
 MAX_ROWS = 1_000_000
@@ -133,18 +133,33 @@ def _client_factory(args):
                          "or give --serial") from None
 
     def make():
-        from dask.distributed import Client, LocalCluster
+        from dask.distributed import Client
 
         if args.scheduler is not None:
             return (Client(args.scheduler, timeout=10), None,
                     f"the Dask scheduler at {args.scheduler}")
         n = args.workers or os.cpu_count() or 1
-        # Its workers' log lines (a task cancelled on Ctrl-C ...) are not for the user.
-        cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=True,
-                               dashboard_address=None, silence_logs=logging.ERROR)
+        cluster = local_cluster(n)
         return Client(cluster), cluster, f"a Dask LocalCluster of {n} worker process(es)"
 
     return make
+
+
+def local_cluster(n_workers):
+    """A Dask ``LocalCluster`` of ``n_workers`` single-threaded worker processes, quiet.
+
+    Its workers' log lines (a task cancelled on Ctrl-C ...) are not for the
+    user, and their statistical profiler is off: sampling the stack every
+    10 ms took about a tenth of their time on this package's Python-heavy
+    rows (measured: 200 regions on two workers, 13.0 s with it, 11.6 s
+    without).
+    """
+    import dask
+    from dask.distributed import LocalCluster
+
+    with dask.config.set({"distributed.worker.profile.enabled": False}):
+        return LocalCluster(n_workers=n_workers, threads_per_worker=1, processes=True,
+                            dashboard_address=None, silence_logs=logging.ERROR)
 
 
 def read_spec(path):

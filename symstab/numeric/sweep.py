@@ -224,6 +224,11 @@ def run_sweep(loop, question, names, rows, *, chunk, store, client=None, progres
         from dask.distributed import as_completed
 
         shared = client.scatter(loop, broadcast=True)
+        if "d" in names:
+            # A row's cost grows with its delay: the longest go first, so that no long chunk
+            # is left to run alone at the end while the other workers wait.
+            column = list(names).index("d")
+            todo.sort(key=lambda i: -rows[slices[i], column].max())
         futures = {client.submit(evaluate_rows, shared, question, names, rows[slices[i]],
                                  pure=False): i for i in todo}
         try:
