@@ -17,10 +17,11 @@ same code wherever it runs, so a cluster gives the serial numbers exactly.
 import dataclasses
 import hashlib
 import json
-import os
 import pathlib
 
 import numpy as np
+
+from ..proof.derive import write_bytes
 
 __all__ = ["QUESTIONS", "Question", "evaluate_rows", "ChunkStore", "run_sweep", "sweep_key"]
 
@@ -128,8 +129,8 @@ class ChunkStore:
 
     ``folder/sweep.json`` holds the sweep's key (:func:`sweep_key`); a
     folder that holds another sweep's chunks is refused, not mixed in.
-    A chunk is written to a temporary name and renamed, so a file there is
-    always whole, also after an interruption.
+    A chunk is written atomically (:func:`symstab.proof.derive.write_bytes`),
+    so a file there is always whole, also after an interruption.
     """
 
     def __init__(self, folder, key, n_chunks):
@@ -145,7 +146,7 @@ class ChunkStore:
                                  f"sweep's): remove it, or write this sweep elsewhere")
         else:
             self.folder.mkdir(parents=True, exist_ok=True)
-            _write_atomically(manifest, json.dumps({"key": key, "chunks": n_chunks}).encode())
+            write_bytes(manifest, json.dumps({"key": key, "chunks": n_chunks}).encode())
         self.n_chunks = n_chunks
 
     def path(self, index):
@@ -160,18 +161,11 @@ class ChunkStore:
 
         buf = io.BytesIO()
         np.savez(buf, values=values, reasons=np.array(reasons, dtype=str))
-        _write_atomically(self.path(index), buf.getvalue())
+        write_bytes(self.path(index), buf.getvalue())
 
     def load(self, index):
         with np.load(self.path(index)) as f:
             return f["values"], [str(r) for r in f["reasons"]]
-
-
-def _write_atomically(path, data):
-    tmp = path.with_name(path.name + ".tmp")
-    with open(tmp, "wb") as fh:
-        fh.write(data)
-    os.replace(tmp, path)
 
 
 def run_sweep(loop, question, names, rows, *, chunk, store, client=None, progress=None):
