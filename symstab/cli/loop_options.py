@@ -35,7 +35,7 @@ __all__ = ["DEVICE_OPTIONS", "POINT_OPTIONS", "EXAMPLE", "LINEAR_WITH_LOOP", "ad
            "uses_loop", "split_unit", "parse_number", "convert_sets", "LoopSetup", "value_text",
            "loop_echo", "load_loop_file", "add_delay", "check_names", "loop_values", "resolve_loop",
            "resolve_setup", "paper_setup", "TABLE_ONE", "point_count", "broadcast", "range_text",
-           "converted_range", "check_box"]
+           "converted_range", "check_box", "check_corners"]
 
 
 #: The paper's device options every numeric command has, with the ``--set``
@@ -438,19 +438,30 @@ def check_box(setup, box, flag):
 
     ``flag`` names the option that gave the box (``--over``, ``--uncertain``).
     """
+    check_corners(setup.loop, setup.values, setup.x, setup.y, box,
+                  " ".join(f"{flag} {n}" for n in box))
+
+
+def check_corners(loop, values, x, y, box, where):
+    """Every corner of ``box`` (``{name: (low, high)}``; ``d`` whole) at ``values``, checked.
+
+    Within the loop file's bounds and the loop's domain (its polynomial
+    exists there, the plane's parameters at 0); the message begins with
+    ``where`` and names the corner.
+    """
     from ..numeric.design import box_corners
     from ..numeric.loop_units import FileParameters, check_bounds
 
-    known = getattr(setup.loop, "file_parameters", None) or FileParameters({})
-    flags = " ".join(f"{flag} {n}" for n in box)
+    known = getattr(loop, "file_parameters", None) or FileParameters({})
     for corner in box_corners(box):
-        values = {**setup.values, **corner}
-        check_bounds(known, values, skip=(setup.x, setup.y), where=lambda names: flags)
+        corner = {n: int(v) if n == "d" else float(v) for n, v in corner.items()}
+        at_corner = {**values, **corner}
+        check_bounds(known, at_corner, skip=(x, y), where=lambda names: where)
         try:
-            setup.loop.polynomial(**{**values, setup.x: 0.0, setup.y: 0.0})
+            loop.polynomial(**{**at_corner, x: 0.0, y: 0.0})
         except (TypeError, ValueError) as exc:
             at = ", ".join(f"{k} = {v:.6g}" for k, v in corner.items())
-            raise ValueError(f"{flags}: at {at}: {exc}") from None
+            raise ValueError(f"{where}: at {at}: {exc}") from None
 
 
 def _quantity_text(name, value):

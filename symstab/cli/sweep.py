@@ -26,7 +26,7 @@ import sys
 
 import numpy as np
 
-from .loop_options import convert_sets, load_loop_file
+from .loop_options import check_corners, convert_sets, load_loop_file
 from .options import add_command
 from .output import check_files, write_output
 
@@ -238,17 +238,9 @@ def read_spec(path):
                  where=lambda bad: f"{where}: a point's " + ", ".join(bad))
     # The box's corners asked of the loop now: a value outside its domain is refused before
     # the run, not in the middle of it.
-    import itertools
-
-    ends = [(n, (rows[:, k].min(), rows[:, k].max())) for k, n in enumerate(names)]
-    ends += [(name, (low, high)) for name, low, high in over]
-    for corner in itertools.product(*[pair for _, pair in ends]):
-        values = {n: int(v) if n == "d" else float(v) for (n, _), v in zip(ends, corner)}
-        try:
-            loop.polynomial(**{**values, x: 0.0, y: 0.0})
-        except (TypeError, ValueError) as exc:
-            at = ", ".join(f"{n} = {v:.6g}" for n, v in values.items())
-            raise ValueError(f"{where}: at {at}: {exc}") from None
+    box = {n: (rows[:, k].min(), rows[:, k].max()) for k, n in enumerate(names)}
+    box.update({name: (low, high) for name, low, high in over})
+    check_corners(loop, loop.defaults, x, y, box, where)
     return {"loop": loop, "loop_text": loop_text, "question": question,
             "names": tuple(names), "rows": rows, "chunk": chunk, "how": how}
 
