@@ -45,7 +45,7 @@ from .numeric.curves import BoundaryCurve, arc_end_angle
 from .numeric.region import boundary_curve
 from .numeric.stability import MARGINAL, STABLE, UNSTABLE, classify, is_stable, spectral_radius
 from .numeric.region import BestVirtualMass, StabilityRegion, best_virtual_mass, limits
-from .numeric.results import Limits, StabilityProbability
+from .numeric.results import Limits, RobustRegion, StabilityProbability
 from .numeric.any_loop import Loop, LoopBoundary, LoopLimits
 from .numeric.loop_files import load_loop
 from .numeric.decomposition import Branch, Cell, Decomposition
@@ -76,6 +76,7 @@ __all__ = [
     "theta_max_approx",
     "Nonidealities", "Simulation", "simulate", "StabilityMap", "stability_map",
     "StabilityProbability",
+    "RobustRegion",
 ]
 
 

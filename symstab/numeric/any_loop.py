@@ -785,8 +785,15 @@ class Loop(LoopModel):
         pieces = self.region(x, y, **values).segments if segments else ()
         return Boundary(x, y, theta, xs, ys, lines=lines, segments=pieces, at=dict(values))
 
-    def region(self, x=None, y=None, *, x_range=None, y_range=None, **values):
+    def region(self, x=None, y=None, *, x_range=None, y_range=None, uncertain=None, strips=64,
+               rtol=1e-6, **values):
         """The complete D-decomposition of the ``(x, y)`` plane: cells, root counts, stable set.
+
+        With ``uncertain``, the robust region instead: the points stable for
+        every value in a box (:func:`symstab.numeric.robust.robust_region`
+        states the guarantee), a
+        :class:`~symstab.numeric.results.RobustRegion` with the nominal
+        decomposition (at the box's centre) beside it.
 
         Every branch of the arc (``theta`` over all of (0, pi)), the z = 1,
         z = -1 and leading-coefficient lines, the cells they cut the window
@@ -809,6 +816,13 @@ class Loop(LoopModel):
             and is widened (up to 10 times) while a stable cell reaches that
             side; if it still does, the side is in
             :attr:`Decomposition.unbounded`.
+        uncertain : dict, optional
+            ``{name: (low, high)}`` of the plant's and environment's
+            parameters (``T`` too) and ``d`` (whole delays): the box.
+        strips, rtol : optional
+            With ``uncertain``: vertical strips across the window, and the
+            resolution of the certified intervals' ends (a fraction of the
+            window's height).
         **values
             Single values of every other parameter.
 
@@ -827,8 +841,16 @@ class Loop(LoopModel):
         >>> region = loop.region("B", "K")
         >>> [cell.count for cell in region.stable]
         [0]
+        >>> robust = loop.region("B", "K", uncertain={"b": (0.0162, 0.0648)}, strips=16)
+        >>> 0 < robust.area < robust.nominal.area
+        True
         """
         x, y = self._plane(x, y)
+        if uncertain is not None:
+            from .robust import robust_region
+
+            return robust_region(self, x, y, uncertain=uncertain, strips=strips, rtol=rtol,
+                                 x_range=x_range, y_range=y_range, **values)
         given = {key: None if window is None else check_window(key, window)
                  for key, window in (("x_range", x_range), ("y_range", y_range))}
         structured, slopes, ends = self.affine_parts((x, y), values, structured=True)
@@ -927,7 +949,10 @@ class Loop(LoopModel):
             :attr:`plane`).
         **values
             Single values of every other parameter (and ``x_range`` /
-            ``y_range`` for :meth:`region`).
+            ``y_range`` for :meth:`region`; with ``uncertain``, ``strips`` and
+            ``rtol``, the robust region's: its limits are then the robust
+            set's, with :attr:`~symstab.numeric.results.Limits.region` the
+            :class:`~symstab.numeric.results.RobustRegion`).
 
         Returns
         -------
@@ -936,6 +961,9 @@ class Loop(LoopModel):
             says why) when no point is stable: proved, not a failure to find
             one (see :meth:`region`).
         """
+        if values.get("uncertain") is not None:
+            return self.region(x, y, **values).limits()
+        values.pop("uncertain", None)
         found = self.region(x, y, **values)
         at = {k: v for k, v in values.items() if k not in ("x_range", "y_range")}
         return found.limits(at=at, line=functools.partial(_stable_intervals_at, self, found.x,

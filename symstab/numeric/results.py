@@ -18,7 +18,7 @@ import numpy as np
 
 from .._validate import check_real
 
-__all__ = ["Limits", "Boundary", "Segment", "StabilityProbability"]
+__all__ = ["Limits", "Boundary", "Segment", "StabilityProbability", "RobustRegion"]
 
 #: The paper's dimensionless plane: x = beta (damping), y = alpha (stiffness).
 PAPER_PLANE = ("beta", "alpha")
@@ -389,3 +389,178 @@ class StabilityProbability:
                 f"{int(np.count_nonzero((p > 0) & (p < 1)))} sometimes, "
                 f"{int(np.count_nonzero(p == 0))} never; largest standard error "
                 f"{float(np.max(self.standard_error)):.2g})")
+
+
+@dataclasses.dataclass(frozen=True, repr=False, eq=False)
+class RobustRegion:
+    """The points of an ``(x, y)`` plane stable for every value of uncertain parameters.
+
+    :func:`symstab.numeric.robust.robust_region` states the guarantee and
+    how it is proved.  The set is a union of rectangles, one strip of ``x``
+    by a certified interval of ``y``: an inner approximation of the robust
+    set (its area grows to the robust set's as the strips narrow).
+
+    Attributes
+    ----------
+    x, y : str
+        The plane.
+    uncertain : dict
+        ``{name: (low, high)}``: the box (``d``: the first and last delay).
+    edges : ndarray
+        The strips' edges in ``x`` (two equal edges: one line).
+    intervals : tuple of tuple
+        Per strip, the robustly stable intervals ``(lo, hi)`` of ``y``.
+    marginal : tuple of tuple
+        Per strip, the intervals of ``y`` where the certificate did not
+        close (neither called stable nor unstable).
+    nominal : symstab.numeric.decomposition.Decomposition
+        The D-decomposition at the box's centre, to be drawn beside.
+    at : dict
+        The values of the other parameters.
+    reason : str
+        Why the set is empty; else empty.
+    examined : int
+        Cells the branch and bound examined.
+    """
+
+    x: str
+    y: str
+    uncertain: dict
+    edges: np.ndarray
+    intervals: tuple
+    marginal: tuple
+    nominal: object = dataclasses.field(default=None, compare=False)
+    at: dict = dataclasses.field(default_factory=dict)
+    reason: str = ""
+    examined: int = 0
+
+    @classmethod
+    def from_strips(cls, x, y, box, delays, edges, robust, marginal, nominal, at, examined=0):
+        """The region from each strip's intervals (the reason said when it is empty)."""
+        uncertain = dict(box)
+        if len(delays) > 1:
+            uncertain["d"] = (delays[0], delays[-1])
+        region = cls(x, y, uncertain, np.asarray(edges, dtype=float),
+                     tuple(tuple(r) for r in robust), tuple(tuple(m) for m in marginal),
+                     nominal, dict(at), examined=examined)
+        if not region.empty:
+            return region
+        box_text = ", ".join(f"{k} in [{lo:g}, {hi:g}]" for k, (lo, hi) in uncertain.items())
+        why = (f"no point of the nominal stable set is stable for every {box_text}: the stable "
+               f"sets of the box's values do not meet"
+               if not any(marginal) else
+               f"no point could be certified stable for every {box_text} (marginal where the "
+               f"stable sets of its values overlap)")
+        return dataclasses.replace(region, reason=why)
+
+    @classmethod
+    def empty_set(cls, x, y, box, delays, nominal, at, reason):
+        """An empty region, with why."""
+        uncertain = dict(box)
+        if len(delays) > 1:
+            uncertain["d"] = (delays[0], delays[-1])
+        return cls(x, y, uncertain, np.zeros(0), (), (), nominal, dict(at), reason=reason)
+
+    @property
+    def empty(self):
+        """Whether no point is robustly stable."""
+        return not any(self.intervals)
+
+    def _rectangles(self, which):
+        out = []
+        for i, spans in enumerate(which):
+            for lo, hi in spans:
+                out.append((self.edges[i], self.edges[i + 1], lo, hi))
+        return np.array(out, dtype=float).reshape(-1, 4)
+
+    @property
+    def area(self):
+        """Area of the robust set (the rectangles' sum)."""
+        r = self._rectangles(self.intervals)
+        return float(np.sum((r[:, 1] - r[:, 0]) * (r[:, 3] - r[:, 2])))
+
+    @property
+    def marginal_area(self):
+        """Area where the certificate did not close."""
+        r = self._rectangles(self.marginal)
+        return float(np.sum((r[:, 1] - r[:, 0]) * (r[:, 3] - r[:, 2])))
+
+    @property
+    def polygons(self):
+        """The robust set's outlines, counter-clockwise: runs of strips with one overlapping interval each join into one staircase polygon."""
+        out, run = [], []
+
+        def close(run):
+            if not run:
+                return
+            bottom = [p for i, (lo, _) in run for p in ((self.edges[i], lo), (self.edges[i + 1], lo))]
+            top = [p for i, (_, hi) in reversed(run) for p in ((self.edges[i + 1], hi), (self.edges[i], hi))]
+            out.append(np.array(bottom + top))
+
+        for i, spans in enumerate(self.intervals):
+            if len(spans) == 1 and run and run[-1][0] == i - 1 \
+                    and spans[0][0] < run[-1][1][1] and run[-1][1][0] < spans[0][1] \
+                    and len(self.intervals[i - 1]) == 1:
+                run.append((i, spans[0]))
+                continue
+            close(run)
+            run = []
+            if len(spans) == 1:
+                run = [(i, spans[0])]
+            else:
+                for lo, hi in spans:
+                    close([(i, (lo, hi))])
+        close(run)
+        return tuple(out)
+
+    def contains(self, x, y):
+        """Whether points are in the robust set (a rectangle's closed inside).
+
+        Parameters
+        ----------
+        x, y : array_like
+            Coordinates (broadcast together).
+
+        Returns
+        -------
+        ndarray of bool
+        """
+        x, y = np.broadcast_arrays(np.asarray(x, dtype=float), np.asarray(y, dtype=float))
+        out = np.zeros(x.shape, dtype=bool)
+        for x0, x1, lo, hi in self._rectangles(self.intervals):
+            out |= (x0 <= x) & (x <= x1) & (lo <= y) & (y <= hi)
+        return out
+
+    def intervals_at(self, x):
+        """The robust intervals of ``y`` at ``x`` (those of the strips holding it)."""
+        spans = []
+        for i, s in enumerate(self.intervals):
+            if self.edges[i] <= x <= self.edges[i + 1]:
+                spans += list(s)
+        out = []
+        for lo, hi in sorted(spans):
+            if out and lo <= out[-1][1]:
+                out[-1] = (out[-1][0], max(out[-1][1], hi))
+            else:
+                out.append((lo, hi))
+        return out
+
+    def limits(self):
+        """The robust set's extent and area as :class:`Limits` (``region`` is this)."""
+        if self.empty:
+            return Limits.empty_set(self.x, self.y, self.reason, cells=0, at=self.at,
+                                    line=self.intervals_at)
+        r = self._rectangles(self.intervals)
+        top = int(np.argmax(r[:, 3]))
+        return Limits(self.x, self.y, float(r[top, 3]), float(0.5 * (r[top, 0] + r[top, 1])),
+                      float(r[:, 0].min()), float(r[:, 1].max()), self.area,
+                      cells=len(self.polygons), region=self, at=self.at, line=self.intervals_at)
+
+    def __repr__(self):
+        box = ", ".join(f"{k} in [{lo:g}, {hi:g}]" for k, (lo, hi) in self.uncertain.items())
+        if self.empty:
+            return f"RobustRegion({self.x} x {self.y}, {box}: empty: {self.reason})"
+        nominal = self.nominal.area if self.nominal is not None else float("nan")
+        return (f"RobustRegion({self.x} x {self.y}, {box}: area {self.area:.6g} "
+                f"(nominal {nominal:.6g}), marginal {self.marginal_area:.3g}, "
+                f"{len(self.edges) - 1} strips)")

@@ -1,0 +1,713 @@
+"""Robust regions: the points of a plane stable for every value of uncertain parameters in a box.
+
+The guarantee.  A point ``(x, y)`` is called *robustly stable* over a box
+``Q`` of parameter values (and a range of delays) when, for every delay,
+
+1. it is stable at one value of the box (its certified root count,
+   :meth:`symstab.Loop.unstable_root_counts`, is 0 at the box's centre);
+2. the leading coefficient of the characteristic polynomial does not
+   vanish anywhere on the piece of the plane and the box it is certified on;
+3. no root reaches the unit circle anywhere: ``chi(exp(j theta); x, y, q)
+   != 0`` for every ``theta`` in [0, pi] and every ``q`` in ``Q`` (zero
+   exclusion; ``theta`` in [pi, 2 pi] is the conjugate).
+
+The piece of the plane, the box and [0, pi] are connected, so by 2 and 3 the
+number of roots outside the circle is the same everywhere on it, and by 1 it
+is 0.
+
+How zero exclusion is proved.  The plane is cut into vertical strips ``x``
+in ``[x0, x1]``; in each strip, intervals of ``y`` are certified.  Over a
+sub-box of ``Q`` the coefficients of ``chi = A0 + x Ax + y Ay`` are enclosed
+in intervals (:func:`symstab.symbolic.discretize.interval_zoh` for the
+plant, interval arithmetic on the environment's symbolic coefficients, all
+in powers of ``w = z - 1``, so that the integrator's pole ``z = 1`` is kept
+however wide the box).  Over an interval of ``theta`` each part is enclosed
+in a disk: its value and slope at the middle with the interval's midpoint
+coefficients, a bound of the second derivative times ``h**2 / 2``, the
+coefficients' radii, and a bound on the rounding.  A cell (strip x
+``y``-interval x ``theta``-interval x sub-box) is excluded when the disk of
+``chi`` misses 0; where it does not, the largest of the ``theta``, box and
+``y`` contributions to the disk is halved (branch and bound), down to a
+``y``-width of ``rtol`` of the window, ``theta``-widths of 1e-12 and
+:data:`BOX_DEPTH` halvings of the box.  What does not close there is
+*marginal*: never counted stable.
+
+Where to look.  The intervals examined in a strip are the intersection, over
+a grid of values of the box (its corners, centre and midpoints) and both
+edges of the strip, of the stable intervals of ``y`` (the one line engine,
+:meth:`symstab.Loop.stable_intervals`): a point outside them is unstable at
+one of those values, so it is not robustly stable; inside them every point
+is certified or called marginal.
+
+The result is a union of rectangles (strip x interval): an inner
+approximation of the robust set whose area converges as the strips narrow
+(:class:`symstab.numeric.results.RobustRegion`).
+"""
+
+import dataclasses
+import itertools
+
+import mpmath
+import numpy as np
+import sympy as sp
+
+from .._resources import chunk_slices
+from .._validate import check_count, check_delay, check_real, check_window
+from ..symbolic import model
+from ..symbolic.discretize import interval_zoh
+from ..symbolic.loop_assembly import poly_coeffs
+from .results import RobustRegion
+
+__all__ = ["robust_region", "BOX_DEPTH", "MAX_CELLS"]
+
+#: Most halvings of the uncertain box along one branch of the search.
+BOX_DEPTH = 10
+#: Most cells (strip x y x theta x sub-box) examined in one robust region;
+#: what is left then is marginal.
+MAX_CELLS = 20_000_000
+#: Narrowest theta-interval the search halves to.
+_THETA_WIDTH = 1e-12
+#: theta-intervals per term of the polynomial at the start.
+_THETA_PER_TERM = 8
+#: Values per uncertain parameter on the grid that finds the candidates.
+_GRID = 3
+#: Digits of the interval arithmetic.
+_DIGITS = 30
+_EPS = 2.0 ** -52
+
+
+def _bound(expr, values):
+    """An :mod:`mpmath.iv` enclosure of a SymPy expression over intervals of its symbols.
+
+    Walks the expression tree (nothing is compiled or executed): sums,
+    products, integer powers, rationals, floats (their decimal value
+    enclosed), ``exp`` and ``sqrt``.
+    """
+    iv = mpmath.iv
+    if expr.is_Symbol:
+        return values[expr.name]
+    if expr.is_Integer:
+        return iv.mpf(int(expr))
+    if expr.is_Rational:
+        return iv.mpf(int(expr.p)) / iv.mpf(int(expr.q))
+    if expr.is_Float:
+        # The literal's decimal value and its binary one, both enclosed.
+        binary, decimal = iv.mpf(mpmath.mpf(expr._mpf_)), iv.mpf(str(expr))
+        return iv.mpf([min(binary.a, decimal.a), max(binary.b, decimal.b)])
+    if expr == sp.pi:
+        return iv.pi
+    if expr == sp.E:
+        return iv.e
+    if expr.is_Add:
+        total = iv.mpf(0)
+        for term in expr.args:
+            total += _bound(term, values)
+        return total
+    if expr.is_Mul:
+        total = iv.mpf(1)
+        for term in expr.args:
+            total *= _bound(term, values)
+        return total
+    if expr.is_Pow:
+        base, exponent = expr.args
+        if exponent.is_Integer:
+            b = _bound(base, values)
+            n = int(exponent)
+            return b ** n if n >= 0 else 1 / b ** -n
+        if exponent == sp.Rational(1, 2):
+            return iv.sqrt(_bound(base, values))
+        return iv.exp(_bound(exponent, values) * iv.log(_bound(base, values)))
+    if isinstance(expr, sp.exp):
+        return iv.exp(_bound(expr.args[0], values))
+    raise TypeError(f"robust regions cannot bound {type(expr).__name__} in the loop's "
+                    f"coefficients ({expr})")
+
+
+def _midpoint_radius(values):
+    """Float midpoints and radii enclosing a list of :mod:`mpmath.iv` numbers."""
+    mid = np.array([float(v.mid) for v in values])
+    radius = np.empty(len(values))
+    for k, v in enumerate(values):
+        m = mpmath.mpf(mid[k])
+        r = max(v.b - m, m - v.a)
+        radius[k] = float(r) * (1 + 1e-12) if r > 0 else 0.0
+    if not (np.all(np.isfinite(mid)) and np.all(np.isfinite(radius))):
+        raise ValueError("the loop's coefficients are not bounded in the box (a division by an "
+                         "interval that holds 0?)")
+    return mid, radius
+
+
+class _Enclosures:
+    """Interval coefficients of ``chi = A0 + x Ax + y Ay`` in ``w = z - 1``, per sub-box.
+
+    Sub-boxes are made by halving (:meth:`children`) and enclosed once
+    each.  ``mid`` and ``rad`` hold, per sub-box, ``(3 parts, 2 kinds,
+    terms)``: the parts ``A0, Ax, Ay``, the kinds the delayed ``Ve_d P_d``
+    and direct ``Ve_n P_n`` polynomials, highest power of ``w`` first.
+    """
+
+    def __init__(self, loop, x, y, box, fixed):
+        self.names = tuple(box)
+        self.fixed = fixed
+        symbols = {str(s): s for s in loop._symbols.values()}
+        ve_n, ve_d = loop._environment_parts
+        k = loop._delay_of_environment
+        ve_d = list(ve_d)[:len(ve_d) - k]
+        w = sp.Dummy("w")
+        plane = {symbols[x]: 0, symbols[y]: 0}
+
+        def in_w(coefficients, slope):
+            n = len(coefficients) - 1
+            expr = sp.Add(*[c * (w + 1) ** (n - i) for i, c in enumerate(coefficients)])
+            expr = sp.diff(expr, symbols[slope]) if slope else expr
+            expr = sp.expand(expr.subs(plane))
+            out = sp.Poly(expr, w).all_coeffs() if expr != 0 else [sp.Integer(0)]
+            return [sp.Integer(0)] * (n + 1 - len(out)) + out
+
+        self.environment = [(in_w(ve_d, slope), in_w(ve_n, slope)) for slope in (None, x, y)]
+        num, den = sp.fraction(sp.cancel(sp.together(loop.plant)))
+        self.plant = (poly_coeffs(num, model.s), poly_coeffs(den, model.s))
+        self.boxes = [np.array([box[n] for n in self.names], dtype=float).reshape(-1, 2)]
+        self.depth = [0]
+        self._children = {}
+        self.mid, self.rad, self.lead = [], [], []
+        self._enclose(0)
+
+    def _enclose(self, index):
+        iv = mpmath.iv
+        before = iv.prec
+        iv.dps = _DIGITS
+        try:
+            values = {n: iv.mpf(float(v)) for n, v in self.fixed.items()}
+            for name, (lo, hi) in zip(self.names, self.boxes[index]):
+                values[name] = iv.mpf([float(lo), float(hi)])
+            plant = [[_bound(c, values) for c in part] for part in self.plant]
+            p_n, p_d = interval_zoh(*plant, values["T"])
+            mids, rads = [], []
+            for ve_d, ve_n in self.environment:
+                parts = (_product([_bound(c, values) for c in ve_d], p_d),
+                         _product([_bound(c, values) for c in ve_n], p_n))
+                pairs = [_midpoint_radius(p) for p in parts]
+                mids.append([p[0] for p in pairs])
+                rads.append([p[1] for p in pairs])
+        finally:
+            iv.prec = before
+        n_d, n_n = len(mids[0][0]), len(mids[0][1])
+        n = max(n_d, n_n)
+        mid = np.zeros((3, 2, n))
+        rad = np.zeros((3, 2, n))
+        for p in range(3):
+            for kind, size in ((0, n_d), (1, n_n)):
+                mid[p, kind, n - size:] = mids[p][kind]
+                rad[p, kind, n - size:] = rads[p][kind]
+        self.mid.append(mid)
+        self.rad.append(rad)
+        self.sizes = (n_d, n_n)
+
+    def children(self, index):
+        """The two halves of sub-box ``index`` (along its relatively widest side), enclosed."""
+        if index not in self._children:
+            box = self.boxes[index]
+            width = (box[:, 1] - box[:, 0]) / np.maximum(np.abs(box).max(axis=1), 1e-300)
+            side = int(np.argmax(width))
+            middle = 0.5 * (box[side, 0] + box[side, 1])
+            pair = []
+            for part in ((box[side, 0], middle), (middle, box[side, 1])):
+                child = box.copy()
+                child[side] = part
+                self.boxes.append(child)
+                self.depth.append(self.depth[index] + 1)
+                self._enclose(len(self.boxes) - 1)
+                pair.append(len(self.boxes) - 1)
+            self._children[index] = tuple(pair)
+        return self._children[index]
+
+    def leading(self, shift):
+        """Per sub-box and part, the leading coefficient (midpoint, radius) of ``z**shift D + N``."""
+        n_d, n_n = self.sizes
+        top_d, top_n = shift + n_d - 1, n_n - 1
+        n = max(n_d, n_n)
+        mid = np.array(self.mid)
+        rad = np.array(self.rad)
+        lead_mid = np.zeros(mid.shape[:2])
+        lead_rad = np.zeros(mid.shape[:2])
+        if top_d >= top_n:
+            lead_mid += mid[:, :, 0, n - n_d]
+            lead_rad += rad[:, :, 0, n - n_d]
+        if top_n >= top_d:
+            lead_mid += mid[:, :, 1, n - n_n]
+            lead_rad += rad[:, :, 1, n - n_n]
+        return lead_mid, lead_rad
+
+
+def _product(a, b):
+    iv = mpmath.iv
+    out = [iv.mpf(0)] * (len(a) + len(b) - 1)
+    for i, u in enumerate(a):
+        for j, v in enumerate(b):
+            out[i + j] += u * v
+    return out
+
+
+def _parts_on_arc(enclosures, shift, theta, h, box):
+    """Each part of ``chi`` on ``theta`` in ``[theta - h, theta + h]``, over sub-box ``box``.
+
+    Returns per cell and part (``A0, Ax, Ay``): the value and the
+    ``theta``-slope at ``theta`` (midpoint coefficients), a bound of the
+    second ``theta``-derivative, the coefficients' radii summed on the
+    interval's largest ``|w|``, and a bound of the rounding of the value.
+    Along ``z = exp(j theta)``, ``d/dtheta = j z d/dz``; for ``z**s w**k``
+    (``w = z - 1``) twice that is ``s**2 z**s w**k + (s k + k (s + 1))
+    z**(s + 1) w**(k - 1) + k (k - 1) z**(s + 2) w**(k - 2)``, bounded with
+    ``|w| <= 2 sin(theta_max / 2)``.
+    """
+    mid = np.array(enclosures.mid)[box]          # (n, 3 parts, 2 kinds, L)
+    rad = np.array(enclosures.rad)[box]
+    n_terms = mid.shape[-1]
+    k = np.arange(n_terms - 1, -1, -1, dtype=float)
+    z = np.exp(1j * theta)
+    w = z - 1.0
+    om = 2.0 * np.sin(np.minimum(theta + h, np.pi) / 2)[:, None]
+    powers = w[:, None] ** k
+    slopes = np.zeros_like(powers)
+    slopes[:, :-1] = k[:-1] * w[:, None] ** (k[:-1] - 1)
+    om_k = om ** k
+    om_1 = np.where(k >= 1, om ** np.maximum(k - 1, 0), 0.0)
+    om_2 = np.where(k >= 2, om ** np.maximum(k - 2, 0), 0.0)
+    shape = mid.shape[:2]
+    value, slope = np.zeros(shape, dtype=complex), np.zeros(shape, dtype=complex)
+    second, coefficient, rounding = np.zeros(shape), np.zeros(shape), np.zeros(shape)
+    for kind, s in ((0, float(shift)), (1, 0.0)):
+        a = mid[:, :, kind, :]
+        rotate = np.exp(1j * s * theta)[:, None] if s else 1.0
+        f = rotate * np.einsum("npk,nk->np", a, powers)
+        value += f
+        slope += 1j * (s * f + rotate * z[:, None] * np.einsum("npk,nk->np", a, slopes))
+        absolute = np.abs(a)
+        bound = s * s * om_k + (s * k + k * (s + 1)) * om_1 + k * (k - 1) * om_2
+        second += np.einsum("npk,nk->np", absolute, bound)
+        coefficient += np.einsum("npk,nk->np", rad[:, :, kind, :], om_k)
+        # Of the sums, and of exp(j s theta) (an error in its phase s theta).
+        rounding += 32 * _EPS * (n_terms + 4) * np.einsum(
+            "npk,nk->np", absolute, np.maximum(om, 1.0) ** k) * (1.0 + s * (theta + h)[:, None])
+    return value, slope, second, coefficient, rounding
+
+
+def _excluded(enclosures, shift, theta, h, box, xc, hx):
+    """The ``y`` where zero exclusion fails on a cell (strip x theta-interval x sub-box).
+
+    With ``P = A0 + xc Ax`` and ``Y = Ay`` at the middle of the
+    ``theta``-interval, ``chi`` lies within ``a + b |y|`` of ``P + y Y``
+    anywhere on the cell, ``a`` and ``b`` summing what the
+    ``theta``-width, the coefficients' radii, the strip's width and the
+    rounding cost; it cannot vanish where ``|P + y Y| > a + b |y|``, a
+    quadratic inequality on each side of ``y = 0``.
+
+    Returns ``(pieces, fixed, theta_cost, box_cost)``: the set as
+    intervals (:func:`_failing`); the same without the ``theta``-width's and
+    the radii's costs (what no refinement of the cell removes); those two
+    costs as ``(a, b)``, ``a + b |y|``.
+    """
+    value, slope, second, coefficient, rounding = _parts_on_arc(enclosures, shift, theta, h, box)
+    h2 = 0.5 * h * h
+    P = value[:, 0] + xc * value[:, 1]
+    Y = value[:, 2]
+    ax = np.abs(xc)
+    theta_a = h * np.abs(slope[:, 0] + xc * slope[:, 1]) + h2 * (second[:, 0] + ax * second[:, 1])
+    theta_b = h * np.abs(slope[:, 2]) + h2 * second[:, 2]
+    box_a = coefficient[:, 0] + ax * coefficient[:, 1]
+    box_b = coefficient[:, 2]
+    # |Ax| anywhere on the cell, times the strip's half-width.
+    strip_a = hx * (np.abs(value[:, 1]) + h * np.abs(slope[:, 1]) + h2 * second[:, 1]
+                    + coefficient[:, 1])
+    round_a = rounding[:, 0] + (ax + hx) * rounding[:, 1]
+    round_b = rounding[:, 2]
+    pieces = _failing(P, Y, theta_a + box_a + strip_a + round_a, theta_b + box_b + round_b)
+    fixed = _failing(P, Y, strip_a + round_a, round_b)
+    return pieces, fixed, (theta_a, theta_b), (box_a, box_b)
+
+
+def _failing(P, Y, a, b):
+    """``{y : |P + y Y| <= a + b |y|}`` per cell, as four intervals ``(lo, hi)`` (empty: lo > hi).
+
+    On ``y >= 0`` (sign +1) and ``y <= 0`` (sign -1) the inequality is
+    ``f(y) = A y**2 + B y + c <= 0`` with ``A = |Y|**2 - b**2``, ``B = 2
+    (Re(P conj Y) - sign a b)``, ``c = |P|**2 - a**2``.  Where ``A > 0`` it
+    holds between the roots; where ``A <= 0`` (``A`` taken below 0, which
+    only adds to the set) outside them, or everywhere without real roots.
+    The roots are moved outwards by their rounding (1e-7 of their size: a
+    double root's ends move by sqrt(eps) of it).
+    """
+    A = np.abs(Y) ** 2 - b * b
+    c = np.abs(P) ** 2 - a * a
+    re = np.real(P * np.conj(Y))
+    convex = A > 0
+    A = np.where(convex, A, np.minimum(A, -1e-300))
+    pieces = []
+    for sign in (1.0, -1.0):
+        B = 2 * (re - sign * a * b)
+        disc = B * B - 4 * A * c
+        real = disc >= 0
+        root = np.sqrt(np.where(real, disc, 0.0))
+        with np.errstate(over="ignore", invalid="ignore", divide="ignore"):
+            r1 = np.minimum((-B - root) / (2 * A), (-B + root) / (2 * A))
+            r2 = np.maximum((-B - root) / (2 * A), (-B + root) / (2 * A))
+            slack = np.nan_to_num(1e-7 * (np.abs(r1) + np.abs(r2)), posinf=np.inf) + 1e-300
+        half = (0.0, np.inf) if sign > 0 else (-np.inf, 0.0)
+        # A > 0: [r1, r2] where real, else nothing.
+        inner_lo = np.where(convex & real, r1 - slack, np.inf)
+        inner_hi = np.where(convex & real, r2 + slack, -np.inf)
+        # A <= 0: (-inf, r1] and [r2, inf) where real, else the whole line.
+        left_hi = np.where(~convex, np.where(real, r1 + slack, np.inf), -np.inf)
+        right_lo = np.where(~convex, np.where(real, r2 - slack, -np.inf), np.inf)
+        for lo, hi in ((inner_lo, inner_hi), (np.full(P.shape, -np.inf), left_hi),
+                       (right_lo, np.full(P.shape, np.inf))):
+            lo, hi = np.maximum(np.nan_to_num(lo, nan=-np.inf), half[0]), np.minimum(
+                np.nan_to_num(hi, nan=np.inf), half[1])
+            pieces.append((lo, hi))
+    return pieces
+
+
+@dataclasses.dataclass
+class _Cells:
+    strip: np.ndarray
+    t0: np.ndarray
+    t1: np.ndarray
+    box: np.ndarray
+
+    def take(self, keep):
+        return _Cells(*(getattr(self, f.name)[keep] for f in dataclasses.fields(self)))
+
+    @staticmethod
+    def join(parts):
+        return _Cells(*(np.concatenate([getattr(p, f.name) for p in parts])
+                        for f in dataclasses.fields(_Cells)))
+
+    def __len__(self):
+        return len(self.strip)
+
+
+def _merge(intervals):
+    """Sorted, disjoint union of a list of (lo, hi)."""
+    out = []
+    for lo, hi in sorted(intervals):
+        if out and lo <= out[-1][1]:
+            out[-1][1] = max(out[-1][1], hi)
+        else:
+            out.append([lo, hi])
+    return [(a, b) for a, b in out]
+
+
+def _subtract(intervals, removed):
+    """``intervals`` less the union ``removed`` (both lists of (lo, hi); removed merged)."""
+    out = []
+    for lo, hi in intervals:
+        start = lo
+        for a, b in removed:
+            if b <= start or a >= hi:
+                continue
+            if a > start:
+                out.append((start, a))
+            start = max(start, b)
+        if start < hi:
+            out.append((start, hi))
+    return out
+
+
+def _open_part(strips, pieces, open_spans, length=False):
+    """Per cell, the hull of the pieces' parts in its strip's open spans: ``(lo, hi)``, empty lo > hi.
+
+    With ``length``, also the parts' total length (pieces assumed disjoint).
+    """
+    out_lo = np.full(len(strips), np.inf)
+    out_hi = np.full(len(strips), -np.inf)
+    total = np.zeros(len(strips))
+    for s in np.unique(strips):
+        rows = np.flatnonzero(strips == s)
+        for a, b in open_spans.get(int(s), ()):
+            for lo, hi in pieces:
+                l, h = np.maximum(lo[rows], a), np.minimum(hi[rows], b)
+                meet = l <= h
+                out_lo[rows[meet]] = np.minimum(out_lo[rows[meet]], l[meet])
+                out_hi[rows[meet]] = np.maximum(out_hi[rows[meet]], h[meet])
+                with np.errstate(over="ignore", invalid="ignore"):
+                    total[rows[meet]] += (h - l)[meet]
+    return (out_lo, out_hi, total) if length else (out_lo, out_hi)
+
+
+def _certify(enclosures, shift, centres, halves, candidates, tol, budget):
+    """Branch and bound over theta and the box: ``(marked, examined)``.
+
+    Each cell (strip x theta-interval x sub-box) excludes zero for every
+    ``y`` outside an interval (:func:`_excluded`).  A cell whose interval
+    misses the strip's candidates is done; one that meets them is halved in
+    ``theta`` or the box (whichever costs more), until its interval is
+    within ``tol`` of what no halving removes (the strip's width, the
+    rounding), or nothing is left to halve: then the interval, clipped to
+    the candidates, is *marked*.  ``marked[strip]`` (merged) is where zero
+    exclusion did not close; the rest of the candidates is certified.
+    """
+    n_terms = shift + enclosures.mid[0].shape[-1]
+    n_theta = max(16, _THETA_PER_TERM * n_terms)
+    edges = np.linspace(0.0, np.pi, n_theta + 1)
+    marked = {s: [] for s in candidates}
+    strips = np.array(sorted(candidates), dtype=np.int64)
+    if not len(strips):
+        return marked, 0
+    cells = _Cells(np.repeat(strips, n_theta), np.tile(edges[:-1], len(strips)),
+                   np.tile(edges[1:], len(strips)), np.zeros(n_theta * len(strips), dtype=np.int64))
+    examined = 0
+    per_cell = 8 * 16 * 6 * enclosures.mid[0].shape[-1]
+    while len(cells):
+        open_spans = {s: _subtract(spans, marked[s]) for s, spans in candidates.items()}
+        if examined + len(cells) > budget:
+            # Out of budget: whatever the cells left could still reach is marginal.
+            for s in np.unique(cells.strip):
+                marked[int(s)] = _merge(marked[int(s)] + open_spans[int(s)])
+            break
+        examined += len(cells)
+        found = []
+        for part in chunk_slices(len(cells), per_cell):
+            c = cells.take(part)
+            theta, h = 0.5 * (c.t0 + c.t1), 0.5 * (c.t1 - c.t0)
+            pieces, fixed, theta_ab, box_ab = _excluded(
+                enclosures, shift, theta, h, c.box, centres[c.strip], halves[c.strip])
+            lo, hi = _open_part(c.strip, pieces, open_spans)
+            meets = lo <= hi
+            if not meets.any():
+                continue
+            lo_fixed, hi_fixed = _open_part(c.strip, fixed, open_spans)
+            # The costs where they are largest on the part that matters.
+            y = np.where(meets, np.maximum(np.abs(np.nan_to_num(lo)), np.abs(np.nan_to_num(hi))), 0.0)
+            found.append((c.take(meets), lo[meets], hi[meets], lo_fixed[meets], hi_fixed[meets],
+                          (theta_ab[0] + y * theta_ab[1])[meets], (box_ab[0] + y * box_ab[1])[meets]))
+        if not found:
+            break
+        c = _Cells.join([f[0] for f in found])
+        lo, hi, lo_fixed, hi_fixed, theta_cost, box_cost = (np.concatenate([f[k] for f in found])
+                                                             for k in range(1, 7))
+        # What the strip's width costs at a cell's middle stays whatever is
+        # halved: marked at once, so that the search goes on only where the
+        # widths of theta and of the box still matter.
+        has = lo_fixed <= hi_fixed
+        for s, a, b in zip(c.strip[has], lo_fixed[has], hi_fixed[has]):
+            marked[int(s)].append((float(a), float(b)))
+        marked = {s: _merge(v) for s, v in marked.items()}
+        open_spans = {s: _subtract(spans, marked[s]) for s, spans in candidates.items()}
+        lo, hi, left = _open_part(c.strip, [(lo, hi)], open_spans, length=True)
+        meets = lo <= hi
+        c, lo, hi, left = c.take(meets), lo[meets], hi[meets], left[meets]
+        theta_cost, box_cost = theta_cost[meets], box_cost[meets]
+        can_theta = (c.t1 - c.t0) > _THETA_WIDTH
+        can_box = np.array(enclosures.depth)[c.box] < BOX_DEPTH
+        # Done when what is left open is within the resolution, or the width
+        # that costs more cannot be halved again (halving the other would
+        # not close the cell).
+        theta_first = theta_cost >= box_cost
+        done = (left <= tol[c.strip]) | np.where(theta_first, ~can_theta, ~can_box)
+        for s, a, b in zip(c.strip[done], lo[done], hi[done]):
+            marked[int(s)].append((float(a), float(b)))
+        marked = {s: _merge(v) for s, v in marked.items()}
+        split_theta = ~done & theta_first
+        split_box = ~done & ~split_theta
+        children = []
+        pick = c.take(split_theta)
+        if len(pick):
+            middle = 0.5 * (pick.t0 + pick.t1)
+            children += [dataclasses.replace(pick, t1=middle), dataclasses.replace(pick, t0=middle)]
+        pick = c.take(split_box)
+        if len(pick):
+            pairs = np.array([enclosures.children(int(b)) for b in pick.box])
+            children += [dataclasses.replace(pick, box=pairs[:, 0]),
+                         dataclasses.replace(pick, box=pairs[:, 1])]
+        if not children:
+            break
+        cells = _Cells.join(children)
+    return {s: _merge(v) for s, v in marked.items()}, examined
+
+
+def _grid(box):
+    """The values of the box the candidates are found at: corners, centre, midpoints."""
+    axes = [np.linspace(lo, hi, _GRID) if hi > lo else np.array([lo]) for lo, hi in box.values()]
+    return [dict(zip(box, point)) for point in itertools.product(*axes)]
+
+
+def _check_uncertain(loop, uncertain, axes):
+    """``(box, delays)``: the continuous parameters' (lo, hi) and the delays, checked."""
+    if not isinstance(uncertain, dict) or not uncertain:
+        raise TypeError(f"uncertain must be a non-empty dict {{name: (low, high)}}, got "
+                        f"{uncertain!r}")
+    box, delays = {}, None
+    for name, spec in uncertain.items():
+        where = f"uncertain[{name!r}]"
+        if name not in loop.parameters:
+            raise ValueError(f"uncertain: {name!r} is not a parameter of the loop (its "
+                             f"parameters: {', '.join(loop.parameters)})")
+        if name in axes:
+            raise ValueError(f"uncertain: {name} is an axis of the ({axes[0]}, {axes[1]}) plane")
+        if not isinstance(spec, (tuple, list)) or len(spec) != 2:
+            raise TypeError(f"{where} must be (low, high), got {spec!r}")
+        if name == "d":
+            low, high = check_delay(spec[0]), check_delay(spec[1])
+            if low > high:
+                raise ValueError(f"{where}: (low, high) must have low <= high, got {spec!r}")
+            delays = list(range(low, high + 1))
+            continue
+        low, high = (check_real(f"{where} bounds", v) for v in spec)
+        if not low <= high:
+            raise ValueError(f"{where}: (low, high) must have low <= high, got {spec!r}")
+        if name == "T" and low <= 0:
+            raise ValueError(f"{where}: the period must be positive, got {spec!r}")
+        box[name] = (float(low), float(high))
+    return box, delays
+
+
+def robust_region(loop, x, y, *, uncertain, strips=64, rtol=1e-6, x_range=None, y_range=None,
+                  budget=MAX_CELLS, **values):
+    """The points of the ``(x, y)`` plane stable for every value in the box (see the module).
+
+    Parameters
+    ----------
+    loop : symstab.Loop
+    x, y : str
+        The plane's parameters: environment parameters, jointly affine.
+    uncertain : dict
+        ``{name: (low, high)}``: the box of the plant's and environment's
+        parameters (``T`` included), and ``d`` a range of whole delays.
+    strips : int
+        Vertical strips across the window (1 to 100 000).
+    rtol : float
+        Resolution of the certified intervals' ends, as a fraction of the
+        window's height (1e-12 to 1e-2).
+    x_range, y_range : (float, float), optional
+        The window; default: the nominal stable set's (at the box's
+        centre), which holds the robust set.  ``x_range = (x0, x0)`` is one
+        line.
+    budget : int
+        Most cells examined (:data:`MAX_CELLS`); beyond, marginal.
+    **values
+        Values of the other parameters.
+
+    Returns
+    -------
+    symstab.numeric.results.RobustRegion
+    """
+    x, y = loop._plane(x, y)
+    strips = check_count("strips", strips, 1)
+    if strips > 100_000:
+        raise ValueError(f"strips must be from 1 to 100000, got {strips}")
+    rtol = check_real("rtol", rtol)
+    if not 1e-12 <= rtol <= 1e-2:
+        raise ValueError(f"rtol must be from 1e-12 to 1e-2, got {rtol!r}")
+    for name in (x, y):
+        if name not in loop._environment_names or name in loop._plant_names or name == "T":
+            raise ValueError(f"robust regions take a plane of the environment's parameters; "
+                             f"{name} is not one")
+    box, delays = _check_uncertain(loop, uncertain, (x, y))
+    unknown = set(values) - set(loop.parameters)
+    if unknown:
+        raise TypeError(f"unknown parameter(s) {', '.join(sorted(unknown))}; parameters of "
+                        f"this loop: {', '.join(loop.parameters)}")
+    fixed = {**loop.defaults, **values}
+    for name in list(box) + ([] if delays is None else ["d"]):
+        fixed.pop(name, None)
+    if delays is None:
+        if "d" not in fixed:
+            raise TypeError("missing value for d")
+        delays = [check_delay(fixed["d"])]
+    fixed.pop("d", None)
+    fixed.pop(x, None)
+    fixed.pop(y, None)
+    missing = [n for n in loop._symbols if n not in fixed and n not in box and n not in (x, y)]
+    if missing:
+        raise TypeError(f"missing value(s) for {', '.join(missing)}")
+    for name, v in fixed.items():
+        fixed[name] = check_real(name, v)
+    centre = {n: 0.5 * (lo + hi) for n, (lo, hi) in box.items()}
+    centre_d = delays[len(delays) // 2]
+    # Every corner of the box is asked of the loop (its domain: a pole that
+    # cancels, a period that is not positive) before any work.
+    for corner in itertools.product(*box.values()):
+        loop.unstable_root_counts(**fixed, **dict(zip(box, corner)), d=centre_d,
+                                  **{x: 0.0, y: 0.0})
+
+    given_x = None
+    if x_range is not None:
+        given_x = check_window("x_range", (x_range[0], x_range[1] + 1.0)) if (
+            isinstance(x_range, (tuple, list)) and len(x_range) == 2
+            and x_range[0] == x_range[1]) else check_window("x_range", x_range)
+        given_x = (given_x[0], float(x_range[1]))
+    if y_range is not None:
+        y_range = check_window("y_range", y_range)
+    line = given_x is not None and given_x[0] == given_x[1]
+    nominal = loop.region(x, y, x_range=None if line else given_x, y_range=y_range, **fixed,
+                          **centre, d=centre_d)
+    if not nominal.stable:
+        return RobustRegion.empty_set(x, y, box, delays, nominal, fixed,
+                                  "the stable set at the box's centre is empty")
+    points = np.vstack([cell.outer for cell in nominal.stable])
+    x_lo, x_hi = given_x or (float(points[:, 0].min()), float(points[:, 0].max()))
+    y_lo, y_hi = y_range or (float(points[:, 1].min()), float(points[:, 1].max()))
+    edges = np.linspace(x_lo, x_hi, strips + 1) if x_hi > x_lo else np.array([x_lo, x_lo])
+    centres, halves = 0.5 * (edges[:-1] + edges[1:]), 0.5 * (edges[1:] - edges[:-1])
+    tol = np.full(len(centres), rtol * (y_hi - y_lo) / 4)
+
+    robust = [[(y_lo, y_hi)] for _ in centres]
+    marginal = [[] for _ in centres]
+    examined = 0
+    grid = _grid(box)
+    enclosures = _Enclosures(loop, x, y, box, fixed)
+    for d in delays:
+        shift = d + loop._delay_of_environment
+        # Candidates: stable at every grid value on both edges of the strip.
+        for point in grid:
+            found = loop.stable_intervals(y, **{x: edges}, **fixed, **point, d=d)
+            for i in range(len(centres)):
+                both = _intersect(found[i], found[i + 1])
+                robust[i] = _intersect(robust[i], both)
+        candidates = {i: spans for i, spans in enumerate(robust) if spans}
+        marked, n = _certify(enclosures, shift, centres, halves, candidates, tol, budget - examined)
+        examined += n
+        lead_mid, lead_rad = enclosures.leading(shift)
+        for i, spans in candidates.items():
+            kept = []
+            for a, b in _subtract(spans, marked[i]):
+                ok = _count_zero(loop, x, y, centres[i], 0.5 * (a + b), fixed, centre, d)
+                ok = ok and _lead_excluded(lead_mid, lead_rad, centres[i], halves[i], a, b)
+                (kept if ok else marginal[i]).append((a, b))
+            marginal[i] = _merge(marginal[i] + [(a, b) for a, b in marked[i]
+                                                if any(a < hi and b > lo for lo, hi in spans)])
+            robust[i] = kept
+        for i in set(range(len(centres))) - set(candidates):
+            robust[i] = []
+    return RobustRegion.from_strips(x, y, box, delays, edges, robust, marginal, nominal, fixed,
+                                    examined=examined)
+
+
+def _intersect(a, b):
+    """Intersection of two sorted lists of disjoint intervals."""
+    out, i, j = [], 0, 0
+    while i < len(a) and j < len(b):
+        lo, hi = max(a[i][0], b[j][0]), min(a[i][1], b[j][1])
+        if lo < hi:
+            out.append((float(lo), float(hi)))
+        if a[i][1] < b[j][1]:
+            i += 1
+        else:
+            j += 1
+    return out
+
+
+def _count_zero(loop, x, y, xv, yv, fixed, centre, d):
+    """Whether the certified root count is 0 at one point, at the box's centre."""
+    return loop.unstable_root_counts(**fixed, **centre, d=d, **{x: float(xv), y: float(yv)}) == 0
+
+
+def _lead_excluded(lead_mid, lead_rad, xc, hx, a, b):
+    """Whether the leading coefficient cannot vanish on the strip's rectangle, over the box."""
+    yc, hy = 0.5 * (a + b), 0.5 * (b - a)
+    m, r = lead_mid[0], lead_rad[0]    # the root box encloses every sub-box
+    centre = m[0] + xc * m[1] + yc * m[2]
+    radius = (r[0] + abs(xc) * r[1] + abs(yc) * r[2] + hx * (abs(m[1]) + r[1])
+              + hy * (abs(m[2]) + r[2]) + 8 * _EPS * (abs(m[0]) + abs(xc * m[1]) + abs(yc * m[2])))
+    return abs(centre) > radius

@@ -1,0 +1,295 @@
+"""Robust regions (:mod:`symstab.numeric.robust`): stable for every value of a box.
+
+Oracles: python-control's ``c2d`` (the plant's pulse transfer function,
+independent of symstab's residues and interval matrix exponential) with the
+environment's polynomials written out here and numpy's eigenvalues of the
+companion matrix (the closed-loop poles); the line engine's nominal stable
+intervals for a box of zero width.
+"""
+
+import numpy as np
+import pytest
+import sympy as sp
+
+import symstab
+from symstab.symbolic.discretize import interval_zoh
+
+control = pytest.importorskip("control")
+
+PAPER = "examples/loops/paper.toml"
+
+
+@pytest.fixture(scope="module")
+def paper():
+    return symstab.load_loop(PAPER)
+
+
+def _in_w(coefficients):
+    """Coefficients in z (highest first) -> in w = z - 1 (highest first), exactly."""
+    w = sp.Symbol("w")
+    n = len(coefficients) - 1
+    expr = sum(sp.Rational(float(c)) * (w + 1) ** (n - i) for i, c in enumerate(coefficients))
+    return [float(c) for c in sp.Poly(sp.expand(expr), w).all_coeffs()]
+
+
+def _c2d(num, den, T):
+    """python-control's ZOH pulse transfer function, monic denominator, highest first."""
+    sys = control.c2d(control.tf(num, den), T, "zoh")
+    n, d = (np.atleast_1d(np.squeeze(np.asarray(c, dtype=float))) for c in (sys.num[0][0],
+                                                                            sys.den[0][0]))
+    n, d = n / d[0], d / d[0]
+    return np.concatenate([np.zeros(len(d) - len(n)), n]), d
+
+
+@pytest.mark.parametrize("num, den, box", [
+    # The paper's plant, m and b +-20 % / +-50 %.
+    ([1.0], lambda m, b: [m, b, 0.0], {"m": (0.0102, 0.0154), "b": (0.0162, 0.0486)}),
+    # A spring on the mass: complex poles.
+    ([1.0], lambda m, b: [m, b, 40.0], {"m": (0.01, 0.02), "b": (0.01, 0.05)}),
+    # An actuator lag and a zero: third order.
+    (lambda m, b: [1.0, 30.0], lambda m, b: list(np.polymul([1.0 / m, 1.0], [m, b, 0.0])),
+     {"m": (0.01, 0.02), "b": (0.02, 0.04)}),
+])
+def test_interval_zoh_encloses_python_control(num, den, box):
+    from mpmath import iv
+
+    T = 1e-3
+    rng = np.random.default_rng(3)
+
+    def coefficients(f, m, b):
+        return f(m, b) if callable(f) else f
+
+    iv.dps = 30
+    try:
+        (m0, m1), (b0, b1) = box["m"], box["b"]
+        # The plant's coefficients as intervals: each is monotone in m and b here,
+        # so its values at the corners bound it.
+        corners = [(m, b) for m in (m0, m1) for b in (b0, b1)]
+        num_iv = [iv.mpf([min(c), max(c)]) for c in zip(*[coefficients(num, *p) for p in corners])]
+        den_iv = [iv.mpf([min(c), max(c)]) for c in zip(*[coefficients(den, *p) for p in corners])]
+        p_n, p_d = interval_zoh(num_iv, den_iv, iv.mpf(T))
+    finally:
+        iv.dps = 15
+    for _ in range(20):
+        m, b = rng.uniform(m0, m1), rng.uniform(b0, b1)
+        n, d = _c2d(coefficients(num, m, b), coefficients(den, m, b), T)
+        n_w, d_w = _in_w(n), _in_w(d)
+        n_w = [0.0] * (len(p_n) - len(n_w)) + n_w
+        scales = [np.abs(n).max()] * len(n_w) + [np.abs(d).max()] * len(d_w)
+        for value, enclosure, scale in zip(n_w + d_w, p_n + p_d, scales):
+            width = float(enclosure.b) - float(enclosure.a)
+            # python-control's coefficients in z are good to about 1e-13 of the
+            # largest (their sums in w too: P_d(1) = 0 comes out as 1e-16).
+            slack = 1e-10 * abs(value) + 1e-13 * scale
+            assert float(enclosure.a) - slack <= value <= float(enclosure.b) + slack, (
+                value, enclosure, width)
+
+
+def _closed_loop_radius(m, b, T, d, K, B, M=0.0):
+    """Largest pole modulus of the paper's loop at (K, B): python-control's plant, numpy's eigenvalues.
+
+    chi = z**d Ve_d P_d + Ve_n P_n with VE = K + B (z - 1)/(T z) + M (z - 1)**2/(T z)**2,
+    Ve_n = K T**2 z**2 + B T z (z - 1) + M (z - 1)**2 and Ve_d = T**2 z**2.
+    """
+    n, p = _c2d([1.0], [m, b, 0.0], T)
+    K, B = np.atleast_1d(K), np.atleast_1d(B)
+    ve_n = (K[:, None] * T**2 * np.array([1.0, 0, 0]) + B[:, None] * T * np.array([1.0, -1, 0])
+            + M * np.array([1.0, -2, 1]))
+    direct = np.stack([np.convolve(row, n) for row in ve_n])
+    delayed = np.concatenate([T**2 * p, np.zeros(d + 2)])
+    chi = np.zeros((len(K), len(delayed)))
+    chi += delayed
+    chi[:, -direct.shape[1]:] += direct
+    chi = chi / chi[:, :1]
+    size = chi.shape[1] - 1
+    companion = np.zeros((len(K), size, size))
+    companion[:, 0, :] = -chi[:, 1:]
+    companion[:, np.arange(1, size), np.arange(size - 1)] = 1.0
+    return np.abs(np.linalg.eigvals(companion)).max(axis=1)
+
+
+def _points_in(region, n, rng):
+    """``n`` points of the robust set: uniform in its rectangles, a tenth on their top and bottom edges."""
+    rects = np.array([(region.edges[i], region.edges[i + 1], lo, hi)
+                      for i, spans in enumerate(region.intervals) for lo, hi in spans])
+    areas = (rects[:, 1] - rects[:, 0]) * (rects[:, 3] - rects[:, 2])
+    pick = rng.choice(len(rects), size=n, p=areas / areas.sum())
+    r = rects[pick]
+    x = rng.uniform(r[:, 0], r[:, 1])
+    y = rng.uniform(r[:, 2], r[:, 3])
+    edge = rng.random(n) < 0.1
+    y[edge] = np.where(rng.random(edge.sum()) < 0.5, r[edge, 2], r[edge, 3])
+    return x, y
+
+
+def test_robust_points_are_stable_at_every_value_of_the_box(paper):
+    """The acceptance: 10 000 robust points, each stable at 100 values of the box (corners too)."""
+    box = {"m": (0.0115, 0.0141), "b": (0.0162, 0.0648)}
+    region = paper.region("B", "K", uncertain=box, strips=32, d=10, M=0.0)
+    assert not region.empty and 0 < region.area < region.nominal.area
+    assert region.contains(*_points_in(region, 200, np.random.default_rng(0))).all()
+    rng = np.random.default_rng(1)
+    x, y = _points_in(region, 10_000, rng)
+    values = [(m, b) for m in box["m"] for b in box["b"]]
+    values += list(zip(rng.uniform(*box["m"], 96), rng.uniform(*box["b"], 96)))
+    worst = 0.0
+    for m, b in values:
+        worst = max(worst, float(_closed_loop_radius(m, b, 1e-3, 10, y, x).max()))
+    assert worst < 1.0
+    # Not vacuous: the nominal set holds points unstable at a corner of the box.
+    nx, ny = np.meshgrid(np.linspace(*region.nominal.x_range, 60), np.linspace(
+        *region.nominal.y_range, 60))
+    inside = region.nominal.contains(nx, ny)
+    radius = _closed_loop_radius(box["m"][0], box["b"][0], 1e-3, 10, ny[inside], nx[inside])
+    assert (radius > 1).any()
+    assert not region.contains(nx[inside][radius > 1], ny[inside][radius > 1]).any()
+
+
+def test_robust_over_a_range_of_delays(paper):
+    """Uncertain delay and damping: the points are stable at every delay of the range."""
+    box = {"b": (0.02, 0.045), "d": (8, 12)}
+    region = paper.region("B", "K", uncertain=box, strips=24, M=0.0, m=0.0128)
+    assert region.uncertain["d"] == (8, 12)
+    rng = np.random.default_rng(2)
+    x, y = _points_in(region, 2_000, rng)
+    for d in range(8, 13):
+        for b in (0.02, 0.045, *rng.uniform(0.02, 0.045, 4)):
+            assert _closed_loop_radius(0.0128, b, 1e-3, d, y, x).max() < 1.0
+    # Smaller than the set of any one delay of the range.
+    for d in (8, 12):
+        assert region.area < paper.region("B", "K", uncertain={"b": (0.02, 0.045)}, strips=24,
+                                          M=0.0, m=0.0128, d=d).area + 1e-12
+
+
+@pytest.mark.parametrize("path, d, lines", [
+    (PAPER, 10, (-0.02, 0.0, 0.5, 1.0)),
+    ("examples/loops/lowpass_velocity.toml", 40, (0.0, 0.05, 0.1)),
+])
+def test_a_box_of_zero_width_gives_the_nominal_set(path, d, lines):
+    """On a line (a strip of zero width) the certified intervals are the line engine's to 1e-6."""
+    loop = symstab.load_loop(path)
+    b = loop.defaults["b"]
+    nominal_set = loop.region("B", "K", d=d)
+    height = nominal_set.limits().y_max
+    for B in lines:
+        found = loop.region("B", "K", uncertain={"b": (b, b)}, x_range=(B, B), rtol=1e-7, d=d)
+        nominal = loop.stable_intervals("K", B=B, d=d)
+        assert nominal and found.intervals[0]
+        robust = found.intervals[0]
+        assert len(nominal) == 1
+        lo, hi = nominal[0]
+        assert abs(robust[0][0] - max(lo, 0.0)) <= 1e-6 * height
+        assert abs(robust[-1][1] - hi) <= 1e-6 * height
+        # Whatever did not close inside is a sliver.
+        gaps = sum(b1 - a1 for (_, a1), (b1, _) in zip(robust[:-1], robust[1:]))
+        assert gaps <= 1e-6 * height
+
+
+def test_a_box_of_zero_width_converges_to_the_nominal_area(paper):
+    """With strips narrowing, the inner approximation's area grows to the nominal set's."""
+    areas = [paper.region("B", "K", uncertain={"b": (0.0324, 0.0324)}, strips=n, d=10,
+                          M=0.0).area for n in (16, 64, 256)]
+    nominal = paper.region("B", "K", d=10, M=0.0).area
+    assert areas[0] < areas[1] < areas[2] < nominal
+    assert nominal - areas[2] < 0.25 * (nominal - areas[1]) + 1e-9
+    assert areas[2] > 0.98 * nominal
+
+
+def test_a_box_where_the_set_vanishes(paper):
+    region = paper.region("B", "K", uncertain={"M": (0.0, 0.019)}, d=10)
+    assert region.empty and region.area == 0 and region.polygons == ()
+    assert "do not meet" in region.reason and "M in [0, 0.019]" in region.reason
+    limits = paper.limits("B", "K", uncertain={"M": (0.0, 0.019)}, d=10)
+    assert limits.empty and limits.reason == region.reason
+    # A box whose centre is unstable.
+    assert "centre is empty" in paper.region("B", "K", uncertain={"M": (0.0, 0.05)}, d=10).reason
+
+
+def test_robust_limits_and_polygons(paper):
+    region = paper.region("B", "K", uncertain={"b": (0.0162, 0.0648)}, strips=32, d=10, M=0.0)
+    limits = paper.limits("B", "K", uncertain={"b": (0.0162, 0.0648)}, strips=32, d=10, M=0.0)
+    assert limits.region.intervals == region.intervals and limits.area == region.area
+    # K_max grows with b: the robust one is at most the smallest b's.
+    assert limits.y_max <= paper.limits("B", "K", b=0.0162, d=10, M=0.0).y_max
+    shoelace = sum(0.5 * abs(np.dot(p[:, 0], np.roll(p[:, 1], -1))
+                             - np.dot(p[:, 1], np.roll(p[:, 0], -1))) for p in region.polygons)
+    assert shoelace == pytest.approx(region.area, rel=1e-12)
+    assert limits.intervals_at(limits.x_at_y_max)[-1][1] == pytest.approx(limits.y_max)
+
+
+@pytest.mark.parametrize("uncertain, strips, rtol, match", [
+    ({"K": (1.0, 2.0)}, 8, 1e-6, "axis"),
+    ({"q": (1.0, 2.0)}, 8, 1e-6, "not a parameter"),
+    ({"b": (0.05, 0.01)}, 8, 1e-6, "low <= high"),
+    ({"d": (12, 8)}, 8, 1e-6, "low <= high"),
+    ({"b": (0.01, 0.05)}, 0, 1e-6, "strips"),
+    ({"b": (0.01, 0.05)}, 8, 0.5, "rtol"),
+    ({"T": (0.0, 1e-3)}, 8, 1e-6, "period"),
+])
+def test_bad_input_is_refused_by_name(paper, uncertain, strips, rtol, match):
+    with pytest.raises((TypeError, ValueError), match=match):
+        paper.region("B", "K", uncertain=uncertain, strips=strips, rtol=rtol, d=10)
+
+
+def test_uncertain_must_be_a_box(paper):
+    with pytest.raises(TypeError, match="uncertain"):
+        paper.region("B", "K", uncertain={"b": 0.03}, d=10)
+    with pytest.raises(TypeError, match="uncertain"):
+        paper.region("B", "K", uncertain={}, d=10)
+
+
+@pytest.mark.parametrize("path, box, d", [
+    (PAPER, {"m": (0.0115, 0.0141), "b": (0.0162, 0.0648)}, 10),
+    ("examples/loops/lowpass_velocity.toml", {"b": (0.02, 0.045), "f_c": (30.0, 70.0)}, 40),
+])
+def test_the_disks_hold_the_polynomial(path, box, d):
+    """Each part of chi at any theta of the interval and any value of the box lies in its disk.
+
+    The part's true value from python-control's plant and the loop's
+    environment polynomials; the disk is the value and slope at the middle
+    (midpoint coefficients) with the second-derivative bound, the
+    coefficients' radii and the rounding.
+    """
+    from symstab.numeric.robust import _Enclosures, _parts_on_arc
+
+    loop = symstab.load_loop(path)
+    fixed = {k: v for k, v in loop.defaults.items() if k not in box and k not in ("B", "K", "d")}
+    enclosures = _Enclosures(loop, "B", "K", box, fixed)
+    k = loop._delay_of_environment
+    shift = d + k
+    rng = np.random.default_rng(5)
+    theta_c = np.concatenate([rng.uniform(0, np.pi, 40), [1e-4, np.pi - 1e-4]])
+    h = theta_c * 0 + 0.01
+    value, slope, second, coefficient, rounding = _parts_on_arc(
+        enclosures, shift, theta_c, h, np.zeros(len(theta_c), dtype=np.int64))
+    symbols = {str(s): s for s in loop._symbols.values()}
+    ve_n, ve_d = loop._environment_parts
+    worst = 0.0
+    for _ in range(12):
+        q = {name: rng.uniform(lo, hi) for name, (lo, hi) in box.items()}
+        at = {**fixed, **q}
+        n, p = _c2d([1.0], [at["m"], at["b"], 0.0], at["T"])
+        sub = {symbols[name]: v for name, v in at.items()}
+        parts = []
+        for slope_of in (None, "B", "K"):
+            def coefficients(c):
+                c = [sp.diff(e, symbols[slope_of]) if slope_of else e for e in c]
+                return np.array([float(e.subs(sub).subs({symbols["B"]: 0, symbols["K"]: 0}))
+                                 for e in c])
+            delayed = np.convolve(coefficients(ve_d)[:len(ve_d) - k], p)
+            direct = np.convolve(coefficients(ve_n), n)
+            parts.append((delayed, direct))
+        u = rng.uniform(-1, 1, len(theta_c))
+        theta = theta_c + u * h
+        z = np.exp(1j * theta)
+        for j, (delayed, direct) in enumerate(parts):
+            true = z**shift * np.polyval(delayed, z) + np.polyval(direct, z)
+            near = value[:, j] + slope[:, j] * (theta - theta_c)
+            bound = 0.5 * (theta - theta_c) ** 2 * second[:, j] + coefficient[:, j] + rounding[:, j]
+            scale = np.abs(delayed).sum() + np.abs(direct).sum()
+            excess = np.abs(true - near) - bound
+            # python-control's coefficients are good to about 1e-13 of the largest.
+            assert (excess <= 1e-12 * scale).all(), (j, excess.max() / scale)
+            worst = max(worst, float((np.abs(true - near) / np.maximum(bound, 1e-300)).max()))
+    # The bound is not vacuous: some points use a good part of it.
+    assert worst > 0.05
