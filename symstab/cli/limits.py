@@ -4,16 +4,22 @@ The paper's loop: alpha_max (K_max), the damping at which it is reached,
 the range of damping over the stable region and its area (Z-width), with
 --beta/--Bw the stable stiffness intervals at that damping.  A loop file
 (``--loop``): the same in its plane (with --at X the stable y at x = X).
-Both give the passive set (Colgate-Schenkel) beside the stable one.
+Both give the passive set (Colgate-Schenkel) beside the stable one.  With
+``--uncertain NAME=LO:HI`` (a loop file) the limits are the robust set's:
+the points stable for every value of the box
+(:func:`symstab.numeric.robust.robust_region`), drawn with ``--png``
+beside the nominal set.
 """
 
 import math
 import sys
 import textwrap
 
+import numpy as np
+
 from .loop_limits import LIMITS, limits_notes, limits_table, named, passive_notes, \
     stable_intervals_at
-from .loop_options import add_loop_options, resolve_setup
+from .loop_options import add_loop_options, resolve_setup, uncertain_box
 from .options import add_command, add_model_options
 from .output import emit
 
@@ -56,6 +62,11 @@ def run(args):
     """
     setup = resolve_setup(args)
     at = _line(args, setup)         # checked before the work
+    if setup.paper is None and args.uncertain is not None:
+        return _robust(args, setup, at)
+    for flag, dest in (("--strips", "strips"), ("--png", "png")):
+        if getattr(args, dest, None) is not None:
+            raise ValueError(f"{flag} is an option of the robust limits: add --uncertain NAME=LO:HI")
     if setup.values["d"] >= _ANNOUNCE_DELAY:
         # Seconds at long delays (the plane's D-decomposition, and the passive set): say what runs.
         print(f"scanning the ({setup.name(setup.x)}, {setup.name(setup.y)}) plane for the "
@@ -93,3 +104,104 @@ def _line(args, setup):
             raise ValueError("--Bw needs a physical device; use --beta with --delta")
         return check_real("beta", float(setup.paper.device.beta(args.Bw)))
     return None if args.beta is None else check_real("beta", args.beta)
+
+
+#: The most strips ``--strips`` takes (as :func:`symstab.numeric.robust.robust_region`).
+_MAX_STRIPS = 100_000
+
+
+def _robust(args, setup, at):
+    """``limits --loop --uncertain``: the robust set's limits, certified; its PNG with --png."""
+    from ..drawing import png_bytes, pyplot
+    from ..numeric.loop_simulate import progress_printer
+    from .output import check_files, write_output
+
+    strips = 64 if args.strips is None else args.strips
+    if not 1 <= strips <= _MAX_STRIPS:
+        raise ValueError(f"--strips must be an integer from 1 to {_MAX_STRIPS}, got {strips}")
+    png = None
+    if args.png is not None:
+        if not args.png.endswith(".png"):
+            raise ValueError(f"--png must end in .png, got {args.png}")
+        png = check_files([("--png", args.png)])["--png"]
+        plt = pyplot()      # matplotlib is there before the work starts
+    box = uncertain_box(args, setup)
+    values = {k: v for k, v in setup.values.items() if k not in box}
+    delays = box["d"][1] - box["d"][0] + 1 if "d" in box else 1
+    if delays > 1 or values.get("d", 0) >= _ANNOUNCE_DELAY:
+        print(f"certifying the ({setup.name(setup.x)}, {setup.name(setup.y)}) plane for every "
+              f"value of the box ({delays} delay(s)) ...", file=sys.stderr, flush=True)
+    lim = setup.loop.limits(x=setup.x, y=setup.y, uncertain=box, strips=strips,
+                            progress=progress_printer("delays", delays), **values)
+    region = lim.region
+    columns, rows = limits_table(setup, lim)
+    x, y = setup.name(setup.x), setup.name(setup.y)
+    box_text = ", ".join(
+        f"{name} in [{lo:.6g}, {hi:.6g}]" + ("" if name == "d" or not setup.unit(name)
+                                            else f" {setup.unit(name)}")
+        for name, (lo, hi) in box.items())
+    nominal = region.nominal
+    notes = [f"robust: the points of the ({x}, {y}) plane stable for every {box_text}, "
+             f"certified by zero exclusion (interval arithmetic over the box and theta; "
+             f"{len(region.edges) - 1 if len(region.edges) else strips} strips, each a "
+             f"rectangle of certified y)"]
+    if lim.empty:
+        notes.append(f"the robust set is empty: {lim.reason}")
+    else:
+        nominal_limits = nominal.limits() if nominal is not None and nominal.stable else None
+        if nominal_limits is not None:
+            notes.append(f"nominal (the box's centre): {y}_max = {nominal_limits.y_max:.6g}, "
+                         f"area = {nominal_limits.area:.6g}; robust: {y}_max = "
+                         f"{lim.y_max:.6g}, area = {lim.area:.6g} "
+                         f"({lim.area / nominal_limits.area:.1%} of it)")
+        notes.append(f"marginal (the certificate did not close): area {region.marginal_area:.3g}; "
+                     f"more strips make the rectangles fit closer")
+        if region.exhausted:
+            notes.append("the search stopped at its budget of cells: what it left open is "
+                         "marginal")
+    result = {"limits": lim.as_dict(),
+              "robust": {"uncertain": {k: list(v) for k, v in box.items()},
+                         "strips": strips, "marginal_area": region.marginal_area,
+                         "nominal_area": None if nominal is None else nominal.area,
+                         "exhausted": region.exhausted}}
+    if at is not None:
+        spans = lim.intervals_at(at)
+        text = ", ".join(f"[{lo:.10g}, {hi:.10g}]" for lo, hi in spans) or "none"
+        notes.append(f"robust {y} at {x} = {at:.10g}: {text}")
+        result["at"] = {"x": at, "intervals": [list(r) for r in spans]}
+    if png is not None:
+        write_output(png, png_bytes(plt, _robust_figure(plt, setup, region)), "--png")
+        notes.append(f"wrote {png}")
+    emit(setup, args.format, columns, rows, result=result, notes=notes, json_rows=False)
+    return 0
+
+
+def _robust_figure(plt, setup, region):
+    """The robust set (filled), what stayed marginal, and the nominal set's outline beside it."""
+    from matplotlib.patches import Patch, Rectangle
+
+    fig, ax = plt.subplots(figsize=(6.4, 4.8))
+    nominal = region.nominal
+    if nominal is not None:
+        for k, cell in enumerate(nominal.stable):
+            ring = np.vstack([cell.outer, cell.outer[:1]])
+            ax.plot(ring[:, 0], ring[:, 1], color="0.2", lw=1.0,
+                    label="stable at the box's centre" if k == 0 else None)
+    for which, color in ((region.marginal, "#f4a582"), (region.intervals, "#4393c3")):
+        for i, spans in enumerate(which):
+            for lo, hi in spans:
+                ax.add_patch(Rectangle((region.edges[i], lo), region.edges[i + 1] - region.edges[i],
+                                       hi - lo, facecolor=color, edgecolor="none"))
+    handles, _ = ax.get_legend_handles_labels()
+    handles += [Patch(color="#4393c3", label="stable for every value of the box"),
+                Patch(color="#f4a582", label="marginal (not certified)")]
+    ax.legend(handles=handles, loc="best", fontsize=8)
+    if nominal is not None:
+        ax.set_xlim(*nominal.x_range)
+        ax.set_ylim(*nominal.y_range)
+    box = ", ".join(f"{k} in [{lo:.4g}, {hi:.4g}]" for k, (lo, hi) in region.uncertain.items())
+    ax.set_title(f"robust stable set: {box}", fontsize=9)
+    ax.set_xlabel(setup.label(setup.x))
+    ax.set_ylabel(setup.label(setup.y))
+    fig.tight_layout()
+    return fig

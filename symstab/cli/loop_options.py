@@ -31,7 +31,7 @@ import numpy as np
 
 from .._resources import check_memory
 
-__all__ = ["DEVICE_OPTIONS", "POINT_OPTIONS", "EXAMPLE", "LINEAR_WITH_LOOP", "add_loop_options",
+__all__ = ["uncertain_box", "DEVICE_OPTIONS", "POINT_OPTIONS", "EXAMPLE", "LINEAR_WITH_LOOP", "add_loop_options",
            "uses_loop", "split_unit", "parse_number", "convert_sets", "LoopSetup", "value_text",
            "loop_echo", "load_loop_file", "add_delay", "check_names", "loop_values", "resolve_loop",
            "resolve_setup", "paper_setup", "TABLE_ONE", "point_count", "broadcast", "range_text",
@@ -86,7 +86,7 @@ _REFUSED = {
 #: The options that only mean something with ``--loop``, per command.
 _LOOP_ONLY = {
     "boundary": ("set_values", "x", "y"),
-    "limits": ("set_values", "x", "y", "at"),
+    "limits": ("set_values", "x", "y", "at", "uncertain", "strips", "png"),
     "classify": ("set_values",),
     "design": ("set_values", "x", "y", "at", "over", "search_range", "delay"),
     "map": ("set_values", "x", "y", "x_range", "y_range", "simulate", "uncertain", "samples",
@@ -97,7 +97,8 @@ _LOOP_ONLY = {
 _FLAGS = {"set_values": "--set", "x": "--x", "y": "--y", "at": "--at",
           "x_range": "--x-range", "y_range": "--y-range", "over": "--over",
           "search_range": "--range", "simulate": "--simulate", "delay": "--delay",
-          "uncertain": "--uncertain", "samples": "--samples", "seed": "--seed"}
+          "uncertain": "--uncertain", "samples": "--samples", "seed": "--seed",
+          "strips": "--strips", "png": "--png"}
 
 
 EXAMPLE = "examples/loops/paper.toml"
@@ -176,6 +177,18 @@ def add_loop_options(p, command):
         g.add_argument("--at", type=float, metavar="X",
                        help="also give the stable intervals of y at x = X"
                             + (" (default: the x of the largest y)" if command == "design" else ""))
+    if command == "limits":
+        g.add_argument("--uncertain", metavar="NAME=LO:HI", action="append",
+                       help="the robust limits instead: of the points stable for every value "
+                            "of NAME in LO:HI (its SI unit, or the unit written after HI: "
+                            "--uncertain \"b=0.02:0.045 N*m*s/rad\"; d: the whole delays "
+                            "LO..HI), certified by zero exclusion; repeatable for a box")
+        g.add_argument("--strips", type=int, metavar="N",
+                       help="with --uncertain: vertical strips across the plane (default 64; "
+                            "more strips, a larger certified set and a longer run)")
+        g.add_argument("--png", metavar="FILE",
+                       help="with --uncertain: draw the robust set beside the nominal one "
+                            "(a .png file)")
     if command == "design":
         g.add_argument("--over", metavar="NAME[=LO:HI]", action="append",
                        help="a parameter searched, with its range in its SI unit or in the "
@@ -652,3 +665,40 @@ def broadcast(values):
         text = ", ".join(f"{n} has {k}" for n, k in lengths.items())
         raise ValueError(f"--set lists must have the same length or one value: {text}")
     return {n: (np.array(v, dtype=float) if isinstance(v, list) else v) for n, v in values.items()}
+
+
+def uncertain_box(args, setup):
+    """``{name: (low, high)}`` of the ``--uncertain`` options, in SI, checked against the file."""
+    from .._validate import check_delay
+
+    loop = setup.loop
+    others = [n for n in loop.parameters if n not in (setup.x, setup.y)]
+    box = {}
+    for text in args.uncertain:
+        name, eq, window = text.partition("=")
+        name = name.strip()
+        if not eq or not name:
+            raise ValueError(f"--uncertain {text}: expected NAME=LO:HI, e.g. --uncertain "
+                             f"b=0.02:0.045")
+        if name in box:
+            raise ValueError(f"--uncertain {name} is given twice; give each parameter once")
+        if name not in loop.parameters:
+            raise ValueError(f"--uncertain {name}: not a parameter of the loop in {args.loop} "
+                             f"(candidates: {', '.join(others)})")
+        if name in (setup.x, setup.y):
+            raise ValueError(f"--uncertain {name}: {name} is an axis of the ({setup.x}, "
+                             f"{setup.y}) plane; give another parameter (candidates: "
+                             f"{', '.join(others)})")
+        low, high, unit = range_text(window, f"--uncertain {name}")
+        if name == "d":
+            if unit is not None or low != int(low) or high != int(high):
+                raise ValueError(f"--uncertain d: the delay is a whole number of samples: give "
+                                 f"d=LO:HI in samples, got {window!r}")
+            try:
+                box[name] = (check_delay(int(low)), check_delay(int(high)))
+            except ValueError as exc:
+                raise ValueError(f"--uncertain d: {exc}") from None
+        else:
+            box[name] = converted_range(setup, name, low, high, unit, flag="--uncertain")
+    check_box(setup, {k: v for k, v in box.items() if k != "d"}, "--uncertain")
+    return box

@@ -16,7 +16,7 @@ import textwrap
 import numpy as np
 
 from .._resources import CHUNK_BYTES, check_memory, chunk_slices
-from .loop_options import (add_loop_options, check_box, converted_range, range_text, resolve_loop,
+from .loop_options import (add_loop_options, resolve_loop, uncertain_box,
                            uses_loop, value_text)
 from .options import add_command, add_model_options, resolve, stiffness_and_damping
 from ..drawing import draw_lines, png_bytes, pyplot_or_none, visible
@@ -371,43 +371,6 @@ def _loop_npz(setup, xs, ys, values, **arrays):
     return buf.getvalue()
 
 
-def _uncertain_box(args, setup):
-    """``{name: (low, high)}`` of the ``--uncertain`` options, in SI, checked against the file."""
-    from .._validate import check_delay
-
-    loop = setup.loop
-    others = [n for n in loop.parameters if n not in (setup.x, setup.y)]
-    box = {}
-    for text in args.uncertain:
-        name, eq, window = text.partition("=")
-        name = name.strip()
-        if not eq or not name:
-            raise ValueError(f"--uncertain {text}: expected NAME=LO:HI, e.g. --uncertain "
-                             f"b=0.02:0.045")
-        if name in box:
-            raise ValueError(f"--uncertain {name} is given twice; give each parameter once")
-        if name not in loop.parameters:
-            raise ValueError(f"--uncertain {name}: not a parameter of the loop in {args.loop} "
-                             f"(candidates: {', '.join(others)})")
-        if name in (setup.x, setup.y):
-            raise ValueError(f"--uncertain {name}: {name} is an axis of the ({setup.x}, "
-                             f"{setup.y}) map; draw another parameter (candidates: "
-                             f"{', '.join(others)})")
-        low, high, unit = range_text(window, f"--uncertain {name}")
-        if name == "d":
-            if unit is not None or low != int(low) or high != int(high):
-                raise ValueError(f"--uncertain d: the delay is a whole number of samples: give "
-                                 f"d=LO:HI in samples, got {window!r}")
-            try:
-                box[name] = (check_delay(int(low)), check_delay(int(high)))
-            except ValueError as exc:
-                raise ValueError(f"--uncertain d: {exc}") from None
-        else:
-            box[name] = converted_range(setup, name, low, high, unit, flag="--uncertain")
-    check_box(setup, {k: v for k, v in box.items() if k != "d"}, "--uncertain")
-    return box
-
-
 def _probability(args, setup, xs, ys, out, png_path):
     """``map --loop --uncertain``: the probability of stability of every cell, its files and PNG."""
     from ..numeric.probability import MAX_SAMPLES, draw_values
@@ -421,7 +384,7 @@ def _probability(args, setup, xs, ys, out, png_path):
             raise ValueError(f"{flag} is an option of the simulation; --uncertain maps root "
                              f"counts: drop {flag}")
     loop, x, y = setup.loop, setup.x, setup.y
-    box = _uncertain_box(args, setup)
+    box = uncertain_box(args, setup)
     samples = 1000 if args.samples is None else args.samples
     seed = 0 if args.seed is None else args.seed
     if not 1 <= samples <= MAX_SAMPLES:

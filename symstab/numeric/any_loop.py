@@ -786,7 +786,7 @@ class Loop(LoopModel):
         return Boundary(x, y, theta, xs, ys, lines=lines, segments=pieces, at=dict(values))
 
     def region(self, x=None, y=None, *, x_range=None, y_range=None, uncertain=None, strips=64,
-               rtol=1e-6, **values):
+               rtol=1e-6, progress=None, **values):
         """The complete D-decomposition of the ``(x, y)`` plane: cells, root counts, stable set.
 
         With ``uncertain``, the robust region instead: the points stable for
@@ -819,10 +819,10 @@ class Loop(LoopModel):
         uncertain : dict, optional
             ``{name: (low, high)}`` of the plant's and environment's
             parameters (``T`` too) and ``d`` (whole delays): the box.
-        strips, rtol : optional
-            With ``uncertain``: vertical strips across the window, and the
+        strips, rtol, progress : optional
+            With ``uncertain``: vertical strips across the window, the
             resolution of the certified intervals' ends (a fraction of the
-            window's height).
+            window's height), a callable given the delays done.
         **values
             Single values of every other parameter.
 
@@ -850,7 +850,7 @@ class Loop(LoopModel):
             from .robust import robust_region
 
             return robust_region(self, x, y, uncertain=uncertain, strips=strips, rtol=rtol,
-                                 x_range=x_range, y_range=y_range, **values)
+                                 x_range=x_range, y_range=y_range, progress=progress, **values)
         given = {key: None if window is None else check_window(key, window)
                  for key, window in (("x_range", x_range), ("y_range", y_range))}
         structured, slopes, ends = self.affine_parts((x, y), values, structured=True)
@@ -963,7 +963,9 @@ class Loop(LoopModel):
         """
         if values.get("uncertain") is not None:
             return self.region(x, y, **values).limits()
-        values.pop("uncertain", None)
+        for option in ("uncertain", "strips", "rtol", "progress"):
+            if values.pop(option, None) is not None and option != "uncertain":
+                raise TypeError(f"{option} is an option of the robust region: give uncertain too")
         found = self.region(x, y, **values)
         at = {k: v for k, v in values.items() if k not in ("x_range", "y_range")}
         return found.limits(at=at, line=functools.partial(_stable_intervals_at, self, found.x,

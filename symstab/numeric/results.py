@@ -421,6 +421,12 @@ class RobustRegion:
         Why the set is empty; else empty.
     examined : int
         Cells the branch and bound examined.
+    exhausted : bool
+        Whether it stopped at its budget of cells (what was left open is
+        then marginal).
+    unbounded : tuple of str
+        The window's sides the nominal set goes beyond and the robust set
+        reaches: it may go on there too (its limits are then infinite).
     """
 
     x: str
@@ -433,16 +439,20 @@ class RobustRegion:
     at: dict = dataclasses.field(default_factory=dict)
     reason: str = ""
     examined: int = 0
+    exhausted: bool = False
+    unbounded: tuple = ()
 
     @classmethod
-    def from_strips(cls, x, y, box, delays, edges, robust, marginal, nominal, at, examined=0):
+    def from_strips(cls, x, y, box, delays, edges, robust, marginal, nominal, at, examined=0,
+                    exhausted=False, unbounded=()):
         """The region from each strip's intervals (the reason said when it is empty)."""
         uncertain = dict(box)
         if len(delays) > 1:
             uncertain["d"] = (delays[0], delays[-1])
         region = cls(x, y, uncertain, np.asarray(edges, dtype=float),
                      tuple(tuple(r) for r in robust), tuple(tuple(m) for m in marginal),
-                     nominal, dict(at), examined=examined)
+                     nominal, dict(at), examined=examined, exhausted=exhausted,
+                     unbounded=tuple(unbounded))
         if not region.empty:
             return region
         box_text = ", ".join(f"{k} in [{lo:g}, {hi:g}]" for k, (lo, hi) in uncertain.items())
@@ -548,19 +558,26 @@ class RobustRegion:
     def limits(self):
         """The robust set's extent and area as :class:`Limits` (``region`` is this)."""
         if self.empty:
-            return Limits.empty_set(self.x, self.y, self.reason, cells=0, at=self.at,
-                                    line=self.intervals_at)
+            return Limits.empty_set(self.x, self.y, self.reason, cells=0, region=self,
+                                    at=self.at, line=self.intervals_at)
         r = self._rectangles(self.intervals)
         top = int(np.argmax(r[:, 3]))
-        return Limits(self.x, self.y, float(r[top, 3]), float(0.5 * (r[top, 0] + r[top, 1])),
-                      float(r[:, 0].min()), float(r[:, 1].max()), self.area,
-                      cells=len(self.polygons), region=self, at=self.at, line=self.intervals_at)
+        sides = set(self.unbounded)
+        return Limits(self.x, self.y, np.inf if "y_max" in sides else float(r[top, 3]),
+                      float(0.5 * (r[top, 0] + r[top, 1])),
+                      -np.inf if "x_min" in sides else float(r[:, 0].min()),
+                      np.inf if "x_max" in sides else float(r[:, 1].max()),
+                      np.inf if sides else self.area, cells=len(self.polygons), region=self,
+                      reason=("the robust set reaches the window's " + ", ".join(sorted(sides))
+                              + " side, which the nominal set goes beyond") if sides else "",
+                      at=self.at, line=self.intervals_at)
 
     def __repr__(self):
         box = ", ".join(f"{k} in [{lo:g}, {hi:g}]" for k, (lo, hi) in self.uncertain.items())
         if self.empty:
             return f"RobustRegion({self.x} x {self.y}, {box}: empty: {self.reason})"
         nominal = self.nominal.area if self.nominal is not None else float("nan")
+        more = ", stopped at its budget" if self.exhausted else ""
         return (f"RobustRegion({self.x} x {self.y}, {box}: area {self.area:.6g} "
                 f"(nominal {nominal:.6g}), marginal {self.marginal_area:.3g}, "
-                f"{len(self.edges) - 1} strips)")
+                f"{len(self.edges) - 1} strips{more})")

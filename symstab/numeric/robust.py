@@ -453,7 +453,7 @@ def _certify(enclosures, shift, centres, halves, candidates, tol, budget):
     marked = {s: [] for s in candidates}
     strips = np.array(sorted(candidates), dtype=np.int64)
     if not len(strips):
-        return marked, 0
+        return marked, 0, False
     cells = _Cells(np.repeat(strips, n_theta), np.tile(edges[:-1], len(strips)),
                    np.tile(edges[1:], len(strips)), np.zeros(n_theta * len(strips), dtype=np.int64))
     examined = 0
@@ -464,7 +464,7 @@ def _certify(enclosures, shift, centres, halves, candidates, tol, budget):
             # Out of budget: whatever the cells left could still reach is marginal.
             for s in np.unique(cells.strip):
                 marked[int(s)] = _merge(marked[int(s)] + open_spans[int(s)])
-            break
+            return {s: _merge(v) for s, v in marked.items()}, examined, True
         examined += len(cells)
         found = []
         for part in chunk_slices(len(cells), per_cell):
@@ -523,7 +523,7 @@ def _certify(enclosures, shift, centres, halves, candidates, tol, budget):
         if not children:
             break
         cells = _Cells.join(children)
-    return {s: _merge(v) for s, v in marked.items()}, examined
+    return {s: _merge(v) for s, v in marked.items()}, examined, False
 
 
 def _grid(box):
@@ -563,7 +563,7 @@ def _check_uncertain(loop, uncertain, axes):
 
 
 def robust_region(loop, x, y, *, uncertain, strips=64, rtol=1e-6, x_range=None, y_range=None,
-                  budget=MAX_CELLS, **values):
+                  budget=MAX_CELLS, progress=None, **values):
     """The points of the ``(x, y)`` plane stable for every value in the box (see the module).
 
     Parameters
@@ -584,7 +584,10 @@ def robust_region(loop, x, y, *, uncertain, strips=64, rtol=1e-6, x_range=None, 
         centre), which holds the robust set.  ``x_range = (x0, x0)`` is one
         line.
     budget : int
-        Most cells examined (:data:`MAX_CELLS`); beyond, marginal.
+        Most cells examined (:data:`MAX_CELLS`); beyond, marginal (and
+        :attr:`~symstab.numeric.results.RobustRegion.exhausted` says so).
+    progress : callable, optional
+        Called with the number of delays done.
     **values
         Values of the other parameters.
 
@@ -654,7 +657,7 @@ def robust_region(loop, x, y, *, uncertain, strips=64, rtol=1e-6, x_range=None, 
 
     robust = [[(y_lo, y_hi)] for _ in centres]
     marginal = [[] for _ in centres]
-    examined = 0
+    examined, exhausted = 0, False
     grid = _grid(box)
     enclosures = _Enclosures(loop, x, y, box, fixed)
     for d in delays:
@@ -666,22 +669,55 @@ def robust_region(loop, x, y, *, uncertain, strips=64, rtol=1e-6, x_range=None, 
                 both = _intersect(found[i], found[i + 1])
                 robust[i] = _intersect(robust[i], both)
         candidates = {i: spans for i, spans in enumerate(robust) if spans}
-        marked, n = _certify(enclosures, shift, centres, halves, candidates, tol, budget - examined)
+        marked, n, out = _certify(enclosures, shift, centres, halves, candidates, tol,
+                                  budget - examined)
         examined += n
+        exhausted |= out
         lead_mid, lead_rad = enclosures.leading(shift)
+        # Each certified piece: its root count at one point (the box's
+        # centre) and its leading coefficient; a count of -1 (undecided) or a
+        # leading coefficient that may vanish leave it marginal, a count
+        # above 0 unstable (not robust).
+        pieces = [(i, a, b) for i, spans in candidates.items()
+                  for a, b in _subtract(spans, marked[i])]
+        counts = np.atleast_1d(loop.unstable_root_counts(
+            **fixed, **centre, d=d, **{x: np.array([centres[i] for i, _, _ in pieces]),
+                                       y: np.array([0.5 * (a + b) for _, a, b in pieces])})) \
+            if pieces else np.zeros(0, dtype=int)
+        kept = {i: [] for i in candidates}
+        for (i, a, b), count in zip(pieces, counts):
+            if count == 0 and _lead_excluded(lead_mid, lead_rad, centres[i], halves[i], a, b):
+                kept[i].append((a, b))
+            elif count <= 0:
+                marginal[i].append((a, b))
         for i, spans in candidates.items():
-            kept = []
-            for a, b in _subtract(spans, marked[i]):
-                ok = _count_zero(loop, x, y, centres[i], 0.5 * (a + b), fixed, centre, d)
-                ok = ok and _lead_excluded(lead_mid, lead_rad, centres[i], halves[i], a, b)
-                (kept if ok else marginal[i]).append((a, b))
             marginal[i] = _merge(marginal[i] + [(a, b) for a, b in marked[i]
                                                 if any(a < hi and b > lo for lo, hi in spans)])
-            robust[i] = kept
+            robust[i] = kept[i]
         for i in set(range(len(centres))) - set(candidates):
             robust[i] = []
-    return RobustRegion.from_strips(x, y, box, delays, edges, robust, marginal, nominal, fixed,
-                                    examined=examined)
+        if progress is not None:
+            progress(delays.index(d) + 1)
+    robust = [_subtract(spans, marginal[i]) for i, spans in enumerate(robust)]
+    at = dict(fixed) if len(delays) > 1 else {**fixed, "d": delays[0]}
+    touched = tuple(side for side in nominal.unbounded
+                    if _touches(side, edges, robust, (x_lo, x_hi, y_lo, y_hi)))
+    return RobustRegion.from_strips(x, y, box, delays, edges, robust, marginal, nominal, at,
+                                    examined=examined, exhausted=exhausted, unbounded=touched)
+
+
+def _touches(side, edges, robust, window):
+    """Whether the robust set reaches a side of the window."""
+    x_lo, x_hi, y_lo, y_hi = window
+    filled = [i for i, spans in enumerate(robust) if spans]
+    if not filled:
+        return False
+    if side == "x_min":
+        return filled[0] == 0 and edges[0] <= x_lo
+    if side == "x_max":
+        return filled[-1] == len(robust) - 1 and edges[-1] >= x_hi
+    ends = [end for spans in robust for end in (spans[0][0], spans[-1][1]) if spans]
+    return min(ends) <= y_lo if side == "y_min" else max(ends) >= y_hi
 
 
 def _intersect(a, b):
@@ -696,11 +732,6 @@ def _intersect(a, b):
         else:
             j += 1
     return out
-
-
-def _count_zero(loop, x, y, xv, yv, fixed, centre, d):
-    """Whether the certified root count is 0 at one point, at the box's centre."""
-    return loop.unstable_root_counts(**fixed, **centre, d=d, **{x: float(xv), y: float(yv)}) == 0
 
 
 def _lead_excluded(lead_mid, lead_rad, xc, hx, a, b):

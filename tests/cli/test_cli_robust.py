@@ -1,0 +1,69 @@
+"""``limits --loop --uncertain``: the robust limits from the command line.
+
+Oracle: the library's robust limits (tested against python-control's poles
+in tests/numeric/test_robust.py) at the values the options name, in any
+unit.  Bad input is one line, exit status 2, before any work, and nothing
+is written.
+"""
+
+import json
+
+import pytest
+
+import symstab
+
+from conftest import REPO, run_cli as run
+
+PAPER = REPO / "examples" / "loops" / "paper.toml"
+
+pytestmark = pytest.mark.usefixtures("loop_cache_dir")
+
+
+def test_robust_limits_are_the_library_s_in_any_unit(capsys, tmp_path):
+    png = tmp_path / "robust.png"
+    status, text, err = run(capsys, "limits", "--loop", PAPER, "--set", "d=10", "--set", "M=0",
+                            "--uncertain", "b=16.2:64.8 g*m^2/s", "--strips", "16",
+                            "--png", png, "--at", "1.0", "--format", "json")
+    assert status == 0, err
+    found = json.loads(text)
+    lim = symstab.load_loop(PAPER).limits("B", "K", uncertain={"b": (0.0162, 0.0648)},
+                                          strips=16, d=10, M=0.0)
+    assert found["limits"]["y_max"] == lim.y_max and found["limits"]["area"] == lim.area
+    assert found["robust"]["uncertain"] == {"b": [0.0162, 0.0648]}
+    assert found["robust"]["nominal_area"] > lim.area
+    assert found["at"]["intervals"] == [list(r) for r in lim.intervals_at(1.0)]
+    assert png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+
+
+def test_robust_limits_over_delays_and_the_empty_set(capsys):
+    status, text, err = run(capsys, "limits", "--loop", PAPER, "--set", "M=0",
+                            "--uncertain", "d=9:11", "--strips", "8")
+    assert status == 0, err
+    assert "stable for every d in [9, 11]" in text
+    status, text, err = run(capsys, "limits", "--loop", PAPER, "--set", "d=10",
+                            "--uncertain", "M=0:0.019", "--strips", "8")
+    assert status == 0, err
+    assert "the robust set is empty" in text and "do not meet" in text
+
+
+@pytest.mark.parametrize("args, message", [
+    (("--uncertain", "b=0.05:0.01"), "LO < HI"),
+    (("--uncertain", "K=1:2"), "axis"),
+    (("--uncertain", "q=1:2"), "not a parameter"),
+    (("--uncertain", "b=0.01:0.05", "--strips", "0"), "--strips"),
+    (("--uncertain", "b=0.01:0.05", "--png", "x.txt"), "--png"),
+    (("--strips", "8"), "--uncertain"),
+    (("--png", "x.png"), "--uncertain"),
+    (("--uncertain", "d=1.5:3"), "whole number"),
+])
+def test_bad_options_are_one_line(capsys, tmp_path, args, message):
+    args = [a.replace("x.png", str(tmp_path / "x.png")) for a in args]
+    status, text, err = run(capsys, "limits", "--loop", PAPER, "--set", "d=10", *args)
+    assert status == 2
+    assert message in err and len(err.strip().splitlines()) == 1
+    assert not list(tmp_path.iterdir())
+
+
+def test_uncertain_needs_a_loop_file(capsys):
+    status, _, err = run(capsys, "limits", "--uncertain", "b=0.01:0.05")
+    assert status == 2 and "--uncertain needs a loop file" in err
