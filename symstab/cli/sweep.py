@@ -1,9 +1,14 @@
 """``symstab sweep SPEC.toml``: one question asked of a loop at many parameter points, on Dask.
 
 The spec (TOML) names the loop file (relative to the spec), the question
-(``limits``, or ``design`` with a ``[design]`` table: ``over = {NAME = [LO,
+(``limits``; ``design`` with a ``[design]`` table: ``over = {NAME = [LO,
 HI]}``, one or two parameters, and ``maximize``, K_max, the Z-width or the
-passive K_max), optionally the plane, the rows per chunk, and the points:
+passive K_max; ``region``, the D-decomposition's cells, stable pieces and
+area; ``robust`` with ``[robust] uncertain = {NAME = [LO, HI]}`` and
+``strips``, the limits of the set stable over the box; ``simulated`` with
+``[simulated] amplitude`` and optionally ``steps``, ``x0``,
+``encoder_resolution``, ``force_limit``, ``force_resolution`` in SI, the
+largest y a simulated run accepts), optionally the plane, the rows per chunk, and the points:
 either ``[grid]``, every combination of the values given for each parameter
 (a list, or ``{from = LO, to = HI, points = N}``; ``unit = "..."`` converts
 them, else they are in the loop file's unit), or ``[random]``, ``samples``
@@ -36,7 +41,8 @@ __all__ = ["register", "run", "MAX_ROWS", "local_cluster", "read_spec"]
 MAX_ROWS = 1_000_000
 #: The largest spec read.
 _MAX_SPEC_BYTES = 1 << 20
-_KEYS = {"loop", "question", "plane", "chunk", "grid", "random", "design"}
+_KEYS = {"loop", "question", "plane", "chunk", "grid", "random", "design", "robust",
+         "simulated"}
 #: ``[design] maximize``'s words (those of ``symstab design --maximize``).
 _TARGETS = {"y_max": "y_max", "K_max": "y_max", "area": "area", "Z-width": "area",
             "passive": "passive"}
@@ -47,9 +53,11 @@ _DEFAULT_CHUNK = 10
 def register(subparsers):
     """Add ``symstab sweep`` to the sub-commands."""
     p = add_command(
-        subparsers, "sweep", help="ask a loop's limits at many parameter points (on Dask)",
-        description="Evaluate the limits of a loop's stable set (K_max, the B where it is "
-                    "reached, the B range, the area) at every row of a grid or of random draws "
+        subparsers, "sweep", help="ask a loop a question at many parameter points (on Dask)",
+        description="Evaluate a question -- the limits of a loop's stable set (K_max, the B "
+                    "where it is reached, the B range, the area), a design, its "
+                    "D-decomposition's cells, the robust limits over a box or the simulated "
+                    "K_max -- at every row of a grid or of random draws "
                     "of its parameters, given in a TOML spec; the chunks run on a Dask cluster "
                     "(pip install '.[sweep]') and are saved as they finish, so a run that is "
                     "interrupted resumes where it stopped.",
@@ -203,13 +211,20 @@ def read_spec(path):
             or not all(isinstance(n, str) for n in plane)):
         raise ValueError(f"{where}: plane must be two parameter names, e.g. [\"B\", \"K\"]")
     x, y = plane
-    if ("design" in spec) != (kind == "design"):
-        raise ValueError(f"{where}: [design] (over, maximize) goes with question = \"design\", "
-                         f"and only with it")
-    over, maximize = (), "y_max"
+    for section, keys in (("design", "over, maximize"), ("robust", "uncertain, strips"),
+                          ("simulated", "amplitude, steps, ...")):
+        if (section in spec) != (kind == section):
+            raise ValueError(f"{where}: [{section}] ({keys}) goes with question = "
+                             f"\"{section}\", and only with it")
+    over, maximize, strips, simulation = (), "y_max", 64, ()
     if kind == "design":
         over, maximize = _design(where, loop, x, y, spec["design"])
-    question = Question(kind, x, y, over=over, maximize=maximize)
+    elif kind == "robust":
+        over, strips = _robust(where, loop, x, y, spec["robust"])
+    elif kind == "simulated":
+        simulation = _simulated(where, loop, y, spec["simulated"])
+    question = Question(kind, x, y, over=over, maximize=maximize, strips=strips,
+                        simulation=simulation)
     chunk = spec.get("chunk", _DEFAULT_CHUNK)
     if isinstance(chunk, bool) or not isinstance(chunk, int) or not 1 <= chunk <= 10_000:
         raise ValueError(f"{where}: chunk must be an integer from 1 to 10000 (rows per task), "
@@ -227,8 +242,10 @@ def read_spec(path):
         raise ValueError(f"{where}: sweep at least one parameter")
     searched = [name for name, _, _ in over if name in names]
     if searched:
-        raise ValueError(f"{where}: {searched[0]} is swept and searched: give it in [grid] or "
-                         f"[random], or in [design] over, not both")
+        what, section = (("uncertain", "[robust] uncertain") if kind == "robust"
+                         else ("searched", "[design] over"))
+        raise ValueError(f"{where}: {searched[0]} is swept and {what}: give it in [grid] or "
+                         f"[random], or in {section}, not both")
     # The first row asked of the loop now: a value out of its domain is refused before the run.
     from ..numeric.loop_units import FileParameters, check_bounds
 
@@ -240,6 +257,8 @@ def read_spec(path):
     # the run, not in the middle of it.
     box = {n: (rows[:, k].min(), rows[:, k].max()) for k, n in enumerate(names)}
     box.update({name: (low, high) for name, low, high in over})
+    if "d" in box:
+        box["d"] = tuple(int(v) for v in box["d"])
     check_corners(loop, loop.defaults, x, y, box, where)
     return {"loop": loop, "loop_text": loop_text, "question": question,
             "names": tuple(names), "rows": rows, "chunk": chunk, "how": how}
@@ -278,6 +297,72 @@ def _design(where, loop, x, y, table):
                              f"{spec!r}")
         ranges.append((name, low, high))
     return tuple(ranges), _TARGETS[maximize]
+
+
+def _robust(where, loop, x, y, table):
+    """``(box, strips)`` of the spec's ``[robust]`` table, the box in SI."""
+    if not isinstance(table, dict):
+        raise ValueError(f"{where}: [robust] must be a table")
+    extra = sorted(set(table) - {"uncertain", "strips"})
+    if extra:
+        raise ValueError(f"{where}: [robust]: unknown key {extra[0]!r} (uncertain, strips)")
+    strips = table.get("strips", 64)
+    if isinstance(strips, bool) or not isinstance(strips, int) or not 1 <= strips <= 100_000:
+        raise ValueError(f"{where}: [robust] strips must be an integer from 1 to 100000, got "
+                         f"{strips!r}")
+    uncertain = table.get("uncertain")
+    if not isinstance(uncertain, dict) or not uncertain:
+        raise ValueError(f"{where}: [robust] uncertain = {{NAME = [LO, HI]}} names the box")
+    box = []
+    for name, spec in uncertain.items():
+        _check_name(where, loop, x, y, name)
+        unit = None
+        if isinstance(spec, dict):
+            unit, spec = spec.get("unit"), spec.get("range")
+        if not isinstance(spec, list) or len(spec) != 2:
+            raise ValueError(f"{where}: [robust] uncertain {name} must be [LO, HI] or "
+                             f"{{range = [LO, HI], unit = \"...\"}}")
+        low, high = _si(f"{where}: [robust] uncertain", loop, name, spec, unit)
+        if not low <= high:
+            raise ValueError(f"{where}: [robust] uncertain {name} = [LO, HI] needs LO <= HI, "
+                             f"got {spec!r}")
+        box.append((name, low, high))
+    return tuple(box), strips
+
+
+def _simulated(where, loop, y, table):
+    """The ``[simulated]`` table's options, in SI (the position's unit for the amplitude)."""
+    from ..numeric.simulate import Nonidealities
+
+    if not isinstance(table, dict):
+        raise ValueError(f"{where}: [simulated] must be a table")
+    from ..numeric.sweep import SIMULATION_KEYS
+
+    extra = sorted(set(table) - set(SIMULATION_KEYS))
+    if extra:
+        raise ValueError(f"{where}: [simulated]: unknown key {extra[0]!r} "
+                         f"({', '.join(SIMULATION_KEYS)})")
+    if "amplitude" not in table:
+        raise ValueError(f"{where}: [simulated] amplitude, the largest |x| accepted at the end "
+                         f"of a run, is required")
+    options = []
+    for key in SIMULATION_KEYS:
+        if key not in table:
+            continue
+        value = table[key]
+        if isinstance(value, bool) or not isinstance(value, (int, float)) \
+                or not math.isfinite(value) or value <= 0 and key != "x0":
+            raise ValueError(f"{where}: [simulated] {key} must be a positive number, got "
+                             f"{value!r}")
+        if key == "steps" and (not float(value).is_integer() or not 10 <= value <= 10_000_000):
+            raise ValueError(f"{where}: [simulated] steps must be a whole number from 10 to "
+                             f"10000000, got {value!r}")
+        options.append((key, float(value)))
+    try:
+        Nonidealities(**{k: v for k, v in options if k not in ("amplitude", "steps", "x0")})
+    except (TypeError, ValueError) as exc:
+        raise ValueError(f"{where}: [simulated]: {exc}") from None
+    return tuple(options)
 
 
 def _check_name(where, loop, x, y, name):
@@ -388,6 +473,8 @@ def _table(plan, values, reasons, suffix):
         if name == "area":
             ux, uy = units.get(question.x, ""), units.get(question.y, "")
             return f"({ux})({uy})" if ux and uy else ""
+        if name == "count":
+            return ""
         return units.get(name, "")
 
     def label(name, of):

@@ -4,9 +4,12 @@ A sweep is a table of rows, each a value of every swept parameter (a
 device family, delays, cut-offs, uncertain values ...), and a question
 asked at every row (:class:`Question`): the limits of the stable set in the
 loop's plane (:meth:`symstab.Loop.limits`: the largest ``y``, the ``x``
-where it is reached, the extent in ``x`` and the area), or the best value
+where it is reached, the extent in ``x`` and the area), the best value
 of one or two parameters for K_max, the Z-width or the passive K_max
-(:meth:`symstab.Loop.design`).  The rows are cut into chunks;
+(:meth:`symstab.Loop.design`), the D-decomposition's cells and stable
+pieces (:meth:`symstab.Loop.region`), the limits of the robust set over a
+box (:meth:`symstab.Loop.limits` with ``uncertain``), or the largest ``y``
+a simulation with non-idealities accepts (:meth:`symstab.Loop.simulated_limit`).  The rows are cut into chunks;
 each chunk is evaluated serially or as one task on a Dask cluster
 (:mod:`dask.distributed`, an optional extra), and saved, complete, in a
 folder as soon as it is done (:class:`ChunkStore`): an interrupted sweep
@@ -29,7 +32,13 @@ __all__ = ["QUESTIONS", "Question", "evaluate_rows", "ChunkStore", "run_sweep", 
 QUESTIONS = {
     "limits": "the limits of the stable set in the plane (Loop.limits)",
     "design": "the best value of one or two parameters (Loop.design)",
+    "region": "the D-decomposition of the plane: its cells, stable pieces and area (Loop.region)",
+    "robust": "the limits of the set stable for every value of a box (Loop.limits, uncertain)",
+    "simulated": "the largest y of a simulated run that stays small (Loop.simulated_limit)",
 }
+#: The options of a simulated row (Nonidealities' and the runs').
+SIMULATION_KEYS = ("amplitude", "steps", "x0", "encoder_resolution", "force_limit",
+                   "force_resolution")
 
 
 @dataclasses.dataclass(frozen=True)
@@ -43,9 +52,15 @@ class Question:
     x, y : str
         The plane.
     over : tuple of (str, float, float)
-        ``design``: the parameters searched and their ranges (SI).
+        ``design``: the parameters searched and their ranges (SI);
+        ``robust``: the box (``d``: whole delays).
     maximize : str
         ``design``: ``"y_max"``, ``"area"`` or ``"passive"``.
+    strips : int
+        ``robust``: the strips across the plane.
+    simulation : tuple of (str, float)
+        ``simulated``: ``amplitude`` (required), ``steps``, ``x0`` and the
+        non-idealities (:data:`SIMULATION_KEYS`), in SI.
     """
 
     kind: str
@@ -53,6 +68,8 @@ class Question:
     y: str
     over: tuple = ()
     maximize: str = "y_max"
+    strips: int = 64
+    simulation: tuple = ()
 
     def __post_init__(self):
         if self.kind not in QUESTIONS:
@@ -61,13 +78,26 @@ class Question:
             raise ValueError("design searches one or two parameters: give over")
         if self.kind == "design" and self.maximize not in ("y_max", "area", "passive"):
             raise ValueError(f"maximize must be y_max, area or passive, got {self.maximize!r}")
+        if self.kind == "robust" and not self.over:
+            raise ValueError("robust needs the box: give over (name, low, high)")
+        if self.kind == "simulated" and "amplitude" not in dict(self.simulation):
+            raise ValueError("simulated needs the accepted amplitude: give simulation "
+                             "(('amplitude', A), ...)")
 
     def columns(self):
         """The answer's columns: ``(name, the parameter whose unit it has, or "area")``."""
         x, y = self.x, self.y
+        limits = ((f"{y}_max", y), (f"{x}_at_{y}_max", x), (f"{x}_min", x), (f"{x}_max", x),
+                  ("area", "area"))
         if self.kind == "limits":
-            return ((f"{y}_max", y), (f"{x}_at_{y}_max", x), (f"{x}_min", x), (f"{x}_max", x),
-                    ("area", "area"))
+            return limits
+        if self.kind == "region":
+            return (("cells", "count"), ("stable_pieces", "count"), ("area", "area"))
+        if self.kind == "robust":
+            return limits + (("marginal_area", "area"), ("nominal_area", "area"))
+        if self.kind == "simulated":
+            return ((f"simulated_{y}_max", y), (f"{x}_at_simulated_{y}_max", x),
+                    (f"linear_{y}_max", y))
         target = {"y_max": (f"{y}_max", y), "area": ("area", "area"),
                   "passive": (f"passive_{y}_max", y)}[self.maximize]
         return tuple((f"best_{name}", name) for name, _, _ in self.over) + (
@@ -75,9 +105,34 @@ class Question:
 
     def answer(self, loop, values):
         """The answer's numbers at one row (NaN: none) and why there is none (or empty)."""
-        if self.kind == "limits":
-            found = loop.limits(self.x, self.y, **values)
-            numbers = (found.y_max, found.x_at_y_max, found.x_min, found.x_max, found.area)
+        if self.kind in ("limits", "robust"):
+            extra = {} if self.kind == "limits" else {
+                "uncertain": {name: (low, high) for name, low, high in self.over},
+                "strips": self.strips}
+            found = loop.limits(self.x, self.y, **extra, **values)
+            numbers = [found.y_max, found.x_at_y_max, found.x_min, found.x_max, found.area]
+            if self.kind == "robust":
+                region = found.region
+                numbers += [region.marginal_area,
+                            region.nominal.area if region.nominal is not None else None]
+            return [np.nan if v is None else float(v) for v in numbers], found.reason
+        if self.kind == "region":
+            found = loop.region(self.x, self.y, **values)
+            reason = found.limits().reason if not found.stable else (
+                "unbounded: the stable set reaches the window's " + ", ".join(found.unbounded)
+                if found.unbounded else "")
+            return [float(len(found.cells)), float(len(found.stable)), found.area], reason
+        if self.kind == "simulated":
+            from .simulate import Nonidealities
+
+            options = dict(self.simulation)
+            nonideal = Nonidealities(**{k: v for k, v in options.items()
+                                        if k not in ("amplitude", "steps", "x0")})
+            steps = options.get("steps")
+            found = loop.simulated_limit(self.x, self.y, amplitude=options["amplitude"],
+                                         nonideal=nonideal, x0=options.get("x0"),
+                                         steps=None if steps is None else int(steps), **values)
+            numbers = (found.y_max, found.x_at_y_max, found.linear.y_max)
             return [np.nan if v is None else float(v) for v in numbers], found.reason
         found = loop.design(over={name: (low, high) for name, low, high in self.over},
                             maximize=self.maximize, x=self.x, y=self.y, **values)

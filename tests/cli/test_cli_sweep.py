@@ -177,6 +177,24 @@ def test_without_dask_the_message_says_what_to_install(capsys, tmp_path, monkeyp
      'maximize = "simulated"\n', "maximize must be one of"),
     ('question = "design"\n[grid]\nd = [3]\n[design]\nover = { M = [0.01, 0] }\n',
      "LO < HI"),
+    ('question = "robust"\n[grid]\nd = [3]\n', "[robust] (uncertain, strips) goes with"),
+    ('question = "robust"\n[grid]\nd = [3]\n[robust]\nstrips = 4\n', "names the box"),
+    ('question = "robust"\n[grid]\nd = [3]\n[robust]\nuncertain = { b = [0.02, 0.01] }\n',
+     "LO <= HI"),
+    ('question = "robust"\n[grid]\nd = [3]\n[robust]\nuncertain = { b = [0.01, 0.02] }\n'
+     'strips = 0\n', "strips must be"),
+    ('question = "robust"\n[grid]\nb = [0.03]\n[robust]\nuncertain = { b = [0.01, 0.02] }\n',
+     "swept and uncertain"),
+    ('question = "robust"\n[grid]\nd = [3]\n[robust]\nuncertain = { K = [1, 2] }\n',
+     "K is an axis"),
+    ('question = "simulated"\n[grid]\nd = [3]\n[simulated]\nsteps = 100\n',
+     "amplitude"),
+    ('question = "simulated"\n[grid]\nd = [3]\n[simulated]\namplitude = -1\n',
+     "positive number"),
+    ('question = "simulated"\n[grid]\nd = [3]\n[simulated]\namplitude = 1\nsteps = 2.5\n',
+     "whole number"),
+    ('question = "simulated"\n[grid]\nd = [3]\n[simulated]\namplitude = 1\ncolour = 2\n',
+     "unknown key 'colour'"),
 ])
 def test_a_bad_spec_is_one_line_before_any_work(capsys, tmp_path, monkeypatch, text, needle):
     path = spec(tmp_path, text)
@@ -200,3 +218,44 @@ def test_bad_options_are_one_line(capsys, tmp_path, monkeypatch, args, needle):
     status, out, err = run(capsys, "sweep", path, *args)
     assert status == 2 and needle in err.strip().splitlines()[-1], err
     assert list((tmp_path / "work").iterdir()) == []
+
+
+def test_robust_region_and_simulated_rows_are_the_loop_s(capsys, tmp_path):
+    """Each row of the new questions is the library's answer at its values (in SI; the CSV
+    keeps 12 digits)."""
+    loop = symstab.load_loop(LOOPS / "paper.toml")
+    path = spec(tmp_path, 'question = "robust"\nchunk = 1\n[grid]\nd = [5, 10]\n[robust]\n'
+                          'uncertain = { b = { range = [16.2, 64.8], unit = "mN m s/rad" } }\n'
+                          'strips = 8\n', "r.toml")
+    status, text, err = run(capsys, "sweep", path, "--out", tmp_path / "r.csv", "--serial")
+    assert status == 0, err
+    header, rows = read_csv(tmp_path / "r.csv")
+    assert header.endswith("marginal_area [(N m s/rad)(N m/rad)],"
+                           "nominal_area [(N m s/rad)(N m/rad)],reason")
+    for d, *answer in rows:
+        found = loop.limits(uncertain={"b": (0.0162, 0.0648)}, strips=8, d=int(d))
+        np.testing.assert_allclose(answer, [found.y_max, found.x_at_y_max, found.x_min,
+                                            found.x_max, found.area, found.region.marginal_area,
+                                            found.region.nominal.area], rtol=1e-11)
+    path = spec(tmp_path, 'question = "region"\n[grid]\nd = [5, 40]\n', "g.toml")
+    status, text, err = run(capsys, "sweep", path, "--out", tmp_path / "g.csv", "--serial")
+    assert status == 0, err
+    header, rows = read_csv(tmp_path / "g.csv")
+    assert header == "d [samples],cells,stable_pieces,area [(N m s/rad)(N m/rad)],reason"
+    for d, cells, pieces, area in rows:
+        found = loop.region(d=int(d))
+        assert (cells, pieces) == (len(found.cells), len(found.stable))
+        assert area == pytest.approx(found.area, rel=1e-12)
+    path = spec(tmp_path, 'question = "simulated"\n[grid]\nd = [5]\n[simulated]\n'
+                          'amplitude = 0.001\nsteps = 2000\nencoder_resolution = 0.0015\n',
+                "s.toml")
+    status, text, err = run(capsys, "sweep", path, "--out", tmp_path / "s.csv", "--serial")
+    assert status == 0, err
+    header, rows = read_csv(tmp_path / "s.csv")
+    from symstab.numeric.simulate import Nonidealities
+
+    found = loop.simulated_limit(amplitude=0.001, steps=2000, d=5,
+                                 nonideal=Nonidealities(encoder_resolution=0.0015))
+    np.testing.assert_allclose(rows[0, 1:], [found.y_max, found.x_at_y_max, found.linear.y_max],
+                               rtol=1e-11)
+    assert found.y_max < found.linear.y_max
