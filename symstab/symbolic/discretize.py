@@ -200,38 +200,44 @@ def numeric_zoh(numerator, denominator, T, *, dps=30):
 
 
 def _interval_expm1(M, n):
-    """An enclosure of ``exp(M) - I`` for an ``n x n`` :class:`mpmath.iv.matrix` ``M``.
+    """An enclosure of ``exp(M) - I`` for an ``n x n`` matrix ``M`` of :mod:`mpmath.iv` numbers.
 
-    Taylor terms to the 30th with the remainder's bound ``mu**31 / 31! / (1
-    - mu / 32)`` (``mu`` the infinity norm, at most 1/2 after scaling by a
-    power of 2) added to every entry, then squared back as ``X (X + 2 I)``
-    (``exp(2 M) - I`` from ``X = exp(M) - I``): the ``- I`` is never formed
-    by subtraction, so a pole next to ``z = 1`` keeps its digits (the
-    expm1 of a matrix).
+    ``M`` is a list of rows.  Taylor terms until the remainder's bound
+    ``mu**(K + 1) / (K + 1)! / (1 - mu / (K + 2))`` (``mu`` the infinity
+    norm, at most 1/2 after scaling by a power of 2) is below 1e-40 (at most
+    40 terms), that bound added to every entry, then squared back as ``X (X
+    + 2 I)`` (``exp(2 M) - I`` from ``X = exp(M) - I``): the ``- I`` is
+    never formed by subtraction, so a pole next to ``z = 1`` keeps its
+    digits (the expm1 of a matrix).
     """
     from mpmath import iv
 
-    mu = max(sum(abs(M[i, j]) for j in range(n)).b for i in range(n))
+    def product(a, b):
+        return [[sum((a[i][k] * b[k][j] for k in range(n)), iv.mpf(0)) for j in range(n)]
+                for i in range(n)]
+
+    mu = max(sum((abs(M[i][j]) for j in range(n)), iv.mpf(0)).b for i in range(n))
     scale = 0
     while mu > 0.5:
         mu, scale = mu / 2, scale + 1
     if scale:
-        M = M * iv.ldexp(iv.mpf(1), -scale)
-    X = iv.matrix(n, n)
-    term = iv.eye(n)
-    terms = 30
-    for k in range(1, terms + 1):
-        term = term * M / k
-        X = X + term
-    # mu is an upper bound of ||M|| (rounded up by the interval sum).
-    rest = iv.mpf(mu) ** (terms + 1) / iv.factorial(terms + 1) / (1 - iv.mpf(mu) / (terms + 2))
+        factor = iv.ldexp(iv.mpf(1), -scale)
+        M = [[c * factor for c in row] for row in M]
+    X = [[iv.mpf(0)] * n for _ in range(n)]
+    term = [[iv.mpf(1) if i == j else iv.mpf(0) for j in range(n)] for i in range(n)]
+    mu = iv.mpf(mu)
+    for k in range(1, 41):
+        term = [[c / k for c in row] for row in product(term, M)]
+        X = [[x + t for x, t in zip(rx, rt)] for rx, rt in zip(X, term)]
+        # mu is an upper bound of ||M|| (rounded up by the interval sum).
+        rest = mu ** (k + 1) / iv.factorial(k + 1) / (1 - mu / (k + 2))
+        if rest.b < 1e-40:
+            break
     rest = iv.mpf([-rest.b, rest.b])
-    for i in range(n):
-        for j in range(n):
-            X[i, j] = X[i, j] + rest
-    two = 2 * iv.eye(n)
+    X = [[x + rest for x in row] for row in X]
     for _ in range(scale):
-        X = X * (X + two)
+        X = product(X, [[x + (2 if i == j else 0) for j, x in enumerate(row)]
+                        for i, row in enumerate(X)])
     return X
 
 
@@ -286,29 +292,23 @@ def interval_zoh(numerator, denominator, T):
     num = [iv.mpf(0)] * (n + 1 - len(num)) + num
     direct = num[0]
     rest = [num[k] - direct * den[k] for k in range(1, n + 1)]
-    A = iv.matrix(n + 1, n + 1)
+    A = [[iv.mpf(0)] * (n + 1) for _ in range(n + 1)]
     for j in range(n):
-        A[0, j] = -den[j + 1]
+        A[0][j] = -den[j + 1] * T
     for i in range(1, n):
-        A[i, i - 1] = iv.mpf(1)
-    A[0, n] = iv.mpf(1)
-    X = _interval_expm1(A * T, n + 1)
-    psi = iv.matrix(n, n)
-    gamma = iv.matrix(n, 1)
-    for i in range(n):
-        gamma[i, 0] = X[i, n]
-        for j in range(n):
-            psi[i, j] = X[i, j]
+        A[i][i - 1] = T
+    A[0][n] = T
+    X = _interval_expm1(A, n + 1)
     # w I - Psi as a matrix of polynomials in w; its determinant and
     # adjugate by cofactors, so that an exact zero of Psi (an integrator's
     # column) stays an exact zero of P_d(1).
-    entries = [[[iv.mpf(1), -psi[i, j]] if i == j else [-psi[i, j]] for j in range(n)]
+    entries = [[[iv.mpf(1), -X[i][j]] if i == j else [-X[i][j]] for j in range(n)]
                for i in range(n)]
     p_d = _poly_det(entries)
     p_n = [direct * c for c in p_d]
     for i in range(n):
         for j in range(n):
-            weight = rest[i] * gamma[j, 0]
+            weight = rest[i] * X[j][n]
             if weight.a == 0 and weight.b == 0:
                 continue
             minor = [[entries[r][c] for c in range(n) if c != i] for r in range(n) if r != j]
