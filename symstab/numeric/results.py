@@ -456,11 +456,12 @@ class RobustRegion:
         if not region.empty:
             return region
         box_text = ", ".join(f"{k} in [{lo:g}, {hi:g}]" for k, (lo, hi) in uncertain.items())
-        why = (f"no point of the nominal stable set is stable for every {box_text}: the stable "
-               f"sets of the box's values do not meet"
+        strips = len(region.edges) - 1
+        why = (f"no point is stable for every {box_text}: on the edges of the {strips} strips "
+               f"the stable sets at the box's corners, centre and midpoints have no common point"
                if not any(marginal) else
                f"no point could be certified stable for every {box_text} (marginal where the "
-               f"stable sets of its values overlap)")
+               f"stable sets at its corners, centre and midpoints overlap)")
         return dataclasses.replace(region, reason=why)
 
     @classmethod

@@ -24,13 +24,17 @@ in powers of ``w = z - 1``, so that the integrator's pole ``z = 1`` is kept
 however wide the box).  Over an interval of ``theta`` each part is enclosed
 in a disk: its value and slope at the middle with the interval's midpoint
 coefficients, a bound of the second derivative times ``h**2 / 2``, the
-coefficients' radii, and a bound on the rounding.  A cell (strip x
-``y``-interval x ``theta``-interval x sub-box) is excluded when the disk of
-``chi`` misses 0; where it does not, the largest of the ``theta``, box and
-``y`` contributions to the disk is halved (branch and bound), down to a
-``y``-width of ``rtol`` of the window, ``theta``-widths of 1e-12 and
-:data:`BOX_DEPTH` halvings of the box.  What does not close there is
-*marginal*: never counted stable.
+coefficients' radii, and a bound on the rounding.  On a cell (strip x
+``theta``-interval x sub-box) ``chi`` is then within ``a + b |y|`` of ``P +
+y Y``, and the ``y`` where it may vanish solve a quadratic inequality
+(:func:`_excluded`; its roots widened by 1e-7 of their size for their
+rounding): every other ``y`` of the strip is excluded on the cell.  Where
+those ``y`` meet the strip's open intervals, the search (branch and bound)
+marks what the strip's width costs at the cell's middle (no halving removes
+it) and halves the ``theta``-interval or the sub-box, whichever costs more,
+until what is left open is within ``rtol`` of the window's height, or
+``theta`` is 1e-12 wide, or the box has been halved :data:`BOX_DEPTH` times.
+What is marked is *marginal*: never counted stable.
 
 Where to look.  The intervals examined in a strip are the intersection, over
 a grid of values of the box (its corners, centre and midpoints) and both
@@ -170,7 +174,7 @@ class _Enclosures:
         self.boxes = [np.array([box[n] for n in self.names], dtype=float).reshape(-1, 2)]
         self.depth = [0]
         self._children = {}
-        self.mid, self.rad, self.lead = [], [], []
+        self.mid, self.rad = [], []
         self._enclose(0)
 
     def _enclose(self, index):
@@ -414,25 +418,25 @@ def _subtract(intervals, removed):
     return out
 
 
-def _open_part(strips, pieces, open_spans, length=False):
-    """Per cell, the hull of the pieces' parts in its strip's open spans: ``(lo, hi)``, empty lo > hi.
-
-    With ``length``, also the parts' total length (pieces assumed disjoint).
-    """
-    out_lo = np.full(len(strips), np.inf)
-    out_hi = np.full(len(strips), -np.inf)
-    total = np.zeros(len(strips))
+def _clip(strips, pieces, open_spans):
+    """The pieces' parts in each cell's strip's open spans: a list of ``(lo, hi)`` arrays (empty: lo > hi)."""
+    most = max((len(v) for v in open_spans.values()), default=0)
+    span_lo = np.full((len(strips), most), np.inf)
+    span_hi = np.full((len(strips), most), -np.inf)
     for s in np.unique(strips):
         rows = np.flatnonzero(strips == s)
-        for a, b in open_spans.get(int(s), ()):
-            for lo, hi in pieces:
-                l, h = np.maximum(lo[rows], a), np.minimum(hi[rows], b)
-                meet = l <= h
-                out_lo[rows[meet]] = np.minimum(out_lo[rows[meet]], l[meet])
-                out_hi[rows[meet]] = np.maximum(out_hi[rows[meet]], h[meet])
-                with np.errstate(over="ignore", invalid="ignore"):
-                    total[rows[meet]] += (h - l)[meet]
-    return (out_lo, out_hi, total) if length else (out_lo, out_hi)
+        for j, (a, b) in enumerate(open_spans.get(int(s), ())):
+            span_lo[rows, j], span_hi[rows, j] = a, b
+    return [(np.maximum(lo, span_lo[:, j]), np.minimum(hi, span_hi[:, j]))
+            for lo, hi in pieces for j in range(most)]
+
+
+def _mark(marked, strips, parts):
+    """Add every non-empty part to its strip's marked list."""
+    for lo, hi in parts:
+        some = lo <= hi
+        for s, a, b in zip(strips[some], lo[some], hi[some]):
+            marked[int(s)].append((float(a), float(b)))
 
 
 def _certify(enclosures, shift, centres, halves, candidates, tol, budget):
@@ -472,32 +476,40 @@ def _certify(enclosures, shift, centres, halves, candidates, tol, budget):
             theta, h = 0.5 * (c.t0 + c.t1), 0.5 * (c.t1 - c.t0)
             pieces, fixed, theta_ab, box_ab = _excluded(
                 enclosures, shift, theta, h, c.box, centres[c.strip], halves[c.strip])
-            lo, hi = _open_part(c.strip, pieces, open_spans)
-            meets = lo <= hi
+            meets = np.zeros(len(c), dtype=bool)
+            far = np.zeros(len(c))
+            for lo, hi in _clip(c.strip, pieces, open_spans):
+                some = lo <= hi
+                meets |= some
+                far = np.where(some, np.maximum(far, np.maximum(np.abs(lo), np.abs(hi))), far)
             if not meets.any():
                 continue
-            lo_fixed, hi_fixed = _open_part(c.strip, fixed, open_spans)
             # The costs where they are largest on the part that matters.
-            y = np.where(meets, np.maximum(np.abs(np.nan_to_num(lo)), np.abs(np.nan_to_num(hi))), 0.0)
-            found.append((c.take(meets), lo[meets], hi[meets], lo_fixed[meets], hi_fixed[meets],
-                          (theta_ab[0] + y * theta_ab[1])[meets], (box_ab[0] + y * box_ab[1])[meets]))
+            found.append((c.take(meets), [(lo[meets], hi[meets]) for lo, hi in pieces],
+                          [(lo[meets], hi[meets]) for lo, hi in fixed],
+                          (theta_ab[0] + far * theta_ab[1])[meets],
+                          (box_ab[0] + far * box_ab[1])[meets]))
         if not found:
             break
         c = _Cells.join([f[0] for f in found])
-        lo, hi, lo_fixed, hi_fixed, theta_cost, box_cost = (np.concatenate([f[k] for f in found])
-                                                             for k in range(1, 7))
+        pieces = [tuple(np.concatenate([f[1][k][j] for f in found]) for j in range(2))
+                  for k in range(len(found[0][1]))]
+        fixed = [tuple(np.concatenate([f[2][k][j] for f in found]) for j in range(2))
+                 for k in range(len(found[0][2]))]
+        theta_cost = np.concatenate([f[3] for f in found])
+        box_cost = np.concatenate([f[4] for f in found])
         # What the strip's width costs at a cell's middle stays whatever is
-        # halved: marked at once, so that the search goes on only where the
-        # widths of theta and of the box still matter.
-        has = lo_fixed <= hi_fixed
-        for s, a, b in zip(c.strip[has], lo_fixed[has], hi_fixed[has]):
-            marked[int(s)].append((float(a), float(b)))
+        # halved: marked at once (each piece apart), so that the search goes
+        # on only where the widths of theta and of the box still matter.
+        _mark(marked, c.strip, _clip(c.strip, fixed, open_spans))
         marked = {s: _merge(v) for s, v in marked.items()}
         open_spans = {s: _subtract(spans, marked[s]) for s, spans in candidates.items()}
-        lo, hi, left = _open_part(c.strip, [(lo, hi)], open_spans, length=True)
-        meets = lo <= hi
-        c, lo, hi, left = c.take(meets), lo[meets], hi[meets], left[meets]
-        theta_cost, box_cost = theta_cost[meets], box_cost[meets]
+        parts = _clip(c.strip, pieces, open_spans)
+        with np.errstate(over="ignore", invalid="ignore"):
+            left = sum(np.maximum(hi - lo, 0.0) for lo, hi in parts)
+        meets = left > 0
+        c, theta_cost, box_cost, left = c.take(meets), theta_cost[meets], box_cost[meets], left[meets]
+        parts = [(lo[meets], hi[meets]) for lo, hi in parts]
         can_theta = (c.t1 - c.t0) > _THETA_WIDTH
         can_box = np.array(enclosures.depth)[c.box] < BOX_DEPTH
         # Done when what is left open is within the resolution, or the width
@@ -505,8 +517,7 @@ def _certify(enclosures, shift, centres, halves, candidates, tol, budget):
         # not close the cell).
         theta_first = theta_cost >= box_cost
         done = (left <= tol[c.strip]) | np.where(theta_first, ~can_theta, ~can_box)
-        for s, a, b in zip(c.strip[done], lo[done], hi[done]):
-            marked[int(s)].append((float(a), float(b)))
+        _mark(marked, c.strip[done], [(lo[done], hi[done]) for lo, hi in parts])
         marked = {s: _merge(v) for s, v in marked.items()}
         split_theta = ~done & theta_first
         split_box = ~done & ~split_theta

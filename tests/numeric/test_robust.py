@@ -198,7 +198,7 @@ def test_a_box_of_zero_width_converges_to_the_nominal_area(paper):
 def test_a_box_where_the_set_vanishes(paper):
     region = paper.region("B", "K", uncertain={"M": (0.0, 0.019)}, d=10)
     assert region.empty and region.area == 0 and region.polygons == ()
-    assert "do not meet" in region.reason and "M in [0, 0.019]" in region.reason
+    assert "no common point" in region.reason and "M in [0, 0.019]" in region.reason
     limits = paper.limits("B", "K", uncertain={"M": (0.0, 0.019)}, d=10)
     assert limits.empty and limits.reason == region.reason
     # A box whose centre is unstable.
