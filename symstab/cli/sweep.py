@@ -279,24 +279,10 @@ def _design(where, loop, x, y, table):
     if not isinstance(over, dict) or not 1 <= len(over) <= 2:
         raise ValueError(f"{where}: [design] over = {{NAME = [LO, HI]}} names one or two "
                          f"parameters to search")
-    ranges = []
-    for name, spec in over.items():
-        _check_name(where, loop, x, y, name)
-        if name == "d":
-            raise ValueError(f"{where}: [design] over d: the delay is a whole number of "
-                             f"samples; sweep it in [grid] instead")
-        unit = None
-        if isinstance(spec, dict):
-            unit, spec = spec.get("unit"), spec.get("range")
-        if not isinstance(spec, list) or len(spec) != 2:
-            raise ValueError(f"{where}: [design] over {name} must be [LO, HI] or "
-                             f"{{range = [LO, HI], unit = \"...\"}}")
-        low, high = _si(f"{where}: [design] over", loop, name, spec, unit)
-        if not low < high:
-            raise ValueError(f"{where}: [design] over {name} = [LO, HI] needs LO < HI, got "
-                             f"{spec!r}")
-        ranges.append((name, low, high))
-    return tuple(ranges), _TARGETS[maximize]
+    if "d" in over:
+        raise ValueError(f"{where}: [design] over d: the delay is a whole number of "
+                         f"samples; sweep it in [grid] instead")
+    return _ranges(where, "[design] over", loop, x, y, over, strict=True), _TARGETS[maximize]
 
 
 def _robust(where, loop, x, y, table):
@@ -313,21 +299,8 @@ def _robust(where, loop, x, y, table):
     uncertain = table.get("uncertain")
     if not isinstance(uncertain, dict) or not uncertain:
         raise ValueError(f"{where}: [robust] uncertain = {{NAME = [LO, HI]}} names the box")
-    box = []
-    for name, spec in uncertain.items():
-        _check_name(where, loop, x, y, name)
-        unit = None
-        if isinstance(spec, dict):
-            unit, spec = spec.get("unit"), spec.get("range")
-        if not isinstance(spec, list) or len(spec) != 2:
-            raise ValueError(f"{where}: [robust] uncertain {name} must be [LO, HI] or "
-                             f"{{range = [LO, HI], unit = \"...\"}}")
-        low, high = _si(f"{where}: [robust] uncertain", loop, name, spec, unit)
-        if not low <= high:
-            raise ValueError(f"{where}: [robust] uncertain {name} = [LO, HI] needs LO <= HI, "
-                             f"got {spec!r}")
-        box.append((name, low, high))
-    return tuple(box), strips
+    box = _ranges(where, "[robust] uncertain", loop, x, y, uncertain, strict=False)
+    return box, strips
 
 
 def _simulated(where, loop, y, table):
@@ -363,6 +336,28 @@ def _simulated(where, loop, y, table):
     except (TypeError, ValueError) as exc:
         raise ValueError(f"{where}: [simulated]: {exc}") from None
     return tuple(options)
+
+
+def _ranges(where, section, loop, x, y, table, *, strict):
+    """``((name, low, high), ...)`` in SI of ``{NAME = [LO, HI] or {range, unit}}``.
+
+    ``LO < HI`` if ``strict``, else ``LO <= HI``.
+    """
+    ranges = []
+    for name, spec in table.items():
+        _check_name(where, loop, x, y, name)
+        unit = None
+        if isinstance(spec, dict):
+            unit, spec = spec.get("unit"), spec.get("range")
+        if not isinstance(spec, list) or len(spec) != 2:
+            raise ValueError(f"{where}: {section} {name} must be [LO, HI] or "
+                             f"{{range = [LO, HI], unit = \"...\"}}")
+        low, high = _si(f"{where}: {section}", loop, name, spec, unit)
+        if not (low < high if strict else low <= high):
+            raise ValueError(f"{where}: {section} {name} = [LO, HI] needs LO "
+                             f"{'<' if strict else '<='} HI, got {spec!r}")
+        ranges.append((name, low, high))
+    return tuple(ranges)
 
 
 def _check_name(where, loop, x, y, name):
