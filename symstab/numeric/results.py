@@ -445,7 +445,27 @@ class RobustRegion:
     @classmethod
     def from_strips(cls, x, y, box, delays, edges, robust, marginal, nominal, at, examined=0,
                     exhausted=False, unbounded=()):
-        """The region from each strip's intervals (the reason said when it is empty)."""
+        """The region from each strip's intervals (the reason said when it is empty).
+
+        Parameters
+        ----------
+        x, y : str
+            The plane.
+        box : dict
+            ``{name: (low, high)}`` of the continuous parameters.
+        delays : list of int
+            The delays (one, or the range's).
+        edges : array_like
+            The strips' edges.
+        robust, marginal : list of list of (float, float)
+            Per strip, the certified and the marginal intervals of ``y``.
+        nominal : Decomposition
+            The decomposition at the box's centre.
+        at : dict
+            The other parameters' values.
+        examined, exhausted, unbounded :
+            As the attributes.
+        """
         uncertain = dict(box)
         if len(delays) > 1:
             uncertain["d"] = (delays[0], delays[-1])
@@ -466,7 +486,15 @@ class RobustRegion:
 
     @classmethod
     def empty_set(cls, x, y, box, delays, nominal, at, reason):
-        """An empty region, with why."""
+        """An empty region, with why.
+
+        Parameters
+        ----------
+        x, y, box, delays, nominal, at :
+            As :meth:`from_strips`.
+        reason : str
+            Why it is empty.
+        """
         uncertain = dict(box)
         if len(delays) > 1:
             uncertain["d"] = (delays[0], delays[-1])
@@ -543,7 +571,17 @@ class RobustRegion:
         return out
 
     def intervals_at(self, x):
-        """The robust intervals of ``y`` at ``x`` (those of the strips holding it)."""
+        """The robust intervals of ``y`` at ``x`` (those of the strips holding it, merged).
+
+        Parameters
+        ----------
+        x : float
+            The value of the plane's ``x``.
+
+        Returns
+        -------
+        list of (float, float)
+        """
         spans = []
         for i, s in enumerate(self.intervals):
             if self.edges[i] <= x <= self.edges[i + 1]:

@@ -257,6 +257,14 @@ def interval_zoh(numerator, denominator, T):
     intervals, and the rest stays within a few times the true spread of the
     coefficients.
 
+    Parameters
+    ----------
+    numerator, denominator : list of mpmath.iv.mpf
+        ``G``'s numerator and denominator coefficients in ``s``, highest
+        power first.
+    T : mpmath.iv.mpf
+        The sample period.
+
     Returns
     -------
     (list of mpmath.iv.mpf, list of mpmath.iv.mpf)
