@@ -128,9 +128,12 @@ def _robust(args, setup, at):
     box = uncertain_box(args, setup)
     values = {k: v for k, v in setup.values.items() if k not in box}
     delays = box["d"][1] - box["d"][0] + 1 if "d" in box else 1
-    if delays > 1 or values.get("d", 0) >= _ANNOUNCE_DELAY:
-        print(f"certifying the ({setup.name(setup.x)}, {setup.name(setup.y)}) plane for every "
-              f"value of the box ({delays} delay(s)) ...", file=sys.stderr, flush=True)
+    # Seconds to minutes: a plant of higher order, a box of several
+    # parameters and many strips or delays cost more (README): say what runs.
+    print(f"certifying the ({setup.name(setup.x)}, {setup.name(setup.y)}) plane for every "
+          f"value of the box ({strips} strips, {delays} delay(s), "
+          f"{len([k for k in box if k != 'd'])} continuous parameter(s)) ...",
+          file=sys.stderr, flush=True)
     lim = setup.loop.limits(x=setup.x, y=setup.y, uncertain=box, strips=strips,
                             progress=progress_printer("delays", delays), **values)
     region = lim.region

@@ -673,6 +673,7 @@ def uncertain_box(args, setup):
 
     loop = setup.loop
     others = [n for n in loop.parameters if n not in (setup.x, setup.y)]
+    given = {text.partition("=")[0].strip() for text in (args.set_values or [])}
     box = {}
     for text in args.uncertain:
         name, eq, window = text.partition("=")
@@ -682,6 +683,8 @@ def uncertain_box(args, setup):
                              f"b=0.02:0.045")
         if name in box:
             raise ValueError(f"--uncertain {name} is given twice; give each parameter once")
+        if name in given:
+            raise ValueError(f"--uncertain {name}: {name} is also given by --set; give it once")
         if name not in loop.parameters:
             raise ValueError(f"--uncertain {name}: not a parameter of the loop in {args.loop} "
                              f"(candidates: {', '.join(others)})")

@@ -113,6 +113,12 @@ def run(args):
               f"{n_chunks} chunks saved in {parts}; the same command resumes there",
               file=sys.stderr)
         return 130
+    except Exception:
+        # An error, not an interruption: a folder with no chunk saved goes
+        # (it would only stand in the way of the corrected sweep).
+        if store is not None and not store.done():
+            shutil.rmtree(parts, ignore_errors=True)
+        raise
     finally:
         if client is not None:
             client.close()
@@ -211,6 +217,10 @@ def read_spec(path):
             or not all(isinstance(n, str) for n in plane)):
         raise ValueError(f"{where}: plane must be two parameter names, e.g. [\"B\", \"K\"]")
     x, y = plane
+    try:
+        loop._check_plane((x, y))
+    except (TypeError, ValueError) as exc:
+        raise ValueError(f"{where}: plane: {exc}") from None
     for section, keys in (("design", "over, maximize"), ("robust", "uncertain, strips"),
                           ("simulated", "amplitude, steps, ...")):
         if (section in spec) != (kind == section):
@@ -325,12 +335,18 @@ def _simulated(where, loop, y, table):
         value = table[key]
         if isinstance(value, bool) or not isinstance(value, (int, float)) \
                 or not math.isfinite(value) or value <= 0 and key != "x0":
-            raise ValueError(f"{where}: [simulated] {key} must be a positive number, got "
-                             f"{value!r}")
+            what = "a finite number" if key == "x0" else "a positive number"
+            raise ValueError(f"{where}: [simulated] {key} must be {what}, got {value!r}")
         if key == "steps" and (not float(value).is_integer() or not 10 <= value <= 10_000_000):
             raise ValueError(f"{where}: [simulated] steps must be a whole number from 10 to "
                              f"10000000, got {value!r}")
         options.append((key, float(value)))
+    from ..numeric.loop_simulate import X0_MAX, X0_MIN
+
+    x0 = dict(options).get("x0")
+    if x0 is not None and not X0_MIN <= abs(x0) <= X0_MAX:
+        raise ValueError(f"{where}: [simulated] x0 must be from {X0_MIN:g} to {X0_MAX:g} in "
+                         f"size, got {x0!r}")
     try:
         Nonidealities(**{k: v for k, v in options if k not in ("amplitude", "steps", "x0")})
     except (TypeError, ValueError) as exc:
@@ -348,6 +364,10 @@ def _ranges(where, section, loop, x, y, table, *, strict):
         _check_name(where, loop, x, y, name)
         unit = None
         if isinstance(spec, dict):
+            extra = sorted(set(spec) - {"range", "unit"})
+            if extra:
+                raise ValueError(f"{where}: {section} {name}: unknown key {extra[0]!r} (range, "
+                                 f"unit)")
             unit, spec = spec.get("unit"), spec.get("range")
         if not isinstance(spec, list) or len(spec) != 2:
             raise ValueError(f"{where}: {section} {name} must be [LO, HI] or "
@@ -404,9 +424,12 @@ def _grid(where, loop, x, y, table):
                 low, high, n = spec.get("from"), spec.get("to"), spec.get("points")
                 if (isinstance(n, bool) or not isinstance(n, int) or n < 1
                         or not all(isinstance(v, (int, float)) and not isinstance(v, bool)
-                                   for v in (low, high))):
+                                   and math.isfinite(v) for v in (low, high))):
                     raise ValueError(f"{where}: [grid] {name} = {{from = LO, to = HI, points = N}} "
-                                     f"needs two numbers and a whole N >= 1")
+                                     f"needs two finite numbers and a whole N >= 1")
+                if n > MAX_ROWS:
+                    raise ValueError(f"{where}: [grid] {name} has {n} points, more than "
+                                     f"{MAX_ROWS}")
                 spec = list(np.linspace(low, high, n))
                 if name == "d":
                     spec = sorted({round(v) for v in spec})

@@ -128,16 +128,19 @@ def _bound(expr, values):
 
 
 def _midpoint_radius(values):
-    """Float midpoints and radii enclosing a list of :mod:`mpmath.iv` numbers."""
-    mid = np.array([float(v.mid) for v in values])
-    radius = np.empty(len(values))
-    for k, v in enumerate(values):
-        m = mpmath.mpf(mid[k])
-        r = max(v.b - m, m - v.a)
-        radius[k] = float(r) * (1 + 1e-12) if r > 0 else 0.0
-    if not (np.all(np.isfinite(mid)) and np.all(np.isfinite(radius))):
-        raise ValueError("the loop's coefficients are not bounded in the box (a division by an "
-                         "interval that holds 0?)")
+    """Float midpoints and radii enclosing a list of :mod:`mpmath.iv` numbers.
+
+    The ends are rounded to the nearest double (half an ulp each), so the
+    radius adds 2 eps of their size.
+    """
+    lo = np.array([float(v.a) for v in values])
+    hi = np.array([float(v.b) for v in values])
+    if not (np.all(np.isfinite(lo)) and np.all(np.isfinite(hi))):
+        raise ValueError("the loop's coefficients are not bounded over the box (a division by "
+                         "an interval that holds 0, or values too large?)")
+    mid = 0.5 * lo + 0.5 * hi
+    radius = (np.maximum(hi - mid, mid - lo) * (1 + 4 * _EPS)
+              + 2 * _EPS * (np.abs(lo) + np.abs(hi)) + np.where(hi > lo, 5e-324, 0.0))
     return mid, radius
 
 
@@ -505,8 +508,10 @@ def _certify(enclosures, shift, centres, halves, candidates, tol, budget):
         marked = {s: _merge(v) for s, v in marked.items()}
         open_spans = {s: _subtract(spans, marked[s]) for s, spans in candidates.items()}
         parts = _clip(c.strip, pieces, open_spans)
+        left = np.zeros(len(c))
         with np.errstate(over="ignore", invalid="ignore"):
-            left = sum(np.maximum(hi - lo, 0.0) for lo, hi in parts)
+            for lo, hi in parts:
+                left += np.maximum(hi - lo, 0.0)
         meets = left > 0
         c, theta_cost, box_cost, left = c.take(meets), theta_cost[meets], box_cost[meets], left[meets]
         parts = [(lo[meets], hi[meets]) for lo, hi in parts]
@@ -654,6 +659,11 @@ def robust_region(loop, x, y, *, uncertain, strips=64, rtol=1e-6, x_range=None, 
     if y_range is not None:
         y_range = check_window("y_range", y_range)
     line = given_x is not None and given_x[0] == given_x[1]
+    try:
+        enclosures = _Enclosures(loop, x, y, box, fixed)
+    except (ValueError, ZeroDivisionError, OverflowError) as exc:
+        words = ", ".join(f"{k} in [{lo:g}, {hi:g}]" for k, (lo, hi) in box.items())
+        raise ValueError(f"uncertain: {words}: {exc}") from None
     nominal = loop.region(x, y, x_range=None if line else given_x, y_range=y_range, **fixed,
                           **centre, d=centre_d)
     if not nominal.stable:
@@ -670,7 +680,6 @@ def robust_region(loop, x, y, *, uncertain, strips=64, rtol=1e-6, x_range=None, 
     marginal = [[] for _ in centres]
     examined, exhausted = 0, False
     grid = _grid(box)
-    enclosures = _Enclosures(loop, x, y, box, fixed)
     for d in delays:
         shift = d + loop._delay_of_environment
         # Candidates: stable at every grid value on both edges of the strip.

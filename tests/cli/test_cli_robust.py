@@ -55,10 +55,13 @@ def test_robust_limits_over_delays_and_the_empty_set(capsys):
     (("--strips", "8"), "--uncertain"),
     (("--png", "x.png"), "--uncertain"),
     (("--uncertain", "d=1.5:3"), "whole number"),
+    (("--set", "b=0.03", "--uncertain", "b=0.01:0.05"), "also given by --set"),
+    (("--set", "d=10", "--uncertain", "d=8:12"), "also given by --set"),
 ])
 def test_bad_options_are_one_line(capsys, tmp_path, args, message):
     args = [a.replace("x.png", str(tmp_path / "x.png")) for a in args]
-    status, text, err = run(capsys, "limits", "--loop", PAPER, "--set", "d=10", *args)
+    delay = () if any(a.startswith("d=") for a in args) else ("--set", "d=10")
+    status, text, err = run(capsys, "limits", "--loop", PAPER, *delay, *args)
     assert status == 2
     assert message in err and len(err.strip().splitlines()) == 1
     assert not list(tmp_path.iterdir())

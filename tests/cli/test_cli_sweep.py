@@ -195,6 +195,11 @@ def test_without_dask_the_message_says_what_to_install(capsys, tmp_path, monkeyp
      "whole number"),
     ('question = "simulated"\n[grid]\nd = [3]\n[simulated]\namplitude = 1\ncolour = 2\n',
      "unknown key 'colour'"),
+    ('question = "simulated"\n[grid]\nd = [3]\n[simulated]\namplitude = 1\nx0 = 0\n', "x0"),
+    ('question = "robust"\n[grid]\nd = [3]\n[robust]\n'
+     'uncertain = { m = { range = [10, 15], units = "g m^2" } }\n', "unknown key 'units'"),
+    ('plane = ["B", "B"]\n[grid]\nd = [3]\n', "must differ"),
+    ('[grid]\nb = { from = 0.01, to = 0.05, points = 100000000000 }\n', "more than"),
 ])
 def test_a_bad_spec_is_one_line_before_any_work(capsys, tmp_path, monkeypatch, text, needle):
     path = spec(tmp_path, text)

@@ -293,3 +293,17 @@ def test_the_disks_hold_the_polynomial(path, box, d):
             worst = max(worst, float((np.abs(true - near) / np.maximum(bound, 1e-300)).max()))
     # The bound is not vacuous: some points use a good part of it.
     assert worst > 0.05
+
+
+def test_an_uncertain_period(paper):
+    """T in a box (the plant's and the environment's): the points are stable at its ends and inside."""
+    region = paper.region("B", "K", uncertain={"T": (0.8e-3, 1.2e-3)}, strips=8, d=10, M=0.0)
+    assert not region.empty
+    x, y = _points_in(region, 500, np.random.default_rng(4))
+    for T in (0.8e-3, 1.0e-3, 1.2e-3, 0.93e-3):
+        assert _closed_loop_radius(0.0128, 0.0324, T, 10, y, x).max() < 1.0
+
+
+def test_a_box_where_the_coefficients_are_unbounded_is_refused_by_name(paper):
+    with pytest.raises(ValueError, match=r"uncertain: m in \[-0.01, 0.02\]: the leading"):
+        paper.region("B", "K", uncertain={"m": (-0.01, 0.02)}, strips=8, d=10)
