@@ -553,7 +553,7 @@ class RobustRegion:
         return tuple(out)
 
     def contains(self, x, y):
-        """Whether points are in the robust set (a rectangle's closed inside).
+        """Whether points are in the robust set (a rectangle, its top and bottom sides excluded).
 
         Parameters
         ----------
@@ -566,8 +566,10 @@ class RobustRegion:
         """
         x, y = np.broadcast_arrays(np.asarray(x, dtype=float), np.asarray(y, dtype=float))
         out = np.zeros(x.shape, dtype=bool)
+        # A certified interval's ends are not certified (an end is where a
+        # marked piece or a sampled stable interval ends): open in y.
         for x0, x1, lo, hi in self._rectangles(self.intervals):
-            out |= (x0 <= x) & (x <= x1) & (lo <= y) & (y <= hi)
+            out |= (x0 <= x) & (x <= x1) & (lo < y) & (y < hi)
         return out
 
     def intervals_at(self, x):

@@ -39,9 +39,10 @@ What is marked is *marginal*: never counted stable.
 Where to look.  The intervals examined in a strip are the intersection, over
 a grid of values of the box (its corners, centre and midpoints) and both
 edges of the strip, of the stable intervals of ``y`` (the one line engine,
-:meth:`symstab.Loop.stable_intervals`): a point outside them is unstable at
-one of those values, so it is not robustly stable; inside them every point
-is certified or called marginal.
+:meth:`symstab.Loop.stable_intervals`): a point of a strip's edge outside
+them is unstable at one of those values; a point inside a strip outside
+them is not examined, so never claimed robust.  Inside them every point is
+certified or marginal.
 
 The result is a union of rectangles (strip x interval): an inner
 approximation of the robust set whose area converges as the strips narrow
@@ -95,8 +96,11 @@ def _bound(expr, values):
     if expr.is_Rational:
         return iv.mpf(int(expr.p)) / iv.mpf(int(expr.q))
     if expr.is_Float:
-        # The literal's decimal value and its binary one, both enclosed.
-        binary, decimal = iv.mpf(mpmath.mpf(expr._mpf_)), iv.mpf(str(expr))
+        # The literal's decimal value and its stored binary one (exactly, as
+        # a rational), both enclosed.
+        exact = sp.Rational(expr)
+        binary = iv.mpf(int(exact.p)) / iv.mpf(int(exact.q))
+        decimal = iv.mpf(str(expr))
         return iv.mpf([min(binary.a, decimal.a), max(binary.b, decimal.b)])
     if expr == sp.pi:
         return iv.pi
@@ -130,8 +134,8 @@ def _bound(expr, values):
 def _midpoint_radius(values):
     """Float midpoints and radii enclosing a list of :mod:`mpmath.iv` numbers.
 
-    The ends are rounded to the nearest double (half an ulp each), so the
-    radius adds 2 eps of their size.
+    The ends are rounded to doubles (mpmath's float() rounds towards zero:
+    up to an ulp each), so the radius adds 2 eps of their size.
     """
     lo = np.array([float(v.a) for v in values])
     hi = np.array([float(v.b) for v in values])
@@ -339,23 +343,36 @@ def _failing(P, Y, a, b):
 
     On ``y >= 0`` (sign +1) and ``y <= 0`` (sign -1) the inequality is
     ``f(y) = A y**2 + B y + c <= 0`` with ``A = |Y|**2 - b**2``, ``B = 2
-    (Re(P conj Y) - sign a b)``, ``c = |P|**2 - a**2``.  Where ``A > 0`` it
-    holds between the roots; where ``A <= 0`` (``A`` taken below 0, which
-    only adds to the set) outside them, or everywhere without real roots.
-    The roots are moved outwards by their rounding (1e-7 of their size: a
-    double root's ends move by sqrt(eps) of it).
+    (Re(P conj Y) - sign a b)``, ``c = |P|**2 - a**2``.  Where ``A > 0``
+    (beyond its rounding) it holds between the roots; elsewhere (``A``
+    taken below 0, which only adds to the set) outside them, or everywhere
+    without real roots.  Where ``A > 0`` the discriminant is computed as
+    ``4 (a**2 |Y|**2 + b**2 |P|**2 - 2 sign a b Re(P conj Y) - Im(P conj
+    Y)**2)``, which does not cancel where ``P`` and ``Y`` are nearly
+    parallel (at a root's crossing; ``B**2 - 4 A c`` there is rounding
+    noise), and taken at the top of its rounding (the set can only grow);
+    elsewhere at the bottom.  The roots are then moved outwards by 1e-7 of
+    their size (a double root's ends move by sqrt(eps) of it).
     """
-    A = np.abs(Y) ** 2 - b * b
-    c = np.abs(P) ** 2 - a * a
-    re = np.real(P * np.conj(Y))
-    convex = A > 0
+    Y2, P2 = np.abs(Y) ** 2, np.abs(P) ** 2
+    A = Y2 - b * b
+    c = P2 - a * a
+    product = P * np.conj(Y)
+    re, im = np.real(product), np.imag(product)
+    convex = A > 8 * _EPS * (Y2 + b * b)
     A = np.where(convex, A, np.minimum(A, -1e-300))
     pieces = []
     for sign in (1.0, -1.0):
         B = 2 * (re - sign * a * b)
-        disc = B * B - 4 * A * c
-        real = disc >= 0
-        root = np.sqrt(np.where(real, disc, 0.0))
+        with np.errstate(over="ignore", invalid="ignore"):
+            quarter = a * a * Y2 + b * b * P2 - 2 * sign * a * b * re - im * im
+            above = quarter + 16 * _EPS * (a * a * Y2 + b * b * P2 + 2 * a * b * np.abs(re)
+                                            + im * im)
+            disc = B * B - 4 * A * c
+            below = disc - 16 * _EPS * (B * B + 4 * np.abs(A * c))
+            use = np.where(convex, 4 * above, below)
+        real = np.where(convex, use >= 0, use > 0)
+        root = np.sqrt(np.where(real, use, 0.0))
         with np.errstate(over="ignore", invalid="ignore", divide="ignore"):
             r1 = np.minimum((-B - root) / (2 * A), (-B + root) / (2 * A))
             r2 = np.maximum((-B - root) / (2 * A), (-B + root) / (2 * A))

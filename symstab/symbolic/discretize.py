@@ -253,7 +253,7 @@ def interval_zoh(numerator, denominator, T):
     ``det(w I - (Phi - I))`` and ``C adj(w I - (Phi - I)) Gamma + D det(...)``
     (by cofactors), never from a difference of two characteristic
     polynomials: an integrator's pole ``z = 1`` then leaves ``P_d(1)``
-    zero to within the Taylor remainder (about 1e-100) however wide the
+    zero to within the Taylor remainder (below 1e-40) however wide the
     intervals, and the rest stays within a few times the true spread of the
     coefficients.
 

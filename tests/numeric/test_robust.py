@@ -109,7 +109,8 @@ def _closed_loop_radius(m, b, T, d, K, B, M=0.0):
 
 
 def _points_in(region, n, rng):
-    """``n`` points of the robust set: uniform in its rectangles, a tenth on their top and bottom edges."""
+    """``n`` points of the robust set: uniform in its rectangles, a tenth next to their top and
+    bottom sides (1e-9 of the height inside: the sides themselves are not certified)."""
     rects = np.array([(region.edges[i], region.edges[i + 1], lo, hi)
                       for i, spans in enumerate(region.intervals) for lo, hi in spans])
     areas = (rects[:, 1] - rects[:, 0]) * (rects[:, 3] - rects[:, 2])
@@ -118,7 +119,8 @@ def _points_in(region, n, rng):
     x = rng.uniform(r[:, 0], r[:, 1])
     y = rng.uniform(r[:, 2], r[:, 3])
     edge = rng.random(n) < 0.1
-    y[edge] = np.where(rng.random(edge.sum()) < 0.5, r[edge, 2], r[edge, 3])
+    inset = 1e-9 * (r[edge, 3] - r[edge, 2])
+    y[edge] = np.where(rng.random(edge.sum()) < 0.5, r[edge, 2] + inset, r[edge, 3] - inset)
     return x, y
 
 
@@ -307,3 +309,28 @@ def test_an_uncertain_period(paper):
 def test_a_box_where_the_coefficients_are_unbounded_is_refused_by_name(paper):
     with pytest.raises(ValueError, match=r"uncertain: m in \[-0.01, 0.02\]: the leading"):
         paper.region("B", "K", uncertain={"m": (-0.01, 0.02)}, strips=8, d=10)
+
+
+def test_the_failing_set_holds_every_zero_and_every_failing_point():
+    """``_failing`` against brute force: the zero of P + y Y when P and Y are parallel (where
+    B**2 - 4 A c cancels to noise), and random points with |P + y Y| <= a + b |y|."""
+    from symstab.numeric.robust import _failing
+
+    rng = np.random.default_rng(7)
+    n = 20_000
+    Y = rng.normal(size=n) + 1j * rng.normal(size=n)
+    zero = rng.uniform(-2, 2, n)
+    P = -zero * Y
+    for ratio in (3e-8, 1e-8, 1e-12):
+        inside = np.zeros(n, dtype=bool)
+        for lo, hi in _failing(P, Y, ratio * np.abs(P) + 1e-300, np.zeros(n)):
+            inside |= (lo <= zero) & (zero <= hi)
+        assert inside.all(), ratio
+    P = rng.normal(size=n) + 1j * rng.normal(size=n)
+    a, b = rng.uniform(0, 1, n), rng.uniform(0, 2, n) * np.abs(Y)
+    y = rng.uniform(-5, 5, n)
+    fails = np.abs(P + y * Y) <= a + b * np.abs(y)
+    inside = np.zeros(n, dtype=bool)
+    for lo, hi in _failing(P, Y, a, b):
+        inside |= (lo <= y) & (y <= hi)
+    assert fails.any() and (inside | ~fails).all()
