@@ -59,7 +59,7 @@ import sympy as sp
 from .._resources import chunk_slices
 from .._validate import check_count, check_delay, check_real, check_window
 from ..symbolic import model
-from ..symbolic.discretize import interval_zoh
+from ..symbolic.discretize import interval_product, interval_zoh
 from ..symbolic.loop_assembly import poly_coeffs
 from .results import RobustRegion
 
@@ -196,8 +196,8 @@ class _Enclosures:
             p_n, p_d = interval_zoh(*plant, values["T"])
             mids, rads = [], []
             for ve_d, ve_n in self.environment:
-                parts = (_product([_bound(c, values) for c in ve_d], p_d),
-                         _product([_bound(c, values) for c in ve_n], p_n))
+                parts = (interval_product([_bound(c, values) for c in ve_d], p_d),
+                         interval_product([_bound(c, values) for c in ve_n], p_n))
                 pairs = [_midpoint_radius(p) for p in parts]
                 mids.append([p[0] for p in pairs])
                 rads.append([p[1] for p in pairs])
@@ -249,15 +249,6 @@ class _Enclosures:
             lead_mid += mid[:, :, 1, n - n_n]
             lead_rad += rad[:, :, 1, n - n_n]
         return lead_mid, lead_rad
-
-
-def _product(a, b):
-    iv = mpmath.iv
-    out = [iv.mpf(0)] * (len(a) + len(b) - 1)
-    for i, u in enumerate(a):
-        for j, v in enumerate(b):
-            out[i + j] += u * v
-    return out
 
 
 def _parts_on_arc(enclosures, shift, theta, h, box):

@@ -14,7 +14,7 @@ from . import model
 
 __all__ = [
     "z_transform_by_residues", "written_poles", "zoh_pulse_transfer_function", "numeric_zoh",
-    "interval_zoh",
+    "interval_zoh", "interval_product",
     "pulse_transfer_function",
     "dimensionless_pulse_transfer_function",
 ]
@@ -342,8 +342,18 @@ def _poly_add(a, b):
     return [x + y for x, y in zip(a, b)]
 
 
-def _poly_mul(a, b):
-    """Product of two polynomials (lists highest first) of :mod:`mpmath.iv` numbers."""
+def interval_product(a, b):
+    """Product of two polynomials of :mod:`mpmath.iv` numbers (enclosing every product).
+
+    Parameters
+    ----------
+    a, b : list of mpmath.iv.mpf
+        Coefficients, highest power first.
+
+    Returns
+    -------
+    list of mpmath.iv.mpf
+    """
     from mpmath import iv
 
     out = [iv.mpf(0)] * (len(a) + len(b) - 1)
@@ -364,6 +374,6 @@ def _poly_det(matrix):
         if all(c.a == 0 and c.b == 0 for c in entry):
             continue
         minor = [row[:j] + row[j + 1:] for row in matrix[1:]]
-        term = _poly_mul(entry, _poly_det(minor))
+        term = interval_product(entry, _poly_det(minor))
         total = _poly_add(total, term if j % 2 == 0 else [-c for c in term])
     return total
