@@ -357,7 +357,7 @@ def _simulated(where, loop, y, table):
 def _ranges(where, section, loop, x, y, table, *, strict):
     """``((name, low, high), ...)`` in SI of ``{NAME = [LO, HI] or {range, unit}}``.
 
-    ``LO < HI`` if ``strict``, else ``LO <= HI``.
+    ``LO < HI`` if ``strict`` (``LO <= HI`` for ``d`` all the same), else ``LO <= HI``.
     """
     ranges = []
     for name, spec in table.items():
@@ -373,9 +373,10 @@ def _ranges(where, section, loop, x, y, table, *, strict):
             raise ValueError(f"{where}: {section} {name} must be [LO, HI] or "
                              f"{{range = [LO, HI], unit = \"...\"}}")
         low, high = _si(f"{where}: {section}", loop, name, spec, unit)
-        if not (low < high if strict else low <= high):
+        less = strict and name != "d"     # whole delays: a range of one is a range
+        if not (low < high if less else low <= high):
             raise ValueError(f"{where}: {section} {name} = [LO, HI] needs LO "
-                             f"{'<' if strict else '<='} HI, got {spec!r}")
+                             f"{'<' if less else '<='} HI, got {spec!r}")
         ranges.append((name, low, high))
     return tuple(ranges)
 
@@ -452,24 +453,9 @@ def _random(where, loop, x, y, table):
         raise ValueError(f"{where}: [random] samples must be an integer from 1 to {MAX_ROWS}")
     if isinstance(seed, bool) or not isinstance(seed, int) or seed < 0:
         raise ValueError(f"{where}: [random] seed must be a non-negative integer, got {seed!r}")
-    ranges = {}
-    for name, spec in table.items():
-        if name in ("samples", "seed"):
-            continue
-        _check_name(where, loop, x, y, name)
-        unit = None
-        if isinstance(spec, dict):
-            extra = sorted(set(spec) - {"range", "unit"})
-            if extra:
-                raise ValueError(f"{where}: [random] {name}: unknown key {extra[0]!r} (give "
-                                 f"[LO, HI] or {{range = [LO, HI], unit = \"...\"}})")
-            unit, spec = spec.get("unit"), spec.get("range")
-        if not isinstance(spec, list) or len(spec) != 2:
-            raise ValueError(f"{where}: [random] {name} must be [LO, HI] (uniform draws)")
-        low, high = _si(f"{where}: [random]", loop, name, spec, unit)
-        if not low < high if name != "d" else not low <= high:
-            raise ValueError(f"{where}: [random] {name} = [LO, HI] needs LO < HI, got {spec!r}")
-        ranges[name] = (int(low), int(high)) if name == "d" else (low, high)
+    named = {k: v for k, v in table.items() if k not in ("samples", "seed")}
+    ranges = {name: (int(low), int(high)) if name == "d" else (low, high)
+              for name, low, high in _ranges(where, "[random]", loop, x, y, named, strict=True)}
     if not ranges:
         return [], np.empty((0, 0)), ""
     from ..numeric.probability import draw_values
