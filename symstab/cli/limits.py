@@ -146,8 +146,8 @@ def _robust(args, setup, at):
     nominal = region.nominal
     notes = [f"robust: the points of the ({x}, {y}) plane stable for every {box_text}, "
              f"certified by zero exclusion (interval arithmetic over the box and theta; "
-             f"{len(region.edges) - 1 if len(region.edges) else strips} strips, each a "
-             f"rectangle of certified y)"]
+             f"{len(region.edges) - 1 if len(region.edges) else strips} strips, each with "
+             f"trapezoids of certified y)"]
     if lim.empty:
         notes.append(f"the robust set is empty: {lim.reason}")
     else:
@@ -158,7 +158,7 @@ def _robust(args, setup, at):
                          f"{lim.y_max:.6g}, area = {lim.area:.6g} "
                          f"({lim.area / nominal_limits.area:.1%} of it)")
         notes.append(f"marginal (the certificate did not close): area {region.marginal_area:.3g}; "
-                     f"more strips make the rectangles fit closer")
+                     f"more strips make the trapezoids fit closer")
         if region.exhausted:
             notes.append("the search stopped at its budget of cells: what it left open is "
                          "marginal")
@@ -181,7 +181,7 @@ def _robust(args, setup, at):
 
 def _robust_figure(plt, setup, region):
     """The robust set (filled), what stayed marginal, and the nominal set's outline beside it."""
-    from matplotlib.patches import Patch, Rectangle
+    from matplotlib.patches import Patch, Polygon
 
     fig, ax = plt.subplots(figsize=(6.4, 4.8))
     nominal = region.nominal
@@ -191,10 +191,11 @@ def _robust_figure(plt, setup, region):
             ax.plot(ring[:, 0], ring[:, 1], color="0.2", lw=1.0,
                     label="stable at the box's centre" if k == 0 else None)
     for which, color in ((region.marginal, "#f4a582"), (region.intervals, "#4393c3")):
-        for i, spans in enumerate(which):
-            for lo, hi in spans:
-                ax.add_patch(Rectangle((region.edges[i], lo), region.edges[i + 1] - region.edges[i],
-                                       hi - lo, facecolor=color, edgecolor="none"))
+        for i, bands in enumerate(which):
+            x0, x1 = region.edges[i], region.edges[i + 1]
+            for lo0, hi0, lo1, hi1 in bands:
+                ax.add_patch(Polygon([(x0, lo0), (x1, lo1), (x1, hi1), (x0, hi0)], closed=True,
+                                     facecolor=color, edgecolor="none"))
     handles, _ = ax.get_legend_handles_labels()
     handles += [Patch(color="#4393c3", label="stable for every value of the box"),
                 Patch(color="#f4a582", label="marginal (not certified)")]

@@ -396,9 +396,9 @@ class RobustRegion:
     """The points of an ``(x, y)`` plane stable for every value of uncertain parameters.
 
     :func:`symstab.numeric.robust.robust_region` states the guarantee and
-    how it is proved.  The set is a union of rectangles, one strip of ``x``
-    by a certified interval of ``y``: an inner approximation of the robust
-    set (its area grows to the robust set's as the strips narrow).
+    how it is proved.  The set is a union of trapezoids, one strip of ``x``
+    by a certified band of ``y`` whose ends run straight from the strip's
+    left edge to its right one: an inner approximation of the robust set.
 
     Attributes
     ----------
@@ -409,10 +409,11 @@ class RobustRegion:
     edges : ndarray
         The strips' edges in ``x`` (two equal edges: one line).
     intervals : tuple of tuple
-        Per strip, the robustly stable intervals ``(lo, hi)`` of ``y``.
+        Per strip, the robustly stable bands ``(lo0, hi0, lo1, hi1)``: the
+        interval of ``y`` at the strip's left edge and at its right edge.
     marginal : tuple of tuple
-        Per strip, the intervals of ``y`` where the certificate did not
-        close (neither called stable nor unstable).
+        Per strip, the bands (as ``intervals``) where the certificate did
+        not close (neither called stable nor unstable).
     nominal : symstab.numeric.decomposition.Decomposition
         The D-decomposition at the box's centre, to be drawn beside.
     at : dict
@@ -457,8 +458,9 @@ class RobustRegion:
             The delays (one, or the range's).
         edges : array_like
             The strips' edges.
-        robust, marginal : list of list of (float, float)
-            Per strip, the certified and the marginal intervals of ``y``.
+        robust, marginal : list of list of (float, float, float, float)
+            Per strip, the certified and the marginal bands ``(lo0, hi0,
+            lo1, hi1)``.
         nominal : Decomposition
             The decomposition at the box's centre.
         at : dict
@@ -505,55 +507,70 @@ class RobustRegion:
         """Whether no point is robustly stable."""
         return not any(self.intervals)
 
-    def _rectangles(self, which):
-        out = []
-        for i, spans in enumerate(which):
-            for lo, hi in spans:
-                out.append((self.edges[i], self.edges[i + 1], lo, hi))
-        return np.array(out, dtype=float).reshape(-1, 4)
+    def _bands(self, which):
+        """Rows ``(x0, x1, lo0, hi0, lo1, hi1)``, one per band."""
+        out = [(self.edges[i], self.edges[i + 1], *band)
+               for i, bands in enumerate(which) for band in bands]
+        return np.array(out, dtype=float).reshape(-1, 6)
+
+    @staticmethod
+    def _areas(r):
+        return (r[:, 1] - r[:, 0]) * 0.5 * ((r[:, 3] - r[:, 2]) + (r[:, 5] - r[:, 4]))
 
     @property
     def area(self):
-        """Area of the robust set (the rectangles' sum)."""
-        r = self._rectangles(self.intervals)
-        return float(np.sum((r[:, 1] - r[:, 0]) * (r[:, 3] - r[:, 2])))
+        """Area of the robust set (the trapezoids' sum)."""
+        return float(np.sum(self._areas(self._bands(self.intervals))))
 
     @property
     def marginal_area(self):
         """Area where the certificate did not close."""
-        r = self._rectangles(self.marginal)
-        return float(np.sum((r[:, 1] - r[:, 0]) * (r[:, 3] - r[:, 2])))
+        return float(np.sum(self._areas(self._bands(self.marginal))))
 
     @property
     def polygons(self):
-        """The robust set's outlines, counter-clockwise: runs of strips with one overlapping interval each join into one staircase polygon."""
+        """The robust set's outlines, counter-clockwise: runs of strips with one band each, touching
+        across the edge between them, join into one polygon."""
         out, run = [], []
 
         def close(run):
             if not run:
                 return
-            bottom = [p for i, (lo, _) in run for p in ((self.edges[i], lo), (self.edges[i + 1], lo))]
-            top = [p for i, (_, hi) in reversed(run) for p in ((self.edges[i + 1], hi), (self.edges[i], hi))]
+            bottom = [p for i, (lo0, _, lo1, _) in run
+                      for p in ((self.edges[i], lo0), (self.edges[i + 1], lo1))]
+            top = [p for i, (_, hi0, _, hi1) in reversed(run)
+                   for p in ((self.edges[i + 1], hi1), (self.edges[i], hi0))]
             out.append(np.array(bottom + top))
 
-        for i, spans in enumerate(self.intervals):
-            if len(spans) == 1 and run and run[-1][0] == i - 1 \
-                    and spans[0][0] < run[-1][1][1] and run[-1][1][0] < spans[0][1] \
-                    and len(self.intervals[i - 1]) == 1:
-                run.append((i, spans[0]))
+        for i, bands in enumerate(self.intervals):
+            if len(bands) == 1 and run and run[-1][0] == i - 1 \
+                    and len(self.intervals[i - 1]) == 1 \
+                    and bands[0][0] < run[-1][1][3] and run[-1][1][2] < bands[0][1]:
+                run.append((i, bands[0]))
                 continue
             close(run)
             run = []
-            if len(spans) == 1:
-                run = [(i, spans[0])]
+            if len(bands) == 1:
+                run = [(i, bands[0])]
             else:
-                for lo, hi in spans:
-                    close([(i, (lo, hi))])
+                for band in bands:
+                    close([(i, band)])
         close(run)
         return tuple(out)
 
+    def _ends_at(self, x):
+        """Per band: its strip holds ``x`` (mask) and its ``(lo, hi)`` there."""
+        r = self._bands(self.intervals)
+        x = np.asarray(x, dtype=float)[..., None]
+        width = r[:, 1] - r[:, 0]
+        with np.errstate(invalid="ignore", divide="ignore"):
+            f = np.where(width > 0, (x - r[:, 0]) / np.where(width > 0, width, 1.0), 0.0)
+        lo = r[:, 2] + f * (r[:, 4] - r[:, 2])
+        hi = r[:, 3] + f * (r[:, 5] - r[:, 3])
+        return (r[:, 0] <= x) & (x <= r[:, 1]), lo, hi
+
     def contains(self, x, y):
-        """Whether points are in the robust set (a rectangle, its top and bottom sides excluded).
+        """Whether points are in the robust set (a trapezoid, its top and bottom sides excluded).
 
         Parameters
         ----------
@@ -565,12 +582,10 @@ class RobustRegion:
         ndarray of bool
         """
         x, y = np.broadcast_arrays(np.asarray(x, dtype=float), np.asarray(y, dtype=float))
-        out = np.zeros(x.shape, dtype=bool)
-        # A certified interval's ends are not certified (an end is where a
-        # marked piece or a sampled stable interval ends): open in y.
-        for x0, x1, lo, hi in self._rectangles(self.intervals):
-            out |= (x0 <= x) & (x <= x1) & (lo < y) & (y < hi)
-        return out
+        # A band's ends are not certified (an end is where a marked piece or
+        # a sampled stable interval ends): open in y.
+        holds, lo, hi = self._ends_at(x)
+        return np.any(holds & (lo < y[..., None]) & (y[..., None] < hi), axis=-1)
 
     def intervals_at(self, x):
         """The robust intervals of ``y`` at ``x`` (those of the strips holding it, merged).
@@ -584,16 +599,13 @@ class RobustRegion:
         -------
         list of (float, float)
         """
-        spans = []
-        for i, s in enumerate(self.intervals):
-            if self.edges[i] <= x <= self.edges[i + 1]:
-                spans += list(s)
+        holds, lo, hi = self._ends_at(float(x))
         out = []
-        for lo, hi in sorted(spans):
-            if out and lo <= out[-1][1]:
-                out[-1] = (out[-1][0], max(out[-1][1], hi))
+        for a, b in sorted(zip(lo[holds].tolist(), hi[holds].tolist())):
+            if out and a <= out[-1][1]:
+                out[-1] = (out[-1][0], max(out[-1][1], b))
             else:
-                out.append((lo, hi))
+                out.append((a, b))
         return out
 
     def limits(self):
@@ -601,11 +613,12 @@ class RobustRegion:
         if self.empty:
             return Limits.empty_set(self.x, self.y, self.reason, cells=0, region=self,
                                     at=self.at, line=self.intervals_at)
-        r = self._rectangles(self.intervals)
-        top = int(np.argmax(r[:, 3]))
+        r = self._bands(self.intervals)
+        # The highest end is at a strip's edge.
+        band, side = np.unravel_index(int(np.argmax(r[:, [3, 5]])), (len(r), 2))
         sides = set(self.unbounded)
-        return Limits(self.x, self.y, np.inf if "y_max" in sides else float(r[top, 3]),
-                      float(0.5 * (r[top, 0] + r[top, 1])),
+        return Limits(self.x, self.y, np.inf if "y_max" in sides else float(r[band, 3 + 2 * side]),
+                      float(r[band, side]),
                       -np.inf if "x_min" in sides else float(r[:, 0].min()),
                       np.inf if "x_max" in sides else float(r[:, 1].max()),
                       np.inf if sides else self.area, cells=len(self.polygons), region=self,

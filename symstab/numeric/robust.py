@@ -276,9 +276,12 @@ def _parts_on_arc(enclosures, shift, theta, h, box):
     om_k = om ** k
     om_1 = np.where(k >= 1, om ** np.maximum(k - 1, 0), 0.0)
     om_2 = np.where(k >= 2, om ** np.maximum(k - 2, 0), 0.0)
+    om_up = np.maximum(om, 1.0)
+    slope_size = np.where(k >= 1, k * om_up ** np.maximum(k - 1, 0), 0.0)
     shape = mid.shape[:2]
     value, slope = np.zeros(shape, dtype=complex), np.zeros(shape, dtype=complex)
     second, coefficient, rounding = np.zeros(shape), np.zeros(shape), np.zeros(shape)
+    slope_rounding = np.zeros(shape)
     for kind, s in ((0, float(shift)), (1, 0.0)):
         a = mid[:, :, kind, :]
         rotate = np.exp(1j * s * theta)[:, None] if s else 1.0
@@ -291,26 +294,47 @@ def _parts_on_arc(enclosures, shift, theta, h, box):
         coefficient += np.einsum("npk,nk->np", rad[:, :, kind, :], om_k)
         # Of the sums, and of exp(j s theta) (an error in its phase s theta).
         rounding += 32 * _EPS * (n_terms + 4) * np.einsum(
-            "npk,nk->np", absolute, np.maximum(om, 1.0) ** k) * (1.0 + s * (theta + h)[:, None])
-    return value, slope, second, coefficient, rounding
+            "npk,nk->np", absolute, om_up ** k) * (1.0 + s * (theta + h)[:, None])
+        slope_rounding += 32 * _EPS * (n_terms + 4) * np.einsum(
+            "npk,nk->np", absolute, s * om_up ** k + slope_size) * (1.0 + s * (theta + h)[:, None])
+    return value, slope, second, coefficient, rounding, slope_rounding
 
 
-def _excluded(enclosures, shift, theta, h, box, xc, hx):
-    """The ``y`` where zero exclusion fails on a cell (strip x theta-interval x sub-box).
+def _excluded(enclosures, shift, theta, h, box, piece):
+    """The ``t`` of a piece where zero exclusion fails on a cell (piece x theta-interval x sub-box).
 
-    With ``P = A0 + xc Ax`` and ``Y = Ay`` at the middle of the
-    ``theta``-interval, ``chi`` lies within ``a + b |y|`` of ``P + y Y``
-    anywhere on the cell, ``a`` and ``b`` summing what the
-    ``theta``-width, the coefficients' radii, the strip's width and the
-    rounding cost; it cannot vanish where ``|P + y Y| > a + b |y|``, a
-    quadratic inequality on each side of ``y = 0``.
+    A piece is a trapezoid of the plane: ``x`` in ``[x0, x1]``, ``y =
+    lo(x) + t (hi(x) - lo(x))`` with ``t`` in [0, 1] and ``lo``, ``hi``
+    straight from ``(lo0, hi0)`` at ``x0`` to ``(lo1, hi1)`` at ``x1``
+    (``piece``: a :class:`_Pieces` row per cell).  Two enclosures of the
+    points where ``chi`` may vanish on the cell, both sound; what is
+    returned is in both:
 
-    Returns ``(pieces, fixed, theta_cost, box_cost)``: the set as
-    intervals (:func:`_failing`); the same without the ``theta``-width's and
-    the radii's costs (what no refinement of the cell removes); those two
-    costs as ``(a, b)``, ``a + b |y|``.
+    * the strip's (:func:`_failing`): with ``P = A0 + xc Ax`` and ``Y =
+      Ay`` at the middle of the ``theta``-interval, ``chi`` lies within ``a
+      + b |y|`` of ``P + y Y`` on the cell, ``a`` and ``b`` summing what
+      the ``theta``-width, the coefficients' radii, the strip's width and
+      the rounding cost, so it cannot vanish where ``|P + y Y| > a + b
+      |y|``; what the strip's width costs is first order in it;
+    * the capsule's (:func:`_capsules`): the zeros lie within ``rho`` of
+      a segment of the zero curve's tangent, ``rho`` second order in the
+      ``theta``-width; it does not exist where the real map ``(x, y) ->
+      x Ax + y Ay`` is nearly singular (``theta`` next to 0 or pi).
+
+    The narrower of the two leads the search: what the ``theta``-width
+    and the coefficients' radii cost (to choose which to halve) and how much
+    of the set halving could still remove, in ``t`` (the capsule's:
+    ``rho``'s share; the strip's: the set's width in ``y`` beyond what the
+    strip's width and the rounding cost, which no halving removes, over the
+    piece's height).
+
+    Returns ``(pieces, theta_cost, box_cost, reducible)``: the set as
+    intervals of ``t`` (empty: lo > hi), the two costs (comparable with
+    each other only) and what halving could remove.
     """
-    value, slope, second, coefficient, rounding = _parts_on_arc(enclosures, shift, theta, h, box)
+    value, slope, second, coefficient, rounding, slope_rounding = _parts_on_arc(
+        enclosures, shift, theta, h, box)
+    xc, hx = 0.5 * (piece.x0 + piece.x1), 0.5 * (piece.x1 - piece.x0)
     h2 = 0.5 * h * h
     P = value[:, 0] + xc * value[:, 1]
     Y = value[:, 2]
@@ -324,9 +348,141 @@ def _excluded(enclosures, shift, theta, h, box, xc, hx):
                     + coefficient[:, 1])
     round_a = rounding[:, 0] + (ax + hx) * rounding[:, 1]
     round_b = rounding[:, 2]
-    pieces = _failing(P, Y, theta_a + box_a + strip_a + round_a, theta_b + box_b + round_b)
-    fixed = _failing(P, Y, strip_a + round_a, round_b)
-    return pieces, fixed, (theta_a, theta_b), (box_a, box_b)
+    strip_y = _failing(P, Y, theta_a + box_a + strip_a + round_a, theta_b + box_b + round_b)
+    fixed_y = _failing(P, Y, strip_a + round_a, round_b)
+    strip = [piece.to_t(lo, hi) for lo, hi in strip_y]
+    y_lo = np.minimum(piece.lo0, piece.lo1)
+    y_hi = np.maximum(piece.hi0, piece.hi1)
+
+    def width(pairs):
+        return sum(np.maximum(np.minimum(hi, y_hi) - np.maximum(lo, y_lo), 0.0) for lo, hi in pairs)
+
+    with np.errstate(invalid="ignore", over="ignore"):
+        reducible = np.nan_to_num((width(strip_y) - width(fixed_y)) / piece.height, nan=np.inf)
+    # The costs where they are largest on the part of the piece that matters.
+    far = np.zeros(len(P))
+    for lo, hi in strip_y:
+        lo, hi = np.maximum(lo, y_lo), np.minimum(hi, y_hi)
+        far = np.where(lo <= hi, np.maximum(far, np.maximum(np.abs(lo), np.abs(hi))), far)
+    height = piece.height
+    theta_cost = (theta_a + far * theta_b) / height
+    box_cost = (box_a + far * box_b) / height
+
+    valid, t_lo, t_hi, rho_theta, rho_box = _capsules(
+        value, slope, second, coefficient, rounding, slope_rounding, h, piece)
+    # The capsule leads where it is the narrower on the piece (next to theta
+    # = 0 or pi, where it fattens as 1 / sigma, the strip's may be).
+    spread = sum(np.maximum(np.minimum(hi, 1.0) - np.maximum(lo, 0.0), 0.0) for lo, hi in strip)
+    lead = valid & (np.maximum(np.minimum(t_hi, 1.0) - np.maximum(t_lo, 0.0), 0.0) <= spread)
+    pieces = [(np.where(valid, np.maximum(lo, t_lo), lo), np.where(valid, np.minimum(hi, t_hi), hi))
+              for lo, hi in strip]
+    theta_cost = np.where(lead, rho_theta, theta_cost)
+    box_cost = np.where(lead, rho_box, box_cost)
+    reducible = np.where(lead, rho_theta + rho_box, reducible)
+    return pieces, theta_cost, box_cost, reducible
+
+
+def _capsules(value, slope, second, coefficient, rounding, slope_rounding, h, piece):
+    """Per cell, the ``t`` of the piece within ``rho`` of the zero curve's tangent segment.
+
+    With the midpoint coefficients, ``chi(v, theta) = a0(theta) +
+    M(theta) v`` for ``v = (x, y)``, ``M`` the real 2 x 2 map of the
+    complex ``Ax, Ay``.  At the middle ``theta_c`` of the interval,
+    ``v*`` solves ``chi = 0`` and ``v'`` its ``theta``-derivative; along
+    ``v_L(u) = v* + u v'`` (``|u| <= h``), ``g(u) = chi(v_L(u), theta_c +
+    u)`` is bounded by ``G = |g(0)| + h |g'(0)| + h**2 / 2 sup |g''|``
+    (``g''  = a0'' + M'' v_L + 2 M' v'``; ``g(0)`` and ``g'(0)`` are
+    rounding, evaluated and bounded).  A zero ``v`` of the true ``chi``
+    (coefficients within ``c0 + c1 |x| + c2 |y|`` of the midpoint ones)
+    at ``theta_c + u`` satisfies ``|M(theta) (v - v_L(u))| <= G + c0 + c1
+    |x| + c2 |y|``, and ``|M(theta) e| >= sigma |e|`` with ``sigma`` the
+    smallest singular value of ``M(theta_c)`` less ``h sup |M'|`` and the
+    rounding, so ``|v - v_L(u)| <= rho = (G + c0 + c1 X + c2 Y) / (sigma
+    - c1 - c2)`` (``X, Y`` bounds of ``|x|, |y|`` on the segment): the
+    zeros lie in the capsule (segment ``v* +- h v'`` widened by ``rho``).
+
+    Its ``t`` on the piece: the segment is clipped to ``x`` in ``[x0 -
+    rho, x1 + rho]``; ``t`` is monotone along it (a ratio of affine
+    functions), so its range is that of the ends, widened by ``rho`` times
+    a bound of ``|grad t|``.
+
+    Returns ``(valid, t_lo, t_hi, rho_theta, rho_box)``: where a capsule
+    exists (``sigma > c1 + c2``), its ``t``-range (empty: lo > hi), and
+    what the ``theta``-width and the coefficients' radii add to the range.
+    """
+    a0, cx, cy = value[:, 0], value[:, 1], value[:, 2]
+    s0, sx, sy = slope[:, 0], slope[:, 1], slope[:, 2]
+    with np.errstate(over="ignore", invalid="ignore", divide="ignore"):
+        det = cx.real * cy.imag - cx.imag * cy.real
+        det_error = 4 * _EPS * (np.abs(cx.real * cy.imag) + np.abs(cx.imag * cy.real))
+
+        def solve(rhs):
+            return ((rhs.real * cy.imag - cy.real * rhs.imag) / det,
+                    (cx.real * rhs.imag - rhs.real * cx.imag) / det)
+
+        xs, ys = solve(-a0)
+        dx, dy = solve(-(s0 + xs * sx + ys * sy))
+        r0 = np.abs(a0 + xs * cx + ys * cy) + rounding[:, 0] + np.abs(xs) * rounding[:, 1] \
+            + np.abs(ys) * rounding[:, 2] + 8 * _EPS * (np.abs(a0) + np.abs(xs * cx)
+                                                        + np.abs(ys * cy))
+        r1 = (np.abs(s0 + xs * sx + ys * sy + dx * cx + dy * cy) + slope_rounding[:, 0]
+              + np.abs(xs) * slope_rounding[:, 1] + np.abs(ys) * slope_rounding[:, 2]
+              + np.abs(dx) * rounding[:, 1] + np.abs(dy) * rounding[:, 2]
+              + 8 * _EPS * (np.abs(s0) + np.abs(xs * sx) + np.abs(ys * sy) + np.abs(dx * cx)
+                            + np.abs(dy * cy)))
+        X, Y = np.abs(xs) + h * np.abs(dx), np.abs(ys) + h * np.abs(dy)
+        # |Ax'|, |Ay'| anywhere on the interval.
+        d1 = np.abs(sx) + slope_rounding[:, 1] + h * second[:, 1]
+        d2 = np.abs(sy) + slope_rounding[:, 2] + h * second[:, 2]
+        g2 = second[:, 0] + X * second[:, 1] + Y * second[:, 2] + 2 * (
+            d1 * np.abs(dx) + d2 * np.abs(dy))
+        G = r0 + h * r1 + 0.5 * h * h * g2
+        # In the scaled (x / ux, y / uy) the map's columns have length 1 at
+        # theta_c; sigma is its smallest singular value anywhere on the cell.
+        ux, uy = 1.0 / np.abs(cx), 1.0 / np.abs(cy)
+        sigma = ((np.abs(det) * ux * uy - det_error * ux * uy) / (np.sqrt(2.0) * (1 + 8 * _EPS))
+                 - np.hypot(rounding[:, 1] * ux, rounding[:, 2] * uy)
+                 - h * np.hypot(d1 * ux, d2 * uy))
+        c0, c1, c2 = coefficient[:, 0], coefficient[:, 1], coefficient[:, 2]
+        denominator = sigma - c1 * ux - c2 * uy
+        rho_theta = G / denominator
+        rho_box = (c0 + c1 * X + c2 * Y) / denominator
+        rho = rho_theta + rho_box
+        # A zero is within (ux rho, uy rho) of the segment, in x and in y.
+        rx, ry = ux * rho, uy * rho
+        valid = (denominator > 0) & np.isfinite(rx) & np.isfinite(ry) & np.isfinite(xs) \
+            & np.isfinite(ys) & np.isfinite(dx) & np.isfinite(dy)
+        # The segment v* + s h v' (|s| <= 1) clipped to x in [x0 - rx, x1 + rx].
+        ex, ey = h * dx, h * dy
+        a, b = piece.x0 - rx, piece.x1 + rx
+        inside = (xs >= a) & (xs <= b)
+        s_a, s_b = (a - xs) / ex, (b - xs) / ex
+        moving = np.abs(ex) > 0
+        s_lo = np.maximum(np.where(moving, np.minimum(s_a, s_b), np.where(inside, -1.0, np.inf)),
+                          -1.0)
+        s_hi = np.minimum(np.where(moving, np.maximum(s_a, s_b), np.where(inside, 1.0, -np.inf)),
+                          1.0)
+        meets = s_lo <= s_hi
+        s_lo, s_hi = np.where(meets, s_lo, 0.0), np.where(meets, s_hi, 0.0)
+        lo_slope, height_slope = piece.lo_slope, piece.height_slope
+        floor = np.minimum(piece.hi0 - piece.lo0, piece.hi1 - piece.lo1) \
+            - rx * np.abs(height_slope)
+        ends = []
+        for s in (s_lo, s_hi):
+            px, py = xs + s * ex, ys + s * ey
+            above = py - (piece.lo0 + lo_slope * (px - piece.x0))
+            ends.append((above, above / (piece.hi0 - piece.lo0 + height_slope * (px - piece.x0))))
+        reach = np.maximum(np.abs(ends[0][0]), np.abs(ends[1][0])) + ry + rx * np.abs(lo_slope)
+        # |t(v) - t(q)| for |x_v - x_q| <= rx, |y_v - y_q| <= ry, per unit of rho.
+        lipschitz = (uy + ux * (np.abs(lo_slope) + reach / floor * np.abs(height_slope))) / floor
+        t_lo = np.minimum(ends[0][1], ends[1][1]) - rho * lipschitz
+        t_hi = np.maximum(ends[0][1], ends[1][1]) + rho * lipschitz
+        t_lo, t_hi = t_lo - 1e-9 * (1 + np.abs(t_lo)), t_hi + 1e-9 * (1 + np.abs(t_hi))
+        valid &= (floor > 0) & np.isfinite(t_lo) & np.isfinite(t_hi)
+        t_lo = np.where(meets, t_lo, np.inf)
+        t_hi = np.where(meets, t_hi, -np.inf)
+        scale = np.where(np.isfinite(lipschitz), lipschitz, 0.0)
+    return valid, t_lo, t_hi, rho_theta * scale, rho_box * scale
 
 
 def _failing(P, Y, a, b):
@@ -381,6 +537,62 @@ def _failing(P, Y, a, b):
                 np.nan_to_num(hi, nan=np.inf), half[1])
             pieces.append((lo, hi))
     return pieces
+
+
+@dataclasses.dataclass
+class _Pieces:
+    """Trapezoids of the plane: ``x`` in ``[x0, x1]``, ``y`` from ``lo`` to ``hi``, each straight
+    from its value at ``x0`` (``lo0``, ``hi0``) to that at ``x1``; a point's ``t`` is where it
+    lies between them (0 on ``lo``, 1 on ``hi``)."""
+
+    x0: np.ndarray
+    x1: np.ndarray
+    lo0: np.ndarray
+    hi0: np.ndarray
+    lo1: np.ndarray
+    hi1: np.ndarray
+
+    def take(self, keep):
+        return _Pieces(*(getattr(self, f.name)[keep] for f in dataclasses.fields(self)))
+
+    def _slope(self, a, b):
+        width = self.x1 - self.x0
+        with np.errstate(invalid="ignore", divide="ignore"):
+            return np.where(width > 0, (b - a) / width, 0.0)
+
+    @property
+    def lo_slope(self):
+        return self._slope(self.lo0, self.lo1)
+
+    @property
+    def height_slope(self):
+        return self._slope(self.hi0 - self.lo0, self.hi1 - self.lo1)
+
+    @property
+    def height(self):
+        return np.maximum(self.hi0 - self.lo0, self.hi1 - self.lo1)
+
+    def to_t(self, lo, hi):
+        """The ``t``-range of the rectangles ``[x0, x1] x [lo, hi]`` (empty where lo > hi).
+
+        ``t`` is increasing in ``y`` and monotone in ``x`` (a ratio of
+        affine functions): its extremes are at the corners.
+        """
+        with np.errstate(invalid="ignore", over="ignore"):
+            corners = [(y - base) / (top - base) for y in (lo, hi)
+                       for base, top in ((self.lo0, self.hi0), (self.lo1, self.hi1))]
+            t_lo, t_hi = np.minimum.reduce(corners), np.maximum.reduce(corners)
+            # Each end moved out by 1e-12 of its size (the rounding).
+            t_lo = t_lo - 1e-12 * (1 + np.abs(t_lo))
+            t_hi = t_hi + 1e-12 * (1 + np.abs(t_hi))
+        empty = (lo > hi) | np.isnan(t_lo) | np.isnan(t_hi)
+        return np.where(empty, np.inf, t_lo), np.where(empty, -np.inf, t_hi)
+
+    def ends(self, p, t_lo, t_hi):
+        """``(lo0, hi0, lo1, hi1)`` of piece ``p`` between ``t_lo`` and ``t_hi``."""
+        lo0, lo1 = float(self.lo0[p]), float(self.lo1[p])
+        d0, d1 = float(self.hi0[p]) - lo0, float(self.hi1[p]) - lo1
+        return (lo0 + t_lo * d0, lo0 + t_hi * d0, lo1 + t_lo * d1, lo1 + t_hi * d1)
 
 
 @dataclasses.dataclass
@@ -450,17 +662,18 @@ def _mark(marked, strips, parts):
             marked[int(s)].append((float(a), float(b)))
 
 
-def _certify(enclosures, shift, centres, halves, candidates, tol, budget):
-    """Branch and bound over theta and the box: ``(marked, examined)``.
+def _certify(enclosures, shift, geometry, candidates, tol, budget):
+    """Branch and bound over theta and the box: ``(marked, examined, exhausted)``.
 
-    Each cell (strip x theta-interval x sub-box) excludes zero for every
-    ``y`` outside an interval (:func:`_excluded`).  A cell whose interval
-    misses the strip's candidates is done; one that meets them is halved in
-    ``theta`` or the box (whichever costs more), until its interval is
-    within ``tol`` of what no halving removes (the strip's width, the
-    rounding), or nothing is left to halve: then the interval, clipped to
-    the candidates, is *marked*.  ``marked[strip]`` (merged) is where zero
-    exclusion did not close; the rest of the candidates is certified.
+    Each cell (piece x theta-interval x sub-box) excludes zero for every
+    ``t`` of its piece (``geometry``, :class:`_Pieces`) outside a few
+    intervals (:func:`_excluded`).  A cell whose intervals miss the piece's
+    open ``t`` (``candidates``) is done; one that meets them is halved in
+    ``theta`` or the box (whichever costs more), until what the halvings
+    can remove is within ``tol`` (per piece, in ``t``), or nothing is left
+    to halve: then the intervals, clipped to the candidates, are *marked*.
+    ``marked[piece]`` (merged) is where zero exclusion did not close; the
+    rest of the candidates is certified.
     """
     n_terms = shift + enclosures.mid[0].shape[-1]
     n_theta = max(16, _THETA_PER_TERM * n_terms)
@@ -485,36 +698,21 @@ def _certify(enclosures, shift, centres, halves, candidates, tol, budget):
         for part in chunk_slices(len(cells), per_cell):
             c = cells.take(part)
             theta, h = 0.5 * (c.t0 + c.t1), 0.5 * (c.t1 - c.t0)
-            pieces, fixed, theta_ab, box_ab = _excluded(
-                enclosures, shift, theta, h, c.box, centres[c.strip], halves[c.strip])
+            pieces, theta_cost, box_cost, reducible = _excluded(
+                enclosures, shift, theta, h, c.box, geometry.take(c.strip))
             meets = np.zeros(len(c), dtype=bool)
-            far = np.zeros(len(c))
             for lo, hi in _clip(c.strip, pieces, open_spans):
-                some = lo <= hi
-                meets |= some
-                far = np.where(some, np.maximum(far, np.maximum(np.abs(lo), np.abs(hi))), far)
+                meets |= lo <= hi
             if not meets.any():
                 continue
-            # The costs where they are largest on the part that matters.
             found.append((c.take(meets), [(lo[meets], hi[meets]) for lo, hi in pieces],
-                          [(lo[meets], hi[meets]) for lo, hi in fixed],
-                          (theta_ab[0] + far * theta_ab[1])[meets],
-                          (box_ab[0] + far * box_ab[1])[meets]))
+                          theta_cost[meets], box_cost[meets], reducible[meets]))
         if not found:
             break
         c = _Cells.join([f[0] for f in found])
         pieces = [tuple(np.concatenate([f[1][k][j] for f in found]) for j in range(2))
                   for k in range(len(found[0][1]))]
-        fixed = [tuple(np.concatenate([f[2][k][j] for f in found]) for j in range(2))
-                 for k in range(len(found[0][2]))]
-        theta_cost = np.concatenate([f[3] for f in found])
-        box_cost = np.concatenate([f[4] for f in found])
-        # What the strip's width costs at a cell's middle stays whatever is
-        # halved: marked at once (each piece apart), so that the search goes
-        # on only where the widths of theta and of the box still matter.
-        _mark(marked, c.strip, _clip(c.strip, fixed, open_spans))
-        marked = {s: _merge(v) for s, v in marked.items()}
-        open_spans = {s: _subtract(spans, marked[s]) for s, spans in candidates.items()}
+        theta_cost, box_cost, reducible = (np.concatenate([f[k] for f in found]) for k in (2, 3, 4))
         parts = _clip(c.strip, pieces, open_spans)
         left = np.zeros(len(c))
         with np.errstate(over="ignore", invalid="ignore"):
@@ -522,14 +720,16 @@ def _certify(enclosures, shift, centres, halves, candidates, tol, budget):
                 left += np.maximum(hi - lo, 0.0)
         meets = left > 0
         c, theta_cost, box_cost, left = c.take(meets), theta_cost[meets], box_cost[meets], left[meets]
+        reducible = reducible[meets]
         parts = [(lo[meets], hi[meets]) for lo, hi in parts]
         can_theta = (c.t1 - c.t0) > _THETA_WIDTH
         can_box = np.array(enclosures.depth)[c.box] < BOX_DEPTH
-        # Done when what is left open is within the resolution, or the width
-        # that costs more cannot be halved again (halving the other would
-        # not close the cell).
+        # Done when what is left open, or what halving could still remove,
+        # is within the resolution, or the width that costs more cannot be
+        # halved again (halving the other would not close the cell).
         theta_first = theta_cost >= box_cost
-        done = (left <= tol[c.strip]) | np.where(theta_first, ~can_theta, ~can_box)
+        done = ((left <= tol[c.strip]) | (reducible <= tol[c.strip])
+                | np.where(theta_first, ~can_theta, ~can_box))
         _mark(marked, c.strip[done], [(lo[done], hi[done]) for lo, hi in parts])
         marked = {s: _merge(v) for s, v in marked.items()}
         split_theta = ~done & theta_first
@@ -680,58 +880,117 @@ def robust_region(loop, x, y, *, uncertain, strips=64, rtol=1e-6, x_range=None, 
     points = np.vstack([cell.outer for cell in nominal.stable])
     x_lo, x_hi = given_x or (float(points[:, 0].min()), float(points[:, 0].max()))
     y_lo, y_hi = y_range or (float(points[:, 1].min()), float(points[:, 1].max()))
-    edges = np.linspace(x_lo, x_hi, strips + 1) if x_hi > x_lo else np.array([x_lo, x_lo])
-    centres, halves = 0.5 * (edges[:-1] + edges[1:]), 0.5 * (edges[1:] - edges[:-1])
-    tol = np.full(len(centres), rtol * (y_hi - y_lo) / 4)
-
-    robust = [[(y_lo, y_hi)] for _ in centres]
-    marginal = [[] for _ in centres]
-    examined, exhausted = 0, False
     grid = _grid(box)
+
+    def look(xs):
+        # Where to look on each line x: stable at every delay and grid value.
+        found = [[(y_lo, y_hi)] for _ in xs]
+        for d in delays:
+            for point in grid:
+                spans = loop.stable_intervals(y, **{x: np.asarray(xs)}, **fixed, **point, d=d)
+                found = [_intersect(a, b) for a, b in zip(found, spans)]
+        return found
+
+    edges = list(np.linspace(x_lo, x_hi, strips + 1)) if x_hi > x_lo else [x_lo, x_lo]
+    edges, spans = _split(look, edges, look(edges), (x_hi - x_lo) * rtol, 4 * strips)
+    geometry, owner = _trapezoids(edges, spans)
+    tol = np.full(len(owner), rtol * (y_hi - y_lo) / 4) / np.maximum(geometry.height, 1e-300)
+    marked = {p: [] for p in range(len(owner))}
+    examined, exhausted = 0, False
     for d in delays:
         shift = d + loop._delay_of_environment
-        # Candidates: stable at every grid value on both edges of the strip.
-        for point in grid:
-            found = loop.stable_intervals(y, **{x: edges}, **fixed, **point, d=d)
-            for i in range(len(centres)):
-                both = _intersect(found[i], found[i + 1])
-                robust[i] = _intersect(robust[i], both)
-        candidates = {i: spans for i, spans in enumerate(robust) if spans}
-        marked, n, out = _certify(enclosures, shift, centres, halves, candidates, tol,
-                                  budget - examined)
+        found, n, out = _certify(enclosures, shift, geometry,
+                                 {p: _subtract([(0.0, 1.0)], marked[p]) for p in marked},
+                                 tol, budget - examined)
         examined += n
         exhausted |= out
-        lead_mid, lead_rad = enclosures.leading(shift)
-        # Each certified piece: its root count at one point (the box's
-        # centre) and its leading coefficient; a count of -1 (undecided) or a
-        # leading coefficient that may vanish leave it marginal, a count
-        # above 0 unstable (not robust).
-        pieces = [(i, a, b) for i, spans in candidates.items()
-                  for a, b in _subtract(spans, marked[i])]
-        counts = np.atleast_1d(loop.unstable_root_counts(
-            **fixed, **centre, d=d, **{x: np.array([centres[i] for i, _, _ in pieces]),
-                                       y: np.array([0.5 * (a + b) for _, a, b in pieces])})) \
-            if pieces else np.zeros(0, dtype=int)
-        kept = {i: [] for i in candidates}
-        for (i, a, b), count in zip(pieces, counts):
-            if count == 0 and _lead_excluded(lead_mid, lead_rad, centres[i], halves[i], a, b):
-                kept[i].append((a, b))
-            elif count <= 0:
-                marginal[i].append((a, b))
-        for i, spans in candidates.items():
-            marginal[i] = _merge(marginal[i] + [(a, b) for a, b in marked[i]
-                                                if any(a < hi and b > lo for lo, hi in spans)])
-            robust[i] = kept[i]
-        for i in set(range(len(centres))) - set(candidates):
-            robust[i] = []
+        for p in marked:
+            marked[p] = _merge(marked[p] + found[p])
         if progress is not None:
             progress(delays.index(d) + 1)
-    robust = [_subtract(spans, marginal[i]) for i, spans in enumerate(robust)]
+    # Each certified piece: its root count at one point (the box's centre)
+    # at every delay, and its leading coefficient; a count of -1 (undecided)
+    # or a leading coefficient that may vanish leave it marginal, a count
+    # above 0 unstable (not robust).
+    pieces = [(p, a, b) for p in marked for a, b in _subtract([(0.0, 1.0)], marked[p])]
+    where = np.array([p for p, _, _ in pieces], dtype=np.int64)
+    inner = geometry.take(where)
+    middle = np.array([0.5 * (a + b) for _, a, b in pieces])
+    px = 0.5 * (inner.x0 + inner.x1)
+    py = 0.5 * (inner.lo0 + inner.lo1) + middle * 0.5 * (inner.hi0 - inner.lo0 + inner.hi1
+                                                         - inner.lo1)
+    status = np.zeros(len(pieces), dtype=int)      # 0 robust, 1 marginal, 2 unstable
+    for d in delays:
+        counts = np.atleast_1d(loop.unstable_root_counts(**fixed, **centre, d=d, **{x: px, y: py})) \
+            if pieces else np.zeros(0, dtype=int)
+        lead_mid, lead_rad = enclosures.leading(d + loop._delay_of_environment)
+        for k, (p, a, b) in enumerate(pieces):
+            ends = geometry.ends(p, a, b)
+            if counts[k] > 0:
+                status[k] = 2
+            elif status[k] == 0 and not (counts[k] == 0 and _lead_excluded(
+                    lead_mid, lead_rad, px[k], 0.5 * (inner.x1[k] - inner.x0[k]),
+                    min(ends), max(ends))):
+                status[k] = 1
+    robust = [[] for _ in range(len(edges) - 1)]
+    marginal = [[] for _ in range(len(edges) - 1)]
+    for k, (p, a, b) in enumerate(pieces):
+        if status[k] < 2:
+            (robust if status[k] == 0 else marginal)[owner[p]].append(
+                geometry.ends(p, a, b))
+    for p, spans in marked.items():
+        marginal[owner[p]] += [geometry.ends(p, max(a, 0.0), min(b, 1.0))
+                               for a, b in spans if a < 1.0 and b > 0.0]
+    robust = [sorted(r, key=lambda e: e[0] + e[2]) for r in robust]
+    marginal = [sorted(m, key=lambda e: e[0] + e[2]) for m in marginal]
     at = dict(fixed) if len(delays) > 1 else {**fixed, "d": delays[0]}
     touched = tuple(side for side in nominal.unbounded
                     if _touches(side, edges, robust, (x_lo, x_hi, y_lo, y_hi)))
     return RobustRegion.from_strips(x, y, box, delays, edges, robust, marginal, nominal, at,
                                     examined=examined, exhausted=exhausted, unbounded=touched)
+
+
+def _split(look, edges, spans, narrowest, most):
+    """Halve the strips whose edges see different numbers of intervals (a corner, an end).
+
+    Down to ``narrowest`` wide and at most ``most`` new edges; returns the
+    edges and the intervals at each.
+    """
+    edges, spans = list(edges), list(spans)
+    added = 0
+    while added < most:
+        halve = [i for i in range(len(edges) - 1)
+                 if len(spans[i]) != len(spans[i + 1]) and edges[i + 1] - edges[i] > narrowest]
+        halve = halve[:most - added]
+        if not halve:
+            break
+        middles = [0.5 * (edges[i] + edges[i + 1]) for i in halve]
+        found = look(middles)
+        for i, m, f in sorted(zip(halve, middles, found), reverse=True):
+            edges.insert(i + 1, m)
+            spans.insert(i + 1, f)
+        added += len(halve)
+    return np.array(edges, dtype=float), spans
+
+
+def _trapezoids(edges, spans):
+    """The pieces to certify: per strip, the intervals at its edges joined in order where they are
+    as many (a trapezoid each), else the intervals common to both (a rectangle each).
+
+    Returns the pieces (:class:`_Pieces`) and each one's strip.
+    """
+    rows, owner = [], []
+    for i in range(len(edges) - 1):
+        left, right = spans[i], spans[i + 1]
+        if len(left) == len(right):
+            pairs = [(a[0], a[1], b[0], b[1]) for a, b in zip(left, right)]
+        else:
+            pairs = [(lo, hi, lo, hi) for lo, hi in _intersect(left, right)]
+        for row in pairs:
+            rows.append((edges[i], edges[i + 1], *row))
+            owner.append(i)
+    table = np.array(rows, dtype=float).reshape(-1, 6)
+    return _Pieces(*table.T.copy()), owner
 
 
 def _touches(side, edges, robust, window):
@@ -744,8 +1003,9 @@ def _touches(side, edges, robust, window):
         return filled[0] == 0 and edges[0] <= x_lo
     if side == "x_max":
         return filled[-1] == len(robust) - 1 and edges[-1] >= x_hi
-    ends = [end for spans in robust for end in (spans[0][0], spans[-1][1]) if spans]
-    return min(ends) <= y_lo if side == "y_min" else max(ends) >= y_hi
+    if side == "y_min":
+        return min(min(spans[0][0], spans[0][2]) for spans in robust if spans) <= y_lo
+    return max(max(spans[-1][1], spans[-1][3]) for spans in robust if spans) >= y_hi
 
 
 def _intersect(a, b):
