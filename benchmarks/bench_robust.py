@@ -10,7 +10,8 @@ intervals at ``samples`` values of the box on the same strips' edges (the
 line engine at each value: what a user would do by hand, and not a
 guarantee between the values).  Prints the medians, their ratio, the areas
 (the sampled set is an outer estimate, the certified one an inner set),
-the marginal area, and how the certified area grows with the strips.
+the marginal area, how the certified area grows with the strips, and, for a
+box of zero width, how close it comes to the nominal set's area.
 """
 
 import argparse
@@ -27,21 +28,28 @@ ROOT = pathlib.Path(__file__).resolve().parent.parent
 
 
 def sampled(loop, box, strips, samples, values):
-    """Area of the intersection of the stable intervals at ``samples`` values per side, per strip."""
+    """Area of the intersection of the stable intervals at ``samples`` values, on the strips' edges."""
     nominal = loop.region("B", "K", **values, **{k: 0.5 * (lo + hi) for k, (lo, hi) in box.items()})
     points = np.vstack([c.outer for c in nominal.stable])
     edges = np.linspace(points[:, 0].min(), points[:, 0].max(), strips + 1)
     rng = np.random.default_rng(0)
     draws = [dict(zip(box, p)) for p in zip(*[rng.uniform(lo, hi, samples)
                                               for lo, hi in box.values()])]
-    kept = [[(-np.inf, np.inf)] for _ in range(strips)]
+    kept = [[(-np.inf, np.inf)] for _ in edges]
     for value in draws:
         found = loop.stable_intervals("K", B=edges, **values, **value)
-        for i in range(strips):
-            for edge in (found[i], found[i + 1]):
-                kept[i] = [(max(a, c), min(b, e)) for a, b in kept[i] for c, e in edge
-                           if max(a, c) < min(b, e)]
-    return sum((edges[i + 1] - edges[i]) * (b - a) for i in range(strips) for a, b in kept[i])
+        kept = [[(max(a, c), min(b, e)) for a, b in k for c, e in f if max(a, c) < min(b, e)]
+                for k, f in zip(kept, found)]
+    # Trapezoids between the edges, as the certified region's pieces.
+    area = 0.0
+    for i in range(strips):
+        left, right = kept[i], kept[i + 1]
+        if len(left) == len(right):
+            area += 0.5 * (edges[i + 1] - edges[i]) * sum(b - a for a, b in left + right)
+        else:
+            area += (edges[i + 1] - edges[i]) * sum(
+                max(0.0, min(b, e) - max(a, c)) for a, b in left for c, e in right)
+    return area
 
 
 def main():
@@ -73,6 +81,28 @@ def main():
     for strips in (16, 64, 256):
         region = loop.region("B", "K", uncertain=box, strips=strips, **values)
         print(f"  {strips:>4} strips  area {region.area:.6g}  marginal {region.marginal_area:.3g}")
+    b = loop.defaults["b"]
+    nominal = nominal_area(loop, values)
+    print(f"a box of zero width (b = {b:g}): the certified area against the nominal set's "
+          f"{nominal:.10g} (its stable intervals' lengths integrated by scipy's quad):")
+    for strips, rtol in ((16, 1e-6), (64, 1e-6), (256, 1e-6), (1024, 1e-7), (4096, 1e-7)):
+        times = timed_runs(lambda: loop.region("B", "K", uncertain={"b": (b, b)}, strips=strips,
+                                               rtol=rtol, **values), 1)
+        region = loop.region("B", "K", uncertain={"b": (b, b)}, strips=strips, rtol=rtol, **values)
+        print(f"  {strips:>4} strips, rtol {rtol:g}  {fmt(statistics.median(times)):>9}  area "
+              f"{region.area:.10g}, short by {(nominal - region.area) / nominal:.2e} of it")
+
+
+def nominal_area(loop, values):
+    """The nominal stable set's area: the line engine's stable intervals' lengths, integrated."""
+    from scipy.integrate import quad
+
+    x_range = loop.region("B", "K", **values).x_range
+
+    def length(B):
+        return sum(hi - lo for lo, hi in loop.stable_intervals("K", B=np.array([B]), **values)[0])
+
+    return quad(length, *x_range, limit=400, epsabs=1e-10, epsrel=1e-12)[0]
 
 
 if __name__ == "__main__":

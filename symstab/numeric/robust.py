@@ -16,37 +16,51 @@ number of roots outside the circle is the same everywhere on it, and by 1 it
 is 0.
 
 How zero exclusion is proved.  The plane is cut into vertical strips ``x``
-in ``[x0, x1]``; in each strip, intervals of ``y`` are certified.  Over a
-sub-box of ``Q`` the coefficients of ``chi = A0 + x Ax + y Ay`` are enclosed
-in intervals (:func:`symstab.symbolic.discretize.interval_zoh` for the
-plant, interval arithmetic on the environment's symbolic coefficients, all
-in powers of ``w = z - 1``, so that the integrator's pole ``z = 1`` is kept
-however wide the box).  Over an interval of ``theta`` each part is enclosed
-in a disk: its value and slope at the middle with the interval's midpoint
-coefficients, a bound of the second derivative times ``h**2 / 2``, the
-coefficients' radii, and a bound on the rounding.  On a cell (strip x
-``theta``-interval x sub-box) ``chi`` is then within ``a + b |y|`` of ``P +
-y Y``, and the ``y`` where it may vanish solve a quadratic inequality
-(:func:`_excluded`; its roots widened by 1e-7 of their size for their
-rounding): every other ``y`` of the strip is excluded on the cell.  Where
-those ``y`` meet the strip's open intervals, the search (branch and bound)
-marks what the strip's width costs at the cell's middle (no halving removes
-it) and halves the ``theta``-interval or the sub-box, whichever costs more,
-until what is left open is within ``rtol`` of the window's height, or
-``theta`` is 1e-12 wide, or the box has been halved :data:`BOX_DEPTH` times.
-What is marked is *marginal*: never counted stable.
+in ``[x0, x1]``; each strip holds *pieces*, trapezoids whose bottom and top
+run straight from an interval of ``y`` at ``x0`` to one at ``x1``; a point
+of a piece has a ``t`` in [0, 1] (0 on its bottom, 1 on its top), and
+intervals of ``t`` are certified.  Over a sub-box of ``Q`` the
+coefficients of ``chi = A0 + x Ax + y Ay`` are enclosed in intervals
+(:func:`symstab.symbolic.discretize.interval_zoh` for the plant, interval
+arithmetic on the environment's symbolic coefficients, all in powers of ``w
+= z - 1``, so that the integrator's pole ``z = 1`` is kept however wide the
+box).  Over an interval of ``theta`` each part is enclosed in a disk: its
+value and slope at the middle with the interval's midpoint coefficients, a
+bound of the second derivative times ``h**2 / 2``, the coefficients' radii,
+and a bound on the rounding.  On a cell (piece x ``theta``-interval x
+sub-box) the zeros of ``chi`` are enclosed twice (:func:`_excluded`):
 
-Where to look.  The intervals examined in a strip are the intersection, over
-a grid of values of the box (its corners, centre and midpoints) and both
-edges of the strip, of the stable intervals of ``y`` (the one line engine,
-:meth:`symstab.Loop.stable_intervals`): a point of a strip's edge outside
-them is unstable at one of those values; a point inside a strip outside
-them is not examined, so never claimed robust.  Inside them every point is
-certified or marginal.
+* in the strip: ``chi`` is within ``a + b |y|`` of ``P + y Y`` and the
+  ``y`` where it may vanish solve a quadratic inequality (:func:`_failing`),
+  the strip's width costing ``a`` first order in it;
+* in a *capsule* (:func:`_capsules`): the tangent segment of the curve
+  where ``chi = 0`` (a 2 x 2 real solve at the middle and its derivative),
+  widened by a radius second order in the ``theta``-width, where the map
+  ``(x, y) -> x Ax + y Ay`` is well conditioned (not next to ``theta`` = 0
+  or pi).
 
-The result is a union of rectangles (strip x interval): an inner
-approximation of the robust set whose area converges as the strips narrow
-(:class:`symstab.numeric.results.RobustRegion`).
+Their ``t`` on the piece, intersected, is where zero exclusion may fail on
+the cell.  Where it meets what is still open, the search (branch and bound)
+halves the ``theta``-interval or the sub-box, whichever costs more, until
+what halving could still remove is within ``rtol`` of the window's height,
+or ``theta`` is 1e-12 wide, or the box has been halved :data:`BOX_DEPTH`
+times; what is then left is *marked*, and what is marked is *marginal*:
+never counted stable.
+
+Where to look.  A strip's pieces join, in order, the intervals of ``y`` its
+two edges hold in common over a grid of values of the box (its corners,
+centre and midpoints) and every delay (the one line engine,
+:meth:`symstab.Loop.stable_intervals`): a point of an edge outside them is
+unstable at one of those values.  Where the edges hold different numbers
+of intervals (a corner, an end of the set) the strip is halved, down to
+``rtol`` of the window's width; a strip still uneven then looks only where
+its edges overlap.  A point inside a strip outside its pieces is not
+examined, so never claimed robust.
+
+The result is a union of trapezoids: an inner approximation of the robust
+set whose area converges as the square of the strips' width (the pieces'
+sides are chords of the boundary;
+:class:`symstab.numeric.results.RobustRegion`).
 """
 
 import dataclasses
@@ -799,7 +813,8 @@ def robust_region(loop, x, y, *, uncertain, strips=64, rtol=1e-6, x_range=None, 
         ``{name: (low, high)}``: the box of the plant's and environment's
         parameters (``T`` included), and ``d`` a range of whole delays.
     strips : int
-        Vertical strips across the window (1 to 100 000).
+        Vertical strips across the window (1 to 100 000); those where the
+        set has a corner or an end are halved (at most ``4 strips`` more).
     rtol : float
         Resolution of the certified intervals' ends, as a fraction of the
         window's height (1e-12 to 1e-2).
