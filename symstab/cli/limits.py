@@ -190,12 +190,14 @@ def _robust_figure(plt, setup, region):
             ring = np.vstack([cell.outer, cell.outer[:1]])
             ax.plot(ring[:, 0], ring[:, 1], color="0.2", lw=1.0,
                     label="stable at the box's centre" if k == 0 else None)
-    for which, color in ((region.marginal, "#f4a582"), (region.intervals, "#4393c3")):
-        for i, bands in enumerate(which):
-            x0, x1 = region.edges[i], region.edges[i + 1]
-            for lo0, hi0, lo1, hi1 in bands:
-                ax.add_patch(Polygon([(x0, lo0), (x1, lo1), (x1, hi1), (x0, hi0)], closed=True,
-                                     facecolor=color, edgecolor="none"))
+    for i, bands in enumerate(region.marginal):
+        x0, x1 = region.edges[i], region.edges[i + 1]
+        for lo0, hi0, lo1, hi1 in bands:
+            ax.add_patch(Polygon([(x0, lo0), (x1, lo1), (x1, hi1), (x0, hi0)], closed=True,
+                                 facecolor="#f4a582", edgecolor="none"))
+    # The robust set's outlines (runs of strips joined: no seams between them).
+    for outline in region.polygons:
+        ax.add_patch(Polygon(outline, closed=True, facecolor="#4393c3", edgecolor="none"))
     handles, _ = ax.get_legend_handles_labels()
     handles += [Patch(color="#4393c3", label="stable for every value of the box"),
                 Patch(color="#f4a582", label="marginal (not certified)")]
