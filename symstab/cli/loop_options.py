@@ -417,8 +417,9 @@ class LoopSetup:
         return out
 
 
-def range_text(text, flag):
-    """``(low, high, unit)`` of ``LO:HI`` with an optional unit after HI (``--over``, ``--uncertain``)."""
+def range_text(text, flag, *, point=False):
+    """``(low, high, unit)`` of ``LO:HI`` with an optional unit after HI (``--over``, ``--uncertain``;
+    ``point``: ``LO == HI`` allowed)."""
     from .._validate import check_real
 
     head, colon, tail = text.partition(":")
@@ -430,8 +431,8 @@ def range_text(text, flag):
     except (ValueError, TypeError):
         raise ValueError(f"{flag} must be LO:HI, two finite numbers (a unit may follow), "
                          f"got {text!r}") from None
-    if not low < high:
-        raise ValueError(f"{flag}: LO:HI must have LO < HI, got {text!r}")
+    if not (low <= high if point else low < high):
+        raise ValueError(f"{flag}: LO:HI must have LO {'<=' if point else '<'} HI, got {text!r}")
     if not math.isfinite(high - low):
         raise ValueError(f"{flag}: HI - LO must be finite (below 1.8e308), got {text!r}")
     return low, high, unit
@@ -667,8 +668,9 @@ def broadcast(values):
     return {n: (np.array(v, dtype=float) if isinstance(v, list) else v) for n, v in values.items()}
 
 
-def uncertain_box(args, setup):
-    """``{name: (low, high)}`` of the ``--uncertain`` options, in SI, checked against the file."""
+def uncertain_box(args, setup, *, point=False):
+    """``{name: (low, high)}`` of the ``--uncertain`` options, in SI, checked against the file
+    (``point``: a range of zero width allowed)."""
     from .._validate import check_delay
 
     loop = setup.loop
@@ -692,7 +694,7 @@ def uncertain_box(args, setup):
             raise ValueError(f"--uncertain {name}: {name} is an axis of the ({setup.x}, "
                              f"{setup.y}) plane; give another parameter (candidates: "
                              f"{', '.join(others)})")
-        low, high, unit = range_text(window, f"--uncertain {name}")
+        low, high, unit = range_text(window, f"--uncertain {name}", point=point)
         if name == "d":
             if unit is not None or low != int(low) or high != int(high):
                 raise ValueError(f"--uncertain d: the delay is a whole number of samples: give "

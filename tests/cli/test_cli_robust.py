@@ -46,8 +46,21 @@ def test_robust_limits_over_delays_and_the_empty_set(capsys):
     assert "the robust set is empty" in text and "no common point" in text
 
 
+def test_a_box_of_zero_width_is_the_nominal_set(capsys):
+    """``--uncertain b=LO:LO``: the nominal set (the line engine's), certified the robust way."""
+    status, text, err = run(capsys, "limits", "--loop", PAPER, "--set", "d=10", "--set", "M=0",
+                            "--uncertain", "b=0.0324:0.0324", "--strips", "64",
+                            "--format", "json")
+    assert status == 0, err
+    found = json.loads(text)
+    loop = symstab.load_loop(PAPER)
+    (lo, hi), = loop.stable_intervals("K", B=found["limits"]["x_at_y_max"], d=10, M=0.0)
+    assert found["limits"]["y_max"] == pytest.approx(hi, rel=1e-6)
+    assert found["limits"]["area"] == pytest.approx(found["robust"]["nominal_area"], rel=1e-3)
+
+
 @pytest.mark.parametrize("args, message", [
-    (("--uncertain", "b=0.05:0.01"), "LO < HI"),
+    (("--uncertain", "b=0.05:0.01"), "LO <= HI"),
     (("--uncertain", "K=1:2"), "axis"),
     (("--uncertain", "q=1:2"), "not a parameter"),
     (("--uncertain", "b=0.01:0.05", "--strips", "0"), "--strips"),
