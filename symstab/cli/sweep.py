@@ -433,7 +433,13 @@ def _grid(where, loop, x, y, table):
                                      f"{MAX_ROWS}")
                 spec = list(np.linspace(low, high, n))
                 if name == "d":
-                    spec = sorted({round(v) for v in spec})
+                    whole = [round(v) for v in spec]
+                    if any(abs(v - w) > 1e-9 for v, w in zip(spec, whole)):
+                        raise ValueError(
+                            f"{where}: [grid] d = {{from = {low}, to = {high}, points = {n}}} "
+                            f"gives delays that are not whole samples ({spec[1]:.6g}, ...): "
+                            f"choose points so that the step is whole, or list the delays")
+                    spec = whole
         if not isinstance(spec, list) or not spec:
             raise ValueError(f"{where}: [grid] {name} must be a non-empty list of values or "
                              f"{{from, to, points}}")

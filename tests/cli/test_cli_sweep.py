@@ -158,6 +158,7 @@ def test_without_dask_the_message_says_what_to_install(capsys, tmp_path, monkeyp
     ('[grid]\nK = [1, 2]\n', "K is an axis"),
     ('[grid]\nq = [1, 2]\n', "'q' is not a parameter"),
     ('[grid]\nd = [1.5]\n', "d counts whole samples"),
+    ('[grid]\nd = { from = 0, to = 10, points = 4 }\n', "not whole samples"),
     ('[grid]\nb = { values = [1], unit = "Hz" }\n', "Hz"),
     ('[grid]\nb = []\n', "non-empty list"),
     ('[grid]\nb = ["x"]\n', "must be numbers"),
