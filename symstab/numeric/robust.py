@@ -553,8 +553,16 @@ def _failing(P, Y, a, b):
     return pieces
 
 
+class _Columns:
+    """A dataclass of equally long arrays, one row per item."""
+
+    def take(self, keep):
+        """The rows ``keep`` (an index array or a mask)."""
+        return type(self)(*(getattr(self, f.name)[keep] for f in dataclasses.fields(self)))
+
+
 @dataclasses.dataclass
-class _Pieces:
+class _Pieces(_Columns):
     """Trapezoids of the plane: ``x`` in ``[x0, x1]``, ``y`` from ``lo`` to ``hi``, each straight
     from its value at ``x0`` (``lo0``, ``hi0``) to that at ``x1``; a point's ``t`` is where it
     lies between them (0 on ``lo``, 1 on ``hi``)."""
@@ -565,9 +573,6 @@ class _Pieces:
     hi0: np.ndarray
     lo1: np.ndarray
     hi1: np.ndarray
-
-    def take(self, keep):
-        return _Pieces(*(getattr(self, f.name)[keep] for f in dataclasses.fields(self)))
 
     def _slope(self, a, b):
         width = self.x1 - self.x0
@@ -610,14 +615,13 @@ class _Pieces:
 
 
 @dataclasses.dataclass
-class _Cells:
+class _Cells(_Columns):
+    """Cells of the search: a piece (``strip``: its index), a theta-interval, a sub-box."""
+
     strip: np.ndarray
     t0: np.ndarray
     t1: np.ndarray
     box: np.ndarray
-
-    def take(self, keep):
-        return _Cells(*(getattr(self, f.name)[keep] for f in dataclasses.fields(self)))
 
     @staticmethod
     def join(parts):
