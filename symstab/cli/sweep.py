@@ -464,6 +464,8 @@ def _random(where, loop, x, y, table):
               for name, low, high in _ranges(where, "[random]", loop, x, y, named, strict=True)}
     if not ranges:
         return [], np.empty((0, 0)), ""
+    # The declared ranges' corners, not only the draws, within the loop's bounds and domain.
+    check_corners(loop, loop.defaults, x, y, ranges, f"{where}: [random]")
     from ..numeric.probability import draw_values
 
     # The draws of the probability map's: one seeded generator, whole delays for d.
