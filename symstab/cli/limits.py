@@ -130,13 +130,26 @@ def _robust(args, setup, at):
     values = {k: v for k, v in setup.values.items() if k not in box}
     delays = box["d"][1] - box["d"][0] + 1 if "d" in box else 1
     # Seconds to minutes: a plant of higher order, a box of several
-    # parameters and many strips or delays cost more (README): say what runs.
-    print(f"certifying the ({setup.name(setup.x)}, {setup.name(setup.y)}) plane for every "
-          f"value of the box ({strips} strips, {delays} delay(s), "
-          f"{len([k for k in box if k != 'd'])} continuous parameter(s)) ...",
-          file=sys.stderr, flush=True)
-    lim = setup.loop.limits(x=setup.x, y=setup.y, uncertain=box, strips=strips,
-                            progress=progress_printer("delays", delays), **values)
+    # parameters and many strips or delays cost more (README): say what runs,
+    # once the library has accepted the box (a refusal stays one line).
+    bar = progress_printer("delays", delays)
+
+    def progress(done):
+        if done == 0:
+            print(f"certifying the ({setup.name(setup.x)}, {setup.name(setup.y)}) plane for "
+                  f"every value of the box ({strips} strips, {delays} delay(s), "
+                  f"{len([k for k in box if k != 'd'])} continuous parameter(s)) ...",
+                  file=sys.stderr, flush=True)
+        bar(done)
+
+    try:
+        lim = setup.loop.limits(x=setup.x, y=setup.y, uncertain=box, strips=strips,
+                                progress=progress, **values)
+    except ValueError as exc:
+        # The library names its argument; here it came from the option.
+        if str(exc).startswith("uncertain: "):
+            raise ValueError(f"--{exc}") from None
+        raise
     region = lim.region
     columns, rows = limits_table(setup, lim)
     x, y = setup.name(setup.x), setup.name(setup.y)

@@ -830,7 +830,8 @@ def robust_region(loop, x, y, *, uncertain, strips=64, rtol=1e-6, x_range=None, 
         Most cells examined (:data:`MAX_CELLS`); beyond, marginal (and
         :attr:`~symstab.numeric.results.RobustRegion.exhausted` says so).
     progress : callable, optional
-        Called with the number of delays done.
+        Called with the number of delays done: 0 once the input is checked
+        and the work begins, then after each delay.
     **values
         Values of the other parameters.
 
@@ -916,6 +917,8 @@ def robust_region(loop, x, y, *, uncertain, strips=64, rtol=1e-6, x_range=None, 
     tol = np.full(len(owner), rtol * (y_hi - y_lo) / 4) / np.maximum(geometry.height, 1e-300)
     marked = {p: [] for p in range(len(owner))}
     examined, exhausted = 0, False
+    if progress is not None:
+        progress(0)
     for d in delays:
         shift = d + loop._delay_of_environment
         found, n, out = _certify(enclosures, shift, geometry,

@@ -70,6 +70,8 @@ def test_a_box_of_zero_width_is_the_nominal_set(capsys):
     (("--uncertain", "d=1.5:3"), "whole number"),
     (("--set", "b=0.03", "--uncertain", "b=0.01:0.05"), "also given by --set"),
     (("--set", "d=10", "--uncertain", "d=8:12"), "also given by --set"),
+    # Refused by the library, before any work: still one line, naming the option.
+    (("--uncertain", "b=1e308:1.7e308", "--png", "x.png"), "--uncertain: b in [1e+308"),
 ])
 def test_bad_options_are_one_line(capsys, tmp_path, args, message):
     args = [a.replace("x.png", str(tmp_path / "x.png")) for a in args]
