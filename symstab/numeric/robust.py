@@ -367,18 +367,15 @@ def _excluded(enclosures, shift, theta, h, box, piece):
     strip = [piece.to_t(lo, hi) for lo, hi in strip_y]
     y_lo = np.minimum(piece.lo0, piece.lo1)
     y_hi = np.maximum(piece.hi0, piece.hi1)
-
-    def width(pairs):
-        return sum(np.maximum(np.minimum(hi, y_hi) - np.maximum(lo, y_lo), 0.0) for lo, hi in pairs)
-
+    height = piece.height
     with np.errstate(invalid="ignore", over="ignore"):
-        reducible = np.nan_to_num((width(strip_y) - width(fixed_y)) / piece.height, nan=np.inf)
+        reducible = np.nan_to_num((_covered(strip_y, y_lo, y_hi) - _covered(fixed_y, y_lo, y_hi))
+                                  / height, nan=np.inf)
     # The costs where they are largest on the part of the piece that matters.
     far = np.zeros(len(P))
     for lo, hi in strip_y:
         lo, hi = np.maximum(lo, y_lo), np.minimum(hi, y_hi)
         far = np.where(lo <= hi, np.maximum(far, np.maximum(np.abs(lo), np.abs(hi))), far)
-    height = piece.height
     theta_cost = (theta_a + far * theta_b) / height
     box_cost = (box_a + far * box_b) / height
 
@@ -386,14 +383,19 @@ def _excluded(enclosures, shift, theta, h, box, piece):
         value, slope, second, coefficient, rounding, slope_rounding, h, piece)
     # The capsule leads where it is the narrower on the piece (next to theta
     # = 0 or pi, where it fattens as 1 / sigma, the strip's may be).
-    spread = sum(np.maximum(np.minimum(hi, 1.0) - np.maximum(lo, 0.0), 0.0) for lo, hi in strip)
-    lead = valid & (np.maximum(np.minimum(t_hi, 1.0) - np.maximum(t_lo, 0.0), 0.0) <= spread)
+    lead = valid & (_covered([(t_lo, t_hi)], 0.0, 1.0) <= _covered(strip, 0.0, 1.0))
     pieces = [(np.where(valid, np.maximum(lo, t_lo), lo), np.where(valid, np.minimum(hi, t_hi), hi))
               for lo, hi in strip]
     theta_cost = np.where(lead, rho_theta, theta_cost)
     box_cost = np.where(lead, rho_box, box_cost)
     reducible = np.where(lead, rho_theta + rho_box, reducible)
     return pieces, theta_cost, box_cost, reducible
+
+
+def _covered(pairs, lo, hi):
+    """Per cell, how much of ``[lo, hi]`` the intervals ``pairs`` cover (their overlaps counted
+    again)."""
+    return sum(np.maximum(np.minimum(b, hi) - np.maximum(a, lo), 0.0) for a, b in pairs)
 
 
 def _capsules(value, slope, second, coefficient, rounding, slope_rounding, h, piece):
