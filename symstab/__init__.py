@@ -32,30 +32,43 @@ on first use), on the same root engine (:mod:`~symstab.numeric.roots`) as the
 dimensionless functions above.
 """
 
-from .symbolic.boundary import boundary, coefficients
-from .symbolic.discretize import dimensionless_pulse_transfer_function, pulse_transfer_function
-from .proof.identity import IdentityResult, assert_identity, check_identity
-from .symbolic.small_theta import small_theta_limits
-from .symbolic.loop import characteristic_polynomial
-from .symbolic.model import dimensionless_values
-from .symbolic.theta_max import closed_form_d0, newton_form_gamma0, theta_max, theta_max_newton
-from .symbolic.unit_circle import unit_circle_split
-from .numeric.units import PAPER_DEVICE, Device
-from .numeric.curves import BoundaryCurve, arc_end_angle
-from .numeric.region import boundary_curve
-from .numeric.stability import MARGINAL, STABLE, UNSTABLE, classify, is_stable, spectral_radius
-from .numeric.region import BestVirtualMass, StabilityRegion, best_virtual_mass, limits
-from .numeric.results import Limits, RobustRegion, StabilityProbability
-from .numeric.any_loop import Loop, LoopBoundary, LoopLimits
-from .numeric.loop_files import load_loop
-from .numeric.decomposition import Branch, Cell, Decomposition
-from .numeric.passivity import PassiveRegion, passive_region
-from .numeric.paper_loop import paper_passive_region
-from .numeric.locus import Crossing, Locus, locus
-from .numeric.paper_loop import paper_locus
-from .numeric.simulate import Nonidealities, Simulation, StabilityMap, simulate, stability_map
-from .numeric.theta_bounds import (ThetaMaxEnclosure, certify_theta_max, theta_max_approx,
-                                   theta_max_enclosure)
+import importlib
+
+#: Where each public name lives (module below ``symstab``).  Imported on first
+#: use (PEP 562), so that ``import symstab`` -- and the command line, which
+#: must handle Ctrl-C before SymPy and NumPy load -- costs nothing up front.
+_HOMES = {
+    "symbolic.boundary": ("boundary", "coefficients"),
+    "symbolic.discretize": ("dimensionless_pulse_transfer_function", "pulse_transfer_function"),
+    "proof.identity": ("IdentityResult", "assert_identity", "check_identity"),
+    "symbolic.small_theta": ("small_theta_limits",),
+    "symbolic.loop": ("characteristic_polynomial",),
+    "symbolic.model": ("dimensionless_values",),
+    "symbolic.theta_max": ("closed_form_d0", "newton_form_gamma0", "theta_max", "theta_max_newton"),
+    "symbolic.unit_circle": ("unit_circle_split",),
+    "numeric.units": ("PAPER_DEVICE", "Device"),
+    "numeric.curves": ("BoundaryCurve", "arc_end_angle"),
+    "numeric.stability": ("MARGINAL", "STABLE", "UNSTABLE", "classify", "is_stable",
+                          "spectral_radius"),
+    "numeric.region": ("boundary_curve", "BestVirtualMass", "StabilityRegion", "best_virtual_mass",
+                       "limits"),
+    "numeric.results": ("Limits", "RobustRegion", "StabilityProbability"),
+    "numeric.any_loop": ("Loop", "LoopBoundary", "LoopLimits"),
+    "numeric.loop_files": ("load_loop",),
+    "numeric.decomposition": ("Branch", "Cell", "Decomposition"),
+    "numeric.passivity": ("PassiveRegion", "passive_region"),
+    "numeric.paper_loop": ("paper_passive_region", "paper_locus"),
+    "numeric.locus": ("Crossing", "Locus", "locus"),
+    "numeric.simulate": ("Nonidealities", "Simulation", "StabilityMap", "simulate",
+                         "stability_map"),
+    "numeric.theta_bounds": ("ThetaMaxEnclosure", "certify_theta_max", "theta_max_approx",
+                             "theta_max_enclosure"),
+}
+_HOME_OF = {name: module for module, names in _HOMES.items() for name in names}
+
+#: The sub-packages and modules, importable as attributes (``symstab.numeric``).
+_SUBMODULES = ("symbolic", "codegen", "proof", "numeric", "cli", "drawing", "figures",
+               "reproduce")
 
 __all__ = [
     "boundary", "coefficients",
@@ -81,9 +94,24 @@ __all__ = [
 
 
 def __getattr__(name):
-    # PAPER_LOOP is derived on first use, not on import (about a second).
     if name == "PAPER_LOOP":
+        # Derived on first use, and again each time it is asked for (cached
+        # by paper_loop()): about a second the first time.
         from .numeric.paper_loop import paper_loop
 
         return paper_loop()
+    if name in _HOME_OF:
+        value = getattr(importlib.import_module(f"{__name__}.{_HOME_OF[name]}"), name)
+        globals()[name] = value
+        return value
+    if name in _SUBMODULES:
+        # As before the names were lazy: ``symstab.numeric.stability`` after
+        # ``import symstab`` finds every module the public names come from.
+        for module in _HOMES:
+            importlib.import_module(f"{__name__}.{module}")
+        return importlib.import_module(f"{__name__}.{name}")
     raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+
+
+def __dir__():
+    return sorted(set(globals()) | set(__all__))

@@ -21,15 +21,13 @@ and exit with status 130 and 143 (128 + the signal number).
 """
 
 import concurrent.futures
-import contextlib
 import os
 import pathlib
-import signal
 import sys
 import tempfile
-import threading
 import time
 
+from ._signals import Terminated, deferred, exit_status, raising
 from ._workers import check_workers, default_workers, worker_pool
 
 __all__ = ["reproduce", "render_index", "worker_pool", "default_workers"]
@@ -109,57 +107,6 @@ def render_index(results, verdicts, drift, where):
     return "\n".join(lines) + "\n"
 
 
-class _Interrupted(BaseException):
-    """SIGINT or SIGTERM, raised in the main thread so that the cleanup runs.
-
-    A BaseException, like KeyboardInterrupt, so that no ``except Exception``
-    on the way swallows it.
-    """
-
-    def __init__(self, signum):
-        super().__init__(signum)
-        self.signum = signum
-
-
-def _on_signal(signum, frame):
-    # One signal is enough: a second one must not cut the cleanup short.
-    signal.signal(signal.SIGINT, signal.SIG_IGN)
-    signal.signal(signal.SIGTERM, signal.SIG_IGN)
-    raise _Interrupted(signum)
-
-
-@contextlib.contextmanager
-def _signals_raise():
-    """SIGINT and SIGTERM raise :class:`_Interrupted` in this block.
-
-    Only in the main thread (elsewhere Python does not allow handlers, and
-    the block runs with the signals as they are).
-    """
-    if threading.current_thread() is not threading.main_thread():
-        yield
-        return
-    previous = {sig: signal.signal(sig, _on_signal) for sig in (signal.SIGINT, signal.SIGTERM)}
-    try:
-        yield
-    finally:
-        for sig, handler in previous.items():
-            signal.signal(sig, handler)
-
-
-@contextlib.contextmanager
-def _signals_deferred():
-    """Hold SIGINT and SIGTERM back until the block is done (it must not be cut in two)."""
-    if threading.current_thread() is not threading.main_thread():
-        yield
-        return
-    held = {signal.SIGINT, signal.SIGTERM}
-    signal.pthread_sigmask(signal.SIG_BLOCK, held)
-    try:
-        yield
-    finally:
-        signal.pthread_sigmask(signal.SIG_UNBLOCK, held)
-
-
 def reproduce(out_dir, *, workers=2, log=None):
     """Run every stage into ``out_dir``; return ``(index path, drifted files)``.
 
@@ -189,18 +136,18 @@ def reproduce(out_dir, *, workers=2, log=None):
     parent = out.resolve().parent
     parent.mkdir(parents=True, exist_ok=True)
     try:
-        with _signals_raise(), \
+        with raising(), \
                 tempfile.TemporaryDirectory(dir=parent, prefix=f".{out.name}.") as tmp:
             index, drift = _run(pathlib.Path(tmp), workers, log)
-            with _signals_deferred():
+            with deferred():
                 for path in sorted(pathlib.Path(tmp).rglob("*")):
                     if path.is_file():
                         target = out / path.relative_to(tmp)
                         target.parent.mkdir(parents=True, exist_ok=True)
                         os.replace(path, target)
-    except _Interrupted as stop:
+    except (KeyboardInterrupt, Terminated) as stop:
         print("symstab reproduce: interrupted", file=sys.stderr, flush=True)
-        raise SystemExit(128 + stop.signum) from None
+        raise SystemExit(exit_status(stop)) from None
     log(f"reproduced into {out}: index.md, REPORT.md, figures/")
     return out / index.name, drift
 

@@ -1,7 +1,7 @@
 """The package is laid out by layer, and no layer imports a layer above it.
 
 From the bottom: the private base (``_project``, ``_resources``,
-``_validate``, ``_generated``), ``symbolic`` (the derivation in SymPy),
+``_signals``, ``_validate``, ``_workers``, ``_generated``), ``symbolic`` (the derivation in SymPy),
 ``codegen`` (float-safe forms, printers, generated kernels), ``proof``
 (the identity checker, every proof obligation, the derivation files),
 ``numeric`` (the numeric API on the kernels), and the front ends (``cli``,
@@ -26,7 +26,7 @@ PACKAGE = pathlib.Path(symstab.__file__).resolve().parent
 
 #: Rank of each layer; a module may import its own rank or lower.
 RANK = {"base": 0, "symbolic": 1, "codegen": 2, "proof": 3, "numeric": 4, "front": 5}
-_BASE = {"_project", "_resources", "_validate", "_workers", "_generated"}
+_BASE = {"_project", "_resources", "_signals", "_validate", "_workers", "_generated"}
 _FRONT = {"cli", "drawing", "figures", "reproduce", "__main__"}
 
 
@@ -343,14 +343,16 @@ def test_no_private_name_is_imported_across_modules():
 def test_the_cli_is_one_module_per_command_over_shared_modules():
     """Each command is a module with ``register`` and ``run``; none imports another command.
 
-    ``symstab.cli.commands`` builds the parser from :data:`~symstab.cli.commands.COMMANDS`;
-    what two commands share lives in a shared module of ``symstab/cli/``.
+    ``symstab.cli.commands`` builds the parser from
+    :func:`~symstab.cli.commands.command_modules`; what two commands share
+    lives in a shared module of ``symstab/cli/``.
     """
     from symstab.cli import commands
 
-    names = {module.__name__ for module in commands.COMMANDS}
-    assert len(names) == len(commands.COMMANDS)
-    for module in commands.COMMANDS:
+    modules = commands.command_modules()
+    names = {module.__name__ for module in modules}
+    assert len(names) == len(modules) == len(commands.COMMAND_NAMES)
+    for module in modules:
         assert callable(module.register) and callable(module.run), module.__name__
     parser_commands = set(commands.build_parser()._subparsers._group_actions[0].choices)
     assert parser_commands == {name.rpartition(".")[2] for name in names}

@@ -17,21 +17,30 @@ interrupted run leaves none behind.
 """
 
 import argparse
+import importlib
 import importlib.metadata
-import signal
 import sys
 import warnings
 
 from .._project import project_root
-from . import (audit, boundary, classify, derive, design, figures, limits, locus, reproduce,
-               simulate, sweep)
-from . import map as map_command
+from .._signals import Terminated, exit_status, raising
 
-__all__ = ["main", "build_parser", "package_version", "project_root", "COMMANDS"]
+__all__ = ["main", "build_parser", "package_version", "project_root", "COMMAND_NAMES",
+           "command_modules"]
 
-#: The command modules, in the order of ``symstab --help``.
-COMMANDS = (derive, audit, figures, reproduce, boundary, limits, classify, design, simulate,
-            map_command, locus, sweep)
+#: The commands, in the order of ``symstab --help``; each is the module of
+#: this package of the same name.
+COMMAND_NAMES = ("derive", "audit", "figures", "reproduce", "boundary", "limits", "classify",
+                 "design", "simulate", "map", "locus", "sweep")
+
+
+def command_modules():
+    """The command modules, in the order of :data:`COMMAND_NAMES` (imported on first use).
+
+    Not at import time: :func:`main` handles Ctrl-C and SIGTERM before the
+    command modules bring in SymPy and NumPy.
+    """
+    return tuple(importlib.import_module(f"{__package__}.{name}") for name in COMMAND_NAMES)
 
 
 def package_version():
@@ -75,26 +84,9 @@ def build_parser():
     # would print one line naming no command).
     sub = parser.add_subparsers(dest="command", metavar="command", title="commands",
                                 parser_class=_Parser)
-    for command in COMMANDS:
+    for command in command_modules():
         command.register(sub)
     return parser
-
-
-class _Terminated(BaseException):
-    """SIGTERM, raised in the main thread so that cleanup (temporary files) runs.
-
-    A BaseException, like KeyboardInterrupt, so that no ``except Exception``
-    on the way swallows it.
-    """
-
-
-def _raise_terminated(signum, frame):
-    raise _Terminated
-
-
-#: Exit statuses of a command stopped by a signal (128 + the signal number).
-EXIT_SIGINT = 128 + signal.SIGINT
-EXIT_SIGTERM = 128 + signal.SIGTERM
 
 
 def _one_line(exc):
@@ -116,8 +108,27 @@ def main(argv=None):
 
     0 on success; 1 when a check finds drift or a failure; 2 on bad input
     (one line on stderr); 130 on Ctrl-C and 143 on SIGTERM (one line
-    ``symstab <command>: interrupted``).
+    ``symstab <command>: interrupted``), wherever the signal lands, the
+    first imports included.
     """
+    argv = sys.argv[1:] if argv is None else list(argv)
+    try:
+        with raising():
+            return _main(argv)
+    except (KeyboardInterrupt, Terminated) as exc:
+        # On a terminal a progress bar may hold the line: start a new one.
+        print(f"{chr(10) if sys.stderr.isatty() else ''}{_prog(argv)}: interrupted",
+              file=sys.stderr)
+        return exit_status(exc)
+
+
+def _prog(argv):
+    """``symstab <command>`` as far as ``argv`` names one (the parser may not have run yet)."""
+    command = next((word for word in argv if word in COMMAND_NAMES), None)
+    return "symstab" if command is None else f"symstab {command}"
+
+
+def _main(argv):
     parser = build_parser()
     try:
         args, extra = parser.parse_known_args(argv)
@@ -136,13 +147,6 @@ def main(argv=None):
     if extra:  # argparse would blame "symstab", not the command
         print(f"{prog}: error: unrecognized arguments: {' '.join(extra)}", file=sys.stderr)
         return 2
-    # `symstab reproduce` stops its worker processes on SIGTERM itself.
-    previous = None
-    if args.command != "reproduce":
-        try:
-            previous = signal.signal(signal.SIGTERM, _raise_terminated)
-        except ValueError:  # not the main thread: leave signals alone
-            previous = None
     try:
         with warnings.catch_warnings():
             # NumPy's floating-point RuntimeWarnings (overflow in an
@@ -151,16 +155,9 @@ def main(argv=None):
             # raises an error naming the parameter.
             warnings.simplefilter("ignore", RuntimeWarning)
             return args.func(args)
-    except (KeyboardInterrupt, _Terminated) as exc:
-        # On a terminal a progress bar may hold the line: start a new one.
-        print(f"{chr(10) if sys.stderr.isatty() else ''}{prog}: interrupted", file=sys.stderr)
-        return EXIT_SIGINT if isinstance(exc, KeyboardInterrupt) else EXIT_SIGTERM
     except (ValueError, TypeError, ArithmeticError, MemoryError, OSError) as exc:
         print(f"{prog}: error: {_one_line(exc)}", file=sys.stderr)
         return 2
-    finally:
-        if previous is not None:
-            signal.signal(signal.SIGTERM, previous)
 
 
 if __name__ == "__main__":  # pragma: no cover

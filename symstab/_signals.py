@@ -1,0 +1,169 @@
+"""Ctrl-C and SIGTERM that stop the program wherever they land.
+
+Python runs a signal handler between two bytecodes of the main thread,
+wherever that is: inside importlib's module-lock callback, a ``__del__`` or
+a weakref callback.  An exception raised there is printed as "Exception
+ignored in ..." and dropped, and the program runs on (a ``symstab map``
+stopped by SIGTERM during an import ran to its end).  Python's own
+KeyboardInterrupt has the same hole.
+
+:func:`raising` closes it.  In its block SIGINT raises KeyboardInterrupt and
+SIGTERM raises :class:`Terminated`.  When Python swallows that exception (it
+reports it to :data:`sys.unraisablehook`, which the block watches), the
+signal is delivered to the main thread again :data:`REDELIVER_SECONDS`
+later, from a short-lived timer thread; a block that ends before then ends
+with the exception.  An interruption a caller catches and handles itself is
+not repeated.  A second signal while the first one's exception is handled
+or cleaned up after (``except`` and ``finally`` blocks on its way) does
+nothing, so a cleanup is never cut short by a second Ctrl-C.
+
+Light on purpose (the standard library only): the command line enters
+:func:`raising` before it imports SymPy and NumPy, so that a signal in the
+first second is handled like one in the tenth.
+"""
+
+import contextlib
+import functools
+import signal
+import sys
+import threading
+
+__all__ = ["Terminated", "raising", "deferred", "exit_status", "REDELIVER_SECONDS"]
+
+#: How often an interruption is delivered again until it has left the block.
+REDELIVER_SECONDS = 0.1
+
+_SIGNALS = (signal.SIGINT, signal.SIGTERM)
+
+
+class Terminated(BaseException):
+    """SIGTERM, raised in the main thread so that cleanup (temporary files) runs.
+
+    A BaseException, like KeyboardInterrupt, so that no ``except Exception``
+    on the way swallows it.
+    """
+
+
+def exit_status(exc):
+    """The exit status of a program stopped by ``exc``: 128 + the signal's number."""
+    return 128 + (signal.SIGTERM if isinstance(exc, Terminated) else signal.SIGINT)
+
+
+class _State:
+    """What the handlers share while a :func:`raising` block runs."""
+
+    def __init__(self):
+        self.depth = 0
+        self.pending = None   # a signal whose exception Python swallowed, until delivered again
+        # Re-entrant: a handler or the hook may run in the main thread while it holds it.
+        self.lock = threading.RLock()
+
+
+_state = _State()
+
+
+def _on_its_way():
+    """True when the exception of an interruption is being handled or cleaned up after."""
+    exc = sys.exc_info()[1]
+    while exc is not None:
+        if isinstance(exc, (KeyboardInterrupt, Terminated)):
+            return True
+        exc = exc.__context__
+    return False
+
+
+def _exception(signum):
+    return Terminated() if signum == signal.SIGTERM else KeyboardInterrupt()
+
+
+def _handler(signum, frame):
+    # A second signal while the first one's exception is handled (its
+    # cleanup runs) must not cut that cleanup short.
+    if _on_its_way():
+        return
+    with _state.lock:
+        _state.pending = None
+    raise _exception(signum)
+
+
+def _unraisable(args, *, previous):
+    """Python swallowed an exception: if it was an interruption's, deliver the signal again."""
+    if not isinstance(args.exc_value, (KeyboardInterrupt, Terminated)):
+        previous(args)
+        return
+    signum = signal.SIGTERM if isinstance(args.exc_value, Terminated) else signal.SIGINT
+    with _state.lock:
+        _state.pending = signum
+    # Not from here: the hook runs inside the callback that swallowed the
+    # exception, and would swallow the next one too.
+    threading.Timer(REDELIVER_SECONDS, _redeliver, args=(threading.main_thread().ident,)).start()
+
+
+def _redeliver(main):
+    with _state.lock:
+        if _state.pending is not None:
+            signal.pthread_kill(main, _state.pending)
+
+
+@contextlib.contextmanager
+def raising():
+    """In this block SIGINT raises KeyboardInterrupt and SIGTERM :class:`Terminated`.
+
+    Wherever the signal lands, the exception reaches the block's end: a
+    delivery swallowed by Python (a handler that fired inside an import's
+    lock callback, a ``__del__``, a weakref callback) is repeated.  Blocks
+    nest (an inner one does nothing).  Outside the main thread, where Python
+    allows no handler, the block runs with the signals as they are.
+
+    Yields
+    ------
+    None
+
+    Examples
+    --------
+    >>> from symstab._signals import Terminated, exit_status, raising
+    >>> try:
+    ...     with raising():
+    ...         raise Terminated
+    ... except Terminated as exc:
+    ...     status = exit_status(exc)
+    >>> status
+    143
+    """
+    if threading.current_thread() is not threading.main_thread() or _state.depth:
+        yield
+        return
+    previous = {sig: signal.signal(sig, _handler) for sig in _SIGNALS}
+    previous_hook = sys.unraisablehook
+    sys.unraisablehook = functools.partial(_unraisable, previous=previous_hook)
+    _state.depth += 1
+    try:
+        yield
+        with _state.lock:
+            swallowed, _state.pending = _state.pending, None
+        if swallowed is not None:  # the block ended before the signal was delivered again
+            raise _exception(swallowed)
+    finally:
+        with _state.lock:
+            _state.pending = None   # a re-delivery still to come does nothing
+        _state.depth -= 1
+        sys.unraisablehook = previous_hook
+        for sig, handler in previous.items():
+            signal.signal(sig, handler)
+
+
+@contextlib.contextmanager
+def deferred():
+    """Hold SIGINT and SIGTERM back until the block is done (it must not be cut in two).
+
+    Only in the main thread; elsewhere the block runs with the signals as they are.
+    """
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    held = set(_SIGNALS)
+    signal.pthread_sigmask(signal.SIG_BLOCK, held)
+    try:
+        yield
+    finally:
+        signal.pthread_sigmask(signal.SIG_UNBLOCK, held)

@@ -1,0 +1,107 @@
+"""``symstab._signals``: an interruption reaches the end of its block wherever it lands.
+
+CI saw a SIGTERM raised inside importlib's module-lock callback: Python
+printed "Exception ignored in: <function _get_module_lock.<locals>.cb>",
+dropped the exception, and the command ran on.  The weakref callback below
+is the same trap, made deterministic.
+"""
+
+import gc
+import signal
+import time
+import weakref
+
+import pytest
+
+from symstab._signals import Terminated, deferred, exit_status, raising
+
+
+class _Object:
+    pass
+
+
+def _signal_inside_a_weakref_callback(signum):
+    """Deliver ``signum`` while Python runs a weakref callback (it swallows what that raises)."""
+    def callback(ref):
+        signal.raise_signal(signum)
+        for _ in range(10_000):   # bytecodes: the handler runs here, inside the callback
+            pass
+
+    obj = _Object()
+    ref = weakref.ref(obj, callback)
+    del obj
+    gc.collect()
+    return ref
+
+
+@pytest.mark.parametrize("signum, exc_type", [(signal.SIGTERM, Terminated),
+                                              (signal.SIGINT, KeyboardInterrupt)])
+def test_a_signal_swallowed_in_a_callback_is_delivered_again(capsys, signum, exc_type):
+    ran_on = False
+    with pytest.raises(exc_type):
+        with raising():
+            _signal_inside_a_weakref_callback(signum)
+            # Before: the exception was dropped and this sleep ran to its end.
+            time.sleep(30)
+            ran_on = True
+    assert not ran_on
+    # The swallowed delivery is not reported as "Exception ignored in ...".
+    assert capsys.readouterr().err == ""
+
+
+def test_a_swallowed_signal_ends_a_block_that_finishes_before_the_delivery(capsys):
+    with pytest.raises(Terminated):
+        with raising():
+            _signal_inside_a_weakref_callback(signal.SIGTERM)
+    assert capsys.readouterr().err == ""
+
+
+def test_an_interruption_the_caller_handles_is_not_delivered_again():
+    handled = False
+    with raising():
+        try:
+            signal.raise_signal(signal.SIGTERM)
+            time.sleep(30)
+        except Terminated:
+            handled = True
+        time.sleep(0.3)   # three re-delivery periods: nothing comes
+    assert handled
+
+
+def test_a_second_signal_does_not_cut_the_cleanup_short():
+    cleaned = False
+    with pytest.raises(KeyboardInterrupt):
+        with raising():
+            try:
+                signal.raise_signal(signal.SIGINT)
+                time.sleep(30)
+            finally:
+                signal.raise_signal(signal.SIGINT)   # pressed again during the cleanup
+                for _ in range(10_000):
+                    pass
+                cleaned = True
+    assert cleaned
+
+
+def test_the_handlers_are_restored_after_the_block():
+    before = signal.getsignal(signal.SIGINT), signal.getsignal(signal.SIGTERM)
+    with raising():
+        assert signal.getsignal(signal.SIGTERM) is not before[1]
+    assert (signal.getsignal(signal.SIGINT), signal.getsignal(signal.SIGTERM)) == before
+
+
+def test_deferred_holds_a_signal_until_the_block_is_done():
+    finished = False
+    with pytest.raises(Terminated):
+        with raising():
+            with deferred():
+                signal.raise_signal(signal.SIGTERM)
+                for _ in range(10_000):
+                    pass
+                finished = True
+    assert finished
+
+
+def test_exit_statuses_are_128_plus_the_signal():
+    assert exit_status(KeyboardInterrupt()) == 128 + signal.SIGINT == 130
+    assert exit_status(Terminated()) == 128 + signal.SIGTERM == 143
