@@ -88,6 +88,11 @@ def shift_to_one(coefficients, dtype=None):
     return p
 
 
+def _defined(p_n, p_d):
+    """True when a pulse transfer function's coefficients are finite with a leading ``P_d`` not 0."""
+    return p_d[0] != 0 and all(mpmath.isfinite(c) for c in (*p_n, *p_d))
+
+
 def _fraction(value):
     """An mpmath number that is real up to rounding, as the exact Fraction of its binary value."""
     if isinstance(value, mpmath.mpc):
@@ -937,23 +942,32 @@ class LoopModel:
         digits = PLANT_DIGITS
         with mpmath.workdps(PLANT_DIGITS):
             point = [mpmath.mpf(float(v)) for v in plant_values]
-            if self._plant_parts is None:
-                sub = {self._symbols[n]: sp.Float(float(v), PLANT_DIGITS)
-                       for n, v in zip(self._plant_names, plant_values)}
-                num, den = sp.fraction(sp.together(self.plant.subs(sub)))
-                num = [mpmath.mpf(sp.Float(c, PLANT_DIGITS)) for c in sp.Poly(num, model.s).all_coeffs()]
-                den = [mpmath.mpf(sp.Float(c, PLANT_DIGITS)) for c in sp.Poly(den, model.s).all_coeffs()]
-                p_n, p_d = numeric_zoh(num, den, mpmath.mpf(float(T)), dps=PLANT_DIGITS)
-            else:
+            if self._plant_parts is not None:
                 p_n, p_d, digits = self._closed_form_plant(point, mpmath.mpf(float(T)))
+            if self._plant_parts is None or not _defined(p_n, p_d):
+                # No closed form, or one that divides by a parameter at 0
+                # (b = 0 in 1/(m s**2 + b s)): the realisation is its limit.
+                digits = PLANT_DIGITS
+                p_n, p_d = self._realised_plant(plant_values, T)
         with mpmath.workdps(digits):
-            lead = p_d[0]
-            if lead == 0 or not all(mpmath.isfinite(c) for c in p_n + p_d):
+            if not _defined(p_n, p_d):
                 given = ", ".join(f"{n} = {float(v):g}" for n, v in zip(self._plant_names, plant_values))
                 raise ValueError(f"the plant's pulse transfer function is not defined at "
-                                 f"{given}, T = {float(T):g} (a pole cancels a parameter, "
-                                 f"e.g. b = 0 in 1/(m s**2 + b s)? write that plant with b = 0)")
+                                 f"{given}, T = {float(T):g} (its leading coefficient in s "
+                                 f"vanishes there, or a value is not finite)")
         return p_n, p_d, digits
+
+    def _realised_plant(self, plant_values, T):
+        """P_n, P_d of the plant at ``plant_values`` by :func:`numeric_zoh` (its realisation)."""
+        with mpmath.workdps(PLANT_DIGITS):
+            sub = {self._symbols[n]: sp.Float(float(v), PLANT_DIGITS)
+                   for n, v in zip(self._plant_names, plant_values)}
+            num, den = sp.fraction(sp.together(self.plant.subs(sub)))
+            num = [mpmath.mpf(sp.Float(c, PLANT_DIGITS)) for c in sp.Poly(num, model.s).all_coeffs()]
+            den = [mpmath.mpf(sp.Float(c, PLANT_DIGITS)) for c in sp.Poly(den, model.s).all_coeffs()]
+            if not den or den[0] == 0:
+                return [mpmath.nan], [mpmath.mpf(0)]
+            return numeric_zoh(num, den, mpmath.mpf(float(T)), dps=PLANT_DIGITS)
 
     def _exact_plant(self, plant_values, T):
         """``(P_n, P_d)`` with monic ``P_d``, as exact Fractions of their 30-digit values.

@@ -23,6 +23,7 @@ from symstab.numeric.stability import MARGINAL, STABLE, UNSTABLE, classify_polyn
 
 from conftest import PAPER_B, PAPER_M, PAPER_T, assert_rel_close
 from oracles import python_control_closed_loop
+from conftest import REPO
 
 control = pytest.importorskip("control")
 
@@ -89,6 +90,30 @@ def test_frictionless_mass_by_residues():
         delay = control.tf([1], [1] + [0] * d, PAPER_T)
         oracle = max(abs(control.feedback(G, VE * delay).poles()))
         assert r == pytest.approx(oracle, rel=1e-7, abs=1e-7)
+
+
+def test_a_parameter_at_zero_that_the_closed_form_divides_by_is_its_limit():
+    """b = 0 in 1/(m s**2 + b s): the closed form is 0/0 there; the loop takes the limit.
+
+    It was refused ("not defined at b = 0"), while a robust box holding
+    b = 0 inside it was certified; a box ending at 0 could not be asked for.
+    """
+    from symstab import load_loop
+
+    loop = load_loop(str(REPO / "examples" / "loops" / "paper.toml"))
+    G = control.sample_system(control.tf([1], [PAPER_M, 0, 0]), PAPER_T, "zoh")
+    zz = control.tf([1, 0], [1], PAPER_T)
+    rng = np.random.default_rng(11)
+    for _ in range(8):
+        K, B, M, d = rng.uniform(0, 60), rng.uniform(0, 1.5), rng.uniform(-0.005, 0.02), 10
+        r = loop.spectral_radius(K=K, B=B, M=M, b=0.0, m=PAPER_M, T=PAPER_T, d=d)
+        VE = K + B * (zz - 1) / (PAPER_T * zz) + M * (zz - 1) ** 2 / (PAPER_T**2 * zz**2)
+        delay = control.tf([1], [1] + [0] * d, PAPER_T)
+        oracle = max(abs(control.feedback(G, VE * delay).poles()))
+        assert r == pytest.approx(oracle, rel=1e-7, abs=1e-7)
+    robust = loop.region("B", "K", uncertain={"b": (0.0, 0.0324)}, strips=8, d=10, M=0.0,
+                         m=PAPER_M, T=PAPER_T)
+    assert robust.area > 0
 
 
 def test_numeric_zoh_matches_python_control():
