@@ -158,10 +158,19 @@ def _robust(args, setup, at):
                                             else f" {setup.unit(name)}")
         for name, (lo, hi) in box.items())
     nominal = region.nominal
+    used = len(region.edges) - 1 if len(region.edges) else strips
+    # The strips where the set has a corner or an end are halved: say so
+    # when the count differs from the one asked for.
+    if used > strips:
+        halved = (f"{strips} strips asked for, {used} after halving those where the set has "
+                  f"a corner or an end")
+    elif used < strips:
+        halved = "one line: the window has no width in x"
+    else:
+        halved = f"{strips} strips"
     notes = [f"robust: the points of the ({x}, {y}) plane stable for every {box_text}, "
              f"certified by zero exclusion (interval arithmetic over the box and theta; "
-             f"{len(region.edges) - 1 if len(region.edges) else strips} strips, each with "
-             f"trapezoids of certified y)"]
+             f"{halved}; each with trapezoids of certified y)"]
     if lim.empty:
         notes.append(f"the robust set is empty: {lim.reason}")
     else:

@@ -10,6 +10,8 @@ import json
 
 import pytest
 
+control = pytest.importorskip("control")
+
 import symstab
 
 from conftest import REPO, run_cli as run
@@ -44,6 +46,38 @@ def test_robust_limits_over_delays_and_the_empty_set(capsys):
                             "--uncertain", "M=0:0.019", "--strips", "8")
     assert status == 0, err
     assert "the robust set is empty" in text and "no common point" in text
+
+
+def test_a_box_ending_at_zero_is_certified_and_the_strip_count_explained(capsys):
+    """b in [0, 0.0324]: refused as "not defined at b = 0" (a box holding 0 inside worked).
+
+    Its robust K_max cannot exceed the nominal one at b = 0, taken here from
+    python-control's poles (a bisection on K at the B of the robust K_max).
+    And the note said "92 strips" after announcing 64: it says why now.
+    """
+    status, text, err = run(capsys, "limits", "--loop", PAPER, "--set", "d=10", "--set", "M=0",
+                            "--uncertain", "b=0:0.0324", "--strips", "8", "--format", "json")
+    assert status == 0, err
+    found = json.loads(text)
+    B = found["limits"]["x_at_y_max"]
+    G = control.sample_system(control.tf([1], [0.0128, 0, 0]), 1e-3, "zoh")
+    z = control.tf([1, 0], [1], 1e-3)
+
+    def stable(K):
+        loop = control.feedback(G, (K + B * (z - 1) / (1e-3 * z)) * control.tf([1], [1] + [0] * 10,
+                                                                                 1e-3))
+        return max(abs(loop.poles())) < 1
+
+    lo, hi = found["limits"]["y_max"], 100.0
+    assert stable(lo) and not stable(hi)
+    for _ in range(50):
+        mid = (lo + hi) / 2
+        lo, hi = (mid, hi) if stable(mid) else (lo, mid)
+    assert found["limits"]["y_max"] <= lo
+    status, text, err = run(capsys, "limits", "--loop", PAPER, "--set", "d=10", "--set", "M=0",
+                            "--uncertain", "b=0:0.0324", "--strips", "8")
+    assert status == 0, err
+    assert "8 strips asked for," in text and "after halving those where the set has" in text
 
 
 def test_a_box_of_zero_width_is_the_nominal_set(capsys):
