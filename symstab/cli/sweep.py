@@ -46,6 +46,14 @@ _KEYS = {"loop", "question", "plane", "chunk", "grid", "random", "design", "robu
 #: ``[design] maximize``'s words (those of ``symstab design --maximize``).
 _TARGETS = {"y_max": "y_max", "K_max": "y_max", "area": "area", "Z-width": "area",
             "passive": "passive"}
+#: The tables that go with a question: their keys, and what they must hold.
+_SECTIONS = (
+    ("design", "over, maximize", "over = {NAME = [LO, HI]}, the one or two parameters searched, "
+     "and optionally maximize"),
+    ("robust", "uncertain, strips", "uncertain = {NAME = [LO, HI]}, the box of uncertain "
+     "values, and optionally strips"),
+    ("simulated", "amplitude, steps, ...", "amplitude, the largest |x| accepted at the end of a "
+     "run, and optionally steps, x0, encoder_resolution, force_limit, force_resolution"))
 #: Rows per chunk by default: a task long enough to hide the cluster's overhead.
 _DEFAULT_CHUNK = 10
 
@@ -232,11 +240,13 @@ def read_spec(path):
         loop._check_plane((x, y))
     except (TypeError, ValueError) as exc:
         raise ValueError(f"{where}: plane: {exc}") from None
-    for section, keys in (("design", "over, maximize"), ("robust", "uncertain, strips"),
-                          ("simulated", "amplitude, steps, ...")):
-        if (section in spec) != (kind == section):
+    for section, keys, holds in _SECTIONS:
+        if kind == section and section not in spec:
+            raise ValueError(f"{where}: question = \"{section}\" needs a [{section}] table and "
+                             f"there is none: give one holding {holds}")
+        if section in spec and kind != section:
             raise ValueError(f"{where}: [{section}] ({keys}) goes with question = "
-                             f"\"{section}\", and only with it")
+                             f"\"{section}\", and only with it (the question is {kind!r})")
     over, maximize, strips, simulation = (), "y_max", 64, ()
     if kind == "design":
         over, maximize = _design(where, loop, x, y, spec["design"])
@@ -412,6 +422,12 @@ def _si(where, loop, name, values, unit):
         return [float(v) for v in values]
     if unit is not None and not isinstance(unit, str):
         raise ValueError(f"{where}: the unit of {name} must be text, got {unit!r}")
+    if not all(math.isfinite(v) for v in values):
+        # TOML has nan and inf; the unit conversion would refuse them without naming the key.
+        unit = unit or (getattr(loop, "file_parameters", None)
+                        and loop.file_parameters.file_unit(name))
+        raise ValueError(f"{where}: {name} must be finite numbers{f' in {unit}' if unit else ''}"
+                         f", got {values!r}")
     converted, _ = convert_sets(loop, {name: (list(values), unit)}, flag=where + ":")
     out = [float(v) for v in converted[name]]
     if not all(math.isfinite(v) for v in out):

@@ -166,6 +166,15 @@ def test_without_dask_the_message_says_what_to_install(capsys, tmp_path, monkeyp
     ('[grid]\nb = { values = [1], unit = "Hz" }\n', "Hz"),
     ('[grid]\nb = []\n', "non-empty list"),
     ('[grid]\nb = ["x"]\n', "must be numbers"),
+    # TOML's nan and inf: "cannot convert NaN to integer ratio" named no key.
+    ('[grid]\nb = [0.01, nan]\n', "[grid]: b must be finite numbers in N m s/rad, got [0.01, nan]"),
+    ('[grid]\nb = { values = [inf], unit = "mN m s/rad" }\n',
+     "[grid]: b must be finite numbers in mN m s/rad, got [inf]"),
+    ('[random]\nsamples = 3\nb = [nan, 0.02]\n', "[random]: b must be finite numbers"),
+    ('question = "design"\n[grid]\nd = [3]\n[design]\nover = { M = [0, nan] }\n',
+     "[design] over: M must be finite numbers in kg m^2"),
+    ('question = "robust"\n[grid]\nd = [3]\n[robust]\nuncertain = { b = [nan, 0.02] }\n',
+     "[robust] uncertain: b must be finite numbers"),
     ('[grid]\nb = { from = 0, to = 1 }\n', "points = N"),
     ('[random]\nsamples = 0\nb = [0.01, 0.02]\n', "samples must be an integer"),
     ('[random]\nsamples = 3\nb = [0.02, 0.01]\n', "LO < HI"),
@@ -173,7 +182,10 @@ def test_without_dask_the_message_says_what_to_install(capsys, tmp_path, monkeyp
     ('[random]\nsamples = 3\nm = [0, 0.02]\n', "[random]: at m = 0"),
     ('[random]\nsamples = 3\nseed = -1\nb = [0.01, 0.02]\n', "seed"),
     ('[grid]\nm = [0]\n', "the sweep spec"),
-    ('question = "design"\n[grid]\nd = [3]\n', "[design] (over, maximize) goes with"),
+    # A question without its table: the table is missing, and what it holds (it read as if
+    # the table were misplaced).
+    ('question = "design"\n[grid]\nd = [3]\n',
+     'question = "design" needs a [design] table and there is none: give one holding over = '),
     ('[grid]\nd = [3]\n[design]\nover = { M = [0, 1] }\n', "goes with question"),
     ('question = "design"\n[grid]\nd = [3]\n[design]\nover = { d = [0, 1] }\n',
      "whole number"),
@@ -183,7 +195,11 @@ def test_without_dask_the_message_says_what_to_install(capsys, tmp_path, monkeyp
      'maximize = "simulated"\n', "maximize must be one of"),
     ('question = "design"\n[grid]\nd = [3]\n[design]\nover = { M = [0.01, 0] }\n',
      "LO < HI"),
-    ('question = "robust"\n[grid]\nd = [3]\n', "[robust] (uncertain, strips) goes with"),
+    ('question = "robust"\n[grid]\nd = [3]\n',
+     'question = "robust" needs a [robust] table and there is none: give one holding '
+     'uncertain = {NAME = [LO, HI]}'),
+    ('question = "simulated"\n[grid]\nd = [3]\n', "needs a [simulated] table and there is "
+     "none: give one holding amplitude"),
     ('question = "robust"\n[grid]\nd = [3]\n[robust]\nstrips = 4\n', "names the box"),
     ('question = "robust"\n[grid]\nd = [3]\n[robust]\nuncertain = { b = [0.02, 0.01] }\n',
      "LO <= HI"),
