@@ -17,8 +17,9 @@ rows drawn uniformly from ``NAME = [LO, HI]`` (whole delays for ``d``) with
 units in the header); the chunks are evaluated on a Dask cluster (a
 ``LocalCluster`` on this machine's cores, or ``--scheduler ADDRESS``) or,
 with ``--serial``, here, and saved as they finish in ``OUT.parts/``: run
-the same command again after an interruption and the saved chunks are not
-recomputed.  Once the table is written the folder is removed.  The spec is data: nothing in it is run.
+the same command again after an interruption (Ctrl-C or SIGTERM) and the saved
+chunks are not recomputed; an interruption before the first chunk is saved
+leaves no folder.  Once the table is written the folder is removed.  The spec is data: nothing in it is run.
 """
 
 import io
@@ -115,18 +116,18 @@ def run(args):
         values, reasons, loaded = run_sweep(
             loop, plan["question"], plan["names"], rows, chunk=chunk, store=store,
             client=client, progress=progress_printer("sweeping", n_chunks))
-    except KeyboardInterrupt:
-        saved = len(store.done()) if store is not None else 0
-        print(f"{chr(10) if sys.stderr.isatty() else ''}symstab sweep: interrupted: {saved} of "
-              f"{n_chunks} chunks saved in {parts}; the same command resumes there",
-              file=sys.stderr)
-        return 130
     except Exception:
         # An error, not an interruption: a folder with no chunk saved goes
         # (it would only stand in the way of the corrected sweep).
         if store is not None and not store.done():
             shutil.rmtree(parts, ignore_errors=True)
         raise
+    except BaseException as exc:
+        if isinstance(exc, (SystemExit, GeneratorExit)):
+            raise
+        # Ctrl-C (KeyboardInterrupt) or SIGTERM (the BaseException the command line raises
+        # for it): both say what is saved and how to resume.
+        return _interrupted(exc, store, parts, n_chunks)
     finally:
         if client is not None:
             client.close()
@@ -142,6 +143,26 @@ def run(args):
     print(f"{answered} of {len(rows)} points answered in full (the others' reasons are in the "
           f"table); wrote {out}")
     return 0
+
+
+def _interrupted(exc, store, parts, n_chunks):
+    """Say what an interrupted sweep saved and how to resume; the exit status (128 + signal).
+
+    A folder holding no chunk goes, as after an error: there is nothing in it to resume.
+    """
+    import signal
+
+    saved = len(store.done()) if store is not None else 0
+    if saved:
+        what = (f"{saved} of {n_chunks} chunks saved in {parts}; the same command resumes "
+                f"there")
+    else:
+        if store is not None:
+            shutil.rmtree(parts, ignore_errors=True)
+        what = f"no chunk of {n_chunks} was saved yet (nothing to resume)"
+    print(f"{chr(10) if sys.stderr.isatty() else ''}symstab sweep: interrupted: {what}",
+          file=sys.stderr)
+    return 128 + (signal.SIGINT if isinstance(exc, KeyboardInterrupt) else signal.SIGTERM)
 
 
 def _client_factory(args):

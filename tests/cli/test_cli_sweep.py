@@ -131,6 +131,48 @@ def test_a_two_worker_cluster_gives_the_serial_table_and_resumes_after_sigint(ca
     assert not parts.exists()
 
 
+def test_a_serial_sweep_stopped_by_sigterm_says_how_to_resume(tmp_path):
+    """SIGTERM gave "interrupted" with no resume hint; now the line is SIGINT's, status 143."""
+    path = spec(tmp_path, 'chunk = 1\n[grid]\nd = { from = 1, to = 200, points = 200 }\n')
+    parts = tmp_path / "t.csv.parts"
+    process = subprocess.Popen([sys.executable, "-m", "symstab", "sweep", str(path), "--out",
+                                str(tmp_path / "t.csv"), "--serial"], stdout=subprocess.PIPE,
+                               stderr=subprocess.PIPE, text=True)
+    try:
+        deadline = time.monotonic() + 60
+        while time.monotonic() < deadline and process.poll() is None:
+            if parts.exists() and list(parts.glob("chunk-*.npz")):
+                break
+            time.sleep(0.02)
+        process.send_signal(signal.SIGTERM)
+        _, stderr = process.communicate(timeout=60)
+    finally:
+        if process.poll() is None:
+            process.kill()
+            process.wait()
+    assert process.returncode == 143, stderr
+    saved = len(list(parts.glob("chunk-*.npz")))
+    assert 1 <= saved < 200, "the sweep ended before the signal: make it longer"
+    assert stderr == (f"symstab sweep: interrupted: {saved} of 200 chunks saved in {parts}; "
+                      f"the same command resumes there\n")
+
+
+def test_an_interruption_before_the_first_chunk_leaves_no_folder(capsys, tmp_path,
+                                                                 monkeypatch):
+    """A folder holding only sweep.json was left (nothing in it to resume from)."""
+    from symstab.numeric import sweep as numeric_sweep
+
+    def interrupted(*args):
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(numeric_sweep, "evaluate_rows", interrupted)
+    status, _, err = run(capsys, "sweep", spec(tmp_path, '[grid]\nd = [3, 4]\n'), "--out",
+                         tmp_path / "t.csv", "--serial")
+    assert status == 130
+    assert err == "symstab sweep: interrupted: no chunk of 1 was saved yet (nothing to resume)\n"
+    assert list(tmp_path.iterdir()) == [tmp_path / "s.toml"]
+
+
 def test_the_chunks_go_once_the_table_is_written_and_another_sweep_s_are_refused(capsys,
                                                                                  tmp_path):
     first = spec(tmp_path, '[grid]\nd = [3]\n', "a.toml")
