@@ -36,7 +36,7 @@ from .loop_options import check_corners, convert_sets, load_loop_file
 from .options import add_command
 from .output import check_files, write_output
 
-__all__ = ["register", "run", "MAX_ROWS", "local_cluster", "read_spec"]
+__all__ = ["register", "run", "MAX_ROWS", "local_cluster", "check_scheduler", "read_spec"]
 
 #: The most rows a sweep has (each is a certified region, about 0.1 to 1 s).
 MAX_ROWS = 1_000_000
@@ -55,6 +55,8 @@ _SECTIONS = (
      "values, and optionally strips"),
     ("simulated", "amplitude, steps, ...", "amplitude, the largest |x| accepted at the end of a "
      "run, and optionally steps, x0, encoder_resolution, force_limit, force_resolution"))
+#: Seconds a ``--scheduler`` may take to answer, by default.
+_CONNECT_TIMEOUT = 10.0
 #: Rows per chunk by default: a task long enough to hide the cluster's overhead.
 _DEFAULT_CHUNK = 10
 
@@ -80,6 +82,9 @@ def register(subparsers):
     g.add_argument("--workers", type=int, metavar="N",
                    help="workers of the LocalCluster (default: the machine's cores)")
     g.add_argument("--serial", action="store_true", help="evaluate here, one chunk after another")
+    p.add_argument("--connect-timeout", type=float, metavar="SECONDS",
+                   help=f"how long the scheduler at --scheduler may take to answer (default "
+                        f"{_CONNECT_TIMEOUT:g})")
 
 
 def run(args):
@@ -89,6 +94,12 @@ def run(args):
     check_files([("--out", out)])
     if args.workers is not None and not 1 <= args.workers <= 256:
         raise ValueError(f"--workers must be an integer from 1 to 256, got {args.workers}")
+    if args.connect_timeout is not None:
+        if args.scheduler is None:
+            raise ValueError("--connect-timeout goes with --scheduler ADDRESS")
+        if not 0 < args.connect_timeout <= 3600:
+            raise ValueError(f"--connect-timeout must be a number of seconds > 0 and <= 3600, "
+                             f"got {args.connect_timeout:g}")
     plan = read_spec(args.spec)
     client_of = None if args.serial else _client_factory(args)
     from ..numeric.sweep import ChunkStore, run_sweep, sweep_key
@@ -179,13 +190,67 @@ def _client_factory(args):
         from dask.distributed import Client
 
         if args.scheduler is not None:
-            return (Client(args.scheduler, timeout=10), None,
+            timeout = args.connect_timeout or _CONNECT_TIMEOUT
+            check_scheduler(args.scheduler, timeout)
+            return (Client(args.scheduler, timeout=timeout), None,
                     f"the Dask scheduler at {args.scheduler}")
         n = args.workers or os.cpu_count() or 1
         cluster = local_cluster(n)
         return Client(cluster), cluster, f"a Dask LocalCluster of {n} worker process(es)"
 
     return make
+
+
+def check_scheduler(address, timeout):
+    """Refuse, in ``timeout`` seconds, an ``address`` where no Dask scheduler answers.
+
+    Dask's ``Client(address, timeout=...)`` bounds the TCP connection, not
+    the handshake after it: a listener that accepts and never answers held
+    it for ever, and one that answers with other bytes than Dask's was read
+    as frame lengths ("Unable to allocate 3.01 EiB").  Here the whole
+    exchange -- connection, handshake and the scheduler's identity -- has
+    one deadline, and anything but a scheduler's answer is one
+    ``ValueError`` naming the address.
+    """
+    import asyncio
+
+    from distributed.comm import connect
+    from distributed.comm.addressing import parse_address, parse_host_port
+    from distributed.comm.registry import get_backend
+
+    where = f"--scheduler {address}"
+    try:
+        scheme, location = parse_address(address)
+        get_backend(scheme)
+        if scheme in ("tcp", "tls"):
+            parse_host_port(location)
+    except ValueError as exc:
+        raise ValueError(f"{where} is not a scheduler's address such as tcp://HOST:PORT: "
+                         f"{exc}") from None
+
+    async def identity():
+        comm = await connect(address, timeout=timeout)
+        try:
+            await comm.write({"op": "identity", "reply": True})
+            return await comm.read()
+        finally:
+            comm.abort()
+
+    try:
+        answer = asyncio.run(asyncio.wait_for(identity(), timeout))
+    except asyncio.TimeoutError:
+        raise ValueError(f"{where}: no answer in {timeout:g} s (is a Dask scheduler there? "
+                         f"--connect-timeout waits longer)") from None
+    except OSError as exc:
+        raise ValueError(f"{where}: cannot connect: {' '.join(str(exc).split())}") from None
+    except Exception as exc:
+        # The peer's bytes, read as Dask's frames: any error is theirs, not ours.
+        raise ValueError(f"{where}: the answer is not Dask's protocol (is it a Dask "
+                         f"scheduler?): {type(exc).__name__}") from None
+    if not isinstance(answer, dict) or answer.get("type") != "Scheduler":
+        kind = answer.get("type") if isinstance(answer, dict) else None
+        raise ValueError(f"{where}: not a Dask scheduler"
+                         f"{f' (a {kind})' if isinstance(kind, str) else ''}")
 
 
 def local_cluster(n_workers):

@@ -7,10 +7,13 @@ evaluating the saved chunks again.  A bad spec is one line, exit status 2,
 before any work, and nothing is written.
 """
 
+import contextlib
 import os
 import signal
+import socket
 import subprocess
 import sys
+import threading
 import time
 
 import numpy as np
@@ -275,10 +278,91 @@ def test_a_bad_spec_is_one_line_before_any_work(capsys, tmp_path, monkeypatch, t
     assert out == "" and list((tmp_path / "work").iterdir()) == []
 
 
+@contextlib.contextmanager
+def listener(answer, hold=20.0):
+    """A loopback TCP address that accepts and sends ``answer`` (b"": nothing), for ``hold`` s.
+
+    The connections are closed after ``hold`` seconds, so that a client waiting for ever
+    ends (and fails its test) rather than hanging the test run.
+    """
+    server = socket.create_server(("127.0.0.1", 0))
+    server.settimeout(0.1)
+    stop = threading.Event()
+
+    def serve():
+        held, started = [], time.monotonic()
+        while not stop.is_set() and time.monotonic() - started < hold:
+            try:
+                conn, _ = server.accept()
+            except TimeoutError:
+                continue
+            held.append(conn)
+            if answer:
+                conn.sendall(answer)
+        for conn in held:
+            conn.close()
+
+    thread = threading.Thread(target=serve, daemon=True)
+    thread.start()
+    try:
+        yield f"tcp://127.0.0.1:{server.getsockname()[1]}"
+    finally:
+        stop.set()
+        thread.join()
+        server.close()
+
+
+@pytest.mark.parametrize("answer, timeout, needle", [
+    (b"", ["--connect-timeout", "0.5"], "no answer in 0.5 s"),
+    # Read as Dask's frame lengths, such bytes asked for exabytes ("out of memory").
+    (b"\xff" * 64 + b"HTTP/1.1 400 Bad Request\r\n\r\n", [],
+     "the answer is not Dask's protocol"),
+], ids=["silent", "garbage"])
+def test_a_scheduler_address_that_does_not_answer_as_dask_is_one_line(capsys, tmp_path, answer,
+                                                                       timeout, needle):
+    """A listener that never answered held the sweep for ever (the timeout bounded only the
+    TCP connection); garbage bytes gave "out of memory"."""
+    pytest.importorskip("dask.distributed")
+    path = spec(tmp_path, '[grid]\nd = [3]\n')
+    with listener(answer) as address:
+        started = time.monotonic()
+        status, out, err = run(capsys, "sweep", path, "--out", tmp_path / "t.csv",
+                               "--scheduler", address, *timeout)
+        elapsed = time.monotonic() - started
+    assert status == 2 and err.count("\n") == 1, err
+    assert err.startswith(f"symstab sweep: error: --scheduler {address}: {needle}"), err
+    assert elapsed < 5 and out == "" and list(tmp_path.iterdir()) == [path]
+
+
+def test_a_running_scheduler_is_used_and_a_worker_s_address_is_refused(capsys, tmp_path):
+    """The check before the Client lets a scheduler through (the sweep runs on it) and
+    refuses another Dask server."""
+    distributed = pytest.importorskip("dask.distributed")
+    from symstab.cli.sweep import check_scheduler
+
+    path = spec(tmp_path, '[grid]\nd = [3]\n')
+    with distributed.LocalCluster(n_workers=1, threads_per_worker=1, processes=False,
+                                  protocol="tcp", dashboard_address=None) as cluster:
+        status, out, err = run(capsys, "sweep", path, "--out", tmp_path / "t.csv",
+                               "--scheduler", cluster.scheduler_address)
+        assert status == 0, err
+        assert f"on the Dask scheduler at {cluster.scheduler_address}" in out
+        worker = next(iter(cluster.workers.values())).address
+        with pytest.raises(ValueError, match=r"not a Dask scheduler \(a Worker\)"):
+            check_scheduler(worker, 5)
+    found = symstab.load_loop(LOOPS / "paper.toml").limits(d=3)
+    assert float(read_csv(tmp_path / "t.csv")[1][0, 1]) == pytest.approx(found.y_max,
+                                                                        rel=1e-11)
+
+
 @pytest.mark.parametrize("args, needle", [
     (["--out", "t.txt"], "--out must end in .csv or .npz"),
     (["--out", "t.csv", "--workers", "0"], "--workers must be"),
     (["--out", "t.csv", "--serial", "--workers", "2"], "not allowed with"),
+    (["--out", "t.csv", "--connect-timeout", "5"], "--connect-timeout goes with --scheduler"),
+    (["--out", "t.csv", "--scheduler", "tcp://127.0.0.1:1", "--connect-timeout", "0"],
+     "--connect-timeout must be a number of seconds > 0"),
+    (["--out", "t.csv", "--scheduler", "nonsense://x"], "is not a scheduler's address"),
 ])
 def test_bad_options_are_one_line(capsys, tmp_path, monkeypatch, args, needle):
     path = spec(tmp_path, '[grid]\nd = [3]\n')
