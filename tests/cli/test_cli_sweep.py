@@ -134,6 +134,69 @@ def test_a_two_worker_cluster_gives_the_serial_table_and_resumes_after_sigint(ca
     assert not parts.exists()
 
 
+def test_ctrl_c_while_the_cluster_starts_stops_the_sweep(tmp_path):
+    """A Ctrl-C while the workers were being started was dropped (SIGINT was ignored then, so
+    that they inherit it): the sweep ran to its end and exited 0."""
+    pytest.importorskip("dask.distributed")
+    psutil = pytest.importorskip("psutil")
+    path = spec(tmp_path, '[grid]\nd = [3, 4]\n')
+    out = tmp_path / "t.csv"
+    process = subprocess.Popen([sys.executable, "-m", "symstab", "sweep", str(path), "--out",
+                                str(out), "--workers", "1"], stdout=subprocess.PIPE,
+                               stderr=subprocess.PIPE, text=True, start_new_session=True)
+    try:
+        # The first worker process spawned: the cluster is starting, not started (its
+        # worker has yet to import Dask and register).
+        deadline, workers = time.monotonic() + 60, []
+        while time.monotonic() < deadline and process.poll() is None and not workers:
+            workers = [child for child in psutil.Process(process.pid).children(recursive=True)
+                       if "spawn_main" in " ".join(child.cmdline())]
+            time.sleep(0.01)
+        assert workers, "no worker process was started"
+        os.killpg(process.pid, signal.SIGINT)
+        stdout, stderr = process.communicate(timeout=60)
+    finally:
+        if process.poll() is None:
+            process.kill()
+            process.wait()
+    assert process.returncode == 130, stderr
+    assert stderr == "symstab sweep: interrupted: no chunk of 1 was saved yet (nothing to " \
+                     "resume)\n"
+    assert "on a Dask LocalCluster" not in stdout
+    assert list(tmp_path.iterdir()) == [path]
+    # The cluster was closed with the command: no worker is left running.
+    assert not psutil.wait_procs(workers, timeout=10)[1]
+
+
+def test_the_errors_of_the_cluster_s_own_tasks_are_not_shown(caplog):
+    """Ctrl-C in client.scatter printed 15 lines of the scheduler's failed replication
+    ("Task exception was never retrieved") after the one line."""
+    pytest.importorskip("dask.distributed")
+    import asyncio
+    import gc
+
+    from symstab.cli.sweep import local_cluster
+
+    async def failing():
+        raise KeyError("tcp://127.0.0.1:1")   # a worker gone, as in Scheduler.replicate
+
+    cluster = local_cluster(1)
+    try:
+        done = threading.Event()
+
+        def start():
+            task = asyncio.get_running_loop().create_task(failing())
+            task.add_done_callback(lambda _: done.set())
+
+        cluster.loop.add_callback(start)
+        assert done.wait(10)
+        time.sleep(0.1)
+        gc.collect()
+    finally:
+        cluster.close()
+    assert not [r for r in caplog.records if r.name == "asyncio"], caplog.text
+
+
 def test_a_serial_sweep_stopped_by_sigterm_says_how_to_resume(tmp_path):
     """SIGTERM gave "interrupted" with no resume hint; now the line is SIGINT's, status 143."""
     path = spec(tmp_path, 'chunk = 1\n[grid]\nd = { from = 1, to = 200, points = 200 }\n')
