@@ -153,6 +153,17 @@ def quiet_when_unread(run):
     process with SIGPIPE itself would skip the cleanup of its files
     (:func:`write_output`).  A broken pipe that is not stdout's (a
     worker's, a socket's) is an error as before.
+
+    Parameters
+    ----------
+    run : callable
+        A command's ``run(args)``, returning its exit status.
+
+    Returns
+    -------
+    callable
+        ``run`` that returns :data:`EXIT_UNREAD` when its reader has gone,
+        with stdout flushed before it returns.
     """
     @functools.wraps(run)
     def wrapped(args):

@@ -212,6 +212,20 @@ def check_scheduler(address, timeout):
     exchange -- connection, handshake and the scheduler's identity -- has
     one deadline, and anything but a scheduler's answer is one
     ``ValueError`` naming the address.
+
+    Parameters
+    ----------
+    address : str
+        The scheduler's address (``tcp://HOST:PORT``), as ``--scheduler`` gives it.
+    timeout : float
+        Seconds for the whole exchange.
+
+    Raises
+    ------
+    ValueError
+        Naming ``--scheduler ADDRESS``: not an address, no connection, no
+        answer in time, an answer not in Dask's protocol, or another Dask
+        server than a scheduler (a worker).
     """
     import asyncio
 
