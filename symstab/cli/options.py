@@ -19,7 +19,7 @@ import textwrap
 
 import numpy as np
 
-from .output import FORMATS
+from .output import FORMATS, quiet_when_unread
 
 __all__ = ["add_command", "Setup", "UNITS_RULE", "add_model_options", "resolve", "parse_list",
            "stiffness_and_damping"]
@@ -30,11 +30,12 @@ def add_command(sub, name, *, help, description, example, func):
 
     ``help`` is the short line of the command list of ``symstab --help``;
     ``example`` is the command line printed (indented) under "example:".
+    A reader of its output that goes stops it quietly (:func:`quiet_when_unread`).
     """
     parser = sub.add_parser(name, help=help, description=textwrap.fill(description, 79),
                             epilog=f"example:\n  {example}",
                             formatter_class=argparse.RawDescriptionHelpFormatter)
-    parser.set_defaults(func=func)
+    parser.set_defaults(func=quiet_when_unread(func))
     return parser
 
 

@@ -5,21 +5,25 @@ Every command checks its output paths before any long work
 (:func:`write_output`): a failed or interrupted run leaves none behind.
 :func:`emit` prints a command's rows as a table (with the echo of the
 inputs and the notes), CSV (the echo and notes on stderr) or JSON.
+:func:`quiet_when_unread` makes a command stop quietly when the reader of
+its output goes (``symstab limits --format json | head -1``).
 """
 
 import csv
+import functools
 import io
 import json
 import math
 import os
 import pathlib
+import select
 import sys
 import tempfile
 
 import numpy as np
 
 __all__ = ["FORMATS", "BYTES_PER_ROW", "check_outputs", "check_files", "write_output", "emit",
-           "number_text", "interval_texts"]
+           "number_text", "interval_texts", "quiet_when_unread", "EXIT_UNREAD"]
 
 
 FORMATS = ("table", "csv", "json")
@@ -125,6 +129,71 @@ def write_output(path, data, flag):
         return write_bytes(path, data)
     except OSError as exc:
         raise OSError(f"cannot write {flag} {path}: {exc.strerror or exc}") from None
+
+
+# --------------------------------------------------------------------------
+# A reader that goes: ``symstab ... | head -1``
+
+#: The exit status of a command whose reader closed its output: a shell's
+#: status of a Unix tool killed by SIGPIPE (128 + 13), as ``yes`` gets in
+#: ``yes | head -1``.
+EXIT_UNREAD = 141
+
+
+def quiet_when_unread(run):
+    """``run(args)``, stopping quietly with :data:`EXIT_UNREAD` when its output's reader goes.
+
+    A Unix tool whose reader goes is killed by SIGPIPE: no message, status
+    141 in the shell.  Python ignores SIGPIPE (a socket's peer that goes
+    must not kill the process) and raises ``BrokenPipeError`` instead; a
+    command has nothing to say to a reader that is gone, so stdout (and
+    stderr, if its reader is gone too) is pointed at the null device, which
+    also keeps the interpreter's last flush from complaining at exit, and
+    the status is that of the tool killed by the signal.  Killing the
+    process with SIGPIPE itself would skip the cleanup of its files
+    (:func:`write_output`).  A broken pipe that is not stdout's (a
+    worker's, a socket's) is an error as before.
+
+    Parameters
+    ----------
+    run : callable
+        A command's ``run(args)``, returning its exit status.
+
+    Returns
+    -------
+    callable
+        ``run`` that returns :data:`EXIT_UNREAD` when its reader has gone,
+        with stdout flushed before it returns.
+    """
+    @functools.wraps(run)
+    def wrapped(args):
+        try:
+            status = run(args)
+            # Flushed here, not at exit, so that a reader gone is found while it can be answered.
+            sys.stdout.flush()
+            return status
+        except BrokenPipeError:
+            if not _unread(sys.stdout):
+                raise
+            for stream in (sys.stdout, sys.stderr):
+                if _unread(stream):
+                    null = os.open(os.devnull, os.O_WRONLY)
+                    os.dup2(null, stream.fileno())
+                    os.close(null)
+            return EXIT_UNREAD
+
+    return wrapped
+
+
+def _unread(stream):
+    """Whether ``stream`` is a pipe or socket whose reader has gone (poll: error or hang-up)."""
+    try:
+        fd = stream.fileno()
+        poll = select.poll()
+    except (AttributeError, OSError, ValueError):   # not a file (captured), or no poll()
+        return False
+    poll.register(fd, select.POLLOUT)
+    return any(events & (select.POLLERR | select.POLLHUP) for _, events in poll.poll(0))
 
 
 # --------------------------------------------------------------------------

@@ -17,8 +17,10 @@ rows drawn uniformly from ``NAME = [LO, HI]`` (whole delays for ``d``) with
 units in the header); the chunks are evaluated on a Dask cluster (a
 ``LocalCluster`` on this machine's cores, or ``--scheduler ADDRESS``) or,
 with ``--serial``, here, and saved as they finish in ``OUT.parts/``: run
-the same command again after an interruption and the saved chunks are not
-recomputed.  Once the table is written the folder is removed.  The spec is data: nothing in it is run.
+the same command again after an interruption (Ctrl-C or SIGTERM) and the
+saved chunks are not recomputed; an interruption before the first chunk is
+saved leaves no folder.  Once the table is written the folder is removed.
+The spec is data: nothing in it is run.
 """
 
 import io
@@ -35,7 +37,7 @@ from .loop_options import check_corners, convert_sets, load_loop_file
 from .options import add_command
 from .output import check_files, write_output
 
-__all__ = ["register", "run", "MAX_ROWS", "local_cluster", "read_spec"]
+__all__ = ["register", "run", "MAX_ROWS", "local_cluster", "check_scheduler", "read_spec"]
 
 #: The most rows a sweep has (each is a certified region, about 0.1 to 1 s).
 MAX_ROWS = 1_000_000
@@ -46,6 +48,16 @@ _KEYS = {"loop", "question", "plane", "chunk", "grid", "random", "design", "robu
 #: ``[design] maximize``'s words (those of ``symstab design --maximize``).
 _TARGETS = {"y_max": "y_max", "K_max": "y_max", "area": "area", "Z-width": "area",
             "passive": "passive"}
+#: The tables that go with a question: their keys, and what they must hold.
+_SECTIONS = (
+    ("design", "over, maximize", "over = {NAME = [LO, HI]}, the one or two parameters searched, "
+     "and optionally maximize"),
+    ("robust", "uncertain, strips", "uncertain = {NAME = [LO, HI]}, the box of uncertain "
+     "values, and optionally strips"),
+    ("simulated", "amplitude, steps, ...", "amplitude, the largest |x| accepted at the end of a "
+     "run, and optionally steps, x0, encoder_resolution, force_limit, force_resolution"))
+#: Seconds a ``--scheduler`` may take to answer, by default.
+_CONNECT_TIMEOUT = 10.0
 #: Rows per chunk by default: a task long enough to hide the cluster's overhead.
 _DEFAULT_CHUNK = 10
 
@@ -71,6 +83,9 @@ def register(subparsers):
     g.add_argument("--workers", type=int, metavar="N",
                    help="workers of the LocalCluster (default: the machine's cores)")
     g.add_argument("--serial", action="store_true", help="evaluate here, one chunk after another")
+    p.add_argument("--connect-timeout", type=float, metavar="SECONDS",
+                   help=f"how long the scheduler at --scheduler may take to answer (default "
+                        f"{_CONNECT_TIMEOUT:g})")
 
 
 def run(args):
@@ -80,6 +95,12 @@ def run(args):
     check_files([("--out", out)])
     if args.workers is not None and not 1 <= args.workers <= 256:
         raise ValueError(f"--workers must be an integer from 1 to 256, got {args.workers}")
+    if args.connect_timeout is not None:
+        if args.scheduler is None:
+            raise ValueError("--connect-timeout goes with --scheduler ADDRESS")
+        if not 0 < args.connect_timeout <= 3600:
+            raise ValueError(f"--connect-timeout must be a number of seconds > 0 and <= 3600, "
+                             f"got {args.connect_timeout:g}")
     plan = read_spec(args.spec)
     client_of = None if args.serial else _client_factory(args)
     from ..numeric.sweep import ChunkStore, run_sweep, sweep_key
@@ -107,18 +128,18 @@ def run(args):
         values, reasons, loaded = run_sweep(
             loop, plan["question"], plan["names"], rows, chunk=chunk, store=store,
             client=client, progress=progress_printer("sweeping", n_chunks))
-    except KeyboardInterrupt:
-        saved = len(store.done()) if store is not None else 0
-        print(f"{chr(10) if sys.stderr.isatty() else ''}symstab sweep: interrupted: {saved} of "
-              f"{n_chunks} chunks saved in {parts}; the same command resumes there",
-              file=sys.stderr)
-        return 130
     except Exception:
         # An error, not an interruption: a folder with no chunk saved goes
         # (it would only stand in the way of the corrected sweep).
         if store is not None and not store.done():
             shutil.rmtree(parts, ignore_errors=True)
         raise
+    except BaseException as exc:
+        if isinstance(exc, (SystemExit, GeneratorExit)):
+            raise
+        # Ctrl-C (KeyboardInterrupt) or SIGTERM (the BaseException the command line raises
+        # for it): both say what is saved and how to resume.
+        return _interrupted(exc, store, parts, n_chunks)
     finally:
         if client is not None:
             client.close()
@@ -136,6 +157,26 @@ def run(args):
     return 0
 
 
+def _interrupted(exc, store, parts, n_chunks):
+    """Say what an interrupted sweep saved and how to resume; the exit status (128 + signal).
+
+    A folder holding no chunk goes, as after an error: there is nothing in it to resume.
+    """
+    import signal
+
+    saved = len(store.done()) if store is not None else 0
+    if saved:
+        what = (f"{saved} of {n_chunks} chunks saved in {parts}; the same command resumes "
+                f"there")
+    else:
+        if store is not None:
+            shutil.rmtree(parts, ignore_errors=True)
+        what = f"no chunk of {n_chunks} was saved yet (nothing to resume)"
+    print(f"{chr(10) if sys.stderr.isatty() else ''}symstab sweep: interrupted: {what}",
+          file=sys.stderr)
+    return 128 + (signal.SIGINT if isinstance(exc, KeyboardInterrupt) else signal.SIGTERM)
+
+
 def _client_factory(args):
     """A callable giving ``(client, cluster or None, description)``; refuses a missing Dask now."""
     import importlib
@@ -150,7 +191,9 @@ def _client_factory(args):
         from dask.distributed import Client
 
         if args.scheduler is not None:
-            return (Client(args.scheduler, timeout=10), None,
+            timeout = args.connect_timeout or _CONNECT_TIMEOUT
+            check_scheduler(args.scheduler, timeout)
+            return (Client(args.scheduler, timeout=timeout), None,
                     f"the Dask scheduler at {args.scheduler}")
         n = args.workers or os.cpu_count() or 1
         cluster = local_cluster(n)
@@ -159,32 +202,153 @@ def _client_factory(args):
     return make
 
 
+def check_scheduler(address, timeout):
+    """Refuse, in ``timeout`` seconds, an ``address`` where no Dask scheduler answers.
+
+    Dask's ``Client(address, timeout=...)`` bounds the TCP connection, not
+    the handshake after it: a listener that accepts and never answers held
+    it for ever, and one that answers with other bytes than Dask's was read
+    as frame lengths ("Unable to allocate 3.01 EiB").  Here the whole
+    exchange -- connection, handshake and the scheduler's identity -- has
+    one deadline, and anything but a scheduler's answer is one
+    ``ValueError`` naming the address.
+
+    Parameters
+    ----------
+    address : str
+        The scheduler's address (``tcp://HOST:PORT``), as ``--scheduler`` gives it.
+    timeout : float
+        Seconds for the whole exchange.
+
+    Raises
+    ------
+    ValueError
+        Naming ``--scheduler ADDRESS``: not an address, no connection, no
+        answer in time, an answer not in Dask's protocol, or another Dask
+        server than a scheduler (a worker).
+    """
+    import asyncio
+
+    from distributed.comm import connect
+    from distributed.comm.addressing import parse_address, parse_host_port
+    from distributed.comm.registry import get_backend
+
+    where = f"--scheduler {address}"
+    try:
+        scheme, location = parse_address(address)
+        get_backend(scheme)
+        if scheme in ("tcp", "tls"):
+            parse_host_port(location)
+    except ValueError as exc:
+        raise ValueError(f"{where} is not a scheduler's address such as tcp://HOST:PORT: "
+                         f"{exc}") from None
+
+    async def identity():
+        comm = await connect(address, timeout=timeout)
+        try:
+            await comm.write({"op": "identity", "reply": True})
+            return await comm.read()
+        finally:
+            comm.abort()
+
+    try:
+        answer = asyncio.run(asyncio.wait_for(identity(), timeout))
+    except asyncio.TimeoutError:
+        raise ValueError(f"{where}: no answer in {timeout:g} s (is a Dask scheduler there? "
+                         f"--connect-timeout waits longer)") from None
+    except OSError as exc:
+        raise ValueError(f"{where}: cannot connect: {' '.join(str(exc).split())}") from None
+    except Exception as exc:
+        # The peer's bytes, read as Dask's frames: any error is theirs, not ours.
+        raise ValueError(f"{where}: the answer is not Dask's protocol (is it a Dask "
+                         f"scheduler?): {type(exc).__name__}") from None
+    if not isinstance(answer, dict) or answer.get("type") != "Scheduler":
+        kind = answer.get("type") if isinstance(answer, dict) else None
+        raise ValueError(f"{where}: not a Dask scheduler"
+                         f"{f' (a {kind})' if isinstance(kind, str) else ''}")
+
+
 def local_cluster(n_workers):
     """A Dask ``LocalCluster`` of ``n_workers`` single-threaded worker processes, quiet.
 
     Its log lines are not for the user (on Ctrl-C the workers stop with the
     command and the scheduler logs, at ERROR, the data they held; a task's
-    failure reaches the sweep as its exception), and the workers'
+    failure reaches the sweep as its exception), nor are the errors of its
+    event loop's own tasks (interrupted in ``client.scatter``, the
+    scheduler's replication fails on the workers gone and asyncio printed
+    its traceback), and the workers'
     statistical profiler is off: sampling the stack every
     10 ms took about a tenth of their time on this package's Python-heavy
     rows (measured: 200 regions on two workers, 13.0 s with it, 11.6 s
     without).
-    """
-    import signal
 
+    A Ctrl-C while the processes start stops the command as it would a
+    second later (the cluster is closed, then KeyboardInterrupt).
+    """
     import dask
     from dask.distributed import LocalCluster
 
-    # Its processes are started ignoring SIGINT (they inherit it): a
-    # terminal's Ctrl-C reaches the whole process group, and the sweep, not
-    # each worker, answers it (the cluster is closed with the command).
-    before = signal.signal(signal.SIGINT, signal.SIG_IGN)
-    try:
+    def start():
         with dask.config.set({"distributed.worker.profile.enabled": False}):
-            return LocalCluster(n_workers=n_workers, threads_per_worker=1, processes=True,
-                                dashboard_address=None, silence_logs=logging.CRITICAL)
+            cluster = LocalCluster(n_workers=n_workers, threads_per_worker=1, processes=True,
+                                   dashboard_address=None, silence_logs=logging.CRITICAL)
+        cluster.loop.asyncio_loop.set_exception_handler(_unreported)
+        return cluster
+
+    return _starting_children(start)
+
+
+def _unreported(loop, context):
+    """The LocalCluster's event loop's exception handler: its own tasks' errors are not shown."""
+
+
+def _starting_children(start):
+    """``start()``, which starts processes that must not answer a terminal's Ctrl-C.
+
+    A terminal's Ctrl-C reaches the whole process group; the command, not
+    each worker, answers it (the cluster is closed with the command).  The
+    workers were started with SIGINT ignored, which they inherit, but a
+    Ctrl-C arriving meanwhile was then discarded: the sweep ran to its end.
+    Here SIGINT is blocked instead, in this thread while ``start()`` runs:
+    the threads it starts (Dask's event loop, which spawns the workers)
+    inherit the mask, and processes keep it across fork and exec (spawn,
+    forkserver and fork alike).  Other threads of this process (the BLAS
+    pool) do not block it and may take the signal: meanwhile a handler only
+    notes that it came.  Once ``start()`` is done the signal is raised again
+    under the handler that was in place (KeyboardInterrupt), and what
+    ``start()`` returned is closed.
+    """
+    import signal
+    import threading
+
+    # Handlers are set in the main thread only, Windows has no mask, and a handler set
+    # outside Python (None) could not be put back.
+    if (threading.current_thread() is not threading.main_thread()
+            or not hasattr(signal, "pthread_sigmask") or signal.getsignal(signal.SIGINT) is None):
+        return start()
+    from multiprocessing import resource_tracker
+
+    # Started now, before the mask: started at the first worker's spawn, in Dask's
+    # thread, it unblocks SIGINT there (SIG_UNBLOCK, not the mask it found), and every
+    # worker spawned after it answered Ctrl-C with a traceback.
+    resource_tracker.ensure_running()
+    arrived = []
+    before = signal.signal(signal.SIGINT, lambda signum, frame: arrived.append(signum))
+    mask = signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGINT})
+    started = None
+    try:
+        started = start()
     finally:
-        signal.signal(signal.SIGINT, before)
+        try:
+            signal.signal(signal.SIGINT, before)
+            signal.pthread_sigmask(signal.SIG_SETMASK, mask)
+            if arrived:
+                signal.raise_signal(signal.SIGINT)
+        except BaseException:
+            if started is not None:
+                started.close()
+            raise
+    return started
 
 
 def read_spec(path):
@@ -232,11 +396,13 @@ def read_spec(path):
         loop._check_plane((x, y))
     except (TypeError, ValueError) as exc:
         raise ValueError(f"{where}: plane: {exc}") from None
-    for section, keys in (("design", "over, maximize"), ("robust", "uncertain, strips"),
-                          ("simulated", "amplitude, steps, ...")):
-        if (section in spec) != (kind == section):
+    for section, keys, holds in _SECTIONS:
+        if kind == section and section not in spec:
+            raise ValueError(f"{where}: question = \"{section}\" needs a [{section}] table and "
+                             f"there is none: give one holding {holds}")
+        if section in spec and kind != section:
             raise ValueError(f"{where}: [{section}] ({keys}) goes with question = "
-                             f"\"{section}\", and only with it")
+                             f"\"{section}\", and only with it (the question is {kind!r})")
     over, maximize, strips, simulation = (), "y_max", 64, ()
     if kind == "design":
         over, maximize = _design(where, loop, x, y, spec["design"])
@@ -412,6 +578,12 @@ def _si(where, loop, name, values, unit):
         return [float(v) for v in values]
     if unit is not None and not isinstance(unit, str):
         raise ValueError(f"{where}: the unit of {name} must be text, got {unit!r}")
+    if not all(math.isfinite(v) for v in values):
+        # TOML has nan and inf; the unit conversion would refuse them without naming the key.
+        unit = unit or (getattr(loop, "file_parameters", None)
+                        and loop.file_parameters.file_unit(name))
+        raise ValueError(f"{where}: {name} must be finite numbers{f' in {unit}' if unit else ''}"
+                         f", got {values!r}")
     converted, _ = convert_sets(loop, {name: (list(values), unit)}, flag=where + ":")
     out = [float(v) for v in converted[name]]
     if not all(math.isfinite(v) for v in out):

@@ -3,6 +3,7 @@
 Every failure is one line ``symstab <command>: error: ...`` and exit status
 2, decided before the long work; NumPy warnings never reach the user;
 SIGINT and SIGTERM print one line and exit 130 and 143, leaving no file;
+a reader of the output that goes (``| head -1``) stops a command quietly;
 output paths are checked (collisions, folders, writability) before the work.
 Most commands run in-process through :func:`symstab.cli.commands.main` (a traceback
 would escape it as an exception and fail the test); what only a process
@@ -350,6 +351,48 @@ def test_a_signal_stops_a_long_map_with_one_line_and_no_file(tmp_path, signum, s
     assert proc.returncode == status, err
     assert err.strip() == "symstab map: interrupted", err
     assert list(tmp_path.iterdir()) == []
+
+
+def test_a_reader_that_goes_stops_the_command_quietly():
+    """``symstab limits --format json | head -1`` printed "error: [Errno 32] Broken pipe" and
+    exited 2; a Unix tool stops quietly (killed by SIGPIPE: 141 in the shell)."""
+    proc = subprocess.Popen([sys.executable, "-m", "symstab", "limits", "--format", "json"],
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    # Gone before the first write (the command takes a second to start): that write fails.
+    proc.stdout.close()
+    try:
+        err = proc.stderr.read()
+        proc.wait(timeout=60)
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+            proc.wait()
+    assert (proc.returncode, err) == (141, "")
+
+
+@pytest.mark.parametrize("args", [
+    ["limits"], ["boundary"], ["classify", *DIMENSIONLESS],
+    ["locus", "--delta", "0.0025", "--d", "2", "--alpha", "0:0.5", "--beta", "0.5"]],
+    ids=lambda args: args[0])
+def test_each_command_stops_quietly_when_its_reader_goes(capsys, monkeypatch, args):
+    read, write = os.pipe()
+    os.close(read)
+    with open(write, "w", encoding="utf-8") as widowed:
+        monkeypatch.setattr(sys, "stdout", widowed)
+        status = cli.main([*args, "--format", "json"])
+        monkeypatch.undo()
+    assert (status, capsys.readouterr().err) == (141, "")
+
+
+def test_a_broken_pipe_that_is_not_stdout_s_is_an_error(capsys, monkeypatch):
+    from symstab.cli import limits
+
+    def broken(args):
+        raise BrokenPipeError(32, "Broken pipe")
+
+    monkeypatch.setattr(limits, "run", broken)
+    status, _, err = _main(capsys, "limits")
+    assert status == 2 and err == "symstab limits: error: [Errno 32] Broken pipe\n"
 
 
 def test_interrupted_in_process_returns_130(capsys, monkeypatch):

@@ -7,10 +7,13 @@ evaluating the saved chunks again.  A bad spec is one line, exit status 2,
 before any work, and nothing is written.
 """
 
+import contextlib
 import os
 import signal
+import socket
 import subprocess
 import sys
+import threading
 import time
 
 import numpy as np
@@ -131,6 +134,111 @@ def test_a_two_worker_cluster_gives_the_serial_table_and_resumes_after_sigint(ca
     assert not parts.exists()
 
 
+def test_ctrl_c_while_the_cluster_starts_stops_the_sweep(tmp_path):
+    """A Ctrl-C while the workers were being started was dropped (SIGINT was ignored then, so
+    that they inherit it): the sweep ran to its end and exited 0."""
+    pytest.importorskip("dask.distributed")
+    psutil = pytest.importorskip("psutil")
+    path = spec(tmp_path, '[grid]\nd = [3, 4]\n')
+    out = tmp_path / "t.csv"
+    process = subprocess.Popen([sys.executable, "-m", "symstab", "sweep", str(path), "--out",
+                                str(out), "--workers", "1"], stdout=subprocess.PIPE,
+                               stderr=subprocess.PIPE, text=True, start_new_session=True)
+    try:
+        # The first worker process spawned: the cluster is starting, not started (its
+        # worker has yet to import Dask and register).
+        deadline, workers = time.monotonic() + 60, []
+        while time.monotonic() < deadline and process.poll() is None and not workers:
+            workers = [child for child in psutil.Process(process.pid).children(recursive=True)
+                       if "spawn_main" in " ".join(child.cmdline())]
+            time.sleep(0.01)
+        assert workers, "no worker process was started"
+        os.killpg(process.pid, signal.SIGINT)
+        stdout, stderr = process.communicate(timeout=60)
+    finally:
+        if process.poll() is None:
+            process.kill()
+            process.wait()
+    assert process.returncode == 130, stderr
+    assert stderr == "symstab sweep: interrupted: no chunk of 1 was saved yet (nothing to " \
+                     "resume)\n"
+    assert "on a Dask LocalCluster" not in stdout
+    assert list(tmp_path.iterdir()) == [path]
+    # The cluster was closed with the command: no worker is left running.
+    assert not psutil.wait_procs(workers, timeout=10)[1]
+
+
+def test_the_errors_of_the_cluster_s_own_tasks_are_not_shown(caplog):
+    """Ctrl-C in client.scatter printed 15 lines of the scheduler's failed replication
+    ("Task exception was never retrieved") after the one line."""
+    pytest.importorskip("dask.distributed")
+    import asyncio
+    import gc
+
+    from symstab.cli.sweep import local_cluster
+
+    async def failing():
+        raise KeyError("tcp://127.0.0.1:1")   # a worker gone, as in Scheduler.replicate
+
+    cluster = local_cluster(1)
+    try:
+        done = threading.Event()
+
+        def start():
+            task = asyncio.get_running_loop().create_task(failing())
+            task.add_done_callback(lambda _: done.set())
+
+        cluster.loop.add_callback(start)
+        assert done.wait(10)
+        time.sleep(0.1)
+        gc.collect()
+    finally:
+        cluster.close()
+    assert not [r for r in caplog.records if r.name == "asyncio"], caplog.text
+
+
+def test_a_serial_sweep_stopped_by_sigterm_says_how_to_resume(tmp_path):
+    """SIGTERM gave "interrupted" with no resume hint; now the line is SIGINT's, status 143."""
+    path = spec(tmp_path, 'chunk = 1\n[grid]\nd = { from = 1, to = 200, points = 200 }\n')
+    parts = tmp_path / "t.csv.parts"
+    process = subprocess.Popen([sys.executable, "-m", "symstab", "sweep", str(path), "--out",
+                                str(tmp_path / "t.csv"), "--serial"], stdout=subprocess.PIPE,
+                               stderr=subprocess.PIPE, text=True)
+    try:
+        deadline = time.monotonic() + 60
+        while time.monotonic() < deadline and process.poll() is None:
+            if parts.exists() and list(parts.glob("chunk-*.npz")):
+                break
+            time.sleep(0.02)
+        process.send_signal(signal.SIGTERM)
+        _, stderr = process.communicate(timeout=60)
+    finally:
+        if process.poll() is None:
+            process.kill()
+            process.wait()
+    assert process.returncode == 143, stderr
+    saved = len(list(parts.glob("chunk-*.npz")))
+    assert 1 <= saved < 200, "the sweep ended before the signal: make it longer"
+    assert stderr == (f"symstab sweep: interrupted: {saved} of 200 chunks saved in {parts}; "
+                      f"the same command resumes there\n")
+
+
+def test_an_interruption_before_the_first_chunk_leaves_no_folder(capsys, tmp_path,
+                                                                 monkeypatch):
+    """A folder holding only sweep.json was left (nothing in it to resume from)."""
+    from symstab.numeric import sweep as numeric_sweep
+
+    def interrupted(*args):
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(numeric_sweep, "evaluate_rows", interrupted)
+    status, _, err = run(capsys, "sweep", spec(tmp_path, '[grid]\nd = [3, 4]\n'), "--out",
+                         tmp_path / "t.csv", "--serial")
+    assert status == 130
+    assert err == "symstab sweep: interrupted: no chunk of 1 was saved yet (nothing to resume)\n"
+    assert list(tmp_path.iterdir()) == [tmp_path / "s.toml"]
+
+
 def test_the_chunks_go_once_the_table_is_written_and_another_sweep_s_are_refused(capsys,
                                                                                  tmp_path):
     first = spec(tmp_path, '[grid]\nd = [3]\n', "a.toml")
@@ -166,6 +274,15 @@ def test_without_dask_the_message_says_what_to_install(capsys, tmp_path, monkeyp
     ('[grid]\nb = { values = [1], unit = "Hz" }\n', "Hz"),
     ('[grid]\nb = []\n', "non-empty list"),
     ('[grid]\nb = ["x"]\n', "must be numbers"),
+    # TOML's nan and inf: "cannot convert NaN to integer ratio" named no key.
+    ('[grid]\nb = [0.01, nan]\n', "[grid]: b must be finite numbers in N m s/rad, got [0.01, nan]"),
+    ('[grid]\nb = { values = [inf], unit = "mN m s/rad" }\n',
+     "[grid]: b must be finite numbers in mN m s/rad, got [inf]"),
+    ('[random]\nsamples = 3\nb = [nan, 0.02]\n', "[random]: b must be finite numbers"),
+    ('question = "design"\n[grid]\nd = [3]\n[design]\nover = { M = [0, nan] }\n',
+     "[design] over: M must be finite numbers in kg m^2"),
+    ('question = "robust"\n[grid]\nd = [3]\n[robust]\nuncertain = { b = [nan, 0.02] }\n',
+     "[robust] uncertain: b must be finite numbers"),
     ('[grid]\nb = { from = 0, to = 1 }\n', "points = N"),
     ('[random]\nsamples = 0\nb = [0.01, 0.02]\n', "samples must be an integer"),
     ('[random]\nsamples = 3\nb = [0.02, 0.01]\n', "LO < HI"),
@@ -173,7 +290,10 @@ def test_without_dask_the_message_says_what_to_install(capsys, tmp_path, monkeyp
     ('[random]\nsamples = 3\nm = [0, 0.02]\n', "[random]: at m = 0"),
     ('[random]\nsamples = 3\nseed = -1\nb = [0.01, 0.02]\n', "seed"),
     ('[grid]\nm = [0]\n', "the sweep spec"),
-    ('question = "design"\n[grid]\nd = [3]\n', "[design] (over, maximize) goes with"),
+    # A question without its table: the table is missing, and what it holds (it read as if
+    # the table were misplaced).
+    ('question = "design"\n[grid]\nd = [3]\n',
+     'question = "design" needs a [design] table and there is none: give one holding over = '),
     ('[grid]\nd = [3]\n[design]\nover = { M = [0, 1] }\n', "goes with question"),
     ('question = "design"\n[grid]\nd = [3]\n[design]\nover = { d = [0, 1] }\n',
      "whole number"),
@@ -183,7 +303,11 @@ def test_without_dask_the_message_says_what_to_install(capsys, tmp_path, monkeyp
      'maximize = "simulated"\n', "maximize must be one of"),
     ('question = "design"\n[grid]\nd = [3]\n[design]\nover = { M = [0.01, 0] }\n',
      "LO < HI"),
-    ('question = "robust"\n[grid]\nd = [3]\n', "[robust] (uncertain, strips) goes with"),
+    ('question = "robust"\n[grid]\nd = [3]\n',
+     'question = "robust" needs a [robust] table and there is none: give one holding '
+     'uncertain = {NAME = [LO, HI]}'),
+    ('question = "simulated"\n[grid]\nd = [3]\n', "needs a [simulated] table and there is "
+     "none: give one holding amplitude"),
     ('question = "robust"\n[grid]\nd = [3]\n[robust]\nstrips = 4\n', "names the box"),
     ('question = "robust"\n[grid]\nd = [3]\n[robust]\nuncertain = { b = [0.02, 0.01] }\n',
      "LO <= HI"),
@@ -217,10 +341,91 @@ def test_a_bad_spec_is_one_line_before_any_work(capsys, tmp_path, monkeypatch, t
     assert out == "" and list((tmp_path / "work").iterdir()) == []
 
 
+@contextlib.contextmanager
+def listener(answer, hold=20.0):
+    """A loopback TCP address that accepts and sends ``answer`` (b"": nothing), for ``hold`` s.
+
+    The connections are closed after ``hold`` seconds, so that a client waiting for ever
+    ends (and fails its test) rather than hanging the test run.
+    """
+    server = socket.create_server(("127.0.0.1", 0))
+    server.settimeout(0.1)
+    stop = threading.Event()
+
+    def serve():
+        held, started = [], time.monotonic()
+        while not stop.is_set() and time.monotonic() - started < hold:
+            try:
+                conn, _ = server.accept()
+            except TimeoutError:
+                continue
+            held.append(conn)
+            if answer:
+                conn.sendall(answer)
+        for conn in held:
+            conn.close()
+
+    thread = threading.Thread(target=serve, daemon=True)
+    thread.start()
+    try:
+        yield f"tcp://127.0.0.1:{server.getsockname()[1]}"
+    finally:
+        stop.set()
+        thread.join()
+        server.close()
+
+
+@pytest.mark.parametrize("answer, timeout, needle", [
+    (b"", ["--connect-timeout", "0.5"], "no answer in 0.5 s"),
+    # Read as Dask's frame lengths, such bytes asked for exabytes ("out of memory").
+    (b"\xff" * 64 + b"HTTP/1.1 400 Bad Request\r\n\r\n", [],
+     "the answer is not Dask's protocol"),
+], ids=["silent", "garbage"])
+def test_a_scheduler_address_that_does_not_answer_as_dask_is_one_line(capsys, tmp_path, answer,
+                                                                       timeout, needle):
+    """A listener that never answered held the sweep for ever (the timeout bounded only the
+    TCP connection); garbage bytes gave "out of memory"."""
+    pytest.importorskip("dask.distributed")
+    path = spec(tmp_path, '[grid]\nd = [3]\n')
+    with listener(answer) as address:
+        started = time.monotonic()
+        status, out, err = run(capsys, "sweep", path, "--out", tmp_path / "t.csv",
+                               "--scheduler", address, *timeout)
+        elapsed = time.monotonic() - started
+    assert status == 2 and err.count("\n") == 1, err
+    assert err.startswith(f"symstab sweep: error: --scheduler {address}: {needle}"), err
+    assert elapsed < 5 and out == "" and list(tmp_path.iterdir()) == [path]
+
+
+def test_a_running_scheduler_is_used_and_a_worker_s_address_is_refused(capsys, tmp_path):
+    """The check before the Client lets a scheduler through (the sweep runs on it) and
+    refuses another Dask server."""
+    distributed = pytest.importorskip("dask.distributed")
+    from symstab.cli.sweep import check_scheduler
+
+    path = spec(tmp_path, '[grid]\nd = [3]\n')
+    with distributed.LocalCluster(n_workers=1, threads_per_worker=1, processes=False,
+                                  protocol="tcp", dashboard_address=None) as cluster:
+        status, out, err = run(capsys, "sweep", path, "--out", tmp_path / "t.csv",
+                               "--scheduler", cluster.scheduler_address)
+        assert status == 0, err
+        assert f"on the Dask scheduler at {cluster.scheduler_address}" in out
+        worker = next(iter(cluster.workers.values())).address
+        with pytest.raises(ValueError, match=r"not a Dask scheduler \(a Worker\)"):
+            check_scheduler(worker, 5)
+    found = symstab.load_loop(LOOPS / "paper.toml").limits(d=3)
+    assert float(read_csv(tmp_path / "t.csv")[1][0, 1]) == pytest.approx(found.y_max,
+                                                                        rel=1e-11)
+
+
 @pytest.mark.parametrize("args, needle", [
     (["--out", "t.txt"], "--out must end in .csv or .npz"),
     (["--out", "t.csv", "--workers", "0"], "--workers must be"),
     (["--out", "t.csv", "--serial", "--workers", "2"], "not allowed with"),
+    (["--out", "t.csv", "--connect-timeout", "5"], "--connect-timeout goes with --scheduler"),
+    (["--out", "t.csv", "--scheduler", "tcp://127.0.0.1:1", "--connect-timeout", "0"],
+     "--connect-timeout must be a number of seconds > 0"),
+    (["--out", "t.csv", "--scheduler", "nonsense://x"], "is not a scheduler's address"),
 ])
 def test_bad_options_are_one_line(capsys, tmp_path, monkeypatch, args, needle):
     path = spec(tmp_path, '[grid]\nd = [3]\n')
