@@ -33,6 +33,7 @@ import sys
 
 import numpy as np
 
+from .._signals import Terminated, exit_status
 from .loop_options import check_corners, convert_sets, load_loop_file
 from .options import add_command
 from .output import check_files, write_output
@@ -134,11 +135,8 @@ def run(args):
         if store is not None and not store.done():
             shutil.rmtree(parts, ignore_errors=True)
         raise
-    except BaseException as exc:
-        if isinstance(exc, (SystemExit, GeneratorExit)):
-            raise
-        # Ctrl-C (KeyboardInterrupt) or SIGTERM (the BaseException the command line raises
-        # for it): both say what is saved and how to resume.
+    except (KeyboardInterrupt, Terminated) as exc:
+        # Ctrl-C or SIGTERM: both say what is saved and how to resume.
         return _interrupted(exc, store, parts, n_chunks)
     finally:
         if client is not None:
@@ -162,8 +160,6 @@ def _interrupted(exc, store, parts, n_chunks):
 
     A folder holding no chunk goes, as after an error: there is nothing in it to resume.
     """
-    import signal
-
     saved = len(store.done()) if store is not None else 0
     if saved:
         what = (f"{saved} of {n_chunks} chunks saved in {parts}; the same command resumes "
@@ -174,7 +170,7 @@ def _interrupted(exc, store, parts, n_chunks):
         what = f"no chunk of {n_chunks} was saved yet (nothing to resume)"
     print(f"{chr(10) if sys.stderr.isatty() else ''}symstab sweep: interrupted: {what}",
           file=sys.stderr)
-    return 128 + (signal.SIGINT if isinstance(exc, KeyboardInterrupt) else signal.SIGTERM)
+    return exit_status(exc)
 
 
 def _client_factory(args):
