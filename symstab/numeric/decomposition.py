@@ -48,9 +48,8 @@ from .polynomial import DelayedPolynomial
 from .results import Limits, Segment
 from .roots import STABLE, classify_polynomials, leading_vanishes, root_counts
 
-__all__ = ["Branch", "Cell", "Decomposition", "StableHull", "decompose", "arc_points", "sample_arc",
-           "window_arc",
-           "stable_hull"]
+__all__ = ["Branch", "Cell", "Decomposition", "StableHull", "Unresolved", "decompose", "arc_points",
+           "sample_arc", "window_arc", "stable_hull"]
 
 #: Change of the unstable count across each piece (crossing rule); the
 #: window's edges are labelled ``"window"``.
@@ -1393,6 +1392,23 @@ def stable_hull(base, ax, ay):
 # The decomposition
 
 
+class Unresolved(ValueError):
+    """A window :func:`decompose` refuses, with what its first, coarser pass found.
+
+    Attributes
+    ----------
+    attempt : Decomposition
+        The pass with the arc sampled at the usual length when it broke no
+        crossing rule, else the finer one: its stable cells say where to
+        narrow the window (:meth:`symstab.Loop.region` does; the narrowed
+        window is decomposed and checked anew).
+    """
+
+    def __init__(self, message, attempt):
+        super().__init__(message)
+        self.attempt = attempt
+
+
 def decompose(base, ax, ay, ends, *, x_range, y_range, names=("x", "y"), arc=None, family=None):
     """The D-decomposition of ``chi = base + x ax + y ay`` inside a window.
 
@@ -1426,9 +1442,11 @@ def decompose(base, ax, ay, ends, *, x_range, y_range, names=("x", "y"), arc=Non
     Raises
     ------
     ValueError
-        If the window is not finite with ``lo < hi``, or if two neighbouring
-        cells break the crossing rule even with the arc sampled 8 times
-        finer (the window is too coarse for the curves in it).
+        If the window is not finite with ``lo < hi``.
+    Unresolved
+        (a ValueError) If two neighbouring cells break the crossing rule
+        even with the arc sampled finer, or a stable cell is too small for
+        the window (the window is too coarse for the curves in it).
 
     Examples
     --------
@@ -1445,6 +1463,7 @@ def decompose(base, ax, ay, ends, *, x_range, y_range, names=("x", "y"), arc=Non
         arc = CramerArc(*(np.asarray(c, dtype=float) for c in (base, ax, ay)))
     found = _decompose(base, ax, ay, ends, x_range=x_range, y_range=y_range, names=names,
                        fine=1.0, arc=arc, family=family)
+    coarse = None if found.mismatches else found
     if found.mismatches or found.resolution > _RESOLUTION:
         # A stable cell small for its window: the arc sampled finer (not
         # beyond 64 times: a window that needs more is refused below).
@@ -1453,18 +1472,19 @@ def decompose(base, ax, ay, ends, *, x_range, y_range, names=("x", "y"), arc=Non
         found = _decompose(base, ax, ay, ends, x_range=x_range, y_range=y_range, names=names,
                            fine=fine, arc=arc, family=family)
     if found.resolution > _RESOLUTION:
-        raise ValueError(
+        raise Unresolved(
             f"the stable set is too small to be resolved in the window {found.x} in "
             f"[{found.x_range[0]:g}, {found.x_range[1]:g}], {found.y} in "
-            f"[{found.y_range[0]:g}, {found.y_range[1]:g}]: narrow the window around it")
+            f"[{found.y_range[0]:g}, {found.y_range[1]:g}]: narrow the window around it",
+            coarse or found)
     if found.mismatches:
         i, j, label, change = found.mismatches[0]
-        raise ValueError(
+        raise Unresolved(
             f"the D-decomposition of {found.x} in [{found.x_range[0]:g}, {found.x_range[1]:g}], "
             f"{found.y} in [{found.y_range[0]:g}, {found.y_range[1]:g}] is not resolved: across "
             f"the {label} piece the counts of two neighbouring cells ({found.cells[i].count}, "
             f"{found.cells[j].count}) differ by {abs(change)}, not {_CHANGE[label]}; narrow "
-            f"the window around the region of interest")
+            f"the window around the region of interest", coarse or found)
     return found
 
 
