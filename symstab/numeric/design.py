@@ -29,8 +29,14 @@ bounds (:func:`scipy.optimize.minimize`) in two.  The scan includes the
 nominal value, and zooms into a run of stable values that holds fewer than
 five scan points (a narrow band of stable values, such as the virtual
 masses of a loop with a fast device, is resolved before the refinement
-rather than missed).  A band that holds neither a scan point nor the
-nominal value can still be missed: :attr:`Design.spacing` says the scan's
+rather than missed).  Where the searched parameters enter the loop's
+polynomial affinely with the plane's (a virtual mass), the scan is laid
+over the values where Stodola's necessary condition can hold
+(:func:`~symstab.numeric.decomposition.stable_ranges`), so a narrow band
+in a wide range is bracketed first, and a range where it holds nowhere is
+proved to have no stable point.  Otherwise a band that holds neither a
+scan point nor the nominal value can still be missed: then the message
+says so (never a bare "none"), :attr:`Design.spacing` says the scan's
 step, and ``n`` makes it finer.
 """
 
@@ -75,8 +81,9 @@ class Design:
     over : dict
         ``{name: (low, high)}``: the parameters searched and their ranges.
     best : dict or None
-        ``{name: value}`` at the optimum; None when no value searched has a
-        stable point (:attr:`message` says so).
+        ``{name: value}`` at the optimum; None when no value evaluated has
+        a stable point (:attr:`message` says whether that is proved for the
+        whole range or which values were not examined).
     value : float or None
         The target there.
     nominal : dict
@@ -96,8 +103,9 @@ class Design:
         then the target (``-inf`` no stable point, NaN not resolved), in
         the order evaluated.
     spacing : dict
-        ``{name: step}`` of the first scan: a band of stable values
-        narrower than this that holds no scan point can be missed.
+        ``{name: step}`` of the first scan (over the bracket of values where
+        a stable point can be, for an affine parameter): a band of stable
+        values narrower than this that holds no scan point can be missed.
     failed : tuple of (dict, str)
         The values the engine could not resolve, with its message.
     values : dict
@@ -465,17 +473,23 @@ def design(loop, *, over, maximize="y_max", x=None, y=None, n=None, rtol=None, d
             return math.nan
 
     include = [tuple(nominal[n_] for n_ in names)] if nominal else []
-    if len(names) == 1:
-        best, value, seen = maximize_scalar(lambda v: target((v,)), *over[names[0]], n,
+    # Where a stable point can be at all: the searched box narrowed to it, or
+    # proved empty (then nothing is scanned).
+    bracket = _bracket(loop, maximize, x, y, names, over, at) if delay is None else over
+    searched = over if bracket is None else bracket
+    if bracket is None:
+        best, value, seen = None, None, []
+    elif len(names) == 1:
+        best, value, seen = maximize_scalar(lambda v: target((v,)), *searched[names[0]], n,
                                             include=[p[0] for p in include], rtol=rtol,
                                             progress=progress)
         best = None if best is None else (best,)
         seen = [((p,), v) for p, v in seen]
     else:
-        best, value, seen = maximize_box(target, tuple(over[k] for k in names), n,
+        best, value, seen = maximize_box(target, tuple(searched[k] for k in names), n,
                                          include=include, rtol=rtol, progress=progress)
     samples = np.array([[*p, v] for p, v in seen], dtype=float).reshape(-1, len(names) + 1)
-    spacing = {k: (hi - lo) / (n - 1) for k, (lo, hi) in over.items()}
+    spacing = {k: (hi - lo) / (n - 1) for k, (lo, hi) in searched.items()}
     value_nominal = None
     if nominal:
         key = tuple(nominal[k] for k in names)
@@ -493,16 +507,62 @@ def design(loop, *, over, maximize="y_max", x=None, y=None, n=None, rtol=None, d
                          f"{failed[0][1]}")
     if best is None:
         ranges = ", ".join(f"{k} in [{lo:.6g}, {hi:.6g}]" for k, (lo, hi) in over.items())
-        what = {"passive": "a passive point",
-                "simulated": f"a point whose simulated run settles below "
-                             f"{simulation.get('amplitude', 0):.3g}"}.get(maximize, "a stable point")
-        return Design(best=None, value=None, limits=None,
-                      message=f"no value of {ranges} has {what} in the ({x}, {y}) plane "
-                              f"(scanned in steps of "
-                              f"{', '.join(f'{s:.3g}' for s in spacing.values())}; "
-                              f"{len(samples)} evaluations)", **common)
+        what = {"passive": "passive point",
+                "simulated": f"point whose simulated run settles below "
+                             f"{simulation.get('amplitude', 0):.3g}"}.get(maximize, "stable point")
+        if bracket is None:
+            message = (f"no value of {ranges} has a {what} in the ({x}, {y}) plane: proved "
+                       f"(Stodola's necessary condition, the coefficients of (w - 1)**n "
+                       f"chi((w + 1)/(w - 1)) all of one sign, holds nowhere in the range)")
+        else:
+            # Only the values evaluated are known: a band of them narrower than
+            # the scan's step can lie between two.
+            inside = ", ".join(f"{k} in [{lo:.6g}, {hi:.6g}]" for k, (lo, hi) in searched.items())
+            narrowed = (f"; outside {inside} none is stable (Stodola's necessary condition)"
+                        if searched != over else "")
+            message = (f"no {what} in the ({x}, {y}) plane was found at the {len(samples)} "
+                       f"values of {inside} evaluated (steps of "
+                       f"{', '.join(f'{s:.3g}' for s in spacing.values())}){narrowed}; between "
+                       f"them the range was not examined: a band of values narrower than a step "
+                       f"may hold one (give a finer n)")
+        return Design(best=None, value=None, limits=None, message=message, **common)
     return Design(best=dict(zip(names, (float(v) for v in best))), value=float(value),
                   limits=answer(best), **common)
+
+
+def _bracket(loop, maximize, x, y, names, over, at):
+    """``over`` narrowed to where a stable point can be, or None when it can be nowhere.
+
+    Where the searched parameters enter the characteristic polynomial affinely
+    with the plane's (a virtual mass, say), Stodola's necessary condition is
+    linear in all of them (:func:`symstab.numeric.decomposition.stable_ranges`):
+    a narrow band of stable values inside a wide range is bracketed before
+    the scan instead of stepped over, and a range where the condition holds
+    nowhere is proved to have no stable point.  Elsewhere (a sample period, a
+    filter's cut-off, the passive target) ``over`` as given.
+    """
+    from .decomposition import stable_ranges
+
+    if maximize == "passive" or not loop._affine((x, y, *names)):
+        return over
+    try:
+        base, slopes, _ = loop.affine_parts((x, y), at(tuple(0.0 for _ in names)))
+        rows = [base, *slopes]
+        for k in range(len(names)):
+            unit = at(tuple(float(j == k) for j in range(len(names))))
+            rows.append(loop.affine_parts((x, y), unit)[0] - base)
+    except ValueError:
+        return over         # 0 or 1 is not a value of the parameter: no bracket
+    ranges = stable_ranges(rows, [None, None, *over.values()])
+    if ranges is None:
+        return None
+    out = {}
+    for name, (lo, hi), (low, high) in zip(names, ranges[2:], over.values()):
+        # A hair wider than the programme's ends (never past the range).
+        pad = 1e-9 * (high - low)
+        lo, hi = max(low, lo - pad), min(high, hi + pad)
+        out[name] = (lo, hi) if lo < hi else (low, high)
+    return out
 
 
 def held_delay(delay, T):
