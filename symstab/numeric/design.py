@@ -47,8 +47,8 @@ import numpy as np
 
 from .._validate import check_count, check_real, check_window
 
-__all__ = ["TARGETS", "Design", "design", "maximize_scalar", "maximize_box", "held_delay",
-           "box_corners"]
+__all__ = ["TARGETS", "Design", "design", "maximize_scalar", "maximize_pieces", "maximize_box",
+           "held_delay", "delay_pieces", "box_corners"]
 
 #: What a design maximises, with what it is.
 TARGETS = {
@@ -66,6 +66,12 @@ _MIN_RUN = 5
 _MAX_ZOOMS = 8
 #: Evaluations of the local refinement at most.
 _MAX_REFINE = 200
+#: The pieces of a piecewise search refined, the best first by their left ends.
+_TOP_PIECES = 3
+#: Scan points of each piece refined.
+_PIECE_POINTS = 5
+#: Whole-sample pieces of a sample period's range at most (one evaluation each at least).
+MAX_PIECES = 400
 
 
 @dataclasses.dataclass(frozen=True)
@@ -293,6 +299,73 @@ def maximize_scalar(f, low, high, n=17, *, include=(), rtol=1e-6, progress=None)
     return x_best, value, [(p[0], v) for p, v in evaluate.seen.items()]
 
 
+def maximize_pieces(f, pieces, *, include=(), rtol=1e-6, progress=None):
+    """The x that maximises ``f``, continuous on each piece but jumping between them.
+
+    A sawtooth (the target against the sample period with the delay held in
+    seconds: ``d`` steps at each ``T = delay / k``) defeats a search of the
+    whole interval: Brent's method climbs one tooth.  Here ``f`` is
+    evaluated at each piece's left end (and at ``include``); the
+    :data:`_TOP_PIECES` pieces best there, and the piece of the best
+    ``include`` point, are each searched by :func:`maximize_scalar`
+    (:data:`_PIECE_POINTS` points, then Brent's method), and the best of
+    all is taken.
+
+    Parameters
+    ----------
+    f : callable
+        ``f(x) -> float``, as for :func:`maximize_scalar`.
+    pieces : sequence of (float, float)
+        Closed intervals, in increasing order, ``a < b``, on each of which
+        ``f`` is continuous.
+    include, rtol, progress : optional
+        As for :func:`maximize_scalar`.
+
+    Returns
+    -------
+    (float, float, list) or (None, None, list)
+        As :func:`maximize_scalar`.
+
+    Examples
+    --------
+    A sawtooth rising to 1 / k at the left end of each piece [1 / k, 1 / (k - 1)]:
+
+    >>> pieces = [(1 / k, 1 / (k - 1) - 1e-9) for k in range(9, 1, -1)]
+    >>> def f(x):
+    ...     k = next(k for k in range(9, 1, -1) if 1 / k <= x < 1 / (k - 1))
+    ...     return k - x * k * k / 2
+    >>> x, value, _ = maximize_pieces(f, pieces)
+    >>> round(x, 6), round(value, 6)
+    (0.111111, 4.5)
+    """
+    pieces = [check_window("a piece", piece) for piece in pieces]
+    if not pieces:
+        raise ValueError("pieces must hold at least one interval (a, b), a < b")
+    evaluate = _Evaluations(lambda p: f(p[0]), progress)
+    for a, _ in pieces:
+        evaluate(a)
+    inside = [float(v) for v in include if any(a <= v <= b for a, b in pieces)]
+    for v in inside:
+        evaluate(v)
+
+    def rank(k):
+        value = evaluate.seen[(pieces[k][0],)]
+        return -math.inf if math.isnan(value) else value
+
+    chosen = sorted(range(len(pieces)), key=rank, reverse=True)[:_TOP_PIECES]
+    chosen += [k for k, (a, b) in enumerate(pieces) for v in inside if a <= v <= b]
+    for k in dict.fromkeys(chosen):
+        a, b = pieces[k]
+        maximize_scalar(lambda x: evaluate((x,)), a, b, _PIECE_POINTS,
+                        include=[v for v in inside if a <= v <= b], rtol=rtol)
+    found = evaluate.best()
+    seen = [(p[0], v) for p, v in evaluate.seen.items()]
+    if found is None:
+        return None, None, seen
+    (x_best,), value = found
+    return x_best, value, seen
+
+
 def maximize_box(f, box, n=9, *, include=(), rtol=1e-6, progress=None):
     """The point of a 2-D box that maximises ``f``: a grid, then Nelder-Mead with bounds.
 
@@ -479,6 +552,13 @@ def design(loop, *, over, maximize="y_max", x=None, y=None, n=None, rtol=None, d
     searched = over if bracket is None else bracket
     if bracket is None:
         best, value, seen = None, None, []
+    elif len(names) == 1 and delay is not None and names[0] == "T":
+        best, value, seen = maximize_pieces(lambda v: target((v,)),
+                                            delay_pieces(delay, *over["T"]),
+                                            include=[p[0] for p in include], rtol=rtol,
+                                            progress=progress)
+        best = None if best is None else (best,)
+        seen = [((p,), v) for p, v in seen]
     elif len(names) == 1:
         best, value, seen = maximize_scalar(lambda v: target((v,)), *searched[names[0]], n,
                                             include=[p[0] for p in include], rtol=rtol,
@@ -563,6 +643,41 @@ def _bracket(loop, maximize, x, y, names, over, at):
         lo, hi = max(low, lo - pad), min(high, hi + pad)
         out[name] = (lo, hi) if lo < hi else (low, high)
     return out
+
+
+def delay_pieces(delay, low, high):
+    """The intervals of ``T`` in ``[low, high]`` on each of which ``held_delay(delay, T)`` is one ``d``.
+
+    ``d = ceil(delay / T)`` is ``d`` for ``T`` in ``[delay / d, delay / (d -
+    1))``: each piece is that interval cut to the range, its open right end
+    taken 1e-8 inside (where ``d`` is still the piece's), in increasing
+    ``T``.  With no delay, the range itself.
+
+    Raises
+    ------
+    ValueError
+        If the range spans more than :data:`MAX_PIECES` whole delays.
+
+    Examples
+    --------
+    >>> [(round(a * 1e3, 4), round(b * 1e3, 4)) for a, b in delay_pieces(0.01, 2e-3, 4e-3)]
+    [(2.0, 2.5), (2.5, 3.3333), (3.3333, 4.0)]
+    """
+    if delay == 0:
+        return [(low, high)]
+    first, last = held_delay(delay, high), held_delay(delay, low)
+    if last - first + 1 > MAX_PIECES:
+        raise ValueError(f"over['T'] in [{low:.6g}, {high:.6g}] with the delay held at "
+                         f"{delay:.6g} s spans {last - first + 1} whole-sample delays (d from "
+                         f"{first} to {last}), above {MAX_PIECES}: each is searched; narrow the "
+                         f"range of T")
+    pieces = []
+    for d in range(last, first - 1, -1):
+        a = max(low, delay / d)
+        b = high if d <= 1 or delay / (d - 1) > high else delay / (d - 1) * (1 - 1e-8)
+        if a < b:
+            pieces.append((a, b))
+    return pieces
 
 
 def held_delay(delay, T):

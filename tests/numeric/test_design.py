@@ -224,3 +224,21 @@ def test_no_stable_value_is_said_with_its_proof():
     assert found.best is None and "proved" in found.message
     for M in np.linspace(0.5, 1.0, 5):
         assert loop.limits(d=40, M=M).y_max is None
+
+
+def test_the_sample_period_search_takes_the_best_whole_sample_piece():
+    """Issue 40, item 2: with the delay held at 5 ms, K_max against T is a sawtooth (d =
+    ceil(5 ms / T) steps at each T = 5 ms / k); Brent's method over the whole range climbed
+    one tooth (T = 1/3 ms, d = 15, K_max 253.375) while d = 16 is better.  Oracle: K_max of
+    the engine at four values of T in each whole-sample piece, d fixed per piece."""
+    loop = symstab.load_loop(LOOPS / "paper.toml")
+    delay, window = 0.005, (3e-4, 8e-4)
+    found = loop.design(over={"T": window}, delay=delay, n=9, M=0.0)
+    scan = []
+    for d in range(math.ceil(delay / window[1]), math.ceil(delay / window[0]) + 1):
+        low, high = max(window[0], delay / d), min(window[1], delay / (d - 1))
+        scan += [(loop.limits(T=float(T), d=d, M=0.0).y_max, d)
+                 for T in np.linspace(low, high, 5)[:-1]]
+    value, d = max(scan)
+    assert found.best_d == d == 16
+    assert found.value == pytest.approx(value, rel=1e-6)
