@@ -160,11 +160,23 @@ class Design:
 
     @property
     def at_edge(self):
-        """The searched parameters whose optimum lies within 1e-3 of the range's width of an end."""
+        """The searched parameters whose optimum lies within 1e-3 of the range's width of an end.
+
+        (With the delay held in seconds, of the width of the end's own whole-sample piece of ``T``.)
+        """
         if self.best is None:
             return ()
-        return tuple(name for name, (lo, hi) in self.over.items()
-                     if min(self.best[name] - lo, hi - self.best[name]) < 1e-3 * (hi - lo))
+        out = []
+        for name, (lo, hi) in self.over.items():
+            width = hi - lo
+            if self.delay is not None and name == "T":
+                # The delay held in seconds: the scale is the end's own piece
+                # (an optimum at the left end of the next piece is not the range's end).
+                pieces = delay_pieces(self.delay, lo, hi)
+                width = min(pieces[0][1] - pieces[0][0], pieces[-1][1] - pieces[-1][0])
+            if min(self.best[name] - lo, hi - self.best[name]) < 1e-3 * width:
+                out.append(name)
+        return tuple(out)
 
     def __repr__(self):
         over = ", ".join(f"{n} in [{lo:.6g}, {hi:.6g}]" for n, (lo, hi) in self.over.items())
