@@ -51,6 +51,9 @@ from .roots import STABLE, classify_polynomials, leading_vanishes, root_counts
 __all__ = ["Branch", "Cell", "Decomposition", "StableHull", "Unresolved", "decompose", "arc_points",
            "sample_arc", "window_arc", "stable_hull", "stable_ranges"]
 
+#: The margin (of coefficients scaled to their largest term) below which
+#: :func:`stable_ranges` calls a box empty: far past HiGHS's 1e-7 tolerance.
+_LP_MARGIN = 1e-6
 #: Change of the unstable count across each piece (crossing rule); the
 #: window's edges are labelled ``"window"``.
 _CHANGE = {"arc": 2, "z = 1": 1, "z = -1": 1, "leading": 0}
@@ -1414,9 +1417,9 @@ def stable_ranges(rows, bounds):
     list of (float, float) or None
         Per parameter, the range (inside its bounds) outside which no point
         is stable; None when no point of the bounded box is stable (the
-        margin is below ``-1e-9`` for both signs: the coefficients are never
-        all of one sign there).  A programme that does not solve leaves the
-        bounds as they are.
+        margin is below ``-1e-6`` for both signs: the coefficients are never
+        all of one sign there).  A programme that does not solve, or whose
+        margin is within 1e-6 of 0, leaves the bounds as they are.
 
     Examples
     --------
@@ -1462,7 +1465,9 @@ def stable_ranges(rows, bounds):
             unclear = True
             continue
         if -margin.fun <= 0:
-            unclear |= -margin.fun > -1e-9
+            # Proved only well past the solver's tolerance (1e-7 on these
+            # scaled rows): a margin that small either way is not decided.
+            unclear |= -margin.fun > -_LP_MARGIN
             continue
         feasible = True
         ranges = []

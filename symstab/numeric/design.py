@@ -650,8 +650,9 @@ def _bracket(loop, maximize, x, y, names, over, at):
         return None
     out = {}
     for name, (lo, hi), (low, high) in zip(names, ranges[2:], over.values()):
-        # A hair wider than the programme's ends (never past the range).
-        pad = 1e-9 * (high - low)
+        # Wider than the programme's ends by more than its tolerance (never
+        # past the range).
+        pad = 1e-6 * (high - low)
         lo, hi = max(low, lo - pad), min(high, hi + pad)
         out[name] = (lo, hi) if lo < hi else (low, high)
     return out
