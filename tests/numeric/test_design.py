@@ -242,3 +242,17 @@ def test_the_sample_period_search_takes_the_best_whole_sample_piece():
     value, d = max(scan)
     assert found.best_d == d == 16
     assert found.value == pytest.approx(value, rel=1e-6)
+
+
+def test_nothing_found_unproved_says_what_was_not_examined():
+    """Issue 40, item 1: a parameter outside Stodola's linear bracket (T) with no stable
+    point at the values evaluated: not "no value of T has a stable point" (a band between
+    two scan points is not excluded) but what was evaluated and what was not examined.
+    Oracle: the engine's limits at each value evaluated are empty."""
+    loop = symstab.load_loop(LOOPS / "paper.toml")
+    found = loop.design(over={"T": (5e-4, 1e-3)}, n=3, M=0.5)
+    assert found.best is None
+    assert "no value" not in found.message and "not examined" in found.message
+    assert "values of T in [0.0005, 0.001] evaluated (steps of 0.00025)" in found.message
+    for T in found.samples[:, 0]:
+        assert loop.limits(T=T, M=0.5).y_max is None
