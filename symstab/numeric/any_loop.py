@@ -47,7 +47,7 @@ from .._validate import check_array, check_box, check_count, check_delay, check_
 from ..symbolic.loop_assembly import PLANT_DIGITS, LoopModel, parse_environment, parse_plant, shift_to_one
 from ..codegen.loop_kernels import environment_kernels, load_numpy_kernels
 from .arcs import END_ANGLE, EXACT_TERMS, ClosedFormArc, CramerArc, ExactPolynomial
-from .decomposition import Decomposition, decompose, stable_hull, window_arc
+from .decomposition import Decomposition, Unresolved, decompose, stable_hull, window_arc
 from .passivity import passive_region
 from .decomposition import lines as _lines
 from .polynomial import DelayedPolynomial
@@ -879,11 +879,39 @@ class Loop(LoopModel):
             return Decomposition(x=x, y=y, x_range=tuple(box[:2]), y_range=tuple(box[2:]),
                                  branches=(), cells=(), mismatches=(), unbounded=(),
                                  polynomial=(base, ax, ay), hull=hull)
+        def fit(box, cells):
+            """The free sides of ``box`` fitted to ``cells``, a quarter of their extent around."""
+            points = np.vstack([cell.outer for cell in cells])
+            box = list(box)
+            for k, side in enumerate(free):
+                if free[side]:
+                    column = points[:, k // 2]
+                    lo, hi = float(column.min()), float(column.max())
+                    pad = 0.25 * (hi - lo) or 0.05 * (box[k // 2 * 2 + 1] - box[k // 2 * 2])
+                    box[k] = lo - pad if k % 2 == 0 else hi + pad
+            return box
+
         found, refused = None, None
         for auto in _start_windows(arc, (structured, *slopes), base, ax, ay, ends, hull):
             box = [*(given["x_range"] or auto[0]), *(given["y_range"] or auto[1])]
             try:
                 found = run(box)
+            except Unresolved as exc:
+                refused = exc
+                # A stable cell tiny beside its window (a sliver near a point where
+                # three arcs cross, say) can break the finer pass's topology where the
+                # coarse pass held: the window narrowed around the stable cells
+                # found resolves it (and is checked anew), and the widening below
+                # still reaches every side a stable cell touches.
+                if not exc.attempt.stable or not any(free.values()):
+                    continue
+                narrowed = fit(box, exc.attempt.stable)
+                if narrowed == box:
+                    continue
+                try:
+                    found, box = run(narrowed), narrowed
+                except ValueError:
+                    continue
             except ValueError as exc:    # a first window too wide to resolve: try the next
                 refused = exc
                 continue
@@ -921,13 +949,7 @@ class Loop(LoopModel):
                     break
                 fitted = False
             elif found.stable and not fitted:
-                points = np.vstack([cell.outer for cell in found.stable])
-                for k, side in enumerate(free):
-                    if free[side]:
-                        column = points[:, k // 2]
-                        lo, hi = float(column.min()), float(column.max())
-                        pad = 0.25 * (hi - lo) or 0.05 * (box[k // 2 * 2 + 1] - box[k // 2 * 2])
-                        box[k] = lo - pad if k % 2 == 0 else hi + pad
+                box = fit(box, found.stable)
                 fitted = True
             else:
                 break

@@ -48,10 +48,12 @@ from .polynomial import DelayedPolynomial
 from .results import Limits, Segment
 from .roots import STABLE, classify_polynomials, leading_vanishes, root_counts
 
-__all__ = ["Branch", "Cell", "Decomposition", "StableHull", "decompose", "arc_points", "sample_arc",
-           "window_arc",
-           "stable_hull"]
+__all__ = ["Branch", "Cell", "Decomposition", "StableHull", "Unresolved", "decompose", "arc_points",
+           "sample_arc", "window_arc", "stable_hull", "stable_ranges"]
 
+#: The margin (of coefficients scaled to their largest term) below which
+#: :func:`stable_ranges` calls a box empty: far past HiGHS's 1e-7 tolerance.
+_LP_MARGIN = 1e-6
 #: Change of the unstable count across each piece (crossing rule); the
 #: window's edges are labelled ``"window"``.
 _CHANGE = {"arc": 2, "z = 1": 1, "z = -1": 1, "leading": 0}
@@ -1389,8 +1391,128 @@ def stable_hull(base, ax, ay):
     return StableHull(tuple(polygons), True)
 
 
+def stable_ranges(rows, bounds):
+    """Where a stable point of ``chi = rows[0] + sum_k u_k rows[k + 1]`` can be, per parameter.
+
+    :func:`stable_hull`'s necessary condition (Stodola's: the ``n + 1``
+    coefficients of ``(w - 1)**n chi((w + 1)/(w - 1))``, each affine in the
+    ``u_k``, nonzero and of one sign) in any number of parameters, some
+    bounded: for each sign a linear programme
+    (:func:`scipy.optimize.linprog`, HiGHS) gives the largest margin by
+    which every coefficient, scaled to its largest term, can be of that
+    sign, and the least and greatest value of each bounded parameter where
+    they all are.  What a search over a parameter of the loop uses to
+    bracket the values that can have a stable point at all.
+
+    Parameters
+    ----------
+    rows : array_like, shape (k + 1, n + 1)
+        Coefficients (highest power first) of ``A0`` and of the slope in each
+        parameter.
+    bounds : sequence of k (float, float) or None
+        Each parameter's range, or None where it is free (a plane's axis).
+
+    Returns
+    -------
+    list of (float, float) or None
+        Per parameter, the range (inside its bounds) outside which no point
+        is stable; None when no point of the bounded box is stable (the
+        margin is below ``-1e-6`` for both signs: the coefficients are never
+        all of one sign there).  A programme that does not solve, or whose
+        margin is within 1e-6 of 0, leaves the bounds as they are.
+
+    Examples
+    --------
+    ``z**2 + x z + y`` with ``y`` in [0.5, 3]: stable only for ``|y| < 1``.
+
+    >>> [tuple(round(v, 9) for v in r) for r in stable_ranges(
+    ...     [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]], [None, (0.5, 3.0)])]
+    [(-inf, inf), (0.5, 1.0)]
+    >>> print(stable_ranges([[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]],
+    ...                     [None, (1.5, 3.0)]))
+    None
+    """
+    from scipy.optimize import linprog
+
+    rows = np.array(rows, dtype=float)
+    bounds = [None if b is None else (float(b[0]), float(b[1])) for b in bounds]
+    if rows.ndim != 2 or rows.shape[0] != len(bounds) + 1 or not np.all(np.isfinite(rows)):
+        raise ValueError("rows must be finite coefficient rows, one more than the bounds")
+    keep = np.flatnonzero(np.any(rows != 0, axis=0))
+    given = [(-math.inf, math.inf) if b is None else b for b in bounds]
+    if keep.size == 0:
+        return None
+    exact = [_bilinear(row) for row in _exact_rows(rows[:, keep[0]:])]
+    # One coefficient's terms over its largest, exactly (binomials overflow floats).
+    q = []
+    for terms in zip(*exact):
+        top = max(abs(v) for v in terms)
+        q.append([float(v / top) if top else 0.0 for v in terms])
+    q = np.array(q)                                           # (n + 1, k + 1)
+    k = len(bounds)
+    box = [(None, None) if b is None else b for b in bounds]
+    out, feasible, unclear = None, False, False
+    for sign in (1.0, -1.0):
+        a = sign * q
+        norm = np.abs(a).max(axis=1)
+        a = a[norm > 0] / norm[norm > 0, None]
+        # s q_j(u) >= t for every j, t as large as can be (capped: a free
+        # direction may be unbounded).
+        a_ub = np.column_stack([-a[:, 1:], np.ones(len(a))])
+        margin = linprog(np.r_[np.zeros(k), -1.0], A_ub=a_ub, b_ub=a[:, 0],
+                         bounds=box + [(None, 1.0)], method="highs")
+        if margin.status != 0:
+            unclear = True
+            continue
+        if -margin.fun <= 0:
+            # Proved only well past the solver's tolerance (1e-7 on these
+            # scaled rows): a margin that small either way is not decided.
+            unclear |= -margin.fun > -_LP_MARGIN
+            continue
+        feasible = True
+        ranges = []
+        for j in range(k):
+            if bounds[j] is None:
+                ranges.append(given[j])
+                continue
+            ends = []
+            for direction in (1.0, -1.0):
+                cost = np.zeros(k + 1)
+                cost[j] = direction
+                end = linprog(cost, A_ub=a_ub, b_ub=a[:, 0], bounds=box + [(0.0, 0.0)],
+                              method="highs")
+                ends.append(float(end.x[j]) if end.status == 0 else direction * -math.inf)
+            ranges.append((max(ends[0], given[j][0]), min(ends[1], given[j][1])))
+        out = ranges if out is None else [(min(r[0], o[0]), max(r[1], o[1]))
+                                          for r, o in zip(ranges, out)]
+    if unclear:
+        # Neither proved empty nor bracketed: the ranges as given (a stable
+        # point at a margin below the programme's tolerance is not excluded).
+        return given
+    if not feasible:
+        return None
+    return out
+
+
 # --------------------------------------------------------------------------
 # The decomposition
+
+
+class Unresolved(ValueError):
+    """A window :func:`decompose` refuses, with what its first, coarser pass found.
+
+    Attributes
+    ----------
+    attempt : Decomposition
+        The pass with the arc sampled at the usual length when it broke no
+        crossing rule, else the finer one: its stable cells say where to
+        narrow the window (:meth:`symstab.Loop.region` does; the narrowed
+        window is decomposed and checked anew).
+    """
+
+    def __init__(self, message, attempt):
+        super().__init__(message)
+        self.attempt = attempt
 
 
 def decompose(base, ax, ay, ends, *, x_range, y_range, names=("x", "y"), arc=None, family=None):
@@ -1426,9 +1548,11 @@ def decompose(base, ax, ay, ends, *, x_range, y_range, names=("x", "y"), arc=Non
     Raises
     ------
     ValueError
-        If the window is not finite with ``lo < hi``, or if two neighbouring
-        cells break the crossing rule even with the arc sampled 8 times
-        finer (the window is too coarse for the curves in it).
+        If the window is not finite with ``lo < hi``.
+    Unresolved
+        (a ValueError) If two neighbouring cells break the crossing rule
+        even with the arc sampled finer, or a stable cell is too small for
+        the window (the window is too coarse for the curves in it).
 
     Examples
     --------
@@ -1445,6 +1569,7 @@ def decompose(base, ax, ay, ends, *, x_range, y_range, names=("x", "y"), arc=Non
         arc = CramerArc(*(np.asarray(c, dtype=float) for c in (base, ax, ay)))
     found = _decompose(base, ax, ay, ends, x_range=x_range, y_range=y_range, names=names,
                        fine=1.0, arc=arc, family=family)
+    coarse = None if found.mismatches else found
     if found.mismatches or found.resolution > _RESOLUTION:
         # A stable cell small for its window: the arc sampled finer (not
         # beyond 64 times: a window that needs more is refused below).
@@ -1453,18 +1578,19 @@ def decompose(base, ax, ay, ends, *, x_range, y_range, names=("x", "y"), arc=Non
         found = _decompose(base, ax, ay, ends, x_range=x_range, y_range=y_range, names=names,
                            fine=fine, arc=arc, family=family)
     if found.resolution > _RESOLUTION:
-        raise ValueError(
+        raise Unresolved(
             f"the stable set is too small to be resolved in the window {found.x} in "
             f"[{found.x_range[0]:g}, {found.x_range[1]:g}], {found.y} in "
-            f"[{found.y_range[0]:g}, {found.y_range[1]:g}]: narrow the window around it")
+            f"[{found.y_range[0]:g}, {found.y_range[1]:g}]: narrow the window around it",
+            coarse or found)
     if found.mismatches:
         i, j, label, change = found.mismatches[0]
-        raise ValueError(
+        raise Unresolved(
             f"the D-decomposition of {found.x} in [{found.x_range[0]:g}, {found.x_range[1]:g}], "
             f"{found.y} in [{found.y_range[0]:g}, {found.y_range[1]:g}] is not resolved: across "
             f"the {label} piece the counts of two neighbouring cells ({found.cells[i].count}, "
             f"{found.cells[j].count}) differ by {abs(change)}, not {_CHANGE[label]}; narrow "
-            f"the window around the region of interest")
+            f"the window around the region of interest", coarse or found)
     return found
 
 

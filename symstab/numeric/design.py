@@ -29,8 +29,14 @@ bounds (:func:`scipy.optimize.minimize`) in two.  The scan includes the
 nominal value, and zooms into a run of stable values that holds fewer than
 five scan points (a narrow band of stable values, such as the virtual
 masses of a loop with a fast device, is resolved before the refinement
-rather than missed).  A band that holds neither a scan point nor the
-nominal value can still be missed: :attr:`Design.spacing` says the scan's
+rather than missed).  Where the searched parameters enter the loop's
+polynomial affinely with the plane's (a virtual mass), the scan is laid
+over the values where Stodola's necessary condition can hold
+(:func:`~symstab.numeric.decomposition.stable_ranges`), so a narrow band
+in a wide range is bracketed first, and a range where it holds nowhere is
+proved to have no stable point.  Otherwise a band that holds neither a
+scan point nor the nominal value can still be missed: then the message
+says so (never a bare "none"), :attr:`Design.spacing` says the scan's
 step, and ``n`` makes it finer.
 """
 
@@ -41,8 +47,8 @@ import numpy as np
 
 from .._validate import check_count, check_real, check_window
 
-__all__ = ["TARGETS", "Design", "design", "maximize_scalar", "maximize_box", "held_delay",
-           "box_corners"]
+__all__ = ["TARGETS", "Design", "design", "maximize_scalar", "maximize_pieces", "maximize_box",
+           "held_delay", "delay_pieces", "box_corners"]
 
 #: What a design maximises, with what it is.
 TARGETS = {
@@ -60,6 +66,12 @@ _MIN_RUN = 5
 _MAX_ZOOMS = 8
 #: Evaluations of the local refinement at most.
 _MAX_REFINE = 200
+#: The pieces of a piecewise search refined, the best first by their left ends.
+_TOP_PIECES = 3
+#: Scan points of each piece refined.
+_PIECE_POINTS = 5
+#: Whole-sample pieces of a sample period's range at most (one evaluation each at least).
+MAX_PIECES = 400
 
 
 @dataclasses.dataclass(frozen=True)
@@ -75,8 +87,9 @@ class Design:
     over : dict
         ``{name: (low, high)}``: the parameters searched and their ranges.
     best : dict or None
-        ``{name: value}`` at the optimum; None when no value searched has a
-        stable point (:attr:`message` says so).
+        ``{name: value}`` at the optimum; None when no value evaluated has
+        a stable point (:attr:`message` says whether that is proved for the
+        whole range or which values were not examined).
     value : float or None
         The target there.
     nominal : dict
@@ -96,8 +109,9 @@ class Design:
         then the target (``-inf`` no stable point, NaN not resolved), in
         the order evaluated.
     spacing : dict
-        ``{name: step}`` of the first scan: a band of stable values
-        narrower than this that holds no scan point can be missed.
+        ``{name: step}`` of the first scan (over the bracket of values where
+        a stable point can be, for an affine parameter): a band of stable
+        values narrower than this that holds no scan point can be missed.
     failed : tuple of (dict, str)
         The values the engine could not resolve, with its message.
     values : dict
@@ -146,11 +160,23 @@ class Design:
 
     @property
     def at_edge(self):
-        """The searched parameters whose optimum lies within 1e-3 of the range's width of an end."""
+        """The searched parameters whose optimum lies within 1e-3 of the range's width of an end.
+
+        (With the delay held in seconds, of the width of the end's own whole-sample piece of ``T``.)
+        """
         if self.best is None:
             return ()
-        return tuple(name for name, (lo, hi) in self.over.items()
-                     if min(self.best[name] - lo, hi - self.best[name]) < 1e-3 * (hi - lo))
+        out = []
+        for name, (lo, hi) in self.over.items():
+            width = hi - lo
+            if self.delay is not None and name == "T":
+                # The delay held in seconds: the scale is the end's own piece
+                # (an optimum at the left end of the next piece is not the range's end).
+                pieces = delay_pieces(self.delay, lo, hi)
+                width = min(pieces[0][1] - pieces[0][0], pieces[-1][1] - pieces[-1][0])
+            if min(self.best[name] - lo, hi - self.best[name]) < 1e-3 * width:
+                out.append(name)
+        return tuple(out)
 
     def __repr__(self):
         over = ", ".join(f"{n} in [{lo:.6g}, {hi:.6g}]" for n, (lo, hi) in self.over.items())
@@ -283,6 +309,73 @@ def maximize_scalar(f, low, high, n=17, *, include=(), rtol=1e-6, progress=None)
                                      "maxiter": _MAX_REFINE})
         (x_best,), value = evaluate.best()
     return x_best, value, [(p[0], v) for p, v in evaluate.seen.items()]
+
+
+def maximize_pieces(f, pieces, *, include=(), rtol=1e-6, progress=None):
+    """The x that maximises ``f``, continuous on each piece but jumping between them.
+
+    A sawtooth (the target against the sample period with the delay held in
+    seconds: ``d`` steps at each ``T = delay / k``) defeats a search of the
+    whole interval: Brent's method climbs one tooth.  Here ``f`` is
+    evaluated at each piece's left end (and at ``include``); the
+    :data:`_TOP_PIECES` pieces best there, and the piece of the best
+    ``include`` point, are each searched by :func:`maximize_scalar`
+    (:data:`_PIECE_POINTS` points, then Brent's method), and the best of
+    all is taken.
+
+    Parameters
+    ----------
+    f : callable
+        ``f(x) -> float``, as for :func:`maximize_scalar`.
+    pieces : sequence of (float, float)
+        Closed intervals, in increasing order, ``a < b``, on each of which
+        ``f`` is continuous.
+    include, rtol, progress : optional
+        As for :func:`maximize_scalar`.
+
+    Returns
+    -------
+    (float, float, list) or (None, None, list)
+        As :func:`maximize_scalar`.
+
+    Examples
+    --------
+    A sawtooth rising to 1 / k at the left end of each piece [1 / k, 1 / (k - 1)]:
+
+    >>> pieces = [(1 / k, 1 / (k - 1) - 1e-9) for k in range(9, 1, -1)]
+    >>> def f(x):
+    ...     k = next(k for k in range(9, 1, -1) if 1 / k <= x < 1 / (k - 1))
+    ...     return k - x * k * k / 2
+    >>> x, value, _ = maximize_pieces(f, pieces)
+    >>> round(x, 6), round(value, 6)
+    (0.111111, 4.5)
+    """
+    pieces = [check_window("a piece", piece) for piece in pieces]
+    if not pieces:
+        raise ValueError("pieces must hold at least one interval (a, b), a < b")
+    evaluate = _Evaluations(lambda p: f(p[0]), progress)
+    for a, _ in pieces:
+        evaluate(a)
+    inside = [float(v) for v in include if any(a <= v <= b for a, b in pieces)]
+    for v in inside:
+        evaluate(v)
+
+    def rank(k):
+        value = evaluate.seen[(pieces[k][0],)]
+        return -math.inf if math.isnan(value) else value
+
+    chosen = sorted(range(len(pieces)), key=rank, reverse=True)[:_TOP_PIECES]
+    chosen += [k for k, (a, b) in enumerate(pieces) for v in inside if a <= v <= b]
+    for k in dict.fromkeys(chosen):
+        a, b = pieces[k]
+        maximize_scalar(lambda x: evaluate((x,)), a, b, _PIECE_POINTS,
+                        include=[v for v in inside if a <= v <= b], rtol=rtol)
+    found = evaluate.best()
+    seen = [(p[0], v) for p, v in evaluate.seen.items()]
+    if found is None:
+        return None, None, seen
+    (x_best,), value = found
+    return x_best, value, seen
 
 
 def maximize_box(f, box, n=9, *, include=(), rtol=1e-6, progress=None):
@@ -465,17 +558,30 @@ def design(loop, *, over, maximize="y_max", x=None, y=None, n=None, rtol=None, d
             return math.nan
 
     include = [tuple(nominal[n_] for n_ in names)] if nominal else []
-    if len(names) == 1:
-        best, value, seen = maximize_scalar(lambda v: target((v,)), *over[names[0]], n,
+    # Where a stable point can be at all: the searched box narrowed to it, or
+    # proved empty (then nothing is scanned).
+    bracket = _bracket(loop, maximize, x, y, names, over, at) if delay is None else over
+    searched = over if bracket is None else bracket
+    if bracket is None:
+        best, value, seen = None, None, []
+    elif len(names) == 1 and delay is not None and names[0] == "T":
+        best, value, seen = maximize_pieces(lambda v: target((v,)),
+                                            delay_pieces(delay, *over["T"]),
+                                            include=[p[0] for p in include], rtol=rtol,
+                                            progress=progress)
+        best = None if best is None else (best,)
+        seen = [((p,), v) for p, v in seen]
+    elif len(names) == 1:
+        best, value, seen = maximize_scalar(lambda v: target((v,)), *searched[names[0]], n,
                                             include=[p[0] for p in include], rtol=rtol,
                                             progress=progress)
         best = None if best is None else (best,)
         seen = [((p,), v) for p, v in seen]
     else:
-        best, value, seen = maximize_box(target, tuple(over[k] for k in names), n,
+        best, value, seen = maximize_box(target, tuple(searched[k] for k in names), n,
                                          include=include, rtol=rtol, progress=progress)
     samples = np.array([[*p, v] for p, v in seen], dtype=float).reshape(-1, len(names) + 1)
-    spacing = {k: (hi - lo) / (n - 1) for k, (lo, hi) in over.items()}
+    spacing = {k: (hi - lo) / (n - 1) for k, (lo, hi) in searched.items()}
     value_nominal = None
     if nominal:
         key = tuple(nominal[k] for k in names)
@@ -493,16 +599,98 @@ def design(loop, *, over, maximize="y_max", x=None, y=None, n=None, rtol=None, d
                          f"{failed[0][1]}")
     if best is None:
         ranges = ", ".join(f"{k} in [{lo:.6g}, {hi:.6g}]" for k, (lo, hi) in over.items())
-        what = {"passive": "a passive point",
-                "simulated": f"a point whose simulated run settles below "
-                             f"{simulation.get('amplitude', 0):.3g}"}.get(maximize, "a stable point")
-        return Design(best=None, value=None, limits=None,
-                      message=f"no value of {ranges} has {what} in the ({x}, {y}) plane "
-                              f"(scanned in steps of "
-                              f"{', '.join(f'{s:.3g}' for s in spacing.values())}; "
-                              f"{len(samples)} evaluations)", **common)
+        what = {"passive": "passive point",
+                "simulated": f"point whose simulated run settles below "
+                             f"{simulation.get('amplitude', 0):.3g}"}.get(maximize, "stable point")
+        if bracket is None:
+            message = (f"no value of {ranges} has a {what} in the ({x}, {y}) plane: proved "
+                       f"(Stodola's necessary condition, the coefficients of (w - 1)**n "
+                       f"chi((w + 1)/(w - 1)) all of one sign, holds nowhere in the range)")
+        else:
+            # Only the values evaluated are known: a band of them narrower than
+            # the scan's step can lie between two.
+            inside = ", ".join(f"{k} in [{lo:.6g}, {hi:.6g}]" for k, (lo, hi) in searched.items())
+            narrowed = (f"; outside {inside} none is stable (Stodola's necessary condition)"
+                        if searched != over else "")
+            message = (f"no {what} in the ({x}, {y}) plane was found at the {len(samples)} "
+                       f"values of {inside} evaluated (steps of "
+                       f"{', '.join(f'{s:.3g}' for s in spacing.values())}){narrowed}; between "
+                       f"them the range was not examined: a band of values narrower than a step "
+                       f"may hold one (give a finer n)")
+        return Design(best=None, value=None, limits=None, message=message, **common)
     return Design(best=dict(zip(names, (float(v) for v in best))), value=float(value),
                   limits=answer(best), **common)
+
+
+def _bracket(loop, maximize, x, y, names, over, at):
+    """``over`` narrowed to where a stable point can be, or None when it can be nowhere.
+
+    Where the searched parameters enter the characteristic polynomial affinely
+    with the plane's (a virtual mass, say), Stodola's necessary condition is
+    linear in all of them (:func:`symstab.numeric.decomposition.stable_ranges`):
+    a narrow band of stable values inside a wide range is bracketed before
+    the scan instead of stepped over, and a range where the condition holds
+    nowhere is proved to have no stable point.  Elsewhere (a sample period, a
+    filter's cut-off, the passive target) ``over`` as given.
+    """
+    from .decomposition import stable_ranges
+
+    if maximize == "passive" or not loop._affine((x, y, *names)):
+        return over
+    try:
+        base, slopes, _ = loop.affine_parts((x, y), at(tuple(0.0 for _ in names)))
+        rows = [base, *slopes]
+        for k in range(len(names)):
+            unit = at(tuple(float(j == k) for j in range(len(names))))
+            rows.append(loop.affine_parts((x, y), unit)[0] - base)
+    except ValueError:
+        return over         # 0 or 1 is not a value of the parameter: no bracket
+    ranges = stable_ranges(rows, [None, None, *over.values()])
+    if ranges is None:
+        return None
+    out = {}
+    for name, (lo, hi), (low, high) in zip(names, ranges[2:], over.values()):
+        # Wider than the programme's ends by more than its tolerance (never
+        # past the range).
+        pad = 1e-6 * (high - low)
+        lo, hi = max(low, lo - pad), min(high, hi + pad)
+        out[name] = (lo, hi) if lo < hi else (low, high)
+    return out
+
+
+def delay_pieces(delay, low, high):
+    """The intervals of ``T`` in ``[low, high]`` on each of which ``held_delay(delay, T)`` is one ``d``.
+
+    ``d = ceil(delay / T)`` is ``d`` for ``T`` in ``[delay / d, delay / (d -
+    1))``: each piece is that interval cut to the range, its open right end
+    taken 1e-8 inside (where ``d`` is still the piece's), in increasing
+    ``T``.  With no delay, the range itself.
+
+    Raises
+    ------
+    ValueError
+        If the range spans more than :data:`MAX_PIECES` whole delays.
+
+    Examples
+    --------
+    >>> [(round(a * 1e3, 4), round(b * 1e3, 4)) for a, b in delay_pieces(0.01, 2e-3, 4e-3)]
+    [(2.0, 2.5), (2.5, 3.3333), (3.3333, 4.0)]
+    """
+    if delay == 0:
+        return [(low, high)]
+    first, last = held_delay(delay, high), held_delay(delay, low)
+    if last - first + 1 > MAX_PIECES:
+        raise ValueError(f"over['T'] in [{low:.6g}, {high:.6g}] with the delay held at "
+                         f"{delay:.6g} s spans {last - first + 1} whole-sample delays (d from "
+                         f"{first} to {last}), above {MAX_PIECES}: each is searched; narrow the "
+                         f"range of T")
+    pieces = []
+    for d in range(last, first - 1, -1):
+        a = max(low, delay / d)
+        b = high if d <= 1 or delay / (d - 1) > high else delay / (d - 1) * (1 - 1e-8)
+        if a < b:
+            pieces.append((a, b))
+    return pieces
 
 
 def held_delay(delay, T):

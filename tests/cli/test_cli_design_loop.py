@@ -233,3 +233,17 @@ def test_the_simulated_target_names_what_it_simulated(capsys, tmp_path):
                           amplitude=1e-3, steps=2000,
                           nonideal=Nonidealities(encoder_resolution=1e-5), d=2)
     assert library.value == pytest.approx(simulated, rel=1e-9)
+
+
+def test_a_band_of_masses_between_four_scan_points_is_found(capsys):
+    """Issue 40, item 1: d = 40 from M = 0.5 over M in [-0.5, 0.5] with 4 points printed
+    "no value of M in [-0.5, 0.5] has a stable point" (exit 0), yet M = 0 has K_max 4.959.
+    Oracle: the published best virtual mass at T_d = 40 ms (README: gamma about 1.0, gain
+    4.14 over K_max at M = 0)."""
+    found = run_json(capsys, "design", "--loop", LOOPS / "paper.toml", "--set", "d=40",
+                     "--set", "M=0.5", "--over", "M=-0.5:0.5", "--points", "4")
+    search = found["search"]
+    assert search["best"] is not None, found.get("notes")
+    assert search["best"] == pytest.approx(1.0 * PAPER_M, rel=1e-2)
+    at_zero = symstab.load_loop(LOOPS / "paper.toml").limits(d=40, M=0.0).y_max
+    assert search["y_max"] / at_zero == pytest.approx(4.14, abs=5e-3)

@@ -72,7 +72,9 @@ def test_a_narrow_band_of_stable_values_in_a_wide_range_is_found():
     _, value = dense_maximum(target_of(loop, "y_max", "M"), -0.0129, 0.0384)
     assert wide.best is not None, wide.message
     assert wide.value == pytest.approx(value, rel=1e-4)
-    assert wide.spacing["M"] == pytest.approx(11 / 16)
+    # The scan is laid over the masses Stodola's condition leaves (issue 40, item 1), not
+    # over all of [-1, 10]: its step is far below 11 / 16.
+    assert wide.spacing["M"] < 0.01
 
 
 def test_a_range_without_a_stable_point_says_so():
@@ -199,3 +201,58 @@ def test_a_held_delay_is_the_whole_samples_that_cover_it(delay, T, d):
     from symstab.numeric.design import held_delay
 
     assert held_delay(delay, T) == d
+
+
+def test_a_band_between_two_scan_points_is_bracketed_not_called_empty():
+    """Issue 40, item 1: d = 5, M in [-1, 10] kg m^2 from M = 5 (step 0.69): the stable masses
+    -0.013 < M < 0.016 lie between two scan points and design said "no value of M has a
+    stable point" while K_max at M = 0 is finite.  Stodola's condition, linear in (B, K, M),
+    brackets the band before the scan.  Oracle: a dense scan of the engine's K_max over a
+    window holding the band, and K_max at M = 0."""
+    loop = symstab.load_loop(LOOPS / "paper.toml")
+    found = loop.design(over={"M": (-1.0, 10.0)}, d=5, M=5.0)
+    assert found.best is not None, found.message
+    _, value = dense_maximum(target_of(loop, "y_max", "M", d=5), -0.02, 0.03)
+    assert found.value == pytest.approx(value, rel=1e-4)
+    assert found.value >= loop.limits(d=5, M=0.0).y_max
+
+
+def test_no_stable_value_is_said_with_its_proof():
+    """M in [0.5, 1] at d = 40: Stodola's condition holds nowhere (proved, nothing scanned)."""
+    loop = symstab.load_loop(LOOPS / "paper.toml")
+    found = loop.design(over={"M": (0.5, 1.0)}, d=40, n=3)
+    assert found.best is None and "proved" in found.message
+    for M in np.linspace(0.5, 1.0, 5):
+        assert loop.limits(d=40, M=M).y_max is None
+
+
+def test_the_sample_period_search_takes_the_best_whole_sample_piece():
+    """Issue 40, item 2: with the delay held at 5 ms, K_max against T is a sawtooth (d =
+    ceil(5 ms / T) steps at each T = 5 ms / k); Brent's method over the whole range climbed
+    one tooth (T = 1/3 ms, d = 15, K_max 253.375) while d = 16 is better.  Oracle: K_max of
+    the engine at four values of T in each whole-sample piece, d fixed per piece."""
+    loop = symstab.load_loop(LOOPS / "paper.toml")
+    delay, window = 0.005, (3e-4, 8e-4)
+    found = loop.design(over={"T": window}, delay=delay, n=9, M=0.0)
+    scan = []
+    for d in range(math.ceil(delay / window[1]), math.ceil(delay / window[0]) + 1):
+        low, high = max(window[0], delay / d), min(window[1], delay / (d - 1))
+        scan += [(loop.limits(T=float(T), d=d, M=0.0).y_max, d)
+                 for T in np.linspace(low, high, 5)[:-1]]
+    value, d = max(scan)
+    assert found.best_d == d == 16
+    assert found.value == pytest.approx(value, rel=1e-6)
+
+
+def test_nothing_found_unproved_says_what_was_not_examined():
+    """Issue 40, item 1: a parameter outside Stodola's linear bracket (T) with no stable
+    point at the values evaluated: not "no value of T has a stable point" (a band between
+    two scan points is not excluded) but what was evaluated and what was not examined.
+    Oracle: the engine's limits at each value evaluated are empty."""
+    loop = symstab.load_loop(LOOPS / "paper.toml")
+    found = loop.design(over={"T": (5e-4, 1e-3)}, n=3, M=0.5)
+    assert found.best is None
+    assert "no value" not in found.message and "not examined" in found.message
+    assert "values of T in [0.0005, 0.001] evaluated (steps of 0.00025)" in found.message
+    for T in found.samples[:, 0]:
+        assert loop.limits(T=T, M=0.5).y_max is None

@@ -17,6 +17,7 @@ import numpy as np
 import pytest
 
 import symstab
+import oracles
 from oracles import first_principles_chi, python_control_closed_loop
 from symstab.numeric.decomposition import stable_hull
 from symstab.numeric.units import PAPER_DEVICE
@@ -270,3 +271,63 @@ def test_the_hull_does_not_trust_its_float_guess(seed, monkeypatch):
         assert got.bounded == want.bounded and len(got.polygons) == len(want.polygons)
         for p, q in zip(got.polygons, want.polygons):
             assert np.array_equal(p, q)
+
+
+
+def _frictionless_radius(loop, M):
+    """``r(B, K)``: the spectral radius of python-control's closed loop of ``frictionless.toml``.
+
+    ``P(z)`` by ``control.c2d``; ``T**2 z**2 VE(z) = (K T**2 + B T + M) z**2 - (B T + 2 M) z
+    + M`` written out here; the poles are the roots of ``Pd Vd z**d + Pn Vn``, the
+    eigenvalues of its companion matrix, batched over ``K``.
+    """
+    values = {**loop.defaults, "M": M}
+    sampled, _, _ = oracles.python_control_parts(loop, values)
+    pn, pd = (np.atleast_1d(np.squeeze(c)) for c in (sampled.num, sampled.den))
+    T, d = values["T"], int(values["d"])
+    shift = np.zeros(d + 1)
+    shift[0] = 1.0
+
+    def chi(B, K):
+        vn = np.array([K * T**2 + B * T + M, -(B * T + 2 * M), M])
+        return np.polyadd(np.polymul(np.polymul(pd, [T**2, 0.0, 0.0]), shift), np.polymul(pn, vn))
+
+    def radius(B, K):
+        K = np.atleast_1d(np.asarray(K, dtype=float))
+        rows = chi(B, 0.0)[None, :] + K[:, None] * (chi(B, 1.0) - chi(B, 0.0))[None, :]
+        n = rows.shape[1] - 1
+        companion = np.zeros((len(K), n, n))
+        companion[:, 0, :] = -rows[:, 1:] / rows[:, :1]
+        companion[:, np.arange(1, n), np.arange(n - 1)] = 1.0
+        return np.max(np.abs(np.linalg.eigvals(companion)), axis=1)
+    return radius
+
+
+def test_a_stable_sliver_beside_a_triple_crossing_is_resolved(tmp_path, monkeypatch):
+    """Issue 40, item 14: at M = 0.0163 kg the stable set of the frictionless mass is a
+    sliver (area 2e-4, four roots within 1e-5 of the circle) whose corner lies within
+    1e-10 of the window of two more arc crossings; the finer pass of the D-decomposition
+    broke the crossing rule there and ``limits`` refused ("counts (2, 2) differ by 0").
+    Oracle: python-control's closed-loop spectral radius, bisected in K just inside the
+    corner where K_max is reached, and scanned over the sliver's B (nothing higher)."""
+    monkeypatch.setenv("SYMSTAB_CACHE_DIR", str(tmp_path))
+    loop = symstab.load_loop(REPO / "examples" / "loops" / "frictionless.toml")
+    found = loop.limits(M=0.0163)
+    radius = _frictionless_radius(loop, 0.0163)
+
+    def top(B, lo, hi):
+        """The largest stable K in [lo, hi] at B: a scan, then a bisection; -inf if none."""
+        ks = np.linspace(lo, hi, 20001)
+        stable = ks[radius(B, ks) < 1]
+        if not stable.size:
+            return -np.inf
+        below, above = stable.max(), stable.max() + (hi - lo) / 20000
+        for _ in range(60):
+            mid = 0.5 * (below + above)
+            below, above = (mid, above) if radius(B, mid)[0] < 1 else (below, mid)
+        return below
+
+    inside = top(found.x_at_y_max - 1e-7, found.y_max - 1.0, found.y_max + 1.0)
+    assert found.y_max == pytest.approx(inside, rel=1e-6)
+    assert found.y_max == pytest.approx(9733.36, abs=0.01)
+    assert max(top(B, 9700.0, 9740.0) for B in np.linspace(1.0784, 1.0808, 25)) <= found.y_max
