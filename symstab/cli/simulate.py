@@ -123,15 +123,16 @@ def _loop(args):
         print(line)
     verdict = "diverged (unstable)" if run.diverged else ("stable" if run.stable else "unstable")
     last = run.positions[-(run.steps // 4):]
-    if run.stable and np.all(last == last[-1]) and nonideal.coulomb_friction is not None:
-        verdict = f"stable (held at rest by friction at x = {last[-1]:.4g})"
-    elif run.stable and not nonideal.ideal and run.amplitude[3] >= 0.9 * run.amplitude[2]:
+    if run.limit_cycle:
+        # The simulator's class (Simulation.limit_cycle), as the map's cells.
         verdict = (f"bounded, not decaying (a limit cycle of amplitude {run.amplitude[3]:.4g}: "
-                   f"the verdict compares the last two quarters)")
-        if run.amplitude[3] > run.amplitude[2]:
-            verdict = (f"bounded (a limit cycle of amplitude {run.amplitude[3]:.4g}, within "
-                       f"{float(run.floor):.4g}, the most the quantization can move the "
-                       f"position here)")
+                   f"neither stable nor growing)")
+    elif run.stable and np.all(last == last[-1]) and nonideal.coulomb_friction is not None:
+        verdict = f"stable (held at rest by friction at x = {last[-1]:.4g})"
+    elif run.stable and 0.9 * run.amplitude[2] <= run.amplitude[3] <= run.floor:
+        verdict = (f"bounded (a limit cycle of amplitude {run.amplitude[3]:.4g}, within "
+                   f"{float(run.floor):.4g}, the most the quantization can move the "
+                   f"position here)")
     print(f"simulated {run.steps} periods from x0 = {x0:g} ({loop_nonideal_text(nonideal)}): "
           f"{verdict}; max |x| per quarter: " + ", ".join(f"{a:.4g}" for a in run.amplitude))
     print(f"theory (the loop's certified root count): spectral radius {radius:.12g} -> "

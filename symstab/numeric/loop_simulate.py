@@ -52,6 +52,15 @@ PAPER_ENCODER_RESOLUTION = math.radians(3 / 3600)
 _OVERFLOW = 1e100
 #: Periods between overflow checks.
 _CHECK_EVERY = 8
+#: A limit cycle's swing over the last quarter stays within this fraction of
+#: the third's.  Its sampled peaks differ by up to 2e-4 between quarters (the
+#: paper's loop saturated at 0.05 N m, d = 10); a linear mode changes by this
+#: much over a quarter only within about 2e-6 of |z| = 1 at the default
+#: horizon, the band that no finite run decides.
+_SUSTAINED = 1e-2
+#: A swing below this fraction of the amplitude is rounding, not motion: a
+#: mass settling off zero at K = 0 keeps a swing of 1e-11 of its position.
+_MOVING = 1e-8
 #: Allowed size of the initial state.  The verdict compares the largest |x|
 #: of the last two quarters and calls |x| > _OVERFLOW divergence: a start at
 #: zero never moves (0 <= 0 reads as stable), and a stable point needs room
@@ -247,14 +256,19 @@ class Simulation:
     diverged : ndarray of bool
         The state overflowed (|x| > 1e100).
     stable : ndarray of bool
-        Not diverged, and the last quarter's amplitude does not exceed the
-        third's or the floor (see the module docstring).
+        Not diverged, not a limit cycle, and the last quarter's amplitude
+        does not exceed the third's or the floor (see the module docstring).
     steps : int
     floor : ndarray
         The amplitude up to which a run counts as bounded whatever it does:
         four encoder counts, plus, with a force quantum, half the quantum
         times the l1 norm of the linear loop's pulse response where the
         linear loop is stable (the most its rounding can move the position).
+    limit_cycle : ndarray of bool
+        A run with non-idealities that keeps swinging, neither decaying nor
+        growing, above the floor: a bounded limit cycle (a saturated
+        unstable loop's), neither stable nor unstable.  Never set for the
+        ideal loop, which is linear.
     """
 
     positions: object
@@ -263,16 +277,25 @@ class Simulation:
     stable: np.ndarray
     steps: int
     floor: np.ndarray
+    limit_cycle: np.ndarray
+
+    @property
+    def bounded(self):
+        """Stable or a limit cycle: the runs that neither grow nor diverge."""
+        return self.stable | self.limit_cycle
 
     def __repr__(self):
         stable = np.asarray(self.stable)
         n_stable, n_diverged = int(np.count_nonzero(stable)), int(np.count_nonzero(self.diverged))
+        n_cycles = int(np.count_nonzero(self.limit_cycle))
         size = f"{stable.size} point{'s' if stable.size != 1 else ''}"
         if stable.ndim > 1:
             size += " (" + " x ".join(map(str, stable.shape)) + ")"
         recorded = ", positions recorded" if self.positions is not None else ""
-        return (f"Simulation({size}, {self.steps} steps: {n_stable} stable, "
-                f"{stable.size - n_stable} unstable of which {n_diverged} diverged{recorded})")
+        cycles = f"{n_cycles} limit cycle{'s' if n_cycles != 1 else ''}, " if n_cycles else ""
+        n_unstable = stable.size - n_stable - n_cycles
+        return (f"Simulation({size}, {self.steps} steps: {n_stable} stable, {cycles}"
+                f"{n_unstable} unstable of which {n_diverged} diverged{recorded})")
 
 
 def progress_printer(label, total, stream=None, min_seconds=2.0):
@@ -321,9 +344,9 @@ def _run_chunks(make_run, n_points, point_bytes, *, steps, d, record, progress, 
                      8 * (steps + 1) * n_points + point_bytes * n_points)
     else:
         # The chunks bound the working set; what stays is the result.
-        check_memory(f"simulating {n_points} point(s)", 8 * 7 * n_points)
+        check_memory(f"simulating {n_points} point(s)", 8 * 11 * n_points)
     chunks = [slice(0, n_points)] if record else chunk_slices(n_points, point_bytes)
-    amplitude = np.zeros((4, n_points))
+    amplitude, swing = np.zeros((4, n_points)), np.zeros((4, n_points))
     diverged = np.zeros(n_points, dtype=bool)
     positions = np.empty((steps + 1, n_points)) if record else None
     response = np.zeros(n_points) if pulse_of is not None else None
@@ -336,13 +359,13 @@ def _run_chunks(make_run, n_points, point_bytes, *, steps, d, record, progress, 
         run.check_every = 1 if record else _CHECK_EVERY
         runs_done = number * (n_runs // len(chunks))
         _run(run, steps, amplitude[:, part], None if positions is None else positions[:, part],
-             progress, report, runs_done, n_runs)
+             progress, report, runs_done, n_runs, swing=swing[:, part])
         diverged[part] = run.diverged
         run = None          # the pulse response's chunk takes its place
         if pulse_of is not None:
             response[part] = _pulse_l1(pulse_of(part), steps, progress, report, runs_done + 1,
                                        n_runs)
-    return _verdict(amplitude, diverged, positions, shape, steps, nonideal, response)
+    return _verdict(amplitude, swing, diverged, positions, shape, steps, nonideal, response)
 
 
 def _pulse_l1(pulse, steps, progress, report, chunk, n_chunks):
@@ -366,29 +389,40 @@ def _pulse_l1(pulse, steps, progress, report, chunk, n_chunks):
     return out
 
 
-def _run(run, steps, amplitude, positions, progress, report, chunk, n_chunks, total=None):
+def _run(run, steps, amplitude, positions, progress, report, chunk, n_chunks, total=None,
+         swing=None):
     """Advance ``run`` ``steps`` periods, keeping the largest |x| of each quarter.
 
     ``progress`` hears the steps done over all chunks, scaled to ``steps``;
-    ``total``, if given, accumulates ``|x|`` of every period after the start.
+    ``total``, if given, accumulates ``|x|`` of every period after the start;
+    ``swing``, if given, gets each quarter's half range of ``x`` (half of
+    its largest less its smallest value).
     """
     quarter = steps // 4
     if positions is not None:
         positions[0] = run.x
-    magnitude = np.empty_like(run.x)
+    # The signed extremes of each quarter: the largest |x| and the swing (a
+    # limit cycle keeps its swing; a mass held off zero keeps |x| with none).
+    high, low = np.full((4, run.x.size), -np.inf), np.full((4, run.x.size), np.inf)
+    magnitude = np.empty_like(run.x) if total is not None else None
     for k in range(steps):
         with np.errstate(over="ignore", invalid="ignore"):
             run.step()
         q = min(k // quarter, 3)
-        np.abs(run.x, out=magnitude)
-        np.maximum(amplitude[q], magnitude, out=amplitude[q])
+        np.maximum(high[q], run.x, out=high[q])
+        np.minimum(low[q], run.x, out=low[q])
         if total is not None:
+            np.abs(run.x, out=magnitude)
             total += magnitude
         if positions is not None:
             positions[k + 1] = run.x
         if progress is not None and ((k + 1) % report == 0 or k + 1 == steps):
             progress((chunk * steps + k + 1) // n_chunks)
     run.freeze_diverged()
+    with np.errstate(invalid="ignore"):
+        np.maximum(high, -low, out=amplitude)
+        if swing is not None:
+            np.multiply(high - low, 0.5, out=swing)
 
 
 @dataclasses.dataclass(frozen=True)
@@ -401,6 +435,9 @@ class StabilityMap(PaperGridNames):
         The 1-D grids.
     stable : ndarray of bool
         Shape ``(len(y_values), len(x_values))``.
+    limit_cycle : ndarray of bool
+        Same shape: the cells whose run settles into a bounded limit cycle
+        (:attr:`Simulation.limit_cycle`), neither stable nor growing.
     growth : ndarray
         Last quarter's amplitude over the third's (``inf`` when diverged).
     steps : int
@@ -420,6 +457,7 @@ class StabilityMap(PaperGridNames):
     y_values: np.ndarray
     x_values: np.ndarray
     stable: np.ndarray
+    limit_cycle: np.ndarray
     growth: np.ndarray
     steps: int
     x: str = PAPER_PLANE[0]
@@ -617,33 +655,53 @@ def check_loop_nonideal(nonideal, loop=None, friction_name="nonideal.coulomb_fri
     return nonideal
 
 
-def _verdict(amplitude, diverged, positions, shape, steps, nonideal, response=None):
-    """The :class:`Simulation` of a run: unstable when the last quarter outgrows the third.
+def _verdict(amplitude, swing, diverged, positions, shape, steps, nonideal, response=None):
+    """The :class:`Simulation` of a run: stable, a limit cycle, or unstable.
 
-    Amplitudes up to a floor count as bounded whatever they do: four
-    encoder counts (a quantization limit cycle), plus, with a force quantum
-    ``q``, at the points whose linear loop is stable, ``q / 2`` times
-    ``response``, the l1 norm over the run of the linear loop's response
-    to a unit force pulse.  Rounding adds to each command an error of at
-    most ``q / 2``; by superposition the position departs from the run
-    without the quantum by at most ``q / 2`` times that norm, and that run
-    decays where the linear loop is stable: a limit cycle within the floor
-    is the quantum's, not growth.  (Without a floor, a limit cycle's last
-    quarter exceeds the third as often as not: on the paper's loop at d = 5
-    with a 1 mN m quantum, 543 of 1 515 stable cells were called unstable.)
-    ``response`` is 0 where the linear loop is not stable.
+    Unstable when the last quarter outgrows the third.  Amplitudes up to a
+    floor count as bounded whatever they do: four encoder counts (a
+    quantization limit cycle), plus, with a force quantum ``q``, at the
+    points whose linear loop is stable, ``q / 2`` times ``response``, the
+    l1 norm over the run of the linear loop's response to a unit force
+    pulse.  Rounding adds to each command an error of at most ``q / 2``; by
+    superposition the position departs from the run without the quantum by
+    at most ``q / 2`` times that norm, and that run decays where the linear
+    loop is stable: a limit cycle within the floor is the quantum's, not
+    growth.  (Without a floor, a limit cycle's last quarter exceeds the
+    third as often as not: on the paper's loop at d = 5 with a 1 mN m
+    quantum, 543 of 1 515 stable cells were called unstable.)  ``response``
+    is 0 where the linear loop is not stable.
+
+    A run of a loop with non-idealities is a limit cycle
+    (:attr:`Simulation.limit_cycle`), neither stable nor unstable, when it
+    keeps swinging: the half range of ``x`` over the last quarter
+    (``swing``) is above the floor and :data:`_MOVING` of the amplitude (a
+    mass held at rest off zero by friction has none), within
+    :data:`_SUSTAINED` of the third quarter's (not decaying, not growing),
+    and the largest ``|x|`` no more than that above the third's (not
+    drifting away).  The sampled peak of a periodic motion differs from one
+    quarter to the next by up to 2e-4 (a saturated paper loop), so the
+    plain comparison called half of such cycles growing and half stable.
+    A linear loop has no limit cycle: a run of the ideal loop that neither
+    grows nor decays is on the boundary, and stays the comparison's.
     """
     amplitude[:, diverged] = np.inf
     floor = 4 * nonideal.encoder_resolution if nonideal.encoder_resolution else 0.0
     if response is not None:
         floor = floor + nonideal.force_resolution / 2 * response
     floor = np.broadcast_to(floor, diverged.shape)
-    stable = ~diverged & (amplitude[3] <= np.maximum(amplitude[2], floor))
+    bounded = ~diverged & (amplitude[3] <= np.maximum(amplitude[2], floor))
+    with np.errstate(invalid="ignore"):
+        limit_cycle = (~diverged & (swing[3] > np.maximum(floor, _MOVING * amplitude[3]))
+                       & (np.abs(swing[3] - swing[2]) <= _SUSTAINED * swing[2])
+                       & (amplitude[3] <= (1 + _SUSTAINED) * amplitude[2]))
+    if nonideal.ideal:
+        limit_cycle[:] = False
     return Simulation(
         positions=None if positions is None else positions.reshape((steps + 1,) + shape),
         amplitude=amplitude.reshape((4,) + shape),
-        diverged=diverged.reshape(shape), stable=stable.reshape(shape), steps=steps,
-        floor=floor.reshape(shape))
+        diverged=diverged.reshape(shape), stable=(bounded & ~limit_cycle).reshape(shape),
+        steps=steps, floor=floor.reshape(shape), limit_cycle=limit_cycle.reshape(shape))
 
 
 def _terms(columns):
@@ -848,4 +906,5 @@ def loop_stability_map(loop, x_values, y_values, *, x=None, y=None, steps=None, 
     with np.errstate(divide="ignore", invalid="ignore"):
         growth = np.where(run.diverged, np.inf, run.amplitude[3] / run.amplitude[2])
     at = {k: v for k, v in {**loop.defaults, **values}.items() if k not in (x, y)}
-    return StabilityMap(y_values, x_values, run.stable, growth, run.steps, x=x, y=y, at=at)
+    return StabilityMap(y_values, x_values, run.stable, run.limit_cycle, growth, run.steps,
+                        x=x, y=y, at=at)

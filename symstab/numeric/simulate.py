@@ -244,6 +244,6 @@ def stability_map(*, alpha, beta, gamma, d, delta, steps=None, x0=1.0, v0=None, 
                    device=device, nonideal=nonideal, progress=progress)
     with np.errstate(divide="ignore", invalid="ignore"):
         growth = np.where(run.diverged, np.inf, run.amplitude[3] / run.amplitude[2])
-    return StabilityMap(alpha, beta, run.stable, growth, run.steps, at={
+    return StabilityMap(alpha, beta, run.stable, run.limit_cycle, growth, run.steps, at={
         "gamma": gamma, "d": d, "delta": float(delta if delta is not None else device.delta)})
 

@@ -291,3 +291,45 @@ def test_the_paper_loop_simulated_as_a_loop_agrees_with_the_paper_simulator(noni
                               nonideal=nonideal, steps=4000)
         assert np.all(paper.floor > 0)
         np.testing.assert_allclose(paper.floor, found.floor, rtol=1e-9)
+
+
+@pytest.mark.parametrize("B, K", [(-0.05, 26.25), (0.1125, 35.0), (1.25, 61.25)])
+def test_a_saturated_unstable_loop_s_bounded_cycle_is_a_limit_cycle_not_stable(B, K):
+    """Issue 40, item 4: 38 such cells of a map were called stable (and the rest of the
+    cycles unstable, by whether a sampled peak of the last quarter exceeded the third's).
+    Oracles: python-control's closed-loop poles (the linear loop is unstable, so the run
+    cannot be decaying to rest) and the run's own trajectory (bounded; its swing, half of
+    max - min, the same over the last three quarters)."""
+    loop = symstab.load_loop(LOOPS / "paper.toml")
+    values = {**loop.defaults, "d": 10, "B": B, "K": K}
+    assert python_control_radius(loop, values) > 1.001
+    steps = 6000
+    run = loop.simulate(steps=steps, x0=0.01, nonideal=Nonidealities(force_limit=0.05),
+                        record=True, **values)
+    quarters = run.positions[1:].reshape(4, steps // 4)
+    swing = (quarters.max(axis=1) - quarters.min(axis=1)) / 2
+    assert np.all(np.abs(run.positions) < 1.0)                  # bounded
+    assert swing[3] > 0.01 * 0.01                               # not at rest
+    assert 0.999 * swing[1] <= swing[3] <= 1.001 * swing[2]     # not decaying, not growing
+    assert run.limit_cycle and not run.stable and not run.diverged and run.bounded
+    # A stable cell of the same loop and limit stays stable; the ideal loop has no cycle.
+    inside = loop.simulate(steps=steps, x0=0.01, nonideal=Nonidealities(force_limit=0.05),
+                           **{**values, "B": 0.6, "K": 26.25})
+    assert inside.stable and not inside.limit_cycle
+    ideal = loop.simulate(steps=steps, x0=0.01, **values)
+    assert not ideal.limit_cycle and not ideal.stable
+
+
+def test_a_map_of_a_saturated_loop_calls_its_cycles_limit_cycles_where_the_count_is_unstable():
+    """The map's classes against the certified root counts: at the cells the count calls
+    unstable the saturated run is a limit cycle (bounded: python-control's poles say the
+    linear loop grows), never stable; where the count is stable, the run is stable."""
+    loop = symstab.load_loop(LOOPS / "paper.toml")
+    xs, ys = np.linspace(-0.05, 1.9, 7), np.linspace(8.75, 70.0, 5)
+    found = loop.stability_map(xs, ys, steps=6000, x0=0.01, d=10,
+                               nonideal=Nonidealities(force_limit=0.05))
+    Y, X = np.meshgrid(ys, xs, indexing="ij")
+    code = loop.classify(B=X, K=Y, d=10)
+    assert np.all(found.limit_cycle[code == -1]) and not np.any(found.stable[code == -1])
+    assert np.all(found.stable[code == 1]) and not np.any(found.limit_cycle[code == 1])
+    assert np.count_nonzero(code == -1) >= 8
