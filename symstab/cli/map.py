@@ -21,8 +21,8 @@ from .loop_options import (add_loop_options, resolve_loop, uncertain_box,
 from .options import add_command, add_model_options, resolve, stiffness_and_damping
 from ..drawing import draw_lines, png_bytes, pyplot_or_none, visible
 from .output import check_files, write_output
-from .simulation import (add_nonideal_options, loop_nonideal_text, nonideal_text, resolve_nonideal,
-                         simulated_theory)
+from .simulation import (add_nonideal_options, check_loop_friction, loop_nonideal_text,
+                         nonideal_text, resolve_nonideal, simulated_theory, with_option_names)
 from .units import tex_unit
 
 __all__ = ["register", "run", "MAX_GRID", "map_outputs", "LOOP_MAP_HEADLINE",
@@ -147,12 +147,17 @@ def _paper(args):
     theory = simulated_theory(setup, nonideal)
     A, B = np.meshgrid(alpha, beta, indexing="ij")
     code = theory.classify(A, B)
+    try:
+        result = stability_map(alpha=alpha, beta=beta, gamma=setup.gamma, d=setup.d,
+                               delta=None if setup.physical else setup.delta, steps=steps, x0=x0,
+                               device=setup.device, nonideal=nonideal,
+                               progress=progress_printer("simulating", steps))
+    except (TypeError, ValueError) as exc:
+        # Its checks before the run (the friction against the device) name the options;
+        # the echo follows the run, so that a refusal is the only line.
+        raise with_option_names(exc) from None
     for line in setup.echo:
         print(line)
-    result = stability_map(alpha=alpha, beta=beta, gamma=setup.gamma, d=setup.d,
-                           delta=None if setup.physical else setup.delta, steps=steps, x0=x0,
-                           device=setup.device, nonideal=nonideal,
-                           progress=progress_printer("simulating", steps))
     exact = code == STABLE
     physical = {}  # K_w and B_w beside alpha and beta, in the units of the echo
     if setup.physical:
@@ -313,6 +318,8 @@ def _loop(args):
         steps = check_steps(args.steps, values["d"])
         # The difference equations at one cell: a plant they cannot step is refused now.
         loop.difference_equations(**{setup.x: xs[0], setup.y: ys[0]}, **values)
+        X, Y = np.meshgrid(xs, ys, indexing="ij")
+        check_loop_friction(nonideal, loop, {setup.x: X, setup.y: Y, **values})
     degree = loop.coefficients(**{setup.x: 0.0, setup.y: 0.0}, **values).shape[-1]
     # The cells are classified a chunk of x at a time; what stays is the codes
     # and the file's text.

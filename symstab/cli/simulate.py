@@ -18,7 +18,8 @@ from .._resources import check_memory
 from .loop_options import add_loop_options, resolve_loop, uses_loop, value_text
 from .options import add_command, add_model_options, parse_list, resolve, stiffness_and_damping
 from .output import check_files, write_output
-from .simulation import add_nonideal_options, loop_nonideal_text, resolve_nonideal, simulated_theory
+from .simulation import (add_nonideal_options, check_loop_friction, loop_nonideal_text,
+                         resolve_nonideal, simulated_theory, with_option_names)
 
 __all__ = ["register", "run"]
 
@@ -72,10 +73,14 @@ def run(args):
     theory = simulated_theory(setup, nonideal)
     code = theory.classify(alpha, beta)
     radius = theory.spectral_radius(alpha, beta)
-    run = simulate(alpha=alpha, beta=beta, gamma=setup.gamma, d=setup.d,
-                   delta=None if setup.physical else setup.delta, steps=steps, x0=x0,
-                   device=setup.device, nonideal=nonideal, record=record,
-                   progress=progress_printer("simulating", steps))
+    try:
+        run = simulate(alpha=alpha, beta=beta, gamma=setup.gamma, d=setup.d,
+                       delta=None if setup.physical else setup.delta, steps=steps, x0=x0,
+                       device=setup.device, nonideal=nonideal, record=record,
+                       progress=progress_printer("simulating", steps))
+    except (TypeError, ValueError) as exc:
+        # Its checks before the run (the friction against the device) name the options.
+        raise with_option_names(exc) from None
     for line in setup.echo:
         print(line)
     verdict = "diverged (unstable)" if run.diverged else ("stable" if run.stable else "unstable")
@@ -115,6 +120,7 @@ def _loop(args):
     # friction from a limit cycle by it).
     check_memory(f"the trajectory of {steps} periods", (steps + 1) * _TRAJECTORY_ROW_BYTES)
     loop.difference_equations(**values)        # a plant it cannot step is refused before the run
+    check_loop_friction(nonideal, loop, values)
     code = int(loop.classify(**values))
     radius = float(loop.spectral_radius(**values))
     run = loop.simulate(steps=steps, x0=x0, nonideal=nonideal, record=True,

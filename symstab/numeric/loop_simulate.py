@@ -37,7 +37,8 @@ from .results import PAPER_PLANE, PaperGridNames
 __all__ = ["Nonidealities", "Simulation", "StabilityMap", "default_horizon", "check_steps",
            "check_x0", "max_steps", "progress_printer", "PAPER_ENCODER_RESOLUTION",
            "MAX_STEPS_ENV", "run_loop", "simulate_loop", "loop_stability_map",
-           "check_loop_nonideal", "default_x0", "MAX_SUBSTEPS", "X0_MIN", "X0_MAX"]
+           "check_loop_nonideal", "default_x0", "MAX_SUBSTEPS", "X0_MIN", "X0_MAX",
+           "check_friction_size", "QUANTUM_MIN", "FRICTION_STEP_MAX"]
 
 
 #: The most sub-steps per period: each multiplies the simulation's time (a
@@ -78,11 +79,15 @@ class Nonidealities:
     Attributes
     ----------
     encoder_resolution : float
-        Position quantum (m or rad), > 0.
+        Position quantum (m or rad), a normal double: at least
+        :data:`QUANTUM_MIN` (see :func:`_check_quantum`).
     velocity_cutoff : float
         Cut-off of the velocity filter (Hz), in (0, Nyquist).
     coulomb_friction : float
-        Coulomb friction force (N or N m), >= 0.
+        Coulomb friction force (N or N m), >= 0, and small enough that its
+        change of the state over a sub-step is a double
+        (:func:`check_friction_size`, checked against the loop's plant
+        before a run).
     stiction : float
         Breakaway force (N or N m), >= coulomb_friction (default: equal).
     friction_compensation : bool
@@ -95,8 +100,9 @@ class Nonidealities:
     force_limit : float
         Largest force command (N or N m), > 0: the command is clipped to it.
     force_resolution : float
-        Force quantum (N or N m), > 0: the command is rounded to a multiple
-        of it (a DAC's step), then clipped to ``force_limit``.
+        Force quantum (N or N m), at least :data:`QUANTUM_MIN`: the command
+        is rounded to a multiple of it (a DAC's step), then clipped to
+        ``force_limit``.
     """
 
     encoder_resolution: float = None
@@ -113,7 +119,7 @@ class Nonidealities:
         # Checked at construction, so that a wrong kind never reaches a run:
         # friction_compensation="no" would otherwise switch compensation on.
         if self.encoder_resolution is not None:
-            check_real("encoder_resolution", self.encoder_resolution, low=0.0, low_open=True)
+            _check_quantum("encoder_resolution", self.encoder_resolution, "positions")
         if self.velocity_cutoff is not None:
             check_real("velocity_cutoff", self.velocity_cutoff, low=0.0, low_open=True)
         if self.coulomb_friction is not None:
@@ -133,7 +139,7 @@ class Nonidealities:
         if self.force_limit is not None:
             check_real("force_limit", self.force_limit, low=0.0, low_open=True)
         if self.force_resolution is not None:
-            check_real("force_resolution", self.force_resolution, low=0.0, low_open=True)
+            _check_quantum("force_resolution", self.force_resolution, "force commands")
             if self.coulomb_friction is not None:
                 # The verdict's floor for the quantum bounds the linear loop's response.
                 raise ValueError("force_resolution with coulomb_friction: the verdict allows "
@@ -174,6 +180,79 @@ class Nonidealities:
                 and self.coulomb_friction is None and self.actuator_bandwidth is None
                 and self.force_limit is None and self.force_resolution is None)
 
+
+
+#: The smallest quantum (encoder or force): the smallest normal double.
+QUANTUM_MIN = float(np.finfo(float).tiny)
+#: The largest change of the state the friction may make over a sub-step:
+#: below double precision's largest number (1.8e308) with room to add it to
+#: the rest of the step.
+FRICTION_STEP_MAX = 1e300
+
+
+def _check_quantum(name, quantum, divided):
+    """Check a quantum: a finite double of at least :data:`QUANTUM_MIN` (ValueError naming it).
+
+    The run divides the values it rounds by the quantum.  A subnormal
+    quantum (1e-320) keeps fewer than 53 significant bits and overflows
+    every such quotient above 1.8e-12: each run diverged.  From a normal
+    quantum on, a quotient that overflows is of a value the quantum is far
+    below the precision of, which rounding leaves as it is
+    (:func:`_rounded`).
+    """
+    check_real(name, quantum, low=0.0, low_open=True)
+    if not quantum >= QUANTUM_MIN:
+        raise ValueError(f"{name} must be a finite real number >= {QUANTUM_MIN!r} (the smallest "
+                         f"normal double: below it the quantum loses its significant bits and "
+                         f"the {divided} divided by it overflow), got {quantum!r}")
+
+
+def _rounded(values, quantum):
+    """``values`` rounded to multiples of ``quantum``; as they are where the quotient overflows.
+
+    (A quotient that overflows is of a value whose precision the quantum
+    is far below: its own multiple to the last bit.)
+    """
+    with np.errstate(over="ignore", invalid="ignore"):
+        rounded = quantum * np.round(values / quantum)
+    return np.where(np.isfinite(rounded), rounded, values)
+
+
+def check_friction_size(nonideal, spaces, name="nonideal.coulomb_friction", scale=1.0):
+    """Refuse a Coulomb friction larger than double precision can step on the plants ``spaces``.
+
+    A sub-step adds ``-gamma_f F`` to the state (:mod:`symstab.numeric.
+    friction`); the friction is refused when its largest entry would pass
+    :data:`FRICTION_STEP_MAX`, from where adding it overflows and a held
+    mass reads as diverged.  Below it any friction is stepped: a large one
+    stops the mass within the sub-step where it stands.
+
+    Parameters
+    ----------
+    nonideal : Nonidealities
+        In the units of the spaces.
+    spaces : list of FrictionSpace
+    name : str
+        The friction's name in the message (the CLI's ``--coulomb``).
+    scale : float
+        The spaces' unit of force over the caller's (the message gives the
+        caller's).
+
+    Raises
+    ------
+    ValueError
+        Naming ``name`` and its range on these plants.
+    """
+    friction = nonideal.coulomb_friction
+    if not friction:
+        return
+    largest = max(float(np.max(np.abs(space.gamma_f))) for space in spaces)
+    if largest > 0 and friction * largest > FRICTION_STEP_MAX:
+        limit = FRICTION_STEP_MAX / largest / scale
+        raise ValueError(f"{name} must be a real number from 0 to {limit:.3g} on this plant (a "
+                         f"sub-step changes its state by up to {largest * scale:.3g} per unit "
+                         f"of friction, and double precision steps a change up to "
+                         f"{FRICTION_STEP_MAX:g}), got {friction / scale:g}")
 
 
 def default_horizon(d):
@@ -545,6 +624,7 @@ def simulate_loop(loop, *, steps=None, x0=1.0, v0=None, nonideal=None, record=Fa
     spaces = None
     if nonideal.coulomb_friction is not None:
         spaces, inverse = loop.friction_spaces(substeps_of(nonideal), **values)
+        check_friction_size(nonideal, spaces)
         spaces = (spaces, inverse.ravel())
     return run_loop(lambda part: [p[part] for p in parts], n_points, d=d, steps=steps, x0=x0,
                     v0=v0, nonideal=nonideal, record=record, progress=progress, shape=shape,
@@ -770,7 +850,7 @@ class _AnyLoop:
 
     def _sample(self, x):
         q = self.quantum
-        return x if not q else q * np.round(x / q)
+        return x if not q else _rounded(x, q)
 
     def _sum(self, out, terms, history, sign):
         tmp = self._scratch
@@ -802,7 +882,7 @@ class _AnyLoop:
         # The environment keeps its own force; the command sent is rounded
         # to the DAC's step and clipped to its range.
         if self.force_quantum is not None:
-            command = self.force_quantum * np.round(command / self.force_quantum)
+            command = _rounded(command, self.force_quantum)
         if self.force_limit is not None:
             command = np.clip(command, -self.force_limit, self.force_limit)
         slot = self.k % (self.d + 1)

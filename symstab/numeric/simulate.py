@@ -69,7 +69,8 @@ import numpy as np
 
 from .._validate import check_array, check_delay, check_loop, check_real
 from .loop_simulate import (MAX_STEPS_ENV, PAPER_ENCODER_RESOLUTION, X0_MAX, Nonidealities,
-                            Simulation, StabilityMap, check_loop_nonideal, check_steps,
+                            QUANTUM_MIN, Simulation, StabilityMap, check_friction_size,
+                            check_loop_nonideal, check_steps,
                             check_x0, default_horizon, default_x0, loop_stability_map,
                             linearly_stable, max_steps, progress_printer, run_loop,
                             simulate_loop)
@@ -79,7 +80,7 @@ from .simulate_theory import paper_simulated_loop
 __all__ = ["Nonidealities", "Simulation", "simulate", "StabilityMap", "stability_map",
            "default_horizon", "check_steps", "check_x0", "max_steps", "progress_printer", "PAPER_ENCODER_RESOLUTION",
            "MAX_STEPS_ENV", "simulate_loop", "loop_stability_map", "check_loop_nonideal",
-           "default_x0"]
+           "default_x0", "check_friction_size"]
 
 
 def simulate(*, alpha, beta, gamma, d, delta, steps=None, x0=1.0, v0=None, device=None,
@@ -181,11 +182,18 @@ def simulate(*, alpha, beta, gamma, d, delta, steps=None, x0=1.0, v0=None, devic
     if lagged:
         values["tau"] = 1 / (2 * math.pi * nonideal.actuator_bandwidth * device.T)
     scale = 1.0 if device is None else device.T**2 / device.m   # force -> f T^2 / m
+    if nonideal.force_resolution is not None and not nonideal.force_resolution * scale >= QUANTUM_MIN:
+        # The run's quantum is in Table I's units: it must be a normal double there.
+        raise ValueError(f"nonideal.force_resolution must be a finite real number >= "
+                         f"{QUANTUM_MIN / scale!r} with this device (T^2/m times it is the run's "
+                         f"quantum, which must be a normal double), got "
+                         f"{nonideal.force_resolution!r}")
     run_nonideal = dataclasses.replace(
         nonideal, velocity_cutoff=None, actuator_bandwidth=None, friction_compensation=False,
         **{name: None if getattr(nonideal, name) is None else getattr(nonideal, name) * scale
            for name in ("coulomb_friction", "stiction", "force_limit", "force_resolution")})
     spaces, _ = loop.friction_spaces(substeps_of(run_nonideal), **dict(values, K=0.0, B=0.0, M=0.0))
+    check_friction_size(run_nonideal, spaces, name="nonideal.coulomb_friction", scale=scale)
     compensation = None
     if nonideal.friction_compensation:
         compensation = (run_nonideal.coulomb_friction,

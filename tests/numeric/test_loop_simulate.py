@@ -333,3 +333,44 @@ def test_a_map_of_a_saturated_loop_calls_its_cycles_limit_cycles_where_the_count
     assert np.all(found.limit_cycle[code == -1]) and not np.any(found.stable[code == -1])
     assert np.all(found.stable[code == 1]) and not np.any(found.limit_cycle[code == 1])
     assert np.count_nonzero(code == -1) >= 8
+
+
+@pytest.mark.parametrize("field", ["encoder_resolution", "force_resolution"])
+def test_a_quantum_double_precision_cannot_hold_is_refused_by_name(field):
+    """Issue 40, item 6: a subnormal quantum (1e-320) overflowed every quotient above 1.8e-12
+    and each run read "diverged (unstable)".  Refused: the smallest normal double."""
+    with pytest.raises(ValueError) as excinfo:
+        Nonidealities(**{field: 1e-320})
+    assert_message_names(excinfo, field)
+    assert f">= {float(np.finfo(float).tiny)!r}" in str(excinfo.value)
+
+
+def test_a_quantum_far_below_a_value_s_precision_leaves_it_as_it_is():
+    """From the smallest normal quantum on, a value whose quotient overflows is rounded to
+    itself (the quantum is far below its last bit), not to inf: the stable loop from x0 = 100
+    with a quantum of 1e-307 is the ideal loop's run, to the bit (it was "diverged")."""
+    loop = symstab.load_loop(LOOPS / "paper.toml")
+    ideal = loop.simulate(d=10, x0=100.0, steps=400, record=True)
+    fine = loop.simulate(d=10, x0=100.0, steps=400, record=True,
+                         nonideal=Nonidealities(encoder_resolution=1e-307))
+    assert not fine.diverged
+    np.testing.assert_array_equal(fine.positions, ideal.positions)
+
+
+def test_a_friction_double_precision_cannot_step_is_refused_before_the_run():
+    """The sub-step adds gamma_f F to the state: past 1e300 that overflows.  Refused with the
+    bound on this plant (1e300 over its largest gamma_f, computed here from the plant's
+    exact sub-step: a mass m with viscous b, gamma_f[1] = (1 - exp(-b h / m)) / b), before
+    a period is run; below the bound a huge friction holds the mass (1e200: at x0)."""
+    loop = symstab.load_loop(LOOPS / "paper.toml")
+    m, b, h = loop.defaults["m"], loop.defaults["b"], loop.defaults["T"] / 20
+    bound = 1e300 / (-math.expm1(-b * h / m) / b)
+    calls = []
+    with pytest.raises(ValueError) as excinfo:
+        loop.simulate(d=10, x0=0.01, progress=calls.append,
+                      nonideal=Nonidealities(coulomb_friction=1.01 * bound))
+    assert_message_names(excinfo, "coulomb_friction")
+    assert f"from 0 to {bound:.3g}" in str(excinfo.value) and calls == []
+    held = loop.simulate(d=10, x0=0.01, steps=400, record=True,
+                         nonideal=Nonidealities(coulomb_friction=1e200))
+    assert held.stable and np.all(held.positions >= 0.01) and np.all(held.positions < 0.0101)
