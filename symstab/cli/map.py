@@ -127,7 +127,8 @@ def map_outputs(args):
 
 def _paper(args):
     """The paper's loop simulated at every cell of the grid."""
-    from ..numeric.simulate import check_steps, progress_printer, stability_map
+    from ..numeric.simulate import (check_device_nonideal, check_steps, progress_printer,
+                                    stability_map)
     from ..numeric.stability import MARGINAL, STABLE
 
     setup = resolve(args)
@@ -147,17 +148,18 @@ def _paper(args):
     theory = simulated_theory(setup, nonideal)
     A, B = np.meshgrid(alpha, beta, indexing="ij")
     code = theory.classify(A, B)
-    try:
-        result = stability_map(alpha=alpha, beta=beta, gamma=setup.gamma, d=setup.d,
-                               delta=None if setup.physical else setup.delta, steps=steps, x0=x0,
-                               device=setup.device, nonideal=nonideal,
-                               progress=progress_printer("simulating", steps))
-    except (TypeError, ValueError) as exc:
-        # Its checks before the run (the friction against the device) name the options;
-        # the echo follows the run, so that a refusal is the only line.
-        raise with_option_names(exc) from None
+    if setup.physical:
+        try:
+            # The simulator's own checks (the friction against the device), before the echo.
+            check_device_nonideal(nonideal, setup.device)
+        except ValueError as exc:
+            raise with_option_names(exc) from None
     for line in setup.echo:
         print(line)
+    result = stability_map(alpha=alpha, beta=beta, gamma=setup.gamma, d=setup.d,
+                           delta=None if setup.physical else setup.delta, steps=steps, x0=x0,
+                           device=setup.device, nonideal=nonideal,
+                           progress=progress_printer("simulating", steps))
     exact = code == STABLE
     physical = {}  # K_w and B_w beside alpha and beta, in the units of the echo
     if setup.physical:

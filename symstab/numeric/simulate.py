@@ -80,7 +80,7 @@ from .simulate_theory import paper_simulated_loop
 __all__ = ["Nonidealities", "Simulation", "simulate", "StabilityMap", "stability_map",
            "default_horizon", "check_steps", "check_x0", "max_steps", "progress_printer", "PAPER_ENCODER_RESOLUTION",
            "MAX_STEPS_ENV", "simulate_loop", "loop_stability_map", "check_loop_nonideal",
-           "default_x0", "check_friction_size"]
+           "default_x0", "check_friction_size", "check_device_nonideal"]
 
 
 def simulate(*, alpha, beta, gamma, d, delta, steps=None, x0=1.0, v0=None, device=None,
@@ -168,13 +168,44 @@ def simulate(*, alpha, beta, gamma, d, delta, steps=None, x0=1.0, v0=None, devic
     steps = check_steps(steps, d)
     x0 = check_x0(x0)
     v0 = x0 / 100 if v0 is None else check_real("v0", v0, low=-X0_MAX, high=X0_MAX)
+    loop, fixed, run_nonideal, spaces, scale = _device_run(nonideal, device, delta, d)
+    values = {**fixed, "K": alpha, "B": beta, "M": gamma}
+    filtered = "f_c" in fixed
+    compensation = None
+    if nonideal.friction_compensation:
+        compensation = (run_nonideal.coulomb_friction,
+                        math.exp(-2 * math.pi * nonideal.velocity_cutoff * device.T)
+                        if filtered else 0.0)
+
+    def parts_of(part):
+        # The difference equations a chunk at a time: their memory stays the chunk's.
+        return loop.difference_parts({k: v[part] if np.ndim(v) else v
+                                      for k, v in values.items()})[0]
+
+    return run_loop(parts_of, alpha.size, d=d, steps=steps, x0=x0, v0=v0, nonideal=run_nonideal,
+                    record=record, progress=progress, shape=shape,
+                    spaces=(spaces, np.zeros(alpha.size, dtype=int)), state=(x0, v0),
+                    compensation=compensation,
+                    linear_stable=linearly_stable(loop, run_nonideal, values, (alpha.size,)))
+
+
+def _device_run(nonideal, device, delta, d):
+    """The loop the paper's simulator runs, in Table I's units, and its checks before a run.
+
+    Returns ``(loop, values, nonideal, spaces, scale)``: the loop, its
+    values but the plane's and ``M``, the non-idealities in its units
+    (forces times ``scale = T^2 / m``), the device's state space and
+    ``scale``.  Raises, naming the field, for a force quantum that is not a
+    normal double in those units or a friction that double precision
+    cannot step on the device (:func:`check_friction_size`).
+    """
     # The paper's loop is a Loop in Table I's units (m = T = 1, b = delta,
     # K = alpha, B = beta, M = gamma), its filter in the environment and its
     # lag in the plant, run by the loop simulator from the state (x0, v0).
     filtered = device is not None and nonideal.velocity_cutoff is not None
     lagged = device is not None and nonideal.actuator_bandwidth is not None
     loop = paper_simulated_loop(filtered, lagged, delta == 0)
-    values = {"m": 1.0, "T": 1.0, "K": alpha, "B": beta, "M": gamma, "d": d}
+    values = {"m": 1.0, "T": 1.0, "d": d}
     if delta != 0:
         values["b"] = delta
     if filtered:
@@ -194,22 +225,28 @@ def simulate(*, alpha, beta, gamma, d, delta, steps=None, x0=1.0, v0=None, devic
            for name in ("coulomb_friction", "stiction", "force_limit", "force_resolution")})
     spaces, _ = loop.friction_spaces(substeps_of(run_nonideal), **dict(values, K=0.0, B=0.0, M=0.0))
     check_friction_size(run_nonideal, spaces, name="nonideal.coulomb_friction", scale=scale)
-    compensation = None
-    if nonideal.friction_compensation:
-        compensation = (run_nonideal.coulomb_friction,
-                        math.exp(-2 * math.pi * nonideal.velocity_cutoff * device.T)
-                        if filtered else 0.0)
+    return loop, values, run_nonideal, spaces, scale
 
-    def parts_of(part):
-        # The difference equations a chunk at a time: their memory stays the chunk's.
-        return loop.difference_parts({k: v[part] if np.ndim(v) else v
-                                      for k, v in values.items()})[0]
 
-    return run_loop(parts_of, alpha.size, d=d, steps=steps, x0=x0, v0=v0, nonideal=run_nonideal,
-                    record=record, progress=progress, shape=shape,
-                    spaces=(spaces, np.zeros(alpha.size, dtype=int)), state=(x0, v0),
-                    compensation=compensation,
-                    linear_stable=linearly_stable(loop, run_nonideal, values, (alpha.size,)))
+def check_device_nonideal(nonideal, device):
+    """Refuse, before a run, non-idealities the paper's simulator cannot step on ``device``.
+
+    The checks :func:`simulate` makes before its run (a force quantum that
+    is not a normal double in Table I's units, a friction whose sub-step
+    overflows), for a caller that must decide before it prints or runs
+    anything (the command line).
+
+    Parameters
+    ----------
+    nonideal : Nonidealities
+    device : symstab.numeric.units.Device
+
+    Raises
+    ------
+    ValueError
+        Naming the field and its range.
+    """
+    _device_run(nonideal, device, device.delta, 0)
 
 
 def stability_map(*, alpha, beta, gamma, d, delta, steps=None, x0=1.0, v0=None, device=None,

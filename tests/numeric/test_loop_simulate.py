@@ -374,3 +374,15 @@ def test_a_friction_double_precision_cannot_step_is_refused_before_the_run():
     held = loop.simulate(d=10, x0=0.01, steps=400, record=True,
                          nonideal=Nonidealities(coulomb_friction=1e200))
     assert held.stable and np.all(held.positions >= 0.01) and np.all(held.positions < 0.0101)
+
+
+def test_the_paper_simulator_refuses_a_quantum_that_its_units_make_subnormal():
+    """The paper's simulator runs in Table I's units, its forces times T^2 / m (7.8e-5 for the
+    paper's device): 3e-308 N m is a normal double, its run's quantum is not."""
+    scale = symstab.PAPER_DEVICE.T**2 / symstab.PAPER_DEVICE.m
+    with pytest.raises(ValueError) as excinfo:
+        symstab.simulate(alpha=0.01, beta=0.1, gamma=0.0, d=10, delta=None, steps=100,
+                         device=symstab.PAPER_DEVICE,
+                         nonideal=Nonidealities(force_resolution=3e-308))
+    assert_message_names(excinfo, "force_resolution")
+    assert f">= {float(np.finfo(float).tiny) / scale!r}" in str(excinfo.value)
