@@ -18,7 +18,9 @@ force and the environment at rest at the sampled ``x0``, with an empty
 delay line; its verdict is unstable when the largest ``|x|`` over the last
 quarter of the horizon exceeds that over the quarter before and a floor
 that quantization can reach (:attr:`Simulation.floor`), or the state
-overflows; its theory is its own root count.
+overflows; a run with non-idealities that keeps swinging above the floor,
+neither decaying nor growing, is a limit cycle (:attr:`Simulation.limit_cycle`),
+neither stable nor unstable; its theory is its own root count.
 """
 
 import dataclasses
@@ -79,8 +81,11 @@ class Nonidealities:
     Attributes
     ----------
     encoder_resolution : float
-        Position quantum (m or rad), a normal double: at least
-        :data:`QUANTUM_MIN` (see :func:`_check_quantum`).
+        Position quantum (m or rad), at least :data:`QUANTUM_MIN`, the
+        smallest normal double: the positions are divided by it, and a
+        subnormal quantum overflows every quotient (a value whose quotient
+        overflows is far above the quantum's precision and rounds to
+        itself).
     velocity_cutoff : float
         Cut-off of the velocity filter (Hz), in (0, Nyquist).
     coulomb_friction : float
@@ -574,7 +579,8 @@ def simulate_loop(loop, *, steps=None, x0=1.0, v0=None, nonideal=None, record=Fa
     ``encoder_resolution`` rounds the sampled position, ``force_resolution``
     rounds the force command to its quantum and ``force_limit`` clips it (a
     saturated unstable loop may settle into a bounded limit cycle, which the
-    verdict calls bounded, not growing; a quantized one, where the linear
+    verdict calls a limit cycle, :attr:`Simulation.limit_cycle`, neither
+    stable nor growing; a quantized one, where the linear
     loop is stable, is bounded up to :attr:`Simulation.floor`, the most the
     rounding can move it).  ``coulomb_friction`` (with ``stiction``
     and ``substeps``) acts on the loop's driven mass, after its

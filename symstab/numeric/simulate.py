@@ -17,7 +17,8 @@ default) need a :class:`symstab.numeric.units.Device`:
 * ``encoder_resolution`` -- the sampled position is rounded to this step;
 * ``force_limit`` -- the force command is clipped to this size (the
   amplifier's saturation: an unstable linear loop then grows into a bounded
-  limit cycle, which the verdict calls bounded, not growing);
+  limit cycle, which the verdict calls a limit cycle, neither stable nor
+  growing: :attr:`Simulation.limit_cycle`);
 * ``force_resolution`` -- the force command is rounded to a multiple of
   this quantum (the DAC's step) before the clip; where the linear loop is
   stable the verdict allows the limit cycle the quantum can cause
