@@ -21,8 +21,8 @@ from .loop_options import (add_loop_options, resolve_loop, uncertain_box,
 from .options import add_command, add_model_options, resolve, stiffness_and_damping
 from ..drawing import draw_lines, png_bytes, pyplot_or_none, visible
 from .output import check_files, write_output
-from .simulation import (add_nonideal_options, loop_nonideal_text, nonideal_text, resolve_nonideal,
-                         simulated_theory)
+from .simulation import (add_nonideal_options, check_loop_friction, loop_nonideal_text,
+                         nonideal_text, resolve_nonideal, simulated_theory, with_option_names)
 from .units import tex_unit
 
 __all__ = ["register", "run", "MAX_GRID", "map_outputs", "LOOP_MAP_HEADLINE",
@@ -39,6 +39,12 @@ LOOP_PROBABILITY_HEADLINE = ("map --loop --uncertain: the probability that each 
 #: The first line of ``map --loop --simulate``.
 LOOP_SIMULATE_HEADLINE = ("map --loop --simulate: every cell simulated, the loop's certified "
                           "root count beside")
+
+#: The colour and legend of a cell whose run settles into a bounded limit cycle
+#: (:attr:`symstab.numeric.simulate.Simulation.limit_cycle`): neither stable
+#: (green) nor growing (white).
+LIMIT_CYCLE_COLOR = "#fdb863"
+LIMIT_CYCLE_LABEL = "bounded limit cycle (simulated)"
 
 #: Bytes per map cell in the CSV and NPZ written, with the Python objects
 #: that build them (generous).
@@ -121,7 +127,8 @@ def map_outputs(args):
 
 def _paper(args):
     """The paper's loop simulated at every cell of the grid."""
-    from ..numeric.simulate import check_steps, progress_printer, stability_map
+    from ..numeric.simulate import (check_device_nonideal, check_steps, progress_printer,
+                                    stability_map)
     from ..numeric.stability import MARGINAL, STABLE
 
     setup = resolve(args)
@@ -141,6 +148,12 @@ def _paper(args):
     theory = simulated_theory(setup, nonideal)
     A, B = np.meshgrid(alpha, beta, indexing="ij")
     code = theory.classify(A, B)
+    if setup.physical:
+        try:
+            # The simulator's own checks (the friction against the device), before the echo.
+            check_device_nonideal(nonideal, setup.device)
+        except ValueError as exc:
+            raise with_option_names(exc) from None
     for line in setup.echo:
         print(line)
     result = stability_map(alpha=alpha, beta=beta, gamma=setup.gamma, d=setup.d,
@@ -157,22 +170,24 @@ def _paper(args):
         buf = io.BytesIO()
         units = {f"{name}_unit": np.array(setup.units[name]) for name in physical}
         np.savez(buf, alpha=alpha, beta=beta, **physical, **units, stable=result.stable,
-                 growth=result.growth, exact_stable=exact, exact_code=code, gamma=setup.gamma,
-                 d=setup.d, delta=setup.delta, steps=steps,
+                 limit_cycle=result.limit_cycle, growth=result.growth, exact_stable=exact,
+                 exact_code=code, gamma=setup.gamma, d=setup.d, delta=setup.delta, steps=steps,
                  nonidealities=np.array(nonideal_text(nonideal, args)),
                  theory=np.array(theory.description))
         data = buf.getvalue()
     else:
         buf = io.StringIO()
         columns = ["alpha", "beta"] + [f"{name} [{setup.units[name]}]" for name in physical]
-        buf.write(",".join(columns + ["stable", "exact_stable", "growth"]) + "\n")
+        buf.write(",".join(columns + ["stable", "limit_cycle", "exact_stable", "growth"]) + "\n")
         cells = [A.ravel(), B.ravel()]
         if physical:
             K, Bw = np.meshgrid(physical["K_w"], physical["B_w"], indexing="ij")
             cells += [K.ravel(), Bw.ravel()]
-        for *values, s, e, g in zip(*cells, result.stable.ravel(), exact.ravel(),
-                                    result.growth.ravel()):
-            buf.write(",".join(f"{v:.12g}" for v in values) + f",{int(s)},{int(e)},{g:.6g}\n")
+        for *values, s, c, e, g in zip(*cells, result.stable.ravel(),
+                                       result.limit_cycle.ravel(), exact.ravel(),
+                                       result.growth.ravel()):
+            buf.write(",".join(f"{v:.12g}" for v in values)
+                      + f",{int(s)},{int(c)},{int(e)},{g:.6g}\n")
         data = buf.getvalue().encode()
     png = _paper_png(args, setup, result, nonideal, given, theory) if png_path is not None else None
     write_output(out, data, "--out")
@@ -182,8 +197,8 @@ def _paper(args):
         written.append(str(png_path))
     decided = code != MARGINAL
     differ = int(np.count_nonzero((result.stable != exact) & decided))
-    print(f"{int(result.stable.sum())} of {result.stable.size} cells stable by simulation "
-          f"({steps} periods); {differ} of the {int(decided.sum())} cells that are not marginal "
+    print(f"{int(result.stable.sum())} of {result.stable.size} cells stable by simulation, "
+          f"{int(result.limit_cycle.sum())} bounded limit cycles ({steps} periods); {differ} of the {int(decided.sum())} cells that are not marginal "
           f"differ from the root-counting classification of the {theory.description}")
     print("wrote " + ", ".join(written))
     return 0
@@ -243,8 +258,10 @@ def _paper_png(args, setup, result, nonideal, given, theory):
 
     x, y, xlabel, ylabel, to_x, to_y = _map_axes(setup, given, result)
     fig, ax = plt.subplots(figsize=(6.4, 4.8), dpi=120)
-    ax.pcolormesh(x, y, result.stable.astype(float), shading="nearest",
-                  cmap=ListedColormap(["white", "#7fc97f"]), vmin=0, vmax=1)
+    # result's arrays are (alpha, beta): y by x, as pcolormesh takes them.
+    ax.pcolormesh(x, y, np.where(result.stable, 1, np.where(result.limit_cycle, 2, 0)),
+                  shading="nearest", cmap=ListedColormap(["white", "#7fc97f", LIMIT_CYCLE_COLOR]),
+                  vmin=0, vmax=2)
     arc_beta, arc_alpha, lines = theory.boundary(((result.beta[0], result.beta[-1]),
                                                   (result.alpha[0], result.alpha[-1])))
     drawn = []
@@ -254,6 +271,9 @@ def _paper_png(args, setup, result, nonideal, given, theory):
         drawn += ax.plot(to_x(arc_beta), to_y(arc_alpha), "k-", lw=1.2,
                          label=f"boundary of {name}")
     drawn += draw_lines(ax, lines, result.beta, result.alpha, to_x, to_y)
+    if np.any(result.limit_cycle):
+        from matplotlib.patches import Patch
+        drawn.append(Patch(facecolor=LIMIT_CYCLE_COLOR, label=LIMIT_CYCLE_LABEL))
     ax.set_xlim(x[0], x[-1])
     ax.set_ylim(y[0], y[-1])
     ax.set_xlabel(xlabel)
@@ -300,6 +320,8 @@ def _loop(args):
         steps = check_steps(args.steps, values["d"])
         # The difference equations at one cell: a plant they cannot step is refused now.
         loop.difference_equations(**{setup.x: xs[0], setup.y: ys[0]}, **values)
+        X, Y = np.meshgrid(xs, ys, indexing="ij")
+        check_loop_friction(nonideal, loop, {setup.x: X, setup.y: Y, **values})
     degree = loop.coefficients(**{setup.x: 0.0, setup.y: 0.0}, **values).shape[-1]
     # The cells are classified a chunk of x at a time; what stays is the codes
     # and the file's text.
@@ -324,24 +346,27 @@ def _loop(args):
                                        **{k: v for k, v in values.items()})
     if out.suffix == ".npz":
         extra = {} if simulated is None else {
-            "simulated_stable": simulated.stable.T, "growth": simulated.growth.T,
+            "simulated_stable": simulated.stable.T,
+            "simulated_limit_cycle": simulated.limit_cycle.T, "growth": simulated.growth.T,
             "steps": steps, "x0": x0, "nonidealities": np.array(loop_nonideal_text(nonideal))}
         data = _loop_npz(setup, xs, ys, values, code=code, stable=stable, **extra)
     else:
         X, Y = np.meshgrid(xs, ys, indexing="ij")
         buf = io.StringIO()
         buf.write(f"{setup.label(setup.x)},{setup.label(setup.y)},code,stable"
-                  + (",simulated_stable,growth" if simulated is not None else "") + "\n")
+                  + (",simulated_stable,simulated_limit_cycle,growth" if simulated is not None
+                     else "") + "\n")
         columns = [X.ravel(), Y.ravel(), code.ravel()]
         if simulated is not None:
-            columns += [simulated.stable.T.ravel(), simulated.growth.T.ravel()]
+            columns += [simulated.stable.T.ravel(), simulated.limit_cycle.T.ravel(),
+                        simulated.growth.T.ravel()]
         for xv, yv, c, *sim in zip(*columns):
             row = f"{xv:.12g},{yv:.12g},{int(c)},{int(c == STABLE)}"
             if sim:
-                row += f",{int(sim[0])},{sim[1]:.6g}"
+                row += f",{int(sim[0])},{int(sim[1])},{sim[2]:.6g}"
             buf.write(row + "\n")
         data = buf.getvalue()
-    image = (_loop_png(setup, xs, ys, code, None if simulated is None else simulated.stable.T)
+    image = (_loop_png(setup, xs, ys, code, None if simulated is None else simulated)
              if png_path is not None else None)
     write_output(out, data, "--out")
     written = [str(out)]
@@ -353,9 +378,10 @@ def _loop(args):
     if simulated is not None:
         decided = code != MARGINAL
         differ = int(np.count_nonzero((simulated.stable.T != stable) & decided))
-        print(f"{int(simulated.stable.sum())} of {code.size} cells stable by simulation "
-              f"({steps} periods; {loop_nonideal_text(nonideal)}); {differ} of the "
-              f"{int(decided.sum())} cells that are not marginal differ from the root counts")
+        print(f"{int(simulated.stable.sum())} of {code.size} cells stable by simulation, "
+              f"{int(simulated.limit_cycle.sum())} bounded limit cycles ({steps} periods; "
+              f"{loop_nonideal_text(nonideal)}); {differ} of the {int(decided.sum())} cells "
+              f"that are not marginal differ from the root counts (a limit cycle is not stable)")
     print("wrote " + ", ".join(written))
     return 0
 
@@ -480,9 +506,10 @@ def _axes(ax, setup, xs, ys):
 def _loop_png(setup, xs, ys, code, simulated=None):
     """The map as PNG bytes (None without matplotlib), with the D-decomposition drawn over it.
 
-    Shaded by the root counts, or by the simulation (``simulated``, stable
-    cells by ``(x, y)``) where one ran: the D-decomposition drawn over it is
-    the root counts' boundary.
+    Shaded by the root counts, or by the simulation (``simulated``, a
+    :class:`~symstab.numeric.simulate.StabilityMap`) where one ran: its
+    stable cells and its bounded limit cycles, each its own colour; the
+    D-decomposition drawn over it is the root counts' boundary.
     """
     from ..numeric.stability import MARGINAL, STABLE
 
@@ -494,14 +521,18 @@ def _loop_png(setup, xs, ys, code, simulated=None):
 
     loop, x, y = setup.loop, setup.x, setup.y
     fig, ax = plt.subplots(figsize=(6.4, 4.8), dpi=120)
-    shade = (np.where(code == STABLE, 2, np.where(code == MARGINAL, 1, 0)) if simulated is None
-             else np.where(simulated, 2, 0)).T
-    ax.pcolormesh(xs, ys, shade, shading="nearest", vmin=0, vmax=2,
-                  cmap=ListedColormap(["white", "#bdbdbd", "#7fc97f"]))
+    if simulated is None:
+        shade = np.where(code == STABLE, 2, np.where(code == MARGINAL, 1, 0)).T
+    else:
+        shade = np.where(simulated.stable, 2, np.where(simulated.limit_cycle, 3, 0))
+    ax.pcolormesh(xs, ys, shade, shading="nearest", vmin=0, vmax=3,
+                  cmap=ListedColormap(["white", "#bdbdbd", "#7fc97f", LIMIT_CYCLE_COLOR]))
     handles = [Patch(facecolor="#7fc97f", label="stable" if simulated is None
                      else "stable by simulation")]
     if simulated is None and np.any(code == MARGINAL):
         handles.append(Patch(facecolor="#bdbdbd", label="marginal"))
+    if simulated is not None and np.any(simulated.limit_cycle):
+        handles.append(Patch(facecolor=LIMIT_CYCLE_COLOR, label=LIMIT_CYCLE_LABEL))
     handles += _draw_boundary(ax, setup, xs, ys)
     _axes(ax, setup, xs, ys)
     # Wrapped to the width of the figure (a two-mass device has eight values),

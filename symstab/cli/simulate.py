@@ -18,7 +18,8 @@ from .._resources import check_memory
 from .loop_options import add_loop_options, resolve_loop, uses_loop, value_text
 from .options import add_command, add_model_options, parse_list, resolve, stiffness_and_damping
 from .output import check_files, write_output
-from .simulation import add_nonideal_options, loop_nonideal_text, resolve_nonideal, simulated_theory
+from .simulation import (add_nonideal_options, check_loop_friction, loop_nonideal_text,
+                         resolve_nonideal, simulated_theory, with_option_names)
 
 __all__ = ["register", "run"]
 
@@ -72,10 +73,14 @@ def run(args):
     theory = simulated_theory(setup, nonideal)
     code = theory.classify(alpha, beta)
     radius = theory.spectral_radius(alpha, beta)
-    run = simulate(alpha=alpha, beta=beta, gamma=setup.gamma, d=setup.d,
-                   delta=None if setup.physical else setup.delta, steps=steps, x0=x0,
-                   device=setup.device, nonideal=nonideal, record=record,
-                   progress=progress_printer("simulating", steps))
+    try:
+        run = simulate(alpha=alpha, beta=beta, gamma=setup.gamma, d=setup.d,
+                       delta=None if setup.physical else setup.delta, steps=steps, x0=x0,
+                       device=setup.device, nonideal=nonideal, record=record,
+                       progress=progress_printer("simulating", steps))
+    except (TypeError, ValueError) as exc:
+        # Its checks before the run (the friction against the device) name the options.
+        raise with_option_names(exc) from None
     for line in setup.echo:
         print(line)
     verdict = "diverged (unstable)" if run.diverged else ("stable" if run.stable else "unstable")
@@ -115,6 +120,7 @@ def _loop(args):
     # friction from a limit cycle by it).
     check_memory(f"the trajectory of {steps} periods", (steps + 1) * _TRAJECTORY_ROW_BYTES)
     loop.difference_equations(**values)        # a plant it cannot step is refused before the run
+    check_loop_friction(nonideal, loop, values)
     code = int(loop.classify(**values))
     radius = float(loop.spectral_radius(**values))
     run = loop.simulate(steps=steps, x0=x0, nonideal=nonideal, record=True,
@@ -123,15 +129,16 @@ def _loop(args):
         print(line)
     verdict = "diverged (unstable)" if run.diverged else ("stable" if run.stable else "unstable")
     last = run.positions[-(run.steps // 4):]
-    if run.stable and np.all(last == last[-1]) and nonideal.coulomb_friction is not None:
-        verdict = f"stable (held at rest by friction at x = {last[-1]:.4g})"
-    elif run.stable and not nonideal.ideal and run.amplitude[3] >= 0.9 * run.amplitude[2]:
+    if run.limit_cycle:
+        # The simulator's class (Simulation.limit_cycle), as the map's cells.
         verdict = (f"bounded, not decaying (a limit cycle of amplitude {run.amplitude[3]:.4g}: "
-                   f"the verdict compares the last two quarters)")
-        if run.amplitude[3] > run.amplitude[2]:
-            verdict = (f"bounded (a limit cycle of amplitude {run.amplitude[3]:.4g}, within "
-                       f"{float(run.floor):.4g}, the most the quantization can move the "
-                       f"position here)")
+                   f"neither stable nor growing)")
+    elif run.stable and np.all(last == last[-1]) and nonideal.coulomb_friction is not None:
+        verdict = f"stable (held at rest by friction at x = {last[-1]:.4g})"
+    elif run.stable and 0.9 * run.amplitude[2] <= run.amplitude[3] <= run.floor:
+        verdict = (f"bounded (a limit cycle of amplitude {run.amplitude[3]:.4g}, within "
+                   f"{float(run.floor):.4g}, the most the quantization can move the "
+                   f"position here)")
     print(f"simulated {run.steps} periods from x0 = {x0:g} ({loop_nonideal_text(nonideal)}): "
           f"{verdict}; max |x| per quarter: " + ", ".join(f"{a:.4g}" for a in run.amplitude))
     print(f"theory (the loop's certified root count): spectral radius {radius:.12g} -> "

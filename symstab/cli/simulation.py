@@ -9,7 +9,7 @@ and actuator lag included), whose root count each simulation is compared with.
 import re
 
 __all__ = ["add_nonideal_options", "resolve_nonideal", "simulated_theory", "nonideal_text",
-           "loop_nonideal_text"]
+           "loop_nonideal_text", "with_option_names", "check_loop_friction"]
 
 
 #: The option of each field of :class:`~symstab.numeric.simulate.Nonidealities`.
@@ -113,6 +113,29 @@ def resolve_nonideal(args, setup, loop=None):
     # Checked here, not only by the simulator, so that nothing is printed before the error.
     x0 = check_x0(args.x0) if args.x0 is not None else default_x0(nonideal)
     return nonideal, x0
+
+
+def with_option_names(exc):
+    """``exc`` (a TypeError or ValueError of the library) naming the options, not the fields.
+
+    For the checks the simulation makes itself before it runs (the friction
+    against the plant's step, :func:`~symstab.numeric.simulate.check_friction_size`).
+    """
+    return type(exc)(_FIELD_NAMES.sub(lambda m: _OPTION_OF[m.group(1)], str(exc)))
+
+
+def check_loop_friction(nonideal, loop, values):
+    """Refuse, naming ``--coulomb``, a friction too large to step on ``loop``'s plant at ``values``.
+
+    Decided before the run (and before anything is printed): the friction
+    spaces are the run's own (cached by the loop).
+    """
+    from ..numeric.friction import substeps_of
+    from ..numeric.simulate import check_friction_size
+
+    if nonideal.coulomb_friction is not None:
+        spaces, _ = loop.friction_spaces(substeps_of(nonideal), **values)
+        check_friction_size(nonideal, spaces, name="--coulomb")
 
 
 def simulated_theory(setup, nonideal):

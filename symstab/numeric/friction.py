@@ -24,7 +24,10 @@ B_f C_v / (C_v B_f)``, the friction taking exactly ``net`` (for a rigid
 mass: nothing moves; for two masses: the one not held goes on).  A moving
 mass feels ``friction_coulomb sign(v)``; a sub-step that would reverse its
 velocity ends at rest, by the friction's impulse on the mass alone,
-``x -= B_f (C_v x) / (C_v B_f)``: the paper's simulator's friction model,
+``x -= B_f (C_v x) / (C_v B_f)``, where the mass stopped: forward of the
+sub-step's start by ``v0 t* / 2`` at the time ``t*`` its velocity reached
+zero (:meth:`StatePlant._stopped_at`), never behind it (friction stops a
+mass; it does not push it back): the paper's simulator's friction model,
 for any mass with any linear structure around it (the paper's device is
 one: :func:`symstab.numeric.simulate.simulate` runs on :class:`StatePlant`).
 Without friction the same state space steps a plant from a given state
@@ -61,6 +64,11 @@ class FrictionSpace:
     start_position, start_change : ndarray
         The state after positions ``x0 - k v0`` (``k = 0, 1, ...``) with no
         force: ``x0 start_position + v0 start_change``.
+    substep : float
+        The sub-step's length ``h = T / substeps`` (s).
+    per_mass : float
+        ``C_v B_f``: the acceleration of a unit force on the mass (one over
+        its mass), so that its acceleration is ``per_mass (net - friction)``.
     """
 
     phi: np.ndarray
@@ -73,6 +81,8 @@ class FrictionSpace:
     impulse: np.ndarray
     start_position: np.ndarray
     start_change: np.ndarray
+    substep: float
+    per_mass: float
 
 
 def _canonical(num, den):
@@ -172,12 +182,14 @@ def friction_space(coefficients, T, substeps):
             out[key] = _snapped(out[key])
         out = {k: np.array(v.tolist(), dtype=float).squeeze() if isinstance(v, mpmath.matrix)
                else float(v) for k, v in out.items()}
+    out["substep"] = float(T) / substeps
+    out["per_mass"] = float(per_mass)
     for key in ("phi", "stuck_phi"):
         out[key] = out[key].reshape(n, n)
     for key, value in out.items():
         if not np.all(np.isfinite(value)):
             raise ValueError(f"the friction state space of the plant is not finite ({key})")
-        if key not in ("phi", "stuck_phi", "net_input"):
+        if key not in ("phi", "stuck_phi", "net_input", "substep", "per_mass"):
             out[key] = np.reshape(value, n)
     # The impulse stops the mass exactly: its velocity component is 1.
     out["impulse"][1] = 1.0
@@ -346,6 +358,9 @@ class StatePlant:
             # A reversal within the sub-step ends at rest (friction cannot
             # push the mass backwards); a stuck mass stays where it is.
             reversed_ = ~self.rest & (direction != 0) & (np.sign(moving[1]) == -direction)
+            if reversed_.any():
+                moving[0] = np.where(reversed_, self._stopped_at(moving[1], net, direction),
+                                     moving[0])
             if stuck.any():
                 kept = _times(sp.stuck_phi, self._state) + _column(sp.stuck_gamma) * held
                 kept[0] = self._state[0]
@@ -354,6 +369,37 @@ class StatePlant:
             self.rest = reversed_ | stuck
             self._stop(self.rest)
         return self._state[0].copy()
+
+    def _stopped_at(self, velocity, net, direction):
+        """Where a moving mass stops within the sub-step whose end ``velocity`` is reversed.
+
+        The sub-step's moving step holds the friction to its end, so its
+        position is where a force that reversed the mass would have pushed
+        it back to (with a large friction, far behind the start: it stopped
+        the mass within the sub-step, then drove it backwards).  The mass
+        stops instead at ``t*``, at ``x0 + v0 t* / 2``: its velocity falls
+        from ``v0`` at the rate of the start, ``per_mass (F_c - sign(v0)
+        net)``, the friction with the other forces on it (``net``), which
+        puts ``t*`` where that rate reaches zero.  Where that rate does not
+        stop the mass within the sub-step (the other forces turned it
+        round), the rate is the sub-step's mean, from ``v0`` to its end
+        ``v1``: ``t* = h v0 / (v0 - v1)``.  Either way the mass ends forward
+        of its start by less than ``v0 h / 2``; the position is exact for
+        forces constant over the stop and otherwise off by their change
+        over it (relatively, at most the other forces over the friction:
+        the stick and reversal times are first order in ``h`` besides).
+        The other states keep the sub-step's end: the stop's impulse acts
+        on the mass alone.
+        """
+        sp = self.space
+        position, start = self._state[0], self._state[1]
+        with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
+            rate = sp.per_mass * (self.coulomb - direction * net)
+            at_start = np.abs(start) / rate
+            mean = sp.substep * start / (start - velocity)
+            time = np.where((rate > 0) & (at_start <= sp.substep), at_start, mean)
+            travel = 0.5 * start * time
+        return position + np.where(np.isfinite(travel), travel, 0.0)
 
     def _linear_rows(self, force, sign):
         """The rows of ``phi state + gamma_u sign force``: new arrays, summed over ``phi``'s nonzero entries."""

@@ -18,7 +18,9 @@ force and the environment at rest at the sampled ``x0``, with an empty
 delay line; its verdict is unstable when the largest ``|x|`` over the last
 quarter of the horizon exceeds that over the quarter before and a floor
 that quantization can reach (:attr:`Simulation.floor`), or the state
-overflows; its theory is its own root count.
+overflows; a run with non-idealities that keeps swinging above the floor,
+neither decaying nor growing, is a limit cycle (:attr:`Simulation.limit_cycle`),
+neither stable nor unstable; its theory is its own root count.
 """
 
 import dataclasses
@@ -37,7 +39,8 @@ from .results import PAPER_PLANE, PaperGridNames
 __all__ = ["Nonidealities", "Simulation", "StabilityMap", "default_horizon", "check_steps",
            "check_x0", "max_steps", "progress_printer", "PAPER_ENCODER_RESOLUTION",
            "MAX_STEPS_ENV", "run_loop", "simulate_loop", "loop_stability_map",
-           "check_loop_nonideal", "default_x0", "MAX_SUBSTEPS", "X0_MIN", "X0_MAX"]
+           "check_loop_nonideal", "default_x0", "MAX_SUBSTEPS", "X0_MIN", "X0_MAX",
+           "check_friction_size", "QUANTUM_MIN", "FRICTION_STEP_MAX"]
 
 
 #: The most sub-steps per period: each multiplies the simulation's time (a
@@ -52,6 +55,15 @@ PAPER_ENCODER_RESOLUTION = math.radians(3 / 3600)
 _OVERFLOW = 1e100
 #: Periods between overflow checks.
 _CHECK_EVERY = 8
+#: A limit cycle's swing over the last quarter stays within this fraction of
+#: the third's.  Its sampled peaks differ by up to 2e-4 between quarters (the
+#: paper's loop saturated at 0.05 N m, d = 10); a linear mode changes by this
+#: much over a quarter only within about 2e-6 of |z| = 1 at the default
+#: horizon, the band that no finite run decides.
+_SUSTAINED = 1e-2
+#: A swing below this fraction of the amplitude is rounding, not motion: a
+#: mass settling off zero at K = 0 keeps a swing of 1e-11 of its position.
+_MOVING = 1e-8
 #: Allowed size of the initial state.  The verdict compares the largest |x|
 #: of the last two quarters and calls |x| > _OVERFLOW divergence: a start at
 #: zero never moves (0 <= 0 reads as stable), and a stable point needs room
@@ -69,11 +81,18 @@ class Nonidealities:
     Attributes
     ----------
     encoder_resolution : float
-        Position quantum (m or rad), > 0.
+        Position quantum (m or rad), at least :data:`QUANTUM_MIN`, the
+        smallest normal double: the positions are divided by it, and a
+        subnormal quantum overflows every quotient (a value whose quotient
+        overflows is far above the quantum's precision and rounds to
+        itself).
     velocity_cutoff : float
         Cut-off of the velocity filter (Hz), in (0, Nyquist).
     coulomb_friction : float
-        Coulomb friction force (N or N m), >= 0.
+        Coulomb friction force (N or N m), >= 0, and small enough that its
+        change of the state over a sub-step is a double
+        (:func:`check_friction_size`, checked against the loop's plant
+        before a run).
     stiction : float
         Breakaway force (N or N m), >= coulomb_friction (default: equal).
     friction_compensation : bool
@@ -86,8 +105,9 @@ class Nonidealities:
     force_limit : float
         Largest force command (N or N m), > 0: the command is clipped to it.
     force_resolution : float
-        Force quantum (N or N m), > 0: the command is rounded to a multiple
-        of it (a DAC's step), then clipped to ``force_limit``.
+        Force quantum (N or N m), at least :data:`QUANTUM_MIN`: the command
+        is rounded to a multiple of it (a DAC's step), then clipped to
+        ``force_limit``.
     """
 
     encoder_resolution: float = None
@@ -104,7 +124,7 @@ class Nonidealities:
         # Checked at construction, so that a wrong kind never reaches a run:
         # friction_compensation="no" would otherwise switch compensation on.
         if self.encoder_resolution is not None:
-            check_real("encoder_resolution", self.encoder_resolution, low=0.0, low_open=True)
+            _check_quantum("encoder_resolution", self.encoder_resolution, "positions")
         if self.velocity_cutoff is not None:
             check_real("velocity_cutoff", self.velocity_cutoff, low=0.0, low_open=True)
         if self.coulomb_friction is not None:
@@ -124,7 +144,7 @@ class Nonidealities:
         if self.force_limit is not None:
             check_real("force_limit", self.force_limit, low=0.0, low_open=True)
         if self.force_resolution is not None:
-            check_real("force_resolution", self.force_resolution, low=0.0, low_open=True)
+            _check_quantum("force_resolution", self.force_resolution, "force commands")
             if self.coulomb_friction is not None:
                 # The verdict's floor for the quantum bounds the linear loop's response.
                 raise ValueError("force_resolution with coulomb_friction: the verdict allows "
@@ -165,6 +185,79 @@ class Nonidealities:
                 and self.coulomb_friction is None and self.actuator_bandwidth is None
                 and self.force_limit is None and self.force_resolution is None)
 
+
+
+#: The smallest quantum (encoder or force): the smallest normal double.
+QUANTUM_MIN = float(np.finfo(float).tiny)
+#: The largest change of the state the friction may make over a sub-step:
+#: below double precision's largest number (1.8e308) with room to add it to
+#: the rest of the step.
+FRICTION_STEP_MAX = 1e300
+
+
+def _check_quantum(name, quantum, divided):
+    """Check a quantum: a finite double of at least :data:`QUANTUM_MIN` (ValueError naming it).
+
+    The run divides the values it rounds by the quantum.  A subnormal
+    quantum (1e-320) keeps fewer than 53 significant bits and overflows
+    every such quotient above 1.8e-12: each run diverged.  From a normal
+    quantum on, a quotient that overflows is of a value the quantum is far
+    below the precision of, which rounding leaves as it is
+    (:func:`_rounded`).
+    """
+    check_real(name, quantum, low=0.0, low_open=True)
+    if not quantum >= QUANTUM_MIN:
+        raise ValueError(f"{name} must be a finite real number >= {QUANTUM_MIN!r} (the smallest "
+                         f"normal double: below it the quantum loses its significant bits and "
+                         f"the {divided} divided by it overflow), got {quantum!r}")
+
+
+def _rounded(values, quantum):
+    """``values`` rounded to multiples of ``quantum``; as they are where the quotient overflows.
+
+    (A quotient that overflows is of a value whose precision the quantum
+    is far below: its own multiple to the last bit.)
+    """
+    with np.errstate(over="ignore", invalid="ignore"):
+        rounded = quantum * np.round(values / quantum)
+    return np.where(np.isfinite(rounded), rounded, values)
+
+
+def check_friction_size(nonideal, spaces, name="nonideal.coulomb_friction", scale=1.0):
+    """Refuse a Coulomb friction larger than double precision can step on the plants ``spaces``.
+
+    A sub-step adds ``-gamma_f F`` to the state (:mod:`symstab.numeric.
+    friction`); the friction is refused when its largest entry would pass
+    :data:`FRICTION_STEP_MAX`, from where adding it overflows and a held
+    mass reads as diverged.  Below it any friction is stepped: a large one
+    stops the mass within the sub-step where it stands.
+
+    Parameters
+    ----------
+    nonideal : Nonidealities
+        In the units of the spaces.
+    spaces : list of FrictionSpace
+    name : str
+        The friction's name in the message (the CLI's ``--coulomb``).
+    scale : float
+        The spaces' unit of force over the caller's (the message gives the
+        caller's).
+
+    Raises
+    ------
+    ValueError
+        Naming ``name`` and its range on these plants.
+    """
+    friction = nonideal.coulomb_friction
+    if not friction:
+        return
+    largest = max(float(np.max(np.abs(space.gamma_f))) for space in spaces)
+    if largest > 0 and friction * largest > FRICTION_STEP_MAX:
+        limit = FRICTION_STEP_MAX / largest / scale
+        raise ValueError(f"{name} must be a real number from 0 to {limit:.3g} on this plant (a "
+                         f"sub-step changes its state by up to {largest * scale:.3g} per unit "
+                         f"of friction, and double precision steps a change up to "
+                         f"{FRICTION_STEP_MAX:g}), got {friction / scale:g}")
 
 
 def default_horizon(d):
@@ -247,14 +340,19 @@ class Simulation:
     diverged : ndarray of bool
         The state overflowed (|x| > 1e100).
     stable : ndarray of bool
-        Not diverged, and the last quarter's amplitude does not exceed the
-        third's or the floor (see the module docstring).
+        Not diverged, not a limit cycle, and the last quarter's amplitude
+        does not exceed the third's or the floor (see the module docstring).
     steps : int
     floor : ndarray
         The amplitude up to which a run counts as bounded whatever it does:
         four encoder counts, plus, with a force quantum, half the quantum
         times the l1 norm of the linear loop's pulse response where the
         linear loop is stable (the most its rounding can move the position).
+    limit_cycle : ndarray of bool
+        A run with non-idealities that keeps swinging, neither decaying nor
+        growing, above the floor: a bounded limit cycle (a saturated
+        unstable loop's), neither stable nor unstable.  Never set for the
+        ideal loop, which is linear.
     """
 
     positions: object
@@ -263,16 +361,25 @@ class Simulation:
     stable: np.ndarray
     steps: int
     floor: np.ndarray
+    limit_cycle: np.ndarray
+
+    @property
+    def bounded(self):
+        """Stable or a limit cycle: the runs that neither grow nor diverge."""
+        return self.stable | self.limit_cycle
 
     def __repr__(self):
         stable = np.asarray(self.stable)
         n_stable, n_diverged = int(np.count_nonzero(stable)), int(np.count_nonzero(self.diverged))
+        n_cycles = int(np.count_nonzero(self.limit_cycle))
         size = f"{stable.size} point{'s' if stable.size != 1 else ''}"
         if stable.ndim > 1:
             size += " (" + " x ".join(map(str, stable.shape)) + ")"
         recorded = ", positions recorded" if self.positions is not None else ""
-        return (f"Simulation({size}, {self.steps} steps: {n_stable} stable, "
-                f"{stable.size - n_stable} unstable of which {n_diverged} diverged{recorded})")
+        cycles = f"{n_cycles} limit cycle{'s' if n_cycles != 1 else ''}, " if n_cycles else ""
+        n_unstable = stable.size - n_stable - n_cycles
+        return (f"Simulation({size}, {self.steps} steps: {n_stable} stable, {cycles}"
+                f"{n_unstable} unstable of which {n_diverged} diverged{recorded})")
 
 
 def progress_printer(label, total, stream=None, min_seconds=2.0):
@@ -321,9 +428,9 @@ def _run_chunks(make_run, n_points, point_bytes, *, steps, d, record, progress, 
                      8 * (steps + 1) * n_points + point_bytes * n_points)
     else:
         # The chunks bound the working set; what stays is the result.
-        check_memory(f"simulating {n_points} point(s)", 8 * 7 * n_points)
+        check_memory(f"simulating {n_points} point(s)", 8 * 11 * n_points)
     chunks = [slice(0, n_points)] if record else chunk_slices(n_points, point_bytes)
-    amplitude = np.zeros((4, n_points))
+    amplitude, swing = np.zeros((4, n_points)), np.zeros((4, n_points))
     diverged = np.zeros(n_points, dtype=bool)
     positions = np.empty((steps + 1, n_points)) if record else None
     response = np.zeros(n_points) if pulse_of is not None else None
@@ -336,13 +443,13 @@ def _run_chunks(make_run, n_points, point_bytes, *, steps, d, record, progress, 
         run.check_every = 1 if record else _CHECK_EVERY
         runs_done = number * (n_runs // len(chunks))
         _run(run, steps, amplitude[:, part], None if positions is None else positions[:, part],
-             progress, report, runs_done, n_runs)
+             progress, report, runs_done, n_runs, swing=swing[:, part])
         diverged[part] = run.diverged
         run = None          # the pulse response's chunk takes its place
         if pulse_of is not None:
             response[part] = _pulse_l1(pulse_of(part), steps, progress, report, runs_done + 1,
                                        n_runs)
-    return _verdict(amplitude, diverged, positions, shape, steps, nonideal, response)
+    return _verdict(amplitude, swing, diverged, positions, shape, steps, nonideal, response)
 
 
 def _pulse_l1(pulse, steps, progress, report, chunk, n_chunks):
@@ -366,29 +473,40 @@ def _pulse_l1(pulse, steps, progress, report, chunk, n_chunks):
     return out
 
 
-def _run(run, steps, amplitude, positions, progress, report, chunk, n_chunks, total=None):
+def _run(run, steps, amplitude, positions, progress, report, chunk, n_chunks, total=None,
+         swing=None):
     """Advance ``run`` ``steps`` periods, keeping the largest |x| of each quarter.
 
     ``progress`` hears the steps done over all chunks, scaled to ``steps``;
-    ``total``, if given, accumulates ``|x|`` of every period after the start.
+    ``total``, if given, accumulates ``|x|`` of every period after the start;
+    ``swing``, if given, gets each quarter's half range of ``x`` (half of
+    its largest less its smallest value).
     """
     quarter = steps // 4
     if positions is not None:
         positions[0] = run.x
-    magnitude = np.empty_like(run.x)
+    # The signed extremes of each quarter: the largest |x| and the swing (a
+    # limit cycle keeps its swing; a mass held off zero keeps |x| with none).
+    high, low = np.full((4, run.x.size), -np.inf), np.full((4, run.x.size), np.inf)
+    magnitude = np.empty_like(run.x) if total is not None else None
     for k in range(steps):
         with np.errstate(over="ignore", invalid="ignore"):
             run.step()
         q = min(k // quarter, 3)
-        np.abs(run.x, out=magnitude)
-        np.maximum(amplitude[q], magnitude, out=amplitude[q])
+        np.maximum(high[q], run.x, out=high[q])
+        np.minimum(low[q], run.x, out=low[q])
         if total is not None:
+            np.abs(run.x, out=magnitude)
             total += magnitude
         if positions is not None:
             positions[k + 1] = run.x
         if progress is not None and ((k + 1) % report == 0 or k + 1 == steps):
             progress((chunk * steps + k + 1) // n_chunks)
     run.freeze_diverged()
+    with np.errstate(invalid="ignore"):
+        np.maximum(high, -low, out=amplitude)
+        if swing is not None:
+            np.multiply(high - low, 0.5, out=swing)
 
 
 @dataclasses.dataclass(frozen=True)
@@ -401,6 +519,9 @@ class StabilityMap(PaperGridNames):
         The 1-D grids.
     stable : ndarray of bool
         Shape ``(len(y_values), len(x_values))``.
+    limit_cycle : ndarray of bool
+        Same shape: the cells whose run settles into a bounded limit cycle
+        (:attr:`Simulation.limit_cycle`), neither stable nor growing.
     growth : ndarray
         Last quarter's amplitude over the third's (``inf`` when diverged).
     steps : int
@@ -420,6 +541,7 @@ class StabilityMap(PaperGridNames):
     y_values: np.ndarray
     x_values: np.ndarray
     stable: np.ndarray
+    limit_cycle: np.ndarray
     growth: np.ndarray
     steps: int
     x: str = PAPER_PLANE[0]
@@ -457,7 +579,8 @@ def simulate_loop(loop, *, steps=None, x0=1.0, v0=None, nonideal=None, record=Fa
     ``encoder_resolution`` rounds the sampled position, ``force_resolution``
     rounds the force command to its quantum and ``force_limit`` clips it (a
     saturated unstable loop may settle into a bounded limit cycle, which the
-    verdict calls bounded, not growing; a quantized one, where the linear
+    verdict calls a limit cycle, :attr:`Simulation.limit_cycle`, neither
+    stable nor growing; a quantized one, where the linear
     loop is stable, is bounded up to :attr:`Simulation.floor`, the most the
     rounding can move it).  ``coulomb_friction`` (with ``stiction``
     and ``substeps``) acts on the loop's driven mass, after its
@@ -507,6 +630,7 @@ def simulate_loop(loop, *, steps=None, x0=1.0, v0=None, nonideal=None, record=Fa
     spaces = None
     if nonideal.coulomb_friction is not None:
         spaces, inverse = loop.friction_spaces(substeps_of(nonideal), **values)
+        check_friction_size(nonideal, spaces)
         spaces = (spaces, inverse.ravel())
     return run_loop(lambda part: [p[part] for p in parts], n_points, d=d, steps=steps, x0=x0,
                     v0=v0, nonideal=nonideal, record=record, progress=progress, shape=shape,
@@ -617,33 +741,53 @@ def check_loop_nonideal(nonideal, loop=None, friction_name="nonideal.coulomb_fri
     return nonideal
 
 
-def _verdict(amplitude, diverged, positions, shape, steps, nonideal, response=None):
-    """The :class:`Simulation` of a run: unstable when the last quarter outgrows the third.
+def _verdict(amplitude, swing, diverged, positions, shape, steps, nonideal, response=None):
+    """The :class:`Simulation` of a run: stable, a limit cycle, or unstable.
 
-    Amplitudes up to a floor count as bounded whatever they do: four
-    encoder counts (a quantization limit cycle), plus, with a force quantum
-    ``q``, at the points whose linear loop is stable, ``q / 2`` times
-    ``response``, the l1 norm over the run of the linear loop's response
-    to a unit force pulse.  Rounding adds to each command an error of at
-    most ``q / 2``; by superposition the position departs from the run
-    without the quantum by at most ``q / 2`` times that norm, and that run
-    decays where the linear loop is stable: a limit cycle within the floor
-    is the quantum's, not growth.  (Without a floor, a limit cycle's last
-    quarter exceeds the third as often as not: on the paper's loop at d = 5
-    with a 1 mN m quantum, 543 of 1 515 stable cells were called unstable.)
-    ``response`` is 0 where the linear loop is not stable.
+    Unstable when the last quarter outgrows the third.  Amplitudes up to a
+    floor count as bounded whatever they do: four encoder counts (a
+    quantization limit cycle), plus, with a force quantum ``q``, at the
+    points whose linear loop is stable, ``q / 2`` times ``response``, the
+    l1 norm over the run of the linear loop's response to a unit force
+    pulse.  Rounding adds to each command an error of at most ``q / 2``; by
+    superposition the position departs from the run without the quantum by
+    at most ``q / 2`` times that norm, and that run decays where the linear
+    loop is stable: a limit cycle within the floor is the quantum's, not
+    growth.  (Without a floor, a limit cycle's last quarter exceeds the
+    third as often as not: on the paper's loop at d = 5 with a 1 mN m
+    quantum, 543 of 1 515 stable cells were called unstable.)  ``response``
+    is 0 where the linear loop is not stable.
+
+    A run of a loop with non-idealities is a limit cycle
+    (:attr:`Simulation.limit_cycle`), neither stable nor unstable, when it
+    keeps swinging: the half range of ``x`` over the last quarter
+    (``swing``) is above the floor and :data:`_MOVING` of the amplitude (a
+    mass held at rest off zero by friction has none), within
+    :data:`_SUSTAINED` of the third quarter's (not decaying, not growing),
+    and the largest ``|x|`` no more than that above the third's (not
+    drifting away).  The sampled peak of a periodic motion differs from one
+    quarter to the next by up to 2e-4 (a saturated paper loop), so the
+    plain comparison called half of such cycles growing and half stable.
+    A linear loop has no limit cycle: a run of the ideal loop that neither
+    grows nor decays is on the boundary, and stays the comparison's.
     """
     amplitude[:, diverged] = np.inf
     floor = 4 * nonideal.encoder_resolution if nonideal.encoder_resolution else 0.0
     if response is not None:
         floor = floor + nonideal.force_resolution / 2 * response
     floor = np.broadcast_to(floor, diverged.shape)
-    stable = ~diverged & (amplitude[3] <= np.maximum(amplitude[2], floor))
+    bounded = ~diverged & (amplitude[3] <= np.maximum(amplitude[2], floor))
+    with np.errstate(invalid="ignore"):
+        limit_cycle = (~diverged & (swing[3] > np.maximum(floor, _MOVING * amplitude[3]))
+                       & (np.abs(swing[3] - swing[2]) <= _SUSTAINED * swing[2])
+                       & (amplitude[3] <= (1 + _SUSTAINED) * amplitude[2]))
+    if nonideal.ideal:
+        limit_cycle[:] = False
     return Simulation(
         positions=None if positions is None else positions.reshape((steps + 1,) + shape),
         amplitude=amplitude.reshape((4,) + shape),
-        diverged=diverged.reshape(shape), stable=stable.reshape(shape), steps=steps,
-        floor=floor.reshape(shape))
+        diverged=diverged.reshape(shape), stable=(bounded & ~limit_cycle).reshape(shape),
+        steps=steps, floor=floor.reshape(shape), limit_cycle=limit_cycle.reshape(shape))
 
 
 def _terms(columns):
@@ -712,7 +856,7 @@ class _AnyLoop:
 
     def _sample(self, x):
         q = self.quantum
-        return x if not q else q * np.round(x / q)
+        return x if not q else _rounded(x, q)
 
     def _sum(self, out, terms, history, sign):
         tmp = self._scratch
@@ -744,7 +888,7 @@ class _AnyLoop:
         # The environment keeps its own force; the command sent is rounded
         # to the DAC's step and clipped to its range.
         if self.force_quantum is not None:
-            command = self.force_quantum * np.round(command / self.force_quantum)
+            command = _rounded(command, self.force_quantum)
         if self.force_limit is not None:
             command = np.clip(command, -self.force_limit, self.force_limit)
         slot = self.k % (self.d + 1)
@@ -848,4 +992,5 @@ def loop_stability_map(loop, x_values, y_values, *, x=None, y=None, steps=None, 
     with np.errstate(divide="ignore", invalid="ignore"):
         growth = np.where(run.diverged, np.inf, run.amplitude[3] / run.amplitude[2])
     at = {k: v for k, v in {**loop.defaults, **values}.items() if k not in (x, y)}
-    return StabilityMap(y_values, x_values, run.stable, growth, run.steps, x=x, y=y, at=at)
+    return StabilityMap(y_values, x_values, run.stable, run.limit_cycle, growth, run.steps,
+                        x=x, y=y, at=at)

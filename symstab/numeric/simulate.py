@@ -17,7 +17,8 @@ default) need a :class:`symstab.numeric.units.Device`:
 * ``encoder_resolution`` -- the sampled position is rounded to this step;
 * ``force_limit`` -- the force command is clipped to this size (the
   amplifier's saturation: an unstable linear loop then grows into a bounded
-  limit cycle, which the verdict calls bounded, not growing);
+  limit cycle, which the verdict calls a limit cycle, neither stable nor
+  growing: :attr:`Simulation.limit_cycle`);
 * ``force_resolution`` -- the force command is rounded to a multiple of
   this quantum (the DAC's step) before the clip; where the linear loop is
   stable the verdict allows the limit cycle the quantum can cause
@@ -69,7 +70,8 @@ import numpy as np
 
 from .._validate import check_array, check_delay, check_loop, check_real
 from .loop_simulate import (MAX_STEPS_ENV, PAPER_ENCODER_RESOLUTION, X0_MAX, Nonidealities,
-                            Simulation, StabilityMap, check_loop_nonideal, check_steps,
+                            QUANTUM_MIN, Simulation, StabilityMap, check_friction_size,
+                            check_loop_nonideal, check_steps,
                             check_x0, default_horizon, default_x0, loop_stability_map,
                             linearly_stable, max_steps, progress_printer, run_loop,
                             simulate_loop)
@@ -79,7 +81,7 @@ from .simulate_theory import paper_simulated_loop
 __all__ = ["Nonidealities", "Simulation", "simulate", "StabilityMap", "stability_map",
            "default_horizon", "check_steps", "check_x0", "max_steps", "progress_printer", "PAPER_ENCODER_RESOLUTION",
            "MAX_STEPS_ENV", "simulate_loop", "loop_stability_map", "check_loop_nonideal",
-           "default_x0"]
+           "default_x0", "check_friction_size", "check_device_nonideal"]
 
 
 def simulate(*, alpha, beta, gamma, d, delta, steps=None, x0=1.0, v0=None, device=None,
@@ -167,25 +169,9 @@ def simulate(*, alpha, beta, gamma, d, delta, steps=None, x0=1.0, v0=None, devic
     steps = check_steps(steps, d)
     x0 = check_x0(x0)
     v0 = x0 / 100 if v0 is None else check_real("v0", v0, low=-X0_MAX, high=X0_MAX)
-    # The paper's loop is a Loop in Table I's units (m = T = 1, b = delta,
-    # K = alpha, B = beta, M = gamma), its filter in the environment and its
-    # lag in the plant, run by the loop simulator from the state (x0, v0).
-    filtered = device is not None and nonideal.velocity_cutoff is not None
-    lagged = device is not None and nonideal.actuator_bandwidth is not None
-    loop = paper_simulated_loop(filtered, lagged, delta == 0)
-    values = {"m": 1.0, "T": 1.0, "K": alpha, "B": beta, "M": gamma, "d": d}
-    if delta != 0:
-        values["b"] = delta
-    if filtered:
-        values["f_c"] = nonideal.velocity_cutoff * device.T
-    if lagged:
-        values["tau"] = 1 / (2 * math.pi * nonideal.actuator_bandwidth * device.T)
-    scale = 1.0 if device is None else device.T**2 / device.m   # force -> f T^2 / m
-    run_nonideal = dataclasses.replace(
-        nonideal, velocity_cutoff=None, actuator_bandwidth=None, friction_compensation=False,
-        **{name: None if getattr(nonideal, name) is None else getattr(nonideal, name) * scale
-           for name in ("coulomb_friction", "stiction", "force_limit", "force_resolution")})
-    spaces, _ = loop.friction_spaces(substeps_of(run_nonideal), **dict(values, K=0.0, B=0.0, M=0.0))
+    loop, fixed, run_nonideal, spaces, scale = _device_run(nonideal, device, delta, d)
+    values = {**fixed, "K": alpha, "B": beta, "M": gamma}
+    filtered = "f_c" in fixed
     compensation = None
     if nonideal.friction_compensation:
         compensation = (run_nonideal.coulomb_friction,
@@ -202,6 +188,66 @@ def simulate(*, alpha, beta, gamma, d, delta, steps=None, x0=1.0, v0=None, devic
                     spaces=(spaces, np.zeros(alpha.size, dtype=int)), state=(x0, v0),
                     compensation=compensation,
                     linear_stable=linearly_stable(loop, run_nonideal, values, (alpha.size,)))
+
+
+def _device_run(nonideal, device, delta, d):
+    """The loop the paper's simulator runs, in Table I's units, and its checks before a run.
+
+    Returns ``(loop, values, nonideal, spaces, scale)``: the loop, its
+    values but the plane's and ``M``, the non-idealities in its units
+    (forces times ``scale = T^2 / m``), the device's state space and
+    ``scale``.  Raises, naming the field, for a force quantum that is not a
+    normal double in those units or a friction that double precision
+    cannot step on the device (:func:`check_friction_size`).
+    """
+    # The paper's loop is a Loop in Table I's units (m = T = 1, b = delta,
+    # K = alpha, B = beta, M = gamma), its filter in the environment and its
+    # lag in the plant, run by the loop simulator from the state (x0, v0).
+    filtered = device is not None and nonideal.velocity_cutoff is not None
+    lagged = device is not None and nonideal.actuator_bandwidth is not None
+    loop = paper_simulated_loop(filtered, lagged, delta == 0)
+    values = {"m": 1.0, "T": 1.0, "d": d}
+    if delta != 0:
+        values["b"] = delta
+    if filtered:
+        values["f_c"] = nonideal.velocity_cutoff * device.T
+    if lagged:
+        values["tau"] = 1 / (2 * math.pi * nonideal.actuator_bandwidth * device.T)
+    scale = 1.0 if device is None else device.T**2 / device.m   # force -> f T^2 / m
+    if nonideal.force_resolution is not None and not nonideal.force_resolution * scale >= QUANTUM_MIN:
+        # The run's quantum is in Table I's units: it must be a normal double there.
+        raise ValueError(f"nonideal.force_resolution must be a finite real number >= "
+                         f"{QUANTUM_MIN / scale!r} with this device (T^2/m times it is the run's "
+                         f"quantum, which must be a normal double), got "
+                         f"{nonideal.force_resolution!r}")
+    run_nonideal = dataclasses.replace(
+        nonideal, velocity_cutoff=None, actuator_bandwidth=None, friction_compensation=False,
+        **{name: None if getattr(nonideal, name) is None else getattr(nonideal, name) * scale
+           for name in ("coulomb_friction", "stiction", "force_limit", "force_resolution")})
+    spaces, _ = loop.friction_spaces(substeps_of(run_nonideal), **dict(values, K=0.0, B=0.0, M=0.0))
+    check_friction_size(run_nonideal, spaces, name="nonideal.coulomb_friction", scale=scale)
+    return loop, values, run_nonideal, spaces, scale
+
+
+def check_device_nonideal(nonideal, device):
+    """Refuse, before a run, non-idealities the paper's simulator cannot step on ``device``.
+
+    The checks :func:`simulate` makes before its run (a force quantum that
+    is not a normal double in Table I's units, a friction whose sub-step
+    overflows), for a caller that must decide before it prints or runs
+    anything (the command line).
+
+    Parameters
+    ----------
+    nonideal : Nonidealities
+    device : symstab.numeric.units.Device
+
+    Raises
+    ------
+    ValueError
+        Naming the field and its range.
+    """
+    _device_run(nonideal, device, device.delta, 0)
 
 
 def stability_map(*, alpha, beta, gamma, d, delta, steps=None, x0=1.0, v0=None, device=None,
@@ -244,6 +290,6 @@ def stability_map(*, alpha, beta, gamma, d, delta, steps=None, x0=1.0, v0=None, 
                    device=device, nonideal=nonideal, progress=progress)
     with np.errstate(divide="ignore", invalid="ignore"):
         growth = np.where(run.diverged, np.inf, run.amplitude[3] / run.amplitude[2])
-    return StabilityMap(alpha, beta, run.stable, growth, run.steps, at={
+    return StabilityMap(alpha, beta, run.stable, run.limit_cycle, growth, run.steps, at={
         "gamma": gamma, "d": d, "delta": float(delta if delta is not None else device.delta)})
 

@@ -6,9 +6,9 @@ non-idealities given (encoder quantization, a force limit), what is the
 largest stiffness ``y`` at which the simulated loop neither grows nor
 settles into a limit cycle above a stated amplitude?
 
-A run is *accepted* when the simulator calls it stable (not diverged, the
-last quarter's amplitude not above the third's, :func:`symstab.numeric.
-simulate.simulate_loop`) **and** the largest ``|x|`` of its last quarter is
+A run is *accepted* when the simulator calls it bounded (stable or a limit
+cycle: not diverged, not growing, :attr:`symstab.numeric.simulate.
+Simulation.bounded`) **and** the largest ``|x|`` of its last quarter is
 at most ``amplitude``.  A slow decay still above ``amplitude`` at the end
 of the run is not accepted: the run is too short to call it settled.
 
@@ -186,7 +186,7 @@ def simulated_limit(loop, *, x, y, amplitude, nonideal=None, steps=None, x0=None
         count["steps"] = run.steps
         if progress is not None:
             progress(count["runs"])
-        return np.asarray(run.stable & (run.amplitude[3] <= amplitude))
+        return np.asarray(run.bounded & (run.amplitude[3] <= amplitude))
 
     Y, X = np.meshgrid(ys, xs, indexing="ij")
     grid = accepted(X.ravel(), Y.ravel()).reshape(n_y, n_x)

@@ -288,7 +288,7 @@ def test_map_stores_Kw_and_Bw_with_units_beside_alpha_and_beta(tmp_path, capsys)
     csv_out = tmp_path / "m.csv"
     status, _, _ = _main(capsys, "map", *GRID, "--linear", "--out", str(csv_out), "--no-png")
     lines = csv_out.read_text().splitlines()
-    assert lines[0] == "alpha,beta,K_w [N/m],B_w [N s/m],stable,exact_stable,growth"
+    assert lines[0] == "alpha,beta,K_w [N/m],B_w [N s/m],stable,limit_cycle,exact_stable,growth"
     rows = np.array([[float(v) for v in line.split(",")[:4]] for line in lines[1:]])
     assert len(rows) == 20
     np.testing.assert_allclose(rows[:, 2], rows[:, 0] * PAPER_M / PAPER_T**2, rtol=1e-11, atol=1e-9)

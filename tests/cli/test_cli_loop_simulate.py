@@ -87,6 +87,49 @@ def test_a_force_quantum_s_limit_cycle_is_bounded_and_the_map_agrees_with_the_ro
                                   code[code != symstab.MARGINAL] == symstab.STABLE)
 
 
+def test_a_saturated_map_s_limit_cycles_are_their_own_class_in_the_files_and_the_png(
+        capsys, tmp_path):
+    """Issue 40, item 4: with a force limit the cells whose certified count is unstable
+    settle into bounded cycles; they were written and drawn stable (38 of them on this
+    grid at the default horizon).  The oracle is the certified count (``code``): a
+    limit cycle exactly where it is -1, stable exactly where it is 1."""
+    grid = ["--set", "d=10", "--x-range=-0.05,1.9,7", "--y-range=8.75,70,5",
+            "--force-limit", "0.05", "--steps", "6000"]
+    out = tmp_path / "map.csv"
+    status, text, err = run(capsys, "map", "--loop", PAPER, "--simulate", *grid, "--out", out)
+    assert status == 0, err
+    rows = np.genfromtxt(out, delimiter=",", names=True)
+    assert rows.dtype.names[2:] == ("code", "stable", "simulated_stable",
+                                    "simulated_limit_cycle", "growth")
+    unstable = rows["code"] == -1
+    assert unstable.sum() >= 8
+    np.testing.assert_array_equal(rows["simulated_limit_cycle"] == 1, unstable)
+    np.testing.assert_array_equal(rows["simulated_stable"] == 1, rows["code"] == 1)
+    assert f"{int(unstable.sum())} bounded limit cycles" in text
+    assert "0 of the 35 cells that are not marginal differ from the root counts" in text
+    npz = tmp_path / "map.npz"
+    status, _, err = run(capsys, "map", "--loop", PAPER, "--simulate", *grid, "--out", npz,
+                         "--no-png")
+    assert status == 0, err
+    with np.load(npz) as f:
+        np.testing.assert_array_equal(f["simulated_limit_cycle"], f["code"] == -1)
+    # The paper's own map (its device options) writes the same class.
+    paper = tmp_path / "paper.npz"
+    status, _, err = run(capsys, "map", "--d", "10", "--Kw=8.75,70,5", "--Bw=-0.05,1.9,7",
+                         "--force-limit", "0.05", "--steps", "6000", "--out", paper, "--no-png")
+    assert status == 0, err
+    with np.load(paper) as g:                                   # (K_w, B_w)
+        np.testing.assert_array_equal(g["limit_cycle"].T, unstable.reshape(7, 5))
+    # The PNG shades the cycles in a colour of their own.
+    from matplotlib.image import imread
+
+    from symstab.cli.map import LIMIT_CYCLE_COLOR
+
+    pixels = (imread(tmp_path / "map.png")[..., :3] * 255).round()
+    colour = [int(LIMIT_CYCLE_COLOR[i:i + 2], 16) for i in (1, 3, 5)]
+    assert np.count_nonzero(np.all(np.abs(pixels - colour) <= 1, axis=-1)) > 1000
+
+
 def test_friction_holds_the_mass_and_the_verdict_says_so(capsys):
     """Two masses, friction on the motor: it ends held within stiction / K of zero."""
     status, text, err = run(capsys, "simulate", "--loop", LOOPS / "two_mass.toml",
@@ -142,6 +185,19 @@ def test_map_simulates_friction_on_the_loop_s_mass(capsys, tmp_path):
     (["simulate", "--loop", PAPER, "--force-resolution", "0"], "--force-resolution must be"),
     (["simulate", "--loop", PAPER, "--force-resolution", "1e-3", "--coulomb", "0.01"],
      "--force-resolution with --coulomb"),
+    # Issue 40, item 6: values double precision cannot step ran, and "diverged (unstable)".
+    (["simulate", "--loop", PAPER, "--set", "d=10", "--force-resolution", "1e-320"],
+     "--force-resolution must be a finite real number >= 2.2250738585072014e-308"),
+    (["simulate", "--loop", PAPER, "--encoder-resolution", "1e-320"],
+     "--encoder-resolution must be a finite real number >= 2.2250738585072014e-308"),
+    (["simulate", "--loop", PAPER, "--coulomb", "1e306"],
+     "--coulomb must be a real number from 0 to 2.56e+302 on this plant"),
+    (["map", "--loop", PAPER, "--x-range=0,1,3", "--y-range=0,1,3", "--out", "m.npz",
+      "--simulate", "--coulomb", "1e306"], "--coulomb must be a real number from 0 to 2.56e+302"),
+    (["simulate", "--Td", "0.01", "--Kw", "2", "--Bw", "0.1", "--coulomb", "1e306"],
+     "--coulomb must be a real number from 0 to 2.56e+305 on this plant"),
+    (["map", "--Td", "0.01", "--Kw=0,2,3", "--Bw=0,1,3", "--out", "m.npz", "--coulomb", "1e306"],
+     "--coulomb must be a real number from 0 to 2.56e+305 on this plant"),
     (["simulate", "--Kw", "3", "--Bw", "0.1", "--substeps", "5"], "drop --substeps"),
     (["map", "--loop", PAPER, "--x-range=0,1,3", "--y-range=0,1,3", "--out", "m.npz",
       "--steps", "100"], "--steps is an option of the simulation: add --simulate"),

@@ -148,3 +148,45 @@ def test_points_with_different_plants_run_as_each_alone():
         np.testing.assert_allclose(together.positions[:, k], alone.positions, rtol=0,
                                    atol=1e-12 * scale)
     assert len({together.positions[-1, k] for k in range(3)}) == 3
+
+
+@pytest.mark.parametrize("coulomb", [1e10, 70.0, 5.0])
+def test_friction_stops_the_mass_where_the_physics_does_never_behind_its_start(coulomb):
+    """Issue 40, item 5: a sub-step that stopped the mass went on pushing it back for the rest
+    of the sub-step (Coulomb 1e10 on the paper's loop: "held at rest at x = -976.5", from
+    x0 = 0.01 moving forward).  Oracle: the paper's mass (m, viscous b) sliding from rest
+    position 0 at v0 under friction F alone, solved by hand, m v' = -b v - F:
+    t* = (m/b) log(1 + b v0 / F), x(t*) = (m/b)(v0 + F/b)(1 - exp(-b t*/m)) - F t*/b,
+    at 40 digits (the floats cancel).  The sub-step's stop treats the forces besides
+    friction as constant over the stop: its error, relative, is at most b v0 / F.  With
+    1e10 the stop falls 2.6e-9 of the way into the first sub-step, with 70 a third of the
+    way, with 5 in the sixth."""
+    import mpmath
+
+    from symstab.numeric.friction import StatePlant
+
+    loop = symstab.load_loop(LOOPS / "paper.toml")
+    m, b, v0 = loop.defaults["m"], loop.defaults["b"], 0.1
+    space = loop.friction_spaces(20, **loop.defaults)[0][0]
+    state = np.zeros((space.phi.shape[0], 1))
+    state[1] = v0
+    plant = StatePlant(space, state, np.array([False]), substeps=20, coulomb=coulomb,
+                       stiction=coulomb)
+    periods = [plant.step(np.zeros(1))[0] for _ in range(3)]
+    with mpmath.workdps(40):
+        M, B, V, F = map(mpmath.mpf, (m, b, v0, coulomb))
+        stop = M / B * mpmath.log1p(B * V / F)
+        exact = float(M / B * (V + F / B) * -mpmath.expm1(-B * stop / M) - F * stop / B)
+    assert abs(periods[0] - exact) <= b * v0 / coulomb * exact
+    assert periods[1] == periods[2] == periods[0] and plant.state[1, 0] == 0.0   # held
+
+
+def test_a_huge_friction_holds_the_loop_s_mass_where_it_started():
+    """The command line's case: the paper's loop at d = 10 from x0 = 0.01, moving forward
+    at x0 / 100 a period.  The mass cannot travel further than it would coast without
+    friction in the first sub-step, nor go back: it stays in [x0, x0 + v0 / 20]."""
+    loop = symstab.load_loop(LOOPS / "paper.toml")
+    run = loop.simulate(d=10, x0=0.01, steps=400, record=True,
+                        nonideal=Nonidealities(coulomb_friction=1e10))
+    assert np.all(run.positions >= 0.01) and np.all(run.positions <= 0.01 + 1e-4 / 20)
+    assert run.stable and not run.diverged

@@ -291,3 +291,98 @@ def test_the_paper_loop_simulated_as_a_loop_agrees_with_the_paper_simulator(noni
                               nonideal=nonideal, steps=4000)
         assert np.all(paper.floor > 0)
         np.testing.assert_allclose(paper.floor, found.floor, rtol=1e-9)
+
+
+@pytest.mark.parametrize("B, K", [(-0.05, 26.25), (0.1125, 35.0), (1.25, 61.25)])
+def test_a_saturated_unstable_loop_s_bounded_cycle_is_a_limit_cycle_not_stable(B, K):
+    """Issue 40, item 4: 38 such cells of a map were called stable (and the rest of the
+    cycles unstable, by whether a sampled peak of the last quarter exceeded the third's).
+    Oracles: python-control's closed-loop poles (the linear loop is unstable, so the run
+    cannot be decaying to rest) and the run's own trajectory (bounded; its swing, half of
+    max - min, the same over the last three quarters)."""
+    loop = symstab.load_loop(LOOPS / "paper.toml")
+    values = {**loop.defaults, "d": 10, "B": B, "K": K}
+    assert python_control_radius(loop, values) > 1.001
+    steps = 6000
+    run = loop.simulate(steps=steps, x0=0.01, nonideal=Nonidealities(force_limit=0.05),
+                        record=True, **values)
+    quarters = run.positions[1:].reshape(4, steps // 4)
+    swing = (quarters.max(axis=1) - quarters.min(axis=1)) / 2
+    assert np.all(np.abs(run.positions) < 1.0)                  # bounded
+    assert swing[3] > 0.01 * 0.01                               # not at rest
+    assert 0.999 * swing[1] <= swing[3] <= 1.001 * swing[2]     # not decaying, not growing
+    assert run.limit_cycle and not run.stable and not run.diverged and run.bounded
+    # A stable cell of the same loop and limit stays stable; the ideal loop has no cycle.
+    inside = loop.simulate(steps=steps, x0=0.01, nonideal=Nonidealities(force_limit=0.05),
+                           **{**values, "B": 0.6, "K": 26.25})
+    assert inside.stable and not inside.limit_cycle
+    ideal = loop.simulate(steps=steps, x0=0.01, **values)
+    assert not ideal.limit_cycle and not ideal.stable
+
+
+def test_a_map_of_a_saturated_loop_calls_its_cycles_limit_cycles_where_the_count_is_unstable():
+    """The map's classes against the certified root counts: at the cells the count calls
+    unstable the saturated run is a limit cycle (bounded: python-control's poles say the
+    linear loop grows), never stable; where the count is stable, the run is stable."""
+    loop = symstab.load_loop(LOOPS / "paper.toml")
+    xs, ys = np.linspace(-0.05, 1.9, 7), np.linspace(8.75, 70.0, 5)
+    found = loop.stability_map(xs, ys, steps=6000, x0=0.01, d=10,
+                               nonideal=Nonidealities(force_limit=0.05))
+    Y, X = np.meshgrid(ys, xs, indexing="ij")
+    code = loop.classify(B=X, K=Y, d=10)
+    assert np.all(found.limit_cycle[code == -1]) and not np.any(found.stable[code == -1])
+    assert np.all(found.stable[code == 1]) and not np.any(found.limit_cycle[code == 1])
+    assert np.count_nonzero(code == -1) >= 8
+
+
+@pytest.mark.parametrize("field", ["encoder_resolution", "force_resolution"])
+def test_a_quantum_double_precision_cannot_hold_is_refused_by_name(field):
+    """Issue 40, item 6: a subnormal quantum (1e-320) overflowed every quotient above 1.8e-12
+    and each run read "diverged (unstable)".  Refused: the smallest normal double."""
+    with pytest.raises(ValueError) as excinfo:
+        Nonidealities(**{field: 1e-320})
+    assert_message_names(excinfo, field)
+    assert f">= {float(np.finfo(float).tiny)!r}" in str(excinfo.value)
+
+
+def test_a_quantum_far_below_a_value_s_precision_leaves_it_as_it_is():
+    """From the smallest normal quantum on, a value whose quotient overflows is rounded to
+    itself (the quantum is far below its last bit), not to inf: the stable loop from x0 = 100
+    with a quantum of 1e-307 is the ideal loop's run, to the bit (it was "diverged")."""
+    loop = symstab.load_loop(LOOPS / "paper.toml")
+    ideal = loop.simulate(d=10, x0=100.0, steps=400, record=True)
+    fine = loop.simulate(d=10, x0=100.0, steps=400, record=True,
+                         nonideal=Nonidealities(encoder_resolution=1e-307))
+    assert not fine.diverged
+    np.testing.assert_array_equal(fine.positions, ideal.positions)
+
+
+def test_a_friction_double_precision_cannot_step_is_refused_before_the_run():
+    """The sub-step adds gamma_f F to the state: past 1e300 that overflows.  Refused with the
+    bound on this plant (1e300 over its largest gamma_f, computed here from the plant's
+    exact sub-step: a mass m with viscous b, gamma_f[1] = (1 - exp(-b h / m)) / b), before
+    a period is run; below the bound a huge friction holds the mass (1e200: at x0)."""
+    loop = symstab.load_loop(LOOPS / "paper.toml")
+    m, b, h = loop.defaults["m"], loop.defaults["b"], loop.defaults["T"] / 20
+    bound = 1e300 / (-math.expm1(-b * h / m) / b)
+    calls = []
+    with pytest.raises(ValueError) as excinfo:
+        loop.simulate(d=10, x0=0.01, progress=calls.append,
+                      nonideal=Nonidealities(coulomb_friction=1.01 * bound))
+    assert_message_names(excinfo, "coulomb_friction")
+    assert f"from 0 to {bound:.3g}" in str(excinfo.value) and calls == []
+    held = loop.simulate(d=10, x0=0.01, steps=400, record=True,
+                         nonideal=Nonidealities(coulomb_friction=1e200))
+    assert held.stable and np.all(held.positions >= 0.01) and np.all(held.positions < 0.0101)
+
+
+def test_the_paper_simulator_refuses_a_quantum_that_its_units_make_subnormal():
+    """The paper's simulator runs in Table I's units, its forces times T^2 / m (7.8e-5 for the
+    paper's device): 3e-308 N m is a normal double, its run's quantum is not."""
+    scale = symstab.PAPER_DEVICE.T**2 / symstab.PAPER_DEVICE.m
+    with pytest.raises(ValueError) as excinfo:
+        symstab.simulate(alpha=0.01, beta=0.1, gamma=0.0, d=10, delta=None, steps=100,
+                         device=symstab.PAPER_DEVICE,
+                         nonideal=Nonidealities(force_resolution=3e-308))
+    assert_message_names(excinfo, "force_resolution")
+    assert f">= {float(np.finfo(float).tiny) / scale!r}" in str(excinfo.value)
