@@ -22,6 +22,7 @@ import ast
 import fractions
 import functools
 import keyword
+import math
 import re
 
 import mpmath
@@ -231,7 +232,9 @@ def parse_expression(text, what):
     subscripts, other calls, comparisons, lambdas) is refused, so a string
     from a loop file cannot run code.  A literal exponent is at most
     :data:`MAX_ORDER` and an exponent holds no power (``2**(10**10)`` would
-    take SymPy forever).
+    take SymPy forever).  A decimal is the exact rational it writes (``0.25``
+    is 1/4, ``0.1`` is 1/10, ``1e-3`` is 1/1000), not the nearest binary
+    float: the derivation stays exact.
 
     Parameters
     ----------
@@ -248,8 +251,9 @@ def parse_expression(text, what):
     if len(text) > MAX_EXPRESSION_LENGTH:
         raise ValueError(f"{what} is {len(text)} characters long, above the limit of "
                          f"{MAX_EXPRESSION_LENGTH}")
+    source = text.replace("^", "**")
     try:
-        tree = ast.parse(text.replace("^", "**"), mode="eval")
+        tree = ast.parse(source, mode="eval")
     except SyntaxError as exc:
         raise ValueError(f"{what} {text!r} is not a valid expression: {exc.msg}") from None
     except (RecursionError, MemoryError):
@@ -284,7 +288,13 @@ def parse_expression(text, what):
                 check_exponent(node.value)
             if isinstance(node.value, int):
                 return sp.Integer(node.value)
-            return sp.Float(repr(node.value))
+            if not math.isfinite(node.value):
+                raise ValueError(f"{what} {text!r}: {node.value!r} is not a finite number")
+            # The decimal as written, exactly (0.25 is 1/4, 0.1 is 1/10): a
+            # Float would make the plant's polynomials inexact, which SymPy's
+            # factoring over the parameters cannot take.
+            written = ast.get_source_segment(source, node) or repr(node.value)
+            return sp.Rational(written.replace("_", ""))
         if isinstance(node, ast.Name) and not node.id.startswith("_"):
             return fixed.get(node.id) or sp.Symbol(node.id)
         if (isinstance(node, ast.Call) and isinstance(node.func, ast.Name)
@@ -295,7 +305,7 @@ def parse_expression(text, what):
                                              for n in ast.walk(inner)):
                 raise ValueError(f"{what} {text!r}: exp() inside exp() is not allowed")
             return _FUNCTIONS[node.func.id](build(inner, in_exponent))
-        shown = ast.get_source_segment(text.replace("^", "**"), node) or type(node).__name__
+        shown = ast.get_source_segment(source, node) or type(node).__name__
         raise ValueError(f"{what} {text!r}: {shown!r} is not allowed (numbers, names, + - * / **, "
                          f"brackets, exp() and sqrt() only)")
 
@@ -311,6 +321,16 @@ def parse_expression(text, what):
     if not isinstance(expr, sp.Expr):
         raise ValueError(f"{what} {text!r} is not an expression")
     return expr
+
+
+def _exact_decimals(expr):
+    """Every SymPy Float in ``expr`` as the exact rational of its decimal digits (0.25 -> 1/4).
+
+    A text is parsed that way already (:func:`parse_expression`); a SymPy
+    expression given directly may hold Floats, which make the plant's
+    polynomials inexact (SymPy's factoring over the parameters fails on them).
+    """
+    return expr.xreplace({f: sp.Rational(str(f)) for f in expr.atoms(sp.Float)})
 
 
 def _real_symbols(expr):
@@ -384,7 +404,7 @@ def parse_plant(plant):
     else:
         raise TypeError(f"plant must be a string, a SymPy expression or a "
                         f"control.TransferFunction, got {type(plant).__name__}")
-    expr = _real_symbols(expr)
+    expr = _real_symbols(_exact_decimals(expr))
     _check_rational(expr, model.s, "plant G(s)", model.z)
     return expr
 
@@ -455,7 +475,7 @@ def _rational(value, what, label, variable, other):
     else:
         raise TypeError(f"{what} must be a string or a SymPy expression, "
                         f"got {type(value).__name__}")
-    expr = _real_symbols(expr)
+    expr = _real_symbols(_exact_decimals(expr))
     _check_rational(expr, variable, label, other)
     return expr
 

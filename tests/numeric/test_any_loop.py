@@ -124,6 +124,23 @@ def test_a_quadratic_factor_by_residues(k_h):
         assert loop.spectral_radius(K=K, B=B, d=d, **values) == pytest.approx(oracle, rel=1e-8)
 
 
+@pytest.mark.parametrize("plant, den", [
+    ("1/(m*s**2 + 0.25*b*s)", [PAPER_M, 0.25 * PAPER_B, 0]),
+    ("1/((0.5*tau*s + 1)*(m*s**2 + b*s))", np.polymul([0.5 * 0.01, 1], [PAPER_M, PAPER_B, 0])),
+    ("1/(m*s**2 + 0.1*b*s)", [PAPER_M, 0.1 * PAPER_B, 0]),
+])
+def test_a_decimal_in_the_plant_is_its_exact_rational(plant, den):
+    """issue 40 item 13: a decimal in the denominator crashed SymPy's factoring (PolyElement * PolyElement)."""
+    loop = Loop(plant, "K + B*(z - 1)/(T*z)")
+    decimals = {str(c) for c in loop.plant.atoms(sp.Rational) if not c.is_Integer}
+    assert decimals <= {"1/4", "1/2", "1/10"} and decimals and not loop.plant.atoms(sp.Float)
+    values = dict(m=PAPER_M, b=PAPER_B, T=PAPER_T, tau=0.01)
+    values = {k: v for k, v in values.items() if k in loop.parameters}
+    for K, B, d in ((300.0, 0.5, 0), (50.0, 0.1, 3)):
+        oracle = _python_control_radius(list(den), K, B, d)
+        assert loop.spectral_radius(K=K, B=B, d=d, **values) == pytest.approx(oracle, rel=1e-8)
+
+
 @pytest.mark.parametrize("name", ["e", "exp"])
 def test_a_parameter_named_like_an_mpmath_name_keeps_its_value(name):
     """``e`` once shadowed Euler's number in the plant's mpmath function (K_max of a gain-49 plant for 7 e)."""
