@@ -360,6 +360,13 @@ def convert_sets(loop, sets, flag="--set"):
             raise ValueError(f"{flag}: unit {unit!r} is {dimension_name(info.dimensions)}, and "
                              f"{name} is in {dimension_name(expected)}"
                              + (f" (the file gives it in {file_unit!r})" if file_unit else ""))
+        if info is not None and expected is not None:
+            # The dimension fits; an angle (a number to pint) must fit too.
+            from ..numeric.loop_units import check_angle, parameter_angle
+            own_info = known.values[name].info if file_unit is not None else None
+            check_angle(name, info, parameter_angle(tuple(expected), own_info), where=flag,
+                        si_unit=items[0].si_unit if own_info is None else
+                        (file_unit if own_info.angle else None))
         values[name] = [i.si_value for i in items] if many else items[0].si_value
         written[name] = (value, items[0].unit, items[0].si_unit)
     return values, written
