@@ -48,6 +48,7 @@ from .numeric.region import BestVirtualMass, StabilityRegion, best_virtual_mass,
 from .numeric.results import Limits, RobustRegion, StabilityProbability
 from .numeric.any_loop import Loop, LoopBoundary, LoopLimits
 from .numeric.loop_files import load_loop
+from .symbolic.loop_assembly import NonPhysicalPlantWarning
 from .numeric.decomposition import Branch, Cell, Decomposition
 from .numeric.passivity import PassiveRegion, passive_region
 from .numeric.paper_loop import paper_passive_region
@@ -68,7 +69,7 @@ __all__ = [
     "BoundaryCurve", "arc_end_angle", "boundary_curve",
     "STABLE", "MARGINAL", "UNSTABLE", "classify", "is_stable", "spectral_radius",
     "StabilityRegion", "Limits", "limits", "BestVirtualMass", "best_virtual_mass",
-    "Loop", "LoopBoundary", "LoopLimits", "load_loop", "PAPER_LOOP",
+    "Loop", "LoopBoundary", "LoopLimits", "load_loop", "PAPER_LOOP", "NonPhysicalPlantWarning",
     "Decomposition", "Cell", "Branch",
     "PassiveRegion", "passive_region", "paper_passive_region",
     "Locus", "Crossing", "locus", "paper_locus",

@@ -25,7 +25,9 @@ evaluated once at the given point) and the output paths.  The caller
 import dataclasses
 import math
 import re
+import sys
 import textwrap
+import warnings
 
 import numpy as np
 
@@ -589,6 +591,27 @@ def loop_values(args, loop, sets, written_sets, *, skip=()):
     return values, written
 
 
+def _report_plant(args, caught):
+    """One stderr line for a plant that is not a physical device's; other warnings as they were.
+
+    The first :class:`~symstab.symbolic.loop_assembly.NonPhysicalPlantWarning`
+    is printed as ``symstab <command>: warning: ...`` (with how many other
+    points have one), and the rest of the command does not repeat it (the
+    CLI's warning filters are restored when the command ends).
+    """
+    from ..symbolic.loop_assembly import NonPhysicalPlantWarning
+
+    plant = [w for w in caught if issubclass(w.category, NonPhysicalPlantWarning)]
+    for w in caught:
+        if not issubclass(w.category, NonPhysicalPlantWarning):
+            warnings.warn_explicit(w.message, w.category, w.filename, w.lineno)
+    if plant:
+        more = (f" (and at {len(plant) - 1} other point{'s' if len(plant) > 2 else ''})"
+                if len(plant) > 1 else "")
+        print(f"symstab {args.command}: warning: {plant[0].message}{more}", file=sys.stderr)
+        warnings.simplefilter("ignore", NonPhysicalPlantWarning)
+
+
 def resolve_loop(args, *, plane=True, lists=False):
     """Check every input of a loop command and return its :class:`LoopSetup`.
 
@@ -618,15 +641,20 @@ def resolve_loop(args, *, plane=True, lists=False):
                 raise ValueError(f"--set {name}: {name} is the plane's {axis} axis and takes no "
                                  f"single value here{hint}")
     values, written = loop_values(args, loop, sets, written_sets, skip=axes)
-    if plane:
-        loop.boundary(x=x, y=y, n=2, **values)   # checks the plane (affine) and the values
-        point = {**values, x: 0.0, y: 0.0}
-    else:
-        check_memory("the points' coefficients", 8 * point_count(values) * (values["d"] + 64))
-        point = broadcast(values)
-    # An overflow in the plant's pulse transfer function (exp(-b T / m) at
-    # T = 1e300, say) is a ValueError of the loop's, here before the work.
-    loop.coefficients(**point)
+    from ..symbolic.loop_assembly import NonPhysicalPlantWarning
+
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always", NonPhysicalPlantWarning)
+        if plane:
+            loop.boundary(x=x, y=y, n=2, **values)   # checks the plane (affine) and the values
+            point = {**values, x: 0.0, y: 0.0}
+        else:
+            check_memory("the points' coefficients", 8 * point_count(values) * (values["d"] + 64))
+            point = broadcast(values)
+        # An overflow in the plant's pulse transfer function (exp(-b T / m) at
+        # T = 1e300, say) is a ValueError of the loop's, here before the work.
+        loop.coefficients(**point)
+    _report_plant(args, caught)
     setup = LoopSetup(str(args.loop), loop, values, tuple(sets), x, y, written=written)
     return dataclasses.replace(setup, echo=loop_echo(setup))
 

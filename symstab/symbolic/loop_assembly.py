@@ -24,6 +24,7 @@ import functools
 import keyword
 import math
 import re
+import warnings
 
 import mpmath
 import numpy as np
@@ -34,7 +35,7 @@ from .._validate import check_delay
 from .derivation_cache import DerivationCache
 from .discretize import numeric_zoh, written_poles, zoh_pulse_transfer_function
 
-__all__ = ["LoopModel", "parse_plant", "parse_environment", "parse_actuator", "parse_expression",
+__all__ = ["LoopModel", "NonPhysicalPlantWarning", "parse_plant", "parse_environment", "parse_actuator", "parse_expression",
            "check_parameter_name", "check_loop_name", "check_text_line", "NAME_PATTERN",
            "is_affine", "poly_coeffs", "shift_to_one", "PLANT_DIGITS"]
 
@@ -67,6 +68,16 @@ NAME_PATTERN = re.compile(r"[A-Za-z0-9_][A-Za-z0-9_.-]{0,63}")
 _PARAMETER_PATTERN = re.compile(r"[A-Za-z][A-Za-z0-9_]{0,39}")
 #: Longest description and unit text (one line each).
 _TEXT_LIMITS = {"description": 200, "unit": 60}
+
+
+class NonPhysicalPlantWarning(UserWarning):
+    """The plant at the values given is not a physical device's: a pole in the open right half
+    plane, or a negative high-frequency gain (a negative mass, friction or stiffness, a typo).
+
+    The loop is analysed as given; the warning names the plant's values
+    (:meth:`LoopModel.plant_defect`).  A loop file bounds its physical
+    parameters (``min = 0``, ``above = 0``) to refuse such a value instead.
+    """
 
 
 def shift_to_one(coefficients, dtype=None):
@@ -947,13 +958,76 @@ class LoopModel:
             total = sum(-mpmath.log10(x) for x in sizes if 0 < x < 1)
         return int(mpmath.ceil(total))
 
+    @functools.cached_property
+    def _plant_fraction(self):
+        """mpmath function of (plant values..., T): the plant's numerator and denominator in ``s``."""
+        num, den = sp.fraction(sp.cancel(sp.together(self.plant)))
+        return self._plant_function([poly_coeffs(num, model.s), poly_coeffs(den, model.s)])
+
+    def plant_defect(self, plant_values, T):
+        """Why the plant at these values is not a physical device's (one line), or None.
+
+        A pole in the open right half plane (the plant alone would diverge),
+        or a negative high-frequency gain (the leading coefficients of its
+        numerator and denominator in ``s`` of opposite signs: a negative
+        mass, say).  The poles are the roots of the denominator (NumPy); one
+        counts as in the right half plane when its real part exceeds 1e-9 of
+        its size (a pole on the imaginary axis, computed with rounding, does
+        not).
+
+        Parameters
+        ----------
+        plant_values : sequence of float
+            The values of the plant's parameters, in the order of its names
+            (sorted; ``T`` apart).
+        T : float
+            The sample period (the plant may use it).
+
+        Returns
+        -------
+        str or None
+        """
+        with mpmath.workdps(PLANT_DIGITS):
+            try:
+                num, den = self._plant_fraction(*(mpmath.mpf(float(v)) for v in plant_values),
+                                                mpmath.mpf(float(T)))
+                num, den = ([float(mpmath.mpmathify(c)) for c in part] for part in (num, den))
+            except (ZeroDivisionError, TypeError, ValueError, OverflowError):
+                return None
+        num, den = np.trim_zeros(num, "f"), np.trim_zeros(den, "f")
+        if not len(num) or not len(den) or not np.all(np.isfinite(np.concatenate([num, den]))):
+            return None
+        problems = []
+        with np.errstate(all="ignore"):
+            poles = np.roots(den)
+        unstable = [p for p in poles if p.real > 1e-9 * abs(p)]
+        if unstable:
+            p = max(unstable, key=lambda p: p.real)
+            shown = f"{p.real:.4g}" if p.imag == 0 else f"{p.real:.4g} {'+-'} {abs(p.imag):.4g}j"
+            problems.append(f"a pole in the open right half plane (s = {shown})")
+        if num[0] * den[0] < 0:
+            problems.append("a negative high-frequency gain (the leading coefficients of its "
+                            "numerator and denominator in s have opposite signs)")
+        if not problems:
+            return None
+        given = ", ".join(f"{n} = {float(v):g}" for n, v in zip(self._plant_names, plant_values))
+        return (f"the plant G(s) = {self.plant} at {given} has {' and '.join(problems)}: not a "
+                f"physical device's (a negative mass, friction or stiffness?); the results are "
+                f"those of that plant")
+
     @functools.lru_cache(maxsize=4096)
     def _plant_digits(self, plant_values, T):
         """``(P_n, P_d, digits)``: the pulse transfer function's coefficients as mpmath numbers.
 
         At :data:`PLANT_DIGITS` digits, or more where the closed form needs
         them (:meth:`_closed_form_plant`); refused where it is not defined.
+        A plant that is not a physical device's at these values
+        (:meth:`plant_defect`) gives a :class:`NonPhysicalPlantWarning`,
+        once per point (the result is cached).
         """
+        defect = self.plant_defect(plant_values, T)
+        if defect is not None:
+            warnings.warn(defect, NonPhysicalPlantWarning, stacklevel=2)
         digits = PLANT_DIGITS
         with mpmath.workdps(PLANT_DIGITS):
             point = [mpmath.mpf(float(v)) for v in plant_values]
