@@ -886,14 +886,71 @@ class LoopModel:
                     <= mpmath.mpf(10) ** -PLANT_DIGITS * max(abs(c) for c in new)
                     for old, new in zip(before, parts)):
                 return (*parts, digits)
+            if before is not None:
+                # Two precisions disagree: poles that meet exactly (k_h = 0)
+                # would make every precision disagree, so say so now.
+                self._check_distinct_poles(point, T)
             before, digits = parts, 2 * digits
         self._refuse_plant(point, T)
 
     def _refuse_plant(self, point, T):
+        self._check_distinct_poles(point, T)
         given = ", ".join(f"{n} = {float(v):g}" for n, v in zip(self._plant_names, point))
         raise ValueError(f"the plant's pulse transfer function at {given}, T = {float(T):g} "
                          f"cancels beyond {PLANT_MAX_DIGITS} digits: a parameter is too small "
                          f"or too large for its closed form")
+
+    @functools.cached_property
+    def _pole_conditions(self):
+        """``[(expression, why)]``: where an expression of the parameters vanishes, poles meet.
+
+        The residues are derived for the poles of ``G(s)/s`` as the symbols
+        write them: a factor of the denominator whose leading coefficient
+        vanishes loses its order, one whose constant term vanishes puts a
+        pole on the hold's pole at ``s = 0``, a quadratic whose discriminant
+        vanishes has a double pole, and two factors whose resultant vanishes
+        share a pole.  Each is a 0/0 of the closed form that no precision
+        resolves.
+        """
+        s = model.s
+        _, den = sp.fraction(sp.cancel(sp.together(self.plant)))
+        factors = [f for f, _ in sp.factor_list(den, s)[1] if f.has(s)]
+        out = []
+        for f in factors:
+            c = sp.Poly(f, s).all_coeffs()
+            if c[0].free_symbols:
+                out.append((c[0], f"the factor {f} loses its leading coefficient (the "
+                                  f"plant's order drops)"))
+            if len(c) > 1 and c[-1].free_symbols:
+                out.append((c[-1], f"the factor {f} has a pole at s = 0, on the pole of "
+                                   f"G(s)/s at 0 (the hold's integrator)"))
+            if len(c) == 3:
+                disc = sp.expand(c[1] ** 2 - 4 * c[0] * c[2])
+                if disc.free_symbols:
+                    out.append((disc, f"the factor {f} has a double pole (its discriminant "
+                                      f"{disc} is 0)"))
+        for i, f in enumerate(factors):
+            for g in factors[i + 1:]:
+                r = sp.resultant(f, g, s)
+                if r.free_symbols:
+                    out.append((r, f"the factors {f} and {g} share a pole"))
+        return out
+
+    def _check_distinct_poles(self, point, T):
+        """Refuse, saying which poles meet, a point where the closed form is 0/0 (:attr:`_pole_conditions`)."""
+        values = {self._symbols[n]: sp.Rational(float(v)) for n, v in zip(self._plant_names, point)}
+        values.setdefault(model.T, sp.Rational(float(T)))
+        for expr, why in self._pole_conditions:
+            if expr.xreplace(values) == 0:
+                names = sorted(str(x) for x in expr.free_symbols)
+                given = ", ".join(f"{n} = {float(values[self._symbols[n]]):g}" for n in names)
+                zero = " and ".join(f"{n} = 0" for n in names
+                                    if values[self._symbols[n]] == 0) or f"{expr} = 0"
+                raise ValueError(
+                    f"the plant G(s) = {self.plant} is degenerate at {given}: {why}, where the "
+                    f"closed form of its pulse transfer function (residues at distinct poles) "
+                    f"is 0/0; give {' or '.join(names)} another value, or write the plant as "
+                    f"it is at {zero} (a loop of its own)")
 
     @functools.cached_property
     def driven_mass(self):
@@ -1043,6 +1100,8 @@ class LoopModel:
         with mpmath.workdps(digits):
             lead = p_d[0]
             if lead == 0 or not all(mpmath.isfinite(c) for c in p_n + p_d):
+                if self._plant_parts is not None:
+                    self._check_distinct_poles(plant_values, T)   # says which poles meet
                 given = ", ".join(f"{n} = {float(v):g}" for n, v in zip(self._plant_names, plant_values))
                 raise ValueError(f"the plant's pulse transfer function is not defined at "
                                  f"{given}, T = {float(T):g} (a pole cancels a parameter, "
