@@ -286,8 +286,12 @@ def split_unit(text, flag):
     return head + comma + number.group(), unit
 
 
-def parse_number(name, text, flag, *, lists):
-    """The value(s) of one ``--set``: a float, d an integer; a list where allowed."""
+def parse_number(name, text, flag, *, lists, written=None):
+    """The value(s) of one ``--set``: a float, d an integer; a list where allowed.
+
+    ``written`` is the value as the user wrote it, unit included
+    (``"5.1 ms"``): the messages show it (default ``text``).
+    """
     items = [t.strip() for t in text.split(",")]
     if len(items) > 1 and not lists:
         raise ValueError(f"{flag}: {name} takes one value here (lists are for classify)")
@@ -301,13 +305,16 @@ def parse_number(name, text, flag, *, lists):
         except ValueError:
             raise ValueError(f"{flag}: {item!r} is not a number") from None
         if not math.isfinite(value):
-            raise ValueError(f"{flag}: {name} must be a finite number, got {item!r}")
+            shown = item if len(items) > 1 or written is None else written.strip()
+            raise ValueError(f"{flag}: {name} must be a finite number, got {shown!r}")
         if name == "d":
             from .._validate import check_delay
             try:
                 value = check_delay(value)
-            except ValueError as exc:
-                raise ValueError(f"{flag}: {exc}") from None
+            except ValueError:
+                shown = (written if written is not None else text).strip()
+                raise ValueError(f"{flag}: delay d must be a non-negative integer, a number of "
+                                 f"samples (unit \"samples\", or none), got {shown!r}") from None
         values.append(value)
     if name == "d" and len(values) > 1:
         raise ValueError(f"{flag}: d takes one value (run classify once per delay)")
@@ -328,8 +335,8 @@ def _parse_sets(texts, *, lists):
             raise ValueError(f"{flag}: expected NAME=VALUE, e.g. --set K=300")
         if name in out:
             raise ValueError(f"--set {name} is given twice; give each parameter once")
-        value, unit = split_unit(value, flag)
-        out[name] = (parse_number(name, value, flag, lists=lists), unit)
+        number, unit = split_unit(value, flag)
+        out[name] = (parse_number(name, number, flag, lists=lists, written=value), unit)
     return out
 
 

@@ -197,3 +197,15 @@ def test_set_with_an_angle_to_the_parameters_power_is_converted(capsys, unit, fa
     out = run_json(capsys, "classify", "--loop", PAPER, "--set", f"K=2 {unit}")
     assert out["inputs"]["values"]["K"] == pytest.approx(2 * factor, rel=1e-15)
     assert out["inputs"]["units"]["K"] == "N m/rad"
+
+
+@pytest.mark.parametrize("setting, shown", [
+    ("d=5.1 ms", "'5.1 ms'"), ("d=5.1", "'5.1'"), ("d=-1 samples", "'-1 samples'"),
+    ("K=1e999 N m/rad", "'1e999 N m/rad'"),
+])
+def test_a_refused_set_value_is_shown_as_written(capsys, setting, shown):
+    """issue 40 item 16: --set "d=5.1 ms" said 'got 5.1', dropping the unit."""
+    status, out, err = run(capsys, "classify", "--loop", PAPER, "--set", setting)
+    assert status == 2 and out == "" and err.count("\n") == 1, err
+    assert err.startswith(f"symstab classify: error: --set {setting}: ") and err.endswith(
+        f", got {shown}\n"), err
