@@ -293,7 +293,8 @@ MAP = ["--x-range=0,1,3", "--y-range=0,1,3", "--out", "m.npz"]
     (["limits", *L, "--set", "d=-1"], "delay d"),
     (["limits", *L, "--set", "T=-1"], "T must be"),
     (["limits", *L, "--set", "T=0"], "T must be"),
-    (["limits", *L, "--set", "m=0"], "not defined"),
+    # The file bounds m above 0 (a zero mass made the plant's transfer function undefined).
+    (["limits", *L, "--set", "m=0"], "m must be a finite real number > 0"),
     # Was "Array must not contain infs or NaNs" from the eigenvalues, after the work began.
     (["classify", *L, "--set", "T=1e300"], "overflows or underflows at"),
     # linspace of -1e308..1e308 is NaN: the grid, not K, is what is wrong.
