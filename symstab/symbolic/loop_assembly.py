@@ -1056,7 +1056,12 @@ class LoopModel:
             return None
         problems = []
         with np.errstate(all="ignore"):
-            poles = np.roots(den)
+            try:
+                poles = np.roots(den)
+            except (ValueError, np.linalg.LinAlgError):
+                # Coefficients whose ratios overflow (b = 1e308): the loop
+                # itself says what is wrong with them; no warning is made up.
+                poles = []
         unstable = [p for p in poles if p.real > 1e-9 * abs(p)]
         if unstable:
             p = max(unstable, key=lambda p: p.real)
