@@ -12,7 +12,7 @@ import numpy as np
 from ._resources import MAX_DELAY_ENV, max_delay
 
 __all__ = ["check_real", "check_count", "check_delay", "check_delay_samples", "check_array",
-           "check_delta", "check_loop", "DELTA_MAX", "PARAMETER_MAX"]
+           "check_delta", "check_loop", "check_progress", "DELTA_MAX", "PARAMETER_MAX"]
 
 
 def _describe_range(low, high, low_open, high_open):
@@ -186,3 +186,47 @@ def check_box(name, value, names=("x", "y")):
         x, y = names
         raise TypeError(f"{name} must be (({x}0, {x}1), ({y}0, {y}1)), got {value!r}")
     return check_window(f"{name}[0]", value[0]), check_window(f"{name}[1]", value[1])
+
+
+def check_progress(progress, bar=None):
+    """A ``progress`` argument as a callable taking the work done so far, or None.
+
+    The one normalisation of every ``progress`` argument of symstab.
+
+    Parameters
+    ----------
+    progress : None, bool or callable
+        None or False: no progress is reported.  True: the caller's progress
+        bar, ``bar()``.  A callable: called with the work done so far (what
+        that counts is the caller's: steps, draws, delays, chunks).
+    bar : callable, optional
+        Makes the bar that True asks for, e.g. ``lambda:
+        progress_printer("simulating", steps)``
+        (:func:`symstab.numeric.loop_simulate.progress_printer`: drawn on
+        stderr when it is a terminal, for work over 2 s).  Without it, True
+        reports nothing.
+
+    Returns
+    -------
+    callable or None
+
+    Raises
+    ------
+    TypeError
+        For anything else (a number, a string).
+
+    Examples
+    --------
+    >>> check_progress(False) is None and check_progress(None) is None
+    True
+    >>> check_progress(print) is print
+    True
+    """
+    if progress is None or progress is False or progress is np.False_:
+        return None
+    if progress is True or progress is np.True_:
+        return None if bar is None else bar()
+    if callable(progress):
+        return progress
+    raise TypeError(f"progress must be True, False, None or a callable taking the work done so "
+                    f"far, got {type(progress).__name__}")

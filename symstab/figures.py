@@ -22,6 +22,7 @@ import dataclasses
 import functools
 import math
 import pathlib
+import sys
 import time
 
 import numpy as np
@@ -837,9 +838,14 @@ FIGURES = (fig3, fig4, fig5, fig6, fig7, fig8, fig10, fig11, fig12)
 def make_figures(out_dir, progress=None):
     """Draw every figure into ``out_dir`` as PNG; return the FigureResults.
 
-    ``progress(name, seconds)`` is called after each figure.
+    ``progress(name, seconds)`` is called after each figure; True prints
+    ``name: seconds`` on stderr (:func:`symstab._validate.check_progress`).
     """
+    from ._validate import check_progress
     from .proof.derive import write_bytes
+
+    progress = check_progress(progress, lambda: lambda name, seconds: print(
+        f"{name}: {seconds:.1f} s", file=sys.stderr, flush=True))
 
     plt = pyplot()
     out = pathlib.Path(out_dir)

@@ -141,3 +141,57 @@ def test_a_ragged_list_is_refused_naming_the_parameter():
 
     with pytest.raises(ValueError, match="alpha must be a real number or a rectangular array"):
         check_array("alpha", [[1.0, 2.0], [3.0]])
+
+
+# check_progress (issue 40 item 16: progress=True raised "'bool' object is not callable") ---
+
+def test_check_progress_normalises_every_kind():
+    from symstab._validate import check_progress
+
+    bar = object()
+    assert check_progress(None) is None and check_progress(False) is None
+    assert check_progress(np.False_, lambda: bar) is None
+    assert check_progress(True, lambda: bar) is bar and check_progress(np.True_, lambda: bar) is bar
+    assert check_progress(True) is None        # a caller without a bar
+    assert check_progress(print) is print
+    for wrong in (1, 0, "yes", 2.0):
+        with pytest.raises(TypeError, match="progress must be True, False, None or a callable"):
+            check_progress(wrong)
+
+
+def _progress_calls():
+    """Every public function with a ``progress`` argument, as ``call(progress)``, small and fast."""
+    import symstab
+    from symstab.numeric.design import maximize_box, maximize_scalar
+
+    loop = symstab.Loop("1/(m*s**2 + b*s)", "K + B*(z - 1)/(T*z)",
+                        values=dict(m=0.0128, b=0.0324, T=1e-3, d=1, K=100.0, B=0.1),
+                        plane=("B", "K"))
+    return {
+        "maximize_scalar": lambda p: maximize_scalar(lambda x: -(x - 0.3) ** 2, 0.0, 1.0, n=5,
+                                                     progress=p),
+        "maximize_box": lambda p: maximize_box(lambda v: -sum((x - 0.3) ** 2 for x in v),
+                                               [(0.0, 1.0), (0.0, 1.0)], n=3, progress=p),
+        "simulate": lambda p: symstab.simulate(alpha=0.1, beta=0.1, gamma=0.0, d=1, delta=0.1,
+                                               steps=50, progress=p),
+        "stability_map": lambda p: symstab.stability_map(alpha=[0.1], beta=[0.1], gamma=0.0, d=1,
+                                                         delta=0.1, steps=50, progress=p),
+        "Loop.simulate": lambda p: loop.simulate(steps=50, progress=p),
+        "Loop.stability_map": lambda p: loop.stability_map([0.1], [100.0], steps=50, progress=p),
+        "Loop.stability_probability": lambda p: loop.stability_probability(
+            [0.1], [100.0], uncertain={"b": (0.03, 0.035)}, samples=4, progress=p),
+        "Loop.region (robust)": lambda p: loop.region(uncertain={"b": (0.03, 0.031)}, strips=2,
+                                                      progress=p),
+    }
+
+
+@pytest.mark.parametrize("name", sorted(_progress_calls()))
+def test_every_progress_argument_takes_true_false_none_or_a_callable(name, loop_cache_dir):
+    call = _progress_calls()[name]
+    done = []
+    # None (and False, its equal here) is every other test's default.
+    results = [call(p) for p in (True, done.append)]
+    assert done, f"{name}: the callable was never called"
+    assert type(results[0]) is type(results[1])
+    with pytest.raises(TypeError, match="progress must be True, False, None or a callable"):
+        call(1)

@@ -25,7 +25,9 @@ evaluated once at the given point) and the output paths.  The caller
 import dataclasses
 import math
 import re
+import sys
 import textwrap
+import warnings
 
 import numpy as np
 
@@ -284,8 +286,12 @@ def split_unit(text, flag):
     return head + comma + number.group(), unit
 
 
-def parse_number(name, text, flag, *, lists):
-    """The value(s) of one ``--set``: a float, d an integer; a list where allowed."""
+def parse_number(name, text, flag, *, lists, written=None):
+    """The value(s) of one ``--set``: a float, d an integer; a list where allowed.
+
+    ``written`` is the value as the user wrote it, unit included
+    (``"5.1 ms"``): the messages show it (default ``text``).
+    """
     items = [t.strip() for t in text.split(",")]
     if len(items) > 1 and not lists:
         raise ValueError(f"{flag}: {name} takes one value here (lists are for classify)")
@@ -299,13 +305,16 @@ def parse_number(name, text, flag, *, lists):
         except ValueError:
             raise ValueError(f"{flag}: {item!r} is not a number") from None
         if not math.isfinite(value):
-            raise ValueError(f"{flag}: {name} must be a finite number, got {item!r}")
+            shown = item if len(items) > 1 or written is None else written.strip()
+            raise ValueError(f"{flag}: {name} must be a finite number, got {shown!r}")
         if name == "d":
             from .._validate import check_delay
             try:
                 value = check_delay(value)
-            except ValueError as exc:
-                raise ValueError(f"{flag}: {exc}") from None
+            except ValueError:
+                shown = (written if written is not None else text).strip()
+                raise ValueError(f"{flag}: delay d must be a non-negative integer, a number of "
+                                 f"samples (unit \"samples\", or none), got {shown!r}") from None
         values.append(value)
     if name == "d" and len(values) > 1:
         raise ValueError(f"{flag}: d takes one value (run classify once per delay)")
@@ -326,8 +335,8 @@ def _parse_sets(texts, *, lists):
             raise ValueError(f"{flag}: expected NAME=VALUE, e.g. --set K=300")
         if name in out:
             raise ValueError(f"--set {name} is given twice; give each parameter once")
-        value, unit = split_unit(value, flag)
-        out[name] = (parse_number(name, value, flag, lists=lists), unit)
+        number, unit = split_unit(value, flag)
+        out[name] = (parse_number(name, number, flag, lists=lists, written=value), unit)
     return out
 
 
@@ -360,6 +369,13 @@ def convert_sets(loop, sets, flag="--set"):
             raise ValueError(f"{flag}: unit {unit!r} is {dimension_name(info.dimensions)}, and "
                              f"{name} is in {dimension_name(expected)}"
                              + (f" (the file gives it in {file_unit!r})" if file_unit else ""))
+        if info is not None and expected is not None:
+            # The dimension fits; an angle (a number to pint) must fit too.
+            from ..numeric.loop_units import check_angle, parameter_angle
+            own_info = known.values[name].info if file_unit is not None else None
+            check_angle(name, info, parameter_angle(tuple(expected), own_info), where=flag,
+                        si_unit=items[0].si_unit if own_info is None else
+                        (file_unit if own_info.angle else None))
         values[name] = [i.si_value for i in items] if many else items[0].si_value
         written[name] = (value, items[0].unit, items[0].si_unit)
     return values, written
@@ -582,6 +598,27 @@ def loop_values(args, loop, sets, written_sets, *, skip=()):
     return values, written
 
 
+def _report_plant(args, caught):
+    """One stderr line for a plant that is not a physical device's; other warnings as they were.
+
+    The first :class:`~symstab.symbolic.loop_assembly.NonPhysicalPlantWarning`
+    is printed as ``symstab <command>: warning: ...`` (with how many other
+    points have one), and the rest of the command does not repeat it (the
+    CLI's warning filters are restored when the command ends).
+    """
+    from ..symbolic.loop_assembly import NonPhysicalPlantWarning
+
+    plant = [w for w in caught if issubclass(w.category, NonPhysicalPlantWarning)]
+    for w in caught:
+        if not issubclass(w.category, NonPhysicalPlantWarning):
+            warnings.warn_explicit(w.message, w.category, w.filename, w.lineno)
+    if plant:
+        more = (f" (and at {len(plant) - 1} other point{'s' if len(plant) > 2 else ''})"
+                if len(plant) > 1 else "")
+        print(f"symstab {args.command}: warning: {plant[0].message}{more}", file=sys.stderr)
+        warnings.simplefilter("ignore", NonPhysicalPlantWarning)
+
+
 def resolve_loop(args, *, plane=True, lists=False):
     """Check every input of a loop command and return its :class:`LoopSetup`.
 
@@ -611,15 +648,20 @@ def resolve_loop(args, *, plane=True, lists=False):
                 raise ValueError(f"--set {name}: {name} is the plane's {axis} axis and takes no "
                                  f"single value here{hint}")
     values, written = loop_values(args, loop, sets, written_sets, skip=axes)
-    if plane:
-        loop.boundary(x=x, y=y, n=2, **values)   # checks the plane (affine) and the values
-        point = {**values, x: 0.0, y: 0.0}
-    else:
-        check_memory("the points' coefficients", 8 * point_count(values) * (values["d"] + 64))
-        point = broadcast(values)
-    # An overflow in the plant's pulse transfer function (exp(-b T / m) at
-    # T = 1e300, say) is a ValueError of the loop's, here before the work.
-    loop.coefficients(**point)
+    from ..symbolic.loop_assembly import NonPhysicalPlantWarning
+
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always", NonPhysicalPlantWarning)
+        if plane:
+            loop.boundary(x=x, y=y, n=2, **values)   # checks the plane (affine) and the values
+            point = {**values, x: 0.0, y: 0.0}
+        else:
+            check_memory("the points' coefficients", 8 * point_count(values) * (values["d"] + 64))
+            point = broadcast(values)
+        # An overflow in the plant's pulse transfer function (exp(-b T / m) at
+        # T = 1e300, say) is a ValueError of the loop's, here before the work.
+        loop.coefficients(**point)
+    _report_plant(args, caught)
     setup = LoopSetup(str(args.loop), loop, values, tuple(sets), x, y, written=written)
     return dataclasses.replace(setup, echo=loop_echo(setup))
 

@@ -20,6 +20,7 @@ the printers change, and ``symstab derive --check`` reports any drift.
 
 import dataclasses
 import functools
+import re
 import textwrap
 
 import sympy as sp
@@ -33,7 +34,8 @@ __all__ = [
     "Kernel", "kernels", "NumPyKernelPrinter", "CKernelPrinter",
     "numpy_module", "c_source", "c_header", "generated_files",
     "COMMAND", "C_PREFIX", "OWNED", "one_line", "comment_text", "docstring_text",
-    "python_function", "c_signature", "c_comment", "c_function",
+    "python_function", "c_signature", "c_comment", "c_function", "c_argument_names",
+    "C_ARGUMENT_PREFIX",
 ]
 
 #: The command that regenerates the files, named in their headers.
@@ -42,6 +44,103 @@ COMMAND = "symstab derive"
 OWNED = ("*.py", "*.c", "*.h")
 #: Prefix of every C symbol.
 C_PREFIX = "symstab_"
+
+
+#: Put before an argument's name in C where the name itself cannot stand there.
+C_ARGUMENT_PREFIX = "arg_"
+
+#: Keywords of C (C89 to C23) and of C++ (the header is read by C++ too, in
+#: ``extern "C"``), and the alternative spellings of <iso646.h>.
+_C_WORDS = frozenset("""
+    auto break case char const continue default do double else enum extern float for goto if
+    inline int long register restrict return short signed sizeof static struct switch typedef
+    union unsigned void volatile while alignas alignof bool constexpr false nullptr
+    static_assert thread_local true typeof typeof_unqual entry fortran asm
+    and and_eq bitand bitor catch char8_t char16_t char32_t class compl concept consteval
+    constinit const_cast co_await co_return co_yield decltype delete dynamic_cast explicit
+    export friend mutable namespace new noexcept not not_eq operator or or_eq private protected
+    public reinterpret_cast requires static_cast template this throw try typeid typename using
+    virtual wchar_t xor xor_eq
+""".split())
+#: The functions of <math.h> and <complex.h> (C99 to C23, POSIX and glibc),
+#: without their float/long double suffixes; a ``c`` before one is a
+#: <complex.h> function (or a name it reserves, ``cerf``, ``cexp2``).
+#: glibc's obsolete ``gamma`` is left out: a parameter may be called gamma
+#: (the paper's M_w / m), and no kernel calls that function (SymPy prints
+#: the gamma function as ``tgamma``).
+_MATH_FUNCTIONS = """
+    acos asin atan atan2 cos sin tan acosh asinh atanh cosh sinh tanh exp exp2 expm1 frexp ilogb
+    ldexp log log10 log1p log2 logb modf scalbn scalbln cbrt fabs abs hypot pow sqrt erf erfc
+    lgamma tgamma ceil floor nearbyint rint lrint llrint round lround llround trunc fmod
+    remainder remquo copysign nan nextafter nexttoward fdim fmax fmin fma acospi asinpi atanpi
+    atan2pi cospi sinpi tanpi exp10 exp10m1 exp2m1 log10p1 logp1 log2p1 compoundn pown powr
+    rootn rsqrt fromfp fromfpx ufromfp ufromfpx roundeven fmaximum fminimum fmaximum_mag
+    fminimum_mag fmaximum_num fminimum_num fmaximum_mag_num fminimum_mag_num nextup nextdown
+    canonicalize iscanonical issignaling issubnormal iszero isinf isnan isfinite isnormal
+    signbit fpclassify isgreater isgreaterequal isless islessequal islessgreater isunordered
+    iseqsig fadd fsub fmul fdiv ffma fsqrt dadd dsub dmul ddiv dfma dsqrt llogb quantum
+    samequantum quantize encodedec decodedec encodebin decodebin totalorder totalordermag
+    getpayload setpayload setpayloadsig j0 j1 jn y0 y1 yn drem finite significand scalb pow10
+    sincos matherr lgamma_r carg cproj conj creal cimag
+""".split()
+_MATH_NAME = re.compile(
+    r"c?(?:%s)(?:f|l|f\d+x?|d\d+)?" % "|".join(sorted(_MATH_FUNCTIONS, key=len, reverse=True)))
+#: Macros, types and variables of <math.h> and <complex.h> (with POSIX's and
+#: glibc's): ``M_PI``, ``HUGE_VAL``, ``FP_NAN``, ``I`` ...
+_MATH_MACROS = frozenset("""
+    HUGE HUGE_VAL HUGE_VALF HUGE_VALL INFINITY NAN SNAN MAXFLOAT math_errhandling float_t
+    double_t long_double_t signgam complex imaginary I CMPLX CMPLXF CMPLXL DOMAIN SING OVERFLOW
+    UNDERFLOW TLOSS PLOSS X_TLOSS exception
+""".split())
+_MATH_MACRO = re.compile(r"(?:M|FP|MATH|HUGE_VAL|SNAN|DEC|FLT|DBL|LDBL)_\w*|_\w*|symstab_\w*")
+
+
+#: Names SymPy's C99 printer would print with a ``_`` after them.
+_PRINTER_WORDS = frozenset(C99CodePrinter().reserved_words)
+
+
+def _needs_c_prefix(name):
+    """Whether ``name`` cannot be a C argument as it is (see :func:`c_argument_names`)."""
+    return (name in _C_WORDS or name in _MATH_MACROS or name in _PRINTER_WORDS
+            or _MATH_NAME.fullmatch(name) is not None or _MATH_MACRO.fullmatch(name) is not None)
+
+
+def c_argument_names(kernel):
+    """``{symbol: name}``: the name each argument of ``kernel`` has in C.
+
+    A name that is a keyword of C (C89 to C23) or C++, a function, macro,
+    type or constant of ``<math.h>`` or ``<complex.h>`` (``exp``, ``pow``,
+    ``HUGE_VAL``, ``INFINITY``, ``NAN``, ``M_PI``, ``I``, ``complex``; with
+    their ``f``/``l`` forms and POSIX's and glibc's additions), a reserved
+    identifier (a leading ``_``; ``FP_``, ``MATH_``, ``M_`` ...) or a name
+    of symstab's C symbols (``symstab_...``) is written
+    :data:`C_ARGUMENT_PREFIX` + name (``arg_HUGE_VAL``), with the prefix
+    repeated while that is another argument's name; every other name stays.
+    A macro of that name would otherwise be expanded (a parameter
+    ``HUGE_VAL`` compiled and read garbage), and a function would be hidden
+    in the body that calls it.  The mapping depends only on the argument
+    names, and :func:`c_comment` documents it.
+
+    Parameters
+    ----------
+    kernel : Kernel
+
+    Returns
+    -------
+    dict
+    """
+    names = [str(symbol) for symbol, _, _ in kernel.args]
+    taken = set(names)
+    out = {}
+    for (symbol, _, _), name in zip(kernel.args, names):
+        if _needs_c_prefix(name):
+            new = C_ARGUMENT_PREFIX + name
+            while new in taken:
+                new = C_ARGUMENT_PREFIX + new
+            taken.add(new)
+            name = new
+        out[symbol] = name
+    return out
 
 
 @dataclasses.dataclass(frozen=True)
@@ -412,7 +511,8 @@ def c_signature(kernel):
     ----------
     kernel : Kernel
     """
-    params = [f"{ctype} {symbol}" for symbol, ctype, _ in kernel.args]
+    names = c_argument_names(kernel)
+    params = [f"{ctype} {names[symbol]}" for symbol, ctype, _ in kernel.args]
     if len(kernel.outputs) == 1:
         return f"double {C_PREFIX}{kernel.name}({', '.join(params)})"
     params += [f"double *{name}" for name, _, _ in kernel.outputs]
@@ -428,8 +528,12 @@ def c_comment(kernel):
     """
     doc = textwrap.wrap(comment_text(kernel.doc, "c"), 72, break_long_words=False)
     lines = ["/*"] + [f" * {line}" for line in doc] + [" *"]
+    names = c_argument_names(kernel)
     for symbol, _, description in kernel.args:
-        lines.append(f" * {symbol}: {comment_text(description, 'c')}")
+        renamed = ("" if names[symbol] == str(symbol) else
+                   f" (the argument {symbol}, renamed in C: a C keyword, a name of <math.h> or "
+                   f"<complex.h>, or a reserved one)")
+        lines.append(f" * {names[symbol]}: {comment_text(description, 'c')}{renamed}")
     for name, _, description in kernel.outputs:
         role = "returns" if len(kernel.outputs) == 1 else f"*{name}"
         lines.append(f" * {role}: {comment_text(description, 'c')}")
@@ -446,6 +550,14 @@ def c_function(kernel, printer):
     printer : CKernelPrinter
     """
     replacements, reduced = kernel.cse()
+    # Each argument printed under its C name (the same Symbol class, so the
+    # printers see what they saw; integer-ness is kept for the delay).
+    names = c_argument_names(kernel)
+    rename = {symbol: sp.Symbol(names[symbol], **symbol.assumptions0)
+              for symbol in names if isinstance(symbol, sp.Symbol) and names[symbol] != str(symbol)}
+    if rename:
+        replacements = [(t, sp.sympify(e).xreplace(rename)) for t, e in replacements]
+        reduced = [sp.sympify(e).xreplace(rename) for e in reduced]
     if kernel.complex_arithmetic:
         printer = CComplexKernelPrinter()
     lines = [c_comment(kernel), c_signature(kernel), "{"]
@@ -456,8 +568,8 @@ def c_function(kernel, printer):
     # under -Wextra, whose -Wunused-parameter would flag it.
     used = set().union(*(e.free_symbols for _, e in replacements), *(e.free_symbols
                                                                       for e in reduced))
-    lines += [f"    (void){symbol};" for symbol, _, _ in kernel.args
-              if isinstance(symbol, sp.Symbol) and symbol not in used]
+    lines += [f"    (void){names[symbol]};" for symbol, _, _ in kernel.args
+              if isinstance(symbol, sp.Symbol) and rename.get(symbol, symbol) not in used]
     for symbol, expr in replacements:
         # An integer temporary (d + 1) stays an int: it is passed as one.
         ctype = "int" if expr.is_integer else ("double complex" if kernel.complex_arithmetic

@@ -45,7 +45,7 @@ import math
 
 import numpy as np
 
-from .._validate import check_count, check_real, check_window
+from .._validate import check_count, check_progress, check_real, check_window
 
 __all__ = ["TARGETS", "Design", "design", "maximize_scalar", "maximize_pieces", "maximize_box",
            "held_delay", "delay_pieces", "box_corners"]
@@ -200,7 +200,9 @@ class _Evaluations:
     """The target at points of the searched box, each evaluated once and remembered."""
 
     def __init__(self, f, progress):
-        self.f, self.progress = f, progress
+        # Called directly by maximize_scalar and maximize_box: the total is
+        # not known there, so True reports nothing (design draws a bar).
+        self.f, self.progress = f, check_progress(progress)
         self.seen = {}
 
     def __call__(self, point):
@@ -503,9 +505,9 @@ def design(loop, *, over, maximize="y_max", x=None, y=None, n=None, rtol=None, d
     rtol = _RTOL.get(maximize, 1e-6) if rtol is None else rtol
     names = tuple(over)
     n = (17 if len(names) == 1 else 9) if n is None else check_count("n", n, 3)
-    if progress is not None and not callable(progress):
-        raise TypeError(f"progress must be a callable taking the number of evaluations, or None, "
-                        f"got {type(progress).__name__}")
+    from .loop_simulate import progress_printer
+
+    progress = check_progress(progress, lambda: progress_printer("designing", n**len(names) + 40))
     for axis, name in (("x", x), ("y", y)) + ((("damping", damping),) if maximize == "passive"
                                                  else ()):
         if name not in loop.parameters:

@@ -31,7 +31,8 @@ wrote in ``loop.file_parameters``.
 A loop file is data, exchanged between colleagues, and nothing in it is
 run: the plant and the environment are built from their syntax tree
 (numbers, parameter names, ``+ - * / **``, ``exp``, ``sqrt``), never
-evaluated; ``name`` is a word of 1 to 64 ASCII letters, digits, ``_``, ``-``
+evaluated, a decimal in them being the exact rational it writes (``0.25`` is
+1/4); ``name`` is a word of 1 to 64 ASCII letters, digits, ``_``, ``-``
 and ``.`` (it becomes a file stem; without it the file's stem is used, made
 such a word); ``description`` and every unit are one line of printable text;
 a parameter's name is an ASCII identifier.  Anything else is refused.

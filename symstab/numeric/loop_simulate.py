@@ -32,7 +32,7 @@ import numpy as np
 
 from .._resources import MAX_STEPS_ENV, check_memory, chunk_slices
 from .._resources import max_steps as _max_steps_setting
-from .._validate import check_array, check_delay, check_real
+from .._validate import check_array, check_delay, check_progress, check_real
 from .friction import StatePlant, stacked_spaces, substeps_of
 from .results import PAPER_PLANE, PaperGridNames
 
@@ -616,11 +616,10 @@ def simulate_loop(loop, *, steps=None, x0=1.0, v0=None, nonideal=None, record=Fa
         force of the same instant), or a run that does not fit in memory.
     """
     nonideal = check_loop_nonideal(nonideal, loop)
-    if progress is not None and not callable(progress):
-        raise TypeError(f"progress must be a callable taking the number of steps done, or None, "
-                        f"got {type(progress).__name__}")
+    check_progress(progress)   # a wrong kind is refused before the work
     parts, d, shape = loop.difference_equations(**values)
     steps = check_steps(steps, d)
+    progress = check_progress(progress, lambda: progress_printer("simulating", steps))
     x0 = check_x0(x0)
     v0 = x0 / 100 if v0 is None else check_real("v0", v0, low=-X0_MAX, high=X0_MAX)
     n_points = int(np.prod(shape))

@@ -43,7 +43,8 @@ import numpy as np
 import sympy as sp
 
 __all__ = ["unit_registry", "ALLOWED_UNITS", "UnitInfo", "unit_info", "dimension_name", "FileValue", "Bound", "FileParameters",
-           "read_parameters", "check_loop_units", "convert", "check_bounds", "SAMPLE_UNITS"]
+           "read_parameters", "check_loop_units", "convert", "check_bounds", "SAMPLE_UNITS",
+           "parameter_angle", "check_angle"]
 
 #: The only units of the delay ``d``, a whole number of samples.
 SAMPLE_UNITS = ("samples", "sample")
@@ -336,6 +337,8 @@ def convert(name, value, unit, *, where):
         raise ValueError(f"{where}: parameter 'T' has unit {unit!r}"
                          + ("" if named == unit else f" ({named})")
                          + ": T is the sample period, a time (s, ms, us)")
+    # A rotary stiffness or damping in N m/deg^2: the dimension fits, the angle does not.
+    check_angle(name, info, parameter_angle(info.dimensions), where=where)
     if info.dimensions == _vector({"[time]": -1}) and info.angle:
         raise ValueError(f"{where}: parameter {name!r} has unit {unit!r}, an angular frequency: "
                          f"give it in Hz or 1/s, as the loop's expressions use it (SI takes "
@@ -348,6 +351,73 @@ def convert(name, value, unit, *, where):
         raise ValueError(f"{where}: parameter {name!r} = {value!r} {unit} is not representable "
                          f"as a float in SI ({info.si})")
     return FileValue(name, value, unit, si_value, info.si, info)
+
+
+def parameter_angle(dimensions, info=None):
+    """The exponent of the angle in a parameter's own unit, or None where it is not known.
+
+    pint (as SI) takes an angle as a number, so ``N m/deg^2`` has the
+    dimension of ``N m/rad`` and would be converted by (180/pi)^2 without
+    a word.  A parameter's own angle exponent is that of the unit its loop
+    file gives it, where that unit writes an angle; else -1 for a rotary
+    stiffness or damping (N m/rad, N m s/rad: the loop's VE(z) maps an angle
+    to a torque); else unknown.
+
+    Parameters
+    ----------
+    dimensions : tuple or None
+        The parameter's dimension (:attr:`UnitInfo.dimensions`).
+    info : UnitInfo, optional
+        The unit the loop file gives the parameter.
+
+    Returns
+    -------
+    fractions.Fraction or None
+    """
+    if info is not None and info.angle:
+        return info.angle
+    if dimensions is None or any(dimensions[3:]):
+        return None
+    if (tuple(dimensions[:3]), -1) in _SI_NAMES and (tuple(dimensions[:3]), 0) in _SI_NAMES:
+        return fractions.Fraction(-1)
+    return None
+
+
+def check_angle(name, info, own, *, where, si_unit=None):
+    """Refuse a unit whose angle exponent is not the parameter's own (:func:`parameter_angle`).
+
+    A unit that writes no angle is taken as SI takes it (``N m`` for ``N m/rad``:
+    the radian is 1); one that writes an angle must write it to the
+    parameter's power, in any angle unit (``N m/deg`` is converted by
+    180/pi).
+
+    Parameters
+    ----------
+    name : str
+        The parameter.
+    info : UnitInfo
+        The unit given.
+    own : fractions.Fraction or None
+        The parameter's angle exponent; None: not checked.
+    where : str
+        Begins the message (the file, or the ``--set`` option).
+    si_unit : str, optional
+        The parameter's unit, named in the message (default: the SI name of
+        ``info``'s dimension with ``own``).
+
+    Raises
+    ------
+    ValueError
+        Naming the parameter, the unit given and the unit it is in.
+    """
+    if own is None or not info.angle or info.angle == own:
+        return
+    expected = si_unit or _si_name(info.dimensions, own)
+    raise ValueError(f"{where}: parameter {name!r} has unit {info.text!r}, whose angle is to the "
+                     f"power {_power(info.angle)}, and {name} is in {expected} (an angle to the "
+                     f"power {_power(own)}): pint takes an angle as a number, so it would be "
+                     f"converted silently; give it in {expected}, or with the angle in another "
+                     f"unit to that power (e.g. 'deg' for 'rad')")
 
 
 def _vector(mapping):

@@ -20,7 +20,7 @@ Draws outside the bounds a loop file declares are refused by name.
 import numpy as np
 
 from .._resources import CHUNK_BYTES, check_memory
-from .._validate import check_array, check_delay, check_real
+from .._validate import check_array, check_delay, check_progress, check_real
 from .results import StabilityProbability
 from .stability import MARGINAL, STABLE
 
@@ -122,8 +122,9 @@ def stability_probability(loop, x_values, y_values, *, x, y, uncertain, samples=
         The random generator's seed: the same seed, the same map.
     x, y : str
         The plane.
-    progress : callable, optional
-        Called with the number of draws done.
+    progress : callable, bool or None, optional
+        Called with the number of draws done; True draws a bar
+        (:func:`symstab._validate.check_progress`).
     **values
         Single values of the other parameters (defaults for the rest).
 
@@ -147,9 +148,9 @@ def stability_probability(loop, x_values, y_values, *, x, y, uncertain, samples=
     for name in draws:
         if name in values:
             raise TypeError(f"{name} is uncertain: give its distribution, not a value")
-    if progress is not None and not callable(progress):
-        raise TypeError(f"progress must be a callable taking the number of draws done, or None, "
-                        f"got {type(progress).__name__}")
+    from .loop_simulate import progress_printer
+
+    progress = check_progress(progress, lambda: progress_printer("drawing", samples))
     known = getattr(loop, "file_parameters", None)
     if known is not None:
         from .loop_units import check_bounds

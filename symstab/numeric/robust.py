@@ -71,7 +71,7 @@ import numpy as np
 import sympy as sp
 
 from .._resources import chunk_slices
-from .._validate import check_count, check_delay, check_real, check_window
+from .._validate import check_count, check_delay, check_progress, check_real, check_window
 from ..symbolic import model
 from ..symbolic.discretize import interval_product, interval_zoh
 from ..symbolic.loop_assembly import poly_coeffs
@@ -831,9 +831,10 @@ def robust_region(loop, x, y, *, uncertain, strips=64, rtol=1e-6, x_range=None, 
     budget : int
         Most cells examined (:data:`MAX_CELLS`); beyond, marginal (and
         :attr:`~symstab.numeric.results.RobustRegion.exhausted` says so).
-    progress : callable, optional
+    progress : callable, bool or None, optional
         Called with the number of delays done: 0 once the input is checked
-        and the work begins, then after each delay.
+        and the work begins, then after each delay; True draws a bar
+        (:func:`symstab._validate.check_progress`).
     **values
         Values of the other parameters.
 
@@ -880,6 +881,9 @@ def robust_region(loop, x, y, *, uncertain, strips=64, rtol=1e-6, x_range=None, 
         loop.unstable_root_counts(**fixed, **dict(zip(box, corner)), d=centre_d,
                                   **{x: 0.0, y: 0.0})
 
+    from .loop_simulate import progress_printer
+
+    progress = check_progress(progress, lambda: progress_printer("delays", len(delays)))
     given_x = None
     if x_range is not None:
         given_x = check_window("x_range", (x_range[0], x_range[1] + 1.0)) if (

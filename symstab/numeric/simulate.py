@@ -68,7 +68,7 @@ import math
 
 import numpy as np
 
-from .._validate import check_array, check_delay, check_loop, check_real
+from .._validate import check_array, check_delay, check_loop, check_progress, check_real
 from .loop_simulate import (MAX_STEPS_ENV, PAPER_ENCODER_RESOLUTION, X0_MAX, Nonidealities,
                             QUANTUM_MIN, Simulation, StabilityMap, check_friction_size,
                             check_loop_nonideal, check_steps,
@@ -119,8 +119,9 @@ def simulate(*, alpha, beta, gamma, d, delta, steps=None, x0=1.0, v0=None, devic
         Off by default.
     record : bool
         Keep every position (memory: ``steps`` times the points).
-    progress : callable
-        Called with the number of steps done (every 1 % or so).
+    progress : callable, bool or None
+        Called with the number of steps done (every 1 % or so); True draws
+        a bar (:func:`symstab._validate.check_progress`).
 
     Returns
     -------
@@ -144,9 +145,8 @@ def simulate(*, alpha, beta, gamma, d, delta, steps=None, x0=1.0, v0=None, devic
                         f"got {type(nonideal).__name__}")
     if device is not None and not isinstance(device, Device):
         raise TypeError(f"device must be a symstab.Device or None, got {type(device).__name__}")
-    if progress is not None and not callable(progress):
-        raise TypeError(f"progress must be a callable taking the number of steps done, or None, "
-                        f"got {type(progress).__name__}")
+    progress = check_progress(progress, lambda: progress_printer(
+        "simulating", default_horizon(check_delay(d)) if steps is None else steps))
     if device is not None:
         nonideal.check(device.T)
         if delta is None:
@@ -260,7 +260,7 @@ def stability_map(*, alpha, beta, gamma, d, delta, steps=None, x0=1.0, v0=None, 
         1-D grids.
     gamma, d, delta, steps, x0, v0, device, nonideal
         As in :func:`simulate`.
-    progress : callable or True
+    progress : callable, bool or None
         ``True`` draws a progress bar on stderr for runs over 2 s.
 
     Returns
@@ -279,12 +279,8 @@ def stability_map(*, alpha, beta, gamma, d, delta, steps=None, x0=1.0, v0=None, 
         raise ValueError("alpha and beta must be 1-D grids")
     gamma = check_real("gamma", gamma)
     d = check_delay(d)
-    if progress is not None and progress is not True and not callable(progress):
-        raise TypeError(f"progress must be True, a callable taking the number of steps done, "
-                        f"or None, got {type(progress).__name__}")
     total = default_horizon(d) if steps is None else steps
-    if progress is True:
-        progress = progress_printer("simulating", total)
+    progress = check_progress(progress, lambda: progress_printer("simulating", total))
     A, B = np.meshgrid(alpha, beta, indexing="ij")
     run = simulate(alpha=A, beta=B, gamma=gamma, d=d, delta=delta, steps=steps, x0=x0, v0=v0,
                    device=device, nonideal=nonideal, progress=progress)

@@ -35,7 +35,7 @@ import math
 
 import numpy as np
 
-from .._validate import check_count, check_real
+from .._validate import check_count, check_progress, check_real
 
 __all__ = ["SimulatedLimit", "simulated_limit"]
 
@@ -132,8 +132,9 @@ def simulated_limit(loop, *, x, y, amplitude, nonideal=None, steps=None, x0=None
         the linear ``y_max`` is added to the grid in ``x``).
     refine : int
         Refinement rounds (each divides the step in ``y`` by nine), ``>= 0``.
-    progress : callable, optional
-        Called with the runs done so far (one per grid or round).
+    progress : callable, bool or None, optional
+        Called with the runs done so far (one per grid or round); True draws
+        a bar (:func:`symstab._validate.check_progress`).
     **values
         Single values of the loop's other parameters.
 
@@ -155,6 +156,10 @@ def simulated_limit(loop, *, x, y, amplitude, nonideal=None, steps=None, x0=None
     x0 = default_x0(nonideal) if x0 is None else check_x0(x0)
     n_x, n_y = _grid_size(n)
     refine = check_count("refine", refine, 0)
+    from .loop_simulate import progress_printer
+
+    # A run per grid and per refinement round.
+    progress = check_progress(progress, lambda: progress_printer("simulating", 1 + refine))
     for name in (x, y):
         if name in values:
             raise TypeError(f"{name} is an axis of the ({x}, {y}) plane: it takes no value here")

@@ -237,8 +237,9 @@ def run_sweep(loop, question, names, rows, *, chunk, store, client=None, progres
         not evaluated again.
     client : dask.distributed.Client, optional
         Evaluate the chunks on its cluster (default: here, one after another).
-    progress : callable, optional
-        Called with the number of chunks finished (saved ones included).
+    progress : callable, bool or None, optional
+        Called with the number of chunks finished (saved ones included);
+        True draws a bar (:func:`symstab._validate.check_progress`).
 
     Returns
     -------
@@ -246,7 +247,11 @@ def run_sweep(loop, question, names, rows, *, chunk, store, client=None, progres
         The answers and reasons of every row, in the rows' order, and the
         number of chunks loaded from the store rather than evaluated.
     """
+    from .._validate import check_progress
+    from .loop_simulate import progress_printer
+
     slices = [slice(i, min(i + chunk, len(rows))) for i in range(0, len(rows), chunk)]
+    progress = check_progress(progress, lambda: progress_printer("chunks", len(slices)))
     values = np.full((len(rows), len(question.columns())), np.nan)
     reasons = [""] * len(rows)
     done = store.done()

@@ -89,9 +89,9 @@ def plant_kernel(loop):
     -------
     symstab.codegen.generator.Kernel or None
         None when the loop's ZOH is computed numerically
-        (``loop.zoh_method == "matrix exponential"``), or when its poles are
-        written with square roots and a parameter is named as a macro of
-        ``<complex.h>`` (``I``, ``complex``, ``imaginary``).
+        (``loop.zoh_method == "matrix exponential"``).  A parameter named
+        as a macro of ``<complex.h>`` (``I``, ``complex``) has another name
+        in C (:func:`symstab.codegen.generator.c_argument_names`).
 
     Notes
     -----
@@ -114,8 +114,6 @@ def plant_kernel(loop):
     args.append((model.T, "sample period T"))
     roots = any(not p.exp.is_integer for p in pulse.atoms(sp.Pow))
     if roots:
-        if {str(x) for x, _ in args} & _COMPLEX_MACROS:
-            return None
         # Divided by P_d's leading coefficient, whose square-root factors are
         # those of the others: the quotients are real for real parameters.
         lead = p_d[0]
@@ -135,10 +133,6 @@ def plant_kernel(loop):
                   f"(such as a small b T / m) cancel digits in double precision; "
                   f"symstab.Loop evaluates them at 30 digits instead.",
                   complex_arithmetic=roots)
-
-
-#: Macros of <complex.h> a parameter's name would collide with.
-_COMPLEX_MACROS = {"I", "complex", "imaginary", "_Complex_I", "_Imaginary_I"}
 
 
 def step_orders(loop):
@@ -268,8 +262,10 @@ def kernel_files(loop):
     Raises
     ------
     ValueError
-        If a parameter's name cannot be printed in C (a C keyword, or an
-        output name of its kernel).
+        If a parameter's name cannot be printed in C (an output name of its
+        kernel).  A name that is a C keyword or a name of ``<math.h>`` or
+        ``<complex.h>`` is renamed in C, and the C comment of each kernel
+        says so (:func:`symstab.codegen.generator.c_argument_names`).
     """
     stem = c_name(loop)
     environment = loop.kernels()
@@ -283,18 +279,14 @@ def kernel_files(loop):
                + (f", and Z[ZOH G] of G(s) = {loop.plant}"
                   + (" (in complex arithmetic)." if plant.complex_arithmetic
                      else ".") if plant is not None else
-                  "; the plant's pulse transfer function is computed numerically."
-                  if loop.zoh_method != "residues" else
-                  "; the plant's pulse transfer function (poles with square roots, a parameter "
-                  "named as a <complex.h> macro) is not printed in C: symstab.Loop evaluates "
-                  "it at 30 digits."))
+                  "; the plant's pulse transfer function is computed numerically."))
     steps, step_prototypes = step_source(loop, prefix)
     c_title += " The loop's step on its samples (any plant: coefficients as arguments)."
     source = c_source(c_kernels, title=c_title, prefix=prefix, command=COMMAND) + "\n" + steps
     # SymPy's C99 printer writes pi as M_PI, which <math.h> defines only
     # outside strict C99 (POSIX): define it where the compiler does not.
     pi = ("#ifndef M_PI\n#define M_PI 3.14159265358979323846264338327950288\n#endif\n"
-          if "M_PI" in source else "")
+          if re.search(r"\bM_PI\b", source) else "")
     source = source.replace("#include <math.h>\n",
                             f'#include <math.h>\n#include "{stem}_kernels.h"\n{pi}', 1)
     return {

@@ -22,7 +22,9 @@ import ast
 import fractions
 import functools
 import keyword
+import math
 import re
+import warnings
 
 import mpmath
 import numpy as np
@@ -33,7 +35,7 @@ from .._validate import check_delay
 from .derivation_cache import DerivationCache
 from .discretize import numeric_zoh, written_poles, zoh_pulse_transfer_function
 
-__all__ = ["LoopModel", "parse_plant", "parse_environment", "parse_actuator", "parse_expression",
+__all__ = ["LoopModel", "NonPhysicalPlantWarning", "parse_plant", "parse_environment", "parse_actuator", "parse_expression",
            "check_parameter_name", "check_loop_name", "check_text_line", "NAME_PATTERN",
            "is_affine", "poly_coeffs", "shift_to_one", "PLANT_DIGITS"]
 
@@ -66,6 +68,16 @@ NAME_PATTERN = re.compile(r"[A-Za-z0-9_][A-Za-z0-9_.-]{0,63}")
 _PARAMETER_PATTERN = re.compile(r"[A-Za-z][A-Za-z0-9_]{0,39}")
 #: Longest description and unit text (one line each).
 _TEXT_LIMITS = {"description": 200, "unit": 60}
+
+
+class NonPhysicalPlantWarning(UserWarning):
+    """The plant at the values given is not a physical device's: a pole in the open right half
+    plane, or a negative high-frequency gain (a negative mass, friction or stiffness, a typo).
+
+    The loop is analysed as given; the warning names the plant's values
+    (:meth:`LoopModel.plant_defect`).  A loop file bounds its physical
+    parameters (``min = 0``, ``above = 0``) to refuse such a value instead.
+    """
 
 
 def shift_to_one(coefficients, dtype=None):
@@ -236,7 +248,9 @@ def parse_expression(text, what):
     subscripts, other calls, comparisons, lambdas) is refused, so a string
     from a loop file cannot run code.  A literal exponent is at most
     :data:`MAX_ORDER` and an exponent holds no power (``2**(10**10)`` would
-    take SymPy forever).
+    take SymPy forever).  A decimal is the exact rational it writes (``0.25``
+    is 1/4, ``0.1`` is 1/10, ``1e-3`` is 1/1000), not the nearest binary
+    float: the derivation stays exact.
 
     Parameters
     ----------
@@ -253,8 +267,9 @@ def parse_expression(text, what):
     if len(text) > MAX_EXPRESSION_LENGTH:
         raise ValueError(f"{what} is {len(text)} characters long, above the limit of "
                          f"{MAX_EXPRESSION_LENGTH}")
+    source = text.replace("^", "**")
     try:
-        tree = ast.parse(text.replace("^", "**"), mode="eval")
+        tree = ast.parse(source, mode="eval")
     except SyntaxError as exc:
         raise ValueError(f"{what} {text!r} is not a valid expression: {exc.msg}") from None
     except (RecursionError, MemoryError):
@@ -289,7 +304,13 @@ def parse_expression(text, what):
                 check_exponent(node.value)
             if isinstance(node.value, int):
                 return sp.Integer(node.value)
-            return sp.Float(repr(node.value))
+            if not math.isfinite(node.value):
+                raise ValueError(f"{what} {text!r}: {node.value!r} is not a finite number")
+            # The decimal as written, exactly (0.25 is 1/4, 0.1 is 1/10): a
+            # Float would make the plant's polynomials inexact, which SymPy's
+            # factoring over the parameters cannot take.
+            written = ast.get_source_segment(source, node) or repr(node.value)
+            return sp.Rational(written.replace("_", ""))
         if isinstance(node, ast.Name) and not node.id.startswith("_"):
             return fixed.get(node.id) or sp.Symbol(node.id)
         if (isinstance(node, ast.Call) and isinstance(node.func, ast.Name)
@@ -300,7 +321,7 @@ def parse_expression(text, what):
                                              for n in ast.walk(inner)):
                 raise ValueError(f"{what} {text!r}: exp() inside exp() is not allowed")
             return _FUNCTIONS[node.func.id](build(inner, in_exponent))
-        shown = ast.get_source_segment(text.replace("^", "**"), node) or type(node).__name__
+        shown = ast.get_source_segment(source, node) or type(node).__name__
         raise ValueError(f"{what} {text!r}: {shown!r} is not allowed (numbers, names, + - * / **, "
                          f"brackets, exp() and sqrt() only)")
 
@@ -316,6 +337,16 @@ def parse_expression(text, what):
     if not isinstance(expr, sp.Expr):
         raise ValueError(f"{what} {text!r} is not an expression")
     return expr
+
+
+def _exact_decimals(expr):
+    """Every SymPy Float in ``expr`` as the exact rational of its decimal digits (0.25 -> 1/4).
+
+    A text is parsed that way already (:func:`parse_expression`); a SymPy
+    expression given directly may hold Floats, which make the plant's
+    polynomials inexact (SymPy's factoring over the parameters fails on them).
+    """
+    return expr.xreplace({f: sp.Rational(str(f)) for f in expr.atoms(sp.Float)})
 
 
 def _real_symbols(expr):
@@ -389,7 +420,7 @@ def parse_plant(plant):
     else:
         raise TypeError(f"plant must be a string, a SymPy expression or a "
                         f"control.TransferFunction, got {type(plant).__name__}")
-    expr = _real_symbols(expr)
+    expr = _real_symbols(_exact_decimals(expr))
     _check_rational(expr, model.s, "plant G(s)", model.z)
     return expr
 
@@ -460,7 +491,7 @@ def _rational(value, what, label, variable, other):
     else:
         raise TypeError(f"{what} must be a string or a SymPy expression, "
                         f"got {type(value).__name__}")
-    expr = _real_symbols(expr)
+    expr = _real_symbols(_exact_decimals(expr))
     _check_rational(expr, variable, label, other)
     return expr
 
@@ -860,14 +891,84 @@ class LoopModel:
                     <= mpmath.mpf(10) ** -PLANT_DIGITS * max(abs(c) for c in new)
                     for old, new in zip(before, parts)):
                 return (*parts, digits)
+            if before is not None and self._meeting_poles(point, T) is not None:
+                # Two precisions disagree because poles meet exactly (k_h = 0):
+                # every precision would; the realisation takes the limit.
+                return [mpmath.nan], [mpmath.mpf(0)], digits
             before, digits = parts, 2 * digits
         self._refuse_plant(point, T)
 
     def _refuse_plant(self, point, T):
+        self._check_distinct_poles(point, T)
         given = ", ".join(f"{n} = {float(v):g}" for n, v in zip(self._plant_names, point))
         raise ValueError(f"the plant's pulse transfer function at {given}, T = {float(T):g} "
                          f"cancels beyond {PLANT_MAX_DIGITS} digits: a parameter is too small "
                          f"or too large for its closed form")
+
+    @functools.cached_property
+    def _pole_conditions(self):
+        """``[(expression, why)]``: where an expression of the parameters vanishes, poles meet.
+
+        The residues are derived for the poles of ``G(s)/s`` as the symbols
+        write them: a factor of the denominator whose leading coefficient
+        vanishes loses its order, one whose constant term vanishes puts a
+        pole on the hold's pole at ``s = 0``, a quadratic whose discriminant
+        vanishes has a double pole, and two factors whose resultant vanishes
+        share a pole.  Each is a 0/0 of the closed form that no precision
+        resolves.
+        """
+        s = model.s
+        _, den = sp.fraction(sp.cancel(sp.together(self.plant)))
+        factors = [f for f, _ in sp.factor_list(den, s)[1] if f.has(s)]
+        out = []
+        for f in factors:
+            c = sp.Poly(f, s).all_coeffs()
+            if c[0].free_symbols:
+                out.append((c[0], f"the factor {f} loses its leading coefficient (the "
+                                  f"plant's order drops)"))
+            if len(c) > 1 and c[-1].free_symbols:
+                out.append((c[-1], f"the factor {f} has a pole at s = 0, on the pole of "
+                                   f"G(s)/s at 0 (the hold's integrator)"))
+            if len(c) == 3:
+                disc = sp.expand(c[1] ** 2 - 4 * c[0] * c[2])
+                if disc.free_symbols:
+                    out.append((disc, f"the factor {f} has a double pole (its discriminant "
+                                      f"{disc} is 0)"))
+        for i, f in enumerate(factors):
+            for g in factors[i + 1:]:
+                r = sp.resultant(f, g, s)
+                if r.free_symbols:
+                    out.append((r, f"the factors {f} and {g} share a pole"))
+        return out
+
+    def _meeting_poles(self, point, T):
+        """``(expression, why, values)`` of the first of :attr:`_pole_conditions` that holds, or None."""
+        values = {self._symbols[n]: sp.Rational(float(v)) for n, v in zip(self._plant_names, point)}
+        values.setdefault(model.T, sp.Rational(float(T)))
+        for expr, why in self._pole_conditions:
+            if expr.xreplace(values) == 0:
+                return expr, why, values
+        return None
+
+    def _check_distinct_poles(self, point, T):
+        """Refuse, naming the parameters and why, a point where :attr:`_pole_conditions` holds.
+
+        Called where neither the closed form nor the realisation gives the
+        pulse transfer function (a factor that loses its order); poles that
+        merely meet are the realisation's limit, not refused.
+        """
+        meeting = self._meeting_poles(point, T)
+        if meeting is None:
+            return
+        expr, why, values = meeting
+        names = sorted(str(x) for x in expr.free_symbols)
+        given = ", ".join(f"{n} = {float(values[self._symbols[n]]):g}" for n in names)
+        zero = " and ".join(f"{n} = 0" for n in names
+                            if values[self._symbols[n]] == 0) or f"{expr} = 0"
+        raise ValueError(
+            f"the plant G(s) = {self.plant} is degenerate at {given}: {why}; give "
+            f"{' or '.join(names)} another value, or write the plant as it is at {zero} "
+            f"(a loop of its own)")
 
     @functools.cached_property
     def driven_mass(self):
@@ -932,13 +1033,81 @@ class LoopModel:
             total = sum(-mpmath.log10(x) for x in sizes if 0 < x < 1)
         return int(mpmath.ceil(total))
 
+    @functools.cached_property
+    def _plant_fraction(self):
+        """mpmath function of (plant values..., T): the plant's numerator and denominator in ``s``."""
+        num, den = sp.fraction(sp.cancel(sp.together(self.plant)))
+        return self._plant_function([poly_coeffs(num, model.s), poly_coeffs(den, model.s)])
+
+    def plant_defect(self, plant_values, T):
+        """Why the plant at these values is not a physical device's (one line), or None.
+
+        A pole in the open right half plane (the plant alone would diverge),
+        or a negative high-frequency gain (the leading coefficients of its
+        numerator and denominator in ``s`` of opposite signs: a negative
+        mass, say).  The poles are the roots of the denominator (NumPy); one
+        counts as in the right half plane when its real part exceeds 1e-9 of
+        its size (a pole on the imaginary axis, computed with rounding, does
+        not).
+
+        Parameters
+        ----------
+        plant_values : sequence of float
+            The values of the plant's parameters, in the order of its names
+            (sorted; ``T`` apart).
+        T : float
+            The sample period (the plant may use it).
+
+        Returns
+        -------
+        str or None
+        """
+        with mpmath.workdps(PLANT_DIGITS):
+            try:
+                num, den = self._plant_fraction(*(mpmath.mpf(float(v)) for v in plant_values),
+                                                mpmath.mpf(float(T)))
+                num, den = ([float(mpmath.mpmathify(c)) for c in part] for part in (num, den))
+            except (ZeroDivisionError, TypeError, ValueError, OverflowError):
+                return None
+        num, den = np.trim_zeros(num, "f"), np.trim_zeros(den, "f")
+        if not len(num) or not len(den) or not np.all(np.isfinite(np.concatenate([num, den]))):
+            return None
+        problems = []
+        with np.errstate(all="ignore"):
+            try:
+                poles = np.roots(den)
+            except (ValueError, np.linalg.LinAlgError):
+                # Coefficients whose ratios overflow (b = 1e308): the loop
+                # itself says what is wrong with them; no warning is made up.
+                poles = []
+        unstable = [p for p in poles if p.real > 1e-9 * abs(p)]
+        if unstable:
+            p = max(unstable, key=lambda p: p.real)
+            shown = f"{p.real:.4g}" if p.imag == 0 else f"{p.real:.4g} {'+-'} {abs(p.imag):.4g}j"
+            problems.append(f"a pole in the open right half plane (s = {shown})")
+        if num[0] * den[0] < 0:
+            problems.append("a negative high-frequency gain (the leading coefficients of its "
+                            "numerator and denominator in s have opposite signs)")
+        if not problems:
+            return None
+        given = ", ".join(f"{n} = {float(v):g}" for n, v in zip(self._plant_names, plant_values))
+        return (f"the plant G(s) = {self.plant} at {given} has {' and '.join(problems)}: not a "
+                f"physical device's (a negative mass, friction or stiffness?); the results are "
+                f"those of that plant")
+
     @functools.lru_cache(maxsize=4096)
     def _plant_digits(self, plant_values, T):
         """``(P_n, P_d, digits)``: the pulse transfer function's coefficients as mpmath numbers.
 
         At :data:`PLANT_DIGITS` digits, or more where the closed form needs
         them (:meth:`_closed_form_plant`); refused where it is not defined.
+        A plant that is not a physical device's at these values
+        (:meth:`plant_defect`) gives a :class:`NonPhysicalPlantWarning`,
+        once per point (the result is cached).
         """
+        defect = self.plant_defect(plant_values, T)
+        if defect is not None:
+            warnings.warn(defect, NonPhysicalPlantWarning, stacklevel=2)
         digits = PLANT_DIGITS
         with mpmath.workdps(PLANT_DIGITS):
             point = [mpmath.mpf(float(v)) for v in plant_values]
@@ -951,6 +1120,8 @@ class LoopModel:
                 p_n, p_d = self._realised_plant(plant_values, T)
         with mpmath.workdps(digits):
             if not _defined(p_n, p_d):
+                if self._plant_parts is not None:
+                    self._check_distinct_poles(plant_values, T)   # says which poles meet
                 given = ", ".join(f"{n} = {float(v):g}" for n, v in zip(self._plant_names, plant_values))
                 raise ValueError(f"the plant's pulse transfer function is not defined at "
                                  f"{given}, T = {float(T):g} (its leading coefficient in s "
@@ -965,9 +1136,15 @@ class LoopModel:
             num, den = sp.fraction(sp.together(self.plant.subs(sub)))
             num = [mpmath.mpf(sp.Float(c, PLANT_DIGITS)) for c in sp.Poly(num, model.s).all_coeffs()]
             den = [mpmath.mpf(sp.Float(c, PLANT_DIGITS)) for c in sp.Poly(den, model.s).all_coeffs()]
-            if not den or den[0] == 0:
+            if len(den) != self._plant_order + 1 or den[0] == 0:
+                # The order drops (m = 0): another loop, not this one's limit.
                 return [mpmath.nan], [mpmath.mpf(0)]
             return numeric_zoh(num, den, mpmath.mpf(float(T)), dps=PLANT_DIGITS)
+
+    @functools.cached_property
+    def _plant_order(self):
+        """The plant's order: the degree in ``s`` of its denominator as the symbols write it."""
+        return sp.Poly(sp.fraction(sp.cancel(sp.together(self.plant)))[1], model.s).degree()
 
     def _exact_plant(self, plant_values, T):
         """``(P_n, P_d)`` with monic ``P_d``, as exact Fractions of their 30-digit values.

@@ -293,7 +293,8 @@ MAP = ["--x-range=0,1,3", "--y-range=0,1,3", "--out", "m.npz"]
     (["limits", *L, "--set", "d=-1"], "delay d"),
     (["limits", *L, "--set", "T=-1"], "T must be"),
     (["limits", *L, "--set", "T=0"], "T must be"),
-    (["limits", *L, "--set", "m=0"], "not defined"),
+    # The file bounds m above 0 (a zero mass made the plant's transfer function undefined).
+    (["limits", *L, "--set", "m=0"], "m must be a finite real number > 0"),
     # Was "Array must not contain infs or NaNs" from the eigenvalues, after the work began.
     (["classify", *L, "--set", "T=1e300"], "overflows or underflows at"),
     # linspace of -1e308..1e308 is NaN: the grid, not K, is what is wrong.
@@ -411,3 +412,48 @@ def test_limits_says_why_a_stable_set_is_empty(capsys):
     note = next(line for line in out.splitlines()
                 if line.startswith("the stable set of the (B, K) plane is empty"))
     assert "necessary condition" in note and "no point is stable" in note
+
+
+# --------------------------------------------------------------------------
+# A plant that is not a physical device's (issue 40 item 8)
+
+
+@pytest.mark.parametrize("command", ["classify", "limits"])
+def test_a_negative_mass_is_refused_by_the_example_files_bounds(capsys, command):
+    """m = -0.2 gave exit 0, K_max -4.5e-67 and a stable area of 70506; paper.toml bounds m above 0."""
+    status, out, err = run(capsys, command, "--loop", PAPER, "--set", "m=-0.2")
+    assert status == 2 and out == "" and err.count("\n") == 1, err
+    assert err.startswith(f"symstab {command}: error: --set m=...: m must be a finite real "
+                          f"number > 0, got -0.2 kg m^2")
+
+
+def test_every_example_file_bounds_its_physical_parameters():
+    """m, b and the operator's, the lag's and the two masses' parameters: min or above 0."""
+    physical = {"m", "b", "m_h", "b_h", "k_h", "tau", "m1", "m2", "b1", "k_t", "c_t"}
+    for path in sorted((REPO / "examples" / "loops").glob("*.toml")):
+        loop = symstab.load_loop(path)
+        bounded = {b.name for b in loop.file_parameters.bounds if b.kind in ("min", "above")
+                   and not b.expression.free_symbols and float(b.expression) == 0}
+        assert physical & set(loop.parameters) <= bounded, path.name
+
+
+@pytest.mark.parametrize("command", ["classify", "limits"])
+def test_a_non_physical_plant_without_bounds_is_one_warning_line(capsys, tmp_path, command):
+    """Without the bound the loop is analysed as given, with one line naming the values.
+
+    The oracle: python-control's poles of 1/(m s^2 + b s) at m = -0.2 hold one at
+    b/0.2 = 0.162 > 0."""
+    control = pytest.importorskip("control")
+    poles = control.tf([1.0], [-0.2, 0.0324, 0.0]).poles()
+    assert max(poles.real) == pytest.approx(0.162, rel=1e-12)
+    path = tmp_path / "unbounded.toml"
+    path.write_text(open(PAPER, encoding="utf-8").read().replace(", above = 0", "")
+                    .replace(", min = 0", ""), encoding="utf-8")
+    status, out, err = run(capsys, command, "--loop", path, "--set", "m=-0.2")
+    assert status == 0 and out
+    assert err.count("\n") == 1, err
+    assert err.startswith(f"symstab {command}: warning: the plant G(s) = 1/(b*s + m*s**2) at "
+                          f"b = 0.0324, m = -0.2 has a pole in the open right half plane "
+                          f"(s = 0.162) and a negative high-frequency gain")
+    status, out, err = run(capsys, command, "--loop", path)
+    assert status == 0 and err == ""

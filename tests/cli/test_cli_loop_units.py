@@ -6,6 +6,7 @@ SI.  Every test here failed before the conversion (the unit was a label,
 have, ``--linear`` was refused without saying why).
 """
 
+import math
 import re
 
 import pytest
@@ -178,3 +179,33 @@ def test_the_paper_loop_file_and_the_device_options_label_the_same_quantities_al
         assert ours == pytest.approx(float(found.group(1)), rel=1e-6, abs=1e-9)
     assert "plane: x = B [N m s/rad], y = K [N m/rad]" in loop
     assert "m = 0.0128 kg m^2" in loop and "m = 0.0128 kg m^2" in paper
+
+
+@pytest.mark.parametrize("unit", ["N m/deg^2", "N m/rad^2", "N m rad", "N mm/arcmin^2"])
+def test_set_with_an_angle_to_another_power_is_refused(capsys, unit):
+    """issue 40 item 7: pint takes an angle as a number; K=2 N m/deg^2 was used as 6565.6 N m/rad."""
+    status, out, err = run(capsys, "classify", "--loop", PAPER, "--set", f"K=2 {unit}")
+    assert status == 2 and out == "" and err.count("\n") == 1, err
+    assert err.startswith(f"symstab classify: error: --set K: parameter 'K' has unit {unit!r}")
+    assert "K is in N m/rad (an angle to the power -1)" in err
+
+
+@pytest.mark.parametrize("unit, factor", [("N m/deg", 180 / math.pi), ("kN m/deg", 18e4 / math.pi),
+                                          ("N m/turn", 1 / (2 * math.pi)), ("N m", 1.0)])
+def test_set_with_an_angle_to_the_parameters_power_is_converted(capsys, unit, factor):
+    """2 N m/deg is 2*180/pi N m/rad, by hand; a unit without an angle is SI's reading (rad = 1)."""
+    out = run_json(capsys, "classify", "--loop", PAPER, "--set", f"K=2 {unit}")
+    assert out["inputs"]["values"]["K"] == pytest.approx(2 * factor, rel=1e-15)
+    assert out["inputs"]["units"]["K"] == "N m/rad"
+
+
+@pytest.mark.parametrize("setting, shown", [
+    ("d=5.1 ms", "'5.1 ms'"), ("d=5.1", "'5.1'"), ("d=-1 samples", "'-1 samples'"),
+    ("K=1e999 N m/rad", "'1e999 N m/rad'"),
+])
+def test_a_refused_set_value_is_shown_as_written(capsys, setting, shown):
+    """issue 40 item 16: --set "d=5.1 ms" said 'got 5.1', dropping the unit."""
+    status, out, err = run(capsys, "classify", "--loop", PAPER, "--set", setting)
+    assert status == 2 and out == "" and err.count("\n") == 1, err
+    assert err.startswith(f"symstab classify: error: --set {setting}: ") and err.endswith(
+        f", got {shown}\n"), err

@@ -7,6 +7,7 @@ polynomial classification, the kernel cache, and the refusals.
 """
 
 import os
+import warnings
 
 import mpmath
 import numpy as np
@@ -147,6 +148,58 @@ def test_a_quadratic_factor_by_residues(k_h):
     for K, B, d in ((300.0, 0.5, 0), (2000.0, 2.0, 2), (50.0, 0.1, 10)):
         oracle = _python_control_radius([PAPER_M + 0.05, PAPER_B + 1.0, k_h], K, B, d)
         assert loop.spectral_radius(K=K, B=B, d=d, **values) == pytest.approx(oracle, rel=1e-8)
+
+
+@pytest.mark.parametrize("plant, den", [
+    ("1/(m*s**2 + 0.25*b*s)", [PAPER_M, 0.25 * PAPER_B, 0]),
+    ("1/((0.5*tau*s + 1)*(m*s**2 + b*s))", np.polymul([0.5 * 0.01, 1], [PAPER_M, PAPER_B, 0])),
+    ("1/(m*s**2 + 0.1*b*s)", [PAPER_M, 0.1 * PAPER_B, 0]),
+])
+def test_a_decimal_in_the_plant_is_its_exact_rational(plant, den):
+    """issue 40 item 13: a decimal in the denominator crashed SymPy's factoring (PolyElement * PolyElement)."""
+    loop = Loop(plant, "K + B*(z - 1)/(T*z)")
+    decimals = {str(c) for c in loop.plant.atoms(sp.Rational) if not c.is_Integer}
+    assert decimals <= {"1/4", "1/2", "1/10"} and decimals and not loop.plant.atoms(sp.Float)
+    values = dict(m=PAPER_M, b=PAPER_B, T=PAPER_T, tau=0.01)
+    values = {k: v for k, v in values.items() if k in loop.parameters}
+    for K, B, d in ((300.0, 0.5, 0), (50.0, 0.1, 3)):
+        oracle = _python_control_radius(list(den), K, B, d)
+        assert loop.spectral_radius(K=K, B=B, d=d, **values) == pytest.approx(oracle, rel=1e-8)
+
+
+@pytest.mark.parametrize("plant, values, rhp, negative", [
+    ("1/(m*s**2 + b*s)", dict(m=-0.2, b=PAPER_B), True, True),        # issue 40 item 8
+    ("1/(m*s**2 + b*s)", dict(m=PAPER_M, b=-0.5), True, False),       # negative friction
+    ("1/((m + m_h)*s**2 + (b + b_h)*s + k_h)", dict(m=PAPER_M, m_h=0.05, b=PAPER_B, b_h=-1.0,
+                                                    k_h=100.0), True, False),  # a growing pair
+    ("-1/(m*s**2 + b*s)", dict(m=PAPER_M, b=PAPER_B), False, True),   # positive feedback
+])
+def test_a_plant_that_is_not_a_physical_devices_warns_naming_its_values(plant, values, rhp,
+                                                                        negative):
+    """Poles and gain against python-control: a warning exactly when one is in the open RHP
+    or the high-frequency gain is negative, naming the plant's values; none for the device."""
+    from symstab import NonPhysicalPlantWarning
+
+    loop = Loop(plant, "K + B*(z - 1)/(T*z)")
+    s = sp.Symbol("s")
+    num, den = sp.fraction(sp.together(sp.sympify(plant, locals={"s": s}).subs(values)))
+    G = control.tf([float(c) for c in sp.Poly(num, s).all_coeffs()],
+                   [float(c) for c in sp.Poly(den, s).all_coeffs()])
+    assert (max(G.poles().real) > 1e-9) == rhp
+    assert (G.num[0][0][0] * G.den[0][0][0] < 0) == negative
+    given = ", ".join(f"{n} = {values[n]:g}" for n in sorted(values))
+    with pytest.warns(NonPhysicalPlantWarning) as record:
+        loop.classify(K=1.0, B=0.1, T=PAPER_T, d=1, **values)
+    (warning,) = record
+    text = str(warning.message)
+    assert f"at {given} has " in text and "\n" not in text
+    assert ("open right half plane" in text) == rhp
+    assert ("negative high-frequency gain" in text) == negative
+    physical = {**values, **{k: abs(v) for k, v in values.items()}}
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", NonPhysicalPlantWarning)
+        Loop(plant.lstrip("-"), "K + B*(z - 1)/(T*z)").classify(K=1.0, B=0.1, T=PAPER_T, d=1,
+                                                                 **physical)
 
 
 @pytest.mark.parametrize("name", ["e", "exp"])

@@ -338,3 +338,19 @@ def test_the_python_loop_keeps_si_units():
     loop = Loop("1/(m*s**2 + b*s)", "K + B*(z - 1)/(T*z)", values=dict(T=1e-3),
                 units={"K": "N/m", "T": "s", "m": "kg"})
     assert loop.units == {"K": "N/m", "T": "s", "m": "kg"}
+
+
+@pytest.mark.parametrize("unit", ["N m/deg^2", "N m/rad^2", "N m rad"])
+def test_a_files_unit_with_an_angle_to_another_power_is_refused(unit):
+    """issue 40 item 7: a rotary stiffness is N m/rad; pint would take N m/deg^2 as (180/pi)^2 N m/rad."""
+    text = _replace((EXAMPLES / "paper.toml").read_text(encoding="utf-8"),
+                    'K = { value = 2.0, unit = "N m/rad"', f'K = {{ value = 2.0, unit = "{unit}"')
+    with pytest.raises(ValueError, match=rf"parameter 'K' has unit {re.escape(repr(unit))}, whose "
+                                         rf"angle is to the power .*K is in N m/rad"):
+        parse_loop_text(text)
+
+
+def test_a_files_unit_per_degree_is_converted_by_hand():
+    text = _replace((EXAMPLES / "paper.toml").read_text(encoding="utf-8"),
+                    'K = { value = 2.0, unit = "N m/rad"', 'K = { value = 2.0, unit = "N m/deg"')
+    assert parse_loop_text(text).defaults["K"] == pytest.approx(2 * 180 / math.pi, rel=1e-15)

@@ -643,3 +643,87 @@ def test_the_c_step_of_every_example_loop_compiles_strictly_and_runs_as_numpy(fi
     expected = np.asarray(run.positions)
     scale = np.maximum(np.abs(expected), 1e-300)
     assert np.all(np.abs(np.array(positions) - expected) <= 1e-12 * np.maximum(scale, 1e-6 * x0))
+
+
+# --------------------------------------------------------------------------
+# Parameter names that C's headers or keywords own (issue 40 item 3)
+
+
+#: Every parameter is named as something of <math.h>, <complex.h> or a C
+#: keyword: HUGE_VAL and INFINITY compiled as macros (and read garbage), NAN,
+#: M_PI, pow and exp did not compile.  The plant's poles are a complex pair
+#: (its kernel runs in <complex.h> arithmetic, where I and complex are macros);
+#: the environment calls exp() and pow() and prints pi as M_PI.
+C_NAMES_LOOP = """\
+name = "c_names"
+plant = "1/(I*s**2 + complex*s + y0)"
+environment = "HUGE_VAL*bool + NAN*exp(-pi*INFINITY*T)*(z - 1)/(T*z) + M_PI*pow*exp*arg_exp*(z - 1)**2/(T**2*z**2)"
+
+[parameters]
+I = 0.0628
+complex = 1.03
+y0 = 100.0
+HUGE_VAL = 300.0
+NAN = 0.5
+INFINITY = 50.0
+M_PI = 0.001
+pow = 2.0
+exp = 0.1
+bool = 3.0
+arg_exp = 0.7
+T = 1e-3
+d = 1
+"""
+
+
+def test_parameters_named_as_c_macros_functions_and_keywords_compile_and_compute(tmp_path):
+    """Each such name is ``arg_<name>`` in C (``arg_arg_exp`` where ``arg_exp`` is taken),
+    said in the kernel's comment; the C kernels equal the NumPy module and SymPy's own
+    evaluation of the derived expressions (30 digits), and the plant's python-control's c2d."""
+    control = pytest.importorskip("control")
+    path = tmp_path / "c_names.toml"
+    path.write_text(C_NAMES_LOOP, encoding="utf-8")
+    folder = tmp_path / "out"
+    status, _, err = run_cli("derive", "--loop", str(path), "--out", str(folder))
+    assert status == 0, err
+    header = (folder / "c_names_kernels.h").read_text(encoding="utf-8")
+    for name in ("HUGE_VAL", "NAN", "INFINITY", "M_PI", "pow", "bool", "I", "complex", "y0"):
+        assert f" * arg_{name}: parameter {name} (the argument {name}, renamed in C" in header
+    assert " * arg_arg_exp: parameter exp (the argument exp, renamed in C" in header
+    assert " * arg_exp: parameter arg_exp\n" in header
+    c = _compile(folder, tmp_path)
+    numpy_module = _numpy_module(folder)
+    loop = load_loop(path)
+    rng = np.random.default_rng(3)
+    kernels = loop.kernels() + [loop_derive.plant_kernel(loop)]
+    assert kernels[-1].complex_arithmetic
+    for kernel in kernels:
+        names = [str(symbol) for symbol, _, _ in kernel.args]
+        for _ in range(3):
+            args = [loop.defaults[n] * rng.uniform(0.5, 2.0) for n in names]
+            got = c[f"symstab_c_names_{kernel.name}"](*args)
+            sub = {symbol: sp.Float(repr(a), 30) for (symbol, _, _), a in zip(kernel.args, args)}
+            exact = np.array([float(sp.re(sp.sympify(expr).replace(
+                lambda e: isinstance(e, sp.Function) and type(e).__name__ == "RealPart",
+                lambda e: e.args[0]).xreplace(sub).evalf(30))) for _, expr, _ in kernel.outputs])
+            np.testing.assert_allclose(got, exact, rtol=1e-9, atol=1e-12, err_msg=kernel.name)
+            if kernel.name == "pulse_transfer_function":
+                value = dict(zip(names, args))
+                sampled = control.c2d(control.tf([1.0], [value["I"], value["complex"],
+                                                         value["y0"]]), value["T"], "zoh")
+                ref_num, ref_den = (np.trim_zeros(np.asarray(x[0][0], dtype=float), "f")
+                                    for x in (sampled.num, sampled.den))
+                np.testing.assert_allclose(got, np.concatenate([ref_num, ref_den]) / ref_den[0],
+                                           rtol=1e-7)
+            else:
+                expected = np.array(getattr(numpy_module, kernel.name)(*args), dtype=float)
+                np.testing.assert_allclose(got, np.broadcast_to(expected, got.shape),
+                                           rtol=1e-14, atol=1e-300, err_msg=kernel.name)
+
+
+@pytest.mark.parametrize("name", ["int", "double", "_Reserved", "__x", "numpy", "x0"])
+def test_a_parameter_named_as_a_keyword_or_reserved_is_refused(name):
+    """What C cannot rename (a keyword of C and Python, a leading _) is refused, naming it."""
+    text = C_NAMES_LOOP.replace("bool", name)
+    with pytest.raises(ValueError, match=re.escape(repr(name))):
+        parse_loop_text(text)
