@@ -75,8 +75,12 @@ def test_a_signal_at_any_moment_ends_the_command_with_one_line(tmp_path):
         results = list(pool.map(_interrupt, folders, *zip(*runs)))
     failures = []
     for (signum, moment), folder, (status, err, seconds) in zip(runs, folders, results):
-        expected = 128 + signum
-        if (status, err.strip()) != (expected, "symstab map: interrupted") or seconds > 5:
+        # After the one line and the cleanup, CPython itself sometimes ends
+        # the process with kill(getpid(), SIGINT) (strace shows it; about 1
+        # run in 25 under load): a shell reports that as 130 too, and it is
+        # how a program tells its shell that Ctrl-C stopped it.
+        expected = {128 + signum} | ({-signal.SIGINT} if signum == signal.SIGINT else set())
+        if status not in expected or err.strip() != "symstab map: interrupted" or seconds > 5:
             failures.append(f"{signum.name} at {moment:.2f} s: exit {status} after {seconds:.1f} s, "
                             f"stderr {err[-300:]!r}")
         if os.listdir(folder):
