@@ -96,7 +96,9 @@ def _unraisable(args, *, previous):
         _state.pending = signum
     # Not from here: the hook runs inside the callback that swallowed the
     # exception, and would swallow the next one too.
-    threading.Timer(REDELIVER_SECONDS, _redeliver, args=(threading.main_thread().ident,)).start()
+    timer = threading.Timer(REDELIVER_SECONDS, _redeliver, args=(threading.main_thread().ident,))
+    timer.daemon = True   # an exit does not wait for it
+    timer.start()
 
 
 def _redeliver(main):
