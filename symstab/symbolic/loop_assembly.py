@@ -1111,13 +1111,20 @@ class LoopModel:
         digits = PLANT_DIGITS
         with mpmath.workdps(PLANT_DIGITS):
             point = [mpmath.mpf(float(v)) for v in plant_values]
-            if self._plant_parts is not None:
+            if self._plant_parts is None:
+                sub = {self._symbols[n]: sp.Float(float(v), PLANT_DIGITS)
+                       for n, v in zip(self._plant_names, plant_values)}
+                num, den = sp.fraction(sp.together(self.plant.subs(sub)))
+                num = [mpmath.mpf(sp.Float(c, PLANT_DIGITS)) for c in sp.Poly(num, model.s).all_coeffs()]
+                den = [mpmath.mpf(sp.Float(c, PLANT_DIGITS)) for c in sp.Poly(den, model.s).all_coeffs()]
+                p_n, p_d = numeric_zoh(num, den, mpmath.mpf(float(T)), dps=PLANT_DIGITS)
+            else:
                 p_n, p_d, digits = self._closed_form_plant(point, mpmath.mpf(float(T)))
-            if self._plant_parts is None or not _defined(p_n, p_d):
-                # No closed form, or one that divides by a parameter at 0
-                # (b = 0 in 1/(m s**2 + b s)): the realisation is its limit.
-                digits = PLANT_DIGITS
-                p_n, p_d = self._realised_plant(plant_values, T)
+                if not _defined(p_n, p_d):
+                    # The closed form divides by a parameter at 0 (b = 0 in
+                    # 1/(m s**2 + b s)) or poles meet: the realisation is its limit.
+                    digits = PLANT_DIGITS
+                    p_n, p_d = self._realised_plant(plant_values, T)
         with mpmath.workdps(digits):
             if not _defined(p_n, p_d):
                 if self._plant_parts is not None:
@@ -1129,22 +1136,34 @@ class LoopModel:
         return p_n, p_d, digits
 
     def _realised_plant(self, plant_values, T):
-        """P_n, P_d of the plant at ``plant_values`` by :func:`numeric_zoh` (its realisation)."""
-        with mpmath.workdps(PLANT_DIGITS):
-            sub = {self._symbols[n]: sp.Float(float(v), PLANT_DIGITS)
-                   for n, v in zip(self._plant_names, plant_values)}
-            num, den = sp.fraction(sp.together(self.plant.subs(sub)))
-            num = [mpmath.mpf(sp.Float(c, PLANT_DIGITS)) for c in sp.Poly(num, model.s).all_coeffs()]
-            den = [mpmath.mpf(sp.Float(c, PLANT_DIGITS)) for c in sp.Poly(den, model.s).all_coeffs()]
-            if len(den) != self._plant_order + 1 or den[0] == 0:
-                # The order drops (m = 0): another loop, not this one's limit.
-                return [mpmath.nan], [mpmath.mpf(0)]
-            return numeric_zoh(num, den, mpmath.mpf(float(T)), dps=PLANT_DIGITS)
+        """P_n, P_d of the plant at ``plant_values`` by :func:`numeric_zoh` (its realisation).
 
-    @functools.cached_property
-    def _plant_order(self):
-        """The plant's order: the degree in ``s`` of its denominator as the symbols write it."""
-        return sp.Poly(sp.fraction(sp.cancel(sp.together(self.plant)))[1], model.s).degree()
+        From the plant as SymPy cancels it (:attr:`_plant_fraction`, the
+        form the closed form is derived from), so a factor written on both
+        sides changes nothing.  Where the closed form exists, ``P_n`` has
+        its length (the realisation pads it with a leading zero).  The
+        marker of an undefined plant where the order drops (``m = 0``):
+        another plant, not this one's limit.
+        """
+        undefined = [mpmath.nan], [mpmath.mpf(0)]
+        with mpmath.workdps(PLANT_DIGITS):
+            num, den = self._plant_fraction(*(mpmath.mpf(float(v)) for v in plant_values),
+                                            mpmath.mpf(float(T)))
+            num, den = ([mpmath.mpmathify(c) for c in part] for part in (num, den))
+            if not den or den[0] == 0 or not all(mpmath.isfinite(c) for c in num + den):
+                return undefined
+            while len(num) > 1 and num[0] == 0:
+                num.pop(0)
+            p_n, p_d = numeric_zoh(num, den, mpmath.mpf(float(T)), dps=PLANT_DIGITS)
+            if self._plant_parts is not None:
+                length = len(self._plant_parts[0])
+                scale = max(abs(c) for c in p_n)
+                while len(p_n) > length and abs(p_n[0]) <= mpmath.mpf(10) ** -PLANT_DIGITS * scale:
+                    p_n = p_n[1:]
+                p_n = [mpmath.mpf(0)] * (length - len(p_n)) + list(p_n)
+                if len(p_n) != length or len(p_d) != len(self._plant_parts[1]):
+                    return undefined
+            return list(p_n), list(p_d)
 
     def _exact_plant(self, plant_values, T):
         """``(P_n, P_d)`` with monic ``P_d``, as exact Fractions of their 30-digit values.

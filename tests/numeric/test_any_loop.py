@@ -117,6 +117,23 @@ def test_a_parameter_at_zero_that_the_closed_form_divides_by_is_its_limit():
     assert robust.area > 0
 
 
+def test_a_grid_through_the_limit_and_a_plant_written_with_a_common_factor():
+    """From a review: a grid over b through 0 mixed the realisation's padded P_n with the
+    closed form's (a ragged array), and the limit was taken of the plant as written, so
+    (s + 10)/(s + 10) let m = 0 through as another plant and refused b = 0."""
+    G = control.sample_system(control.tf([1], [PAPER_M, 0, 0]), PAPER_T, "zoh")
+    zz = control.tf([1, 0], [1], PAPER_T)
+    VE = 30.0 + 0.4 * (zz - 1) / (PAPER_T * zz)
+    oracle = max(abs(control.feedback(G, VE * control.tf([1], [1, 0, 0, 0], PAPER_T)).poles()))
+    for plant in ("1/(m*s**2 + b*s)", "(s + 10)/(m*s**3 + (b + 10*m)*s**2 + 10*b*s)"):
+        loop = Loop(plant, ENVIRONMENT)
+        radii = loop.spectral_radius(K=30.0, B=0.4, M=0.0, b=np.array([0.0, 0.0324]),
+                                     m=PAPER_M, T=PAPER_T, d=3)
+        assert radii[0] == pytest.approx(oracle, rel=1e-7), plant
+        with pytest.raises(ValueError, match="order drops"):
+            loop.spectral_radius(K=30.0, B=0.4, M=0.0, b=0.0324, m=0.0, T=PAPER_T, d=3)
+
+
 def test_numeric_zoh_matches_python_control():
     """The matrix-exponential path against scipy's (through python-control)."""
     num, den, T = [2.0, 3.0, 50.0], [0.01, 0.3, 40.0, 100.0, 0.0], 1e-3
