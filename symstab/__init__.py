@@ -106,10 +106,6 @@ def __getattr__(name):
         globals()[name] = value
         return value
     if name in _SUBMODULES:
-        # As before the names were lazy: ``symstab.numeric.stability`` after
-        # ``import symstab`` finds every module the public names come from.
-        for module in _HOMES:
-            importlib.import_module(f"{__name__}.{module}")
         return importlib.import_module(f"{__name__}.{name}")
     raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
 

@@ -30,7 +30,7 @@ import threading
 
 __all__ = ["Terminated", "raising", "deferred", "exit_status", "REDELIVER_SECONDS"]
 
-#: How often an interruption is delivered again until it has left the block.
+#: How long after Python swallowed an interruption's exception the signal is delivered again.
 REDELIVER_SECONDS = 0.1
 
 _SIGNALS = (signal.SIGINT, signal.SIGTERM)
@@ -135,37 +135,45 @@ def raising():
     if threading.current_thread() is not threading.main_thread() or _state.depth:
         yield
         return
-    previous = {sig: signal.signal(sig, _handler) for sig in _SIGNALS}
-    previous_hook = sys.unraisablehook
-    sys.unraisablehook = functools.partial(_unraisable, previous=previous_hook)
-    _state.depth += 1
+    # Setting up and tearing down are held against a signal: one landing
+    # there would leave the handlers (or the hook) installed for good.  A
+    # signal held during the set-up arrives when it ends, inside the try.
+    previous, previous_hook = {}, sys.unraisablehook
     try:
+        with deferred():
+            _state.depth += 1
+            sys.unraisablehook = functools.partial(_unraisable, previous=previous_hook)
+            previous = {sig: signal.signal(sig, _handler) for sig in _SIGNALS}
         yield
         with _state.lock:
             swallowed, _state.pending = _state.pending, None
         if swallowed is not None:  # the block ended before the signal was delivered again
             raise _exception(swallowed)
     finally:
-        with _state.lock:
-            _state.pending = None   # a re-delivery still to come does nothing
-        _state.depth -= 1
-        sys.unraisablehook = previous_hook
-        for sig, handler in previous.items():
-            signal.signal(sig, handler)
-
+        with deferred():
+            with _state.lock:
+                _state.pending = None   # a re-delivery still to come does nothing
+            for sig, handler in previous.items():
+                # None: a handler not set from Python, which cannot be put back from it.
+                if handler is not None:
+                    signal.signal(sig, handler)
+            sys.unraisablehook = previous_hook
+            _state.depth -= 1
 
 @contextlib.contextmanager
 def deferred():
-    """Hold SIGINT and SIGTERM back until the block is done (it must not be cut in two).
+    """Hold SIGINT and SIGTERM back from the main thread until the block is done.
 
-    Only in the main thread; elsewhere the block runs with the signals as they are.
+    Only the main thread's mask: a signal sent to the process while another
+    thread (NumPy's BLAS, Dask) has it unblocked still trips Python's flag,
+    and the handler runs at the main thread's next bytecode.  Outside the
+    main thread the block runs with the signals as they are.
     """
     if threading.current_thread() is not threading.main_thread():
         yield
         return
-    held = set(_SIGNALS)
-    signal.pthread_sigmask(signal.SIG_BLOCK, held)
+    before = signal.pthread_sigmask(signal.SIG_BLOCK, set(_SIGNALS))
     try:
         yield
     finally:
-        signal.pthread_sigmask(signal.SIG_UNBLOCK, held)
+        signal.pthread_sigmask(signal.SIG_SETMASK, before)

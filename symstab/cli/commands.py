@@ -1,7 +1,7 @@
 """The ``symstab`` command line: the parser built from the command modules, and ``main``.
 
 Each command is a module of this package with ``register(subparsers)`` and
-``run(args)`` (:data:`COMMANDS`, in the order of ``symstab --help``); the
+``run(args)`` (:data:`COMMAND_NAMES`, in the order of ``symstab --help``); the
 options, units and output they share are in :mod:`symstab.cli.options`,
 :mod:`symstab.cli.loop_options`, :mod:`symstab.cli.units` and
 :mod:`symstab.cli.output`.  A command module imports shared modules only,

@@ -26,3 +26,16 @@ def test_first_release_call_runs_from_the_top_level():
     assert found.stable.shape == (1, 1) and bool(found.stable[0, 0])
     run = symstab.simulate(alpha=0.0, beta=0.0, gamma=0.0, d=0, delta=0.1, steps=8)
     assert isinstance(run, symstab.Simulation) and np.shape(run.stable) == ()
+
+
+def test_modules_are_attributes_whatever_was_used_first():
+    """From a review: with the names loaded on first use, ``symstab.numeric.stability`` failed
+    after ``symstab.Device`` (which imports ``symstab.numeric`` but not its other modules)."""
+    import subprocess
+    import sys
+
+    code = ("import symstab; symstab.Device; "
+            "print(symstab.numeric.stability.unstable_root_counts.__name__, "
+            "symstab.symbolic.boundary.boundary.__name__, hasattr(symstab.numeric, 'nothing'))")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)
+    assert out.stdout.split() == ["unstable_root_counts", "boundary", "False"], out.stderr
