@@ -60,7 +60,7 @@ import time
 
 import numpy as np
 
-from symstab.numeric.units import PAPER_DEVICE
+from symstab.numeric.paper.device import PAPER_DEVICE
 
 REPO = pathlib.Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(REPO / "benchmarks"))
@@ -270,7 +270,7 @@ def bench_classify(args, oracles):
     import control
 
     import symstab
-    from symstab.numeric.stability import MARGINAL, STABLE
+    from symstab.numeric.engine.roots import MARGINAL, STABLE
 
     loop = _paper_loop()
     m, b, T = M_DEV, B_DEV, T_DEV

@@ -4,13 +4,13 @@
 
 Every row is one run on the same machine state, medians of ``--runs``:
 
-1. Certified root counts (:func:`symstab.numeric.roots.root_counts`) of the
+1. Certified root counts (:func:`symstab.numeric.engine.roots.root_counts`) of the
    paper's loop at d = 10, 100, 1000 for ``--points`` random (K, B) points:
    the loop of ``examples/loops/paper.toml`` (the Loop path of a user's
    loop: plant at 30 digits, environment kernel, structured chi; the same
    loop as ``symstab.PAPER_LOOP``, which counts the roots of eq. (5)'s
    closed form instead) against the dimensionless
-   path (``symstab.numeric.stability.unstable_root_counts``: generated
+   path (``symstab.numeric.paper.stability.unstable_root_counts``: generated
    kernel, structured chi), and against the obvious alternative, the same
    counter on the dense coefficients (O(d) per angle: O(d**2) per point,
    what Loop did before the structured polynomial).
@@ -43,8 +43,9 @@ import statistics
 import numpy as np
 
 import symstab
-from symstab.numeric import roots, stability
-from symstab.numeric.polynomial import DelayedPolynomial
+from symstab.numeric.engine import roots
+from symstab.numeric.paper import stability
+from symstab.numeric.engine.polynomial import DelayedPolynomial
 
 from _timing import fmt, timed_runs
 

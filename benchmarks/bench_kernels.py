@@ -13,7 +13,7 @@ runs after one warm-up, timed with ``time.perf_counter``.
    c2d included, then ``.poles()``; and the same with ``Gd = c2d(G)`` built
    once and ``feedback(VE z^-d Gd, 1)``), against ``symstab.spectral_radius``
    (batched eigenvalues) and against a ``numpy.roots`` loop on the
-   coefficients of ``symstab.numeric.stability.loop_coefficients``.  python-control
+   coefficients of ``symstab.numeric.paper.stability.loop_coefficients``.  python-control
    is timed per point on a random subset of the grid (``--pc-points``); its
    median per point is extrapolated to the 10^4 points, and its verdicts are
    checked against ``classify`` on the subset.  Ratio = alternative per point
@@ -47,7 +47,7 @@ import time
 
 import numpy as np
 
-from symstab.numeric.units import PAPER_DEVICE
+from symstab.numeric.paper.device import PAPER_DEVICE
 
 REPO = pathlib.Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(REPO / "benchmarks"))
@@ -89,7 +89,8 @@ def bench_grid(args, oracles):
     import control
 
     import symstab
-    from symstab.numeric.stability import MARGINAL, STABLE, UNSTABLE, loop_coefficients
+    from symstab.numeric.engine.roots import MARGINAL, STABLE, UNSTABLE
+    from symstab.numeric.paper.stability import loop_coefficients
 
     A, B = np.meshgrid(np.linspace(*ALPHA_WINDOW, N_GRID), np.linspace(*BETA_WINDOW, N_GRID))
     n_points = A.size

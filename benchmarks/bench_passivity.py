@@ -3,7 +3,7 @@
     python benchmarks/bench_passivity.py [--runs 3] [--delays 10,100,1000]
 
 Colgate and Schenkel's condition of a plane is ``a0 + x ax + y ay <= 0``
-at every angle; :mod:`symstab.numeric.passivity` evaluates each term as a
+at every angle; :mod:`symstab.numeric.analysis.passivity` evaluates each term as a
 short sum of Dirichlet kernels in closed form (``len(N) + len(D) - 1``
 sines per angle, whatever the delay).  The obvious alternative, what the
 module did before, expands the same sum into a cosine series of ``d + 3``
@@ -25,8 +25,8 @@ import statistics
 import mpmath
 import numpy as np
 
-from symstab.numeric import passivity
-from symstab.numeric.paper_loop import paper_point
+from symstab.numeric.analysis import passivity
+from symstab.numeric.paper.paper_loop import paper_point
 
 from _timing import fmt, timed_runs
 

@@ -5,7 +5,7 @@
 The paper's loop (examples/loops/paper.toml) at d = 10 with b uncertain by
 +-50 % (and, second, m by +-10 % too).  The certified region
 (``Loop.region(..., uncertain=box)``: zero exclusion over the box and theta,
-:mod:`symstab.numeric.robust`) against the intersection of the stable
+:mod:`symstab.numeric.analysis.robust`) against the intersection of the stable
 intervals at ``samples`` values of the box on the same strips' edges (the
 line engine at each value: what a user would do by hand, and not a
 guarantee between the values).  Prints the medians, their ratio, the areas

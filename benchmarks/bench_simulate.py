@@ -2,7 +2,7 @@
 
     python benchmarks/bench_simulate.py [--runs 5] [--dlsim-points 40]
 
-1. symstab.numeric.simulate.simulate on a 100 x 100 (alpha, beta) grid at d = 10 on
+1. symstab.numeric.paper.simulate.simulate on a 100 x 100 (alpha, beta) grid at d = 10 on
    the paper's device, ideal loop, 8000 periods: point-steps per second
    (median of ``--runs``).
 2. The obvious alternative, side by side in the same run: for each point of
@@ -32,8 +32,9 @@ import numpy as np
 import scipy.signal
 
 import symstab
-from symstab.numeric.simulate import Nonidealities, simulate
-from symstab.numeric.stability import loop_coefficients
+from symstab.numeric.paper.simulate import simulate
+from symstab.numeric.simulation.simulator import Nonidealities
+from symstab.numeric.paper.stability import loop_coefficients
 
 
 def _companion(coeffs):
@@ -101,7 +102,7 @@ def main():
         start = time.perf_counter()
         loop.simulate(K=K, B=Bw, d=d, M=0.0, steps=args.steps, nonideal=quantum)
         quantum_times.append(time.perf_counter() - start)
-    print(f"  symstab.numeric.simulate (all points at once)   {ours:10.3g} point-steps/s "
+    print(f"  symstab.numeric.paper.simulate (all points at once)   {ours:10.3g} point-steps/s "
           f"(median {statistics.median(times):.2f} s per run)")
     print(f"  scipy.signal.dlsim per point            {theirs:10.3g} point-steps/s "
           f"(median over {args.dlsim_points} points)")

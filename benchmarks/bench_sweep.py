@@ -21,7 +21,7 @@ import numpy as np
 
 import symstab
 from symstab.cli.sweep import local_cluster
-from symstab.numeric.sweep import ChunkStore, Question, run_sweep
+from symstab.cli.sweep_store import ChunkStore, Question, run_sweep
 
 from _timing import fmt
 

@@ -4,7 +4,7 @@
 
 The box is gamma in [-1, 3], d in 0..200, delta in [1e-6, 1].  The reference
 at every point is the certified enclosure
-(:func:`symstab.numeric.theta_bounds.theta_max_enclosure`, relative width
+(:func:`symstab.numeric.paper.theta_bounds.theta_max_enclosure`, relative width
 about 4e-16, proved by interval arithmetic; the 30-digit scan
 :func:`symstab.theta_max` is timed beside it on a few points; since the
 scan proves every cell before the first root root-free, it no longer steps
@@ -18,7 +18,7 @@ Forms compared, each on the same points:
 * the paper's eq. (12): one Newton step on N_alpha from pi / (2 (d + 1)),
   printed for gamma = 0 only, so measured on the gamma = 0 points;
 * the same step with the gamma terms of N_alpha kept, on every point;
-* :func:`symstab.numeric.theta_bounds.theta_max_approx` (8 Newton steps on
+* :func:`symstab.numeric.paper.theta_bounds.theta_max_approx` (8 Newton steps on
   the phase form of the reduced equation from a start derived from the
   model; no fitted constant).
 
@@ -36,7 +36,7 @@ import mpmath
 import numpy as np
 import sympy as sp
 
-from symstab.numeric.theta_bounds import theta_max_approx, theta_max_enclosure
+from symstab.numeric.paper.theta_bounds import theta_max_approx, theta_max_enclosure
 from symstab.symbolic import model
 from symstab.symbolic.boundary import boundary
 from symstab.symbolic.theta_max import theta_max, theta_max_newton

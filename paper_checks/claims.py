@@ -3,7 +3,7 @@
 Numbers are compared at the paper's own precision: a value is reproduced
 when the derived number, rounded to the digits the paper prints, equals the
 printed number.  Stability of a region is decided by counting characteristic
-roots outside the unit circle (:mod:`symstab.numeric.region`, through
+roots outside the unit circle (:mod:`symstab.numeric.paper.region`, through
 :mod:`paper_checks.regions`), not by the "right-sided / left-sided" shape of a
 curve, and so are the stable intervals along a line, whose ends are exact
 where they are known (alpha = 0 on the z = 1 line).  The device is
@@ -13,10 +13,10 @@ where they are known (alpha = 0 on the z = 1 line).  The device is
 import decimal
 
 from symstab.symbolic import model
-from symstab.numeric.evaluate import alpha_max_on_arc, arc_end, boundary_point
+from symstab.numeric.paper.reference import alpha_max_on_arc, arc_end, boundary_point
 from symstab.symbolic.small_theta import small_theta_limits
-from symstab.numeric.region import limits
-from symstab.numeric.units import PAPER_DEVICE
+from symstab.numeric.paper.region import limits
+from symstab.numeric.paper.device import PAPER_DEVICE
 from symstab.symbolic.theta_max import theta_max
 
 from . import regions

@@ -17,7 +17,7 @@ regions".
   (signs decided, identities proved by the exact checker).
 * For each of the 40 curves of Figs. 6 and 8, the closed-loop roots outside
   the unit circle are counted (certified,
-  :func:`symstab.numeric.stability.unstable_root_counts`, and checked against
+  :func:`symstab.numeric.paper.stability.unstable_root_counts`, and checked against
   ``numpy.roots``) just beneath and just outside the arc -- "beneath" being
   inside the closed curve arc + ``alpha = 0``, the region the paper reads
   (:mod:`paper_checks.regions`) -- at three points along it: near its start
@@ -31,9 +31,9 @@ import dataclasses
 
 import numpy as np
 
-from symstab.numeric.region import StabilityRegion, boundary_curve
-from symstab.numeric.stability import loop_coefficients, unstable_root_counts
-from symstab.numeric.units import PAPER_DEVICE
+from symstab.numeric.paper.region import StabilityRegion, boundary_curve
+from symstab.numeric.paper.stability import loop_coefficients, unstable_root_counts
+from symstab.numeric.paper.device import PAPER_DEVICE
 from symstab.proof import necessity
 from symstab.proof.identity import check_identity
 from symstab.symbolic import model

@@ -6,12 +6,12 @@ simulation" that the region beneath a *right-sided* arc is stable and the
 region beneath a *left-sided* arc unstable (lines 287-300 and 325-341; a proof
 is left to future work).  Here the question is settled by counting the roots
 of the characteristic polynomial outside the unit circle, with the library's
-one home for it: :class:`symstab.numeric.region.StabilityRegion` (the number
+one home for it: :class:`symstab.numeric.paper.region.StabilityRegion` (the number
 of roots outside changes only where a root crosses the circle -- on the arc,
 on ``alpha = 0`` (``z = 1``) or on the line ``alpha + 2 beta = c``
-(``z = -1``, :func:`symstab.numeric.curves.minus_one_line`) -- and is
+(``z = -1``, :func:`symstab.numeric.paper.curves.minus_one_line`) -- and is
 counted along each line from its closed-form ends) and
-:func:`symstab.numeric.stability.unstable_root_counts` (certified) at the
+:func:`symstab.numeric.paper.stability.unstable_root_counts` (certified) at the
 probes.
 
 What is this module's own is the paper's side of the comparison:
@@ -21,10 +21,10 @@ What is this module's own is the paper's side of the comparison:
   small-theta limits (:func:`symstab.symbolic.small_theta.small_theta_limits`)
   at 30 digits;
 * :func:`classify` -- for one curve: its side, the stable region's extent
-  (:meth:`symstab.numeric.region.StabilityRegion.limits`), and whether the
+  (:meth:`symstab.numeric.paper.region.StabilityRegion.limits`), and whether the
   stable set lies beneath the arc, i.e. inside the closed curve arc +
   ``alpha = 0`` (even-odd rule on the arc's samples from
-  :func:`symstab.numeric.region.boundary_curve`), as the paper reads its
+  :func:`symstab.numeric.paper.region.boundary_curve`), as the paper reads its
   figures;
 * :data:`FIGURE_CASES` -- what the paper says about each curve of Figs. 6 and
   8 -- and :data:`LIMIT_CASES` -- its limits ``gamma <= -1`` (no stable
@@ -46,11 +46,11 @@ import sympy as sp
 from symstab.symbolic import model
 from symstab._validate import check_count, check_loop, check_real
 from symstab.symbolic.small_theta import small_theta_limits
-from symstab.numeric.curves import arc_end_angle, minus_one_line
-from symstab.numeric.region import StabilityRegion, boundary_curve
-from symstab.numeric.stability import unstable_root_counts
+from symstab.numeric.paper.curves import arc_end_angle, minus_one_line
+from symstab.numeric.paper.region import StabilityRegion, boundary_curve
+from symstab.numeric.paper.stability import unstable_root_counts
 from symstab.symbolic.loop import characteristic_polynomial
-from symstab.numeric.units import PAPER_DEVICE
+from symstab.numeric.paper.device import PAPER_DEVICE
 
 __all__ = [
     "InitialDirection", "initial_direction", "side",
@@ -239,7 +239,7 @@ class Probe:
     """Unstable-root count at one representative point.
 
     ``unstable_roots`` is ``None`` when a root is marginal (on the unit
-    circle to within rounding, :func:`symstab.numeric.stability.unstable_root_counts`).
+    circle to within rounding, :func:`symstab.numeric.paper.stability.unstable_root_counts`).
     """
 
     name: str
@@ -270,8 +270,8 @@ class RegionResult:
         Smallest and largest beta on the arc.
     minus_one_line : float
         ``c`` of the line ``alpha + 2 beta = c`` on which ``z = -1`` is a
-        root (:func:`symstab.numeric.curves.minus_one_line`).
-    limits : symstab.numeric.region.Limits
+        root (:func:`symstab.numeric.paper.curves.minus_one_line`).
+    limits : symstab.numeric.paper.region.Limits
         The stable region's extent, from the root count.
     stable_exists : bool
         Some point is stable.
@@ -388,7 +388,7 @@ def classify(gamma, d, delta=PAPER_DEVICE.delta, *, n_beta=41, arc_points=None,
         the region's top is added.
     arc_points : int, optional
         Steps of theta between the arc's samples
-        (:func:`symstab.numeric.region.boundary_curve`, ``arc_points + 1``
+        (:func:`symstab.numeric.paper.region.boundary_curve`, ``arc_points + 1``
         samples from theta = 0 to theta_max); by default ``200 + 20 d
         theta_max``.
     tolerance : float, optional
@@ -412,7 +412,7 @@ def classify(gamma, d, delta=PAPER_DEVICE.delta, *, n_beta=41, arc_points=None,
         must be positive: the arc's start direction is evaluated from the
         derivation's forms, which carry a factor ``delta**2``).
     ValueError
-        If :func:`symstab.numeric.curves.arc_end_angle` returns nan: no arc
+        If :func:`symstab.numeric.paper.curves.arc_end_angle` returns nan: no arc
         enters ``alpha > 0`` (``alpha_theta2 <= 0``), or the arc is too short
         for its grid.
 

@@ -14,21 +14,21 @@ beta(theta), C-coefficients) -> :mod:`~symstab.symbolic.small_theta`,
 :mod:`~symstab.symbolic.theta_max`; :mod:`~symstab.proof.identity` is the exact equality
 checker and :mod:`~symstab.proof.derive` writes everything out.
 
-:mod:`~symstab.codegen.forms` rewrites the boundary and the loop polynomial in
+:mod:`~symstab.codegen.float_forms` rewrites the boundary and the loop polynomial in
 forms that keep their digits in floating point, :mod:`~symstab.codegen.generator`
 prints them as NumPy and C99 kernels into ``symstab/_generated``, and the
-numeric API builds on those: :mod:`~symstab.numeric.units` (:class:`Device`),
-:mod:`~symstab.numeric.curves` and :mod:`~symstab.numeric.region` (:func:`boundary_curve`), :mod:`~symstab.numeric.stability`
+numeric API builds on those: :mod:`~symstab.numeric.paper.device` (:class:`Device`),
+:mod:`~symstab.numeric.paper.curves` and :mod:`~symstab.numeric.paper.region` (:func:`boundary_curve`), :mod:`~symstab.numeric.paper.stability`
 (:func:`spectral_radius`, :func:`is_stable`, :func:`classify`),
-:mod:`~symstab.numeric.region` (:func:`limits`, :func:`best_virtual_mass`) and
-:mod:`~symstab.numeric.simulate` (:func:`simulate`, :func:`stability_map`, with
+:mod:`~symstab.numeric.paper.region` (:func:`limits`, :func:`best_virtual_mass`) and
+:mod:`~symstab.numeric.paper.simulate` (:func:`simulate`, :func:`stability_map`, with
 the :class:`Nonidealities` of a real device).
 
 Any other loop -- the user's own plant and virtual environment -- is a
-:class:`Loop` (:mod:`~symstab.numeric.any_loop`), derived and classified the same
+:class:`Loop` (:mod:`~symstab.numeric.loop.sampled_loop`), derived and classified the same
 way, and can be read from a TOML loop file (:func:`load_loop`).  The paper's
-loop is one of them: ``PAPER_LOOP`` (:mod:`~symstab.numeric.paper_loop`, built
-on first use), on the same root engine (:mod:`~symstab.numeric.roots`) as the
+loop is one of them: ``PAPER_LOOP`` (:mod:`~symstab.numeric.paper.paper_loop`, built
+on first use), on the same root engine (:mod:`~symstab.numeric.engine.roots`) as the
 dimensionless functions above.
 """
 
@@ -46,24 +46,24 @@ _HOMES = {
     "symbolic.model": ("dimensionless_values",),
     "symbolic.theta_max": ("closed_form_d0", "newton_form_gamma0", "theta_max", "theta_max_newton"),
     "symbolic.unit_circle": ("unit_circle_split",),
-    "numeric.units": ("PAPER_DEVICE", "Device"),
-    "numeric.curves": ("BoundaryCurve", "arc_end_angle"),
-    "numeric.stability": ("MARGINAL", "STABLE", "UNSTABLE", "classify", "is_stable",
-                          "spectral_radius"),
-    "numeric.region": ("boundary_curve", "BestVirtualMass", "StabilityRegion", "best_virtual_mass",
-                       "limits"),
-    "numeric.results": ("Limits", "RobustRegion", "StabilityProbability"),
-    "numeric.any_loop": ("Loop", "LoopBoundary", "LoopLimits"),
-    "numeric.loop_files": ("load_loop",),
+    "numeric.engine.roots": ("MARGINAL", "STABLE", "UNSTABLE"),
+    "numeric.engine.results": ("Limits", "RobustRegion", "StabilityProbability"),
+    "numeric.engine.decomposition": ("Branch", "Cell", "Decomposition"),
+    "numeric.engine.locus": ("Crossing", "Locus", "locus"),
+    "numeric.loop.sampled_loop": ("Loop", "LoopBoundary", "LoopLimits"),
+    "numeric.loop.files": ("load_loop",),
     "symbolic.loop_assembly": ("NonPhysicalPlantWarning",),
-    "numeric.decomposition": ("Branch", "Cell", "Decomposition"),
-    "numeric.passivity": ("PassiveRegion", "passive_region"),
-    "numeric.paper_loop": ("paper_passive_region", "paper_locus"),
-    "numeric.locus": ("Crossing", "Locus", "locus"),
-    "numeric.simulate": ("Nonidealities", "Simulation", "StabilityMap", "simulate",
-                         "stability_map"),
-    "numeric.theta_bounds": ("ThetaMaxEnclosure", "certify_theta_max", "theta_max_approx",
-                             "theta_max_enclosure"),
+    "numeric.simulation.simulator": ("Nonidealities", "Simulation", "StabilityMap"),
+    "numeric.analysis.passivity": ("PassiveRegion", "passive_region"),
+    "numeric.paper.device": ("PAPER_DEVICE", "Device"),
+    "numeric.paper.curves": ("BoundaryCurve", "arc_end_angle"),
+    "numeric.paper.stability": ("classify", "is_stable", "spectral_radius"),
+    "numeric.paper.region": ("boundary_curve", "BestVirtualMass", "StabilityRegion",
+                             "best_virtual_mass", "limits"),
+    "numeric.paper.paper_loop": ("paper_passive_region", "paper_locus"),
+    "numeric.paper.simulate": ("simulate", "stability_map"),
+    "numeric.paper.theta_bounds": ("ThetaMaxEnclosure", "certify_theta_max", "theta_max_approx",
+                                   "theta_max_enclosure"),
 }
 _HOME_OF = {name: module for module, names in _HOMES.items() for name in names}
 
@@ -98,7 +98,7 @@ def __getattr__(name):
     if name == "PAPER_LOOP":
         # Derived on first use, and again each time it is asked for (cached
         # by paper_loop()): about a second the first time.
-        from .numeric.paper_loop import paper_loop
+        from .numeric.paper.paper_loop import paper_loop
 
         return paper_loop()
     if name in _HOME_OF:

@@ -19,7 +19,7 @@ test or a user can change them without re-importing:
     Most sampling periods of one simulation; default 10 million (a period
     costs tens of microseconds, so that is minutes per point).  The
     simulator's default horizon is always allowed
-    (:func:`symstab.numeric.simulate.max_steps`).
+    (:func:`symstab.numeric.paper.simulate.max_steps`).
 """
 
 import os

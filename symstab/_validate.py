@@ -202,7 +202,7 @@ def check_progress(progress, bar=None):
     bar : callable, optional
         Makes the bar that True asks for, e.g. ``lambda:
         progress_printer("simulating", steps)``
-        (:func:`symstab.numeric.loop_simulate.progress_printer`: drawn on
+        (:func:`symstab._progress.progress_printer`: drawn on
         stderr when it is a terminal, for work over 2 s).  Without it, True
         reports nothing.
 

@@ -108,7 +108,7 @@ def label_log_axis(ax):
 
 
 def design_figure(plt, found, labels, target_label):
-    """A :class:`~symstab.numeric.design.Design` drawn: its target against the parameter(s) searched.
+    """A :class:`~symstab.numeric.analysis.design.Design` drawn: its target against the parameter(s) searched.
 
     One parameter: the target at every value evaluated (a line through the
     scan and the refinement), the values with no stable point marked at the
@@ -119,7 +119,7 @@ def design_figure(plt, found, labels, target_label):
     ----------
     plt : module
         :func:`pyplot`.
-    found : symstab.numeric.design.Design
+    found : symstab.numeric.analysis.design.Design
     labels : list of str
         The axis label of each parameter searched.
     target_label : str

@@ -9,8 +9,8 @@ Figures 6, 7, 8 and 10 draw the whole boundary -- the arc of eq. (7) up to
 theta_max (solid) and the same curve on to theta = pi (dashed), which bounds
 stable sets too (the lower edge of the gamma = 1 band in Fig. 10) -- and
 fill the stable set: the cells of the exact D-decomposition with no
-unstable pole (:meth:`symstab.numeric.region.StabilityRegion.decomposition`).
-Simulation (:func:`symstab.numeric.simulate.stability_map`) is drawn over it
+unstable pole (:meth:`symstab.numeric.paper.region.StabilityRegion.decomposition`).
+Simulation (:func:`symstab.numeric.paper.simulate.stability_map`) is drawn over it
 as a check, hatched; it takes most of the time.  Fig. 10 writes in every
 cell its number of unstable closed-loop poles; Figs. 11 and 12 end the
 Z-width at the gamma where the region vanishes, found by bisection.  Everything is in the paper's device
@@ -28,13 +28,14 @@ import time
 import numpy as np
 
 from .drawing import LEGEND_SIZE, PANEL_TITLE_SIZE, SUPTITLE_SIZE, label_log_axis, png_bytes, pyplot
-from .numeric.curves import arc_end_angle
-from .numeric.region import arc_polylines
-from .numeric.region import boundary_curve
-from .numeric.paper_loop import paper_passive_region
-from .numeric.region import StabilityRegion, limits, vanishing_gamma
-from .numeric.simulate import PAPER_ENCODER_RESOLUTION, Nonidealities, stability_map
-from .numeric.units import PAPER_DEVICE
+from .numeric.paper.curves import arc_end_angle
+from .numeric.paper.region import arc_polylines
+from .numeric.paper.region import boundary_curve
+from .numeric.paper.paper_loop import paper_passive_region
+from .numeric.paper.region import StabilityRegion, limits, vanishing_gamma
+from .numeric.paper.simulate import stability_map
+from .numeric.simulation.simulator import PAPER_ENCODER_RESOLUTION, Nonidealities
+from .numeric.paper.device import PAPER_DEVICE
 
 __all__ = ["FigureResult", "FIGURES", "make_figures"]
 
@@ -193,7 +194,7 @@ def _decomposition(gamma, d, window):
     Every branch of the boundary cuts the window into cells; each cell
     carries its number of unstable closed-loop poles, and the stable set
     is the union of the cells with none
-    (:meth:`symstab.numeric.region.StabilityRegion.decomposition`).
+    (:meth:`symstab.numeric.paper.region.StabilityRegion.decomposition`).
     """
     x_range, y_range = window
     return _region(gamma, d).decomposition(x_range=tuple(map(float, x_range)),
@@ -210,7 +211,7 @@ def _fill_stable(ax, gamma, d, window, color, scale=(1.0, 1.0)):
 def _shade_cells(ax, decomposition, color, scale=(1.0, 1.0)):
     """Fill the stable cells of a D-decomposition, holes included.
 
-    ``decomposition`` is a :class:`symstab.numeric.decomposition.Decomposition`
+    ``decomposition`` is a :class:`symstab.numeric.engine.decomposition.Decomposition`
     (x = beta, y = alpha); ``scale`` multiplies its coordinates into the
     plotted units.
     """
@@ -334,7 +335,7 @@ def figure_horizon(d):
 
     Enough for the picture (on the paper's 32 grids it changes 6 of 320 000
     cells, all next to the boundary); the tests use the full
-    :func:`symstab.numeric.simulate.default_horizon`.
+    :func:`symstab.numeric.paper.simulate.default_horizon`.
     """
     return 4000 + 400 * d
 
@@ -842,7 +843,7 @@ def make_figures(out_dir, progress=None):
     ``name: seconds`` on stderr (:func:`symstab._validate.check_progress`).
     """
     from ._validate import check_progress
-    from .proof.derive import write_bytes
+    from ._io import write_bytes
 
     progress = check_progress(progress, lambda: lambda name, seconds: print(
         f"{name}: {seconds:.1f} s", file=sys.stderr, flush=True))

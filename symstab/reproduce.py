@@ -156,7 +156,8 @@ def _run(out, workers, log):
     from paper_checks import audit
 
     from . import figures
-    from .proof.derive import write, write_bytes
+    from ._io import write_bytes
+    from .proof.derive import write
 
     total = time.perf_counter()
     timings = []

@@ -367,7 +367,7 @@ def simulated_loop_radius(K, B, *, d, f_c=None, f_a=None, M=0.0, m=None, b=None,
     """
     import control
 
-    from symstab.numeric.units import PAPER_DEVICE
+    from symstab.numeric.paper.device import PAPER_DEVICE
 
     m = PAPER_DEVICE.m if m is None else m
     b = PAPER_DEVICE.b if b is None else b

@@ -1,18 +1,21 @@
 """The package is laid out by layer, and no layer imports a layer above it.
 
-From the bottom: the private base (``_project``, ``_resources``,
-``_signals``, ``_validate``, ``_workers``, ``_generated``), ``symbolic`` (the derivation in SymPy),
+From the bottom: the private base (``_io``, ``_lazy``, ``_memo``, ``_progress``,
+``_project``, ``_resources``, ``_signals``, ``_validate``, ``_workers``,
+``_generated``), ``symbolic`` (the derivation in SymPy),
 ``codegen`` (float-safe forms, printers, generated kernels), ``proof``
 (the identity checker, every proof obligation, the derivation files),
-``numeric`` (the numeric API on the kernels), and the front ends (``cli``,
-``figures``, ``reproduce``).  ``paper_checks`` sits between the library and
+``numeric`` (the numeric API on the kernels, in rooms of their own order:
+``engine`` < ``loop`` < ``simulation`` < ``analysis`` < ``paper``), and the
+front ends (``cli``, ``figures``, ``reproduce``).  ``paper_checks`` sits between the library and
 the front ends: the front ends may import it, the library may not.  Imports
 are read from the source (static, lazy ones inside functions included).
 
 Besides the layers: no import cycle (strongly connected components of the
 module graph of symstab and of paper_checks), no private name imported
 from another module (:data:`PRIVATE_IMPORTS_ALLOWED` lists the few left, each
-with its reason), and the command line one module per command.
+with its reason) nor reached on another module's object, no two library
+modules of one file name, and the command line one module per command.
 """
 
 import ast
@@ -26,7 +29,8 @@ PACKAGE = pathlib.Path(symstab.__file__).resolve().parent
 
 #: Rank of each layer; a module may import its own rank or lower.
 RANK = {"base": 0, "symbolic": 1, "codegen": 2, "proof": 3, "numeric": 4, "front": 5}
-_BASE = {"_project", "_resources", "_signals", "_validate", "_workers", "_generated"}
+_BASE = {"_io", "_lazy", "_memo", "_progress", "_project", "_resources", "_signals", "_validate", "_workers",
+         "_generated"}
 _FRONT = {"cli", "drawing", "figures", "reproduce", "__main__"}
 
 
@@ -88,6 +92,87 @@ def test_no_layer_imports_a_layer_above(path, parts):
             f"a layer above it")
 
 
+#: The rooms of ``symstab.numeric`` in their order: a room may import its own
+#: rank or lower.  ``paper`` (Table I's plane) is above every general room,
+#: so nothing general leans on the paper.
+NUMERIC_RANK = {"engine": 0, "loop": 1, "simulation": 2, "analysis": 3, "paper": 4}
+
+#: Modules whose functions may import upward, and what: ``Loop``'s question
+#: methods are pass-throughs to the module functions of the rooms above
+#: (inside the method, never at module level), as python-control's
+#: ``TransferFunction`` methods are.
+FACADES = {("numeric", "loop", "sampled_loop"): {"simulation", "analysis"}}
+
+
+def _room(parts):
+    """The room of a numeric module (``parts`` below ``symstab``), or None outside numeric."""
+    if parts[0] != "numeric" or len(parts) < 3:
+        return None
+    if parts[1] not in NUMERIC_RANK:
+        raise AssertionError(f"symstab/{'/'.join(parts)}.py is in no room of numeric: "
+                             f"put it in one of {sorted(NUMERIC_RANK)}")
+    return parts[1]
+
+
+def _nested_imports(path):
+    """Line numbers of the imports inside a function body (lazy ones)."""
+    tree = ast.parse(path.read_text(encoding="utf-8"))
+    lines = set()
+    for node in ast.walk(tree):
+        if isinstance(node, (ast.FunctionDef, ast.AsyncFunctionDef)):
+            lines |= {inner.lineno for inner in ast.walk(node)
+                      if isinstance(inner, (ast.Import, ast.ImportFrom))}
+    return lines
+
+
+NUMERIC_MODULES = [(path, parts) for path, parts in MODULES if _room(parts)]
+
+
+@pytest.mark.parametrize("path, parts", NUMERIC_MODULES, ids=["/".join(p) for _, p in NUMERIC_MODULES])
+def test_numeric_rooms_import_downwards(path, parts):
+    """engine < loop < simulation < analysis < paper; only front ends import the paper's room."""
+    own = _room(parts)
+    lazy = _nested_imports(path)
+    allowed_up = FACADES.get(tuple(parts), set())
+    for line, target in _imports(path, parts):
+        if target[:2] != ["symstab", "numeric"] or len(target) < 3 or target[2] not in NUMERIC_RANK:
+            continue
+        theirs = target[2]
+        if NUMERIC_RANK[theirs] <= NUMERIC_RANK[own]:
+            continue
+        assert theirs in allowed_up and line in lazy, (
+            f"symstab/{'/'.join(parts)}.py:{line} ({own}) imports {'.'.join(target)} ({theirs}), "
+            f"a room above it")
+
+
+def test_only_front_ends_import_the_papers_room():
+    for path, parts in MODULES:
+        if _layer(parts) == "front" or _room(parts) == "paper":
+            continue
+        for line, target in _imports(path, parts):
+            assert target[:3] != ["symstab", "numeric", "paper"], (
+                f"symstab/{'/'.join(parts)}.py:{line} imports {'.'.join(target)}: only the front "
+                f"ends, paper_checks and symstab/__init__.py use the paper's room")
+
+
+def test_numeric_holds_only_rooms():
+    """``symstab/numeric/`` has no module of its own: old paths are deprecated aliases."""
+    flat = sorted(p.name for p in (PACKAGE / "numeric").glob("*.py") if p.name != "__init__.py")
+    assert flat == []
+    rooms = sorted(p.name for p in (PACKAGE / "numeric").iterdir() if (p / "__init__.py").exists())
+    assert rooms == sorted(NUMERIC_RANK)
+
+
+def test_no_two_library_modules_share_a_file_name():
+    """``forms.py`` twice was two things of one name; CLI modules are named after their commands."""
+    seen = {}
+    for _, parts in MODULES:
+        if parts[0] == "cli" or parts[-1] == "__init__":
+            continue
+        seen.setdefault(parts[-1], []).append("/".join(parts))
+    assert {stem: where for stem, where in seen.items() if len(where) > 1} == {}
+
+
 def test_every_layer_is_a_folder_and_every_module_in_one():
     folders = {p.name for p in PACKAGE.iterdir() if p.is_dir() and not p.name.startswith("__")}
     assert {"symbolic", "codegen", "proof", "numeric", "cli", "_generated"} <= folders
@@ -107,6 +192,9 @@ def test_the_test_folders_are_the_layers():
     layers = {p.name for p in PACKAGE.iterdir() if p.is_dir() and (p / "__init__.py").exists()
               and not p.name.startswith("_")}
     assert folders == layers == {"symbolic", "codegen", "proof", "numeric", "cli"}
+    rooms = {p.name for p in (tests / "numeric").iterdir() if p.is_dir() and not p.name.startswith("_")}
+    assert rooms == set(NUMERIC_RANK)
+    assert sorted(p.name for p in (tests / "numeric").glob("*.py")) == []
 
 
 def test_no_public_name_shadows_a_submodule():
@@ -361,3 +449,101 @@ def test_the_cli_is_one_module_per_command_over_shared_modules():
                       for line, target, _, _ in _imports_of(name, MODULE_NAMES[name])
                       if target in names and target != name)
     assert crossing == [], crossing
+
+
+# --------------------------------------------------------------------------
+# No private attribute reached on another module's object
+
+#: Private attribute names that are a third party's protocol, not our privacy:
+#: mpmath's number internals, namedtuple's API, CPython's own.
+PROTOCOL_ATTRIBUTES = {"_mpf_", "_mpc_", "_asdict", "_replace", "_fields", "_make", "_exit",
+                       "_getframe", "_current_frames", "_subparsers", "_group_actions",
+                       "_print"}
+
+#: ``{(module, attribute): reason}`` of the reaches left, each with its reason.
+PRIVATE_ATTRIBUTES_ALLOWED = {
+    ("symstab.symbolic.derivation_cache", "_prec"): "a SymPy Float's binary precision, which the "
+    "cache must store to give back the same Float (SymPy has no public accessor)",
+    ("symstab.symbolic.derivation_cache", "_new"): "sympy.Float._new rebuilds a Float from its "
+    "mpf tuple and precision without rounding through a decimal string",
+}
+
+
+def _defined_private_names(tree):
+    """Private names a module defines itself: functions, classes, ``x._y = ...`` and class bodies."""
+    names = set()
+    for node in ast.walk(tree):
+        if isinstance(node, (ast.FunctionDef, ast.AsyncFunctionDef, ast.ClassDef)):
+            names.add(node.name)
+        elif isinstance(node, ast.Attribute) and isinstance(node.ctx, ast.Store):
+            names.add(node.attr)
+        elif isinstance(node, ast.Name) and isinstance(node.ctx, ast.Store):
+            names.add(node.id)
+        elif isinstance(node, ast.AnnAssign) and isinstance(node.target, ast.Name):
+            names.add(node.target.id)
+    return names
+
+
+def _private_attribute_reaches():
+    """``(module, line, expression)`` of every ``obj._name`` that reaches into another module.
+
+    ``self._x`` and ``cls._x`` are the object's own; ``other._x`` where this
+    module defines ``_x`` (its own class's attribute, read on a second
+    instance) is too.  Anything else is a reach into another module's
+    private state: make the name public, documented, in its home.
+    """
+    found = []
+    for name, path in MODULE_NAMES.items():
+        if "_generated" in name.split("."):
+            continue
+        tree = ast.parse(path.read_text(encoding="utf-8"))
+        own = _defined_private_names(tree)
+        for node in ast.walk(tree):
+            if not isinstance(node, ast.Attribute):
+                continue
+            attr = node.attr
+            if not attr.startswith("_") or (attr.startswith("__") and attr.endswith("__")):
+                continue
+            if attr in PROTOCOL_ATTRIBUTES or attr in own:
+                continue
+            if isinstance(node.value, ast.Name) and node.value.id in {"self", "cls"}:
+                continue
+            found.append((name, node.lineno, ast.unparse(node)))
+    return sorted(set(found))
+
+
+def test_no_private_attribute_is_reached_across_modules():
+    found = _private_attribute_reaches()
+    offenders = [(m, line, expr) for m, line, expr in found
+                 if (m, expr.rpartition(".")[2]) not in PRIVATE_ATTRIBUTES_ALLOWED]
+    for module, line, expr in offenders:
+        print(f"{module}:{line} reaches {expr}")
+    assert offenders == [], f"{len(offenders)} private attribute(s) reached across modules"
+
+
+def test_the_reach_finder_finds_reaches(tmp_path):
+    """The finder on made-up modules: a reach, its own attribute, self, a protocol name."""
+    source = ("class A:\n    def __init__(self):\n        self._mine = 1\n"
+              "    def same(self, other):\n        return other._mine\n"
+              "def reach(loop, x):\n    return loop._environment_parts, x._mpf_, len(x)\n")
+    tree = ast.parse(source)
+    own = _defined_private_names(tree)
+    reaches = [ast.unparse(n) for n in ast.walk(tree) if isinstance(n, ast.Attribute)
+               and n.attr.startswith("_") and n.attr not in own | PROTOCOL_ATTRIBUTES
+               and not (n.attr.startswith("__") and n.attr.endswith("__"))]
+    assert reaches == ["loop._environment_parts"]
+
+
+@pytest.mark.parametrize("package", ["numeric", "codegen"])
+def test_a_moved_module_still_imports_with_a_warning(package):
+    """The old flat paths are the new modules, one release long, with a DeprecationWarning."""
+    import importlib
+    import sys
+
+    moved = importlib.import_module(f"symstab.{package}").MOVED
+    for old, new in sorted(moved.items()):
+        sys.modules.pop(f"symstab.{package}.{old}", None)
+        with pytest.warns(DeprecationWarning, match=new.replace(".", r"\.")):
+            module = importlib.import_module(f"symstab.{package}.{old}")
+        assert module is importlib.import_module(new)
+        assert not (PACKAGE / package / f"{old}.py").exists()

@@ -470,8 +470,8 @@ def test_region_top_is_the_top_of_the_arc(gamma, d):
     to 1e-12.  Its own eigenvalue scan found the gamma = 2 sliver's top only
     on its grid: 3.9571 against 4.0068."""
     from paper_checks import regions
-    from symstab.numeric.curves import arc_end_angle
-    from symstab.numeric.units import PAPER_DEVICE
+    from symstab.numeric.paper.curves import arc_end_angle
+    from symstab.numeric.paper.device import PAPER_DEVICE
 
     delta = PAPER_DEVICE.delta
     r = regions.classify(gamma, d)
@@ -523,7 +523,7 @@ def test_open_question_counts_match_first_principles(gamma, d):
 
     from oracles import first_principles_boundary_point, first_principles_chi_float
     from paper_checks import open_questions
-    from symstab.numeric.units import PAPER_DEVICE
+    from symstab.numeric.paper.device import PAPER_DEVICE
 
     delta = PAPER_DEVICE.delta
     counted = open_questions.curve_counts(gamma, d)
@@ -663,7 +663,7 @@ def test_an_empty_window_is_said_in_words_and_is_empty_for_python_control(audit_
 
     import numpy as np
     from oracles import python_control_closed_loop
-    from symstab.numeric.units import PAPER_DEVICE as dev
+    from symstab.numeric.paper.device import PAPER_DEVICE as dev
 
     _, report, _ = audit_run
     assert "none N" not in report.read_text(encoding="utf-8")

@@ -34,11 +34,11 @@ def test_readme_python_examples_run(monkeypatch, tmp_path):
     assert runner.failures == 0
 
 
-@pytest.mark.parametrize("module", ["symstab.numeric.units", "symstab.numeric.curves", "symstab.numeric.stability",
-                                    "symstab.numeric.region", "symstab.symbolic.model", "symstab.symbolic.theta_max",
-                                    "symstab.numeric.any_loop", "symstab.numeric.decomposition",
-                                    "symstab.numeric.theta_bounds", "symstab.numeric.passivity",
-                                    "symstab.numeric.locus"])
+@pytest.mark.parametrize("module", ["symstab.numeric.paper.device", "symstab.numeric.paper.curves", "symstab.numeric.paper.stability",
+                                    "symstab.numeric.paper.region", "symstab.symbolic.model", "symstab.symbolic.theta_max",
+                                    "symstab.numeric.loop.sampled_loop", "symstab.numeric.engine.decomposition",
+                                    "symstab.numeric.paper.theta_bounds", "symstab.numeric.analysis.passivity",
+                                    "symstab.numeric.engine.locus"])
 def test_docstring_examples_run(module, monkeypatch, tmp_path):
     monkeypatch.setenv("SYMSTAB_CACHE_DIR", str(tmp_path))
     mod = importlib.import_module(module)

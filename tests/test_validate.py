@@ -162,7 +162,7 @@ def test_check_progress_normalises_every_kind():
 def _progress_calls():
     """Every public function with a ``progress`` argument, as ``call(progress)``, small and fast."""
     import symstab
-    from symstab.numeric.design import maximize_box, maximize_scalar
+    from symstab.numeric.analysis.design import maximize_box, maximize_scalar
 
     loop = symstab.Loop("1/(m*s**2 + b*s)", "K + B*(z - 1)/(T*z)",
                         values=dict(m=0.0128, b=0.0324, T=1e-3, d=1, K=100.0, B=0.1),

@@ -40,10 +40,10 @@ def run(args):
     (:func:`symstab.cli.loop_options.resolve_setup`); for them the rows are
     eq. (7)'s arc up to theta_max, for a loop file the whole arc and the
     z = +-1 lines; for both the segments of those lines that close the
-    stable set (:attr:`symstab.numeric.decomposition.Decomposition.segments`).
+    stable set (:attr:`symstab.numeric.engine.decomposition.Decomposition.segments`).
     """
     from .._validate import check_count
-    from ..numeric.region import boundary_curve
+    from ..numeric.paper.region import boundary_curve
 
     setup = resolve_setup(args)
     n = check_count("n", args.n, 2)

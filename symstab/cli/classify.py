@@ -44,7 +44,7 @@ def register(subparsers):
 
 def run(args):
     """Run ``symstab classify``: a loop file's points (``--loop``), else the paper's."""
-    from ..numeric.stability import MARGINAL, STABLE
+    from ..numeric.engine.roots import MARGINAL, STABLE
 
     setup = resolve_setup(args, plane=False, lists=True)
     if setup.paper is None:

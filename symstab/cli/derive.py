@@ -91,7 +91,7 @@ def _derive_loop(args):
     """
     from ..proof import derive
     from ..proof import loop_derive
-    from ..numeric.loop_files import load_loop
+    from ..numeric.loop.files import load_loop
 
     start = time.perf_counter()
     if args.codegen_out is not None:

@@ -294,7 +294,7 @@ _TARGET_ROWS = {
 
 def _search(args, setup, over, target, notes, png, delay=None, simulation=None):
     """The values of ``over`` that maximise ``target`` in the plane of ``setup``: one design."""
-    from ..numeric.simulate import progress_printer
+    from .._progress import progress_printer
 
     names = tuple(over)
     y_word = setup.name(setup.y)
@@ -432,7 +432,7 @@ def _search(args, setup, over, target, notes, png, delay=None, simulation=None):
 #: Values whose simulated target lies within this fraction of the best are ties: near
 #: the limit the accepted set's edge is ragged (quantization limit cycles near the
 #: amplitude); for the paper's device at d = 5 the target varies by about 1 % between
-#: nearby values (measured, symstab/numeric/simulate_limit.py).
+#: nearby values (measured, symstab/numeric/simulation/simulated_limit.py).
 SIMULATED_TIE = 0.01
 
 
@@ -473,7 +473,7 @@ def _failed_notes(found):
 
 def _at(setup, point, delay):
     """The values at ``point`` of the searched parameters (``d`` held by ``delay`` if given)."""
-    from ..numeric.design import held_delay
+    from ..numeric.analysis.design import held_delay
 
     values = {**setup.values, **point}
     if delay is not None:
@@ -490,7 +490,7 @@ def _search_json(setup, found, names, lim):
     """The search for JSON: one parameter as numbers, two as ``{name: ...}``.
 
     ``y_max`` and ``x_at_y_max`` are the stable set's at the optimum (``lim``,
-    the plane's :class:`~symstab.numeric.results.Limits`), whatever the target.
+    the plane's :class:`~symstab.numeric.engine.results.Limits`), whatever the target.
     """
     one = len(names) == 1
     y_max = None if lim is None or lim.y_max is None else lim.y_max
@@ -521,7 +521,7 @@ def _search_json(setup, found, names, lim):
 
 def _result(setup, search, lim):
     """The JSON: the search and the limits at its best value; for the paper's options also
-    ``best`` under :class:`symstab.numeric.region.BestVirtualMass`'s names."""
+    ``best`` under :class:`symstab.numeric.paper.region.BestVirtualMass`'s names."""
     out = {"search": search, "limits": None if lim is None else named(setup, lim).as_dict()}
     if setup.paper is not None and search["maximize"] == "y_max":
         out["best"] = {"gamma": search["best"], "beta": search["x_at_y_max"],

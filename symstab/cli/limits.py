@@ -7,7 +7,7 @@ the range of damping over the stable region and its area (Z-width), with
 Both give the passive set (Colgate-Schenkel) beside the stable one.  With
 ``--uncertain NAME=LO:HI`` (a loop file) the limits are the robust set's:
 the points stable for every value of the box
-(:func:`symstab.numeric.robust.robust_region`), drawn with ``--png``
+(:func:`symstab.numeric.analysis.robust.robust_region`), drawn with ``--png``
 beside the nominal set.
 """
 
@@ -106,14 +106,14 @@ def _line(args, setup):
     return None if args.beta is None else check_real("beta", args.beta)
 
 
-#: The most strips ``--strips`` takes (as :func:`symstab.numeric.robust.robust_region`).
+#: The most strips ``--strips`` takes (as :func:`symstab.numeric.analysis.robust.robust_region`).
 _MAX_STRIPS = 100_000
 
 
 def _robust(args, setup, at):
     """``limits --loop --uncertain``: the robust set's limits, certified; its PNG with --png."""
     from ..drawing import png_bytes, pyplot
-    from ..numeric.loop_simulate import progress_printer
+    from .._progress import progress_printer
     from .output import check_files, write_output
 
     strips = 64 if args.strips is None else args.strips

@@ -5,7 +5,7 @@ commands (:mod:`symstab.cli.options`) and a path: one of the stiffness
 (``--Kw``/``--alpha``) and the damping (``--Bw``/``--beta``) as a range
 ``LOW:HIGH[:N]``, the other as one value.  A loop file takes ``--loop FILE``
 and ``--set NAME=VALUE``, one of the ``--set`` values a range.  The
-crossings of the unit circle (:func:`symstab.numeric.locus.locus`) are
+crossings of the unit circle (:func:`symstab.numeric.engine.locus.locus`) are
 printed as one table; ``--png`` draws the poles in the z-plane, coloured by
 the path's parameter, beside their largest modulus along the path.  Every
 input is checked before the work; the PNG is written atomically.
@@ -214,7 +214,7 @@ def _track(setup, parameter, path, others, **shown):
     The memory is decided first, so that a refusal is the one error line;
     a long run says on stderr what runs.
     """
-    from ..numeric.locus import check_locus_memory, locus
+    from ..numeric.engine.locus import check_locus_memory, locus
 
     values = {**setup.values, **others}
     degree = setup.loop.coefficients(**values, **{parameter: path[0]}).shape[-1] - 1
@@ -363,7 +363,7 @@ def _notes(view, stretches, certified):
         count = stretches[0][2]
         notes.append(f"no pole crosses the unit circle along the path; "
                      f"{'unknown' if count is None else count} pole(s) outside it throughout")
-    from ..numeric.stability import MARGINAL, STABLE, UNSTABLE
+    from ..numeric.engine.roots import MARGINAL, STABLE, UNSTABLE
 
     stable, codes = [], []
     ends = {float(locus.values[0]): certified[0], float(locus.values[-1]): certified[-1]}

@@ -49,7 +49,7 @@ def stable_intervals_at(setup, at):
     return notes, {"x": at, "intervals": [list(r) for r in runs], "ends": kinds}
 
 
-#: The quantities of ``limits``: (field of :class:`~symstab.numeric.results.Limits`,
+#: The quantities of ``limits``: (field of :class:`~symstab.numeric.engine.results.Limits`,
 #: name in the plane ``(x, y)``, the paper's name in Table I's plane and in the
 #: device's units, meaning, what its unit is).  The paper's names say what each is:
 #: ``beta_left``/``beta_right`` are the ends of the stable set's beta range, which a
@@ -162,12 +162,12 @@ def passive_notes(setup, lim):
     """The passive set beside the stable one: (notes, json), one line per fact.
 
     Colgate and Schenkel's condition with the device's friction ``b`` and
-    the delay (:func:`symstab.numeric.passivity.passive_region`).  A loop
+    the delay (:func:`symstab.numeric.analysis.passivity.passive_region`).  A loop
     it does not cover (no ``b``, a plant other than ``1/(m s**2 + b s)``)
     gets a note saying why, not an error: the stable limits stand on their
     own.
     """
-    from ..numeric.passivity import passive_region
+    from ..numeric.analysis.passivity import passive_region
 
     x, y = setup.name(setup.x), setup.name(setup.y)
     paper = setup.paper

@@ -5,7 +5,7 @@ file (:func:`symstab.load_loop`) instead of the paper's device options; the
 file's default values are changed with ``--set NAME=VALUE`` (repeatable) and
 the parameter plane is the file's ``plane`` unless ``--x``/``--y`` name
 another.  The file's values are converted to SI when it is read
-(:mod:`symstab.numeric.loop_units`); a ``--set`` value is in the file's unit
+(:mod:`symstab.numeric.loop.quantities`); a ``--set`` value is in the file's unit
 for that parameter, or in the unit it gives (``--set T=0.5ms``), converted
 the same way and checked against the file's bounds.  Everything else on the
 command line (``--at``, ``--x-range``, ``--y-range``) and every result is in
@@ -349,7 +349,7 @@ def convert_sets(loop, sets, flag="--set"):
     implied by the loop).  ``written`` keeps what was typed, for the echo.
     Messages name ``flag NAME`` (``--over`` for design's ranges).
     """
-    from ..numeric.loop_units import FileParameters, convert
+    from ..numeric.loop.quantities import FileParameters, convert
 
     known = getattr(loop, "file_parameters", None) or FileParameters({})
     values, written = {}, {}
@@ -365,13 +365,13 @@ def convert_sets(loop, sets, flag="--set"):
         expected = (known.values[name].info.dimensions if file_unit is not None and name != "d"
                     else known.dimensions.get(name))
         if info is not None and expected is not None and info.dimensions != tuple(expected):
-            from ..numeric.loop_units import dimension_name
+            from ..numeric.loop.quantities import dimension_name
             raise ValueError(f"{flag}: unit {unit!r} is {dimension_name(info.dimensions)}, and "
                              f"{name} is in {dimension_name(expected)}"
                              + (f" (the file gives it in {file_unit!r})" if file_unit else ""))
         if info is not None and expected is not None:
             # The dimension fits; an angle (a number to pint) must fit too.
-            from ..numeric.loop_units import check_angle, parameter_angle
+            from ..numeric.loop.quantities import check_angle, parameter_angle
             own_info = known.values[name].info if file_unit is not None else None
             check_angle(name, info, parameter_angle(tuple(expected), own_info), where=flag,
                         si_unit=items[0].si_unit if own_info is None else
@@ -397,7 +397,7 @@ class LoopSetup:
     written: dict = dataclasses.field(default_factory=dict)
     #: The paper's device options (a :class:`symstab.cli.options.Setup`) where
     #: they gave the loop: ``loop`` is then the paper's loop in Table I's
-    #: variables (:func:`symstab.numeric.paper_loop.paper_point`).
+    #: variables (:func:`symstab.numeric.paper.paper_loop.paper_point`).
     paper: object = None
 
     def unit(self, name):
@@ -479,8 +479,8 @@ def check_corners(loop, values, x, y, box, where):
     exists there, the plane's parameters at 0); the message begins with
     ``where`` and names the corner.
     """
-    from ..numeric.design import box_corners
-    from ..numeric.loop_units import FileParameters, check_bounds
+    from ..numeric.analysis.design import box_corners
+    from ..numeric.loop.quantities import FileParameters, check_bounds
 
     known = getattr(loop, "file_parameters", None) or FileParameters({})
     for corner in box_corners(box):
@@ -533,7 +533,7 @@ def loop_echo(setup):
 
 def load_loop_file(path):
     """The :class:`symstab.Loop` of the loop file at ``path`` (:func:`symstab.load_loop`)."""
-    from ..numeric.loop_files import load_loop
+    from ..numeric.loop.files import load_loop
 
     return load_loop(path)
 
@@ -586,7 +586,7 @@ def loop_values(args, loop, sets, written_sets, *, skip=()):
     known = getattr(loop, "file_parameters", None)
     written = {}
     if known is not None:
-        from ..numeric.loop_units import check_bounds
+        from ..numeric.loop.quantities import check_bounds
 
         written = {n: (v.value, v.unit, v.si_unit) for n, v in known.values.items()
                    if v.converted}
@@ -670,7 +670,7 @@ def resolve_setup(args, *, plane=True, lists=False):
     """The :class:`LoopSetup` of a command: the loop file of ``--loop``, else the paper's options.
 
     The paper's device options (:func:`symstab.cli.options.resolve`) are
-    shorthand for the paper's loop: :func:`~symstab.numeric.paper_loop.paper_point`
+    shorthand for the paper's loop: :func:`~symstab.numeric.paper.paper_loop.paper_point`
     at their ``gamma, d, delta``, whose plane ``(B, K)`` is Table I's
     ``(beta, alpha)``, with :attr:`LoopSetup.paper` the device for the
     physical columns and the echo.
@@ -686,10 +686,10 @@ def paper_setup(paper, *, plane=True):
     """The :class:`LoopSetup` of the paper's device options ``paper`` (a resolved ``Setup``).
 
     The paper's loop at ``m = T = 1``
-    (:func:`~symstab.numeric.paper_loop.paper_point`): its parameters are
+    (:func:`~symstab.numeric.paper.paper_loop.paper_point`): its parameters are
     Table I's variables, its plane ``(B, K)`` is ``(beta, alpha)``.
     """
-    from ..numeric.paper_loop import paper_point
+    from ..numeric.paper.paper_loop import paper_point
 
     loop, values = paper_point(gamma=paper.gamma, d=paper.d, delta=paper.delta)
     x, y = ("B", "K") if plane else (None, None)

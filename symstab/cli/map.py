@@ -41,7 +41,7 @@ LOOP_SIMULATE_HEADLINE = ("map --loop --simulate: every cell simulated, the loop
                           "root count beside")
 
 #: The colour and legend of a cell whose run settles into a bounded limit cycle
-#: (:attr:`symstab.numeric.simulate.Simulation.limit_cycle`): neither stable
+#: (:attr:`symstab.numeric.paper.simulate.Simulation.limit_cycle`): neither stable
 #: (green) nor growing (white).
 LIMIT_CYCLE_COLOR = "#fdb863"
 LIMIT_CYCLE_LABEL = "bounded limit cycle (simulated)"
@@ -127,9 +127,10 @@ def map_outputs(args):
 
 def _paper(args):
     """The paper's loop simulated at every cell of the grid."""
-    from ..numeric.simulate import (check_device_nonideal, check_steps, progress_printer,
-                                    stability_map)
-    from ..numeric.stability import MARGINAL, STABLE
+    from ..numeric.paper.simulate import check_device_nonideal, stability_map
+    from .._progress import progress_printer
+    from ..numeric.simulation.simulator import check_steps
+    from ..numeric.engine.roots import MARGINAL, STABLE
 
     setup = resolve(args)
     nonideal, x0 = resolve_nonideal(args, setup)
@@ -296,8 +297,9 @@ _LOOP_SIMULATION_OPTIONS = (("--steps", "steps"), ("--x0", "x0"),
 
 def _loop(args):
     """A loop file classified by its root counts at every cell of the grid (and simulated)."""
-    from ..numeric.simulate import check_steps, progress_printer
-    from ..numeric.stability import MARGINAL, STABLE
+    from .._progress import progress_printer
+    from ..numeric.simulation.simulator import check_steps
+    from ..numeric.engine.roots import MARGINAL, STABLE
 
     setup = resolve_loop(args)
     if args.x_range is None or args.y_range is None:
@@ -399,8 +401,8 @@ def _loop_npz(setup, xs, ys, values, **arrays):
 
 def _probability(args, setup, xs, ys, out, png_path):
     """``map --loop --uncertain``: the probability of stability of every cell, its files and PNG."""
-    from ..numeric.probability import MAX_SAMPLES, draw_values
-    from ..numeric.simulate import progress_printer
+    from ..numeric.analysis.probability import MAX_SAMPLES, draw_values
+    from .._progress import progress_printer
 
     if args.simulate:
         raise ValueError("--uncertain maps the probability of stability by root counts; "
@@ -507,11 +509,11 @@ def _loop_png(setup, xs, ys, code, simulated=None):
     """The map as PNG bytes (None without matplotlib), with the D-decomposition drawn over it.
 
     Shaded by the root counts, or by the simulation (``simulated``, a
-    :class:`~symstab.numeric.simulate.StabilityMap`) where one ran: its
+    :class:`~symstab.numeric.paper.simulate.StabilityMap`) where one ran: its
     stable cells and its bounded limit cycles, each its own colour; the
     D-decomposition drawn over it is the root counts' boundary.
     """
-    from ..numeric.stability import MARGINAL, STABLE
+    from ..numeric.engine.roots import MARGINAL, STABLE
 
     plt = pyplot_or_none()
     if plt is None:

@@ -43,7 +43,7 @@ def add_command(sub, name, *, help, description, example, func):
 class Setup:
     """The resolved inputs of a numeric command."""
 
-    device: object  # symstab.numeric.units.Device or None (dimensionless input)
+    device: object  # symstab.numeric.paper.device.Device or None (dimensionless input)
     gamma: float
     d: int
     delta: float
@@ -117,7 +117,7 @@ def resolve(args, *, mass=True):
     ``mass=False`` (``design``, which searches over the virtual mass) leaves
     the virtual mass out of the echo and of the JSON inputs.
     """
-    from ..numeric.units import PAPER_DEVICE, Device
+    from ..numeric.paper.device import PAPER_DEVICE, Device
 
     physical = [name for name in ("m", "b", "T", "Td") if getattr(args, name) is not None]
     if args.delta is not None:

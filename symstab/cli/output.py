@@ -121,7 +121,7 @@ def write_output(path, data, flag):
     (:func:`symstab.proof.derive.write_bytes`), which is removed on any failure,
     Ctrl-C and SIGTERM included.
     """
-    from ..proof.derive import write_bytes
+    from .._io import write_bytes
 
     if isinstance(data, str):
         data = data.encode("utf-8")
@@ -234,7 +234,7 @@ def interval_texts(runs, codes, name, unit="", *, stable_ends="boundary"):
     runs : list of (float, float)
         The stable intervals, increasing; an end may be infinite.
     codes : list of (int, int)
-        The classification (:data:`symstab.numeric.stability.MARGINAL`,
+        The classification (:data:`symstab.numeric.paper.stability.MARGINAL`,
         ``UNSTABLE`` or ``STABLE``) of each finite end (ignored for infinite ones).
     name, unit : str
         The parameter along the intervals, and its unit.
@@ -251,7 +251,7 @@ def interval_texts(runs, codes, name, unit="", *, stable_ends="boundary"):
         (``"marginal"``, ``"unstable"``, ``"boundary"``, ``"stable"`` or
         ``"infinite"``) for JSON.
     """
-    from ..numeric.stability import MARGINAL, STABLE, UNSTABLE
+    from ..numeric.engine.roots import MARGINAL, STABLE, UNSTABLE
 
     if stable_ends not in ("boundary", "closed"):
         raise ValueError(f"stable_ends must be 'boundary' or 'closed', got {stable_ends!r}")

@@ -56,9 +56,10 @@ def run(args):
                          f"writes the trajectory as CSV with --out")
     if uses_loop(args):
         return _loop(args)
-    from ..numeric.simulate import simulate
-    from ..numeric.stability import MARGINAL, STABLE, UNSTABLE
-    from ..numeric.simulate import check_steps, progress_printer
+    from ..numeric.paper.simulate import simulate
+    from ..numeric.engine.roots import MARGINAL, STABLE, UNSTABLE
+    from .._progress import progress_printer
+    from ..numeric.simulation.simulator import check_steps
 
     setup = resolve(args)
     alpha, beta = _point(args, setup)
@@ -107,8 +108,9 @@ def run(args):
 
 def _loop(args):
     """A loop file simulated at its values changed by ``--set``, its root count beside."""
-    from ..numeric.simulate import check_steps, progress_printer
-    from ..numeric.stability import MARGINAL, STABLE, UNSTABLE
+    from .._progress import progress_printer
+    from ..numeric.simulation.simulator import check_steps
+    from ..numeric.engine.roots import MARGINAL, STABLE, UNSTABLE
 
     setup = resolve_loop(args, plane=False)
     loop, values = setup.loop, setup.values

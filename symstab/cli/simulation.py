@@ -12,7 +12,7 @@ __all__ = ["add_nonideal_options", "resolve_nonideal", "simulated_theory", "noni
            "loop_nonideal_text", "with_option_names", "check_loop_friction"]
 
 
-#: The option of each field of :class:`~symstab.numeric.simulate.Nonidealities`.
+#: The option of each field of :class:`~symstab.numeric.paper.simulate.Nonidealities`.
 _OPTION_OF = {"encoder_resolution": "--encoder-resolution", "velocity_cutoff": "--velocity-cutoff",
               "coulomb_friction": "--coulomb", "stiction": "--stiction",
               "friction_compensation": "--friction-compensation",
@@ -68,8 +68,8 @@ def resolve_nonideal(args, setup, loop=None):
     ``setup`` is the paper's device options, or None for a loop file,
     ``loop``, whose simulation the options are checked against.
     """
-    from ..numeric.simulate import (PAPER_ENCODER_RESOLUTION, Nonidealities, check_loop_nonideal,
-                                    check_x0, default_x0)
+    from ..numeric.simulation.simulator import (PAPER_ENCODER_RESOLUTION, Nonidealities,
+        check_loop_nonideal, check_x0, default_x0)
 
     # A command with add_nonideal_options(loop_only=True) has not the paper's options.
     option = {name: getattr(args, name, None) for name in (
@@ -119,7 +119,7 @@ def with_option_names(exc):
     """``exc`` (a TypeError or ValueError of the library) naming the options, not the fields.
 
     For the checks the simulation makes itself before it runs (the friction
-    against the plant's step, :func:`~symstab.numeric.simulate.check_friction_size`).
+    against the plant's step, :func:`~symstab.numeric.paper.simulate.check_friction_size`).
     """
     return type(exc)(_FIELD_NAMES.sub(lambda m: _OPTION_OF[m.group(1)], str(exc)))
 
@@ -130,8 +130,8 @@ def check_loop_friction(nonideal, loop, values):
     Decided before the run (and before anything is printed): the friction
     spaces are the run's own (cached by the loop).
     """
-    from ..numeric.friction import substeps_of
-    from ..numeric.simulate import check_friction_size
+    from ..numeric.simulation.friction import substeps_of
+    from ..numeric.simulation.simulator import check_friction_size
 
     if nonideal.coulomb_friction is not None:
         spaces, _ = loop.friction_spaces(substeps_of(nonideal), **values)
@@ -139,8 +139,8 @@ def check_loop_friction(nonideal, loop, values):
 
 
 def simulated_theory(setup, nonideal):
-    """The :class:`symstab.numeric.simulate_theory.LinearTheory` of the loop simulated."""
-    from ..numeric.simulate_theory import linear_theory
+    """The :class:`symstab.numeric.paper.simulate_theory.LinearTheory` of the loop simulated."""
+    from ..numeric.paper.simulate_theory import linear_theory
 
     return linear_theory(gamma=setup.gamma, d=setup.d, delta=setup.delta,
                          device=setup.device, nonideal=nonideal)

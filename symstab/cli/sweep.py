@@ -104,8 +104,8 @@ def run(args):
                              f"got {args.connect_timeout:g}")
     plan = read_spec(args.spec)
     client_of = None if args.serial else _client_factory(args)
-    from ..numeric.sweep import ChunkStore, run_sweep, sweep_key
-    from ..numeric.simulate import progress_printer
+    from .sweep_store import ChunkStore, run_sweep, sweep_key
+    from .._progress import progress_printer
 
     rows, chunk = plan["rows"], plan["chunk"]
     n_chunks = math.ceil(len(rows) / chunk)
@@ -349,7 +349,7 @@ def _starting_children(start):
 
 def read_spec(path):
     """The sweep of the spec at ``path``: its loop, plane, question, rows (SI) and chunk size."""
-    from ..numeric.loop_files import tomllib
+    from ..numeric.loop.files import tomllib
 
     path = pathlib.Path(path)
     try:
@@ -377,7 +377,7 @@ def read_spec(path):
         loop_text = loop_path.read_text(encoding="utf-8")
     except OSError as exc:
         raise ValueError(f"{where}: cannot read {loop_path}: {exc.strerror or exc}") from None
-    from ..numeric.sweep import QUESTIONS, Question
+    from .sweep_store import QUESTIONS, Question
 
     kind = spec.get("question", "limits")
     if kind not in QUESTIONS:
@@ -389,7 +389,7 @@ def read_spec(path):
         raise ValueError(f"{where}: plane must be two parameter names, e.g. [\"B\", \"K\"]")
     x, y = plane
     try:
-        loop._check_plane((x, y))
+        loop.check_plane((x, y))
     except (TypeError, ValueError) as exc:
         raise ValueError(f"{where}: plane: {exc}") from None
     for section, keys, holds in _SECTIONS:
@@ -430,7 +430,7 @@ def read_spec(path):
         raise ValueError(f"{where}: {searched[0]} is swept and {what}: give it in [grid] or "
                          f"[random], or in {section}, not both")
     # The first row asked of the loop now: a value out of its domain is refused before the run.
-    from ..numeric.loop_units import FileParameters, check_bounds
+    from ..numeric.loop.quantities import FileParameters, check_bounds
 
     known = getattr(loop, "file_parameters", None) or FileParameters({})
     columns = {n: rows[:, k] for k, n in enumerate(names)}
@@ -488,11 +488,11 @@ def _robust(where, loop, x, y, table):
 
 def _simulated(where, loop, y, table):
     """The ``[simulated]`` table's options, in SI (the position's unit for the amplitude)."""
-    from ..numeric.simulate import Nonidealities
+    from ..numeric.simulation.simulator import Nonidealities
 
     if not isinstance(table, dict):
         raise ValueError(f"{where}: [simulated] must be a table")
-    from ..numeric.sweep import SIMULATION_KEYS
+    from .sweep_store import SIMULATION_KEYS
 
     extra = sorted(set(table) - set(SIMULATION_KEYS))
     if extra:
@@ -514,7 +514,7 @@ def _simulated(where, loop, y, table):
             raise ValueError(f"{where}: [simulated] steps must be a whole number from 10 to "
                              f"10000000, got {value!r}")
         options.append((key, float(value)))
-    from ..numeric.loop_simulate import X0_MAX, X0_MIN
+    from ..numeric.simulation.simulator import X0_MAX, X0_MIN
 
     x0 = dict(options).get("x0")
     if x0 is not None and not X0_MIN <= abs(x0) <= X0_MAX:
@@ -645,7 +645,7 @@ def _random(where, loop, x, y, table):
         return [], np.empty((0, 0)), ""
     # The declared ranges' corners, not only the draws, within the loop's bounds and domain.
     check_corners(loop, loop.defaults, x, y, ranges, f"{where}: [random]")
-    from ..numeric.probability import draw_values
+    from ..numeric.analysis.probability import draw_values
 
     # The draws of the probability map's: one seeded generator, whole delays for d.
     draws = draw_values(loop, ranges, samples, seed, axes=(x, y))

@@ -4,7 +4,7 @@ __all__ = ["tex_unit", "physical_columns"]
 
 
 def tex_unit(unit):
-    """A unit string of :meth:`symstab.numeric.units.Device.units` for matplotlib ("kg m^2" -> "kg m$^2$")."""
+    """A unit string of :meth:`symstab.numeric.paper.device.Device.units` for matplotlib ("kg m^2" -> "kg m$^2$")."""
     return unit.replace("^2", "$^2$")
 
 

@@ -2,12 +2,9 @@
 printers and file layout (``symstab/_generated``), and any loop's kernels.
 """
 
+from .._lazy import submodules
 
-def __getattr__(name):
-    # Modules load on first use (``symstab.numeric.stability`` after ``import symstab``).
-    import importlib
-    import importlib.util
+#: Modules that moved: ``forms`` shared its name with :mod:`symstab.symbolic.forms`.
+MOVED = {"forms": "symstab.codegen.float_forms"}
 
-    if name.startswith("__") or importlib.util.find_spec(f"{__name__}.{name}") is None:
-        raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
-    return importlib.import_module(f"{__name__}.{name}")
+__getattr__ = submodules(__name__, MOVED)

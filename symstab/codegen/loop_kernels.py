@@ -204,12 +204,12 @@ def environment_kernels(loop):
     -------
     (list of Kernel, tuple of str)
     """
-    names = loop._environment_names
+    names = loop.environment_names
     if model.T in loop.environment.free_symbols:
         names = names + ("T",)
     names = tuple(dict.fromkeys(names))
-    args = [(loop._symbols[n], f"parameter {n}") for n in names]
-    ve_n, ve_d = loop._environment_parts
+    args = [(loop.symbols[n], f"parameter {n}") for n in names]
+    ve_n, ve_d = loop.environment_parts
     outputs = ([(f"num{k}", c, f"coefficient of z^{len(ve_n) - 1 - k} of Ve_n")
                 for k, c in enumerate(ve_n)]
                + [(f"den{k}", c, f"coefficient of z^{len(ve_d) - 1 - k} of Ve_d")
@@ -217,8 +217,8 @@ def environment_kernels(loop):
     kernels = [kernel("environment", args, outputs,
                       f"Numerator and denominator of VE(z) = {loop.environment}, "
                       f"highest power of z first.")]
-    for name in loop._environment_names:
-        symbol = loop._symbols[name]
+    for name in loop.environment_names:
+        symbol = loop.symbols[name]
         if is_affine(ve_n + ve_d, [symbol]):
             kernels.append(kernel(
                 f"environment_slope_{name}", args,

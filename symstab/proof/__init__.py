@@ -2,12 +2,6 @@
 derivation files that ``symstab derive`` writes and checks for drift.
 """
 
+from .._lazy import submodules
 
-def __getattr__(name):
-    # Modules load on first use (``symstab.numeric.stability`` after ``import symstab``).
-    import importlib
-    import importlib.util
-
-    if name.startswith("__") or importlib.util.find_spec(f"{__name__}.{name}") is None:
-        raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
-    return importlib.import_module(f"{__name__}.{name}")
+__getattr__ = submodules(__name__)

@@ -10,13 +10,12 @@ run gives identical files.
 writes it atomically; :func:`check` compares it with what is on disk.
 """
 
-import os
 import pathlib
-import tempfile
 
 import sympy as sp
 
-from ..codegen import forms as kernel_forms
+from .._io import write_bytes
+from ..codegen import float_forms as kernel_forms
 from . import loop_derive, necessity
 from .steps import Step, render  # noqa: F401  (part of this module's API)
 from ..symbolic import model
@@ -171,32 +170,6 @@ def derivation_steps():
     steps.append(Step("08_necessity", "Necessary conditions for stability, for every delay d",
                       necessity.objects()))
     return steps
-
-
-def write_bytes(path, data):
-    """Write ``data`` (bytes) to ``path`` atomically.
-
-    The bytes go to a temporary name in the same folder, which is renamed
-    into place, so a failure never leaves a half-written file.  A link is
-    followed (its target is replaced, not the link), and a path that exists
-    but is not a regular file (a device such as ``/dev/null``, a pipe) is
-    refused: the rename would replace it.
-    """
-    path = pathlib.Path(os.path.realpath(path))
-    if path.exists() and not path.is_file():
-        raise OSError(f"{path} exists and is not a regular file (a device, a pipe or a folder)")
-    folder = path.parent
-    folder.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(dir=folder, prefix=f".{path.name}.", suffix=".tmp")
-    try:
-        with os.fdopen(fd, "wb") as fh:
-            fh.write(data)
-        os.chmod(tmp, 0o644)
-        os.replace(tmp, path)
-    except BaseException:
-        pathlib.Path(tmp).unlink(missing_ok=True)
-        raise
-    return path
 
 
 def write(out_dir, files):

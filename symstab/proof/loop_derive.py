@@ -350,7 +350,7 @@ def derivation_steps(loop):
     from .steps import Step
 
     z, d = model.z, model.d
-    ve_n, ve_d = (_poly_expr(c) for c in loop._environment_parts)
+    ve_n, ve_d = (_poly_expr(c) for c in loop.environment_parts)
     plant_names = [str(x) for x in _parameter_symbols(loop, loop.plant) if x != model.T]
     # The loop file's text is checked to be one printable line; escaped all the
     # same, since render writes titles and descriptions into LaTeX comments.

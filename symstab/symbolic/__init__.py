@@ -3,12 +3,6 @@ polynomial, its split on the unit circle, the boundary, theta_max and the
 small-theta limits, and any loop's symbolic assembly.
 """
 
+from .._lazy import submodules
 
-def __getattr__(name):
-    # Modules load on first use (``symstab.numeric.stability`` after ``import symstab``).
-    import importlib
-    import importlib.util
-
-    if name.startswith("__") or importlib.util.find_spec(f"{__name__}.{name}") is None:
-        raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
-    return importlib.import_module(f"{__name__}.{name}")
+__getattr__ = submodules(__name__)

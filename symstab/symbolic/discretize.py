@@ -245,7 +245,7 @@ def interval_zoh(numerator, denominator, T):
     """Enclosures of Z[ZOH G]'s coefficients in ``w = z - 1`` over intervals of G's coefficients.
 
     The interval counterpart of :func:`numeric_zoh` (same realisation),
-    for the robust regions of :mod:`symstab.numeric.robust`:
+    for the robust regions of :mod:`symstab.numeric.analysis.robust`:
     ``numerator`` and ``denominator`` are :class:`mpmath.iv.mpf` intervals
     of ``G``'s coefficients in ``s`` (highest power first) and ``T`` one of
     the period.  ``Psi = exp([[A, B], [0, 0]] T) - I`` is enclosed with a

@@ -31,6 +31,7 @@ import numpy as np
 import sympy as sp
 
 from . import model
+from .._memo import method_cache
 from .._validate import check_delay
 from .derivation_cache import DerivationCache
 from .discretize import numeric_zoh, written_poles, zoh_pulse_transfer_function
@@ -565,13 +566,15 @@ class LoopModel:
         symbols.pop("T", None)
         for name in symbols:
             check_parameter_name(name)
-        self._symbols = dict(sorted(symbols.items()))
-        self._symbols["T"] = model.T
-        self._plant_names = tuple(n for n in self._symbols
-                                  if self._symbols[n] in self.plant.free_symbols)
-        self._environment_names = tuple(n for n in self._symbols
-                                        if self._symbols[n] in self.environment.free_symbols)
-        self.parameters = tuple(self._symbols) + ("d",)
+        #: ``{name: SymPy symbol}`` of the loop's parameters (``T`` last), read-only.
+        self.symbols = dict(sorted(symbols.items()))
+        self.symbols["T"] = model.T
+        #: The parameters that appear in the plant ``G(s)``, and in the environment.
+        self.plant_names = tuple(n for n in self.symbols
+                                  if self.symbols[n] in self.plant.free_symbols)
+        self.environment_names = tuple(n for n in self.symbols
+                                        if self.symbols[n] in self.environment.free_symbols)
+        self.parameters = tuple(self.symbols) + ("d",)
         self.defaults = {}
         for key, value in (values or {}).items():
             if key not in self.parameters:
@@ -592,7 +595,7 @@ class LoopModel:
             plane = tuple(plane)
             if len(plane) != 2:
                 raise ValueError(f"plane must be two parameter names, got {plane!r}")
-            self._check_plane(plane)
+            self.check_plane(plane)
             self.plane = plane
 
     def __repr__(self):
@@ -603,7 +606,7 @@ class LoopModel:
     def _derivation(self):
         """The loop's derivation cached on disk (:mod:`symstab.symbolic.derivation_cache`)."""
         return DerivationCache(self.plant, self.environment,
-                               dict(self._symbols, s=model.s, z=model.z))
+                               dict(self.symbols, s=model.s, z=model.z))
 
     def _derived(self, name, derive, agrees=None):
         """``derive()``, or what an earlier derivation of this loop stored under ``name``.
@@ -633,9 +636,9 @@ class LoopModel:
     def _check_point(self):
         """Parameter values (none 0, 1 or equal to another) for checking cached parts."""
         point = {model.T: sp.Float("0.0213", PLANT_DIGITS)}
-        others = [n for n in self._symbols if n != "T"]
+        others = [n for n in self.symbols if n != "T"]
         for k, name in enumerate(others):
-            point[self._symbols[name]] = sp.Float(repr(1 + 0.3183098861837907 * (k + 1)), PLANT_DIGITS)
+            point[self.symbols[name]] = sp.Float(repr(1 + 0.3183098861837907 * (k + 1)), PLANT_DIGITS)
         return point
 
     def _at_check_point(self, coefficients):
@@ -670,13 +673,19 @@ class LoopModel:
 
     def _parts_agree(self, parts):
         """Whether the delayed and direct parts are Ve_d P_d and Ve_n P_n at the check point."""
-        (ve_n, ve_d), (p_n, p_d) = self._environment_parts, self._plant_parts
+        (ve_n, ve_d), (p_n, p_d) = self.environment_parts, self._plant_parts
         at = self._at_check_point
         return (self._close(at(parts[0]), at(ve_d) * at(p_d))
                 and self._close(at(parts[1]), at(ve_n) * at(p_n)))
 
     @functools.cached_property
-    def _environment_parts(self):
+    def environment_parts(self):
+        """``(Ve_n, Ve_d)``: the environment's numerator and denominator coefficients in ``z``.
+
+        Lists of SymPy expressions in the loop's symbols, highest power of
+        ``z`` first, from ``VE(z)`` brought over one denominator and
+        cancelled (derived once, and kept in the derivation cache).
+        """
         def derive():
             num, den = sp.fraction(sp.cancel(sp.together(self.environment)))
             return poly_coeffs(num, model.z), poly_coeffs(den, model.z)
@@ -739,20 +748,20 @@ class LoopModel:
                            else self._symbolic_parts(values))
         poly = (z**model.d * sp.Add(*[c * z**k for k, c in enumerate(reversed(delayed))])
                 + sp.Add(*[c * z**k for k, c in enumerate(reversed(direct))]))
-        sub = {self._symbols[k]: v for k, v in values.items() if k != "d"}
+        sub = {self.symbols[k]: v for k, v in values.items() if k != "d"}
         poly = poly.subs(sub)
         if "d" in values:
             poly = poly.subs(model.d, check_delay(values["d"]))
         return poly
 
     def _symbolic_parts(self, values=None):
-        ve_n, ve_d = self._environment_parts
+        ve_n, ve_d = self.environment_parts
         if self._plant_parts is None:
-            need = [n for n in self._plant_names + ("T",) if n not in (values or {})]
+            need = [n for n in self.plant_names + ("T",) if n not in (values or {})]
             if need:
                 raise ValueError(f"the plant is discretised numerically: give "
                                  f"{', '.join(need)} to get its polynomial")
-            p_n, p_d = self._numeric_plant(tuple(float(values[n]) for n in self._plant_names),
+            p_n, p_d = self._numeric_plant(tuple(float(values[n]) for n in self.plant_names),
                                            float(values["T"]))[:2]
             p_n = [sp.Float(str(c), PLANT_DIGITS) for c in p_n]
             p_d = [sp.Float(str(c), PLANT_DIGITS) for c in p_d]
@@ -780,48 +789,77 @@ class LoopModel:
         plant discretised numerically only environment parameters qualify.
         """
         out = []
-        for name in self._symbols:
-            if self._affine((name,)):
+        for name in self.symbols:
+            if self.affine_in((name,)):
                 out.append(name)
         return tuple(out)
 
-    @functools.lru_cache(maxsize=None)
-    def _affine(self, names):
+    @method_cache()
+    def affine_in(self, names):
+        """Whether the characteristic polynomial is affine in the parameters ``names`` jointly.
+
+        Parameters
+        ----------
+        names : tuple of str
+            One or two parameter names of the loop.
+
+        Returns
+        -------
+        bool
+            True when every coefficient of chi is ``c0 + sum(c_i p_i)``
+            with no product of the ``p_i``: the parameters then span a plane
+            (or a line) the D-decomposition and the line engine can take.
+        """
         return self._derived(f"affine {','.join(names)}", lambda: self._decide_affine(names))
 
     def _decide_affine(self, names):
-        symbols = [self._symbols[n] for n in names]
+        symbols = [self.symbols[n] for n in names]
         if self._plant_parts is None:
-            if any(n in self._plant_names or n == "T" for n in names):
+            if any(n in self.plant_names or n == "T" for n in names):
                 return False
-            ve_n, ve_d = self._environment_parts
+            ve_n, ve_d = self.environment_parts
             return is_affine(ve_n + ve_d, symbols)
-        if len(names) == 2 and any(n in self._plant_names for n in names) and not all(
-                n in self._plant_names for n in names):
+        if len(names) == 2 and any(n in self.plant_names for n in names) and not all(
+                n in self.plant_names for n in names):
             # One in each block: affine only if the cross terms cancel, which
             # the slopes computed block by block would miss; refuse instead.
             return False
         delayed, direct = self._parts
-        if any(n in self._plant_names and n in self._environment_names for n in names):
+        if any(n in self.plant_names and n in self.environment_names for n in names):
             return False
         return is_affine(delayed + direct, symbols)
 
-    def _check_plane(self, names):
+    def check_plane(self, names):
+        """Refuse a plane (or line) whose parameters the loop cannot decompose over.
+
+        Parameters
+        ----------
+        names : tuple of str
+            The plane's one or two parameter names.
+
+        Raises
+        ------
+        TypeError
+            A name that is not a string.
+        ValueError
+            A name that is not a parameter of the loop, the same name twice,
+            or parameters that do not enter chi (jointly) affinely.
+        """
         for name in names:
             if not isinstance(name, str):
                 raise TypeError(f"a plane parameter must be a name (str), got {type(name).__name__}")
-            if name not in self._symbols:
+            if name not in self.symbols:
                 raise ValueError(f"{name!r} is not a parameter of this loop "
-                                 f"(parameters: {', '.join(self._symbols)})")
+                                 f"(parameters: {', '.join(self.symbols)})")
         if len(set(names)) != len(names):
             raise ValueError(f"the plane's parameters must differ, got {names[0]!r} twice")
         for name in names:
-            if not self._affine((name,)):
+            if not self.affine_in((name,)):
                 raise ValueError(
                     f"parameter {name!r} does not enter the characteristic polynomial affinely; "
                     f"a plane or a line needs affine parameters: "
                     f"{', '.join(self.affine_parameters()) or 'none'}")
-        if len(names) == 2 and not self._affine(tuple(names)):
+        if len(names) == 2 and not self.affine_in(tuple(names)):
             raise ValueError(f"parameters {names[0]!r} and {names[1]!r} do not enter the "
                              f"characteristic polynomial jointly affinely (a product of the two "
                              f"appears)")
@@ -844,8 +882,8 @@ class LoopModel:
         argument twice.  The plant's own ``T``, when it has one, is given
         the same value by the caller as the last argument.
         """
-        names = [self._symbols[n] for n in self._plant_names]
-        args = [sp.Dummy(n) for n in self._plant_names] + [sp.Dummy("T")]
+        names = [self.symbols[n] for n in self.plant_names]
+        args = [sp.Dummy(n) for n in self.plant_names] + [sp.Dummy("T")]
         rename = dict(zip(names, args))
         rename.setdefault(model.T, args[-1])
         exprs = [[sp.sympify(c).xreplace(rename) for c in part] for part in exprs]
@@ -900,7 +938,7 @@ class LoopModel:
 
     def _refuse_plant(self, point, T):
         self._check_distinct_poles(point, T)
-        given = ", ".join(f"{n} = {float(v):g}" for n, v in zip(self._plant_names, point))
+        given = ", ".join(f"{n} = {float(v):g}" for n, v in zip(self.plant_names, point))
         raise ValueError(f"the plant's pulse transfer function at {given}, T = {float(T):g} "
                          f"cancels beyond {PLANT_MAX_DIGITS} digits: a parameter is too small "
                          f"or too large for its closed form")
@@ -943,7 +981,7 @@ class LoopModel:
 
     def _meeting_poles(self, point, T):
         """``(expression, why, values)`` of the first of :attr:`_pole_conditions` that holds, or None."""
-        values = {self._symbols[n]: sp.Rational(float(v)) for n, v in zip(self._plant_names, point)}
+        values = {self.symbols[n]: sp.Rational(float(v)) for n, v in zip(self.plant_names, point)}
         values.setdefault(model.T, sp.Rational(float(T)))
         for expr, why in self._pole_conditions:
             if expr.xreplace(values) == 0:
@@ -962,9 +1000,9 @@ class LoopModel:
             return
         expr, why, values = meeting
         names = sorted(str(x) for x in expr.free_symbols)
-        given = ", ".join(f"{n} = {float(values[self._symbols[n]]):g}" for n in names)
+        given = ", ".join(f"{n} = {float(values[self.symbols[n]]):g}" for n in names)
         zero = " and ".join(f"{n} = 0" for n in names
-                            if values[self._symbols[n]] == 0) or f"{expr} = 0"
+                            if values[self.symbols[n]] == 0) or f"{expr} = 0"
         raise ValueError(
             f"the plant G(s) = {self.plant} is degenerate at {given}: {why}; give "
             f"{' or '.join(names)} another value, or write the plant as it is at {zero} "
@@ -976,7 +1014,7 @@ class LoopModel:
 
         ``[A_n, A_d, N, D]`` in ``s``, highest power first: the actuator
         ``A = A_n / A_d`` and the mass ``G / A = N / D`` (relative degree 2),
-        from which :mod:`symstab.numeric.friction` builds the state space on
+        from which :mod:`symstab.numeric.simulation.friction` builds the state space on
         which Coulomb friction acts.
 
         Raises
@@ -1090,12 +1128,12 @@ class LoopModel:
                             "numerator and denominator in s have opposite signs)")
         if not problems:
             return None
-        given = ", ".join(f"{n} = {float(v):g}" for n, v in zip(self._plant_names, plant_values))
+        given = ", ".join(f"{n} = {float(v):g}" for n, v in zip(self.plant_names, plant_values))
         return (f"the plant G(s) = {self.plant} at {given} has {' and '.join(problems)}: not a "
                 f"physical device's (a negative mass, friction or stiffness?); the results are "
                 f"those of that plant")
 
-    @functools.lru_cache(maxsize=4096)
+    @method_cache(maxsize=4096)
     def _plant_digits(self, plant_values, T):
         """``(P_n, P_d, digits)``: the pulse transfer function's coefficients as mpmath numbers.
 
@@ -1112,8 +1150,8 @@ class LoopModel:
         with mpmath.workdps(PLANT_DIGITS):
             point = [mpmath.mpf(float(v)) for v in plant_values]
             if self._plant_parts is None:
-                sub = {self._symbols[n]: sp.Float(float(v), PLANT_DIGITS)
-                       for n, v in zip(self._plant_names, plant_values)}
+                sub = {self.symbols[n]: sp.Float(float(v), PLANT_DIGITS)
+                       for n, v in zip(self.plant_names, plant_values)}
                 num, den = sp.fraction(sp.together(self.plant.subs(sub)))
                 num = [mpmath.mpf(sp.Float(c, PLANT_DIGITS)) for c in sp.Poly(num, model.s).all_coeffs()]
                 den = [mpmath.mpf(sp.Float(c, PLANT_DIGITS)) for c in sp.Poly(den, model.s).all_coeffs()]
@@ -1129,7 +1167,7 @@ class LoopModel:
             if not _defined(p_n, p_d):
                 if self._plant_parts is not None:
                     self._check_distinct_poles(plant_values, T)   # says which poles meet
-                given = ", ".join(f"{n} = {float(v):g}" for n, v in zip(self._plant_names, plant_values))
+                given = ", ".join(f"{n} = {float(v):g}" for n, v in zip(self.plant_names, plant_values))
                 raise ValueError(f"the plant's pulse transfer function is not defined at "
                                  f"{given}, T = {float(T):g} (its leading coefficient in s "
                                  f"vanishes there, or a value is not finite)")
@@ -1168,7 +1206,7 @@ class LoopModel:
     def _exact_plant(self, plant_values, T):
         """``(P_n, P_d)`` with monic ``P_d``, as exact Fractions of their 30-digit values.
 
-        For the arc's brackets (:class:`symstab.numeric.arcs.CramerArc`):
+        For the arc's brackets (:class:`symstab.numeric.engine.arcs.CramerArc`):
         rounded to doubles, the coefficients of a plant with a zero or a
         pole next to ``z = +-1`` lose what the arc needs there.
         """
@@ -1177,7 +1215,7 @@ class LoopModel:
             lead = p_d[0]
             return tuple(tuple(_fraction(c / lead) for c in part) for part in (p_n, p_d))
 
-    @functools.lru_cache(maxsize=4096)
+    @method_cache(maxsize=4096)
     def _plant_cache(self, plant_values, T):
         """(P_n, P_d, ends, P_d in z - 1) as float arrays, monic P_d, evaluated at 30 digits.
 

@@ -10,7 +10,7 @@ over one period (the zero-order hold) the state advances exactly as
 computed here by SymPy's matrix exponential and integral.  In Table I's
 units -- position as it is, ``v T`` for the velocity and ``f T**2 / m`` for
 the force -- the step depends on ``delta`` alone; :func:`dimensionless_step`
-returns it, and :mod:`symstab.codegen.forms` rewrites it with ``expm1`` for
+returns it, and :mod:`symstab.codegen.float_forms` rewrites it with ``expm1`` for
 floating point (proved equal by ``symstab derive``).
 """
 

@@ -22,8 +22,8 @@ equation R (:func:`reduced_equation`) in every arithmetic: it proves each
 cell before the root free of roots with a bound on ``|R''|``
 (:func:`reduced_curvature`), so it cannot step over a narrow dip of alpha
 below zero nor a root next to theta = pi.  The float
-:func:`symstab.numeric.curves.arc_end_angle` uses it too, and the interval
-enclosure (:mod:`symstab.numeric.theta_bounds`) shares its R
+:func:`symstab.numeric.paper.curves.arc_end_angle` uses it too, and the interval
+enclosure (:mod:`symstab.numeric.paper.theta_bounds`) shares its R
 (:func:`reduced_value_slope`) and q, r.
 """
 
@@ -456,8 +456,8 @@ def phase_equation():
 
 # -- The first root of R: a scan that cannot step over one ------------------
 #
-# theta_max (30 digits, here), the float arc_end_angle (symstab.numeric.curves)
-# and the certified enclosure (symstab.numeric.theta_bounds) all need R and
+# theta_max (30 digits, here), the float arc_end_angle (symstab.numeric.paper.curves)
+# and the certified enclosure (symstab.numeric.paper.theta_bounds) all need R and
 # R' in one non-symbolic arithmetic or another; the formulas live here, below
 # all three.
 

@@ -227,7 +227,7 @@ def test_the_simulated_target_names_what_it_simulated(capsys, tmp_path):
     assert found["search"]["simulated"]["x0"] == 0.01
     assert found["search"]["simulated"]["at_top"] is False
     loop = symstab.load_loop(LOOPS / "lowpass_velocity.toml")
-    from symstab.numeric.simulate import Nonidealities
+    from symstab.numeric.simulation.simulator import Nonidealities
 
     library = loop.design(over={"f_c": (50.0, 400.0)}, n=3, maximize="simulated",
                           amplitude=1e-3, steps=2000,

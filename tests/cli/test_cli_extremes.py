@@ -113,7 +113,7 @@ def test_the_delay_cap_follows_its_environment_variable(capsys, monkeypatch):
 
 def test_a_billion_boundary_points_are_refused_before_any_allocation(capsys, monkeypatch):
     """boundary --n 1e9 grew to 23 GB; now refused naming --n and the limit, allocating nothing."""
-    from symstab.numeric import region
+    from symstab.numeric.paper import region
 
     _forbid(monkeypatch, region, "boundary_curve", "boundary_curve")
     tracemalloc.start()
@@ -128,7 +128,7 @@ def test_a_billion_boundary_points_are_refused_before_any_allocation(capsys, mon
 
 def test_a_trajectory_beyond_the_memory_limit_is_refused_before_simulating(capsys, tmp_path,
                                                                           monkeypatch):
-    from symstab.numeric import simulate
+    from symstab.numeric.paper import simulate
 
     monkeypatch.chdir(tmp_path)
     monkeypatch.setenv("SYMSTAB_MEMORY_LIMIT", "1M")
@@ -207,7 +207,7 @@ def test_long_delays_answer_or_refuse_in_one_line(tmp_path, args):
 @pytest.mark.parametrize("png", ["m.npz", "./m.npz", "sub/../m.npz", "ABSOLUTE"])
 def test_map_refuses_png_and_out_naming_the_same_file(capsys, tmp_path, monkeypatch, png):
     """--png m.npz overwrote the NPZ with the PNG and reported both written."""
-    from symstab.numeric import simulate
+    from symstab.numeric.paper import simulate
 
     monkeypatch.chdir(tmp_path)
     (tmp_path / "sub").mkdir()
@@ -222,7 +222,7 @@ def test_map_refuses_png_and_out_naming_the_same_file(capsys, tmp_path, monkeypa
 def test_an_output_that_is_a_device_or_a_pipe_is_refused_before_the_work(capsys, tmp_path,
                                                                         monkeypatch):
     """--png /dev/null was replaced by a regular file (the atomic rename); a pipe likewise."""
-    from symstab.numeric import locus
+    from symstab.numeric.engine import locus
 
     pipe = tmp_path / "pipe"
     os.mkfifo(pipe)
@@ -233,7 +233,7 @@ def test_an_output_that_is_a_device_or_a_pipe_is_refused_before_the_work(capsys,
 
 
 def test_an_output_behind_a_link_replaces_the_target_not_the_link(tmp_path):
-    from symstab.proof.derive import write_bytes
+    from symstab._io import write_bytes
 
     target = tmp_path / "target.txt"
     target.write_text("old")
@@ -259,7 +259,7 @@ def _unwritable_folder(tmp_path):
 def test_output_folder_is_checked_before_the_simulation(capsys, tmp_path, monkeypatch, command,
                                                        where):
     """An unwritable --out folder was found after the whole run, named by a temporary file."""
-    from symstab.numeric import simulate
+    from symstab.numeric.paper import simulate
 
     monkeypatch.chdir(tmp_path)
     if where == "missing":
@@ -282,7 +282,7 @@ def test_output_folder_is_checked_before_the_simulation(capsys, tmp_path, monkey
 
 
 def test_map_png_folder_is_checked_before_the_simulation(capsys, tmp_path, monkeypatch):
-    from symstab.numeric import simulate
+    from symstab.numeric.paper import simulate
 
     monkeypatch.chdir(tmp_path)
     target = str(tmp_path / "missing" / "m.png")

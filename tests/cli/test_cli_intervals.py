@@ -14,7 +14,7 @@ import re
 import numpy as np
 import pytest
 
-from symstab.numeric.stability import MARGINAL, STABLE, UNSTABLE
+from symstab.numeric.engine.roots import MARGINAL, STABLE, UNSTABLE
 
 from conftest import REPO, run_cli
 

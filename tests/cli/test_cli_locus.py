@@ -65,7 +65,7 @@ def test_table_lists_each_crossing_once(capsys):
 
 def test_dimensionless_path_along_beta(capsys):
     """β from -0.5 to 3 at α = 0.5, γ = 1, d = 1: in at one end of the stable β, out at the other."""
-    from symstab.numeric.stability import unstable_root_counts
+    from symstab.numeric.paper.stability import unstable_root_counts
 
     data = run_json(capsys, "locus", "--delta", "0.0025", "--d", "1", "--gamma", "1",
                     "--alpha", "0.5", "--beta=-0.5:3:351")

@@ -124,8 +124,8 @@ def test_a_huge_stiffness_is_decided_not_lost_in_rounding(capsys):
 
 
 def test_boundary_lies_on_the_derived_curve_and_names_its_lines(capsys):
-    from symstab.numeric.curves import minus_one_line
-    from symstab.numeric.evaluate import boundary_point
+    from symstab.numeric.paper.curves import minus_one_line
+    from symstab.numeric.paper.reference import boundary_point
 
     data = run_json(capsys, "boundary", "--loop", PAPER, "--set", "d=10", "--n", "40")
     rows = data["rows"]
@@ -236,7 +236,7 @@ def test_map_files_are_the_same_bytes_run_to_run(capsys, tmp_path):
 
 
 def test_map_interrupted_while_classifying_writes_nothing(capsys, tmp_path, monkeypatch):
-    from symstab.numeric.any_loop import Loop
+    from symstab.numeric.loop.sampled_loop import Loop
 
     def interrupted(self, **values):
         raise KeyboardInterrupt

@@ -166,7 +166,7 @@ def test_map_simulates_friction_on_the_loop_s_mass(capsys, tmp_path):
         assert "Coulomb friction 0.02" in str(f["nonidealities"])
         B, K = np.meshgrid(f["x"], f["y"], indexing="ij")
         run_ = loop.simulate(B=B, K=K, steps=3000, x0=0.01,
-                             nonideal=symstab.numeric.simulate.Nonidealities(coulomb_friction=0.02))
+                             nonideal=symstab.numeric.paper.simulate.Nonidealities(coulomb_friction=0.02))
         np.testing.assert_array_equal(f["simulated_stable"], run_.stable)
 
 

@@ -1,7 +1,7 @@
 """``map --loop --uncertain``: the probability of stability of every cell, from the command line.
 
 Oracles: the library's map (tested against an independent python-control
-sampling in tests/numeric/test_probability.py) at the values the options
+sampling in tests/numeric/analysis/test_probability.py) at the values the options
 name, whatever unit they are written in; the root counts where nothing
 varies.  Bad input is one line, exit status 2, before any work, and nothing
 is written.

@@ -1,7 +1,7 @@
 """``limits --loop --uncertain``: the robust limits from the command line.
 
 Oracle: the library's robust limits (tested against python-control's poles
-in tests/numeric/test_robust.py) at the values the options name, in any
+in tests/numeric/analysis/test_robust.py) at the values the options name, in any
 unit.  Bad input is one line, exit status 2, before any work, and nothing
 is written.
 """

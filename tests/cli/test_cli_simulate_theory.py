@@ -11,8 +11,8 @@ functions, the delay, and the closed loop's poles.
 import numpy as np
 import pytest
 
-from symstab.numeric.stability import MARGINAL, STABLE
-from symstab.numeric.units import PAPER_DEVICE
+from symstab.numeric.engine.roots import MARGINAL, STABLE
+from symstab.numeric.paper.device import PAPER_DEVICE
 
 from conftest import run_cli
 from oracles import simulated_loop_radius as oracle_radius

@@ -226,7 +226,7 @@ def test_a_serial_sweep_stopped_by_sigterm_says_how_to_resume(tmp_path):
 def test_an_interruption_before_the_first_chunk_leaves_no_folder(capsys, tmp_path,
                                                                  monkeypatch):
     """A folder holding only sweep.json was left (nothing in it to resume from)."""
-    from symstab.numeric import sweep as numeric_sweep
+    from symstab.cli import sweep_store as numeric_sweep
 
     def interrupted(*args):
         raise KeyboardInterrupt
@@ -469,7 +469,7 @@ def test_robust_region_and_simulated_rows_are_the_loop_s(capsys, tmp_path):
     status, text, err = run(capsys, "sweep", path, "--out", tmp_path / "s.csv", "--serial")
     assert status == 0, err
     header, rows = read_csv(tmp_path / "s.csv")
-    from symstab.numeric.simulate import Nonidealities
+    from symstab.numeric.simulation.simulator import Nonidealities
 
     found = loop.simulated_limit(amplitude=0.001, steps=2000, d=5,
                                  nonideal=Nonidealities(encoder_resolution=0.0015))

@@ -128,7 +128,7 @@ DELTA = figures.DELTA
 
 def _numpy_unstable(alpha, beta, gamma, d):
     """Closed-loop poles outside the unit circle, by numpy's eigenvalue roots (the oracle)."""
-    from symstab.numeric.stability import loop_coefficients
+    from symstab.numeric.paper.stability import loop_coefficients
 
     c = loop_coefficients(alpha=alpha, beta=beta, gamma=gamma, d=d, delta=DELTA)
     return int(np.sum(np.abs(np.roots(c)) > 1.0))
@@ -145,7 +145,7 @@ def _panels(fig, d):
 def test_every_named_arc_is_whole_in_some_panel_of_its_delay(drawn, name, gammas, delays):
     # Fig. 8 showed gamma = 1.5, 2 and 2.2 at d = 1 as stubs at the left edge;
     # Fig. 7 cut the tips of gamma = 2.5 and 3, which then read as two lines each.
-    from symstab.numeric.region import boundary_curve
+    from symstab.numeric.paper.region import boundary_curve
 
     fig = drawn[name]
     for d in delays:
@@ -204,7 +204,7 @@ def test_no_legend_covers_a_plotted_point(drawn, name):
 def test_z_width_closes_to_zero_where_the_region_vanishes(drawn, name, right):
     # Fig. 12 left a gap between the last stable gamma of the grid and the
     # "no stable region" band; the Z-width never reached 0.
-    from symstab.numeric.region import limits
+    from symstab.numeric.paper.region import limits
 
     lower = drawn[name].axes[4:8]
     assert len(lower) == 4, "a lower row of linear Z-width panels"
@@ -227,8 +227,8 @@ def test_z_width_closes_to_zero_where_the_region_vanishes(drawn, name, right):
 def test_fig10_draws_the_lower_edge_of_the_gamma_1_band(drawn):
     # Panel (d) drew eq. (7) only up to theta_max: the stable band's lower
     # edge was not drawn and half the loop read as a disagreement.
-    from symstab.numeric.region import StabilityRegion
-    from symstab.numeric.units import PAPER_DEVICE as dev
+    from symstab.numeric.paper.region import StabilityRegion
+    from symstab.numeric.paper.device import PAPER_DEVICE as dev
 
     ax = drawn["fig10"].axes[3]
     assert r"M_w = m$" in ax.get_title()  # not "1 m"
@@ -261,7 +261,7 @@ def test_fig10_draws_the_lower_edge_of_the_gamma_1_band(drawn):
 
 
 def test_fig10_counts_in_the_cells_agree_with_numpy_roots(drawn):
-    from symstab.numeric.units import PAPER_DEVICE as dev
+    from symstab.numeric.paper.device import PAPER_DEVICE as dev
 
     fig = drawn["fig10"]
     for ax, g in zip(fig.axes[:4], (-0.5, 0.0, 0.5, 1.0)):
@@ -276,7 +276,7 @@ def test_fig10_counts_in_the_cells_agree_with_numpy_roots(drawn):
 def test_fig10_passive_outline_lies_in_the_stable_set(drawn):
     # Colgate-Schenkel: a passive environment on the passive device is stable,
     # so the outline drawn as passive must lie in the stable set (numpy's roots).
-    from symstab.numeric.units import PAPER_DEVICE as dev
+    from symstab.numeric.paper.device import PAPER_DEVICE as dev
 
     ax = drawn["fig10"].axes[1]  # gamma = 0: the only panel with a passive set
     outline, = [line for line in ax.lines if line.get_color() == figures._PASSIVE]

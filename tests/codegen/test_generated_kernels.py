@@ -1,6 +1,6 @@
 """Tests of the generated numeric kernels in ``symstab/_generated/``.
 
-``symstab derive`` prints the float-safe forms of :mod:`symstab.codegen.forms`
+``symstab derive`` prints the float-safe forms of :mod:`symstab.codegen.float_forms`
 as a NumPy module (``kernels.py``) and a C99 library
 (``symstab_kernels.c`` / ``.h``).  The exact checker proves the *forms*
 equal to the derivation; these tests measure what is left, the floating-point
@@ -10,7 +10,7 @@ evaluation of the printed code:
   signatures are the ones the kernels are called with;
 * C and NumPy agree to 1e-12 on a few thousand seeded random points;
 * both kernels match 50-digit mpmath references -- the derivation's own
-  (unrearranged) boundary :func:`symstab.numeric.evaluate.boundary_point`, the
+  (unrearranged) boundary :func:`symstab.numeric.paper.reference.boundary_point`, the
   definitions of the series functions (zoh_b1, ...) and ``characteristic_polynomial().numeric_coeffs``;
 * the naive float evaluation of the derivation's C-coefficient form fails
   the same accuracy check at small delta, so that check can fail, and the
@@ -42,8 +42,8 @@ import symstab
 from symstab.symbolic import model
 from symstab._generated import kernels as numpy_kernels
 from symstab.symbolic.boundary import boundary
-from symstab.numeric.evaluate import boundary_point
-from symstab.codegen.forms import SERIES_FUNCTIONS
+from symstab.numeric.paper.reference import boundary_point
+from symstab.codegen.float_forms import SERIES_FUNCTIONS
 from symstab.symbolic.theta_max import theta_max
 
 GENERATED = REPO / "symstab" / "_generated"

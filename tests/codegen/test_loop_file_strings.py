@@ -31,8 +31,8 @@ else:   # pragma: no cover - Python 3.10
 from symstab.cli import commands as cli
 from symstab.codegen.generator import comment_text, docstring_text, one_line
 from symstab.codegen.loop_kernels import c_source, environment_kernels, numpy_source
-from symstab.numeric.loop_files import load_loop, parse_loop_text
-from symstab.numeric.stability import STABLE
+from symstab.numeric.loop.files import load_loop, parse_loop_text
+from symstab.numeric.engine.roots import STABLE
 from symstab.symbolic.loop_assembly import NAME_PATTERN
 
 from conftest import REPO

@@ -34,7 +34,7 @@ from symstab.cli import commands as cli
 from symstab.proof import loop_derive
 from symstab.proof.identity import check_identity
 from symstab.codegen.loop_kernels import _digest
-from symstab.numeric.loop_files import load_loop, parse_loop_text
+from symstab.numeric.loop.files import load_loop, parse_loop_text
 
 PAPER_FILE = REPO / "examples" / "loops" / "paper.toml"
 

@@ -48,7 +48,7 @@ def test_zero_alpha_has_a_root_at_one(beta, gamma, d, delta):
 @pytest.mark.parametrize("gamma, d, delta", [(0.0, 0, 0.05), (0.5, 1, 0.3), (-0.5, 4, 1.0),
                                             (1.5, 7, 0.01), (2.0, 10, 2.5e-3)])
 def test_minus_one_line_agrees_with_the_numeric_line_and_the_roots(gamma, d, delta):
-    from symstab.numeric.curves import minus_one_line
+    from symstab.numeric.paper.curves import minus_one_line
 
     label = "even" if d % 2 == 0 else "odd"
     objects = {name: expr for name, _, expr in _conditions()["minus_one_line"].objects}

@@ -100,7 +100,7 @@ def test_the_cache_is_read_without_eval_or_exec(cache, monkeypatch):
         mp.setattr(sp, "sympify", refuse)
         mp.setattr(sp, "parse_expr", refuse)
         reread = DerivationCache(loop.plant, loop.environment,
-                                 dict(loop._symbols, s=model.s, z=model.z))
+                                 dict(loop.symbols, s=model.s, z=model.z))
         values = {name: reread.get(name) for name in expected}
     assert {k: repr(v) for k, v in values.items()} == {k: repr(v) for k, v in expected.items()}
 

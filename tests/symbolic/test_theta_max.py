@@ -197,7 +197,7 @@ def test_theta_max_at_large_delta_agrees_with_the_float_arc_end(delta):
 @pytest.mark.parametrize("func", ["theta_max", "boundary_point", "theta_max_newton"])
 def test_references_refuse_delta_zero_instead_of_dividing_zero_by_zero(func):
     import symstab
-    from symstab.numeric.evaluate import boundary_point
+    from symstab.numeric.paper.reference import boundary_point
     calls = {"theta_max": lambda: theta_max(gamma=0.0, d=0, delta=0.0),
              "boundary_point": lambda: boundary_point(0.5, gamma=0.0, d=0, delta=0.0),
              "theta_max_newton": lambda: symstab.theta_max_newton(d=0, delta=0.0)}
@@ -207,8 +207,8 @@ def test_references_refuse_delta_zero_instead_of_dividing_zero_by_zero(func):
 
 # No root stepped over: the scan isolates with a bound on R'' ------------------
 #
-# Oracles: the certified interval enclosure (symstab.numeric.theta_bounds,
-# its R proved equal to the derivation's in tests/numeric/test_theta_bounds.py)
+# Oracles: the certified interval enclosure (symstab.numeric.paper.theta_bounds,
+# its R proved equal to the derivation's in tests/numeric/paper/test_theta_bounds.py)
 # and the paper's alpha from eqs. (1), (2), (4) at 40 digits, whose sign must
 # be + just below theta_max and - just above.
 
@@ -221,7 +221,7 @@ MISSED = [(1000.0, 0, 0.5), (1e6, 0, 1e-6), (2.4818442699578145, 200, 0.00702425
 
 @pytest.mark.parametrize("gamma, d, delta", MISSED + theta_max_box_sample(1212, 10))
 def test_theta_max_is_the_certified_first_root(gamma, d, delta):
-    from symstab.numeric.theta_bounds import theta_max_enclosure
+    from symstab.numeric.paper.theta_bounds import theta_max_enclosure
     box = theta_max_enclosure(gamma=gamma, d=d, delta=delta)
     top = theta_max(gamma=gamma, d=d, delta=delta)
     assert box.lo <= top <= box.hi, (top, box)

@@ -1,0 +1,753 @@
+"""The design search: the value of one or two loop parameters that maximises a target.
+
+:meth:`symstab.Loop.design` asks: which virtual mass (filter cut-off, sample
+period, ...) gives the largest renderable stiffness, the largest Z-width or
+the largest passive stiffness?  Each evaluation is a certified answer of the
+one engine at one value of the searched parameters:
+
+* ``"y_max"`` -- :attr:`Limits.y_max <symstab.numeric.engine.results.Limits.y_max>`
+  of :meth:`symstab.Loop.limits` (``K_max`` in the plane ``(B, K)``);
+* ``"area"`` -- :attr:`Limits.area <symstab.numeric.engine.results.Limits.area>`,
+  the Z-width where ``x`` is a damping and ``y`` a stiffness;
+* ``"passive"`` -- ``y_max`` of :meth:`symstab.Loop.passive_region` (the
+  passive ``K_max``);
+* ``"simulated"`` -- ``y_max`` of
+  :func:`~symstab.numeric.simulation.simulated_limit.simulated_limit`: the largest
+  ``y`` whose simulated run, with the non-idealities given, neither grows
+  nor ends above a stated ``amplitude`` (not certified: a simulation,
+  resolved to its grid).
+
+A value where no point is stable has no target (``-inf``); one the engine
+cannot resolve (a stable set shrinking to a sliver it refuses) is skipped
+and reported in :attr:`Design.failed`.
+
+The search (:func:`maximize_scalar`, :func:`maximize_box`) is a coarse scan
+first, so that a second maximum is not missed, then ``scipy.optimize``
+from the best scan point: a bounded scalar search (Brent's method,
+:func:`scipy.optimize.minimize_scalar`) in one parameter, Nelder-Mead with
+bounds (:func:`scipy.optimize.minimize`) in two.  The scan includes the
+nominal value, and zooms into a run of stable values that holds fewer than
+five scan points (a narrow band of stable values, such as the virtual
+masses of a loop with a fast device, is resolved before the refinement
+rather than missed).  Where the searched parameters enter the loop's
+polynomial affinely with the plane's (a virtual mass), the scan is laid
+over the values where Stodola's necessary condition can hold
+(:func:`~symstab.numeric.engine.decomposition.stable_ranges`), so a narrow band
+in a wide range is bracketed first, and a range where it holds nowhere is
+proved to have no stable point.  Otherwise a band that holds neither a
+scan point nor the nominal value can still be missed: then the message
+says so (never a bare "none"), :attr:`Design.spacing` says the scan's
+step, and ``n`` makes it finer.
+"""
+
+import dataclasses
+import math
+
+import numpy as np
+
+from ..._validate import check_count, check_progress, check_real, check_window
+
+__all__ = ["TARGETS", "Design", "design", "maximize_scalar", "maximize_pieces", "maximize_box",
+           "held_delay", "delay_pieces", "box_corners"]
+
+#: What a design maximises, with what it is.
+TARGETS = {
+    "y_max": "the largest stable y (K_max in the (B, K) plane)",
+    "area": "the area of the stable set (the Z-width in the (B, K) plane)",
+    "passive": "the largest passive y (the passive K_max in the (B, K) plane)",
+    "simulated": "the largest y whose simulated run settles below the amplitude given",
+}
+#: The relative accuracy of the search by default: a simulated target is
+#: resolved to its grid, about 1e-4 of its y_max, so finer is wasted.
+_RTOL = {"simulated": 1e-3}
+#: A run of stable scan values shorter than this is zoomed into before refining.
+_MIN_RUN = 5
+#: Zooms at most (each divides the step by about n / 2).
+_MAX_ZOOMS = 8
+#: Evaluations of the local refinement at most.
+_MAX_REFINE = 200
+#: The pieces of a piecewise search refined, the best first by their left ends.
+_TOP_PIECES = 3
+#: Scan points of each piece refined.
+_PIECE_POINTS = 5
+#: Whole-sample pieces of a sample period's range at most (one evaluation each at least).
+MAX_PIECES = 400
+
+
+@dataclasses.dataclass(frozen=True)
+class Design:
+    """What :meth:`symstab.Loop.design` found.
+
+    Attributes
+    ----------
+    target : str
+        What was maximised: a key of :data:`TARGETS`.
+    x, y : str
+        The plane whose stable (or passive) set the target measures.
+    over : dict
+        ``{name: (low, high)}``: the parameters searched and their ranges.
+    best : dict or None
+        ``{name: value}`` at the optimum; None when no value evaluated has
+        a stable point (:attr:`message` says whether that is proved for the
+        whole range or which values were not examined).
+    value : float or None
+        The target there.
+    nominal : dict
+        ``{name: value}`` of the searched parameters as given or defaulted
+        (empty when one has no value).
+    value_nominal : float or None
+        The target at the nominal values (None where there are none; ``-inf``
+        when no point is stable there).
+    limits : object or None
+        At the optimum: the :class:`~symstab.numeric.engine.results.Limits` of the
+        plane (targets ``y_max``, ``area``) or the
+        :class:`~symstab.numeric.analysis.passivity.PassiveRegion` (``passive``) or
+        the :class:`~symstab.numeric.simulation.simulated_limit.SimulatedLimit`
+        (``simulated``).
+    samples : ndarray
+        Every evaluation, ``(k, len(over) + 1)``: the parameters' values,
+        then the target (``-inf`` no stable point, NaN not resolved), in
+        the order evaluated.
+    spacing : dict
+        ``{name: step}`` of the first scan (over the bracket of values where
+        a stable point can be, for an affine parameter): a band of stable
+        values narrower than this that holds no scan point can be missed.
+    failed : tuple of (dict, str)
+        The values the engine could not resolve, with its message.
+    values : dict
+        The other parameters' values, as given.
+    message : str
+        Why there is no optimum; else empty.
+    delay : float or None
+        The loop delay held in seconds while ``T`` varies (``d = ceil(delay
+        / T)`` at each value), or None (``d`` as given).
+    """
+
+    target: str
+    x: str
+    y: str
+    over: dict
+    best: object
+    value: object
+    nominal: dict
+    value_nominal: object
+    limits: object
+    samples: np.ndarray
+    spacing: dict
+    failed: tuple = ()
+    values: dict = dataclasses.field(default_factory=dict)
+    message: str = ""
+    delay: object = None
+
+    @property
+    def best_d(self):
+        """The delay in samples at the optimum: ``ceil(delay / T)`` where the delay is held in seconds."""
+        if self.best is None:
+            return None
+        if self.delay is None:
+            return self.values.get("d")
+        return held_delay(self.delay, self.best.get("T", self.values.get("T")))
+
+    @property
+    def gain(self):
+        """:attr:`value` over :attr:`value_nominal`, where both are finite and positive; else None."""
+        if self.value is None or self.value_nominal is None:
+            return None
+        if not (math.isfinite(self.value) and math.isfinite(self.value_nominal)
+                and self.value_nominal > 0):
+            return None
+        return self.value / self.value_nominal
+
+    @property
+    def at_edge(self):
+        """The searched parameters whose optimum lies within 1e-3 of the range's width of an end.
+
+        (With the delay held in seconds, of the width of the end's own whole-sample piece of ``T``.)
+        """
+        if self.best is None:
+            return ()
+        out = []
+        for name, (lo, hi) in self.over.items():
+            width = hi - lo
+            if self.delay is not None and name == "T":
+                # The delay held in seconds: the scale is the end's own piece
+                # (an optimum at the left end of the next piece is not the range's end).
+                pieces = delay_pieces(self.delay, lo, hi)
+                width = min(pieces[0][1] - pieces[0][0], pieces[-1][1] - pieces[-1][0])
+            if min(self.best[name] - lo, hi - self.best[name]) < 1e-3 * width:
+                out.append(name)
+        return tuple(out)
+
+    def __repr__(self):
+        over = ", ".join(f"{n} in [{lo:.6g}, {hi:.6g}]" for n, (lo, hi) in self.over.items())
+        if self.best is None:
+            return f"Design({self.target} over {over}: {self.message})"
+        best = ", ".join(f"{n}={v:.6g}" for n, v in self.best.items())
+        gain = f", gain {self.gain:.4g}" if self.gain is not None else ""
+        return f"Design({self.target} over {over}: {best}, {self.target}={self.value:.6g}{gain})"
+
+    def as_dict(self):
+        """The numbers, for tables and JSON."""
+        return {"target": self.target, "x": self.x, "y": self.y,
+                "over": {n: list(r) for n, r in self.over.items()}, "best": self.best,
+                "value": self.value, "nominal": self.nominal,
+                "value_nominal": self.value_nominal, "gain": self.gain,
+                "evaluations": int(self.samples.shape[0]), "spacing": self.spacing,
+                "failed": len(self.failed), "message": self.message}
+
+
+class _Evaluations:
+    """The target at points of the searched box, each evaluated once and remembered."""
+
+    def __init__(self, f, progress):
+        # Called directly by maximize_scalar and maximize_box: the total is
+        # not known there, so True reports nothing (design draws a bar).
+        self.f, self.progress = f, check_progress(progress)
+        self.seen = {}
+
+    def __call__(self, point):
+        key = tuple(float(v) for v in np.atleast_1d(point))
+        if key not in self.seen:
+            self.seen[key] = float(self.f(key))
+            if self.progress is not None:
+                self.progress(len(self.seen))
+        return self.seen[key]
+
+    def best(self):
+        """``(point, value)`` of the largest finite (or +inf) value seen, or None."""
+        found = [(v, p) for p, v in self.seen.items() if not math.isnan(v) and v > -math.inf]
+        if not found:
+            return None
+        value, point = max(found)
+        return point, value
+
+    def penalised(self, point):
+        """The value to minimise: minus the target, and past the worst value where there is none."""
+        value = self(point)
+        if math.isnan(value) or value == -math.inf:
+            finite = [v for v in self.seen.values() if math.isfinite(v)]
+            worst = min(finite, default=0.0)
+            return -(worst - abs(worst) - 1.0)
+        return -value
+
+
+def maximize_scalar(f, low, high, n=17, *, include=(), rtol=1e-6, progress=None):
+    """The x of [low, high] that maximises a scalar ``f``: a scan, then Brent's method.
+
+    ``f`` is evaluated on ``n`` evenly spaced points of ``[low, high]`` and
+    at the values ``include`` that lie inside; a run of finite values that
+    holds the best one and fewer than five points is scanned again between
+    its infeasible neighbours (up to eight times).  The best point is then
+    refined by :func:`scipy.optimize.minimize_scalar` (``method="bounded"``)
+    between its neighbours, to ``rtol`` times the larger of ``|x|`` and the
+    bracket's width.
+
+    Parameters
+    ----------
+    f : callable
+        ``f(x) -> float``; ``-inf`` where there is nothing to maximise (no
+        stable point), NaN where it could not be evaluated.
+    low, high : float
+        The interval searched, ``low < high``.
+    n : int
+        Points of the scan, ``n >= 3``.
+    include : iterable of float
+        Points evaluated with the scan (the nominal value).
+    rtol : float
+        Relative accuracy of the optimum, ``> 0``.
+    progress : callable, optional
+        Called with the number of evaluations so far.
+
+    Returns
+    -------
+    (float, float, list) or (None, None, list)
+        The best point seen and ``f`` there (None when ``f`` has no finite
+        value at any point evaluated), and every evaluation ``[(x, f(x)), ...]``.
+
+    Examples
+    --------
+    >>> x, value, _ = maximize_scalar(lambda x: -(x - 0.3)**2, 0.0, 1.0)
+    >>> round(x, 5), value <= 0
+    (0.3, True)
+    """
+    from scipy.optimize import minimize_scalar
+
+    low, high = check_window("the interval searched", (low, high))
+    n = check_count("n", n, 3)
+    rtol = check_real("rtol", rtol, low=0.0, low_open=True)
+    evaluate = _Evaluations(lambda p: f(p[0]), progress)
+    xs = sorted(set(np.linspace(low, high, n).tolist())
+                | {float(v) for v in include if low <= v <= high})
+    for x in xs:
+        evaluate(x)
+    for _ in range(_MAX_ZOOMS):
+        found = evaluate.best()
+        if found is None or not math.isfinite(found[1]):
+            break
+        xs = sorted(p[0] for p in evaluate.seen)
+        ok = [math.isfinite(evaluate.seen[(x,)]) for x in xs]
+        k = xs.index(found[0][0])
+        i, j = k, k
+        while i > 0 and ok[i - 1]:
+            i -= 1
+        while j < len(xs) - 1 and ok[j + 1]:
+            j += 1
+        if j - i + 1 >= _MIN_RUN:
+            break
+        a, b = xs[max(i - 1, 0)], xs[min(j + 1, len(xs) - 1)]
+        for x in np.linspace(a, b, n):
+            evaluate(float(x))
+    found = evaluate.best()
+    if found is None:
+        return None, None, [(p[0], v) for p, v in evaluate.seen.items()]
+    (x_best,), value = found
+    if math.isfinite(value):
+        xs = sorted(p[0] for p in evaluate.seen)
+        k = xs.index(x_best)
+        a, b = xs[max(k - 1, 0)], xs[min(k + 1, len(xs) - 1)]
+        if a < b:
+            minimize_scalar(lambda x: evaluate.penalised(x), bounds=(a, b), method="bounded",
+                            options={"xatol": rtol * max(abs(x_best), b - a),
+                                     "maxiter": _MAX_REFINE})
+        (x_best,), value = evaluate.best()
+    return x_best, value, [(p[0], v) for p, v in evaluate.seen.items()]
+
+
+def maximize_pieces(f, pieces, *, include=(), rtol=1e-6, progress=None):
+    """The x that maximises ``f``, continuous on each piece but jumping between them.
+
+    A sawtooth (the target against the sample period with the delay held in
+    seconds: ``d`` steps at each ``T = delay / k``) defeats a search of the
+    whole interval: Brent's method climbs one tooth.  Here ``f`` is
+    evaluated at each piece's left end (and at ``include``); the
+    :data:`_TOP_PIECES` pieces best there, and the piece of the best
+    ``include`` point, are each searched by :func:`maximize_scalar`
+    (:data:`_PIECE_POINTS` points, then Brent's method), and the best of
+    all is taken.
+
+    Parameters
+    ----------
+    f : callable
+        ``f(x) -> float``, as for :func:`maximize_scalar`.
+    pieces : sequence of (float, float)
+        Closed intervals, in increasing order, ``a < b``, on each of which
+        ``f`` is continuous.
+    include, rtol, progress : optional
+        As for :func:`maximize_scalar`.
+
+    Returns
+    -------
+    (float, float, list) or (None, None, list)
+        As :func:`maximize_scalar`.
+
+    Examples
+    --------
+    A sawtooth rising to 1 / k at the left end of each piece [1 / k, 1 / (k - 1)]:
+
+    >>> pieces = [(1 / k, 1 / (k - 1) - 1e-9) for k in range(9, 1, -1)]
+    >>> def f(x):
+    ...     k = next(k for k in range(9, 1, -1) if 1 / k <= x < 1 / (k - 1))
+    ...     return k - x * k * k / 2
+    >>> x, value, _ = maximize_pieces(f, pieces)
+    >>> round(x, 6), round(value, 6)
+    (0.111111, 4.5)
+    """
+    pieces = [check_window("a piece", piece) for piece in pieces]
+    if not pieces:
+        raise ValueError("pieces must hold at least one interval (a, b), a < b")
+    evaluate = _Evaluations(lambda p: f(p[0]), progress)
+    for a, _ in pieces:
+        evaluate(a)
+    inside = [float(v) for v in include if any(a <= v <= b for a, b in pieces)]
+    for v in inside:
+        evaluate(v)
+
+    def rank(k):
+        value = evaluate.seen[(pieces[k][0],)]
+        return -math.inf if math.isnan(value) else value
+
+    chosen = sorted(range(len(pieces)), key=rank, reverse=True)[:_TOP_PIECES]
+    chosen += [k for k, (a, b) in enumerate(pieces) for v in inside if a <= v <= b]
+    for k in dict.fromkeys(chosen):
+        a, b = pieces[k]
+        maximize_scalar(lambda x: evaluate((x,)), a, b, _PIECE_POINTS,
+                        include=[v for v in inside if a <= v <= b], rtol=rtol)
+    found = evaluate.best()
+    seen = [(p[0], v) for p, v in evaluate.seen.items()]
+    if found is None:
+        return None, None, seen
+    (x_best,), value = found
+    return x_best, value, seen
+
+
+def maximize_box(f, box, n=9, *, include=(), rtol=1e-6, progress=None):
+    """The point of a 2-D box that maximises ``f``: a grid, then Nelder-Mead with bounds.
+
+    ``f`` is evaluated on an ``n x n`` grid of the box and at the points
+    ``include`` inside it; while fewer than four grid points have a finite
+    value, the grid is laid again over the box those points and their
+    neighbours span (up to eight times).  The best point is refined by
+    :func:`scipy.optimize.minimize` (``method="Nelder-Mead"``, bounded by
+    the box) from a simplex one grid step wide, in coordinates scaled to the
+    box, to ``rtol`` of the box's width.
+
+    Parameters
+    ----------
+    f : callable
+        ``f((u, v)) -> float``; ``-inf`` where there is nothing to maximise,
+        NaN where it could not be evaluated.
+    box : ((float, float), (float, float))
+        The ranges of the two parameters.
+    n : int
+        Grid points per parameter, ``n >= 3``.
+    include : iterable of (float, float)
+        Points evaluated with the grid (the nominal values).
+    rtol : float
+        Relative accuracy of the optimum, ``> 0``.
+    progress : callable, optional
+        Called with the number of evaluations so far.
+
+    Returns
+    -------
+    (tuple, float, list) or (None, None, list)
+        As :func:`maximize_scalar`, with points ``(u, v)``.
+
+    Examples
+    --------
+    >>> p, value, _ = maximize_box(lambda p: -(p[0] - 0.3)**2 - (p[1] + 1)**2,
+    ...                            ((0.0, 1.0), (-2.0, 2.0)))
+    >>> round(p[0], 4), round(p[1], 4)
+    (0.3, -1.0)
+    """
+    from scipy.optimize import minimize
+
+    (u0, u1), (v0, v1) = (check_window(f"box[{k}]", r) for k, r in enumerate(box))
+    n = check_count("n", n, 3)
+    rtol = check_real("rtol", rtol, low=0.0, low_open=True)
+    evaluate = _Evaluations(f, progress)
+    for p in include:
+        if u0 <= p[0] <= u1 and v0 <= p[1] <= v1:
+            evaluate((float(p[0]), float(p[1])))
+    step = ((u1 - u0) / (n - 1), (v1 - v0) / (n - 1))
+    grid = ((u0, u1), (v0, v1))
+    for _ in range(_MAX_ZOOMS + 1):
+        us, vs = np.linspace(*grid[0], n), np.linspace(*grid[1], n)
+        for u in us:
+            for v in vs:
+                evaluate((float(u), float(v)))
+        finite = [p for p in evaluate.seen if math.isfinite(evaluate.seen[p])]
+        if len(finite) >= 4 or not finite:
+            break
+        du, dv = (us[1] - us[0]), (vs[1] - vs[0])
+        pu, pv = [p[0] for p in finite], [p[1] for p in finite]
+        grid = ((max(u0, min(pu) - du), min(u1, max(pu) + du)),
+                (max(v0, min(pv) - dv), min(v1, max(pv) + dv)))
+        if not (grid[0][0] < grid[0][1] and grid[1][0] < grid[1][1]):
+            break
+        step = ((grid[0][1] - grid[0][0]) / (n - 1), (grid[1][1] - grid[1][0]) / (n - 1))
+    found = evaluate.best()
+    if found is None:
+        return None, None, list(evaluate.seen.items())
+    point, value = found
+    if math.isfinite(value):
+        width = np.array([u1 - u0, v1 - v0])
+        origin = np.array([u0, v0])
+        start = (np.array(point) - origin) / width
+        cell = np.array(step) / width
+
+        def scaled(q):
+            q = np.clip(q, 0.0, 1.0)
+            return evaluate.penalised(tuple((origin + q * width).tolist()))
+
+        simplex = np.array([start, start + [cell[0], 0.0], start + [0.0, cell[1]]])
+        # A simplex vertex past the box is reflected inside it.
+        simplex = np.where(simplex > 1.0, 2 * start - simplex, simplex).clip(0.0, 1.0)
+        minimize(scaled, start, method="Nelder-Mead", bounds=[(0.0, 1.0), (0.0, 1.0)],
+                 options={"initial_simplex": simplex, "xatol": rtol,
+                          "fatol": rtol * abs(value) if value else rtol,
+                          "maxfev": _MAX_REFINE})
+        point, value = evaluate.best()
+    return point, value, list(evaluate.seen.items())
+
+
+def _check_over(loop, over, x, y):
+    """``{name: (low, high)}``: one or two parameters of the loop, outside the plane."""
+    if not isinstance(over, dict) or not 1 <= len(over) <= 2:
+        raise TypeError(f"over must be a dict of one or two {{name: (low, high)}}, got {over!r}")
+    out = {}
+    others = [p for p in loop.parameters if p not in (x, y, "d")]
+    for name, window in over.items():
+        if name not in loop.parameters:
+            raise ValueError(f"over: {name!r} is not a parameter of the loop (candidates: "
+                             f"{', '.join(others)})")
+        if name == "d":
+            raise ValueError("over: the delay d is a whole number of samples; design once per delay")
+        if name in (x, y):
+            raise ValueError(f"over: {name} is an axis of the ({x}, {y}) plane; search another "
+                             f"parameter (candidates: {', '.join(others)})")
+        out[name] = check_window(f"over[{name!r}]", window)
+    return out
+
+
+def design(loop, *, over, maximize="y_max", x=None, y=None, n=None, rtol=None, damping="b",
+           delay=None, progress=None, amplitude=None, nonideal=None, x0=None, steps=None,
+           **values):
+    """The value of one or two parameters of ``loop`` that maximises a target.
+
+    See :meth:`symstab.Loop.design`, which calls this with the plane ``x``,
+    ``y`` resolved.
+    """
+    if maximize not in TARGETS:
+        raise ValueError(f"maximize must be one of {', '.join(map(repr, TARGETS))}, "
+                         f"got {maximize!r}")
+    over = _check_over(loop, over, x, y)
+    simulation = _check_simulation(maximize, amplitude, nonideal, x0, steps, loop)
+    rtol = _RTOL.get(maximize, 1e-6) if rtol is None else rtol
+    names = tuple(over)
+    n = (17 if len(names) == 1 else 9) if n is None else check_count("n", n, 3)
+    from ..._progress import progress_printer
+
+    progress = check_progress(progress, lambda: progress_printer("designing", n**len(names) + 40))
+    for axis, name in (("x", x), ("y", y)) + ((("damping", damping),) if maximize == "passive"
+                                                 else ()):
+        if name not in loop.parameters:
+            need = (": maximize='passive' needs the device's viscous friction"
+                    if axis == "damping" else "")
+            raise ValueError(f"{axis}: {name!r} is not a parameter of the loop{need} "
+                             f"(parameters: {', '.join(loop.parameters)})")
+    for name in (x, y):
+        if name in values:
+            raise TypeError(f"{name} is an axis of the ({x}, {y}) plane: it takes no value here")
+    if delay is not None:
+        delay = check_real("delay", delay, low=0.0)
+        if "d" in values:
+            raise TypeError("give the delay in seconds (delay) or in samples (d), not both")
+    merged = {**loop.defaults, **values}
+    nominal = {name: float(merged[name]) for name in names if name in merged}
+    if len(nominal) != len(names):
+        nominal = {}
+    # The values are checked once, before the scan: a wrong one is the caller's
+    # error, not a value of the searched parameter without an answer.
+    def at(point):
+        """The values at a point of the search; with ``delay``, d = ceil(delay / T) there."""
+        out = {**values, **dict(zip(names, point))}
+        if delay is not None:
+            out["d"] = held_delay(delay, out.get("T", loop.defaults.get("T")))
+        return out
+
+    middle = tuple(0.5 * (lo + hi) for lo, hi in over.values())
+    loop.polynomial(**{**at(middle), x: 0.0, y: 0.0})
+    if maximize == "passive":
+        # A plant the passivity theorem does not cover is refused here, once.
+        loop.passive_region(x, y, damping=damping, **at(middle))
+    if simulation:
+        # The horizon is checked at every corner's delay (held in seconds, d
+        # varies with T), before the scan.
+        from ..simulation.simulator import check_steps
+
+        for corner in box_corners(over):
+            check_steps(steps, at(tuple(corner.values())).get("d", loop.defaults.get("d", 0)))
+    failed = []
+
+    def answer(point):
+        return _answer(loop, maximize, x, y, damping, at(point), simulation)
+
+    def target(point):
+        try:
+            return _target(maximize, answer(point))
+        except ValueError as exc:
+            failed.append((dict(zip(names, point)), str(exc)))
+            return math.nan
+
+    include = [tuple(nominal[n_] for n_ in names)] if nominal else []
+    # Where a stable point can be at all: the searched box narrowed to it, or
+    # proved empty (then nothing is scanned).
+    bracket = _bracket(loop, maximize, x, y, names, over, at) if delay is None else over
+    searched = over if bracket is None else bracket
+    if bracket is None:
+        best, value, seen = None, None, []
+    elif len(names) == 1 and delay is not None and names[0] == "T":
+        best, value, seen = maximize_pieces(lambda v: target((v,)),
+                                            delay_pieces(delay, *over["T"]),
+                                            include=[p[0] for p in include], rtol=rtol,
+                                            progress=progress)
+        best = None if best is None else (best,)
+        seen = [((p,), v) for p, v in seen]
+    elif len(names) == 1:
+        best, value, seen = maximize_scalar(lambda v: target((v,)), *searched[names[0]], n,
+                                            include=[p[0] for p in include], rtol=rtol,
+                                            progress=progress)
+        best = None if best is None else (best,)
+        seen = [((p,), v) for p, v in seen]
+    else:
+        best, value, seen = maximize_box(target, tuple(searched[k] for k in names), n,
+                                         include=include, rtol=rtol, progress=progress)
+    samples = np.array([[*p, v] for p, v in seen], dtype=float).reshape(-1, len(names) + 1)
+    spacing = {k: (hi - lo) / (n - 1) for k, (lo, hi) in searched.items()}
+    value_nominal = None
+    if nominal:
+        key = tuple(nominal[k] for k in names)
+        hits = [v for p, v in seen if tuple(p) == key]
+        value_nominal = hits[0] if hits else target(key)
+        if value_nominal is not None and math.isnan(value_nominal):
+            value_nominal = None
+    common = dict(target=maximize, x=x, y=y, over=over, nominal=nominal,
+                  value_nominal=value_nominal, samples=samples, spacing=spacing,
+                  failed=tuple(failed), values=dict(values), delay=delay)
+    if best is None and failed and not np.any(samples[:, -1] == -np.inf):
+        what = {"passive": "passive set", "simulated": "simulated limit"}.get(maximize, "limits")
+        raise ValueError(f"the {what} could not "
+                         f"be computed at any of the {len(samples)} values searched: "
+                         f"{failed[0][1]}")
+    if best is None:
+        ranges = ", ".join(f"{k} in [{lo:.6g}, {hi:.6g}]" for k, (lo, hi) in over.items())
+        what = {"passive": "passive point",
+                "simulated": f"point whose simulated run settles below "
+                             f"{simulation.get('amplitude', 0):.3g}"}.get(maximize, "stable point")
+        if bracket is None:
+            message = (f"no value of {ranges} has a {what} in the ({x}, {y}) plane: proved "
+                       f"(Stodola's necessary condition, the coefficients of (w - 1)**n "
+                       f"chi((w + 1)/(w - 1)) all of one sign, holds nowhere in the range)")
+        else:
+            # Only the values evaluated are known: a band of them narrower than
+            # the scan's step can lie between two.
+            inside = ", ".join(f"{k} in [{lo:.6g}, {hi:.6g}]" for k, (lo, hi) in searched.items())
+            narrowed = (f"; outside {inside} none is stable (Stodola's necessary condition)"
+                        if searched != over else "")
+            message = (f"no {what} in the ({x}, {y}) plane was found at the {len(samples)} "
+                       f"values of {inside} evaluated (steps of "
+                       f"{', '.join(f'{s:.3g}' for s in spacing.values())}){narrowed}; between "
+                       f"them the range was not examined: a band of values narrower than a step "
+                       f"may hold one (give a finer n)")
+        return Design(best=None, value=None, limits=None, message=message, **common)
+    return Design(best=dict(zip(names, (float(v) for v in best))), value=float(value),
+                  limits=answer(best), **common)
+
+
+def _bracket(loop, maximize, x, y, names, over, at):
+    """``over`` narrowed to where a stable point can be, or None when it can be nowhere.
+
+    Where the searched parameters enter the characteristic polynomial affinely
+    with the plane's (a virtual mass, say), Stodola's necessary condition is
+    linear in all of them (:func:`symstab.numeric.engine.decomposition.stable_ranges`):
+    a narrow band of stable values inside a wide range is bracketed before
+    the scan instead of stepped over, and a range where the condition holds
+    nowhere is proved to have no stable point.  Elsewhere (a sample period, a
+    filter's cut-off, the passive target) ``over`` as given.
+    """
+    from ..engine.decomposition import stable_ranges
+
+    if maximize == "passive" or not loop.affine_in((x, y, *names)):
+        return over
+    try:
+        base, slopes, _ = loop.affine_parts((x, y), at(tuple(0.0 for _ in names)))
+        rows = [base, *slopes]
+        for k in range(len(names)):
+            unit = at(tuple(float(j == k) for j in range(len(names))))
+            rows.append(loop.affine_parts((x, y), unit)[0] - base)
+    except ValueError:
+        return over         # 0 or 1 is not a value of the parameter: no bracket
+    ranges = stable_ranges(rows, [None, None, *over.values()])
+    if ranges is None:
+        return None
+    out = {}
+    for name, (lo, hi), (low, high) in zip(names, ranges[2:], over.values()):
+        # Wider than the programme's ends by more than its tolerance (never
+        # past the range).
+        pad = 1e-6 * (high - low)
+        lo, hi = max(low, lo - pad), min(high, hi + pad)
+        out[name] = (lo, hi) if lo < hi else (low, high)
+    return out
+
+
+def delay_pieces(delay, low, high):
+    """The intervals of ``T`` in ``[low, high]`` on each of which ``held_delay(delay, T)`` is one ``d``.
+
+    ``d = ceil(delay / T)`` is ``d`` for ``T`` in ``[delay / d, delay / (d -
+    1))``: each piece is that interval cut to the range, its open right end
+    taken 1e-8 inside (where ``d`` is still the piece's), in increasing
+    ``T``.  With no delay, the range itself.
+
+    Raises
+    ------
+    ValueError
+        If the range spans more than :data:`MAX_PIECES` whole delays.
+
+    Examples
+    --------
+    >>> [(round(a * 1e3, 4), round(b * 1e3, 4)) for a, b in delay_pieces(0.01, 2e-3, 4e-3)]
+    [(2.0, 2.5), (2.5, 3.3333), (3.3333, 4.0)]
+    """
+    if delay == 0:
+        return [(low, high)]
+    first, last = held_delay(delay, high), held_delay(delay, low)
+    if last - first + 1 > MAX_PIECES:
+        raise ValueError(f"over['T'] in [{low:.6g}, {high:.6g}] with the delay held at "
+                         f"{delay:.6g} s spans {last - first + 1} whole-sample delays (d from "
+                         f"{first} to {last}), above {MAX_PIECES}: each is searched; narrow the "
+                         f"range of T")
+    pieces = []
+    for d in range(last, first - 1, -1):
+        a = max(low, delay / d)
+        b = high if d <= 1 or delay / (d - 1) > high else delay / (d - 1) * (1 - 1e-8)
+        if a < b:
+            pieces.append((a, b))
+    return pieces
+
+
+def held_delay(delay, T):
+    """``d = ceil(delay / T)``: a delay held in seconds, in the whole samples of ``T`` that cover it.
+
+    A force can only be applied at a sample, so a delay of 2.5 periods acts
+    as 3 (rounding down would render a shorter delay than the device has).
+    A quotient within 1e-9 of a whole number is that number.
+    """
+    quotient = delay / float(T)
+    return int(round(quotient)) if abs(quotient - round(quotient)) <= 1e-9 * max(1.0, quotient) \
+        else math.ceil(quotient)
+
+
+def _check_simulation(maximize, amplitude, nonideal, x0, steps, loop=None):
+    """The simulation's settings of ``maximize="simulated"`` (checked), else ``{}``."""
+    given = {k: v for k, v in (("amplitude", amplitude), ("nonideal", nonideal), ("x0", x0),
+                               ("steps", steps)) if v is not None}
+    if maximize != "simulated":
+        if given:
+            raise TypeError(f"{', '.join(given)}: only with maximize='simulated' (the other "
+                            f"targets are certified, not simulated)")
+        return {}
+    from ..simulation.simulator import check_loop_nonideal, check_x0, default_x0
+
+    if amplitude is None:
+        raise TypeError("maximize='simulated' needs amplitude: the largest |x| accepted at the "
+                        "end of a run (the position's unit)")
+    nonideal = check_loop_nonideal(nonideal, loop)
+    return {"amplitude": check_real("amplitude", amplitude, low=0.0, low_open=True),
+            "nonideal": nonideal, "x0": default_x0(nonideal) if x0 is None else check_x0(x0),
+            "steps": steps}
+
+
+def box_corners(over):
+    """``[{name: value}, ...]``: the corners of the box ``{name: (low, high)}`` searched."""
+    corners = [{}]
+    for name, ends in over.items():
+        corners = [{**c, name: v} for c in corners for v in ends]
+    return corners
+
+
+def _answer(loop, maximize, x, y, damping, values, simulation):
+    """The answer whose number is the target: Limits, PassiveRegion or SimulatedLimit."""
+    if maximize == "simulated":
+        from ..simulation.simulated_limit import simulated_limit
+
+        return simulated_limit(loop, x=x, y=y, **simulation, **values)
+    if maximize == "passive":
+        return loop.passive_region(x, y, damping=damping, **values)
+    return loop.limits(x, y, **values)
+
+
+def _target(maximize, answer):
+    """The target's number of an answer; ``-inf`` where no point is stable (passive)."""
+    if answer.y_max is None:
+        return -math.inf
+    return float(answer.area if maximize == "area" else answer.y_max)

@@ -1,0 +1,206 @@
+"""The probability that each point of a loop's plane is stable when some parameters are uncertain.
+
+A device's mass and damping are identified with errors, a network's delay
+varies: given a distribution for each uncertain parameter,
+:func:`stability_probability` draws ``samples`` values of them (one random
+generator, seeded: the same seed gives the same map) and classifies every
+cell of an ``(x, y)`` grid at every draw with the loop's certified root
+count (:meth:`symstab.Loop.classify`).  The probability of a cell is the
+fraction of draws at which it is stable (a marginal draw, a root on the
+unit circle to within rounding, counts as not stable and is counted
+apart), with the Monte Carlo standard error ``sqrt(p (1 - p) / samples)``.
+
+Distributions: ``(low, high)`` is uniform on that interval (for the delay
+``d``, the integers from ``low`` to ``high``); any object with SciPy's
+``rvs(size=..., random_state=...)`` (a frozen :mod:`scipy.stats`
+distribution, e.g. ``scipy.stats.norm(0.0324, 0.003)``) is drawn from.
+Draws outside the bounds a loop file declares are refused by name.
+"""
+
+import numpy as np
+
+from ..._resources import CHUNK_BYTES, check_memory
+from ..._validate import check_array, check_delay, check_progress, check_real
+from ..engine.results import StabilityProbability
+from ..engine.roots import MARGINAL, STABLE
+
+__all__ = ["stability_probability", "draw_values", "MAX_SAMPLES"]
+
+#: The most draws per map: its standard error is then at most 5e-4 (a cell
+#: with p = 1/2); more is time, not information.
+MAX_SAMPLES = 1_000_000
+#: Floats of a cell's characteristic polynomial and its work (as the loop's own
+#: check_memory counts them): the chunk of draws classified at once.
+_CELL_FLOATS = 64
+
+
+def draw_values(loop, uncertain, samples, seed, *, axes=()):
+    """``{name: ndarray of samples}``: the draws of each uncertain parameter, in the order given.
+
+    Parameters
+    ----------
+    loop : symstab.Loop
+    uncertain : dict
+        ``{name: (low, high)}`` (uniform; ``d``: integers ``low .. high``)
+        or ``{name: distribution}`` (an object with ``rvs(size=...,
+        random_state=...)``).
+    samples : int
+        Draws, 1 to :data:`MAX_SAMPLES`.
+    seed : int
+        Seed of :func:`numpy.random.default_rng`.
+    axes : tuple of str
+        The plane's parameters, which cannot be uncertain.
+
+    Raises
+    ------
+    TypeError, ValueError
+        Naming the parameter: not the loop's, an axis, a range that is not
+        two finite numbers with ``low < high`` (``low <= high`` for ``d``,
+        integers), a distribution without ``rvs``, a draw that is not finite.
+    """
+    if not isinstance(uncertain, dict) or not uncertain:
+        raise TypeError(f"uncertain must be a non-empty dict {{name: (low, high) or distribution}}, "
+                        f"got {uncertain!r}")
+    if isinstance(samples, (bool, np.bool_)) or not isinstance(samples, (int, np.integer)) \
+            or not 1 <= samples <= MAX_SAMPLES:
+        raise ValueError(f"samples must be an integer from 1 to {MAX_SAMPLES}, got {samples!r}")
+    if isinstance(seed, (bool, np.bool_)) or not isinstance(seed, (int, np.integer)) or seed < 0:
+        raise ValueError(f"seed must be a non-negative integer, got {seed!r}")
+    rng = np.random.default_rng(int(seed))
+    draws = {}
+    for name, spec in uncertain.items():
+        if name not in loop.parameters:
+            raise ValueError(f"uncertain: {name!r} is not a parameter of the loop "
+                             f"(its parameters: {', '.join(loop.parameters)})")
+        if name in axes:
+            raise ValueError(f"uncertain: {name} is an axis of the ({axes[0]}, {axes[1]}) plane; "
+                             f"a map's axes are not drawn")
+        where = f"uncertain[{name!r}]"
+        if hasattr(spec, "rvs"):
+            values = np.asarray(spec.rvs(size=int(samples), random_state=rng), dtype=float)
+            if values.shape != (samples,) or not np.all(np.isfinite(values)):
+                raise ValueError(f"{where}: the distribution must draw {samples} finite numbers")
+            if name == "d" and not np.all(values == np.round(values)):
+                raise ValueError(f"{where}: the delay is a whole number of samples; its "
+                                 f"distribution drew {values[values != np.round(values)][0]!r}")
+        elif isinstance(spec, (tuple, list)) and len(spec) == 2:
+            low, high = (check_real(f"{where} bounds", v) for v in spec)
+            if name == "d":
+                low, high = check_delay(spec[0]), check_delay(spec[1])
+                if low > high:
+                    raise ValueError(f"{where}: (low, high) must have low <= high, got {spec!r}")
+                values = rng.integers(low, high, endpoint=True, size=int(samples)).astype(float)
+            else:
+                if not low < high or not np.isfinite(high - low):
+                    raise ValueError(f"{where}: (low, high) must have low < high (and a finite "
+                                     f"width), got {spec!r}")
+                values = rng.uniform(low, high, size=int(samples))
+        else:
+            raise TypeError(f"{where} must be (low, high) or a distribution with rvs(size=..., "
+                            f"random_state=...), got {spec!r}")
+        draws[name] = values
+    if "d" in draws:
+        for d in np.unique(draws["d"]):
+            check_delay(int(d))
+    return draws
+
+
+def stability_probability(loop, x_values, y_values, *, x, y, uncertain, samples=1000, seed=0,
+                          progress=None, **values):
+    """The probability that each cell of an ``(x, y)`` grid is stable (:meth:`symstab.Loop.stability_probability`).
+
+    Parameters
+    ----------
+    loop : symstab.Loop
+    x_values, y_values : array_like
+        1-D grids of the plane's parameters.
+    uncertain : dict
+        The uncertain parameters and their distributions (:func:`draw_values`).
+    samples : int
+        Draws (default 1000: a standard error of at most 0.016).
+    seed : int
+        The random generator's seed: the same seed, the same map.
+    x, y : str
+        The plane.
+    progress : callable, bool or None, optional
+        Called with the number of draws done; True draws a bar
+        (:func:`symstab._validate.check_progress`).
+    **values
+        Single values of the other parameters (defaults for the rest).
+
+    Returns
+    -------
+    StabilityProbability
+
+    Raises
+    ------
+    TypeError, ValueError
+        As :func:`draw_values` and :meth:`symstab.Loop.classify`; a draw
+        outside a loop file's bounds; a grid that does not fit in memory.
+    """
+    x_values, y_values = check_array(x, x_values), check_array(y, y_values)
+    if x_values.ndim != 1 or y_values.ndim != 1 or not x_values.size or not y_values.size:
+        raise ValueError(f"the grids of {x} and {y} must be 1-D and not empty")
+    for name in (x, y):
+        if name in values:
+            raise TypeError(f"{name} is an axis of the map: give its grid, not a value")
+    draws = draw_values(loop, uncertain, samples, seed, axes=(x, y))
+    for name in draws:
+        if name in values:
+            raise TypeError(f"{name} is uncertain: give its distribution, not a value")
+    from ..._progress import progress_printer
+
+    progress = check_progress(progress, lambda: progress_printer("drawing", samples))
+    known = getattr(loop, "file_parameters", None)
+    if known is not None:
+        from ..loop.quantities import check_bounds
+
+        fixed = {k: v for k, v in {**loop.defaults, **values}.items() if k not in draws}
+        check_bounds(known, {**fixed, **draws}, skip=(x, y),
+                     where=lambda names: "uncertain: a draw of " + ", ".join(names))
+    cells = x_values.size * y_values.size
+    check_memory(f"a map of {cells} cells", 8 * 4 * cells + 8 * _CELL_FLOATS * cells)
+    per_chunk = max(1, CHUNK_BYTES // (8 * _CELL_FLOATS * cells))
+    Y, X = np.meshgrid(y_values, x_values, indexing="ij")
+    stable = np.zeros(Y.shape, dtype=np.int64)
+    marginal = np.zeros(Y.shape, dtype=np.int64)
+    # Draws of one delay are classified together (the delay is one integer a call).
+    delays = draws["d"].astype(int) if "d" in draws else None
+    groups = ([np.arange(samples)] if delays is None
+              else [np.flatnonzero(delays == d) for d in np.unique(delays)])
+    done = 0
+    for group in groups:
+        fixed = dict(values)
+        if delays is not None:
+            fixed["d"] = int(delays[group[0]])
+        for start in range(0, group.size, per_chunk):
+            part = group[start:start + per_chunk]
+            drawn = {name: v[part][:, None, None] for name, v in draws.items() if name != "d"}
+            codes = np.asarray(loop.classify(**{x: X[None], y: Y[None]}, **drawn, **fixed))
+            codes = np.broadcast_to(codes, (part.size,) + Y.shape)
+            stable += np.count_nonzero(codes == STABLE, axis=0)
+            marginal += np.count_nonzero(codes == MARGINAL, axis=0)
+            done += part.size
+            if progress is not None:
+                progress(done)
+    probability = stable / samples
+    at = {k: v for k, v in {**loop.defaults, **values}.items() if k not in (x, y) and k not in draws}
+    return StabilityProbability(
+        y_values=y_values, x_values=x_values, probability=probability,
+        standard_error=np.sqrt(probability * (1 - probability) / samples), marginal=marginal,
+        samples=int(samples), seed=int(seed),
+        uncertain={k: _describe(k, v) for k, v in uncertain.items()},
+        x=x, y=y, at=at)
+
+
+def _describe(name, spec):
+    """The distribution of ``name`` in words, for the result and its files."""
+    if hasattr(spec, "rvs"):
+        dist = getattr(spec, "dist", None)
+        name = getattr(dist, "name", type(spec).__name__)
+        args = ", ".join(f"{a:g}" for a in getattr(spec, "args", ()))
+        kwds = ", ".join(f"{k}={v:g}" for k, v in getattr(spec, "kwds", {}).items())
+        return f"{name}({', '.join(p for p in (args, kwds) if p)})"
+    if name == "d":
+        return f"the integers {int(spec[0])} to {int(spec[1])}, equally likely"
+    return f"uniform({float(spec[0]):g}, {float(spec[1]):g})"

@@ -1,0 +1,964 @@
+"""The loop simulator: any :class:`symstab.Loop` in time, many parameter points at once.
+
+Every period ``T`` the position is sampled, the virtual environment's
+difference equation computes a force from the sampled positions, the force
+waits ``d`` samples in the delay line, and a zero-order hold applies it to
+the plant, stepped exactly on the samples by its pulse transfer function
+``P(z)`` (derived by the loop), or on its continuous state space
+(:mod:`symstab.numeric.simulation.friction`) where Coulomb friction acts inside the
+period or the run starts from a state.  All points run together as NumPy
+arrays, one loop over time; :func:`run_loop` is the engine,
+:func:`simulate_loop` and :func:`loop_stability_map` run a loop
+(:meth:`symstab.Loop.simulate`, :meth:`symstab.Loop.stability_map`), and
+the paper's simulator (:mod:`symstab.numeric.paper.simulate`) runs the paper's
+loop on it.
+
+A loop's run starts from positions ``x0 - k v0`` before the start, no
+force and the environment at rest at the sampled ``x0``, with an empty
+delay line; its verdict is unstable when the largest ``|x|`` over the last
+quarter of the horizon exceeds that over the quarter before and a floor
+that quantization can reach (:attr:`Simulation.floor`), or the state
+overflows; a run with non-idealities that keeps swinging above the floor,
+neither decaying nor growing, is a limit cycle (:attr:`Simulation.limit_cycle`),
+neither stable nor unstable; its theory is its own root count.
+"""
+
+import dataclasses
+import math
+
+import numpy as np
+
+from ..._progress import progress_printer
+from ..._resources import MAX_STEPS_ENV, check_memory, chunk_slices
+from ..._resources import max_steps as _max_steps_setting
+from ..._validate import check_array, check_delay, check_progress, check_real
+from .friction import StatePlant, stacked_spaces, substeps_of
+from ..engine.results import PAPER_PLANE, PaperGridNames
+
+__all__ = ["Nonidealities", "Simulation", "StabilityMap", "default_horizon", "check_steps",
+           "check_x0", "max_steps", "progress_printer", "PAPER_ENCODER_RESOLUTION",
+           "MAX_STEPS_ENV", "run_loop", "simulate_loop", "loop_stability_map",
+           "check_loop_nonideal", "default_x0", "MAX_SUBSTEPS", "X0_MIN", "X0_MAX",
+           "check_friction_size", "QUANTUM_MIN", "FRICTION_STEP_MAX"]
+
+
+#: The most sub-steps per period: each multiplies the simulation's time (a
+#: billion once hung it), and friction's stick and reversal times, which they
+#: resolve, are first order in ``1/substeps``: a thousand is far past any use.
+MAX_SUBSTEPS = 1000
+
+#: The paper's encoder: better than 3 arc seconds after quadrature and gear
+#: train (Section VI), in rad.
+PAPER_ENCODER_RESOLUTION = math.radians(3 / 3600)
+#: |x| above this is divergence: the run stops for that point.
+_OVERFLOW = 1e100
+#: Periods between overflow checks.
+_CHECK_EVERY = 8
+#: A limit cycle's swing over the last quarter stays within this fraction of
+#: the third's.  Its sampled peaks differ by up to 2e-4 between quarters (the
+#: paper's loop saturated at 0.05 N m, d = 10); a linear mode changes by this
+#: much over a quarter only within about 2e-6 of |z| = 1 at the default
+#: horizon, the band that no finite run decides.
+_SUSTAINED = 1e-2
+#: A swing below this fraction of the amplitude is rounding, not motion: a
+#: mass settling off zero at K = 0 keeps a swing of 1e-11 of its position.
+_MOVING = 1e-8
+#: Allowed size of the initial state.  The verdict compares the largest |x|
+#: of the last two quarters and calls |x| > _OVERFLOW divergence: a start at
+#: zero never moves (0 <= 0 reads as stable), and a stable point needs room
+#: above |x0| for its transient before the overflow threshold (50 orders of
+#: magnitude), as a decaying or growing run needs room below it before
+#: subnormal numbers lose the ratio (about 200 orders down to 1e-308).
+X0_MIN = 1e-100
+X0_MAX = _OVERFLOW * 1e-50
+
+
+@dataclasses.dataclass(frozen=True)
+class Nonidealities:
+    """Departures from the ideal loop, in physical units; ``None``/False is off.
+
+    Attributes
+    ----------
+    encoder_resolution : float
+        Position quantum (m or rad), at least :data:`QUANTUM_MIN`, the
+        smallest normal double: the positions are divided by it, and a
+        subnormal quantum overflows every quotient (a value whose quotient
+        overflows is far above the quantum's precision and rounds to
+        itself).
+    velocity_cutoff : float
+        Cut-off of the velocity filter (Hz), in (0, Nyquist).
+    coulomb_friction : float
+        Coulomb friction force (N or N m), >= 0, and small enough that its
+        change of the state over a sub-step is a double
+        (:func:`check_friction_size`, checked against the loop's plant
+        before a run).
+    stiction : float
+        Breakaway force (N or N m), >= coulomb_friction (default: equal).
+    friction_compensation : bool
+        Add ``coulomb_friction * sign(v_hat)`` to the command.
+    actuator_bandwidth : float
+        First-order lag of the applied force (Hz), > 0.
+    substeps : int
+        Sub-steps per period, 1 to :data:`MAX_SUBSTEPS`: friction is
+        decided at their ends (the actuator lag is exact at any number).
+    force_limit : float
+        Largest force command (N or N m), > 0: the command is clipped to it.
+    force_resolution : float
+        Force quantum (N or N m), at least :data:`QUANTUM_MIN`: the command
+        is rounded to a multiple of it (a DAC's step), then clipped to
+        ``force_limit``.
+    """
+
+    encoder_resolution: float = None
+    velocity_cutoff: float = None
+    coulomb_friction: float = None
+    stiction: float = None
+    friction_compensation: bool = False
+    actuator_bandwidth: float = None
+    substeps: int = 20
+    force_limit: float = None
+    force_resolution: float = None
+
+    def __post_init__(self):
+        # Checked at construction, so that a wrong kind never reaches a run:
+        # friction_compensation="no" would otherwise switch compensation on.
+        if self.encoder_resolution is not None:
+            _check_quantum("encoder_resolution", self.encoder_resolution, "positions")
+        if self.velocity_cutoff is not None:
+            check_real("velocity_cutoff", self.velocity_cutoff, low=0.0, low_open=True)
+        if self.coulomb_friction is not None:
+            check_real("coulomb_friction", self.coulomb_friction, low=0.0)
+        if self.stiction is not None:
+            if self.coulomb_friction is None:
+                raise ValueError("stiction needs coulomb_friction")
+            check_real("stiction", self.stiction, low=self.coulomb_friction)
+        if not isinstance(self.friction_compensation, (bool, np.bool_)):
+            raise TypeError(f"friction_compensation must be True or False, "
+                            f"got {type(self.friction_compensation).__name__} "
+                            f"{self.friction_compensation!r}")
+        if self.friction_compensation and self.coulomb_friction is None:
+            raise ValueError("friction_compensation needs coulomb_friction")
+        if self.actuator_bandwidth is not None:
+            check_real("actuator_bandwidth", self.actuator_bandwidth, low=0.0, low_open=True)
+        if self.force_limit is not None:
+            check_real("force_limit", self.force_limit, low=0.0, low_open=True)
+        if self.force_resolution is not None:
+            _check_quantum("force_resolution", self.force_resolution, "force commands")
+            if self.coulomb_friction is not None:
+                # The verdict's floor for the quantum bounds the linear loop's response.
+                raise ValueError("force_resolution with coulomb_friction: the verdict allows "
+                                 "a force quantum's limit cycle by a bound on the linear "
+                                 "loop's response, which friction does not have; simulate "
+                                 "them one at a time")
+        if isinstance(self.substeps, (bool, np.bool_)) or \
+                not isinstance(self.substeps, (int, np.integer)):
+            raise TypeError(f"substeps must be an integer >= 1, got "
+                            f"{type(self.substeps).__name__} {self.substeps!r}")
+        if not 1 <= self.substeps <= MAX_SUBSTEPS:
+            raise ValueError(f"substeps must be an integer from 1 to {MAX_SUBSTEPS}, "
+                             f"got {self.substeps!r}")
+
+    def check(self, T):
+        """Validate against the sample period ``T``; raise ValueError naming the field.
+
+        The fields themselves are checked at construction; what depends on
+        ``T`` is the velocity filter's cut-off, below the Nyquist frequency.
+
+        Parameters
+        ----------
+        T : float
+            The sample period (s).
+
+        Raises
+        ------
+        ValueError
+            Naming ``velocity_cutoff`` and its range when it is not below ``0.5 / T``.
+        """
+        if self.velocity_cutoff is not None:
+            check_real("velocity_cutoff", self.velocity_cutoff, low=0.0, low_open=True,
+                       high=0.5 / T, high_open=True)
+
+    @property
+    def ideal(self):
+        return (self.encoder_resolution is None and self.velocity_cutoff is None
+                and self.coulomb_friction is None and self.actuator_bandwidth is None
+                and self.force_limit is None and self.force_resolution is None)
+
+
+
+#: The smallest quantum (encoder or force): the smallest normal double.
+QUANTUM_MIN = float(np.finfo(float).tiny)
+#: The largest change of the state the friction may make over a sub-step:
+#: below double precision's largest number (1.8e308) with room to add it to
+#: the rest of the step.
+FRICTION_STEP_MAX = 1e300
+
+
+def _check_quantum(name, quantum, divided):
+    """Check a quantum: a finite double of at least :data:`QUANTUM_MIN` (ValueError naming it).
+
+    The run divides the values it rounds by the quantum.  A subnormal
+    quantum (1e-320) keeps fewer than 53 significant bits and overflows
+    every such quotient above 1.8e-12: each run diverged.  From a normal
+    quantum on, a quotient that overflows is of a value the quantum is far
+    below the precision of, which rounding leaves as it is
+    (:func:`_rounded`).
+    """
+    check_real(name, quantum, low=0.0, low_open=True)
+    if not quantum >= QUANTUM_MIN:
+        raise ValueError(f"{name} must be a finite real number >= {QUANTUM_MIN!r} (the smallest "
+                         f"normal double: below it the quantum loses its significant bits and "
+                         f"the {divided} divided by it overflow), got {quantum!r}")
+
+
+def _rounded(values, quantum):
+    """``values`` rounded to multiples of ``quantum``; as they are where the quotient overflows.
+
+    (A quotient that overflows is of a value whose precision the quantum
+    is far below: its own multiple to the last bit.)
+    """
+    with np.errstate(over="ignore", invalid="ignore"):
+        rounded = quantum * np.round(values / quantum)
+    return np.where(np.isfinite(rounded), rounded, values)
+
+
+def check_friction_size(nonideal, spaces, name="nonideal.coulomb_friction", scale=1.0):
+    """Refuse a Coulomb friction larger than double precision can step on the plants ``spaces``.
+
+    A sub-step adds ``-gamma_f F`` to the state (:mod:`symstab.numeric.
+    friction`); the friction is refused when its largest entry would pass
+    :data:`FRICTION_STEP_MAX`, from where adding it overflows and a held
+    mass reads as diverged.  Below it any friction is stepped: a large one
+    stops the mass within the sub-step where it stands.
+
+    Parameters
+    ----------
+    nonideal : Nonidealities
+        In the units of the spaces.
+    spaces : list of FrictionSpace
+    name : str
+        The friction's name in the message (the CLI's ``--coulomb``).
+    scale : float
+        The spaces' unit of force over the caller's (the message gives the
+        caller's).
+
+    Raises
+    ------
+    ValueError
+        Naming ``name`` and its range on these plants.
+    """
+    friction = nonideal.coulomb_friction
+    if not friction:
+        return
+    largest = max(float(np.max(np.abs(space.gamma_f))) for space in spaces)
+    if largest > 0 and friction * largest > FRICTION_STEP_MAX:
+        limit = FRICTION_STEP_MAX / largest / scale
+        raise ValueError(f"{name} must be a real number from 0 to {limit:.3g} on this plant (a "
+                         f"sub-step changes its state by up to {largest * scale:.3g} per unit "
+                         f"of friction, and double precision steps a change up to "
+                         f"{FRICTION_STEP_MAX:g}), got {friction / scale:g}")
+
+
+def default_horizon(d):
+    """Periods simulated by default: long enough for the slow modes near the boundary.
+
+    ``12000 + 800 d``: on the paper's 100 x 100 grids (d in 0..10, eight
+    virtual masses) every cell that no boundary curve crosses then gets the
+    exact verdict; with ``4000 + 400 d`` six cells whose slowest mode grows
+    by 1e-4 to 5e-4 per period still looked stable.  Slower growth needs a
+    longer horizon.
+    """
+    return 12000 + 800 * check_delay(d)
+
+
+def default_x0(nonideal):
+    """The initial position when none is given: 1, or 0.01 with non-idealities.
+
+    A quantized or saturated run starts within a few hundred encoder counts
+    of the paper's (0.01 rad is 688 of its 3 arc-second counts), where its
+    limit cycles are seen; an ideal loop is linear, so any start will do.
+    """
+    return 1.0 if nonideal is None or nonideal.ideal else 0.01
+
+
+def check_x0(x0):
+    """Return the initial position ``x0`` as a float in ``X0_MIN <= |x0| <= X0_MAX``.
+
+    Raises
+    ------
+    TypeError, ValueError
+        Naming ``x0`` and the range.
+    """
+    x0 = check_real("x0", x0)
+    if not X0_MIN <= abs(x0) <= X0_MAX:
+        raise ValueError(f"x0 must be a finite real number with {X0_MIN:g} <= |x0| <= {X0_MAX:g} "
+                         f"(the verdict compares amplitudes and calls |x| > {_OVERFLOW:g} "
+                         f"divergence), got {x0!r}")
+    return x0
+
+
+def check_steps(steps, d):
+    """Return ``steps`` (None: :func:`default_horizon` of ``d``) as an int from 8 to :func:`max_steps`.
+
+    Raises
+    ------
+    ValueError
+        Naming ``steps``, the range and the variable that raises the limit.
+    """
+    steps = default_horizon(d) if steps is None else steps
+    if isinstance(steps, bool) or not isinstance(steps, (int, np.integer)) or steps < 8:
+        raise ValueError(f"steps must be an integer >= 8, got {steps!r}")
+    steps = int(steps)
+    limit = max_steps(d)
+    if steps > limit:
+        raise ValueError(f"steps must be an integer from 8 to {limit}, got {steps} (about "
+                         f"{steps * 3e-5 / 3600:.2g} hours per point; raise the limit with "
+                         f"{MAX_STEPS_ENV})")
+    return steps
+
+
+def max_steps(d):
+    """The largest ``steps`` accepted at delay ``d``.
+
+    ``SYMSTAB_MAX_STEPS`` (default 10 million), or :func:`default_horizon`
+    of ``d`` when that is longer.
+    """
+    return max(_max_steps_setting(), default_horizon(d))
+
+
+@dataclasses.dataclass(frozen=True)
+class Simulation:
+    """What a run returns.
+
+    Attributes
+    ----------
+    positions : ndarray or None
+        ``(steps + 1, *shape)`` positions (with ``record=True``).
+    amplitude : ndarray
+        ``(4, *shape)``: the largest ``|x|`` in each quarter of the run.
+    diverged : ndarray of bool
+        The state overflowed (|x| > 1e100).
+    stable : ndarray of bool
+        Not diverged, not a limit cycle, and the last quarter's amplitude
+        does not exceed the third's or the floor (see the module docstring).
+    steps : int
+    floor : ndarray
+        The amplitude up to which a run counts as bounded whatever it does:
+        four encoder counts, plus, with a force quantum, half the quantum
+        times the l1 norm of the linear loop's pulse response where the
+        linear loop is stable (the most its rounding can move the position).
+    limit_cycle : ndarray of bool
+        A run with non-idealities that keeps swinging, neither decaying nor
+        growing, above the floor: a bounded limit cycle (a saturated
+        unstable loop's), neither stable nor unstable.  Never set for the
+        ideal loop, which is linear.
+    """
+
+    positions: object
+    amplitude: np.ndarray
+    diverged: np.ndarray
+    stable: np.ndarray
+    steps: int
+    floor: np.ndarray
+    limit_cycle: np.ndarray
+
+    @property
+    def bounded(self):
+        """Stable or a limit cycle: the runs that neither grow nor diverge."""
+        return self.stable | self.limit_cycle
+
+    def __repr__(self):
+        stable = np.asarray(self.stable)
+        n_stable, n_diverged = int(np.count_nonzero(stable)), int(np.count_nonzero(self.diverged))
+        n_cycles = int(np.count_nonzero(self.limit_cycle))
+        size = f"{stable.size} point{'s' if stable.size != 1 else ''}"
+        if stable.ndim > 1:
+            size += " (" + " x ".join(map(str, stable.shape)) + ")"
+        recorded = ", positions recorded" if self.positions is not None else ""
+        cycles = f"{n_cycles} limit cycle{'s' if n_cycles != 1 else ''}, " if n_cycles else ""
+        n_unstable = stable.size - n_stable - n_cycles
+        return (f"Simulation({size}, {self.steps} steps: {n_stable} stable, {cycles}"
+                f"{n_unstable} unstable of which {n_diverged} diverged{recorded})")
+
+
+def _run_chunks(make_run, n_points, point_bytes, *, steps, d, record, progress, nonideal, shape,
+                pulse_of=None):
+    """Run ``n_points`` in chunks of about :data:`~symstab._resources.CHUNK_BYTES`; the :class:`Simulation`.
+
+    The driver of every run: ``make_run(part)`` builds the state of the
+    points ``part`` (an :class:`_AnyLoop`) of ``point_bytes`` each.  Recording keeps every position, so it runs in
+    one chunk and its memory is checked first.  ``pulse_of(part)``, with
+    a force quantum: the linear loop's response to a unit force pulse at
+    the points of ``part`` it bounds (an :class:`_AnyLoop` or None), whose
+    l1 norm over the run sets their verdict's floor (:func:`_verdict`).
+    """
+    if record:
+        check_memory(f"recording {steps} periods of {n_points} point(s) at d = {d}",
+                     8 * (steps + 1) * n_points + point_bytes * n_points)
+    else:
+        # The chunks bound the working set; what stays is the result.
+        check_memory(f"simulating {n_points} point(s)", 8 * 11 * n_points)
+    chunks = [slice(0, n_points)] if record else chunk_slices(n_points, point_bytes)
+    amplitude, swing = np.zeros((4, n_points)), np.zeros((4, n_points))
+    diverged = np.zeros(n_points, dtype=bool)
+    positions = np.empty((steps + 1, n_points)) if record else None
+    response = np.zeros(n_points) if pulse_of is not None else None
+    report = max(1, steps // 100)
+    # Each chunk runs once, or twice with the pulse response: the bar counts runs.
+    n_runs = len(chunks) * (1 if pulse_of is None else 2)
+    for number, part in enumerate(chunks):
+        run = make_run(part)
+        # Recorded positions must never hold an overflowed value: check every period then.
+        run.check_every = 1 if record else _CHECK_EVERY
+        runs_done = number * (n_runs // len(chunks))
+        _run(run, steps, amplitude[:, part], None if positions is None else positions[:, part],
+             progress, report, runs_done, n_runs, swing=swing[:, part])
+        diverged[part] = run.diverged
+        run = None          # the pulse response's chunk takes its place
+        if pulse_of is not None:
+            response[part] = _pulse_l1(pulse_of(part), steps, progress, report, runs_done + 1,
+                                       n_runs)
+    return _verdict(amplitude, swing, diverged, positions, shape, steps, nonideal, response)
+
+
+def _pulse_l1(pulse, steps, progress, report, chunk, n_chunks):
+    """``sum_{k=1}^{steps} |h[k]|`` of a pulse response run ``(run, points)``, at every point of the chunk.
+
+    ``points`` (bool) are those of the chunk that ``run`` holds; the
+    others get 0.
+    """
+    run, points = pulse
+    out = np.zeros(points.size)
+    if run is None:
+        if progress is not None:
+            progress(((chunk + 1) * steps) // n_chunks)
+        return out
+    total = np.zeros(run.x.size)
+    with np.errstate(over="ignore", invalid="ignore"):
+        _run(run, steps, np.zeros((4, run.x.size)), None, progress, report, chunk, n_chunks,
+             total=total)
+    # A point whose response overflowed has no bound: it keeps no floor.
+    out[points] = np.where(run.diverged, 0.0, total)
+    return out
+
+
+def _run(run, steps, amplitude, positions, progress, report, chunk, n_chunks, total=None,
+         swing=None):
+    """Advance ``run`` ``steps`` periods, keeping the largest |x| of each quarter.
+
+    ``progress`` hears the steps done over all chunks, scaled to ``steps``;
+    ``total``, if given, accumulates ``|x|`` of every period after the start;
+    ``swing``, if given, gets each quarter's half range of ``x`` (half of
+    its largest less its smallest value).
+    """
+    quarter = steps // 4
+    if positions is not None:
+        positions[0] = run.x
+    # The signed extremes of each quarter: the largest |x| and the swing (a
+    # limit cycle keeps its swing; a mass held off zero keeps |x| with none).
+    high, low = np.full((4, run.x.size), -np.inf), np.full((4, run.x.size), np.inf)
+    magnitude = np.empty_like(run.x) if total is not None else None
+    for k in range(steps):
+        with np.errstate(over="ignore", invalid="ignore"):
+            run.step()
+        q = min(k // quarter, 3)
+        np.maximum(high[q], run.x, out=high[q])
+        np.minimum(low[q], run.x, out=low[q])
+        if total is not None:
+            np.abs(run.x, out=magnitude)
+            total += magnitude
+        if positions is not None:
+            positions[k + 1] = run.x
+        if progress is not None and ((k + 1) % report == 0 or k + 1 == steps):
+            progress((chunk * steps + k + 1) // n_chunks)
+    run.freeze_diverged()
+    with np.errstate(invalid="ignore"):
+        np.maximum(high, -low, out=amplitude)
+        if swing is not None:
+            np.multiply(high - low, 0.5, out=swing)
+
+
+@dataclasses.dataclass(frozen=True)
+class StabilityMap(PaperGridNames):
+    """Stability by simulation on a grid of the ``(x, y)`` plane.
+
+    Attributes
+    ----------
+    y_values, x_values : ndarray
+        The 1-D grids.
+    stable : ndarray of bool
+        Shape ``(len(y_values), len(x_values))``.
+    limit_cycle : ndarray of bool
+        Same shape: the cells whose run settles into a bounded limit cycle
+        (:attr:`Simulation.limit_cycle`), neither stable nor growing.
+    growth : ndarray
+        Last quarter's amplitude over the third's (``inf`` when diverged).
+    steps : int
+        Periods simulated.
+    x, y : str
+        The plane (``"beta"``, ``"alpha"``: the paper's, Table I's variables).
+    at : dict
+        The other parameters' values (the paper's ``gamma``, ``d``, ``delta``).
+
+    Notes
+    -----
+    In the paper's plane ``alpha`` and ``beta`` are aliases of the grids and
+    ``gamma``, ``d``, ``delta`` of :attr:`at`, as in
+    :class:`~symstab.numeric.engine.results.Limits`.
+    """
+
+    y_values: np.ndarray
+    x_values: np.ndarray
+    stable: np.ndarray
+    limit_cycle: np.ndarray
+    growth: np.ndarray
+    steps: int
+    x: str = PAPER_PLANE[0]
+    y: str = PAPER_PLANE[1]
+    at: dict = dataclasses.field(default_factory=dict)
+
+
+
+# --------------------------------------------------------------------------
+# Any loop: its plant's pulse transfer function and its environment, stepped
+
+
+#: Floats held per point besides the delay line and the histories: the
+#: position, the sampled position, the force and about five temporaries.
+_ANY_LOOP_FLOATS = 8
+
+
+def simulate_loop(loop, *, steps=None, x0=1.0, v0=None, nonideal=None, record=False,
+                  progress=None, **values):
+    """Run a :class:`symstab.Loop` for every parameter point at once (:meth:`symstab.Loop.simulate`).
+
+    The plant is its exact ZOH step on the samples: the difference equation
+    of ``P(z) = Z[ZOH G] = P_n / P_d``, whose coefficients the loop derives
+    (by residues, or the matrix exponential at 30 digits where there is no
+    closed form), ``P_d(z) y = P_n(z) u``.  The environment is its
+    difference equation ``Ve_d(z) f = Ve_n(z) x_s`` on the sampled position
+    ``x_s``, and the force waits ``d`` samples: ``u[k] = -f[k - d]``, the
+    loop whose characteristic polynomial is ``chi = z**d Ve_d P_d + Ve_n
+    P_n`` (:meth:`symstab.Loop.polynomial`).  The run starts from the
+    position ``x0``, earlier positions ``x0 - k v0``, the sampled history at
+    ``x0``, no force and an empty delay line; the verdict is
+    :func:`simulate`'s.
+
+    Non-idealities (:class:`Nonidealities`, physical units):
+    ``encoder_resolution`` rounds the sampled position, ``force_resolution``
+    rounds the force command to its quantum and ``force_limit`` clips it (a
+    saturated unstable loop may settle into a bounded limit cycle, which the
+    verdict calls a limit cycle, :attr:`Simulation.limit_cycle`, neither
+    stable nor growing; a quantized one, where the linear
+    loop is stable, is bounded up to :attr:`Simulation.floor`, the most the
+    rounding can move it).  ``coulomb_friction`` (with ``stiction``
+    and ``substeps``) acts on the loop's driven mass, after its
+    :attr:`~symstab.Loop.actuator`: the plant is then stepped on its
+    continuous state space, ``substeps`` exact sub-steps a period, with the
+    paper's simulator's stick and reversal rules
+    (:mod:`symstab.numeric.simulation.friction`).  A velocity filter or an actuator
+    lag is part of a loop's own environment or plant.
+
+    Parameters
+    ----------
+    loop : symstab.Loop
+    steps, x0, v0, record, progress
+        As in :func:`simulate` (``v0`` is a position change per period,
+        default ``x0 / 100``).
+    nonideal : Nonidealities, optional
+        Only the fields above (and ``substeps``).
+    **values
+        The loop's parameters (or their defaults); arrays broadcast, ``d``
+        one integer.
+
+    Returns
+    -------
+    Simulation
+        Of the broadcast shape of the values.
+
+    Raises
+    ------
+    TypeError, ValueError
+        For a value of the wrong kind or out of range, a non-ideality a
+        general loop does not have, a plant with direct feed-through (its
+        ``P_n`` as high as ``P_d``: the sampled position would depend on the
+        force of the same instant), or a run that does not fit in memory.
+    """
+    nonideal = check_loop_nonideal(nonideal, loop)
+    check_progress(progress)   # a wrong kind is refused before the work
+    parts, d, shape = loop.difference_equations(**values)
+    steps = check_steps(steps, d)
+    progress = check_progress(progress, lambda: progress_printer("simulating", steps))
+    x0 = check_x0(x0)
+    v0 = x0 / 100 if v0 is None else check_real("v0", v0, low=-X0_MAX, high=X0_MAX)
+    n_points = int(np.prod(shape))
+    parts = [np.broadcast_to(p, shape + p.shape[-1:]).reshape(n_points, p.shape[-1])
+             for p in parts]
+    orders = parts[1].shape[-1] + parts[3].shape[-1]
+    spaces = None
+    if nonideal.coulomb_friction is not None:
+        spaces, inverse = loop.friction_spaces(substeps_of(nonideal), **values)
+        check_friction_size(nonideal, spaces)
+        spaces = (spaces, inverse.ravel())
+    return run_loop(lambda part: [p[part] for p in parts], n_points, d=d, steps=steps, x0=x0,
+                    v0=v0, nonideal=nonideal, record=record, progress=progress, shape=shape,
+                    spaces=spaces, parts_floats=2 * orders + sum(p.shape[-1] for p in parts),
+                    linear_stable=linearly_stable(loop, nonideal, values, shape))
+
+
+def linearly_stable(loop, nonideal, values, shape):
+    """Where ``loop``'s linear part is stable at ``values`` (raveled), if ``nonideal`` quantizes the force.
+
+    The certified root count (:meth:`symstab.Loop.unstable_root_counts`)
+    at every point: 0 is stable; a marginal point (-1) is not.  None
+    without a force quantum (no run needs it).
+    """
+    if nonideal.force_resolution is None:
+        return None
+    counts = loop.unstable_root_counts(**values)
+    return np.broadcast_to(np.asarray(counts) == 0, shape).ravel()
+
+
+def run_loop(parts_of, n_points, *, d, steps, x0, v0, nonideal, record, progress, shape,
+             spaces=None, state=None, compensation=None, parts_floats=64, linear_stable=None):
+    """Run ``n_points`` of a loop a chunk at a time: the one engine; the :class:`Simulation`.
+
+    Parameters
+    ----------
+    parts_of : callable
+        ``parts_of(part)``: the difference equations ``(a, b, c, e)`` of
+        the points ``part`` (a slice), as :meth:`symstab.Loop.difference_equations`.
+    n_points, d, steps, x0, v0, record, progress
+        As :func:`simulate_loop` (checked by the caller).
+    nonideal : Nonidealities
+        Encoder, force limit and friction, in the loop's units.
+    shape : tuple
+        The shape of the result (``n_points`` in all).
+    spaces : (list of FrictionSpace, ndarray of int), optional
+        The plant on its state space (:mod:`symstab.numeric.simulation.friction`),
+        each point's index into the list; default: ``P(z)`` on the samples.
+    state : (float, float), optional
+        With ``spaces``: start from the mass's position and velocity (the
+        rest of the plant at rest), not from positions ``x0 - k v0``.
+    compensation : (float, float), optional
+        The paper's friction compensation: ``F_c`` and the pole of its
+        velocity filter (0: the backward difference).
+    parts_floats : int
+        Floats a point's difference equations take (for the chunk size).
+    linear_stable : ndarray of bool, optional
+        ``(n_points,)``: the points whose linear loop is stable (a certified
+        root count of 0); needed with a force quantum, whose verdict floor
+        they get (:func:`_verdict`).
+    """
+    def pulse(part):
+        # The linear loop's response to a unit force pulse, at its stable points only.
+        points = np.asarray(linear_stable[part], dtype=bool)
+        if not points.any():
+            return None, points
+        return _AnyLoop([p[points] for p in parts_of(part)], d, 0.0, 0.0, Nonidealities(),
+                        pulse=1.0), points
+
+    if nonideal.force_resolution is not None and (
+            linear_stable is None or np.shape(linear_stable) != (n_points,)):
+        raise ValueError("a force quantum's verdict needs linear_stable, one bool a point")
+    pulse_of = None if nonideal.force_resolution is None else pulse
+    point_bytes = 8 * (d + 1 + parts_floats + _ANY_LOOP_FLOATS)
+    if spaces is None:
+        def make_run(part):
+            return _AnyLoop(parts_of(part), d, x0, v0, nonideal, compensation=compensation)
+    else:
+        spaces, inverse = spaces
+        n = spaces[0].phi.shape[0]
+        # The state, its two candidates and their temporaries; per-point matrices.
+        point_bytes += 8 * (6 * n + 4 + (0 if len(spaces) == 1 else 2 * n * n + 10 * n))
+
+        def make_run(part):
+            return _StateLoop(parts_of(part), d, x0, v0, nonideal,
+                                 stacked_spaces(spaces, inverse[part]), state=state,
+                                 compensation=compensation)
+    return _run_chunks(make_run, n_points, point_bytes, steps=steps, d=d, record=record,
+                       progress=progress, nonideal=nonideal, shape=shape, pulse_of=pulse_of)
+
+
+def check_loop_nonideal(nonideal, loop=None, friction_name="nonideal.coulomb_friction"):
+    """``nonideal`` (None: ideal) as the :class:`Nonidealities` of a general loop, or raise.
+
+    A general loop has encoder quantization, a force limit and Coulomb
+    friction on its driven mass (with ``loop``: checked to have one,
+    :meth:`symstab.Loop.driven_mass`); the velocity filter and the actuator
+    lag belong in its environment and plant, and friction compensation
+    needs the paper's velocity estimate.  ``friction_name`` names the
+    friction in the message (the CLI's ``--coulomb``).
+    """
+    nonideal = Nonidealities() if nonideal is None else nonideal
+    if not isinstance(nonideal, Nonidealities):
+        raise TypeError(f"nonideal must be a symstab.numeric.paper.simulate.Nonidealities or None, "
+                        f"got {type(nonideal).__name__}")
+    for field, instead in (("velocity_cutoff", "write the filter into the loop's environment"),
+                           ("actuator_bandwidth", "write the lag into the loop's plant"),
+                           ("friction_compensation", "a general loop has no velocity estimate "
+                            "to compensate with")):
+        if getattr(nonideal, field) not in (None, False):
+            raise ValueError(f"nonideal.{field}: {instead} (the paper's simulator, "
+                             f"symstab.simulate, has it)")
+    if loop is not None and nonideal.coulomb_friction is not None:
+        try:
+            loop.driven_mass
+        except ValueError as exc:
+            raise ValueError(f"{friction_name}: {exc}") from None
+    return nonideal
+
+
+def _verdict(amplitude, swing, diverged, positions, shape, steps, nonideal, response=None):
+    """The :class:`Simulation` of a run: stable, a limit cycle, or unstable.
+
+    Unstable when the last quarter outgrows the third.  Amplitudes up to a
+    floor count as bounded whatever they do: four encoder counts (a
+    quantization limit cycle), plus, with a force quantum ``q``, at the
+    points whose linear loop is stable, ``q / 2`` times ``response``, the
+    l1 norm over the run of the linear loop's response to a unit force
+    pulse.  Rounding adds to each command an error of at most ``q / 2``; by
+    superposition the position departs from the run without the quantum by
+    at most ``q / 2`` times that norm, and that run decays where the linear
+    loop is stable: a limit cycle within the floor is the quantum's, not
+    growth.  (Without a floor, a limit cycle's last quarter exceeds the
+    third as often as not: on the paper's loop at d = 5 with a 1 mN m
+    quantum, 543 of 1 515 stable cells were called unstable.)  ``response``
+    is 0 where the linear loop is not stable.
+
+    A run of a loop with non-idealities is a limit cycle
+    (:attr:`Simulation.limit_cycle`), neither stable nor unstable, when it
+    keeps swinging: the half range of ``x`` over the last quarter
+    (``swing``) is above the floor and :data:`_MOVING` of the amplitude (a
+    mass held at rest off zero by friction has none), within
+    :data:`_SUSTAINED` of the third quarter's (not decaying, not growing),
+    and the largest ``|x|`` no more than that above the third's (not
+    drifting away).  The sampled peak of a periodic motion differs from one
+    quarter to the next by up to 2e-4 (a saturated paper loop), so the
+    plain comparison called half of such cycles growing and half stable.
+    A linear loop has no limit cycle: a run of the ideal loop that neither
+    grows nor decays is on the boundary, and stays the comparison's.
+    """
+    amplitude[:, diverged] = np.inf
+    floor = 4 * nonideal.encoder_resolution if nonideal.encoder_resolution else 0.0
+    if response is not None:
+        floor = floor + nonideal.force_resolution / 2 * response
+    floor = np.broadcast_to(floor, diverged.shape)
+    bounded = ~diverged & (amplitude[3] <= np.maximum(amplitude[2], floor))
+    with np.errstate(invalid="ignore"):
+        limit_cycle = (~diverged & (swing[3] > np.maximum(floor, _MOVING * amplitude[3]))
+                       & (np.abs(swing[3] - swing[2]) <= _SUSTAINED * swing[2])
+                       & (amplitude[3] <= (1 + _SUSTAINED) * amplitude[2]))
+    if nonideal.ideal:
+        limit_cycle[:] = False
+    return Simulation(
+        positions=None if positions is None else positions.reshape((steps + 1,) + shape),
+        amplitude=amplitude.reshape((4,) + shape),
+        diverged=diverged.reshape(shape), stable=(bounded & ~limit_cycle).reshape(shape),
+        steps=steps, floor=floor.reshape(shape), limit_cycle=limit_cycle.reshape(shape))
+
+
+def _terms(columns):
+    """``[(k, coefficient), ...]`` of the nonzero columns of ``(N, k)`` coefficients.
+
+    A column equal at every point is a float (a scalar product is faster).
+    """
+    out = []
+    for k in range(columns.shape[1]):
+        column = columns[:, k]
+        if np.all(column == 0):
+            continue
+        out.append((k, float(column[0]) if np.all(column == column[0]) else
+                    np.ascontiguousarray(column)))
+    return out
+
+
+class _AnyLoop:
+    """A loop's samples for N points: :meth:`step` advances one period.
+
+    ``a``, ``b``: the plant's ``P_d`` (monic, without its leading 1) and
+    ``P_n`` (its coefficients of ``z**(n-1) .. 1``); ``c``, ``e``: the
+    environment's ``Ve_d`` (monic, without its leading 1) and ``Ve_n``
+    (``z**m .. 1``).  Histories are lists, newest first, rotated (no copies);
+    the delay line is a ring of the commands themselves, and the plant's
+    input history keeps the commands ``f`` (its sum has ``-b``: ``u = -f``).
+    """
+
+    def __init__(self, parts, d, x0, v0, nonideal, compensation=None, pulse=None):
+        a, b, c, e = parts
+        n_points = a.shape[0]
+        # Each sum keeps its nonzero terms only (a backward difference's Ve_d
+        # is z**k: no force feedback at all), with a float coefficient where
+        # every point has the same (the plant of a plane of the environment).
+        self.a, self.c = _terms(a), _terms(c)
+        self.minus_b = _terms(-b)
+        self.e0, self.e = e[:, 0], _terms(e[:, 1:])
+        self.e0 = float(self.e0[0]) if np.all(self.e0 == self.e0[0]) else self.e0
+        self.d = d
+        self.quantum = nonideal.encoder_resolution
+        self.force_limit = nonideal.force_limit
+        self.force_quantum = nonideal.force_resolution
+        n, m = a.shape[1], c.shape[1]
+        self.x = np.full(n_points, float(x0))
+        # y[k-1], y[k-2], ... before the start: x0 - k v0; no force applied yet.
+        self.y_past = [np.full(n_points, x0 - k * v0) for k in range(1, n + 1)]
+        self.f_past_plant = [np.zeros(n_points) for _ in range(n)]
+        sampled = self._sample(self.x)
+        # The environment at rest at the sampled x0: its force Ve(1) x_s
+        # (none where Ve has a pole at z = 1, an integrator's).
+        with np.errstate(all="ignore"):
+            dc_gain = np.where(1 + c.sum(axis=1) != 0, e.sum(axis=1) / (1 + c.sum(axis=1)), 0.0)
+        self.s_past = [np.array(sampled) for _ in range(m)]
+        self.f_past = [dc_gain * sampled for _ in range(m)]
+        # The paper's friction compensation: (F_c, filter pole) on the
+        # velocity estimate, the filtered backward difference.
+        self.compensation = compensation
+        self.v_hat = np.zeros(n_points)
+        self.line = [np.zeros(n_points) for _ in range(d + 1)]
+        self._scratch = np.empty(n_points)
+        self.k = 0
+        self.diverged = np.zeros(n_points, dtype=bool)
+        self.check_every = _CHECK_EVERY
+        # A force added to the first command only (the pulse response).
+        self.pulse = pulse
+
+    def _sample(self, x):
+        q = self.quantum
+        return x if not q else _rounded(x, q)
+
+    def _sum(self, out, terms, history, sign):
+        tmp = self._scratch
+        for k, coefficient in terms:
+            np.multiply(coefficient, history[k], out=tmp)
+            if sign > 0:
+                out += tmp
+            else:
+                out -= tmp
+
+    def step(self):
+        # The environment's force from the sampled position of this instant.
+        # (self.x is a new array every period, so the histories may keep it.)
+        sampled = self._sample(self.x)
+        force = np.multiply(self.e0, sampled)
+        self._sum(force, self.e, self.s_past, 1)
+        self._sum(force, self.c, self.f_past, -1)
+        command = force
+        if self.pulse is not None:
+            command, self.pulse = force + self.pulse, None
+        if self.compensation is not None:
+            # u = -f + F_c sign(v_hat): the command f less the compensation.
+            coulomb, pole = self.compensation
+            self.v_hat = pole * self.v_hat + (1 - pole) * (sampled - self.s_past[0])
+            command = force - coulomb * np.sign(self.v_hat)
+        if self.s_past:
+            self.s_past = [sampled] + self.s_past[:-1]
+            self.f_past = [force] + self.f_past[:-1]
+        # The environment keeps its own force; the command sent is rounded
+        # to the DAC's step and clipped to its range.
+        if self.force_quantum is not None:
+            command = _rounded(command, self.force_quantum)
+        if self.force_limit is not None:
+            command = np.clip(command, -self.force_limit, self.force_limit)
+        slot = self.k % (self.d + 1)
+        self.line[slot] = command
+        self.k += 1
+        # The command of d periods ago (d = 0: this one) drives the plant.
+        self.x = self._plant_step(self.line[(slot + 1) % (self.d + 1)] if self.d else command)
+        if self.k % self.check_every == 0:
+            self.freeze_diverged()
+
+    def _plant_step(self, command):
+        """The plant's next sample under ``u = -command``: ``P_d(z) y = P_n(z) u``."""
+        self.y_past = [self.x] + self.y_past[:-1]
+        self.f_past_plant = [command] + self.f_past_plant[:-1]
+        (k, first), *rest = self.minus_b
+        x = np.multiply(first, self.f_past_plant[k])
+        self._sum(x, rest, self.f_past_plant, 1)
+        self._sum(x, self.a, self.y_past, -1)
+        return x
+
+    def freeze_diverged(self):
+        """Mark the points whose state left [-1e100, 1e100] or is not finite; zero them."""
+        bad = ~(np.abs(self.x) < _OVERFLOW)
+        for history in (self.y_past, self.f_past_plant, self.f_past):
+            for value in history:
+                bad |= ~np.isfinite(value)
+        if bad.any():
+            self.diverged |= bad
+            self.x[bad] = 0.0
+            for history in (self.line, self.y_past, self.f_past_plant, self.s_past, self.f_past):
+                for value in history:
+                    value[bad] = 0.0
+            self.v_hat[bad] = 0.0
+
+
+class _StateLoop(_AnyLoop):
+    """A loop whose plant is a :class:`~symstab.numeric.simulation.friction.StatePlant`: on its state space.
+
+    With Coulomb friction on its mass, or started from a state: ``state =
+    (x0, v0)``, the mass's position and velocity (the rest of the plant at
+    rest) rather than a history of positions.
+    """
+
+    def __init__(self, parts, d, x0, v0, nonideal, space, state=None, compensation=None):
+        super().__init__(parts, d, x0, v0, nonideal, compensation=compensation)
+        self.y_past = self.f_past_plant = []      # the state space holds the plant's past
+        coulomb = nonideal.coulomb_friction
+        stiction = nonideal.stiction if nonideal.stiction is not None else coulomb
+        if state is None:
+            self.plant = StatePlant.from_history(space, x0, v0, self.x.size, nonideal)
+        else:
+            start = np.zeros((space.phi.shape[0], self.x.size))
+            start[0], start[1] = state
+            self.plant = StatePlant(space, start, np.full(self.x.size, state[1] == 0),
+                                    substeps=substeps_of(nonideal), coulomb=coulomb,
+                                    stiction=stiction)
+
+    def _plant_step(self, command):
+        return self.plant.step(command, -1.0)
+
+    def freeze_diverged(self):
+        bad = ~(np.abs(self.x) < _OVERFLOW) | ~self.plant.finite()
+        if bad.any():
+            self.plant.freeze(bad)
+            self.x[bad] = np.inf        # marked diverged below, with everything zeroed
+        super().freeze_diverged()
+
+
+def loop_stability_map(loop, x_values, y_values, *, x=None, y=None, steps=None, x0=1.0, v0=None,
+                       nonideal=None, progress=None, **values):
+    """Stable cells of an ``(x, y)`` grid of a loop by simulation (:meth:`symstab.Loop.stability_map`).
+
+    Parameters
+    ----------
+    loop : symstab.Loop
+    x_values, y_values : array_like
+        1-D grids of the plane's parameters.
+    x, y : str, optional
+        The plane (default: the loop's :attr:`~symstab.Loop.plane`).
+    steps, x0, v0, nonideal, progress
+        As in :func:`simulate_loop` (``progress=True`` draws a bar).
+    **values
+        Single values of the other parameters.
+
+    Returns
+    -------
+    StabilityMap
+    """
+    x_values, y_values = check_array(x, x_values), check_array(y, y_values)
+    if x_values.ndim != 1 or y_values.ndim != 1:
+        raise ValueError(f"the grids of {x} and {y} must be 1-D")
+    for name in (x, y):
+        if name in values:
+            raise TypeError(f"{name} is an axis of the map: give its grid, not a value")
+    if progress is True:
+        progress = progress_printer("simulating", check_steps(
+            steps, check_delay(values.get("d", loop.defaults.get("d", 0)))))
+    Y, X = np.meshgrid(y_values, x_values, indexing="ij")
+    run = simulate_loop(loop, steps=steps, x0=x0, v0=v0, nonideal=nonideal, progress=progress,
+                        **{x: X, y: Y}, **values)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        growth = np.where(run.diverged, np.inf, run.amplitude[3] / run.amplitude[2])
+    at = {k: v for k, v in {**loop.defaults, **values}.items() if k not in (x, y)}
+    return StabilityMap(y_values, x_values, run.stable, run.limit_cycle, growth, run.steps,
+                        x=x, y=y, at=at)
