@@ -1,8 +1,11 @@
-"""The one home of matplotlib: the style, the PNG bytes and the shared pieces of every drawing.
+"""The one home of matplotlib: the style, the PNG bytes and every drawing of the command line.
 
-:mod:`symstab.figures`, the command line's PNGs (``symstab map``, ``locus``,
-...) and :mod:`symstab.reproduce` draw through this module and compute
-nothing here: what they draw comes from the numeric API.  matplotlib is an
+The command line's PNGs (``symstab map``, ``locus``, ``limits``,
+``design``) are drawn here whole: the command computes (through the
+numeric API) and hands the results over; nothing here computes a
+stability question.  :mod:`symstab.figures` and :mod:`symstab.reproduce`
+draw through the style and pieces of this module.  No module of
+:mod:`symstab.cli` imports matplotlib (``tests/test_layers.py``).  matplotlib is an
 extra (``pip install 'symstab[figures]'``); :func:`require_matplotlib` says
 so in one line where it is missing.
 """
@@ -14,13 +17,22 @@ import sys
 import numpy as np
 
 __all__ = ["require_matplotlib", "pyplot", "pyplot_or_none", "png_bytes", "visible",
-           "draw_lines", "label_log_axis", "design_figure", "SUPTITLE_SIZE", "PANEL_TITLE_SIZE", "LEGEND_SIZE"]
+           "draw_lines", "label_log_axis", "design_figure", "design_png", "simulated_map_png",
+           "loop_map_png", "probability_map_png", "robust_png", "locus_png",
+           "LIMIT_CYCLE_COLOR", "LIMIT_CYCLE_LABEL", "SUPTITLE_SIZE", "PANEL_TITLE_SIZE",
+           "LEGEND_SIZE"]
 
 #: Font sizes (pt).  A figure's own title sits above its panels' titles, so it
 #: is the largest; legends stay readable at the saved 110 dpi (6-7 pt was not).
 SUPTITLE_SIZE = 13
 PANEL_TITLE_SIZE = 11
 LEGEND_SIZE = 8
+
+#: The colour and legend of a map's cell whose run settles into a bounded
+#: limit cycle (:attr:`symstab.numeric.simulation.simulator.Simulation.limit_cycle`):
+#: neither stable (green) nor growing (white).
+LIMIT_CYCLE_COLOR = "#fdb863"
+LIMIT_CYCLE_LABEL = "bounded limit cycle (simulated)"
 
 
 def require_matplotlib():
@@ -173,3 +185,402 @@ def design_figure(plt, found, labels, target_label):
     ax.legend(fontsize=LEGEND_SIZE, loc="best")
     fig.tight_layout()
     return fig
+
+
+def design_png(found, labels, target_label):
+    """:func:`design_figure` as PNG bytes.
+
+    Parameters
+    ----------
+    found : symstab.numeric.analysis.design.Design
+    labels : list of str
+        The axis label of each parameter searched.
+    target_label : str
+        The target's label, with its unit.
+
+    Returns
+    -------
+    bytes
+    """
+    plt = pyplot()
+    return png_bytes(plt, design_figure(plt, found, labels, target_label))
+
+
+# --------------------------------------------------------------------------
+# symstab map
+
+
+def simulated_map_png(x, y, stable, limit_cycle, *, boundary, xlabel, ylabel, title):
+    """The paper's map simulated, as PNG bytes (None, said on stderr, without matplotlib).
+
+    The cells shaded by the simulation's verdict (stable green, a bounded
+    limit cycle :data:`LIMIT_CYCLE_COLOR`), the boundary of the loop
+    simulated drawn over them.
+
+    Parameters
+    ----------
+    x, y : numpy.ndarray
+        The grids of the axes (in the units the user gave).
+    stable, limit_cycle : numpy.ndarray of bool
+        The simulation's verdicts, ``(y, x)``.
+    boundary : dict
+        ``curve`` (the arc's ``(x, y)`` in the plane's coordinates, NaN
+        between branches), ``label`` (the arc's legend), ``lines`` (the
+        D-decomposition's lines, as :func:`draw_lines`), ``plane`` (the
+        grids ``(x, y)`` in the plane's coordinates), ``to_x`` and ``to_y``
+        (the plane's coordinates to the axes').
+    xlabel, ylabel, title : str
+
+    Returns
+    -------
+    bytes or None
+    """
+    plt = pyplot_or_none()
+    if plt is None:
+        return None
+    from matplotlib.colors import ListedColormap
+    from matplotlib.patches import Patch
+
+    to_x, to_y = boundary["to_x"], boundary["to_y"]
+    fig, ax = plt.subplots(figsize=(6.4, 4.8), dpi=120)
+    ax.pcolormesh(x, y, np.where(stable, 1, np.where(limit_cycle, 2, 0)),
+                  shading="nearest", cmap=ListedColormap(["white", "#7fc97f", LIMIT_CYCLE_COLOR]),
+                  vmin=0, vmax=2)
+    arc_x, arc_y = boundary["curve"]
+    drawn = []
+    if np.any(np.isfinite(arc_x)):
+        drawn += ax.plot(to_x(arc_x), to_y(arc_y), "k-", lw=1.2, label=boundary["label"])
+    drawn += draw_lines(ax, boundary["lines"], *boundary["plane"], to_x, to_y)
+    if np.any(limit_cycle):
+        drawn.append(Patch(facecolor=LIMIT_CYCLE_COLOR, label=LIMIT_CYCLE_LABEL))
+    ax.set_xlim(x[0], x[-1])
+    ax.set_ylim(y[0], y[-1])
+    ax.set_xlabel(xlabel)
+    ax.set_ylabel(ylabel)
+    ax.set_title(title, fontsize=10)
+    if drawn:
+        ax.legend(handles=drawn, loc="upper right", fontsize=9)
+    fig.tight_layout()
+    return png_bytes(plt, fig)
+
+
+def _loop_boundary(ax, curve, xs, ys, label=""):
+    """A loop's D-decomposition (a :class:`~symstab.numeric.engine.results.Boundary`) on ``ax``.
+
+    Returns the legend's handles.
+    """
+    bx, by = visible(curve.x_values, xs[0], xs[-1]), visible(curve.y_values, ys[0], ys[-1])
+    bx[np.isnan(by)] = np.nan
+    handles = []
+    if np.any(np.isfinite(bx)):
+        handles += ax.plot(bx, by, "k-", lw=1.2,
+                           label=label + r"$z = e^{j\theta}$ root (D-decomposition)")
+    return handles + draw_lines(ax, curve.lines, xs, ys)
+
+
+def _map_frame(ax, xs, ys, xlabel, ylabel):
+    """A map's limits and its axes' names."""
+    ax.set_xlim(xs[0], xs[-1])
+    ax.set_ylim(ys[0], ys[-1])
+    ax.set_xlabel(xlabel)
+    ax.set_ylabel(ylabel)
+
+
+def loop_map_png(xs, ys, shade, legend, curve, *, xlabel, ylabel, title):
+    """A loop file's map as PNG bytes (None without matplotlib), its D-decomposition over it.
+
+    Parameters
+    ----------
+    xs, ys : numpy.ndarray
+        The grids.
+    shade : numpy.ndarray of int
+        ``(y, x)``: 0 unstable (white), 1 marginal (grey), 2 stable (green),
+        3 a bounded limit cycle (:data:`LIMIT_CYCLE_COLOR`).
+    legend : list of (str, str)
+        ``(colour, label)`` of each shade named in the legend.
+    curve : symstab.numeric.engine.results.Boundary
+        The loop's D-decomposition over the window.
+    xlabel, ylabel, title : str
+
+    Returns
+    -------
+    bytes or None
+    """
+    plt = pyplot_or_none()
+    if plt is None:
+        return None
+    from matplotlib.colors import ListedColormap
+    from matplotlib.patches import Patch
+
+    fig, ax = plt.subplots(figsize=(6.4, 4.8), dpi=120)
+    ax.pcolormesh(xs, ys, shade, shading="nearest", vmin=0, vmax=3,
+                  cmap=ListedColormap(["white", "#bdbdbd", "#7fc97f", LIMIT_CYCLE_COLOR]))
+    handles = [Patch(facecolor=color, label=label) for color, label in legend]
+    handles += _loop_boundary(ax, curve, xs, ys)
+    _map_frame(ax, xs, ys, xlabel, ylabel)
+    ax.set_title(title, fontsize=9)
+    ax.legend(handles=handles, loc="best", fontsize=8, framealpha=0.9)
+    fig.tight_layout()
+    return png_bytes(plt, fig)
+
+
+def probability_map_png(found, curve, *, xlabel, ylabel, title):
+    """The probability of stability as PNG bytes (None without matplotlib), the nominal boundary.
+
+    Parameters
+    ----------
+    found : symstab.numeric.engine.results.StabilityProbability
+    curve : symstab.numeric.engine.results.Boundary
+        The nominal loop's D-decomposition over the window.
+    xlabel, ylabel, title : str
+
+    Returns
+    -------
+    bytes or None
+    """
+    plt = pyplot_or_none()
+    if plt is None:
+        return None
+    xs, ys = found.x_values, found.y_values
+    fig, ax = plt.subplots(figsize=(6.4, 4.8), dpi=120)
+    mesh = ax.pcolormesh(xs, ys, found.probability, shading="nearest", vmin=0.0, vmax=1.0,
+                         cmap="Greens")
+    fig.colorbar(mesh, ax=ax, label="probability of stability")
+    handles = _loop_boundary(ax, curve, xs, ys, "nominal loop: ")
+    _map_frame(ax, xs, ys, xlabel, ylabel)
+    ax.set_title(title, fontsize=8)
+    if handles:
+        ax.legend(handles=handles, loc="best", fontsize=8, framealpha=0.9)
+    fig.tight_layout()
+    return png_bytes(plt, fig)
+
+
+# --------------------------------------------------------------------------
+# symstab limits --uncertain
+
+
+def robust_png(region, xlabel, ylabel):
+    """The robust set (filled), what stayed marginal and the nominal set's outline, as PNG bytes.
+
+    Parameters
+    ----------
+    region : symstab.numeric.engine.results.RobustRegion
+    xlabel, ylabel : str
+
+    Returns
+    -------
+    bytes
+    """
+    plt = pyplot()
+    from matplotlib.patches import Patch, Polygon
+
+    fig, ax = plt.subplots(figsize=(6.4, 4.8))
+    nominal = region.nominal
+    if nominal is not None:
+        for k, cell in enumerate(nominal.stable):
+            ring = np.vstack([cell.outer, cell.outer[:1]])
+            ax.plot(ring[:, 0], ring[:, 1], color="0.2", lw=1.0,
+                    label="stable at the box's centre" if k == 0 else None)
+    for i, bands in enumerate(region.marginal):
+        x0, x1 = region.edges[i], region.edges[i + 1]
+        for lo0, hi0, lo1, hi1 in bands:
+            ax.add_patch(Polygon([(x0, lo0), (x1, lo1), (x1, hi1), (x0, hi0)], closed=True,
+                                 facecolor="#f4a582", edgecolor="none"))
+    # The robust set's outlines (runs of strips joined: no seams between them).
+    for outline in region.polygons:
+        ax.add_patch(Polygon(outline, closed=True, facecolor="#4393c3", edgecolor="none"))
+    handles, _ = ax.get_legend_handles_labels()
+    handles += [Patch(color="#4393c3", label="stable for every value of the box"),
+                Patch(color="#f4a582", label="marginal (not certified)")]
+    ax.legend(handles=handles, loc="best", fontsize=8)
+    if nominal is not None:
+        ax.set_xlim(*nominal.x_range)
+        ax.set_ylim(*nominal.y_range)
+    box = ", ".join(f"{k} in [{lo:.4g}, {hi:.4g}]" for k, (lo, hi) in region.uncertain.items())
+    ax.set_title(f"robust stable set: {box}", fontsize=9)
+    ax.set_xlabel(xlabel)
+    ax.set_ylabel(ylabel)
+    fig.tight_layout()
+    return png_bytes(plt, fig)
+
+
+# --------------------------------------------------------------------------
+# symstab locus
+
+#: Poles farther out than this are left out of the z-plane panel (said in its title).
+_PLANE_LIMIT = 3.0
+
+
+def _zoom(poles, crossings, limit):
+    """``(x0, x1, y0, y1)``: a square window on where the poles move and cross.
+
+    The bounding box of the poles that move at least a tenth as far as the
+    one that moves most, with the crossings; if that is most of the plane,
+    the stretch of the first crossing pole's path (a pair's first) near
+    its crossing, or where a pole comes nearest the circle.
+    """
+    finite = np.isfinite(poles) & (np.abs(poles) <= limit)
+    steps = np.where(finite[1:] & finite[:-1], np.abs(np.diff(np.where(finite, poles, 0), axis=0)),
+                     0.0)
+    moved = steps.sum(axis=0)
+    points = [complex(c.z) for c in crossings] + [complex(c.z).conjugate() for c in crossings]
+    if moved.max() > 0:
+        columns = moved >= 0.1 * moved.max()
+        points += list(poles[:, columns][finite[:, columns]])
+    half = _half_width(points)
+    if half is None or half > 0.4 * limit:
+        if crossings:
+            pick = next((c for c in crossings if c.kind == "pair"), crossings[0])
+            path = poles[:, pick.pole_index]
+            near = finite[:, pick.pole_index] & (np.abs(path - pick.z) <= 0.3)
+            points = [complex(pick.z), complex(pick.z).conjugate()] + list(path[near])
+        else:
+            distance = np.where(finite, np.abs(np.abs(poles) - 1.0), np.inf)
+            points = [complex(poles.flat[int(np.argmin(distance))])]
+        half = max(_half_width(points), 0.05)
+    box = np.array(points)
+    centre = (0.5 * (box.real.min() + box.real.max()), 0.5 * (box.imag.min() + box.imag.max()))
+    return centre[0] - half, centre[0] + half, centre[1] - half, centre[1] + half
+
+
+def _half_width(points):
+    if not points:
+        return None
+    box = np.array(points)
+    return max(0.5 * max(np.ptp(box.real), np.ptp(box.imag)) * 1.15, 0.01)
+
+
+_MARKS = {"pair": ("*", "C3", "complex pair crossing"), "z = 1": ("s", "C1", "real pole crossing"),
+          "z = -1": ("D", "C1", "real pole crossing")}
+
+
+def _plane(ax, locus, shown, symbol, norm, limit, window=None):
+    """One z-plane panel: the poles coloured by the path's value, the circle, the crossings."""
+    poles = locus.poles
+    finite = np.isfinite(poles)
+    keep = finite & (np.abs(poles) <= limit)
+    if window is not None:
+        x0, x1, y0, y1 = window
+        keep &= (poles.real >= x0) & (poles.real <= x1) & (poles.imag >= y0) & (poles.imag <= y1)
+    colour = np.broadcast_to(shown[:, None], poles.shape)
+    theta = np.linspace(0, 2 * np.pi, 20001)
+    ax.plot(np.cos(theta), np.sin(theta), color="0.25", lw=1.0, zorder=1,
+            label=r"unit circle $|z| = 1$")
+    dots = ax.scatter(poles.real[keep], poles.imag[keep], c=colour[keep], s=4, cmap="viridis",
+                      norm=norm, zorder=2, linewidths=0)
+    start = keep[0]
+    ax.plot(poles.real[0][start], poles.imag[0][start], "o", mfc="none", mec="0.4", ms=4,
+            mew=0.7, lw=0, zorder=3,
+            label=f"poles at the start, {symbol} = {shown[0]:.4g}")
+    labelled = set()
+    for k, c in enumerate(locus.crossings):
+        marker, color, label = _MARKS[c.kind]
+        for imag in ((c.z.imag, -c.z.imag) if c.kind == "pair" else (c.z.imag,)):
+            ax.plot([c.z.real], [imag], marker, color=color, mec="k", ms=11, zorder=4,
+                    label=None if label in labelled else label)
+            labelled.add(label)
+        ax.annotate(f"{k + 1}", (c.z.real, c.z.imag), xytext=(8, 6), textcoords="offset points",
+                    fontsize=10, fontweight="bold", zorder=5,
+                    bbox=dict(boxstyle="round,pad=0.15", fc="white", ec="none", alpha=0.8))
+    if window is None:
+        ax.set_xlim(-limit, limit)
+        ax.set_ylim(-limit, limit)
+    else:
+        ax.set_xlim(window[0], window[1])
+        ax.set_ylim(window[2], window[3])
+    ax.set_aspect("equal")
+    ax.set_xlabel(r"Re $z$")
+    ax.set_ylabel(r"Im $z$")
+    return dots
+
+
+def locus_png(locus, given, show, stretches, *, symbol, tex, title):
+    """A root locus as PNG bytes: the z-plane, a zoom on where the poles cross, the largest modulus.
+
+    Parameters
+    ----------
+    locus : symstab.numeric.engine.locus.Locus
+    given : array_like
+        The path's values as the user gave them (in the units shown).
+    show : callable
+        The path's values to the units shown.
+    stretches : list of (float, float, int or None)
+        The path's stretches (in the path's values) and the poles outside the
+        circle along each (None: undecided).
+    symbol : str
+        The path's parameter in mathtext, for the legend.
+    tex : str
+        The path's axis label, mathtext.
+    title : str
+        The figure's title.
+
+    Returns
+    -------
+    bytes
+    """
+    plt = pyplot()
+    from matplotlib.colors import Normalize
+    from matplotlib.patches import Rectangle
+
+    shown = np.asarray(given, dtype=float)
+    poles = locus.poles
+    finite = np.isfinite(poles)
+    radius = float(np.max(np.abs(poles[finite]))) if finite.any() else 1.0
+    limit = min(max(1.15, 1.05 * radius), _PLANE_LIMIT)
+    norm = Normalize(vmin=float(min(shown[0], shown[-1])), vmax=float(max(shown[0], shown[-1])))
+    fig = plt.figure(figsize=(11.5, 10.5))
+    grid = fig.add_gridspec(2, 2, height_ratios=[1.25, 1.0])
+    ax, zx, bx = fig.add_subplot(grid[0, 0]), fig.add_subplot(grid[0, 1]), fig.add_subplot(grid[1, :])
+    dots = _plane(ax, locus, shown, symbol, norm, limit)
+    window = _zoom(poles, locus.crossings, limit)
+    _plane(zx, locus, shown, symbol, norm, limit, window)
+    ax.add_patch(Rectangle((window[0], window[2]), window[1] - window[0], window[3] - window[2],
+                           fill=False, ec="C3", lw=1.0, ls="--", zorder=6))
+    hidden = bool((finite & (np.abs(poles) > limit)).any())
+    ax.set_title("closed-loop poles in the $z$-plane" + (
+        f"\n(poles beyond $|z|$ = {limit:g} not shown)" if hidden else ""),
+        fontsize=PANEL_TITLE_SIZE)
+    zx.set_title("zoom on the dashed square: where the poles move and cross",
+                 fontsize=PANEL_TITLE_SIZE)
+    handles, labels = ax.get_legend_handles_labels()
+    fig.legend(handles, labels, loc="upper center", bbox_to_anchor=(0.5, 0.505), ncol=4,
+               fontsize=LEGEND_SIZE + 1, frameon=False)
+    # The largest modulus along the path, the stable stretches shaded.
+    rho = locus.spectral_radius()
+    bx.plot(shown, rho, color="C0", lw=1.6, label=r"largest pole modulus $\max|z|$")
+    bx.axhline(1.0, color="0.25", lw=1.0, ls="--", label=r"$|z| = 1$")
+    first = True
+    top = bx.get_ylim()[1]
+    for lo, hi, count in stretches:
+        lo, hi = sorted((float(show(lo)), float(show(hi))))
+        if count == 0:
+            bx.axvspan(lo, hi, color="#7fc97f", alpha=0.35, lw=0,
+                       label="stable (no pole outside)" if first else None)
+            first = False
+        if count is not None and hi - lo > 0.06 * abs(shown[-1] - shown[0]):
+            bx.text(0.5 * (lo + hi), top, f"{count} outside", ha="center", va="bottom",
+                    fontsize=9, color="0.2")
+    for k, c in enumerate(locus.crossings):
+        x = float(show(c.value))
+        marker, color, _ = _MARKS[c.kind]
+        bx.axvline(x, color=color, lw=0.9, ls=":")
+        bx.plot([x], [1.0], marker, color=color, mec="k", ms=9, zorder=4)
+        # Alternately below and above the line: neighbouring crossings stay apart.
+        bx.annotate(f"{k + 1}", (x, 1.0), xytext=(6, -14 if k % 2 == 0 else 6),
+                    textcoords="offset points",
+                    fontsize=10, fontweight="bold")
+    bx.set_xlabel(tex)
+    bx.set_ylabel(r"$\max|z|$")
+    bx.set_xlim(float(min(shown[0], shown[-1])), float(max(shown[0], shown[-1])))
+    bx.set_title("largest pole modulus along the path; crossings numbered as in the table, "
+                 "poles outside the circle counted above", fontsize=PANEL_TITLE_SIZE, pad=18)
+    bx.legend(fontsize=LEGEND_SIZE + 1, loc="upper center", bbox_to_anchor=(0.5, -0.12), ncol=3,
+              frameon=False)
+    fig.suptitle(title, fontsize=SUPTITLE_SIZE)
+    fig.subplots_adjust(left=0.07, right=0.89, top=0.92, bottom=0.1, hspace=0.45, wspace=0.22)
+    # The colour bar beside the z-plane panels, in an axes of its own (so
+    # that it takes no width from the zoom).
+    place = zx.get_position()
+    bar = fig.colorbar(dots, cax=fig.add_axes([0.91, place.y0, 0.015, place.height]))
+    bar.set_label("pole colour: " + tex)
+    return png_bytes(plt, fig)

@@ -537,9 +537,8 @@ def _write_png(png, setup, found, notes):
     """Draw the target against the searched parameter(s) into ``png`` (if given)."""
     if png is None:
         return
-    from ..drawing import design_figure, png_bytes, pyplot
+    from ..drawing import design_png
 
-    plt = pyplot()
     names = tuple(found.over)
     labels = [setup.label(n) for n in names]
     label, _ = _TARGET_ROWS[found.target]
@@ -549,6 +548,5 @@ def _write_png(png, setup, found, notes):
         found.target, f"({setup.unit(setup.x)})({setup.unit(setup.y)})"
         if setup.unit(setup.x) and setup.unit(setup.y) else "")
     target_label = label[0].format(y=y) + (f" [{unit}]" if unit else "")
-    fig = design_figure(plt, found, labels, target_label)
-    write_output(png, png_bytes(plt, fig), "--png")
+    write_output(png, design_png(found, labels, target_label), "--png")
     notes.append(f"wrote {png}")

@@ -19,7 +19,8 @@ from .._resources import CHUNK_BYTES, check_memory, chunk_slices
 from .loop_options import (add_loop_options, resolve_loop, uncertain_box,
                            uses_loop, value_text)
 from .options import add_command, add_model_options, resolve, stiffness_and_damping
-from ..drawing import draw_lines, png_bytes, pyplot_or_none, visible
+from ..drawing import (LIMIT_CYCLE_COLOR, LIMIT_CYCLE_LABEL, loop_map_png,
+                       probability_map_png, simulated_map_png)
 from .output import check_files, write_output
 from .simulation import (add_nonideal_options, check_loop_friction, loop_nonideal_text,
                          nonideal_text, resolve_nonideal, simulated_theory, with_option_names)
@@ -39,12 +40,6 @@ LOOP_PROBABILITY_HEADLINE = ("map --loop --uncertain: the probability that each 
 #: The first line of ``map --loop --simulate``.
 LOOP_SIMULATE_HEADLINE = ("map --loop --simulate: every cell simulated, the loop's certified "
                           "root count beside")
-
-#: The colour and legend of a cell whose run settles into a bounded limit cycle
-#: (:attr:`symstab.numeric.paper.simulate.Simulation.limit_cycle`): neither stable
-#: (green) nor growing (white).
-LIMIT_CYCLE_COLOR = "#fdb863"
-LIMIT_CYCLE_LABEL = "bounded limit cycle (simulated)"
 
 #: Bytes per map cell in the CSV and NPZ written, with the Python objects
 #: that build them (generous).
@@ -246,44 +241,24 @@ def _map_title(setup, nonideal, args, steps_text):
 
 
 def _paper_png(args, setup, result, nonideal, given, theory):
-    """The map as PNG bytes, or None without matplotlib.
+    """The map as PNG bytes, or None without matplotlib (:func:`symstab.drawing.simulated_map_png`).
 
     Drawn in the units of the grids the user gave (K_w, B_w or alpha, beta),
     with the non-idealities of the simulation in the title and the boundary
     of the loop simulated (its linear part, ``theory``) over it.
     """
-    plt = pyplot_or_none()
-    if plt is None:
-        return None
-    from matplotlib.colors import ListedColormap
-
     x, y, xlabel, ylabel, to_x, to_y = _map_axes(setup, given, result)
-    fig, ax = plt.subplots(figsize=(6.4, 4.8), dpi=120)
-    # result's arrays are (alpha, beta): y by x, as pcolormesh takes them.
-    ax.pcolormesh(x, y, np.where(result.stable, 1, np.where(result.limit_cycle, 2, 0)),
-                  shading="nearest", cmap=ListedColormap(["white", "#7fc97f", LIMIT_CYCLE_COLOR]),
-                  vmin=0, vmax=2)
     arc_beta, arc_alpha, lines = theory.boundary(((result.beta[0], result.beta[-1]),
                                                   (result.alpha[0], result.alpha[-1])))
-    drawn = []
-    if np.any(np.isfinite(arc_beta)):
-        name = ("the ideal loop, eq. (7)" if theory.loop is None
-                else f"the {theory.label} (D-decomposition)")
-        drawn += ax.plot(to_x(arc_beta), to_y(arc_alpha), "k-", lw=1.2,
-                         label=f"boundary of {name}")
-    drawn += draw_lines(ax, lines, result.beta, result.alpha, to_x, to_y)
-    if np.any(result.limit_cycle):
-        from matplotlib.patches import Patch
-        drawn.append(Patch(facecolor=LIMIT_CYCLE_COLOR, label=LIMIT_CYCLE_LABEL))
-    ax.set_xlim(x[0], x[-1])
-    ax.set_ylim(y[0], y[-1])
-    ax.set_xlabel(xlabel)
-    ax.set_ylabel(ylabel)
-    ax.set_title(_map_title(setup, nonideal, args, f"{result.steps} periods"), fontsize=10)
-    if drawn:
-        ax.legend(handles=drawn, loc="upper right", fontsize=9)
-    fig.tight_layout()
-    return png_bytes(plt, fig)
+    name = ("the ideal loop, eq. (7)" if theory.loop is None
+            else f"the {theory.label} (D-decomposition)")
+    # result's arrays are (alpha, beta): y by x, as the map is drawn.
+    return simulated_map_png(
+        x, y, result.stable, result.limit_cycle,
+        boundary={"curve": (arc_beta, arc_alpha), "label": f"boundary of {name}", "lines": lines,
+                  "plane": (result.beta, result.alpha), "to_x": to_x, "to_y": to_y},
+        xlabel=xlabel, ylabel=ylabel,
+        title=_map_title(setup, nonideal, args, f"{result.steps} periods"))
 
 
 #: The simulation options ``map --loop`` takes with ``--simulate`` only.
@@ -462,88 +437,57 @@ def _probability(args, setup, xs, ys, out, png_path):
 
 def _probability_png(setup, found, fixed, drawn):
     """The probability map as PNG bytes (None without matplotlib), the nominal boundary over it."""
-    plt = pyplot_or_none()
-    if plt is None:
-        return None
     xs, ys = found.x_values, found.y_values
-    fig, ax = plt.subplots(figsize=(6.4, 4.8), dpi=120)
-    mesh = ax.pcolormesh(xs, ys, found.probability, shading="nearest", vmin=0.0, vmax=1.0,
-                         cmap="Greens")
-    fig.colorbar(mesh, ax=ax, label="probability of stability")
-    handles = _draw_boundary(ax, setup, xs, ys, "nominal loop: ")
-    _axes(ax, setup, xs, ys)
     rest = ", ".join(value_text(setup, n, fixed[n]).replace(" ", "\u00a0")
                      for n in setup.loop.parameters if n in fixed)
-    ax.set_title("\n".join([f"loop {setup.loop.name}: probability of stability, "
-                            f"{found.samples} draws"] + textwrap.wrap(", ".join(drawn), 80)
-                           + textwrap.wrap(rest, 80)), fontsize=8)
-    if handles:
-        ax.legend(handles=handles, loc="best", fontsize=8, framealpha=0.9)
-    fig.tight_layout()
-    return png_bytes(plt, fig)
+    title = "\n".join([f"loop {setup.loop.name}: probability of stability, "
+                       f"{found.samples} draws"] + textwrap.wrap(", ".join(drawn), 80)
+                      + textwrap.wrap(rest, 80))
+    return probability_map_png(found, _boundary(setup, xs, ys), **_axis_labels(setup),
+                               title=title)
 
 
-def _draw_boundary(ax, setup, xs, ys, label=""):
-    """The loop's D-decomposition at ``setup.values`` drawn on ``ax``; the legend's handles."""
-    curve = setup.loop.boundary(x=setup.x, y=setup.y, window=((xs[0], xs[-1]), (ys[0], ys[-1])),
-                                **setup.values)
-    bx, by = visible(curve.x_values, xs[0], xs[-1]), visible(curve.y_values, ys[0], ys[-1])
-    bx[np.isnan(by)] = np.nan
-    handles = []
-    if np.any(np.isfinite(bx)):
-        handles += ax.plot(bx, by, "k-", lw=1.2,
-                           label=label + r"$z = e^{j\theta}$ root (D-decomposition)")
-    return handles + draw_lines(ax, curve.lines, xs, ys)
+def _boundary(setup, xs, ys):
+    """The loop's D-decomposition at ``setup.values`` over the map's window."""
+    return setup.loop.boundary(x=setup.x, y=setup.y, window=((xs[0], xs[-1]), (ys[0], ys[-1])),
+                               **setup.values)
 
 
-def _axes(ax, setup, xs, ys):
-    """The map's limits and its axes' names with their units."""
-    ax.set_xlim(xs[0], xs[-1])
-    ax.set_ylim(ys[0], ys[-1])
-    for name, set_label in ((setup.x, ax.set_xlabel), (setup.y, ax.set_ylabel)):
+def _axis_labels(setup):
+    """The map's axes' names with their units: ``{"xlabel": ..., "ylabel": ...}``."""
+    labels = {}
+    for name, key in ((setup.x, "xlabel"), (setup.y, "ylabel")):
         unit = setup.unit(name)
-        set_label(f"{name} [{tex_unit(unit)}]" if unit else name)
+        labels[key] = f"{name} [{tex_unit(unit)}]" if unit else name
+    return labels
 
 
 def _loop_png(setup, xs, ys, code, simulated=None):
     """The map as PNG bytes (None without matplotlib), with the D-decomposition drawn over it.
 
     Shaded by the root counts, or by the simulation (``simulated``, a
-    :class:`~symstab.numeric.paper.simulate.StabilityMap`) where one ran: its
+    :class:`~symstab.numeric.simulation.simulator.StabilityMap`) where one ran: its
     stable cells and its bounded limit cycles, each its own colour; the
     D-decomposition drawn over it is the root counts' boundary.
     """
     from ..numeric.engine.roots import MARGINAL, STABLE
 
-    plt = pyplot_or_none()
-    if plt is None:
-        return None
-    from matplotlib.colors import ListedColormap
-    from matplotlib.patches import Patch
-
     loop, x, y = setup.loop, setup.x, setup.y
-    fig, ax = plt.subplots(figsize=(6.4, 4.8), dpi=120)
     if simulated is None:
         shade = np.where(code == STABLE, 2, np.where(code == MARGINAL, 1, 0)).T
     else:
         shade = np.where(simulated.stable, 2, np.where(simulated.limit_cycle, 3, 0))
-    ax.pcolormesh(xs, ys, shade, shading="nearest", vmin=0, vmax=3,
-                  cmap=ListedColormap(["white", "#bdbdbd", "#7fc97f", LIMIT_CYCLE_COLOR]))
-    handles = [Patch(facecolor="#7fc97f", label="stable" if simulated is None
-                     else "stable by simulation")]
+    legend = [("#7fc97f", "stable" if simulated is None else "stable by simulation")]
     if simulated is None and np.any(code == MARGINAL):
-        handles.append(Patch(facecolor="#bdbdbd", label="marginal"))
+        legend.append(("#bdbdbd", "marginal"))
     if simulated is not None and np.any(simulated.limit_cycle):
-        handles.append(Patch(facecolor=LIMIT_CYCLE_COLOR, label=LIMIT_CYCLE_LABEL))
-    handles += _draw_boundary(ax, setup, xs, ys)
-    _axes(ax, setup, xs, ys)
+        legend.append((LIMIT_CYCLE_COLOR, LIMIT_CYCLE_LABEL))
     # Wrapped to the width of the figure (a two-mass device has eight values),
     # between values only: no-break spaces inside each.
     fixed = ", ".join(value_text(setup, n, setup.values[n]).replace(" ", "\u00a0")
                       for n in loop.parameters if n in setup.values)
     how = "root counts" if simulated is None else "simulated; lines: root counts"
-    ax.set_title("\n".join([f"loop {loop.name}: stable set in the ({x}, {y}) plane ({how})"]
-                           + textwrap.wrap(fixed, 80)), fontsize=9)
-    ax.legend(handles=handles, loc="best", fontsize=8, framealpha=0.9)
-    fig.tight_layout()
-    return png_bytes(plt, fig)
+    title = "\n".join([f"loop {loop.name}: stable set in the ({x}, {y}) plane ({how})"]
+                      + textwrap.wrap(fixed, 80))
+    return loop_map_png(xs, ys, shade, legend, _boundary(setup, xs, ys), **_axis_labels(setup),
+                        title=title)
