@@ -605,55 +605,16 @@ def _mass_label(g):
 
 def fig10(n=40):
     """Physical units at Td = 40 ms: theory and simulations, ideal and quantized + filtered."""
-    import matplotlib
     from matplotlib.lines import Line2D
     from matplotlib.patches import Patch
 
     plt = pyplot()
-    dev, d = PAPER_DEVICE, 40
-    # K_w and B_w are alpha and beta times constants: the plane is only rescaled.
-    scale = (float(dev.damping(1.0)), float(dev.stiffness(1.0)))
     qf = Nonidealities(encoder_resolution=PAPER_ENCODER_RESOLUTION, velocity_cutoff=50.0)
     fig, axes = plt.subplots(2, 2, figsize=(11, 9.6))
     found, counted, passive_k = [], {}, {}
     for ax, g in zip(axes.ravel(), (-0.5, 0.0, 0.5, 1.0)):
-        lim = limits(gamma=g, d=d, delta=DELTA)
-        curve = boundary_curve(gamma=g, d=d, delta=DELTA, n=1000, segments=False)
-        top = 1.12 * float(curve.alpha.max())
-        pad = 0.06 * float(curve.beta.max() - curve.beta.min())
-        window = ((float(curve.beta.min()) - pad, float(curve.beta.max()) + pad), (-0.05 * top, top))
-        (b0, b1), (a0, a1) = window
-        ax.axhline(0.0, zorder=2, **_Z_ONE)
-        _fill_stable(ax, g, d, window, "#4292c6", scale)
-        alpha, beta = np.linspace(0.0, a1, n), np.linspace(b0, b1, n)
-        ideal = stability_map(alpha=alpha, beta=beta, gamma=g, d=d, delta=DELTA)
-        quant = stability_map(alpha=alpha, beta=beta, gamma=g, d=d, delta=None, device=dev,
-                              nonideal=qf, x0=0.01)
-        K, B = dev.stiffness(alpha), dev.damping(beta)
-        with matplotlib.rc_context({"hatch.color": "#08519c", "hatch.linewidth": 0.6}):
-            ax.contourf(B, K, ideal.stable.astype(float), levels=[0.5, 1.5], colors="none",
-                        hatches=[_SIM_HATCH], zorder=2)
-        ax.contour(B, K, quant.stable.astype(float), levels=[0.5], colors=["#2ca02c"],
-                   linestyles="--", linewidths=1.6, zorder=4)
-        _draw_boundary(ax, g, d, window, "k", scale)
-        passive = paper_passive_region(gamma=g, d=d, delta=DELTA)
-        if not passive.empty:
-            outline = np.vstack([passive.polygon, passive.polygon[:1]]) * scale
-            ax.plot(outline[:, 0], outline[:, 1], color=_PASSIVE, ls="--", lw=1.5, zorder=5)
-        passive_k[g] = None if passive.empty else float(dev.stiffness(passive.y_max))
-        ax.set_xlim(b0 * scale[0], b1 * scale[0])
-        ax.set_ylim(a0 * scale[1], a1 * scale[1])
-        counted[g] = _write_counts(ax, g, d, window, scale)
-        ax.set_title(fr"${_mass_label(g)}$ ($\gamma = {g:g}$)"
-                     + (", no passive point" if passive.empty else ""), fontsize=PANEL_TITLE_SIZE)
-        _labels(ax, physical=True)
-        A, Bm = np.meshgrid(alpha, beta, indexing="ij")
-
-        def top_of(mask):
-            return (dev.stiffness(A[mask].max()), dev.damping(Bm[mask].max())) if mask.any() else (0.0, 0.0)
-
-        (ki, bi), (kq, bq) = top_of(ideal.stable), top_of(quant.stable)
-        found.append((g, float(dev.stiffness(lim.alpha_max)), ki, kq, bi, bq))
+        row, counted[g], passive_k[g] = _fig10_panel(ax, g, n, qf)
+        found.append(row)
     handles = _style_handles("k") + [
         Patch(facecolor="#4292c6", alpha=_FILL_ALPHA + 0.1, label="stable (root counting, exact)"),
         Patch(facecolor="none", edgecolor="#08519c", hatch=_SIM_HATCH,
@@ -665,14 +626,70 @@ def fig10(n=40):
     fig.suptitle(r"Fig. 10: physical units, $T_d = 40$ ms (the PI current-controller cases and "
                  "the experiments are not modelled)", fontsize=SUPTITLE_SIZE)
     _legend_below(fig, handles, ncol=2)
-    text = "; ".join(f"gamma = {g:g}: K_max theory {kt:.2f}, ideal sim {ki:.2f}, QF sim {kq:.2f} N m/rad "
-                     f"(QF/ideal {kq / ki if ki else float('nan'):.2f}); B_max QF/ideal "
-                     f"{bq / bi if bi else float('nan'):.2f}" for g, kt, ki, kq, bi, bq in found)
-    band = sorted({c for _, _, c in counted[1.0]})
     return FigureResult(
         "fig10_physical_td40", "physical units at Td = 40 ms, gamma = M_w/m = -0.5, 0, 0.5, 1", fig,
         "theory against simulations (ideal; quantization + filter; PI controller high/low gains) and "
         "experiments; PI(-), QF(+) gives a lower K_max than the theory.",
+        _fig10_finding(found, counted, passive_k, n))
+
+
+def _fig10_panel(ax, g, n, qf):
+    """One panel of Fig. 10 at ``gamma = g``: the exact set, the two simulations, passivity.
+
+    Returns ``((g, K_max theory, K_max ideal sim, K_max QF sim, B_max ideal sim,
+    B_max QF sim), the cells' counts, the passive K_max or None)``.
+    """
+    import matplotlib
+
+    dev, d = PAPER_DEVICE, 40
+    # K_w and B_w are alpha and beta times constants: the plane is only rescaled.
+    scale = (float(dev.damping(1.0)), float(dev.stiffness(1.0)))
+    lim = limits(gamma=g, d=d, delta=DELTA)
+    curve = boundary_curve(gamma=g, d=d, delta=DELTA, n=1000, segments=False)
+    top = 1.12 * float(curve.alpha.max())
+    pad = 0.06 * float(curve.beta.max() - curve.beta.min())
+    window = ((float(curve.beta.min()) - pad, float(curve.beta.max()) + pad), (-0.05 * top, top))
+    (b0, b1), (a0, a1) = window
+    ax.axhline(0.0, zorder=2, **_Z_ONE)
+    _fill_stable(ax, g, d, window, "#4292c6", scale)
+    alpha, beta = np.linspace(0.0, a1, n), np.linspace(b0, b1, n)
+    ideal = stability_map(alpha=alpha, beta=beta, gamma=g, d=d, delta=DELTA)
+    quant = stability_map(alpha=alpha, beta=beta, gamma=g, d=d, delta=None, device=dev,
+                          nonideal=qf, x0=0.01)
+    K, B = dev.stiffness(alpha), dev.damping(beta)
+    with matplotlib.rc_context({"hatch.color": "#08519c", "hatch.linewidth": 0.6}):
+        ax.contourf(B, K, ideal.stable.astype(float), levels=[0.5, 1.5], colors="none",
+                    hatches=[_SIM_HATCH], zorder=2)
+    ax.contour(B, K, quant.stable.astype(float), levels=[0.5], colors=["#2ca02c"],
+               linestyles="--", linewidths=1.6, zorder=4)
+    _draw_boundary(ax, g, d, window, "k", scale)
+    passive = paper_passive_region(gamma=g, d=d, delta=DELTA)
+    if not passive.empty:
+        outline = np.vstack([passive.polygon, passive.polygon[:1]]) * scale
+        ax.plot(outline[:, 0], outline[:, 1], color=_PASSIVE, ls="--", lw=1.5, zorder=5)
+    passive_k = None if passive.empty else float(dev.stiffness(passive.y_max))
+    ax.set_xlim(b0 * scale[0], b1 * scale[0])
+    ax.set_ylim(a0 * scale[1], a1 * scale[1])
+    counted = _write_counts(ax, g, d, window, scale)
+    ax.set_title(fr"${_mass_label(g)}$ ($\gamma = {g:g}$)"
+                 + (", no passive point" if passive.empty else ""), fontsize=PANEL_TITLE_SIZE)
+    _labels(ax, physical=True)
+    A, Bm = np.meshgrid(alpha, beta, indexing="ij")
+
+    def top_of(mask):
+        return (dev.stiffness(A[mask].max()), dev.damping(Bm[mask].max())) if mask.any() else (0.0, 0.0)
+
+    (ki, bi), (kq, bq) = top_of(ideal.stable), top_of(quant.stable)
+    return (g, float(dev.stiffness(lim.alpha_max)), ki, kq, bi, bq), counted, passive_k
+
+
+def _fig10_finding(found, counted, passive_k, n):
+    """What symstab finds for Fig. 10, in words (the rows of :func:`_fig10_panel`)."""
+    text = "; ".join(f"gamma = {g:g}: K_max theory {kt:.2f}, ideal sim {ki:.2f}, QF sim {kq:.2f} N m/rad "
+                     f"(QF/ideal {kq / ki if ki else float('nan'):.2f}); B_max QF/ideal "
+                     f"{bq / bi if bi else float('nan'):.2f}" for g, kt, ki, kq, bi, bq in found)
+    band = sorted({c for _, _, c in counted[1.0]})
+    return (
         f"{text} (grid {n} x {n}, so K and B are resolved to one cell). "
         + ("The ideal simulation reaches the theoretical K_max within two cells in every panel; "
            if all(abs(ki - kt) <= 2.5 * kt / n for _, kt, ki, _, _, _ in found)

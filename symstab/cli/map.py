@@ -273,7 +273,6 @@ _LOOP_SIMULATION_OPTIONS = (("--steps", "steps"), ("--x0", "x0"),
 def _loop(args):
     """A loop file classified by its root counts at every cell of the grid (and simulated)."""
     from .._progress import progress_printer
-    from ..numeric.simulation.simulator import check_steps
     from ..numeric.engine.roots import MARGINAL, STABLE
 
     setup = resolve_loop(args)
@@ -288,17 +287,7 @@ def _loop(args):
             raise ValueError(f"{flag} counts the draws of --uncertain: add --uncertain NAME=LO:HI")
     loop, values = setup.loop, setup.values
     simulate = bool(args.simulate)
-    if not simulate:
-        for flag, dest in _LOOP_SIMULATION_OPTIONS:
-            if getattr(args, dest) not in (None, False):
-                raise ValueError(f"{flag} is an option of the simulation: add --simulate")
-    else:
-        nonideal, x0 = resolve_nonideal(args, None, loop)
-        steps = check_steps(args.steps, values["d"])
-        # The difference equations at one cell: a plant they cannot step is refused now.
-        loop.difference_equations(**{setup.x: xs[0], setup.y: ys[0]}, **values)
-        X, Y = np.meshgrid(xs, ys, indexing="ij")
-        check_loop_friction(nonideal, loop, {setup.x: X, setup.y: Y, **values})
+    nonideal, x0, steps = _loop_simulation(args, setup, xs, ys)
     degree = loop.coefficients(**{setup.x: 0.0, setup.y: 0.0}, **values).shape[-1]
     # The cells are classified a chunk of x at a time; what stays is the codes
     # and the file's text.
@@ -328,21 +317,7 @@ def _loop(args):
             "steps": steps, "x0": x0, "nonidealities": np.array(loop_nonideal_text(nonideal))}
         data = _loop_npz(setup, xs, ys, values, code=code, stable=stable, **extra)
     else:
-        X, Y = np.meshgrid(xs, ys, indexing="ij")
-        buf = io.StringIO()
-        buf.write(f"{setup.label(setup.x)},{setup.label(setup.y)},code,stable"
-                  + (",simulated_stable,simulated_limit_cycle,growth" if simulated is not None
-                     else "") + "\n")
-        columns = [X.ravel(), Y.ravel(), code.ravel()]
-        if simulated is not None:
-            columns += [simulated.stable.T.ravel(), simulated.limit_cycle.T.ravel(),
-                        simulated.growth.T.ravel()]
-        for xv, yv, c, *sim in zip(*columns):
-            row = f"{xv:.12g},{yv:.12g},{int(c)},{int(c == STABLE)}"
-            if sim:
-                row += f",{int(sim[0])},{int(sim[1])},{sim[2]:.6g}"
-            buf.write(row + "\n")
-        data = buf.getvalue()
+        data = _loop_csv(setup, xs, ys, code, simulated)
     image = (_loop_png(setup, xs, ys, code, None if simulated is None else simulated)
              if png_path is not None else None)
     write_output(out, data, "--out")
@@ -361,6 +336,50 @@ def _loop(args):
               f"that are not marginal differ from the root counts (a limit cycle is not stable)")
     print("wrote " + ", ".join(written))
     return 0
+
+
+def _loop_simulation(args, setup, xs, ys):
+    """``(nonideal, x0, steps)`` of ``map --loop --simulate``, checked before any work.
+
+    Without ``--simulate``: ``(None, None, None)``, and a simulation option
+    given is refused.
+    """
+    from ..numeric.simulation.simulator import check_steps
+
+    loop, values = setup.loop, setup.values
+    if not args.simulate:
+        for flag, dest in _LOOP_SIMULATION_OPTIONS:
+            if getattr(args, dest) not in (None, False):
+                raise ValueError(f"{flag} is an option of the simulation: add --simulate")
+        return None, None, None
+    nonideal, x0 = resolve_nonideal(args, None, loop)
+    steps = check_steps(args.steps, values["d"])
+    # The difference equations at one cell: a plant they cannot step is refused now.
+    loop.difference_equations(**{setup.x: xs[0], setup.y: ys[0]}, **values)
+    X, Y = np.meshgrid(xs, ys, indexing="ij")
+    check_loop_friction(nonideal, loop, {setup.x: X, setup.y: Y, **values})
+    return nonideal, x0, steps
+
+
+def _loop_csv(setup, xs, ys, code, simulated=None):
+    """A loop map's CSV text: a row a cell, its root count, and its simulation where one ran."""
+    from ..numeric.engine.roots import STABLE
+
+    X, Y = np.meshgrid(xs, ys, indexing="ij")
+    buf = io.StringIO()
+    buf.write(f"{setup.label(setup.x)},{setup.label(setup.y)},code,stable"
+              + (",simulated_stable,simulated_limit_cycle,growth" if simulated is not None
+                 else "") + "\n")
+    columns = [X.ravel(), Y.ravel(), code.ravel()]
+    if simulated is not None:
+        columns += [simulated.stable.T.ravel(), simulated.limit_cycle.T.ravel(),
+                    simulated.growth.T.ravel()]
+    for xv, yv, c, *sim in zip(*columns):
+        row = f"{xv:.12g},{yv:.12g},{int(c)},{int(c == STABLE)}"
+        if sim:
+            row += f",{int(sim[0])},{int(sim[1])},{sim[2]:.6g}"
+        buf.write(row + "\n")
+    return buf.getvalue()
 
 
 def _loop_npz(setup, xs, ys, values, **arrays):
