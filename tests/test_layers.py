@@ -457,12 +457,15 @@ def _matplotlib_imports(path, parts):
             if target[0] == "matplotlib"]
 
 
-CLI_MODULES = [(path, parts) for path, parts in MODULES if parts[0] == "cli"]
+#: The front ends that compute what is drawn and leave the drawing to :mod:`symstab.drawing`.
+COMPUTING_FRONT_ENDS = [(path, parts) for path, parts in MODULES
+                        if parts[0] == "cli" or parts == ("figures",)]
 
 
-@pytest.mark.parametrize("path, parts", CLI_MODULES, ids=["/".join(p) for _, p in CLI_MODULES])
-def test_the_cli_draws_nothing_itself(path, parts):
-    """The commands compute; :mod:`symstab.drawing` draws every PNG (no matplotlib in the CLI)."""
+@pytest.mark.parametrize("path, parts", COMPUTING_FRONT_ENDS,
+                         ids=["/".join(p) for _, p in COMPUTING_FRONT_ENDS])
+def test_the_cli_and_the_figures_draw_nothing_themselves(path, parts):
+    """The commands and the figures compute; :mod:`symstab.drawing` draws every PNG."""
     found = _matplotlib_imports(path, parts)
     assert found == [], (f"symstab/{'/'.join(parts)}.py imports matplotlib "
                          f"({', '.join(f'{m} on line {n}' for n, m in found)}): draw in "
