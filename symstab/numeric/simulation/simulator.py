@@ -37,9 +37,9 @@ from ..engine.results import PAPER_PLANE, PaperGridNames
 
 __all__ = ["Nonidealities", "FrictionCompensation", "Simulation", "StabilityMap",
            "default_horizon", "check_steps", "check_x0", "max_steps", "progress_printer",
-           "PAPER_ENCODER_RESOLUTION", "MAX_STEPS_ENV", "run_loop", "simulate_loop", "loop_stability_map",
-           "check_loop_nonideal", "default_x0", "MAX_SUBSTEPS", "X0_MIN", "X0_MAX",
-           "check_friction_size", "QUANTUM_MIN", "FRICTION_STEP_MAX"]
+           "PAPER_ENCODER_RESOLUTION", "MAX_STEPS_ENV", "run_loop", "simulate_loop",
+           "loop_stability_map", "check_loop_nonideal", "default_x0", "MAX_SUBSTEPS", "X0_MIN",
+           "X0_MAX", "check_friction_size", "QUANTUM_MIN", "FRICTION_STEP_MAX"]
 
 
 #: The most sub-steps per period: each multiplies the simulation's time (a
