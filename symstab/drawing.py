@@ -22,6 +22,7 @@ __all__ = ["require_matplotlib", "pyplot", "pyplot_or_none", "png_bytes", "visib
            "loop_map_png", "probability_map_png", "robust_png", "locus_png",
            "theta_max_gamma_figure", "theta_max_delay_figure", "eq14_figure", "regions_figure",
            "boundaries_d0_figure", "physical_figure", "limits_figure", "FIGURE_COLORS",
+           "PASSIVE_COLOR",
            "LIMIT_CYCLE_COLOR", "LIMIT_CYCLE_LABEL", "SUPTITLE_SIZE", "PANEL_TITLE_SIZE",
            "LEGEND_SIZE"]
 
@@ -605,8 +606,9 @@ _Z_ONE = {"color": "0.35", "ls": "-", "lw": 0.9}    # alpha = 0: a root at z = 1
 _SIM_HATCH = "////"
 #: Opacity of the exact stable set's fill.
 _FILL_ALPHA = 0.28
-#: Colour of the passive set's outline.
-_PASSIVE = "#d62728"
+#: Colour of the passive set's outline (a test finds the outline by it).
+PASSIVE_COLOR = "#d62728"
+_PASSIVE = PASSIVE_COLOR
 #: Caption of the root counts, for the figures' legends.
 _COUNTS_NOTE = ("numbers: closed-loop poles outside the unit circle in that cell "
                 "(certified root count)")

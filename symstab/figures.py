@@ -43,6 +43,8 @@ DELTA = PAPER_DEVICE.delta
 #: The delays of Figs. 6, 8, 11 and 12.
 DELAYS = (0, 1, 5, 10)
 _COLORS = drawing.FIGURE_COLORS
+#: The passive set's outline colour in Fig. 10 (drawn by :func:`symstab.drawing.physical_figure`).
+_PASSIVE = drawing.PASSIVE_COLOR
 
 
 @dataclasses.dataclass
