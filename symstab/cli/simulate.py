@@ -146,11 +146,11 @@ def _loop_plan(args):
     code = int(loop.classify(**values))
     radius = float(loop.spectral_radius(**values))
 
-    def run_loop():
+    def run_file():
         return loop.simulate(steps=steps, x0=x0, nonideal=nonideal, record=True,
                              progress=progress_printer("simulating", steps), **values)
 
-    return _Plan(run_loop, x0, nonideal, code, radius, "the loop's certified root count",
+    return _Plan(run_file, x0, nonideal, code, radius, "the loop's certified root count",
                  setup.echo, conditions=f" ({loop_nonideal_text(nonideal)})",
                  csv_header=f"k,t [s],x (SI; {value_text(setup, 'T', values['T'])})",
                  period=float(values["T"]), record=True)
