@@ -451,6 +451,36 @@ def test_the_cli_is_one_module_per_command_over_shared_modules():
     assert crossing == [], crossing
 
 
+def _matplotlib_imports(path, parts):
+    """``[(line, module)]`` of the imports of matplotlib in one module (lazy ones included)."""
+    return [(line, ".".join(target)) for line, target in _imports(path, parts)
+            if target[0] == "matplotlib"]
+
+
+#: The front ends that compute what is drawn and leave the drawing to :mod:`symstab.drawing`.
+COMPUTING_FRONT_ENDS = [(path, parts) for path, parts in MODULES
+                        if parts[0] == "cli" or parts == ("figures",)]
+
+
+@pytest.mark.parametrize("path, parts", COMPUTING_FRONT_ENDS,
+                         ids=["/".join(p) for _, p in COMPUTING_FRONT_ENDS])
+def test_the_cli_and_the_figures_draw_nothing_themselves(path, parts):
+    """The commands and the figures compute; :mod:`symstab.drawing` draws every PNG."""
+    found = _matplotlib_imports(path, parts)
+    assert found == [], (f"symstab/{'/'.join(parts)}.py imports matplotlib "
+                         f"({', '.join(f'{m} on line {n}' for n, m in found)}): draw in "
+                         f"symstab/drawing.py")
+
+
+def test_the_matplotlib_finder_finds_lazy_imports(tmp_path):
+    source = ("import numpy\n\ndef draw():\n    from matplotlib.patches import Patch\n"
+              "    import matplotlib.pyplot as plt\n")
+    path = tmp_path / "fake.py"
+    path.write_text(source, encoding="utf-8")
+    assert _matplotlib_imports(path, ("cli", "fake")) == [(4, "matplotlib.patches"),
+                                                          (5, "matplotlib.pyplot")]
+
+
 # --------------------------------------------------------------------------
 # No private attribute reached on another module's object
 
