@@ -539,7 +539,7 @@ def design(loop, *, over, maximize="y_max", x=None, y=None, n=None, rtol=None, d
     # proved empty (then nothing is scanned).
     bracket = _bracket(loop, maximize, x, y, names, over, at) if delay is None else over
     searched = over if bracket is None else bracket
-    best, value, seen = (None, None, []) if bracket is None else _search(
+    best, value, seen = (None, None, []) if bracket is None else _maximize_over(
         target, names, over, searched, delay, n, include, rtol, progress)
     samples = np.array([[*p, v] for p, v in seen], dtype=float).reshape(-1, len(names) + 1)
     spacing = {k: (hi - lo) / (n - 1) for k, (lo, hi) in searched.items()}
@@ -605,7 +605,7 @@ def _check_values_once(loop, maximize, x, y, damping, over, at, simulation, step
             check_steps(steps, at(tuple(corner.values())).get("d", loop.defaults.get("d", 0)))
 
 
-def _search(target, names, over, searched, delay, n, include, rtol, progress):
+def _maximize_over(target, names, over, searched, delay, n, include, rtol, progress):
     """``(best, value, seen)``: the search of ``target`` over ``searched``, points as tuples.
 
     One parameter: :func:`maximize_scalar`, or with ``T`` and a delay held
