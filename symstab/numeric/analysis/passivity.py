@@ -540,7 +540,7 @@ def _passive_polygon(plane, grid, table):
     rows = np.concatenate([plane.static_row(), plane.rows(grid)])
     polygon, rows = _cut(plane, grid, table, tolerance, _clip_all(_box(_BOX, _BOX), rows), rows)
     on_box = np.abs(polygon) >= _BOX * (1 - 1e-9)
-    unbounded = bool(on_box[:, 0].any()) or bool(on_box[:, 1].any()) if len(polygon) else False
+    unbounded = bool(on_box.any()) if len(polygon) else False
     if len(polygon) and not unbounded:
         # Redo the cuts in a box fitted to the set: its vertices then carry
         # the rounding of its own size, not of the far box's, which merged
@@ -563,12 +563,12 @@ def _fitted_window(plane, polygon, on_box, x_range, y_range):
     scaled plane's unit, the set's natural size); an empty set the
     plane's unit around 0.
     """
-    unbounded = bool(on_box.any()) if len(polygon) else False
     if len(polygon) == 0:
         return (x_range, y_range) if x_range is not None else (
             (-plane.sx, plane.sx), (-plane.sy, plane.sy))
     if x_range is not None:
         return (x_range, y_range)
+    unbounded = bool(on_box.any())
     finite = polygon[~on_box.any(axis=1)] if unbounded else polygon
     if len(finite) == 0:
         finite = np.zeros((1, 2))

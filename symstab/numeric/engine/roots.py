@@ -296,7 +296,7 @@ def root_counts(chi, *, coefficient_ulps=COEFFICIENT_ULPS):
 def _count_chunk(delayed, direct, s, n_arcs, coefficient_ulps, near_one=None):
     """Roots outside the circle of one chunk of rows: :func:`root_counts`'s argument principle.
 
-    Four steps, each vectorised over every row and arc of the chunk: the
+    The steps, each vectorised over every row and arc of the chunk: the
     rows' bounds (:func:`_chunk_bounds`), the first pass on the shared grid
     (:func:`_first_pass`), rounds of the arc test (:func:`_arcs_pass`)
     that halve the arcs it did not pass (:meth:`_Arcs.halve`), and the
