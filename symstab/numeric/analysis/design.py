@@ -508,26 +508,12 @@ def design(loop, *, over, maximize="y_max", x=None, y=None, n=None, rtol=None, d
     from ..._progress import progress_printer
 
     progress = check_progress(progress, lambda: progress_printer("designing", n**len(names) + 40))
-    for axis, name in (("x", x), ("y", y)) + ((("damping", damping),) if maximize == "passive"
-                                                 else ()):
-        if name not in loop.parameters:
-            need = (": maximize='passive' needs the device's viscous friction"
-                    if axis == "damping" else "")
-            raise ValueError(f"{axis}: {name!r} is not a parameter of the loop{need} "
-                             f"(parameters: {', '.join(loop.parameters)})")
-    for name in (x, y):
-        if name in values:
-            raise TypeError(f"{name} is an axis of the ({x}, {y}) plane: it takes no value here")
-    if delay is not None:
-        delay = check_real("delay", delay, low=0.0)
-        if "d" in values:
-            raise TypeError("give the delay in seconds (delay) or in samples (d), not both")
+    delay = _check_design_names(loop, maximize, x, y, damping, delay, values)
     merged = {**loop.defaults, **values}
     nominal = {name: float(merged[name]) for name in names if name in merged}
     if len(nominal) != len(names):
         nominal = {}
-    # The values are checked once, before the scan: a wrong one is the caller's
-    # error, not a value of the searched parameter without an answer.
+
     def at(point):
         """The values at a point of the search; with ``delay``, d = ceil(delay / T) there."""
         out = {**values, **dict(zip(names, point))}
@@ -535,18 +521,7 @@ def design(loop, *, over, maximize="y_max", x=None, y=None, n=None, rtol=None, d
             out["d"] = held_delay(delay, out.get("T", loop.defaults.get("T")))
         return out
 
-    middle = tuple(0.5 * (lo + hi) for lo, hi in over.values())
-    loop.polynomial(**{**at(middle), x: 0.0, y: 0.0})
-    if maximize == "passive":
-        # A plant the passivity theorem does not cover is refused here, once.
-        loop.passive_region(x, y, damping=damping, **at(middle))
-    if simulation:
-        # The horizon is checked at every corner's delay (held in seconds, d
-        # varies with T), before the scan.
-        from ..simulation.simulator import check_steps
-
-        for corner in box_corners(over):
-            check_steps(steps, at(tuple(corner.values())).get("d", loop.defaults.get("d", 0)))
+    _check_values_once(loop, maximize, x, y, damping, over, at, simulation, steps)
     failed = []
 
     def answer(point):
@@ -564,24 +539,8 @@ def design(loop, *, over, maximize="y_max", x=None, y=None, n=None, rtol=None, d
     # proved empty (then nothing is scanned).
     bracket = _bracket(loop, maximize, x, y, names, over, at) if delay is None else over
     searched = over if bracket is None else bracket
-    if bracket is None:
-        best, value, seen = None, None, []
-    elif len(names) == 1 and delay is not None and names[0] == "T":
-        best, value, seen = maximize_pieces(lambda v: target((v,)),
-                                            delay_pieces(delay, *over["T"]),
-                                            include=[p[0] for p in include], rtol=rtol,
-                                            progress=progress)
-        best = None if best is None else (best,)
-        seen = [((p,), v) for p, v in seen]
-    elif len(names) == 1:
-        best, value, seen = maximize_scalar(lambda v: target((v,)), *searched[names[0]], n,
-                                            include=[p[0] for p in include], rtol=rtol,
-                                            progress=progress)
-        best = None if best is None else (best,)
-        seen = [((p,), v) for p, v in seen]
-    else:
-        best, value, seen = maximize_box(target, tuple(searched[k] for k in names), n,
-                                         include=include, rtol=rtol, progress=progress)
+    best, value, seen = (None, None, []) if bracket is None else _maximize_over(
+        target, names, over, searched, delay, n, include, rtol, progress)
     samples = np.array([[*p, v] for p, v in seen], dtype=float).reshape(-1, len(names) + 1)
     spacing = {k: (hi - lo) / (n - 1) for k, (lo, hi) in searched.items()}
     value_nominal = None
@@ -594,34 +553,113 @@ def design(loop, *, over, maximize="y_max", x=None, y=None, n=None, rtol=None, d
     common = dict(target=maximize, x=x, y=y, over=over, nominal=nominal,
                   value_nominal=value_nominal, samples=samples, spacing=spacing,
                   failed=tuple(failed), values=dict(values), delay=delay)
-    if best is None and failed and not np.any(samples[:, -1] == -np.inf):
+    if best is None:
+        message = _not_found(maximize, simulation, x, y, over, searched, bracket, samples,
+                             spacing, failed)
+        return Design(best=None, value=None, limits=None, message=message, **common)
+    return Design(best=dict(zip(names, (float(v) for v in best))), value=float(value),
+                  limits=answer(best), **common)
+
+
+def _check_design_names(loop, maximize, x, y, damping, delay, values):
+    """The delay in seconds (checked, or None): the plane's and the damping's names are the loop's.
+
+    A step of :func:`design`'s input checks: the axes take no value, and a
+    delay is given in seconds or in samples, not both.
+    """
+    for axis, name in (("x", x), ("y", y)) + ((("damping", damping),) if maximize == "passive"
+                                                 else ()):
+        if name not in loop.parameters:
+            need = (": maximize='passive' needs the device's viscous friction"
+                    if axis == "damping" else "")
+            raise ValueError(f"{axis}: {name!r} is not a parameter of the loop{need} "
+                             f"(parameters: {', '.join(loop.parameters)})")
+    for name in (x, y):
+        if name in values:
+            raise TypeError(f"{name} is an axis of the ({x}, {y}) plane: it takes no value here")
+    if delay is not None:
+        delay = check_real("delay", delay, low=0.0)
+        if "d" in values:
+            raise TypeError("give the delay in seconds (delay) or in samples (d), not both")
+    return delay
+
+
+def _check_values_once(loop, maximize, x, y, damping, over, at, simulation, steps):
+    """The values asked of the loop once, at the box's middle (and its corners), before the scan.
+
+    A wrong value is then the caller's error, not a value of the searched
+    parameter without an answer: the polynomial at the middle, the
+    passivity theorem's plant with ``maximize="passive"``, and the
+    simulation's horizon at every corner's delay (held in seconds, ``d``
+    varies with ``T``).
+    """
+    middle = tuple(0.5 * (lo + hi) for lo, hi in over.values())
+    loop.polynomial(**{**at(middle), x: 0.0, y: 0.0})
+    if maximize == "passive":
+        # A plant the passivity theorem does not cover is refused here, once.
+        loop.passive_region(x, y, damping=damping, **at(middle))
+    if simulation:
+        from ..simulation.simulator import check_steps
+
+        for corner in box_corners(over):
+            check_steps(steps, at(tuple(corner.values())).get("d", loop.defaults.get("d", 0)))
+
+
+def _maximize_over(target, names, over, searched, delay, n, include, rtol, progress):
+    """``(best, value, seen)``: the search of ``target`` over ``searched``, points as tuples.
+
+    One parameter: :func:`maximize_scalar`, or with ``T`` and a delay held
+    in seconds :func:`maximize_pieces` over the pieces of one whole delay
+    each; two: :func:`maximize_box`.
+    """
+    if len(names) == 1 and delay is not None and names[0] == "T":
+        best, value, seen = maximize_pieces(lambda v: target((v,)),
+                                            delay_pieces(delay, *over["T"]),
+                                            include=[p[0] for p in include], rtol=rtol,
+                                            progress=progress)
+    elif len(names) == 1:
+        best, value, seen = maximize_scalar(lambda v: target((v,)), *searched[names[0]], n,
+                                            include=[p[0] for p in include], rtol=rtol,
+                                            progress=progress)
+    else:
+        return maximize_box(target, tuple(searched[k] for k in names), n,
+                            include=include, rtol=rtol, progress=progress)
+    best = None if best is None else (best,)
+    return best, value, [((p,), v) for p, v in seen]
+
+
+def _not_found(maximize, simulation, x, y, over, searched, bracket, samples, spacing, failed):
+    """The message of a design that found no point: proved (Stodola) or not seen on the scan.
+
+    Raises
+    ------
+    ValueError
+        If the target could not be computed at any value searched (none
+        was merely without a point).
+    """
+    if failed and not np.any(samples[:, -1] == -np.inf):
         what = {"passive": "passive set", "simulated": "simulated limit"}.get(maximize, "limits")
         raise ValueError(f"the {what} could not "
                          f"be computed at any of the {len(samples)} values searched: "
                          f"{failed[0][1]}")
-    if best is None:
-        ranges = ", ".join(f"{k} in [{lo:.6g}, {hi:.6g}]" for k, (lo, hi) in over.items())
-        what = {"passive": "passive point",
-                "simulated": f"point whose simulated run settles below "
-                             f"{simulation.get('amplitude', 0):.3g}"}.get(maximize, "stable point")
-        if bracket is None:
-            message = (f"no value of {ranges} has a {what} in the ({x}, {y}) plane: proved "
-                       f"(Stodola's necessary condition, the coefficients of (w - 1)**n "
-                       f"chi((w + 1)/(w - 1)) all of one sign, holds nowhere in the range)")
-        else:
-            # Only the values evaluated are known: a band of them narrower than
-            # the scan's step can lie between two.
-            inside = ", ".join(f"{k} in [{lo:.6g}, {hi:.6g}]" for k, (lo, hi) in searched.items())
-            narrowed = (f"; outside {inside} none is stable (Stodola's necessary condition)"
-                        if searched != over else "")
-            message = (f"no {what} in the ({x}, {y}) plane was found at the {len(samples)} "
-                       f"values of {inside} evaluated (steps of "
-                       f"{', '.join(f'{s:.3g}' for s in spacing.values())}){narrowed}; between "
-                       f"them the range was not examined: a band of values narrower than a step "
-                       f"may hold one (give a finer n)")
-        return Design(best=None, value=None, limits=None, message=message, **common)
-    return Design(best=dict(zip(names, (float(v) for v in best))), value=float(value),
-                  limits=answer(best), **common)
+    ranges = ", ".join(f"{k} in [{lo:.6g}, {hi:.6g}]" for k, (lo, hi) in over.items())
+    what = {"passive": "passive point",
+            "simulated": f"point whose simulated run settles below "
+                         f"{simulation.get('amplitude', 0):.3g}"}.get(maximize, "stable point")
+    if bracket is None:
+        return (f"no value of {ranges} has a {what} in the ({x}, {y}) plane: proved "
+                f"(Stodola's necessary condition, the coefficients of (w - 1)**n "
+                f"chi((w + 1)/(w - 1)) all of one sign, holds nowhere in the range)")
+    # Only the values evaluated are known: a band of them narrower than
+    # the scan's step can lie between two.
+    inside = ", ".join(f"{k} in [{lo:.6g}, {hi:.6g}]" for k, (lo, hi) in searched.items())
+    narrowed = (f"; outside {inside} none is stable (Stodola's necessary condition)"
+                if searched != over else "")
+    return (f"no {what} in the ({x}, {y}) plane was found at the {len(samples)} "
+            f"values of {inside} evaluated (steps of "
+            f"{', '.join(f'{s:.3g}' for s in spacing.values())}){narrowed}; between "
+            f"them the range was not examined: a band of values narrower than a step "
+            f"may hold one (give a finer n)")
 
 
 def _bracket(loop, maximize, x, y, names, over, at):

@@ -463,11 +463,32 @@ def _solve(plane, x, y, x_range, y_range, hints=(0.0, 0.0)):
 
     ``hints`` are sizes of the axes (the loop's defaults) used only where
     the condition gives no scale of its own (no line crosses that axis).
+    The steps: the plane's scale (:func:`_natural_scales`), the polygon cut
+    to the condition (:func:`_passive_polygon`), the window
+    (:func:`_fitted_window`) and the region in the plane's units
+    (:func:`_region_of`).
     """
     grid = _grid(plane.harmonic)
     table = plane.terms(grid)
+    plane.sx, plane.sy = _natural_scales(table, hints)
+    polygon, rows, on_box = _passive_polygon(plane, grid, table)
+    window = _fitted_window(plane, polygon, on_box, x_range, y_range)
+    halfplanes = rows * np.array([1.0, 1.0 / plane.sx, 1.0 / plane.sy])
+    if len(polygon) == 0:
+        return _with_halfplanes(PassiveRegion(x, y, np.zeros((0, 2)), True, tuple(window[0]),
+                                              tuple(window[1]), 0.0, None, None),
+                                halfplanes)
+    return _with_halfplanes(_region_of(plane, x, y, polygon, on_box, window), halfplanes)
 
-    # The plane's natural scale: where the grid's lines cross the axes.
+
+def _natural_scales(table, hints):
+    """``[sx, sy]``: the plane's natural scale, where the grid's lines cross the axes.
+
+    The set's own scale wins over the hint: the cuts start in a box of
+    :data:`_BOX` units and drop vertices closer than 1e-9 of the polygon's
+    span, so a unit much larger than the set (a hint of 1 with a damping
+    of 1e-6) loses it to rounding (an empty set).  1 where neither gives one.
+    """
     scales = []
     for axis, hint in ((1, hints[0]), (2, hints[1])):
         slope = np.abs(table[axis])
@@ -476,42 +497,51 @@ def _solve(plane, x, y, x_range, y_range, hints=(0.0, 0.0)):
             ratio = np.abs(table[0][big]) / slope[big]
         ratio = ratio[np.isfinite(ratio) & (ratio > 0)]
         s = float(np.median(ratio)) if ratio.size else 0.0
-        # The set's own scale wins over the hint: the cuts start in a box
-        # of _BOX units and drop vertices closer than 1e-9 of the polygon's
-        # span, so a unit much larger than the set (a hint of 1 with a
-        # damping of 1e-6) loses it to rounding (an empty set).
         if not s > 0:
             s = abs(hint)
         scales.append(s if s > 0 else 1.0)
-    plane.sx, plane.sy = scales
-    tolerance = _RTOL * (plane.damping if plane.damping_axis is None else scales[plane.damping_axis])
+    return scales
 
-    def cut(polygon, rows):
-        """Cutting planes until every vertex meets the condition to ``tolerance``."""
-        for _ in range(_MAX_ROUNDS):
-            if len(polygon) == 0:
-                return polygon, rows
-            value, theta = _worst(plane, grid, table, polygon[:, 0], polygon[:, 1])
-            failing = value > tolerance
-            if not failing.any():
-                return polygon, rows
-            new = plane.rows(np.unique(theta[failing]))
-            rows = np.concatenate([rows, new])
-            polygon = _clip_all(polygon, new)
-            if len(polygon) > _MAX_VERTICES:
-                raise ArithmeticError(f"the passive set's boundary needs more than "
-                                      f"{_MAX_VERTICES} vertices to meet the tolerance")
-        raise ArithmeticError(f"the passive set did not converge in {_MAX_ROUNDS} rounds of "
-                              f"cutting planes")
 
+def _cut(plane, grid, table, tolerance, polygon, rows):
+    """Cutting planes until every vertex meets the condition to ``tolerance``: ``(polygon, rows)``.
+
+    Each round adds the half-plane of the worst angle at every failing
+    vertex (:func:`_worst`); an ArithmeticError if the boundary needs more
+    than :data:`_MAX_VERTICES` vertices or :data:`_MAX_ROUNDS` rounds.
+    """
+    for _ in range(_MAX_ROUNDS):
+        if len(polygon) == 0:
+            return polygon, rows
+        value, theta = _worst(plane, grid, table, polygon[:, 0], polygon[:, 1])
+        failing = value > tolerance
+        if not failing.any():
+            return polygon, rows
+        new = plane.rows(np.unique(theta[failing]))
+        rows = np.concatenate([rows, new])
+        polygon = _clip_all(polygon, new)
+        if len(polygon) > _MAX_VERTICES:
+            raise ArithmeticError(f"the passive set's boundary needs more than "
+                                  f"{_MAX_VERTICES} vertices to meet the tolerance")
+    raise ArithmeticError(f"the passive set did not converge in {_MAX_ROUNDS} rounds of "
+                          f"cutting planes")
+
+
+def _passive_polygon(plane, grid, table):
+    """``(polygon, rows, on_box)``: the passive set (scaled units), its half-planes, far vertices.
+
+    The grid's half-planes cut a far box (:data:`_BOX`), then
+    :func:`_cut` adds the worst angles' until the condition holds; a
+    vertex on the far box (``on_box``, per coordinate) means the set runs
+    off to infinity.  A bounded set is cut again in a box fitted to it.
+    """
+    tolerance = _RTOL * (plane.damping if plane.damping_axis is None else
+                         (plane.sx, plane.sy)[plane.damping_axis])
     rows = np.concatenate([plane.static_row(), plane.rows(grid)])
-    polygon, rows = cut(_clip_all(_box(_BOX, _BOX), rows), rows)
-
-    # The far box: a vertex on it means the set runs off to infinity.
+    polygon, rows = _cut(plane, grid, table, tolerance, _clip_all(_box(_BOX, _BOX), rows), rows)
     on_box = np.abs(polygon) >= _BOX * (1 - 1e-9)
-    unbounded_x, unbounded_y = (bool(on_box[:, 0].any()), bool(on_box[:, 1].any())) if len(
-        polygon) else (False, False)
-    if len(polygon) and not (unbounded_x or unbounded_y):
+    unbounded = bool(on_box.any()) if len(polygon) else False
+    if len(polygon) and not unbounded:
         # Redo the cuts in a box fitted to the set: its vertices then carry
         # the rounding of its own size, not of the far box's, which merged
         # vertices closer than 1e-9 of its span, and a polished corner has
@@ -520,57 +550,63 @@ def _solve(plane, x, y, x_range, y_range, hints=(0.0, 0.0)):
         lo, hi = polygon.min(axis=0), polygon.max(axis=0)
         half = np.maximum(hi - lo, 1e-300)
         polygon = _polish(_clip_all(_box(half[0], half[1], (lo + hi) / 2), rows), rows)
-        polygon, rows = cut(polygon, rows)
+        polygon, rows = _cut(plane, grid, table, tolerance, polygon, rows)
         on_box = np.zeros(polygon.shape, dtype=bool)
+    return polygon, rows, on_box
 
-    unscale = np.array([plane.sx, plane.sy])
-    window_given = x_range is not None
+
+def _fitted_window(plane, polygon, on_box, x_range, y_range):
+    """``((x0, x1), (y0, y1))``: the window given, else the polygon's box with a margin.
+
+    A bounded set gets 5 % of its size around it; a set that runs off
+    gets its finite vertices' box grown by its own size (at least the
+    scaled plane's unit, the set's natural size); an empty set the
+    plane's unit around 0.
+    """
     if len(polygon) == 0:
-        window = (x_range, y_range) if window_given else (
+        return (x_range, y_range) if x_range is not None else (
             (-plane.sx, plane.sx), (-plane.sy, plane.sy))
-    elif window_given:
-        window = (x_range, y_range)
+    if x_range is not None:
+        return (x_range, y_range)
+    unbounded = bool(on_box.any())
+    finite = polygon[~on_box.any(axis=1)] if unbounded else polygon
+    if len(finite) == 0:
+        finite = np.zeros((1, 2))
+    lo, hi = finite.min(axis=0), finite.max(axis=0)
+    span = hi - lo
+    if unbounded:
+        grow = np.maximum(span, 1.0)
     else:
-        finite = polygon[~on_box.any(axis=1)] if (unbounded_x or unbounded_y) else polygon
-        if len(finite) == 0:
-            finite = np.zeros((1, 2))
-        lo, hi = finite.min(axis=0), finite.max(axis=0)
-        span = hi - lo
-        if unbounded_x or unbounded_y:
-            # The scaled plane's unit is the set's natural size: show at
-            # least that much of the part that runs off.
-            grow = np.maximum(span, 1.0)
-        else:
-            grow = 0.05 * np.maximum(span, 1e-9 * np.maximum(np.abs(hi), 1.0))
-        lo, hi = (lo - grow) * unscale, (hi + grow) * unscale
-        window = ((float(lo[0]), float(hi[0])), (float(lo[1]), float(hi[1])))
+        grow = 0.05 * np.maximum(span, 1e-9 * np.maximum(np.abs(hi), 1.0))
+    unscale = np.array([plane.sx, plane.sy])
+    lo, hi = (lo - grow) * unscale, (hi + grow) * unscale
+    return ((float(lo[0]), float(hi[0])), (float(lo[1]), float(hi[1])))
 
-    halfplanes = rows * np.array([1.0, 1.0 / plane.sx, 1.0 / plane.sy])
-    if len(polygon) == 0:
-        return _with_halfplanes(PassiveRegion(x, y, np.zeros((0, 2)), True, tuple(window[0]),
-                                              tuple(window[1]), 0.0, None, None),
-                                halfplanes)
-    full = polygon * unscale + 0.0     # no -0.0
+
+def _region_of(plane, x, y, polygon, on_box, window):
+    """The :class:`PassiveRegion` of a non-empty scaled ``polygon``, clipped to ``window``.
+
+    Its highest point is infinite where the highest vertex is a corner of
+    the far box (nothing but the box stops the set going up).
+    """
+    full = polygon * np.array([plane.sx, plane.sy]) + 0.0     # no -0.0
     (x0, x1), (y0, y1) = window
     inside = (full[:, 0] >= x0) & (full[:, 0] <= x1) & (full[:, 1] >= y0) & (full[:, 1] <= y1)
-    bounded = not (unbounded_x or unbounded_y) and bool(inside.all())
+    bounded = not on_box.any() and bool(inside.all())
     clipped = full
     for row in ((x0, -1.0, 0.0), (-x1, 1.0, 0.0), (y0, 0.0, -1.0), (-y1, 0.0, 1.0)):
         clipped = _clip_all(clipped, np.array([row]))
     top_vertex = int(np.argmax(polygon[:, 1]))
     if on_box[top_vertex].any():
-        # The highest vertex is a corner of the far box: nothing but the box
-        # stops the set going up.
         y_max, x_at = math.inf, math.nan
     else:
         top = full[:, 1].max()
         level = full[:, 1] >= top - 1e-12 * max(abs(top), 1e-300)
         y_max = float(top)
         x_at = float(0.5 * (full[level, 0].min() + full[level, 0].max()))
-    return _with_halfplanes(
-        PassiveRegion(x, y, clipped if len(clipped) else np.zeros((0, 2)), bounded,
-                      (float(x0), float(x1)), (float(y0), float(y1)), _area(clipped), y_max, x_at),
-        halfplanes)
+    return PassiveRegion(x, y, clipped if len(clipped) else np.zeros((0, 2)), bounded,
+                         (float(x0), float(x1)), (float(y0), float(y1)), _area(clipped), y_max,
+                         x_at)
 
 
 def _with_halfplanes(region, halfplanes):
@@ -681,26 +717,7 @@ def passive_region(loop, x=None, y=None, *, damping="b", x_range=None, y_range=N
     >>> round(r.y_max, 9)          # K T / 2 + |B| < b: K_max = 2 b / T at B = 0
     64.8
     """
-    from ...symbolic import model
-
-    if not isinstance(damping, str):
-        raise TypeError(f"damping must be a parameter name (str), got {type(damping).__name__}")
-    parameters = tuple(loop.parameters)
-    if damping not in parameters:
-        raise ValueError(f"damping: {damping!r} is not a parameter of this loop (parameters: "
-                         f"{', '.join(parameters)}); name the device's viscous friction")
-    if x is None and y is None and getattr(loop, "plane", None) is not None:
-        x, y = loop.plane
-    if x is None or y is None:
-        raise TypeError("give the plane's parameters x and y (this loop has no default plane)")
-    for axis, name in (("x", x), ("y", y)):
-        if not isinstance(name, str):
-            raise TypeError(f"{axis} must be a parameter name (str), got {type(name).__name__}")
-        if name not in parameters or name in ("d", "T"):
-            raise ValueError(f"{axis}: {name!r} is not a parameter the plane can take (parameters: "
-                             f"{', '.join(p for p in parameters if p not in ('d', 'T'))})")
-    if x == y:
-        raise ValueError(f"the plane's parameters must differ, got {x!r} twice")
+    parameters, x, y = _check_passive_plane(loop, x, y, damping)
     x_range, y_range = _windows(x_range, y_range)
 
     symbols = {name: sp.Symbol(name) for name in parameters}
@@ -709,66 +726,11 @@ def passive_region(loop, x=None, y=None, *, damping="b", x_range=None, y_range=N
     plant_symbols = {str(s): s for s in loop.plant.free_symbols}
     symbols.update(env_symbols)
     symbols.update(plant_symbols)
-    b_symbol = symbols[damping]
-
-    # The theorem's device: 1/G = m s**2 + b s exactly.
-    inverse = sp.cancel(1 / loop.plant)
-    try:
-        poly = sp.Poly(inverse, model.s)
-    except sp.PolynomialError:
-        poly = None
-    coefficients = poly.all_coeffs() if poly is not None else []
-    if (len(coefficients) != 3 or coefficients[2] != 0 or sp.expand(coefficients[1] - b_symbol) != 0
-            or coefficients[0].has(b_symbol)):
-        raise ValueError(f"Colgate and Schenkel's condition covers a device 1/(m*s**2 + "
-                         f"{damping}*s) (a mass with viscous friction {damping}); this loop's "
-                         f"plant is {loop.plant}")
-
-    unknown = set(values) - set(parameters)
-    if unknown:
-        raise TypeError(f"unknown parameter(s) {', '.join(sorted(unknown))}; parameters of this "
-                        f"loop: {', '.join(parameters)}")
-    given = dict(getattr(loop, "defaults", {}))
-    given.update(values)
-    for axis in (x, y):
-        given.pop(axis, None)
+    _check_device(loop, damping, symbols[damping])
     env_names = [n for n in parameters if n in env_symbols and n != "T"]
-    for name in (x, y):
-        if name != damping and name not in env_names:
-            raise ValueError(f"parameter {name!r} does not enter the passivity condition (only "
-                             f"the environment's parameters and the damping {damping!r} do)")
-    need = ["d", "T"] + [damping] * (damping not in (x, y)) + [n for n in env_names
-                                                                 if n not in (x, y)]
-    missing = [n for n in need if n not in given]
-    if missing:
-        raise TypeError(f"missing value(s) for {', '.join(missing)}")
-    d = check_delay(given["d"])
-    T = check_real("T", given["T"], low=0.0, low_open=True)
-    b = None
-    if damping not in (x, y):
-        b = check_real(damping, given[damping], low=0.0, low_open=True)
-    numbers = {symbols[n]: sp.Float(repr(check_real(n, given[n])), 30)
-               for n in env_names if n not in (x, y)}
-    numbers[model.T] = sp.Float(repr(T), 30)
-    if "T" in env_symbols:
-        numbers[env_symbols["T"]] = sp.Float(repr(T), 30)
-
-    num, den = sp.fraction(sp.cancel(sp.together(environment)))
-    num = sp.Poly(sp.expand(num), model.z).all_coeffs()
-    den = sp.Poly(sp.expand(den), model.z).all_coeffs()
-    axes = [symbols[n] for n in (x, y) if n != damping]
-    for name in (x, y):
-        if name != damping and any(c.has(symbols[name]) for c in den):
-            raise ValueError(f"parameter {name!r} enters the environment's denominator: the "
-                             f"passive set is then not an intersection of half-planes")
-    from ...symbolic.loop_assembly import is_affine
-
-    for name in (x, y):
-        if name != damping and not is_affine(num, [symbols[name]]):
-            raise ValueError(f"parameter {name!r} does not enter the environment affinely")
-    if len(axes) == 2 and not is_affine(num, axes):
-        raise ValueError(f"parameters {x!r} and {y!r} do not enter the environment jointly "
-                         f"affinely (a product of the two appears)")
+    d, T, b, numbers = _passive_values(loop, parameters, x, y, damping, env_names, symbols,
+                                       env_symbols, values)
+    num, den = _environment_coefficients(environment, symbols, x, y, damping)
 
     def evaluate(coefficients, at):
         sub = dict(numbers)
@@ -790,3 +752,114 @@ def passive_region(loop, x=None, y=None, *, damping="b", x_range=None, y_range=N
     hints = tuple(abs(float(defaults[n])) if isinstance(defaults.get(n), (int, float)) else 0.0
                   for n in (x, y))
     return _solve(plane, x, y, x_range, y_range, hints)
+
+
+def _check_passive_plane(loop, x, y, damping):
+    """``(parameters, x, y)``: the loop's parameters and the plane, default the loop's, checked.
+
+    The first of :func:`passive_region`'s checks: the damping and the
+    plane's axes name parameters (not ``d`` or ``T``), two different ones.
+    """
+    if not isinstance(damping, str):
+        raise TypeError(f"damping must be a parameter name (str), got {type(damping).__name__}")
+    parameters = tuple(loop.parameters)
+    if damping not in parameters:
+        raise ValueError(f"damping: {damping!r} is not a parameter of this loop (parameters: "
+                         f"{', '.join(parameters)}); name the device's viscous friction")
+    if x is None and y is None and getattr(loop, "plane", None) is not None:
+        x, y = loop.plane
+    if x is None or y is None:
+        raise TypeError("give the plane's parameters x and y (this loop has no default plane)")
+    for axis, name in (("x", x), ("y", y)):
+        if not isinstance(name, str):
+            raise TypeError(f"{axis} must be a parameter name (str), got {type(name).__name__}")
+        if name not in parameters or name in ("d", "T"):
+            raise ValueError(f"{axis}: {name!r} is not a parameter the plane can take (parameters: "
+                             f"{', '.join(p for p in parameters if p not in ('d', 'T'))})")
+    if x == y:
+        raise ValueError(f"the plane's parameters must differ, got {x!r} twice")
+    return parameters, x, y
+
+
+def _check_device(loop, damping, b_symbol):
+    """A ValueError unless the loop's plant is the theorem's device: 1/G = m s**2 + b s exactly."""
+    from ...symbolic import model
+
+    inverse = sp.cancel(1 / loop.plant)
+    try:
+        poly = sp.Poly(inverse, model.s)
+    except sp.PolynomialError:
+        poly = None
+    coefficients = poly.all_coeffs() if poly is not None else []
+    if (len(coefficients) != 3 or coefficients[2] != 0 or sp.expand(coefficients[1] - b_symbol) != 0
+            or coefficients[0].has(b_symbol)):
+        raise ValueError(f"Colgate and Schenkel's condition covers a device 1/(m*s**2 + "
+                         f"{damping}*s) (a mass with viscous friction {damping}); this loop's "
+                         f"plant is {loop.plant}")
+
+
+def _passive_values(loop, parameters, x, y, damping, env_names, symbols, env_symbols, values):
+    """``(d, T, b, numbers)``: the values the condition needs, checked (``b`` None on an axis).
+
+    ``numbers`` maps the environment's symbols off the plane (and ``T``)
+    to 30-digit floats.  Only the environment's parameters and the damping
+    may be the plane's axes; a value is needed for each of them that is
+    not one, for ``d`` and for ``T``.
+    """
+    from ...symbolic import model
+
+    unknown = set(values) - set(parameters)
+    if unknown:
+        raise TypeError(f"unknown parameter(s) {', '.join(sorted(unknown))}; parameters of this "
+                        f"loop: {', '.join(parameters)}")
+    given = dict(getattr(loop, "defaults", {}))
+    given.update(values)
+    for axis in (x, y):
+        given.pop(axis, None)
+    for name in (x, y):
+        if name != damping and name not in env_names:
+            raise ValueError(f"parameter {name!r} does not enter the passivity condition (only "
+                             f"the environment's parameters and the damping {damping!r} do)")
+    need = ["d", "T"] + [damping] * (damping not in (x, y)) + [n for n in env_names
+                                                                 if n not in (x, y)]
+    missing = [n for n in need if n not in given]
+    if missing:
+        raise TypeError(f"missing value(s) for {', '.join(missing)}")
+    d = check_delay(given["d"])
+    T = check_real("T", given["T"], low=0.0, low_open=True)
+    b = None
+    if damping not in (x, y):
+        b = check_real(damping, given[damping], low=0.0, low_open=True)
+    numbers = {symbols[n]: sp.Float(repr(check_real(n, given[n])), 30)
+               for n in env_names if n not in (x, y)}
+    numbers[model.T] = sp.Float(repr(T), 30)
+    if "T" in env_symbols:
+        numbers[env_symbols["T"]] = sp.Float(repr(T), 30)
+    return d, T, b, numbers
+
+
+def _environment_coefficients(environment, symbols, x, y, damping):
+    """``(num, den)``: VE(z)'s coefficients in z (SymPy), the plane's axes checked in them.
+
+    An axis other than the damping must enter the numerator affinely (both
+    jointly) and not the denominator: the passive set is then an
+    intersection of half-planes.
+    """
+    from ...symbolic import model
+    from ...symbolic.loop_assembly import is_affine
+
+    num, den = sp.fraction(sp.cancel(sp.together(environment)))
+    num = sp.Poly(sp.expand(num), model.z).all_coeffs()
+    den = sp.Poly(sp.expand(den), model.z).all_coeffs()
+    axes = [symbols[n] for n in (x, y) if n != damping]
+    for name in (x, y):
+        if name != damping and any(c.has(symbols[name]) for c in den):
+            raise ValueError(f"parameter {name!r} enters the environment's denominator: the "
+                             f"passive set is then not an intersection of half-planes")
+    for name in (x, y):
+        if name != damping and not is_affine(num, [symbols[name]]):
+            raise ValueError(f"parameter {name!r} does not enter the environment affinely")
+    if len(axes) == 2 and not is_affine(num, axes):
+        raise ValueError(f"parameters {x!r} and {y!r} do not enter the environment jointly "
+                         f"affinely (a product of the two appears)")
+    return num, den

@@ -849,6 +849,56 @@ def robust_region(loop, x, y, *, uncertain, strips=64, rtol=1e-6, x_range=None, 
     rtol = check_real("rtol", rtol)
     if not 1e-12 <= rtol <= 1e-2:
         raise ValueError(f"rtol must be from 1e-12 to 1e-2, got {rtol!r}")
+    box, delays, fixed = _check_robust_values(loop, x, y, uncertain, values)
+    centre = {n: 0.5 * (lo + hi) for n, (lo, hi) in box.items()}
+    centre_d = delays[len(delays) // 2]
+    # Every corner of the box is asked of the loop (its domain: a pole that
+    # cancels, a period that is not positive) before any work.
+    for corner in itertools.product(*box.values()):
+        loop.unstable_root_counts(**fixed, **dict(zip(box, corner)), d=centre_d,
+                                  **{x: 0.0, y: 0.0})
+
+    from ..._progress import progress_printer
+
+    progress = check_progress(progress, lambda: progress_printer("delays", len(delays)))
+    given_x, y_range = _check_robust_window(x_range, y_range)
+    line = given_x is not None and given_x[0] == given_x[1]
+    try:
+        enclosures = _Enclosures(loop, x, y, box, fixed)
+    except (ValueError, ZeroDivisionError, OverflowError) as exc:
+        words = ", ".join(f"{k} in [{lo:g}, {hi:g}]" for k, (lo, hi) in box.items())
+        raise ValueError(f"uncertain: {words}: {exc}") from None
+    nominal = loop.region(x, y, x_range=None if line else given_x, y_range=y_range, **fixed,
+                          **centre, d=centre_d)
+    if not nominal.stable:
+        return RobustRegion.empty_set(x, y, box, delays, nominal, fixed,
+                                  "the stable set at the box's centre is empty")
+    points = np.vstack([cell.outer for cell in nominal.stable])
+    x_lo, x_hi = given_x or (float(points[:, 0].min()), float(points[:, 0].max()))
+    y_lo, y_hi = y_range or (float(points[:, 1].min()), float(points[:, 1].max()))
+    window = (x_lo, x_hi, y_lo, y_hi)
+    edges, geometry, owner = _strip_geometry(loop, x, y, fixed, box, delays, window, strips,
+                                             rtol)
+    tol = np.full(len(owner), rtol * (y_hi - y_lo) / 4) / np.maximum(geometry.height, 1e-300)
+    marked, examined, exhausted = _certify_delays(enclosures, loop.environment_delay, geometry,
+                                                  len(owner), delays, tol, budget, progress)
+    pieces, status = _piece_status(loop, x, y, enclosures, geometry, marked, delays,
+                                   {**fixed, **centre})
+    robust, marginal = _strip_intervals(pieces, status, marked, geometry, owner, len(edges) - 1)
+    at = dict(fixed) if len(delays) > 1 else {**fixed, "d": delays[0]}
+    touched = tuple(side for side in nominal.unbounded if _touches(side, edges, robust, window))
+    return RobustRegion.from_strips(x, y, box, delays, edges, robust, marginal, nominal, at,
+                                    examined=examined, exhausted=exhausted, unbounded=touched)
+
+
+def _check_robust_values(loop, x, y, uncertain, values):
+    """``(box, delays, fixed)``: :func:`robust_region`'s parameters, checked, in three kinds.
+
+    The box of the uncertain continuous parameters, the delays (the
+    uncertain range, else the one given), and the values of every other
+    parameter but the plane's, as floats.  A step of its own: every
+    question about the input is asked here, before any work.
+    """
     for name in (x, y):
         if name not in loop.environment_names or name in loop.plant_names or name == "T":
             raise ValueError(f"robust regions take a plane of the environment's parameters; "
@@ -873,17 +923,11 @@ def robust_region(loop, x, y, *, uncertain, strips=64, rtol=1e-6, x_range=None, 
         raise TypeError(f"missing value(s) for {', '.join(missing)}")
     for name, v in fixed.items():
         fixed[name] = check_real(name, v)
-    centre = {n: 0.5 * (lo + hi) for n, (lo, hi) in box.items()}
-    centre_d = delays[len(delays) // 2]
-    # Every corner of the box is asked of the loop (its domain: a pole that
-    # cancels, a period that is not positive) before any work.
-    for corner in itertools.product(*box.values()):
-        loop.unstable_root_counts(**fixed, **dict(zip(box, corner)), d=centre_d,
-                                  **{x: 0.0, y: 0.0})
+    return box, delays, fixed
 
-    from ..._progress import progress_printer
 
-    progress = check_progress(progress, lambda: progress_printer("delays", len(delays)))
+def _check_robust_window(x_range, y_range):
+    """``(x_range, y_range)`` checked; ``x_range = (x0, x0)``, one line, is allowed."""
     given_x = None
     if x_range is not None:
         given_x = check_window("x_range", (x_range[0], x_range[1] + 1.0)) if (
@@ -892,20 +936,19 @@ def robust_region(loop, x, y, *, uncertain, strips=64, rtol=1e-6, x_range=None, 
         given_x = (given_x[0], float(x_range[1]))
     if y_range is not None:
         y_range = check_window("y_range", y_range)
-    line = given_x is not None and given_x[0] == given_x[1]
-    try:
-        enclosures = _Enclosures(loop, x, y, box, fixed)
-    except (ValueError, ZeroDivisionError, OverflowError) as exc:
-        words = ", ".join(f"{k} in [{lo:g}, {hi:g}]" for k, (lo, hi) in box.items())
-        raise ValueError(f"uncertain: {words}: {exc}") from None
-    nominal = loop.region(x, y, x_range=None if line else given_x, y_range=y_range, **fixed,
-                          **centre, d=centre_d)
-    if not nominal.stable:
-        return RobustRegion.empty_set(x, y, box, delays, nominal, fixed,
-                                  "the stable set at the box's centre is empty")
-    points = np.vstack([cell.outer for cell in nominal.stable])
-    x_lo, x_hi = given_x or (float(points[:, 0].min()), float(points[:, 0].max()))
-    y_lo, y_hi = y_range or (float(points[:, 1].min()), float(points[:, 1].max()))
+    return given_x, y_range
+
+
+def _strip_geometry(loop, x, y, fixed, box, delays, window, strips, rtol):
+    """``(edges, geometry, owner)``: the strips of the window and the pieces where to look.
+
+    The first step of the work: on each strip's edges, the intervals of
+    ``y`` stable at every delay and grid value of the box; strips whose
+    edges see different numbers of them are halved (:func:`_split`), and
+    each strip's intervals are joined into trapezoids
+    (:func:`_trapezoids`: ``geometry``, and ``owner``, each one's strip).
+    """
+    x_lo, x_hi, y_lo, y_hi = window
     grid = _grid(box)
 
     def look(xs):
@@ -920,13 +963,24 @@ def robust_region(loop, x, y, *, uncertain, strips=64, rtol=1e-6, x_range=None, 
     edges = list(np.linspace(x_lo, x_hi, strips + 1)) if x_hi > x_lo else [x_lo, x_lo]
     edges, spans = _split(look, edges, look(edges), (x_hi - x_lo) * rtol, 4 * strips)
     geometry, owner = _trapezoids(edges, spans)
-    tol = np.full(len(owner), rtol * (y_hi - y_lo) / 4) / np.maximum(geometry.height, 1e-300)
-    marked = {p: [] for p in range(len(owner))}
+    return edges, geometry, owner
+
+
+def _certify_delays(enclosures, environment_delay, geometry, n_pieces, delays, tol, budget,
+                    progress):
+    """``(marked, examined, exhausted)``: the pieces' spans not certified, at every delay.
+
+    The second step: zero exclusion (:func:`_certify`) delay by delay,
+    each delay looking only where the delays before certified; ``marked``
+    holds, per piece, the spans of ``t`` left open.  ``progress`` is
+    called with 0, then with the number of delays done.
+    """
+    marked = {p: [] for p in range(n_pieces)}
     examined, exhausted = 0, False
     if progress is not None:
         progress(0)
     for d in delays:
-        shift = d + loop.environment_delay
+        shift = d + environment_delay
         found, n, out = _certify(enclosures, shift, geometry,
                                  {p: _subtract([(0.0, 1.0)], marked[p]) for p in marked},
                                  tol, budget - examined)
@@ -936,10 +990,17 @@ def robust_region(loop, x, y, *, uncertain, strips=64, rtol=1e-6, x_range=None, 
             marked[p] = _merge(marked[p] + found[p])
         if progress is not None:
             progress(delays.index(d) + 1)
-    # Each certified piece: its root count at one point (the box's centre)
-    # at every delay, and its leading coefficient; a count of -1 (undecided)
-    # or a leading coefficient that may vanish leave it marginal, a count
-    # above 0 unstable (not robust).
+    return marked, examined, exhausted
+
+
+def _piece_status(loop, x, y, enclosures, geometry, marked, delays, at_centre):
+    """``(pieces, status)``: the certified pieces, each robust (0), marginal (1) or unstable (2).
+
+    The third step: each certified piece's root count at one point (the
+    box's centre, ``at_centre``) at every delay, and its leading
+    coefficient; a count of -1 (undecided) or a leading coefficient that
+    may vanish leave it marginal, a count above 0 unstable (not robust).
+    """
     pieces = [(p, a, b) for p in marked for a, b in _subtract([(0.0, 1.0)], marked[p])]
     where = np.array([p for p, _, _ in pieces], dtype=np.int64)
     inner = geometry.take(where)
@@ -949,7 +1010,7 @@ def robust_region(loop, x, y, *, uncertain, strips=64, rtol=1e-6, x_range=None, 
                                                          - inner.lo1)
     status = np.zeros(len(pieces), dtype=int)      # 0 robust, 1 marginal, 2 unstable
     for d in delays:
-        counts = np.atleast_1d(loop.unstable_root_counts(**fixed, **centre, d=d, **{x: px, y: py})) \
+        counts = np.atleast_1d(loop.unstable_root_counts(**at_centre, d=d, **{x: px, y: py})) \
             if pieces else np.zeros(0, dtype=int)
         lead_mid, lead_rad = enclosures.leading(d + loop.environment_delay)
         for k, (p, a, b) in enumerate(pieces):
@@ -960,8 +1021,17 @@ def robust_region(loop, x, y, *, uncertain, strips=64, rtol=1e-6, x_range=None, 
                     lead_mid, lead_rad, px[k], 0.5 * (inner.x1[k] - inner.x0[k]),
                     min(ends), max(ends))):
                 status[k] = 1
-    robust = [[] for _ in range(len(edges) - 1)]
-    marginal = [[] for _ in range(len(edges) - 1)]
+    return pieces, status
+
+
+def _strip_intervals(pieces, status, marked, geometry, owner, n_strips):
+    """``(robust, marginal)``: per strip, the trapezoids' ends of each kind, from the bottom up.
+
+    The last step: robust pieces, and marginal ones with the spans left
+    open (not unstable ones), as :meth:`_Pieces.ends` in their strips.
+    """
+    robust = [[] for _ in range(n_strips)]
+    marginal = [[] for _ in range(n_strips)]
     for k, (p, a, b) in enumerate(pieces):
         if status[k] < 2:
             (robust if status[k] == 0 else marginal)[owner[p]].append(
@@ -971,11 +1041,7 @@ def robust_region(loop, x, y, *, uncertain, strips=64, rtol=1e-6, x_range=None, 
                                for a, b in spans if a < 1.0 and b > 0.0]
     robust = [sorted(r, key=lambda e: e[0] + e[2]) for r in robust]
     marginal = [sorted(m, key=lambda e: e[0] + e[2]) for m in marginal]
-    at = dict(fixed) if len(delays) > 1 else {**fixed, "d": delays[0]}
-    touched = tuple(side for side in nominal.unbounded
-                    if _touches(side, edges, robust, (x_lo, x_hi, y_lo, y_hi)))
-    return RobustRegion.from_strips(x, y, box, delays, edges, robust, marginal, nominal, at,
-                                    examined=examined, exhausted=exhausted, unbounded=touched)
+    return robust, marginal
 
 
 def _split(look, edges, spans, narrowest, most):

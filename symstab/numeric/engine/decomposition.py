@@ -1595,45 +1595,104 @@ def decompose(base, ax, ay, ends, *, x_range, y_range, names=("x", "y"), arc=Non
 
 
 def _decompose(base, ax, ay, ends, *, x_range, y_range, names, fine, arc, family=None):
-    """:func:`decompose` with the arc's chords ``fine`` times the usual length."""
+    """:func:`decompose` with the arc's chords ``fine`` times the usual length.
+
+    The steps: the pieces traced in the window and crossed
+    (:func:`_trace`), the planar graph of their segments split at the
+    crossings (:func:`_split_at_crossings`, :func:`_prune_edges`), its
+    faces with holes and an interior point each (:class:`_Faces`), the
+    cells' root counts (:func:`_cell_counts`), and what the result reports
+    of them: the cells, the crossing rule's mismatches, the window's sides
+    a stable cell touches and how finely the arc draws the stable cells.
+    """
     base, ax, ay = (np.asarray(c, dtype=float) for c in (base, ax, ay))
-    x0, x1 = (float(v) for v in x_range)
-    y0, y1 = (float(v) for v in y_range)
-    for name, (lo, hi) in ((names[0], (x0, x1)), (names[1], (y0, y1))):
-        if not (math.isfinite(lo) and math.isfinite(hi) and lo < hi):
-            raise ValueError(f"the window of {name} must be finite with lo < hi, got ({lo}, {hi})")
-    sx, sy = x1 - x0, y1 - y0
+    window = _Window(x_range, y_range, names)
+    polylines, branches, (p, q, owner, _), hits = _trace(base, ax, ay, ends, arc, window, fine)
+    n_segments = len(p)
+    check_memory(f"the D-decomposition's {n_segments} segments", 64 * n_segments * 64)
+    labels = [label for _, label, _ in polylines]
+    nodes, xy, edges, edge_label = _split_at_crossings(p, q, owner, labels, hits)
+    edges, edge_label = _prune_edges(xy, edges, edge_label)
+    cells = []
+    mismatches = []
+    if len(edges):
+        faces = _Faces(nodes, xy, edges, edge_label)
+        points = window.from_unit(np.array(faces.points).reshape(-1, 2))
+        counts = _cell_counts(base, ax, ay, family, points, names)
+        scale = window.sx * window.sy
+        for n, f in enumerate(faces.keep):
+            outer = window.from_unit(faces.rings[f])
+            hole_rings = tuple(window.from_unit(faces.rings[h]) for h in faces.holes[f])
+            area = scale * (faces.areas[f] + sum(faces.areas[h] for h in faces.holes[f]))
+            point = (float(points[n, 0]), float(points[n, 1]))
+            cells.append(Cell(outer, hole_rings, int(counts[n]), point, float(area)))
+        mismatches = _crossing_mismatches(faces, counts)
+        stable = [f for n, f in enumerate(faces.keep) if counts[n] == 0]
+        unbounded = _unbounded_sides(faces, stable, xy)
+        sides = _line_sides([faces.cycles[f] for f in stable], faces.src, faces.dst,
+                            faces.half_label)
+        resolution = _resolution(faces, stable, xy)
+    else:
+        unbounded, sides = (), []
+        resolution = 0.0
+    found = Decomposition(x=names[0], y=names[1], x_range=(window.x0, window.x1),
+                          y_range=(window.y0, window.y1), branches=tuple(branches),
+                          cells=tuple(cells), mismatches=tuple(mismatches), unbounded=unbounded,
+                          polynomial=(base, ax, ay), resolution=resolution, arc=arc)
+    coefficients = lines(base, ax, ay, ends)
+    segments = [found._segment(label, coefficients, window.from_unit(xy[[a, b]]))
+                for label, a, b in sides]
+    segments.sort(key=lambda g: (g.root != "z=1", g.x0))
+    return dataclasses.replace(found, segments=tuple(segments))
 
-    def to_unit(x, y):
-        return (np.asarray(x) - x0) / sx, (np.asarray(y) - y0) / sy
 
-    def from_unit(uv):
-        return np.column_stack([x0 + sx * uv[:, 0], y0 + sy * uv[:, 1]])
+class _Window:
+    """The window ``[x0, x1] x [y0, y1]``, checked, and its map to the unit square.
 
+    The decomposition's geometry works in window units (the window is
+    ``[0, 1]**2``), so that its tolerances (:data:`_MERGE`, ...) are
+    fractions of the window whatever the parameters' units.
+    """
+
+    def __init__(self, x_range, y_range, names):
+        self.x0, self.x1 = (float(v) for v in x_range)
+        self.y0, self.y1 = (float(v) for v in y_range)
+        for name, (lo, hi) in ((names[0], (self.x0, self.x1)), (names[1], (self.y0, self.y1))):
+            if not (math.isfinite(lo) and math.isfinite(hi) and lo < hi):
+                raise ValueError(f"the window of {name} must be finite with lo < hi, got "
+                                 f"({lo}, {hi})")
+        self.sx, self.sy = self.x1 - self.x0, self.y1 - self.y0
+        self.box = (self.x0, self.x1, self.y0, self.y1)
+
+    def to_unit(self, x, y):
+        """``(u, v)``: points of the plane in window units."""
+        return (np.asarray(x) - self.x0) / self.sx, (np.asarray(y) - self.y0) / self.sy
+
+    def from_unit(self, uv):
+        """Rows ``(x, y)`` of the plane from rows ``(u, v)`` in window units."""
+        return np.column_stack([self.x0 + self.sx * uv[:, 0], self.y0 + self.sy * uv[:, 1]])
+
+
+def _trace(base, ax, ay, ends, arc, window, fine):
+    """The first step: the pieces in the window as segments, and where they cross.
+
+    The arc is sampled, cut into pieces with the lines (:func:`_pieces`)
+    and its chords crossed with every piece's; where the arc crosses a
+    piece it is sampled finer (:func:`_hot_angles`), up to
+    :data:`_CROSSING_ROUNDS` times, until the chords' crossings are the
+    curves'.  Returns ``(polylines, branches, (p, q, owner, position),
+    hits)`` of the last round.
+    """
     samples = None
     for _ in range(_CROSSING_ROUNDS):
-        samples = sample_arc(arc, len(base) - 1, to_unit, samples, fine)
+        samples = sample_arc(arc, len(base) - 1, window.to_unit, samples, fine)
         theta, xs, ys, det = samples
         sign = np.sign(det)
-        polylines, branches = _pieces(base, ax, ay, ends, arc, theta, xs, ys, sign, to_unit,
-                                      from_unit, (x0, x1, y0, y1))
+        polylines, branches = _pieces(base, ax, ay, ends, arc, theta, xs, ys, sign,
+                                      window.to_unit, window.from_unit, window.box)
         p, q, owner, position = _segments(polylines)
-        labels = [label for _, label, _ in polylines]
         hits = _intersections(p, q, owner, position)
-        # Where the arc crosses a piece, the crossing of two chords is off the
-        # curves' by the chords' sag: refine the arc there until it is not.
-        hot = []
-        for i, j, ti, tj in hits:
-            for k, t in ((int(i), ti), (int(j), tj)):
-                th = polylines[owner[k]][2]
-                if th is None or not (1e-6 < t < 1 - 1e-6):
-                    continue
-                a_, b_ = th[position[k]], th[position[k] + 1]
-                if b_ - a_ > _CROSSING_GAP and 1e-4 < a_ and b_ < np.pi - 1e-4:
-                    # Two new angles close around the chords' crossing: the
-                    # chord through it is 32 times shorter, its sag 1000 times.
-                    middle = a_ + t * (b_ - a_)
-                    hot.extend([max(a_, middle - (b_ - a_) / 64), min(b_, middle + (b_ - a_) / 64)])
+        hot = _hot_angles(hits, polylines, owner, position)
         if not hot:
             break
         # The angles added are evaluated by the next round's sampling, the
@@ -1643,10 +1702,37 @@ def _decompose(base, ax, ay, ends, *, x_range, y_range, names, fine, arc, family
         unknown = np.full(len(hot), np.nan)
         samples = tuple(np.concatenate([a, b])[order] for a, b in
                         zip(samples, (hot, unknown, unknown, unknown)))
-    n_segments = len(p)
-    check_memory(f"the D-decomposition's {n_segments} segments", 64 * n_segments * 64)
+    return polylines, branches, (p, q, owner, position), hits
 
-    # Split each segment at its crossings; nodes merged within _MERGE.
+
+def _hot_angles(hits, polylines, owner, position):
+    """Angles of the arc to add around the crossings of its chords with a piece.
+
+    Where the arc crosses a piece, the crossing of two chords is off the
+    curves' by the chords' sag: two new angles close around it make the
+    chord through it 32 times shorter, its sag 1000 times.  Empty when
+    every crossing's chord is short enough (or at an end, or near 0 or pi).
+    """
+    hot = []
+    for i, j, ti, tj in hits:
+        for k, t in ((int(i), ti), (int(j), tj)):
+            th = polylines[owner[k]][2]
+            if th is None or not (1e-6 < t < 1 - 1e-6):
+                continue
+            a_, b_ = th[position[k]], th[position[k] + 1]
+            if b_ - a_ > _CROSSING_GAP and 1e-4 < a_ and b_ < np.pi - 1e-4:
+                middle = a_ + t * (b_ - a_)
+                hot.extend([max(a_, middle - (b_ - a_) / 64), min(b_, middle + (b_ - a_) / 64)])
+    return hot
+
+
+def _split_at_crossings(p, q, owner, labels, hits):
+    """The second step: the planar graph of the segments ``p -> q`` split at their crossings.
+
+    Nodes closer than :data:`_MERGE` are one (:class:`_Nodes`).  Returns
+    ``(nodes, xy, edges, edge_label)``: the nodes, their points, the edges
+    as pairs of nodes and each edge's piece's label.
+    """
     nodes = _Nodes()
     cuts = [[(0.0, None), (1.0, None)] for _ in range(len(p))]
     for i, j, ti, tj in hits:
@@ -1670,9 +1756,14 @@ def _decompose(base, ax, ay, ends, *, x_range, y_range, names, fine, arc, family
                 edge_label.append(labels[owner[k]])
     xy = np.array(nodes.xy)
     edges = np.array(edge_list, dtype=np.int64).reshape(-1, 2)
-    edge_label = np.array(edge_label, dtype=object)
-    # One edge per pair of nodes; inside the window only.
-    # Where a piece runs along the window's edge, the edge is the piece's.
+    return nodes, xy, edges, np.array(edge_label, dtype=object)
+
+
+def _prune_edges(xy, edges, edge_label):
+    """The edges that bound cells: one per pair of nodes, inside the window, none dangling.
+
+    Where a piece runs along the window's edge, the edge is the piece's.
+    """
     order = np.argsort(edge_label == "window", kind="stable")
     edges, edge_label = edges[order], edge_label[order]
     key = np.sort(edges, axis=1)
@@ -1689,15 +1780,45 @@ def _decompose(base, ax, ay, ends, *, x_range, y_range, names, fine, arc, family
         if not loose.any():
             break
         edges, edge_label = edges[~loose], edge_label[~loose]
+    return edges, edge_label
 
-    cells = []
-    mismatches = []
-    if len(edges):
-        src, dst, twin, cycles = _faces(xy, edges)
-        half_label = np.concatenate([edge_label, edge_label])
-        rings = [xy[src[c]] for c in cycles]
-        areas = np.array([_signed_area(r) for r in rings])
-        # Connected components, to put floating pieces as holes into their face.
+
+class _Faces:
+    """The third step: the faces of the planar graph that are cells, with their holes.
+
+    ``src``, ``dst``, ``twin`` and ``half_label`` describe the half-edges,
+    ``cycles`` the faces as lists of half-edges (each face on its left),
+    ``rings`` and ``areas`` their points and signed areas (window units);
+    ``holes[f]`` the floating pieces inside face ``f``, ``face_of`` the
+    face of each half-edge (-1 where none), and ``keep``/``points`` the
+    faces that have an interior point, with that point (window units).
+    """
+
+    def __init__(self, nodes, xy, edges, edge_label):
+        self.src, self.dst, self.twin, self.cycles = _faces(xy, edges)
+        self.half_label = np.concatenate([edge_label, edge_label])
+        self.rings = [xy[self.src[c]] for c in self.cycles]
+        self.areas = np.array([_signed_area(r) for r in self.rings])
+        faces, self.holes = self._holes(nodes, xy, edges)
+        self.face_of = np.full(len(self.src), -1)
+        self.keep, self.points = [], []
+        for f in faces:
+            self.face_of[self.cycles[f]] = f
+            ring_list = [self.rings[f]] + [self.rings[h] for h in self.holes[f]]
+            pt = _interior_point(ring_list)
+            if pt is None:
+                continue
+            self.keep.append(f)
+            self.points.append(pt)
+
+    def _holes(self, nodes, xy, edges):
+        """``(faces, {face: [holes]})``: the faces of positive area, floating pieces in them.
+
+        A floating piece (a component of the graph apart from the window's)
+        is a cycle of negative area, put into the smallest face of another
+        component that holds it.
+        """
+        src, cycles, rings, areas = self.src, self.cycles, self.rings, self.areas
         component = _components(len(xy), edges)
         faces = [k for k in range(len(cycles)) if areas[k] > _AREA]
         holes = {k: [] for k in faces}
@@ -1708,117 +1829,114 @@ def _decompose(base, ax, ay, ends, *, x_range, y_range, names, fine, arc, family
             if areas[k] > -_AREA:
                 continue
             probe = rings[k][0]
-            around = [f for f in faces if component[src[cycles[f][0]]] != component[src[cycles[k][0]]]
+            own = component[src[cycles[k][0]]]
+            around = [f for f in faces if component[src[cycles[f][0]]] != own
                       and _inside(rings[f], probe[0], probe[1])]
             if around:
                 holes[min(around, key=lambda f: areas[f])].append(k)
-        face_of = np.full(len(src), -1)
-        points, keep = [], []
-        for f in faces:
-            face_of[cycles[f]] = f
-            ring_list = [rings[f]] + [rings[h] for h in holes[f]]
-            pt = _interior_point(ring_list)
-            if pt is None:
-                continue
-            keep.append(f)
-            points.append(pt)
-        points = from_unit(np.array(points).reshape(-1, 2))
-        if family is not None:
-            chi = family[0].combine((points[:, 0], points[:, 1]), family[1:])
-        else:
-            chi = DelayedPolynomial.from_dense(
-                base[None, :] + points[:, :1] * ax[None, :] + points[:, 1:] * ay[None, :])
-        counts = root_counts(chi) if len(points) else np.zeros(0, dtype=np.int64)
-        infinite = leading_vanishes(chi)
-        counts[infinite] = -1
-        # Where the count's bounds cannot be closed in double precision (long
-        # delays: thousands of roots near the circle), the float Schur-Cohn
-        # test with its safe margin can still tell a stable cell.
-        open_ = np.flatnonzero((counts == -1) & ~infinite)
-        if len(open_):
-            counts[open_[classify_polynomials(chi.take(open_)) == STABLE]] = 0
-            open_ = np.flatnonzero((counts == -1) & ~infinite)
-        if len(open_):
-            p = points[open_[0]]
-            raise ValueError(
-                f"the unstable roots of {len(open_)} of the {len(points)} cells cannot be counted in "
-                f"double precision (degree {len(base) - 1}; e.g. at {names[0]} = {p[0]:.6g}, "
-                f"{names[1]} = {p[1]:.6g}): roots too close to the unit circle for the "
-                f"certified count")
-        count_of = dict(zip(keep, counts))
-        index_of = {f: n for n, f in enumerate(keep)}
-        scale = sx * sy
-        for n, f in enumerate(keep):
-            outer = from_unit(rings[f])
-            hole_rings = tuple(from_unit(rings[h]) for h in holes[f])
-            area = scale * (areas[f] + sum(areas[h] for h in holes[f]))
-            cells.append(Cell(outer, hole_rings, int(counts[n]), (float(points[n, 0]),
-                                                                   float(points[n, 1])), float(area)))
-        # The crossing rule across each edge between two cells.
-        seen = set()
-        for h in range(len(src)):
-            a, b = face_of[h], face_of[twin[h]]
-            label = half_label[h]
-            if a < 0 or b < 0 or a not in count_of or b not in count_of or label == "window":
-                continue
-            pair = (min(a, b), max(a, b), label)
-            if pair in seen:
-                continue
-            seen.add(pair)
-            ca, cb = count_of[a], count_of[b]
-            if ca < 0 or cb < 0:
-                continue
-            if abs(int(ca) - int(cb)) != _CHANGE[label]:
-                mismatches.append((index_of[a], index_of[b], label, int(cb) - int(ca)))
-        # The window's sides a stable cell has an edge on (a piece running
-        # along the window's edge is the piece's, not the window's).
-        touched = set()
-        for n, f in enumerate(keep):
-            if counts[n] != 0:
-                continue
-            for h in cycles[f]:
-                if half_label[h] == "window":
-                    u, v = 0.5 * (xy[src[h]] + xy[dst[h]])
-                    touched.add("x_min" if u < 1e-6 else "x_max" if u > 1 - 1e-6
-                                else "y_min" if v < 1e-6 else "y_max")
-        unbounded = tuple(side for side in ("x_min", "x_max", "y_min", "y_max") if side in touched)
-        sides = _line_sides([cycles[f] for n, f in enumerate(keep) if counts[n] == 0],
-                            src, dst, half_label)
-        # How finely the arc draws each stable cell.
-        resolution = 0.0
-        for n, f in enumerate(keep):
-            if counts[n] != 0:
-                continue
-            extent = float(np.min(np.ptp(rings[f], axis=0)))
-            if extent < _SMALLEST:
-                # The merging and end tolerances are the window's: they
-                # would be visible on a cell this small.
-                resolution = math.inf
-                break
-            cycle = np.array(cycles[f])
-            on_arc = half_label[cycle] == "arc"
-            both = on_arc & np.roll(on_arc, 1)
-            if both.any() and extent > 0:
-                # The sag of two chords meeting at an angle phi is about
-                # L phi / 8: against the cell's thinner extent.
-                step = xy[dst[cycle]] - xy[src[cycle]]
-                length = np.hypot(step[:, 0], step[:, 1])
-                heading = np.arctan2(step[:, 1], step[:, 0])
-                phi = np.abs(np.angle(np.exp(1j * (heading - np.roll(heading, 1)))))
-                sag = np.maximum(length, np.roll(length, 1)) * phi / 8
-                resolution = max(resolution, float(np.max(sag[both])) / extent)
+        return faces, holes
+
+
+def _cell_counts(base, ax, ay, family, points, names):
+    """The fourth step: the unstable root count of each cell at its interior point.
+
+    ``family`` (:func:`decompose`'s) keeps the count O(d) per cell.  Where
+    the count's bounds cannot be closed in double precision (long delays:
+    thousands of roots near the circle), the float Schur-Cohn test with its
+    safe margin can still tell a stable cell; a cell neither decides is a
+    ValueError.  A leading coefficient that vanishes counts -1.
+    """
+    if family is not None:
+        chi = family[0].combine((points[:, 0], points[:, 1]), family[1:])
     else:
-        unbounded, sides = (), []
-        resolution = 0.0
-    found = Decomposition(x=names[0], y=names[1], x_range=(x0, x1), y_range=(y0, y1),
-                          branches=tuple(branches), cells=tuple(cells),
-                          mismatches=tuple(mismatches), unbounded=unbounded,
-                          polynomial=(base, ax, ay), resolution=resolution, arc=arc)
-    coefficients = lines(base, ax, ay, ends)
-    segments = [found._segment(label, coefficients, from_unit(xy[[a, b]]))
-                for label, a, b in sides]
-    segments.sort(key=lambda g: (g.root != "z=1", g.x0))
-    return dataclasses.replace(found, segments=tuple(segments))
+        chi = DelayedPolynomial.from_dense(
+            base[None, :] + points[:, :1] * ax[None, :] + points[:, 1:] * ay[None, :])
+    counts = root_counts(chi) if len(points) else np.zeros(0, dtype=np.int64)
+    infinite = leading_vanishes(chi)
+    counts[infinite] = -1
+    open_ = np.flatnonzero((counts == -1) & ~infinite)
+    if len(open_):
+        counts[open_[classify_polynomials(chi.take(open_)) == STABLE]] = 0
+        open_ = np.flatnonzero((counts == -1) & ~infinite)
+    if len(open_):
+        p = points[open_[0]]
+        raise ValueError(
+            f"the unstable roots of {len(open_)} of the {len(points)} cells cannot be counted in "
+            f"double precision (degree {len(base) - 1}; e.g. at {names[0]} = {p[0]:.6g}, "
+            f"{names[1]} = {p[1]:.6g}): roots too close to the unit circle for the "
+            f"certified count")
+    return counts
+
+
+def _crossing_mismatches(faces, counts):
+    """The crossing rule across each edge between two counted cells: the pairs that break it.
+
+    ``(cell, cell, label, change)`` for each pair of neighbouring cells
+    whose counts differ across a piece by other than :data:`_CHANGE` of its
+    label (the arc sampled too coarsely, or a window too wide).
+    """
+    count_of = dict(zip(faces.keep, counts))
+    index_of = {f: n for n, f in enumerate(faces.keep)}
+    face_of, twin, half_label = faces.face_of, faces.twin, faces.half_label
+    mismatches = []
+    seen = set()
+    for h in range(len(faces.src)):
+        a, b = face_of[h], face_of[twin[h]]
+        label = half_label[h]
+        if a < 0 or b < 0 or a not in count_of or b not in count_of or label == "window":
+            continue
+        pair = (min(a, b), max(a, b), label)
+        if pair in seen:
+            continue
+        seen.add(pair)
+        ca, cb = count_of[a], count_of[b]
+        if ca < 0 or cb < 0:
+            continue
+        if abs(int(ca) - int(cb)) != _CHANGE[label]:
+            mismatches.append((index_of[a], index_of[b], label, int(cb) - int(ca)))
+    return mismatches
+
+
+def _unbounded_sides(faces, stable, xy):
+    """The window's sides the ``stable`` faces have an edge on (x_min, x_max, y_min, y_max).
+
+    A piece running along the window's edge is the piece's, not the
+    window's: only half-edges labelled ``"window"`` count.
+    """
+    touched = set()
+    for f in stable:
+        for h in faces.cycles[f]:
+            if faces.half_label[h] == "window":
+                u, v = 0.5 * (xy[faces.src[h]] + xy[faces.dst[h]])
+                touched.add("x_min" if u < 1e-6 else "x_max" if u > 1 - 1e-6
+                            else "y_min" if v < 1e-6 else "y_max")
+    return tuple(side for side in ("x_min", "x_max", "y_min", "y_max") if side in touched)
+
+
+def _resolution(faces, stable, xy):
+    """How finely the arc draws the ``stable`` faces: the chords' largest sag over a cell's extent.
+
+    Infinite for a cell thinner than :data:`_SMALLEST` of the window: the
+    merging and end tolerances are the window's and would be visible on it.
+    """
+    resolution = 0.0
+    for f in stable:
+        extent = float(np.min(np.ptp(faces.rings[f], axis=0)))
+        if extent < _SMALLEST:
+            return math.inf
+        cycle = np.array(faces.cycles[f])
+        on_arc = faces.half_label[cycle] == "arc"
+        both = on_arc & np.roll(on_arc, 1)
+        if both.any() and extent > 0:
+            # The sag of two chords meeting at an angle phi is about
+            # L phi / 8: against the cell's thinner extent.
+            step = xy[faces.dst[cycle]] - xy[faces.src[cycle]]
+            length = np.hypot(step[:, 0], step[:, 1])
+            heading = np.arctan2(step[:, 1], step[:, 0])
+            phi = np.abs(np.angle(np.exp(1j * (heading - np.roll(heading, 1)))))
+            sag = np.maximum(length, np.roll(length, 1)) * phi / 8
+            resolution = max(resolution, float(np.max(sag[both])) / extent)
+    return resolution
 
 
 def _line_sides(rings, src, dst, half_label):

@@ -294,8 +294,64 @@ def root_counts(chi, *, coefficient_ulps=COEFFICIENT_ULPS):
 
 
 def _count_chunk(delayed, direct, s, n_arcs, coefficient_ulps, near_one=None):
+    """Roots outside the circle of one chunk of rows: :func:`root_counts`'s argument principle.
+
+    The steps, each vectorised over every row and arc of the chunk: the
+    rows' bounds (:func:`_chunk_bounds`), the first pass on the shared grid
+    (:func:`_first_pass`), rounds of the arc test (:func:`_arcs_pass`)
+    that halve the arcs it did not pass (:meth:`_Arcs.halve`), and the
+    count from the summed argument change (:func:`_whole_count`).
+    """
     n_rows = len(delayed)
     n = max(s + delayed.shape[1] - 1, direct.shape[1] - 1)
+    bounds = _chunk_bounds(delayed, direct, s, coefficient_ulps, near_one)
+    arcs, undecided = _first_pass(bounds, n_arcs)
+    change = np.zeros(n_rows)
+    for _ in range(_MAX_ROUNDS):
+        if arcs.row.size == 0:
+            break
+        ok, step = _arcs_pass(bounds, arcs)
+        np.add.at(change, arcs.row[ok], step)
+        bad = ~ok
+        # A row whose open arcs multiply has |chi| within rounding of 0 along
+        # a stretch of the circle (clustered roots on it): marginal.
+        crowded = np.bincount(arcs.row[bad], minlength=n_rows) > _MAX_OPEN_ARCS
+        undecided |= crowded
+        bad &= ~crowded[arcs.row]
+        if not bad.any():
+            break
+        arcs = arcs.halve(bad, bounds)
+        if not np.all(arcs.hi > arcs.lo):
+            undecided[np.unique(arcs.row[~(arcs.hi > arcs.lo)])] = True
+    else:
+        undecided[np.unique(arcs.row)] = True
+    return _whole_count(change, undecided, n)
+
+
+class _ChunkBounds:
+    """One chunk's rows scaled, with the sums and rounding bounds every arc test reads.
+
+    ``part`` is the delayed part as :func:`_delayed_values` takes it,
+    ``direct`` the direct part, ``s`` the shift; ``sd*``/``sn*`` the sums
+    :func:`_sums` of the delayed and direct parts, ``e_*`` the per-row
+    rounding bounds of their values (``0``) and slopes (``1``), and
+    ``spin_error`` that of the phase ``exp(j s theta)``.
+    """
+
+    __slots__ = ("part", "direct", "s", "sd0", "sd1", "sd2", "sn1", "sn2",
+                 "e_d0", "e_d1", "e_n0", "e_n1", "spin_error")
+
+    def __init__(self, **fields):
+        for name, value in fields.items():
+            setattr(self, name, value)
+
+
+def _chunk_bounds(delayed, direct, s, coefficient_ulps, near_one):
+    """The first step: rows divided by their largest coefficient, and their error bounds.
+
+    A step of its own because the bounds depend on the rows only: every
+    round of the arc test reads them, indexed by each arc's row.
+    """
     with np.errstate(all="ignore"):
         scale = np.maximum(np.max(np.abs(delayed), axis=1), np.max(np.abs(direct), axis=1))
         scale = np.where(scale > 0, scale, 1.0)[:, None]
@@ -318,9 +374,67 @@ def _count_chunk(delayed, direct, s, n_arcs, coefficient_ulps, near_one=None):
         e, err = near_one
         part = (delayed, (e / scale, err / scale),
                 2 * _U * (8 * (delayed.shape[1] + 1) + coefficient_ulps))
+    return _ChunkBounds(part=part, direct=direct, s=s, sd0=sd0, sd1=sd1, sd2=sd2, sn1=sn1,
+                        sn2=sn2, e_d0=e_d0, e_d1=e_d1, e_n0=e_n0, e_n1=e_n1,
+                        spin_error=spin_error)
 
-    # The first pass: the arcs' ends (chi only) and midpoints (chi, chi' and
-    # the parts' sizes for the bounds), on grids shared by every row.
+
+class _Arcs:
+    """The open arcs of a chunk, one entry per arc (flat arrays, any row).
+
+    ``row`` is the arc's row, ``lo``/``hi`` its ends' angles; ``chi_lo``,
+    ``chi_mid``, ``chi_hi`` chi at its ends and midpoint, ``dchi_mid`` chi'
+    at the midpoint; ``dm``, ``d1m``, ``nm``, ``n1m`` the moduli of ``D``,
+    ``z D'``, ``N``, ``z N'`` there and ``e_dm`` the rounding bound of
+    ``D`` there.
+    """
+
+    __slots__ = ("row", "lo", "hi", "chi_lo", "chi_mid", "chi_hi", "dchi_mid",
+                 "dm", "d1m", "nm", "n1m", "e_dm")
+
+    def __init__(self, *columns):
+        for name, value in zip(self.__slots__, columns):
+            setattr(self, name, value)
+
+    def take(self, keep):
+        """The arcs where ``keep`` is True."""
+        return _Arcs(*(getattr(self, name)[keep] for name in self.__slots__))
+
+    def halve(self, bad, bounds):
+        """The arcs ``bad`` halved, ``[lo, mid]`` and ``[mid, hi]``, with their midpoints' values.
+
+        The step that makes the test's next round finer: only the
+        midpoints are new, the ends are the old arcs' ends and midpoints.
+        """
+        row, lo, hi = self.row[bad], self.lo[bad], self.hi[bad]
+        chi_lo, chi_mid, chi_hi = self.chi_lo[bad], self.chi_mid[bad], self.chi_hi[bad]
+        mid = 0.5 * (lo + hi)
+        row = np.concatenate([row, row])
+        lo, hi = np.concatenate([lo, mid]), np.concatenate([mid, hi])
+        chi_lo, chi_hi = np.concatenate([chi_lo, chi_mid]), np.concatenate([chi_mid, chi_hi])
+        mid = 0.5 * (lo + hi)
+        s = bounds.s
+        with np.errstate(all="ignore"):
+            d_val, d_slope, e_dm = _delayed_values(bounds.part, mid, row)
+            n_val, n_slope = _part_values(bounds.direct, mid, row)
+            spin = np.exp(1j * (s * mid))
+            chi_mid = spin * d_val + n_val
+            dchi_mid = 1j * (spin * (s * d_val + d_slope) + n_slope)
+        return _Arcs(row, lo, hi, chi_lo, chi_mid, chi_hi, dchi_mid, np.abs(d_val),
+                     np.abs(d_slope), np.abs(n_val), np.abs(n_slope), e_dm)
+
+
+def _first_pass(bounds, n_arcs):
+    """The second step: every row's ``n_arcs`` arcs of [0, pi] on grids shared by every row.
+
+    The arcs' ends (chi only) and midpoints (chi, chi' and the parts'
+    sizes for the bounds) come from tables of the grid, far cheaper than
+    the halved arcs' own evaluations; a row with a root at z = 1 or -1 to
+    within rounding is marginal at once (returned in ``undecided``),
+    without halving arcs down to it.  Returns ``(arcs, undecided)``.
+    """
+    part, direct, s = bounds.part, bounds.direct, bounds.s
+    n_rows = len(direct)
     ends, mids = _grid(n_arcs)
     with np.errstate(all="ignore"):
         d_end, _, e_end = _delayed_values(part, ends, grid=(n_arcs, 0))
@@ -331,10 +445,8 @@ def _count_chunk(delayed, direct, s, n_arcs, coefficient_ulps, near_one=None):
         spin = np.exp(1j * (s * mids))[None, :]
         chi_mid = (spin * d_val + n_val).ravel()
         dchi_mid = (1j * (spin * (s * d_val + d_slope) + n_slope)).ravel()
-    # A root at z = 1 or -1 to within rounding: marginal, without halving
-    # arcs down to it.
-    ends_error = (np.broadcast_to(e_end, d_end.shape)[:, [0, -1]].T + e_n0
-                  + (spin_error + 8 * _U) * np.abs(d_end[:, [0, -1]]).T
+    ends_error = (np.broadcast_to(e_end, d_end.shape)[:, [0, -1]].T + bounds.e_n0
+                  + (bounds.spin_error + 8 * _U) * np.abs(d_end[:, [0, -1]]).T
                   + 2 * _U * np.abs(n_end[:, [0, -1]]).T)
     on_circle = np.any(np.abs(chi_end[:, [0, -1]]).T <= 2 * ends_error, axis=0)
 
@@ -344,80 +456,71 @@ def _count_chunk(delayed, direct, s, n_arcs, coefficient_ulps, near_one=None):
     chi_lo, chi_hi = chi_end[:, :-1].ravel(), chi_end[:, 1:].ravel()
     dm, d1m, nm, n1m = (np.abs(x).ravel() for x in (d_val, d_slope, n_val, n_slope))
     e_dm = np.broadcast_to(e_mid, d_val.shape).ravel()
-    change = np.zeros(n_rows)
-    undecided = on_circle.copy()
+    arcs = _Arcs(row, lo, hi, chi_lo, chi_mid, chi_hi, dchi_mid, dm, d1m, nm, n1m, e_dm)
     if on_circle.any():
-        live = ~on_circle[row]
-        row, lo, hi = row[live], lo[live], hi[live]
-        chi_lo, chi_mid, chi_hi, dchi_mid = chi_lo[live], chi_mid[live], chi_hi[live], dchi_mid[live]
-        dm, d1m, nm, n1m, e_dm = dm[live], d1m[live], nm[live], n1m[live], e_dm[live]
-    for _ in range(_MAX_ROUNDS):
-        if row.size == 0:
-            break
-        half = 0.5 * (hi - lo)
-        with np.errstate(all="ignore"):
-            # Bounds over the arc of the true |D|, |D'| and |N'|: Taylor from
-            # the midpoint (|D''| <= S_2(D) on the circle), capped by the sums.
-            d_at = dm + e_dm
-            d1_at = d1m + e_d1[row]
-            d_max = np.minimum(sd0[row] + e_d0[row], d_at + half * (d1_at + 0.5 * half * sd2[row]))
-            d1_max = np.minimum(sd1[row], d1_at + half * sd2[row])
-            n1_max = np.minimum(sn1[row], n1m + e_n1[row] + half * sn2[row])
-            error = (e_dm + e_n0[row] + (spin_error + 8 * _U) * dm + 2 * _U * nm) * (1 + 8 * _U)
-            size = np.abs(chi_mid)
-            ok = (s * d_max + d1_max + n1_max) * half * (1 + 4 * _U) + error < size
-            # Second order, for the arcs the first did not pass: chi(theta) =
-            # chi_m + chi'_m t + R, |t| <= h, |R| <= M2 h**2 / 2 with M2 =
-            # s**2 |D| + 2 s |D'| + S_2(D) + S_2(N); the tube around that
-            # segment must miss 0.
-            i = np.flatnonzero(~ok)
-            r_i = row[i]
-            h_i = half[i]
-            curve = s * s * d_max[i] + 2 * s * d1_max[i] + sd2[r_i] + sn2[r_i]
-            slope_error = ((spin_error + 8 * _U) * (s * dm[i] + d1m[i]) + s * e_dm[i]
-                           + e_d1[r_i] + e_n1[r_i] + 8 * _U * n1m[i])
-            radius = (0.5 * curve * h_i**2 + error[i] + slope_error * h_i) * (1 + 8 * _U)
-            # The nearest point to 0 on the segment: t = -Re(chi_m / chi'_m)
-            # (a quotient, not |chi'_m|**2, which could overflow); a flat
-            # segment (chi'_m = 0) is its midpoint; anything not finite fails.
-            c_i, dc_i = chi_mid[i], dchi_mid[i]
-            flat = dc_i == 0
-            t = np.where(flat, 0.0, -np.real(c_i / np.where(flat, 1.0, dc_i)))
-            t = np.clip(t, -h_i, h_i)
-            near = np.abs(c_i + dc_i * t) * (1 - 4 * _U)
-            ok[i] = np.isfinite(t) & np.isfinite(near) & (near > radius)
-            # The image of a passed arc lies in a convex set that misses 0
-            # (a disc or a tube), so its argument changes by less than pi:
-            # one angle gives the change.
-            step = np.angle(chi_hi[ok] / chi_lo[ok])
-        np.add.at(change, row[ok], step)
-        bad = ~ok
-        # A row whose open arcs multiply has |chi| within rounding of 0 along
-        # a stretch of the circle (clustered roots on it): marginal.
-        crowded = np.bincount(row[bad], minlength=n_rows) > _MAX_OPEN_ARCS
-        undecided |= crowded
-        bad &= ~crowded[row]
-        if not bad.any():
-            break
-        # Halve the arcs that did not pass: [lo, mid] and [mid, hi].
-        row, lo, hi = row[bad], lo[bad], hi[bad]
-        chi_lo, chi_mid, chi_hi = chi_lo[bad], chi_mid[bad], chi_hi[bad]
-        mid = 0.5 * (lo + hi)
-        row = np.concatenate([row, row])
-        lo, hi = np.concatenate([lo, mid]), np.concatenate([mid, hi])
-        chi_lo, chi_hi = np.concatenate([chi_lo, chi_mid]), np.concatenate([chi_mid, chi_hi])
-        mid = 0.5 * (lo + hi)
-        with np.errstate(all="ignore"):
-            d_val, d_slope, e_dm = _delayed_values(part, mid, row)
-            n_val, n_slope = _part_values(direct, mid, row)
-            spin = np.exp(1j * (s * mid))
-            chi_mid = spin * d_val + n_val
-            dchi_mid = 1j * (spin * (s * d_val + d_slope) + n_slope)
-        dm, d1m, nm, n1m = np.abs(d_val), np.abs(d_slope), np.abs(n_val), np.abs(n_slope)
-        if not np.all(hi > lo):
-            undecided[np.unique(row[~(hi > lo)])] = True
-    else:
-        undecided[np.unique(row)] = True
+        arcs = arcs.take(~on_circle[row])
+    return arcs, on_circle.copy()
+
+
+def _arcs_pass(bounds, arcs):
+    """The third step: which arcs provably keep chi's image off 0, and their argument change.
+
+    An arc passes on the first-order test (a disc from a bound on
+    ``|chi'|`` over the arc) or, failing it, on the second-order one (a
+    tube around the midpoint's tangent).  Returns ``(ok, step)``: a mask
+    over the arcs and the argument change over each passed arc.
+    """
+    b, s, row, dm, e_dm = bounds, bounds.s, arcs.row, arcs.dm, arcs.e_dm
+    chi_mid = arcs.chi_mid
+    half = 0.5 * (arcs.hi - arcs.lo)
+    with np.errstate(all="ignore"):
+        # Bounds over the arc of the true |D|, |D'| and |N'|: Taylor from
+        # the midpoint (|D''| <= S_2(D) on the circle), capped by the sums.
+        d_at = dm + e_dm
+        d1_at = arcs.d1m + b.e_d1[row]
+        d_max = np.minimum(b.sd0[row] + b.e_d0[row],
+                           d_at + half * (d1_at + 0.5 * half * b.sd2[row]))
+        d1_max = np.minimum(b.sd1[row], d1_at + half * b.sd2[row])
+        n1_max = np.minimum(b.sn1[row], arcs.n1m + b.e_n1[row] + half * b.sn2[row])
+        error = (e_dm + b.e_n0[row] + (b.spin_error + 8 * _U) * dm
+                 + 2 * _U * arcs.nm) * (1 + 8 * _U)
+        size = np.abs(chi_mid)
+        ok = (s * d_max + d1_max + n1_max) * half * (1 + 4 * _U) + error < size
+        # Second order, for the arcs the first did not pass: chi(theta) =
+        # chi_m + chi'_m t + R, |t| <= h, |R| <= M2 h**2 / 2 with M2 =
+        # s**2 |D| + 2 s |D'| + S_2(D) + S_2(N); the tube around that
+        # segment must miss 0.
+        i = np.flatnonzero(~ok)
+        r_i = row[i]
+        h_i = half[i]
+        curve = s * s * d_max[i] + 2 * s * d1_max[i] + b.sd2[r_i] + b.sn2[r_i]
+        slope_error = ((b.spin_error + 8 * _U) * (s * dm[i] + arcs.d1m[i]) + s * e_dm[i]
+                       + b.e_d1[r_i] + b.e_n1[r_i] + 8 * _U * arcs.n1m[i])
+        radius = (0.5 * curve * h_i**2 + error[i] + slope_error * h_i) * (1 + 8 * _U)
+        # The nearest point to 0 on the segment: t = -Re(chi_m / chi'_m)
+        # (a quotient, not |chi'_m|**2, which could overflow); a flat
+        # segment (chi'_m = 0) is its midpoint; anything not finite fails.
+        c_i, dc_i = chi_mid[i], arcs.dchi_mid[i]
+        flat = dc_i == 0
+        t = np.where(flat, 0.0, -np.real(c_i / np.where(flat, 1.0, dc_i)))
+        t = np.clip(t, -h_i, h_i)
+        near = np.abs(c_i + dc_i * t) * (1 - 4 * _U)
+        ok[i] = np.isfinite(t) & np.isfinite(near) & (near > radius)
+        # The image of a passed arc lies in a convex set that misses 0
+        # (a disc or a tube), so its argument changes by less than pi:
+        # one angle gives the change.
+        step = np.angle(arcs.chi_hi[ok] / arcs.chi_lo[ok])
+    return ok, step
+
+
+def _whole_count(change, undecided, n):
+    """The last step: the roots outside the circle from the argument change, -1 where undecided.
+
+    For real coefficients the change of the argument over the half circle
+    is pi times the number of roots inside (the argument principle and the
+    conjugate symmetry): a change far from a whole multiple of pi is a
+    bug, not a marginal row.
+    """
     inside = change / np.pi
     whole = np.rint(inside)
     if np.any(~undecided & (np.abs(inside - whole) > 0.25)):
