@@ -282,7 +282,9 @@ def _fitted(box, cells, free):
 
 
 def _first_decomposition(plane, given, free, hull):
-    """The first window that holds a stable cell (:func:`_start_windows`), decomposed: ``(found, box)``.
+    """The first window that holds a stable cell (:func:`_start_windows`), decomposed.
+
+    Returns ``(found, box)``.
 
     Raises what the last window refused, or a ValueError, when no window
     holds a stable cell and the windows tried do not hold every point that
