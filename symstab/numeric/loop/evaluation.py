@@ -72,7 +72,7 @@ def _convolve(a, b):
 
 
 def finite(c, values):
-    """``c`` if every row of coefficients is finite and not all 0, else a ValueError naming the values.
+    """``c`` if every row of coefficients is finite and not all 0, else a ValueError naming them.
 
     Parameters
     ----------
@@ -197,7 +197,9 @@ class LoopEvaluation:
         return np.unique(columns, axis=0, return_inverse=True)
 
     def plant_arrays(self, values, shape):
-        """(P_n, P_d, ends, P_d in z - 1) per point, shape ``shape + (k,)``, one 30-digit evaluation per distinct row.
+        """(P_n, P_d, ends, P_d in z - 1) per point, shape ``shape + (k,)``.
+
+        One 30-digit evaluation per distinct row of the plant's values.
 
         Parameters
         ----------

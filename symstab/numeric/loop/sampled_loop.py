@@ -41,8 +41,8 @@ import sympy as sp
 from ...symbolic.loop_assembly import LoopModel, parse_environment, parse_plant
 from ...codegen.loop_kernels import environment_kernels, load_numpy_kernels
 from ..engine.results import Boundary, Limits
-from .evaluation import (LoopEvaluation, classify, difference_equations, difference_parts, is_stable,
-                         spectral_radius, unstable_root_counts)
+from .evaluation import (LoopEvaluation, classify, difference_equations, difference_parts,
+                         is_stable, spectral_radius, unstable_root_counts)
 from .plane import boundary, limits, region, stable_intervals
 
 __all__ = ["Loop", "LoopLimits", "LoopBoundary", "parse_plant", "parse_environment"]
@@ -404,7 +404,7 @@ class Loop(LoopModel):
                              x_range=x_range, y_range=y_range, progress=progress, **values)
 
     def limits(self, x=None, y=None, **values):
-        """The extent and area of the stable set in the ``(x, y)`` plane (robust with ``uncertain``).
+        """The extent and area of the stable set in the ``(x, y)`` plane (robust with uncertain).
 
         See :func:`symstab.numeric.loop.plane.limits`; with ``uncertain``, the
         limits of :meth:`robust_region`.
@@ -491,7 +491,7 @@ class Loop(LoopModel):
         return difference_equations(self, **values)
 
     def difference_parts(self, values):
-        """:meth:`difference_equations` of the dict ``values``, with coefficients that overflow kept.
+        """:meth:`difference_equations` of the dict ``values``, coefficients that overflow kept.
 
         See :func:`symstab.numeric.loop.evaluation.difference_parts`.
         """

@@ -39,7 +39,8 @@ import dataclasses
 import mpmath
 import numpy as np
 
-__all__ = ["FrictionSpace", "friction_space", "friction_spaces", "stacked_spaces", "StatePlant", "substeps_of"]
+__all__ = ["FrictionSpace", "friction_space", "friction_spaces", "stacked_spaces", "StatePlant",
+           "substeps_of"]
 
 #: Digits of the matrix exponentials (as the plant's pulse transfer function).
 DIGITS = 30

@@ -948,7 +948,7 @@ class _StateLoop(_AnyLoop):
 
 def loop_stability_map(loop, x_values, y_values, *, x=None, y=None, steps=None, x0=1.0, v0=None,
                        nonideal=None, progress=None, **values):
-    """Stable cells of an ``(x, y)`` grid of a loop by simulation (:func:`simulate_loop` on every cell).
+    """Stable cells of an ``(x, y)`` grid of a loop by simulation (:func:`simulate_loop` on each).
 
     Parameters
     ----------
