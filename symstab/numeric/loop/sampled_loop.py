@@ -20,6 +20,12 @@ pairs and poles at 0 included), otherwise by the
 matrix exponential at 30 digits once the plant's values are known
 (:attr:`Loop.zoh_method` says which).
 
+The loop holds the model; its numbers are its :attr:`Loop.evaluation`
+(:mod:`symstab.numeric.loop.evaluation`) and its questions module functions
+that take it (the plane's in :mod:`symstab.numeric.loop.plane`, the others
+in :mod:`symstab.numeric.analysis` and :mod:`symstab.numeric.simulation`),
+which its methods pass through to.
+
 Numbers: the environment's polynomials come from a NumPy kernel generated
 for the loop (:mod:`symstab.codegen.loop_kernels`, cached on disk); the plant's
 pulse transfer function is evaluated at 30 digits for each distinct set of
