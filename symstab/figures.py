@@ -1,9 +1,9 @@
 """The paper's figures, regenerated from symstab's derivation and simulator.
 
-Each ``fig*`` function computes its data with the library, draws it with
-matplotlib and returns a :class:`FigureResult`: the figure, what the paper
-shows in it, and what symstab finds -- the line that goes into the
-reproduction's ``index.md``.  :func:`make_figures` writes them all as PNGs.
+Each ``fig*`` function computes its data with the library, has
+:mod:`symstab.drawing` draw it (no matplotlib here) and returns a
+:class:`FigureResult`: the figure, what the paper shows in it, and what
+symstab finds -- the line that goes into the reproduction's ``index.md``.  :func:`make_figures` writes them all as PNGs.
 
 Figures 6, 7, 8 and 10 draw the whole boundary -- the arc of eq. (7) up to
 theta_max (solid) and the same curve on to theta = pi (dashed), which bounds
@@ -27,7 +27,7 @@ import time
 
 import numpy as np
 
-from .drawing import LEGEND_SIZE, PANEL_TITLE_SIZE, SUPTITLE_SIZE, label_log_axis, png_bytes, pyplot
+from . import drawing
 from .numeric.paper.curves import arc_end_angle
 from .numeric.paper.region import arc_polylines
 from .numeric.paper.region import boundary_curve
@@ -42,10 +42,9 @@ __all__ = ["FigureResult", "FIGURES", "make_figures"]
 DELTA = PAPER_DEVICE.delta
 #: The delays of Figs. 6, 8, 11 and 12.
 DELAYS = (0, 1, 5, 10)
-_COLORS = ("#1f77b4", "#d62728", "#2ca02c", "#ff7f0e", "#9467bd", "#8c564b", "#e377c2")
-#: Legend of the arc's end angle in Figs. 3 and 4, in words rather than in
-#: the derivation's terms ("first root of alpha").
-_THETA_MAX_EXACT = r"exact: where the arc ends, $\alpha(\theta_{\max}) = 0$"
+_COLORS = drawing.FIGURE_COLORS
+#: The passive set's outline colour in Fig. 10 (drawn by :func:`symstab.drawing.physical_figure`).
+_PASSIVE = drawing.PASSIVE_COLOR
 
 
 @dataclasses.dataclass
@@ -59,15 +58,6 @@ class FigureResult:
     symstab: str
 
 
-def _labels(ax, physical=False):
-    if physical:
-        ax.set_xlabel(r"$B_w$ (N m s/rad)")
-        ax.set_ylabel(r"$K_w$ (N m/rad)")
-    else:
-        ax.set_xlabel(r"$\beta = B_w T/m$")
-        ax.set_ylabel(r"$\alpha = K_w T^2/m$")
-
-
 # --------------------------------------------------------------------------
 # theta_max
 
@@ -78,7 +68,6 @@ def fig3():
     from .symbolic import model
     import sympy as sp
 
-    plt = pyplot()
     gammas = np.linspace(-1.0, 2.0, 121)
     exact = np.array([arc_end_angle(gamma=g, d=0, delta=DELTA) for g in gammas])
     form = sp.lambdify((model.gamma, model.delta, model.Gamma), closed_form_d0().theta_max, "mpmath")
@@ -87,13 +76,7 @@ def fig3():
     with mpmath.workdps(30):  # the closed form cancels near gamma = -1; 30 digits keep it exact
         closed = np.array([float(form(mpmath.mpf(g), mpmath.mpf(DELTA), mpmath.exp(DELTA)).real)
                            for g in gammas])
-    fig, ax = plt.subplots(figsize=(6, 4))
-    ax.plot(gammas, exact, "-", color=_COLORS[0], lw=2, label=_THETA_MAX_EXACT)
-    ax.plot(gammas[::6], closed[::6], "o", color=_COLORS[1], ms=4, label="closed form (8)")
-    ax.set_xlabel(r"$\gamma = M_w/m$")
-    ax.set_ylabel(r"$\theta_{\max}$ (rad)")
-    ax.set_title(r"Fig. 3: $\theta_{\max}$ versus $\gamma$, $d = 0$")
-    ax.legend()
+    fig = drawing.theta_max_gamma_figure(gammas, exact, closed)
     finite = np.isfinite(exact)
     gap = np.nanmax(np.abs(closed[finite] - exact[finite]) / exact[finite])
     return FigureResult(
@@ -111,18 +94,10 @@ def fig4():
     """theta_max versus d, gamma = 0: exact and the Newton form (12)."""
     from .symbolic.theta_max import theta_max_newton
 
-    plt = pyplot()
     ds = np.arange(0, 101)
     exact = np.array([arc_end_angle(gamma=0.0, d=int(d), delta=DELTA) for d in ds])
     newton = np.array([theta_max_newton(d=int(d), delta=DELTA) if d > 0 else np.nan for d in ds])
-    fig, ax = plt.subplots(figsize=(6, 4))
-    ax.semilogy(ds, exact, "-", color=_COLORS[0], lw=2, label=_THETA_MAX_EXACT)
-    ax.semilogy(ds[1:], newton[1:], "--", color=_COLORS[1], lw=1.5, label="one Newton step, eq. (12)")
-    ax.set_xlabel(r"delay $d = T_d / T$ (samples)")
-    ax.set_ylabel(r"$\theta_{\max}$ (rad)")
-    label_log_axis(ax)  # theta_max spans two decades, 1.6 to 0.017 rad
-    ax.set_title(r"Fig. 4: $\theta_{\max}$ versus $d$, $\gamma = 0$")
-    ax.legend()
+    fig = drawing.theta_max_delay_figure(ds, exact, newton)
     err = np.abs(newton[1:] - exact[1:]) / exact[1:]
     return FigureResult(
         "fig04_theta_max_vs_d", "theta_max versus d (gamma = 0), exact and eq. (12)", fig,
@@ -138,20 +113,13 @@ def fig5():
     from .symbolic import model
     from paper_checks.printed import printed
 
-    plt = pyplot()
     curve = boundary_curve(gamma=0.0, d=0, delta=DELTA, n=400, segments=False)
     args = (model.theta, model.delta, model.Gamma)
     fa = sp.lambdify(args, printed("eq14.alpha").expr, "numpy")
     fb = sp.lambdify(args, printed("eq14.beta").expr, "numpy")
     t = curve.theta[1:]
     pa, pb = fa(t, DELTA, math.exp(DELTA)), fb(t, DELTA, math.exp(DELTA))
-    fig, ax = plt.subplots(figsize=(6, 4))
-    ax.plot(curve.beta, curve.alpha, "-", color=_COLORS[2], lw=2.5,
-            label=r"symstab (derived for any $d$ and $\gamma$)")
-    ax.plot(pb, pa, "--", color=_COLORS[0], lw=1.5, label="eq. (14) as printed")
-    _labels(ax)
-    ax.set_title(r"Fig. 5: boundary for $d = 0$, $\gamma = 0$")
-    ax.legend()
+    fig = drawing.eq14_figure(curve, pb, pa)
     gap = np.max(np.abs(pa - curve.alpha[1:])) / np.max(curve.alpha)
     return FigureResult(
         "fig05_eq14_boundary", "the eq. (14) boundary (d = 0, gamma = 0)", fig,
@@ -165,21 +133,6 @@ def fig5():
 
 # --------------------------------------------------------------------------
 # The whole boundary, the stable set and the root counts in the cells
-
-#: Styles of the boundary's parts, shared by the panels and the legends.
-_ARC = {"ls": "-", "lw": 1.6}                       # eq. (7): theta from 0 to theta_max
-_BEYOND = {"ls": (0, (4, 2)), "lw": 0.9}            # the same curve for theta_max < theta < pi
-_Z_ONE = {"color": "0.35", "ls": "-", "lw": 0.9}    # alpha = 0: a root at z = 1
-#: How the simulation is drawn: hatched, over the exact stable set's fill.
-_SIM_HATCH = "////"
-#: Opacity of the exact stable set's fill.
-_FILL_ALPHA = 0.28
-#: Colour of the passive set's outline.
-_PASSIVE = "#d62728"
-#: Caption of the root counts, for the figures' legends.
-_COUNTS_NOTE = ("numbers: closed-loop poles outside the unit circle in that cell "
-                "(certified root count)")
-
 
 @functools.lru_cache(maxsize=64)
 def _region(gamma, d):
@@ -199,105 +152,6 @@ def _decomposition(gamma, d, window):
     x_range, y_range = window
     return _region(gamma, d).decomposition(x_range=tuple(map(float, x_range)),
                                            y_range=tuple(map(float, y_range)))
-
-
-def _fill_stable(ax, gamma, d, window, color, scale=(1.0, 1.0)):
-    """Fill the exact stable set of ``(gamma, d)`` in ``window``; True when it meets the window."""
-    decomposition = _decomposition(gamma, d, window)
-    _shade_cells(ax, decomposition, color, scale)
-    return bool(decomposition.stable)
-
-
-def _shade_cells(ax, decomposition, color, scale=(1.0, 1.0)):
-    """Fill the stable cells of a D-decomposition, holes included.
-
-    ``decomposition`` is a :class:`symstab.numeric.engine.decomposition.Decomposition`
-    (x = beta, y = alpha); ``scale`` multiplies its coordinates into the
-    plotted units.
-    """
-    from matplotlib.patches import PathPatch
-    from matplotlib.path import Path
-
-    sx, sy = scale
-
-    def ring(points, clockwise):
-        # A hole must wind the other way round than its outline to be left empty.
-        x, y = points[:, 0] * sx, points[:, 1] * sy
-        area = 0.5 * np.sum(x * np.roll(y, -1) - np.roll(x, -1) * y)
-        if (area < 0) != clockwise:
-            x, y = x[::-1], y[::-1]
-        vertices = np.column_stack([np.append(x, x[0]), np.append(y, y[0])])
-        codes = np.full(len(vertices), Path.LINETO)
-        codes[0], codes[-1] = Path.MOVETO, Path.CLOSEPOLY
-        return vertices, codes
-
-    for cell in decomposition.stable:
-        parts = [ring(cell.outer, False)] + [ring(h, True) for h in cell.holes]
-        path = Path(np.concatenate([v for v, _ in parts]), np.concatenate([c for _, c in parts]))
-        ax.add_patch(PathPatch(path, facecolor=color, edgecolor="none", alpha=_FILL_ALPHA, zorder=1))
-
-
-def _count_text(ax, x, y, count):
-    ax.text(x, y, str(count), ha="center", va="center", fontsize=10, fontweight="bold",
-            color="0.15", zorder=5,
-            bbox={"boxstyle": "circle,pad=0.2", "fc": "white", "ec": "0.5", "lw": 0.6, "alpha": 0.85})
-
-
-def _pixels_to_edge(ax, ring, point):
-    """Distance in pixels from ``point`` to the closed polyline ``ring`` (both in data units)."""
-    xy = ax.transData.transform(np.vstack([ring, ring[:1]]))
-    p = ax.transData.transform([point])[0]
-    a, ab = xy[:-1], np.diff(xy, axis=0)
-    t = np.clip(np.sum((p - a) * ab, axis=1) / np.maximum(np.sum(ab * ab, axis=1), 1e-300), 0.0, 1.0)
-    return float(np.min(np.hypot(*(a + t[:, None] * ab - p).T)))
-
-
-def _write_counts(ax, gamma, d, window, scale=(1.0, 1.0), room=9.0):
-    """Write its number of unstable closed-loop poles in every cell of ``window`` with room for it.
-
-    The number goes at the cell's interior point, where the decomposition
-    counted it (Schur-Cohn, checked against the crossing rule); cells whose
-    point lies within ``room`` pixels of the cell's edge are left
-    unlabelled, so no number sits on a curve.  Call it after the axes'
-    limits are set.  Returns the ``(beta, alpha, count)`` written.
-    """
-    sx, sy = scale
-    written = []
-    for cell in _decomposition(gamma, d, window).cells:
-        if cell.count < 0:
-            continue  # marginal or unresolved: no number to write
-        x, y = cell.point
-        rings = [cell.outer * (sx, sy)] + [h * (sx, sy) for h in cell.holes]
-        if min(_pixels_to_edge(ax, r, (x * sx, y * sy)) for r in rings) < room:
-            continue
-        _count_text(ax, x * sx, y * sy, cell.count)
-        written.append((float(x), float(y), int(cell.count)))
-    return written
-
-
-def _draw_boundary(ax, gamma, d, window, color, scale=(1.0, 1.0), beyond=True):
-    """Draw the arc of eq. (7) (solid) and, with ``beyond``, the rest of the arc up to pi (dashed)."""
-    first, rest = arc_polylines(gamma=gamma, d=d, delta=DELTA, window=window)
-    sx, sy = scale
-    if len(first):
-        ax.plot(first[:, 0] * sx, first[:, 1] * sy, color=color, zorder=3, **_ARC)
-    if beyond and len(rest):
-        ax.plot(rest[:, 0] * sx, rest[:, 1] * sy, color=color, zorder=3, **_BEYOND)
-    return first, rest
-
-
-def _style_handles(color="k", beyond=True, z_one=True):
-    """Legend handles for the boundary's parts."""
-    from matplotlib.lines import Line2D
-
-    handles = [Line2D([], [], color=color, **_ARC,
-                      label=r"eq. (7), $0 < \theta \leq \theta_{\max}$")]
-    if beyond:
-        handles.append(Line2D([], [], color=color, **_BEYOND,
-                              label=r"the same curve, $\theta_{\max} < \theta < \pi$"))
-    if z_one:
-        handles.append(Line2D([], [], **_Z_ONE, label=r"$\alpha = 0$: a root at $z = 1$"))
-    return handles
 
 
 def _window(gammas, d):
@@ -340,93 +194,55 @@ def figure_horizon(d):
     return 4000 + 400 * d
 
 
-def _simulated(ax, gamma, d, window, n, color, scale=(1.0, 1.0), **kwargs):
-    """Simulate an ``n`` x ``n`` grid of the window's alpha >= 0 part; hatch what stays bounded."""
-    import matplotlib
-
+def _simulated(gamma, d, window, n):
+    """Simulate an ``n`` x ``n`` grid of the window's alpha >= 0 part: ``(beta, alpha, map)``."""
     (b0, b1), (a0, a1) = window
     alpha, beta = np.linspace(max(a0, 0.0), a1, n), np.linspace(b0, b1, n)
-    result = stability_map(alpha=alpha, beta=beta, gamma=gamma, d=d, delta=kwargs.pop("delta", DELTA),
-                           steps=kwargs.pop("steps", figure_horizon(d)), **kwargs)
-    if result.stable.any():
-        with matplotlib.rc_context({"hatch.color": color, "hatch.linewidth": 0.7}):
-            ax.contourf(beta * scale[0], alpha * scale[1], result.stable.astype(float),
-                        levels=[0.5, 1.5], colors="none", hatches=[_SIM_HATCH], zorder=2)
-    return result, alpha, beta
+    result = stability_map(alpha=alpha, beta=beta, gamma=gamma, d=d, delta=DELTA,
+                           steps=figure_horizon(d))
+    return beta, alpha, result
 
 
-def _gamma_handles(gammas, verdicts):
-    from matplotlib.lines import Line2D
+def _regions_panel(gammas, d, window, n, verdicts, beyond=True, colors=_COLORS, title=None):
+    """A panel of exact stable sets, every branch of the boundary and simulation, to be drawn.
 
-    return [Line2D([], [], color=c, lw=2.5, label=fr"$\gamma = {g:g}$ ({verdicts[g]})")
-            for g, c in zip(gammas, _COLORS)]
-
-
-def _legend_below(fig, handles, ncol):
-    """One legend for the whole figure, under the panels, where it covers nothing.
-
-    Lays the panels out in the space above it (call it last, after the
-    suptitle).
+    The panel of :func:`symstab.drawing.regions_figure`; each simulated
+    gamma's verdict is appended to ``verdicts``.
     """
-    legend = fig.legend(handles=handles, loc="lower center", ncol=ncol, fontsize=LEGEND_SIZE + 1,
-                        frameon=False, bbox_to_anchor=(0.5, 0.0))
-    height = legend.get_window_extent(fig.canvas.get_renderer()).height / fig.bbox.height
-    fig.tight_layout(rect=(0, height + 0.01, 1, 1))
-    return legend
-
-
-def _regions_panel(ax, gammas, d, window, n, verdicts, beyond=True, colors=_COLORS):
-    """Exact stable sets (filled), every branch of the boundary, simulation (hatched)."""
-    (b0, b1), (a0, a1) = window
-    ax.axhline(0.0, zorder=2, **_Z_ONE)
+    layers = []
     for g, color in zip(gammas, colors):
-        exact = _fill_stable(ax, g, d, window, color)
-        result, _, _ = _simulated(ax, g, d, window, n, color) if n else (None, None, None)
-        _draw_boundary(ax, g, d, window, color, beyond=beyond)
-        if result is not None:
-            verdicts.append((g, d, "S" if result.stable.any() else "U", int(result.stable.sum()), exact))
-    ax.set_xlim(b0, b1)
-    ax.set_ylim(a0, a1)
-    _labels(ax)
+        decomposition = _decomposition(g, d, window)
+        simulated = None
+        if n:
+            beta, alpha, result = _simulated(g, d, window, n)
+            simulated = (beta, alpha, result.stable)
+            verdicts.append((g, d, "S" if result.stable.any() else "U", int(result.stable.sum()),
+                             bool(decomposition.stable)))
+        layers.append((color, decomposition, simulated,
+                       arc_polylines(gamma=g, d=d, delta=DELTA, window=window)))
+    return {"window": window, "layers": layers, "beyond": beyond, "title": title}
 
 
-def _fig_overlay(name, title, suptitle, gammas, n, paper, claimed, extra_row=None):
+def _fig_overlay(name, title, suptitle, gammas, n, paper, claimed, lower=None):
     """Boundaries, exact stable sets and simulated ones; ``claimed[(gamma, d)]`` is the paper's S, U or B.
 
     ``title`` is the plain-text line of the reproduction's index, ``suptitle``
-    the same in mathtext for the figure.  ``extra_row(axes, windows)``, when
-    given, draws a second row of panels under the first (Fig. 8's whole
-    arcs and zoom).
+    the same in mathtext for the figure.  ``lower(windows)``, when given,
+    returns a second row of panels under the first (Fig. 8's whole arcs and
+    zoom).
     """
-    plt = pyplot()
-    if extra_row is None:
-        fig, axes = plt.subplots(2, 2, figsize=(11, 9.4))
-        top = axes.ravel()
-    else:
-        fig, axes = plt.subplots(2, 4, figsize=(16, 9.4))
-        top = axes[0]
-    verdicts, windows = [], {}
-    for ax, d in zip(top, DELAYS):
-        windows[d] = _arcs_window(gammas, d) if extra_row and d == 0 else _window(gammas, d)
-        _regions_panel(ax, gammas, d, windows[d], n, verdicts)
-        ax.set_title(f"$d = {d}$", fontsize=PANEL_TITLE_SIZE)
-    if extra_row is not None:
-        extra_row(axes[1], windows)
+    verdicts, windows, top = [], {}, []
+    for d in DELAYS:
+        windows[d] = _arcs_window(gammas, d) if lower and d == 0 else _window(gammas, d)
+        top.append(_regions_panel(gammas, d, windows[d], n, verdicts, title=f"$d = {d}$"))
     marks = {}
     for g in gammas:
         stable = [d for gg, d, v, _, _ in verdicts if gg == g and v == "S"]
         unstable = [d for gg, d, v, _, _ in verdicts if gg == g and v == "U"]
         marks[g] = ("S" if not unstable else "U" if not stable else
                     f"S at $d = {', '.join(map(str, stable))}$, U at $d = {', '.join(map(str, unstable))}$")
-    from matplotlib.patches import Patch
-
-    handles = _gamma_handles(gammas, marks) + _style_handles() + [
-        Patch(facecolor="0.6", alpha=_FILL_ALPHA + 0.1, label="stable (root counting, exact)"),
-        Patch(facecolor="none", edgecolor="0.3", hatch=_SIM_HATCH,
-              label=fr"stable by simulation, ${n} \times {n}$ grid (a check)")]
-    fig.suptitle(suptitle + ": the boundary, the exact stable sets (filled; S: stable region, "
-                 "U: none) and a simulated check (hatched)", fontsize=SUPTITLE_SIZE)
-    _legend_below(fig, handles, ncol=5 if extra_row else 3)
+    fig = drawing.regions_figure(top, gammas, marks, n, suptitle,
+                                 lower=None if lower is None else lower(windows))
     text = "; ".join(f"d={d}: " + ", ".join(f"{g:g} {v}" for g, dd, v, _, _ in verdicts if dd == d)
                      for d in DELAYS)
     differ = [f"gamma {g:g}, d {d}: paper {claimed[(g, d)]}, simulation {v}"
@@ -457,36 +273,23 @@ def fig6(n=100):
 
 def _fig8_second_row(gammas):
     """Fig. 8's lower panels: the gamma = 2 sliver at d = 0 magnified, every arc whole at d > 0."""
-    from matplotlib.patches import Rectangle
-
-    def draw(axes, windows):
+    def panels(windows):
         # d = 0: the sliver between the two halves of the gamma = 2 arc, at beta = -1.
         zoom = ((-1.011, -0.989), (1.978, 2.022))
-        ax = axes[0]
-        _regions_panel(ax, (2.0,), 0, zoom, 0, [], beyond=False, colors=(_COLORS[gammas.index(2.0)],))
-        ax.set_title(r"$d = 0$, magnified: the $\gamma = 2$ sliver", fontsize=PANEL_TITLE_SIZE)
-        (b0, b1), (a0, a1) = zoom
-        axes_top = axes[0].figure.axes[0]
-        axes_top.add_patch(Rectangle((b0, a0), b1 - b0, a1 - a0, fill=False, ec="k", lw=1.0, zorder=6))
-        axes_top.annotate("magnified below", (b1, a0), xytext=(12, -18), textcoords="offset points",
-                          fontsize=8, arrowprops={"arrowstyle": "-", "lw": 0.6})
-        for ax, d in zip(axes[1:], DELAYS[1:]):
+        row = [_regions_panel((2.0,), 0, zoom, 0, [], beyond=False,
+                              colors=(_COLORS[gammas.index(2.0)],),
+                              title=r"$d = 0$, magnified: the $\gamma = 2$ sliver")]
+        for d in DELAYS[1:]:
             whole = _arcs_window(gammas, d)
-            (b0, b1), (a0, a1) = whole
-            ax.axhline(0.0, zorder=2, **_Z_ONE)
-            for g, color in zip(gammas, _COLORS):
-                # The stable sets lie in the upper panel's window: its decomposition serves.
-                _fill_stable(ax, g, d, windows[d], color)
-                _draw_boundary(ax, g, d, whole, color, beyond=False)
-            (zb0, zb1), (za0, za1) = windows[d]
-            ax.add_patch(Rectangle((zb0, za0), zb1 - zb0, za1 - za0, fill=False, ec="k", lw=1.0,
-                                   zorder=6))
-            ax.set_xlim(b0, b1)
-            ax.set_ylim(a0, a1)
-            _labels(ax)
-            ax.set_title(f"$d = {d}$, zoomed out: every arc whole", fontsize=PANEL_TITLE_SIZE)
+            # The stable sets lie in the upper panel's window: its decomposition serves.
+            layers = [(color, _decomposition(g, d, windows[d]), None,
+                       arc_polylines(gamma=g, d=d, delta=DELTA, window=whole))
+                      for g, color in zip(gammas, _COLORS)]
+            row.append({"window": whole, "layers": layers, "beyond": False, "box": windows[d],
+                        "title": f"$d = {d}$, zoomed out: every arc whole"})
+        return row
 
-    return draw
+    return panels
 
 
 def fig8(n=100):
@@ -502,7 +305,7 @@ def fig8(n=100):
                         r"Fig. 8, $\gamma \geq 0$", gammas, n,
                         "d=0: gamma < 2 stable, 2 boundary (B), 2.2 unstable; d=1: 1.5 and 2 "
                         "unstable, the rest (2.2 included) stable; d=5, 10: 0, 0.5, 1 stable, 1.5, 2, "
-                        "2.2 unstable.", claimed, extra_row=_fig8_second_row(gammas))
+                        "2.2 unstable.", claimed, lower=_fig8_second_row(gammas))
 
 
 def _loop_counts(gamma, first, beta, window):
@@ -527,20 +330,16 @@ def _loop_counts(gamma, first, beta, window):
 
 def fig7():
     """Boundaries for gamma 0 .. 3 at d = 0 with the numbered points."""
-    plt = pyplot()
-    fig, ax = plt.subplots(figsize=(11, 6.4))
     gammas = (0.0, 0.5, 1.0, 1.5, 2.0, 2.5, 3.0)
     window = ((-4.5, 2.2), (-0.25, 6.6))
-    ax.axhline(0.0, zorder=2, **_Z_ONE)
-    loops = {}
+    loops, layers = {}, []
     for g, color in zip(gammas, _COLORS):
         lim = limits(gamma=g, d=0, delta=DELTA)
         tag = "U" if lim.empty else ("S, a thin sliver" if lim.z_width < 0.05 else "S")
-        _fill_stable(ax, g, 0, window, color)
-        first, _ = _draw_boundary(ax, g, 0, window, color)
-        ax.plot([], [], color=color, lw=2.5, label=fr"$\gamma = {g:g}$ ({tag})")
+        arc = arc_polylines(gamma=g, d=0, delta=DELTA, window=window)
+        layers.append((g, color, tag, _decomposition(g, 0, window), arc))
         if lim.empty:
-            loops[g] = (_loop_counts(g, first, -1.5, window), color)
+            loops[g] = (_loop_counts(g, arc[0], -1.5, window), color)
     points = []
     lim0 = limits(gamma=0.0, d=0, delta=DELTA)
     points.append((1, lim0.beta_at_alpha_max, lim0.alpha_max))
@@ -551,34 +350,7 @@ def fig7():
     points.append((4, lim2.beta_at_alpha_max, lim2.alpha_max))
     (lo, hi), = StabilityRegion(gamma=1.5, d=0, delta=DELTA).alpha_intervals(-0.5)
     points += [(5, -0.5, hi), (6, -0.5, lo)]
-    # Each number sits beside its circle, on a white box, where no curve runs.
-    offsets = {1: (0, -17), 2: (18, 8), 3: (0, 17), 4: (0, 17), 5: (20, 4), 6: (30, 0)}
-    for k, b, a in points:
-        ax.plot(b, a, "o", ms=11, mfc="none", mec="k", mew=1.2, zorder=6)
-        ax.annotate(str(k), (b, a), xytext=offsets[k], textcoords="offset points", ha="center",
-                    va="center", fontsize=9, fontweight="bold", zorder=7,
-                    bbox={"boxstyle": "round,pad=0.15", "fc": "white", "ec": "none"})
-    ax.axvline(-0.5, color="k", ls=":", lw=0.8, zorder=2)
-    ax.annotate(r"$\beta = -0.5$", (-0.5, 3.7), xytext=(4, 0), textcoords="offset points",
-                fontsize=8, va="center")
-    for row, (g, ((inside, outside, a_tip, b_tip), color)) in enumerate(sorted(loops.items())):
-        ax.annotate(fr"$\gamma = {g:g}$: both lines are one thin loop of eq. (7)," "\n"
-                    fr"its tip at $\alpha = {a_tip:.2f}$; {inside} poles outside the unit" "\n"
-                    f"circle inside the loop, {outside} outside it: no stable cell",
-                    (b_tip, a_tip), xytext=(-0.3, 4.75 + 1.1 * row), textcoords="data", fontsize=8,
-                    color=color, va="center", zorder=7,
-                    bbox={"boxstyle": "round,pad=0.25", "fc": "white", "ec": color, "lw": 0.6},
-                    arrowprops={"arrowstyle": "->", "color": color, "lw": 0.8})
-    (b0, b1), (a0, a1) = window
-    ax.set_xlim(b0, b1)
-    ax.set_ylim(a0, a1)
-    _labels(ax)
-    ax.set_title(r"Fig. 7: boundaries for $d = 0$; S: a stable region (filled), U: none "
-                 "(root counting)", fontsize=PANEL_TITLE_SIZE + 1)
-    handles, _ = ax.get_legend_handles_labels()
-    ax.legend(handles=handles + _style_handles(), fontsize=LEGEND_SIZE + 1, loc="upper left",
-              bbox_to_anchor=(1.01, 1.0), borderaxespad=0.0)
-    fig.tight_layout()
+    fig = drawing.boundaries_d0_figure(layers, points, loops, window)
     text = ", ".join(f"{k}: (beta {b:.4f}, alpha {a:.4f})" for k, b, a in points)
     loop_text = "; ".join(f"gamma = {g:g}: the two parallel lines are one thin loop of eq. (7) with its "
                           f"tip at alpha {a:.2f}, beta {b:.2f} ({i} unstable poles inside it, {o} "
@@ -605,74 +377,68 @@ def _mass_label(g):
 
 def fig10(n=40):
     """Physical units at Td = 40 ms: theory and simulations, ideal and quantized + filtered."""
-    import matplotlib
-    from matplotlib.lines import Line2D
-    from matplotlib.patches import Patch
-
-    plt = pyplot()
-    dev, d = PAPER_DEVICE, 40
-    # K_w and B_w are alpha and beta times constants: the plane is only rescaled.
-    scale = (float(dev.damping(1.0)), float(dev.stiffness(1.0)))
     qf = Nonidealities(encoder_resolution=PAPER_ENCODER_RESOLUTION, velocity_cutoff=50.0)
-    fig, axes = plt.subplots(2, 2, figsize=(11, 9.6))
-    found, counted, passive_k = [], {}, {}
-    for ax, g in zip(axes.ravel(), (-0.5, 0.0, 0.5, 1.0)):
-        lim = limits(gamma=g, d=d, delta=DELTA)
-        curve = boundary_curve(gamma=g, d=d, delta=DELTA, n=1000, segments=False)
-        top = 1.12 * float(curve.alpha.max())
-        pad = 0.06 * float(curve.beta.max() - curve.beta.min())
-        window = ((float(curve.beta.min()) - pad, float(curve.beta.max()) + pad), (-0.05 * top, top))
-        (b0, b1), (a0, a1) = window
-        ax.axhline(0.0, zorder=2, **_Z_ONE)
-        _fill_stable(ax, g, d, window, "#4292c6", scale)
-        alpha, beta = np.linspace(0.0, a1, n), np.linspace(b0, b1, n)
-        ideal = stability_map(alpha=alpha, beta=beta, gamma=g, d=d, delta=DELTA)
-        quant = stability_map(alpha=alpha, beta=beta, gamma=g, d=d, delta=None, device=dev,
-                              nonideal=qf, x0=0.01)
-        K, B = dev.stiffness(alpha), dev.damping(beta)
-        with matplotlib.rc_context({"hatch.color": "#08519c", "hatch.linewidth": 0.6}):
-            ax.contourf(B, K, ideal.stable.astype(float), levels=[0.5, 1.5], colors="none",
-                        hatches=[_SIM_HATCH], zorder=2)
-        ax.contour(B, K, quant.stable.astype(float), levels=[0.5], colors=["#2ca02c"],
-                   linestyles="--", linewidths=1.6, zorder=4)
-        _draw_boundary(ax, g, d, window, "k", scale)
-        passive = paper_passive_region(gamma=g, d=d, delta=DELTA)
-        if not passive.empty:
-            outline = np.vstack([passive.polygon, passive.polygon[:1]]) * scale
-            ax.plot(outline[:, 0], outline[:, 1], color=_PASSIVE, ls="--", lw=1.5, zorder=5)
-        passive_k[g] = None if passive.empty else float(dev.stiffness(passive.y_max))
-        ax.set_xlim(b0 * scale[0], b1 * scale[0])
-        ax.set_ylim(a0 * scale[1], a1 * scale[1])
-        counted[g] = _write_counts(ax, g, d, window, scale)
-        ax.set_title(fr"${_mass_label(g)}$ ($\gamma = {g:g}$)"
-                     + (", no passive point" if passive.empty else ""), fontsize=PANEL_TITLE_SIZE)
-        _labels(ax, physical=True)
-        A, Bm = np.meshgrid(alpha, beta, indexing="ij")
-
-        def top_of(mask):
-            return (dev.stiffness(A[mask].max()), dev.damping(Bm[mask].max())) if mask.any() else (0.0, 0.0)
-
-        (ki, bi), (kq, bq) = top_of(ideal.stable), top_of(quant.stable)
-        found.append((g, float(dev.stiffness(lim.alpha_max)), ki, kq, bi, bq))
-    handles = _style_handles("k") + [
-        Patch(facecolor="#4292c6", alpha=_FILL_ALPHA + 0.1, label="stable (root counting, exact)"),
-        Patch(facecolor="none", edgecolor="#08519c", hatch=_SIM_HATCH,
-              label="stable in simulation, ideal: PI(−), QF(−) (a check)"),
-        Line2D([], [], color="#2ca02c", ls="--", lw=1.6,
-               label="edge of the stable set in simulation, quantized + 50 Hz filter: PI(−), QF(+)"),
-        Line2D([], [], color=_PASSIVE, ls="--", lw=1.5, label="passive (Colgate–Schenkel)"),
-        Line2D([], [], ls="none", marker="$2$", color="0.15", ms=8, label=_COUNTS_NOTE)]
-    fig.suptitle(r"Fig. 10: physical units, $T_d = 40$ ms (the PI current-controller cases and "
-                 "the experiments are not modelled)", fontsize=SUPTITLE_SIZE)
-    _legend_below(fig, handles, ncol=2)
-    text = "; ".join(f"gamma = {g:g}: K_max theory {kt:.2f}, ideal sim {ki:.2f}, QF sim {kq:.2f} N m/rad "
-                     f"(QF/ideal {kq / ki if ki else float('nan'):.2f}); B_max QF/ideal "
-                     f"{bq / bi if bi else float('nan'):.2f}" for g, kt, ki, kq, bi, bq in found)
-    band = sorted({c for _, _, c in counted[1.0]})
+    found, panels, passive_k = [], [], {}
+    gammas = (-0.5, 0.0, 0.5, 1.0)
+    for g in gammas:
+        row, panel, passive_k[g] = _fig10_panel(g, n, qf)
+        found.append(row)
+        panels.append(panel)
+    fig, written = drawing.physical_figure(panels)
+    counted = dict(zip(gammas, written))
     return FigureResult(
         "fig10_physical_td40", "physical units at Td = 40 ms, gamma = M_w/m = -0.5, 0, 0.5, 1", fig,
         "theory against simulations (ideal; quantization + filter; PI controller high/low gains) and "
         "experiments; PI(-), QF(+) gives a lower K_max than the theory.",
+        _fig10_finding(found, counted, passive_k, n))
+
+
+def _fig10_panel(g, n, qf):
+    """One panel of Fig. 10 at ``gamma = g``: the exact set, the two simulations, passivity.
+
+    Returns ``((g, K_max theory, K_max ideal sim, K_max QF sim, B_max ideal sim,
+    B_max QF sim), the panel to draw, the passive K_max or None)``.
+    """
+    dev, d = PAPER_DEVICE, 40
+    # K_w and B_w are alpha and beta times constants: the plane is only rescaled.
+    scale = (float(dev.damping(1.0)), float(dev.stiffness(1.0)))
+    lim = limits(gamma=g, d=d, delta=DELTA)
+    curve = boundary_curve(gamma=g, d=d, delta=DELTA, n=1000, segments=False)
+    top = 1.12 * float(curve.alpha.max())
+    pad = 0.06 * float(curve.beta.max() - curve.beta.min())
+    window = ((float(curve.beta.min()) - pad, float(curve.beta.max()) + pad), (-0.05 * top, top))
+    (b0, b1), (a0, a1) = window
+    decomposition = _decomposition(g, d, window)
+    alpha, beta = np.linspace(0.0, a1, n), np.linspace(b0, b1, n)
+    ideal = stability_map(alpha=alpha, beta=beta, gamma=g, d=d, delta=DELTA)
+    quant = stability_map(alpha=alpha, beta=beta, gamma=g, d=d, delta=None, device=dev,
+                          nonideal=qf, x0=0.01)
+    passive = paper_passive_region(gamma=g, d=d, delta=DELTA)
+    panel = {"window": window, "scale": scale, "decomposition": decomposition,
+             "arc": arc_polylines(gamma=g, d=d, delta=DELTA, window=window),
+             "grid": (dev.stiffness(alpha), dev.damping(beta)), "ideal": ideal.stable,
+             "quantized": quant.stable,
+             "passive": None if passive.empty else
+             np.vstack([passive.polygon, passive.polygon[:1]]) * scale,
+             "title": fr"${_mass_label(g)}$ ($\gamma = {g:g}$)"
+                      + (", no passive point" if passive.empty else "")}
+    passive_k = None if passive.empty else float(dev.stiffness(passive.y_max))
+    A, Bm = np.meshgrid(alpha, beta, indexing="ij")
+
+    def top_of(mask):
+        return (dev.stiffness(A[mask].max()), dev.damping(Bm[mask].max())) if mask.any() else (0.0, 0.0)
+
+    (ki, bi), (kq, bq) = top_of(ideal.stable), top_of(quant.stable)
+    return (g, float(dev.stiffness(lim.alpha_max)), ki, kq, bi, bq), panel, passive_k
+
+
+def _fig10_finding(found, counted, passive_k, n):
+    """What symstab finds for Fig. 10, in words (the rows of :func:`_fig10_panel`)."""
+    text = "; ".join(f"gamma = {g:g}: K_max theory {kt:.2f}, ideal sim {ki:.2f}, QF sim {kq:.2f} N m/rad "
+                     f"(QF/ideal {kq / ki if ki else float('nan'):.2f}); B_max QF/ideal "
+                     f"{bq / bi if bi else float('nan'):.2f}" for g, kt, ki, kq, bi, bq in found)
+    band = sorted({c for _, _, c in counted[1.0]})
+    return (
         f"{text} (grid {n} x {n}, so K and B are resolved to one cell). "
         + ("The ideal simulation reaches the theoretical K_max within two cells in every panel; "
            if all(abs(ki - kt) <= 2.5 * kt / n for _, kt, ki, _, _, _ in found)
@@ -710,90 +476,70 @@ def _fig_limits(name, title, suptitle, gammas, paper, note):
     the grid.  ``title`` is the plain-text line of the reproduction's
     index, ``suptitle`` the same in mathtext for the figure.
     """
-    from matplotlib.lines import Line2D
-    from matplotlib.patches import Patch
-
-    plt = pyplot()
-    fig, axes = plt.subplots(2, 4, figsize=(16, 8.6), sharex=True)
-    summary, facts = [], []
-    for column, d in enumerate(DELAYS):
-        rows = [limits(gamma=g, d=d, delta=DELTA) for g in gammas]
-        empty = np.array([r.empty for r in rows])
-        have = np.flatnonzero(~empty)
-        right = gammas[0] >= 0  # Fig. 12: the region ends on the right
-        edge = have[-1] if right else have[0]
-        beyond = edge + 1 if right else edge - 1
-        vanish, edge_rows = None, []
-        if 0 <= beyond < len(gammas) and empty[beyond]:
-            vanish = vanishing_gamma(d=d, delta=DELTA, inside=gammas[edge], outside=gammas[beyond])
-            # A few points between the last grid gamma and the vanishing one,
-            # closer and closer, show how the Z-width goes to zero.
-            edge_rows = [(g, limits(gamma=g, d=d, delta=DELTA)) for g in
-                         (vanish[0] + (gammas[edge] - vanish[0]) * s for s in (0.3, 0.1, 0.0))]
-        g_edge = [g for g, _ in edge_rows]
-        z_edge = [r.z_width for _, r in edge_rows]
-        g_all = np.array(gammas, dtype=float)
-        bm = np.array([np.nan if r.empty else r.beta_right for r in rows])
-        am = np.array([np.nan if r.empty else r.alpha_max for r in rows])
-        zw = np.array([r.z_width for r in rows])
-        ax, lin = axes[0, column], axes[1, column]
-        ax.set_yscale("log")
-        # beta_max and alpha_max up to the vanishing gamma (where they stay
-        # finite); the Z-width on the grid only: its last few points fall by
-        # decades and would stretch the log axis.
-        order = np.argsort(np.concatenate([g_all, [g for g, _ in edge_rows]]))
-        g_ab = np.concatenate([g_all, [g for g, _ in edge_rows]])[order]
-        b_ab = np.concatenate([bm, [r.beta_right for _, r in edge_rows]])[order]
-        a_ab = np.concatenate([am, [r.alpha_max for _, r in edge_rows]])[order]
-        with np.errstate(invalid="ignore"):
-            ax.plot(g_ab, np.where(b_ab > 0, b_ab, np.nan), "-", color=_COLORS[0], lw=1.8)
-            ax.plot(g_ab, np.where(a_ab > 0, a_ab, np.nan), "--", color=_COLORS[1], lw=1.8)
-            ax.plot(g_all, np.where(zw > 0, zw, np.nan), ":", color=_COLORS[3], lw=2.2)
-        # The Z-width, linear: the grid, then the points that close on the vanishing gamma.
-        order = np.argsort(np.concatenate([g_all[~empty], g_edge]))
-        g_lin = np.concatenate([g_all[~empty], g_edge])[order]
-        z_lin = np.concatenate([zw[~empty], z_edge])[order]
-        if vanish is not None:
-            g_lin = np.append(g_lin, vanish[1]) if right else np.insert(g_lin, 0, vanish[1])
-            z_lin = np.append(z_lin, 0.0) if right else np.insert(z_lin, 0, 0.0)
-        lin.plot(g_lin, z_lin, ":", color=_COLORS[3], lw=2.2)
-        lin.set_ylim(0.0, 1.1 * float(np.max(z_lin)))
-        for a in (ax, lin):
-            if vanish is not None:
-                lo, hi = (vanish[1], gammas[-1]) if right else (gammas[0], vanish[1])
-                a.axvspan(lo, hi, color="red", alpha=0.15, lw=0)
-                a.axvline(vanish[1], color="red", lw=0.9)
-            a.set_xlim(gammas[0], gammas[-1])
-        if vanish is not None:
-            lin.annotate(fr"$\gamma^* = {vanish[1]:.4f}$", (vanish[1], 0.0), xytext=(-6 if right else 6, 30),
-                         textcoords="offset points", ha="right" if right else "left", fontsize=9,
-                         color="darkred", arrowprops={"arrowstyle": "->", "color": "darkred", "lw": 0.8},
-                         bbox={"boxstyle": "round,pad=0.2", "fc": "white", "ec": "none"})
-        lin.set_xlabel(r"$\gamma = M_w/m$")
-        ax.set_ylabel("dimensionless, log scale")
-        lin.set_ylabel("Z-width, linear scale")
-        label_log_axis(ax)
-        ax.set_title(f"$d = {d}$", fontsize=PANEL_TITLE_SIZE)
+    summary, facts, columns = [], [], []
+    for d in DELAYS:
+        column, fact = _limits_column(gammas, d)
+        columns.append(column)
+        facts.append(fact)
+        am, bm, zw, edge, vanish = (fact[k] for k in ("am", "bm", "zw", "edge", "vanish"))
         k = int(np.nanargmax(am))
-        facts.append(dict(d=d, am=am, bm=bm, zw=zw, edge=edge, empty=empty, vanish=vanish,
-                          z_lin=z_lin, g_lin=g_lin))
         summary.append(f"d={d}: alpha_max peaks at {am[k]:.4g} (gamma {gammas[k]:.2f}); "
-                       f"{'last' if right else 'first'} gamma of the scan with a region "
+                       f"{'last' if column['right'] else 'first'} gamma of the scan with a region "
                        f"{gammas[edge]:.2f}: alpha_max {am[edge]:.3g}, beta_max {bm[edge]:.3g}, "
                        f"Z-width {zw[edge]:.3g}"
                        + (f"; the region vanishes at gamma = {vanish[1]:.5f} (bisection on "
                           f"root counting, to {abs(vanish[1] - vanish[0]):.0e})" if vanish else ""))
-    handles = [Line2D([], [], color=_COLORS[0], lw=1.8, label=r"$\beta_{\max}$"),
-               Line2D([], [], color=_COLORS[1], ls="--", lw=1.8, label=r"$\alpha_{\max}$"),
-               Line2D([], [], color=_COLORS[3], ls=":", lw=2.2, label="Z-width (area of the stable set)"),
-               Patch(facecolor="red", alpha=0.15,
-                     label=r"no stable region (from $\gamma^*$, found by bisection on root counting)")]
-    fig.suptitle(suptitle + ": upper row on a log scale, lower row the Z-width on a linear scale",
-                 fontsize=SUPTITLE_SIZE)
-    _legend_below(fig, handles, ncol=4)
+    fig = drawing.limits_figure(columns, suptitle)
     return FigureResult(name, title, fig, paper, "; ".join(summary) + "; " + note(facts)
                         + " Upper panels: log scale (the three span up to three decades); lower "
                           "panels: the Z-width on a linear scale, closing to 0 at gamma*.")
+
+
+def _limits_column(gammas, d):
+    """The limits of ``gammas`` at delay ``d``: the column to draw and its facts for the text.
+
+    Where the region ends inside the scan, the gamma where it vanishes
+    (bisection) and a few points closer and closer to it.
+    """
+    rows = [limits(gamma=g, d=d, delta=DELTA) for g in gammas]
+    empty = np.array([r.empty for r in rows])
+    have = np.flatnonzero(~empty)
+    right = gammas[0] >= 0  # Fig. 12: the region ends on the right
+    edge = have[-1] if right else have[0]
+    beyond = edge + 1 if right else edge - 1
+    vanish, edge_rows = None, []
+    if 0 <= beyond < len(gammas) and empty[beyond]:
+        vanish = vanishing_gamma(d=d, delta=DELTA, inside=gammas[edge], outside=gammas[beyond])
+        # A few points between the last grid gamma and the vanishing one,
+        # closer and closer, show how the Z-width goes to zero.
+        edge_rows = [(g, limits(gamma=g, d=d, delta=DELTA)) for g in
+                     (vanish[0] + (gammas[edge] - vanish[0]) * s for s in (0.3, 0.1, 0.0))]
+    g_edge = [g for g, _ in edge_rows]
+    z_edge = [r.z_width for _, r in edge_rows]
+    g_all = np.array(gammas, dtype=float)
+    bm = np.array([np.nan if r.empty else r.beta_right for r in rows])
+    am = np.array([np.nan if r.empty else r.alpha_max for r in rows])
+    zw = np.array([r.z_width for r in rows])
+    # beta_max and alpha_max up to the vanishing gamma (where they stay
+    # finite); the Z-width on the grid only: its last few points fall by
+    # decades and would stretch the log axis.
+    order = np.argsort(np.concatenate([g_all, [g for g, _ in edge_rows]]))
+    g_ab = np.concatenate([g_all, [g for g, _ in edge_rows]])[order]
+    b_ab = np.concatenate([bm, [r.beta_right for _, r in edge_rows]])[order]
+    a_ab = np.concatenate([am, [r.alpha_max for _, r in edge_rows]])[order]
+    # The Z-width, linear: the grid, then the points that close on the vanishing gamma.
+    order = np.argsort(np.concatenate([g_all[~empty], g_edge]))
+    g_lin = np.concatenate([g_all[~empty], g_edge])[order]
+    z_lin = np.concatenate([zw[~empty], z_edge])[order]
+    if vanish is not None:
+        g_lin = np.append(g_lin, vanish[1]) if right else np.insert(g_lin, 0, vanish[1])
+        z_lin = np.append(z_lin, 0.0) if right else np.insert(z_lin, 0, 0.0)
+    column = {"d": d, "log": (g_ab, b_ab, a_ab), "grid": (g_all, zw), "linear": (g_lin, z_lin),
+              "vanish": None if vanish is None else vanish[1], "right": right,
+              "range": (gammas[0], gammas[-1])}
+    fact = dict(d=d, am=am, bm=bm, zw=zw, edge=edge, empty=empty, vanish=vanish,
+                z_lin=z_lin, g_lin=g_lin)
+    return column, fact
 
 
 def fig11(n=22):
@@ -848,13 +594,13 @@ def make_figures(out_dir, progress=None):
     progress = check_progress(progress, lambda: lambda name, seconds: print(
         f"{name}: {seconds:.1f} s", file=sys.stderr, flush=True))
 
-    plt = pyplot()
+    plt = drawing.pyplot()
     out = pathlib.Path(out_dir)
     results = []
     for make in FIGURES:
         start = time.perf_counter()
         result = make()
-        write_bytes(out / f"{result.name}.png", png_bytes(plt, result.figure))
+        write_bytes(out / f"{result.name}.png", drawing.png_bytes(plt, result.figure))
         result.figure = None
         results.append(result)
         if progress is not None:

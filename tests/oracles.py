@@ -268,6 +268,37 @@ def chi_mp(z, coeffs):
     return value, size
 
 
+def roots_outside_unit_circle_mp(coeffs, *, dps=60, n=1024, max_n=2**16):
+    """How many roots of the polynomial ``coeffs`` (highest first) lie outside |z| = 1.
+
+    The argument principle at ``dps`` digits: the winding number of
+    ``chi(e^{j theta})`` over ``n`` equal steps counts the roots inside; each
+    step must turn the phase by less than pi / 4, else the grid is doubled
+    (up to ``max_n``; past it, or on a value within its rounding of 0, a
+    root is on the circle to this precision and ``ValueError`` is raised).
+    Independent of the code under test: no root finder, no Schur-Cohn.
+    """
+    with mpmath.workdps(dps):
+        c = [mpmath.mpf(x) for x in coeffs]
+        while c and c[0] == 0:
+            c = c[1:]
+        while n <= max_n:
+            phases = []
+            for k in range(n):
+                value, size = chi_mp(mpmath.expjpi(mpmath.mpf(2 * k) / n), c)
+                if abs(value) <= size * mpmath.mpf(10) ** (10 - dps):
+                    raise ValueError("a root is on the unit circle to this precision")
+                phases.append(mpmath.arg(value))
+            phases.append(phases[0])
+            steps = [(b - a + mpmath.pi) % (2 * mpmath.pi) - mpmath.pi
+                     for a, b in zip(phases, phases[1:])]
+            if max(abs(s) for s in steps) < mpmath.pi / 4:
+                inside = int(mpmath.nint(sum(steps) / (2 * mpmath.pi)))
+                return len(c) - 1 - inside
+            n *= 2
+    raise ValueError(f"the phase of chi on the circle was not resolved on {max_n} points")
+
+
 @functools.lru_cache(maxsize=None)
 def boundary_functions():
     """mpmath functions alpha(theta, gamma, d, delta, Gamma), beta(...) of boundary()."""

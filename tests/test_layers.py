@@ -19,6 +19,7 @@ modules of one file name, and the command line one module per command.
 """
 
 import ast
+import functools
 import pathlib
 
 import pytest
@@ -26,6 +27,12 @@ import pytest
 import symstab
 
 PACKAGE = pathlib.Path(symstab.__file__).resolve().parent
+
+
+@functools.lru_cache(maxsize=None)
+def _tree(path):
+    """The module's syntax tree, parsed once for all the checks below."""
+    return ast.parse(path.read_text(encoding="utf-8"))
 
 #: Rank of each layer; a module may import its own rank or lower.
 RANK = {"base": 0, "symbolic": 1, "codegen": 2, "proof": 3, "numeric": 4, "front": 5}
@@ -56,7 +63,7 @@ def _modules():
 
 def _imports(path, parts):
     """(line, absolute module path below symstab or 'paper_checks...') of every import."""
-    tree = ast.parse(path.read_text(encoding="utf-8"))
+    tree = _tree(path)
     package = list(parts[:-1]) if parts[-1] != "__init__" else list(parts[:-1])
     for node in ast.walk(tree):
         if isinstance(node, ast.ImportFrom):
@@ -116,7 +123,7 @@ def _room(parts):
 
 def _nested_imports(path):
     """Line numbers of the imports inside a function body (lazy ones)."""
-    tree = ast.parse(path.read_text(encoding="utf-8"))
+    tree = _tree(path)
     lines = set()
     for node in ast.walk(tree):
         if isinstance(node, (ast.FunctionDef, ast.AsyncFunctionDef)):
@@ -216,7 +223,7 @@ def test_paper_checks_uses_the_library_and_no_front_end():
     if not root.is_dir():
         pytest.skip("paper_checks is not installed beside the package")
     for path in sorted(root.glob("*.py")):
-        tree = ast.parse(path.read_text(encoding="utf-8"))
+        tree = _tree(path)
         for node in ast.walk(tree):
             module = node.module if isinstance(node, ast.ImportFrom) else None
             names = [a.name for a in node.names] if isinstance(node, ast.Import) else [module or ""]
@@ -292,7 +299,7 @@ def _imports_of(name, path):
     ``from package import x`` where ``x`` is a submodule imports the
     submodule (not the package's ``__init__``), and its name is None.
     """
-    tree = ast.parse(path.read_text(encoding="utf-8"))
+    tree = _tree(path)
     for node in ast.walk(tree):
         if isinstance(node, ast.Import):
             for alias in node.names:
@@ -402,7 +409,7 @@ def _private_imports():
 
     found = []
     for name, path in MODULE_NAMES.items():
-        tree = ast.parse(path.read_text(encoding="utf-8"))
+        tree = _tree(path)
         aliases = {}
         for line, target, imported, alias in _imports_of(name, path):
             if imported is not None and private(imported) and target != name:
@@ -451,6 +458,36 @@ def test_the_cli_is_one_module_per_command_over_shared_modules():
     assert crossing == [], crossing
 
 
+def _matplotlib_imports(path, parts):
+    """``[(line, module)]`` of the imports of matplotlib in one module (lazy ones included)."""
+    return [(line, ".".join(target)) for line, target in _imports(path, parts)
+            if target[0] == "matplotlib"]
+
+
+#: The front ends that compute what is drawn and leave the drawing to :mod:`symstab.drawing`.
+COMPUTING_FRONT_ENDS = [(path, parts) for path, parts in MODULES
+                        if parts[0] == "cli" or parts == ("figures",)]
+
+
+@pytest.mark.parametrize("path, parts", COMPUTING_FRONT_ENDS,
+                         ids=["/".join(p) for _, p in COMPUTING_FRONT_ENDS])
+def test_the_cli_and_the_figures_draw_nothing_themselves(path, parts):
+    """The commands and the figures compute; :mod:`symstab.drawing` draws every PNG."""
+    found = _matplotlib_imports(path, parts)
+    assert found == [], (f"symstab/{'/'.join(parts)}.py imports matplotlib "
+                         f"({', '.join(f'{m} on line {n}' for n, m in found)}): draw in "
+                         f"symstab/drawing.py")
+
+
+def test_the_matplotlib_finder_finds_lazy_imports(tmp_path):
+    source = ("import numpy\n\ndef draw():\n    from matplotlib.patches import Patch\n"
+              "    import matplotlib.pyplot as plt\n")
+    path = tmp_path / "fake.py"
+    path.write_text(source, encoding="utf-8")
+    assert _matplotlib_imports(path, ("cli", "fake")) == [(4, "matplotlib.patches"),
+                                                          (5, "matplotlib.pyplot")]
+
+
 # --------------------------------------------------------------------------
 # No private attribute reached on another module's object
 
@@ -496,7 +533,7 @@ def _private_attribute_reaches():
     for name, path in MODULE_NAMES.items():
         if "_generated" in name.split("."):
             continue
-        tree = ast.parse(path.read_text(encoding="utf-8"))
+        tree = _tree(path)
         own = _defined_private_names(tree)
         for node in ast.walk(tree):
             if not isinstance(node, ast.Attribute):

@@ -294,6 +294,46 @@ _TARGET_ROWS = {
 
 def _search(args, setup, over, target, notes, png, delay=None, simulation=None):
     """The values of ``over`` that maximise ``target`` in the plane of ``setup``: one design."""
+    names = tuple(over)
+    found = _run_design(args, setup, over, target, delay, simulation)
+    at_nominal = _nominal_row(setup, found, names, target)
+    if found.best is None:
+        search = _search_json(setup, found, names, None)
+        notes += ([found.message] + _failed_notes(found)
+                  + limits_notes(setup, _limits(setup, found.nominal, delay)))
+        columns, rows = plane_table(setup, [at_nominal], over=names)
+        _write_png(png, setup, found, notes)
+        emit(setup, args.format, columns, rows, result=_result(setup, search, None),
+             notes=notes, json_rows=False)
+        return 0
+    # The plane's certified limits at the best values, whatever the target.
+    if target == "passive":
+        lim = _limits(setup, found.best, delay)
+    elif target == "simulated":
+        lim = found.limits.linear
+    else:
+        lim = found.limits
+    search = _search_json(setup, found, names, lim)
+    rows = _best_rows(found, names, target, lim, at_nominal)
+    notes += limits_notes(setup, lim)
+    if target == "simulated":
+        notes += _simulation_notes(setup, found, simulation)
+    line = _at_the_best(args, setup, found, target, lim, delay, rows, notes)
+    notes += _failed_notes(found)
+    for name in found.at_edge:
+        notes.append(f"the best {setup.name(name)} is at an end of the range searched"
+                     + (f": widen --over {name}=LO:HI" if setup.paper is None else ""))
+    columns, rows = plane_table(setup, rows, over=names)
+    result = _result(setup, search, lim)
+    if line is not None:
+        result["at"] = line
+    _write_png(png, setup, found, notes)
+    emit(setup, args.format, columns, rows, result=result, notes=notes, json_rows=False)
+    return 0
+
+
+def _run_design(args, setup, over, target, delay, simulation):
+    """Check ``--maximize`` against the plane and run the design, saying what it searches."""
     from .._progress import progress_printer
 
     names = tuple(over)
@@ -327,34 +367,28 @@ def _search(args, setup, over, target, notes, png, delay=None, simulation=None):
                               **{k: v for k, v in setup.values.items()
                                  if not (delay is not None and k == "d")})
     progress(n**len(names) + 40)
+    return found
+
+
+def _nominal_row(setup, found, names, target):
+    """The table's row of the target at the nominal values of the parameters searched."""
     label, meaning = _TARGET_ROWS[target]
+    y = setup.name(setup.y)
     nominal_text = ", ".join(f"{{{k}}} = {setup.values[name]:.6g}"
                              for k, name in zip("pq", names))
     value_nominal = found.value_nominal
-    at_nominal = (((label[0] + f" at {nominal_text}"),
-                   None if setup.paper is None else
-                   f"{label[1] or label[0].format(y=y)} at gamma = 0",
-                   f"{label[2]} at M_w = 0"),
-                  value_nominal if value_nominal is None or value_nominal > -math.inf else None,
-                  "area" if target == "area" else "y", f"{meaning} at the nominal "
-                  + " and ".join(f"{{{k}}}" for k in "pq"[:len(names)]))
-    if found.best is None:
-        search = _search_json(setup, found, names, None)
-        notes += ([found.message] + _failed_notes(found)
-                  + limits_notes(setup, _limits(setup, found.nominal, delay)))
-        columns, rows = plane_table(setup, [at_nominal], over=names)
-        _write_png(png, setup, found, notes)
-        emit(setup, args.format, columns, rows, result=_result(setup, search, None),
-             notes=notes, json_rows=False)
-        return 0
-    # The plane's certified limits at the best values, whatever the target.
-    if target == "passive":
-        lim = _limits(setup, found.best, delay)
-    elif target == "simulated":
-        lim = found.limits.linear
-    else:
-        lim = found.limits
-    search = _search_json(setup, found, names, lim)
+    return (((label[0] + f" at {nominal_text}"),
+             None if setup.paper is None else
+             f"{label[1] or label[0].format(y=y)} at gamma = 0",
+             f"{label[2]} at M_w = 0"),
+            value_nominal if value_nominal is None or value_nominal > -math.inf else None,
+            "area" if target == "area" else "y", f"{meaning} at the nominal "
+            + " and ".join(f"{{{k}}}" for k in "pq"[:len(names)]))
+
+
+def _best_rows(found, names, target, lim, at_nominal):
+    """The table's rows of a design that found a best value: it, the target, the limits there."""
+    label, meaning = _TARGET_ROWS[target]
     kind = "area" if target == "area" else "y"
     rows = [(f"{{{k}}} (best)", found.best[name], k, f"the {{{k}}} that maximises {label[0]}")
             for k, name in zip("pq", names)]
@@ -376,9 +410,18 @@ def _search(args, setup, over, target, notes, png, delay=None, simulation=None):
                       "Z-width at the best M_w"), lim.area, "area",
                      "area of the stable set (the Z-width where {x} is a damping and {y} a "
                      "stiffness)"))
-    notes += limits_notes(setup, lim)
-    if target == "simulated":
-        notes += _simulation_notes(setup, found, simulation)
+    return rows
+
+
+def _at_the_best(args, setup, found, target, lim, delay, rows, notes):
+    """The stable intervals at the best values (a row and notes added); their JSON or None.
+
+    Also the notes on the delay held in seconds and on a best value at the
+    tip of a thin sliver of the stable set.
+    """
+    x, y = setup.name(setup.x), setup.name(setup.y)
+    names = tuple(found.over)
+    units = {n: setup.unit(n) for n in names}
     at_best = dataclasses.replace(setup, values=_at(setup, found.best, delay))
     if delay is not None:
         T = at_best.values["T"]
@@ -416,17 +459,7 @@ def _search(args, setup, over, target, notes, png, delay=None, simulation=None):
         notes.append(f"the best {best_text} lies where the stable set is a thin sliver (area "
                      f"{lim.area:.3g} against {nominal_lim.area:.3g} at the nominal values): "
                      f"the gain needs very precise tuning of {', '.join(names)} and {x}")
-    notes += _failed_notes(found)
-    for name in found.at_edge:
-        notes.append(f"the best {setup.name(name)} is at an end of the range searched"
-                     + (f": widen --over {name}=LO:HI" if setup.paper is None else ""))
-    columns, rows = plane_table(setup, rows, over=names)
-    result = _result(setup, search, lim)
-    if line is not None:
-        result["at"] = line
-    _write_png(png, setup, found, notes)
-    emit(setup, args.format, columns, rows, result=result, notes=notes, json_rows=False)
-    return 0
+    return line
 
 
 #: Values whose simulated target lies within this fraction of the best are ties: near
@@ -537,9 +570,8 @@ def _write_png(png, setup, found, notes):
     """Draw the target against the searched parameter(s) into ``png`` (if given)."""
     if png is None:
         return
-    from ..drawing import design_figure, png_bytes, pyplot
+    from ..drawing import design_png
 
-    plt = pyplot()
     names = tuple(found.over)
     labels = [setup.label(n) for n in names]
     label, _ = _TARGET_ROWS[found.target]
@@ -549,6 +581,5 @@ def _write_png(png, setup, found, notes):
         found.target, f"({setup.unit(setup.x)})({setup.unit(setup.y)})"
         if setup.unit(setup.x) and setup.unit(setup.y) else "")
     target_label = label[0].format(y=y) + (f" [{unit}]" if unit else "")
-    fig = design_figure(plt, found, labels, target_label)
-    write_output(png, png_bytes(plt, fig), "--png")
+    write_output(png, design_png(found, labels, target_label), "--png")
     notes.append(f"wrote {png}")

@@ -15,7 +15,6 @@ import math
 import sys
 import textwrap
 
-import numpy as np
 
 from .loop_limits import LIMITS, limits_notes, limits_table, named, passive_notes, \
     stable_intervals_at
@@ -112,7 +111,7 @@ _MAX_STRIPS = 100_000
 
 def _robust(args, setup, at):
     """``limits --loop --uncertain``: the robust set's limits, certified; its PNG with --png."""
-    from ..drawing import png_bytes, pyplot
+    from ..drawing import require_matplotlib, robust_png
     from .._progress import progress_printer
     from .output import check_files, write_output
 
@@ -124,7 +123,7 @@ def _robust(args, setup, at):
         if not args.png.endswith(".png"):
             raise ValueError(f"--png must end in .png, got {args.png}")
         png = check_files([("--png", args.png)])["--png"]
-        plt = pyplot()      # matplotlib is there before the work starts
+        require_matplotlib()      # matplotlib is there before the work starts
     # A box of zero width is the nominal set, certified the robust way.
     box = uncertain_box(args, setup, point=True)
     values = {k: v for k, v in setup.values.items() if k not in box}
@@ -196,41 +195,7 @@ def _robust(args, setup, at):
         notes.append(f"robust {y} at {x} = {at:.10g}: {text}")
         result["at"] = {"x": at, "intervals": [list(r) for r in spans]}
     if png is not None:
-        write_output(png, png_bytes(plt, _robust_figure(plt, setup, region)), "--png")
+        write_output(png, robust_png(region, setup.label(setup.x), setup.label(setup.y)), "--png")
         notes.append(f"wrote {png}")
     emit(setup, args.format, columns, rows, result=result, notes=notes, json_rows=False)
     return 0
-
-
-def _robust_figure(plt, setup, region):
-    """The robust set (filled), what stayed marginal, and the nominal set's outline beside it."""
-    from matplotlib.patches import Patch, Polygon
-
-    fig, ax = plt.subplots(figsize=(6.4, 4.8))
-    nominal = region.nominal
-    if nominal is not None:
-        for k, cell in enumerate(nominal.stable):
-            ring = np.vstack([cell.outer, cell.outer[:1]])
-            ax.plot(ring[:, 0], ring[:, 1], color="0.2", lw=1.0,
-                    label="stable at the box's centre" if k == 0 else None)
-    for i, bands in enumerate(region.marginal):
-        x0, x1 = region.edges[i], region.edges[i + 1]
-        for lo0, hi0, lo1, hi1 in bands:
-            ax.add_patch(Polygon([(x0, lo0), (x1, lo1), (x1, hi1), (x0, hi0)], closed=True,
-                                 facecolor="#f4a582", edgecolor="none"))
-    # The robust set's outlines (runs of strips joined: no seams between them).
-    for outline in region.polygons:
-        ax.add_patch(Polygon(outline, closed=True, facecolor="#4393c3", edgecolor="none"))
-    handles, _ = ax.get_legend_handles_labels()
-    handles += [Patch(color="#4393c3", label="stable for every value of the box"),
-                Patch(color="#f4a582", label="marginal (not certified)")]
-    ax.legend(handles=handles, loc="best", fontsize=8)
-    if nominal is not None:
-        ax.set_xlim(*nominal.x_range)
-        ax.set_ylim(*nominal.y_range)
-    box = ", ".join(f"{k} in [{lo:.4g}, {hi:.4g}]" for k, (lo, hi) in region.uncertain.items())
-    ax.set_title(f"robust stable set: {box}", fontsize=9)
-    ax.set_xlabel(setup.label(setup.x))
-    ax.set_ylabel(setup.label(setup.y))
-    fig.tight_layout()
-    return fig

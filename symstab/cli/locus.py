@@ -21,7 +21,7 @@ from .loop_options import (DEVICE_OPTIONS, EXAMPLE, LINEAR_WITH_LOOP, POINT_OPTI
                            add_delay, check_names, convert_sets, load_loop_file, loop_echo,
                            loop_values, paper_setup, parse_number, split_unit)
 from .options import add_command, add_model_options, resolve
-from ..drawing import png_bytes
+from ..drawing import locus_png
 from .output import check_outputs, emit, interval_texts, write_output
 from .units import tex_unit
 
@@ -31,8 +31,6 @@ __all__ = ["register", "run"]
 #: Points of a path given as LOW:HIGH, and the most a path may have.
 DEFAULT_POINTS = 401
 MAX_POINTS = 100_000
-#: Poles farther out than this are left out of the z-plane panel (said in its title).
-_PLANE_LIMIT = 3.0
 #: The paper's options refused with --loop, and what replaces each (those of
 #: the other numeric commands, but --linear, which locus does not have).
 _DEVICE_OPTIONS = tuple(option for option in DEVICE_OPTIONS
@@ -431,7 +429,9 @@ def run(args):
     certified = _certified(view)
     columns, rows, stretches = _rows(view)
     notes = _notes(view, stretches, certified)
-    image = _png(view, stretches) if png is not None else None
+    image = (locus_png(view.locus, view.given, view.show, stretches, symbol=view.symbol,
+                       tex=view.tex, title=_title(view))
+             if png is not None else None)
     if image is not None:
         write_output(png, image, "--png")
         notes.append(f"wrote {png}")
@@ -442,164 +442,6 @@ def run(args):
 
 # --------------------------------------------------------------------------
 # The figure
-
-
-def _zoom(poles, crossings, limit):
-    """``(x0, x1, y0, y1)``: a square window on where the poles move and cross.
-
-    The bounding box of the poles that move at least a tenth as far as the
-    one that moves most, with the crossings; if that is most of the plane,
-    the stretch of the first crossing pole's path (a pair's first) near
-    its crossing, or where a pole comes nearest the circle.
-    """
-    finite = np.isfinite(poles) & (np.abs(poles) <= limit)
-    steps = np.where(finite[1:] & finite[:-1], np.abs(np.diff(np.where(finite, poles, 0), axis=0)),
-                     0.0)
-    moved = steps.sum(axis=0)
-    points = [complex(c.z) for c in crossings] + [complex(c.z).conjugate() for c in crossings]
-    if moved.max() > 0:
-        columns = moved >= 0.1 * moved.max()
-        points += list(poles[:, columns][finite[:, columns]])
-    half = _half_width(points)
-    if half is None or half > 0.4 * limit:
-        if crossings:
-            pick = next((c for c in crossings if c.kind == "pair"), crossings[0])
-            path = poles[:, pick.pole_index]
-            near = finite[:, pick.pole_index] & (np.abs(path - pick.z) <= 0.3)
-            points = [complex(pick.z), complex(pick.z).conjugate()] + list(path[near])
-        else:
-            distance = np.where(finite, np.abs(np.abs(poles) - 1.0), np.inf)
-            points = [complex(poles.flat[int(np.argmin(distance))])]
-        half = max(_half_width(points), 0.05)
-    box = np.array(points)
-    centre = (0.5 * (box.real.min() + box.real.max()), 0.5 * (box.imag.min() + box.imag.max()))
-    return centre[0] - half, centre[0] + half, centre[1] - half, centre[1] + half
-
-
-def _half_width(points):
-    if not points:
-        return None
-    box = np.array(points)
-    return max(0.5 * max(np.ptp(box.real), np.ptp(box.imag)) * 1.15, 0.01)
-
-
-_MARKS = {"pair": ("*", "C3", "complex pair crossing"), "z = 1": ("s", "C1", "real pole crossing"),
-          "z = -1": ("D", "C1", "real pole crossing")}
-
-
-def _plane(ax, view, norm, limit, window=None):
-    """One z-plane panel: the poles coloured by the path's value, the circle, the crossings."""
-    locus = view.locus
-    poles = locus.poles
-    shown = np.asarray(view.given, dtype=float)
-    finite = np.isfinite(poles)
-    keep = finite & (np.abs(poles) <= limit)
-    if window is not None:
-        x0, x1, y0, y1 = window
-        keep &= (poles.real >= x0) & (poles.real <= x1) & (poles.imag >= y0) & (poles.imag <= y1)
-    colour = np.broadcast_to(shown[:, None], poles.shape)
-    theta = np.linspace(0, 2 * np.pi, 20001)
-    ax.plot(np.cos(theta), np.sin(theta), color="0.25", lw=1.0, zorder=1,
-            label=r"unit circle $|z| = 1$")
-    dots = ax.scatter(poles.real[keep], poles.imag[keep], c=colour[keep], s=4, cmap="viridis",
-                      norm=norm, zorder=2, linewidths=0)
-    start = keep[0]
-    ax.plot(poles.real[0][start], poles.imag[0][start], "o", mfc="none", mec="0.4", ms=4,
-            mew=0.7, lw=0, zorder=3,
-            label=f"poles at the start, {view.symbol} = {shown[0]:.4g}")
-    labelled = set()
-    for k, c in enumerate(locus.crossings):
-        marker, color, label = _MARKS[c.kind]
-        for imag in ((c.z.imag, -c.z.imag) if c.kind == "pair" else (c.z.imag,)):
-            ax.plot([c.z.real], [imag], marker, color=color, mec="k", ms=11, zorder=4,
-                    label=None if label in labelled else label)
-            labelled.add(label)
-        ax.annotate(f"{k + 1}", (c.z.real, c.z.imag), xytext=(8, 6), textcoords="offset points",
-                    fontsize=10, fontweight="bold", zorder=5,
-                    bbox=dict(boxstyle="round,pad=0.15", fc="white", ec="none", alpha=0.8))
-    if window is None:
-        ax.set_xlim(-limit, limit)
-        ax.set_ylim(-limit, limit)
-    else:
-        ax.set_xlim(window[0], window[1])
-        ax.set_ylim(window[2], window[3])
-    ax.set_aspect("equal")
-    ax.set_xlabel(r"Re $z$")
-    ax.set_ylabel(r"Im $z$")
-    return dots
-
-
-def _png(view, stretches):
-    """The locus as PNG bytes: the z-plane, a zoom on where the poles cross, the largest modulus."""
-    from ..drawing import LEGEND_SIZE, PANEL_TITLE_SIZE, SUPTITLE_SIZE, pyplot
-
-    plt = pyplot()
-    from matplotlib.colors import Normalize
-    from matplotlib.patches import Rectangle
-
-    locus = view.locus
-    shown = np.asarray(view.given, dtype=float)
-    poles = locus.poles
-    finite = np.isfinite(poles)
-    radius = float(np.max(np.abs(poles[finite]))) if finite.any() else 1.0
-    limit = min(max(1.15, 1.05 * radius), _PLANE_LIMIT)
-    norm = Normalize(vmin=float(min(shown[0], shown[-1])), vmax=float(max(shown[0], shown[-1])))
-    fig = plt.figure(figsize=(11.5, 10.5))
-    grid = fig.add_gridspec(2, 2, height_ratios=[1.25, 1.0])
-    ax, zx, bx = fig.add_subplot(grid[0, 0]), fig.add_subplot(grid[0, 1]), fig.add_subplot(grid[1, :])
-    dots = _plane(ax, view, norm, limit)
-    window = _zoom(poles, locus.crossings, limit)
-    _plane(zx, view, norm, limit, window)
-    ax.add_patch(Rectangle((window[0], window[2]), window[1] - window[0], window[3] - window[2],
-                           fill=False, ec="C3", lw=1.0, ls="--", zorder=6))
-    hidden = bool((finite & (np.abs(poles) > limit)).any())
-    ax.set_title("closed-loop poles in the $z$-plane" + (
-        f"\n(poles beyond $|z|$ = {limit:g} not shown)" if hidden else ""),
-        fontsize=PANEL_TITLE_SIZE)
-    zx.set_title("zoom on the dashed square: where the poles move and cross",
-                 fontsize=PANEL_TITLE_SIZE)
-    handles, labels = ax.get_legend_handles_labels()
-    fig.legend(handles, labels, loc="upper center", bbox_to_anchor=(0.5, 0.505), ncol=4,
-               fontsize=LEGEND_SIZE + 1, frameon=False)
-    # The largest modulus along the path, the stable stretches shaded.
-    rho = locus.spectral_radius()
-    bx.plot(shown, rho, color="C0", lw=1.6, label=r"largest pole modulus $\max|z|$")
-    bx.axhline(1.0, color="0.25", lw=1.0, ls="--", label=r"$|z| = 1$")
-    first = True
-    top = bx.get_ylim()[1]
-    for lo, hi, count in stretches:
-        lo, hi = sorted((float(view.show(lo)), float(view.show(hi))))
-        if count == 0:
-            bx.axvspan(lo, hi, color="#7fc97f", alpha=0.35, lw=0,
-                       label="stable (no pole outside)" if first else None)
-            first = False
-        if count is not None and hi - lo > 0.06 * abs(shown[-1] - shown[0]):
-            bx.text(0.5 * (lo + hi), top, f"{count} outside", ha="center", va="bottom",
-                    fontsize=9, color="0.2")
-    for k, c in enumerate(locus.crossings):
-        x = float(view.show(c.value))
-        marker, color, _ = _MARKS[c.kind]
-        bx.axvline(x, color=color, lw=0.9, ls=":")
-        bx.plot([x], [1.0], marker, color=color, mec="k", ms=9, zorder=4)
-        # Alternately below and above the line: neighbouring crossings stay apart.
-        bx.annotate(f"{k + 1}", (x, 1.0), xytext=(6, -14 if k % 2 == 0 else 6),
-                    textcoords="offset points",
-                    fontsize=10, fontweight="bold")
-    bx.set_xlabel(view.tex)
-    bx.set_ylabel(r"$\max|z|$")
-    bx.set_xlim(float(min(shown[0], shown[-1])), float(max(shown[0], shown[-1])))
-    bx.set_title("largest pole modulus along the path; crossings numbered as in the table, "
-                 "poles outside the circle counted above", fontsize=PANEL_TITLE_SIZE, pad=18)
-    bx.legend(fontsize=LEGEND_SIZE + 1, loc="upper center", bbox_to_anchor=(0.5, -0.12), ncol=3,
-              frameon=False)
-    fig.suptitle(_title(view), fontsize=SUPTITLE_SIZE)
-    fig.subplots_adjust(left=0.07, right=0.89, top=0.92, bottom=0.1, hspace=0.45, wspace=0.22)
-    # The colour bar beside the z-plane panels, in an axes of its own (so
-    # that it takes no width from the zoom).
-    place = zx.get_position()
-    bar = fig.colorbar(dots, cax=fig.add_axes([0.91, place.y0, 0.015, place.height]))
-    bar.set_label("pole colour: " + view.tex)
-    return png_bytes(plt, fig)
 
 
 def _title(view):

@@ -5,7 +5,9 @@ The paper's loop is simulated at every cell (with the non-idealities of
 (``--loop``) is classified by its root count at every cell, with the
 D-decomposition drawn over the map, and with ``--simulate`` also simulated
 (:meth:`symstab.Loop.stability_map`: encoder quantization, force
-saturation, and Coulomb friction on the driven mass).  The output paths are
+saturation, and Coulomb friction on the driven mass).  Both run one flow
+(:func:`_map`): a plan checks every input first, then the cells are
+classified, simulated, written and summed up the same way.  The output paths are
 checked before the work and the files written atomically.
 """
 
@@ -19,7 +21,8 @@ from .._resources import CHUNK_BYTES, check_memory, chunk_slices
 from .loop_options import (add_loop_options, resolve_loop, uncertain_box,
                            uses_loop, value_text)
 from .options import add_command, add_model_options, resolve, stiffness_and_damping
-from ..drawing import draw_lines, png_bytes, pyplot_or_none, visible
+from ..drawing import (LIMIT_CYCLE_COLOR, LIMIT_CYCLE_LABEL, loop_map_png,
+                       probability_map_png, simulated_map_png)
 from .output import check_files, write_output
 from .simulation import (add_nonideal_options, check_loop_friction, loop_nonideal_text,
                          nonideal_text, resolve_nonideal, simulated_theory, with_option_names)
@@ -39,12 +42,6 @@ LOOP_PROBABILITY_HEADLINE = ("map --loop --uncertain: the probability that each 
 #: The first line of ``map --loop --simulate``.
 LOOP_SIMULATE_HEADLINE = ("map --loop --simulate: every cell simulated, the loop's certified "
                           "root count beside")
-
-#: The colour and legend of a cell whose run settles into a bounded limit cycle
-#: (:attr:`symstab.numeric.paper.simulate.Simulation.limit_cycle`): neither stable
-#: (green) nor growing (white).
-LIMIT_CYCLE_COLOR = "#fdb863"
-LIMIT_CYCLE_LABEL = "bounded limit cycle (simulated)"
 
 #: Bytes per map cell in the CSV and NPZ written, with the Python objects
 #: that build them (generous).
@@ -86,7 +83,57 @@ def run(args):
     if args.format != "table":
         raise ValueError(f"--format {args.format}: map writes its cells with --out (.csv or "
                          f".npz)")
-    return _loop(args) if uses_loop(args) else _paper(args)
+    if not uses_loop(args):
+        return _map(_PaperMap(args))
+    setup = resolve_loop(args)
+    if args.x_range is None or args.y_range is None:
+        raise ValueError("map --loop needs the grid: --x-range LOW,HIGH,N and --y-range LOW,HIGH,N")
+    xs, ys = _grid(args.x_range, "--x-range"), _grid(args.y_range, "--y-range")
+    out, png_path = map_outputs(args)
+    if args.uncertain is not None:
+        return _probability(args, setup, xs, ys, out, png_path)
+    return _map(_LoopMap(args, setup, xs, ys, out, png_path))
+
+
+def _map(plan):
+    """One map, of the paper's loop or of a loop file: ``plan`` checked, run, written, said.
+
+    ``plan`` (a :class:`_PaperMap` or a :class:`_LoopMap`) has checked
+    every input and decided the memory before anything is printed; here it
+    classifies the cells by their root counts, simulates them (the paper's
+    loop always, a loop file with ``--simulate``), writes the table and
+    the PNG, and says what it found.
+    """
+    for line in plan.echo:
+        print(line)
+    code = plan.classify()
+    simulated = plan.simulate()
+    data = plan.table(code, simulated)
+    image = plan.png(code, simulated) if plan.png_path is not None else None
+    write_output(plan.out, data, "--out")
+    written = [str(plan.out)]
+    if image is not None:
+        write_output(plan.png_path, image, "--png")
+        written.append(str(plan.png_path))
+    for line in plan.summary(code, simulated):
+        print(line)
+    print("wrote " + ", ".join(written))
+    return 0
+
+
+def _simulated_line(stable, limit_cycle, code, steps, conditions, against):
+    """The map's line on its simulation: how many cells are stable, cycle, differ from ``code``.
+
+    ``stable`` and ``limit_cycle`` in the orientation of ``code``.
+    """
+    from ..numeric.engine.roots import MARGINAL, STABLE
+
+    decided = code != MARGINAL
+    differ = int(np.count_nonzero((stable != (code == STABLE)) & decided))
+    return (f"{int(stable.sum())} of {stable.size} cells stable by simulation, "
+            f"{int(limit_cycle.sum())} bounded limit cycles ({steps} periods{conditions}); "
+            f"{differ} of the {int(decided.sum())} cells that are not marginal differ from "
+            f"{against}")
 
 
 #: Largest number of grid points along one axis of ``symstab map``.
@@ -125,58 +172,88 @@ def map_outputs(args):
     return paths["--out"], paths.get("--png")
 
 
-def _paper(args):
-    """The paper's loop simulated at every cell of the grid."""
-    from ..numeric.paper.simulate import check_device_nonideal, stability_map
-    from .._progress import progress_printer
-    from ..numeric.simulation.simulator import check_steps
-    from ..numeric.engine.roots import MARGINAL, STABLE
+class _PaperMap:
+    """``symstab map`` of the paper's loop: simulated at every cell, its theory's root count beside.
 
-    setup = resolve(args)
-    nonideal, x0 = resolve_nonideal(args, setup)
-    given = {}  # the grids as the user gave them, by flag: the PNG is drawn in their units
+    The loop simulated is the paper's with the non-idealities of the options
+    (:mod:`symstab.cli.simulation`), its filter and lag in it; its linear
+    part is the theory, classified before the run so that a refusal costs no
+    simulation.  Everything is checked at construction.
+    """
 
-    def grid(text, flag):
-        given[flag] = _grid(text, flag)
-        return given[flag]
+    def __init__(self, args):
+        from ..numeric.paper.simulate import check_device_nonideal
+        from ..numeric.simulation.simulator import check_steps
 
-    alpha, beta = (np.atleast_1d(x) for x in stiffness_and_damping(args, setup, grid))
-    out, png_path = map_outputs(args)
-    check_memory(f"a map of {alpha.size} x {beta.size} cells", alpha.size * beta.size * _MAP_CELL_BYTES)
-    steps = check_steps(args.steps, setup.d)
-    # The loop simulated, classified by its roots before the simulation (a
-    # refusal then costs no run): its linear part, filter and lag included.
-    theory = simulated_theory(setup, nonideal)
-    A, B = np.meshgrid(alpha, beta, indexing="ij")
-    code = theory.classify(A, B)
-    if setup.physical:
-        try:
-            # The simulator's own checks (the friction against the device), before the echo.
-            check_device_nonideal(nonideal, setup.device)
-        except ValueError as exc:
-            raise with_option_names(exc) from None
-    for line in setup.echo:
-        print(line)
-    result = stability_map(alpha=alpha, beta=beta, gamma=setup.gamma, d=setup.d,
-                           delta=None if setup.physical else setup.delta, steps=steps, x0=x0,
-                           device=setup.device, nonideal=nonideal,
-                           progress=progress_printer("simulating", steps))
-    exact = code == STABLE
-    physical = {}  # K_w and B_w beside alpha and beta, in the units of the echo
-    if setup.physical:
+        self.args = args
+        setup = self.setup = resolve(args)
+        self.nonideal, self.x0 = resolve_nonideal(args, setup)
+        given = self.given = {}  # the grids as the user gave them, by flag: the PNG's units
+
+        def grid(text, flag):
+            given[flag] = _grid(text, flag)
+            return given[flag]
+
+        alpha, beta = (np.atleast_1d(x) for x in stiffness_and_damping(args, setup, grid))
+        self.alpha, self.beta = alpha, beta
+        self.out, self.png_path = map_outputs(args)
+        check_memory(f"a map of {alpha.size} x {beta.size} cells",
+                     alpha.size * beta.size * _MAP_CELL_BYTES)
+        self.steps = check_steps(args.steps, setup.d)
+        # The loop simulated, classified by its roots before the simulation (a
+        # refusal then costs no run): its linear part, filter and lag included.
+        self.theory = simulated_theory(setup, self.nonideal)
+        A, B = np.meshgrid(alpha, beta, indexing="ij")
+        self.code = self.theory.classify(A, B)
+        if setup.physical:
+            try:
+                # The simulator's own checks (the friction against the device), before the echo.
+                check_device_nonideal(self.nonideal, setup.device)
+            except ValueError as exc:
+                raise with_option_names(exc) from None
+        self.echo = setup.echo
+
+    def classify(self):
+        """The root counts of the loop simulated, ``(alpha, beta)``."""
+        return self.code
+
+    def simulate(self):
+        """The paper's loop simulated at every cell (the paper's adapter on the loop simulator)."""
+        from ..numeric.paper.simulate import stability_map
+        from .._progress import progress_printer
+
+        setup = self.setup
+        return stability_map(alpha=self.alpha, beta=self.beta, gamma=setup.gamma, d=setup.d,
+                             delta=None if setup.physical else setup.delta, steps=self.steps,
+                             x0=self.x0, device=setup.device, nonideal=self.nonideal,
+                             progress=progress_printer("simulating", self.steps))
+
+    def _physical(self):
+        """K_w and B_w beside alpha and beta, in the units of the echo (none without a device)."""
+        setup, alpha, beta = self.setup, self.alpha, self.beta
+        if not setup.physical:
+            return {}
         dev = setup.device
-        physical = {"K_w": given.get("--Kw", np.atleast_1d(dev.stiffness(alpha))),
-                    "B_w": given.get("--Bw", np.atleast_1d(dev.damping(beta)))}
-    if out.suffix == ".npz":
-        buf = io.BytesIO()
-        units = {f"{name}_unit": np.array(setup.units[name]) for name in physical}
-        np.savez(buf, alpha=alpha, beta=beta, **physical, **units, stable=result.stable,
-                 limit_cycle=result.limit_cycle, growth=result.growth, exact_stable=exact,
-                 exact_code=code, gamma=setup.gamma, d=setup.d, delta=setup.delta, steps=steps,
-                 nonidealities=np.array(nonideal_text(nonideal, args)),
-                 theory=np.array(theory.description))
-        data = buf.getvalue()
-    else:
+        return {"K_w": self.given.get("--Kw", np.atleast_1d(dev.stiffness(alpha))),
+                "B_w": self.given.get("--Bw", np.atleast_1d(dev.damping(beta)))}
+
+    def table(self, code, result):
+        """The map's file: NPZ bytes or CSV text, by the suffix of ``--out``."""
+        from ..numeric.engine.roots import STABLE
+
+        setup, alpha, beta, steps = self.setup, self.alpha, self.beta, self.steps
+        exact = code == STABLE
+        physical = self._physical()
+        if self.out.suffix == ".npz":
+            buf = io.BytesIO()
+            units = {f"{name}_unit": np.array(setup.units[name]) for name in physical}
+            np.savez(buf, alpha=alpha, beta=beta, **physical, **units, stable=result.stable,
+                     limit_cycle=result.limit_cycle, growth=result.growth, exact_stable=exact,
+                     exact_code=code, gamma=setup.gamma, d=setup.d, delta=setup.delta,
+                     steps=steps, nonidealities=np.array(nonideal_text(self.nonideal, self.args)),
+                     theory=np.array(self.theory.description))
+            return buf.getvalue()
+        A, B = np.meshgrid(alpha, beta, indexing="ij")
         buf = io.StringIO()
         columns = ["alpha", "beta"] + [f"{name} [{setup.units[name]}]" for name in physical]
         buf.write(",".join(columns + ["stable", "limit_cycle", "exact_stable", "growth"]) + "\n")
@@ -189,20 +266,17 @@ def _paper(args):
                                        result.growth.ravel()):
             buf.write(",".join(f"{v:.12g}" for v in values)
                       + f",{int(s)},{int(c)},{int(e)},{g:.6g}\n")
-        data = buf.getvalue().encode()
-    png = _paper_png(args, setup, result, nonideal, given, theory) if png_path is not None else None
-    write_output(out, data, "--out")
-    written = [str(out)]
-    if png is not None:
-        write_output(png_path, png, "--png")
-        written.append(str(png_path))
-    decided = code != MARGINAL
-    differ = int(np.count_nonzero((result.stable != exact) & decided))
-    print(f"{int(result.stable.sum())} of {result.stable.size} cells stable by simulation, "
-          f"{int(result.limit_cycle.sum())} bounded limit cycles ({steps} periods); {differ} of the {int(decided.sum())} cells that are not marginal "
-          f"differ from the root-counting classification of the {theory.description}")
-    print("wrote " + ", ".join(written))
-    return 0
+        return buf.getvalue().encode()
+
+    def png(self, code, result):
+        """The map's PNG bytes (None without matplotlib)."""
+        return _paper_png(self.args, self.setup, result, self.nonideal, self.given, self.theory)
+
+    def summary(self, code, result):
+        """The lines that say what the map found."""
+        return [_simulated_line(result.stable, result.limit_cycle, code, self.steps, "",
+                                f"the root-counting classification of the "
+                                f"{self.theory.description}")]
 
 
 def _keep_nan(convert):
@@ -246,44 +320,24 @@ def _map_title(setup, nonideal, args, steps_text):
 
 
 def _paper_png(args, setup, result, nonideal, given, theory):
-    """The map as PNG bytes, or None without matplotlib.
+    """The map as PNG bytes, or None without matplotlib (:func:`symstab.drawing.simulated_map_png`).
 
     Drawn in the units of the grids the user gave (K_w, B_w or alpha, beta),
     with the non-idealities of the simulation in the title and the boundary
     of the loop simulated (its linear part, ``theory``) over it.
     """
-    plt = pyplot_or_none()
-    if plt is None:
-        return None
-    from matplotlib.colors import ListedColormap
-
     x, y, xlabel, ylabel, to_x, to_y = _map_axes(setup, given, result)
-    fig, ax = plt.subplots(figsize=(6.4, 4.8), dpi=120)
-    # result's arrays are (alpha, beta): y by x, as pcolormesh takes them.
-    ax.pcolormesh(x, y, np.where(result.stable, 1, np.where(result.limit_cycle, 2, 0)),
-                  shading="nearest", cmap=ListedColormap(["white", "#7fc97f", LIMIT_CYCLE_COLOR]),
-                  vmin=0, vmax=2)
     arc_beta, arc_alpha, lines = theory.boundary(((result.beta[0], result.beta[-1]),
                                                   (result.alpha[0], result.alpha[-1])))
-    drawn = []
-    if np.any(np.isfinite(arc_beta)):
-        name = ("the ideal loop, eq. (7)" if theory.loop is None
-                else f"the {theory.label} (D-decomposition)")
-        drawn += ax.plot(to_x(arc_beta), to_y(arc_alpha), "k-", lw=1.2,
-                         label=f"boundary of {name}")
-    drawn += draw_lines(ax, lines, result.beta, result.alpha, to_x, to_y)
-    if np.any(result.limit_cycle):
-        from matplotlib.patches import Patch
-        drawn.append(Patch(facecolor=LIMIT_CYCLE_COLOR, label=LIMIT_CYCLE_LABEL))
-    ax.set_xlim(x[0], x[-1])
-    ax.set_ylim(y[0], y[-1])
-    ax.set_xlabel(xlabel)
-    ax.set_ylabel(ylabel)
-    ax.set_title(_map_title(setup, nonideal, args, f"{result.steps} periods"), fontsize=10)
-    if drawn:
-        ax.legend(handles=drawn, loc="upper right", fontsize=9)
-    fig.tight_layout()
-    return png_bytes(plt, fig)
+    name = ("the ideal loop, eq. (7)" if theory.loop is None
+            else f"the {theory.label} (D-decomposition)")
+    # result's arrays are (alpha, beta): y by x, as the map is drawn.
+    return simulated_map_png(
+        x, y, result.stable, result.limit_cycle,
+        boundary={"curve": (arc_beta, arc_alpha), "label": f"boundary of {name}", "lines": lines,
+                  "plane": (result.beta, result.alpha), "to_x": to_x, "to_y": to_y},
+        xlabel=xlabel, ylabel=ylabel,
+        title=_map_title(setup, nonideal, args, f"{result.steps} periods"))
 
 
 #: The simulation options ``map --loop`` takes with ``--simulate`` only.
@@ -295,97 +349,132 @@ _LOOP_SIMULATION_OPTIONS = (("--steps", "steps"), ("--x0", "x0"),
                             ("--stiction", "stiction"), ("--substeps", "substeps"))
 
 
-def _loop(args):
-    """A loop file classified by its root counts at every cell of the grid (and simulated)."""
-    from .._progress import progress_printer
-    from ..numeric.simulation.simulator import check_steps
-    from ..numeric.engine.roots import MARGINAL, STABLE
+class _LoopMap:
+    """``symstab map --loop``: a loop file's root counts at every cell, and its simulation.
 
-    setup = resolve_loop(args)
-    if args.x_range is None or args.y_range is None:
-        raise ValueError("map --loop needs the grid: --x-range LOW,HIGH,N and --y-range LOW,HIGH,N")
-    xs, ys = _grid(args.x_range, "--x-range"), _grid(args.y_range, "--y-range")
-    out, png_path = map_outputs(args)
-    if args.uncertain is not None:
-        return _probability(args, setup, xs, ys, out, png_path)
-    for flag, dest in (("--samples", "samples"), ("--seed", "seed")):
-        if getattr(args, dest) is not None:
-            raise ValueError(f"{flag} counts the draws of --uncertain: add --uncertain NAME=LO:HI")
-    loop, values = setup.loop, setup.values
-    simulate = bool(args.simulate)
-    if not simulate:
-        for flag, dest in _LOOP_SIMULATION_OPTIONS:
-            if getattr(args, dest) not in (None, False):
-                raise ValueError(f"{flag} is an option of the simulation: add --simulate")
-    else:
-        nonideal, x0 = resolve_nonideal(args, None, loop)
-        steps = check_steps(args.steps, values["d"])
-        # The difference equations at one cell: a plant they cannot step is refused now.
-        loop.difference_equations(**{setup.x: xs[0], setup.y: ys[0]}, **values)
-        X, Y = np.meshgrid(xs, ys, indexing="ij")
-        check_loop_friction(nonideal, loop, {setup.x: X, setup.y: Y, **values})
-    degree = loop.coefficients(**{setup.x: 0.0, setup.y: 0.0}, **values).shape[-1]
-    # The cells are classified a chunk of x at a time; what stays is the codes
-    # and the file's text.
-    check_memory(f"a map of {xs.size} x {ys.size} cells",
-                 xs.size * ys.size * _MAP_CELL_BYTES
-                 + max(CHUNK_BYTES, ys.size * _BYTES_PER_COEFFICIENT * degree))
-    print(LOOP_SIMULATE_HEADLINE if simulate else LOOP_MAP_HEADLINE)
-    for line in setup.echo:
-        print(line)
-    code = np.empty((xs.size, ys.size), dtype=np.int8)
-    progress = progress_printer("classifying", xs.size)
-    for part in chunk_slices(xs.size, ys.size * _BYTES_PER_COEFFICIENT * degree, CHUNK_BYTES):
-        X, Y = np.meshgrid(xs[part], ys, indexing="ij")
-        code[part] = loop.classify(**{setup.x: X, setup.y: Y}, **values)
-        progress(part.stop)
-    stable = code == STABLE
-    simulated = None
-    if simulate:
-        simulated = loop.stability_map(xs, ys, x=setup.x, y=setup.y, steps=steps, x0=x0,
-                                       nonideal=nonideal,
-                                       progress=progress_printer("simulating", steps),
-                                       **{k: v for k, v in values.items()})
-    if out.suffix == ".npz":
+    Classified by the certified root counts a chunk of x at a time; with
+    ``--simulate`` also simulated (:meth:`symstab.Loop.stability_map`:
+    encoder quantization, force saturation, Coulomb friction on the driven
+    mass).  Everything is checked at construction.
+    """
+
+    def __init__(self, args, setup, xs, ys, out, png_path):
+        for flag, dest in (("--samples", "samples"), ("--seed", "seed")):
+            if getattr(args, dest) is not None:
+                raise ValueError(f"{flag} counts the draws of --uncertain: add --uncertain "
+                                 f"NAME=LO:HI")
+        self.setup, self.xs, self.ys, self.out, self.png_path = setup, xs, ys, out, png_path
+        loop, values = setup.loop, setup.values
+        self.nonideal, self.x0, self.steps = _loop_simulation(args, setup, xs, ys)
+        self.degree = loop.coefficients(**{setup.x: 0.0, setup.y: 0.0}, **values).shape[-1]
+        # The cells are classified a chunk of x at a time; what stays is the codes
+        # and the file's text.
+        check_memory(f"a map of {xs.size} x {ys.size} cells",
+                     xs.size * ys.size * _MAP_CELL_BYTES
+                     + max(CHUNK_BYTES, ys.size * _BYTES_PER_COEFFICIENT * self.degree))
+        self.echo = [LOOP_SIMULATE_HEADLINE if self.steps is not None else LOOP_MAP_HEADLINE,
+                     *setup.echo]
+
+    def classify(self):
+        """The certified root counts, ``(x, y)``."""
+        from .._progress import progress_printer
+
+        setup, xs, ys = self.setup, self.xs, self.ys
+        code = np.empty((xs.size, ys.size), dtype=np.int8)
+        progress = progress_printer("classifying", xs.size)
+        for part in chunk_slices(xs.size, ys.size * _BYTES_PER_COEFFICIENT * self.degree,
+                                 CHUNK_BYTES):
+            X, Y = np.meshgrid(xs[part], ys, indexing="ij")
+            code[part] = setup.loop.classify(**{setup.x: X, setup.y: Y}, **setup.values)
+            progress(part.stop)
+        return code
+
+    def simulate(self):
+        """The loop simulated at every cell (``(y, x)``), or None without ``--simulate``."""
+        from .._progress import progress_printer
+
+        if self.steps is None:
+            return None
+        setup = self.setup
+        return setup.loop.stability_map(self.xs, self.ys, x=setup.x, y=setup.y,
+                                        steps=self.steps, x0=self.x0, nonideal=self.nonideal,
+                                        progress=progress_printer("simulating", self.steps),
+                                        **{k: v for k, v in setup.values.items()})
+
+    def table(self, code, simulated):
+        """The map's file: NPZ bytes or CSV text, by the suffix of ``--out``."""
+        from ..numeric.engine.roots import STABLE
+
+        setup, xs, ys = self.setup, self.xs, self.ys
+        if self.out.suffix != ".npz":
+            return _loop_csv(setup, xs, ys, code, simulated)
         extra = {} if simulated is None else {
             "simulated_stable": simulated.stable.T,
             "simulated_limit_cycle": simulated.limit_cycle.T, "growth": simulated.growth.T,
-            "steps": steps, "x0": x0, "nonidealities": np.array(loop_nonideal_text(nonideal))}
-        data = _loop_npz(setup, xs, ys, values, code=code, stable=stable, **extra)
-    else:
-        X, Y = np.meshgrid(xs, ys, indexing="ij")
-        buf = io.StringIO()
-        buf.write(f"{setup.label(setup.x)},{setup.label(setup.y)},code,stable"
-                  + (",simulated_stable,simulated_limit_cycle,growth" if simulated is not None
-                     else "") + "\n")
-        columns = [X.ravel(), Y.ravel(), code.ravel()]
+            "steps": self.steps, "x0": self.x0,
+            "nonidealities": np.array(loop_nonideal_text(self.nonideal))}
+        return _loop_npz(setup, xs, ys, setup.values, code=code, stable=code == STABLE, **extra)
+
+    def png(self, code, simulated):
+        """The map's PNG bytes (None without matplotlib)."""
+        return _loop_png(self.setup, self.xs, self.ys, code, simulated)
+
+    def summary(self, code, simulated):
+        """The lines that say what the map found."""
+        from ..numeric.engine.roots import MARGINAL, STABLE
+
+        lines = [f"{int((code == STABLE).sum())} of {code.size} cells stable, "
+                 f"{int((code == MARGINAL).sum())} marginal (code 1 stable, 0 marginal, -1 "
+                 f"unstable; certified root counts)"]
         if simulated is not None:
-            columns += [simulated.stable.T.ravel(), simulated.limit_cycle.T.ravel(),
-                        simulated.growth.T.ravel()]
-        for xv, yv, c, *sim in zip(*columns):
-            row = f"{xv:.12g},{yv:.12g},{int(c)},{int(c == STABLE)}"
-            if sim:
-                row += f",{int(sim[0])},{int(sim[1])},{sim[2]:.6g}"
-            buf.write(row + "\n")
-        data = buf.getvalue()
-    image = (_loop_png(setup, xs, ys, code, None if simulated is None else simulated)
-             if png_path is not None else None)
-    write_output(out, data, "--out")
-    written = [str(out)]
-    if image is not None:
-        write_output(png_path, image, "--png")
-        written.append(str(png_path))
-    print(f"{int(stable.sum())} of {code.size} cells stable, {int((code == MARGINAL).sum())} "
-          f"marginal (code 1 stable, 0 marginal, -1 unstable; certified root counts)")
+            lines.append(_simulated_line(simulated.stable.T, simulated.limit_cycle, code,
+                                         self.steps, f"; {loop_nonideal_text(self.nonideal)}",
+                                         "the root counts (a limit cycle is not stable)"))
+        return lines
+
+
+def _loop_simulation(args, setup, xs, ys):
+    """``(nonideal, x0, steps)`` of ``map --loop --simulate``, checked before any work.
+
+    Without ``--simulate``: ``(None, None, None)``, and a simulation option
+    given is refused.
+    """
+    from ..numeric.simulation.simulator import check_steps
+
+    loop, values = setup.loop, setup.values
+    if not args.simulate:
+        for flag, dest in _LOOP_SIMULATION_OPTIONS:
+            if getattr(args, dest) not in (None, False):
+                raise ValueError(f"{flag} is an option of the simulation: add --simulate")
+        return None, None, None
+    nonideal, x0 = resolve_nonideal(args, None, loop)
+    steps = check_steps(args.steps, values["d"])
+    # The difference equations at one cell: a plant they cannot step is refused now.
+    loop.difference_equations(**{setup.x: xs[0], setup.y: ys[0]}, **values)
+    X, Y = np.meshgrid(xs, ys, indexing="ij")
+    check_loop_friction(nonideal, loop, {setup.x: X, setup.y: Y, **values})
+    return nonideal, x0, steps
+
+
+def _loop_csv(setup, xs, ys, code, simulated=None):
+    """A loop map's CSV text: a row a cell, its root count, and its simulation where one ran."""
+    from ..numeric.engine.roots import STABLE
+
+    X, Y = np.meshgrid(xs, ys, indexing="ij")
+    buf = io.StringIO()
+    buf.write(f"{setup.label(setup.x)},{setup.label(setup.y)},code,stable"
+              + (",simulated_stable,simulated_limit_cycle,growth" if simulated is not None
+                 else "") + "\n")
+    columns = [X.ravel(), Y.ravel(), code.ravel()]
     if simulated is not None:
-        decided = code != MARGINAL
-        differ = int(np.count_nonzero((simulated.stable.T != stable) & decided))
-        print(f"{int(simulated.stable.sum())} of {code.size} cells stable by simulation, "
-              f"{int(simulated.limit_cycle.sum())} bounded limit cycles ({steps} periods; "
-              f"{loop_nonideal_text(nonideal)}); {differ} of the {int(decided.sum())} cells "
-              f"that are not marginal differ from the root counts (a limit cycle is not stable)")
-    print("wrote " + ", ".join(written))
-    return 0
+        columns += [simulated.stable.T.ravel(), simulated.limit_cycle.T.ravel(),
+                    simulated.growth.T.ravel()]
+    for xv, yv, c, *sim in zip(*columns):
+        row = f"{xv:.12g},{yv:.12g},{int(c)},{int(c == STABLE)}"
+        if sim:
+            row += f",{int(sim[0])},{int(sim[1])},{sim[2]:.6g}"
+        buf.write(row + "\n")
+    return buf.getvalue()
 
 
 def _loop_npz(setup, xs, ys, values, **arrays):
@@ -462,88 +551,57 @@ def _probability(args, setup, xs, ys, out, png_path):
 
 def _probability_png(setup, found, fixed, drawn):
     """The probability map as PNG bytes (None without matplotlib), the nominal boundary over it."""
-    plt = pyplot_or_none()
-    if plt is None:
-        return None
     xs, ys = found.x_values, found.y_values
-    fig, ax = plt.subplots(figsize=(6.4, 4.8), dpi=120)
-    mesh = ax.pcolormesh(xs, ys, found.probability, shading="nearest", vmin=0.0, vmax=1.0,
-                         cmap="Greens")
-    fig.colorbar(mesh, ax=ax, label="probability of stability")
-    handles = _draw_boundary(ax, setup, xs, ys, "nominal loop: ")
-    _axes(ax, setup, xs, ys)
     rest = ", ".join(value_text(setup, n, fixed[n]).replace(" ", "\u00a0")
                      for n in setup.loop.parameters if n in fixed)
-    ax.set_title("\n".join([f"loop {setup.loop.name}: probability of stability, "
-                            f"{found.samples} draws"] + textwrap.wrap(", ".join(drawn), 80)
-                           + textwrap.wrap(rest, 80)), fontsize=8)
-    if handles:
-        ax.legend(handles=handles, loc="best", fontsize=8, framealpha=0.9)
-    fig.tight_layout()
-    return png_bytes(plt, fig)
+    title = "\n".join([f"loop {setup.loop.name}: probability of stability, "
+                       f"{found.samples} draws"] + textwrap.wrap(", ".join(drawn), 80)
+                      + textwrap.wrap(rest, 80))
+    return probability_map_png(found, _boundary(setup, xs, ys), **_axis_labels(setup),
+                               title=title)
 
 
-def _draw_boundary(ax, setup, xs, ys, label=""):
-    """The loop's D-decomposition at ``setup.values`` drawn on ``ax``; the legend's handles."""
-    curve = setup.loop.boundary(x=setup.x, y=setup.y, window=((xs[0], xs[-1]), (ys[0], ys[-1])),
-                                **setup.values)
-    bx, by = visible(curve.x_values, xs[0], xs[-1]), visible(curve.y_values, ys[0], ys[-1])
-    bx[np.isnan(by)] = np.nan
-    handles = []
-    if np.any(np.isfinite(bx)):
-        handles += ax.plot(bx, by, "k-", lw=1.2,
-                           label=label + r"$z = e^{j\theta}$ root (D-decomposition)")
-    return handles + draw_lines(ax, curve.lines, xs, ys)
+def _boundary(setup, xs, ys):
+    """The loop's D-decomposition at ``setup.values`` over the map's window."""
+    return setup.loop.boundary(x=setup.x, y=setup.y, window=((xs[0], xs[-1]), (ys[0], ys[-1])),
+                               **setup.values)
 
 
-def _axes(ax, setup, xs, ys):
-    """The map's limits and its axes' names with their units."""
-    ax.set_xlim(xs[0], xs[-1])
-    ax.set_ylim(ys[0], ys[-1])
-    for name, set_label in ((setup.x, ax.set_xlabel), (setup.y, ax.set_ylabel)):
+def _axis_labels(setup):
+    """The map's axes' names with their units: ``{"xlabel": ..., "ylabel": ...}``."""
+    labels = {}
+    for name, key in ((setup.x, "xlabel"), (setup.y, "ylabel")):
         unit = setup.unit(name)
-        set_label(f"{name} [{tex_unit(unit)}]" if unit else name)
+        labels[key] = f"{name} [{tex_unit(unit)}]" if unit else name
+    return labels
 
 
 def _loop_png(setup, xs, ys, code, simulated=None):
     """The map as PNG bytes (None without matplotlib), with the D-decomposition drawn over it.
 
     Shaded by the root counts, or by the simulation (``simulated``, a
-    :class:`~symstab.numeric.paper.simulate.StabilityMap`) where one ran: its
+    :class:`~symstab.numeric.simulation.simulator.StabilityMap`) where one ran: its
     stable cells and its bounded limit cycles, each its own colour; the
     D-decomposition drawn over it is the root counts' boundary.
     """
     from ..numeric.engine.roots import MARGINAL, STABLE
 
-    plt = pyplot_or_none()
-    if plt is None:
-        return None
-    from matplotlib.colors import ListedColormap
-    from matplotlib.patches import Patch
-
     loop, x, y = setup.loop, setup.x, setup.y
-    fig, ax = plt.subplots(figsize=(6.4, 4.8), dpi=120)
     if simulated is None:
         shade = np.where(code == STABLE, 2, np.where(code == MARGINAL, 1, 0)).T
     else:
         shade = np.where(simulated.stable, 2, np.where(simulated.limit_cycle, 3, 0))
-    ax.pcolormesh(xs, ys, shade, shading="nearest", vmin=0, vmax=3,
-                  cmap=ListedColormap(["white", "#bdbdbd", "#7fc97f", LIMIT_CYCLE_COLOR]))
-    handles = [Patch(facecolor="#7fc97f", label="stable" if simulated is None
-                     else "stable by simulation")]
+    legend = [("#7fc97f", "stable" if simulated is None else "stable by simulation")]
     if simulated is None and np.any(code == MARGINAL):
-        handles.append(Patch(facecolor="#bdbdbd", label="marginal"))
+        legend.append(("#bdbdbd", "marginal"))
     if simulated is not None and np.any(simulated.limit_cycle):
-        handles.append(Patch(facecolor=LIMIT_CYCLE_COLOR, label=LIMIT_CYCLE_LABEL))
-    handles += _draw_boundary(ax, setup, xs, ys)
-    _axes(ax, setup, xs, ys)
+        legend.append((LIMIT_CYCLE_COLOR, LIMIT_CYCLE_LABEL))
     # Wrapped to the width of the figure (a two-mass device has eight values),
     # between values only: no-break spaces inside each.
     fixed = ", ".join(value_text(setup, n, setup.values[n]).replace(" ", "\u00a0")
                       for n in loop.parameters if n in setup.values)
     how = "root counts" if simulated is None else "simulated; lines: root counts"
-    ax.set_title("\n".join([f"loop {loop.name}: stable set in the ({x}, {y}) plane ({how})"]
-                           + textwrap.wrap(fixed, 80)), fontsize=9)
-    ax.legend(handles=handles, loc="best", fontsize=8, framealpha=0.9)
-    fig.tight_layout()
-    return png_bytes(plt, fig)
+    title = "\n".join([f"loop {loop.name}: stable set in the ({x}, {y}) plane ({how})"]
+                      + textwrap.wrap(fixed, 80))
+    return loop_map_png(xs, ys, shade, legend, _boundary(setup, xs, ys), **_axis_labels(setup),
+                        title=title)

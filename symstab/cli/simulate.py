@@ -1,7 +1,12 @@
 """``symstab simulate``: simulate a loop at one point; write its trajectory as CSV.
 
-The paper's loop by default; a loop file with ``--loop`` (its values
-changed by ``--set``), run by :meth:`symstab.Loop.simulate`.
+The paper's loop by default (its options build the paper's loop, with the
+velocity filter and the actuator lag in it, run by the paper's adapter on
+the loop simulator, :func:`symstab.numeric.paper.simulate.simulate`); a
+loop file with ``--loop`` (its values changed by ``--set``), run by
+:meth:`symstab.Loop.simulate`.  Both go through one flow: a plan of the run
+(checked before anything runs or is printed), the run, the same verdict
+(stable, a limit cycle, held at rest by friction) and the same files.
 
 The device and delay options are those of the numeric commands
 (:mod:`symstab.cli.options`), the non-idealities those of
@@ -10,6 +15,7 @@ simulation and the file is written atomically (:mod:`symstab.cli.output`):
 a failed or interrupted run leaves nothing behind.
 """
 
+import dataclasses
 import io
 
 import numpy as np
@@ -49,15 +55,40 @@ def register(subparsers):
     add_loop_options(p, "simulate")
 
 
+@dataclasses.dataclass
+class _Plan:
+    """One simulation, checked and ready to run: what the flow prints and writes around it.
+
+    The paper's options and a loop file (``--loop``) each build one; the
+    rest of ``symstab simulate`` is the same for both.
+    """
+
+    run: object             # run(): the Simulation (the paper's loop or the loop file's)
+    x0: float
+    nonideal: object        # the Nonidealities simulated
+    code: int               # the theory's root count: STABLE, MARGINAL or UNSTABLE
+    radius: float           # the theory's spectral radius
+    theory: str             # what the theory is, for its line
+    echo: list              # the inputs' echo, printed once the run is done
+    point: str = None       # the point's line (the paper's options), or None
+    conditions: str = ""    # the non-idealities beside the run's line (a loop file's)
+    csv_header: str = ""    # the trajectory's CSV header (without its newline)
+    period: float = 1.0     # seconds (or periods) per step, the CSV's t column
+    record: bool = False    # the trajectory is kept (for --out, or the verdict)
+
+
 def run(args):
     """Run ``symstab simulate``; return the exit status."""
     if args.format != "table":
         raise ValueError(f"--format {args.format}: simulate prints its verdict as text and "
                          f"writes the trajectory as CSV with --out")
-    if uses_loop(args):
-        return _loop(args)
+    plan = _loop_plan(args) if uses_loop(args) else _paper_plan(args)
+    return _simulate(args, plan)
+
+
+def _paper_plan(args):
+    """The paper's loop at one point of the paper's options: the loop simulated, its theory."""
     from ..numeric.paper.simulate import simulate
-    from ..numeric.engine.roots import MARGINAL, STABLE, UNSTABLE
     from .._progress import progress_printer
     from ..numeric.simulation.simulator import check_steps
 
@@ -74,50 +105,39 @@ def run(args):
     theory = simulated_theory(setup, nonideal)
     code = theory.classify(alpha, beta)
     radius = theory.spectral_radius(alpha, beta)
-    try:
-        run = simulate(alpha=alpha, beta=beta, gamma=setup.gamma, d=setup.d,
-                       delta=None if setup.physical else setup.delta, steps=steps, x0=x0,
-                       device=setup.device, nonideal=nonideal, record=record,
-                       progress=progress_printer("simulating", steps))
-    except (TypeError, ValueError) as exc:
-        # Its checks before the run (the friction against the device) name the options.
-        raise with_option_names(exc) from None
-    for line in setup.echo:
-        print(line)
-    verdict = "diverged (unstable)" if run.diverged else ("stable" if run.stable else "unstable")
-    amp = run.amplitude
-    print(f"point: alpha = {alpha:.10g}, beta = {beta:.10g}"
-          + (f" (K_w = {float(setup.device.stiffness(alpha)):.10g} {setup.units['K_w']}, "
-             f"B_w = {float(setup.device.damping(beta)):.10g} {setup.units['B_w']})" if setup.physical else ""))
-    print(f"simulated {run.steps} periods from x0 = {x0:g}: {verdict}; max |x| per quarter: "
-          + ", ".join(f"{a:.4g}" for a in amp))
-    print(f"theory ({theory.description}): spectral radius {radius:.12g} -> "
-          + {STABLE: "stable", MARGINAL: "marginal", UNSTABLE: "unstable"}[code])
-    if args.out is not None:
-        k = np.arange(run.steps + 1)
-        t = k * (setup.device.T if setup.physical else 1.0)
-        buf = io.StringIO()
-        buf.write(("k,t [s]," if setup.physical else "k,t [T],")
-                  + ("x [rad]" if setup.physical and not args.linear else
-                     "x [m]" if setup.physical else "x") + "\n")
-        np.savetxt(buf, np.column_stack([k, t, run.positions]), delimiter=",", fmt=["%d", "%.9g", "%.17g"])
-        write_output(args.out, buf.getvalue(), "--out")
-        print(f"wrote the trajectory to {args.out}")
-    return 0
+
+    def run_paper():
+        try:
+            return simulate(alpha=alpha, beta=beta, gamma=setup.gamma, d=setup.d,
+                            delta=None if setup.physical else setup.delta, steps=steps, x0=x0,
+                            device=setup.device, nonideal=nonideal, record=record,
+                            progress=progress_printer("simulating", steps))
+        except (TypeError, ValueError) as exc:
+            # Its checks before the run (the friction against the device) name the options.
+            raise with_option_names(exc) from None
+
+    point = (f"point: alpha = {alpha:.10g}, beta = {beta:.10g}"
+             + (f" (K_w = {float(setup.device.stiffness(alpha)):.10g} {setup.units['K_w']}, "
+                f"B_w = {float(setup.device.damping(beta)):.10g} {setup.units['B_w']})"
+                if setup.physical else ""))
+    header = (("k,t [s]," if setup.physical else "k,t [T],")
+              + ("x [rad]" if setup.physical and not args.linear else
+                 "x [m]" if setup.physical else "x"))
+    return _Plan(run_paper, x0, nonideal, code, radius, theory.description, setup.echo,
+                 point=point, csv_header=header,
+                 period=setup.device.T if setup.physical else 1.0, record=record)
 
 
-def _loop(args):
-    """A loop file simulated at its values changed by ``--set``, its root count beside."""
+def _loop_plan(args):
+    """A loop file at its values changed by ``--set``: the loop simulated, its root count."""
     from .._progress import progress_printer
     from ..numeric.simulation.simulator import check_steps
-    from ..numeric.engine.roots import MARGINAL, STABLE, UNSTABLE
 
     setup = resolve_loop(args, plane=False)
     loop, values = setup.loop, setup.values
     nonideal, x0 = resolve_nonideal(args, None, loop)
     _check_out(args.out)
     steps = check_steps(args.steps, values["d"])
-    record = args.out is not None
     # One point: its trajectory is kept (the verdict tells a mass held by
     # friction from a limit cycle by it).
     check_memory(f"the trajectory of {steps} periods", (steps + 1) * _TRAJECTORY_ROW_BYTES)
@@ -125,35 +145,58 @@ def _loop(args):
     check_loop_friction(nonideal, loop, values)
     code = int(loop.classify(**values))
     radius = float(loop.spectral_radius(**values))
-    run = loop.simulate(steps=steps, x0=x0, nonideal=nonideal, record=True,
-                        progress=progress_printer("simulating", steps), **values)
-    for line in setup.echo:
+
+    def run_file():
+        return loop.simulate(steps=steps, x0=x0, nonideal=nonideal, record=True,
+                             progress=progress_printer("simulating", steps), **values)
+
+    return _Plan(run_file, x0, nonideal, code, radius, "the loop's certified root count",
+                 setup.echo, conditions=f" ({loop_nonideal_text(nonideal)})",
+                 csv_header=f"k,t [s],x (SI; {value_text(setup, 'T', values['T'])})",
+                 period=float(values["T"]), record=True)
+
+
+def _simulate(args, plan):
+    """Run ``plan``; print the inputs, the verdict and the theory; write the trajectory."""
+    from ..numeric.engine.roots import MARGINAL, STABLE, UNSTABLE
+
+    run = plan.run()
+    for line in plan.echo:
         print(line)
-    verdict = "diverged (unstable)" if run.diverged else ("stable" if run.stable else "unstable")
-    last = run.positions[-(run.steps // 4):]
-    if run.limit_cycle:
-        # The simulator's class (Simulation.limit_cycle), as the map's cells.
-        verdict = (f"bounded, not decaying (a limit cycle of amplitude {run.amplitude[3]:.4g}: "
-                   f"neither stable nor growing)")
-    elif run.stable and np.all(last == last[-1]) and nonideal.coulomb_friction is not None:
-        verdict = f"stable (held at rest by friction at x = {last[-1]:.4g})"
-    elif run.stable and 0.9 * run.amplitude[2] <= run.amplitude[3] <= run.floor:
-        verdict = (f"bounded (a limit cycle of amplitude {run.amplitude[3]:.4g}, within "
-                   f"{float(run.floor):.4g}, the most the quantization can move the "
-                   f"position here)")
-    print(f"simulated {run.steps} periods from x0 = {x0:g} ({loop_nonideal_text(nonideal)}): "
-          f"{verdict}; max |x| per quarter: " + ", ".join(f"{a:.4g}" for a in run.amplitude))
-    print(f"theory (the loop's certified root count): spectral radius {radius:.12g} -> "
-          + {STABLE: "stable", MARGINAL: "marginal", UNSTABLE: "unstable"}[code])
-    if record:
+    if plan.point is not None:
+        print(plan.point)
+    print(f"simulated {run.steps} periods from x0 = {plan.x0:g}{plan.conditions}: "
+          f"{_verdict(run, plan.nonideal)}; max |x| per quarter: "
+          + ", ".join(f"{a:.4g}" for a in run.amplitude))
+    print(f"theory ({plan.theory}): spectral radius {plan.radius:.12g} -> "
+          + {STABLE: "stable", MARGINAL: "marginal", UNSTABLE: "unstable"}[plan.code])
+    if args.out is not None:
         k = np.arange(run.steps + 1)
         buf = io.StringIO()
-        buf.write(f"k,t [s],x (SI; {value_text(setup, 'T', values['T'])})\n")
-        np.savetxt(buf, np.column_stack([k, k * float(values["T"]), run.positions]),
-                   delimiter=",", fmt=["%d", "%.9g", "%.17g"])
+        buf.write(plan.csv_header + "\n")
+        np.savetxt(buf, np.column_stack([k, k * plan.period, run.positions]), delimiter=",",
+                   fmt=["%d", "%.9g", "%.17g"])
         write_output(args.out, buf.getvalue(), "--out")
         print(f"wrote the trajectory to {args.out}")
     return 0
+
+
+def _verdict(run, nonideal):
+    """The run's verdict in words: stable, unstable, a limit cycle, held at rest by friction."""
+    verdict = "diverged (unstable)" if run.diverged else ("stable" if run.stable else "unstable")
+    if run.limit_cycle:
+        # The simulator's class (Simulation.limit_cycle), as the map's cells.
+        return (f"bounded, not decaying (a limit cycle of amplitude {run.amplitude[3]:.4g}: "
+                f"neither stable nor growing)")
+    if run.positions is not None:
+        last = run.positions[-(run.steps // 4):]
+        if run.stable and np.all(last == last[-1]) and nonideal.coulomb_friction is not None:
+            return f"stable (held at rest by friction at x = {last[-1]:.4g})"
+    if run.stable and 0.9 * run.amplitude[2] <= run.amplitude[3] <= run.floor:
+        return (f"bounded (a limit cycle of amplitude {run.amplitude[3]:.4g}, within "
+                f"{float(run.floor):.4g}, the most the quantization can move the "
+                f"position here)")
+    return verdict
 
 
 def _check_out(out):

@@ -349,9 +349,47 @@ def _starting_children(start):
 
 def read_spec(path):
     """The sweep of the spec at ``path``: its loop, plane, question, rows (SI) and chunk size."""
+    path = pathlib.Path(path)
+    spec = _read_toml(path)
+    where = f"the sweep spec {path}"
+    if not isinstance(spec.get("loop"), str):
+        raise ValueError(f"{where}: loop = \"FILE\", the loop file (relative to the spec), is "
+                         f"required")
+    loop_path = (path.parent / spec["loop"])
+    loop = load_loop_file(str(loop_path))
+    try:
+        loop_text = loop_path.read_text(encoding="utf-8")
+    except OSError as exc:
+        raise ValueError(f"{where}: cannot read {loop_path}: {exc.strerror or exc}") from None
+    question = _question(where, loop, spec)
+    x, y, over = question.x, question.y, question.over
+    chunk = spec.get("chunk", _DEFAULT_CHUNK)
+    if isinstance(chunk, bool) or not isinstance(chunk, int) or not 1 <= chunk <= 10_000:
+        raise ValueError(f"{where}: chunk must be an integer from 1 to 10000 (rows per task), "
+                         f"got {chunk!r}")
+    names, rows, how = _points(where, loop, spec, question)
+    # The first row asked of the loop now: a value out of its domain is refused before the run.
+    from ..numeric.loop.quantities import FileParameters, check_bounds
+
+    known = getattr(loop, "file_parameters", None) or FileParameters({})
+    columns = {n: rows[:, k] for k, n in enumerate(names)}
+    check_bounds(known, {**loop.defaults, **columns}, skip=(x, y),
+                 where=lambda bad: f"{where}: a point's " + ", ".join(bad))
+    # The box's corners asked of the loop now: a value outside its domain is refused before
+    # the run, not in the middle of it.
+    box = {n: (rows[:, k].min(), rows[:, k].max()) for k, n in enumerate(names)}
+    box.update({name: (low, high) for name, low, high in over})
+    if "d" in box:
+        box["d"] = tuple(int(v) for v in box["d"])
+    check_corners(loop, loop.defaults, x, y, box, where)
+    return {"loop": loop, "loop_text": loop_text, "question": question,
+            "names": tuple(names), "rows": rows, "chunk": chunk, "how": how}
+
+
+def _read_toml(path):
+    """The spec file's TOML table, its size and keys checked."""
     from ..numeric.loop.files import tomllib
 
-    path = pathlib.Path(path)
     try:
         with open(path, "rb") as fh:
             data = fh.read(_MAX_SPEC_BYTES + 1)
@@ -367,16 +405,11 @@ def read_spec(path):
     if unknown:
         raise ValueError(f"the sweep spec {path}: unknown key {unknown[0]!r} (the keys are "
                          f"{', '.join(sorted(_KEYS))})")
-    where = f"the sweep spec {path}"
-    if not isinstance(spec.get("loop"), str):
-        raise ValueError(f"{where}: loop = \"FILE\", the loop file (relative to the spec), is "
-                         f"required")
-    loop_path = (path.parent / spec["loop"])
-    loop = load_loop_file(str(loop_path))
-    try:
-        loop_text = loop_path.read_text(encoding="utf-8")
-    except OSError as exc:
-        raise ValueError(f"{where}: cannot read {loop_path}: {exc.strerror or exc}") from None
+    return spec
+
+
+def _question(where, loop, spec):
+    """The spec's :class:`~symstab.cli.sweep_store.Question`: its kind, plane and section."""
     from .sweep_store import QUESTIONS, Question
 
     kind = spec.get("question", "limits")
@@ -406,45 +439,31 @@ def read_spec(path):
         over, strips = _robust(where, loop, x, y, spec["robust"])
     elif kind == "simulated":
         simulation = _simulated(where, loop, y, spec["simulated"])
-    question = Question(kind, x, y, over=over, maximize=maximize, strips=strips,
-                        simulation=simulation)
-    chunk = spec.get("chunk", _DEFAULT_CHUNK)
-    if isinstance(chunk, bool) or not isinstance(chunk, int) or not 1 <= chunk <= 10_000:
-        raise ValueError(f"{where}: chunk must be an integer from 1 to 10000 (rows per task), "
-                         f"got {chunk!r}")
+    return Question(kind, x, y, over=over, maximize=maximize, strips=strips,
+                    simulation=simulation)
+
+
+def _points(where, loop, spec, question):
+    """``(names, rows, how)`` of the spec's [grid] or [random], none searched or uncertain."""
     if ("grid" in spec) == ("random" in spec):
         raise ValueError(f"{where}: give the points as [grid] or as [random], one of them")
     table = spec.get("grid", spec.get("random"))
     if not isinstance(table, dict):
         raise ValueError(f"{where}: [grid] or [random] must be a table")
+    x, y = question.x, question.y
     if "grid" in spec:
         names, rows, how = _grid(where, loop, x, y, table)
     else:
         names, rows, how = _random(where, loop, x, y, table)
     if not names:
         raise ValueError(f"{where}: sweep at least one parameter")
-    searched = [name for name, _, _ in over if name in names]
+    searched = [name for name, _, _ in question.over if name in names]
     if searched:
-        what, section = (("uncertain", "[robust] uncertain") if kind == "robust"
+        what, section = (("uncertain", "[robust] uncertain") if question.kind == "robust"
                          else ("searched", "[design] over"))
         raise ValueError(f"{where}: {searched[0]} is swept and {what}: give it in [grid] or "
                          f"[random], or in {section}, not both")
-    # The first row asked of the loop now: a value out of its domain is refused before the run.
-    from ..numeric.loop.quantities import FileParameters, check_bounds
-
-    known = getattr(loop, "file_parameters", None) or FileParameters({})
-    columns = {n: rows[:, k] for k, n in enumerate(names)}
-    check_bounds(known, {**loop.defaults, **columns}, skip=(x, y),
-                 where=lambda bad: f"{where}: a point's " + ", ".join(bad))
-    # The box's corners asked of the loop now: a value outside its domain is refused before
-    # the run, not in the middle of it.
-    box = {n: (rows[:, k].min(), rows[:, k].max()) for k, n in enumerate(names)}
-    box.update({name: (low, high) for name, low, high in over})
-    if "d" in box:
-        box["d"] = tuple(int(v) for v in box["d"])
-    check_corners(loop, loop.defaults, x, y, box, where)
-    return {"loop": loop, "loop_text": loop_text, "question": question,
-            "names": tuple(names), "rows": rows, "chunk": chunk, "how": how}
+    return names, rows, how
 
 
 def _design(where, loop, x, y, table):

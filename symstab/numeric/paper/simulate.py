@@ -34,8 +34,10 @@ default) need a :class:`symstab.numeric.paper.device.Device`:
   force is within the stiction force (:mod:`symstab.numeric.simulation.friction`, the
   model of every loop's friction);
 * ``friction_compensation`` -- the command adds ``F_c sign(v_hat)``, with
-  ``v_hat`` the (filtered) velocity estimate (the paper's loop only: a
-  general loop's environment has no velocity estimate of its own);
+  ``v_hat`` the (filtered) velocity estimate: the loop simulator's
+  :class:`~symstab.numeric.simulation.simulator.FrictionCompensation`
+  option, with the pole of the velocity filter (a loop file passes that
+  option to :func:`~symstab.numeric.simulation.simulator.simulate_loop`);
 * ``actuator_bandwidth`` -- the applied force follows the command through a
   first-order lag of that bandwidth: the device behind its lag is stepped
   exactly on its state space (the lag is the loop's actuator, as in
@@ -69,7 +71,7 @@ import math
 import numpy as np
 
 from ..._validate import check_array, check_delay, check_loop, check_progress, check_real
-from ..simulation.simulator import (X0_MAX, Nonidealities,
+from ..simulation.simulator import (X0_MAX, FrictionCompensation, Nonidealities,
                             QUANTUM_MIN, StabilityMap, check_friction_size,
                             check_steps,
                             check_x0, default_horizon, linearly_stable, progress_printer, run_loop)
@@ -169,9 +171,11 @@ def simulate(*, alpha, beta, gamma, d, delta, steps=None, x0=1.0, v0=None, devic
     filtered = "f_c" in fixed
     compensation = None
     if nonideal.friction_compensation:
-        compensation = (run_nonideal.coulomb_friction,
-                        math.exp(-2 * math.pi * nonideal.velocity_cutoff * device.T)
-                        if filtered else 0.0)
+        # The paper's switch as the loop simulator's option: its estimate
+        # low-pass filtered as the velocity filter of the paper's loop.
+        compensation = FrictionCompensation(
+            run_nonideal.coulomb_friction,
+            math.exp(-2 * math.pi * nonideal.velocity_cutoff * device.T) if filtered else 0.0)
 
     def parts_of(part):
         # The difference equations a chunk at a time: their memory stays the chunk's.

@@ -35,11 +35,11 @@ from ..._validate import check_array, check_delay, check_progress, check_real
 from .friction import StatePlant, stacked_spaces, substeps_of
 from ..engine.results import PAPER_PLANE, PaperGridNames
 
-__all__ = ["Nonidealities", "Simulation", "StabilityMap", "default_horizon", "check_steps",
-           "check_x0", "max_steps", "progress_printer", "PAPER_ENCODER_RESOLUTION",
-           "MAX_STEPS_ENV", "run_loop", "simulate_loop", "loop_stability_map",
-           "check_loop_nonideal", "default_x0", "MAX_SUBSTEPS", "X0_MIN", "X0_MAX",
-           "check_friction_size", "QUANTUM_MIN", "FRICTION_STEP_MAX"]
+__all__ = ["Nonidealities", "FrictionCompensation", "Simulation", "StabilityMap",
+           "default_horizon", "check_steps", "check_x0", "max_steps", "progress_printer",
+           "PAPER_ENCODER_RESOLUTION", "MAX_STEPS_ENV", "run_loop", "simulate_loop",
+           "loop_stability_map", "check_loop_nonideal", "default_x0", "MAX_SUBSTEPS", "X0_MIN",
+           "X0_MAX", "check_friction_size", "QUANTUM_MIN", "FRICTION_STEP_MAX"]
 
 
 #: The most sub-steps per period: each multiplies the simulation's time (a
@@ -86,7 +86,9 @@ class Nonidealities:
         overflows is far above the quantum's precision and rounds to
         itself).
     velocity_cutoff : float
-        Cut-off of the velocity filter (Hz), in (0, Nyquist).
+        Cut-off of the velocity filter (Hz), in (0, Nyquist): the paper's
+        simulator's, whose adapter writes the filter into the paper's
+        loop's environment (a loop file writes it into its own).
     coulomb_friction : float
         Coulomb friction force (N or N m), >= 0, and small enough that its
         change of the state over a sub-step is a double
@@ -95,9 +97,17 @@ class Nonidealities:
     stiction : float
         Breakaway force (N or N m), >= coulomb_friction (default: equal).
     friction_compensation : bool
-        Add ``coulomb_friction * sign(v_hat)`` to the command.
+        Add ``coulomb_friction * sign(v_hat)`` to the command: the paper's
+        simulator's switch (:func:`symstab.numeric.paper.simulate.simulate`),
+        which its adapter hands the loop simulator as its
+        :class:`FrictionCompensation` option, with its velocity filter's
+        pole.  A loop file is simulated with ``compensation=`` of
+        :func:`simulate_loop` instead (its velocity estimate is the
+        simulator's, not its environment's).
     actuator_bandwidth : float
-        First-order lag of the applied force (Hz), > 0.
+        First-order lag of the applied force (Hz), > 0: the paper's
+        simulator's, whose adapter writes the lag into the paper's loop's
+        plant (a loop file writes it into its own).
     substeps : int
         Sub-steps per period, 1 to :data:`MAX_SUBSTEPS`: friction is
         decided at their ends (the actuator lag is exact at any number).
@@ -183,6 +193,34 @@ class Nonidealities:
         return (self.encoder_resolution is None and self.velocity_cutoff is None
                 and self.coulomb_friction is None and self.actuator_bandwidth is None
                 and self.force_limit is None and self.force_resolution is None)
+
+
+@dataclasses.dataclass(frozen=True)
+class FrictionCompensation:
+    """The loop simulator's friction compensation: the command adds ``coulomb * sign(v_hat)``.
+
+    ``v_hat`` is the simulator's velocity estimate from the sampled (quantized)
+    position, ``v_hat[k] = pole v_hat[k-1] + (1 - pole) (x_s[k] - x_s[k-1])``,
+    a position change per period (its sign is all that counts): the backward
+    difference at ``pole = 0``, low-pass filtered otherwise.  An option of
+    :func:`simulate_loop` and :func:`run_loop`; the paper's simulator hands it
+    over for ``Nonidealities(friction_compensation=True)``, with the pole of
+    its velocity filter.
+
+    Attributes
+    ----------
+    coulomb : float
+        The force added (the loop's force unit), finite and >= 0.
+    pole : float
+        The estimate's low-pass pole, ``0 <= pole < 1`` (default 0).
+    """
+
+    coulomb: float
+    pole: float = 0.0
+
+    def __post_init__(self):
+        check_real("compensation.coulomb", self.coulomb, low=0.0)
+        check_real("compensation.pole", self.pole, low=0.0, high=1.0, high_open=True)
 
 
 
@@ -529,7 +567,7 @@ _ANY_LOOP_FLOATS = 8
 
 
 def simulate_loop(loop, *, steps=None, x0=1.0, v0=None, nonideal=None, record=False,
-                  progress=None, **values):
+                  progress=None, compensation=None, **values):
     """Run a :class:`symstab.Loop` in time for every parameter point at once.
 
     The plant's exact ZOH step on the samples, the environment's difference
@@ -579,6 +617,10 @@ def simulate_loop(loop, *, steps=None, x0=1.0, v0=None, nonideal=None, record=Fa
         Keep every position.
     progress : callable, optional
         Called with the number of steps done.
+    compensation : FrictionCompensation, optional
+        Add ``coulomb * sign(v_hat)`` to every force command, ``v_hat`` the
+        simulator's velocity estimate (:class:`FrictionCompensation`); off
+        by default.
     **values
         The loop's parameters (or their defaults); arrays broadcast, ``d``
         one integer.
@@ -606,6 +648,9 @@ def simulate_loop(loop, *, steps=None, x0=1.0, v0=None, nonideal=None, record=Fa
     [True, False]
     """
     nonideal = check_loop_nonideal(nonideal, loop)
+    if compensation is not None and not isinstance(compensation, FrictionCompensation):
+        raise TypeError(f"compensation must be a FrictionCompensation or None, got "
+                        f"{type(compensation).__name__}")
     check_progress(progress)   # a wrong kind is refused before the work
     parts, d, shape = loop.difference_equations(**values)
     steps = check_steps(steps, d)
@@ -624,6 +669,7 @@ def simulate_loop(loop, *, steps=None, x0=1.0, v0=None, nonideal=None, record=Fa
     return run_loop(lambda part: [p[part] for p in parts], n_points, d=d, steps=steps, x0=x0,
                     v0=v0, nonideal=nonideal, record=record, progress=progress, shape=shape,
                     spaces=spaces, parts_floats=2 * orders + sum(p.shape[-1] for p in parts),
+                    compensation=compensation,
                     linear_stable=linearly_stable(loop, nonideal, values, shape))
 
 
@@ -661,9 +707,9 @@ def run_loop(parts_of, n_points, *, d, steps, x0, v0, nonideal, record, progress
     state : (float, float), optional
         With ``spaces``: start from the mass's position and velocity (the
         rest of the plant at rest), not from positions ``x0 - k v0``.
-    compensation : (float, float), optional
-        The paper's friction compensation: ``F_c`` and the pole of its
-        velocity filter (0: the backward difference).
+    compensation : FrictionCompensation, optional
+        Friction compensation on the simulator's velocity estimate (the
+        paper's simulator gives its filter's pole).
     parts_floats : int
         Floats a point's difference equations take (for the chunk size).
     linear_stable : ndarray of bool, optional
@@ -671,6 +717,9 @@ def run_loop(parts_of, n_points, *, d, steps, x0, v0, nonideal, record, progress
         root count of 0); needed with a force quantum, whose verdict floor
         they get (:func:`_verdict`).
     """
+    if compensation is not None:
+        compensation = (compensation.coulomb, compensation.pole)
+
     def pulse(part):
         # The linear loop's response to a unit force pulse, at its stable points only.
         points = np.asarray(linear_stable[part], dtype=bool)
@@ -707,8 +756,9 @@ def check_loop_nonideal(nonideal, loop=None, friction_name="nonideal.coulomb_fri
     A general loop has encoder quantization, a force limit and Coulomb
     friction on its driven mass (with ``loop``: checked to have one,
     :meth:`symstab.Loop.driven_mass`); the velocity filter and the actuator
-    lag belong in its environment and plant, and friction compensation
-    needs the paper's velocity estimate.  ``friction_name`` names the
+    lag belong in its environment and plant, and friction compensation is
+    the ``compensation=`` option of :func:`simulate_loop` (the
+    :class:`Nonidealities` field is the paper's simulator's switch).  ``friction_name`` names the
     friction in the message (the CLI's ``--coulomb``).
     """
     nonideal = Nonidealities() if nonideal is None else nonideal
@@ -718,7 +768,8 @@ def check_loop_nonideal(nonideal, loop=None, friction_name="nonideal.coulomb_fri
     for field, instead in (("velocity_cutoff", "write the filter into the loop's environment"),
                            ("actuator_bandwidth", "write the lag into the loop's plant"),
                            ("friction_compensation", "a general loop has no velocity estimate "
-                            "to compensate with")):
+                            "of its own to compensate with: give the loop simulator's option, "
+                            "simulate_loop(..., compensation=FrictionCompensation(F_c))")):
         if getattr(nonideal, field) not in (None, False):
             raise ValueError(f"nonideal.{field}: {instead} (the paper's simulator, "
                              f"symstab.simulate, has it)")
@@ -831,10 +882,12 @@ class _AnyLoop:
             dc_gain = np.where(1 + c.sum(axis=1) != 0, e.sum(axis=1) / (1 + c.sum(axis=1)), 0.0)
         self.s_past = [np.array(sampled) for _ in range(m)]
         self.f_past = [dc_gain * sampled for _ in range(m)]
-        # The paper's friction compensation: (F_c, filter pole) on the
-        # velocity estimate, the filtered backward difference.
+        # Friction compensation: (F_c, filter pole) on the velocity
+        # estimate, the filtered backward difference of the sampled position
+        # (kept here: an environment without memory keeps no sample).
         self.compensation = compensation
         self.v_hat = np.zeros(n_points)
+        self.sample_before = sampled
         self.line = [np.zeros(n_points) for _ in range(d + 1)]
         self._scratch = np.empty(n_points)
         self.k = 0
@@ -869,8 +922,9 @@ class _AnyLoop:
         if self.compensation is not None:
             # u = -f + F_c sign(v_hat): the command f less the compensation.
             coulomb, pole = self.compensation
-            self.v_hat = pole * self.v_hat + (1 - pole) * (sampled - self.s_past[0])
+            self.v_hat = pole * self.v_hat + (1 - pole) * (sampled - self.sample_before)
             command = force - coulomb * np.sign(self.v_hat)
+            self.sample_before = sampled
         if self.s_past:
             self.s_past = [sampled] + self.s_past[:-1]
             self.f_past = [force] + self.f_past[:-1]

@@ -387,3 +387,46 @@ def test_the_paper_simulator_refuses_a_quantum_that_its_units_make_subnormal():
                          nonideal=Nonidealities(force_resolution=3e-308))
     assert_message_names(excinfo, "force_resolution")
     assert f">= {float(np.finfo(float).tiny) / scale!r}" in str(excinfo.value)
+
+
+# --------------------------------------------------------------------------
+# Friction compensation: an option of the loop simulator
+
+
+def test_friction_compensation_is_an_option_of_the_loop_simulator():
+    """``compensation=`` of simulate_loop: none at F_c = 0 (the same run, bit for bit), a
+    different run otherwise, on a loop file and on a spring alone (an environment that keeps
+    no sample, whose estimate is the simulator's own)."""
+    from symstab.numeric.simulation.simulator import FrictionCompensation, simulate_loop
+
+    loop = symstab.load_loop(LOOPS / "paper.toml")
+    friction = Nonidealities(coulomb_friction=0.01)
+    at = {"K": 30.0, "B": 1.0, "d": 10}
+    plain = simulate_loop(loop, steps=400, x0=0.01, nonideal=friction, record=True, **at)
+    zero = simulate_loop(loop, steps=400, x0=0.01, nonideal=friction, record=True,
+                         compensation=FrictionCompensation(0.0), **at)
+    np.testing.assert_array_equal(zero.positions, plain.positions)
+    compensated = simulate_loop(loop, steps=400, x0=0.01, nonideal=friction, record=True,
+                                compensation=FrictionCompensation(0.01, pole=0.5), **at)
+    assert not np.array_equal(compensated.positions, plain.positions)
+    spring = symstab.Loop("1/(m*s**2)", "K", values={"m": 1.0, "K": 0.5, "T": 1e-3, "d": 1})
+    pushed = simulate_loop(spring, steps=100, x0=0.01, record=True,
+                           compensation=FrictionCompensation(1e-3))
+    free = simulate_loop(spring, steps=100, x0=0.01, record=True)
+    assert not np.array_equal(pushed.positions, free.positions)
+
+
+@pytest.mark.parametrize("compensation, error, name", [
+    ((0.01, 0.0), TypeError, "compensation"),
+    ("compensation(-1)", ValueError, "compensation.coulomb"),
+    ("compensation(0.01, 1.0)", ValueError, "compensation.pole"),
+])
+def test_a_wrong_compensation_is_refused_by_name(compensation, error, name):
+    from symstab.numeric.simulation.simulator import FrictionCompensation, simulate_loop
+
+    loop = symstab.load_loop(LOOPS / "paper.toml")
+    with pytest.raises(error) as excinfo:
+        if isinstance(compensation, str):
+            compensation = eval(compensation, {"compensation": FrictionCompensation})
+        simulate_loop(loop, steps=100, compensation=compensation)
+    assert_message_names(excinfo, name)
