@@ -459,7 +459,6 @@ class Loop(LoopModel):
         """
         from ..simulation.simulator import loop_stability_map
 
-        x, y = self.plane_of(x, y)
         return loop_stability_map(self, x_values, y_values, x=x, y=y, steps=steps, x0=x0, v0=v0,
                                   nonideal=nonideal, progress=progress, **values)
 

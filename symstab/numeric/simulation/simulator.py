@@ -1025,6 +1025,7 @@ def loop_stability_map(loop, x_values, y_values, *, x=None, y=None, steps=None, 
     StabilityMap
         ``stable`` of shape ``(len(y_values), len(x_values))``.
     """
+    x, y = loop.plane_of(x, y)
     x_values, y_values = check_array(x, x_values), check_array(y, y_values)
     if x_values.ndim != 1 or y_values.ndim != 1:
         raise ValueError(f"the grids of {x} and {y} must be 1-D")
