@@ -4,7 +4,7 @@
 
 The paper's loop (examples/loops/paper.toml) at d = 10 with b uncertain by
 +-50 % (and, second, m by +-10 % too).  The certified region
-(``Loop.region(..., uncertain=box)``: zero exclusion over the box and theta,
+(``Loop.robust_region(..., uncertain=box)``: zero exclusion over the box and theta,
 :mod:`symstab.numeric.analysis.robust`) against the intersection of the stable
 intervals at ``samples`` values of the box on the same strips' edges (the
 line engine at each value: what a user would do by hand, and not a
@@ -62,9 +62,9 @@ def main():
     values = {"d": 10, "M": 0.0}
     for box in ({"b": (0.0162, 0.0648)}, {"b": (0.0162, 0.0648), "m": (0.0115, 0.0141)}):
         words = ", ".join(f"{k} in [{lo:g}, {hi:g}]" for k, (lo, hi) in box.items())
-        region = loop.region("B", "K", uncertain=box, strips=args.strips, **values)
-        certified = timed_runs(lambda: loop.region("B", "K", uncertain=box, strips=args.strips,
-                                                   **values), args.runs)
+        region = loop.robust_region("B", "K", uncertain=box, strips=args.strips, **values)
+        certified = timed_runs(lambda: loop.robust_region("B", "K", uncertain=box,
+                                                          strips=args.strips, **values), args.runs)
         area = sampled(loop, box, args.strips, args.samples, values)
         by_hand = timed_runs(lambda: sampled(loop, box, args.strips, args.samples, values),
                              args.runs)
@@ -79,16 +79,17 @@ def main():
     box = {"b": (0.0162, 0.0648)}
     print("the certified area as the strips narrow (b in [0.0162, 0.0648]):")
     for strips in (16, 64, 256):
-        region = loop.region("B", "K", uncertain=box, strips=strips, **values)
+        region = loop.robust_region("B", "K", uncertain=box, strips=strips, **values)
         print(f"  {strips:>4} strips  area {region.area:.6g}  marginal {region.marginal_area:.3g}")
     b = loop.defaults["b"]
     nominal = nominal_area(loop, values)
     print(f"a box of zero width (b = {b:g}): the certified area against the nominal set's "
           f"{nominal:.10g} (its stable intervals' lengths integrated by scipy's quad):")
     for strips, rtol in ((16, 1e-6), (64, 1e-6), (256, 1e-6), (1024, 1e-7), (4096, 1e-7)):
-        times = timed_runs(lambda: loop.region("B", "K", uncertain={"b": (b, b)}, strips=strips,
-                                               rtol=rtol, **values), 1)
-        region = loop.region("B", "K", uncertain={"b": (b, b)}, strips=strips, rtol=rtol, **values)
+        times = timed_runs(lambda: loop.robust_region("B", "K", uncertain={"b": (b, b)},
+                                                      strips=strips, rtol=rtol, **values), 1)
+        region = loop.robust_region("B", "K", uncertain={"b": (b, b)}, strips=strips, rtol=rtol,
+                                    **values)
         print(f"  {strips:>4} strips, rtol {rtol:g}  {fmt(statistics.median(times)):>9}  area "
               f"{region.area:.10g}, short by {(nominal - region.area) / nominal:.2e} of it")
 

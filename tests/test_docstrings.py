@@ -7,8 +7,15 @@ must appear in its numpydoc ``Parameters`` section (a dataclass's in its
 ``Attributes``), by name or in a shared
 entry such as ``alpha, beta, gamma : float``.  A ``**values``-style
 collector must be named in the section as ``**values``.
+
+A method that passes through to a module function (its docstring says
+"See :func:`symstab....`", python-control's ``LTI.step_response``) is
+documented there: its parameters are looked up in that function's
+section (and its own, for a parameter it keeps alone), and the function
+is checked as well.
 """
 
+import importlib
 import inspect
 import re
 
@@ -49,7 +56,30 @@ def _documented(doc, section="Parameters"):
     return names
 
 
-CALLABLES = sorted(_public_callables(), key=lambda item: item[0])
+#: The "See :func:`...`" of a pass-through method's docstring.
+SEE = re.compile(r"^See :func:`(symstab\.[\w.]+)`", re.M)
+
+
+def _target(doc):
+    """The module function a pass-through's docstring names, or None."""
+    match = SEE.search(doc or "")
+    if not match:
+        return None
+    module, _, name = match.group(1).rpartition(".")
+    return getattr(importlib.import_module(module), name)
+
+
+def _with_targets(callables):
+    """``callables`` and the module functions their pass-throughs name, each once."""
+    out = dict(callables)
+    for name, obj in list(out.items()):
+        target = _target(inspect.getdoc(obj))
+        if target is not None:
+            out.setdefault(f"{target.__module__}.{target.__name__}", target)
+    return out.items()
+
+
+CALLABLES = sorted(_with_targets(_public_callables()), key=lambda item: item[0])
 
 
 @pytest.mark.parametrize("name, obj", CALLABLES, ids=[n for n, _ in CALLABLES])
@@ -75,6 +105,10 @@ def test_every_parameter_is_documented(name, obj):
     if not wanted:
         return
     documented = _documented(doc)
+    see = _target(doc)
+    if see is not None:
+        assert see is not obj and callable(see), f"{name}: names no function to see"
+        documented |= _documented(inspect.getdoc(see) or "")
     if inspect.isclass(obj):
         # A dataclass documents its fields as Attributes.
         documented |= _documented(doc, "Attributes")

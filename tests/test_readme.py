@@ -38,7 +38,11 @@ def test_readme_python_examples_run(monkeypatch, tmp_path):
                                     "symstab.numeric.paper.region", "symstab.symbolic.model", "symstab.symbolic.theta_max",
                                     "symstab.numeric.loop.sampled_loop", "symstab.numeric.engine.decomposition",
                                     "symstab.numeric.paper.theta_bounds", "symstab.numeric.analysis.passivity",
-                                    "symstab.numeric.engine.locus"])
+                                    "symstab.numeric.engine.locus", "symstab.numeric.loop.plane",
+                                    "symstab.numeric.analysis.robust", "symstab.numeric.analysis.design",
+                                    "symstab.numeric.analysis.probability",
+                                    "symstab.numeric.simulation.simulator",
+                                    "symstab.numeric.simulation.simulated_limit"])
 def test_docstring_examples_run(module, monkeypatch, tmp_path):
     monkeypatch.setenv("SYMSTAB_CACHE_DIR", str(tmp_path))
     mod = importlib.import_module(module)

@@ -180,8 +180,8 @@ def _progress_calls():
         "Loop.stability_map": lambda p: loop.stability_map([0.1], [100.0], steps=50, progress=p),
         "Loop.stability_probability": lambda p: loop.stability_probability(
             [0.1], [100.0], uncertain={"b": (0.03, 0.035)}, samples=4, progress=p),
-        "Loop.region (robust)": lambda p: loop.region(uncertain={"b": (0.03, 0.031)}, strips=2,
-                                                      progress=p),
+        "Loop.robust_region": lambda p: loop.robust_region(uncertain={"b": (0.03, 0.031)},
+                                                           strips=2, progress=p),
     }
 
 

@@ -492,10 +492,81 @@ def _check_over(loop, over, x, y):
 def design(loop, *, over, maximize="y_max", x=None, y=None, n=None, rtol=None, damping="b",
            delay=None, progress=None, amplitude=None, nonideal=None, x0=None, steps=None,
            **values):
-    """The value of one or two parameters of ``loop`` that maximises a target.
+    """The value of one or two parameters that maximises K_max, the Z-width, the passive K_max
+    or the simulated K_max.
 
-    See :meth:`symstab.Loop.design`, which calls this with the plane ``x``,
-    ``y`` resolved.
+    Each evaluation of the linear targets is a certified answer at one
+    value of the searched parameters (:meth:`symstab.Loop.limits`, or
+    :meth:`symstab.Loop.passive_region` for ``maximize="passive"``); the simulated
+    target is :func:`~symstab.numeric.simulation.simulated_limit.simulated_limit`
+    (runs of :meth:`symstab.Loop.simulate` with the non-idealities given).  The
+    search is a coarse scan, then
+    ``scipy.optimize`` (the module says how, and what it can miss).
+
+    Parameters
+    ----------
+    loop : symstab.Loop
+        The loop.
+    over : dict
+        ``{name: (low, high)}``, one or two parameters outside the plane
+        (not ``d``), e.g. ``{"M": (0.0, 0.04)}``.
+    maximize : str
+        ``"y_max"`` (the largest stable ``y``, K_max), ``"area"`` (the
+        Z-width), ``"passive"`` (the passive K_max) or ``"simulated"``
+        (the largest ``y`` whose simulated run neither grows nor ends
+        above ``amplitude``).
+    x, y : str, optional
+        The plane (default: the loop's :attr:`~symstab.Loop.plane`;
+        :meth:`symstab.Loop.design` resolves it).
+    n : int, optional
+        Scan points per parameter, ``>= 3`` (default 17 for one
+        parameter, 9 for two).
+    rtol : float, optional
+        Relative accuracy of the optimum (default 1e-6; 1e-3 for
+        ``"simulated"``, which is resolved to its grid).
+    damping : str
+        The device's viscous friction, for ``maximize="passive"``.
+    delay : float, optional
+        The loop delay in seconds, held while the sample period ``T``
+        is searched: ``d = ceil(delay / T)`` at each value, the whole
+        samples that cover it (instead
+        of ``d``).
+    progress : callable, optional
+        Called with the number of evaluations so far.
+    amplitude : float
+        ``maximize="simulated"`` only (and needed there): the largest
+        ``|x|`` accepted in the last quarter of a run (the position's
+        unit).
+    nonideal, x0, steps : optional
+        ``maximize="simulated"`` only: as in :meth:`symstab.Loop.simulate` (``x0``
+        default 1, or 0.01 with non-idealities, as ``symstab design``;
+        ``steps`` is periods, so with ``delay`` and ``T`` searched a
+        fixed ``steps`` is a shorter time at a smaller ``T``).
+    **values
+        Single values of the other parameters; the searched ones' values
+        here (or defaults) are the nominal point the gain is measured
+        against.
+
+    Returns
+    -------
+    symstab.numeric.analysis.design.Design
+
+    Raises
+    ------
+    TypeError, ValueError
+        For a parameter that is unknown, the delay, an axis of the
+        plane, a range that is not ``(low, high)`` with ``low < high``,
+        or an unknown target.
+
+    Examples
+    --------
+    >>> from symstab import Loop
+    >>> loop = Loop("1/(m*s**2 + b*s)", "K + B*(z - 1)/(T*z) + M*(z - 1)**2/(T**2*z**2)",
+    ...             plane=("B", "K"))
+    >>> best = design(loop, x="B", y="K", over={"M": (0.0, 0.03)}, m=0.0128, b=0.0324,
+    ...               T=1e-3, d=1, M=0.0)
+    >>> 0.006 < best.best["M"] < 0.02 and best.gain > 2
+    True
     """
     if maximize not in TARGETS:
         raise ValueError(f"maximize must be one of {', '.join(map(repr, TARGETS))}, "

@@ -107,21 +107,30 @@ def draw_values(loop, uncertain, samples, seed, *, axes=()):
 
 def stability_probability(loop, x_values, y_values, *, x, y, uncertain, samples=1000, seed=0,
                           progress=None, **values):
-    """The probability that each cell of an ``(x, y)`` grid is stable (:meth:`symstab.Loop.stability_probability`).
+    """The probability that each cell of an ``(x, y)`` grid is stable when parameters are uncertain.
+
+    Monte Carlo over the draws of the uncertain parameters, each cell
+    classified by its certified root count at every draw (the module says
+    how).
 
     Parameters
     ----------
     loop : symstab.Loop
+        The loop.
     x_values, y_values : array_like
         1-D grids of the plane's parameters.
     uncertain : dict
-        The uncertain parameters and their distributions (:func:`draw_values`).
+        ``{name: (low, high)}`` (uniform; ``d``: the integers from
+        ``low`` to ``high``) or ``{name: distribution}`` (a frozen
+        :mod:`scipy.stats` distribution, or any object with
+        ``rvs(size=..., random_state=...)``); :func:`draw_values`.
     samples : int
         Draws (default 1000: a standard error of at most 0.016).
     seed : int
         The random generator's seed: the same seed, the same map.
     x, y : str
-        The plane.
+        The plane (:meth:`symstab.Loop.stability_probability` takes the
+        loop's :attr:`~symstab.Loop.plane` by default).
     progress : callable, bool or None, optional
         Called with the number of draws done; True draws a bar
         (:func:`symstab._validate.check_progress`).
@@ -137,6 +146,16 @@ def stability_probability(loop, x_values, y_values, *, x, y, uncertain, samples=
     TypeError, ValueError
         As :func:`draw_values` and :meth:`symstab.Loop.classify`; a draw
         outside a loop file's bounds; a grid that does not fit in memory.
+
+    Examples
+    --------
+    >>> from symstab import Loop
+    >>> loop = Loop("1/(m*s**2 + b*s)", "K + B*(z - 1)/(T*z)", plane=("B", "K"),
+    ...             values={"m": 0.0128, "b": 0.0324, "T": 1e-3, "d": 10})
+    >>> found = stability_probability(loop, [-0.03, 0.05], [1.0], x="B", y="K", samples=200,
+    ...                               uncertain={"b": (0.0162, 0.0648)})
+    >>> found.probability.tolist(), round(float(found.standard_error[0, 0]), 3)
+    ([[0.57, 1.0]], 0.035)
     """
     x_values, y_values = check_array(x, x_values), check_array(y, y_values)
     if x_values.ndim != 1 or y_values.ndim != 1 or not x_values.size or not y_values.size:

@@ -806,15 +806,24 @@ def _check_uncertain(loop, uncertain, axes):
     return box, delays
 
 
-def robust_region(loop, x, y, *, uncertain, strips=64, rtol=1e-6, x_range=None, y_range=None,
-                  budget=MAX_CELLS, progress=None, **values):
-    """The points of the ``(x, y)`` plane stable for every value in the box (see the module).
+def robust_region(loop, x=None, y=None, *, uncertain, strips=64, rtol=1e-6, x_range=None,
+                  y_range=None, budget=MAX_CELLS, progress=None, **values):
+    """The points of a loop's ``(x, y)`` plane stable for every value in a box.
+
+    The robust region: the module states the guarantee and says how it is
+    built.  It is a :class:`~symstab.numeric.engine.results.RobustRegion`
+    with the nominal decomposition (at the box's centre,
+    :func:`symstab.numeric.loop.plane.region`) beside it; its
+    ``limits()`` are the robust set's (:meth:`symstab.Loop.limits` with
+    ``uncertain``).
 
     Parameters
     ----------
     loop : symstab.Loop
-    x, y : str
-        The plane's parameters: environment parameters, jointly affine.
+        The loop.
+    x, y : str, optional
+        The plane's parameters: environment parameters, jointly affine
+        (default: the loop's :attr:`~symstab.Loop.plane`).
     uncertain : dict
         ``{name: (low, high)}``: the box of the plant's and environment's
         parameters (``T`` included), and ``d`` a range of whole delays.
@@ -841,6 +850,15 @@ def robust_region(loop, x, y, *, uncertain, strips=64, rtol=1e-6, x_range=None, 
     Returns
     -------
     symstab.numeric.engine.results.RobustRegion
+
+    Examples
+    --------
+    >>> from symstab import Loop
+    >>> loop = Loop("1/(m*s**2 + b*s)", "K + B*(z - 1)/(T*z)",
+    ...             values=dict(m=0.0128, b=0.0324, T=1e-3, d=10))
+    >>> robust = robust_region(loop, "B", "K", uncertain={"b": (0.0162, 0.0648)}, strips=16)
+    >>> 0 < robust.area < robust.nominal.area
+    True
     """
     x, y = loop.plane_of(x, y)
     strips = check_count("strips", strips, 1)

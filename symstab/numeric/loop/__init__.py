@@ -1,7 +1,11 @@
 """The loop: :class:`~symstab.Loop`, the model of any sampled haptic loop.
 
-The loop object and its evaluation (:mod:`.sampled_loop`), loop files
-(:mod:`.files`) and their units with pint (:mod:`.quantities`).
+The loop object, the model (:mod:`.sampled_loop`); ``chi`` in floats, the
+helper object every loop holds as ``Loop.evaluation``, and the questions
+asked of ``chi`` at points (:mod:`.evaluation`); the questions of a plane
+of two parameters: region, limits, boundary, stable intervals
+(:mod:`.plane`); loop files (:mod:`.files`) and their units with pint
+(:mod:`.quantities`).
 
 May import: the base layer, ``symbolic``, ``codegen`` and
 :mod:`symstab.numeric.engine`.  ``Loop``'s question methods are

@@ -42,7 +42,7 @@ import re
 import numpy as np
 import sympy as sp
 
-__all__ = ["unit_registry", "ALLOWED_UNITS", "UnitInfo", "unit_info", "dimension_name", "FileValue", "Bound", "FileParameters",
+__all__ = ["unit_registry", "check_si_units", "ALLOWED_UNITS", "UnitInfo", "unit_info", "dimension_name", "FileValue", "Bound", "FileParameters",
            "read_parameters", "check_loop_units", "convert", "check_bounds", "SAMPLE_UNITS",
            "parameter_angle", "check_angle"]
 
@@ -594,6 +594,36 @@ def check_loop_units(loop, file_values, raw_bounds, *, source):
                  missing_ok=True)
     return parameters
 
+
+def check_si_units(loop):
+    """Check the units a :class:`symstab.Loop` was given: SI, and fitting the loop.
+
+    A unit here names the unit of values the loop computes with as they
+    are: one that is not SI would be a label on a wrong number.
+
+    Parameters
+    ----------
+    loop : symstab.Loop
+        The loop, with its ``units`` and ``defaults``.
+
+    Raises
+    ------
+    ValueError
+        For a unit that is not SI (naming the SI one), or units whose
+        dimensions do not fit the loop.
+    """
+    given = {}
+    for key, unit in loop.units.items():
+        item = convert(key, 1, unit, where="units")
+        if item.si_value != 1:
+            raise ValueError(f"units: {key!r} is given in {unit!r}, which is "
+                             f"{float(item.si_value):g} {item.si_unit}: Loop takes its values "
+                             f"in SI, so give {key} in {item.si_unit} (a loop file's units are "
+                             f"converted: symstab.load_loop)")
+        given[key] = convert(key, loop.defaults.get(key, 1), unit, where="units")
+    for key, value in loop.defaults.items():
+        given.setdefault(key, convert(key, value, None, where="values"))
+    check_loop_units(loop, given, [], source="units")
 
 def _check_dimensions(loop, file_values, bounds, source):
     system = _Dimensions()

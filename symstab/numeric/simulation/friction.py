@@ -39,7 +39,8 @@ import dataclasses
 import mpmath
 import numpy as np
 
-__all__ = ["FrictionSpace", "friction_space", "stacked_spaces", "StatePlant", "substeps_of"]
+__all__ = ["FrictionSpace", "friction_space", "friction_spaces", "stacked_spaces", "StatePlant",
+           "substeps_of"]
 
 #: Digits of the matrix exponentials (as the plant's pulse transfer function).
 DIGITS = 30
@@ -430,3 +431,33 @@ class StatePlant:
         for row in (self._state if self._rows is None else self._rows):
             row[bad] = 0.0
         self.rest[bad] = True
+
+
+def friction_spaces(loop, substeps, **values):
+    """The state spaces of a loop in which friction acts: ``(spaces, inverse)``.
+
+    One :class:`FrictionSpace` per distinct plant among the points
+    (``values`` broadcast), and the index of each point's (of the
+    broadcast shape); each space is built once per loop
+    (:meth:`symstab.numeric.loop.evaluation.LoopEvaluation.friction_spaces`).
+
+    Parameters
+    ----------
+    loop : symstab.Loop
+        The loop.
+    substeps : int
+        Sub-steps per period (:class:`~symstab.numeric.paper.simulate.Nonidealities`).
+    **values
+        The loop's parameters (or their defaults); arrays broadcast.
+
+    Returns
+    -------
+    (list of FrictionSpace, ndarray of int)
+
+    Raises
+    ------
+    ValueError
+        When the plant (over :attr:`~symstab.Loop.actuator`) is not a mass's
+        force to position, or its state is not determined by its positions.
+    """
+    return loop.evaluation.friction_spaces(substeps, values, build=friction_space, digits=DIGITS)

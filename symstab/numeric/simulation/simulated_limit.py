@@ -107,15 +107,24 @@ class SimulatedLimit:
                 f"amplitude <= {self.amplitude:.3g}, {self.runs} runs)")
 
 
-def simulated_limit(loop, *, x, y, amplitude, nonideal=None, steps=None, x0=None, n=(12, 16),
-                    refine=3, progress=None, **values):
-    """The largest ``y`` of the plane at which the simulated loop is accepted.
+def simulated_limit(loop, *, x=None, y=None, amplitude, nonideal=None, steps=None, x0=None,
+                    n=(12, 16), refine=3, progress=None, **values):
+    """The largest ``y`` at which the simulated loop neither grows nor ends above ``amplitude``.
+
+    The simulated counterpart of :meth:`symstab.Loop.limits`' ``y_max``,
+    with the non-idealities the linear model leaves out (encoder
+    quantization, a force limit, Coulomb friction): runs of
+    :meth:`symstab.Loop.simulate` on a grid over the certified stable set,
+    refined in ``y`` (the module says how, and how accurate it is).  Not
+    certified.
 
     Parameters
     ----------
     loop : symstab.Loop
-    x, y : str
-        The plane (``y`` the stiffness).
+        The loop.
+    x, y : str, optional
+        The plane, ``y`` the stiffness (default: the loop's
+        :attr:`~symstab.Loop.plane`).
     amplitude : float
         The largest ``|x|`` (the position's unit) accepted in the last
         quarter of a run, ``> 0``: a limit cycle above it, or a decay not
@@ -148,9 +157,21 @@ def simulated_limit(loop, *, x, y, amplitude, nonideal=None, steps=None, x0=None
         As :meth:`symstab.Loop.simulate` and :meth:`symstab.Loop.limits`,
         and for an ``amplitude`` that is not a positive number or a linear
         stable set unbounded in ``x``.
+
+    Examples
+    --------
+    >>> from symstab import Loop
+    >>> from symstab.numeric.paper.simulate import Nonidealities
+    >>> loop = Loop("1/(m*s**2 + b*s)", "K + B*(z - 1)/(T*z)")
+    >>> found = simulated_limit(loop, x="B", y="K", amplitude=1e-3, steps=3000,
+    ...                         nonideal=Nonidealities(encoder_resolution=1e-5),
+    ...                         m=0.0128, b=0.0324, T=1e-3, d=1)
+    >>> 0.9 * found.linear.y_max < found.y_max < found.linear.y_max
+    True
     """
     from .simulator import check_loop_nonideal, check_x0, default_x0
 
+    x, y = loop.plane_of(x, y)
     amplitude = check_real("amplitude", amplitude, low=0.0, low_open=True)
     nonideal = check_loop_nonideal(nonideal, loop)
     x0 = default_x0(nonideal) if x0 is None else check_x0(x0)

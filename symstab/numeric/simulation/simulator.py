@@ -568,7 +568,11 @@ _ANY_LOOP_FLOATS = 8
 
 def simulate_loop(loop, *, steps=None, x0=1.0, v0=None, nonideal=None, record=False,
                   progress=None, compensation=None, **values):
-    """Run a :class:`symstab.Loop` for every parameter point at once (:meth:`symstab.Loop.simulate`).
+    """Run a :class:`symstab.Loop` in time for every parameter point at once.
+
+    The plant's exact ZOH step on the samples, the environment's difference
+    equation and the delay line; stable when the last quarter of the run
+    does not outgrow the third (:func:`simulate`'s verdict).
 
     The plant is its exact ZOH step on the samples: the difference equation
     of ``P(z) = Z[ZOH G] = P_n / P_d``, whose coefficients the loop derives
@@ -600,11 +604,19 @@ def simulate_loop(loop, *, steps=None, x0=1.0, v0=None, nonideal=None, record=Fa
     Parameters
     ----------
     loop : symstab.Loop
-    steps, x0, v0, record, progress
-        As in :func:`simulate` (``v0`` is a position change per period,
-        default ``x0 / 100``).
+        The loop.
+    steps : int, optional
+        Periods (default: 12000 + 800 d).
+    x0, v0 : float
+        Initial position and its change per period (default ``x0 / 100``).
     nonideal : Nonidealities, optional
-        Only the fields above (and ``substeps``).
+        Encoder quantization, force saturation, and Coulomb friction on
+        the driven mass (after :attr:`~symstab.Loop.actuator`): only the
+        fields above (and ``substeps``).
+    record : bool
+        Keep every position.
+    progress : callable, optional
+        Called with the number of steps done.
     compensation : FrictionCompensation, optional
         Add ``coulomb * sign(v_hat)`` to every force command, ``v_hat`` the
         simulator's velocity estimate (:class:`FrictionCompensation`); off
@@ -625,6 +637,15 @@ def simulate_loop(loop, *, steps=None, x0=1.0, v0=None, nonideal=None, record=Fa
         general loop does not have, a plant with direct feed-through (its
         ``P_n`` as high as ``P_d``: the sampled position would depend on the
         force of the same instant), or a run that does not fit in memory.
+
+    Examples
+    --------
+    >>> from symstab import Loop
+    >>> loop = Loop("1/(m*s**2 + b*s)", "K + B*(z - 1)/(T*z)")
+    >>> run = simulate_loop(loop, K=[100.0, 3000.0], B=0.5, m=0.0128, b=0.0324, T=1e-3, d=1,
+    ...                     steps=4000)
+    >>> run.stable.tolist()
+    [True, False]
     """
     nonideal = check_loop_nonideal(nonideal, loop)
     if compensation is not None and not isinstance(compensation, FrictionCompensation):
@@ -981,24 +1002,30 @@ class _StateLoop(_AnyLoop):
 
 def loop_stability_map(loop, x_values, y_values, *, x=None, y=None, steps=None, x0=1.0, v0=None,
                        nonideal=None, progress=None, **values):
-    """Stable cells of an ``(x, y)`` grid of a loop by simulation (:meth:`symstab.Loop.stability_map`).
+    """Stable cells of an ``(x, y)`` grid of a loop by simulation (:func:`simulate_loop` on each).
 
     Parameters
     ----------
     loop : symstab.Loop
+        The loop.
     x_values, y_values : array_like
         1-D grids of the plane's parameters.
     x, y : str, optional
         The plane (default: the loop's :attr:`~symstab.Loop.plane`).
-    steps, x0, v0, nonideal, progress
-        As in :func:`simulate_loop` (``progress=True`` draws a bar).
+    steps, x0, v0, nonideal
+        As in :func:`simulate_loop`.
+    progress : callable or True
+        As in :func:`simulate_loop`; ``True`` draws a progress bar on
+        stderr for runs over 2 s.
     **values
         Single values of the other parameters.
 
     Returns
     -------
     StabilityMap
+        ``stable`` of shape ``(len(y_values), len(x_values))``.
     """
+    x, y = loop.plane_of(x, y)
     x_values, y_values = check_array(x, x_values), check_array(y, y_values)
     if x_values.ndim != 1 or y_values.ndim != 1:
         raise ValueError(f"the grids of {x} and {y} must be 1-D")

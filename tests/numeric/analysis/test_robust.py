@@ -127,7 +127,7 @@ def _points_in(region, n, rng):
 def test_robust_points_are_stable_at_every_value_of_the_box(paper):
     """The acceptance: 10 000 robust points, each stable at 100 values of the box (corners too)."""
     box = {"m": (0.0115, 0.0141), "b": (0.0162, 0.0648)}
-    region = paper.region("B", "K", uncertain=box, strips=32, d=10, M=0.0)
+    region = paper.robust_region("B", "K", uncertain=box, strips=32, d=10, M=0.0)
     assert not region.empty and 0 < region.area < region.nominal.area
     assert region.contains(*_points_in(region, 200, np.random.default_rng(0))).all()
     rng = np.random.default_rng(1)
@@ -150,7 +150,7 @@ def test_robust_points_are_stable_at_every_value_of_the_box(paper):
 def test_robust_over_a_range_of_delays(paper):
     """Uncertain delay and damping: the points are stable at every delay of the range."""
     box = {"b": (0.02, 0.045), "d": (8, 12)}
-    region = paper.region("B", "K", uncertain=box, strips=24, M=0.0, m=0.0128)
+    region = paper.robust_region("B", "K", uncertain=box, strips=24, M=0.0, m=0.0128)
     assert region.uncertain["d"] == (8, 12)
     rng = np.random.default_rng(2)
     x, y = _points_in(region, 2_000, rng)
@@ -159,8 +159,8 @@ def test_robust_over_a_range_of_delays(paper):
             assert _closed_loop_radius(0.0128, b, 1e-3, d, y, x).max() < 1.0
     # Smaller than the set of any one delay of the range.
     for d in (8, 12):
-        assert region.area < paper.region("B", "K", uncertain={"b": (0.02, 0.045)}, strips=24,
-                                          M=0.0, m=0.0128, d=d).area + 1e-12
+        assert region.area < paper.robust_region("B", "K", uncertain={"b": (0.02, 0.045)},
+                                                 strips=24, M=0.0, m=0.0128, d=d).area + 1e-12
 
 
 @pytest.mark.parametrize("path, d, lines", [
@@ -174,7 +174,8 @@ def test_a_box_of_zero_width_gives_the_nominal_set(path, d, lines):
     nominal_set = loop.region("B", "K", d=d)
     height = nominal_set.limits().y_max
     for B in lines:
-        found = loop.region("B", "K", uncertain={"b": (b, b)}, x_range=(B, B), rtol=1e-7, d=d)
+        found = loop.robust_region("B", "K", uncertain={"b": (b, b)}, x_range=(B, B), rtol=1e-7,
+                                   d=d)
         nominal = loop.stable_intervals("K", B=B, d=d)
         robust = found.intervals_at(B)
         assert nominal and robust
@@ -202,8 +203,8 @@ def _nominal_area(loop, x_range, **values):
 def test_a_box_of_zero_width_gives_the_nominal_set_in_the_plane(paper):
     """The acceptance: with a box of zero width the robust set is the nominal one to 1e-6 (area,
     and the ends of y at 200 random x, as fractions of the set's area and height)."""
-    region = paper.region("B", "K", uncertain={"b": (0.0324, 0.0324)}, strips=4096, rtol=1e-7,
-                          d=10, M=0.0)
+    region = paper.robust_region("B", "K", uncertain={"b": (0.0324, 0.0324)}, strips=4096,
+                                 rtol=1e-7, d=10, M=0.0)
     nominal = _nominal_area(paper, region.nominal.x_range, d=10, M=0.0)
     assert nominal - 1e-6 * nominal < region.area <= nominal
     height = region.limits().y_max
@@ -220,8 +221,8 @@ def test_a_box_of_zero_width_converges_to_the_nominal_area(paper):
     """With strips narrowing, the area grows to the nominal set's, second order (the trapezoids'
     sides are chords of the boundary)."""
     nominal = _nominal_area(paper, paper.region("B", "K", d=10, M=0.0).x_range, d=10, M=0.0)
-    losses = [nominal - paper.region("B", "K", uncertain={"b": (0.0324, 0.0324)}, strips=n,
-                                     d=10, M=0.0).area for n in (16, 64, 256)]
+    losses = [nominal - paper.robust_region("B", "K", uncertain={"b": (0.0324, 0.0324)}, strips=n,
+                                            d=10, M=0.0).area for n in (16, 64, 256)]
     assert 0 < losses[2] < losses[1] < losses[0]
     # A quarter of the strips' width: a sixteenth of the loss, give or take.
     assert losses[1] < losses[0] / 8 and losses[2] < losses[1] / 8
@@ -229,17 +230,19 @@ def test_a_box_of_zero_width_converges_to_the_nominal_area(paper):
 
 
 def test_a_box_where_the_set_vanishes(paper):
-    region = paper.region("B", "K", uncertain={"M": (0.0, 0.019)}, d=10)
+    region = paper.robust_region("B", "K", uncertain={"M": (0.0, 0.019)}, d=10)
     assert region.empty and region.area == 0 and region.polygons == ()
     assert "no common point" in region.reason and "M in [0, 0.019]" in region.reason
     limits = paper.limits("B", "K", uncertain={"M": (0.0, 0.019)}, d=10)
     assert limits.empty and limits.reason == region.reason
     # A box whose centre is unstable.
-    assert "centre is empty" in paper.region("B", "K", uncertain={"M": (0.0, 0.05)}, d=10).reason
+    assert "centre is empty" in paper.robust_region("B", "K", uncertain={"M": (0.0, 0.05)},
+                                                    d=10).reason
 
 
 def test_robust_limits_and_polygons(paper):
-    region = paper.region("B", "K", uncertain={"b": (0.0162, 0.0648)}, strips=32, d=10, M=0.0)
+    region = paper.robust_region("B", "K", uncertain={"b": (0.0162, 0.0648)}, strips=32, d=10,
+                                 M=0.0)
     limits = paper.limits("B", "K", uncertain={"b": (0.0162, 0.0648)}, strips=32, d=10, M=0.0)
     assert limits.region.intervals == region.intervals and limits.area == region.area
     # K_max grows with b: the robust one is at most the smallest b's.
@@ -261,14 +264,30 @@ def test_robust_limits_and_polygons(paper):
 ])
 def test_bad_input_is_refused_by_name(paper, uncertain, strips, rtol, match):
     with pytest.raises((TypeError, ValueError), match=match):
-        paper.region("B", "K", uncertain=uncertain, strips=strips, rtol=rtol, d=10)
+        paper.robust_region("B", "K", uncertain=uncertain, strips=strips, rtol=rtol, d=10)
 
+
+
+def test_the_robust_region_has_its_own_entry_and_region_uncertain_is_deprecated(paper):
+    """``robust_region(loop, ...)`` is the entry, ``Loop.robust_region`` its method; the old
+    ``Loop.region(uncertain=...)`` still answers, one release, with a DeprecationWarning."""
+    from symstab.numeric.analysis.robust import robust_region
+    from symstab.numeric.engine.results import RobustRegion
+
+    box = {"b": (0.0162, 0.0648)}
+    found = paper.robust_region("B", "K", uncertain=box, strips=4, d=10, M=0.0)
+    assert isinstance(found, RobustRegion)
+    assert robust_region(paper, "B", "K", uncertain=box, strips=4, d=10, M=0.0).intervals \
+        == found.intervals
+    with pytest.warns(DeprecationWarning, match="use Loop.robust_region"):
+        old = paper.region("B", "K", uncertain=box, strips=4, d=10, M=0.0)
+    assert isinstance(old, RobustRegion) and old.intervals == found.intervals
 
 def test_uncertain_must_be_a_box(paper):
     with pytest.raises(TypeError, match="uncertain"):
-        paper.region("B", "K", uncertain={"b": 0.03}, d=10)
+        paper.robust_region("B", "K", uncertain={"b": 0.03}, d=10)
     with pytest.raises(TypeError, match="uncertain"):
-        paper.region("B", "K", uncertain={}, d=10)
+        paper.robust_region("B", "K", uncertain={}, d=10)
 
 
 @pytest.mark.parametrize("path, box, d", [
@@ -330,7 +349,7 @@ def test_the_disks_hold_the_polynomial(path, box, d):
 
 def test_an_uncertain_period(paper):
     """T in a box (the plant's and the environment's): the points are stable at its ends and inside."""
-    region = paper.region("B", "K", uncertain={"T": (0.8e-3, 1.2e-3)}, strips=8, d=10, M=0.0)
+    region = paper.robust_region("B", "K", uncertain={"T": (0.8e-3, 1.2e-3)}, strips=8, d=10, M=0.0)
     assert not region.empty
     x, y = _points_in(region, 500, np.random.default_rng(4))
     for T in (0.8e-3, 1.0e-3, 1.2e-3, 0.93e-3):
@@ -341,7 +360,7 @@ def test_a_box_where_the_coefficients_are_unbounded_is_refused_by_name(paper):
     # The box's lower corner is a negative mass: said by a warning, then refused.
     with pytest.warns(symstab.NonPhysicalPlantWarning, match="m = -0.01"), \
             pytest.raises(ValueError, match=r"uncertain: m in \[-0.01, 0.02\]: the leading"):
-        paper.region("B", "K", uncertain={"m": (-0.01, 0.02)}, strips=8, d=10)
+        paper.robust_region("B", "K", uncertain={"m": (-0.01, 0.02)}, strips=8, d=10)
 
 
 def test_the_failing_set_holds_every_zero_and_every_failing_point():

@@ -112,8 +112,8 @@ def test_a_parameter_at_zero_that_the_closed_form_divides_by_is_its_limit():
         delay = control.tf([1], [1] + [0] * d, PAPER_T)
         oracle = max(abs(control.feedback(G, VE * delay).poles()))
         assert r == pytest.approx(oracle, rel=1e-7, abs=1e-7)
-    robust = loop.region("B", "K", uncertain={"b": (0.0, 0.0324)}, strips=8, d=10, M=0.0,
-                         m=PAPER_M, T=PAPER_T)
+    robust = loop.robust_region("B", "K", uncertain={"b": (0.0, 0.0324)}, strips=8, d=10, M=0.0,
+                                m=PAPER_M, T=PAPER_T)
     assert robust.area > 0
 
 

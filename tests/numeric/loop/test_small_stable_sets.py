@@ -199,11 +199,11 @@ def test_without_a_bounded_enclosure_nothing_found_is_not_called_empty(paper_fil
     extent: before, ``limits`` answered "no stable point found" (empty) from
     them; a set outside them was not excluded.
     """
-    import symstab.numeric.loop.sampled_loop as any_loop
+    import symstab.numeric.loop.plane as plane
     from symstab.numeric.engine.decomposition import StableHull
 
     assert paper_file_loop.limits(d=1, M=2.1 * M).empty
-    monkeypatch.setattr(any_loop, "stable_hull", lambda *rows: StableHull((), False))
+    monkeypatch.setattr(plane, "stable_hull", lambda *rows: StableHull((), False))
     with pytest.raises(ValueError, match="not excluded: give x_range and y_range"):
         paper_file_loop.limits(d=1, M=2.1 * M)
     # A window given is answered for that window.
