@@ -584,3 +584,65 @@ def test_a_moved_module_still_imports_with_a_warning(package):
             module = importlib.import_module(f"symstab.{package}.{old}")
         assert module is importlib.import_module(new)
         assert not (PACKAGE / package / f"{old}.py").exists()
+
+
+# --------------------------------------------------------------------------
+# Short functions, and Loop a facade
+
+#: The most lines of code a function of symstab may have (outside
+#: ``_generated``): docstrings, comments and blank lines not counted.  A longer
+#: algorithm is a few named steps, each with its docstring and its test.
+MAX_CODE_LINES = 80
+
+#: The most lines ``Loop``'s class body may have, docstrings included: the
+#: model and its pass-throughs, the questions computed in module functions.
+MAX_LOOP_LINES = 500
+
+
+def _code_lines(lines, node):
+    """Lines of ``node`` that are code: not blank, not a comment, not in a docstring."""
+    docstrings = set()
+    for inner in ast.walk(node):
+        body = getattr(inner, "body", None)
+        if (isinstance(inner, (ast.FunctionDef, ast.AsyncFunctionDef, ast.ClassDef)) and body
+                and isinstance(body[0], ast.Expr) and isinstance(body[0].value, ast.Constant)
+                and isinstance(body[0].value.value, str)):
+            docstrings |= set(range(body[0].lineno, body[0].end_lineno + 1))
+    return sum(1 for i in range(node.lineno, node.end_lineno + 1)
+               if i not in docstrings and lines[i - 1].strip()
+               and not lines[i - 1].strip().startswith("#"))
+
+
+def _long_functions(path, limit):
+    source = path.read_text(encoding="utf-8")
+    lines = source.split("\n")
+    return [(node.name, node.lineno, _code_lines(lines, node))
+            for node in ast.walk(ast.parse(source))
+            if isinstance(node, (ast.FunctionDef, ast.AsyncFunctionDef))
+            and _code_lines(lines, node) > limit]
+
+
+def test_no_function_is_over_80_lines_of_code():
+    found = [f"symstab/{'/'.join(parts)}.py:{line} {name} ({count} lines of code)"
+             for path, parts in MODULES for name, line, count in _long_functions(path, MAX_CODE_LINES)]
+    assert found == []
+
+
+def test_the_line_counter_counts_code_only(tmp_path):
+    """A docstring, comments and blank lines are not code; statements are."""
+    body = "\n".join(f"    x{i} = {i}" for i in range(MAX_CODE_LINES - 1))
+    # f: its def line and 79 statements, 80 lines of code; g: one more.
+    source = (f'def f():\n    """Doc.\n\n    More doc.\n    """\n    # a comment\n\n{body}\n'
+              f"def g():\n{body}\n    return x0\n")
+    path = tmp_path / "m.py"
+    path.write_text(source, encoding="utf-8")
+    assert [(name, count) for name, _, count in _long_functions(path, MAX_CODE_LINES)] == [
+        ("g", MAX_CODE_LINES + 1)]
+
+
+def test_loop_is_a_facade():
+    """``Loop``: the model, its evaluation and pass-throughs, under 500 lines."""
+    path = PACKAGE / "numeric" / "loop" / "sampled_loop.py"
+    (node,) = [n for n in ast.parse(path.read_text(encoding="utf-8")).body
+               if isinstance(n, ast.ClassDef) and n.name == "Loop"]
+    assert node.end_lineno - node.lineno + 1 < MAX_LOOP_LINES
