@@ -564,7 +564,7 @@ def design(loop, *, over, maximize="y_max", x=None, y=None, n=None, rtol=None, d
     >>> loop = Loop("1/(m*s**2 + b*s)", "K + B*(z - 1)/(T*z) + M*(z - 1)**2/(T**2*z**2)",
     ...             plane=("B", "K"))
     >>> best = design(loop, x="B", y="K", over={"M": (0.0, 0.03)}, m=0.0128, b=0.0324,
-    ...               T=1e-3, d=1, M=0.0)
+    ...               T=1e-3, d=1, M=0.0, rtol=1e-3)
     >>> 0.006 < best.best["M"] < 0.02 and best.gain > 2
     True
     """
