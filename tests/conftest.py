@@ -265,6 +265,26 @@ def run_cli(capsys, *args):
     return status, out, err
 
 
+@pytest.fixture(scope="session")
+def shared_cli_run():
+    """``run(*args) -> (exit status, stdout, stderr)`` of ``symstab ARGS`` in this process, once.
+
+    A command run that several tests read (a design search takes seconds)
+    is run by the first test that asks for it and remembered for the
+    session, keyed by its arguments; the later tests read the same output.
+    Per xdist worker, like any session fixture.
+    """
+    runs = {}
+
+    def run(*args):
+        key = tuple(str(a) for a in args)
+        if key not in runs:
+            runs[key] = _main_in_process(list(key))
+        return runs[key]
+
+    return run
+
+
 def run_cli_json(capsys, *args):
     """``symstab ARGS --format json``, which must succeed; its parsed output."""
     status, out, err = run_cli(capsys, *args, "--format", "json")

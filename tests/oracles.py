@@ -429,19 +429,39 @@ def dense_maximum(f, low, high, *, points=11, levels=7):
     stable set shrinking to a sliver and vanishing): the last grid's step,
     ``(2 / (points - 1))**(levels - 1)`` of the first's, keeps a steep side
     within 1e-4.  ``f`` returns ``-inf`` where there is nothing to maximise.
+
+    Each grid's ends are the points beside the best of the grid before, so
+    ``f`` (a certified answer near a kink takes seconds) is called once per
+    distinct point: the points a grid shares with the one before are
+    remembered, not evaluated again.
     """
     best_value, best = -math.inf, None
     ends = low, high
+    seen = {}
+
+    def value(v):
+        if v not in seen:
+            seen[v] = f(v)
+        return seen[v]
+
     for _ in range(levels):
         grid = np.linspace(low, high, points)
-        found = [f(v) for v in grid]
+        if best is not None:
+            # The best point so far is the middle of this grid, up to rounding: itself.
+            i = int(np.argmin(np.abs(grid - best)))
+            if abs(grid[i] - best) <= 1e-9 * (high - low):
+                grid[i] = best
+        found = [value(float(v)) for v in grid]
         k = int(np.argmax(found))
         if found[k] > best_value:
-            best_value, best = found[k], grid[k]
+            best_value, best = found[k], float(grid[k])
         if best is None:
             return None, -math.inf
-        step = grid[1] - grid[0]
-        low, high = max(ends[0], best - step), min(ends[1], best + step)
+        # The next grid spans a step of this one on each side of the best point, at most
+        # to the ends; a side inside this grid is its point there (evaluated already).
+        j, step = int(np.argmin(np.abs(grid - best))), grid[1] - grid[0]
+        low = float(grid[j - 1]) if j > 0 else max(ends[0], best - step)
+        high = float(grid[j + 1]) if j < points - 1 else min(ends[1], best + step)
     return best, best_value
 
 

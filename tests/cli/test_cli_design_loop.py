@@ -1,33 +1,38 @@
 """``symstab design --loop``: the search of a third parameter, as ``design`` searches the virtual mass.
 
 Oracles: an independent dense scan of :meth:`symstab.Loop.limits` over the
-parameter (nested grids, no golden section), and, on the paper's
+parameter (nested grids, no golden section: ``oracles.dense_maximum``), and, on the paper's
 loop file, ``symstab design`` of the paper's options at the same device
 (the optimum M = gamma m).  Bad input is one line and exit status 2 before
 the search.
 """
 
+import json
 import math
 import re
 
-import numpy as np
 import pytest
 
 import symstab
 
 from conftest import PAPER_DELTA, PAPER_M, PAPER_T, REPO, run_cli as run, run_cli_json as run_json
+from oracles import dense_maximum
 
 LOOPS = REPO / "examples" / "loops"
 
 pytestmark = pytest.mark.usefixtures("loop_cache_dir")
 
 
-def dense_scan(loop, name, low, high, **values):
-    """The largest y_max over ``name`` in [low, high]: seven nested 11-point grids.
+def shared_json(shared_cli_run, *args):
+    """``symstab ARGS --format json`` run once per session (a search takes seconds): its output."""
+    status, out, err = shared_cli_run(*args, "--format", "json")
+    assert status == 0, err
+    return json.loads(out)
 
-    The optimum may be a kink (the stable set shrinks to a sliver and
-    vanishes): the last grid's step, 2e-5 of the first's, keeps a steep
-    side within 1e-4.
+
+def dense_scan(loop, name, low, high, **values):
+    """The largest y_max over ``name`` in [low, high]: ``oracles.dense_maximum``'s seven
+    nested 11-point grids.
 
     A plane the decomposition does not resolve is skipped (as design skips it).
     """
@@ -38,22 +43,13 @@ def dense_scan(loop, name, low, high, **values):
             return -math.inf
         return -math.inf if lim.empty else lim.y_max
 
-    best_value, best = -math.inf, None
-    for _ in range(7):
-        grid = np.linspace(low, high, 11)
-        found = [y_max(v) for v in grid]
-        k = int(np.argmax(found))
-        if found[k] > best_value:
-            best_value, best = found[k], grid[k]
-        step = grid[1] - grid[0]
-        low, high = best - step, best + step
-    return best, best_value
+    return dense_maximum(y_max, low, high)
 
 
 @pytest.mark.parametrize("file, extra", [("paper.toml", ["--set", "d=10"]),
                                          ("frictionless.toml", [])])
-def test_design_finds_the_best_mass_of_a_dense_scan(capsys, file, extra):
-    out = run_json(capsys, "design", "--loop", LOOPS / file, *extra)
+def test_design_finds_the_best_mass_of_a_dense_scan(shared_cli_run, file, extra):
+    out = shared_json(shared_cli_run, "design", "--loop", LOOPS / file, *extra)
     search = out["search"]
     assert search["over"] == "M" and search["nominal"] == 0.0
     loop = symstab.load_loop(LOOPS / file)
@@ -68,10 +64,13 @@ def test_design_finds_the_best_mass_of_a_dense_scan(capsys, file, extra):
     assert out["limits"]["y_max"] == search["y_max"]
 
 
-def test_design_of_the_paper_file_is_the_paper_design_at_the_same_device(capsys):
-    """paper.toml at d = 10: the best M is gamma m of ``symstab design --d 10`` and K_max the same."""
-    loop = run_json(capsys, "design", "--loop", LOOPS / "paper.toml", "--set", "d=10")
-    paper = run_json(capsys, "design", "--d", "10")["best"]
+def test_design_of_the_paper_file_is_the_paper_design_at_the_same_device(shared_cli_run):
+    """paper.toml at d = 10: the best M is gamma m of ``symstab design --d 10`` and K_max the same.
+
+    (``--delta`` of the paper's device with ``--d 10``: the same search, in Table I's
+    variables; the runs are shared with the tests above and test_cli_numeric's.)"""
+    loop = shared_json(shared_cli_run, "design", "--loop", LOOPS / "paper.toml", "--set", "d=10")
+    paper = shared_json(shared_cli_run, "design", "--delta", str(PAPER_DELTA), "--d", "10")["best"]
     search = loop["search"]
     # design's gamma range times m: the same scan points, the same search.
     assert search["range"] == pytest.approx([PAPER_M * (-1 - 11 * PAPER_DELTA + 1e-3), 3 * PAPER_M],

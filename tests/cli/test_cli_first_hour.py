@@ -195,14 +195,14 @@ def test_derive_check_from_another_folder_compares_with_the_checkout(
 # design echoes only what was given
 
 
-def test_design_does_not_echo_a_virtual_mass_it_searches_over(capsys):
+def test_design_does_not_echo_a_virtual_mass_it_searches_over(capsys, shared_cli_run):
     status, out, err = _main(capsys, "design", "--Td", "0.01")
     assert status == 0
     echo = out.split("\n\n")[0]
     assert "Td = 0.01 s (d = 10)" in echo
     assert "M_w" not in echo and "gamma" not in echo, echo
-    status, out, _ = _main(capsys, "design", "--delta", str(PAPER_DELTA), "--d", "10",
-                           "--format", "json")
+    status, out, _ = shared_cli_run("design", "--delta", str(PAPER_DELTA), "--d", "10",
+                                    "--format", "json")
     data = json.loads(out)
     assert "gamma" not in data["inputs"] and "M_w" not in data["inputs"]
     assert data["inputs"]["d"] == 10

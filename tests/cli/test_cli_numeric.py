@@ -85,9 +85,10 @@ def test_classify_agrees_with_python_control(capsys):
         assert row["verdict"] == ("stable" if radius < 1 else "unstable")
 
 
-def test_design_finds_a_gain_over_no_virtual_mass(capsys):
-    status, out, err = run(capsys, "design", "--delta", str(PAPER_DELTA), "--d", "10",
-                           "--format", "json")
+def test_design_finds_a_gain_over_no_virtual_mass(shared_cli_run):
+    # The same run as test_cli_first_hour's and test_cli_design_loop's (shared: a search).
+    status, out, err = shared_cli_run("design", "--delta", str(PAPER_DELTA), "--d", "10",
+                                      "--format", "json")
     assert status == 0 and "searching" in err
     best = json.loads(out)["best"]
     assert best["gain"] > 1

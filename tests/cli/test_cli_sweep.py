@@ -58,9 +58,22 @@ def test_each_row_is_the_loop_s_limits_at_its_values_in_si(capsys, tmp_path):
                                     found.area], rtol=1e-11)
 
 
-def test_a_design_sweep_finds_the_best_virtual_mass_at_each_delay(capsys, tmp_path):
+def test_a_design_sweep_finds_the_best_virtual_mass_at_each_delay(capsys, tmp_path, monkeypatch):
     """The virtual mass M that maximises K_max at d = 0 and d = 40: the gains over M = 0
-    are best_virtual_mass's published 5.82 and 4.14, and each row is Loop.design's."""
+    are best_virtual_mass's published 5.82 and 4.14, and each row is Loop.design's.
+
+    Loop.design is watched while the serial sweep runs (in this process): each row is
+    the answer of the call ``loop.design(over={"M": (-0.0141, 0.0384)}, d=d)`` on
+    paper.toml's loop, checked to be that call, rather than searched a second time."""
+    calls = []
+    design = symstab.Loop.design
+
+    def watched(loop, **kwargs):
+        found = design(loop, **kwargs)
+        calls.append((loop, kwargs, found))
+        return found
+
+    monkeypatch.setattr(symstab.Loop, "design", watched)
     path = spec(tmp_path, 'question = "design"\n[grid]\nd = [0, 40]\n'
                           '[design]\nover = { M = { range = [-14.1, 38.4], unit = "g m^2" } }\n'
                           'maximize = "K_max"\n')
@@ -73,8 +86,12 @@ def test_a_design_sweep_finds_the_best_virtual_mass_at_each_delay(capsys, tmp_pa
     gains = answers[:, 1] / answers[:, 2]
     np.testing.assert_allclose(gains, [5.82, 4.14], atol=0.005)
     loop = symstab.load_loop(LOOPS / "paper.toml")
-    for d, (best, value, nominal) in zip((0, 40), answers):
-        found = loop.design(over={"M": (-0.0141, 0.0384)}, d=d)
+    assert len(calls) == 2
+    for d, (best, value, nominal), (used, kwargs, found) in zip((0, 40), answers, calls):
+        # The call: paper.toml's loop, over M in [-0.0141, 0.0384] kg m^2 at d, K_max in (B, K).
+        assert used.defaults == loop.defaults and str(used) == str(loop)
+        assert kwargs == {"over": {"M": (-0.0141, 0.0384)}, "maximize": "y_max", "x": "B",
+                          "y": "K", "d": d}
         assert (best, value, nominal) == (found.best["M"], found.value, found.value_nominal)
 
 

