@@ -71,6 +71,24 @@ def entry_files(folder):
     return sorted((folder / "derivations").glob("loop_*.json"))
 
 
+@pytest.fixture(scope="module")
+def derived_once(tmp_path_factory):
+    """The loop derived once into a cache of the module's.
+
+    Returns ``(that folder, numbers(loop), {name: the derived value})``.
+    The tests that read or damage an entry start from a copy of this one
+    instead of deriving the loop afresh (the same entry, the same numbers,
+    one derivation).
+    """
+    folder = tmp_path_factory.mktemp("derived_once") / "cache"
+    with pytest.MonkeyPatch.context() as mp:
+        mp.setenv("SYMSTAB_CACHE_DIR", str(folder))
+        loop = Loop(PLANT, ENVIRONMENT, plane=("B", "K"))
+        fresh = numbers(loop)
+        derived = {name: loop._derivation.get(name) for name in loop._derivation._values}
+    return folder, fresh, derived
+
+
 def test_a_second_load_reads_the_derivation_and_gives_identical_numbers(zoh_calls,
                                                                            cache):
     """issue 18: every load derived the loop again (33 s for operator_arm)."""
@@ -85,11 +103,12 @@ def test_a_second_load_reads_the_derivation_and_gives_identical_numbers(zoh_call
         sp.srepr(c) for part in first._plant_parts for c in part]
 
 
-def test_the_cache_is_read_without_eval_or_exec(cache, monkeypatch):
+def test_the_cache_is_read_without_eval_or_exec(derived_once, cache, monkeypatch):
     from symstab.symbolic.derivation_cache import DerivationCache
 
+    folder, _, expected = derived_once     # what the derivation computed, and wrote
+    shutil.copytree(folder, cache)
     loop = Loop(PLANT, ENVIRONMENT, plane=("B", "K"))
-    expected = {name: loop._derivation.get(name) for name in loop._derivation._values}
     assert {"plant_parts", "parts", "environment_parts", "affine B", "affine B,K"} <= set(expected)
 
     def refuse(*args, **kwargs):
@@ -106,26 +125,12 @@ def test_the_cache_is_read_without_eval_or_exec(cache, monkeypatch):
     assert {k: repr(v) for k, v in values.items()} == {k: repr(v) for k, v in expected.items()}
 
 
-@pytest.fixture(scope="module")
-def derived_once(tmp_path_factory):
-    """The loop derived once into a cache of the module's: ``(that folder, numbers(loop))``.
-
-    Each damage test starts from a copy of this entry instead of deriving
-    the loop afresh (the same entry, the same numbers, one derivation).
-    """
-    folder = tmp_path_factory.mktemp("derived_once") / "cache"
-    with pytest.MonkeyPatch.context() as mp:
-        mp.setenv("SYMSTAB_CACHE_DIR", str(folder))
-        fresh = numbers(Loop(PLANT, ENVIRONMENT, plane=("B", "K")))
-    return folder, fresh
-
-
 @pytest.mark.parametrize("damage", ["truncated", "checksum", "symbol", "node", "number",
                                     "plant_parts", "parts", "environment_parts"])
 def test_a_damaged_or_tampered_entry_is_derived_again(damage, derived_once, zoh_calls, cache,
                                                       tmp_path, monkeypatch):
     monkeypatch.chdir(tmp_path)
-    pristine, fresh = derived_once
+    pristine, fresh, _ = derived_once
     shutil.copytree(pristine, cache)
     (path,) = entry_files(cache)
     document = json.loads(path.read_text(encoding="utf-8"))
