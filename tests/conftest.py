@@ -22,11 +22,22 @@ except ImportError:  # Windows: no shared runs between xdist workers
 
 import mpmath
 import pytest
+from hypothesis import settings
 
 from symstab.symbolic.boundary import boundary
 from symstab.symbolic.loop import characteristic_polynomial
 
 REPO = pathlib.Path(__file__).resolve().parents[1]
+
+# Hypothesis: the "ci" profile (the default) draws a bounded number of
+# examples, the same ones on every run (derandomized, no example database),
+# so that the suite costs the same every time; HYPOTHESIS_PROFILE=thorough
+# draws many more, at random, for a hunt before a release.  A test sets its
+# own health-check suppressions, not its number of examples.
+settings.register_profile("ci", max_examples=15, derandomize=True, deadline=None,
+                          database=None)
+settings.register_profile("thorough", max_examples=500, deadline=None)
+settings.load_profile(os.environ.get("HYPOTHESIS_PROFILE", "ci"))
 
 # The paper's device (Section IV-A): T = 1 ms, m = 0.0128 kg m^2, b = 0.0324 N m s/rad.
 PAPER_M = 0.0128

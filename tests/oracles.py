@@ -261,10 +261,10 @@ def loop_coefficients_mp(*, alpha, beta, gamma, d, delta):
 
 def chi_mp(z, coeffs):
     """Return ``(chi(z), sum |c_k| |z|^k)`` for coefficients highest first."""
-    value, size = mpmath.mpf(0), mpmath.mpf(0)
+    value, size, radius = mpmath.mpf(0), mpmath.mpf(0), abs(z)
     for c in coeffs:
         value = value * z + c
-        size = size * abs(z) + abs(c)
+        size = size * radius + abs(c)
     return value, size
 
 

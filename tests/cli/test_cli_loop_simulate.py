@@ -159,13 +159,14 @@ def test_map_simulates_friction_on_the_loop_s_mass(capsys, tmp_path):
     out = tmp_path / "f.npz"
     status, text, err = run(capsys, "map", "--loop", LOOPS / "actuator_lag.toml", "--simulate",
                             "--coulomb", "0.02", "--x-range=0.2,1,3", "--y-range=50,400,3",
-                            "--steps", "3000", "--out", out, "--no-png")
+                            "--steps", "1000", "--out", out, "--no-png")
     assert status == 0, err
     loop = symstab.load_loop(LOOPS / "actuator_lag.toml")
     with np.load(out) as f:
         assert "Coulomb friction 0.02" in str(f["nonidealities"])
         B, K = np.meshgrid(f["x"], f["y"], indexing="ij")
-        run_ = loop.simulate(B=B, K=K, steps=3000, x0=0.01,
+        # 1000 periods (was 3000): the same verdicts, not symmetric in B and K.
+        run_ = loop.simulate(B=B, K=K, steps=1000, x0=0.01,
                              nonideal=symstab.numeric.paper.simulate.Nonidealities(coulomb_friction=0.02))
         np.testing.assert_array_equal(f["simulated_stable"], run_.stable)
 

@@ -12,6 +12,10 @@ import pytest
 
 from conftest import PAPER_B, PAPER_DELTA, PAPER_T, REPO, run_cli as run
 
+# The session's loop cache: operator_arm (8 s to derive) is read, not derived
+# again, and nothing is written to ~/.cache.
+pytestmark = pytest.mark.usefixtures("loop_cache_dir")
+
 
 def test_paper_limits_give_the_wall_passive_k_max_in_both_units(capsys):
     status, out, _ = run(capsys, "limits", "--d", "0", "--format", "json")

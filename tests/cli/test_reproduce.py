@@ -70,7 +70,12 @@ def test_a_signal_stops_reproduce_at_once_and_cleanly(tmp_path, signum, status):
             lines.append(line)
             if line.startswith("[2/3]"):
                 break
-        time.sleep(3)
+        # The workers are forked (no imports to wait for): once both are
+        # there, a second more and they are inside their first figures.
+        wait_until = time.monotonic() + 3
+        while len(_children(proc.pid)) < 2 and time.monotonic() < wait_until:
+            time.sleep(0.05)
+        time.sleep(1)
         workers = _children(proc.pid)
         assert len(workers) >= 2, f"expected the worker processes, found {workers}"
         assert list(tmp_path.glob(".out.*")), "no temporary folder while reproduce runs"

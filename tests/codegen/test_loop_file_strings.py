@@ -255,8 +255,7 @@ loop_strings = st.fixed_dictionaries({
 })
 
 
-@settings(max_examples=40, deadline=None,
-          suppress_health_check=[HealthCheck.function_scoped_fixture, HealthCheck.too_slow])
+@settings(suppress_health_check=[HealthCheck.function_scoped_fixture, HealthCheck.too_slow])
 @given(strings=loop_strings)
 def test_fuzz_every_string_field_is_refused_in_one_line_or_shown_literally(strings, tmp_path):
     if strings["plane"] == ("B", "@stiffness"):

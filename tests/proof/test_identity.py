@@ -202,8 +202,7 @@ _terms = st.lists(st.tuples(_coefficient, st.booleans(), _frequency), min_size=1
 _nonzero_term = st.tuples(_coefficient, st.booleans(), _frequency).filter(
     lambda t: not (t[1] and t[2] == (0, 0)))   # sin(0) is zero
 
-_SETTINGS = settings(max_examples=40, deadline=None, derandomize=True, database=None,
-                     suppress_health_check=[HealthCheck.too_slow])
+_SETTINGS = settings(suppress_health_check=[HealthCheck.too_slow])
 
 
 def _poly(terms):

@@ -64,8 +64,13 @@ C_FLAGS = ["-std=c99", "-O2", "-Wall", "-Wextra", "-pedantic", "-Werror", "-fPIC
 
 @pytest.fixture(scope="module")
 def cache_dir(tmp_path_factory):
-    """Per-loop NumPy kernels go to a temporary cache, never to ~/.cache."""
-    folder = tmp_path_factory.mktemp("symstab_cache")
+    """Per-loop NumPy kernels go to a temporary cache, never to ~/.cache.
+
+    The session's (conftest's ``loop_cache_dir`` folder): a loop another
+    module derived (operator_arm: 8 s) is read here, not derived again.
+    """
+    folder = tmp_path_factory.getbasetemp() / "loop-kernels"
+    folder.mkdir(exist_ok=True)
     with pytest.MonkeyPatch.context() as mp:
         mp.setenv("SYMSTAB_CACHE_DIR", str(folder))
         yield folder
@@ -90,6 +95,27 @@ def paper_folder(tmp_path_factory, cache_dir):
     status, _, err = run_cli("derive", "--loop", str(PAPER_FILE), "--out", str(folder))
     assert status == 0, err
     return folder
+
+
+@pytest.fixture(scope="module")
+def example_derived(tmp_path_factory, cache_dir):
+    """``derived(path)``: ``symstab derive --loop path`` run and its C compiled, once per file.
+
+    Returns ``(output folder, the compiled C functions)``; the complex-pair
+    test and the every-example test share operator_arm's.
+    """
+    done = {}
+
+    def derived(path):
+        if path not in done:
+            base = tmp_path_factory.mktemp(path.stem)
+            folder = base / "out"
+            status, _, err = run_cli("derive", "--loop", str(path), "--out", str(folder))
+            assert status == 0, err
+            done[path] = folder, _compile(folder, base)
+        return done[path]
+
+    return derived
 
 
 @pytest.fixture(scope="module")
@@ -391,7 +417,8 @@ def _second_order_zoh_mp(a, b, c, T):
         return np.array([float(mpmath.re(x)) for x in coefficients]), float(closeness)
 
 
-def test_c_pulse_transfer_function_of_a_complex_pair_matches_mpmath_and_python_control(tmp_path):
+def test_c_pulse_transfer_function_of_a_complex_pair_matches_mpmath_and_python_control(
+        example_derived):
     """operator_arm's plant (m + m_h) s^2 + (b + b_h) s + k_h: its poles are written with a
     square root, imaginary for a complex pair, so the kernel runs in C99 complex arithmetic
     (it was left out of the C file).  Against the residues by hand at 40 digits (both
@@ -403,12 +430,9 @@ def test_c_pulse_transfer_function_of_a_complex_pair_matches_mpmath_and_python_c
     where |p| T >= 0.05, as for the paper's kernel.
     """
     control = pytest.importorskip("control")
-    folder = tmp_path / "out"
-    status, _, err = run_cli("derive", "--loop", str(REPO / "examples" / "loops" / "operator_arm.toml"),
-                             "--out", str(folder))
-    assert status == 0, err
+    folder, compiled = example_derived(REPO / "examples" / "loops" / "operator_arm.toml")
     assert "#include <complex.h>" in (folder / "operator_arm_kernels.c").read_text(encoding="utf-8")
-    c = _compile(folder, tmp_path)["symstab_operator_arm_pulse_transfer_function"]
+    c = compiled["symstab_operator_arm_pulse_transfer_function"]
     rng = np.random.default_rng(5)
     regimes, compared = set(), 0
     for _ in range(100):
@@ -546,17 +570,14 @@ T = 1e-3
 
 
 @pytest.mark.parametrize("source", ["pi"] + sorted(p.name for p in PAPER_FILE.parent.glob("*.toml")))
-def test_every_example_loop_compiles_and_its_c_matches_numpy(source, tmp_path):
+def test_every_example_loop_compiles_and_its_c_matches_numpy(source, tmp_path, example_derived):
     """Every shipped example, and a loop with pi (printed M_PI, which strict C99 lacks)."""
     if source == "pi":
         path = tmp_path / "pi.toml"
         path.write_text(PI_LOOP, encoding="utf-8")
     else:
         path = PAPER_FILE.parent / source
-    folder = tmp_path / "out"
-    status, _, err = run_cli("derive", "--loop", str(path), "--out", str(folder))
-    assert status == 0, err
-    c = _compile(folder, tmp_path)
+    folder, c = example_derived(path)
     numpy_module = _numpy_module(folder)
     loop = load_loop(path)
     stem = loop_derive.c_name(loop)

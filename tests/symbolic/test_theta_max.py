@@ -4,6 +4,7 @@ Oracle: the first positive root of alpha(theta) solved from eq. (2) with
 eqs. (1) and (4) (oracles.first_principles_theta_max), at 40 digits.
 """
 
+import functools
 import math
 
 import mpmath
@@ -249,6 +250,7 @@ def test_an_arc_that_runs_to_pi_returns_pi():
             assert first_principles_alpha(mpmath.mpf(t), gamma, d, delta) > 0, t
 
 
+@functools.lru_cache(maxsize=None)   # one differentiation and lambdify per order, not per case
 def _reduced_mp(derivative):
     from symstab.symbolic.theta_max import reduced_equation
     eq = reduced_equation()
