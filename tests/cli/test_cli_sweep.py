@@ -460,14 +460,14 @@ def test_robust_region_and_simulated_rows_are_the_loop_s(capsys, tmp_path):
     loop = symstab.load_loop(LOOPS / "paper.toml")
     path = spec(tmp_path, 'question = "robust"\nchunk = 1\n[grid]\nd = [5, 10]\n[robust]\n'
                           'uncertain = { b = { range = [16.2, 64.8], unit = "mN m s/rad" } }\n'
-                          'strips = 8\n', "r.toml")
+                          'strips = 4\n', "r.toml")
     status, text, err = run(capsys, "sweep", path, "--out", tmp_path / "r.csv", "--serial")
     assert status == 0, err
     header, rows = read_csv(tmp_path / "r.csv")
     assert header.endswith("marginal_area [(N m s/rad)(N m/rad)],"
                            "nominal_area [(N m s/rad)(N m/rad)],reason")
     for d, *answer in rows:
-        found = loop.limits(uncertain={"b": (0.0162, 0.0648)}, strips=8, d=int(d))
+        found = loop.limits(uncertain={"b": (0.0162, 0.0648)}, strips=4, d=int(d))
         np.testing.assert_allclose(answer, [found.y_max, found.x_at_y_max, found.x_min,
                                             found.x_max, found.area, found.region.marginal_area,
                                             found.region.nominal.area], rtol=1e-11)

@@ -24,6 +24,12 @@ def paper():
     return symstab.load_loop(PAPER)
 
 
+@pytest.fixture(scope="module")
+def nominal_area_d10(paper):
+    """The paper's nominal stable area at d = 10, M = 0 by scipy's quad (two tests read it)."""
+    return _nominal_area(paper, paper.region("B", "K", d=10, M=0.0).x_range, d=10, M=0.0)
+
+
 def _in_w(coefficients):
     """Coefficients in z (highest first) -> in w = z - 1 (highest first), exactly."""
     w = sp.Symbol("w")
@@ -125,13 +131,17 @@ def _points_in(region, n, rng):
 
 
 def test_robust_points_are_stable_at_every_value_of_the_box(paper):
-    """The acceptance: 10 000 robust points, each stable at 100 values of the box (corners too)."""
+    """The acceptance: 2 000 robust points, each stable at 100 values of the box (corners too).
+
+    (10 000 points until issue 41: 5x the CPU; a set too large by a part of the box shows at
+    the points next to its sides, a tenth of them.)
+    """
     box = {"m": (0.0115, 0.0141), "b": (0.0162, 0.0648)}
     region = paper.robust_region("B", "K", uncertain=box, strips=32, d=10, M=0.0)
     assert not region.empty and 0 < region.area < region.nominal.area
     assert region.contains(*_points_in(region, 200, np.random.default_rng(0))).all()
     rng = np.random.default_rng(1)
-    x, y = _points_in(region, 10_000, rng)
+    x, y = _points_in(region, 2_000, rng)
     values = [(m, b) for m in box["m"] for b in box["b"]]
     values += list(zip(rng.uniform(*box["m"], 96), rng.uniform(*box["b"], 96)))
     worst = 0.0
@@ -200,12 +210,13 @@ def _nominal_area(loop, x_range, **values):
     return area
 
 
-def test_a_box_of_zero_width_gives_the_nominal_set_in_the_plane(paper):
+def test_a_box_of_zero_width_gives_the_nominal_set_in_the_plane(paper, nominal_area_d10):
     """The acceptance: with a box of zero width the robust set is the nominal one to 1e-6 (area,
     and the ends of y at 200 random x, as fractions of the set's area and height)."""
     region = paper.robust_region("B", "K", uncertain={"b": (0.0324, 0.0324)}, strips=4096,
                                  rtol=1e-7, d=10, M=0.0)
-    nominal = _nominal_area(paper, region.nominal.x_range, d=10, M=0.0)
+    assert region.nominal.x_range == paper.region("B", "K", d=10, M=0.0).x_range
+    nominal = nominal_area_d10
     assert nominal - 1e-6 * nominal < region.area <= nominal
     height = region.limits().y_max
     rng = np.random.default_rng(7)
@@ -217,10 +228,10 @@ def test_a_box_of_zero_width_gives_the_nominal_set_in_the_plane(paper):
         assert abs(robust[0][1] - found[0][1]) <= 1e-6 * height
 
 
-def test_a_box_of_zero_width_converges_to_the_nominal_area(paper):
+def test_a_box_of_zero_width_converges_to_the_nominal_area(paper, nominal_area_d10):
     """With strips narrowing, the area grows to the nominal set's, second order (the trapezoids'
     sides are chords of the boundary)."""
-    nominal = _nominal_area(paper, paper.region("B", "K", d=10, M=0.0).x_range, d=10, M=0.0)
+    nominal = nominal_area_d10
     losses = [nominal - paper.robust_region("B", "K", uncertain={"b": (0.0324, 0.0324)}, strips=n,
                                             d=10, M=0.0).area for n in (16, 64, 256)]
     assert 0 < losses[2] < losses[1] < losses[0]
@@ -349,7 +360,8 @@ def test_the_disks_hold_the_polynomial(path, box, d):
 
 def test_an_uncertain_period(paper):
     """T in a box (the plant's and the environment's): the points are stable at its ends and inside."""
-    region = paper.robust_region("B", "K", uncertain={"T": (0.8e-3, 1.2e-3)}, strips=8, d=10, M=0.0)
+    # 4 strips (8 until issue 41: 2.5x the CPU, in mpmath's interval exponential of T).
+    region = paper.robust_region("B", "K", uncertain={"T": (0.8e-3, 1.2e-3)}, strips=4, d=10, M=0.0)
     assert not region.empty
     x, y = _points_in(region, 500, np.random.default_rng(4))
     for T in (0.8e-3, 1.0e-3, 1.2e-3, 0.93e-3):

@@ -303,14 +303,13 @@ def _frictionless_radius(loop, M):
     return radius
 
 
-def test_a_stable_sliver_beside_a_triple_crossing_is_resolved(tmp_path, monkeypatch):
+def test_a_stable_sliver_beside_a_triple_crossing_is_resolved(loop_cache_dir):
     """Issue 40, item 14: at M = 0.0163 kg the stable set of the frictionless mass is a
     sliver (area 2e-4, four roots within 1e-5 of the circle) whose corner lies within
     1e-10 of the window of two more arc crossings; the finer pass of the D-decomposition
     broke the crossing rule there and ``limits`` refused ("counts (2, 2) differ by 0").
     Oracle: python-control's closed-loop spectral radius, bisected in K just inside the
     corner where K_max is reached, and scanned over the sliver's B (nothing higher)."""
-    monkeypatch.setenv("SYMSTAB_CACHE_DIR", str(tmp_path))
     loop = symstab.load_loop(REPO / "examples" / "loops" / "frictionless.toml")
     found = loop.limits(M=0.0163)
     radius = _frictionless_radius(loop, 0.0163)

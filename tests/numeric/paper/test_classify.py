@@ -462,9 +462,12 @@ def test_clustered_roots_get_the_true_verdict_or_marginal(theta):
             assert code in (truth, MARGINAL), (alpha, code, mpmath.nstr(radius - 1, 5))
 
 
-@pytest.mark.parametrize("d", [200, 1000])
+@pytest.mark.parametrize("d", [200, 500])
 def test_long_delay_verdicts_match_polished_roots(d):
-    """At long delays every point goes to the certified count (O(d) a point)."""
+    """At long delays every point goes to the certified count (O(d) a point).
+
+    d = 500, not 1000 (until issue 41): the same paths of the library (degree over 128, no
+    eigenvalues), a tenth of the oracle's cost (numpy's roots and Newton at 30 digits)."""
     alphas = np.array([1e-6, 2e-5, 1e-4, 1e-3]) if d == 200 else np.array([1e-6, 1e-4])
     beta, gamma, delta = 1e-3, 0.0, PAPER_DELTA
     codes = classify(alpha=alphas, beta=beta, gamma=gamma, d=d, delta=delta)
