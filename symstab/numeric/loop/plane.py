@@ -38,6 +38,8 @@ LARGEST_COORDINATE = 1e150
 
 #: The four sides of a window, in the order of ``(x_min, x_max, y_min, y_max)``.
 _SIDES = ("x_min", "x_max", "y_min", "y_max")
+#: A free side a stable cell reaches moves out by this many widths of its window.
+_GROWTH = 3
 
 
 def stable_intervals(loop, name, **values):
@@ -281,6 +283,27 @@ def _fitted(box, cells, free):
     return box
 
 
+def _shrunk(box, cells, sides):
+    """``box`` with ``sides`` moved in to the ``cells``, as far out from them as a widening grows.
+
+    A side no stable cell reaches need not run far past the stable set: the
+    set may still grow towards it with the widening of the others (a thin
+    diagonal sliver does), by at most :data:`_GROWTH` times its extent.
+    """
+    if not cells or not sides:
+        return box
+    points = np.vstack([cell.outer for cell in cells])
+    box = list(box)
+    for side in sides:
+        k = _SIDES.index(side)
+        column = points[:, k // 2]
+        lo, hi = float(column.min()), float(column.max())
+        pad = (_GROWTH + 1) * (hi - lo)
+        if pad > 0:
+            box[k] = max(box[k], lo - pad) if k % 2 == 0 else min(box[k], hi + pad)
+    return box
+
+
 def _first_decomposition(plane, given, free, hull):
     """The first window that holds a stable cell (:func:`_start_windows`), decomposed.
 
@@ -344,10 +367,16 @@ def _widened(plane, found, box, free, enclosure):
         grow = [side for side in found.unbounded if free[side]]
         before = list(box)
         if grow:
+            # The free sides no stable cell reaches are fitted to the stable set
+            # as the others grow: a window tall beside a thin sliver (a first
+            # window found on a step far below the set's width) samples the arc
+            # finely along all of its height, seconds a decomposition.
+            box = _shrunk(box, found.stable, [side for side in _SIDES
+                                              if free[side] and side not in grow])
             span = (box[1] - box[0], box[3] - box[2])
             for side in grow:
                 k = _SIDES.index(side)
-                box[k] += (-1 if k % 2 == 0 else 1) * span[k // 2]
+                box[k] += (-1 if k % 2 == 0 else 1) * _GROWTH * span[k // 2]
                 box[k] = max(box[k], limit[k]) if k % 2 == 0 else min(box[k], limit[k])
             if box == before:
                 break
