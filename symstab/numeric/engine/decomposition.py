@@ -40,6 +40,8 @@ import dataclasses
 import math
 
 import numpy as np
+import scipy.sparse
+import scipy.sparse.csgraph
 
 from ..._resources import check_memory, chunk_slices
 from .arcs import CramerArc
@@ -782,6 +784,53 @@ class _Nodes:
         return len(self.xy) - 1
 
 
+def _merged_nodes(points):
+    """The node of each of ``points`` (rows, in order), as :class:`_Nodes` would add them.
+
+    Returns ``(node, xy)``: the node index of each point and the nodes'
+    points, numbered in the order of the points that made them.  A point
+    given again is its node again, and a point with no other within
+    :data:`_MERGE` is a node of its own: only the few points that have a
+    close neighbour are merged one by one, by :class:`_Nodes`, in their
+    order (the tens of thousands of chords' ends of a finely sampled arc
+    would take seconds there).
+    """
+    unique, first, inverse = np.unique(points, axis=0, return_index=True, return_inverse=True)
+    inverse = inverse.reshape(-1)
+    close = _has_close_neighbour(unique)
+    made = ~close        # the unique points that make a node
+    merged = np.arange(len(unique))
+    greedy, made_by = _Nodes(), []
+    for u in np.flatnonzero(close)[np.argsort(first[close], kind="stable")]:
+        index = greedy.add(float(unique[u, 0]), float(unique[u, 1]))
+        if index == len(made_by):
+            made_by.append(u)
+            made[u] = True
+        merged[u] = made_by[index]
+    makers = np.flatnonzero(made)
+    makers = makers[np.argsort(first[makers], kind="stable")]
+    number = np.empty(len(unique), dtype=np.int64)
+    number[makers] = np.arange(len(makers))
+    return number[merged][inverse], unique[makers]
+
+
+def _has_close_neighbour(xy):
+    """Whether each of the distinct points ``xy`` has another within :data:`_MERGE` (max norm)."""
+    close = np.zeros(len(xy), dtype=bool)
+    order = np.argsort(xy[:, 0], kind="stable")
+    x, y = xy[order, 0], xy[order, 1]
+    shift = 1
+    while shift < len(xy):
+        near_x = x[shift:] - x[:-shift] <= _MERGE
+        if not near_x.any():
+            break
+        near = near_x & (np.abs(y[shift:] - y[:-shift]) <= _MERGE)
+        close[order[shift:][near]] = True
+        close[order[:-shift][near]] = True
+        shift += 1
+    return close
+
+
 def _segments(polylines):
     """Flatten polylines into segments: start, end, polyline index, position in it."""
     starts, ends, owner, position = [], [], [], []
@@ -841,7 +890,10 @@ def _candidate_pairs(lo, hi):
     if not pairs:
         return np.zeros(0, dtype=np.int64), np.zeros(0, dtype=np.int64)
     pairs = np.sort(np.concatenate(pairs), axis=1)
-    key = np.unique(pairs[:, 0] * n + pairs[:, 1])
+    # Sorted and deduplicated by hand: np.unique hashes integers (NumPy 2.3+),
+    # 50 times slower than this sort on the 10**5 keys of a fine pass.
+    key = np.sort(pairs[:, 0] * n + pairs[:, 1])
+    key = key[np.r_[True, key[1:] != key[:-1]]]
     i, j = key // n, key % n
     return i[i != j], j[i != j]
 
@@ -1611,12 +1663,12 @@ def _decompose(base, ax, ay, ends, *, x_range, y_range, names, fine, arc, family
     n_segments = len(p)
     check_memory(f"the D-decomposition's {n_segments} segments", 64 * n_segments * 64)
     labels = [label for _, label, _ in polylines]
-    nodes, xy, edges, edge_label = _split_at_crossings(p, q, owner, labels, hits)
+    xy, edges, edge_label = _split_at_crossings(p, q, owner, labels, hits)
     edges, edge_label = _prune_edges(xy, edges, edge_label)
     cells = []
     mismatches = []
     if len(edges):
-        faces = _Faces(nodes, xy, edges, edge_label)
+        faces = _Faces(xy, edges, edge_label)
         points = window.from_unit(np.array(faces.points).reshape(-1, 2))
         counts = _cell_counts(base, ax, ay, family, points, names)
         scale = window.sx * window.sy
@@ -1729,34 +1781,37 @@ def _hot_angles(hits, polylines, owner, position):
 def _split_at_crossings(p, q, owner, labels, hits):
     """The second step: the planar graph of the segments ``p -> q`` split at their crossings.
 
-    Nodes closer than :data:`_MERGE` are one (:class:`_Nodes`).  Returns
-    ``(nodes, xy, edges, edge_label)``: the nodes, their points, the edges
-    as pairs of nodes and each edge's piece's label.
+    Nodes closer than :data:`_MERGE` are one (:func:`_merged_nodes`).  Returns
+    ``(xy, edges, edge_label)``: the nodes' points, the edges as pairs of
+    nodes and each edge's piece's label.
     """
-    nodes = _Nodes()
-    cuts = [[(0.0, None), (1.0, None)] for _ in range(len(p))]
-    for i, j, ti, tj in hits:
-        i, j = int(i), int(j)
-        point = p[i] + ti * (q[i] - p[i])
-        node = nodes.add(float(point[0]), float(point[1]))
-        cuts[i].append((ti, node))
-        cuts[j].append((tj, node))
-    edge_list, edge_label = [], []
-    for k in range(len(p)):
-        entries = []
-        for t, node in cuts[k]:
-            if node is None:
-                point = p[k] if t == 0.0 else q[k]
-                node = nodes.add(float(point[0]), float(point[1]))
-            entries.append((t, node))
-        entries.sort()
-        for (_, a), (_, b) in zip(entries[:-1], entries[1:]):
-            if a != b:
-                edge_list.append((a, b))
-                edge_label.append(labels[owner[k]])
-    xy = np.array(nodes.xy)
-    edges = np.array(edge_list, dtype=np.int64).reshape(-1, 2)
-    return nodes, xy, edges, np.array(edge_label, dtype=object)
+    hits = np.asarray(hits, dtype=float).reshape(-1, 4)
+    cut_i, cut_j = hits[:, 0].astype(np.int64), hits[:, 1].astype(np.int64)
+    crossings = p[cut_i] + hits[:, 2:3] * (q[cut_i] - p[cut_i])
+    ends = np.column_stack([p, q]).reshape(-1, 2)     # p[0], q[0], p[1], q[1], ...
+    node, xy = _merged_nodes(np.concatenate([crossings, ends]))
+    crossing_node, start, finish = node[:len(hits)], node[len(hits)::2], node[len(hits) + 1::2]
+    cuts = {}
+    for i, j, ti, tj, at in zip(cut_i.tolist(), cut_j.tolist(), hits[:, 2].tolist(),
+                                hits[:, 3].tolist(), crossing_node.tolist()):
+        cuts.setdefault(i, []).append((ti, at))
+        cuts.setdefault(j, []).append((tj, at))
+    # A segment without a crossing is one edge; a crossed one an edge per stretch.
+    pieces = [np.column_stack([start, finish])]
+    at = [np.arange(len(p))]
+    for k, entries in cuts.items():
+        entries = sorted([(0.0, int(start[k])), (1.0, int(finish[k]))] + entries)
+        pieces[0][k] = -1
+        pieces.append(np.array([(a, b) for (_, a), (_, b) in zip(entries[:-1], entries[1:])],
+                               dtype=np.int64))
+        at.append(np.full(len(pieces[-1]), k))
+    edges, at = np.concatenate(pieces), np.concatenate(at)
+    order = np.argsort(at, kind="stable")
+    edges, at = edges[order], at[order]
+    keep = (edges[:, 0] != edges[:, 1]) & (edges[:, 0] >= 0)
+    edges, at = edges[keep], at[keep]
+    edge_label = np.array(labels, dtype=object)[owner[at]] if len(at) else np.zeros(0, object)
+    return xy, edges, edge_label
 
 
 def _prune_edges(xy, edges, edge_label):
@@ -1794,12 +1849,12 @@ class _Faces:
     faces that have an interior point, with that point (window units).
     """
 
-    def __init__(self, nodes, xy, edges, edge_label):
+    def __init__(self, xy, edges, edge_label):
         self.src, self.dst, self.twin, self.cycles = _faces(xy, edges)
         self.half_label = np.concatenate([edge_label, edge_label])
         self.rings = [xy[self.src[c]] for c in self.cycles]
         self.areas = np.array([_signed_area(r) for r in self.rings])
-        faces, self.holes = self._holes(nodes, xy, edges)
+        faces, self.holes = self._holes(xy, edges)
         self.face_of = np.full(len(self.src), -1)
         self.keep, self.points = [], []
         for f in faces:
@@ -1811,7 +1866,7 @@ class _Faces:
             self.keep.append(f)
             self.points.append(pt)
 
-    def _holes(self, nodes, xy, edges):
+    def _holes(self, xy, edges):
         """``(faces, {face: [holes]})``: the faces of positive area, floating pieces in them.
 
         A floating piece (a component of the graph apart from the window's)
@@ -1822,9 +1877,10 @@ class _Faces:
         component = _components(len(xy), edges)
         faces = [k for k in range(len(cycles)) if areas[k] > _AREA]
         holes = {k: [] for k in faces}
-        corner = nodes.add(0.0, 0.0)
+        # The window's corner (0, 0): a node of the window's own component.
+        corner = component[int(np.flatnonzero(np.max(np.abs(xy), axis=1) <= _MERGE)[0])]
         for k in range(len(cycles)):
-            if areas[k] > _AREA or component[src[cycles[k][0]]] == component[corner]:
+            if areas[k] > _AREA or component[src[cycles[k][0]]] == corner:
                 continue
             if areas[k] > -_AREA:
                 continue
@@ -1879,16 +1935,17 @@ def _crossing_mismatches(faces, counts):
     index_of = {f: n for n, f in enumerate(faces.keep)}
     face_of, twin, half_label = faces.face_of, faces.twin, faces.half_label
     mismatches = []
-    seen = set()
-    for h in range(len(faces.src)):
-        a, b = face_of[h], face_of[twin[h]]
+    # Only the half-edges between two counted cells (none on the window) are compared.
+    counted = np.isin(face_of, list(count_of))
+    between = np.flatnonzero(counted & counted[twin] & (half_label != "window"))
+    # Each pair of cells and piece once, at its first half-edge.
+    a, b = face_of[between], face_of[twin[between]]
+    _, code = np.unique(half_label[between].astype(str), return_inverse=True)
+    _, first = np.unique(np.column_stack([np.minimum(a, b), np.maximum(a, b), code.ravel()]),
+                         axis=0, return_index=True)
+    for h in between[np.sort(first)].tolist():
+        a, b = int(face_of[h]), int(face_of[twin[h]])
         label = half_label[h]
-        if a < 0 or b < 0 or a not in count_of or b not in count_of or label == "window":
-            continue
-        pair = (min(a, b), max(a, b), label)
-        if pair in seen:
-            continue
-        seen.add(pair)
         ca, cb = count_of[a], count_of[b]
         if ca < 0 or cb < 0:
             continue
@@ -1964,16 +2021,7 @@ def _line_sides(rings, src, dst, half_label):
 
 
 def _components(n, edges):
-    parent = np.arange(n)
-
-    def find(a):
-        while parent[a] != a:
-            parent[a] = parent[parent[a]]
-            a = parent[a]
-        return a
-
-    for a, b in edges:
-        ra, rb = find(a), find(b)
-        if ra != rb:
-            parent[ra] = rb
-    return np.array([find(a) for a in range(n)])
+    """The connected component of each of ``n`` nodes joined by ``edges`` (labels, equal or not)."""
+    graph = scipy.sparse.coo_matrix((np.ones(len(edges)), (edges[:, 0], edges[:, 1])),
+                                    shape=(n, n))
+    return scipy.sparse.csgraph.connected_components(graph, directed=False)[1]
