@@ -1567,7 +1567,8 @@ class Unresolved(ValueError):
         self.attempt = attempt
 
 
-def decompose(base, ax, ay, ends, *, x_range, y_range, names=("x", "y"), arc=None, family=None):
+def decompose(base, ax, ay, ends, *, x_range, y_range, names=("x", "y"), arc=None, family=None,
+              refine=True):
     """The D-decomposition of ``chi = base + x ax + y ay`` inside a window.
 
     Parameters
@@ -1592,6 +1593,12 @@ def decompose(base, ax, ay, ends, *, x_range, y_range, names=("x", "y"), arc=Non
         ``A0``, ``Ax`` and ``Ay`` again in their structure (one polynomial
         each, a common shift): the cells' root counts are taken on it,
         O(d) per cell where the dense rows cost O(d**2).
+    refine : bool
+        Sample the arc finer where the first pass leaves the crossing rule
+        broken or a stable cell too small for its chords (default).  False
+        raises :class:`Unresolved` at once there: a caller that only looks
+        for where the stable set is (to narrow its window) saves the finer
+        pass, which may take up to 64 times the chords.
 
     Returns
     -------
@@ -1622,7 +1629,7 @@ def decompose(base, ax, ay, ends, *, x_range, y_range, names=("x", "y"), arc=Non
     found = _decompose(base, ax, ay, ends, x_range=x_range, y_range=y_range, names=names,
                        fine=1.0, arc=arc, family=family)
     coarse = None if found.mismatches else found
-    if found.mismatches or found.resolution > _RESOLUTION:
+    if refine and (found.mismatches or found.resolution > _RESOLUTION):
         # A stable cell small for its window: the arc sampled finer (not
         # beyond 64 times: a window that needs more is refused below).
         fine = max(min(0.125, 0.5 * _RESOLUTION / max(found.resolution, 1e-300)), 1 / 64)

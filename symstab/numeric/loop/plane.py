@@ -146,7 +146,7 @@ class _PlaneParts:
         arc = loop.evaluation.arc_source(x, y, values, (structured, *slopes))
         return cls(x, y, base, ax, ay, ends, arc, (structured, *slopes))
 
-    def decompose(self, box):
+    def decompose(self, box, refine=True):
         """:func:`~symstab.numeric.engine.decomposition.decompose` in the window ``box``."""
         if not all(abs(v) <= LARGEST_COORDINATE for v in box):
             x, y = self.x, self.y
@@ -157,7 +157,7 @@ class _PlaneParts:
                 f"units that keep the plane's numbers smaller")
         return decompose(self.base, self.ax, self.ay, self.ends, x_range=box[:2],
                          y_range=box[2:], names=(self.x, self.y), arc=self.arc,
-                         family=self.family)
+                         family=self.family, refine=refine)
 
 
 def boundary(loop, x=None, y=None, n=1000, *, window=None, segments=False, **values):
@@ -317,23 +317,7 @@ def _first_decomposition(plane, given, free, hull):
     for auto in _start_windows(plane, hull):
         box = [*(given["x_range"] or auto[0]), *(given["y_range"] or auto[1])]
         try:
-            found = plane.decompose(box)
-        except Unresolved as exc:
-            refused = exc
-            # A stable cell tiny beside its window (a sliver near a point where
-            # three arcs cross, say) can break the finer pass's topology where the
-            # coarse pass held: the window narrowed around the stable cells
-            # found resolves it (and is checked anew), and the widening
-            # still reaches every side a stable cell touches.
-            if not exc.attempt.stable or not any(free.values()):
-                continue
-            narrowed = _fitted(box, exc.attempt.stable, free)
-            if narrowed == box:
-                continue
-            try:
-                found, box = plane.decompose(narrowed), narrowed
-            except ValueError:
-                continue
+            found, box = _decomposed_start(plane, box, free)
         except ValueError as exc:    # a first window too wide to resolve: try the next
             refused = exc
             continue
@@ -350,6 +334,31 @@ def _first_decomposition(plane, given, free, hull):
             f"coefficient of the loop's polynomial changes in it, say), so a stable set outside "
             f"them is not excluded: give x_range and y_range")
     return found, box
+
+
+def _decomposed_start(plane, box, free):
+    """A first window decomposed, or narrowed to the stable cells its first pass cannot resolve.
+
+    Returns ``(found, box)``.  A stable cell tiny beside its window (a
+    sliver where the stable set is about to vanish, or next to a point
+    where three arcs cross) breaks the first pass's resolution or topology:
+    the window narrowed around the stable cells that pass found resolves it
+    (and is checked anew; the widening still reaches every side a stable
+    cell touches), without sampling the whole window up to 64 times finer.
+    When that fails, the window is decomposed with the finer pass, whose
+    refusal is raised.
+    """
+    try:
+        return plane.decompose(box, refine=False), box
+    except Unresolved as exc:
+        narrowed = (_fitted(box, exc.attempt.stable, free)
+                    if exc.attempt.stable and any(free.values()) else box)
+    if narrowed != box:
+        try:
+            return plane.decompose(narrowed), narrowed
+        except ValueError:
+            pass
+    return plane.decompose(box), box
 
 
 def _widened(plane, found, box, free, enclosure):
