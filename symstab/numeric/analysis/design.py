@@ -240,7 +240,8 @@ def maximize_scalar(f, low, high, n=17, *, include=(), rtol=1e-6, progress=None)
     its infeasible neighbours (up to eight times).  The best point is then
     refined by :func:`scipy.optimize.minimize_scalar` (``method="bounded"``)
     between its neighbours, to ``rtol`` times the larger of ``|x|`` and the
-    bracket's width.
+    bracket's width; at an end of the range that ``f`` rises to (lower a
+    thousandth of a step inside), the end is the maximum.
 
     Parameters
     ----------
@@ -305,12 +306,29 @@ def maximize_scalar(f, low, high, n=17, *, include=(), rtol=1e-6, progress=None)
         xs = sorted(p[0] for p in evaluate.seen)
         k = xs.index(x_best)
         a, b = xs[max(k - 1, 0)], xs[min(k + 1, len(xs) - 1)]
-        if a < b:
+        if a < b and not _rising_to_end(evaluate, x_best, value, low, high, a, b):
             minimize_scalar(lambda x: evaluate.penalised(x), bounds=(a, b), method="bounded",
                             options={"xatol": rtol * max(abs(x_best), b - a),
                                      "maxiter": _MAX_REFINE})
         (x_best,), value = evaluate.best()
     return x_best, value, [(p[0], v) for p, v in evaluate.seen.items()]
+
+
+def _rising_to_end(evaluate, x_best, value, low, high, a, b):
+    """Whether the best point is an end of ``[low, high]`` that ``f`` rises to.
+
+    Brent's bounded search never evaluates its ends: with the maximum at the
+    end of the range (a target rising with a filter's cut-off), it creeps
+    towards it by golden sections, 25 evaluations to reach ``rtol``, each a
+    certified answer.  A point a thousandth of the neighbour's step inside
+    the end, below it, shows the end is the local maximum there, as Brent
+    would have found it (an interior maximum higher than the end, between
+    the two, is a second local maximum, which Brent does not promise either).
+    """
+    if x_best not in (low, high):
+        return False
+    inside = x_best + (1e-3 if x_best == low else -1e-3) * (b - a)
+    return evaluate(inside) < value
 
 
 def maximize_pieces(f, pieces, *, include=(), rtol=1e-6, progress=None):
