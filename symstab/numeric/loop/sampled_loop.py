@@ -441,7 +441,7 @@ class Loop(LoopModel):
                               **values)
 
     def simulate(self, *, steps=None, x0=1.0, v0=None, nonideal=None, record=False,
-                 progress=None, **values):
+                 progress=None, compensation=None, start="samples", overflow="raise", **values):
         """Run the loop in time for every parameter point at once.
 
         See :func:`symstab.numeric.simulation.simulator.simulate_loop`.
@@ -449,7 +449,8 @@ class Loop(LoopModel):
         from ..simulation.simulator import simulate_loop
 
         return simulate_loop(self, steps=steps, x0=x0, v0=v0, nonideal=nonideal, record=record,
-                             progress=progress, **values)
+                             progress=progress, compensation=compensation, start=start,
+                             overflow=overflow, **values)
 
     def stability_map(self, x_values, y_values, *, x=None, y=None, steps=None, x0=1.0, v0=None,
                       nonideal=None, progress=None, **values):

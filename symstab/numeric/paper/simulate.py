@@ -1,15 +1,17 @@
 """The paper's sampled loop in time: many parameter points at once.
 
 :func:`simulate` and :func:`stability_map` run the paper's loop on the loop
-simulator (:mod:`symstab.numeric.simulation.simulator`, the one engine of every
+simulator (:meth:`symstab.Loop.simulate`, the run of every
 :class:`symstab.Loop`): the loop of
 :func:`~symstab.numeric.paper.simulate_theory.paper_simulated_loop` in Table I's
 units (``m = T = 1``, ``b = delta``, ``K = alpha``, ``B = beta``, ``M =
 gamma``; position, ``v T``, force ``f T**2 / m``), the velocity filter in
 its environment and the actuator lag as its actuator, the device on its
-state space from the position ``x0`` and the velocity ``v0 / T``.  The
-engine's names (:class:`Nonidealities`, :class:`Simulation`,
-:func:`simulate_loop`, ...) are importable from here too.
+state space from the position ``x0`` and the velocity ``v0 / T``
+(``start="state"``), a point whose difference equations overflow run as
+diverged (``overflow="diverge"``).  :class:`Nonidealities`,
+:class:`FrictionCompensation` and :class:`StabilityMap` are importable
+from here too.
 
 Non-idealities (:class:`Nonidealities`, physical units, each off by
 default) need a :class:`symstab.numeric.paper.device.Device`:
@@ -34,10 +36,12 @@ default) need a :class:`symstab.numeric.paper.device.Device`:
   force is within the stiction force (:mod:`symstab.numeric.simulation.friction`, the
   model of every loop's friction);
 * ``friction_compensation`` -- the command adds ``F_c sign(v_hat)``, with
-  ``v_hat`` the (filtered) velocity estimate: the loop simulator's
+  ``v_hat`` the velocity estimate: the backward difference, as for any
+  loop with friction (:func:`~symstab.numeric.simulation.simulator.simulate_loop`),
+  or with ``velocity_cutoff`` that difference through the velocity filter
+  (the loop simulator's
   :class:`~symstab.numeric.simulation.simulator.FrictionCompensation`
-  option, with the pole of the velocity filter (a loop file passes that
-  option to :func:`~symstab.numeric.simulation.simulator.simulate_loop`);
+  option with the filter's pole);
 * ``actuator_bandwidth`` -- the applied force follows the command through a
   first-order lag of that bandwidth: the device behind its lag is stepped
   exactly on its state space (the lag is the loop's actuator, as in
@@ -71,10 +75,9 @@ import math
 import numpy as np
 
 from ..._validate import check_array, check_delay, check_loop, check_progress, check_real
-from ..simulation.simulator import (X0_MAX, FrictionCompensation, Nonidealities,
-                            QUANTUM_MIN, StabilityMap, check_friction_size,
-                            check_steps,
-                            check_x0, default_horizon, linearly_stable, progress_printer, run_loop)
+from ..simulation.simulator import (X0_MAX, FrictionCompensation, Nonidealities, QUANTUM_MIN,
+                                    StabilityMap, check_friction_size, check_steps, check_x0,
+                                    default_horizon, progress_printer)
 from ..simulation.friction import substeps_of
 from .simulate_theory import paper_simulated_loop
 
@@ -85,9 +88,9 @@ def simulate(*, alpha, beta, gamma, d, delta, steps=None, x0=1.0, v0=None, devic
              nonideal=None, record=False, progress=None):
     """Run the paper's sampled loop for every parameter point at once.
 
-    The loop simulator's engine (:func:`simulate_loop`) on the paper's loop
-    in Table I's units, the device stepped on its state space from ``x0``
-    and ``v0`` (see the module docstring).
+    :meth:`symstab.Loop.simulate` on the paper's loop in Table I's units,
+    the device stepped on its state space from ``x0`` and ``v0`` (see the
+    module docstring).
 
     Parameters
     ----------
@@ -158,46 +161,36 @@ def simulate(*, alpha, beta, gamma, d, delta, steps=None, x0=1.0, v0=None, devic
         raise ValueError("nonideal needs a device (physical units)")
     arrays = np.broadcast_arrays(check_array("alpha", alpha), check_array("beta", beta),
                                  check_array("gamma", gamma))
-    shape = arrays[0].shape
-    alpha, beta, gamma = (a.ravel() for a in arrays)
     if delta is None:
         raise TypeError("delta must be a real number (or None with a device), got None")
     _, d, delta = check_loop(0.0, d, delta)
     steps = check_steps(steps, d)
     x0 = check_x0(x0)
     v0 = x0 / 100 if v0 is None else check_real("v0", v0, low=-X0_MAX, high=X0_MAX)
-    loop, fixed, run_nonideal, spaces, scale = _device_run(nonideal, device, delta, d)
-    values = {**fixed, "K": alpha, "B": beta, "M": gamma}
-    filtered = "f_c" in fixed
+    loop, fixed, run_nonideal = _device_run(nonideal, device, delta, d)
     compensation = None
-    if nonideal.friction_compensation:
-        # The paper's switch as the loop simulator's option: its estimate
-        # low-pass filtered as the velocity filter of the paper's loop.
-        compensation = FrictionCompensation(
-            run_nonideal.coulomb_friction,
-            math.exp(-2 * math.pi * nonideal.velocity_cutoff * device.T) if filtered else 0.0)
-
-    def parts_of(part):
-        # The difference equations a chunk at a time: their memory stays the chunk's.
-        return loop.difference_parts({k: v[part] if np.ndim(v) else v
-                                      for k, v in values.items()})[0]
-
-    return run_loop(parts_of, alpha.size, d=d, steps=steps, x0=x0, v0=v0, nonideal=run_nonideal,
-                    record=record, progress=progress, shape=shape,
-                    spaces=(spaces, np.zeros(alpha.size, dtype=int)), state=(x0, v0),
-                    compensation=compensation,
-                    linear_stable=linearly_stable(loop, run_nonideal, values, (alpha.size,)))
+    if nonideal.friction_compensation and "f_c" in fixed:
+        # The estimate low-pass filtered as the paper's loop's velocity
+        # filter; unfiltered, the loop simulator's own backward difference.
+        pole = math.exp(-2 * math.pi * nonideal.velocity_cutoff * device.T)
+        compensation = FrictionCompensation(run_nonideal.coulomb_friction, pole)
+    # The device on its state space from (x0, v0 / T) (T = 1 here); a point
+    # whose equations overflow (alpha = 1e308) diverges at once, as it always has.
+    return loop.simulate(steps=steps, x0=x0, v0=v0, nonideal=run_nonideal, record=record,
+                         progress=progress, compensation=compensation, start="state",
+                         overflow="diverge", **fixed, K=arrays[0], B=arrays[1], M=arrays[2])
 
 
 def _device_run(nonideal, device, delta, d):
     """The loop the paper's simulator runs, in Table I's units, and its checks before a run.
 
-    Returns ``(loop, values, nonideal, spaces, scale)``: the loop, its
-    values but the plane's and ``M``, the non-idealities in its units
-    (forces times ``scale = T^2 / m``), the device's state space and
-    ``scale``.  Raises, naming the field, for a force quantum that is not a
-    normal double in those units or a friction that double precision
-    cannot step on the device (:func:`check_friction_size`).
+    Returns ``(loop, values, nonideal)``: the loop, its values but the
+    plane's and ``M``, and the non-idealities in its units (forces times
+    ``T^2 / m``; the velocity filter and the actuator lag are the loop's
+    own, the compensation stays the switch).  Raises, naming the field,
+    for a force quantum that is not a normal double in those units or a
+    friction that double precision cannot step on the device
+    (:func:`check_friction_size`).
     """
     # The paper's loop is a Loop in Table I's units (m = T = 1, b = delta,
     # K = alpha, B = beta, M = gamma), its filter in the environment and its
@@ -220,12 +213,12 @@ def _device_run(nonideal, device, delta, d):
                          f"quantum, which must be a normal double), got "
                          f"{nonideal.force_resolution!r}")
     run_nonideal = dataclasses.replace(
-        nonideal, velocity_cutoff=None, actuator_bandwidth=None, friction_compensation=False,
+        nonideal, velocity_cutoff=None, actuator_bandwidth=None,
         **{name: None if getattr(nonideal, name) is None else getattr(nonideal, name) * scale
            for name in ("coulomb_friction", "stiction", "force_limit", "force_resolution")})
     spaces, _ = loop.friction_spaces(substeps_of(run_nonideal), **dict(values, K=0.0, B=0.0, M=0.0))
     check_friction_size(run_nonideal, spaces, name="nonideal.coulomb_friction", scale=scale)
-    return loop, values, run_nonideal, spaces, scale
+    return loop, values, run_nonideal
 
 
 def check_device_nonideal(nonideal, device):

@@ -11,9 +11,11 @@ arrays, one loop over time; :func:`run_loop` is the engine,
 :func:`simulate_loop` and :func:`loop_stability_map` run a loop
 (:meth:`symstab.Loop.simulate`, :meth:`symstab.Loop.stability_map`), and
 the paper's simulator (:mod:`symstab.numeric.paper.simulate`) runs the paper's
-loop on it.
+loop through :func:`simulate_loop` (its friction compensation, start from
+the device's state and overflow rule are options of every loop's run).
 
-A loop's run starts from positions ``x0 - k v0`` before the start, no
+A loop's run starts from positions ``x0 - k v0`` before the start (or
+from its driven mass's state, ``start="state"``), no
 force and the environment at rest at the sampled ``x0``, with an empty
 delay line; its verdict is unstable when the largest ``|x|`` over the last
 quarter of the horizon exceeds that over the quarter before and a floor
@@ -97,13 +99,14 @@ class Nonidealities:
     stiction : float
         Breakaway force (N or N m), >= coulomb_friction (default: equal).
     friction_compensation : bool
-        Add ``coulomb_friction * sign(v_hat)`` to the command: the paper's
-        simulator's switch (:func:`symstab.numeric.paper.simulate.simulate`),
-        which its adapter hands the loop simulator as its
-        :class:`FrictionCompensation` option, with its velocity filter's
-        pole.  A loop file is simulated with ``compensation=`` of
-        :func:`simulate_loop` instead (its velocity estimate is the
-        simulator's, not its environment's).
+        Add ``coulomb_friction * sign(v_hat)`` to the command, ``v_hat``
+        the loop simulator's velocity estimate from the sampled position
+        (any loop with Coulomb friction, :func:`simulate_loop`): the
+        backward difference, ``FrictionCompensation(coulomb_friction,
+        pole=0)``, unless the run's ``compensation=`` option gives the
+        estimate's filter pole (the paper's simulator,
+        :func:`symstab.numeric.paper.simulate.simulate`, gives its velocity
+        filter's).
     actuator_bandwidth : float
         First-order lag of the applied force (Hz), > 0: the paper's
         simulator's, whose adapter writes the lag into the paper's loop's
@@ -203,9 +206,11 @@ class FrictionCompensation:
     position, ``v_hat[k] = pole v_hat[k-1] + (1 - pole) (x_s[k] - x_s[k-1])``,
     a position change per period (its sign is all that counts): the backward
     difference at ``pole = 0``, low-pass filtered otherwise.  An option of
-    :func:`simulate_loop` and :func:`run_loop`; the paper's simulator hands it
-    over for ``Nonidealities(friction_compensation=True)``, with the pole of
-    its velocity filter.
+    :func:`simulate_loop` and :func:`run_loop`;
+    ``Nonidealities(friction_compensation=True)`` is
+    ``FrictionCompensation(coulomb_friction)`` where the option is not
+    given (the paper's simulator gives it, with the pole of its velocity
+    filter).
 
     Attributes
     ----------
@@ -567,7 +572,7 @@ _ANY_LOOP_FLOATS = 8
 
 
 def simulate_loop(loop, *, steps=None, x0=1.0, v0=None, nonideal=None, record=False,
-                  progress=None, compensation=None, **values):
+                  progress=None, compensation=None, start="samples", overflow="raise", **values):
     """Run a :class:`symstab.Loop` in time for every parameter point at once.
 
     The plant's exact ZOH step on the samples, the environment's difference
@@ -582,9 +587,12 @@ def simulate_loop(loop, *, steps=None, x0=1.0, v0=None, nonideal=None, record=Fa
     ``x_s``, and the force waits ``d`` samples: ``u[k] = -f[k - d]``, the
     loop whose characteristic polynomial is ``chi = z**d Ve_d P_d + Ve_n
     P_n`` (:meth:`symstab.Loop.polynomial`).  The run starts from the
-    position ``x0``, earlier positions ``x0 - k v0``, the sampled history at
-    ``x0``, no force and an empty delay line; the verdict is
-    :func:`simulate`'s.
+    position ``x0``, earlier positions ``x0 - k v0`` (``start="samples"``)
+    or the driven mass's velocity ``v0 / T`` (``start="state"``), the
+    sampled history at ``x0``, no force and an empty delay line; the
+    verdict is :func:`simulate`'s.  The difference equations are computed a
+    chunk of points at a time, so the working memory does not grow with
+    the points (only the result does).
 
     Non-idealities (:class:`Nonidealities`, physical units):
     ``encoder_resolution`` rounds the sampled position, ``force_resolution``
@@ -598,8 +606,12 @@ def simulate_loop(loop, *, steps=None, x0=1.0, v0=None, nonideal=None, record=Fa
     :attr:`~symstab.Loop.actuator`: the plant is then stepped on its
     continuous state space, ``substeps`` exact sub-steps a period, with the
     paper's simulator's stick and reversal rules
-    (:mod:`symstab.numeric.simulation.friction`).  A velocity filter or an actuator
-    lag is part of a loop's own environment or plant.
+    (:mod:`symstab.numeric.simulation.friction`).  ``friction_compensation``
+    adds ``coulomb_friction * sign(v_hat)`` to the command, ``v_hat`` the
+    simulator's own velocity estimate, the backward difference of the
+    sampled position (:class:`FrictionCompensation` with ``pole = 0``),
+    unless ``compensation`` is given.  A velocity filter or an actuator lag
+    is part of a loop's own environment or plant.
 
     Parameters
     ----------
@@ -611,16 +623,30 @@ def simulate_loop(loop, *, steps=None, x0=1.0, v0=None, nonideal=None, record=Fa
         Initial position and its change per period (default ``x0 / 100``).
     nonideal : Nonidealities, optional
         Encoder quantization, force saturation, and Coulomb friction on
-        the driven mass (after :attr:`~symstab.Loop.actuator`): only the
-        fields above (and ``substeps``).
+        the driven mass (after :attr:`~symstab.Loop.actuator`) with its
+        compensation: only the fields above (and ``substeps``).
     record : bool
         Keep every position.
     progress : callable, optional
         Called with the number of steps done.
     compensation : FrictionCompensation, optional
         Add ``coulomb * sign(v_hat)`` to every force command, ``v_hat`` the
-        simulator's velocity estimate (:class:`FrictionCompensation`); off
-        by default.
+        simulator's velocity estimate low-pass filtered with the option's
+        pole (:class:`FrictionCompensation`).  Default: off, or with
+        ``nonideal.friction_compensation`` the backward difference's
+        ``FrictionCompensation(nonideal.coulomb_friction)``; given, it is
+        the compensation either way (the paper's simulator gives the pole
+        of its velocity filter).
+    start : {"samples", "state"}
+        Where the plant starts: its sampled history ``x0 - k v0``, ``k = 0,
+        1, ...`` with no force (default), or the driven mass's state, the
+        position ``x0`` and the velocity ``v0 / T`` with the rest of the
+        plant at rest, the plant then stepped on its state space (needs a
+        driven mass, :meth:`symstab.Loop.driven_mass`, and one ``T``).
+    overflow : {"raise", "diverge"}
+        A point whose difference equations overflow double precision (``K
+        = 1e308``) is refused before the run (default), or run as a point
+        that diverges at once (the paper's simulator).
     **values
         The loop's parameters (or their defaults); arrays broadcast, ``d``
         one integer.
@@ -648,29 +674,88 @@ def simulate_loop(loop, *, steps=None, x0=1.0, v0=None, nonideal=None, record=Fa
     [True, False]
     """
     nonideal = check_loop_nonideal(nonideal, loop)
-    if compensation is not None and not isinstance(compensation, FrictionCompensation):
-        raise TypeError(f"compensation must be a FrictionCompensation or None, got "
-                        f"{type(compensation).__name__}")
+    compensation = _compensation_of(nonideal, compensation)
+    if start not in ("samples", "state"):
+        raise ValueError(f"start must be 'samples' or 'state', got {start!r}")
+    if overflow not in ("raise", "diverge"):
+        raise ValueError(f"overflow must be 'raise' or 'diverge', got {overflow!r}")
     check_progress(progress)   # a wrong kind is refused before the work
-    parts, d, shape = loop.difference_equations(**values)
+    parts_of, d, shape, parts_floats, period = _parts_by_chunk(loop, values, overflow)
     steps = check_steps(steps, d)
     progress = check_progress(progress, lambda: progress_printer("simulating", steps))
     x0 = check_x0(x0)
     v0 = x0 / 100 if v0 is None else check_real("v0", v0, low=-X0_MAX, high=X0_MAX)
-    n_points = int(np.prod(shape))
-    parts = [np.broadcast_to(p, shape + p.shape[-1:]).reshape(n_points, p.shape[-1])
-             for p in parts]
-    orders = parts[1].shape[-1] + parts[3].shape[-1]
-    spaces = None
-    if nonideal.coulomb_friction is not None:
+    spaces = state = None
+    if start == "state":
+        if np.ndim(period):
+            raise ValueError(f"start='state' needs one sample period T (the velocity is v0 / T), "
+                             f"got T of shape {np.shape(period)}")
+        _check_driven_mass(loop, "start='state'")
+        state = (x0, v0 / float(period))
+    if nonideal.coulomb_friction is not None or state is not None:
         spaces, inverse = loop.friction_spaces(substeps_of(nonideal), **values)
         check_friction_size(nonideal, spaces)
         spaces = (spaces, inverse.ravel())
-    return run_loop(lambda part: [p[part] for p in parts], n_points, d=d, steps=steps, x0=x0,
-                    v0=v0, nonideal=nonideal, record=record, progress=progress, shape=shape,
-                    spaces=spaces, parts_floats=2 * orders + sum(p.shape[-1] for p in parts),
+    return run_loop(parts_of, int(np.prod(shape)), d=d, steps=steps, x0=x0, v0=v0,
+                    nonideal=nonideal, record=record, progress=progress, shape=shape,
+                    spaces=spaces, state=state, parts_floats=parts_floats,
                     compensation=compensation,
                     linear_stable=linearly_stable(loop, nonideal, values, shape))
+
+
+def _compensation_of(nonideal, compensation):
+    """The :class:`FrictionCompensation` of a run: ``compensation``, else the switch's (or None)."""
+    if compensation is not None and not isinstance(compensation, FrictionCompensation):
+        raise TypeError(f"compensation must be a FrictionCompensation or None, got "
+                        f"{type(compensation).__name__}")
+    if compensation is None and nonideal.friction_compensation:
+        # The simulator's own estimate, the backward difference (pole 0).
+        return FrictionCompensation(nonideal.coulomb_friction)
+    return compensation
+
+
+def _parts_by_chunk(loop, values, overflow):
+    """A loop's difference equations a chunk of points at a time.
+
+    Returns ``(parts_of, d, shape, parts_floats, T)``: ``parts_of(part)``
+    gives ``(a, b, c, e)`` of the points ``part`` (a slice of the raveled
+    broadcast ``shape``), each ``(points, k)``; the floats a point's
+    equations take; the sample period (an array where it varies).  With
+    ``overflow="raise"`` every chunk is computed once here, so that a value
+    the equations refuse (an overflow, a leading coefficient 0, direct
+    feed-through) is refused before the run.
+    """
+    prepared, d, shape = loop.evaluation.prepare(values)
+    n_points = int(np.prod(shape))
+    flat = {name: np.broadcast_to(value, shape).ravel() if value.ndim else value
+            for name, value in prepared.items()}
+    if overflow == "diverge":
+        equations = loop.difference_parts
+    else:
+        def equations(chunk):
+            return loop.difference_equations(**chunk)
+
+    def parts_of(part):
+        size = len(range(n_points)[part])
+        parts, _, _ = equations({**{name: value[part] if value.ndim else value
+                                    for name, value in flat.items()}, "d": d})
+        return [np.broadcast_to(p, (size, p.shape[-1])) for p in parts]
+
+    if overflow == "raise":
+        # About 64 floats a point while the equations are computed.
+        for part in chunk_slices(n_points, 8 * 64):
+            parts_of(part)
+    first = parts_of(slice(0, 1))
+    orders = first[1].shape[-1] + first[3].shape[-1]
+    return parts_of, d, shape, 2 * orders + sum(p.shape[-1] for p in first), prepared["T"]
+
+
+def _check_driven_mass(loop, name):
+    """Raise ValueError naming ``name`` where ``loop`` has no driven mass (friction, a state)."""
+    try:
+        loop.driven_mass
+    except ValueError as exc:
+        raise ValueError(f"{name}: {exc}") from None
 
 
 def linearly_stable(loop, nonideal, values, shape):
@@ -753,31 +838,25 @@ def run_loop(parts_of, n_points, *, d, steps, x0, v0, nonideal, record, progress
 def check_loop_nonideal(nonideal, loop=None, friction_name="nonideal.coulomb_friction"):
     """``nonideal`` (None: ideal) as the :class:`Nonidealities` of a general loop, or raise.
 
-    A general loop has encoder quantization, a force limit and Coulomb
-    friction on its driven mass (with ``loop``: checked to have one,
-    :meth:`symstab.Loop.driven_mass`); the velocity filter and the actuator
-    lag belong in its environment and plant, and friction compensation is
-    the ``compensation=`` option of :func:`simulate_loop` (the
-    :class:`Nonidealities` field is the paper's simulator's switch).  ``friction_name`` names the
-    friction in the message (the CLI's ``--coulomb``).
+    A general loop has encoder quantization, force quantization and a force
+    limit, and Coulomb friction on its driven mass (with ``loop``: checked
+    to have one, :meth:`symstab.Loop.driven_mass`), compensated on the loop
+    simulator's velocity estimate with ``friction_compensation``
+    (:func:`simulate_loop`); the velocity filter and the actuator lag are
+    refused: they belong in its environment and plant.  ``friction_name``
+    names the friction in the message (the CLI's ``--coulomb``).
     """
     nonideal = Nonidealities() if nonideal is None else nonideal
     if not isinstance(nonideal, Nonidealities):
         raise TypeError(f"nonideal must be a symstab.numeric.paper.simulate.Nonidealities or None, "
                         f"got {type(nonideal).__name__}")
     for field, instead in (("velocity_cutoff", "write the filter into the loop's environment"),
-                           ("actuator_bandwidth", "write the lag into the loop's plant"),
-                           ("friction_compensation", "a general loop has no velocity estimate "
-                            "of its own to compensate with: give the loop simulator's option, "
-                            "simulate_loop(..., compensation=FrictionCompensation(F_c))")):
-        if getattr(nonideal, field) not in (None, False):
+                           ("actuator_bandwidth", "write the lag into the loop's plant")):
+        if getattr(nonideal, field) is not None:
             raise ValueError(f"nonideal.{field}: {instead} (the paper's simulator, "
                              f"symstab.simulate, has it)")
     if loop is not None and nonideal.coulomb_friction is not None:
-        try:
-            loop.driven_mass
-        except ValueError as exc:
-            raise ValueError(f"{friction_name}: {exc}") from None
+        _check_driven_mass(loop, friction_name)
     return nonideal
 
 

@@ -15,6 +15,7 @@ cell agrees with the root counts; the growth per period agrees with
 python-control's pole radius to 2e-5 and better.
 """
 
+import dataclasses
 import math
 
 import numpy as np
@@ -235,7 +236,6 @@ def test_a_loop_map_has_no_paper_names():
 @pytest.mark.parametrize("nonideal, name", [
     (Nonidealities(velocity_cutoff=50.0), "velocity_cutoff"),
     (Nonidealities(actuator_bandwidth=100.0), "actuator_bandwidth"),
-    (Nonidealities(coulomb_friction=0.01, friction_compensation=True), "friction_compensation"),
     ("none", "nonideal"),
 ])
 def test_what_a_loop_does_not_model_is_refused_by_name(nonideal, name):
@@ -414,6 +414,112 @@ def test_friction_compensation_is_an_option_of_the_loop_simulator():
                            compensation=FrictionCompensation(1e-3))
     free = simulate_loop(spring, steps=100, x0=0.01, record=True)
     assert not np.array_equal(pushed.positions, free.positions)
+
+
+@pytest.mark.parametrize("cutoff", [None, 50.0])
+def test_friction_compensation_of_a_loop_is_the_paper_simulators(cutoff):
+    """Issue 41, item 3: ``Nonidealities(friction_compensation=True)`` compensates any loop's
+    Coulomb friction on the simulator's backward difference (every loop refused it), or on
+    that difference filtered with the ``compensation=`` option's pole.  Oracle: the paper's
+    simulator, another path to the same device (its loop in Table I's units, forces times
+    T^2/m, its own switch and velocity filter), from the same state: paper.toml, and
+    lowpass_velocity.toml with the filter's pole.  Unfiltered it is the run with the option
+    ``FrictionCompensation(F_c, 0.0)`` given explicitly, bit for bit, and not the
+    uncompensated run; filtered, not the run on the unfiltered estimate."""
+    from symstab.numeric.simulation.simulator import FrictionCompensation
+
+    device, friction = symstab.PAPER_DEVICE, 0.004
+    alpha, beta = np.array([0.001, 0.004, 0.008]), np.array([[0.05], [0.15]])
+    compensated = Nonidealities(coulomb_friction=friction, friction_compensation=True)
+    common = dict(steps=300, x0=0.01, v0=-2e-4, record=True)
+    paper = symstab.simulate(alpha=alpha, beta=beta, gamma=0.0, d=6, delta=None, device=device,
+                             nonideal=dataclasses.replace(compensated, velocity_cutoff=cutoff),
+                             **common)
+    at = dict(K=device.stiffness(alpha), B=device.damping(beta), m=device.m, b=device.b,
+              T=device.T, d=6, start="state", **common)
+    if cutoff is None:
+        loop, option = symstab.load_loop(LOOPS / "paper.toml"), {}
+        at["M"] = 0.0
+    else:
+        loop = symstab.load_loop(LOOPS / "lowpass_velocity.toml")
+        at["f_c"] = cutoff
+        option = {"compensation": FrictionCompensation(
+            friction, math.exp(-2 * math.pi * cutoff * device.T))}
+    run = loop.simulate(nonideal=compensated, **option, **at)
+    np.testing.assert_allclose(run.positions, paper.positions, rtol=1e-9, atol=1e-14)
+    np.testing.assert_array_equal(run.stable, paper.stable)
+    np.testing.assert_array_equal(run.limit_cycle, paper.limit_cycle)
+    friction_only = Nonidealities(coulomb_friction=friction)
+    if cutoff is None:
+        explicit = loop.simulate(nonideal=friction_only,
+                                 compensation=FrictionCompensation(friction, 0.0), **at)
+        np.testing.assert_array_equal(explicit.positions, run.positions)
+        other = loop.simulate(nonideal=friction_only, **at)
+    else:
+        other = loop.simulate(nonideal=compensated, **at)
+    assert np.max(np.abs(other.positions - run.positions)) > 1e-5
+
+
+@pytest.mark.parametrize("start", ["samples", "state"])
+def test_a_run_starts_from_the_samples_or_from_the_driven_mass_state(start):
+    """Before the delayed force arrives the mass moves freely, ``x(t) = x0 + c (1 - exp(-b t /
+    m))``: from the mass's state (position x0, velocity v0 / T) ``c = v0 m / (b T)``; from the
+    sampled history ``x0 - k v0`` (x(-T) = x0 - v0) ``c = v0 / (exp(b T / m) - 1)``."""
+    loop = symstab.load_loop(LOOPS / "paper.toml")
+    m, b, T, d, x0, v0 = 0.0128, 0.0324, 1e-3, 8, 0.01, 3e-4
+    run = loop.simulate(steps=40, x0=x0, v0=v0, record=True, start=start, K=20.0, B=0.5,
+                        m=m, b=b, T=T, d=d)
+    c = v0 * m / (b * T) if start == "state" else v0 / math.expm1(b * T / m)
+    free = x0 - c * np.expm1(-b * T / m * np.arange(d + 1))
+    np.testing.assert_allclose(run.positions[:d + 1], free, rtol=1e-13)
+    assert not np.allclose(run.positions[d + 2], x0 - c * math.expm1(-b * T / m * (d + 2)))
+
+
+def test_start_and_overflow_are_checked_and_an_overflow_may_diverge():
+    """``overflow="diverge"`` runs a point whose equations overflow as diverged (the paper's
+    rule); by default it is refused before the run, as a wrong ``start`` or ``overflow``."""
+    loop = symstab.load_loop(LOOPS / "paper.toml")
+    run = loop.simulate(steps=400, overflow="diverge", K=[20.0, 1e308], B=[0.5, 1e308], d=1)
+    assert run.diverged.tolist() == [False, True] and run.stable.tolist() == [True, False]
+    calls = []
+    with pytest.raises(ValueError, match="overflows or underflows"):
+        loop.simulate(steps=40, K=[20.0, 1e308], B=[0.5, 1e308], progress=calls.append)
+    assert calls == []
+    for kwargs, name in (({"start": "rest"}, "start"), ({"overflow": "ignore"}, "overflow")):
+        with pytest.raises(ValueError) as excinfo:
+            loop.simulate(steps=40, **kwargs)
+        assert_message_names(excinfo, name)
+    lag = symstab.Loop("1/((tau*s + 1)*(m*s**2 + b*s))", "K", values={
+        "m": 0.0128, "b": 0.0324, "tau": 1e-3, "T": 1e-3, "d": 1, "K": 10.0})
+    with pytest.raises(ValueError) as excinfo:
+        lag.simulate(steps=40, start="state")
+    assert_message_names(excinfo, "start")
+
+
+def test_the_equations_are_computed_a_chunk_at_a_time(monkeypatch):
+    """Peak traced memory per point of a 200 x 200 grid at d = 40 in chunks of 256 KiB: the
+    result's 11 floats (88 bytes) a point and the chunks.  The difference equations of every
+    point at once took 160 bytes a point; a chunk at a time they stay within the chunks.
+    And the run in chunks is the run in one, bit for bit."""
+    import tracemalloc
+
+    from symstab import _resources
+    from symstab.numeric.simulation import simulator as module
+
+    loop = symstab.load_loop(LOOPS / "paper.toml")
+    B, K = np.meshgrid(np.linspace(0.0, 2.0, 200), np.linspace(0.0, 50.0, 200))
+    whole = loop.simulate(steps=48, B=B[:5], K=K[:5], d=40)
+    monkeypatch.setattr(module, "chunk_slices",
+                        lambda n, size: _resources.chunk_slices(n, size, budget=256 * 1024))
+    tracemalloc.start()
+    try:
+        loop.simulate(steps=48, B=B, K=K, d=40)
+        _, peak = tracemalloc.get_traced_memory()
+    finally:
+        tracemalloc.stop()
+    assert peak < 120 * B.size + 2 * 256 * 1024, peak
+    chunked = loop.simulate(steps=48, B=B[:5], K=K[:5], d=40)    # three chunks
+    np.testing.assert_array_equal(chunked.amplitude, whole.amplitude)
 
 
 @pytest.mark.parametrize("compensation, error, name", [

@@ -9,6 +9,7 @@ scan of the same target (``oracles.dense_maximum``) for the design.
 
 import math
 
+import numpy as np
 import pytest
 
 import symstab
@@ -121,9 +122,10 @@ def test_design_checks_the_simulation_before_the_scan():
         ({"maximize": "simulated", "amplitude": -1.0}, ValueError, "amplitude"),
         ({"maximize": "y_max", "amplitude": 1.0}, TypeError, "amplitude"),
         ({"maximize": "area", "nonideal": Nonidealities()}, TypeError, "nonideal"),
-        ({"maximize": "simulated", "amplitude": 1.0,
+        # A compensated friction passes (a loop's run compensates it): the next check speaks.
+        ({"maximize": "simulated", "amplitude": 1.0, "x0": 0.0,
           "nonideal": Nonidealities(coulomb_friction=0.01, friction_compensation=True)},
-         ValueError, "nonideal.friction_compensation"),
+         ValueError, "x0"),
         ({"maximize": "simulated", "amplitude": 1.0, "x0": 0.0}, ValueError, "x0"),
         ({"maximize": "simulated", "amplitude": 1.0, "steps": 10**9}, ValueError, "steps"),
     ]
@@ -143,6 +145,35 @@ def test_design_checks_the_simulation_before_the_scan():
     assert "relative degree 3" in str(excinfo.value)
     assert calls == []
 
+
+
+def test_a_compensated_friction_has_the_limit_of_the_compensated_runs():
+    """Issue 41, item 3: ``Nonidealities(friction_compensation=True)`` in simulated_limit (the
+    design's simulated target; every loop refused it).  With no refinement the limit is the
+    highest accepted cell of the first grid, which is run here with the compensation given
+    explicitly, ``FrictionCompensation(F_c, 0.0)`` (the simulator's backward difference);
+    the same grid uncompensated has another best cell."""
+    from symstab.numeric.simulation.simulator import FrictionCompensation
+
+    loop = symstab.load_loop(LOOPS / "paper.toml")
+    at = {"M": 0.0, "d": 5}
+    found = simulated_limit(loop, x="B", y="K", amplitude=3e-3, steps=400, x0=0.01, n=(3, 5),
+                            refine=0, nonideal=Nonidealities(coulomb_friction=1.0,
+                                                             friction_compensation=True), **at)
+    linear = found.linear
+    xs = np.union1d(np.linspace(linear.x_min, linear.x_max, 3), [linear.x_at_y_max])
+    ys = np.linspace(0.0, 4 * found.resolution, 5)
+    B, K = np.meshgrid(xs, ys)
+
+    def best(**compensation):
+        run = loop.simulate(steps=400, x0=0.01, B=B, K=K, nonideal=Nonidealities(
+            coulomb_friction=1.0), **compensation, **at)
+        accepted = run.bounded & (run.amplitude[3] <= 3e-3)
+        row = np.flatnonzero(accepted.any(axis=1)).max()
+        return float(ys[row]), float(xs[np.flatnonzero(accepted[row])[0]])
+
+    assert (found.y_max, found.x_at_y_max) == best(compensation=FrictionCompensation(1.0, 0.0))
+    assert best() != (found.y_max, found.x_at_y_max)
 
 
 def test_a_loop_without_a_stable_stiffness_has_no_simulated_limit(lowpass):
