@@ -63,16 +63,13 @@ _GRID_OPTIONS = tuple((flag, dest, "--x-range/--y-range (the plane is --x/--y)")
                       for flag, dest, _ in POINT_OPTIONS)
 
 #: The simulation options of the paper's device that a general loop has not:
-#: its filter and lag are the loop's own environment and plant, and friction
-#: compensation needs the paper's velocity estimate.
+#: its filter and lag are the loop's own environment and plant.
 _SIMULATION_OPTIONS = (
     ("--velocity-cutoff", "velocity_cutoff",
      "a velocity filter written into the loop file's environment (examples/loops/"
      "lowpass_velocity.toml)"),
     ("--actuator-bandwidth", "actuator_bandwidth",
-     "an actuator lag written into the loop file's plant (examples/loops/actuator_lag.toml)"),
-    ("--friction-compensation", "friction_compensation",
-     "--coulomb alone (a general loop has no velocity estimate to compensate with)"))
+     "an actuator lag written into the loop file's plant (examples/loops/actuator_lag.toml)"))
 
 #: The options each command refuses with ``--loop``.
 _REFUSED = {

@@ -174,7 +174,9 @@ def loop_nonideal_text(nonideal):
         parts.append(f"encoder quantum {nonideal.encoder_resolution:.4g}")
     if nonideal.coulomb_friction is not None:
         stiction = "" if nonideal.stiction is None else f", stiction {nonideal.stiction:g}"
-        parts.append(f"Coulomb friction {nonideal.coulomb_friction:g}{stiction}, "
+        compensated = (", compensated on the backward-difference velocity"
+                       if nonideal.friction_compensation else "")
+        parts.append(f"Coulomb friction {nonideal.coulomb_friction:g}{stiction}{compensated}, "
                      f"{nonideal.substeps} sub-steps a period")
     if nonideal.force_limit is not None:
         parts.append(f"force limit {nonideal.force_limit:g}")
