@@ -234,7 +234,7 @@ FRAGMENTS = [
     "é", "Ω", "\u00a0", "😀", "\u202e", "\u2028", "\x1b[2J", "\x00", "\t",
     f"\nimport os; os.system('touch {MARKER}')\n#",
     f'"""\nimport os; os.system("touch {MARKER}")\n"""',
-    f"__import__('os').environ.__setitem__('SYMSTAB_FUZZ_RAN', '1')",
+    "__import__('os').environ.__setitem__('SYMSTAB_FUZZ_RAN', '1')",
 ]
 nasty = st.lists(st.one_of(st.sampled_from(FRAGMENTS), st.text(max_size=4)),
                  max_size=4).map("".join)

@@ -26,7 +26,8 @@ from ...symbolic import model
 from ..engine.results import PAPER_PLANE
 from .device import PAPER_DEVICE
 
-__all__ = ["PAPER_LOOP", "paper_loop", "PAPER_NAMES", "paper_point", "paper_arc", "closed_form_arc",
+__all__ = ["PAPER_LOOP",  # noqa: F822 (built on first use by __getattr__ below)
+           "paper_loop", "PAPER_NAMES", "paper_point", "paper_arc", "closed_form_arc",
            "closed_form_polynomial", "paper_limits",
            "paper_passive_region", "paper_locus"]
 

@@ -5,7 +5,6 @@ of its terms, and the line z = 1 of the paper's loop came out at K = 3.8e-26
 N/m (T = 0.25 ms), printed as the end of the stable interval.
 """
 
-import numpy as np
 import pytest
 
 import symstab
