@@ -2,10 +2,12 @@
 
 The command line's PNGs (``symstab map``, ``locus``, ``limits``,
 ``design``) and the paper's figures (:mod:`symstab.figures`, which
-:mod:`symstab.reproduce` saves) are drawn here whole: the command or the
-figure computes (through the numeric API) and hands the results over;
-nothing here computes a stability question (what is drawn where, such as
-which cells have room for their root count, is decided here).  No module of
+:mod:`symstab.reproduce` saves) are drawn here whole, each by a function
+that returns its figure (:func:`png_of` makes a command's PNG bytes of
+it): the command or the figure computes (through the numeric API) and
+hands the results over; nothing here computes a stability question (what
+is drawn where, such as which cells have room for their root count, is
+decided here).  No module of
 :mod:`symstab.cli` imports matplotlib (``tests/test_layers.py``).  matplotlib is an
 extra (``pip install 'symstab[figures]'``); :func:`require_matplotlib` says
 so in one line where it is missing.
@@ -18,8 +20,9 @@ import sys
 import numpy as np
 
 __all__ = ["require_matplotlib", "pyplot", "pyplot_or_none", "png_bytes", "visible",
-           "draw_lines", "label_log_axis", "design_figure", "design_png", "simulated_map_png",
-           "loop_map_png", "probability_map_png", "robust_png", "locus_png",
+           "draw_lines", "label_log_axis", "png_of", "png_or_none", "design_figure",
+           "simulated_map_figure", "loop_map_figure", "probability_map_figure", "robust_figure",
+           "locus_figure",
            "theta_max_gamma_figure", "theta_max_delay_figure", "eq14_figure", "regions_figure",
            "boundaries_d0_figure", "physical_figure", "limits_figure", "FIGURE_COLORS",
            "PASSIVE_COLOR",
@@ -74,6 +77,47 @@ def png_bytes(plt, fig):
     fig.savefig(buf, format="png", metadata={"Software": None})
     plt.close(fig)
     return buf.getvalue()
+
+
+def png_of(figure, *args, **kwargs):
+    """The figure that ``figure`` draws, as PNG bytes (:func:`png_bytes`).
+
+    Parameters
+    ----------
+    figure : callable
+        ``figure(plt, *args, **kwargs)`` draws with ``plt`` (:func:`pyplot`)
+        and returns the :class:`matplotlib.figure.Figure`, as
+        :func:`design_figure` and the maps' figures do.
+    *args, **kwargs
+        Handed to ``figure``.
+
+    Returns
+    -------
+    bytes
+
+    Raises
+    ------
+    ValueError
+        Where matplotlib is missing, in one line (:func:`require_matplotlib`).
+    """
+    plt = pyplot()
+    return png_bytes(plt, figure(plt, *args, **kwargs))
+
+
+def png_or_none(figure, *args, **kwargs):
+    """:func:`png_of`, or None (said on stderr) where matplotlib is missing.
+
+    Parameters
+    ----------
+    figure, *args, **kwargs
+        As in :func:`png_of`.
+
+    Returns
+    -------
+    bytes or None
+    """
+    plt = pyplot_or_none()
+    return None if plt is None else png_bytes(plt, figure(plt, *args, **kwargs))
 
 
 def visible(values, lo, hi):
@@ -191,31 +235,12 @@ def design_figure(plt, found, labels, target_label):
     return fig
 
 
-def design_png(found, labels, target_label):
-    """:func:`design_figure` as PNG bytes.
-
-    Parameters
-    ----------
-    found : symstab.numeric.analysis.design.Design
-    labels : list of str
-        The axis label of each parameter searched.
-    target_label : str
-        The target's label, with its unit.
-
-    Returns
-    -------
-    bytes
-    """
-    plt = pyplot()
-    return png_bytes(plt, design_figure(plt, found, labels, target_label))
-
-
 # --------------------------------------------------------------------------
 # symstab map
 
 
-def simulated_map_png(x, y, stable, limit_cycle, *, boundary, xlabel, ylabel, title):
-    """The paper's map simulated, as PNG bytes (None, said on stderr, without matplotlib).
+def simulated_map_figure(plt, x, y, stable, limit_cycle, *, boundary, xlabel, ylabel, title):
+    """The paper's map simulated.
 
     The cells shaded by the simulation's verdict (stable green, a bounded
     limit cycle :data:`LIMIT_CYCLE_COLOR`), the boundary of the loop
@@ -223,6 +248,8 @@ def simulated_map_png(x, y, stable, limit_cycle, *, boundary, xlabel, ylabel, ti
 
     Parameters
     ----------
+    plt : module
+        :func:`pyplot`.
     x, y : numpy.ndarray
         The grids of the axes (in the units the user gave).
     stable, limit_cycle : numpy.ndarray of bool
@@ -237,11 +264,8 @@ def simulated_map_png(x, y, stable, limit_cycle, *, boundary, xlabel, ylabel, ti
 
     Returns
     -------
-    bytes or None
+    matplotlib.figure.Figure
     """
-    plt = pyplot_or_none()
-    if plt is None:
-        return None
     from matplotlib.colors import ListedColormap
     from matplotlib.patches import Patch
 
@@ -265,7 +289,7 @@ def simulated_map_png(x, y, stable, limit_cycle, *, boundary, xlabel, ylabel, ti
     if drawn:
         ax.legend(handles=drawn, loc="upper right", fontsize=9)
     fig.tight_layout()
-    return png_bytes(plt, fig)
+    return fig
 
 
 def _loop_boundary(ax, curve, xs, ys, label=""):
@@ -290,11 +314,13 @@ def _map_frame(ax, xs, ys, xlabel, ylabel):
     ax.set_ylabel(ylabel)
 
 
-def loop_map_png(xs, ys, shade, legend, curve, *, xlabel, ylabel, title):
-    """A loop file's map as PNG bytes (None without matplotlib), its D-decomposition over it.
+def loop_map_figure(plt, xs, ys, shade, legend, curve, *, xlabel, ylabel, title):
+    """A loop file's map, its D-decomposition over it.
 
     Parameters
     ----------
+    plt : module
+        :func:`pyplot`.
     xs, ys : numpy.ndarray
         The grids.
     shade : numpy.ndarray of int
@@ -308,11 +334,8 @@ def loop_map_png(xs, ys, shade, legend, curve, *, xlabel, ylabel, title):
 
     Returns
     -------
-    bytes or None
+    matplotlib.figure.Figure
     """
-    plt = pyplot_or_none()
-    if plt is None:
-        return None
     from matplotlib.colors import ListedColormap
     from matplotlib.patches import Patch
 
@@ -325,14 +348,16 @@ def loop_map_png(xs, ys, shade, legend, curve, *, xlabel, ylabel, title):
     ax.set_title(title, fontsize=9)
     ax.legend(handles=handles, loc="best", fontsize=8, framealpha=0.9)
     fig.tight_layout()
-    return png_bytes(plt, fig)
+    return fig
 
 
-def probability_map_png(found, curve, *, xlabel, ylabel, title):
-    """The probability of stability as PNG bytes (None without matplotlib), the nominal boundary.
+def probability_map_figure(plt, found, curve, *, xlabel, ylabel, title):
+    """The probability of stability, the nominal loop's boundary over it.
 
     Parameters
     ----------
+    plt : module
+        :func:`pyplot`.
     found : symstab.numeric.engine.results.StabilityProbability
     curve : symstab.numeric.engine.results.Boundary
         The nominal loop's D-decomposition over the window.
@@ -340,11 +365,8 @@ def probability_map_png(found, curve, *, xlabel, ylabel, title):
 
     Returns
     -------
-    bytes or None
+    matplotlib.figure.Figure
     """
-    plt = pyplot_or_none()
-    if plt is None:
-        return None
     xs, ys = found.x_values, found.y_values
     fig, ax = plt.subplots(figsize=(6.4, 4.8), dpi=120)
     mesh = ax.pcolormesh(xs, ys, found.probability, shading="nearest", vmin=0.0, vmax=1.0,
@@ -356,26 +378,29 @@ def probability_map_png(found, curve, *, xlabel, ylabel, title):
     if handles:
         ax.legend(handles=handles, loc="best", fontsize=8, framealpha=0.9)
     fig.tight_layout()
-    return png_bytes(plt, fig)
+    return fig
 
 
 # --------------------------------------------------------------------------
 # symstab limits --uncertain
 
 
-def robust_png(region, xlabel, ylabel):
-    """The robust set (filled), what stayed marginal and the nominal set's outline, as PNG bytes.
+def robust_figure(plt, region, xlabel, ylabel):
+    """The robust set (filled), what stayed marginal and the nominal set's outline.
 
     Parameters
     ----------
+    plt : module
+        :func:`pyplot`.
     region : symstab.numeric.engine.results.RobustRegion
+        The robust set, with the nominal loop's region.
     xlabel, ylabel : str
+        The axes' names.
 
     Returns
     -------
-    bytes
+    matplotlib.figure.Figure
     """
-    plt = pyplot()
     from matplotlib.patches import Patch, Polygon
 
     fig, ax = plt.subplots(figsize=(6.4, 4.8))
@@ -405,7 +430,7 @@ def robust_png(region, xlabel, ylabel):
     ax.set_xlabel(xlabel)
     ax.set_ylabel(ylabel)
     fig.tight_layout()
-    return png_bytes(plt, fig)
+    return fig
 
 
 # --------------------------------------------------------------------------
@@ -498,11 +523,13 @@ def _plane(ax, locus, shown, symbol, norm, limit, window=None):
     return dots
 
 
-def locus_png(locus, given, show, stretches, *, symbol, tex, title):
-    """A root locus as PNG bytes: the z-plane, a zoom on where the poles cross, the largest modulus.
+def locus_figure(plt, locus, given, show, stretches, *, symbol, tex, title):
+    """A root locus: the z-plane, a zoom on where the poles cross, the largest modulus.
 
     Parameters
     ----------
+    plt : module
+        :func:`pyplot`.
     locus : symstab.numeric.engine.locus.Locus
     given : array_like
         The path's values as the user gave them (in the units shown).
@@ -520,9 +547,8 @@ def locus_png(locus, given, show, stretches, *, symbol, tex, title):
 
     Returns
     -------
-    bytes
+    matplotlib.figure.Figure
     """
-    plt = pyplot()
     from matplotlib.colors import Normalize
     from matplotlib.patches import Rectangle
 
@@ -587,7 +613,7 @@ def locus_png(locus, given, show, stretches, *, symbol, tex, title):
     place = zx.get_position()
     bar = fig.colorbar(dots, cax=fig.add_axes([0.91, place.y0, 0.015, place.height]))
     bar.set_label("pole colour: " + tex)
-    return png_bytes(plt, fig)
+    return fig
 
 
 # --------------------------------------------------------------------------
@@ -635,8 +661,7 @@ def theta_max_gamma_figure(gammas, exact, closed):
     -------
     matplotlib.figure.Figure
     """
-    plt = pyplot()
-    fig, ax = plt.subplots(figsize=(6, 4))
+    fig, ax = pyplot().subplots(figsize=(6, 4))
     ax.plot(gammas, exact, "-", color=FIGURE_COLORS[0], lw=2, label=_THETA_MAX_EXACT)
     ax.plot(gammas[::6], closed[::6], "o", color=FIGURE_COLORS[1], ms=4, label="closed form (8)")
     ax.set_xlabel(r"$\gamma = M_w/m$")
@@ -658,8 +683,7 @@ def theta_max_delay_figure(ds, exact, newton):
     -------
     matplotlib.figure.Figure
     """
-    plt = pyplot()
-    fig, ax = plt.subplots(figsize=(6, 4))
+    fig, ax = pyplot().subplots(figsize=(6, 4))
     ax.semilogy(ds, exact, "-", color=FIGURE_COLORS[0], lw=2, label=_THETA_MAX_EXACT)
     ax.semilogy(ds[1:], newton[1:], "--", color=FIGURE_COLORS[1], lw=1.5,
                 label="one Newton step, eq. (12)")
@@ -677,6 +701,7 @@ def eq14_figure(curve, printed_beta, printed_alpha):
     Parameters
     ----------
     curve : symstab.numeric.paper.region.BoundaryCurve
+        The boundary as symstab derives it.
     printed_beta, printed_alpha : numpy.ndarray
         Eq. (14) as printed, at the curve's angles.
 
@@ -684,8 +709,7 @@ def eq14_figure(curve, printed_beta, printed_alpha):
     -------
     matplotlib.figure.Figure
     """
-    plt = pyplot()
-    fig, ax = plt.subplots(figsize=(6, 4))
+    fig, ax = pyplot().subplots(figsize=(6, 4))
     ax.plot(curve.beta, curve.alpha, "-", color=FIGURE_COLORS[2], lw=2.5,
             label=r"symstab (derived for any $d$ and $\gamma$)")
     ax.plot(printed_beta, printed_alpha, "--", color=FIGURE_COLORS[0], lw=1.5,

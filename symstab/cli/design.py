@@ -570,7 +570,7 @@ def _write_png(png, setup, found, notes):
     """Draw the target against the searched parameter(s) into ``png`` (if given)."""
     if png is None:
         return
-    from ..drawing import design_png
+    from ..drawing import design_figure, png_of
 
     names = tuple(found.over)
     labels = [setup.label(n) for n in names]
@@ -581,5 +581,5 @@ def _write_png(png, setup, found, notes):
         found.target, f"({setup.unit(setup.x)})({setup.unit(setup.y)})"
         if setup.unit(setup.x) and setup.unit(setup.y) else "")
     target_label = label[0].format(y=y) + (f" [{unit}]" if unit else "")
-    write_output(png, design_png(found, labels, target_label), "--png")
+    write_output(png, png_of(design_figure, found, labels, target_label), "--png")
     notes.append(f"wrote {png}")

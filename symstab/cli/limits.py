@@ -111,7 +111,7 @@ _MAX_STRIPS = 100_000
 
 def _robust(args, setup, at):
     """``limits --loop --uncertain``: the robust set's limits, certified; its PNG with --png."""
-    from ..drawing import require_matplotlib, robust_png
+    from ..drawing import png_of, require_matplotlib, robust_figure
     from .._progress import progress_printer
     from .output import check_files, write_output
 
@@ -195,7 +195,8 @@ def _robust(args, setup, at):
         notes.append(f"robust {y} at {x} = {at:.10g}: {text}")
         result["at"] = {"x": at, "intervals": [list(r) for r in spans]}
     if png is not None:
-        write_output(png, robust_png(region, setup.label(setup.x), setup.label(setup.y)), "--png")
+        image = png_of(robust_figure, region, setup.label(setup.x), setup.label(setup.y))
+        write_output(png, image, "--png")
         notes.append(f"wrote {png}")
     emit(setup, args.format, columns, rows, result=result, notes=notes, json_rows=False)
     return 0

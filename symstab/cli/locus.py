@@ -21,7 +21,7 @@ from .loop_options import (DEVICE_OPTIONS, EXAMPLE, LINEAR_WITH_LOOP, POINT_OPTI
                            add_delay, check_names, convert_sets, load_loop_file, loop_echo,
                            loop_values, paper_setup, parse_number, split_unit)
 from .options import add_command, add_model_options, resolve
-from ..drawing import locus_png
+from ..drawing import locus_figure, png_of
 from .output import check_outputs, emit, interval_texts, write_output
 from .units import tex_unit
 
@@ -429,8 +429,8 @@ def run(args):
     certified = _certified(view)
     columns, rows, stretches = _rows(view)
     notes = _notes(view, stretches, certified)
-    image = (locus_png(view.locus, view.given, view.show, stretches, symbol=view.symbol,
-                       tex=view.tex, title=_title(view))
+    image = (png_of(locus_figure, view.locus, view.given, view.show, stretches,
+                    symbol=view.symbol, tex=view.tex, title=_title(view))
              if png is not None else None)
     if image is not None:
         write_output(png, image, "--png")

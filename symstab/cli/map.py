@@ -21,8 +21,8 @@ from .._resources import CHUNK_BYTES, check_memory, chunk_slices
 from .loop_options import (add_loop_options, resolve_loop, uncertain_box,
                            uses_loop, value_text)
 from .options import add_command, add_model_options, resolve, stiffness_and_damping
-from ..drawing import (LIMIT_CYCLE_COLOR, LIMIT_CYCLE_LABEL, loop_map_png,
-                       probability_map_png, simulated_map_png)
+from ..drawing import (LIMIT_CYCLE_COLOR, LIMIT_CYCLE_LABEL, loop_map_figure, png_or_none,
+                       probability_map_figure, simulated_map_figure)
 from .output import check_files, write_output
 from .simulation import (add_nonideal_options, check_loop_friction, loop_nonideal_text,
                          nonideal_text, resolve_nonideal, simulated_theory, with_option_names)
@@ -320,7 +320,7 @@ def _map_title(setup, nonideal, args, steps_text):
 
 
 def _paper_png(args, setup, result, nonideal, given, theory):
-    """The map as PNG bytes, or None without matplotlib (:func:`symstab.drawing.simulated_map_png`).
+    """The map as PNG bytes, or None without matplotlib (:func:`~symstab.drawing.png_or_none`).
 
     Drawn in the units of the grids the user gave (K_w, B_w or alpha, beta),
     with the non-idealities of the simulation in the title and the boundary
@@ -332,8 +332,8 @@ def _paper_png(args, setup, result, nonideal, given, theory):
     name = ("the ideal loop, eq. (7)" if theory.loop is None
             else f"the {theory.label} (D-decomposition)")
     # result's arrays are (alpha, beta): y by x, as the map is drawn.
-    return simulated_map_png(
-        x, y, result.stable, result.limit_cycle,
+    return png_or_none(
+        simulated_map_figure, x, y, result.stable, result.limit_cycle,
         boundary={"curve": (arc_beta, arc_alpha), "label": f"boundary of {name}", "lines": lines,
                   "plane": (result.beta, result.alpha), "to_x": to_x, "to_y": to_y},
         xlabel=xlabel, ylabel=ylabel,
@@ -557,8 +557,8 @@ def _probability_png(setup, found, fixed, drawn):
     title = "\n".join([f"loop {setup.loop.name}: probability of stability, "
                        f"{found.samples} draws"] + textwrap.wrap(", ".join(drawn), 80)
                       + textwrap.wrap(rest, 80))
-    return probability_map_png(found, _boundary(setup, xs, ys), **_axis_labels(setup),
-                               title=title)
+    return png_or_none(probability_map_figure, found, _boundary(setup, xs, ys),
+                       **_axis_labels(setup), title=title)
 
 
 def _boundary(setup, xs, ys):
@@ -603,5 +603,5 @@ def _loop_png(setup, xs, ys, code, simulated=None):
     how = "root counts" if simulated is None else "simulated; lines: root counts"
     title = "\n".join([f"loop {loop.name}: stable set in the ({x}, {y}) plane ({how})"]
                       + textwrap.wrap(fixed, 80))
-    return loop_map_png(xs, ys, shade, legend, _boundary(setup, xs, ys), **_axis_labels(setup),
-                        title=title)
+    return png_or_none(loop_map_figure, xs, ys, shade, legend, _boundary(setup, xs, ys),
+                       **_axis_labels(setup), title=title)

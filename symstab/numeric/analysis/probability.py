@@ -115,10 +115,9 @@ def stability_probability(loop, x_values, y_values, *, x, y, uncertain, samples=
 
     Parameters
     ----------
-    loop : symstab.Loop
-        The loop.
-    x_values, y_values : array_like
-        1-D grids of the plane's parameters.
+    loop, x_values, y_values
+        As in :func:`symstab.numeric.simulation.simulator.loop_stability_map`,
+        which maps the same grid by simulation.
     uncertain : dict
         ``{name: (low, high)}`` (uniform; ``d``: the integers from
         ``low`` to ``high``) or ``{name: distribution}`` (a frozen

@@ -109,6 +109,14 @@ class LoopEvaluation:
     parts of its model that are not public: its plant's 30-digit values, its
     NumPy kernels and its closed forms.
 
+    Its methods share the names of their arguments: ``given`` is a dict of
+    values of the loop's parameters, the defaults for the rest (a
+    :class:`symstab.Loop` method's ``**values``); ``values``, ``d`` and
+    ``shape`` are what :meth:`prepare` makes of it (the values by symbol
+    name, the delay, their broadcast shape); ``x, y`` or ``names`` are the
+    plane's parameters, and ``given`` then holds single values of the
+    others.
+
     Parameters
     ----------
     loop : symstab.Loop
@@ -201,13 +209,6 @@ class LoopEvaluation:
 
         One 30-digit evaluation per distinct row of the plant's values.
 
-        Parameters
-        ----------
-        values : dict
-            Prepared values (:meth:`prepare`).
-        shape : tuple
-            Their broadcast shape.
-
         Returns
         -------
         tuple of ndarray
@@ -230,10 +231,6 @@ class LoopEvaluation:
 
         Parameters
         ----------
-        values : dict
-            Prepared values (:meth:`prepare`).
-        shape : tuple
-            Their broadcast shape.
         slope : str, optional
             A parameter entering the environment affinely.
 
@@ -259,12 +256,6 @@ class LoopEvaluation:
 
         Parameters
         ----------
-        values : dict
-            Prepared values (:meth:`prepare`).
-        d : int
-            The loop's delay.
-        shape : tuple
-            The broadcast shape.
         slope : str, optional
             The parameter whose slope is wanted.
         plant : tuple, optional
@@ -342,11 +333,6 @@ class LoopEvaluation:
     def polynomial(self, given):
         """:meth:`symstab.Loop.polynomial` of the dict ``given``.
 
-        Parameters
-        ----------
-        given : dict
-            Values of the loop's parameters (defaults for the rest).
-
         Returns
         -------
         symstab.numeric.engine.polynomial.DelayedPolynomial
@@ -362,11 +348,6 @@ class LoopEvaluation:
     def root_polynomial(self, given):
         """The polynomial whose roots are counted: the closed form where the loop has one.
 
-        Parameters
-        ----------
-        given : dict
-            Values of the loop's parameters (defaults for the rest).
-
         Returns
         -------
         symstab.numeric.engine.polynomial.DelayedPolynomial
@@ -379,21 +360,7 @@ class LoopEvaluation:
         return self._closed_polynomial(values, d)
 
     def affine_parts(self, names, given, *, structured=False):
-        """:meth:`symstab.Loop.affine_parts` (which says what they are).
-
-        Parameters
-        ----------
-        names : tuple of str
-            One or two parameters in which ``chi`` is jointly affine.
-        given : dict
-            Single values of the other parameters (defaults for the rest).
-        structured : bool
-            DelayedPolynomial parts instead of dense rows.
-
-        Returns
-        -------
-        (A0, [A_x, A_y], [ends of A0, of A_x, of A_y])
-        """
+        """:meth:`symstab.Loop.affine_parts`, which documents its parameters and the parts returned."""
         self.loop.check_plane(names)
         values, d, shape = self.prepare(given, scalar=self.loop.parameters, drop=names)
         for name in names:
@@ -417,13 +384,6 @@ class LoopEvaluation:
     def closed_form(self, x, y, values):
         """``theta -> (x, y)`` of the arc in closed form, or None (the loop's ``arc`` option).
 
-        Parameters
-        ----------
-        x, y : str or None
-            The plane.
-        values : dict
-            Single values of the other parameters.
-
         Returns
         -------
         callable or None
@@ -437,10 +397,6 @@ class LoopEvaluation:
 
         Parameters
         ----------
-        x, y : str
-            The plane.
-        values : dict
-            Single values of the other parameters.
         parts : tuple
             ``(A0, A_x, A_y)``, structured (:meth:`affine_parts`).
 
@@ -460,13 +416,6 @@ class LoopEvaluation:
         float parts lose their digits only next to ``z = +-1``, and a
         family of lines at a long delay crosses the arc thousands of times
         in between.
-
-        Parameters
-        ----------
-        x, y : str
-            The plane.
-        values : dict
-            Single values of the other parameters.
 
         Returns
         -------
@@ -499,13 +448,6 @@ class LoopEvaluation:
         slope is not computed exactly) or a part is longer than the arc's
         exact sums take.
 
-        Parameters
-        ----------
-        names : tuple of str
-            The plane.
-        given : dict
-            Single values of the other parameters.
-
         Returns
         -------
         tuple of symstab.numeric.engine.arcs.ExactPolynomial or None
@@ -535,8 +477,6 @@ class LoopEvaluation:
 
         Parameters
         ----------
-        given : dict
-            Values of the loop's parameters (defaults for the rest).
         keep_overflow : bool
             Keep coefficients that overflow (:meth:`symstab.Loop.difference_parts`)
             instead of refusing them.
@@ -578,8 +518,6 @@ class LoopEvaluation:
         ----------
         substeps : int
             Sub-steps per period.
-        given : dict
-            Values of the loop's parameters (defaults for the rest).
         build : callable
             ``build(coefficients, T, substeps)``: the space from the driven
             mass's coefficients (the simulation room's ``friction_space``).
@@ -624,6 +562,12 @@ class LoopEvaluation:
         return num, chi, float(values["T"])
 
 
+def _per_point(question, loop, values, number):
+    """``question`` of the loop's root polynomial at ``values``: a ``number`` at a single point."""
+    answer = question(loop.evaluation.root_polynomial(values))
+    return number(answer) if answer.ndim == 0 else answer
+
+
 def spectral_radius(loop, **values):
     """Largest modulus of a loop's closed-loop poles.
 
@@ -633,19 +577,15 @@ def spectral_radius(loop, **values):
 
     Parameters
     ----------
-    loop : symstab.Loop
-        The loop.
-    **values
-        Every parameter (:attr:`~symstab.Loop.parameters`) or its default;
-        arrays broadcast; ``d`` is an integer.
+    loop, **values
+        As in :func:`classify`.
 
     Returns
     -------
     float or ndarray
         Of the broadcast shape.
     """
-    r = roots.spectral_radius(loop.evaluation.root_polynomial(values))
-    return float(r) if r.ndim == 0 else r
+    return _per_point(roots.spectral_radius, loop, values, float)
 
 
 def classify(loop, **values):
@@ -668,8 +608,7 @@ def classify(loop, **values):
     -------
     int or ndarray of int8
     """
-    codes = roots.classify_polynomials(loop.evaluation.root_polynomial(values))
-    return int(codes) if codes.ndim == 0 else codes
+    return _per_point(roots.classify_polynomials, loop, values, int)
 
 
 def is_stable(loop, **values):
@@ -679,11 +618,8 @@ def is_stable(loop, **values):
 
     Parameters
     ----------
-    loop : symstab.Loop
-        The loop.
-    **values
-        Every parameter (:attr:`~symstab.Loop.parameters`) or its default;
-        arrays broadcast; ``d`` is an integer.
+    loop, **values
+        As in :func:`classify`, whose codes it reads.
 
     Returns
     -------
@@ -699,23 +635,18 @@ def unstable_root_counts(loop, **values):
     """Certified number of a loop's closed-loop poles outside the unit circle (-1: marginal).
 
     :func:`symstab.numeric.engine.roots.root_counts`, O(d) per point; -1 also
-    where a root is at infinity to within rounding (an ill-posed loop),
-    as in :func:`classify`.
+    where a root is at infinity to within rounding (an ill-posed loop).
 
     Parameters
     ----------
-    loop : symstab.Loop
-        The loop.
-    **values
-        Every parameter (:attr:`~symstab.Loop.parameters`) or its default;
-        arrays broadcast; ``d`` is an integer.
+    loop, **values
+        As in :func:`classify`, which is marginal where this is -1.
 
     Returns
     -------
     int or ndarray of int
     """
-    counts = roots.root_counts(loop.evaluation.root_polynomial(values))
-    return int(counts) if counts.ndim == 0 else counts
+    return _per_point(roots.root_counts, loop, values, int)
 
 
 def difference_equations(loop, **values):
@@ -761,9 +692,8 @@ def difference_parts(loop, values):
     Parameters
     ----------
     loop : symstab.Loop
-        The loop.
     values : dict
-        Every parameter (or its default); arrays broadcast.
+        The ``**values`` of :func:`difference_equations` in one dict.
 
     Returns
     -------

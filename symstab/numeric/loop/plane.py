@@ -409,11 +409,8 @@ def limits(loop, x=None, y=None, **values):
 
     Parameters
     ----------
-    loop : symstab.Loop
-        The loop.
-    x, y : str
-        The plane's parameters, jointly affine (default: the loop's
-        :attr:`~symstab.Loop.plane`).
+    loop, x, y
+        As in :func:`region`.
     **values
         Single values of every other parameter (and ``x_range`` /
         ``y_range`` for :func:`region`).  The robust set's limits are
