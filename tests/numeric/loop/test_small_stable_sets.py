@@ -13,6 +13,8 @@ polynomial kernel), python-control's closed-loop poles
 enclosure of :func:`symstab.numeric.engine.decomposition.stable_hull`.
 """
 
+import functools
+
 import numpy as np
 import pytest
 
@@ -148,12 +150,20 @@ def _stodola_holds(c):
     n = len(c) - 1
     q = [Fraction(0)] * (n + 1)
     for i, value in enumerate(c):
-        j = n - i         # c[i] multiplies z**j
-        term = np.polymul(np.array(np.poly1d([1, 1]) ** j, dtype=object),
-                          np.array(np.poly1d([1, -1]) ** (n - j), dtype=object))
-        for k, t in enumerate(term[::-1]):
-            q[k] += Fraction(float(value)) * int(t)
+        for k, t in enumerate(_bilinear_term(n, n - i)):     # c[i] multiplies z**(n - i)
+            q[k] += Fraction(float(value)) * t
     return all(v > 0 for v in q) or all(v < 0 for v in q)
+
+
+@functools.lru_cache(maxsize=None)
+def _bilinear_term(n, j):
+    """The integer coefficients of ``(w + 1)**j (w - 1)**(n - j)``, lowest power first.
+
+    The same for every point of a test: expanded once per ``(n, j)``.
+    """
+    term = np.polymul(np.array(np.poly1d([1, 1]) ** j, dtype=object),
+                      np.array(np.poly1d([1, -1]) ** (n - j), dtype=object))
+    return tuple(int(t) for t in term[::-1])
 
 
 def _real_root_family(rng, n):
