@@ -305,8 +305,9 @@ def _clip(vertices, row):
         return vertices[:0]
     m = len(vertices)
     # Convex: the inside vertices are one cyclic run; k is its first, l its last.
-    k = int(np.flatnonzero(inside & ~np.roll(inside, 1))[0])
-    run = np.roll(np.arange(m), -k)[: int(inside.sum())]
+    # (Slices, not np.roll: this runs once per cutting line, thousands of times.)
+    k = int(np.flatnonzero(inside & ~_previous(inside))[0])
+    run = (np.arange(int(inside.sum())) + k) % m
     last = run[-1]
 
     def cut(i, j):
@@ -319,12 +320,17 @@ def _clip(vertices, row):
     return _tidy(out)
 
 
+def _previous(a):
+    """``np.roll(a, 1, axis=0)``: each row's predecessor, cyclically."""
+    return np.concatenate([a[-1:], a[:-1]])
+
+
 def _tidy(vertices):
     """Drop consecutive vertices that coincide to rounding."""
     if len(vertices) < 2:
         return vertices
-    span = max(float(np.ptp(vertices[:, 0])), float(np.ptp(vertices[:, 1])), 1e-300)
-    step = np.hypot(*(vertices - np.roll(vertices, 1, axis=0)).T)
+    span = max(*(float(v) for v in vertices.max(axis=0) - vertices.min(axis=0)), 1e-300)
+    step = np.hypot(*(vertices - _previous(vertices)).T)
     # Many lines through one corner (at d = 0 every theta's line passes
     # through the wall's apex) give copies of it a few ulps apart.
     keep = step > 1e-9 * span
@@ -335,8 +341,8 @@ def _tidy(vertices):
         return vertices
     # A vertex where the boundary does not turn (a grid line through a
     # corner cuts it at the corner) is no vertex.
-    before = vertices - np.roll(vertices, 1, axis=0)
-    after = np.roll(vertices, -1, axis=0) - vertices
+    before = vertices - _previous(vertices)
+    after = np.concatenate([vertices[1:], vertices[:1]]) - vertices
     turn = before[:, 0] * after[:, 1] - before[:, 1] * after[:, 0]
     straight = np.abs(turn) <= 1e-12 * np.hypot(*before.T) * np.hypot(*after.T)
     return vertices[~straight] if (~straight).sum() >= 3 else vertices

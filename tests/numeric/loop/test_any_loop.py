@@ -23,7 +23,7 @@ from symstab.numeric.engine.roots import root_counts, spectral_radius
 from symstab.numeric.engine.roots import MARGINAL, STABLE, UNSTABLE, classify_polynomials
 
 from conftest import PAPER_B, PAPER_M, PAPER_T, assert_rel_close
-from oracles import python_control_closed_loop
+from oracles import polyroots, python_control_closed_loop
 from conftest import REPO
 
 control = pytest.importorskip("control")
@@ -308,8 +308,7 @@ def test_paper_loop_stable_intervals_against_python_control(paper_loop):
                                         gamma=0.0, d=d, delta=delta, m=PAPER_M, T=PAPER_T)
         den = np.trim_zeros(np.asarray(cl.den[0][0], dtype=float), "b")   # drop the pole at 0
         with mpmath.workdps(40):
-            roots = mpmath.polyroots([mpmath.mpf(float(c)) for c in den], maxsteps=400,
-                                     extraprec=400)
+            roots = polyroots([mpmath.mpf(float(c)) for c in den], maxsteps=400, extraprec=400)
             return max(abs(r) for r in roots) < 1
 
     for B, d in ((0.3, 40), (1.0, 10), (5.0, 0)):
@@ -350,8 +349,8 @@ def test_closed_loop_poles_are_the_characteristic_roots(paper_loop):
 def _mp_outside(coefficients):
     """Roots outside the circle, the smallest | |z| - 1 | and the largest |z|, at 40 digits."""
     with mpmath.workdps(40):
-        roots = mpmath.polyroots([mpmath.mpf(float(c)) for c in coefficients], maxsteps=200,
-                                 extraprec=200)
+        roots = polyroots([mpmath.mpf(float(c)) for c in coefficients], maxsteps=200,
+                          extraprec=200)
         return (sum(1 for r in roots if abs(r) > 1), min(abs(abs(r) - 1) for r in roots),
                 max(abs(r) for r in roots))
 

@@ -6,8 +6,8 @@ the file's comment: the plant as a numeric continuous ``control.tf`` (or
 ``control.ss`` from the equations of motion), discretised by
 ``control.sample_system(G, T, 'zoh')``; the environment as a discrete
 ``control.tf(..., dt=T)``; the delay ``z**-d``.  The closed-loop poles are the
-roots of ``z**d Ve_d P_d + Ve_n P_n``, assembled with ``np.polymul`` and
-``np.polyadd`` from python-control's polynomials, which
+roots of ``z**d Ve_d P_d + Ve_n P_n``, assembled with ``np.polymul``'s
+arithmetic and ``np.polyadd`` from python-control's polynomials, which
 :func:`test_oracle_polynomial_is_control_feedback` checks against
 ``control.feedback(G_zoh, VE * delay).poles()``.  The parameter values are
 read from the file with ``tomllib``, not through the loop.
@@ -164,22 +164,64 @@ class Example:
         num, den = self.oracle.environment(self.values, K, B)
         return control.tf(num, den, self.values["T"])
 
-    def poles(self, K, B, d):
-        """Closed-loop poles at one point: roots of z**d Ve_d P_d + Ve_n P_n."""
+    def chi(self, K, B, d):
+        """The closed loop's polynomial at one point: z**d Ve_d P_d + Ve_n P_n."""
         ve = self.environment_tf(K, B)
         ve_num, ve_den = np.asarray(ve.num[0][0], float), np.asarray(ve.den[0][0], float)
-        delayed = np.polymul(np.polymul(ve_den, self.p_den), np.r_[1.0, np.zeros(d)])
-        chi = np.polyadd(delayed, np.polymul(ve_num, self.p_num))
-        return np.roots(chi)
+        delayed = _polymul(_polymul(ve_den, self.p_den), np.r_[1.0, np.zeros(d)])
+        return np.polyadd(delayed, _polymul(ve_num, self.p_num))
+
+    def poles(self, K, B, d):
+        """Closed-loop poles at one point: the roots of :meth:`chi`."""
+        return np.roots(self.chi(K, B, d))
 
     def radius(self, x_values, y_values, d):
         K, B = np.broadcast_arrays(*self.kb(np.asarray(x_values, float),
                                             np.asarray(y_values, float)))
-        out = np.array([np.max(np.abs(self.poles(k, b, d))) for k, b in zip(K.ravel(), B.ravel())])
+        out = _largest_moduli([self.chi(k, b, d) for k, b in zip(K.ravel(), B.ravel())])
         return out.reshape(K.shape)
 
     def stable(self, x_values, y_values, d):
         return self.radius(x_values, y_values, d) < 1.0
+
+
+def _polymul(a, b):
+    """``np.polymul(a, b)`` of 1-D arrays: the convolution of their poly1d coefficients.
+
+    The same numbers without two ``np.poly1d`` per call (their
+    ``np.trim_zeros`` was most of the oracle's time): leading zeros dropped,
+    an all-zero polynomial kept as ``[0]``.
+    """
+    def coefficients(c):
+        c = np.atleast_1d(c)
+        nonzero = np.flatnonzero(c)
+        return c[nonzero[0]:] if nonzero.size else np.zeros(1, dtype=c.dtype)
+
+    return np.convolve(coefficients(a), coefficients(b))
+
+
+def _largest_moduli(rows):
+    """``max |np.roots(row)|`` of each row, the companion matrices of equal degree batched.
+
+    ``np.roots`` of a row with nonzero first and last coefficients is
+    ``eigvals`` of the companion whose first row is ``-row[1:] / row[0]``;
+    the same matrices in one stacked ``eigvals`` call give the same roots
+    without a call per row.  Any other row goes to ``np.roots`` itself.
+    """
+    out = np.empty(len(rows))
+    batches = {}
+    for i, row in enumerate(rows):
+        if len(row) > 1 and row[0] != 0 and row[-1] != 0 and np.all(np.isfinite(row)):
+            batches.setdefault(len(row), []).append(i)
+        else:
+            out[i] = np.max(np.abs(np.roots(row)))
+    for size, members in batches.items():
+        table = np.array([rows[i] for i in members])
+        companion = np.zeros((len(members), size - 1, size - 1))
+        companion[:, np.arange(1, size - 1), np.arange(size - 2)] = 1.0
+        companion[:, 0, :] = -table[:, 1:] / table[:, :1]
+        out[members] = np.max(np.abs(np.linalg.eigvals(companion)), axis=1)
+    return out
 
 
 @pytest.fixture(scope="module")
@@ -377,9 +419,12 @@ def test_is_stable_agrees_with_python_control(path, examples):
 # --------------------------------------------------------------------------
 
 def _oracle_intervals(stable_at, lo, hi, n=400, extra=()):
-    """Stable intervals of a predicate on [lo, hi]: grid, then bisection of each change."""
+    """Stable intervals of a predicate on [lo, hi]: grid, then bisection of each change.
+
+    ``stable_at`` takes an array of values (the grid, in one call) or one value.
+    """
     grid = np.unique(np.concatenate([np.linspace(lo, hi, n), extra]))
-    state = np.array([stable_at(g) for g in grid])
+    state = np.asarray(stable_at(grid), dtype=bool)
     edges = []
     for i in np.flatnonzero(state[1:] != state[:-1]):
         a, b = grid[i], grid[i + 1]
@@ -430,7 +475,7 @@ def test_stable_intervals_agree_with_bisection(path, examples):
 
         def stable_at(value):
             point = {name: value, other: other_value}
-            return bool(example.stable(point[example.x], point[example.y], d))
+            return example.stable(point[example.x], point[example.y], d)
 
         # The oracle also looks inside each interval the loop reports, so a
         # stable interval narrower than its grid is not missed.

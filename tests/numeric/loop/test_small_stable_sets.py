@@ -13,6 +13,8 @@ polynomial kernel), python-control's closed-loop poles
 enclosure of :func:`symstab.numeric.engine.decomposition.stable_hull`.
 """
 
+import functools
+
 import numpy as np
 import pytest
 
@@ -148,12 +150,20 @@ def _stodola_holds(c):
     n = len(c) - 1
     q = [Fraction(0)] * (n + 1)
     for i, value in enumerate(c):
-        j = n - i         # c[i] multiplies z**j
-        term = np.polymul(np.array(np.poly1d([1, 1]) ** j, dtype=object),
-                          np.array(np.poly1d([1, -1]) ** (n - j), dtype=object))
-        for k, t in enumerate(term[::-1]):
-            q[k] += Fraction(float(value)) * int(t)
+        for k, t in enumerate(_bilinear_term(n, n - i)):     # c[i] multiplies z**(n - i)
+            q[k] += Fraction(float(value)) * t
     return all(v > 0 for v in q) or all(v < 0 for v in q)
+
+
+@functools.lru_cache(maxsize=None)
+def _bilinear_term(n, j):
+    """The integer coefficients of ``(w + 1)**j (w - 1)**(n - j)``, lowest power first.
+
+    The same for every point of a test: expanded once per ``(n, j)``.
+    """
+    term = np.polymul(np.array(np.poly1d([1, 1]) ** j, dtype=object),
+                      np.array(np.poly1d([1, -1]) ** (n - j), dtype=object))
+    return tuple(int(t) for t in term[::-1])
 
 
 def _real_root_family(rng, n):
@@ -315,9 +325,18 @@ def test_a_stable_sliver_beside_a_triple_crossing_is_resolved(loop_cache_dir):
     radius = _frictionless_radius(loop, 0.0163)
 
     def top(B, lo, hi):
-        """The largest stable K in [lo, hi] at B: a scan, then a bisection; -inf if none."""
+        """The largest stable K in [lo, hi] at B: a scan, then a bisection; -inf if none.
+
+        The scan goes down from ``hi`` 2000 points at a time and stops at the
+        first block with a stable point: the same largest stable point as
+        the whole grid's (each point's radius is its own eigenvalue problem).
+        """
         ks = np.linspace(lo, hi, 20001)
-        stable = ks[radius(B, ks) < 1]
+        for end in range(len(ks), 0, -2000):
+            block = ks[max(0, end - 2000):end]
+            stable = block[radius(B, block) < 1]
+            if stable.size:
+                break
         if not stable.size:
             return -np.inf
         below, above = stable.max(), stable.max() + (hi - lo) / 20000

@@ -7,7 +7,8 @@ Oracles (none of them goes through symstab's kernels; symstab's 30/50-digit
   (``oracles.python_control_closed_loop``), its poles' largest modulus;
 * the characteristic polynomial written out from the paper's eqs. (1), (2)
   and (4) with m = T = 1, b = delta (:func:`eq4_chi`), evaluated in mpmath;
-  its roots by ``mpmath.polyroots`` at 40 digits (d = 40), or by
+  its roots by ``mpmath.polyroots`` at 40 digits (d = 40; started from
+  numpy's roots, :func:`oracles.polyroots`), or by
   :func:`polished_roots`: numpy's roots of the coefficients rounded once from
   30 digits, Newton-polished at 40 digits (all of them, or those within 1e-3
   of the unit circle) and checked to be distinct (d = 200, where polyroots
@@ -38,7 +39,7 @@ from symstab.numeric.paper.reference import boundary_point
 from symstab.numeric.paper.stability import loop_coefficients, schur_cohn
 
 from conftest import PAPER_DELTA, assert_message_names
-from oracles import (dimensionless, first_principles_chi, first_principles_chi_float,
+from oracles import (dimensionless, first_principles_chi, first_principles_chi_float, polyroots,
                      python_control_closed_loop, random_loop_points)
 
 
@@ -196,7 +197,7 @@ HIGH_D_POINTS = [
 @pytest.mark.parametrize("alpha, beta, gamma, d, delta", [p for p in HIGH_D_POINTS if p[3] == 40])
 def test_spectral_radius_matches_mpmath_polyroots_at_d40(alpha, beta, gamma, d, delta):
     with mpmath.workdps(40):
-        roots = mpmath.polyroots(eq4_chi(alpha, beta, gamma, d, delta), maxsteps=400, extraprec=200)
+        roots = polyroots(eq4_chi(alpha, beta, gamma, d, delta), maxsteps=400, extraprec=200)
         expected = max(abs(r) for r in roots)
         got = spectral_radius(alpha=alpha, beta=beta, gamma=gamma, d=d, delta=delta)
         err = abs(got - expected) / expected
@@ -455,8 +456,7 @@ def test_clustered_roots_get_the_true_verdict_or_marginal(theta):
     codes = classify(alpha=alphas, beta=b, gamma=gamma, d=d, delta=delta)
     with mpmath.workdps(80):
         for alpha, code in zip(alphas, codes):
-            roots = mpmath.polyroots(eq4_chi(alpha, b, gamma, d, delta), maxsteps=400,
-                                     extraprec=400)
+            roots = polyroots(eq4_chi(alpha, b, gamma, d, delta), maxsteps=400, extraprec=400)
             radius = max(abs(r) for r in roots)
             truth = STABLE if radius < 1 else UNSTABLE
             assert code in (truth, MARGINAL), (alpha, code, mpmath.nstr(radius - 1, 5))
