@@ -335,7 +335,9 @@ def test_unbounded_set_is_clipped_and_flagged():
     region = passive_region(paper_loop(d=2), x="b", y="K", B=0.0)
     assert not region.bounded and math.isinf(region.y_max)
     (x0, x1), (y0, y1) = region.x_range, region.y_range
+    # Clipped to its window on every side.
     assert np.all(region.polygon[:, 0] >= x0 - 1e-12) and np.all(region.polygon[:, 1] <= y1 + 1e-9)
+    assert np.all(region.polygon[:, 0] <= x1 + 1e-12) and np.all(region.polygon[:, 1] >= y0 - 1e-9)
     b = 0.02
     k = 2 * b / (5 * PAPER_T)
     assert region.contains([b, b], [k * (1 - 1e-6), k * (1 + 1e-6)]).tolist() == [True, False]
