@@ -922,12 +922,9 @@ class _AnyLoop:
 
     def _sum(self, out, terms, history, sign):
         tmp = self._scratch
+        combine = np.add if sign > 0 else np.subtract
         for k, coefficient in terms:
-            np.multiply(coefficient, history[k], out=tmp)
-            if sign > 0:
-                out += tmp
-            else:
-                out -= tmp
+            combine(out, np.multiply(coefficient, history[k], out=tmp), out=out)
 
     def step(self):
         """One period; the caller ignores NumPy's overflow and invalid values (:func:`_run`)."""
@@ -966,12 +963,13 @@ class _AnyLoop:
 
     def _plant_step(self, command):
         """The plant's next sample under ``u = -command``: ``P_d(z) y = P_n(z) u``."""
-        self.y_past = [self.x] + self.y_past[:-1]
-        self.f_past_plant = [command] + self.f_past_plant[:-1]
+        self.y_past = y_past = [self.x] + self.y_past[:-1]
+        self.f_past_plant = f_past = [command] + self.f_past_plant[:-1]
         (k, first), *rest = self.minus_b
-        x = np.multiply(first, self.f_past_plant[k])
-        self._sum(x, rest, self.f_past_plant, 1)
-        self._sum(x, self.a, self.y_past, -1)
+        x = np.multiply(first, f_past[k])
+        if rest:
+            self._sum(x, rest, f_past, 1)
+        self._sum(x, self.a, y_past, -1)
         return x
 
     def freeze_diverged(self):
