@@ -269,7 +269,19 @@ def limits(*, gamma, d, delta, n_beta=None):
     Limits(gamma=0, d=0, delta=0.00253125: alpha_max=0.68967 at beta=0.827933, beta from ...)
     """
     _deprecated_n_beta(n_beta)
-    return StabilityRegion(gamma=gamma, d=d, delta=delta).limits()
+    gamma, d, delta = check_loop(gamma, d, delta)
+    return _region_at(gamma.hex(), d, delta.hex()).limits()
+
+
+@functools.lru_cache(maxsize=32)
+def _region_at(gamma_hex, d, delta_hex):
+    """The :class:`StabilityRegion` of one point (its floats in hex: -0.0 is not 0.0), kept.
+
+    Its limits are asked again at once: a figure's scan of gamma, then the
+    bisection of :func:`vanishing_gamma` from two of its gammas, then the
+    gamma it ends at.  32 regions hold about 3 MB.
+    """
+    return StabilityRegion(gamma=float.fromhex(gamma_hex), d=d, delta=float.fromhex(delta_hex))
 
 
 def vanishing_gamma(*, d, delta, inside, outside, tol=5e-5):
