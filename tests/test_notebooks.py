@@ -106,7 +106,7 @@ def kernel(tmp_path_factory):
 
 
 def _execute(nbclient, nb, manager):
-    """Execute ``nb`` top to bottom in the kernel of ``manager``; the client's channels closed after."""
+    """Execute ``nb`` top to bottom in the kernel of ``manager``; close the client's channels."""
     client = nbclient.NotebookClient(nb, km=manager, timeout=300, kernel_name="python3",
                                      resources={"metadata": {"path": str(DERIVATIONS)}})
     try:

@@ -359,7 +359,7 @@ def vanishing_gamma(*, d, delta, inside, outside, tol=5e-5):
 
 
 def _lines_across(found, n=7):
-    """Dampings of ``n`` vertical lines across the stable region of ``found`` (a :class:`Limits`)."""
+    """Dampings of ``n`` vertical lines across the stable region of ``found``, a :class:`Limits`."""
     inner = np.linspace(found.x_min, found.x_max, n + 2)[1:-1]
     return np.union1d(inner, [found.x_at_y_max])
 

@@ -531,7 +531,7 @@ def _run(run, steps, amplitude, positions, progress, report, chunk, n_chunks, to
 
 
 def _quarters(steps):
-    """``(start, stop)`` of the periods of each quarter: ``k // (steps // 4)``, the last open-ended."""
+    """``(start, stop)`` of each quarter's periods: ``k // (steps // 4)``, the last open-ended."""
     quarter = steps // 4      # steps >= 8 (check_steps)
     return [(q * quarter, (q + 1) * quarter if q < 3 else steps) for q in range(4)]
 
