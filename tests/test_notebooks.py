@@ -8,12 +8,19 @@ through :class:`symstab.Loop` and asserts its answers against
 python-control's poles; ``09`` answers the velocity filter's cut-off
 question (linear model against simulation with the encoder) and asserts
 its answer.  The notebooks are stored without outputs; these tests
-execute them in a fresh ``python3`` kernel with nbclient and fail on any cell
-error.  The execution tests are skipped when nbclient or ipykernel is not
-installed; the storage tests only need the standard library.
+execute each top to bottom with nbclient and fail on any cell error.  They
+share one ``python3`` kernel per test process, its namespace reset
+(``%reset -f``) and its figures closed before each notebook, so a notebook
+sees no name another defined; what stays is what a user's session keeps
+too: the modules imported and the derivation cached in them (each notebook
+re-derived the paper's loop in a kernel of its own: 8 kernel starts and
+about half of the notebooks' time).  The execution tests are skipped when
+nbclient or ipykernel is not installed; the storage tests only need the
+standard library.
 """
 
 import json
+import os
 import pathlib
 
 import pytest
@@ -71,19 +78,55 @@ def _notebook_client():
     return nbclient
 
 
-@pytest.mark.parametrize("name", EXPECTED)
-def test_notebook_executes_without_errors(name, tmp_path, monkeypatch):
-    nbclient = _notebook_client()
-    import nbformat
+#: Run before each notebook in the shared kernel: a clean namespace, no open figure.
+_RESET = ("%reset -f\n"
+          "import sys as _sys\n"
+          "if 'matplotlib.pyplot' in _sys.modules:\n"
+          "    _sys.modules['matplotlib.pyplot'].close('all')\n"
+          "del _sys")
 
-    # The kernel inherits the environment: a loop's generated kernels go to a
-    # temporary cache, not to the user's ~/.cache.
-    monkeypatch.setenv("SYMSTAB_CACHE_DIR", str(tmp_path / "cache"))
-    nb = nbformat.read(DERIVATIONS / name, as_version=4)
-    client = nbclient.NotebookClient(nb, timeout=300, kernel_name="python3",
+
+@pytest.fixture(scope="module")
+def kernel(tmp_path_factory):
+    """One ``python3`` kernel for the notebooks of this process, started in ``derivations/``.
+
+    It inherits the environment, with a loop's generated kernels going to
+    the session's temporary cache (the ``loop_cache_dir`` folder), not to
+    the user's ~/.cache.
+    """
+    _notebook_client()
+    from jupyter_client.manager import KernelManager
+
+    cache = tmp_path_factory.getbasetemp() / "loop-kernels"
+    cache.mkdir(exist_ok=True)
+    manager = KernelManager(kernel_name="python3")
+    manager.start_kernel(cwd=str(DERIVATIONS), env={**os.environ, "SYMSTAB_CACHE_DIR": str(cache)})
+    yield manager
+    manager.shutdown_kernel(now=True)
+
+
+def _execute(nbclient, nb, manager):
+    """Execute ``nb`` top to bottom in the kernel of ``manager``; close the client's channels."""
+    client = nbclient.NotebookClient(nb, km=manager, timeout=300, kernel_name="python3",
                                      resources={"metadata": {"path": str(DERIVATIONS)}})
     try:
         client.execute()
+    finally:
+        if client.kc is not None:
+            client.kc.stop_channels()
+
+
+@pytest.mark.parametrize("name", EXPECTED)
+def test_notebook_executes_without_errors(name, kernel):
+    nbclient = _notebook_client()
+    import nbformat
+
+    if not kernel.is_alive():      # a notebook before this one ended the kernel
+        kernel.restart_kernel(now=True)
+    _execute(nbclient, nbformat.v4.new_notebook(cells=[nbformat.v4.new_code_cell(_RESET)]), kernel)
+    nb = nbformat.read(DERIVATIONS / name, as_version=4)
+    try:
+        _execute(nbclient, nb, kernel)
     except nbclient.exceptions.CellExecutionError as exc:
         pytest.fail(f"{name}: a cell raised\n{exc}", pytrace=False)
     errors = [output for cell in nb.cells if cell.cell_type == "code"

@@ -261,7 +261,18 @@ def _rounded(values, quantum):
     is far below: its own multiple to the last bit.)
     """
     with np.errstate(over="ignore", invalid="ignore"):
-        rounded = quantum * np.round(values / quantum)
+        return _rounded_quietly(values, quantum)
+
+
+def _rounded_quietly(values, quantum):
+    """:func:`_rounded` for a caller that already ignores overflow and invalid values.
+
+    The run's loop (:func:`_run`) sets NumPy's error state once for all its
+    periods: entering it again in every period cost a fifth of a run's time.
+    (``np.rint`` is ``np.round`` to no decimals, without its dispatch.)
+    """
+    rounded = np.rint(values / quantum)
+    rounded *= quantum
     return np.where(np.isfinite(rounded), rounded, values)
 
 
@@ -494,31 +505,40 @@ def _run(run, steps, amplitude, positions, progress, report, chunk, n_chunks, to
     ``swing``, if given, gets each quarter's half range of ``x`` (half of
     its largest less its smallest value).
     """
-    quarter = steps // 4
     if positions is not None:
         positions[0] = run.x
     # The signed extremes of each quarter: the largest |x| and the swing (a
     # limit cycle keeps its swing; a mass held off zero keeps |x| with none).
     high, low = np.full((4, run.x.size), -np.inf), np.full((4, run.x.size), np.inf)
     magnitude = np.empty_like(run.x) if total is not None else None
-    for k in range(steps):
-        with np.errstate(over="ignore", invalid="ignore"):
-            run.step()
-        q = min(k // quarter, 3)
-        np.maximum(high[q], run.x, out=high[q])
-        np.minimum(low[q], run.x, out=low[q])
-        if total is not None:
-            np.abs(run.x, out=magnitude)
-            total += magnitude
-        if positions is not None:
-            positions[k + 1] = run.x
-        if progress is not None and ((k + 1) % report == 0 or k + 1 == steps):
-            progress((chunk * steps + k + 1) // n_chunks)
+    # One error state for every period (run.step() counts on it); the
+    # quarters' rows as views made once, not in every period.
+    with np.errstate(over="ignore", invalid="ignore"):
+        for q, (start, stop) in enumerate(_quarters(steps)):
+            high_q, low_q = high[q], low[q]
+            for k in range(start, stop):
+                run.step()
+                x = run.x
+                np.maximum(high_q, x, out=high_q)
+                np.minimum(low_q, x, out=low_q)
+                if total is not None:
+                    np.abs(x, out=magnitude)
+                    total += magnitude
+                if positions is not None:
+                    positions[k + 1] = x
+                if progress is not None and ((k + 1) % report == 0 or k + 1 == steps):
+                    progress((chunk * steps + k + 1) // n_chunks)
     run.freeze_diverged()
     with np.errstate(invalid="ignore"):
         np.maximum(high, -low, out=amplitude)
         if swing is not None:
             np.multiply(high - low, 0.5, out=swing)
+
+
+def _quarters(steps):
+    """``(start, stop)`` of each quarter's periods: ``k // (steps // 4)``, the last open-ended."""
+    quarter = steps // 4      # steps >= 8 (check_steps)
+    return [(q * quarter, (q + 1) * quarter if q < 3 else steps) for q in range(4)]
 
 
 @dataclasses.dataclass(frozen=True)
@@ -981,17 +1001,16 @@ class _AnyLoop:
 
     def _sum(self, out, terms, history, sign):
         tmp = self._scratch
+        combine = np.add if sign > 0 else np.subtract
         for k, coefficient in terms:
-            np.multiply(coefficient, history[k], out=tmp)
-            if sign > 0:
-                out += tmp
-            else:
-                out -= tmp
+            combine(out, np.multiply(coefficient, history[k], out=tmp), out=out)
 
     def step(self):
+        """One period; the caller ignores NumPy's overflow and invalid values (:func:`_run`)."""
         # The environment's force from the sampled position of this instant.
         # (self.x is a new array every period, so the histories may keep it.)
-        sampled = self._sample(self.x)
+        q = self.quantum
+        sampled = _rounded_quietly(self.x, q) if q else self.x
         force = np.multiply(self.e0, sampled)
         self._sum(force, self.e, self.s_past, 1)
         self._sum(force, self.c, self.f_past, -1)
@@ -1010,7 +1029,7 @@ class _AnyLoop:
         # The environment keeps its own force; the command sent is rounded
         # to the DAC's step and clipped to its range.
         if self.force_quantum is not None:
-            command = _rounded(command, self.force_quantum)
+            command = _rounded_quietly(command, self.force_quantum)
         if self.force_limit is not None:
             command = np.clip(command, -self.force_limit, self.force_limit)
         slot = self.k % (self.d + 1)
@@ -1023,12 +1042,13 @@ class _AnyLoop:
 
     def _plant_step(self, command):
         """The plant's next sample under ``u = -command``: ``P_d(z) y = P_n(z) u``."""
-        self.y_past = [self.x] + self.y_past[:-1]
-        self.f_past_plant = [command] + self.f_past_plant[:-1]
+        self.y_past = y_past = [self.x] + self.y_past[:-1]
+        self.f_past_plant = f_past = [command] + self.f_past_plant[:-1]
         (k, first), *rest = self.minus_b
-        x = np.multiply(first, self.f_past_plant[k])
-        self._sum(x, rest, self.f_past_plant, 1)
-        self._sum(x, self.a, self.y_past, -1)
+        x = np.multiply(first, f_past[k])
+        if rest:
+            self._sum(x, rest, f_past, 1)
+        self._sum(x, self.a, y_past, -1)
         return x
 
     def freeze_diverged(self):
