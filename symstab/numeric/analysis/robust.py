@@ -661,25 +661,38 @@ def _subtract(intervals, removed):
     return out
 
 
-def _clip(strips, pieces, open_spans):
-    """The pieces' parts in each cell's strip's open spans: a list of ``(lo, hi)`` arrays (empty: lo > hi)."""
+def _span_table(open_spans):
+    """The pieces' open spans as two arrays ``(lo, hi)``, a row per piece (its index), a column
+    per span (empty: ``inf, -inf``): built once per round of the search, read by :func:`_clip`."""
     most = max((len(v) for v in open_spans.values()), default=0)
-    span_lo = np.full((len(strips), most), np.inf)
-    span_hi = np.full((len(strips), most), -np.inf)
-    for s in np.unique(strips):
-        rows = np.flatnonzero(strips == s)
-        for j, (a, b) in enumerate(open_spans.get(int(s), ())):
-            span_lo[rows, j], span_hi[rows, j] = a, b
+    size = max(open_spans, default=-1) + 1
+    lo, hi = np.full((size, most), np.inf), np.full((size, most), -np.inf)
+    rows = [(s, j, a, b) for s, spans in open_spans.items() for j, (a, b) in enumerate(spans)]
+    if rows:
+        s, j, a, b = zip(*rows)
+        lo[s, j], hi[s, j] = a, b
+    return lo, hi
+
+
+def _clip(strips, pieces, table):
+    """The pieces' parts in each cell's strip's open spans (``table``, :func:`_span_table`): a
+    list of ``(lo, hi)`` arrays (empty: lo > hi)."""
+    span_lo, span_hi = table[0][strips], table[1][strips]
     return [(np.maximum(lo, span_lo[:, j]), np.minimum(hi, span_hi[:, j]))
-            for lo, hi in pieces for j in range(most)]
+            for lo, hi in pieces for j in range(span_lo.shape[1])]
 
 
 def _mark(marked, strips, parts):
-    """Add every non-empty part to its strip's marked list."""
+    """Add every non-empty part to its strip's marked list, and merge the lists that grew."""
+    touched = set()
     for lo, hi in parts:
         some = lo <= hi
         for s, a, b in zip(strips[some], lo[some], hi[some]):
             marked[int(s)].append((float(a), float(b)))
+            touched.add(int(s))
+    for s in touched:
+        marked[s] = _merge(marked[s])
+    return touched
 
 
 def _certify(enclosures, shift, geometry, candidates, tol, budget):
@@ -706,8 +719,9 @@ def _certify(enclosures, shift, geometry, candidates, tol, budget):
                    np.tile(edges[1:], len(strips)), np.zeros(n_theta * len(strips), dtype=np.int64))
     examined = 0
     per_cell = 8 * 16 * 6 * enclosures.mid[0].shape[-1]
+    open_spans = {s: _subtract(spans, marked[s]) for s, spans in candidates.items()}
     while len(cells):
-        open_spans = {s: _subtract(spans, marked[s]) for s, spans in candidates.items()}
+        table = _span_table(open_spans)
         if examined + len(cells) > budget:
             # Out of budget: whatever the cells left could still reach is marginal.
             for s in np.unique(cells.strip):
@@ -721,7 +735,7 @@ def _certify(enclosures, shift, geometry, candidates, tol, budget):
             pieces, theta_cost, box_cost, reducible = _excluded(
                 enclosures, shift, theta, h, c.box, geometry.take(c.strip))
             meets = np.zeros(len(c), dtype=bool)
-            for lo, hi in _clip(c.strip, pieces, open_spans):
+            for lo, hi in _clip(c.strip, pieces, table):
                 meets |= lo <= hi
             if not meets.any():
                 continue
@@ -733,7 +747,7 @@ def _certify(enclosures, shift, geometry, candidates, tol, budget):
         pieces = [tuple(np.concatenate([f[1][k][j] for f in found]) for j in range(2))
                   for k in range(len(found[0][1]))]
         theta_cost, box_cost, reducible = (np.concatenate([f[k] for f in found]) for k in (2, 3, 4))
-        parts = _clip(c.strip, pieces, open_spans)
+        parts = _clip(c.strip, pieces, table)
         left = np.zeros(len(c))
         with np.errstate(over="ignore", invalid="ignore"):
             for lo, hi in parts:
@@ -750,8 +764,8 @@ def _certify(enclosures, shift, geometry, candidates, tol, budget):
         theta_first = theta_cost >= box_cost
         done = ((left <= tol[c.strip]) | (reducible <= tol[c.strip])
                 | np.where(theta_first, ~can_theta, ~can_box))
-        _mark(marked, c.strip[done], [(lo[done], hi[done]) for lo, hi in parts])
-        marked = {s: _merge(v) for s, v in marked.items()}
+        for s in _mark(marked, c.strip[done], [(lo[done], hi[done]) for lo, hi in parts]):
+            open_spans[s] = _subtract(candidates[s], marked[s])
         split_theta = ~done & theta_first
         split_box = ~done & ~split_theta
         children = []
