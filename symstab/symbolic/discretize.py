@@ -7,6 +7,7 @@ simple pole at s = -b/m).  Nothing here is typed in from the paper's eq. (4).
 """
 
 import functools
+import math
 
 import sympy as sp
 
@@ -219,7 +220,7 @@ def _interval_expm1(M, n):
     from mpmath import iv
     from mpmath.libmp import (finf, fhalf, fone, from_float, from_int, fzero, mpf_gt, mpf_lt,
                               mpf_neg, mpf_shift, mpi_abs, mpi_add, mpi_div, mpi_mul, mpi_pow,
-                              mpi_sub)
+                              mpi_sub, to_float)
     from mpmath.libmp.libmpi import mpi_zero
 
     prec = iv.prec
@@ -241,6 +242,7 @@ def _interval_expm1(M, n):
         M = [[mpi_mul(c, factor, prec) for c in row] for row in M]
     X = [[mpi_zero] * n for _ in range(n)]
     term = [[(fone, fone) if i == j else mpi_zero for j in range(n)] for i in range(n)]
+    mu_float = to_float(mu)
     mu = (mu, mu)
     tiny = from_float(1e-40)
     for k in range(1, 41):
@@ -249,7 +251,11 @@ def _interval_expm1(M, n):
                 for row in _raw_product(term, M, prec)]
         X = [[x if t == mpi_zero else mpi_add(x, t, prec) for x, t in zip(rx, rt)]
              for rx, rt in zip(X, term)]
-        # mu is an upper bound of ||M|| (rounded up by the interval sum).
+        # mu is an upper bound of ||M|| (rounded up by the interval sum).  The
+        # bound decreases with k: where a float estimate of it is far above
+        # 1e-40, the enclosure's check cannot stop the series yet.
+        if k < 40 and mu_float ** (k + 1) / math.factorial(k + 1) > 1e-38:
+            continue
         rest = mpi_div(mpi_div(mpi_pow(mu, (from_int(k + 1),) * 2, prec),
                                _interval_factorial(k + 1, prec), prec),
                        mpi_sub((fone, fone), mpi_div(mu, (from_int(k + 2),) * 2, prec), prec),
@@ -396,6 +402,9 @@ def _poly_add(a, b):
 def interval_product(a, b):
     """Product of two polynomials of :mod:`mpmath.iv` numbers (enclosing every product).
 
+    On mpmath's raw intervals (what :mod:`mpmath.iv` calls, at its
+    precision: the same enclosures), exact zero products skipped.
+
     Parameters
     ----------
     a, b : list of mpmath.iv.mpf
@@ -406,12 +415,20 @@ def interval_product(a, b):
     list of mpmath.iv.mpf
     """
     from mpmath import iv
+    from mpmath.libmp import mpi_add, mpi_mul
+    from mpmath.libmp.libmpi import mpi_zero
 
-    out = [iv.mpf(0)] * (len(a) + len(b) - 1)
+    prec = iv.prec
+    a = [x._mpi_ for x in a]
+    b = [y._mpi_ for y in b]
+    out = [mpi_zero] * (len(a) + len(b) - 1)
     for i, x in enumerate(a):
+        if x == mpi_zero:
+            continue
         for j, y in enumerate(b):
-            out[i + j] += x * y
-    return out
+            if y != mpi_zero:
+                out[i + j] = mpi_add(out[i + j], mpi_mul(x, y, prec), prec)
+    return [iv.make_mpf(c) for c in out]
 
 
 def _poly_det(matrix):

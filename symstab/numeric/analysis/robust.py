@@ -69,6 +69,7 @@ import itertools
 import mpmath
 import numpy as np
 import sympy as sp
+from mpmath.libmp import to_float
 
 from ..._resources import chunk_slices
 from ..._validate import check_count, check_delay, check_progress, check_real, check_window
@@ -151,8 +152,8 @@ def _midpoint_radius(values):
     The ends are rounded to doubles (mpmath's float() rounds towards zero:
     up to an ulp each), so the radius adds 2 eps of their size.
     """
-    lo = np.array([float(v.a) for v in values])
-    hi = np.array([float(v.b) for v in values])
+    lo = np.array([to_float(v._mpi_[0]) for v in values])
+    hi = np.array([to_float(v._mpi_[1]) for v in values])
     if not (np.all(np.isfinite(lo)) and np.all(np.isfinite(hi))):
         raise ValueError("the loop's coefficients are not bounded over the box (a division by "
                          "an interval that holds 0, or values too large?)")
