@@ -91,6 +91,8 @@ _THETA_WIDTH = 1e-12
 _THETA_PER_TERM = 8
 #: Values per uncertain parameter on the grid that finds the candidates.
 _GRID = 3
+#: Most points :func:`_split` asks the line engine for in one round, looking ahead.
+_LOOK_AHEAD = 32
 #: Digits of the interval arithmetic.
 _DIGITS = 30
 _EPS = 2.0 ** -52
@@ -1081,9 +1083,14 @@ def _split(look, edges, spans, narrowest, most):
     """Halve the strips whose edges see different numbers of intervals (a corner, an end).
 
     Down to ``narrowest`` wide and at most ``most`` new edges; returns the
-    edges and the intervals at each.
+    edges and the intervals at each.  The line engine's cost is mostly per
+    call, so a round asks at once for the midpoints that the next rounds'
+    halvings of its strips may need (:func:`_halvings`, up to
+    :data:`_LOOK_AHEAD` points): the same edges in a few calls, not one a
+    round.
     """
     edges, spans = list(edges), list(spans)
+    known = {}
     added = 0
     while added < most:
         halve = [i for i in range(len(edges) - 1)
@@ -1092,12 +1099,25 @@ def _split(look, edges, spans, narrowest, most):
         if not halve:
             break
         middles = [0.5 * (edges[i] + edges[i + 1]) for i in halve]
-        found = look(middles)
+        wanted = [(edges[i], edges[i + 1]) for i, m in zip(halve, middles) if m not in known]
+        if wanted:
+            depth = max(1, int(np.log2(_LOOK_AHEAD / len(wanted) + 1)))
+            ahead = [m for a, b in wanted for m in _halvings(a, b, depth)]
+            known.update(zip(ahead, look(ahead)))
+        found = [known[m] for m in middles]
         for i, m, f in sorted(zip(halve, middles, found), reverse=True):
             edges.insert(i + 1, m)
             spans.insert(i + 1, f)
         added += len(halve)
     return np.array(edges, dtype=float), spans
+
+
+def _halvings(a, b, depth):
+    """The midpoints of ``[a, b]`` halved ``depth`` times over, as :func:`_split` computes them."""
+    middle = 0.5 * (a + b)
+    if depth == 1:
+        return [middle]
+    return [middle] + _halvings(a, middle, depth - 1) + _halvings(middle, b, depth - 1)
 
 
 def _trapezoids(edges, spans):
