@@ -63,8 +63,10 @@ sides are chords of the boundary;
 :class:`symstab.numeric.engine.results.RobustRegion`).
 """
 
+import collections
 import dataclasses
 import itertools
+import threading
 
 import mpmath
 import numpy as np
@@ -91,6 +93,13 @@ _THETA_WIDTH = 1e-12
 _THETA_PER_TERM = 8
 #: Values per uncertain parameter on the grid that finds the candidates.
 _GRID = 3
+#: Enclosures kept for the next robust region of the same loop, box and values
+#: (:func:`_enclosures_of`): enclosing the sub-boxes is most of a region's work, and
+#: ``limits``, another delay or another window ask for the same sub-boxes again.
+_KEPT_ENCLOSURES = 4
+_ENCLOSURES = collections.OrderedDict()
+#: One thread at a time encloses (mpmath's precision is global) or reads the kept ones.
+_LOCK = threading.RLock()
 #: Most points :func:`_split` asks the line engine for in one round, looking ahead.
 _LOOK_AHEAD = 32
 #: Digits of the interval arithmetic.
@@ -199,7 +208,9 @@ class _Enclosures:
         self.depth = [0]
         self._children = {}
         self.mid, self.rad = [], []
-        self._enclose(0)
+        self._stacked = None
+        with _LOCK:
+            self._enclose(0)
 
     def _enclose(self, index):
         iv = mpmath.iv
@@ -232,8 +243,19 @@ class _Enclosures:
         self.rad.append(rad)
         self.sizes = (n_d, n_n)
 
+    def stacked(self):
+        """``(mid, rad)`` of every sub-box enclosed so far, as two arrays (stacked again only
+        when sub-boxes were added)."""
+        if self._stacked is None or len(self._stacked[0]) != len(self.mid):
+            self._stacked = (np.array(self.mid), np.array(self.rad))
+        return self._stacked
+
     def children(self, index):
         """The two halves of sub-box ``index`` (along its relatively widest side), enclosed."""
+        with _LOCK:
+            return self._halves(index)
+
+    def _halves(self, index):
         if index not in self._children:
             box = self.boxes[index]
             width = (box[:, 1] - box[:, 0]) / np.maximum(np.abs(box).max(axis=1), 1e-300)
@@ -268,6 +290,24 @@ class _Enclosures:
         return lead_mid, lead_rad
 
 
+def _enclosures_of(loop, x, y, box, fixed):
+    """The loop's :class:`_Enclosures` over ``box``, kept (:data:`_KEPT_ENCLOSURES`) by what
+    they are made of -- the plant, the environment, the plane and the values, not the loop
+    object -- with the sub-boxes enclosed so far (each is enclosed the same way whenever it
+    is asked for, so a kept one gives the same region)."""
+    key = (sp.srepr(loop.plant), sp.srepr(tuple(loop.environment_parts)),
+           loop.environment_delay, x, y, tuple(box.items()), tuple(sorted(fixed.items())))
+    with _LOCK:
+        if key in _ENCLOSURES:
+            _ENCLOSURES.move_to_end(key)
+            return _ENCLOSURES[key]
+        enclosures = _Enclosures(loop, x, y, box, fixed)
+        _ENCLOSURES[key] = enclosures
+        while len(_ENCLOSURES) > _KEPT_ENCLOSURES:
+            _ENCLOSURES.popitem(last=False)
+        return enclosures
+
+
 def _parts_on_arc(enclosures, shift, theta, h, box):
     """Each part of ``chi`` on ``theta`` in ``[theta - h, theta + h]``, over sub-box ``box``.
 
@@ -280,8 +320,8 @@ def _parts_on_arc(enclosures, shift, theta, h, box):
     z**(s + 1) w**(k - 1) + k (k - 1) z**(s + 2) w**(k - 2)``, bounded with
     ``|w| <= 2 sin(theta_max / 2)``.
     """
-    mid = np.array(enclosures.mid)[box]          # (n, 3 parts, 2 kinds, L)
-    rad = np.array(enclosures.rad)[box]
+    mid, rad = enclosures.stacked()
+    mid, rad = mid[box], rad[box]                # (n, 3 parts, 2 kinds, L)
     n_terms = mid.shape[-1]
     k = np.arange(n_terms - 1, -1, -1, dtype=float)
     z = np.exp(1j * theta)
@@ -778,7 +818,9 @@ def _certify(enclosures, shift, geometry, candidates, tol, budget):
             children += [dataclasses.replace(pick, t1=middle), dataclasses.replace(pick, t0=middle)]
         pick = c.take(split_box)
         if len(pick):
-            pairs = np.array([enclosures.children(int(b)) for b in pick.box])
+            # Each sub-box halved once, however many cells it holds.
+            boxes, where = np.unique(pick.box, return_inverse=True)
+            pairs = np.array([enclosures.children(int(b)) for b in boxes])[where.ravel()]
             children += [dataclasses.replace(pick, box=pairs[:, 0]),
                          dataclasses.replace(pick, box=pairs[:, 1])]
         if not children:
@@ -899,7 +941,7 @@ def robust_region(loop, x=None, y=None, *, uncertain, strips=64, rtol=1e-6, x_ra
     given_x, y_range = _check_robust_window(x_range, y_range)
     line = given_x is not None and given_x[0] == given_x[1]
     try:
-        enclosures = _Enclosures(loop, x, y, box, fixed)
+        enclosures = _enclosures_of(loop, x, y, box, fixed)
     except (ValueError, ZeroDivisionError, OverflowError) as exc:
         words = ", ".join(f"{k} in [{lo:g}, {hi:g}]" for k, (lo, hi) in box.items())
         raise ValueError(f"uncertain: {words}: {exc}") from None
