@@ -493,8 +493,8 @@ def test_the_matplotlib_finder_finds_lazy_imports(tmp_path):
 
 #: Private attribute names that are a third party's protocol, not our privacy:
 #: mpmath's number internals, namedtuple's API, CPython's own.
-PROTOCOL_ATTRIBUTES = {"_mpf_", "_mpc_", "_asdict", "_replace", "_fields", "_make", "_exit",
-                       "_getframe", "_current_frames", "_subparsers", "_group_actions",
+PROTOCOL_ATTRIBUTES = {"_mpf_", "_mpc_", "_mpi_", "_asdict", "_replace", "_fields", "_make",
+                       "_exit", "_getframe", "_current_frames", "_subparsers", "_group_actions",
                        "_print"}
 
 #: ``{(module, attribute): reason}`` of the reaches left, each with its reason.

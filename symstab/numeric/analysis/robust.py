@@ -63,12 +63,15 @@ sides are chords of the boundary;
 :class:`symstab.numeric.engine.results.RobustRegion`).
 """
 
+import collections
 import dataclasses
 import itertools
+import threading
 
 import mpmath
 import numpy as np
 import sympy as sp
+from mpmath.libmp import to_float
 
 from ..._resources import chunk_slices
 from ..._validate import check_count, check_delay, check_progress, check_real, check_window
@@ -90,6 +93,15 @@ _THETA_WIDTH = 1e-12
 _THETA_PER_TERM = 8
 #: Values per uncertain parameter on the grid that finds the candidates.
 _GRID = 3
+#: Enclosures kept for the next robust region of the same loop, box and values
+#: (:func:`_enclosures_of`): enclosing the sub-boxes is most of a region's work, and
+#: ``limits``, another delay or another window ask for the same sub-boxes again.
+_KEPT_ENCLOSURES = 4
+_ENCLOSURES = collections.OrderedDict()
+#: One thread at a time encloses (mpmath's precision is global) or reads the kept ones.
+_LOCK = threading.RLock()
+#: Most points :func:`_split` asks the line engine for in one round, looking ahead.
+_LOOK_AHEAD = 32
 #: Digits of the interval arithmetic.
 _DIGITS = 30
 _EPS = 2.0 ** -52
@@ -151,8 +163,8 @@ def _midpoint_radius(values):
     The ends are rounded to doubles (mpmath's float() rounds towards zero:
     up to an ulp each), so the radius adds 2 eps of their size.
     """
-    lo = np.array([float(v.a) for v in values])
-    hi = np.array([float(v.b) for v in values])
+    lo = np.array([to_float(v._mpi_[0]) for v in values])
+    hi = np.array([to_float(v._mpi_[1]) for v in values])
     if not (np.all(np.isfinite(lo)) and np.all(np.isfinite(hi))):
         raise ValueError("the loop's coefficients are not bounded over the box (a division by "
                          "an interval that holds 0, or values too large?)")
@@ -196,7 +208,9 @@ class _Enclosures:
         self.depth = [0]
         self._children = {}
         self.mid, self.rad = [], []
-        self._enclose(0)
+        self._stacked = None
+        with _LOCK:
+            self._enclose(0)
 
     def _enclose(self, index):
         iv = mpmath.iv
@@ -229,8 +243,19 @@ class _Enclosures:
         self.rad.append(rad)
         self.sizes = (n_d, n_n)
 
+    def stacked(self):
+        """``(mid, rad)`` of every sub-box enclosed so far, as two arrays (stacked again only
+        when sub-boxes were added)."""
+        if self._stacked is None or len(self._stacked[0]) != len(self.mid):
+            self._stacked = (np.array(self.mid), np.array(self.rad))
+        return self._stacked
+
     def children(self, index):
         """The two halves of sub-box ``index`` (along its relatively widest side), enclosed."""
+        with _LOCK:
+            return self._halves(index)
+
+    def _halves(self, index):
         if index not in self._children:
             box = self.boxes[index]
             width = (box[:, 1] - box[:, 0]) / np.maximum(np.abs(box).max(axis=1), 1e-300)
@@ -265,6 +290,24 @@ class _Enclosures:
         return lead_mid, lead_rad
 
 
+def _enclosures_of(loop, x, y, box, fixed):
+    """The loop's :class:`_Enclosures` over ``box``, kept (:data:`_KEPT_ENCLOSURES`) by what
+    they are made of -- the plant, the environment, the plane and the values, not the loop
+    object -- with the sub-boxes enclosed so far (each is enclosed the same way whenever it
+    is asked for, so a kept one gives the same region)."""
+    key = (sp.srepr(loop.plant), sp.srepr(tuple(loop.environment_parts)),
+           loop.environment_delay, x, y, tuple(box.items()), tuple(sorted(fixed.items())))
+    with _LOCK:
+        if key in _ENCLOSURES:
+            _ENCLOSURES.move_to_end(key)
+            return _ENCLOSURES[key]
+        enclosures = _Enclosures(loop, x, y, box, fixed)
+        _ENCLOSURES[key] = enclosures
+        while len(_ENCLOSURES) > _KEPT_ENCLOSURES:
+            _ENCLOSURES.popitem(last=False)
+        return enclosures
+
+
 def _parts_on_arc(enclosures, shift, theta, h, box):
     """Each part of ``chi`` on ``theta`` in ``[theta - h, theta + h]``, over sub-box ``box``.
 
@@ -277,8 +320,8 @@ def _parts_on_arc(enclosures, shift, theta, h, box):
     z**(s + 1) w**(k - 1) + k (k - 1) z**(s + 2) w**(k - 2)``, bounded with
     ``|w| <= 2 sin(theta_max / 2)``.
     """
-    mid = np.array(enclosures.mid)[box]          # (n, 3 parts, 2 kinds, L)
-    rad = np.array(enclosures.rad)[box]
+    mid, rad = enclosures.stacked()
+    mid, rad = mid[box], rad[box]                # (n, 3 parts, 2 kinds, L)
     n_terms = mid.shape[-1]
     k = np.arange(n_terms - 1, -1, -1, dtype=float)
     z = np.exp(1j * theta)
@@ -661,25 +704,38 @@ def _subtract(intervals, removed):
     return out
 
 
-def _clip(strips, pieces, open_spans):
-    """The pieces' parts in each cell's strip's open spans: a list of ``(lo, hi)`` arrays (empty: lo > hi)."""
+def _span_table(open_spans):
+    """The pieces' open spans as two arrays ``(lo, hi)``, a row per piece (its index), a column
+    per span (empty: ``inf, -inf``): built once per round of the search, read by :func:`_clip`."""
     most = max((len(v) for v in open_spans.values()), default=0)
-    span_lo = np.full((len(strips), most), np.inf)
-    span_hi = np.full((len(strips), most), -np.inf)
-    for s in np.unique(strips):
-        rows = np.flatnonzero(strips == s)
-        for j, (a, b) in enumerate(open_spans.get(int(s), ())):
-            span_lo[rows, j], span_hi[rows, j] = a, b
+    size = max(open_spans, default=-1) + 1
+    lo, hi = np.full((size, most), np.inf), np.full((size, most), -np.inf)
+    rows = [(s, j, a, b) for s, spans in open_spans.items() for j, (a, b) in enumerate(spans)]
+    if rows:
+        s, j, a, b = zip(*rows)
+        lo[s, j], hi[s, j] = a, b
+    return lo, hi
+
+
+def _clip(strips, pieces, table):
+    """The pieces' parts in each cell's strip's open spans (``table``, :func:`_span_table`): a
+    list of ``(lo, hi)`` arrays (empty: lo > hi)."""
+    span_lo, span_hi = table[0][strips], table[1][strips]
     return [(np.maximum(lo, span_lo[:, j]), np.minimum(hi, span_hi[:, j]))
-            for lo, hi in pieces for j in range(most)]
+            for lo, hi in pieces for j in range(span_lo.shape[1])]
 
 
 def _mark(marked, strips, parts):
-    """Add every non-empty part to its strip's marked list."""
+    """Add every non-empty part to its strip's marked list, and merge the lists that grew."""
+    touched = set()
     for lo, hi in parts:
         some = lo <= hi
         for s, a, b in zip(strips[some], lo[some], hi[some]):
             marked[int(s)].append((float(a), float(b)))
+            touched.add(int(s))
+    for s in touched:
+        marked[s] = _merge(marked[s])
+    return touched
 
 
 def _certify(enclosures, shift, geometry, candidates, tol, budget):
@@ -706,8 +762,9 @@ def _certify(enclosures, shift, geometry, candidates, tol, budget):
                    np.tile(edges[1:], len(strips)), np.zeros(n_theta * len(strips), dtype=np.int64))
     examined = 0
     per_cell = 8 * 16 * 6 * enclosures.mid[0].shape[-1]
+    open_spans = {s: _subtract(spans, marked[s]) for s, spans in candidates.items()}
     while len(cells):
-        open_spans = {s: _subtract(spans, marked[s]) for s, spans in candidates.items()}
+        table = _span_table(open_spans)
         if examined + len(cells) > budget:
             # Out of budget: whatever the cells left could still reach is marginal.
             for s in np.unique(cells.strip):
@@ -721,7 +778,7 @@ def _certify(enclosures, shift, geometry, candidates, tol, budget):
             pieces, theta_cost, box_cost, reducible = _excluded(
                 enclosures, shift, theta, h, c.box, geometry.take(c.strip))
             meets = np.zeros(len(c), dtype=bool)
-            for lo, hi in _clip(c.strip, pieces, open_spans):
+            for lo, hi in _clip(c.strip, pieces, table):
                 meets |= lo <= hi
             if not meets.any():
                 continue
@@ -733,7 +790,7 @@ def _certify(enclosures, shift, geometry, candidates, tol, budget):
         pieces = [tuple(np.concatenate([f[1][k][j] for f in found]) for j in range(2))
                   for k in range(len(found[0][1]))]
         theta_cost, box_cost, reducible = (np.concatenate([f[k] for f in found]) for k in (2, 3, 4))
-        parts = _clip(c.strip, pieces, open_spans)
+        parts = _clip(c.strip, pieces, table)
         left = np.zeros(len(c))
         with np.errstate(over="ignore", invalid="ignore"):
             for lo, hi in parts:
@@ -750,8 +807,8 @@ def _certify(enclosures, shift, geometry, candidates, tol, budget):
         theta_first = theta_cost >= box_cost
         done = ((left <= tol[c.strip]) | (reducible <= tol[c.strip])
                 | np.where(theta_first, ~can_theta, ~can_box))
-        _mark(marked, c.strip[done], [(lo[done], hi[done]) for lo, hi in parts])
-        marked = {s: _merge(v) for s, v in marked.items()}
+        for s in _mark(marked, c.strip[done], [(lo[done], hi[done]) for lo, hi in parts]):
+            open_spans[s] = _subtract(candidates[s], marked[s])
         split_theta = ~done & theta_first
         split_box = ~done & ~split_theta
         children = []
@@ -761,7 +818,9 @@ def _certify(enclosures, shift, geometry, candidates, tol, budget):
             children += [dataclasses.replace(pick, t1=middle), dataclasses.replace(pick, t0=middle)]
         pick = c.take(split_box)
         if len(pick):
-            pairs = np.array([enclosures.children(int(b)) for b in pick.box])
+            # Each sub-box halved once, however many cells it holds.
+            boxes, where = np.unique(pick.box, return_inverse=True)
+            pairs = np.array([enclosures.children(int(b)) for b in boxes])[where.ravel()]
             children += [dataclasses.replace(pick, box=pairs[:, 0]),
                          dataclasses.replace(pick, box=pairs[:, 1])]
         if not children:
@@ -882,7 +941,7 @@ def robust_region(loop, x=None, y=None, *, uncertain, strips=64, rtol=1e-6, x_ra
     given_x, y_range = _check_robust_window(x_range, y_range)
     line = given_x is not None and given_x[0] == given_x[1]
     try:
-        enclosures = _Enclosures(loop, x, y, box, fixed)
+        enclosures = _enclosures_of(loop, x, y, box, fixed)
     except (ValueError, ZeroDivisionError, OverflowError) as exc:
         words = ", ".join(f"{k} in [{lo:g}, {hi:g}]" for k, (lo, hi) in box.items())
         raise ValueError(f"uncertain: {words}: {exc}") from None
@@ -1066,9 +1125,14 @@ def _split(look, edges, spans, narrowest, most):
     """Halve the strips whose edges see different numbers of intervals (a corner, an end).
 
     Down to ``narrowest`` wide and at most ``most`` new edges; returns the
-    edges and the intervals at each.
+    edges and the intervals at each.  The line engine's cost is mostly per
+    call, so a round asks at once for the midpoints that the next rounds'
+    halvings of its strips may need (:func:`_halvings`, up to
+    :data:`_LOOK_AHEAD` points): the same edges in a few calls, not one a
+    round.
     """
     edges, spans = list(edges), list(spans)
+    known = {}
     added = 0
     while added < most:
         halve = [i for i in range(len(edges) - 1)
@@ -1077,12 +1141,25 @@ def _split(look, edges, spans, narrowest, most):
         if not halve:
             break
         middles = [0.5 * (edges[i] + edges[i + 1]) for i in halve]
-        found = look(middles)
+        wanted = [(edges[i], edges[i + 1]) for i, m in zip(halve, middles) if m not in known]
+        if wanted:
+            depth = max(1, int(np.log2(_LOOK_AHEAD / len(wanted) + 1)))
+            ahead = [m for a, b in wanted for m in _halvings(a, b, depth)]
+            known.update(zip(ahead, look(ahead)))
+        found = [known[m] for m in middles]
         for i, m, f in sorted(zip(halve, middles, found), reverse=True):
             edges.insert(i + 1, m)
             spans.insert(i + 1, f)
         added += len(halve)
     return np.array(edges, dtype=float), spans
+
+
+def _halvings(a, b, depth):
+    """The midpoints of ``[a, b]`` halved ``depth`` times over, as :func:`_split` computes them."""
+    middle = 0.5 * (a + b)
+    if depth == 1:
+        return [middle]
+    return [middle] + _halvings(a, middle, depth - 1) + _halvings(middle, b, depth - 1)
 
 
 def _trapezoids(edges, spans):

@@ -131,10 +131,13 @@ def _points_in(region, n, rng):
 
 
 def test_robust_points_are_stable_at_every_value_of_the_box(paper):
-    """The acceptance: 2 000 robust points, each stable at 100 values of the box (corners too).
+    """The acceptance: 2 000 robust points, each stable at 20 values of the box (its corners and
+    16 inside).
 
     (10 000 points until issue 41: 5x the CPU; a set too large by a part of the box shows at
-    the points next to its sides, a tenth of them.)
+    the points next to its sides, a tenth of them.  100 values of the box until issue 41: with
+    the coefficients' radii cut to a quarter and the candidates looked for at the centre only,
+    the set grew by a sixth and the 20 values still saw 25 unstable pairs, at two corners.)
     """
     box = {"m": (0.0115, 0.0141), "b": (0.0162, 0.0648)}
     region = paper.robust_region("B", "K", uncertain=box, strips=32, d=10, M=0.0)
@@ -143,7 +146,7 @@ def test_robust_points_are_stable_at_every_value_of_the_box(paper):
     rng = np.random.default_rng(1)
     x, y = _points_in(region, 2_000, rng)
     values = [(m, b) for m in box["m"] for b in box["b"]]
-    values += list(zip(rng.uniform(*box["m"], 96), rng.uniform(*box["b"], 96)))
+    values += list(zip(rng.uniform(*box["m"], 16), rng.uniform(*box["b"], 16)))
     worst = 0.0
     for m, b in values:
         worst = max(worst, float(_closed_loop_radius(m, b, 1e-3, 10, y, x).max()))
@@ -158,14 +161,18 @@ def test_robust_points_are_stable_at_every_value_of_the_box(paper):
 
 
 def test_robust_over_a_range_of_delays(paper):
-    """Uncertain delay and damping: the points are stable at every delay of the range."""
+    """Uncertain delay and damping: the points are stable at every delay of the range.
+
+    (At 4 values of b, 6 until issue 41: the last delay left uncertified, or the coefficients'
+    radii cut to a tenth with the candidates looked for at the centre only, still fail.)
+    """
     box = {"b": (0.02, 0.045), "d": (8, 12)}
     region = paper.robust_region("B", "K", uncertain=box, strips=24, M=0.0, m=0.0128)
     assert region.uncertain["d"] == (8, 12)
     rng = np.random.default_rng(2)
     x, y = _points_in(region, 2_000, rng)
     for d in range(8, 13):
-        for b in (0.02, 0.045, *rng.uniform(0.02, 0.045, 4)):
+        for b in (0.02, 0.045, *rng.uniform(0.02, 0.045, 2)):
             assert _closed_loop_radius(0.0128, b, 1e-3, d, y, x).max() < 1.0
     # Smaller than the set of any one delay of the range.
     for d in (8, 12):
@@ -199,14 +206,19 @@ def test_a_box_of_zero_width_gives_the_nominal_set(path, d, lines):
 
 
 def _nominal_area(loop, x_range, **values):
-    """The nominal stable set's area: its stable intervals' lengths integrated (scipy's quad)."""
-    from scipy.integrate import quad
+    """The nominal stable set's area: its stable intervals' lengths integrated (scipy's adaptive
+    Gauss-Kronrod cubature, which asks for the lengths at many lines at once: the line engine
+    takes them together; quad took one line per call, 6x the CPU, until issue 41)."""
+    from scipy.integrate import cubature
 
     def length(B):
-        return sum(hi - lo for lo, hi in loop.stable_intervals("K", B=np.array([B]), **values)[0])
+        spans = loop.stable_intervals("K", B=B[:, 0], **values)
+        return np.array([sum(hi - lo for lo, hi in line) for line in spans])
 
-    area, error = quad(length, *x_range, limit=400, epsabs=1e-10, epsrel=1e-12)
-    assert error < 1e-9 * area
+    found = cubature(length, [x_range[0]], [x_range[1]], rule="gk21", rtol=1e-12, atol=1e-10,
+                     max_subdivisions=10_000)
+    area, error = float(found.estimate), float(found.error)
+    assert found.status == "converged" and error < 1e-9 * area
     return area
 
 
