@@ -12,8 +12,11 @@ SIGTERM raises :class:`Terminated`.  When Python swallows that exception (it
 reports it to :data:`sys.unraisablehook`, which the block watches), the
 signal is delivered to the main thread again :data:`REDELIVER_SECONDS`
 later, from a short-lived timer thread; a block that ends before then ends
-with the exception.  An interruption a caller catches and handles itself is
-not repeated.  A second signal while the first one's exception is handled
+with the exception.  An error that Python raised from the interruption
+(a class's ``__set_name__`` in Python 3.11 wraps it in a RuntimeError) is
+the interruption again, and a signal landing in a module that catches
+every exception (:data:`SWALLOWING_MODULES`) is delivered again later.
+An interruption a caller catches and handles itself is not repeated.  A second signal while the first one's exception is handled
 or cleaned up after (``except`` and ``finally`` blocks on its way) does
 nothing, so a cleanup is never cut short by a second Ctrl-C.
 
@@ -28,12 +31,20 @@ import signal
 import sys
 import threading
 
-__all__ = ["Terminated", "raising", "deferred", "exit_status", "REDELIVER_SECONDS"]
+__all__ = ["Terminated", "raising", "deferred", "exit_status", "REDELIVER_SECONDS",
+           "SWALLOWING_MODULES"]
 
 #: How long after Python swallowed an interruption's exception the signal is delivered again.
 REDELIVER_SECONDS = 0.1
 
 _SIGNALS = (signal.SIGINT, signal.SIGTERM)
+
+#: Modules whose code catches every exception, an interruption's too, and
+#: goes on: mpmath's backend wraps ``import gmpy2`` in ``try: ... except:
+#: pass``, so a SIGTERM landing in gmpy2's import was dropped for good (no
+#: "Exception ignored": nothing for the hook to see) and the command ran on.
+#: A signal landing while one of them runs is delivered again later.
+SWALLOWING_MODULES = ("mpmath.libmp.backend",)
 
 
 class Terminated(BaseException):
@@ -81,9 +92,30 @@ def _handler(signum, frame):
     # cleanup runs) must not cut that cleanup short.
     if _on_its_way():
         return
+    if _inside_swallowing(frame):
+        _deliver_again(signum)
+        return
     with _state.lock:
         _state.pending = None
     raise _exception(signum)
+
+
+def _inside_swallowing(frame):
+    """Whether ``frame`` runs inside the code of one of :data:`SWALLOWING_MODULES`."""
+    while frame is not None:
+        if frame.f_globals.get("__name__") in SWALLOWING_MODULES:
+            return True
+        frame = frame.f_back
+    return False
+
+
+def _deliver_again(signum):
+    """Deliver ``signum`` to the main thread again :data:`REDELIVER_SECONDS` from now."""
+    with _state.lock:
+        _state.pending = signum
+    timer = threading.Timer(REDELIVER_SECONDS, _redeliver, args=(threading.main_thread().ident,))
+    timer.daemon = True   # an exit does not wait for it
+    timer.start()
 
 
 def _unraisable(args, *, previous):
@@ -91,14 +123,9 @@ def _unraisable(args, *, previous):
     if not isinstance(args.exc_value, (KeyboardInterrupt, Terminated)):
         previous(args)
         return
-    signum = signal.SIGTERM if isinstance(args.exc_value, Terminated) else signal.SIGINT
-    with _state.lock:
-        _state.pending = signum
     # Not from here: the hook runs inside the callback that swallowed the
     # exception, and would swallow the next one too.
-    timer = threading.Timer(REDELIVER_SECONDS, _redeliver, args=(threading.main_thread().ident,))
-    timer.daemon = True   # an exit does not wait for it
-    timer.start()
+    _deliver_again(signal.SIGTERM if isinstance(args.exc_value, Terminated) else signal.SIGINT)
 
 
 def _redeliver(main):
@@ -144,7 +171,13 @@ def raising():
             _state.depth += 1
             sys.unraisablehook = functools.partial(_unraisable, previous=previous_hook)
             previous = {sig: signal.signal(sig, _handler) for sig in _SIGNALS}
-        yield
+        try:
+            yield
+        except Exception as exc:
+            interruption = _interruption_behind(exc)
+            if interruption is None:
+                raise
+            raise interruption from None
         with _state.lock:
             swallowed, _state.pending = _state.pending, None
         if swallowed is not None:  # the block ended before the signal was delivered again
@@ -159,6 +192,24 @@ def raising():
                     signal.signal(sig, handler)
             sys.unraisablehook = previous_hook
             _state.depth -= 1
+
+def _interruption_behind(exc):
+    """The interruption ``exc`` was raised from, when Python turned one into another error.
+
+    Python 3.11 wraps an exception raised while a class is created, in a
+    descriptor's ``__set_name__`` (NumPy's ``finfo`` has one, run on
+    import), in a RuntimeError "Error calling __set_name__" raised from
+    it: a SIGTERM landing there ended ``symstab`` with a traceback and
+    exit status 1.  None when no interruption is behind ``exc``.
+    """
+    seen = set()
+    while exc is not None and id(exc) not in seen:
+        if isinstance(exc, (KeyboardInterrupt, Terminated)):
+            return exc
+        seen.add(id(exc))
+        exc = exc.__cause__
+    return None
+
 
 @contextlib.contextmanager
 def deferred():

@@ -56,6 +56,56 @@ def test_a_swallowed_signal_ends_a_block_that_finishes_before_the_delivery(capsy
     assert capsys.readouterr().err == ""
 
 
+class _Descriptor:
+    def __init__(self, signum):
+        self.signum = signum
+
+    def __set_name__(self, owner, name):
+        signal.raise_signal(self.signum)
+        for _ in range(10_000):   # bytecodes: the handler runs here, inside __set_name__
+            pass
+
+
+@pytest.mark.parametrize("signum, exc_type", [(signal.SIGTERM, Terminated),
+                                              (signal.SIGINT, KeyboardInterrupt)])
+def test_a_signal_inside_a_class_s_set_name_is_the_interruption(signum, exc_type):
+    """CI: a SIGTERM landed while NumPy's ``finfo`` class was created on import; Python 3.11
+    wraps what ``__set_name__`` raises in "RuntimeError: Error calling __set_name__", and
+    ``symstab`` ended with that traceback and status 1 instead of one line and 143."""
+    with pytest.raises(exc_type):
+        with raising():
+            type("Created", (), {"field": _Descriptor(signum)})
+            time.sleep(30)
+
+
+@pytest.mark.parametrize("signum, exc_type", [(signal.SIGTERM, Terminated),
+                                              (signal.SIGINT, KeyboardInterrupt)])
+def test_a_signal_inside_a_module_that_catches_everything_is_delivered_again(signum, exc_type):
+    """CI: a SIGTERM landed in gmpy2's import, which mpmath's backend wraps in a bare
+    ``except: pass``; the command ran on to its end.  The same code, run as that module."""
+    swallowing = ("try:\n"
+                  "    signal.raise_signal(signum)\n"
+                  "    for _ in range(10_000):\n"
+                  "        pass\n"
+                  "except:\n"
+                  "    pass\n")
+    ran_on = False
+    with pytest.raises(exc_type):
+        with raising():
+            exec(swallowing, {"__name__": "mpmath.libmp.backend", "signal": signal,
+                              "signum": signum})
+            time.sleep(5)
+            ran_on = True
+    assert not ran_on
+
+
+def test_an_error_raised_from_something_else_is_left_alone():
+    with pytest.raises(RuntimeError) as excinfo:
+        with raising():
+            raise RuntimeError("not an interruption") from ValueError("cause")
+    assert isinstance(excinfo.value.__cause__, ValueError)
+
+
 def test_an_interruption_the_caller_handles_is_not_delivered_again():
     handled = False
     with raising():
