@@ -101,9 +101,14 @@ def _handler(signum, frame):
 
 
 def _inside_swallowing(frame):
-    """Whether ``frame`` runs inside the code of one of :data:`SWALLOWING_MODULES`."""
+    """Whether ``frame`` runs inside the import of one of :data:`SWALLOWING_MODULES`.
+
+    Only the module's own body (its import) counts: a function of it that
+    is on the stack later (mpmath's backend defines some) catches nothing.
+    """
     while frame is not None:
-        if frame.f_globals.get("__name__") in SWALLOWING_MODULES:
+        if (frame.f_code.co_name == "<module>"
+                and frame.f_globals.get("__name__") in SWALLOWING_MODULES):
             return True
         frame = frame.f_back
     return False
