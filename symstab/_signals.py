@@ -14,8 +14,8 @@ signal is delivered to the main thread again :data:`REDELIVER_SECONDS`
 later, from a short-lived timer thread; a block that ends before then ends
 with the exception.  An error that Python raised from the interruption
 (a class's ``__set_name__`` in Python 3.11 wraps it in a RuntimeError) is
-the interruption again, and a signal landing in a module that catches
-every exception (:data:`SWALLOWING_MODULES`) is delivered again later.
+the interruption again, and a module that another imports inside a bare
+``except`` is imported first, outside it (:func:`import_outside_swallowers`).
 An interruption a caller catches and handles itself is not repeated.  A second signal while the first one's exception is handled
 or cleaned up after (``except`` and ``finally`` blocks on its way) does
 nothing, so a cleanup is never cut short by a second Ctrl-C.
@@ -31,20 +31,20 @@ import signal
 import sys
 import threading
 
-__all__ = ["Terminated", "raising", "deferred", "exit_status", "REDELIVER_SECONDS",
-           "SWALLOWING_MODULES"]
+__all__ = ["Terminated", "raising", "deferred", "exit_status", "import_outside_swallowers",
+           "REDELIVER_SECONDS"]
 
 #: How long after Python swallowed an interruption's exception the signal is delivered again.
 REDELIVER_SECONDS = 0.1
 
 _SIGNALS = (signal.SIGINT, signal.SIGTERM)
 
-#: Modules whose code catches every exception, an interruption's too, and
-#: goes on: mpmath's backend wraps ``import gmpy2`` in ``try: ... except:
-#: pass``, so a SIGTERM landing in gmpy2's import was dropped for good (no
-#: "Exception ignored": nothing for the hook to see) and the command ran on.
-#: A signal landing while one of them runs is delivered again later.
-SWALLOWING_MODULES = ("mpmath.libmp.backend",)
+#: Modules that other modules import inside ``try: ... except: pass``:
+#: mpmath's backend does so with gmpy2, so a SIGTERM landing in gmpy2's
+#: import was dropped for good (no "Exception ignored": nothing for the
+#: hook to see) and the command ran on.  :func:`import_outside_swallowers`
+#: imports them first, where an interruption raises.
+SWALLOWED_IMPORTS = ("gmpy2",)
 
 
 class Terminated(BaseException):
@@ -92,26 +92,23 @@ def _handler(signum, frame):
     # cleanup runs) must not cut that cleanup short.
     if _on_its_way():
         return
-    if _inside_swallowing(frame):
-        _deliver_again(signum)
-        return
     with _state.lock:
         _state.pending = None
     raise _exception(signum)
 
 
-def _inside_swallowing(frame):
-    """Whether ``frame`` runs inside the import of one of :data:`SWALLOWING_MODULES`.
+def import_outside_swallowers(names=SWALLOWED_IMPORTS):
+    """Import ``names`` (those installed) before a module that would swallow an interruption does.
 
-    Only the module's own body (its import) counts: a function of it that
-    is on the stack later (mpmath's backend defines some) catches nothing.
+    See :data:`SWALLOWED_IMPORTS`: imported here, an interruption landing
+    in their import raises as anywhere else; the swallowing module then
+    finds them in ``sys.modules``.
     """
-    while frame is not None:
-        if (frame.f_code.co_name == "<module>"
-                and frame.f_globals.get("__name__") in SWALLOWING_MODULES):
-            return True
-        frame = frame.f_back
-    return False
+    for name in names:
+        try:
+            __import__(name)
+        except ImportError:
+            pass
 
 
 def _deliver_again(signum):

@@ -23,7 +23,7 @@ import sys
 import warnings
 
 from .._project import project_root
-from .._signals import Terminated, exit_status, raising
+from .._signals import Terminated, exit_status, import_outside_swallowers, raising
 
 __all__ = ["main", "build_parser", "package_version", "project_root", "COMMAND_NAMES",
            "command_modules"]
@@ -147,6 +147,8 @@ def _main(argv):
     if extra:  # argparse would blame "symstab", not the command
         print(f"{prog}: error: unrecognized arguments: {' '.join(extra)}", file=sys.stderr)
         return 2
+    # Before any numerics (mpmath would import gmpy2 where a signal is dropped).
+    import_outside_swallowers()
     try:
         with warnings.catch_warnings():
             # NumPy's floating-point RuntimeWarnings (overflow in an
