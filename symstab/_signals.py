@@ -14,7 +14,7 @@ signal is delivered to the main thread again :data:`REDELIVER_SECONDS`
 later, from a short-lived timer thread; a block that ends before then ends
 with the exception.  An error that Python raised from the interruption
 (a class's ``__set_name__`` in Python 3.11 wraps it in a RuntimeError) is
-the interruption again, and a module that another imports inside a bare
+found behind it by :func:`interruption_behind`, and a module that another imports inside a bare
 ``except`` is imported first, outside it (:func:`import_outside_swallowers`).
 An interruption a caller catches and handles itself is not repeated.  A second signal while the first one's exception is handled
 or cleaned up after (``except`` and ``finally`` blocks on its way) does
@@ -32,7 +32,7 @@ import sys
 import threading
 
 __all__ = ["Terminated", "raising", "deferred", "exit_status", "import_outside_swallowers",
-           "REDELIVER_SECONDS"]
+           "interruption_behind", "REDELIVER_SECONDS"]
 
 #: How long after Python swallowed an interruption's exception the signal is delivered again.
 REDELIVER_SECONDS = 0.1
@@ -173,13 +173,7 @@ def raising():
             _state.depth += 1
             sys.unraisablehook = functools.partial(_unraisable, previous=previous_hook)
             previous = {sig: signal.signal(sig, _handler) for sig in _SIGNALS}
-        try:
-            yield
-        except Exception as exc:
-            interruption = _interruption_behind(exc)
-            if interruption is None:
-                raise
-            raise interruption from None
+        yield
         with _state.lock:
             swallowed, _state.pending = _state.pending, None
         if swallowed is not None:  # the block ended before the signal was delivered again
@@ -195,7 +189,7 @@ def raising():
             sys.unraisablehook = previous_hook
             _state.depth -= 1
 
-def _interruption_behind(exc):
+def interruption_behind(exc):
     """The interruption ``exc`` was raised from, when Python turned one into another error.
 
     Python 3.11 wraps an exception raised while a class is created, in a

@@ -23,7 +23,8 @@ import sys
 import warnings
 
 from .._project import project_root
-from .._signals import Terminated, exit_status, import_outside_swallowers, raising
+from .._signals import (Terminated, exit_status, import_outside_swallowers,
+                        interruption_behind, raising)
 
 __all__ = ["main", "build_parser", "package_version", "project_root", "COMMAND_NAMES",
            "command_modules"]
@@ -113,8 +114,15 @@ def main(argv=None):
     """
     argv = sys.argv[1:] if argv is None else list(argv)
     try:
-        with raising():
-            return _main(argv)
+        try:
+            with raising():
+                return _main(argv)
+        except Exception as exc:
+            # An interruption Python wrapped (a class's __set_name__, 3.11).
+            interruption = interruption_behind(exc)
+            if interruption is None:
+                raise
+            raise interruption from None
     except (KeyboardInterrupt, Terminated) as exc:
         # On a terminal a progress bar may hold the line: start a new one.
         print(f"{chr(10) if sys.stderr.isatty() else ''}{_prog(argv)}: interrupted",
