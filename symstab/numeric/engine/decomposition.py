@@ -814,6 +814,10 @@ def _merged_nodes(points):
     return number[merged][inverse], unique[makers]
 
 
+#: Neighbours in x compared at most, before the points of a vertical run are all merged one by one.
+_MAX_SHIFTS = 64
+
+
 def _has_close_neighbour(xy):
     """Whether each of the distinct points ``xy`` has another within :data:`_MERGE` (max norm)."""
     close = np.zeros(len(xy), dtype=bool)
@@ -823,6 +827,12 @@ def _has_close_neighbour(xy):
     while shift < len(xy):
         near_x = x[shift:] - x[:-shift] <= _MERGE
         if not near_x.any():
+            break
+        if shift > _MAX_SHIFTS:
+            # Many points on one vertical: every point with an x-neighbour
+            # that close is merged one by one (the same nodes, just slower).
+            run = np.r_[x[1:] - x[:-1] <= _MERGE, False] | np.r_[False, x[1:] - x[:-1] <= _MERGE]
+            close[order[run]] = True
             break
         near = near_x & (np.abs(y[shift:] - y[:-shift]) <= _MERGE)
         close[order[shift:][near]] = True
