@@ -11,7 +11,7 @@ KeyboardInterrupt has the same hole.
 SIGTERM raises :class:`Terminated`.  When Python swallows that exception (it
 reports it to :data:`sys.unraisablehook`, which the block watches), the
 signal is delivered to the main thread again :data:`REDELIVER_SECONDS`
-later, from a short-lived timer thread; a block that ends before then ends
+later, from a short-lived thread, and again until its handler has run; a block that ends before then ends
 with the exception.  An error that Python raised from the interruption
 (a class's ``__set_name__`` in Python 3.11 wraps it in a RuntimeError) is
 found behind it by :func:`interruption_behind`, and a module that another imports inside a bare
@@ -30,6 +30,7 @@ import functools
 import signal
 import sys
 import threading
+import time
 
 __all__ = ["Terminated", "raising", "deferred", "exit_status", "import_outside_swallowers",
            "interruption_behind", "REDELIVER_SECONDS"]
@@ -90,10 +91,10 @@ def _exception(signum):
 def _handler(signum, frame):
     # A second signal while the first one's exception is handled (its
     # cleanup runs) must not cut that cleanup short.
+    with _state.lock:
+        _state.pending = None   # delivered: no repeat
     if _on_its_way():
         return
-    with _state.lock:
-        _state.pending = None
     raise _exception(signum)
 
 
@@ -112,12 +113,12 @@ def import_outside_swallowers(names=SWALLOWED_IMPORTS):
 
 
 def _deliver_again(signum):
-    """Deliver ``signum`` to the main thread again :data:`REDELIVER_SECONDS` from now."""
+    """Deliver ``signum`` to the main thread every :data:`REDELIVER_SECONDS` until it is handled."""
     with _state.lock:
         _state.pending = signum
-    timer = threading.Timer(REDELIVER_SECONDS, _redeliver, args=(threading.main_thread().ident,))
-    timer.daemon = True   # an exit does not wait for it
-    timer.start()
+    thread = threading.Thread(target=_redeliver, args=(threading.main_thread().ident,),
+                              name="symstab-redeliver", daemon=True)   # an exit does not wait
+    thread.start()
 
 
 def _unraisable(args, *, previous):
@@ -131,8 +132,20 @@ def _unraisable(args, *, previous):
 
 
 def _redeliver(main):
-    with _state.lock:
-        if _state.pending is not None:
+    """Send the pending signal to ``main`` until its handler has run or the block has ended.
+
+    Once is not always enough: a signal that lands after the main thread's
+    last check for handlers and before it enters a blocking call (a
+    ``time.sleep``, a wait on a lock or a subprocess) sets Python's flag
+    but does not interrupt the call, and the handler would run only when
+    the call returns (CI: a 30-second sleep ran to its end).  The next
+    delivery interrupts it.
+    """
+    while True:
+        time.sleep(REDELIVER_SECONDS)
+        with _state.lock:
+            if _state.pending is None:
+                return
             signal.pthread_kill(main, _state.pending)
 
 
