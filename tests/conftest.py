@@ -264,13 +264,36 @@ def pytest_collection_modifyitems(config, items):
 # Command runs in-process, and the loops' kernel cache
 # --------------------------------------------------------------------------
 
-@pytest.fixture
-def loop_cache_dir(tmp_path_factory, monkeypatch):
-    """The loops' generated kernels go to one temporary folder per run, never to ~/.cache."""
-    folder = tmp_path_factory.getbasetemp() / "loop-kernels"
+def _shared_folder(tmp_path_factory, name):
+    """A folder of this test session shared by its xdist workers (the parent of their bases)."""
+    base = tmp_path_factory.getbasetemp()
+    root = base.parent if os.environ.get("PYTEST_XDIST_WORKER") is not None else base
+    folder = root / name
     folder.mkdir(exist_ok=True)
-    monkeypatch.setenv("SYMSTAB_CACHE_DIR", str(folder))
     return folder
+
+
+@pytest.fixture(scope="session", autouse=True)
+def session_cache_dir(tmp_path_factory):
+    """symstab's cache (loop derivations, generated kernels) for the whole run, never ~/.cache.
+
+    One folder for the session, shared by the xdist workers: a loop is
+    derived once per run, not once per worker and per test (its cache
+    entries are written atomically, so two workers deriving the same loop
+    at once only both derive it).  A test of the cache itself sets its own
+    folder.
+    """
+    folder = _shared_folder(tmp_path_factory, "symstab-cache")
+    with pytest.MonkeyPatch.context() as mp:
+        mp.setenv("SYMSTAB_CACHE_DIR", str(folder))
+        yield folder
+
+
+@pytest.fixture
+def loop_cache_dir(session_cache_dir, monkeypatch):
+    """The session's cache folder, set again for a test that changed the environment."""
+    monkeypatch.setenv("SYMSTAB_CACHE_DIR", str(session_cache_dir))
+    return session_cache_dir
 
 
 def run_cli(capsys, *args):

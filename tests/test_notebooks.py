@@ -87,18 +87,17 @@ _RESET = ("%reset -f\n"
 
 
 @pytest.fixture(scope="module")
-def kernel(tmp_path_factory):
+def kernel(session_cache_dir):
     """One ``python3`` kernel for the notebooks of this process, started in ``derivations/``.
 
     It inherits the environment, with a loop's generated kernels going to
-    the session's temporary cache (the ``loop_cache_dir`` folder), not to
+    the session's temporary cache (conftest's ``session_cache_dir``), not to
     the user's ~/.cache.
     """
     _notebook_client()
     from jupyter_client.manager import KernelManager
 
-    cache = tmp_path_factory.getbasetemp() / "loop-kernels"
-    cache.mkdir(exist_ok=True)
+    cache = session_cache_dir
     manager = KernelManager(kernel_name="python3")
     manager.start_kernel(cwd=str(DERIVATIONS), env={**os.environ, "SYMSTAB_CACHE_DIR": str(cache)})
     yield manager

@@ -21,9 +21,7 @@ def test_readme_audit_summary_matches_the_report():
     assert _table(block) == _table(summary) and len(_table(block)) == 6
 
 
-def test_readme_python_examples_run(monkeypatch, tmp_path):
-    # The README builds loops, whose kernels go to the cache: keep it out of ~/.cache.
-    monkeypatch.setenv("SYMSTAB_CACHE_DIR", str(tmp_path))
+def test_readme_python_examples_run(monkeypatch):
     monkeypatch.chdir(REPO)
     readme = (REPO / "README.md").read_text(encoding="utf-8")
     parser = doctest.DocTestParser()
@@ -43,8 +41,7 @@ def test_readme_python_examples_run(monkeypatch, tmp_path):
                                     "symstab.numeric.analysis.probability",
                                     "symstab.numeric.simulation.simulator",
                                     "symstab.numeric.simulation.simulated_limit"])
-def test_docstring_examples_run(module, monkeypatch, tmp_path):
-    monkeypatch.setenv("SYMSTAB_CACHE_DIR", str(tmp_path))
+def test_docstring_examples_run(module):
     mod = importlib.import_module(module)
     failures, tried = doctest.testmod(mod, optionflags=doctest.NORMALIZE_WHITESPACE)
     assert tried > 0 and failures == 0

@@ -63,17 +63,9 @@ C_FLAGS = ["-std=c99", "-O2", "-Wall", "-Wextra", "-pedantic", "-Werror", "-fPIC
 
 
 @pytest.fixture(scope="module")
-def cache_dir(tmp_path_factory):
-    """Per-loop NumPy kernels go to a temporary cache, never to ~/.cache.
-
-    The session's (conftest's ``loop_cache_dir`` folder): a loop another
-    module derived (operator_arm: 8 s) is read here, not derived again.
-    """
-    folder = tmp_path_factory.getbasetemp() / "loop-kernels"
-    folder.mkdir(exist_ok=True)
-    with pytest.MonkeyPatch.context() as mp:
-        mp.setenv("SYMSTAB_CACHE_DIR", str(folder))
-        yield folder
+def cache_dir(session_cache_dir):
+    """The session's cache (conftest): a loop another module derived is read here."""
+    return session_cache_dir
 
 
 @pytest.fixture(autouse=True)

@@ -33,11 +33,6 @@ ENVIRONMENT = "K + B*(z - 1)/(T*z) + M*(z - 1)**2/(T**2*z**2)"
 DEVICE = dict(m=PAPER_M, b=PAPER_B, T=PAPER_T)
 
 
-@pytest.fixture(autouse=True)
-def _cache(tmp_path, monkeypatch):
-    monkeypatch.setenv("SYMSTAB_CACHE_DIR", str(tmp_path / "cache"))
-
-
 @pytest.fixture(scope="module")
 def paper_loop():
     return Loop(PLANT, ENVIRONMENT)

@@ -225,18 +225,16 @@ def _largest_moduli(rows):
 
 
 @pytest.fixture(scope="module")
-def examples(tmp_path_factory):
-    """Loaded examples, built once; the loops' kernels go to a temporary cache."""
+def examples():
+    """Loaded examples, built once (their derivations in the session's cache)."""
     cache = {}
-    with pytest.MonkeyPatch.context() as mp:
-        mp.setenv("SYMSTAB_CACHE_DIR", str(tmp_path_factory.mktemp("loop_cache")))
 
-        def get(path):
-            if path not in cache:
-                cache[path] = Example(path)
-            return cache[path]
+    def get(path):
+        if path not in cache:
+            cache[path] = Example(path)
+        return cache[path]
 
-        yield get
+    return get
 
 
 def _ids(paths):

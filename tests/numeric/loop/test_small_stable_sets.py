@@ -32,10 +32,8 @@ M, T, DELTA = PAPER_DEVICE.m, PAPER_DEVICE.T, PAPER_DEVICE.delta
 
 
 @pytest.fixture(scope="module")
-def paper_file_loop(tmp_path_factory):
-    with pytest.MonkeyPatch.context() as mp:
-        mp.setenv("SYMSTAB_CACHE_DIR", str(tmp_path_factory.mktemp("loop_cache")))
-        yield symstab.load_loop(REPO / "examples" / "loops" / "paper.toml")
+def paper_file_loop():
+    return symstab.load_loop(REPO / "examples" / "loops" / "paper.toml")
 
 
 def _radius(B, K, gamma, d):
