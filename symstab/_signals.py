@@ -67,6 +67,7 @@ class _State:
     def __init__(self):
         self.depth = 0
         self.pending = None   # a signal whose exception Python swallowed, until delivered again
+        self.deliverer = None   # the thread that delivers it again, while one runs
         # Re-entrant: a handler or the hook may run in the main thread while it holds it.
         self.lock = threading.RLock()
 
@@ -88,11 +89,25 @@ def _exception(signum):
     return Terminated() if signum == signal.SIGTERM else KeyboardInterrupt()
 
 
+def _in_the_hook(frame):
+    """True when ``frame`` runs inside :func:`_unraisable` (Python swallows what it raises)."""
+    while frame is not None:
+        if frame.f_code is _unraisable.__code__:
+            return True
+        frame = frame.f_back
+    return False
+
+
 def _handler(signum, frame):
-    # A second signal while the first one's exception is handled (its
-    # cleanup runs) must not cut that cleanup short.
+    if _in_the_hook(frame):
+        # Raised here, the exception would be dropped for good ("Exception
+        # ignored in sys.unraisablehook"): left to the delivery again.
+        _deliver_again(signum)
+        return
     with _state.lock:
         _state.pending = None   # delivered: no repeat
+    # A second signal while the first one's exception is handled (its
+    # cleanup runs) must not cut that cleanup short.
     if _on_its_way():
         return
     raise _exception(signum)
@@ -113,12 +128,19 @@ def import_outside_swallowers(names=SWALLOWED_IMPORTS):
 
 
 def _deliver_again(signum):
-    """Deliver ``signum`` to the main thread every :data:`REDELIVER_SECONDS` until it is handled."""
+    """Deliver ``signum`` to the main thread every :data:`REDELIVER_SECONDS` until it is handled.
+
+    One thread delivers, started when none is running (it is recorded
+    before it starts: a signal landing in ``start()`` finds it).
+    """
     with _state.lock:
         _state.pending = signum
-    thread = threading.Thread(target=_redeliver, args=(threading.main_thread().ident,),
-                              name="symstab-redeliver", daemon=True)   # an exit does not wait
-    thread.start()
+        if _state.deliverer is not None:
+            return
+        _state.deliverer = threading.Thread(
+            target=_redeliver, args=(threading.main_thread().ident,), name="symstab-redeliver",
+            daemon=True)   # an exit does not wait for it
+        _state.deliverer.start()
 
 
 def _unraisable(args, *, previous):
@@ -145,6 +167,7 @@ def _redeliver(main):
         time.sleep(REDELIVER_SECONDS)
         with _state.lock:
             if _state.pending is None:
+                _state.deliverer = None
                 return
             signal.pthread_kill(main, _state.pending)
 

@@ -153,7 +153,8 @@ def test_numpy_warnings_never_reach_the_user(capsys, tmp_path, monkeypatch):
         status, out, err = _main(capsys, "classify", "--delta", "0.0025", "--alpha", "1e150",
                                  "--beta", "0.5")
     assert status == 0, err
-    assert err == "" and caught == []
+    assert err == "" and caught == [], [f"{w.filename}:{w.lineno}: {w.category.__name__}: "
+                                        f"{w.message}" for w in caught]
     assert "unstable" in out
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
