@@ -110,7 +110,8 @@ def test_random_rows_are_drawn_in_range_and_the_npz_names_them(capsys, tmp_path)
 
 def test_a_two_worker_cluster_gives_the_serial_table_and_resumes_after_sigint(capsys, tmp_path):
     pytest.importorskip("dask.distributed")
-    path = spec(tmp_path, 'chunk = 1\n[grid]\nd = { from = 1, to = 30, points = 30 }\n'
+    # 20 chunks (60 until issue 41): the SIGINT lands after 2, with many still to go.
+    path = spec(tmp_path, 'chunk = 1\n[grid]\nd = { from = 1, to = 28, points = 10 }\n'
                           'b = [0.0162, 0.0648]\n')
     status, _, err = run(capsys, "sweep", path, "--out", tmp_path / "serial.npz", "--serial")
     assert status == 0, err
@@ -131,8 +132,8 @@ def test_a_two_worker_cluster_gives_the_serial_table_and_resumes_after_sigint(ca
     # One line says what happened: no worker's traceback, no scheduler's log.
     assert "Traceback" not in stderr and "ERROR" not in stderr and "distributed" not in stderr
     saved = sorted(parts.glob("chunk-*.npz"))
-    assert 2 <= len(saved) < 60, "the sweep ended before the interruption: make it longer"
-    assert f"interrupted: {len(saved)} of 60 chunks saved in {parts}" in stderr
+    assert 2 <= len(saved) < 20, "the sweep ended before the interruption: make it longer"
+    assert f"interrupted: {len(saved)} of 20 chunks saved in {parts}" in stderr
     assert not out.exists() and not list(parts.glob("*.tmp"))
     # A saved chunk is used as saved, not evaluated again: mark one, and the table shows it.
     marked = int(saved[0].stem.split("-")[1])         # chunk = 1: chunk k is row k
@@ -141,11 +142,11 @@ def test_a_two_worker_cluster_gives_the_serial_table_and_resumes_after_sigint(ca
     np.savez(saved[0], values=np.full((1, 5), -1.0), reasons=reasons)
     status, text, err = run(capsys, "sweep", path, "--out", out, "--workers", "2")
     assert status == 0, err
-    assert f"resumed: {len(saved)} of 60 chunks were saved by an earlier run" in text
+    assert f"resumed: {len(saved)} of 20 chunks were saved by an earlier run" in text
     with np.load(out) as f, np.load(tmp_path / "serial.npz") as g:
-        assert np.array_equal(f["inputs"], g["inputs"]) and f["answers"].shape == (60, 5)
+        assert np.array_equal(f["inputs"], g["inputs"]) and f["answers"].shape == (20, 5)
         assert np.all(f["answers"][marked] == -1.0)
-        others = np.arange(60) != marked
+        others = np.arange(20) != marked
         # The cluster's numbers are the serial run's, to the last bit.
         assert np.array_equal(f["answers"][others], g["answers"][others])
     assert not parts.exists()
