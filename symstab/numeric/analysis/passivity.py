@@ -296,19 +296,24 @@ def _normalise(rows):
 
 
 def _clip(vertices, row):
-    """The convex polygon ``vertices`` (counter-clockwise) cut by ``c0 + cx x + cy y <= 0``."""
-    s = row[0] + row[1] * vertices[:, 0] + row[2] * vertices[:, 1]
+    """The convex polygon ``vertices`` (counter-clockwise) cut by ``c0 + cx x + cy y <= 0``.
+
+    ``row`` is ``(c0, cx, cy)``, Python floats or NumPy ones (the same arithmetic).
+    """
+    c0, cx, cy = row
+    s = c0 + cx * vertices[:, 0] + cy * vertices[:, 1]
     inside = s <= 0
-    if inside.all():
+    count = int(inside.sum())
+    if count == len(inside):
         return vertices
-    if not inside.any():
+    if not count:
         return vertices[:0]
     m = len(vertices)
     # Convex: the inside vertices are one cyclic run; k is its first, l its last.
     # (Slices, not np.roll: this runs once per cutting line, thousands of times.)
     k = int(np.flatnonzero(inside & ~_previous(inside))[0])
-    run = (np.arange(int(inside.sum())) + k) % m
-    last = run[-1]
+    run = (np.arange(count) + k) % m
+    last = int(run[-1])
 
     def cut(i, j):
         t = s[i] / (s[i] - s[j])
@@ -329,23 +334,33 @@ def _tidy(vertices):
     """Drop consecutive vertices that coincide to rounding."""
     if len(vertices) < 2:
         return vertices
-    span = max(*(float(v) for v in vertices.max(axis=0) - vertices.min(axis=0)), 1e-300)
-    step = np.hypot(*(vertices - _previous(vertices)).T)
+    extent = vertices.max(axis=0) - vertices.min(axis=0)
+    span = max(float(extent[0]), float(extent[1]), 1e-300)
+    before = vertices - _previous(vertices)
+    step = np.hypot(before[:, 0], before[:, 1])
     # Many lines through one corner (at d = 0 every theta's line passes
     # through the wall's apex) give copies of it a few ulps apart.
     keep = step > 1e-9 * span
-    if not keep.any():
+    kept = int(keep.sum())
+    if not kept:
         return vertices[:1]
-    vertices = vertices[keep]
-    if len(vertices) < 4:
+    if kept < len(vertices):
+        vertices = vertices[keep]
+        if len(vertices) < 4:
+            return vertices
+        before = vertices - _previous(vertices)
+        step = np.hypot(before[:, 0], before[:, 1])
+    elif len(vertices) < 4:
         return vertices
     # A vertex where the boundary does not turn (a grid line through a
-    # corner cuts it at the corner) is no vertex.
-    before = vertices - _previous(vertices)
-    after = np.concatenate([vertices[1:], vertices[:1]]) - vertices
+    # corner cuts it at the corner) is no vertex.  Each vertex's step to
+    # the next is the next one's step from it: the same differences.
+    after = np.concatenate([before[1:], before[:1]])
+    after_step = np.concatenate([step[1:], step[:1]])
     turn = before[:, 0] * after[:, 1] - before[:, 1] * after[:, 0]
-    straight = np.abs(turn) <= 1e-12 * np.hypot(*before.T) * np.hypot(*after.T)
-    return vertices[~straight] if (~straight).sum() >= 3 else vertices
+    straight = np.abs(turn) <= 1e-12 * step * after_step
+    bent = int(len(straight) - straight.sum())
+    return vertices[~straight] if bent >= 3 else vertices
 
 
 def _box(half_x, half_y, centre=(0.0, 0.0)):
@@ -355,7 +370,8 @@ def _box(half_x, half_y, centre=(0.0, 0.0)):
 
 
 def _clip_all(vertices, rows):
-    for row in rows:
+    # Python floats: a NumPy scalar's every operation costs more, for the same arithmetic.
+    for row in np.asarray(rows, dtype=float).tolist():
         if len(vertices) == 0:
             break
         if abs(row[1]) == 0 and abs(row[2]) == 0:
