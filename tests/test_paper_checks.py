@@ -555,12 +555,20 @@ def test_open_questions_explain_the_left_sided_curves():
     assert "2/4, 4/6, 6/8, 8/10" in outcome.evidence
 
 
-def test_open_minimum_damping_states_what_is_proved_and_what_is_numerical():
-    outcome = audit.registered()["claim:open_minimum_damping"][3]()
-    assert outcome.verdict == "not-reproduced"
-    assert "For d >= 2, s > 0, so beta > -delta is necessary (proved)" in outcome.evidence
-    assert "numerical evidence only" in outcome.evidence
-    assert "within the proved bound" in outcome.evidence
+def _audited(audit_run, cid):
+    """The row of check ``cid`` in the session's ``symstab audit --json`` (its verdict and
+    detail: the evidence, then the corrected form if any), not computed again here."""
+    _, _, js = audit_run
+    (row,) = [r for r in json.loads(js.read_text(encoding="utf-8")) if r["id"] == cid]
+    return row
+
+
+def test_open_minimum_damping_states_what_is_proved_and_what_is_numerical(audit_run):
+    row = _audited(audit_run, "claim:open_minimum_damping")
+    assert row["verdict"] == "not-reproduced"
+    assert "For d >= 2, s > 0, so beta > -delta is necessary (proved)" in row["detail"]
+    assert "numerical evidence only" in row["detail"]
+    assert "within the proved bound" in row["detail"]
 
 
 # --------------------------------------------------------------------------
@@ -649,7 +657,7 @@ def test_no_stable_alpha_interval_has_a_negative_end(audit_run):
                        text)
     assert len(found) >= 6
     assert all(float(lo) >= 0.0 for lo, _ in found), found
-    evidence = audit.registered()["claim:alpha_beta0_gamma0"][3]().evidence
+    evidence = _audited(audit_run, "claim:alpha_beta0_gamma0")["detail"]
     assert "stable alpha interval (0, 0.00506464)" in evidence
     assert "alpha = 0 is the z = 1 line, exactly" in evidence
 
@@ -667,9 +675,9 @@ def test_an_empty_window_is_said_in_words_and_is_empty_for_python_control(audit_
 
     _, report, _ = audit_run
     assert "none N" not in report.read_text(encoding="utf-8")
-    low = audit.registered()["claim:exp_window_lg"][3]().evidence
+    low = _audited(audit_run, "claim:exp_window_lg")["detail"]
     assert "at B_w = 0.6 N m s/rad, M_w = m, Td = 40 ms the linear model is stable for no K_w" in low
-    high = audit.registered()["claim:exp_window_hg"][3]().evidence
+    high = _audited(audit_run, "claim:exp_window_hg")["detail"]
     k_lo, k_hi = (float(x) for x in re.search(r"stable for ([0-9.]+) < K_w < ([0-9.]+) N m/rad",
                                                 high).groups())
 
