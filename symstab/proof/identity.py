@@ -30,6 +30,7 @@ is reported with the point that shows it.
 ``d theta``.
 """
 
+import collections
 import dataclasses
 import functools
 import random
@@ -283,6 +284,29 @@ def check_identity(lhs, rhs, *, samples=12, dps=40, seed=0):
     """
     if dps < 30:
         raise ValueError(f"dps must be an integer >= 30, got {dps!r}")
+    try:
+        key = (sp.sympify(lhs), sp.sympify(rhs), samples, dps, seed)
+        hash(key)
+    except (TypeError, sp.SympifyError):
+        return _check_identity(lhs, rhs, samples=samples, dps=dps, seed=seed)
+    if key not in _RESULTS:
+        _RESULTS[key] = _check_identity(lhs, rhs, samples=samples, dps=dps, seed=seed)
+        if len(_RESULTS) > _RESULTS_KEPT:
+            _RESULTS.popitem(last=False)
+    result = _RESULTS[key]
+    return dataclasses.replace(result, witness=dict(result.witness))
+
+
+#: Verdicts of this process by (lhs, rhs, samples, dps, seed): the audit's
+#: checks prove some identities twice (an erratum's printed and corrected
+#: forms against the same derived one, a form shared by two checks).  A
+#: verdict that raised (RuntimeError) is not kept.
+_RESULTS = collections.OrderedDict()
+_RESULTS_KEPT = 1024
+
+
+def _check_identity(lhs, rhs, *, samples, dps, seed):
+    """:func:`check_identity` computed (no cache)."""
     tol = 10.0 ** -(dps - 10)
     rel, point = numeric_difference(lhs, rhs, samples=samples, dps=dps, seed=seed)
     try:
