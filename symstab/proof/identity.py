@@ -39,6 +39,7 @@ import mpmath
 import sympy as sp
 from sympy.polys.fields import field
 from sympy.polys.monomials import monomial_div, monomial_lcm
+from sympy.polys.polyerrors import CoercionFailed
 from sympy.polys.rings import ring
 
 from ..symbolic import model
@@ -118,14 +119,17 @@ class _Fraction:
         if expr.is_Pow and expr.exp.is_Integer:
             return cls.of(expr.base, gens, R) ** int(expr.exp)
         if expr.is_Number or expr is sp.I:
-            return cls(R.ground_new(R.domain.convert(expr)), R.one)
+            try:
+                return cls(R.ground_new(R.domain.convert(expr)), R.one)
+            except CoercionFailed:
+                pass
         raise _NotPolynomial(expr)
 
     def __add__(self, other):
         if self.denom == other.denom:
             return _Fraction(self.numer + other.numer, self.denom)
-        if len(self.denom) == 1 and len(other.denom) == 1:  # monic monomials
-            R = self.denom.ring
+        R = self.denom.ring
+        if all(len(q) == 1 and q.LC == R.domain.one for q in (self.denom, other.denom)):
             m1, m2 = self.denom.LM, other.denom.LM
             lcm = monomial_lcm(m1, m2)
             return _Fraction(
