@@ -201,6 +201,14 @@ def test_report_counts_match_the_rows(audit_run):
         assert f"| {row['id']} |" in text
 
 
+def _audited(audit_run, cid):
+    """The row of check ``cid`` in the session's ``symstab audit --json`` (its verdict and
+    detail: the evidence, then the corrected form if any), not computed again here."""
+    _, _, js = audit_run
+    (row,) = [r for r in json.loads(js.read_text(encoding="utf-8")) if r["id"] == cid]
+    return row
+
+
 def test_every_printed_equation_has_a_check():
     assert set(printed.PRINTED) <= set(audit.registered())
 
@@ -407,7 +415,7 @@ def test_run_audit_rejects_a_bad_worker_count(workers):
         audit.run_audit(["eq1"], workers=workers)
 
 
-def test_gamma2_claims_do_not_hang_on_one_sample(monkeypatch):
+def test_gamma2_claims_do_not_hang_on_one_sample(monkeypatch, audit_run):
     """alpha_max at gamma = 2 is the top of a sliver: raising the arc polyline
     of the region scan by 1e-11 (relative) made that scan miss its top sample
     (3.9571 instead of 4.0068, and 5.74-fold instead of 5.8).  The claims and
@@ -421,7 +429,9 @@ def test_gamma2_claims_do_not_hang_on_one_sample(monkeypatch):
     ids = ["claim:alpha_max_gamma2", "claim:fold_5.8", "claim:max_gamma_2_d0",
            "claim:gamma2_is_boundary"]
     checks = audit.registered()
-    exact = {cid: checks[cid][3]() for cid in ids}
+    # The findings as the session's audit computed them (verdict and detail).
+    exact = {cid: (row["verdict"], row["detail"])
+             for cid, row in ((cid, _audited(audit_run, cid)) for cid in ids)}
     curve = regions.boundary_curve
 
     def raised(**kw):
@@ -431,10 +441,12 @@ def test_gamma2_claims_do_not_hang_on_one_sample(monkeypatch):
     monkeypatch.setattr(regions, "boundary_curve", raised)
     for memo in (claims._classify, claims._limits):
         monkeypatch.setattr(memo, "values", {})
-    assert {cid: checks[cid][3]() for cid in ids} == exact
-    assert exact["claim:alpha_max_gamma2"].verdict == "confirmed"
-    assert "largest stable alpha 4.0068 at beta = -2.0034" in exact["claim:alpha_max_gamma2"].evidence
-    assert exact["claim:fold_5.8"].verdict == "confirmed"
+    raised_outcomes = {cid: checks[cid][3]() for cid in ids}
+    assert {cid: (o.verdict, o.evidence + (f" Corrected: {o.corrected}" if o.corrected else ""))
+            for cid, o in raised_outcomes.items()} == exact
+    assert exact["claim:alpha_max_gamma2"][0] == "confirmed"
+    assert "largest stable alpha 4.0068 at beta = -2.0034" in exact["claim:alpha_max_gamma2"][1]
+    assert exact["claim:fold_5.8"][0] == "confirmed"
 
 
 @pytest.mark.parametrize("call", ["classify", "initial_direction"])
@@ -555,12 +567,12 @@ def test_open_questions_explain_the_left_sided_curves():
     assert "2/4, 4/6, 6/8, 8/10" in outcome.evidence
 
 
-def test_open_minimum_damping_states_what_is_proved_and_what_is_numerical():
-    outcome = audit.registered()["claim:open_minimum_damping"][3]()
-    assert outcome.verdict == "not-reproduced"
-    assert "For d >= 2, s > 0, so beta > -delta is necessary (proved)" in outcome.evidence
-    assert "numerical evidence only" in outcome.evidence
-    assert "within the proved bound" in outcome.evidence
+def test_open_minimum_damping_states_what_is_proved_and_what_is_numerical(audit_run):
+    row = _audited(audit_run, "claim:open_minimum_damping")
+    assert row["verdict"] == "not-reproduced"
+    assert "For d >= 2, s > 0, so beta > -delta is necessary (proved)" in row["detail"]
+    assert "numerical evidence only" in row["detail"]
+    assert "within the proved bound" in row["detail"]
 
 
 # --------------------------------------------------------------------------
@@ -649,7 +661,7 @@ def test_no_stable_alpha_interval_has_a_negative_end(audit_run):
                        text)
     assert len(found) >= 6
     assert all(float(lo) >= 0.0 for lo, _ in found), found
-    evidence = audit.registered()["claim:alpha_beta0_gamma0"][3]().evidence
+    evidence = _audited(audit_run, "claim:alpha_beta0_gamma0")["detail"]
     assert "stable alpha interval (0, 0.00506464)" in evidence
     assert "alpha = 0 is the z = 1 line, exactly" in evidence
 
@@ -667,9 +679,9 @@ def test_an_empty_window_is_said_in_words_and_is_empty_for_python_control(audit_
 
     _, report, _ = audit_run
     assert "none N" not in report.read_text(encoding="utf-8")
-    low = audit.registered()["claim:exp_window_lg"][3]().evidence
+    low = _audited(audit_run, "claim:exp_window_lg")["detail"]
     assert "at B_w = 0.6 N m s/rad, M_w = m, Td = 40 ms the linear model is stable for no K_w" in low
-    high = audit.registered()["claim:exp_window_hg"][3]().evidence
+    high = _audited(audit_run, "claim:exp_window_hg")["detail"]
     k_lo, k_hi = (float(x) for x in re.search(r"stable for ([0-9.]+) < K_w < ([0-9.]+) N m/rad",
                                                 high).groups())
 

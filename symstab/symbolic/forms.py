@@ -70,8 +70,16 @@ def exponential_form(expr, *, theta=model.theta, d=model.d, delta=model.delta,
         a square root, ...).
     """
     expr = sp.sympify(expr)
+    # The forms repeat their subexpressions (sin(d theta) dozens of times):
+    # each distinct one is rewritten once.
+    done = {}
 
     def rec(e):
+        if e not in done:
+            done[e] = rewrite(e)
+        return done[e]
+
+    def rewrite(e):
         if not e.has(theta) and not e.has(sp.exp):
             return e
         if e == theta:

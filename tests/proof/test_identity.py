@@ -119,6 +119,40 @@ def test_assert_identity():
         assert_identity(theta * sin(2 * theta), 2 * theta * sin(theta) * cos(theta))
 
 
+@pytest.mark.parametrize("lhs, rhs, equal", [
+    (1 / (Gamma + 1) + 1 / (Gamma - 1), 2 * Gamma / (Gamma**2 - 1), True),
+    (1 / (Gamma + 1) + 1 / (Gamma - 1), 2 / (Gamma**2 - 1), False),
+    (Gamma / (3 * sin(theta)) + 1 / (2 * sin(theta)), (2 * Gamma + 3) / (6 * sin(theta)), True),
+    (Gamma / (3 * sin(theta)) + 1 / (2 * cos(theta)), (2 * Gamma + 3) / (6 * sin(theta)), False),
+    ((1 / (Gamma - 1) - 1 / Gamma) ** 2 * Gamma**2 * (Gamma - 1) ** 2, sp.Integer(1), True),
+])
+def test_rational_differences_with_unreduced_denominators(lhs, rhs, equal):
+    """The difference is never reduced (sums of fractions over other denominators,
+    monomial denominators with a coefficient): zero exactly when it is zero."""
+    result = check_identity(lhs, rhs)
+    assert result.equal is equal and result.method == "exact"
+
+
+def test_a_repeated_check_is_answered_from_the_process_cache(monkeypatch):
+    """The audit proves some identities twice: the second verdict is the first one's."""
+    from symstab.proof import identity
+
+    x = 3 * d * theta
+    lhs, rhs = sin(x + theta), sin(x) * cos(theta) + cos(x) * sin(theta)
+    first = check_identity(lhs, rhs, seed=41)
+
+    def refuse(*args, **kwargs):
+        raise AssertionError("computed again")
+
+    monkeypatch.setattr(identity, "numeric_difference", refuse)
+    again = check_identity(lhs, rhs, seed=41)
+    assert again == first and again.equal is True
+    again.witness.clear()                 # a caller's edit does not reach the cache
+    assert check_identity(lhs, rhs, seed=41).witness == first.witness != {}
+    with pytest.raises(AssertionError, match="computed again"):
+        check_identity(lhs, rhs, seed=42)  # another sample is another check
+
+
 def test_numeric_difference_is_relative():
     rel, point = numeric_difference(sin(theta), sin(theta) * (1 + sp.Rational(1, 1000)))
     assert 1e-4 < rel < 1e-3 and "theta" in point
