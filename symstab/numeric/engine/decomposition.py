@@ -855,12 +855,15 @@ def _segments(polylines):
 
 
 def _candidate_pairs(lo, hi):
-    """Pairs ``i < j`` of segments whose bounding boxes may overlap.
+    """Pairs ``i < j`` of segments whose bounding boxes overlap.
 
     Short segments (the sampled arc) are hashed into a grid of cells as
     large as the longest of them, so each lies in at most four cells and
     only segments sharing a cell are paired; the few long ones (the lines,
-    the window's edges) are paired with everything.
+    the window's edges) are paired with every segment whose box meets
+    theirs.  The pairs are taken in one step each (a pair's boxes are
+    compared before it is sorted: a long piece meets few of the arc's
+    thousand chords).
     """
     n = len(lo)
     extent = np.max(hi - lo, axis=1)
@@ -890,22 +893,47 @@ def _candidate_pairs(lo, hi):
             raise ValueError(f"the window holds too many pieces of the boundary ({total:,} pairs of "
                              f"chords to intersect, more than {_MAX_PAIRS:,}): narrow it")
         check_memory("the D-decomposition's pairs of chords", 48 * total)
-        rows = np.arange(len(cells))
-        for k in range(1, int(after.max(initial=0)) + 1):
-            rows = rows[after[rows] >= k]
-            pairs.append(np.stack([cells[rows, 2], cells[rows + k, 2]], axis=1))
-    for i in np.flatnonzero(long_):
-        others = np.arange(n)
-        pairs.append(np.stack([np.full(n, i), others], axis=1))
-    if not pairs:
+        pairs += _cell_pairs(cells[:, 2], after, lo, hi)
+    wide = np.flatnonzero(long_)
+    if len(wide):
+        a, b = np.nonzero(_meet(lo[wide, None, :], hi[wide, None, :], lo, hi))
+        pairs.append(np.stack([wide[a], b], axis=1))
+    pairs = np.concatenate(pairs) if pairs else np.zeros((0, 2), dtype=np.int64)
+    if not len(pairs):
         return np.zeros(0, dtype=np.int64), np.zeros(0, dtype=np.int64)
-    pairs = np.sort(np.concatenate(pairs), axis=1)
+    pairs = np.sort(pairs, axis=1)
     # Sorted and deduplicated by hand: np.unique hashes integers (NumPy 2.3+),
     # 50 times slower than this sort on the 10**5 keys of a fine pass.
     key = np.sort(pairs[:, 0] * n + pairs[:, 1])
     key = key[np.r_[True, key[1:] != key[:-1]]]
     i, j = key // n, key % n
     return i[i != j], j[i != j]
+
+
+def _cell_pairs(segment, after, lo, hi):
+    """The pairs of each ``segment`` with the ``after`` next ones in its cell whose boxes meet.
+
+    Made and compared about 10**6 pairs at a time (a row's partners are
+    the rows just below it: its cell's segments are consecutive).
+    """
+    out = []
+    cumulative = np.cumsum(after)
+    cuts = np.searchsorted(cumulative, np.arange(1_000_000, int(cumulative[-1]), 1_000_000))
+    for rows in np.split(np.arange(len(segment)), np.unique(cuts)):
+        counts = after[rows]
+        row = np.repeat(rows, counts)
+        # The k-th partner of a row is k rows below it.
+        step = np.arange(len(row)) - np.repeat(np.cumsum(counts) - counts, counts) + 1
+        i, j = segment[row], segment[row + step]
+        meet = _meet(lo[i], hi[i], lo[j], hi[j])
+        out.append(np.stack([i[meet], j[meet]], axis=1))
+    return out
+
+
+def _meet(lo_a, hi_a, lo_b, hi_b):
+    """Whether boxes ``a`` meet boxes ``b`` (corners in the last axis; the rest broadcast)."""
+    return ((lo_a[..., 0] <= hi_b[..., 0]) & (lo_b[..., 0] <= hi_a[..., 0])
+            & (lo_a[..., 1] <= hi_b[..., 1]) & (lo_b[..., 1] <= hi_a[..., 1]))
 
 
 def _intersections(p, q, owner, position):
@@ -917,11 +945,8 @@ def _intersections(p, q, owner, position):
     out = []
     for part in range(0, len(ii), 1_000_000):
         i, j = ii[part:part + 1_000_000], jj[part:part + 1_000_000]
-        overlap = ((lo[i, 0] <= hi[j, 0]) & (lo[j, 0] <= hi[i, 0])
-                   & (lo[i, 1] <= hi[j, 1]) & (lo[j, 1] <= hi[i, 1]))
         # Neighbours along one polyline share their end point: not a crossing.
-        adjacent = (owner[i] == owner[j]) & (np.abs(position[i] - position[j]) == 1)
-        keep = overlap & ~adjacent
+        keep = ~((owner[i] == owner[j]) & (np.abs(position[i] - position[j]) == 1))
         i, j = i[keep], j[keep]
         if not len(i):
             continue
@@ -943,7 +968,8 @@ def _end_touches(p, q, owner, position):
 
     It may arrive tangentially, where the crossing of two chords is
     ill-conditioned: so each piece's end point is also projected on every
-    segment, and one within :data:`_MERGE` of it touches it there.
+    segment, and one within :data:`_MERGE` of it touches it there.  The
+    ends are projected together, in chunks of :data:`CHUNK_BYTES`.
     """
     first = np.flatnonzero(np.r_[True, owner[1:] != owner[:-1]])
     last = np.flatnonzero(np.r_[owner[1:] != owner[:-1], True])
@@ -952,14 +978,15 @@ def _end_touches(p, q, owner, position):
     t_end = np.concatenate([np.zeros(len(first)), np.ones(len(last))])
     r = q - p
     length2 = np.sum(r * r, axis=1)
-    out = []
-    for k, point, t in zip(ends, at, t_end):
+    out = [np.zeros((0, 4))]
+    for part in chunk_slices(len(ends), 96 * len(p)):
+        point = at[part, None, :]
         with np.errstate(all="ignore"):
-            s = np.clip(np.sum((point - p) * r, axis=1) / length2, 0.0, 1.0)
-        gap = np.hypot(*(p + s[:, None] * r - point).T)
-        near = np.flatnonzero((gap <= _MERGE) & (owner != owner[k]))
-        out.extend((k, j, t, s[j]) for j in near)
-    return np.array(out, dtype=float).reshape(-1, 4)
+            s = np.clip(np.sum((point - p) * r, axis=-1) / length2, 0.0, 1.0)
+        gap = np.hypot(p[:, 0] + s * r[:, 0] - point[..., 0], p[:, 1] + s * r[:, 1] - point[..., 1])
+        k, j = np.nonzero((gap <= _MERGE) & (owner != owner[ends[part], None]))
+        out.append(np.column_stack([ends[part][k], j, t_end[part][k], s[k, j]]).astype(float))
+    return np.concatenate(out)
 
 
 def _faces(xy, edges):
