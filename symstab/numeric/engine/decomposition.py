@@ -872,28 +872,29 @@ def _candidate_pairs(lo, hi):
     pairs = []
     if len(short):
         h = max(float(np.max(extent[short])), 1e-6)
-        cells = []
-        for kx in (0, 1):
-            for ky in (0, 1):
-                cx = np.floor((lo[short, 0] if kx == 0 else hi[short, 0]) / h).astype(np.int64)
-                cy = np.floor((lo[short, 1] if ky == 0 else hi[short, 1]) / h).astype(np.int64)
-                cells.append(np.stack([cx, cy, short], axis=1))
-        cells = np.concatenate(cells)
+        # The cells of a box's four corners (columns compared one by one:
+        # NumPy's any along a row of three is slow).
+        x = np.floor(np.concatenate([lo[short, 0], lo[short, 0], hi[short, 0], hi[short, 0]])
+                     / h).astype(np.int64)
+        y = np.floor(np.concatenate([lo[short, 1], hi[short, 1], lo[short, 1], hi[short, 1]])
+                     / h).astype(np.int64)
+        segment = np.tile(short, 4)
         # Sorted by cell, then segment, each (cell, segment) once.
-        cells = cells[np.lexsort((cells[:, 2], cells[:, 1], cells[:, 0]))]
-        fresh = np.ones(len(cells), dtype=bool)
-        fresh[1:] = np.any(cells[1:] != cells[:-1], axis=1)
-        cells = cells[fresh]
+        order = np.lexsort((segment, y, x))
+        x, y, segment = x[order], y[order], segment[order]
+        new_cell = np.r_[True, (x[1:] != x[:-1]) | (y[1:] != y[:-1])]
+        fresh = new_cell | np.r_[True, segment[1:] != segment[:-1]]
+        segment, new_cell = segment[fresh], new_cell[fresh]
         # Each segment is paired with those after it in its grid cell.
-        starts = np.flatnonzero(np.r_[True, np.any(cells[1:, :2] != cells[:-1, :2], axis=1)])
-        sizes = np.diff(np.r_[starts, len(cells)])
-        after = np.repeat(sizes, sizes) - (np.arange(len(cells)) - np.repeat(starts, sizes)) - 1
+        starts = np.flatnonzero(new_cell)
+        sizes = np.diff(np.r_[starts, len(segment)])
+        after = np.repeat(sizes, sizes) - (np.arange(len(segment)) - np.repeat(starts, sizes)) - 1
         total = int(after.sum()) + int(long_.sum()) * n
         if total > _MAX_PAIRS:
             raise ValueError(f"the window holds too many pieces of the boundary ({total:,} pairs of "
                              f"chords to intersect, more than {_MAX_PAIRS:,}): narrow it")
         check_memory("the D-decomposition's pairs of chords", 48 * total)
-        pairs += _cell_pairs(cells[:, 2], after, lo, hi)
+        pairs += _cell_pairs(segment, after, lo, hi)
     wide = np.flatnonzero(long_)
     if len(wide):
         a, b = np.nonzero(_meet(lo[wide, None, :], hi[wide, None, :], lo, hi))
@@ -919,9 +920,10 @@ def _cell_pairs(segment, after, lo, hi):
     out = []
     cumulative = np.cumsum(after)
     cuts = np.searchsorted(cumulative, np.arange(1_000_000, int(cumulative[-1]), 1_000_000))
-    for rows in np.split(np.arange(len(segment)), np.unique(cuts)):
-        counts = after[rows]
-        row = np.repeat(rows, counts)
+    cuts = [0, *cuts.tolist(), len(segment)]
+    for start, stop in zip(cuts[:-1], cuts[1:]):
+        counts = after[start:stop]
+        row = np.repeat(np.arange(start, stop), counts)
         # The k-th partner of a row is k rows below it.
         step = np.arange(len(row)) - np.repeat(np.cumsum(counts) - counts, counts) + 1
         i, j = segment[row], segment[row + step]
