@@ -980,14 +980,22 @@ def _end_touches(p, q, owner, position):
     t_end = np.concatenate([np.zeros(len(first)), np.ones(len(last))])
     r = q - p
     length2 = np.sum(r * r, axis=1)
+    # A segment can be that close only if its box, widened by more than
+    # _MERGE and the rounding of the projection, holds the end.
+    lo, hi = np.minimum(p, q), np.maximum(p, q)
+    margin = 2 * _MERGE + 1e-12 * np.maximum(np.max(np.abs(lo), axis=1), np.max(np.abs(hi), axis=1))
+    lo, hi = lo - margin[:, None], hi + margin[:, None]
     out = [np.zeros((0, 4))]
-    for part in chunk_slices(len(ends), 96 * len(p)):
+    for part in chunk_slices(len(ends), 16 * len(p)):
         point = at[part, None, :]
+        k, j = np.nonzero(_meet(point, point, lo, hi) & (owner != owner[ends[part], None]))
+        point = at[part][k]
         with np.errstate(all="ignore"):
-            s = np.clip(np.sum((point - p) * r, axis=-1) / length2, 0.0, 1.0)
-        gap = np.hypot(p[:, 0] + s * r[:, 0] - point[..., 0], p[:, 1] + s * r[:, 1] - point[..., 1])
-        k, j = np.nonzero((gap <= _MERGE) & (owner != owner[ends[part], None]))
-        out.append(np.column_stack([ends[part][k], j, t_end[part][k], s[k, j]]).astype(float))
+            s = np.clip(np.sum((point - p[j]) * r[j], axis=-1) / length2[j], 0.0, 1.0)
+        gap = np.hypot(p[j, 0] + s * r[j, 0] - point[:, 0], p[j, 1] + s * r[j, 1] - point[:, 1])
+        near = gap <= _MERGE
+        out.append(np.column_stack([ends[part][k[near]], j[near], t_end[part][k[near]],
+                                    s[near]]).astype(float))
     return np.concatenate(out)
 
 
