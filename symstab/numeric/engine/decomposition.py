@@ -1048,12 +1048,14 @@ def _inside(poly, x, y):
     return inside
 
 
-def _inside_intervals(rings, value, axis):
-    """The inside intervals of the line ``axis-coordinate = value`` through the rings."""
+def _inside_intervals(sides, value, axis):
+    """The inside intervals of the line ``axis-coordinate = value`` through the rings.
+
+    ``sides`` holds each ring's ``(ring, ring rolled by one)``: its sides' two ends.
+    """
     other = 1 - axis
     cuts = []
-    for ring in rings:
-        a, b = ring, np.roll(ring, -1, axis=0)
+    for a, b in sides:
         crosses = (a[:, axis] > value) != (b[:, axis] > value)
         a, b = a[crosses], b[crosses]
         cuts.append(a[:, other] + (value - a[:, axis]) * (b[:, other] - a[:, other])
@@ -1067,16 +1069,17 @@ def _interior_point(rings):
     outer = rings[0]
     v0, v1 = outer[:, 1].min(), outer[:, 1].max()
     best, best_width = None, -1.0
+    sides = [(ring, np.roll(ring, -1, axis=0)) for ring in rings]
     for f in (0.5, 0.25, 0.75, 0.125, 0.375, 0.625, 0.875, 0.0625, 0.9375, 0.03125, 0.96875):
         v = v0 + f * (v1 - v0)
-        for lo, hi in _inside_intervals(rings, v, 1):
+        for lo, hi in _inside_intervals(sides, v, 1):
             if hi - lo > best_width:
                 best, best_width = (0.5 * (lo + hi), v), hi - lo
     if best is None:
         return None
     # Centre it vertically too, on the vertical line through it.
     u = best[0]
-    spans = _inside_intervals(rings, u, 0)
+    spans = _inside_intervals(sides, u, 0)
     for lo, hi in spans:
         if lo <= best[1] <= hi:
             return (u, 0.5 * (lo + hi))
