@@ -1016,7 +1016,9 @@ def _faces(xy, edges):
     t = twin
     head = dst
     nxt = order[first[head] + (rank[t] - first[head] - 1) % degree[head]]
-    seen = np.zeros(len(src), dtype=bool)
+    # Walked in Python lists: indexing NumPy arrays one element at a time is slower.
+    nxt = nxt.tolist()
+    seen = [False] * len(src)
     cycles = []
     for h in range(len(src)):
         if seen[h]:
