@@ -675,19 +675,19 @@ def window_arc(arc, n, x_range, y_range, *, angles=()):
     return theta, xs, ys
 
 
-def _pieces(base, ax, ay, ends, arc, theta, xs, ys, sign, to_unit, from_unit, box):
+def _pieces(base, ax, ay, ends, arc_ends, theta, xs, ys, sign, to_unit, from_unit, box):
     """The branches (in the plane's units) and the polylines to intersect (in window units).
 
     Each polyline is ``(points, label, theta)`` (``theta`` None for a line
     and for the window's edges), cut to the runs of segments that reach the
-    window.  The arc's ends at ``theta = 0`` and ``pi`` are the arc
-    source's (there its equations are ``chi(+-1) = chi'(+-1) = 0``), None
-    where that system is singular.
+    window.  The arc's ends at ``theta = 0`` and ``pi``, ``arc_ends = (x,
+    y)``, are the arc source's (there its equations are ``chi(+-1) =
+    chi'(+-1) = 0``), None where that system is singular.
     """
     polylines, branches = [], []
     u, v = to_unit(xs, ys)
     finite = np.isfinite(u) & np.isfinite(v)
-    end_x, end_y, _ = arc(np.array([0.0, np.pi]))
+    end_x, end_y = arc_ends
     ends_xy = [(x, y) if math.isfinite(x) and math.isfinite(y) else None
                for x, y in zip(end_x.tolist(), end_y.tolist())]
     cut = np.flatnonzero((sign[1:] != sign[:-1]) | ~finite[1:] | ~finite[:-1]) + 1
@@ -1795,11 +1795,12 @@ def _trace(base, ax, ay, ends, arc, window, fine):
     hits)`` of the last round.
     """
     samples = None
+    arc_ends = arc(np.array([0.0, np.pi]))[:2]      # the same in every round
     for _ in range(_CROSSING_ROUNDS):
         samples = sample_arc(arc, len(base) - 1, window.to_unit, samples, fine)
         theta, xs, ys, det = samples
         sign = np.sign(det)
-        polylines, branches = _pieces(base, ax, ay, ends, arc, theta, xs, ys, sign,
+        polylines, branches = _pieces(base, ax, ay, ends, arc_ends, theta, xs, ys, sign,
                                       window.to_unit, window.from_unit, window.box)
         p, q, owner, position = _segments(polylines)
         hits = _intersections(p, q, owner, position)
