@@ -261,6 +261,26 @@ def pytest_collection_modifyitems(config, items):
 
 
 # --------------------------------------------------------------------------
+# The paper's best virtual mass (seconds a delay), read by test_region and test_design
+# --------------------------------------------------------------------------
+
+@pytest.fixture(scope="session")
+def best_d0():
+    """``best_virtual_mass(d=0)`` of the paper's device, once per session (per xdist worker)."""
+    from symstab import best_virtual_mass
+
+    return best_virtual_mass(d=0, delta=PAPER_DELTA)
+
+
+@pytest.fixture(scope="session")
+def best_d40():
+    """``best_virtual_mass(d=40)`` of the paper's device, once per session (per xdist worker)."""
+    from symstab import best_virtual_mass
+
+    return best_virtual_mass(d=40, delta=PAPER_DELTA)
+
+
+# --------------------------------------------------------------------------
 # Command runs in-process, and the loops' kernel cache
 # --------------------------------------------------------------------------
 

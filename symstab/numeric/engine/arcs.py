@@ -394,6 +394,10 @@ class Brackets:
                 for end, three in enumerate(bracket):
                     for f, c in enumerate(three):
                         self._ends[end, b, f, :len(c)] = c
+            # Per end, a row per power of u: the forms' coefficients, then their
+            # moduli (one Horner's scheme evaluates both).
+            flat = self._ends.reshape(2, 3 * len(series), size)
+            self._horner = [np.ascontiguousarray(np.concatenate([f, np.abs(f)]).T) for f in flat]
 
     @property
     def frequencies(self):
@@ -433,16 +437,16 @@ class Brackets:
         k = len(self.pairs)
         half = 0.5 * np.where(mirror, (np.pi - theta) + _PI_LOW, theta)
         u = np.sin(half) ** 2
-        # Horner's scheme on (M, 3 k) arrays: a matrix product this skinny
-        # costs more in BLAS's threads than it computes.
-        forms = self._ends[1 if mirror else 0].reshape(3 * k, -1)
-        size = np.abs(forms)
-        value = np.zeros((len(u), 3 * k))
-        scale = np.zeros((len(u), 3 * k))
+        # Horner's scheme on an (M, 6 k) array, the values and their scales
+        # side by side: a matrix product this skinny costs more in BLAS's
+        # threads than it computes.
+        rows = self._horner[1 if mirror else 0]
+        both = np.zeros((len(u), rows.shape[1]))
         column = u[:, None]
-        for power in range(forms.shape[-1] - 1, -1, -1):
-            value = value * column + forms[:, power]
-            scale = scale * column + size[:, power]
+        for row in rows[::-1]:
+            both *= column
+            both += row
+        value, scale = both[:, :3 * k], both[:, 3 * k:]
         if self.shift:
             ratio, cosine = _multiple(self.shift, theta)
         else:

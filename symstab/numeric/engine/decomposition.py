@@ -675,19 +675,19 @@ def window_arc(arc, n, x_range, y_range, *, angles=()):
     return theta, xs, ys
 
 
-def _pieces(base, ax, ay, ends, arc, theta, xs, ys, sign, to_unit, from_unit, box):
+def _pieces(base, ax, ay, ends, arc_ends, theta, xs, ys, sign, to_unit, from_unit, box):
     """The branches (in the plane's units) and the polylines to intersect (in window units).
 
     Each polyline is ``(points, label, theta)`` (``theta`` None for a line
     and for the window's edges), cut to the runs of segments that reach the
-    window.  The arc's ends at ``theta = 0`` and ``pi`` are the arc
-    source's (there its equations are ``chi(+-1) = chi'(+-1) = 0``), None
-    where that system is singular.
+    window.  The arc's ends at ``theta = 0`` and ``pi``, ``arc_ends = (x,
+    y)``, are the arc source's (there its equations are ``chi(+-1) =
+    chi'(+-1) = 0``), None where that system is singular.
     """
     polylines, branches = [], []
     u, v = to_unit(xs, ys)
     finite = np.isfinite(u) & np.isfinite(v)
-    end_x, end_y, _ = arc(np.array([0.0, np.pi]))
+    end_x, end_y = arc_ends
     ends_xy = [(x, y) if math.isfinite(x) and math.isfinite(y) else None
                for x, y in zip(end_x.tolist(), end_y.tolist())]
     cut = np.flatnonzero((sign[1:] != sign[:-1]) | ~finite[1:] | ~finite[:-1]) + 1
@@ -855,12 +855,15 @@ def _segments(polylines):
 
 
 def _candidate_pairs(lo, hi):
-    """Pairs ``i < j`` of segments whose bounding boxes may overlap.
+    """Pairs ``i < j`` of segments whose bounding boxes overlap.
 
     Short segments (the sampled arc) are hashed into a grid of cells as
     large as the longest of them, so each lies in at most four cells and
     only segments sharing a cell are paired; the few long ones (the lines,
-    the window's edges) are paired with everything.
+    the window's edges) are paired with every segment whose box meets
+    theirs.  The pairs are taken in one step each (a pair's boxes are
+    compared before it is sorted: a long piece meets few of the arc's
+    thousand chords).
     """
     n = len(lo)
     extent = np.max(hi - lo, axis=1)
@@ -869,43 +872,70 @@ def _candidate_pairs(lo, hi):
     pairs = []
     if len(short):
         h = max(float(np.max(extent[short])), 1e-6)
-        cells = []
-        for kx in (0, 1):
-            for ky in (0, 1):
-                cx = np.floor((lo[short, 0] if kx == 0 else hi[short, 0]) / h).astype(np.int64)
-                cy = np.floor((lo[short, 1] if ky == 0 else hi[short, 1]) / h).astype(np.int64)
-                cells.append(np.stack([cx, cy, short], axis=1))
-        cells = np.concatenate(cells)
+        # The cells of a box's four corners (columns compared one by one:
+        # NumPy's any along a row of three is slow).
+        x = np.floor(np.concatenate([lo[short, 0], lo[short, 0], hi[short, 0], hi[short, 0]])
+                     / h).astype(np.int64)
+        y = np.floor(np.concatenate([lo[short, 1], hi[short, 1], lo[short, 1], hi[short, 1]])
+                     / h).astype(np.int64)
+        segment = np.tile(short, 4)
         # Sorted by cell, then segment, each (cell, segment) once.
-        cells = cells[np.lexsort((cells[:, 2], cells[:, 1], cells[:, 0]))]
-        fresh = np.ones(len(cells), dtype=bool)
-        fresh[1:] = np.any(cells[1:] != cells[:-1], axis=1)
-        cells = cells[fresh]
+        order = np.lexsort((segment, y, x))
+        x, y, segment = x[order], y[order], segment[order]
+        new_cell = np.r_[True, (x[1:] != x[:-1]) | (y[1:] != y[:-1])]
+        fresh = new_cell | np.r_[True, segment[1:] != segment[:-1]]
+        segment, new_cell = segment[fresh], new_cell[fresh]
         # Each segment is paired with those after it in its grid cell.
-        starts = np.flatnonzero(np.r_[True, np.any(cells[1:, :2] != cells[:-1, :2], axis=1)])
-        sizes = np.diff(np.r_[starts, len(cells)])
-        after = np.repeat(sizes, sizes) - (np.arange(len(cells)) - np.repeat(starts, sizes)) - 1
+        starts = np.flatnonzero(new_cell)
+        sizes = np.diff(np.r_[starts, len(segment)])
+        after = np.repeat(sizes, sizes) - (np.arange(len(segment)) - np.repeat(starts, sizes)) - 1
         total = int(after.sum()) + int(long_.sum()) * n
         if total > _MAX_PAIRS:
             raise ValueError(f"the window holds too many pieces of the boundary ({total:,} pairs of "
                              f"chords to intersect, more than {_MAX_PAIRS:,}): narrow it")
         check_memory("the D-decomposition's pairs of chords", 48 * total)
-        rows = np.arange(len(cells))
-        for k in range(1, int(after.max(initial=0)) + 1):
-            rows = rows[after[rows] >= k]
-            pairs.append(np.stack([cells[rows, 2], cells[rows + k, 2]], axis=1))
-    for i in np.flatnonzero(long_):
-        others = np.arange(n)
-        pairs.append(np.stack([np.full(n, i), others], axis=1))
-    if not pairs:
+        pairs += _cell_pairs(segment, after, lo, hi)
+    wide = np.flatnonzero(long_)
+    if len(wide):
+        a, b = np.nonzero(_meet(lo[wide, None, :], hi[wide, None, :], lo, hi))
+        pairs.append(np.stack([wide[a], b], axis=1))
+    pairs = np.concatenate(pairs) if pairs else np.zeros((0, 2), dtype=np.int64)
+    if not len(pairs):
         return np.zeros(0, dtype=np.int64), np.zeros(0, dtype=np.int64)
-    pairs = np.sort(np.concatenate(pairs), axis=1)
+    pairs = np.sort(pairs, axis=1)
     # Sorted and deduplicated by hand: np.unique hashes integers (NumPy 2.3+),
     # 50 times slower than this sort on the 10**5 keys of a fine pass.
     key = np.sort(pairs[:, 0] * n + pairs[:, 1])
     key = key[np.r_[True, key[1:] != key[:-1]]]
     i, j = key // n, key % n
     return i[i != j], j[i != j]
+
+
+def _cell_pairs(segment, after, lo, hi):
+    """The pairs of each ``segment`` with the ``after`` next ones in its cell whose boxes meet.
+
+    Made and compared about 10**6 pairs at a time (a row's partners are
+    the rows just below it: its cell's segments are consecutive).
+    """
+    out = []
+    cumulative = np.cumsum(after)
+    cuts = np.searchsorted(cumulative, np.arange(1_000_000, int(cumulative[-1]), 1_000_000))
+    cuts = [0, *cuts.tolist(), len(segment)]
+    for start, stop in zip(cuts[:-1], cuts[1:]):
+        counts = after[start:stop]
+        row = np.repeat(np.arange(start, stop), counts)
+        # The k-th partner of a row is k rows below it.
+        step = np.arange(len(row)) - np.repeat(np.cumsum(counts) - counts, counts) + 1
+        i, j = segment[row], segment[row + step]
+        meet = _meet(lo[i], hi[i], lo[j], hi[j])
+        out.append(np.stack([i[meet], j[meet]], axis=1))
+    return out
+
+
+def _meet(lo_a, hi_a, lo_b, hi_b):
+    """Whether boxes ``a`` meet boxes ``b`` (corners in the last axis; the rest broadcast)."""
+    return ((lo_a[..., 0] <= hi_b[..., 0]) & (lo_b[..., 0] <= hi_a[..., 0])
+            & (lo_a[..., 1] <= hi_b[..., 1]) & (lo_b[..., 1] <= hi_a[..., 1]))
 
 
 def _intersections(p, q, owner, position):
@@ -917,11 +947,8 @@ def _intersections(p, q, owner, position):
     out = []
     for part in range(0, len(ii), 1_000_000):
         i, j = ii[part:part + 1_000_000], jj[part:part + 1_000_000]
-        overlap = ((lo[i, 0] <= hi[j, 0]) & (lo[j, 0] <= hi[i, 0])
-                   & (lo[i, 1] <= hi[j, 1]) & (lo[j, 1] <= hi[i, 1]))
         # Neighbours along one polyline share their end point: not a crossing.
-        adjacent = (owner[i] == owner[j]) & (np.abs(position[i] - position[j]) == 1)
-        keep = overlap & ~adjacent
+        keep = ~((owner[i] == owner[j]) & (np.abs(position[i] - position[j]) == 1))
         i, j = i[keep], j[keep]
         if not len(i):
             continue
@@ -943,7 +970,8 @@ def _end_touches(p, q, owner, position):
 
     It may arrive tangentially, where the crossing of two chords is
     ill-conditioned: so each piece's end point is also projected on every
-    segment, and one within :data:`_MERGE` of it touches it there.
+    segment, and one within :data:`_MERGE` of it touches it there.  The
+    ends are projected together, in chunks of :data:`CHUNK_BYTES`.
     """
     first = np.flatnonzero(np.r_[True, owner[1:] != owner[:-1]])
     last = np.flatnonzero(np.r_[owner[1:] != owner[:-1], True])
@@ -952,14 +980,23 @@ def _end_touches(p, q, owner, position):
     t_end = np.concatenate([np.zeros(len(first)), np.ones(len(last))])
     r = q - p
     length2 = np.sum(r * r, axis=1)
-    out = []
-    for k, point, t in zip(ends, at, t_end):
+    # A segment can be that close only if its box, widened by more than
+    # _MERGE and the rounding of the projection, holds the end.
+    lo, hi = np.minimum(p, q), np.maximum(p, q)
+    margin = 2 * _MERGE + 1e-12 * np.maximum(np.max(np.abs(lo), axis=1), np.max(np.abs(hi), axis=1))
+    lo, hi = lo - margin[:, None], hi + margin[:, None]
+    out = [np.zeros((0, 4))]
+    for part in chunk_slices(len(ends), 16 * len(p)):
+        point = at[part, None, :]
+        k, j = np.nonzero(_meet(point, point, lo, hi) & (owner != owner[ends[part], None]))
+        point = at[part][k]
         with np.errstate(all="ignore"):
-            s = np.clip(np.sum((point - p) * r, axis=1) / length2, 0.0, 1.0)
-        gap = np.hypot(*(p + s[:, None] * r - point).T)
-        near = np.flatnonzero((gap <= _MERGE) & (owner != owner[k]))
-        out.extend((k, j, t, s[j]) for j in near)
-    return np.array(out, dtype=float).reshape(-1, 4)
+            s = np.clip(np.sum((point - p[j]) * r[j], axis=-1) / length2[j], 0.0, 1.0)
+        gap = np.hypot(p[j, 0] + s * r[j, 0] - point[:, 0], p[j, 1] + s * r[j, 1] - point[:, 1])
+        near = gap <= _MERGE
+        out.append(np.column_stack([ends[part][k[near]], j[near], t_end[part][k[near]],
+                                    s[near]]).astype(float))
+    return np.concatenate(out)
 
 
 def _faces(xy, edges):
@@ -979,7 +1016,9 @@ def _faces(xy, edges):
     t = twin
     head = dst
     nxt = order[first[head] + (rank[t] - first[head] - 1) % degree[head]]
-    seen = np.zeros(len(src), dtype=bool)
+    # Walked in Python lists: indexing NumPy arrays one element at a time is slower.
+    nxt = nxt.tolist()
+    seen = [False] * len(src)
     cycles = []
     for h in range(len(src)):
         if seen[h]:
@@ -1011,12 +1050,14 @@ def _inside(poly, x, y):
     return inside
 
 
-def _inside_intervals(rings, value, axis):
-    """The inside intervals of the line ``axis-coordinate = value`` through the rings."""
+def _inside_intervals(sides, value, axis):
+    """The inside intervals of the line ``axis-coordinate = value`` through the rings.
+
+    ``sides`` holds each ring's ``(ring, ring rolled by one)``: its sides' two ends.
+    """
     other = 1 - axis
     cuts = []
-    for ring in rings:
-        a, b = ring, np.roll(ring, -1, axis=0)
+    for a, b in sides:
         crosses = (a[:, axis] > value) != (b[:, axis] > value)
         a, b = a[crosses], b[crosses]
         cuts.append(a[:, other] + (value - a[:, axis]) * (b[:, other] - a[:, other])
@@ -1030,16 +1071,17 @@ def _interior_point(rings):
     outer = rings[0]
     v0, v1 = outer[:, 1].min(), outer[:, 1].max()
     best, best_width = None, -1.0
+    sides = [(ring, np.roll(ring, -1, axis=0)) for ring in rings]
     for f in (0.5, 0.25, 0.75, 0.125, 0.375, 0.625, 0.875, 0.0625, 0.9375, 0.03125, 0.96875):
         v = v0 + f * (v1 - v0)
-        for lo, hi in _inside_intervals(rings, v, 1):
+        for lo, hi in _inside_intervals(sides, v, 1):
             if hi - lo > best_width:
                 best, best_width = (0.5 * (lo + hi), v), hi - lo
     if best is None:
         return None
     # Centre it vertically too, on the vertical line through it.
     u = best[0]
-    spans = _inside_intervals(rings, u, 0)
+    spans = _inside_intervals(sides, u, 0)
     for lo, hi in spans:
         if lo <= best[1] <= hi:
             return (u, 0.5 * (lo + hi))
@@ -1753,11 +1795,12 @@ def _trace(base, ax, ay, ends, arc, window, fine):
     hits)`` of the last round.
     """
     samples = None
+    arc_ends = arc(np.array([0.0, np.pi]))[:2]      # the same in every round
     for _ in range(_CROSSING_ROUNDS):
         samples = sample_arc(arc, len(base) - 1, window.to_unit, samples, fine)
         theta, xs, ys, det = samples
         sign = np.sign(det)
-        polylines, branches = _pieces(base, ax, ay, ends, arc, theta, xs, ys, sign,
+        polylines, branches = _pieces(base, ax, ay, ends, arc_ends, theta, xs, ys, sign,
                                       window.to_unit, window.from_unit, window.box)
         p, q, owner, position = _segments(polylines)
         hits = _intersections(p, q, owner, position)

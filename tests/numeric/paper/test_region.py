@@ -732,18 +732,9 @@ def test_empty_region(gamma, d, delta):
 
 
 # --------------------------------------------------------------------------
-# best_virtual_mass (slow: one call per delay)
+# best_virtual_mass (slow: one call per delay; conftest's session fixtures best_d0 and
+# best_d40, which test_design reads too)
 # --------------------------------------------------------------------------
-
-@pytest.fixture(scope="module")
-def best_d0():
-    return best_virtual_mass(d=0, delta=PAPER_DELTA)
-
-
-@pytest.fixture(scope="module")
-def best_d40():
-    return best_virtual_mass(d=40, delta=PAPER_DELTA)
-
 
 @pytest.mark.parametrize("which, d, others", [
     ("best_d0", 0, (0.5, 1.0, 1.5, 1.9, 2.0, -0.5)),
