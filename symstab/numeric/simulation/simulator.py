@@ -517,8 +517,9 @@ def _run(run, steps, amplitude, positions, progress, report, chunk, n_chunks, to
     ``total``, if given, accumulates ``|x|`` of every period after the start;
     ``swing``, if given, gets each quarter's half range of ``x`` (half of
     its largest less its smallest value).  The run advances in blocks
-    (:meth:`_AnyLoop.advance`) that end at each quarter's end and at every
-    overflow check, where one period at a time would.
+    (:meth:`_AnyLoop.advance`) that end at each quarter's end (and at every
+    period when it records: a diverged point's positions are zero from the
+    period it is found in).
     """
     if positions is not None:
         positions[0] = run.x
@@ -535,7 +536,9 @@ def _run(run, steps, amplitude, positions, progress, report, chunk, n_chunks, to
             high_q, low_q = high[q], low[q]
             k = start
             while k < stop:
-                count = min(run.block, stop - k, every - k % every)
+                count = min(run.block, stop - k)
+                if run.aligned or every == 1:
+                    count = min(count, every - k % every)
                 run.advance(count)
                 block = run.positions
                 if count == 1:
@@ -613,10 +616,20 @@ class StabilityMap(PaperGridNames):
 # Any loop: its plant's pulse transfer function and its environment, stepped
 
 
-#: Floats held per point besides the delay line and the histories: the
-#: rows of a block (:data:`_CHECK_EVERY` periods) of the positions, samples,
-#: forces, commands and their temporaries, and a few more.
-_ANY_LOOP_FLOATS = 8 + 6 * _CHECK_EVERY
+#: Floats held per point besides the delay line, the histories and the
+#: blocks: the velocity estimate, the extremes and a few more.
+_ANY_LOOP_FLOATS = 8
+#: Floats per point of each row of a block: the positions, samples, forces,
+#: commands and two temporaries.
+_BLOCK_FLOATS = 6
+#: The most periods a block runs (:meth:`_AnyLoop.advance`): past a few
+#: dozen, the Python work per block is a small part of a period's.
+_BLOCK_MAX = 32
+
+
+def _block_rows(d):
+    """Periods a block of a loop with delay ``d`` runs: ``d``, from 1 to :data:`_BLOCK_MAX`."""
+    return max(1, min(d, _BLOCK_MAX))
 
 
 def simulate_loop(loop, *, steps=None, x0=1.0, v0=None, nonideal=None, record=False,
@@ -865,7 +878,7 @@ def run_loop(parts_of, n_points, *, d, steps, x0, v0, nonideal, record, progress
             linear_stable is None or np.shape(linear_stable) != (n_points,)):
         raise ValueError("a force quantum's verdict needs linear_stable, one bool a point")
     pulse_of = None if nonideal.force_resolution is None else pulse
-    point_bytes = 8 * (d + 1 + parts_floats + _ANY_LOOP_FLOATS)
+    point_bytes = 8 * (d + 1 + parts_floats + _ANY_LOOP_FLOATS + _BLOCK_FLOATS * _block_rows(d))
     if spaces is None:
         def make_run(part):
             return _AnyLoop(parts_of(part), d, x0, v0, nonideal, compensation=compensation)
@@ -983,7 +996,7 @@ class _AnyLoop:
     ``-u``) is a buffer of rows in time, oldest first: the past a period
     reads, then the rows of the block being computed.
 
-    A block is up to ``d`` periods (and :data:`_CHECK_EVERY`): the plant
+    A block is up to ``d`` periods (:func:`_block_rows`): the plant
     reads commands ``d`` periods old, all known when the block starts, so
     its positions come first, then the block's samples, forces and
     commands.  What is not a recursion (the rounding, the sums over past
@@ -994,6 +1007,9 @@ class _AnyLoop:
     the runs are the same to the last bit; the Python work per period is a
     few calls (the paper's loop at d >= 8: four), not twenty.
     """
+
+    #: Blocks end at the overflow checks (a loop whose check reads a state of the block's end).
+    aligned = False
 
     def __init__(self, parts, d, x0, v0, nonideal, compensation=None, pulse=None):
         a, b, c, e = parts
@@ -1012,7 +1028,7 @@ class _AnyLoop:
         n, m = a.shape[1], c.shape[1]
         self.n, self.m = n, m
         self.size = n_points
-        self.block = max(1, min(d, _CHECK_EVERY))
+        self.block = _block_rows(d)
         rows = self.block
         # The past each buffer keeps before its block: x[k-n] .. x[k] (the
         # overflow check reads x[k-n]), u[k-d-n] .. u[k-1], the samples and
@@ -1066,8 +1082,10 @@ class _AnyLoop:
         """``count`` periods, at most :attr:`block`; the caller ignores overflow and invalid values.
 
         (:func:`_run`'s error state.)  The block's positions are then
-        :attr:`positions`; the diverged points are frozen when the period
-        count reaches a multiple of :attr:`check_every`.
+        :attr:`positions`.  The overflow check runs where one period at a
+        time would run it, after every :attr:`check_every` periods, on the
+        values of that period, still in the buffers: a point then frozen has
+        diverged whatever it does after (its verdict does not read them).
         """
         if self.filled:
             self._shift(self.filled)
@@ -1078,9 +1096,10 @@ class _AnyLoop:
             self._environment_block(1)
             self._plant_block(1)
         self.filled = count
+        start, every = self.k, self.check_every
         self.k += count
-        if self.k % self.check_every == 0:
-            self.freeze_diverged()
+        for done in range(start - start % every + every, self.k + 1, every):
+            self.freeze_diverged(done - start)
 
     def _shift(self, count):
         for buffer, keep in ((self.X, self.keep_x), (self.U, self.keep_u),
@@ -1160,18 +1179,43 @@ class _AnyLoop:
         np.sign(estimate, out=estimate)
         np.subtract(force, np.multiply(coulomb, estimate, out=estimate), out=command)
 
-    def _unfinite(self):
-        """Per point: a history the plant reads is not finite (x[k-n..k-1], u[k-d-n..k-d-1])."""
-        newest_x, newest_u = self.keep_x - 1 + self.filled, self.keep_u - 1 + self.filled
+    def _unfinite(self, filled):
+        """Per point: a history the plant reads is not finite (x[k-n..k-1], u[k-d-n..k-d-1]).
+
+        ``k`` the period after the block's first ``filled`` rows.
+        """
+        newest_x, newest_u = self.keep_x - 1 + filled, self.keep_u - 1 + filled
         n, d = self.n, self.d
         bad = ~np.isfinite(self.X[newest_x - n:newest_x]).all(axis=0)
         bad |= ~np.isfinite(self.U[newest_u - d - n + 1:newest_u - d + 1]).all(axis=0)
         return bad
 
-    def freeze_diverged(self):
-        """Mark the points whose state left [-1e100, 1e100] or is not finite; zero them."""
-        bad = ~(np.abs(self.x) < _OVERFLOW) | self._unfinite()
-        newest_f = self.keep_f - 1 + self.filled
+    def _calm(self, filled):
+        """True when no point can have diverged: a quick test, which :meth:`freeze_diverged` makes exact.
+
+        Every position the check reads below the overflow, and the sums of
+        the commands and forces it reads finite (a sum that overflows sends
+        the check to the exact test).
+        """
+        newest_x, newest_u = self.keep_x - 1 + filled, self.keep_u - 1 + filled
+        newest_f = self.keep_f - 1 + filled
+        n, d = self.n, self.d
+        with np.errstate(over="ignore", invalid="ignore"):
+            return bool(np.maximum.reduce(np.abs(self.X[newest_x - n:newest_x + 1]), axis=None)
+                        < _OVERFLOW) and math.isfinite(
+                np.add.reduce(self.U[newest_u - d - n + 1:newest_u - d + 1], axis=None)
+                + np.add.reduce(self.F[newest_f - self.m + 1:newest_f + 1], axis=None))
+
+    def freeze_diverged(self, filled=None):
+        """Mark the points whose state left [-1e100, 1e100] or is not finite; zero them.
+
+        The state after the block's first ``filled`` rows (default: all).
+        """
+        filled = self.filled if filled is None else filled
+        if self._calm(filled):
+            return
+        bad = ~(np.abs(self.X[self.keep_x - 1 + filled]) < _OVERFLOW) | self._unfinite(filled)
+        newest_f = self.keep_f - 1 + filled
         bad |= ~np.isfinite(self.F[newest_f - self.m + 1:newest_f + 1]).all(axis=0)
         if bad.any():
             self.diverged |= bad
@@ -1207,10 +1251,13 @@ class _StateLoop(_AnyLoop):
         for r in range(count):
             self.X[self.keep_x + r] = self.plant.step(self.U[first_u + r], -1.0)
 
-    def _unfinite(self):
+    aligned = True
+
+    def _unfinite(self, filled):
         return np.zeros(self.size, dtype=bool)      # the plant's past is its state
 
-    def freeze_diverged(self):
+    def freeze_diverged(self, filled=None):
+        # The plant's state is of the block's end only: its blocks end at the checks.
         bad = ~(np.abs(self.x) < _OVERFLOW) | ~self.plant.finite()
         if bad.any():
             self.plant.freeze(bad)
