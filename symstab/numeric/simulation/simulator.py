@@ -619,12 +619,18 @@ class StabilityMap(PaperGridNames):
 #: Floats held per point besides the delay line, the histories and the
 #: blocks: the velocity estimate, the extremes and a few more.
 _ANY_LOOP_FLOATS = 8
-#: Floats per point of each row of a block: the positions, samples, forces,
-#: commands and two temporaries.
-_BLOCK_FLOATS = 6
+#: Buffers of rows in time (:class:`_AnyLoop`): the positions, samples,
+#: forces and commands (each with its spare rows; two temporaries have a
+#: block's).
+_BUFFERS = 4
 #: The most periods a block runs (:meth:`_AnyLoop.advance`): past a few
 #: dozen, the Python work per block is a small part of a period's.
 _BLOCK_MAX = 32
+
+
+def _spare_rows(block):
+    """Rows of a buffer after its past: a few blocks, or 16 periods (moved back when full)."""
+    return max(4 * block, 16)
 
 
 def _block_rows(d):
@@ -878,7 +884,8 @@ def run_loop(parts_of, n_points, *, d, steps, x0, v0, nonideal, record, progress
             linear_stable is None or np.shape(linear_stable) != (n_points,)):
         raise ValueError("a force quantum's verdict needs linear_stable, one bool a point")
     pulse_of = None if nonideal.force_resolution is None else pulse
-    point_bytes = 8 * (d + 1 + parts_floats + _ANY_LOOP_FLOATS + _BLOCK_FLOATS * _block_rows(d))
+    point_bytes = 8 * (d + 1 + parts_floats + _ANY_LOOP_FLOATS + 2 * _block_rows(d)
+                       + _BUFFERS * _spare_rows(_block_rows(d)))
     if spaces is None:
         def make_run(part):
             return _AnyLoop(parts_of(part), d, x0, v0, nonideal, compensation=compensation)
@@ -1028,11 +1035,16 @@ class _AnyLoop:
         # overflow check reads x[k-n]), u[k-d-n] .. u[k-1], the samples and
         # forces of the last m periods (one sample at least: the velocity
         # estimate's).
-        self.keep_x, self.keep_u, self.keep_s, self.keep_f = n + 1, d + n, max(m, 1), m
-        self.X = np.empty((self.keep_x + rows, n_points))
-        self.U = np.zeros((self.keep_u + rows, n_points))
-        self.S = np.empty((self.keep_s + rows, n_points))
-        self.F = np.empty((self.keep_f + rows, n_points))
+        self.past = (n + 1, d + n, max(m, 1), m)
+        # keep_x, ...: the row of each buffer where the block starts; the
+        # blocks follow one another in the spare rows, which are moved back
+        # to the start (the past only) when they run out.
+        self.keep_x, self.keep_u, self.keep_s, self.keep_f = self.past
+        self.spare = _spare_rows(rows)
+        self.X = np.empty((self.keep_x + self.spare, n_points))
+        self.U = np.zeros((self.keep_u + self.spare, n_points))
+        self.S = np.empty((self.keep_s + self.spare, n_points))
+        self.F = np.empty((self.keep_f + self.spare, n_points))
         # x[k] = x0; x[k-i] = x0 - i v0 before the start; no force applied yet.
         self.X[n] = float(x0)
         for i in range(1, n + 1):
@@ -1100,11 +1112,17 @@ class _AnyLoop:
                 self.freeze_diverged(done - start)
 
     def _shift(self, count):
-        for buffer, keep in ((self.X, self.keep_x), (self.U, self.keep_u),
-                             (self.S, self.keep_s), (self.F, self.keep_f)):
-            if keep:
-                buffer[:keep] = buffer[count:count + keep]
+        """The last block's rows join the past; back to the buffers' start when the rows run out."""
         self.filled = 0
+        moved = self.keep_x + count - self.past[0]
+        if moved + self.block <= self.spare:
+            self.keep_x, self.keep_u, self.keep_s, self.keep_f = (
+                keep + moved for keep in self.past)
+            return
+        for buffer, keep in zip((self.X, self.U, self.S, self.F), self.past):
+            if keep:
+                buffer[:keep] = buffer[moved:moved + keep]
+        self.keep_x, self.keep_u, self.keep_s, self.keep_f = self.past
 
     def _combine(self, out, terms, buffer, first_row, sign):
         """``out (+/-)= c * buffer[first_row - k:][:rows]`` for each term ``(k, c)``, in order."""
