@@ -536,9 +536,7 @@ def _run(run, steps, amplitude, positions, progress, report, chunk, n_chunks, to
             high_q, low_q = high[q], low[q]
             k = start
             while k < stop:
-                count = min(run.block, stop - k)
-                if run.aligned or every == 1:
-                    count = min(count, every - k % every)
+                count = min(run.block, stop - k) if every > 1 else 1
                 run.advance(count)
                 block = run.positions
                 if count == 1:
@@ -1011,9 +1009,6 @@ class _AnyLoop:
     few calls (the paper's loop at d >= 8: four), not twenty.
     """
 
-    #: Blocks end at the overflow checks (a loop whose check reads a state of the block's end).
-    aligned = False
-
     def __init__(self, parts, d, x0, v0, nonideal, compensation=None, pulse=None):
         a, b, c, e = parts
         n_points = a.shape[0]
@@ -1116,8 +1111,10 @@ class _AnyLoop:
         self.filled = 0
         moved = self.keep_x + count - self.past[0]
         if moved + self.block <= self.spare:
-            self.keep_x, self.keep_u, self.keep_s, self.keep_f = (
-                keep + moved for keep in self.past)
+            self.keep_x += count
+            self.keep_u += count
+            self.keep_s += count
+            self.keep_f += count
             return
         for buffer, keep in zip((self.X, self.U, self.S, self.F), self.past):
             if keep:
@@ -1236,6 +1233,10 @@ class _AnyLoop:
             for buffer in (self.X, self.U, self.S, self.F):
                 buffer[:, bad] = 0.0
             self.v_hat[bad] = 0.0
+            self._freeze_plant(bad)
+
+    def _freeze_plant(self, bad):
+        """Zero the plant's own state of the points ``bad`` (a state space has one)."""
 
 
 class _StateLoop(_AnyLoop):
@@ -1250,6 +1251,7 @@ class _StateLoop(_AnyLoop):
         super().__init__(parts, d, x0, v0, nonideal, compensation=compensation)
         coulomb = nonideal.coulomb_friction
         stiction = nonideal.stiction if nonideal.stiction is not None else coulomb
+        self._unfinite_at = {}
         if state is None:
             self.plant = StatePlant.from_history(space, x0, v0, self.size, nonideal)
         else:
@@ -1260,23 +1262,35 @@ class _StateLoop(_AnyLoop):
                                     stiction=stiction)
 
     def _plant_block(self, count):
-        # The state space holds the plant's past: one period at a time.
-        first_u = self.keep_u - self.d
+        # The state space holds the plant's past: one period at a time; the
+        # state's check of each period that has one is kept for the block's
+        # checks (:meth:`_AnyLoop.advance`).
+        first_u, every, start = self.keep_u - self.d, self.check_every, self.k
+        self._unfinite_at = {}
         for r in range(count):
             self.X[self.keep_x + r] = self.plant.step(self.U[first_u + r], -1.0)
-
-    aligned = True
+            if (start + r + 1) % every == 0:
+                bad = ~self.plant.finite()
+                if bad.any():
+                    self._unfinite_at[r + 1] = bad
 
     def _unfinite(self, filled):
-        return np.zeros(self.size, dtype=bool)      # the plant's past is its state
+        # The plant's past is its state, whose check the block kept.
+        return self._unfinite_at.get(filled, np.zeros(self.size, dtype=bool))
+
+    def _calm(self, first, last):
+        return not self._unfinite_at and super()._calm(first, last)
 
     def freeze_diverged(self, filled=None):
-        # The plant's state is of the block's end only: its blocks end at the checks.
-        bad = ~(np.abs(self.x) < _OVERFLOW) | ~self.plant.finite()
-        if bad.any():
-            self.plant.freeze(bad)
-            self.x[bad] = np.inf        # marked diverged below, with everything zeroed
-        super().freeze_diverged()
+        if filled is None:
+            # The run's end: the plant's state now.
+            bad = ~self.plant.finite()
+            if bad.any():
+                self._unfinite_at[self.filled] = bad | self._unfinite(self.filled)
+        super().freeze_diverged(filled)
+
+    def _freeze_plant(self, bad):
+        self.plant.freeze(bad)
 
 
 def loop_stability_map(loop, x_values, y_values, *, x=None, y=None, steps=None, x0=1.0, v0=None,
