@@ -1060,6 +1060,7 @@ class _AnyLoop:
         # The filter's pole at every point: an array multiplies faster than a float.
         self._pole = None if compensation is None else np.full(n_points, compensation[1])
         self._x_rows, self._f_rows = list(self.X), list(self.F)
+        self._u_rows, self._s_rows = list(self.U), list(self.S)
         self.filled = 0          # rows of the last block, not yet shifted into the past
         self.k = 0
         self.diverged = np.zeros(n_points, dtype=bool)
@@ -1074,7 +1075,7 @@ class _AnyLoop:
     @property
     def x(self):
         """The newest position (a view of the buffer)."""
-        return self.X[self.keep_x - 1 + self.filled]
+        return self._x_rows[self.keep_x - 1 + self.filled]
 
     @property
     def positions(self):
@@ -1092,7 +1093,9 @@ class _AnyLoop:
         """
         if self.filled:
             self._shift(self.filled)
-        if self.d:
+        if count == 1:
+            self._one_period()
+        elif self.d:
             self._plant_block(count)
             self._environment_block(count)
         else:
@@ -1177,6 +1180,56 @@ class _AnyLoop:
             _round_into(command, command.copy(), self.force_quantum)
         if self.force_limit is not None:
             np.clip(command, -self.force_limit, self.force_limit, out=command)
+
+    def _one_period(self):
+        """A block of one period on the buffers' rows, views made once: no slicing.
+
+        The operations of :meth:`_plant_block` and :meth:`_environment_block`
+        on one row (d = 0 or 1, or a recorded run: blocks of one period,
+        where making the views of a block took as long as the arithmetic).
+        """
+        if self.d:
+            self._plant_one()
+        X, S, F, tmp = self._x_rows, self._s_rows, self._f_rows, self._tmp[0]
+        ks, kf = self.keep_s, self.keep_f
+        sampled, force = S[ks], F[kf]
+        if self.quantum:
+            _round_into(sampled, X[self.keep_x - 1], self.quantum)
+        else:
+            np.copyto(sampled, X[self.keep_x - 1])
+        np.multiply(self.e0, sampled, out=force)
+        for k, coefficient in self.e:
+            np.add(force, np.multiply(coefficient, S[ks - 1 - k], out=tmp), out=force)
+        for k, coefficient in self.c:
+            np.subtract(force, np.multiply(coefficient, F[kf - 1 - k], out=tmp), out=force)
+        command = self._u_rows[self.keep_u]
+        if self.compensation is not None:
+            ku = self.keep_u
+            self._compensated(self.U[ku:ku + 1], self.F[kf:kf + 1], self.S[ks:ks + 1], 1)
+            self.pulse = None
+        else:
+            np.copyto(command, force)
+            if self.pulse is not None:
+                np.add(force, self.pulse, out=command)
+                self.pulse = None
+        if self.force_quantum is not None:
+            _round_into(command, command.copy(), self.force_quantum)
+        if self.force_limit is not None:
+            np.clip(command, -self.force_limit, self.force_limit, out=command)
+        if not self.d:
+            self._plant_one()
+
+    def _plant_one(self):
+        """:meth:`_plant_block` of one period on the rows."""
+        X, U, tmp = self._x_rows, self._u_rows, self._tmp[0]
+        kx, first_u = self.keep_x, self.keep_u - self.d
+        out = X[kx]
+        (k, first), *rest = self.minus_b
+        np.multiply(first, U[first_u - k], out=out)
+        for k, coefficient in rest:
+            np.add(out, np.multiply(coefficient, U[first_u - k], out=tmp), out=out)
+        for k, coefficient in self.a:
+            np.subtract(out, np.multiply(coefficient, X[kx - 1 - k], out=tmp), out=out)
 
     def _compensated(self, command, force, sampled, count):
         """``command = force - F_c sign(v_hat)``, ``v_hat`` filtered period by period."""
@@ -1273,6 +1326,15 @@ class _StateLoop(_AnyLoop):
                 bad = ~self.plant.finite()
                 if bad.any():
                     self._unfinite_at[r + 1] = bad
+
+    def _plant_one(self):
+        np.copyto(self._x_rows[self.keep_x],
+                  self.plant.step(self._u_rows[self.keep_u - self.d], -1.0))
+        self._unfinite_at = {}
+        if (self.k + 1) % self.check_every == 0:
+            bad = ~self.plant.finite()
+            if bad.any():
+                self._unfinite_at[1] = bad
 
     def _unfinite(self, filled):
         # The plant's past is its state, whose check the block kept.
