@@ -1095,12 +1095,9 @@ class _AnyLoop:
             self._shift(self.filled)
         if count == 1:
             self._one_period()
-        elif self.d:
+        else:                   # d >= 2 (count <= d): the plant reads no command of the block
             self._plant_block(count)
             self._environment_block(count)
-        else:
-            self._environment_block(1)
-            self._plant_block(1)
         self.filled = count
         start, every = self.k, self.check_every
         self.k += count
