@@ -1318,15 +1318,14 @@ class _StateLoop(_AnyLoop):
         first_u, every, start = self.keep_u - self.d, self.check_every, self.k
         self._unfinite_at = {}
         for r in range(count):
-            self.X[self.keep_x + r] = self.plant.step(self.U[first_u + r], -1.0)
+            self.plant.step(self.U[first_u + r], -1.0, out=self._x_rows[self.keep_x + r])
             if (start + r + 1) % every == 0:
                 bad = ~self.plant.finite()
                 if bad.any():
                     self._unfinite_at[r + 1] = bad
 
     def _plant_one(self):
-        np.copyto(self._x_rows[self.keep_x],
-                  self.plant.step(self._u_rows[self.keep_u - self.d], -1.0))
+        self.plant.step(self._u_rows[self.keep_u - self.d], -1.0, out=self._x_rows[self.keep_x])
         self._unfinite_at = {}
         if (self.k + 1) % self.check_every == 0:
             bad = ~self.plant.finite()
