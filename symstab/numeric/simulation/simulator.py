@@ -538,11 +538,12 @@ def _run(run, steps, amplitude, positions, progress, report, chunk, n_chunks, to
             while k < stop:
                 count = min(run.block, stop - k) if every > 1 else 1
                 run.advance(count)
-                block = run.positions
                 if count == 1:
+                    block = run.x[None]
                     np.maximum(high_q, block[0], out=high_q)
                     np.minimum(low_q, block[0], out=low_q)
                 else:
+                    block = run.positions
                     np.maximum(high_q, np.maximum.reduce(block, axis=0, out=extreme), out=high_q)
                     np.minimum(low_q, np.minimum.reduce(block, axis=0, out=extreme), out=low_q)
                 if total is not None:
@@ -624,6 +625,10 @@ _BUFFERS = 4
 #: The most periods a block runs (:meth:`_AnyLoop.advance`): past a few
 #: dozen, the Python work per block is a small part of a period's.
 _BLOCK_MAX = 32
+#: The most bytes of a block's rows of one signal: a block of many points
+#: that outgrows the processor's cache runs slower than one period at a
+#: time (whose NumPy calls cost little beside the arithmetic then).
+_BLOCK_BYTES = 256 * 1024
 
 
 def _spare_rows(block):
@@ -631,9 +636,10 @@ def _spare_rows(block):
     return max(4 * block, 16)
 
 
-def _block_rows(d):
-    """Periods a block of a loop with delay ``d`` runs: ``d``, from 1 to :data:`_BLOCK_MAX`."""
-    return max(1, min(d, _BLOCK_MAX))
+def _block_rows(d, n_points=1):
+    """Periods a block of ``n_points`` of a loop with delay ``d`` runs: ``d``, from 1 to
+    :data:`_BLOCK_MAX`, and rows of at most :data:`_BLOCK_BYTES`."""
+    return max(1, min(d, _BLOCK_MAX, _BLOCK_BYTES // (8 * n_points)))
 
 
 def simulate_loop(loop, *, steps=None, x0=1.0, v0=None, nonideal=None, record=False,
@@ -1024,7 +1030,7 @@ class _AnyLoop:
         n, m = a.shape[1], c.shape[1]
         self.n, self.m = n, m
         self.size = n_points
-        self.block = _block_rows(d)
+        self.block = _block_rows(d, n_points)
         rows = self.block
         # The past each buffer keeps before its block: x[k-n] .. x[k] (the
         # overflow check reads x[k-n]), u[k-d-n] .. u[k-1], the samples and
