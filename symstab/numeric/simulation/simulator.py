@@ -260,20 +260,25 @@ def _rounded(values, quantum):
     (A quotient that overflows is of a value whose precision the quantum
     is far below: its own multiple to the last bit.)
     """
+    out = np.empty_like(values)
     with np.errstate(over="ignore", invalid="ignore"):
-        return _rounded_quietly(values, quantum)
+        _round_into(out, values, quantum)
+    return out
 
 
-def _rounded_quietly(values, quantum):
-    """:func:`_rounded` for a caller that already ignores overflow and invalid values.
+def _round_into(out, values, quantum):
+    """``out[...] =`` :func:`_rounded` ``(values, quantum)``, for a caller that ignores overflow.
 
     The run's loop (:func:`_run`) sets NumPy's error state once for all its
     periods: entering it again in every period cost a fifth of a run's time.
     (``np.rint`` is ``np.round`` to no decimals, without its dispatch.)
     """
-    rounded = np.rint(values / quantum)
-    rounded *= quantum
-    return np.where(np.isfinite(rounded), rounded, values)
+    np.divide(values, quantum, out=out)
+    np.rint(out, out=out)
+    np.multiply(out, quantum, out=out)
+    finite = np.isfinite(out)
+    if not finite.all():
+        np.copyto(out, values, where=~finite)
 
 
 def check_friction_size(nonideal, spaces, name="nonideal.coulomb_friction", scale=1.0):
@@ -503,32 +508,48 @@ def _run(run, steps, amplitude, positions, progress, report, chunk, n_chunks, to
     ``progress`` hears the steps done over all chunks, scaled to ``steps``;
     ``total``, if given, accumulates ``|x|`` of every period after the start;
     ``swing``, if given, gets each quarter's half range of ``x`` (half of
-    its largest less its smallest value).
+    its largest less its smallest value).  The run advances in blocks
+    (:meth:`_AnyLoop.advance`) that end at each quarter's end (and at every
+    period when it records: a diverged point's positions are zero from the
+    period it is found in).
     """
     if positions is not None:
         positions[0] = run.x
     # The signed extremes of each quarter: the largest |x| and the swing (a
     # limit cycle keeps its swing; a mass held off zero keeps |x| with none).
-    high, low = np.full((4, run.x.size), -np.inf), np.full((4, run.x.size), np.inf)
-    magnitude = np.empty_like(run.x) if total is not None else None
-    # One error state for every period (run.step() counts on it); the
+    high, low = np.full((4, run.size), -np.inf), np.full((4, run.size), np.inf)
+    magnitude = np.empty(run.size) if total is not None else None
+    extreme = np.empty(run.size)
+    every = run.check_every
+    # One error state for every period (run.advance() counts on it); the
     # quarters' rows as views made once, not in every period.
     with np.errstate(over="ignore", invalid="ignore"):
         for q, (start, stop) in enumerate(_quarters(steps)):
             high_q, low_q = high[q], low[q]
-            for k in range(start, stop):
-                run.step()
-                x = run.x
-                np.maximum(high_q, x, out=high_q)
-                np.minimum(low_q, x, out=low_q)
+            k = start
+            while k < stop:
+                count = min(run.block, stop - k) if every > 1 else 1
+                run.advance(count)
+                if count == 1:
+                    block = run.x[None]
+                    np.maximum(high_q, block[0], out=high_q)
+                    np.minimum(low_q, block[0], out=low_q)
+                else:
+                    block = run.positions
+                    np.maximum(high_q, np.maximum.reduce(block, axis=0, out=extreme), out=high_q)
+                    np.minimum(low_q, np.minimum.reduce(block, axis=0, out=extreme), out=low_q)
                 if total is not None:
-                    np.abs(x, out=magnitude)
-                    total += magnitude
+                    for x in block:      # in order: the sum is the same to the last bit
+                        np.abs(x, out=magnitude)
+                        total += magnitude
                 if positions is not None:
-                    positions[k + 1] = x
-                if progress is not None and ((k + 1) % report == 0 or k + 1 == steps):
-                    progress((chunk * steps + k + 1) // n_chunks)
-    run.freeze_diverged()
+                    positions[k + 1:k + 1 + count] = block
+                if progress is not None:
+                    for done in range(k + 1, k + count + 1):
+                        if done % report == 0 or done == steps:
+                            progress((chunk * steps + done) // n_chunks)
+                k += count
+        run.freeze_diverged()
     with np.errstate(invalid="ignore"):
         np.maximum(high, -low, out=amplitude)
         if swing is not None:
@@ -586,9 +607,31 @@ class StabilityMap(PaperGridNames):
 # Any loop: its plant's pulse transfer function and its environment, stepped
 
 
-#: Floats held per point besides the delay line and the histories: the
-#: position, the sampled position, the force and about five temporaries.
+#: Floats held per point besides the delay line, the histories and the
+#: blocks: the velocity estimate, the extremes and a few more.
 _ANY_LOOP_FLOATS = 8
+#: Buffers of rows in time (:class:`_AnyLoop`): the positions, samples,
+#: forces and commands (each with its spare rows; two temporaries have a
+#: block's).
+_BUFFERS = 4
+#: The most periods a block runs (:meth:`_AnyLoop.advance`): past a few
+#: dozen, the Python work per block is a small part of a period's.
+_BLOCK_MAX = 32
+#: The most bytes of a block's rows of one signal: a block of many points
+#: that outgrows the processor's cache runs slower than one period at a
+#: time (whose NumPy calls cost little beside the arithmetic then).
+_BLOCK_BYTES = 256 * 1024
+
+
+def _spare_rows(block):
+    """Rows of a buffer after its past: a few blocks, or 16 periods (moved back when full)."""
+    return max(4 * block, 16)
+
+
+def _block_rows(d, n_points=1):
+    """Periods a block of ``n_points`` of a loop with delay ``d`` runs: ``d``, from 1 to
+    :data:`_BLOCK_MAX`, and rows of at most :data:`_BLOCK_BYTES`."""
+    return max(1, min(d, _BLOCK_MAX, _BLOCK_BYTES // (8 * n_points)))
 
 
 def simulate_loop(loop, *, steps=None, x0=1.0, v0=None, nonideal=None, record=False,
@@ -837,7 +880,8 @@ def run_loop(parts_of, n_points, *, d, steps, x0, v0, nonideal, record, progress
             linear_stable is None or np.shape(linear_stable) != (n_points,)):
         raise ValueError("a force quantum's verdict needs linear_stable, one bool a point")
     pulse_of = None if nonideal.force_resolution is None else pulse
-    point_bytes = 8 * (d + 1 + parts_floats + _ANY_LOOP_FLOATS)
+    point_bytes = 8 * (d + 1 + parts_floats + _ANY_LOOP_FLOATS + 2 * _block_rows(d)
+                       + _BUFFERS * _spare_rows(_block_rows(d)))
     if spaces is None:
         def make_run(part):
             return _AnyLoop(parts_of(part), d, x0, v0, nonideal, compensation=compensation)
@@ -932,63 +976,90 @@ def _verdict(amplitude, swing, diverged, positions, shape, steps, nonideal, resp
 def _terms(columns):
     """``[(k, coefficient), ...]`` of the nonzero columns of ``(N, k)`` coefficients.
 
-    A column equal at every point is a float (a scalar product is faster).
+    Each coefficient an array of the N points, even where they are equal:
+    NumPy multiplies by an array in half the time it takes to convert a
+    float (the product is the same double).
     """
-    out = []
-    for k in range(columns.shape[1]):
-        column = columns[:, k]
-        if np.all(column == 0):
-            continue
-        out.append((k, float(column[0]) if np.all(column == column[0]) else
-                    np.ascontiguousarray(column)))
-    return out
+    return [(k, np.ascontiguousarray(columns[:, k])) for k in range(columns.shape[1])
+            if not np.all(columns[:, k] == 0)]
 
 
 class _AnyLoop:
-    """A loop's samples for N points: :meth:`step` advances one period.
+    """A loop's samples for N points: :meth:`advance` runs a block of periods.
 
     ``a``, ``b``: the plant's ``P_d`` (monic, without its leading 1) and
     ``P_n`` (its coefficients of ``z**(n-1) .. 1``); ``c``, ``e``: the
     environment's ``Ve_d`` (monic, without its leading 1) and ``Ve_n``
-    (``z**m .. 1``).  Histories are lists, newest first, rotated (no copies);
-    the delay line is a ring of the commands themselves, and the plant's
-    input history keeps the commands ``f`` (its sum has ``-b``: ``u = -f``).
+    (``z**m .. 1``).  Each signal (the positions ``x``, the sampled
+    positions, the forces and the commands ``u``, whose plant input is
+    ``-u``) is a buffer of rows in time, oldest first: the past a period
+    reads, then the rows of the block being computed.
+
+    A block is up to ``d`` periods (:func:`_block_rows`): the plant
+    reads commands ``d`` periods old, all known when the block starts, so
+    its positions come first, then the block's samples, forces and
+    commands.  What is not a recursion (the rounding, the sums over past
+    commands and samples, the non-idealities of the command) runs on the
+    block's rows in one NumPy call each; the recursions (the sums over past
+    positions and forces) run period by period.  Every number is computed
+    by the same operations in the same order as one period at a time, so
+    the runs are the same to the last bit; the Python work per period is a
+    few calls (the paper's loop at d >= 8: four), not twenty.
     """
 
     def __init__(self, parts, d, x0, v0, nonideal, compensation=None, pulse=None):
         a, b, c, e = parts
         n_points = a.shape[0]
         # Each sum keeps its nonzero terms only (a backward difference's Ve_d
-        # is z**k: no force feedback at all), with a float coefficient where
-        # every point has the same (the plant of a plane of the environment).
+        # is z**k: no force feedback at all).
         self.a, self.c = _terms(a), _terms(c)
         self.minus_b = _terms(-b)
-        self.e0, self.e = e[:, 0], _terms(e[:, 1:])
-        self.e0 = float(self.e0[0]) if np.all(self.e0 == self.e0[0]) else self.e0
+        self.e0, self.e = np.ascontiguousarray(e[:, 0]), _terms(e[:, 1:])
         self.d = d
         self.quantum = nonideal.encoder_resolution
         self.force_limit = nonideal.force_limit
         self.force_quantum = nonideal.force_resolution
         n, m = a.shape[1], c.shape[1]
-        self.x = np.full(n_points, float(x0))
-        # y[k-1], y[k-2], ... before the start: x0 - k v0; no force applied yet.
-        self.y_past = [np.full(n_points, x0 - k * v0) for k in range(1, n + 1)]
-        self.f_past_plant = [np.zeros(n_points) for _ in range(n)]
-        sampled = self._sample(self.x)
+        self.n, self.m = n, m
+        self.size = n_points
+        self.block = _block_rows(d, n_points)
+        rows = self.block
+        # The past each buffer keeps before its block: x[k-n] .. x[k] (the
+        # overflow check reads x[k-n]), u[k-d-n] .. u[k-1], the samples and
+        # forces of the last m periods (one sample at least: the velocity
+        # estimate's).
+        self.past = (n + 1, d + n, max(m, 1), m)
+        # keep_x, ...: the row of each buffer where the block starts; the
+        # blocks follow one another in the spare rows, which are moved back
+        # to the start (the past only) when they run out.
+        self.keep_x, self.keep_u, self.keep_s, self.keep_f = self.past
+        self.spare = _spare_rows(rows)
+        self.X = np.empty((self.keep_x + self.spare, n_points))
+        self.U = np.zeros((self.keep_u + self.spare, n_points))
+        self.S = np.empty((self.keep_s + self.spare, n_points))
+        self.F = np.empty((self.keep_f + self.spare, n_points))
+        # x[k] = x0; x[k-i] = x0 - i v0 before the start; no force applied yet.
+        self.X[n] = float(x0)
+        for i in range(1, n + 1):
+            self.X[n - i] = x0 - i * v0
+        sampled = self._sample(self.X[n])
         # The environment at rest at the sampled x0: its force Ve(1) x_s
         # (none where Ve has a pole at z = 1, an integrator's).
         with np.errstate(all="ignore"):
             dc_gain = np.where(1 + c.sum(axis=1) != 0, e.sum(axis=1) / (1 + c.sum(axis=1)), 0.0)
-        self.s_past = [np.array(sampled) for _ in range(m)]
-        self.f_past = [dc_gain * sampled for _ in range(m)]
+        self.S[:self.keep_s] = sampled
+        self.F[:m] = dc_gain * sampled
         # Friction compensation: (F_c, filter pole) on the velocity
-        # estimate, the filtered backward difference of the sampled position
-        # (kept here: an environment without memory keeps no sample).
+        # estimate, the filtered backward difference of the sampled position.
         self.compensation = compensation
         self.v_hat = np.zeros(n_points)
-        self.sample_before = sampled
-        self.line = [np.zeros(n_points) for _ in range(d + 1)]
-        self._scratch = np.empty(n_points)
+        self._tmp = np.empty((rows, n_points))
+        self._more = np.empty((rows, n_points)) if compensation is not None else None
+        # The filter's pole at every point: an array multiplies faster than a float.
+        self._pole = None if compensation is None else np.full(n_points, compensation[1])
+        self._x_rows, self._f_rows = list(self.X), list(self.F)
+        self._u_rows, self._s_rows = list(self.U), list(self.S)
+        self.filled = 0          # rows of the last block, not yet shifted into the past
         self.k = 0
         self.diverged = np.zeros(n_points, dtype=bool)
         self.check_every = _CHECK_EVERY
@@ -999,71 +1070,221 @@ class _AnyLoop:
         q = self.quantum
         return x if not q else _rounded(x, q)
 
-    def _sum(self, out, terms, history, sign):
-        tmp = self._scratch
+    @property
+    def x(self):
+        """The newest position (a view of the buffer)."""
+        return self._x_rows[self.keep_x - 1 + self.filled]
+
+    @property
+    def positions(self):
+        """The positions the last block computed, ``(rows, N)`` (views of the buffer)."""
+        return self.X[self.keep_x:self.keep_x + self.filled]
+
+    def advance(self, count):
+        """``count`` periods, at most :attr:`block`; the caller ignores overflow and invalid values.
+
+        (:func:`_run`'s error state.)  The block's positions are then
+        :attr:`positions`.  The overflow check runs where one period at a
+        time would run it, after every :attr:`check_every` periods, on the
+        values of that period, still in the buffers: a point then frozen has
+        diverged whatever it does after (its verdict does not read them).
+        """
+        if self.filled:
+            self._shift(self.filled)
+        if count == 1:
+            self._one_period()
+        else:                   # d >= 2 (count <= d): the plant reads no command of the block
+            self._plant_block(count)
+            self._environment_block(count)
+        self.filled = count
+        start, every = self.k, self.check_every
+        self.k += count
+        checks = range(start - start % every + every, self.k + 1, every)
+        if checks and not self._calm(checks[0] - start, checks[-1] - start):
+            for done in checks:
+                self.freeze_diverged(done - start)
+
+    def _shift(self, count):
+        """The last block's rows join the past; back to the buffers' start when the rows run out."""
+        self.filled = 0
+        moved = self.keep_x + count - self.past[0]
+        if moved + self.block <= self.spare:
+            self.keep_x += count
+            self.keep_u += count
+            self.keep_s += count
+            self.keep_f += count
+            return
+        for buffer, keep in zip((self.X, self.U, self.S, self.F), self.past):
+            if keep:
+                buffer[:keep] = buffer[moved:moved + keep]
+        self.keep_x, self.keep_u, self.keep_s, self.keep_f = self.past
+
+    def _combine(self, out, terms, buffer, first_row, sign):
+        """``out (+/-)= c * buffer[first_row - k:][:rows]`` for each term ``(k, c)``, in order."""
+        rows = out.shape[0]
+        tmp = self._tmp[:rows]
         combine = np.add if sign > 0 else np.subtract
         for k, coefficient in terms:
-            combine(out, np.multiply(coefficient, history[k], out=tmp), out=out)
+            start = first_row - k
+            combine(out, np.multiply(coefficient, buffer[start:start + rows], out=tmp), out=out)
 
-    def step(self):
-        """One period; the caller ignores NumPy's overflow and invalid values (:func:`_run`)."""
-        # The environment's force from the sampled position of this instant.
-        # (self.x is a new array every period, so the histories may keep it.)
-        q = self.quantum
-        sampled = _rounded_quietly(self.x, q) if q else self.x
-        force = np.multiply(self.e0, sampled)
-        self._sum(force, self.e, self.s_past, 1)
-        self._sum(force, self.c, self.f_past, -1)
-        command = force
-        if self.pulse is not None:
-            command, self.pulse = force + self.pulse, None
+    def _recur(self, rows, terms, first_row, count):
+        """``rows[first_row + r] -= c * rows[first_row + r - 1 - k]`` per term, period by period."""
+        tmp = self._tmp[0]
+        for r in range(first_row, first_row + count):
+            row = rows[r]
+            for k, coefficient in terms:
+                np.subtract(row, np.multiply(coefficient, rows[r - 1 - k], out=tmp), out=row)
+
+    def _plant_block(self, count):
+        """The plant's next ``count`` samples: ``P_d(z) y = P_n(z) u``, ``u = -command``."""
+        kx = self.keep_x
+        out = self.X[kx:kx + count]
+        # u[j - d - k] of the periods j of the block, the newest term first.
+        first_u = self.keep_u - self.d
+        (k, first), *rest = self.minus_b
+        np.multiply(first, self.U[first_u - k:first_u - k + count], out=out)
+        self._combine(out, rest, self.U, first_u, 1)
+        self._recur(self._x_rows, self.a, kx, count)
+
+    def _environment_block(self, count):
+        """The samples, forces and commands of the block's periods (its positions known)."""
+        q, kx, ks, kf, ku = self.quantum, self.keep_x, self.keep_s, self.keep_f, self.keep_u
+        positions = self.X[kx - 1:kx - 1 + count]
+        sampled = self.S[ks:ks + count]
+        if q:
+            _round_into(sampled, positions, q)
+        else:
+            np.copyto(sampled, positions)
+        force = self.F[kf:kf + count]
+        np.multiply(self.e0, sampled, out=force)
+        self._combine(force, self.e, self.S, ks - 1, 1)
+        self._recur(self._f_rows, self.c, kf, count)
+        command = self.U[ku:ku + count]
         if self.compensation is not None:
-            # u = -f + F_c sign(v_hat): the command f less the compensation.
-            coulomb, pole = self.compensation
-            self.v_hat = pole * self.v_hat + (1 - pole) * (sampled - self.sample_before)
-            command = force - coulomb * np.sign(self.v_hat)
-            self.sample_before = sampled
-        if self.s_past:
-            self.s_past = [sampled] + self.s_past[:-1]
-            self.f_past = [force] + self.f_past[:-1]
+            self._compensated(command, force, sampled, count)
+            self.pulse = None
+        else:
+            np.copyto(command, force)
+            if self.pulse is not None:
+                command[0] = force[0] + self.pulse
+                self.pulse = None
         # The environment keeps its own force; the command sent is rounded
         # to the DAC's step and clipped to its range.
         if self.force_quantum is not None:
-            command = _rounded_quietly(command, self.force_quantum)
+            _round_into(command, command.copy(), self.force_quantum)
         if self.force_limit is not None:
-            command = np.clip(command, -self.force_limit, self.force_limit)
-        slot = self.k % (self.d + 1)
-        self.line[slot] = command
-        self.k += 1
-        # The command of d periods ago (d = 0: this one) drives the plant.
-        self.x = self._plant_step(self.line[(slot + 1) % (self.d + 1)] if self.d else command)
-        if self.k % self.check_every == 0:
-            self.freeze_diverged()
+            np.clip(command, -self.force_limit, self.force_limit, out=command)
 
-    def _plant_step(self, command):
-        """The plant's next sample under ``u = -command``: ``P_d(z) y = P_n(z) u``."""
-        self.y_past = y_past = [self.x] + self.y_past[:-1]
-        self.f_past_plant = f_past = [command] + self.f_past_plant[:-1]
+    def _one_period(self):
+        """A block of one period on the buffers' rows, views made once: no slicing.
+
+        The operations of :meth:`_plant_block` and :meth:`_environment_block`
+        on one row (d = 0 or 1, or a recorded run: blocks of one period,
+        where making the views of a block took as long as the arithmetic).
+        """
+        if self.d:
+            self._plant_one()
+        X, S, F, tmp = self._x_rows, self._s_rows, self._f_rows, self._tmp[0]
+        ks, kf = self.keep_s, self.keep_f
+        sampled, force = S[ks], F[kf]
+        if self.quantum:
+            _round_into(sampled, X[self.keep_x - 1], self.quantum)
+        else:
+            np.copyto(sampled, X[self.keep_x - 1])
+        np.multiply(self.e0, sampled, out=force)
+        for k, coefficient in self.e:
+            np.add(force, np.multiply(coefficient, S[ks - 1 - k], out=tmp), out=force)
+        for k, coefficient in self.c:
+            np.subtract(force, np.multiply(coefficient, F[kf - 1 - k], out=tmp), out=force)
+        command = self._u_rows[self.keep_u]
+        if self.compensation is not None:
+            ku = self.keep_u
+            self._compensated(self.U[ku:ku + 1], self.F[kf:kf + 1], self.S[ks:ks + 1], 1)
+            self.pulse = None
+        else:
+            np.copyto(command, force)
+            if self.pulse is not None:
+                np.add(force, self.pulse, out=command)
+                self.pulse = None
+        if self.force_quantum is not None:
+            _round_into(command, command.copy(), self.force_quantum)
+        if self.force_limit is not None:
+            np.clip(command, -self.force_limit, self.force_limit, out=command)
+        if not self.d:
+            self._plant_one()
+
+    def _plant_one(self):
+        """:meth:`_plant_block` of one period on the rows."""
+        X, U, tmp = self._x_rows, self._u_rows, self._tmp[0]
+        kx, first_u = self.keep_x, self.keep_u - self.d
+        out = X[kx]
         (k, first), *rest = self.minus_b
-        x = np.multiply(first, f_past[k])
-        if rest:
-            self._sum(x, rest, f_past, 1)
-        self._sum(x, self.a, y_past, -1)
-        return x
+        np.multiply(first, U[first_u - k], out=out)
+        for k, coefficient in rest:
+            np.add(out, np.multiply(coefficient, U[first_u - k], out=tmp), out=out)
+        for k, coefficient in self.a:
+            np.subtract(out, np.multiply(coefficient, X[kx - 1 - k], out=tmp), out=out)
 
-    def freeze_diverged(self):
-        """Mark the points whose state left [-1e100, 1e100] or is not finite; zero them."""
-        bad = ~(np.abs(self.x) < _OVERFLOW)
-        for history in (self.y_past, self.f_past_plant, self.f_past):
-            for value in history:
-                bad |= ~np.isfinite(value)
+    def _compensated(self, command, force, sampled, count):
+        """``command = force - F_c sign(v_hat)``, ``v_hat`` filtered period by period."""
+        coulomb, pole = self.compensation
+        change = self._tmp[:count]
+        np.subtract(sampled, self.S[self.keep_s - 1:self.keep_s - 1 + count], out=change)
+        np.multiply(1 - pole, change, out=change)
+        estimate, v_hat, pole = self._more[:count], self.v_hat, self._pole
+        for r in range(count):
+            np.add(np.multiply(pole, v_hat, out=estimate[r]), change[r], out=estimate[r])
+            v_hat = estimate[r]
+        self.v_hat = v_hat.copy()
+        np.sign(estimate, out=estimate)
+        np.subtract(force, np.multiply(coulomb, estimate, out=estimate), out=command)
+
+    def _unfinite(self, filled):
+        """Per point: a history the plant reads is not finite (x[k-n..k-1], u[k-d-n..k-d-1]).
+
+        ``k`` the period after the block's first ``filled`` rows.
+        """
+        newest_x, newest_u = self.keep_x - 1 + filled, self.keep_u - 1 + filled
+        n, d = self.n, self.d
+        bad = ~np.isfinite(self.X[newest_x - n:newest_x]).all(axis=0)
+        bad |= ~np.isfinite(self.U[newest_u - d - n + 1:newest_u - d + 1]).all(axis=0)
+        return bad
+
+    def _calm(self, first, last):
+        """True when no check after ``first`` to ``last`` rows of the block can find a point.
+
+        A quick test of the values those checks read (:meth:`freeze_diverged`
+        is exact): every position below the overflow, and the sums of the
+        commands and forces finite (a sum that overflows sends the checks to
+        the exact test).  The caller ignores overflow (:func:`_run`).
+        """
+        x, u, f = self.keep_x - 1, self.keep_u - 1 - self.d, self.keep_f - 1
+        return bool(np.maximum.reduce(np.abs(self.X[x + first - self.n:x + last + 1]), axis=None)
+                    < _OVERFLOW) and math.isfinite(
+            np.add.reduce(self.U[u + first - self.n + 1:u + last + 1], axis=None)
+            + np.add.reduce(self.F[f + first - self.m + 1:f + last + 1], axis=None))
+
+    def freeze_diverged(self, filled=None):
+        """Mark the points whose state left [-1e100, 1e100] or is not finite; zero them.
+
+        The state after the block's first ``filled`` rows (default: all).
+        """
+        filled = self.filled if filled is None else filled
+        if self._calm(filled, filled):
+            return
+        bad = ~(np.abs(self.X[self.keep_x - 1 + filled]) < _OVERFLOW) | self._unfinite(filled)
+        newest_f = self.keep_f - 1 + filled
+        bad |= ~np.isfinite(self.F[newest_f - self.m + 1:newest_f + 1]).all(axis=0)
         if bad.any():
             self.diverged |= bad
-            self.x[bad] = 0.0
-            for history in (self.line, self.y_past, self.f_past_plant, self.s_past, self.f_past):
-                for value in history:
-                    value[bad] = 0.0
+            for buffer in (self.X, self.U, self.S, self.F):
+                buffer[:, bad] = 0.0
             self.v_hat[bad] = 0.0
+            self._freeze_plant(bad)
+
+    def _freeze_plant(self, bad):
+        """Zero the plant's own state of the points ``bad`` (a state space has one)."""
 
 
 class _StateLoop(_AnyLoop):
@@ -1076,27 +1297,56 @@ class _StateLoop(_AnyLoop):
 
     def __init__(self, parts, d, x0, v0, nonideal, space, state=None, compensation=None):
         super().__init__(parts, d, x0, v0, nonideal, compensation=compensation)
-        self.y_past = self.f_past_plant = []      # the state space holds the plant's past
         coulomb = nonideal.coulomb_friction
         stiction = nonideal.stiction if nonideal.stiction is not None else coulomb
+        self._unfinite_at = {}
         if state is None:
-            self.plant = StatePlant.from_history(space, x0, v0, self.x.size, nonideal)
+            self.plant = StatePlant.from_history(space, x0, v0, self.size, nonideal)
         else:
-            start = np.zeros((space.phi.shape[0], self.x.size))
+            start = np.zeros((space.phi.shape[0], self.size))
             start[0], start[1] = state
-            self.plant = StatePlant(space, start, np.full(self.x.size, state[1] == 0),
+            self.plant = StatePlant(space, start, np.full(self.size, state[1] == 0),
                                     substeps=substeps_of(nonideal), coulomb=coulomb,
                                     stiction=stiction)
 
-    def _plant_step(self, command):
-        return self.plant.step(command, -1.0)
+    def _plant_block(self, count):
+        # The state space holds the plant's past: one period at a time; the
+        # state's check of each period that has one is kept for the block's
+        # checks (:meth:`_AnyLoop.advance`).
+        first_u, every, start = self.keep_u - self.d, self.check_every, self.k
+        self._unfinite_at = {}
+        for r in range(count):
+            self.plant.step(self.U[first_u + r], -1.0, out=self._x_rows[self.keep_x + r])
+            if (start + r + 1) % every == 0:
+                bad = ~self.plant.finite()
+                if bad.any():
+                    self._unfinite_at[r + 1] = bad
 
-    def freeze_diverged(self):
-        bad = ~(np.abs(self.x) < _OVERFLOW) | ~self.plant.finite()
-        if bad.any():
-            self.plant.freeze(bad)
-            self.x[bad] = np.inf        # marked diverged below, with everything zeroed
-        super().freeze_diverged()
+    def _plant_one(self):
+        self.plant.step(self._u_rows[self.keep_u - self.d], -1.0, out=self._x_rows[self.keep_x])
+        self._unfinite_at = {}
+        if (self.k + 1) % self.check_every == 0:
+            bad = ~self.plant.finite()
+            if bad.any():
+                self._unfinite_at[1] = bad
+
+    def _unfinite(self, filled):
+        # The plant's past is its state, whose check the block kept.
+        return self._unfinite_at.get(filled, np.zeros(self.size, dtype=bool))
+
+    def _calm(self, first, last):
+        return not self._unfinite_at and super()._calm(first, last)
+
+    def freeze_diverged(self, filled=None):
+        if filled is None:
+            # The run's end: the plant's state now.
+            bad = ~self.plant.finite()
+            if bad.any():
+                self._unfinite_at[self.filled] = bad | self._unfinite(self.filled)
+        super().freeze_diverged(filled)
+
+    def _freeze_plant(self, bad):
+        self.plant.freeze(bad)
 
 
 def loop_stability_map(loop, x_values, y_values, *, x=None, y=None, steps=None, x0=1.0, v0=None,

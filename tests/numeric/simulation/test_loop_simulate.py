@@ -536,3 +536,43 @@ def test_a_wrong_compensation_is_refused_by_name(compensation, error, name):
             compensation = eval(compensation, {"compensation": FrictionCompensation})
         simulate_loop(loop, steps=100, compensation=compensation)
     assert_message_names(excinfo, name)
+
+
+def _fields(run):
+    return [np.asarray(getattr(run, name)).tobytes() for name in
+            ("amplitude", "diverged", "stable", "floor", "limit_cycle")]
+
+
+@pytest.mark.parametrize("d", [3, 40])
+def test_blocks_of_periods_change_no_bit_of_a_run(monkeypatch, d):
+    """Blocks of up to d periods (the vectorised engine) = one period at a time, bit for bit.
+
+    Oracle: the same runs with blocks of one period (``_BLOCK_MAX = 1``),
+    the engine's other path; diverging, quantized, saturated, compensated
+    and force-quantized runs, the overflow checks inside the blocks.
+    """
+    from symstab.numeric.simulation import simulator
+    from symstab.numeric.simulation.simulator import FrictionCompensation
+
+    lowpass = symstab.load_loop(LOOPS / "lowpass_velocity.toml")
+    paper = symstab.load_loop(LOOPS / "paper.toml")
+    B = np.linspace(-0.2, 0.4, 7)[:, None]
+    quantum = simulator.PAPER_ENCODER_RESOLUTION
+
+    def runs():
+        return [lowpass.simulate(B=B, K=np.linspace(-500, 5e4, 9), f_c=300.0, d=d, steps=3001),
+                lowpass.simulate(B=B, K=np.linspace(0, 400, 9), f_c=100.0, d=d, steps=1203,
+                                 x0=0.01, nonideal=Nonidealities(encoder_resolution=quantum,
+                                                                 force_limit=0.05)),
+                paper.simulate(M=0.0, K=np.linspace(0, 60, 9), B=0.05, d=d, steps=805, x0=0.01,
+                               compensation=FrictionCompensation(1e-3, 0.5),
+                               nonideal=Nonidealities(coulomb_friction=1e-3,
+                                                      encoder_resolution=quantum)),
+                paper.simulate(M=0.0, K=np.linspace(-10, 900, 9), B=0.05, d=d, steps=805,
+                               nonideal=Nonidealities(force_resolution=1e-4))]
+
+    blocks = runs()
+    assert any(run.diverged.any() for run in blocks) and any(run.stable.any() for run in blocks)
+    monkeypatch.setattr(simulator, "_BLOCK_MAX", 1)
+    for blocked, one in zip(blocks, runs()):
+        assert _fields(blocked) == _fields(one)
