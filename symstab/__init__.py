@@ -95,6 +95,12 @@ __all__ = [
 
 
 def __getattr__(name):
+    if name == "__version__":
+        # From the installed package's metadata (one file read, on first use).
+        from ._project import version
+
+        globals()[name] = version()
+        return globals()[name]
     if name == "PAPER_LOOP":
         # Derived on first use, and again each time it is asked for (cached
         # by paper_loop()): about a second the first time.
@@ -111,4 +117,4 @@ def __getattr__(name):
 
 
 def __dir__():
-    return sorted(set(globals()) | set(__all__))
+    return sorted(set(globals()) | set(__all__) | {"__version__"})

@@ -18,11 +18,10 @@ interrupted run leaves none behind.
 
 import argparse
 import importlib
-import importlib.metadata
 import sys
 import warnings
 
-from .._project import project_root
+from .._project import package_version, project_root
 from .._signals import (Terminated, exit_status, import_outside_swallowers,
                         interruption_behind, raising)
 
@@ -42,30 +41,6 @@ def command_modules():
     command modules bring in SymPy and NumPy.
     """
     return tuple(importlib.import_module(f"{__package__}.{name}") for name in COMMAND_NAMES)
-
-
-def package_version():
-    """The installed version of symstab (package metadata), else the checkout's, else "unknown".
-
-    A checkout run without ``pip install`` has no metadata: its
-    ``pyproject.toml`` gives the version, marked "not installed".
-    """
-    try:
-        return importlib.metadata.version("symstab")
-    except importlib.metadata.PackageNotFoundError:
-        pass
-    root = project_root()
-    if root is not None:
-        try:
-            import tomllib
-        except ImportError:   # Python 3.10: no TOML reader in the standard library
-            tomllib = None
-        if tomllib is not None:
-            with open(root / "pyproject.toml", "rb") as fh:
-                version = tomllib.load(fh).get("project", {}).get("version")
-            if version:
-                return f"{version} (source checkout {root}, not installed)"
-    return "unknown (not installed: no package metadata)"
 
 
 class _Parser(argparse.ArgumentParser):

@@ -65,8 +65,11 @@ def test_version_without_metadata_falls_back_to_the_checkout(monkeypatch, capsys
     assert status == 0
     assert out.startswith(f"symstab {version} (source checkout") and "not installed" in out
     # An installed copy without metadata and without a checkout says so.
-    monkeypatch.setattr(cli, "project_root", lambda *args: None)
+    from symstab import _project
+
+    monkeypatch.setattr(_project, "project_root", lambda *args: None)
     assert cli.package_version().startswith("unknown")
+    assert _project.version() == "0+unknown"
 
 
 def test_no_command_prints_the_usage_and_every_command(capsys):
