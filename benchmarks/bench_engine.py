@@ -44,8 +44,8 @@ import numpy as np
 
 import symstab
 from symstab.numeric.engine import roots
-from symstab.numeric.paper import stability
 from symstab.numeric.engine.polynomial import DelayedPolynomial
+from symstab.numeric.paper import stability
 
 from _timing import fmt, timed_runs
 

@@ -180,7 +180,7 @@ def bench_grid(args, oracles):
             print(f"; max |radius - spectral_radius| = {np.max(np.abs(r - radius.ravel())):.1e}"
                   if label == "numpy.roots" else "")
     worst = min(min(c, h) for _, c, h in headline)
-    print(f"   ratio python-control / classify per point: "
+    print("   ratio python-control / classify per point: "
           + "; ".join(f"gamma {g:g}: {c:,.0f}x (c2d in), {h:,.0f}x (Gd once)" for g, c, h in headline)
           + f" -> target >= {TARGET_RATIO:,.0f}x {'met' if worst >= TARGET_RATIO else 'NOT met'} "
           f"(worst {worst:,.0f}x)")

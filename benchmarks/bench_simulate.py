@@ -33,8 +33,8 @@ import scipy.signal
 
 import symstab
 from symstab.numeric.paper.simulate import simulate
-from symstab.numeric.simulation.simulator import Nonidealities
 from symstab.numeric.paper.stability import loop_coefficients
+from symstab.numeric.simulation.simulator import Nonidealities
 
 
 def _companion(coeffs):

@@ -7,7 +7,7 @@ import sympy as sp
 from symstab.proof.identity import check_identity
 
 from .outcome import Outcome
-from .printed import C, PRINTED_COEFFICIENTS, printed, section_of
+from .printed import PRINTED_COEFFICIENTS, C, printed, section_of
 
 __all__ = ["where", "place", "with_printed_coefficients", "prove", "compare",
            "show", "Memo"]

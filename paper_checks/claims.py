@@ -12,11 +12,11 @@ where they are known (alpha = 0 on the z = 1 line).  The device is
 
 import decimal
 
-from symstab.symbolic import model
-from symstab.numeric.paper.reference import alpha_max_on_arc, arc_end, boundary_point
-from symstab.symbolic.small_theta import small_theta_limits
-from symstab.numeric.paper.region import limits
 from symstab.numeric.paper.device import PAPER_DEVICE
+from symstab.numeric.paper.reference import alpha_max_on_arc, arc_end, boundary_point
+from symstab.numeric.paper.region import limits
+from symstab.symbolic import model
+from symstab.symbolic.small_theta import small_theta_limits
 from symstab.symbolic.theta_max import theta_max
 
 from . import regions

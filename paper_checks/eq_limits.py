@@ -11,11 +11,11 @@
 import mpmath
 import sympy as sp
 
+from symstab.numeric.paper.device import PAPER_DEVICE
+from symstab.numeric.paper.reference import boundary_point
 from symstab.symbolic import model
 from symstab.symbolic.boundary import boundary, coefficients
-from symstab.numeric.paper.reference import boundary_point
 from symstab.symbolic.small_theta import small_theta_limits, taylor_coefficients
-from symstab.numeric.paper.device import PAPER_DEVICE
 
 from ._common import compare, show, where, with_printed_coefficients
 from .audit import Outcome, check

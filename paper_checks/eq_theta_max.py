@@ -10,10 +10,10 @@
 import mpmath
 import sympy as sp
 
+from symstab.numeric.paper.device import PAPER_DEVICE
 from symstab.symbolic import model
 from symstab.symbolic.boundary import boundary, coefficients
 from symstab.symbolic.theta_max import closed_form_d0, newton_form_gamma0, theta_max
-from symstab.numeric.paper.device import PAPER_DEVICE
 
 from ._common import Memo, compare, prove, show, where, with_printed_coefficients
 from .audit import Outcome, check

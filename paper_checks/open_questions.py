@@ -31,9 +31,9 @@ import dataclasses
 
 import numpy as np
 
+from symstab.numeric.paper.device import PAPER_DEVICE
 from symstab.numeric.paper.region import StabilityRegion, boundary_curve
 from symstab.numeric.paper.stability import loop_coefficients, unstable_root_counts
-from symstab.numeric.paper.device import PAPER_DEVICE
 from symstab.proof import necessity
 from symstab.proof.identity import check_identity
 from symstab.symbolic import model

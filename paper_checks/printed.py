@@ -42,7 +42,21 @@ import dataclasses
 import sympy as sp
 
 from symstab.symbolic.model import (
-    B_w, Gamma, K_w, M_w, T, alpha, b, beta, d, delta, gamma, m, s, theta, z,
+    B_w,
+    Gamma,
+    K_w,
+    M_w,
+    T,
+    alpha,
+    b,
+    beta,
+    d,
+    delta,
+    gamma,
+    m,
+    s,
+    theta,
+    z,
 )
 
 __all__ = [

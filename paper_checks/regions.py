@@ -43,14 +43,14 @@ import mpmath
 import numpy as np
 import sympy as sp
 
-from symstab.symbolic import model
 from symstab._validate import check_count, check_loop, check_real
-from symstab.symbolic.small_theta import small_theta_limits
 from symstab.numeric.paper.curves import arc_end_angle, minus_one_line
+from symstab.numeric.paper.device import PAPER_DEVICE
 from symstab.numeric.paper.region import StabilityRegion, boundary_curve
 from symstab.numeric.paper.stability import unstable_root_counts
+from symstab.symbolic import model
 from symstab.symbolic.loop import characteristic_polynomial
-from symstab.numeric.paper.device import PAPER_DEVICE
+from symstab.symbolic.small_theta import small_theta_limits
 
 __all__ = [
     "InitialDirection", "initial_direction", "side",

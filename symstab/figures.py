@@ -29,13 +29,17 @@ import numpy as np
 
 from . import drawing
 from .numeric.paper.curves import arc_end_angle
-from .numeric.paper.region import arc_polylines
-from .numeric.paper.region import boundary_curve
+from .numeric.paper.device import PAPER_DEVICE
 from .numeric.paper.paper_loop import paper_passive_region
-from .numeric.paper.region import StabilityRegion, limits, vanishing_gamma
+from .numeric.paper.region import (
+    StabilityRegion,
+    arc_polylines,
+    boundary_curve,
+    limits,
+    vanishing_gamma,
+)
 from .numeric.paper.simulate import stability_map
 from .numeric.simulation.simulator import PAPER_ENCODER_RESOLUTION, Nonidealities
-from .numeric.paper.device import PAPER_DEVICE
 
 __all__ = ["FigureResult", "FIGURES", "make_figures"]
 
@@ -64,9 +68,10 @@ class FigureResult:
 
 def fig3():
     """theta_max versus gamma, d = 0 (eq. (8))."""
-    from .symbolic.theta_max import closed_form_d0
-    from .symbolic import model
     import sympy as sp
+
+    from .symbolic import model
+    from .symbolic.theta_max import closed_form_d0
 
     gammas = np.linspace(-1.0, 2.0, 121)
     exact = np.array([arc_end_angle(gamma=g, d=0, delta=DELTA) for g in gammas])
@@ -110,8 +115,10 @@ def fig4():
 def fig5():
     """The eq. (14) boundary (d = 0, gamma = 0), printed form against the derivation."""
     import sympy as sp
-    from .symbolic import model
+
     from paper_checks.printed import printed
+
+    from .symbolic import model
 
     curve = boundary_curve(gamma=0.0, d=0, delta=DELTA, n=400, segments=False)
     args = (model.theta, model.delta, model.Gamma)
@@ -588,8 +595,8 @@ def make_figures(out_dir, progress=None):
     ``progress(name, seconds)`` is called after each figure; True prints
     ``name: seconds`` on stderr (:func:`symstab._validate.check_progress`).
     """
-    from ._validate import check_progress
     from ._io import write_bytes
+    from ._validate import check_progress
 
     progress = check_progress(progress, lambda: lambda name, seconds: print(
         f"{name}: {seconds:.1f} s", file=sys.stderr, flush=True))

@@ -51,9 +51,9 @@ def _figure_task(name):
 
 
 def _derive(out, log):
+    from ._project import project_root
     from .codegen import generator as codegen
     from .proof import derive
-    from ._project import project_root
 
     files = derive.render(derive.derivation_steps())
     code = codegen.generated_files()

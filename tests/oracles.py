@@ -39,7 +39,6 @@ from symstab.symbolic import model
 from symstab.symbolic.boundary import boundary
 from symstab.symbolic.loop import characteristic_polynomial
 
-
 # --------------------------------------------------------------------------
 # First-principles oracle: the paper's eqs. (1), (2), (4)
 # --------------------------------------------------------------------------

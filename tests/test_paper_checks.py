@@ -463,6 +463,7 @@ def _arc_top_first_principles(gamma, d, delta, theta_end):
     """(alpha, beta) at the top of the arc: eq. (2) by Cramer's rule at 40 digits
     (tests/oracles.py), its alpha maximised by a scan and Newton on d alpha / d theta."""
     import mpmath
+
     from oracles import first_principles_boundary_point
 
     with mpmath.workdps(40):
@@ -533,9 +534,10 @@ def test_open_question_counts_match_first_principles(gamma, d):
     import mpmath
     import numpy as np
 
-    from oracles import first_principles_boundary_point, first_principles_chi_float
     from paper_checks import open_questions
     from symstab.numeric.paper.device import PAPER_DEVICE
+
+    from oracles import first_principles_boundary_point, first_principles_chi_float
 
     delta = PAPER_DEVICE.delta
     counted = open_questions.curve_counts(gamma, d)
@@ -674,8 +676,10 @@ def test_an_empty_window_is_said_in_words_and_is_empty_for_python_control(audit_
     import re
 
     import numpy as np
-    from oracles import python_control_closed_loop
+
     from symstab.numeric.paper.device import PAPER_DEVICE as dev
+
+    from oracles import python_control_closed_loop
 
     _, report, _ = audit_run
     assert "none N" not in report.read_text(encoding="utf-8")

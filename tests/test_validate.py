@@ -10,7 +10,6 @@ from symstab._validate import check_delay, check_delay_samples, check_real
 
 from conftest import assert_message_names
 
-
 # check_real ---------------------------------------------------------------
 
 @pytest.mark.parametrize("value, expected", [

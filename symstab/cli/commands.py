@@ -22,8 +22,13 @@ import sys
 import warnings
 
 from .._project import package_version, project_root
-from .._signals import (Terminated, exit_status, import_outside_swallowers,
-                        interruption_behind, raising)
+from .._signals import (
+    Terminated,
+    exit_status,
+    import_outside_swallowers,
+    interruption_behind,
+    raising,
+)
 
 __all__ = ["main", "build_parser", "package_version", "project_root", "COMMAND_NAMES",
            "command_modules"]

@@ -89,9 +89,8 @@ def _derive_loop(args):
     current folder), and a file of the user's in ``--out`` under a name the
     derivation would write (never overwritten).
     """
-    from ..proof import derive
-    from ..proof import loop_derive
     from ..numeric.loop.files import load_loop
+    from ..proof import derive, loop_derive
 
     start = time.perf_counter()
     if args.codegen_out is not None:

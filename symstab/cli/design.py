@@ -19,8 +19,17 @@ import math
 import sys
 
 from .loop_limits import limits_notes, named, plane_table, stable_intervals_at
-from .loop_options import (EXAMPLE, add_loop_options, check_box, converted_range, paper_setup,
-                           range_text, resolve_loop, split_unit, uses_loop)
+from .loop_options import (
+    EXAMPLE,
+    add_loop_options,
+    check_box,
+    converted_range,
+    paper_setup,
+    range_text,
+    resolve_loop,
+    split_unit,
+    uses_loop,
+)
 from .options import add_command, add_model_options, resolve
 from .output import check_outputs, emit, write_output
 from .simulation import add_nonideal_options, loop_nonideal_text, resolve_nonideal

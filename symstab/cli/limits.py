@@ -15,9 +15,14 @@ import math
 import sys
 import textwrap
 
-
-from .loop_limits import LIMITS, limits_notes, limits_table, named, passive_notes, \
-    stable_intervals_at
+from .loop_limits import (
+    LIMITS,
+    limits_notes,
+    limits_table,
+    named,
+    passive_notes,
+    stable_intervals_at,
+)
 from .loop_options import add_loop_options, resolve_setup, uncertain_box
 from .options import add_command, add_model_options
 from .output import emit
@@ -111,8 +116,8 @@ _MAX_STRIPS = 100_000
 
 def _robust(args, setup, at):
     """``limits --loop --uncertain``: the robust set's limits, certified; its PNG with --png."""
-    from ..drawing import png_of, require_matplotlib, robust_figure
     from .._progress import progress_printer
+    from ..drawing import png_of, require_matplotlib, robust_figure
     from .output import check_files, write_output
 
     strips = 64 if args.strips is None else args.strips

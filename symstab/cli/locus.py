@@ -17,11 +17,24 @@ import sys
 
 import numpy as np
 
-from .loop_options import (DEVICE_OPTIONS, EXAMPLE, LINEAR_WITH_LOOP, POINT_OPTIONS, LoopSetup,
-                           add_delay, check_names, convert_sets, load_loop_file, loop_echo,
-                           loop_values, paper_setup, parse_number, split_unit)
-from .options import add_command, add_model_options, resolve
 from ..drawing import locus_figure, png_of
+from .loop_options import (
+    DEVICE_OPTIONS,
+    EXAMPLE,
+    LINEAR_WITH_LOOP,
+    POINT_OPTIONS,
+    LoopSetup,
+    add_delay,
+    check_names,
+    convert_sets,
+    load_loop_file,
+    loop_echo,
+    loop_values,
+    paper_setup,
+    parse_number,
+    split_unit,
+)
+from .options import add_command, add_model_options, resolve
 from .output import check_outputs, emit, interval_texts, write_output
 from .units import tex_unit
 

@@ -18,14 +18,26 @@ import textwrap
 import numpy as np
 
 from .._resources import CHUNK_BYTES, check_memory, chunk_slices
-from .loop_options import (add_loop_options, resolve_loop, uncertain_box,
-                           uses_loop, value_text)
+from ..drawing import (
+    LIMIT_CYCLE_COLOR,
+    LIMIT_CYCLE_LABEL,
+    loop_map_figure,
+    png_or_none,
+    probability_map_figure,
+    simulated_map_figure,
+)
+from .loop_options import add_loop_options, resolve_loop, uncertain_box, uses_loop, value_text
 from .options import add_command, add_model_options, resolve, stiffness_and_damping
-from ..drawing import (LIMIT_CYCLE_COLOR, LIMIT_CYCLE_LABEL, loop_map_figure, png_or_none,
-                       probability_map_figure, simulated_map_figure)
 from .output import check_files, write_output
-from .simulation import (add_nonideal_options, check_loop_friction, loop_nonideal_text,
-                         nonideal_text, resolve_nonideal, simulated_theory, with_option_names)
+from .simulation import (
+    add_nonideal_options,
+    check_loop_friction,
+    loop_nonideal_text,
+    nonideal_text,
+    resolve_nonideal,
+    simulated_theory,
+    with_option_names,
+)
 from .units import tex_unit
 
 __all__ = ["register", "run", "MAX_GRID", "map_outputs", "LOOP_MAP_HEADLINE",
@@ -219,8 +231,8 @@ class _PaperMap:
 
     def simulate(self):
         """The paper's loop simulated at every cell (the paper's adapter on the loop simulator)."""
-        from ..numeric.paper.simulate import stability_map
         from .._progress import progress_printer
+        from ..numeric.paper.simulate import stability_map
 
         setup = self.setup
         return stability_map(alpha=self.alpha, beta=self.beta, gamma=setup.gamma, d=setup.d,
@@ -490,8 +502,8 @@ def _loop_npz(setup, xs, ys, values, **arrays):
 
 def _probability(args, setup, xs, ys, out, png_path):
     """``map --loop --uncertain``: the probability of stability of every cell, its files and PNG."""
-    from ..numeric.analysis.probability import MAX_SAMPLES, draw_values
     from .._progress import progress_printer
+    from ..numeric.analysis.probability import MAX_SAMPLES, draw_values
 
     if args.simulate:
         raise ValueError("--uncertain maps the probability of stability by root counts; "

@@ -24,8 +24,14 @@ from .._resources import check_memory
 from .loop_options import add_loop_options, resolve_loop, uses_loop, value_text
 from .options import add_command, add_model_options, parse_list, resolve, stiffness_and_damping
 from .output import check_files, write_output
-from .simulation import (add_nonideal_options, check_loop_friction, loop_nonideal_text,
-                         resolve_nonideal, simulated_theory, with_option_names)
+from .simulation import (
+    add_nonideal_options,
+    check_loop_friction,
+    loop_nonideal_text,
+    resolve_nonideal,
+    simulated_theory,
+    with_option_names,
+)
 
 __all__ = ["register", "run"]
 
@@ -88,8 +94,8 @@ def run(args):
 
 def _paper_plan(args):
     """The paper's loop at one point of the paper's options: the loop simulated, its theory."""
-    from ..numeric.paper.simulate import simulate
     from .._progress import progress_printer
+    from ..numeric.paper.simulate import simulate
     from ..numeric.simulation.simulator import check_steps
 
     setup = resolve(args)

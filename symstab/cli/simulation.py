@@ -68,8 +68,13 @@ def resolve_nonideal(args, setup, loop=None):
     ``setup`` is the paper's device options, or None for a loop file,
     ``loop``, whose simulation the options are checked against.
     """
-    from ..numeric.simulation.simulator import (PAPER_ENCODER_RESOLUTION, Nonidealities,
-        check_loop_nonideal, check_x0, default_x0)
+    from ..numeric.simulation.simulator import (
+        PAPER_ENCODER_RESOLUTION,
+        Nonidealities,
+        check_loop_nonideal,
+        check_x0,
+        default_x0,
+    )
 
     # A command with add_nonideal_options(loop_only=True) has not the paper's options.
     option = {name: getattr(args, name, None) for name in (

@@ -104,8 +104,8 @@ def run(args):
                              f"got {args.connect_timeout:g}")
     plan = read_spec(args.spec)
     client_of = None if args.serial else _client_factory(args)
-    from .sweep_store import ChunkStore, run_sweep, sweep_key
     from .._progress import progress_printer
+    from .sweep_store import ChunkStore, run_sweep, sweep_key
 
     rows, chunk = plan["rows"], plan["chunk"]
     n_chunks = math.ceil(len(rows) / chunk)

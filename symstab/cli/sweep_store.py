@@ -247,8 +247,8 @@ def run_sweep(loop, question, names, rows, *, chunk, store, client=None, progres
         The answers and reasons of every row, in the rows' order, and the
         number of chunks loaded from the store rather than evaluated.
     """
-    from .._validate import check_progress
     from .._progress import progress_printer
+    from .._validate import check_progress
 
     slices = [slice(i, min(i + chunk, len(rows))) for i in range(0, len(rows), chunk)]
     progress = check_progress(progress, lambda: progress_printer("chunks", len(slices)))

@@ -31,10 +31,16 @@ import tempfile
 import sympy as sp
 
 from ..symbolic import model
-from .generator import (CKernelPrinter, Kernel, NumPyKernelPrinter, c_function,
-                        python_function, comment_text)
 from ..symbolic.derivation_cache import CACHE_ENV, cache_dir
 from ..symbolic.loop_assembly import is_affine
+from .generator import (
+    CKernelPrinter,
+    Kernel,
+    NumPyKernelPrinter,
+    c_function,
+    comment_text,
+    python_function,
+)
 
 __all__ = ["CACHE_ENV", "cache_dir", "header", "numpy_source", "c_source", "load_numpy_kernels",
            "environment_kernels"]

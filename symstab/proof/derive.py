@@ -16,16 +16,16 @@ import sympy as sp
 
 from .._io import write_bytes
 from ..codegen import float_forms as kernel_forms
-from . import loop_derive, necessity
-from .steps import Step, render  # noqa: F401  (part of this module's API)
 from ..symbolic import model
-from ..symbolic.boundary import boundary, coefficients, beta_relations
+from ..symbolic.boundary import beta_relations, boundary, coefficients
 from ..symbolic.discretize import dimensionless_pulse_transfer_function, pulse_transfer_function
-from .identity import check_identity
-from ..symbolic.small_theta import small_theta_limits
 from ..symbolic.loop import characteristic_polynomial
+from ..symbolic.small_theta import small_theta_limits
 from ..symbolic.theta_max import closed_form_d0, newton_form_gamma0
 from ..symbolic.unit_circle import unit_circle_split
+from . import loop_derive, necessity
+from .identity import check_identity
+from .steps import Step, render  # noqa: F401  (part of this module's API)
 
 __all__ = ["Step", "derivation_steps", "render", "write", "write_bytes", "check", "proofs", "OWNED"]
 

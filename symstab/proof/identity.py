@@ -44,8 +44,14 @@ from sympy.polys.polyerrors import CoercionFailed
 from sympy.polys.rings import ring
 
 from ..symbolic import model
-from ..symbolic.forms import (E, UnsupportedExpression, conjugate_on_circle, exponential_form,
-                              trig_form, w)
+from ..symbolic.forms import (
+    E,
+    UnsupportedExpression,
+    conjugate_on_circle,
+    exponential_form,
+    trig_form,
+    w,
+)
 
 __all__ = [
     "IdentityResult", "check_identity", "assert_identity", "numeric_difference",

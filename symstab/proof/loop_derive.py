@@ -19,9 +19,9 @@ import re
 
 import sympy as sp
 
-from ..symbolic import model
 from ..codegen.generator import RealPart, c_comment, c_signature, comment_text
 from ..codegen.loop_kernels import c_source, header, kernel, numpy_source
+from ..symbolic import model
 
 __all__ = ["COMMAND", "OWNED", "MARKER", "PAPER_PLANT", "PAPER_ENVIRONMENT", "delay_parts", "step_source", "step_orders",
            "plant_kernel", "c_name",
@@ -560,9 +560,9 @@ def paper_loop_proofs():
 def _against_the_paper(plant, environment):
     """:func:`paper_loop_proofs` for the loop of ``plant`` and ``environment`` (parameters
     ``m, b`` and ``K, B, M``): the tests give another loop, whose statements must fail."""
-    from ..symbolic.loop_assembly import LoopModel
     from ..symbolic.boundary import boundary
     from ..symbolic.loop import characteristic_polynomial
+    from ..symbolic.loop_assembly import LoopModel
 
     loop = LoopModel(plant, environment)
     chi = loop.characteristic_polynomial()

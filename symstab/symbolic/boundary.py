@@ -35,8 +35,8 @@ import functools
 import sympy as sp
 
 from . import model
-from .forms import conjugate_on_circle, exponential_form, trig_form, w
 from .discretize import dimensionless_pulse_transfer_function
+from .forms import conjugate_on_circle, exponential_form, trig_form, w
 from .unit_circle import unit_circle_split
 
 __all__ = [

@@ -220,9 +220,25 @@ def _interval_expm1(M, n):
     the robust regions enclose thousands of sub-boxes.
     """
     from mpmath import iv
-    from mpmath.libmp import (finf, fhalf, fone, from_float, from_int, fzero, mpf_gt, mpf_lt,
-                              mpf_neg, mpf_shift, mpi_abs, mpi_add, mpi_div, mpi_mul, mpi_pow,
-                              mpi_sub, to_float)
+    from mpmath.libmp import (
+        fhalf,
+        finf,
+        fone,
+        from_float,
+        from_int,
+        fzero,
+        mpf_gt,
+        mpf_lt,
+        mpf_neg,
+        mpf_shift,
+        mpi_abs,
+        mpi_add,
+        mpi_div,
+        mpi_mul,
+        mpi_pow,
+        mpi_sub,
+        to_float,
+    )
     from mpmath.libmp.libmpi import mpi_zero
 
     prec = iv.prec

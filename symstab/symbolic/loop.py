@@ -20,8 +20,8 @@ import mpmath
 import numpy as np
 import sympy as sp
 
-from . import model
 from .._validate import check_delay, check_real
+from . import model
 from .discretize import dimensionless_pulse_transfer_function
 
 __all__ = ["LoopPolynomial", "characteristic_polynomial", "dimensionless_environment"]

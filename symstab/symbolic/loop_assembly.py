@@ -30,9 +30,9 @@ import mpmath
 import numpy as np
 import sympy as sp
 
-from . import model
 from .._memo import method_cache
 from .._validate import check_delay
+from . import model
 from .derivation_cache import DerivationCache
 from .discretize import numeric_zoh, written_poles, zoh_pulse_transfer_function
 

@@ -35,8 +35,8 @@ import mpmath
 import numpy as np
 import sympy as sp
 
-from . import model
 from .._validate import check_loop
+from . import model
 from .boundary import boundary
 from .forms import E, exponential_form, trig_form, w
 from .small_theta import taylor_coefficients

@@ -15,7 +15,9 @@ import pytest
 
 import symstab
 
-from conftest import PAPER_DELTA, PAPER_M, PAPER_T, REPO, run_cli as run, run_cli_json as run_json
+from conftest import PAPER_DELTA, PAPER_M, PAPER_T, REPO
+from conftest import run_cli as run
+from conftest import run_cli_json as run_json
 from oracles import dense_maximum
 
 LOOPS = REPO / "examples" / "loops"

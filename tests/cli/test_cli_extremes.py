@@ -25,7 +25,6 @@ import pytest
 
 from symstab.cli import commands as cli
 
-
 DIMENSIONLESS = ["--delta", "0.0025", "--alpha", "0.1", "--beta", "0.5"]
 
 

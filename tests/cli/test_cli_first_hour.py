@@ -23,8 +23,8 @@ import pytest
 
 import symstab
 from symstab.cli import commands as cli
-from symstab.numeric.simulation.simulator import Nonidealities
 from symstab.numeric.paper.simulate_theory import linear_theory
+from symstab.numeric.simulation.simulator import Nonidealities
 
 from conftest import PAPER_DELTA, PAPER_M, PAPER_T, REPO
 from oracles import python_control_closed_loop

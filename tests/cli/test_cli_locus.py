@@ -12,7 +12,9 @@ import pytest
 
 import symstab
 
-from conftest import PAPER_M, PAPER_T, REPO, run_cli as run, run_cli_json as run_json
+from conftest import PAPER_M, PAPER_T, REPO
+from conftest import run_cli as run
+from conftest import run_cli_json as run_json
 
 PAPER = str(REPO / "examples" / "loops" / "paper.toml")
 TUSTIN = str(REPO / "examples" / "loops" / "tustin_damper.toml")

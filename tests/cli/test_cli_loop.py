@@ -17,7 +17,9 @@ import pytest
 import symstab
 from symstab.cli import commands as cli
 
-from conftest import PAPER_DELTA, PAPER_M, PAPER_T, REPO, run_cli as run, run_cli_json as run_json
+from conftest import PAPER_DELTA, PAPER_M, PAPER_T, REPO
+from conftest import run_cli as run
+from conftest import run_cli_json as run_json
 from oracles import python_control_closed_loop
 
 PAPER = str(REPO / "examples" / "loops" / "paper.toml")

@@ -12,7 +12,8 @@ import pytest
 
 import symstab
 
-from conftest import REPO, run_cli as run
+from conftest import REPO
+from conftest import run_cli as run
 
 LOOPS = REPO / "examples" / "loops"
 PAPER = LOOPS / "paper.toml"

@@ -11,7 +11,9 @@ import re
 
 import pytest
 
-from conftest import REPO, run_cli as run, run_cli_json as run_json
+from conftest import REPO
+from conftest import run_cli as run
+from conftest import run_cli_json as run_json
 
 pytestmark = pytest.mark.usefixtures("loop_cache_dir")
 

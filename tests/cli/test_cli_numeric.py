@@ -15,7 +15,8 @@ import pytest
 
 import symstab
 
-from conftest import PAPER_B, PAPER_DELTA, PAPER_M, PAPER_T, run_cli as run
+from conftest import PAPER_B, PAPER_DELTA, PAPER_M, PAPER_T
+from conftest import run_cli as run
 from oracles import python_control_closed_loop
 
 

@@ -10,7 +10,8 @@ import json
 
 import pytest
 
-from conftest import PAPER_B, PAPER_DELTA, PAPER_T, REPO, run_cli as run
+from conftest import PAPER_B, PAPER_DELTA, PAPER_T, REPO
+from conftest import run_cli as run
 
 # The session's loop cache: operator_arm (8 s to derive) is read, not derived
 # again, and nothing is written to ~/.cache.

@@ -14,7 +14,8 @@ control = pytest.importorskip("control")
 
 import symstab
 
-from conftest import REPO, run_cli as run
+from conftest import REPO
+from conftest import run_cli as run
 
 PAPER = REPO / "examples" / "loops" / "paper.toml"
 

@@ -227,8 +227,8 @@ def test_z_width_closes_to_zero_where_the_region_vanishes(drawn, name, right):
 def test_fig10_draws_the_lower_edge_of_the_gamma_1_band(drawn):
     # Panel (d) drew eq. (7) only up to theta_max: the stable band's lower
     # edge was not drawn and half the loop read as a disagreement.
-    from symstab.numeric.paper.region import StabilityRegion
     from symstab.numeric.paper.device import PAPER_DEVICE as dev
+    from symstab.numeric.paper.region import StabilityRegion
 
     ax = drawn["fig10"].axes[3]
     assert r"M_w = m$" in ax.get_title()  # not "1 m"

@@ -36,15 +36,20 @@ import numpy as np
 import pytest
 import sympy as sp
 
-from conftest import PAPER_DELTA, REPO, relative_error
-from oracles import first_principles_boundary_point, first_principles_chi, first_principles_chi_float
 import symstab
-from symstab.symbolic import model
 from symstab._generated import kernels as numpy_kernels
-from symstab.symbolic.boundary import boundary
-from symstab.numeric.paper.reference import boundary_point
 from symstab.codegen.float_forms import SERIES_FUNCTIONS
+from symstab.numeric.paper.reference import boundary_point
+from symstab.symbolic import model
+from symstab.symbolic.boundary import boundary
 from symstab.symbolic.theta_max import theta_max
+
+from conftest import PAPER_DELTA, REPO, relative_error
+from oracles import (
+    first_principles_boundary_point,
+    first_principles_chi,
+    first_principles_chi_float,
+)
 
 GENERATED = REPO / "symstab" / "_generated"
 C_SOURCE = GENERATED / "symstab_kernels.c"

@@ -21,7 +21,8 @@ import sys
 import tempfile
 
 import pytest
-from hypothesis import HealthCheck, event, given, settings, strategies as st
+from hypothesis import HealthCheck, event, given, settings
+from hypothesis import strategies as st
 
 if sys.version_info >= (3, 11):
     import tomllib
@@ -31,8 +32,8 @@ else:   # pragma: no cover - Python 3.10
 from symstab.cli import commands as cli
 from symstab.codegen.generator import comment_text, docstring_text, one_line
 from symstab.codegen.loop_kernels import c_source, environment_kernels, numpy_source
-from symstab.numeric.loop.files import load_loop, parse_loop_text
 from symstab.numeric.engine.roots import STABLE
+from symstab.numeric.loop.files import load_loop, parse_loop_text
 from symstab.symbolic.loop_assembly import NAME_PATTERN
 
 from conftest import REPO

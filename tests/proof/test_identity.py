@@ -6,10 +6,15 @@ import sympy as sp
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
+from symstab.proof.identity import (
+    IdentityResult,
+    assert_identity,
+    check_identity,
+    numeric_difference,
+)
 from symstab.symbolic import model
 from symstab.symbolic.boundary import coefficients
 from symstab.symbolic.forms import E, UnsupportedExpression, exponential_form, trig_form, w
-from symstab.proof.identity import IdentityResult, assert_identity, check_identity, numeric_difference
 
 theta, d, delta, Gamma = model.theta, model.d, model.delta, model.Gamma
 sin, cos = sp.sin, sp.cos

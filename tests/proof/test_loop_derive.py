@@ -26,15 +26,16 @@ import subprocess
 import sys
 
 import numpy as np
-import sympy as sp
 import pytest
+import sympy as sp
 
-from conftest import REPO, hash_seed_other_than_ours
 from symstab.cli import commands as cli
-from symstab.proof import loop_derive
-from symstab.proof.identity import check_identity
 from symstab.codegen.loop_kernels import _digest
 from symstab.numeric.loop.files import load_loop, parse_loop_text
+from symstab.proof import loop_derive
+from symstab.proof.identity import check_identity
+
+from conftest import REPO, hash_seed_other_than_ours
 
 PAPER_FILE = REPO / "examples" / "loops" / "paper.toml"
 

@@ -9,13 +9,21 @@ import sympy as sp
 
 from symstab.symbolic import model
 from symstab.symbolic.boundary import (
-    ALPHA_MONOMIALS, boundary, BETA_MONOMIALS, DENOMINATOR_MONOMIALS, beta_relations, coefficients,
+    ALPHA_MONOMIALS,
+    BETA_MONOMIALS,
+    DENOMINATOR_MONOMIALS,
+    beta_relations,
+    boundary,
+    coefficients,
 )
 from symstab.symbolic.theta_max import theta_max
 
 from conftest import PAPER_DELTA, assert_rel_close
 from oracles import (
-    boundary_point_mp, chi_mp, first_principles_boundary_point, loop_coefficients_mp,
+    boundary_point_mp,
+    chi_mp,
+    first_principles_boundary_point,
+    loop_coefficients_mp,
 )
 
 ARGS = (model.theta, model.gamma, model.d, model.delta, model.Gamma)

@@ -19,7 +19,6 @@ from symstab import Loop
 from symstab.symbolic import loop_assembly, model
 
 
-
 @pytest.fixture
 def cache(tmp_path, monkeypatch):
     """A cache folder of this test's own: every test starts with nothing derived."""

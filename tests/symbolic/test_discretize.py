@@ -7,7 +7,9 @@ import sympy as sp
 
 from symstab.symbolic import model
 from symstab.symbolic.discretize import (
-    dimensionless_pulse_transfer_function, pulse_transfer_function, z_transform_by_residues,
+    dimensionless_pulse_transfer_function,
+    pulse_transfer_function,
+    z_transform_by_residues,
 )
 
 from conftest import PAPER_B, PAPER_M, PAPER_T, assert_rel_close

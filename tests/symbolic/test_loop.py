@@ -17,7 +17,10 @@ from symstab.symbolic import model
 
 from conftest import assert_message_names, assert_rel_close
 from oracles import (
-    delta_of_z, dimensionless, loop_coefficients_mp, python_control_closed_loop,
+    delta_of_z,
+    dimensionless,
+    loop_coefficients_mp,
+    python_control_closed_loop,
     random_loop_points,
 )
 

@@ -12,7 +12,6 @@ from symstab.symbolic.model import dimensionless_values
 from conftest import PAPER_B, PAPER_DELTA, PAPER_M, PAPER_T, assert_message_names, assert_rel_close
 from oracles import eq1_virtual_environment
 
-
 # Symbols and blocks ---------------------------------------------------------
 
 @pytest.mark.parametrize("symbol, assumption", [

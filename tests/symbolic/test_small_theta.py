@@ -117,7 +117,7 @@ _t, _d, _g = model.theta, model.d, model.Gamma
     (sp.sin(_d * _t) / _t + sp.cos(_t), True),    # not a polynomial after all: falls back
 ])
 def test_taylor_coefficients_equal_sympy_series(expr, fast):
-    from symstab.symbolic.small_theta import taylor_coefficients, _trig_taylor
+    from symstab.symbolic.small_theta import _trig_taylor, taylor_coefficients
 
     order = 5
     assert (_trig_taylor(expr, order) is not None) is fast

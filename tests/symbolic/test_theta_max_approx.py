@@ -15,8 +15,15 @@ import sympy as sp
 
 from symstab.numeric.paper.theta_bounds import APPROX_WORST_RELATIVE_ERROR, theta_max_approx
 from symstab.symbolic import model
-from symstab.symbolic.theta_max import (alpha_numerator_function, phase_equation, q_sym,
-                                        r_sym, reduced_equation, theta_max, theta_max_newton)
+from symstab.symbolic.theta_max import (
+    alpha_numerator_function,
+    phase_equation,
+    q_sym,
+    r_sym,
+    reduced_equation,
+    theta_max,
+    theta_max_newton,
+)
 
 from conftest import PAPER_DELTA, assert_message_names
 from oracles import first_principles_alpha

@@ -38,9 +38,9 @@ import numpy as np
 
 from ..._resources import chunk_slices
 from .arcs import Brackets, crossing_change
-from .search import bracketed_root, scan_grid, zoom_max
 from .polynomial import DelayedPolynomial, horner
 from .roots import root_counts
+from .search import bracketed_root, scan_grid, zoom_max
 
 __all__ = ["line_intervals", "family_intervals", "Unresolved", "RESIDUAL"]
 

@@ -44,9 +44,9 @@ import numpy as np
 
 from ..._resources import CHUNK_BYTES, check_memory, chunk_slices
 from ..._validate import check_array, check_real
-from .search import bracketed_root
 from .polynomial import horner
 from .roots import leading_vanishes, polish_roots
+from .search import bracketed_root
 
 __all__ = ["Locus", "Crossing", "locus", "check_path", "ON_CIRCLE"]
 

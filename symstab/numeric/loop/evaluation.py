@@ -31,8 +31,8 @@ from ..._memo import method_cache
 from ..._resources import check_memory
 from ..._validate import check_array, check_delay
 from ...symbolic.loop_assembly import PLANT_DIGITS, shift_to_one
-from ..engine.arcs import END_ANGLE, EXACT_TERMS, ClosedFormArc, CramerArc, ExactPolynomial
 from ..engine import roots
+from ..engine.arcs import END_ANGLE, EXACT_TERMS, ClosedFormArc, CramerArc, ExactPolynomial
 from ..engine.polynomial import DelayedPolynomial
 
 __all__ = ["LoopEvaluation", "finite", "spectral_radius", "classify", "is_stable",

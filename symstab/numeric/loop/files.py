@@ -47,8 +47,8 @@ if sys.version_info >= (3, 11):
 else:   # pragma: no cover - Python 3.10
     import tomli as tomllib
 
-from .sampled_loop import Loop
 from .quantities import check_loop_units, read_parameters
+from .sampled_loop import Loop
 
 __all__ = ["load_loop", "parse_loop_text"]
 

@@ -44,11 +44,18 @@ import warnings
 
 import sympy as sp
 
-from ...symbolic.loop_assembly import LoopModel, parse_environment, parse_plant
 from ...codegen.loop_kernels import environment_kernels, load_numpy_kernels
+from ...symbolic.loop_assembly import LoopModel, parse_environment, parse_plant
 from ..engine.results import Boundary, Limits
-from .evaluation import (LoopEvaluation, classify, difference_equations, difference_parts,
-                         is_stable, spectral_radius, unstable_root_counts)
+from .evaluation import (
+    LoopEvaluation,
+    classify,
+    difference_equations,
+    difference_parts,
+    is_stable,
+    spectral_radius,
+    unstable_root_counts,
+)
 from .plane import boundary, limits, region, stable_intervals
 
 __all__ = ["Loop", "LoopLimits", "LoopBoundary", "parse_plant", "parse_environment"]

@@ -22,7 +22,12 @@ import numpy as np
 
 from ..._generated import kernels
 from ..._validate import check_loop
-from ...symbolic.theta_max import first_sign_change, reduced_curvature, reduced_qr, reduced_value_slope
+from ...symbolic.theta_max import (
+    first_sign_change,
+    reduced_curvature,
+    reduced_qr,
+    reduced_value_slope,
+)
 from ..engine.results import Boundary
 from ..engine.search import bracketed_root
 

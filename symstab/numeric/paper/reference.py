@@ -11,8 +11,8 @@ import functools
 import mpmath
 import sympy as sp
 
-from ...symbolic import model
 from ..._validate import check_loop
+from ...symbolic import model
 from ...symbolic.boundary import boundary
 from ...symbolic.theta_max import theta_max
 

@@ -28,10 +28,10 @@ import numpy as np
 
 from ..._resources import check_memory, chunk_slices
 from ..._validate import check_array, check_box, check_count, check_loop, check_real, check_window
-from .curves import KERNEL_BYTES_PER_POINT, KERNEL_CHUNK_BYTES, arc_end_angle, minus_one_line
 from ..engine.decomposition import window_arc
-from .paper_loop import closed_form_arc, paper_arc, paper_point
 from ..engine.results import PAPER_PLANE, Boundary
+from .curves import KERNEL_BYTES_PER_POINT, KERNEL_CHUNK_BYTES, arc_end_angle, minus_one_line
+from .paper_loop import closed_form_arc, paper_arc, paper_point
 
 __all__ = ["StabilityRegion", "limits", "vanishing_gamma", "BestVirtualMass", "best_virtual_mass",
            "boundary_curve", "arc_polylines"]

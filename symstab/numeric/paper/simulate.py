@@ -75,10 +75,19 @@ import math
 import numpy as np
 
 from ..._validate import check_array, check_delay, check_loop, check_progress, check_real
-from ..simulation.simulator import (X0_MAX, FrictionCompensation, Nonidealities, QUANTUM_MIN,
-                                    StabilityMap, check_friction_size, check_steps, check_x0,
-                                    default_horizon, progress_printer)
 from ..simulation.friction import substeps_of
+from ..simulation.simulator import (
+    QUANTUM_MIN,
+    X0_MAX,
+    FrictionCompensation,
+    Nonidealities,
+    StabilityMap,
+    check_friction_size,
+    check_steps,
+    check_x0,
+    default_horizon,
+    progress_printer,
+)
 from .simulate_theory import paper_simulated_loop
 
 __all__ = ["simulate", "stability_map", "check_device_nonideal"]

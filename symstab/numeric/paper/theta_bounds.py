@@ -37,13 +37,19 @@ import functools
 import math
 
 import mpmath
-from mpmath import iv
 import sympy as sp
+from mpmath import iv
 
 from ..._validate import check_count, check_loop, check_real
 from ...symbolic import model
-from ...symbolic.theta_max import (phase_equation, q_sym, r_sym, reduced_qr, reduced_qr_functions,
-                                   reduced_value_slope)
+from ...symbolic.theta_max import (
+    phase_equation,
+    q_sym,
+    r_sym,
+    reduced_qr,
+    reduced_qr_functions,
+    reduced_value_slope,
+)
 from .curves import arc_end_angle
 
 __all__ = ["ThetaMaxEnclosure", "NotCertified", "theta_max_enclosure", "certify_theta_max",

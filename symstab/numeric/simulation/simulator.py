@@ -34,8 +34,8 @@ from ..._progress import progress_printer
 from ..._resources import MAX_STEPS_ENV, check_memory, chunk_slices
 from ..._resources import max_steps as _max_steps_setting
 from ..._validate import check_array, check_delay, check_progress, check_real
-from .friction import StatePlant, stacked_spaces, substeps_of
 from ..engine.results import PAPER_PLANE, PaperGridNames
+from .friction import StatePlant, stacked_spaces, substeps_of
 
 __all__ = ["Nonidealities", "FrictionCompensation", "Simulation", "StabilityMap",
            "default_horizon", "check_steps", "check_x0", "max_steps", "progress_printer",

@@ -27,8 +27,8 @@ import numpy as np
 import pytest
 
 import symstab
-from symstab.numeric.paper.paper_loop import paper_passive_region
 from symstab.numeric.analysis.passivity import PassiveRegion, passive_region
+from symstab.numeric.paper.paper_loop import paper_passive_region
 
 from conftest import PAPER_B, PAPER_DELTA, PAPER_M, PAPER_T, REPO
 

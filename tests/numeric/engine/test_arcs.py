@@ -16,8 +16,8 @@ import pytest
 import symstab
 from symstab.numeric.engine import decomposition
 from symstab.numeric.engine.arcs import CramerArc, sine_ratio
-from symstab.numeric.paper.paper_loop import paper_arc
 from symstab.numeric.engine.polynomial import DelayedPolynomial
+from symstab.numeric.paper.paper_loop import paper_arc
 from symstab.numeric.paper.stability import paper_polynomial
 
 EXAMPLES = sorted(glob.glob(os.path.join(os.path.dirname(__file__), "..", "..", "..", "examples",
@@ -170,8 +170,9 @@ def test_paper_loops_closed_form_arc_matches_the_printed_model_on_the_whole_circ
     # PAPER_LOOP's arc hook in Table I's variables (m = T = 1: B = beta,
     # K = alpha), against the 50-digit solve of the printed eqs. (1), (2),
     # (4): exact coefficients, not the rounded ones the Cramer oracle uses.
-    from oracles import first_principles_boundary_point
     from symstab.numeric.paper.paper_loop import closed_form_arc, paper_point
+
+    from oracles import first_principles_boundary_point
 
     _, values = paper_point(gamma=gamma, d=d, delta=delta)
     beta, alpha = closed_form_arc("B", "K", values)(THETA)

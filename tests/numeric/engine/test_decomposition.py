@@ -22,11 +22,12 @@ import os
 import numpy as np
 import pytest
 
-from oracles import python_control_closed_loop
 from symstab.numeric.engine.decomposition import Cell, decompose
 from symstab.numeric.loop.files import load_loop
 from symstab.numeric.paper.region import StabilityRegion
 from symstab.numeric.paper.stability import loop_coefficients
+
+from oracles import python_control_closed_loop
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__)))))
 EXAMPLES = sorted(glob.glob(os.path.join(ROOT, "examples", "loops", "*.toml")))
@@ -241,6 +242,7 @@ def test_window_validation_names_the_parameter():
 def test_a_piece_ending_tangentially_on_a_line_still_cuts_the_plane():
     """A biproper plant: the arc ends on z = -1 along it; the point below the arc is unstable."""
     import control
+
     from symstab import Loop
 
     loop = Loop("(s + a)/(s + p)", "K + B*(z-1)/(T*z)",

@@ -12,9 +12,10 @@ import numpy as np
 import pytest
 
 import symstab
-from oracles import first_principles_chi, python_control_closed_loop
 from symstab.numeric.engine.results import Limits
 from symstab.numeric.paper.device import PAPER_DEVICE
+
+from oracles import first_principles_chi, python_control_closed_loop
 
 control = pytest.importorskip("control")
 

@@ -7,7 +7,8 @@ coefficients, and python-control's poles of the paper's closed loop.
 import mpmath
 import numpy as np
 import pytest
-from hypothesis import given, settings, strategies as st
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from symstab.numeric.engine import roots
 from symstab.numeric.engine.polynomial import DelayedPolynomial

@@ -15,16 +15,21 @@ import pytest
 import sympy as sp
 
 import symstab
-from symstab.symbolic import model
-from symstab.numeric.loop.sampled_loop import Loop
-from symstab.symbolic.discretize import numeric_zoh, zoh_pulse_transfer_function
 from symstab.numeric.engine.polynomial import DelayedPolynomial
-from symstab.numeric.engine.roots import root_counts, spectral_radius
-from symstab.numeric.engine.roots import MARGINAL, STABLE, UNSTABLE, classify_polynomials
+from symstab.numeric.engine.roots import (
+    MARGINAL,
+    STABLE,
+    UNSTABLE,
+    classify_polynomials,
+    root_counts,
+    spectral_radius,
+)
+from symstab.numeric.loop.sampled_loop import Loop
+from symstab.symbolic import model
+from symstab.symbolic.discretize import numeric_zoh, zoh_pulse_transfer_function
 
-from conftest import PAPER_B, PAPER_M, PAPER_T, assert_rel_close
+from conftest import PAPER_B, PAPER_M, PAPER_T, REPO, assert_rel_close
 from oracles import polyroots, python_control_closed_loop
-from conftest import REPO
 
 control = pytest.importorskip("control")
 

@@ -19,12 +19,12 @@ import numpy as np
 import pytest
 
 import symstab
-import oracles
-from oracles import first_principles_chi, python_control_closed_loop
 from symstab.numeric.engine.decomposition import stable_hull
 from symstab.numeric.paper.device import PAPER_DEVICE
 
+import oracles
 from conftest import REPO
+from oracles import first_principles_chi, python_control_closed_loop
 
 control = pytest.importorskip("control")
 

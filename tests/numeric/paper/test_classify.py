@@ -39,9 +39,14 @@ from symstab.numeric.paper.reference import boundary_point
 from symstab.numeric.paper.stability import loop_coefficients, schur_cohn
 
 from conftest import PAPER_DELTA, assert_message_names
-from oracles import (dimensionless, first_principles_chi, first_principles_chi_float, polyroots,
-                     python_control_closed_loop, random_loop_points)
-
+from oracles import (
+    dimensionless,
+    first_principles_chi,
+    first_principles_chi_float,
+    polyroots,
+    python_control_closed_loop,
+    random_loop_points,
+)
 
 # --------------------------------------------------------------------------
 # Independent oracle: chi(z) from the printed eqs. (1), (2), (4)

@@ -88,9 +88,9 @@ def test_coefficients_at_a_tiny_damping_match_the_first_principles_polynomial(de
     """The plant's closed form cancels 2 log10(1 / delta) digits (its (exp(-delta) - 1 + delta) /
     delta**2): at 30 fixed digits delta = 1e-14 gave P_n = (0.49895, 0.50093), not (0.5, 0.5),
     and limits 2.5e-3 off.  Oracle: eqs. (1), (2), (4) at 60 digits (tests/oracles.py)."""
-    from oracles import first_principles_chi
-
     from symstab.numeric.paper.paper_loop import paper_point
+
+    from oracles import first_principles_chi
 
     loop, values = paper_point(gamma=0.3, d=2, delta=delta)
     got = loop.coefficients(K=0.4, B=0.7, **values)

@@ -39,14 +39,27 @@ import numpy as np
 import pytest
 
 import symstab
-from symstab import (PAPER_DEVICE, STABLE, Device, StabilityRegion, arc_end_angle,
-                     best_virtual_mass, boundary_curve, classify, limits)
+from symstab import (
+    PAPER_DEVICE,
+    STABLE,
+    Device,
+    StabilityRegion,
+    arc_end_angle,
+    best_virtual_mass,
+    boundary_curve,
+    classify,
+    limits,
+)
 from symstab.numeric.paper.reference import alpha_max_on_arc, boundary_point
 
 from conftest import PAPER_DELTA, assert_message_names
-from oracles import (first_principles_boundary_point, first_principles_chi_float, first_principles_radius,
-                     stable_alpha_intervals, theta_max_box_sample)
-
+from oracles import (
+    first_principles_boundary_point,
+    first_principles_chi_float,
+    first_principles_radius,
+    stable_alpha_intervals,
+    theta_max_box_sample,
+)
 
 #: The first-principles polynomial of eqs. (1), (2), (4) (tests/oracles.py),
 #: at 30 digits, rounded once to floats.
@@ -917,8 +930,9 @@ def test_vanishing_gamma_refuses_ends_on_the_wrong_side():
 def test_arc_polylines_lie_on_the_boundary_by_python_control(gamma, d):
     """Every drawn arc point has a closed-loop pole on the unit circle (python-control's poles of
     the sampled loop); the first piece starts at the corner (-delta, 0) and ends on alpha = 0."""
-    from oracles import python_control_closed_loop
     from symstab.numeric.paper.region import arc_polylines
+
+    from oracles import python_control_closed_loop
 
     window = ((-0.5, 2.5), (-0.1, 4.0))
     first, beyond = arc_polylines(gamma=gamma, d=d, delta=PAPER_DELTA, window=window)

@@ -27,13 +27,17 @@ import pytest
 import scipy.signal
 
 import symstab
-from conftest import PAPER_B, PAPER_DELTA, PAPER_M, PAPER_T, assert_message_names
-from oracles import python_control_closed_loop
 from symstab._generated import kernels
 from symstab.numeric.paper.curves import minus_one_line
 from symstab.numeric.paper.simulate import simulate, stability_map
-from symstab.numeric.simulation.simulator import (PAPER_ENCODER_RESOLUTION, Nonidealities,
-    default_horizon)
+from symstab.numeric.simulation.simulator import (
+    PAPER_ENCODER_RESOLUTION,
+    Nonidealities,
+    default_horizon,
+)
+
+from conftest import PAPER_B, PAPER_DELTA, PAPER_M, PAPER_T, assert_message_names
+from oracles import python_control_closed_loop
 
 PAPER_DEVICE = symstab.Device(m=PAPER_M, b=PAPER_B, T=PAPER_T)
 

@@ -9,9 +9,9 @@ import numpy as np
 import pytest
 
 import symstab
-from symstab.numeric.simulation.simulator import Nonidealities
-from symstab.numeric.paper.simulate_theory import linear_theory
 from symstab.numeric.engine.roots import MARGINAL, STABLE, UNSTABLE
+from symstab.numeric.paper.simulate_theory import linear_theory
+from symstab.numeric.simulation.simulator import Nonidealities
 
 from conftest import REPO
 from oracles import simulated_loop_radius as oracle_radius

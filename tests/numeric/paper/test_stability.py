@@ -7,8 +7,14 @@ from symstab.numeric.paper.reference import boundary_point
 from symstab.numeric.paper.stability import spectral_radius
 
 from conftest import PAPER_DELTA
-from oracles import (coefficients_at, dimensionless, python_control_closed_loop,
-                     random_loop_points, stable_alpha_intervals, unstable_root_count)
+from oracles import (
+    coefficients_at,
+    dimensionless,
+    python_control_closed_loop,
+    random_loop_points,
+    stable_alpha_intervals,
+    unstable_root_count,
+)
 
 
 @pytest.mark.parametrize("point", random_loop_points(seed=7, n=20, delta_range=(1e-3, 1.0)))

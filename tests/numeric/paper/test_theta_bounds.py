@@ -14,7 +14,6 @@ import mpmath
 import numpy as np
 import pytest
 import sympy as sp
-
 from mpmath import iv
 
 from symstab.numeric.paper import theta_bounds

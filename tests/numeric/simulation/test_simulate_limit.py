@@ -13,8 +13,8 @@ import numpy as np
 import pytest
 
 import symstab
-from symstab.numeric.simulation.simulator import Nonidealities
 from symstab.numeric.simulation.simulated_limit import simulated_limit
+from symstab.numeric.simulation.simulator import Nonidealities
 
 from conftest import REPO, assert_message_names
 from oracles import dense_maximum, simulated_loop_radius
