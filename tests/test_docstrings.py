@@ -72,7 +72,7 @@ def _target(doc):
 def _with_targets(callables):
     """``callables`` and the module functions their pass-throughs name, each once."""
     out = dict(callables)
-    for name, obj in list(out.items()):
+    for obj in list(out.values()):
         target = _target(inspect.getdoc(obj))
         if target is not None:
             out.setdefault(f"{target.__module__}.{target.__name__}", target)

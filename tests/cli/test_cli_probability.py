@@ -59,7 +59,7 @@ def test_a_delay_drawn_and_the_csv(capsys, tmp_path):
     # Each delay is equally likely: the expected probability is the fraction of the eleven
     # delays at which the cell is stable; 100 draws are within 3 standard errors of it.
     loop = symstab.load_loop(PAPER)
-    for B, K, p, error, _ in rows:
+    for B, K, p, _error, _marginal in rows:
         expected = np.mean([loop.classify(B=B, K=K, d=d) == symstab.STABLE
                             for d in range(5, 16)])
         assert abs(p - expected) <= 3 * np.sqrt(expected * (1 - expected) / 100) + 1e-12

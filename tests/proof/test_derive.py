@@ -112,7 +112,7 @@ def test_json_latex_is_the_objects_latex(rendered_files, derivation):
 
 
 def test_srepr_round_trips_structurally(rendered_files, derivation):
-    for filename, obj, original in _json_objects(rendered_files, derivation):
+    for filename, obj, _original in _json_objects(rendered_files, derivation):
         assert sp.srepr(_rebuild(obj["srepr"])) == obj["srepr"], (filename, obj["name"])
 
 

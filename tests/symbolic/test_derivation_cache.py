@@ -171,9 +171,9 @@ def test_a_damaged_or_tampered_entry_is_derived_again(damage, derived_once, zoh_
 
 
 def test_another_plant_or_environment_is_another_entry(cache, zoh_calls):
-    Loop(PLANT, ENVIRONMENT)._plant_parts
-    Loop(PLANT.replace("k)", "2*k)"), ENVIRONMENT)._plant_parts
-    Loop(PLANT, ENVIRONMENT.replace("0.5", "0.25"))._plant_parts
+    _ = Loop(PLANT, ENVIRONMENT)._plant_parts
+    _ = Loop(PLANT.replace("k)", "2*k)"), ENVIRONMENT)._plant_parts
+    _ = Loop(PLANT, ENVIRONMENT.replace("0.5", "0.25"))._plant_parts
     assert len(entry_files(cache)) == 3 and len(zoh_calls) == 3
 
 

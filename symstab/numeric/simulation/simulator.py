@@ -816,7 +816,7 @@ def _parts_by_chunk(loop, values, overflow):
 def _check_driven_mass(loop, name):
     """Raise ValueError naming ``name`` where ``loop`` has no driven mass (friction, a state)."""
     try:
-        loop.driven_mass
+        _ = loop.driven_mass
     except ValueError as exc:
         raise ValueError(f"{name}: {exc}") from None
 

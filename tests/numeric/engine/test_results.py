@@ -150,9 +150,9 @@ def test_a_loops_boundary_is_the_same_type_with_the_planes_names():
     assert type(loop) is type(paper) is symstab.LoopBoundary is symstab.BoundaryCurve
     assert (loop.x, loop.y) == ("B", "K") and set(loop.lines) >= {"z = 1", "z = -1"}
     with pytest.raises(AttributeError, match="use y_values"):
-        loop.alpha
+        _ = loop.alpha
     with pytest.raises(AttributeError, match="paper's"):
-        loop.gamma
+        _ = loop.gamma
     # The arc starts at (beta, alpha) = (-delta, 0): the names are not swapped.
     assert (paper.beta[0], paper.alpha[0]) == (-PAPER_DEVICE.delta, 0.0)
     assert (paper.x_values[0], paper.y_values[0]) == (-PAPER_DEVICE.delta, 0.0)

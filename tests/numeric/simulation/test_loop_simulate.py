@@ -230,7 +230,7 @@ def test_a_loop_map_has_no_paper_names():
     loop = symstab.load_loop(LOOPS / "frictionless.toml")
     found = loop.stability_map([0.05], [20.0], steps=100)
     with pytest.raises(AttributeError, match="x_values"):
-        found.beta
+        _ = found.beta
 
 
 @pytest.mark.parametrize("nonideal, name", [
