@@ -121,7 +121,7 @@ def _times_interleaved(fns, runs, warmup=1):
             fn()
     out = [[] for _ in fns]
     for _ in range(runs):
-        for fn, times in zip(fns, out):
+        for fn, times in zip(fns, out, strict=True):
             start = time.perf_counter()
             fn()
             times.append(time.perf_counter() - start)
@@ -416,8 +416,8 @@ def bench_limits(args):
                     ends.append(np.inf)
                     print(f"     B = {beta * m / T:.6g}: Loop {got} vs paper {want}")
                     continue
-                ends += [abs(g[0] - w[0]) / k_max for g, w in zip(got, want)]
-                ends += [_rel(g[1], w[1]) for g, w in zip(got, want)]
+                ends += [abs(g[0] - w[0]) / k_max for g, w in zip(got, want, strict=True)]
+                ends += [_rel(g[1], w[1]) for g, w in zip(got, want, strict=True)]
             diffs["K intervals"] = max(ends, default=0.0)
             worst = max(diffs, key=diffs.get)
             worst_all = max(worst_all, diffs[worst])

@@ -38,7 +38,7 @@ def cosine_series_terms(plane, theta):
     q = np.zeros((int(plane.orders.max()) + 1, 3))
     orders = plane.orders.astype(int)
     # D_m = 1 + 2 (cos theta + ... + cos m theta).
-    for m, w in zip(orders, plane.weights):
+    for m, w in zip(orders, plane.weights, strict=True):
         q[0] += w
         q[1:m + 1] += 2 * w
     c = np.cos(theta)
@@ -80,7 +80,8 @@ def reference_terms(plane, theta):
             kernels = [2 * m + 1 if t == 0 else mpmath.sin((m + 0.5) * t) / mpmath.sin(t / 2)
                        for m in plane.orders]
             a = [plane.scale * mpmath.fsum(mpmath.mpf(float(w)) * k
-                                           for w, k in zip(plane.weights[:, j], kernels)) / r
+                                           for w, k in zip(plane.weights[:, j], kernels,
+                                                           strict=True)) / r
                  for j in range(3)]
             a[0] -= plane.damping
             out.append([float(v) for v in a])

@@ -33,13 +33,13 @@ def sampled(loop, box, strips, samples, values):
     points = np.vstack([c.outer for c in nominal.stable])
     edges = np.linspace(points[:, 0].min(), points[:, 0].max(), strips + 1)
     rng = np.random.default_rng(0)
-    draws = [dict(zip(box, p)) for p in zip(*[rng.uniform(lo, hi, samples)
-                                              for lo, hi in box.values()])]
+    draws = [dict(zip(box, p, strict=True)) for p in zip(*[rng.uniform(lo, hi, samples)
+                                              for lo, hi in box.values()], strict=True)]
     kept = [[(-np.inf, np.inf)] for _ in edges]
     for value in draws:
         found = loop.stable_intervals("K", B=edges, **values, **value)
         kept = [[(max(a, c), min(b, e)) for a, b in k for c, e in f if max(a, c) < min(b, e)]
-                for k, f in zip(kept, found)]
+                for k, f in zip(kept, found, strict=True)]
     # Trapezoids between the edges, as the certified region's pieces.
     area = 0.0
     for i in range(strips):

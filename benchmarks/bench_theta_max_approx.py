@@ -125,7 +125,7 @@ def main(argv=None):
     header = ("form", "points", "worst rel. err", "where", "median err", "time/eval")
     widths = [max(len(str(r[i])) for r in rows + [header]) for i in range(len(header))]
     for row in [header] + rows:
-        print("  ".join(str(c).ljust(w) for c, w in zip(row, widths)))
+        print("  ".join(str(c).ljust(w) for c, w in zip(row, widths, strict=True)))
     print("time/eval: median on a shared, loaded machine; the Newton step on N_alpha runs in "
           "mpmath at 30 digits (its float form cancels), theta_max_approx in floats")
 

@@ -337,7 +337,7 @@ def _register_panel(figure, d, where, text):
         lambda: _panel_outcome(figure, d))
 
 
-for _d, _panel in zip((0, 1, 5, 10), "abcd"):
+for _d, _panel in zip((0, 1, 5, 10), "abcd", strict=True):
     _register_panel("6", _d, place(f"Fig. 6({_panel})", 264, 266, 527),
                     f"d = {_d}: the region beneath each curve gamma = 0, -0.25, -0.5, -0.75 is stable")
 _register_panel("8", 0, place("Fig. 8(a)", 325, 327, 527),

@@ -456,7 +456,7 @@ def classify(gamma, d, delta=PAPER_DEVICE.delta, *, n_beta=41, arc_points=None,
         runs = region.alpha_intervals_on(lines)
 
     inside_arc, outside = (None, 0.0) if not stable_exists else (False, math.inf)
-    points = np.array([(b, a) for b, r in zip(lines, runs) for lo, hi in r
+    points = np.array([(b, a) for b, r in zip(lines, runs, strict=True) for lo, hi in r
                        for a in np.linspace(lo, hi, 5)]).reshape(-1, 2)
     if len(points):
         inside = inside_even_odd(points, polygon)
@@ -468,12 +468,12 @@ def classify(gamma, d, delta=PAPER_DEVICE.delta, *, n_beta=41, arc_points=None,
 
     # On alpha = 0 a root sits at z = 1: the counted intervals that start
     # there start at exactly 0, so any positive start is a minimum stiffness.
-    raised = [(float(b), r[0][0]) for b, r in zip(lines, runs) if r and r[0][0] > 0.0]
+    raised = [(float(b), r[0][0]) for b, r in zip(lines, runs, strict=True) if r and r[0][0] > 0.0]
     min_alpha_where = raised[len(raised) // 2] if raised else None
     min_alpha_betas = (raised[0][0], raised[-1][0]) if raised else None
 
     stable_point = None
-    meeting = [(b, r) for b, r in zip(lines, runs) if r]
+    meeting = [(b, r) for b, r in zip(lines, runs, strict=True) if r]
     if meeting:
         b, r = meeting[len(meeting) // 2]
         lo, hi = r[len(r) // 2]
@@ -548,7 +548,7 @@ def _probes(gamma, d, delta, polygon, beta_top, alpha_top, beta_end, width, stab
         alpha=np.array([float(a) for _, _, a in points]),
         beta=np.array([float(b) for _, b, _ in points]), gamma=gamma, d=d, delta=delta))
     return tuple(Probe(name, float(b), float(a), None if n < 0 else int(n))
-                 for (name, b, a), n in zip(points, counts))
+                 for (name, b, a), n in zip(points, counts, strict=True))
 
 
 # --------------------------------------------------------------------------
@@ -775,7 +775,7 @@ def main(processes=2):
     unique = list(dict.fromkeys((c.gamma, c.d) for c in claims))
     started = time.perf_counter()
     with multiprocessing.Pool(processes) as pool:
-        results = dict(zip(unique, pool.map(_classify_or_none, unique)))
+        results = dict(zip(unique, pool.map(_classify_or_none, unique), strict=True))
     rows = [(c, results[(c.gamma, c.d)]) for c in claims]
     print(format_table(rows))
     print(f"\n{len(unique)} parameter points in {time.perf_counter() - started:.1f} s")

@@ -900,7 +900,7 @@ def regions_figure(top, gammas, marks, n, suptitle, lower=None):
     else:
         fig, axes = plt.subplots(2, 4, figsize=(16, 9.4))
         first_row = axes[0]
-    for ax, panel in zip(first_row, top):
+    for ax, panel in zip(first_row, top, strict=True):
         _regions_panel(ax, panel)
     if lower is not None:
         zoom = lower[0]
@@ -912,10 +912,10 @@ def regions_figure(top, gammas, marks, n, suptitle, lower=None):
         axes_top.annotate("magnified below", (b1, a0), xytext=(12, -18),
                           textcoords="offset points", fontsize=8,
                           arrowprops={"arrowstyle": "-", "lw": 0.6})
-        for ax, panel in zip(axes[1][1:], lower[1:]):
+        for ax, panel in zip(axes[1][1:], lower[1:], strict=True):
             _regions_panel(ax, panel)
     handles = [Line2D([], [], color=c, lw=2.5, label=fr"$\gamma = {g:g}$ ({marks[g]})")
-               for g, c in zip(gammas, FIGURE_COLORS)]
+               for g, c in zip(gammas, FIGURE_COLORS, strict=False)]
     handles += _style_handles() + [
         Patch(facecolor="0.6", alpha=_FILL_ALPHA + 0.1, label="stable (root counting, exact)"),
         Patch(facecolor="none", edgecolor="0.3", hatch=_SIM_HATCH,
@@ -1008,7 +1008,7 @@ def physical_figure(panels):
     plt = pyplot()
     fig, axes = plt.subplots(2, 2, figsize=(11, 9.6))
     counted = []
-    for ax, panel in zip(axes.ravel(), panels):
+    for ax, panel in zip(axes.ravel(), panels, strict=True):
         scale = panel["scale"]
         (b0, b1), (a0, a1) = panel["window"]
         ax.axhline(0.0, zorder=2, **_Z_ONE)

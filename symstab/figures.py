@@ -217,7 +217,7 @@ def _regions_panel(gammas, d, window, n, verdicts, beyond=True, colors=_COLORS, 
     gamma's verdict is appended to ``verdicts``.
     """
     layers = []
-    for g, color in zip(gammas, colors):
+    for g, color in zip(gammas, colors, strict=False):
         decomposition = _decomposition(g, d, window)
         simulated = None
         if n:
@@ -291,7 +291,7 @@ def _fig8_second_row(gammas):
             # The stable sets lie in the upper panel's window: its decomposition serves.
             layers = [(color, _decomposition(g, d, windows[d]), None,
                        arc_polylines(gamma=g, d=d, delta=DELTA, window=whole))
-                      for g, color in zip(gammas, _COLORS)]
+                      for g, color in zip(gammas, _COLORS, strict=False)]
             row.append({"window": whole, "layers": layers, "beyond": False, "box": windows[d],
                         "title": f"$d = {d}$, zoomed out: every arc whole"})
         return row
@@ -340,7 +340,7 @@ def fig7():
     gammas = (0.0, 0.5, 1.0, 1.5, 2.0, 2.5, 3.0)
     window = ((-4.5, 2.2), (-0.25, 6.6))
     loops, layers = {}, []
-    for g, color in zip(gammas, _COLORS):
+    for g, color in zip(gammas, _COLORS, strict=False):
         lim = limits(gamma=g, d=0, delta=DELTA)
         tag = "U" if lim.empty else ("S, a thin sliver" if lim.z_width < 0.05 else "S")
         arc = arc_polylines(gamma=g, d=0, delta=DELTA, window=window)
@@ -392,7 +392,7 @@ def fig10(n=40):
         found.append(row)
         panels.append(panel)
     fig, written = drawing.physical_figure(panels)
-    counted = dict(zip(gammas, written))
+    counted = dict(zip(gammas, written, strict=True))
     return FigureResult(
         "fig10_physical_td40", "physical units at Td = 40 ms, gamma = M_w/m = -0.5, 0, 0.5, 1", fig,
         "theory against simulations (ideal; quantization + filter; PI controller high/low gains) and "
@@ -462,9 +462,10 @@ def _fig10_finding(found, counted, passive_k, n):
         + "; ".join(f"gamma = {g:g}: " + ("no passive point" if k is None else
                                           f"passive K_max {k:.2f} N m/rad against the stable "
                                           f"{kt:.2f}")
-                    for (g, k), (_, kt, _, _, _, _) in zip(passive_k.items(), found))
+                    for (g, k), (_, kt, _, _, _, _) in zip(passive_k.items(), found, strict=True))
         + ("; the loop is stable far outside the passive set." if any(
-            k is not None and k < kt for (_, k), (_, kt, _, _, _, _) in zip(passive_k.items(), found))
+            k is not None and k < kt
+            for (_, k), (_, kt, _, _, _, _) in zip(passive_k.items(), found, strict=True))
            else "."))
 
 

@@ -303,7 +303,7 @@ def roots_outside_unit_circle_mp(coeffs, *, dps=60, n=1024, max_n=2**16):
                 phases.append(mpmath.arg(value))
             phases.append(phases[0])
             steps = [(b - a + mpmath.pi) % (2 * mpmath.pi) - mpmath.pi
-                     for a, b in zip(phases, phases[1:])]
+                     for a, b in zip(phases, phases[1:], strict=False)]
             if max(abs(s) for s in steps) < mpmath.pi / 4:
                 inside = int(mpmath.nint(sum(steps) / (2 * mpmath.pi)))
                 return len(c) - 1 - inside

@@ -285,7 +285,7 @@ def _prefetching_modules(monkeypatch, values=(int, int)):
     from paper_checks._common import Memo
 
     checks, memos = {}, []
-    for tag, value in zip("abc", values):
+    for tag, value in zip("abc", values, strict=False):   # two or three modules
         module = types.ModuleType(f"fake_checks_{tag}")
         monkeypatch.setitem(sys.modules, module.__name__, module)
 
@@ -541,7 +541,7 @@ def test_open_question_counts_match_first_principles(gamma, d):
 
     delta = PAPER_DEVICE.delta
     counted = open_questions.curve_counts(gamma, d)
-    for fraction, pair in zip(open_questions.FRACTIONS, counted.counts):
+    for fraction, pair in zip(open_questions.FRACTIONS, counted.counts, strict=True):
         with mpmath.workdps(40):
             alpha, beta = (float(x) for x in first_principles_boundary_point(
                 mpmath.mpf(fraction) * counted.theta_max, gamma, d, delta))

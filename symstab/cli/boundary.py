@@ -61,18 +61,18 @@ def run(args):
         else:
             notes = []
         columns = ["theta [rad]", setup.label(setup.x), setup.label(setup.y)]
-        rows = list(zip(curve.theta, curve.x_values, curve.y_values))
+        rows = list(zip(curve.theta, curve.x_values, curve.y_values, strict=True))
         notes.insert(0, f"D-decomposition: z = exp(j theta) is a closed-loop pole at ({setup.x}, "
                         f"{setup.y}) (nan: the 2 x 2 system is singular at that theta)")
         notes += [_line_text(setup, label, line) for label, line in curve.lines.items()]
         if not curve.lines:
             notes.append("no real-root or leading-coefficient line crosses this plane")
-        result = {"lines": {label: dict(zip(("c0", "cx", "cy"), line))
+        result = {"lines": {label: dict(zip(("c0", "cx", "cy"), line, strict=True))
                             for label, line in curve.lines.items()}}
     else:
         curve = boundary_curve(gamma=paper.gamma, d=paper.d, delta=paper.delta, n=n)
         columns = ["theta [rad]", "alpha", "beta"]
-        rows = list(zip(curve.theta, curve.alpha, curve.beta))
+        rows = list(zip(curve.theta, curve.alpha, curve.beta, strict=True))
         if paper.physical:
             columns += physical_columns(paper, ["K_w", "B_w"])
             rows = [r + (paper.device.stiffness(r[1]), paper.device.damping(r[2])) for r in rows]

@@ -384,7 +384,7 @@ def _nominal_row(setup, found, names, target):
     label, meaning = _TARGET_ROWS[target]
     y = setup.name(setup.y)
     nominal_text = ", ".join(f"{{{k}}} = {setup.values[name]:.6g}"
-                             for k, name in zip("pq", names))
+                             for k, name in zip("pq", names, strict=False))
     value_nominal = found.value_nominal
     return (((label[0] + f" at {nominal_text}"),
              None if setup.paper is None else
@@ -400,7 +400,7 @@ def _best_rows(found, names, target, lim, at_nominal):
     label, meaning = _TARGET_ROWS[target]
     kind = "area" if target == "area" else "y"
     rows = [(f"{{{k}}} (best)", found.best[name], k, f"the {{{k}}} that maximises {label[0]}")
-            for k, name in zip("pq", names)]
+            for k, name in zip("pq", names, strict=False)]
     rows.append((label, found.value, kind, f"{meaning} at the best "
                  + " and ".join(f"{{{k}}}" for k in "pq"[:len(names)])))
     if target == "simulated":

@@ -309,7 +309,7 @@ def _stretches(view):
     # The stretch of each path point: the crossings it has passed.
     position = np.searchsorted(forward * np.array(cuts), forward * values, side="right")
     known = {}
-    for k, c in zip(position, counts):
+    for k, c in zip(position, counts, strict=True):
         if c >= 0 and k not in known:
             known[int(k)] = int(c)
     out = [None] * (len(cuts) + 1)

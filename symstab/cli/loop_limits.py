@@ -118,7 +118,7 @@ def plane_table(setup, rows, *, over=None):
     in the device's units beside them (``K_w``, ``B_w``, ``M_w``).
     """
     names = {"x": setup.name(setup.x), "y": setup.name(setup.y),
-             **{k: setup.name(n) if n else "" for k, n in zip("pq", _searched(over))}}
+             **{k: setup.name(n) if n else "" for k, n in zip("pq", _searched(over), strict=True)}}
     physical_names = {"x": "B_w", "y": "K_w", "p": "M_w"}
     paper = setup.paper
     physical = paper is not None and paper.physical

@@ -275,7 +275,7 @@ class _PaperMap:
             cells += [K.ravel(), Bw.ravel()]
         for *values, s, c, e, g in zip(*cells, result.stable.ravel(),
                                        result.limit_cycle.ravel(), exact.ravel(),
-                                       result.growth.ravel()):
+                                       result.growth.ravel(), strict=True):
             buf.write(",".join(f"{v:.12g}" for v in values)
                       + f",{int(s)},{int(c)},{int(e)},{g:.6g}\n")
         return buf.getvalue().encode()
@@ -481,7 +481,7 @@ def _loop_csv(setup, xs, ys, code, simulated=None):
     if simulated is not None:
         columns += [simulated.stable.T.ravel(), simulated.limit_cycle.T.ravel(),
                     simulated.growth.T.ravel()]
-    for xv, yv, c, *sim in zip(*columns):
+    for xv, yv, c, *sim in zip(*columns, strict=True):
         row = f"{xv:.12g},{yv:.12g},{int(c)},{int(c == STABLE)}"
         if sim:
             row += f",{int(sim[0])},{int(sim[1])},{sim[2]:.6g}"
@@ -542,7 +542,8 @@ def _probability(args, setup, xs, ys, out, png_path):
         X, Y = np.meshgrid(xs, ys, indexing="ij")
         buf = io.StringIO()
         buf.write(f"{setup.label(x)},{setup.label(y)},probability,standard_error,marginal\n")
-        for row in zip(X.ravel(), Y.ravel(), p.ravel(), error.ravel(), marginal.ravel()):
+        for row in zip(X.ravel(), Y.ravel(), p.ravel(), error.ravel(), marginal.ravel(),
+                       strict=True):
             buf.write(f"{row[0]:.12g},{row[1]:.12g},{row[2]:.6g},{row[3]:.3g},{int(row[4])}\n")
         data = buf.getvalue()
     image = _probability_png(setup, found, fixed, drawn) if png_path is not None else None

@@ -259,14 +259,15 @@ def interval_texts(runs, codes, name, unit="", *, stable_ends="boundary"):
     if not runs:
         return "none", None, []
     closed = [tuple(stable_ends == "closed" and code == STABLE and not math.isinf(value)
-                    for value, code in zip(run, pair)) for run, pair in zip(runs, codes)]
+                    for value, code in zip(run, pair, strict=True))
+              for run, pair in zip(runs, codes, strict=True)]
     text = ", ".join(f"{'[' if shut[0] else '('}{_end_text(lo)}, {_end_text(hi)}"
                      f"{']' if shut[1] else ')'}"
-                     for (lo, hi), shut in zip(runs, closed)) + suffix
+                     for (lo, hi), shut in zip(runs, closed, strict=True)) + suffix
     kinds, found = [], {"marginal": [], "unstable": [], "boundary": []}
-    for (lo, hi), pair in zip(runs, codes):
+    for (lo, hi), pair in zip(runs, codes, strict=True):
         row = []
-        for value, code in zip((lo, hi), pair):
+        for value, code in zip((lo, hi), pair, strict=True):
             if math.isinf(value):
                 row.append("infinite")
                 continue
@@ -299,7 +300,8 @@ def emit(setup, fmt, columns, rows, *, result=None, notes=(), out=None, json_row
         payload = {"inputs": setup.as_dict(), **(result or {})}
         if rows and json_rows:
             payload["rows"] = [dict(zip(columns, (None if isinstance(v, float) and math.isnan(v)
-                                                  else v for v in row))) for row in rows]
+                                                  else v for v in row), strict=True))
+                               for row in rows]
         if notes:
             payload["notes"] = list(notes)
         json.dump(_plain(payload), out, indent=1, sort_keys=False)
@@ -324,7 +326,7 @@ def emit(setup, fmt, columns, rows, *, result=None, notes=(), out=None, json_row
         widths = [max(len(r[i]) for r in cells) for i in range(len(columns))]
         print(file=out)
         for k, r in enumerate(cells):
-            print("  ".join(c.rjust(w) for c, w in zip(r, widths)).rstrip(), file=out)
+            print("  ".join(c.rjust(w) for c, w in zip(r, widths, strict=True)).rstrip(), file=out)
             if k == 0:
                 print("  ".join("-" * w for w in widths), file=out)
     if notes:

@@ -632,7 +632,7 @@ def _grid(where, loop, x, y, table):
                 spec = list(np.linspace(low, high, n))
                 if name == "d":
                     whole = [round(v) for v in spec]
-                    if any(abs(v - w) > 1e-9 for v, w in zip(spec, whole)):
+                    if any(abs(v - w) > 1e-9 for v, w in zip(spec, whole, strict=True)):
                         raise ValueError(
                             f"{where}: [grid] d = {{from = {low}, to = {high}, points = {n}}} "
                             f"gives delays that are not whole samples ({spec[1]:.6g}, ...): "
@@ -648,7 +648,8 @@ def _grid(where, loop, x, y, table):
         raise ValueError(f"{where}: the grid has {size} points, more than {MAX_ROWS}")
     mesh = np.meshgrid(*[np.asarray(a) for a in axes], indexing="ij")
     rows = np.column_stack([m.ravel() for m in mesh]) if names else np.empty((0, 0))
-    return names, rows, "a grid of " + " x ".join(f"{len(a)} {n}" for n, a in zip(names, axes))
+    return names, rows, "a grid of " + " x ".join(f"{len(a)} {n}"
+                                                  for n, a in zip(names, axes, strict=True))
 
 
 def _random(where, loop, x, y, table):
@@ -702,7 +703,7 @@ def _table(plan, values, reasons, suffix):
         return buf.getvalue()
     buf = io.StringIO()
     buf.write(",".join(inputs + outputs + ["reason"]) + "\n")
-    for row, answer, reason in zip(plan["rows"], values, reasons):
+    for row, answer, reason in zip(plan["rows"], values, reasons, strict=True):
         cells = [f"{v:.12g}" for v in row] + [f"{v:.12g}" for v in answer]
         reason = " ".join(reason.split()).replace('"', "'")
         buf.write(",".join(cells + [f'"{reason}"']) + "\n")

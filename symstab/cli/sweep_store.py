@@ -164,7 +164,7 @@ def evaluate_rows(loop, question, names, rows):
     out = np.full((len(rows), len(question.columns())), np.nan)
     reasons = []
     for i, row in enumerate(rows):
-        values = {n: int(v) if n == "d" else float(v) for n, v in zip(names, row)}
+        values = {n: int(v) if n == "d" else float(v) for n, v in zip(names, row, strict=True)}
         out[i], reason = question.answer(loop, values)
         reasons.append(reason)
     return out, reasons

@@ -387,10 +387,10 @@ def proofs():
         out.append((f"{name}_closed_form", f"{name}: the closed form evaluated above "
                     f"delta = {function.switch} = its definition",
                     closed.subs(sp.exp(-dl), 1 / G), function.definition(dl).subs(sp.exp(-dl), 1 / G)))
-    for k, (form, derived) in enumerate(zip(delayed, chi.delayed.all_coeffs()[:3])):
+    for k, (form, derived) in enumerate(zip(delayed, chi.delayed.all_coeffs()[:3], strict=True)):
         out.append((f"delayed_coefficient_{k}", f"coefficient {k} of the delayed part / (delta^2 Gamma)",
                     as_derivation(form), derived / scale))
-    for k, (form, derived) in enumerate(zip(direct, chi.direct.all_coeffs())):
+    for k, (form, derived) in enumerate(zip(direct, chi.direct.all_coeffs(), strict=True)):
         out.append((f"direct_coefficient_{k}", f"coefficient {k} of the direct part / (delta^2 Gamma)",
                     as_derivation(form), derived / scale))
     step = dimensionless_step()

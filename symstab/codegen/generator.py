@@ -132,7 +132,7 @@ def c_argument_names(kernel):
     names = [str(symbol) for symbol, _, _ in kernel.args]
     taken = set(names)
     out = {}
-    for (symbol, _, _), name in zip(kernel.args, names):
+    for (symbol, _, _), name in zip(kernel.args, names, strict=True):
         if _needs_c_prefix(name):
             new = C_ARGUMENT_PREFIX + name
             while new in taken:
@@ -257,7 +257,7 @@ def kernels():
     names = ["z^(d+4)", "z^(d+3)", "z^(d+2)", "z^3", "z^2", "z^1", "z^0"]
     coefficient_outputs = tuple(
         (f"c{k}", kf.as_evaluable(expr), f"coefficient of {name}")
-        for k, (expr, name) in enumerate(zip(delayed + direct, names)))
+        for k, (expr, name) in enumerate(zip(delayed + direct, names, strict=True)))
     return (
         *(Kernel(f.__name__, (_ARG["delta"],),
                  ((f.__name__, f.evaluation(x), f.formula),),
@@ -578,7 +578,7 @@ def c_function(kernel, printer):
     if len(reduced) == 1:
         lines.append(f"    return {printer.doprint(reduced[0])};")
     else:
-        for (name, _, _), expr in zip(kernel.outputs, reduced):
+        for (name, _, _), expr in zip(kernel.outputs, reduced, strict=True):
             lines.append(f"    *{name} = {printer.doprint(expr)};")
     lines.append("}")
     return "\n".join(lines)

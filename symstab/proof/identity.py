@@ -86,7 +86,7 @@ def _rational_difference(lhs, rhs):
         return sp.nsimplify(diff) if diff.is_Float else sp.simplify(diff)
     R, *_ = ring(gens, sp.QQ_I)
     try:
-        return _Fraction.of(diff, dict(zip(R.symbols, R.gens)), R).numer
+        return _Fraction.of(diff, dict(zip(R.symbols, R.gens, strict=True)), R).numer
     except _NotPolynomial:
         # Outside what _Fraction builds: SymPy's field decides (and raises what it raises).
         K, *_ = field(gens, sp.QQ_I)

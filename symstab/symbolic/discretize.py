@@ -267,8 +267,8 @@ def _interval_expm1(M, n):
         divisor = (from_int(k),) * 2
         term = [[c if c == mpi_zero else mpi_div(c, divisor, prec) for c in row]
                 for row in _raw_product(term, M, prec)]
-        X = [[x if t == mpi_zero else mpi_add(x, t, prec) for x, t in zip(rx, rt)]
-             for rx, rt in zip(X, term)]
+        X = [[x if t == mpi_zero else mpi_add(x, t, prec) for x, t in zip(rx, rt, strict=True)]
+             for rx, rt in zip(X, term, strict=True)]
         # mu is an upper bound of ||M|| (rounded up by the interval sum).  The
         # bound decreases with k: where a float estimate of it is far above
         # 1e-40, the enclosure's check cannot stop the series yet.
@@ -414,7 +414,7 @@ def _poly_add(a, b):
     n = max(len(a), len(b))
     a = [iv.mpf(0)] * (n - len(a)) + list(a)
     b = [iv.mpf(0)] * (n - len(b)) + list(b)
-    return [x + y for x, y in zip(a, b)]
+    return [x + y for x, y in zip(a, b, strict=True)]
 
 
 def interval_product(a, b):

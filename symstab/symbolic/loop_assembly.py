@@ -884,7 +884,7 @@ class LoopModel:
         """
         names = [self.symbols[n] for n in self.plant_names]
         args = [sp.Dummy(n) for n in self.plant_names] + [sp.Dummy("T")]
-        rename = dict(zip(names, args))
+        rename = dict(zip(names, args, strict=False))
         rename.setdefault(model.T, args[-1])
         exprs = [[sp.sympify(c).xreplace(rename) for c in part] for part in exprs]
         return sp.lambdify(args, exprs, modules="mpmath")
@@ -925,9 +925,9 @@ class LoopModel:
             if not all(mpmath.isfinite(c) for part in parts for c in part):
                 return (*parts, digits)
             if before is not None and all(
-                    max(abs(a - b) for a, b in zip(old, new))
+                    max(abs(a - b) for a, b in zip(old, new, strict=True))
                     <= mpmath.mpf(10) ** -PLANT_DIGITS * max(abs(c) for c in new)
-                    for old, new in zip(before, parts)):
+                    for old, new in zip(before, parts, strict=True)):
                 return (*parts, digits)
             if before is not None and self._meeting_poles(point, T) is not None:
                 # Two precisions disagree because poles meet exactly (k_h = 0):
@@ -938,7 +938,8 @@ class LoopModel:
 
     def _refuse_plant(self, point, T):
         self._check_distinct_poles(point, T)
-        given = ", ".join(f"{n} = {float(v):g}" for n, v in zip(self.plant_names, point))
+        given = ", ".join(f"{n} = {float(v):g}"
+                          for n, v in zip(self.plant_names, point, strict=True))
         raise ValueError(f"the plant's pulse transfer function at {given}, T = {float(T):g} "
                          f"cancels beyond {PLANT_MAX_DIGITS} digits: a parameter is too small "
                          f"or too large for its closed form")
@@ -981,7 +982,8 @@ class LoopModel:
 
     def _meeting_poles(self, point, T):
         """``(expression, why, values)`` of the first of :attr:`_pole_conditions` that holds, or None."""
-        values = {self.symbols[n]: sp.Rational(float(v)) for n, v in zip(self.plant_names, point)}
+        values = {self.symbols[n]: sp.Rational(float(v))
+                  for n, v in zip(self.plant_names, point, strict=True)}
         values.setdefault(model.T, sp.Rational(float(T)))
         for expr, why in self._pole_conditions:
             if expr.xreplace(values) == 0:
@@ -1128,7 +1130,8 @@ class LoopModel:
                             "numerator and denominator in s have opposite signs)")
         if not problems:
             return None
-        given = ", ".join(f"{n} = {float(v):g}" for n, v in zip(self.plant_names, plant_values))
+        given = ", ".join(f"{n} = {float(v):g}"
+                          for n, v in zip(self.plant_names, plant_values, strict=True))
         return (f"the plant G(s) = {self.plant} at {given} has {' and '.join(problems)}: not a "
                 f"physical device's (a negative mass, friction or stiffness?); the results are "
                 f"those of that plant")
@@ -1151,7 +1154,7 @@ class LoopModel:
             point = [mpmath.mpf(float(v)) for v in plant_values]
             if self._plant_parts is None:
                 sub = {self.symbols[n]: sp.Float(float(v), PLANT_DIGITS)
-                       for n, v in zip(self.plant_names, plant_values)}
+                       for n, v in zip(self.plant_names, plant_values, strict=True)}
                 num, den = sp.fraction(sp.together(self.plant.subs(sub)))
                 num = [mpmath.mpf(sp.Float(c, PLANT_DIGITS)) for c in sp.Poly(num, model.s).all_coeffs()]
                 den = [mpmath.mpf(sp.Float(c, PLANT_DIGITS)) for c in sp.Poly(den, model.s).all_coeffs()]
@@ -1167,7 +1170,8 @@ class LoopModel:
             if not _defined(p_n, p_d):
                 if self._plant_parts is not None:
                     self._check_distinct_poles(plant_values, T)   # says which poles meet
-                given = ", ".join(f"{n} = {float(v):g}" for n, v in zip(self.plant_names, plant_values))
+                given = ", ".join(f"{n} = {float(v):g}"
+                                  for n, v in zip(self.plant_names, plant_values, strict=True))
                 raise ValueError(f"the plant's pulse transfer function is not defined at "
                                  f"{given}, T = {float(T):g} (its leading coefficient in s "
                                  f"vanishes there, or a value is not finite)")
@@ -1239,7 +1243,7 @@ class LoopModel:
             # 6e-25 N/m for the z = 1 line at T = 0.25 ms); an end within
             # 1000 ulps of its terms is that zero.
             ends = [mpmath.mpf(0) if abs(end) <= mpmath.mpf(10)**(3 - PLANT_DIGITS) * sum(abs(c) for c in part)
-                    else end for end, part in zip(ends, (p_n, p_d, p_n, p_d))]
+                    else end for end, part in zip(ends, (p_n, p_d, p_n, p_d), strict=True)]
             monic = [c / lead for c in p_d]
             near_one = list(shift_to_one(monic, dtype=object))
             return tuple(np.array(_real_floats(part)) for part in

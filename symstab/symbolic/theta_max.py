@@ -648,7 +648,9 @@ def first_sign_change(evaluate, points, cells, *, slope0, slope0_error, curvatur
     for first in range(1, cells + 1, chunk):
         more = points(np.arange(first, min(first + chunk, cells + 1)))
         values = evaluate(more)
-        t, v, p, ve, pe = (np.concatenate([old, new]) for old, new in zip(start, (more,) + tuple(values)))
+        # start[5] (the zero flags) has no counterpart in values: it is extended below.
+        t, v, p, ve, pe = (np.concatenate([old, new])
+                           for old, new in zip(start, (more,) + tuple(values), strict=False))
         zero = np.concatenate([start[5], np.zeros(more.size, dtype=bool)])
         if root_at_end and first + chunk > cells:
             v[-1], ve[-1] = nought, nought

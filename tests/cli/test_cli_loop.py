@@ -78,7 +78,7 @@ def test_classify_gives_todays_radius_and_python_controls_pole_count(capsys):
                      "--Kw", ",".join(map(str, kw)), "--Bw", ",".join(map(str, bw)))
     assert len(loop["rows"]) == 4
     verdicts = set()
-    for row, today, k, b in zip(loop["rows"], paper["rows"], kw, bw):
+    for row, today, k, b in zip(loop["rows"], paper["rows"], kw, bw, strict=True):
         assert (row["K [N m/rad]"], row["B [N m s/rad]"]) == (k, b)
         assert row["spectral radius"] == pytest.approx(today["spectral radius"], rel=1e-6)
         assert row["verdict"] == today["verdict"]

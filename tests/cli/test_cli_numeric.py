@@ -77,7 +77,7 @@ def test_classify_agrees_with_python_control(capsys):
                          "--Bw", ",".join(map(str, bw)), "--format", "json")
     assert status == 0
     rows = json.loads(out)["rows"]
-    for row, k, b in zip(rows, kw, bw):
+    for row, k, b in zip(rows, kw, bw, strict=True):
         alpha, beta = k * PAPER_T**2 / PAPER_M, b * PAPER_T / PAPER_M
         poles = python_control_closed_loop(alpha=alpha, beta=beta, gamma=0.0, d=10,
                                            delta=PAPER_DELTA, m=PAPER_M, T=PAPER_T).poles()

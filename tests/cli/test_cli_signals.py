@@ -72,9 +72,10 @@ def test_a_signal_at_any_moment_ends_the_command_with_one_line(tmp_path):
     for folder in folders:
         folder.mkdir()
     with concurrent.futures.ThreadPoolExecutor(4) as pool:
-        results = list(pool.map(_interrupt, folders, *zip(*runs)))
+        results = list(pool.map(_interrupt, folders, *zip(*runs, strict=True)))
     failures = []
-    for (signum, moment), folder, (status, err, seconds) in zip(runs, folders, results):
+    for (signum, moment), folder, (status, err, seconds) in zip(runs, folders, results,
+                                                                strict=True):
         # After the one line and the cleanup, CPython itself sometimes ends
         # the process with kill(getpid(), SIGINT) (strace shows it; about 1
         # run in 25 under load): a shell reports that as 130 too, and it is

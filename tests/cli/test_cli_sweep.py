@@ -88,7 +88,8 @@ def test_a_design_sweep_finds_the_best_virtual_mass_at_each_delay(capsys, tmp_pa
     np.testing.assert_allclose(gains, [5.82, 4.14], atol=0.005)
     loop = symstab.load_loop(LOOPS / "paper.toml")
     assert len(calls) == 2
-    for d, (best, value, nominal), (used, kwargs, found) in zip((0, 40), answers, calls):
+    for d, (best, value, nominal), (used, kwargs, found) in zip((0, 40), answers, calls,
+                                                                strict=True):
         # The call: paper.toml's loop, over M in [-0.0141, 0.0384] kg m^2 at d, K_max in (B, K).
         assert used.defaults == loop.defaults and str(used) == str(loop)
         assert kwargs == {"over": {"M": (-0.0141, 0.0384)}, "maximize": "y_max", "x": "B",

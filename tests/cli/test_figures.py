@@ -208,7 +208,7 @@ def test_z_width_closes_to_zero_where_the_region_vanishes(drawn, name, right):
 
     lower = drawn[name].axes[4:8]
     assert len(lower) == 4, "a lower row of linear Z-width panels"
-    for ax, d in zip(lower, figures.DELAYS):
+    for ax, d in zip(lower, figures.DELAYS, strict=True):
         line, = ax.lines[:1]
         g, z = line.get_xdata(), line.get_ydata()
         end, before = (-1, -2) if right else (0, 1)
@@ -264,7 +264,7 @@ def test_fig10_counts_in_the_cells_agree_with_numpy_roots(drawn):
     from symstab.numeric.paper.device import PAPER_DEVICE as dev
 
     fig = drawn["fig10"]
-    for ax, g in zip(fig.axes[:4], (-0.5, 0.0, 0.5, 1.0)):
+    for ax, g in zip(fig.axes[:4], (-0.5, 0.0, 0.5, 1.0), strict=True):
         counts = [t for t in ax.texts if t.get_text().isdigit()]
         assert len(counts) >= 2, ax.get_title()
         for t in counts:

@@ -260,7 +260,7 @@ def test_c_boundary_matches_numpy(c_kernels, random_points):
         numpy_alpha[m], numpy_beta[m] = numpy_kernels.boundary(p["theta"][m], p["gamma"][m],
                                                                int(d), p["delta"][m])
     c_alpha, c_beta = np.array([c_kernels.boundary(t, g, d, dl) for t, g, d, dl in
-                                zip(p["theta"], p["gamma"], p["d"], p["delta"])]).T
+                                zip(p["theta"], p["gamma"], p["d"], p["delta"], strict=True)]).T
     where = {k: p[k] for k in ("theta", "gamma", "d", "delta")}
     _assert_all_below(_mixed_error(c_alpha, numpy_alpha), C_VS_NUMPY_RTOL, where, "alpha, C vs NumPy")
     _assert_all_below(_mixed_error(c_beta, numpy_beta), C_VS_NUMPY_RTOL, where, "beta, C vs NumPy")
@@ -270,7 +270,7 @@ def test_c_loop_coefficients_match_numpy(c_kernels, random_points):
     p = random_points
     args = [p[k] for k in ("alpha", "beta", "gamma", "delta")]
     numpy_c = numpy_kernels.loop_coefficients(*args)
-    c_c = np.array([c_kernels.loop_coefficients(*point) for point in zip(*args)]).T
+    c_c = np.array([c_kernels.loop_coefficients(*point) for point in zip(*args, strict=True)]).T
     where = {k: p[k] for k in ("alpha", "beta", "gamma", "delta")}
     for k in range(7):
         # c2 is the constant 1 (a scalar in NumPy): broadcast before comparing.
@@ -344,7 +344,8 @@ def test_boundary_matches_derivation_at_50_digits(c_kernels, delta, d, gamma):
     for theta in thetas:
         ref = boundary_point(float(theta), gamma=gamma, d=d, delta=delta, dps=50)
         for kernel, f in _kernel_boundaries(c_kernels).items():
-            for name, value, expected in zip(("alpha", "beta"), f(theta, gamma, d, delta), ref):
+            for name, value, expected in zip(("alpha", "beta"), f(theta, gamma, d, delta), ref,
+                                             strict=True):
                 err = relative_error(mpmath.mpf(float(value)), expected)
                 if not err <= BOUNDARY_RTOL:
                     failures.append(f"{kernel} {name} at theta={theta!r}: {float(value)!r} vs "
@@ -468,7 +469,7 @@ def test_series_functions_match_definition_from_0_to_1e6(request, kernel, name):
         c = request.getfixturevalue("c_kernels")
         values = np.array([c.series_function(name, x) for x in SERIES_POINTS])
     errors = np.array([float(relative_error(mpmath.mpf(float(v)), _series_reference(name, x)))
-                       for v, x in zip(values, SERIES_POINTS)])
+                       for v, x in zip(values, SERIES_POINTS, strict=True)])
     _assert_all_below(errors, SERIES_FUNCTION_RTOL, {"delta": SERIES_POINTS}, f"{kernel} {name}")
 
 
@@ -591,7 +592,8 @@ def test_c_plant_step_coefficients_match_numpy(c_kernels, simulator_points):
 def test_c_plant_step_matches_numpy(c_kernels, simulator_points):
     p = simulator_points
     args = [p[k] for k in ("position", "velocity", "force", "delta")]
-    c = np.array([_c_call(c_kernels.lib.symstab_plant_step, point, 2) for point in zip(*args)]).T
+    c = np.array([_c_call(c_kernels.lib.symstab_plant_step, point, 2)
+                  for point in zip(*args, strict=True)]).T
     numpy_c = numpy_kernels.plant_step(*args)
     where = {k: p[k] for k in ("position", "velocity", "force", "delta")}
     for k, name in enumerate(("position_next", "velocity_next")):
@@ -605,7 +607,7 @@ def test_c_environment_force_matches_numpy(c_kernels, simulator_points):
     names = ("x_k", "x_km1", "x_km2", "alpha", "beta", "gamma")
     args = [p[k] for k in names]
     function = c_kernels.lib.symstab_environment_force
-    c = np.array([function(*(float(a) for a in point)) for point in zip(*args)])
+    c = np.array([function(*(float(a) for a in point)) for point in zip(*args, strict=True)])
     _assert_all_below(_mixed_error(c, numpy_kernels.environment_force(*args)), C_VS_NUMPY_RTOL,
                       {k: p[k] for k in names}, "force, C vs NumPy")
 
@@ -680,7 +682,7 @@ def test_classification_at_extreme_delta_matches_60_digit_roots(delta, d):
     codes = symstab.classify(alpha=alphas, beta=beta, gamma=0.0, d=d, delta=delta)
     radii = symstab.spectral_radius(alpha=alphas, beta=beta, gamma=0.0, d=d, delta=delta)
     with mpmath.workdps(60):
-        for a, code, radius in zip(alphas, codes, radii):
+        for a, code, radius in zip(alphas, codes, radii, strict=True):
             roots = mpmath.polyroots(first_principles_chi(a, beta, 0.0, d, delta),
                                      maxsteps=200, extraprec=200)
             exact = max(abs(r) for r in roots)

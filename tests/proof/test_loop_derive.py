@@ -716,13 +716,14 @@ def test_parameters_named_as_c_macros_functions_and_keywords_compile_and_compute
         for _ in range(3):
             args = [loop.defaults[n] * rng.uniform(0.5, 2.0) for n in names]
             got = c[f"symstab_c_names_{kernel.name}"](*args)
-            sub = {symbol: sp.Float(repr(a), 30) for (symbol, _, _), a in zip(kernel.args, args)}
+            sub = {symbol: sp.Float(repr(a), 30)
+                   for (symbol, _, _), a in zip(kernel.args, args, strict=True)}
             exact = np.array([float(sp.re(sp.sympify(expr).replace(
                 lambda e: isinstance(e, sp.Function) and type(e).__name__ == "RealPart",
                 lambda e: e.args[0]).xreplace(sub).evalf(30))) for _, expr, _ in kernel.outputs])
             np.testing.assert_allclose(got, exact, rtol=1e-9, atol=1e-12, err_msg=kernel.name)
             if kernel.name == "pulse_transfer_function":
-                value = dict(zip(names, args))
+                value = dict(zip(names, args, strict=True))
                 sampled = control.c2d(control.tf([1.0], [value["I"], value["complex"],
                                                          value["y0"]]), value["T"], "zoh")
                 ref_num, ref_den = (np.trim_zeros(np.asarray(x[0][0], dtype=float), "f")

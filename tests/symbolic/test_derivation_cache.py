@@ -59,7 +59,7 @@ def numbers(loop):
 
 
 def assert_identical(a, b):
-    for x, y in zip(a, b):
+    for x, y in zip(a, b, strict=True):
         if isinstance(x, np.ndarray):
             np.testing.assert_array_equal(x, y)
         else:

@@ -92,7 +92,7 @@ def test_every_well_conditioned_root_matches_python_control(point):
     rows, cols = linear_sum_assignment(cost)
     kappa = _root_condition_numbers(coeffs, roots)
     checked = 0
-    for i, j in zip(rows, cols):
+    for i, j in zip(rows, cols, strict=True):
         # A root with condition number kappa moves by ~kappa * 1e-16 relative
         # under rounding of the coefficients; compare those up to kappa = 1e4.
         if kappa[j] < 1e4:
@@ -114,7 +114,7 @@ def test_numeric_coeffs_loses_accuracy_for_small_delta(loop, delta_value):
     with mpmath.workdps(30):
         exact = loop_coefficients_mp(**point)
     numeric = loop.numeric_coeffs(**point)
-    for e, x in zip(exact, numeric):
+    for e, x in zip(exact, numeric, strict=True):
         assert abs(x - float(e)) <= 1e-12 * abs(float(e)), (float(e), x)
 
 

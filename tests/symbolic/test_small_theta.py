@@ -124,7 +124,7 @@ def test_taylor_coefficients_equal_sympy_series(expr, fast):
     series = sp.expand(sp.series(expr, _t, 0, order + 1).removeO())
     expected = [series.coeff(_t, k) for k in range(order + 1)]
     got = taylor_coefficients(expr, order)
-    assert [sp.simplify(a - b) for a, b in zip(got, expected)] == [0] * (order + 1)
+    assert [sp.simplify(a - b) for a, b in zip(got, expected, strict=True)] == [0] * (order + 1)
 
 
 def test_boundary_forms_take_the_fast_path():

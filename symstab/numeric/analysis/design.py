@@ -605,7 +605,7 @@ def design(loop, *, over, maximize="y_max", x=None, y=None, n=None, rtol=None, d
 
     def at(point):
         """The values at a point of the search; with ``delay``, d = ceil(delay / T) there."""
-        out = {**values, **dict(zip(names, point))}
+        out = {**values, **dict(zip(names, point, strict=True))}
         if delay is not None:
             out["d"] = held_delay(delay, out.get("T", loop.defaults.get("T")))
         return out
@@ -632,7 +632,7 @@ def design(loop, *, over, maximize="y_max", x=None, y=None, n=None, rtol=None, d
                 kept[tuple(float(v) for v in point)] = (value, found)
             return value
         except ValueError as exc:
-            failed.append((dict(zip(names, point)), str(exc)))
+            failed.append((dict(zip(names, point, strict=True)), str(exc)))
             return math.nan
 
     include = [tuple(nominal[n_] for n_ in names)] if nominal else []
@@ -658,7 +658,7 @@ def design(loop, *, over, maximize="y_max", x=None, y=None, n=None, rtol=None, d
         message = _not_found(maximize, simulation, x, y, over, searched, bracket, samples,
                              spacing, failed)
         return Design(best=None, value=None, limits=None, message=message, **common)
-    return Design(best=dict(zip(names, (float(v) for v in best))), value=float(value),
+    return Design(best=dict(zip(names, (float(v) for v in best), strict=True)), value=float(value),
                   limits=answer(best), **common)
 
 
@@ -790,7 +790,7 @@ def _bracket(loop, maximize, x, y, names, over, at):
     if ranges is None:
         return None
     out = {}
-    for name, (lo, hi), (low, high) in zip(names, ranges[2:], over.values()):
+    for name, (lo, hi), (low, high) in zip(names, ranges[2:], over.values(), strict=True):
         # Wider than the programme's ends by more than its tolerance (never
         # past the range).
         pad = 1e-6 * (high - low)

@@ -218,7 +218,7 @@ class _Enclosures:
         iv.dps = _DIGITS
         try:
             values = {n: iv.mpf(float(v)) for n, v in self.fixed.items()}
-            for name, (lo, hi) in zip(self.names, self.boxes[index]):
+            for name, (lo, hi) in zip(self.names, self.boxes[index], strict=True):
                 values[name] = iv.mpf([float(lo), float(hi)])
             plant = [[_bound(c, values) for c in part] for part in self.plant]
             p_n, p_d = interval_zoh(*plant, values["T"])
@@ -712,7 +712,7 @@ def _span_table(open_spans):
     lo, hi = np.full((size, most), np.inf), np.full((size, most), -np.inf)
     rows = [(s, j, a, b) for s, spans in open_spans.items() for j, (a, b) in enumerate(spans)]
     if rows:
-        s, j, a, b = zip(*rows)
+        s, j, a, b = zip(*rows, strict=True)
         lo[s, j], hi[s, j] = a, b
     return lo, hi
 
@@ -730,7 +730,7 @@ def _mark(marked, strips, parts):
     touched = set()
     for lo, hi in parts:
         some = lo <= hi
-        for s, a, b in zip(strips[some], lo[some], hi[some]):
+        for s, a, b in zip(strips[some], lo[some], hi[some], strict=True):
             marked[int(s)].append((float(a), float(b)))
             touched.add(int(s))
     for s in touched:
@@ -832,7 +832,7 @@ def _certify(enclosures, shift, geometry, candidates, tol, budget):
 def _grid(box):
     """The values of the box the candidates are found at: corners, centre, midpoints."""
     axes = [np.linspace(lo, hi, _GRID) if hi > lo else np.array([lo]) for lo, hi in box.values()]
-    return [dict(zip(box, point)) for point in itertools.product(*axes)]
+    return [dict(zip(box, point, strict=True)) for point in itertools.product(*axes)]
 
 
 def _check_uncertain(loop, uncertain, axes):
@@ -932,7 +932,7 @@ def robust_region(loop, x=None, y=None, *, uncertain, strips=64, rtol=1e-6, x_ra
     # Every corner of the box is asked of the loop (its domain: a pole that
     # cancels, a period that is not positive) before any work.
     for corner in itertools.product(*box.values()):
-        loop.unstable_root_counts(**fixed, **dict(zip(box, corner)), d=centre_d,
+        loop.unstable_root_counts(**fixed, **dict(zip(box, corner, strict=True)), d=centre_d,
                                   **{x: 0.0, y: 0.0})
 
     from ..._progress import progress_printer
@@ -1034,7 +1034,7 @@ def _strip_geometry(loop, x, y, fixed, box, delays, window, strips, rtol):
         for d in delays:
             for point in grid:
                 spans = loop.stable_intervals(y, **{x: np.asarray(xs)}, **fixed, **point, d=d)
-                found = [_intersect(a, b) for a, b in zip(found, spans)]
+                found = [_intersect(a, b) for a, b in zip(found, spans, strict=True)]
         return found
 
     edges = list(np.linspace(x_lo, x_hi, strips + 1)) if x_hi > x_lo else [x_lo, x_lo]
@@ -1141,13 +1141,14 @@ def _split(look, edges, spans, narrowest, most):
         if not halve:
             break
         middles = [0.5 * (edges[i] + edges[i + 1]) for i in halve]
-        wanted = [(edges[i], edges[i + 1]) for i, m in zip(halve, middles) if m not in known]
+        wanted = [(edges[i], edges[i + 1])
+                  for i, m in zip(halve, middles, strict=True) if m not in known]
         if wanted:
             depth = max(1, int(np.log2(_LOOK_AHEAD / len(wanted) + 1)))
             ahead = [m for a, b in wanted for m in _halvings(a, b, depth)]
-            known.update(zip(ahead, look(ahead)))
+            known.update(zip(ahead, look(ahead), strict=True))
         found = [known[m] for m in middles]
-        for i, m, f in sorted(zip(halve, middles, found), reverse=True):
+        for i, m, f in sorted(zip(halve, middles, found, strict=True), reverse=True):
             edges.insert(i + 1, m)
             spans.insert(i + 1, f)
         added += len(halve)
@@ -1172,7 +1173,7 @@ def _trapezoids(edges, spans):
     for i in range(len(edges) - 1):
         left, right = spans[i], spans[i + 1]
         if len(left) == len(right):
-            pairs = [(a[0], a[1], b[0], b[1]) for a, b in zip(left, right)]
+            pairs = [(a[0], a[1], b[0], b[1]) for a, b in zip(left, right, strict=True)]
         else:
             pairs = [(lo, hi, lo, hi) for lo, hi in _intersect(left, right)]
         for row in pairs:

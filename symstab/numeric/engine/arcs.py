@@ -245,8 +245,8 @@ def _bracket(first, second):
     if p.dtype == object or q.dtype == object:
         # Exact coefficients: the sums in rational arithmetic, rounded once.
         sums = {}
-        for j, a in zip(pj.tolist(), p):
-            for k, b in zip(qk.tolist(), q):
+        for j, a in zip(pj.tolist(), p, strict=True):
+            for k, b in zip(qk.tolist(), q, strict=True):
                 if j != k:
                     term = _exact(a) * _exact(b)
                     sums[abs(j - k)] = sums.get(abs(j - k), 0) + (term if j > k else -term)
@@ -265,7 +265,9 @@ def _bracket(first, second):
     frequencies, start = np.unique(m, return_index=True)
     stop = np.append(start[1:], len(m))
     terms = np.concatenate([(sign * hi)[:, None], (sign * lo)[:, None]], axis=1)
-    e = np.array([math.fsum(terms[a:b].ravel()) for a, b in zip(start, stop)], dtype=float)
+    # strict=False: with no term of nonzero frequency (m empty), stop is [0] beside no start.
+    e = np.array([math.fsum(terms[a:b].ravel()) for a, b in zip(start, stop, strict=False)],
+                 dtype=float)
     keep = e != 0
     return frequencies[keep].astype(float), e[keep]
 
@@ -381,7 +383,7 @@ class Brackets:
         # One table of sin(m theta) / sin(theta) for the frequencies of all brackets.
         self._frequencies = np.unique(np.concatenate([m for m, _ in series]))
         self._coefficients = np.zeros((len(series), len(self._frequencies)))
-        for row, (m, e) in zip(self._coefficients, series):
+        for row, (m, e) in zip(self._coefficients, series, strict=True):
             row[np.searchsorted(self._frequencies, m)] = e
         longest = max(max(len(p[0]), len(p[1])) for p in parts)
         self._ends = None

@@ -251,7 +251,8 @@ def _prepared(given, ends):
         if ends is not None:
             ends = (ends[0], (0.0, 0.0), ends[-1])
     given = (base, across, slope)
-    polynomials = _common([_one(p, name) for p, name in zip(given, ("base", "across", "slope"))])
+    polynomials = _common([_one(p, name)
+                           for p, name in zip(given, ("base", "across", "slope"), strict=True)])
     if all(isinstance(x, DelayedPolynomial) for x in given):
         given = polynomials
     if ends is None:
@@ -269,7 +270,7 @@ def _carry(counts, steps, first):
     lost, or it follows a marginal stretch).
     """
     need = []
-    for start, stop in zip(first[:-1], first[1:]):
+    for start, stop in zip(first[:-1], first[1:], strict=True):
         for k in range(start + 1, stop):
             if counts[k] != -2:
                 continue
@@ -396,7 +397,7 @@ def family_intervals(base, across, slope, at, ends=None, *, arc=None):
             out.append(None)
             continue
         runs = []
-        for c, lo, hi in zip(counts[s], edges_lo[s], edges_hi[s]):
+        for c, lo, hi in zip(counts[s], edges_lo[s], edges_hi[s], strict=True):
             if c != 0:
                 continue
             lo, hi = float(lo) + 0.0, float(hi) + 0.0     # no -0.0

@@ -443,7 +443,7 @@ def _track(values, coefficients):
         halvings[split] += 1
         halvings = np.insert(halvings, at, halvings[split])
         parts = []
-        for whole, l_part, r_part in zip((match, clear, turn), left, right):
+        for whole, l_part, r_part in zip((match, clear, turn), left, right, strict=True):
             whole[split] = l_part
             parts.append(np.insert(whole, at, r_part, axis=0))
         match, clear, turn = parts
@@ -549,7 +549,7 @@ def _crossings(p, tracked, coefficients):
         brackets += [(int(seen[t]), int(seen[t + 1]), k) for t in turn]
     if not brackets:
         return ()
-    start, end, column = (np.array(x) for x in zip(*brackets))
+    start, end, column = (np.array(x) for x in zip(*brackets, strict=True))
     za, zb = tracked[start, column], tracked[end, column]
     pa, pb = p[start], p[end]
 

@@ -147,7 +147,7 @@ class DelayedPolynomial:
         near = self.near_one
         if near is not None:
             near = [np.array(near[0]), np.array(near[1])]
-        for w, other in zip(weights, others):
+        for w, other in zip(weights, others, strict=True):
             if (other.shift != self.shift or other.delayed.shape[-1] != delayed.shape[-1]
                     or other.direct.shape[-1] != direct.shape[-1]):
                 raise ValueError("an affine family needs parts of the same structure")

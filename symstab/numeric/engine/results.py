@@ -601,7 +601,7 @@ class RobustRegion:
         """
         holds, lo, hi = self._ends_at(float(x))
         out = []
-        for a, b in sorted(zip(lo[holds].tolist(), hi[holds].tolist())):
+        for a, b in sorted(zip(lo[holds].tolist(), hi[holds].tolist(), strict=True)):
             if out and a <= out[-1][1]:
                 out[-1] = (out[-1][0], max(out[-1][1], b))
             else:

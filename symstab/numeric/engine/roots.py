@@ -393,7 +393,7 @@ class _Arcs:
                  "dm", "d1m", "nm", "n1m", "e_dm")
 
     def __init__(self, *columns):
-        for name, value in zip(self.__slots__, columns):
+        for name, value in zip(self.__slots__, columns, strict=True):
             setattr(self, name, value)
 
     def take(self, keep):

@@ -322,7 +322,8 @@ class LoopEvaluation:
         unique, inverse = self._plant_rows(values, shape)
         rows = []
         for row in unique:
-            sub = {symbols[n]: sp.Float(repr(float(v)), PLANT_DIGITS) for n, v in zip(names, row)}
+            sub = {symbols[n]: sp.Float(repr(float(v)), PLANT_DIGITS)
+                   for n, v in zip(names, row, strict=True)}
             lead = den[0].subs(sub).evalf(PLANT_DIGITS)
             rows.append(([float(sp.diff(c, symbol).subs(sub).evalf(PLANT_DIGITS) / lead) for c in num],
                          [float(sp.diff(c, symbol).subs(sub).evalf(PLANT_DIGITS) / lead) for c in den]))

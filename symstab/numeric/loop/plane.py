@@ -112,7 +112,7 @@ def stable_intervals(loop, name, **values):
                             arc=arc)
     if across is not None and not family:
         values = {**values, across: float(at[0])}
-    for value, r in zip(at, runs):
+    for value, r in zip(at, runs, strict=True):
         if r is None:
             fixed = ", ".join(f"{k} = {v:g}" for k, v in values.items() if k != "d")
             if family:

@@ -149,7 +149,7 @@ def _power(x):
 def _dimension_text(dimensions):
     """``"kg m^2 s^-2"``: a dimension in SI base units (``"1"`` when dimensionless)."""
     parts = [_BASE_SYMBOLS[b] + ("" if e == 1 else f"^{_power(e)}")
-             for b, e in zip(_BASES, dimensions) if e]
+             for b, e in zip(_BASES, dimensions, strict=True) if e]
     return " ".join(parts) or "1"
 
 
@@ -503,12 +503,13 @@ class _Dimensions:
             first, first_dims = terms[0]
             for term, dims in terms[1:]:
                 self.constraints.append(((where, first, term),
-                                         tuple(a - b for a, b in zip(first_dims, dims))))
+                                         tuple(a - b for a, b in zip(first_dims, dims,
+                                                                     strict=True))))
             return first_dims
         if isinstance(expr, sp.Mul):
             out = (0,) * len(_BASES)
             for factor in expr.args:
-                out = tuple(a + b for a, b in zip(out, self.of(factor, where)))
+                out = tuple(a + b for a, b in zip(out, self.of(factor, where), strict=True))
             return out
         if isinstance(expr, sp.Pow) and not expr.exp.free_symbols:
             power = sp.nsimplify(expr.exp, rational=True)
@@ -530,7 +531,7 @@ def _solve(equations, unknowns):
     solution = sp.linsolve(equations, free)
     if solution == sp.EmptySet:
         return None
-    return dict(zip(free, next(iter(solution))))
+    return dict(zip(free, next(iter(solution)), strict=True))
 
 
 #: VE(z): force over displacement, linear (N/m) or rotary (N m/rad).
@@ -629,7 +630,8 @@ def _check_dimensions(loop, file_values, bounds, source):
     system = _Dimensions()
     plant = system.of(loop.plant, "the plant G(s)")
     environment = system.of(loop.environment, "the environment VE(z)")
-    system.constraints.append((("loop", None, None), tuple(a + b for a, b in zip(plant, environment))))
+    system.constraints.append((("loop", None, None),
+                               tuple(a + b for a, b in zip(plant, environment, strict=True))))
     known = {"T": _vector({"[time]": 1})}
     for name, entry in file_values.items():
         if entry.info is not None:
@@ -641,9 +643,9 @@ def _check_dimensions(loop, file_values, bounds, source):
         sub = {}
         for name in fixed:
             sub.update(zip(system.unknown(name), (sp.Rational(x.numerator, x.denominator)
-                                                  for x in fixed[name])))
+                                                  for x in fixed[name]), strict=True))
         ve = tuple(a - sp.Rational(b.numerator, b.denominator)
-                   for a, b in zip(environment, _STIFFNESS[stiffness]))
+                   for a, b in zip(environment, _STIFFNESS[stiffness], strict=True))
         out = {}
         for k in range(len(_BASES)):
             equations = [c[1][k] for c in system.constraints] + [ve[k]]
@@ -710,7 +712,7 @@ def _check_bound_dimensions(bounds, dimensions, source):
         sub = {}
         for name in names:
             sub.update(zip(_Dimensions.unknown(name), (sp.Rational(x.numerator, x.denominator)
-                                                        for x in dimensions[name])))
+                                                        for x in dimensions[name]), strict=True))
         system = _Dimensions()
         dims = [sp.expand(sp.sympify(v).xreplace(sub)) for v in system.of(bound.expression, "")]
         broken = [c for c in system.constraints
@@ -734,7 +736,7 @@ def _reason(system, known, loop):
     sub = {}
     for name, dims in known.items():
         sub.update(zip(_Dimensions.unknown(name), (sp.Rational(x.numerator, x.denominator)
-                                                    for x in dims)))
+                                                    for x in dims), strict=True))
 
     def dims_of(expr):
         vec = _Dimensions().of(expr, "")

@@ -1114,7 +1114,7 @@ class _AnyLoop:
             self.keep_s += count
             self.keep_f += count
             return
-        for buffer, keep in zip((self.X, self.U, self.S, self.F), self.past):
+        for buffer, keep in zip((self.X, self.U, self.S, self.F), self.past, strict=True):
             if keep:
                 buffer[:keep] = buffer[moved:moved + keep]
         self.keep_x, self.keep_u, self.keep_s, self.keep_f = self.past

@@ -106,7 +106,7 @@ def check_against_sweep(region, terms, damping, fixed, static, rng, n_points=60,
     ys = rng.uniform(y0, y1, n_points)
     passive = region.contains(xs, ys)
     decided = {True: 0, False: 0}
-    for x, y, verdict in zip(xs, ys, passive):
+    for x, y, verdict in zip(xs, ys, passive, strict=True):
         point = dict(fixed, **{region.x: x, region.y: y})
         margin = worst_margin(terms, point, damping)
         if abs(margin) < 2e-3 * damping or abs(static(point)) < 1e-9:

@@ -71,8 +71,10 @@ def test_interval_zoh_encloses_python_control(num, den, box):
         # The plant's coefficients as intervals: each is monotone in m and b here,
         # so its values at the corners bound it.
         corners = [(m, b) for m in (m0, m1) for b in (b0, b1)]
-        num_iv = [iv.mpf([min(c), max(c)]) for c in zip(*[coefficients(num, *p) for p in corners])]
-        den_iv = [iv.mpf([min(c), max(c)]) for c in zip(*[coefficients(den, *p) for p in corners])]
+        num_iv = [iv.mpf([min(c), max(c)])
+                  for c in zip(*[coefficients(num, *p) for p in corners], strict=True)]
+        den_iv = [iv.mpf([min(c), max(c)])
+                  for c in zip(*[coefficients(den, *p) for p in corners], strict=True)]
         p_n, p_d = interval_zoh(num_iv, den_iv, iv.mpf(T))
     finally:
         iv.dps = 15
@@ -82,7 +84,7 @@ def test_interval_zoh_encloses_python_control(num, den, box):
         n_w, d_w = _in_w(n), _in_w(d)
         n_w = [0.0] * (len(p_n) - len(n_w)) + n_w
         scales = [np.abs(n).max()] * len(n_w) + [np.abs(d).max()] * len(d_w)
-        for value, enclosure, scale in zip(n_w + d_w, p_n + p_d, scales):
+        for value, enclosure, scale in zip(n_w + d_w, p_n + p_d, scales, strict=True):
             width = float(enclosure.b) - float(enclosure.a)
             # python-control's coefficients in z are good to about 1e-13 of the
             # largest (their sums in w too: P_d(1) = 0 comes out as 1e-16).
@@ -146,7 +148,7 @@ def test_robust_points_are_stable_at_every_value_of_the_box(paper):
     rng = np.random.default_rng(1)
     x, y = _points_in(region, 2_000, rng)
     values = [(m, b) for m in box["m"] for b in box["b"]]
-    values += list(zip(rng.uniform(*box["m"], 16), rng.uniform(*box["b"], 16)))
+    values += list(zip(rng.uniform(*box["m"], 16), rng.uniform(*box["b"], 16), strict=True))
     worst = 0.0
     for m, b in values:
         worst = max(worst, float(_closed_loop_radius(m, b, 1e-3, 10, y, x).max()))
@@ -201,7 +203,7 @@ def test_a_box_of_zero_width_gives_the_nominal_set(path, d, lines):
         assert abs(robust[0][0] - max(lo, 0.0)) <= 1e-6 * height
         assert abs(robust[-1][1] - hi) <= 1e-6 * height
         # Whatever did not close inside is a sliver.
-        gaps = sum(b1 - a1 for (_, a1), (b1, _) in zip(robust[:-1], robust[1:]))
+        gaps = sum(b1 - a1 for (_, a1), (b1, _) in zip(robust[:-1], robust[1:], strict=True))
         assert gaps <= 1e-6 * height
 
 
@@ -233,7 +235,7 @@ def test_a_box_of_zero_width_gives_the_nominal_set_in_the_plane(paper, nominal_a
     height = region.limits().y_max
     rng = np.random.default_rng(7)
     xs = rng.uniform(region.edges[0], region.edges[-1], 200)
-    for B, found in zip(xs, paper.stable_intervals("K", B=xs, d=10, M=0.0)):
+    for B, found in zip(xs, paper.stable_intervals("K", B=xs, d=10, M=0.0), strict=True):
         robust = region.intervals_at(B)
         assert len(robust) == len(found) == 1
         assert abs(robust[0][0] - found[0][0]) <= 1e-6 * height
@@ -459,7 +461,7 @@ def test_every_zero_of_a_cell_is_in_its_set(path, box, d, h, narrow_width):
         # How far python-control's own rounding (1e-12 of the coefficients, as above) can move the
         # point: its error over the map's smallest singular value.
         sigma = np.array([np.linalg.svd([[u.real, v.real], [u.imag, v.imag]], compute_uv=False)[-1]
-                          for u, v in zip(ax, ay)])
+                          for u, v in zip(ax, ay, strict=True)])
         moved = 1e-12 * scale * (1 + np.abs(x) + np.abs(y)) / sigma
         # A trapezoid around each point: random slopes, the point at a random t.
         wx = 0.02 * (1 + np.abs(x))

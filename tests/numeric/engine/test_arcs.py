@@ -55,7 +55,7 @@ def oracle(polynomials, theta):
 def relative_error(xs, ys, reference):
     """max |(x, y) - reference| / max(|x_ref|, |y_ref|) over the angles (norm-wise)."""
     worst = 0.0
-    for x, y, (rx, ry, _) in zip(xs, ys, reference):
+    for x, y, (rx, ry, _) in zip(xs, ys, reference, strict=True):
         if not (np.isfinite(x) and np.isfinite(y)):
             return np.inf        # max() would skip a NaN
         scale = max(abs(rx), abs(ry))
@@ -90,7 +90,7 @@ def test_cramer_arc_matches_the_50_digit_solve(make):
     xs, ys, det = CramerArc(*polynomials)(THETA)
     assert relative_error(xs, ys, reference) <= TOLERANCE
     # The determinant with sin(theta) divided out, too.
-    worst = max(float(abs(v - r[2]) / abs(r[2])) for v, r in zip(det, reference))
+    worst = max(float(abs(v - r[2]) / abs(r[2])) for v, r in zip(det, reference, strict=True))
     assert worst <= TOLERANCE
 
 
@@ -149,7 +149,7 @@ def test_sine_ratio_against_mpmath():
             got = sine_ratio(m, t)
             tt = mpmath.mpf(float(t))
             want = [mpmath.sin(int(k) * tt) / mpmath.sin(tt) for k in m]
-            for g, w in zip(got, want):
+            for g, w in zip(got, want, strict=True):
                 assert abs(g - w) <= 4e-16 * (1 + abs(int(m[-1]) * tt)) * max(1, abs(w)), (t, g, w)
 
 

@@ -57,7 +57,7 @@ def _crossed(decomposition, xs, ys):
     crossed = np.zeros((len(ys), len(xs)), dtype=bool)
     for branch in decomposition.branches:
         pts = branch.points
-        for a, b in zip(pts[:-1], pts[1:]):
+        for a, b in zip(pts[:-1], pts[1:], strict=True):
             if not (np.all(np.isfinite(a)) and np.all(np.isfinite(b))):
                 continue
             # The part of the segment inside the grid (Liang-Barsky).

@@ -238,7 +238,8 @@ def test_pair_crossings_are_points_of_eq7(parameter, values, fixed, gamma, d, n_
     with mpmath.workdps(30):
         for c in pairs:
             point = dict(zip(("alpha", "beta"),
-                             first_principles_boundary_point(c.angle, gamma, d, PAPER_DELTA)))
+                             first_principles_boundary_point(c.angle, gamma, d, PAPER_DELTA),
+                             strict=True))
             assert float(point[other]) == pytest.approx(fixed, rel=1e-7)
             assert float(point[parameter]) == pytest.approx(c.value, rel=1e-7)
 
@@ -367,7 +368,7 @@ def test_continued_roots_are_the_eigenvalues(paper_loop):
     assert coefficients.shape[1] - 1 >= locus_module._CONTINUATION_DEGREE
     continued = locus_module._roots_along(coefficients)
     eigenvalues = locus_module._roots(coefficients)
-    assert max(_hausdorff(a, b) for a, b in zip(continued, eigenvalues)) < 1e-10
+    assert max(_hausdorff(a, b) for a, b in zip(continued, eigenvalues, strict=True)) < 1e-10
     path = locus(paper_loop, "K", values, B=0.1, d=100)
     _assert_counts_agree(path.unstable_counts(),
                          paper_loop.unstable_root_counts(K=values, B=0.1, d=100))

@@ -117,7 +117,7 @@ def test_near_one_form_keeps_counts_next_to_z_equal_1():
     chi = paper_polynomial(alpha=alpha, beta=0.0, gamma=0.0, d=3, delta=1e-9)
     got = roots.root_counts(chi)
     moduli = _exact_moduli(chi)
-    for g, m in zip(got, moduli):
+    for g, m in zip(got, moduli, strict=True):
         expected = _count_oracle(m, gap=0)
         assert g in (expected, -1)
     dense = roots.root_counts(DelayedPolynomial.from_dense(chi.dense()))

@@ -323,7 +323,7 @@ def test_paper_loop_stable_intervals_against_python_control(paper_loop):
 def test_boundary_points_put_a_root_on_the_circle(paper_loop):
     curve = paper_loop.boundary("B", "K", n=50, M=0.0, d=5, **DEVICE)
     assert set(curve.lines) == {"z = 1", "z = -1"}
-    for theta, B, K in list(zip(curve.theta, curve.x_values, curve.y_values))[::7]:
+    for theta, B, K in list(zip(curve.theta, curve.x_values, curve.y_values, strict=True))[::7]:
         coefficients = paper_loop.coefficients(K=K, B=B, M=0.0, d=5, **DEVICE)
         roots = np.roots(coefficients)
         target = np.exp(1j * theta)
@@ -589,10 +589,10 @@ def test_a_family_of_lines_is_its_lines_one_by_one():
             across[0] = a1[0] = 0.0
             at = np.linspace(-1.5, 1.5, 9)
             together = family_intervals(a0, across, a1, at)
-            for v, runs in zip(at, together):
+            for v, runs in zip(at, together, strict=True):
                 alone = line_intervals(a0 + v * across, a1)
                 assert len(runs) == len(alone), (degree, v, runs, alone)
-                for got, want in zip(runs, alone):
+                for got, want in zip(runs, alone, strict=True):
                     np.testing.assert_allclose(got, want, rtol=1e-9, atol=1e-12)
                 for lo, hi in runs:
                     if np.isfinite(lo + hi):
@@ -609,7 +609,7 @@ def test_loop_family_of_lines_equals_its_single_lines():
     dampings = np.array([-0.01, 0.0, 0.05, 0.2, 0.6])
     together = loop.stable_intervals("K", B=dampings, **values)
     assert len(together) == len(dampings)
-    for B, runs in zip(dampings, together):
+    for B, runs in zip(dampings, together, strict=True):
         # One line is a family of one: the same arithmetic.
         assert runs == loop.stable_intervals("K", B=float(B), **values)
         assert runs == loop.stable_intervals("K", B=np.array([B]), **values)[0]

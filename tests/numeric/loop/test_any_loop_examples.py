@@ -178,7 +178,8 @@ class Example:
     def radius(self, x_values, y_values, d):
         K, B = np.broadcast_arrays(*self.kb(np.asarray(x_values, float),
                                             np.asarray(y_values, float)))
-        out = _largest_moduli([self.chi(k, b, d) for k, b in zip(K.ravel(), B.ravel())])
+        out = _largest_moduli([self.chi(k, b, d)
+                               for k, b in zip(K.ravel(), B.ravel(), strict=True)])
         return out.reshape(K.shape)
 
     def stable(self, x_values, y_values, d):
@@ -324,7 +325,7 @@ def test_oracle_polynomial_is_control_feedback(path, examples):
     T = example.values["T"]
     for d in (0, 3):
         (x0, x1), (y0, y1) = _stable_box(example, d)
-        for xv, yv in zip(rng.uniform(x0, x1, 4), rng.uniform(y0, y1, 4)):
+        for xv, yv in zip(rng.uniform(x0, x1, 4), rng.uniform(y0, y1, 4), strict=True):
             K, B = example.kb(xv, yv)
             delay = control.tf([1.0], np.r_[1.0, np.zeros(d)], T)
             closed = control.feedback(example.plant_zoh, example.environment_tf(K, B) * delay)
@@ -484,7 +485,7 @@ def test_stable_intervals_agree_with_bisection(path, examples):
         if len(clipped) != len(expected):
             failures.append(f"{label} = {got}; oracle on [{lo:.6g}, {hi:.6g}]: {expected}")
             continue
-        for (a, b), (ea, eb) in zip(clipped, expected):
+        for (a, b), (ea, eb) in zip(clipped, expected, strict=True):
             for value, reference in ((a, ea), (b, eb)):
                 scale = max(abs(reference), eb - ea)
                 if abs(value - reference) > INTERVAL_RTOL * scale:

@@ -64,7 +64,7 @@ def _same(a, b):
     assert counts_a == counts_b
     assert radius_a == pytest.approx(radius_b, rel=1e-12)
     assert len(runs_a) == len(runs_b)
-    for (lo_a, hi_a), (lo_b, hi_b) in zip(runs_a, runs_b):
+    for (lo_a, hi_a), (lo_b, hi_b) in zip(runs_a, runs_b, strict=True):
         assert lo_a == pytest.approx(lo_b, rel=1e-9, abs=1e-12)
         assert hi_a == pytest.approx(hi_b, rel=1e-9)
 

@@ -81,7 +81,7 @@ def test_empty_sets_are_reported_empty(paper_file_loop, gamma):
         boxes.append(region.hull.box())
     rng = np.random.default_rng(18)
     for (x0, x1), (y0, y1) in boxes:
-        for B, K in zip(rng.uniform(x0, x1, 20), rng.uniform(y0, y1, 20)):
+        for B, K in zip(rng.uniform(x0, x1, 20), rng.uniform(y0, y1, 20), strict=True):
             assert _radius(B, K, gamma, 40) > 1.0
 
 
@@ -127,7 +127,7 @@ def test_every_stable_point_lies_in_the_hull(seed):
     # Half of the points near the stable centre, half far out.
     x, y = (np.r_[rng.uniform(-w, w, 2000), rng.uniform(-3, 3, 2000)] for w in (0.3, 0.3))
     stable = np.array([np.max(np.abs(np.roots(centre + a * ax + b * ay))) < 1 - 1e-9
-                       for a, b in zip(x, y)])
+                       for a, b in zip(x, y, strict=True)])
     assert stable.sum() > 10 and hull.bounded
     inside = np.zeros(len(x), dtype=bool)
     for polygon in hull.polygons:
@@ -184,7 +184,7 @@ def test_the_hull_is_the_set_where_stodolas_condition_holds(seed):
     inside = _inside_convex(hull.polygons[0], x, y)
     # Points within 1e-6 of an edge are too close to call with the slack.
     strict = _inside_convex(hull.polygons[0], x, y) == ~_outside_by(hull.polygons[0], x, y, 1e-6)
-    holds = np.array([_stodola_holds(centre + a * ax + b * ay) for a, b in zip(x, y)])
+    holds = np.array([_stodola_holds(centre + a * ax + b * ay) for a, b in zip(x, y, strict=True)])
     assert holds.any() and not holds.all()
     assert np.array_equal(inside[strict], holds[strict])
 
@@ -277,7 +277,7 @@ def test_the_hull_does_not_trust_its_float_guess(seed, monkeypatch):
         monkeypatch.setattr(decomposition, "_float_candidates", wrong)
         got = stable_hull(centre, ax, ay)
         assert got.bounded == want.bounded and len(got.polygons) == len(want.polygons)
-        for p, q in zip(got.polygons, want.polygons):
+        for p, q in zip(got.polygons, want.polygons, strict=True):
             assert np.array_equal(p, q)
 
 

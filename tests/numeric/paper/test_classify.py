@@ -460,7 +460,7 @@ def test_clustered_roots_get_the_true_verdict_or_marginal(theta):
     alphas = a * np.array([1.0, 1 - 1e-6, 1 + 1e-6, 1 - 1e-3, 1 + 1e-3, 0.5, 2.0])
     codes = classify(alpha=alphas, beta=b, gamma=gamma, d=d, delta=delta)
     with mpmath.workdps(80):
-        for alpha, code in zip(alphas, codes):
+        for alpha, code in zip(alphas, codes, strict=True):
             roots = polyroots(eq4_chi(alpha, b, gamma, d, delta), maxsteps=400, extraprec=400)
             radius = max(abs(r) for r in roots)
             truth = STABLE if radius < 1 else UNSTABLE
@@ -478,7 +478,7 @@ def test_long_delay_verdicts_match_polished_roots(d):
     codes = classify(alpha=alphas, beta=beta, gamma=gamma, d=d, delta=delta)
     counts = symstab.numeric.paper.stability.unstable_root_counts(alpha=alphas, beta=beta, gamma=gamma, d=d,
                                                      delta=delta)
-    for alpha, code, count in zip(alphas, codes, counts):
+    for alpha, code, count in zip(alphas, codes, counts, strict=True):
         expected = _count_outside(alpha, beta, gamma, d, delta, dps=30, near=1e-8)
         assert expected is not None
         assert count == expected

@@ -300,7 +300,7 @@ def _assert_runs_match_a_brute_force_scan(runs, gamma, d, delta, beta, starts_at
         assert runs == [] and first.size == 0
         return
     assert len(first) == len(runs), (runs, grid[first], grid[last])
-    for (a0, a1), i, j in zip(runs, first, last):
+    for (a0, a1), i, j in zip(runs, first, last, strict=True):
         assert a0 < a1
         assert a0 <= grid[i] <= a0 + step and a1 - step <= grid[j] <= a1, ((a0, a1), grid[i], grid[j])
         # the scan's edges, checked with the first-principles roots
@@ -332,7 +332,7 @@ def test_alpha_intervals_on_many_lines_match_a_brute_force_scan(gamma, d, delta)
     region = StabilityRegion(gamma=gamma, d=d, delta=delta)
     runs = region.alpha_intervals_on([beta for beta, _ in cases])
     assert len(runs) == len(cases)
-    for r, (beta, starts_at_zero) in zip(runs, cases):
+    for r, (beta, starts_at_zero) in zip(runs, cases, strict=True):
         _assert_runs_match_a_brute_force_scan(r, gamma, d, delta, beta, starts_at_zero)
 
 
@@ -364,7 +364,7 @@ def test_interval_ends_keep_the_closed_forms_digits(gamma, d, delta, betas):
     = 0.009); refined on eq. (7)'s closed form they are not.
     """
     runs = StabilityRegion(gamma=gamma, d=d, delta=delta).alpha_intervals_on(betas)
-    for beta, r in zip(betas, runs):
+    for beta, r in zip(betas, runs, strict=True):
         top = r[-1][1]
         want, theta = _arc_point_at_beta(gamma, d, delta, beta, top)
         assert top == pytest.approx(want, rel=1e-13, abs=0), (beta, theta)
@@ -429,7 +429,7 @@ def test_minimum_stiffness_of_fig7_circle6_is_above_one():
         f = lambda t: first_principles_boundary_point(t, 1.5, 0, PAPER_DELTA)[1] + mpmath.mpf("0.5")  # noqa: E731
         grid = [mpmath.mpf(k) / 100 for k in range(1, 300)]
         roots = [mpmath.findroot(f, (a, b), solver="anderson")
-                 for a, b in zip(grid[:-1], grid[1:]) if f(a) * f(b) < 0]
+                 for a, b in zip(grid[:-1], grid[1:], strict=True) if f(a) * f(b) < 0]
         alphas = sorted(float(first_principles_boundary_point(t, 1.5, 0, PAPER_DELTA)[0]) for t in roots)
     assert min(abs(lo - a) for a in alphas) <= 1e-12 * lo, (lo, alphas)
     assert min(abs(hi - a) for a in alphas) <= 1e-12 * hi, (hi, alphas)
@@ -447,7 +447,7 @@ def test_beta_intervals_match_a_brute_force_scan():
     edges = np.diff(np.r_[0, stable.astype(np.int8), 0])
     first, last = np.flatnonzero(edges == 1), np.flatnonzero(edges == -1) - 1
     assert len(first) == len(runs)
-    for (b0, b1), i, j in zip(runs, first, last):
+    for (b0, b1), i, j in zip(runs, first, last, strict=True):
         assert b0 <= grid[i] <= b0 + step and b1 - step <= grid[j] <= b1
 
 
@@ -599,7 +599,8 @@ def first_principles_arc_alphas(beta, gamma, d, delta, theta_end, n=64):
         grid = [mpmath.mpf(theta_end) * k / n for k in range(1, n + 1)]
         values = [f(t) for t in grid]
         roots = [mpmath.findroot(f, (a, b), solver="anderson")
-                 for a, b, fa, fb in zip(grid[:-1], grid[1:], values[:-1], values[1:]) if fa * fb < 0]
+                 for a, b, fa, fb in zip(grid[:-1], grid[1:], values[:-1], values[1:], strict=True)
+                 if fa * fb < 0]
         return [float(first_principles_boundary_point(t, gamma, d, delta)[0]) for t in roots]
 
 

@@ -156,12 +156,12 @@ def test_plant_step_coefficients_match_zoh_discretisation(delta):
     refs = {"python-control c2d": [Ad[0, 1], Ad[1, 1], Bd[0], Bd[1]],
             "scipy cont2discrete": [Ad2[0, 1], Ad2[1, 1], Bd2[0], Bd2[1]]}
     failures = []
-    for name, value, ref in zip(names, kernel, exact):
+    for name, value, ref in zip(names, kernel, exact, strict=True):
         err = float(abs((mpmath.mpf(value) - ref) / ref))
         if not err <= 1e-12:
             failures.append(f"kernel {name} = {value!r} vs mpmath {mpmath.nstr(ref, 20)}: {err:.3g}")
     for label, values in refs.items():
-        for name, value, ref in zip(names, values, exact):
+        for name, value, ref in zip(names, values, exact, strict=True):
             err = float(abs((mpmath.mpf(float(value)) - ref) / ref))
             if not err <= 1e-12:
                 failures.append(f"{label} {name} = {value!r} vs mpmath {mpmath.nstr(ref, 20)}: "
@@ -425,7 +425,8 @@ def test_simulated_maps_agree_with_exact_classification():
                 ia, ib = np.nonzero(mismatch & ~crossed)
                 line += "; outside at " + ", ".join(
                     f"(alpha={alpha[p]:.5g}, beta={beta[q]:.5g}, sim={bool(sim.stable[p, q])}, "
-                    f"growth={sim.growth[p, q]:.6g})" for p, q in list(zip(ia, ib))[:5])
+                    f"growth={sim.growth[p, q]:.6g})"
+                    for p, q in list(zip(ia, ib, strict=True))[:5])
             lines.append(line)
     summary = (f"32 maps: {total_crossed} crossed cells, {total_inside} mismatches inside them "
                f"({inside_alpha0} on the alpha = 0 row where classify is MARGINAL), "
@@ -546,7 +547,7 @@ def test_velocity_cutoff_near_nyquist_approaches_ideal():
             diffs.append(relative_max_difference(run.positions, ideal))
         lines.append(f"d={d} gamma={gamma}: " + ", ".join(f"{x:.3g}" for x in diffs))
         pole = math.exp(-2 * math.pi * 0.499)
-        assert all(a > b for a, b in zip(diffs, diffs[1:])), lines[-1]
+        assert all(a > b for a, b in zip(diffs, diffs[1:], strict=False)), lines[-1]
         assert diffs[-1] < pole, lines[-1]
     print("\n".join(lines))
 

@@ -52,7 +52,7 @@ def test_classify_and_radius_match_python_control(f_c, f_a, gamma, d):
     Kw, Bw = rng.uniform(0, 80, 40), rng.uniform(-0.2, 2.5, 40)
     codes = theory.classify(DEV.alpha(Kw), DEV.beta(Bw))
     decided = 0
-    for K, B, code in zip(Kw, Bw, codes):
+    for K, B, code in zip(Kw, Bw, codes, strict=True):
         r = oracle_radius(K, B, d=d, f_c=f_c, f_a=f_a, M=DEV.mass(gamma))
         assert theory.spectral_radius(DEV.alpha(K), DEV.beta(B)) == pytest.approx(r, abs=1e-9)
         if abs(r - 1) > 1e-6:

@@ -574,5 +574,5 @@ def test_blocks_of_periods_change_no_bit_of_a_run(monkeypatch, d):
     blocks = runs()
     assert any(run.diverged.any() for run in blocks) and any(run.stable.any() for run in blocks)
     monkeypatch.setattr(simulator, "_BLOCK_MAX", 1)
-    for blocked, one in zip(blocks, runs()):
+    for blocked, one in zip(blocks, runs(), strict=True):
         assert _fields(blocked) == _fields(one)
