@@ -303,7 +303,7 @@ def bench_classify(args, oracles):
         print(f" M = {M_w:g} kg")
         kw = dict(K=K, B=B, M=M_w, d=D_GRID)
 
-        def convert(K_w, B_w):
+        def convert(K_w, B_w, M_w=M_w):
             v = symstab.dimensionless_values(m=m, b=b, T=T, K_w=K_w, B_w=B_w, M_w=M_w, Td=D_GRID * T)
             return v["alpha"], v["beta"], v["gamma"], v["delta"], v["d"]
 
@@ -315,7 +315,8 @@ def bench_classify(args, oracles):
                    d=int(d.flat[0]))
         codes, paper_codes = loop.classify(**kw), symstab.classify(**dkw)
         t_loop, t_paper = (statistics.median(t) for t in _times_interleaved(
-            [lambda: loop.classify(**kw), lambda: symstab.classify(**dkw)], args.runs))
+            [lambda kw=kw: loop.classify(**kw), lambda dkw=dkw: symstab.classify(**dkw)],
+            args.runs))
         per_loop = t_loop / n_points
         kernel_ratios.append(t_loop / t_paper)
         print(f"  {'Loop.classify (per-loop kernel)':<46} {fmt(t_loop):>11} {fmt(per_loop):>10} "
@@ -392,7 +393,8 @@ def bench_limits(args):
         for M_w in MASSES:
             gamma = M_w / m
             t_loop, t_paper = (statistics.median(t) for t in _times_interleaved(
-                [lambda: loop.limits(d=d, M=M_w), lambda: symstab.limits(gamma=gamma, d=d, delta=delta)],
+                [lambda d=d, M_w=M_w: loop.limits(d=d, M=M_w),
+                 lambda d=d, gamma=gamma: symstab.limits(gamma=gamma, d=d, delta=delta)],
                 args.limits_runs, warmup))
             lim, ref = loop.limits(d=d, M=M_w), symstab.limits(gamma=gamma, d=d, delta=delta)
             k_max = ref.alpha_max * m / T**2
@@ -406,8 +408,10 @@ def bench_limits(args):
             diffs = {k: _rel(*v) for k, v in numbers.items()}
             betas = [ref.beta_left + f * (ref.beta_right - ref.beta_left) for f in (0.25, 0.5, 0.75)]
             t_int, t_ref_int = (statistics.median(t) for t in _times_interleaved(
-                [lambda: loop.stable_intervals("K", B=betas[1] * m / T, M=M_w, d=d),
-                 lambda: ref.region.alpha_intervals(betas[1])], args.limits_runs, warmup))
+                [lambda d=d, M_w=M_w, betas=betas:
+                 loop.stable_intervals("K", B=betas[1] * m / T, M=M_w, d=d),
+                 lambda ref=ref, betas=betas: ref.region.alpha_intervals(betas[1])],
+                args.limits_runs, warmup))
             ends = []
             for beta in betas:
                 got = loop.stable_intervals("K", B=beta * m / T, M=M_w, d=d)

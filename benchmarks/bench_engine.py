@@ -69,17 +69,17 @@ def main(argv=None):
     print(f"{'what':<34} {'d':>5} {'Loop':>9} {'paper':>9} {'ratio':>6} {'dense':>9} {'dense/structured':>17}")
     for d in (10, 100, 1000):
         paper = dict(alpha=alpha, beta=beta, gamma=0.0, d=d, delta=device.delta)
-        t_loop = _median(lambda: own.unstable_root_counts(K=K, B=B, d=d), args.runs)
-        t_paper = _median(lambda: stability.unstable_root_counts(**paper), args.runs)
+        t_loop = _median(lambda d=d: own.unstable_root_counts(K=K, B=B, d=d), args.runs)
+        t_paper = _median(lambda paper=paper: stability.unstable_root_counts(**paper), args.runs)
         dense = DelayedPolynomial.from_dense(stability.loop_coefficients(**paper))
         runs = args.runs if d < 1000 else 1
-        t_dense = _median(lambda: roots.root_counts(dense), runs)
+        t_dense = _median(lambda dense=dense: roots.root_counts(dense), runs)
         agree = np.array_equal(own.unstable_root_counts(K=K, B=B, d=d), stability.unstable_root_counts(**paper))
         print(f"{'certified counts (' + str(args.points) + ' pts)':<34} {d:>5} {fmt(t_loop):>9} "
               f"{fmt(t_paper):>9} {t_loop / t_paper:>6.2f} {fmt(t_dense):>9} {t_dense / t_paper:>17.1f}"
               f"{'' if agree else '  COUNTS DIFFER'}")
-        t_loop = _median(lambda: own.classify(K=K, B=B, d=d), args.runs)
-        t_paper = _median(lambda: stability.classify(**paper), args.runs)
+        t_loop = _median(lambda d=d: own.classify(K=K, B=B, d=d), args.runs)
+        t_paper = _median(lambda paper=paper: stability.classify(**paper), args.runs)
         print(f"{'classify':<34} {d:>5} {fmt(t_loop):>9} {fmt(t_paper):>9} {t_loop / t_paper:>6.2f}")
     d = 2000
     chi = stability.paper_polynomial(alpha=device.alpha(3.0), beta=device.beta(0.01), gamma=0.0, d=d,
@@ -103,9 +103,10 @@ def main(argv=None):
         runs, warmup = (args.runs, 1) if d < 1000 else (1, 0)
         found = {}
         t_loop = statistics.median(timed_runs(
-            lambda: found.update(loop=loop.limits(d=d)), runs, warmup))
+            lambda d=d, found=found: found.update(loop=loop.limits(d=d)), runs, warmup))
         t_paper = statistics.median(timed_runs(
-            lambda: found.update(paper=symstab.limits(gamma=0.0, d=d, delta=device.delta)),
+            lambda d=d, found=found:
+            found.update(paper=symstab.limits(gamma=0.0, d=d, delta=device.delta)),
             runs, warmup))
         ours, theirs = found["loop"].y_max, float(device.stiffness(found["paper"].alpha_max))
         print(f"{'':<8} {d:>5} {fmt(t_loop):>9} {fmt(t_paper):>9} {t_paper / t_loop:>11.2f}  "
@@ -118,10 +119,12 @@ def main(argv=None):
         dampings = np.linspace(lim.x_min, lim.x_max, args.lines + 2)[1:-1]
         runs = args.runs if d < 1000 else 1
         found = {}
-        t_family = _median(lambda: found.update(family=loop.stable_intervals("K", B=dampings, d=d)),
-                           runs)
-        t_single = _median(lambda: found.update(single=[loop.stable_intervals("K", B=b, d=d)
-                                                        for b in dampings]), runs)
+        t_family = _median(
+            lambda d=d, found=found, dampings=dampings:
+            found.update(family=loop.stable_intervals("K", B=dampings, d=d)), runs)
+        t_single = _median(
+            lambda d=d, found=found, dampings=dampings:
+            found.update(single=[loop.stable_intervals("K", B=b, d=d) for b in dampings]), runs)
         print(f"{'':<26} {d:>5} {fmt(t_family):>9} {fmt(t_single):>11} "
               f"{t_single / t_family:>6.1f}  {found['family'] == found['single']}")
 

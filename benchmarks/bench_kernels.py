@@ -122,7 +122,7 @@ def bench_grid(args, oracles):
         print(f" gamma = {gamma:g}")
         kw = dict(alpha=A, beta=B, gamma=gamma, d=D_GRID, delta=DELTA)
         codes = symstab.classify(**kw)
-        t_cls = statistics.median(timed_runs(lambda: symstab.classify(**kw), args.runs))
+        t_cls = statistics.median(timed_runs(lambda kw=kw: symstab.classify(**kw), args.runs))
         per_cls = t_cls / n_points
         counts = {name: int(np.count_nonzero(codes == c))
                   for name, c in (("stable", STABLE), ("marginal", MARGINAL), ("unstable", UNSTABLE))}
@@ -130,10 +130,11 @@ def bench_grid(args, oracles):
              ", ".join(f"{k} {v}" for k, v in counts.items()))
 
         radius = symstab.spectral_radius(**kw)
-        t_rad = statistics.median(timed_runs(lambda: symstab.spectral_radius(**kw), args.runs))
+        t_rad = statistics.median(timed_runs(lambda kw=kw: symstab.spectral_radius(**kw),
+                                             args.runs))
         _row("symstab.spectral_radius (batched eig)", fmt(t_rad), fmt(t_rad / n_points), t_rad / t_cls)
 
-        def roots_loop():
+        def roots_loop(kw=kw):
             coeffs = loop_coefficients(**kw).reshape(n_points, -1)
             return np.array([np.max(np.abs(np.roots(c))) for c in coeffs])
 
@@ -346,8 +347,9 @@ def bench_region(args):
     for d in (0, 10, 40):
         cells = []
         for gamma in GAMMAS:
-            t = statistics.median(timed_runs(lambda: symstab.limits(gamma=gamma, d=d, delta=DELTA),
-                                         args.limits_runs))
+            t = statistics.median(timed_runs(
+                lambda gamma=gamma, d=d: symstab.limits(gamma=gamma, d=d, delta=DELTA),
+                args.limits_runs))
             cells.append(f"gamma {gamma:g}: {fmt(t):>9}")
         print(f"  limits, d = {d:<3} " + "   ".join(cells))
     t = statistics.median(timed_runs(lambda: symstab.best_virtual_mass(d=0, delta=DELTA), args.limits_runs))

@@ -89,9 +89,10 @@ def main():
     rows = []
     for d in (int(x) for x in args.delays.split(",")):
         runs = args.runs if d <= 200 else 1
-        t_curve, curve = _median_time(lambda: symstab.boundary_curve(
+        t_curve, curve = _median_time(lambda d=d: symstab.boundary_curve(
             gamma=GAMMA, d=d, delta=DELTA, n=64), runs)
-        t_limits, lim = _median_time(lambda: symstab.limits(gamma=GAMMA, d=d, delta=DELTA), runs)
+        t_limits, lim = _median_time(lambda d=d: symstab.limits(gamma=GAMMA, d=d, delta=DELTA),
+                                     runs)
         t_grid, note, found = _brute_force(d, lim, None if d <= 10 else args.columns, rng)
         rows.append((d, t_curve, t_limits, t_grid, note))
         print(f"d = {d}: alpha_max {lim.alpha_max:.9g} at beta {lim.beta_at_alpha_max:.6g}, "

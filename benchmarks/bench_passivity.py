@@ -101,9 +101,10 @@ def main(argv=None):
         plane = _plane(d)
         for label, theta in (("grid", passivity._grid(plane.harmonic)),
                              ("2000", np.sort(rng.uniform(0, np.pi, 2000)))):
-            ours = statistics.median(timed_runs(lambda: plane.terms(theta), args.runs))
-            other = statistics.median(timed_runs(lambda: cosine_series_terms(plane, theta),
-                                                 args.runs))
+            ours = statistics.median(timed_runs(lambda plane=plane, theta=theta:
+                                                plane.terms(theta), args.runs))
+            other = statistics.median(timed_runs(lambda plane=plane, theta=theta:
+                                                 cosine_series_terms(plane, theta), args.runs))
             print(f"{d:>5} {theta.size if label == 'grid' else label:>8} {fmt(ours):>10} "
                   f"{fmt(other):>10} {other / ours:>7.1f}")
         theta = np.concatenate([[0.0, 1e-7, 1e-3, np.pi], rng.uniform(0, np.pi, 36)])
@@ -119,9 +120,10 @@ def main(argv=None):
         loop, values = paper_point(gamma=0.0, d=d, delta=DELTA)
         runs = args.runs if d < 1000 else 1
         passive = statistics.median(timed_runs(
-            lambda: passivity.passive_region(loop, "B", "K", **values), runs, warmup=0))
-        limits = statistics.median(timed_runs(lambda: loop.limits("B", "K", **values), runs,
-                                              warmup=0))
+            lambda loop=loop, values=values: passivity.passive_region(loop, "B", "K", **values),
+            runs, warmup=0))
+        limits = statistics.median(timed_runs(
+            lambda loop=loop, values=values: loop.limits("B", "K", **values), runs, warmup=0))
         print(f"{d:>5} {fmt(passive):>10} {fmt(limits):>10}")
 
 

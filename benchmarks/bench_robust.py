@@ -63,10 +63,10 @@ def main():
     for box in ({"b": (0.0162, 0.0648)}, {"b": (0.0162, 0.0648), "m": (0.0115, 0.0141)}):
         words = ", ".join(f"{k} in [{lo:g}, {hi:g}]" for k, (lo, hi) in box.items())
         region = loop.robust_region("B", "K", uncertain=box, strips=args.strips, **values)
-        certified = timed_runs(lambda: loop.robust_region("B", "K", uncertain=box,
+        certified = timed_runs(lambda box=box: loop.robust_region("B", "K", uncertain=box,
                                                           strips=args.strips, **values), args.runs)
         area = sampled(loop, box, args.strips, args.samples, values)
-        by_hand = timed_runs(lambda: sampled(loop, box, args.strips, args.samples, values),
+        by_hand = timed_runs(lambda box=box: sampled(loop, box, args.strips, args.samples, values),
                              args.runs)
         c, s = statistics.median(certified), statistics.median(by_hand)
         print(f"{words}, {args.strips} strips (median of {args.runs}):")
@@ -86,8 +86,8 @@ def main():
     print(f"a box of zero width (b = {b:g}): the certified area against the nominal set's "
           f"{nominal:.10g} (its stable intervals' lengths integrated by scipy's quad):")
     for strips, rtol in ((16, 1e-6), (64, 1e-6), (256, 1e-6), (1024, 1e-7), (4096, 1e-7)):
-        times = timed_runs(lambda: loop.robust_region("B", "K", uncertain={"b": (b, b)},
-                                                      strips=strips, rtol=rtol, **values), 1)
+        times = timed_runs(lambda strips=strips, rtol=rtol: loop.robust_region(
+            "B", "K", uncertain={"b": (b, b)}, strips=strips, rtol=rtol, **values), 1)
         region = loop.robust_region("B", "K", uncertain={"b": (b, b)}, strips=strips, rtol=rtol,
                                     **values)
         print(f"  {strips:>4} strips, rtol {rtol:g}  {fmt(statistics.median(times)):>9}  area "

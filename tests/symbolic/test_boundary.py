@@ -146,7 +146,8 @@ def test_K2_K3_K4_match_their_definitions_in_the_docstring():
             t, G = mpmath.mpf(t), mpmath.mpf(G)
             zz = mpmath.expj(t)
 
-            def n2(dl):  # |Gamma N4|^2, N4 the numerator of eq. (4), e^-delta -> 1/Gamma
+            # |Gamma N4|^2, N4 the numerator of eq. (4), e^-delta -> 1/Gamma
+            def n2(dl, G=G, zz=zz):
                 return abs(G * ((1 / G - 1 + dl) * zz + 1 - (1 + dl) / G)) ** 2
 
             K2, K3 = f(t, G)

@@ -461,7 +461,8 @@ def _worst(plane, grid, table, vx, vy):
         valid = np.isfinite(top_values)
         lo, hi, px, py = lo[valid], hi[valid], px[valid], py[valid]
         # Down to 1e-9 of the angle: the maximum's value is then exact to rounding.
-        theta = zoom_max(lambda t, i: plane.at(t, px[i, None], py[i, None]), lo, hi, rtol=1e-9)
+        theta = zoom_max(lambda t, i, px=px, py=py: plane.at(t, px[i, None], py[i, None]),
+                         lo, hi, rtol=1e-9)
         refined = np.full(top.shape, -np.inf)
         refined[valid] = plane.at(theta, px, py)
         angles = np.full(top.shape, np.nan)

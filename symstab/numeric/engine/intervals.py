@@ -172,8 +172,9 @@ def _angles(family, n_lines, degree):
             s = sign[line - part.start, k]
             lo, hi = grid[k - 1], grid[k + 1]
             low_point = zoom_max(
-                lambda t, i: -s[i, None] * family(t.ravel(), np.repeat(line[i], t.shape[1]))[0]
-                .reshape(t.shape), lo, hi, rtol=_DIP_RTOL, enough=lambda fx: fx > 0)
+                lambda t, i, s=s, line=line: -s[i, None]
+                * family(t.ravel(), np.repeat(line[i], t.shape[1]))[0].reshape(t.shape),
+                lo, hi, rtol=_DIP_RTOL, enough=lambda fx: fx > 0)
             flipped = s * family(low_point, line)[0] < 0
             mid = low_point[flipped]
             brackets.append((line[flipped], lo[flipped], mid))

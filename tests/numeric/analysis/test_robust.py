@@ -349,7 +349,7 @@ def test_the_disks_hold_the_polynomial(path, box, d):
         sub = {symbols[name]: v for name, v in at.items()}
         parts = []
         for slope_of in (None, "B", "K"):
-            def coefficients(c):
+            def coefficients(c, slope_of=slope_of, sub=sub):
                 c = [sp.diff(e, symbols[slope_of]) if slope_of else e for e in c]
                 return np.array([float(e.subs(sub).subs({symbols["B"]: 0, symbols["K"]: 0}))
                                  for e in c])
@@ -443,7 +443,7 @@ def test_every_zero_of_a_cell_is_in_its_set(path, box, d, h, narrow_width):
         sub = {symbols[name]: v for name, v in at.items()}
         parts, scale = [], 0.0
         for slope_of in (None, "B", "K"):
-            def coefficients(c):
+            def coefficients(c, slope_of=slope_of, sub=sub):
                 c = [sp.diff(e, symbols[slope_of]) if slope_of else e for e in c]
                 return [float(e.subs(sub).subs({symbols["B"]: 0, symbols["K"]: 0})) for e in c]
             delayed = np.convolve(coefficients(ve_d)[:len(ve_d) - k], p)

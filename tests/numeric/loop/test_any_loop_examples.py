@@ -472,7 +472,7 @@ def test_stable_intervals_agree_with_bisection(path, examples):
     for name, other, other_value, d, (lo, hi) in _lines(example):
         got = example.loop.stable_intervals(name, **{other: other_value}, d=d)
 
-        def stable_at(value):
+        def stable_at(value, name=name, other=other, other_value=other_value, d=d):
             point = {name: value, other: other_value}
             return example.stable(point[example.x], point[example.y], d)
 
@@ -584,7 +584,7 @@ def test_actuator_lag_points_the_region_misses_are_boundary_pixels(examples, M, 
         edge = b[k] - a[k]
         outward = np.array([edge[1], -edge[0]]) / np.hypot(*edge)    # the ring is counter-clockwise
         inner, outer = 0.0, 4 * sag
-        at = lambda s: (p + s * outward) * scale    # noqa: E731
+        at = lambda s, p=p, outward=outward: (p + s * outward) * scale    # noqa: E731
         assert _oracle_radii(example, np.array(at(outer)[1]), np.array(at(outer)[0]), d, M) > 1
         for _ in range(40):
             middle = 0.5 * (inner + outer)
