@@ -34,7 +34,11 @@ import mpmath
 import numpy as np
 import sympy as sp
 
-from paper_checks.regions import coefficients_at, stable_alpha_intervals, unstable_root_count  # noqa: F401
+from paper_checks.regions import (  # noqa: F401
+    coefficients_at,
+    stable_alpha_intervals,
+    unstable_root_count,
+)
 from symstab.symbolic import model
 from symstab.symbolic.boundary import boundary
 from symstab.symbolic.loop import characteristic_polynomial
