@@ -45,10 +45,10 @@ import scipy.sparse.csgraph
 
 from ..._resources import check_memory, chunk_slices
 from .arcs import CramerArc
-from .search import bracketed_root, refit_root, zoom_max
 from .polynomial import DelayedPolynomial
 from .results import Limits, Segment
 from .roots import STABLE, classify_polynomials, leading_vanishes, root_counts
+from .search import bracketed_root, refit_root, zoom_max
 
 __all__ = ["Branch", "Cell", "Decomposition", "StableHull", "Unresolved", "decompose", "arc_points",
            "sample_arc", "window_arc", "stable_hull", "stable_ranges"]
@@ -398,7 +398,7 @@ class Decomposition:
             j = int(np.flatnonzero(crossing)[np.argmin(gap[crossing])])
             source = self.arc if self.arc is not None else CramerArc(*self.polynomial)
 
-            def along(theta):
+            def along(theta, source=source, side=side):
                 xs, ys = source(theta.ravel())[:2]
                 return side(np.column_stack([xs, ys])).reshape(theta.shape)
 
@@ -458,7 +458,7 @@ class Decomposition:
                  f"[{self.y_range[0]:.6g}, {self.y_range[1]:.6g}]")
         box = hull.box(0.0) if hull is not None else None
         if box is not None and all(w[0] <= b[0] and b[1] <= w[1]
-                                   for w, b in zip((self.x_range, self.y_range), box)):
+                                   for w, b in zip((self.x_range, self.y_range), box, strict=True)):
             return (f"every cell of the window {where}, which holds every point that passes the "
                     f"necessary condition of the roots inside the unit circle, has a root "
                     f"outside it{_UNRESOLVED}")
@@ -632,7 +632,8 @@ def sample_arc(arc, n, to_unit, samples=None, fine=1.0):
         mids = 0.5 * (theta[1:] + theta[:-1])[split]
         order = np.argsort(np.concatenate([theta, mids]), kind="stable")
         theta, xs, ys, det = (np.concatenate([a, b])[order]
-                              for a, b in zip((theta, xs, ys, det), (mids, *arc(mids))))
+                              for a, b in zip((theta, xs, ys, det), (mids, *arc(mids)),
+                                              strict=True))
     return theta, xs, ys, det
 
 
@@ -667,7 +668,7 @@ def window_arc(arc, n, x_range, y_range, *, angles=()):
         order = np.argsort(np.concatenate([theta, extra]), kind="stable")
         more = arc(extra)
         theta, xs, ys = (np.concatenate([a, b])[order] for a, b in
-                         zip((theta, xs, ys), (extra, more[0], more[1])))
+                         zip((theta, xs, ys), (extra, more[0], more[1]), strict=True))
     with np.errstate(invalid="ignore"):
         far = ~(np.isfinite(xs) & np.isfinite(ys)) \
             | (xs < x0 - 5 * sx) | (xs > x1 + 5 * sx) | (ys < y0 - 5 * sy) | (ys > y1 + 5 * sy)
@@ -689,7 +690,7 @@ def _pieces(base, ax, ay, ends, arc_ends, theta, xs, ys, sign, to_unit, from_uni
     finite = np.isfinite(u) & np.isfinite(v)
     end_x, end_y = arc_ends
     ends_xy = [(x, y) if math.isfinite(x) and math.isfinite(y) else None
-               for x, y in zip(end_x.tolist(), end_y.tolist())]
+               for x, y in zip(end_x.tolist(), end_y.tolist(), strict=True)]
     cut = np.flatnonzero((sign[1:] != sign[:-1]) | ~finite[1:] | ~finite[:-1]) + 1
     arc_rows, arc_theta = [], []
     for part in np.split(np.arange(len(theta)), cut):
@@ -921,7 +922,7 @@ def _cell_pairs(segment, after, lo, hi):
     cumulative = np.cumsum(after)
     cuts = np.searchsorted(cumulative, np.arange(1_000_000, int(cumulative[-1]), 1_000_000))
     cuts = [0, *cuts.tolist(), len(segment)]
-    for start, stop in zip(cuts[:-1], cuts[1:]):
+    for start, stop in zip(cuts[:-1], cuts[1:], strict=True):
         counts = after[start:stop]
         row = np.repeat(np.arange(start, stop), counts)
         # The k-th partner of a row is k rows below it.
@@ -1042,7 +1043,7 @@ def _inside(poly, x, y):
     inside = np.zeros(np.shape(x), dtype=bool)
     px, py = poly[:, 0], poly[:, 1]
     qx, qy = np.roll(px, -1), np.roll(py, -1)
-    for ax_, ay_, bx, by in zip(px, py, qx, qy):
+    for ax_, ay_, bx, by in zip(px, py, qx, qy, strict=True):
         crosses = (ay_ > y) != (by > y)
         with np.errstate(all="ignore"):
             xc = ax_ + (y - ay_) * (bx - ax_) / (by - ay_)
@@ -1224,7 +1225,7 @@ def _bilinear(c):
     q = [0] * (n + 1)
     for i, v in enumerate(c):
         if v:
-            q = [acc + v * t for acc, t in zip(q, _plus_minus(n, n - i))]
+            q = [acc + v * t for acc, t in zip(q, _plus_minus(n, n - i), strict=True)]
     return q
 
 
@@ -1358,7 +1359,8 @@ def _closed_cycle(edges):
     cy = sum(v[1] for v in vertices) / len(vertices)
     vertices.sort(key=lambda v: math.atan2(float(v[1] - cy), float(v[0] - cx)))
     sides = {frozenset(edge) for edge in edges if edge[0] != edge[1]}
-    return all(frozenset((u, v)) in sides for u, v in zip(vertices, vertices[1:] + vertices[:1]))
+    return all(frozenset((u, v)) in sides
+               for u, v in zip(vertices, vertices[1:] + vertices[:1], strict=True))
 
 
 def _half_plane_polygon(rows):
@@ -1479,7 +1481,7 @@ def stable_hull(base, ax, ay):
     q = [_bilinear(row) for row in exact]
     polygons, bounded = [], True
     for s in (1, -1):
-        half_planes = [(s * q0, s * qx, s * qy) for q0, qx, qy in zip(*q)]
+        half_planes = [(s * q0, s * qx, s * qy) for q0, qx, qy in zip(*q, strict=True)]
         vertices, side_bounded, interior = _half_plane_polygon(half_planes)
         if not side_bounded:
             bounded = False
@@ -1549,7 +1551,7 @@ def stable_ranges(rows, bounds):
     exact = [_bilinear(row) for row in _exact_rows(rows[:, keep[0]:])]
     # One coefficient's terms over its largest, exactly (binomials overflow floats).
     q = []
-    for terms in zip(*exact):
+    for terms in zip(*exact, strict=True):
         top = max(abs(v) for v in terms)
         q.append([float(v / top) if top else 0.0 for v in terms])
     q = np.array(q)                                           # (n + 1, k + 1)
@@ -1588,7 +1590,7 @@ def stable_ranges(rows, bounds):
                 ends.append(float(end.x[j]) if end.status == 0 else direction * -math.inf)
             ranges.append((max(ends[0], given[j][0]), min(ends[1], given[j][1])))
         out = ranges if out is None else [(min(r[0], o[0]), max(r[1], o[1]))
-                                          for r, o in zip(ranges, out)]
+                                          for r, o in zip(ranges, out, strict=True)]
     if unclear:
         # Neither proved empty nor bracketed: the ranges as given (a stable
         # point at a margin below the programme's tolerance is not excluded).
@@ -1813,7 +1815,7 @@ def _trace(base, ax, ay, ends, arc, window, fine):
         order = np.argsort(np.concatenate([theta, hot]), kind="stable")
         unknown = np.full(len(hot), np.nan)
         samples = tuple(np.concatenate([a, b])[order] for a, b in
-                        zip(samples, (hot, unknown, unknown, unknown)))
+                        zip(samples, (hot, unknown, unknown, unknown), strict=True))
     return polylines, branches, (p, q, owner, position), hits
 
 
@@ -1853,7 +1855,7 @@ def _split_at_crossings(p, q, owner, labels, hits):
     crossing_node, start, finish = node[:len(hits)], node[len(hits)::2], node[len(hits) + 1::2]
     cuts = {}
     for i, j, ti, tj, at in zip(cut_i.tolist(), cut_j.tolist(), hits[:, 2].tolist(),
-                                hits[:, 3].tolist(), crossing_node.tolist()):
+                                hits[:, 3].tolist(), crossing_node.tolist(), strict=True):
         cuts.setdefault(i, []).append((ti, at))
         cuts.setdefault(j, []).append((tj, at))
     # A segment without a crossing is one edge; a crossed one an edge per stretch.
@@ -1862,7 +1864,8 @@ def _split_at_crossings(p, q, owner, labels, hits):
     for k, entries in cuts.items():
         entries = sorted([(0.0, int(start[k])), (1.0, int(finish[k]))] + entries)
         pieces[0][k] = -1
-        pieces.append(np.array([(a, b) for (_, a), (_, b) in zip(entries[:-1], entries[1:])],
+        pieces.append(np.array([(a, b) for (_, a), (_, b)
+                                in zip(entries[:-1], entries[1:], strict=True)],
                                dtype=np.int64))
         at.append(np.full(len(pieces[-1]), k))
     edges, at = np.concatenate(pieces), np.concatenate(at)
@@ -1991,7 +1994,7 @@ def _crossing_mismatches(faces, counts):
     whose counts differ across a piece by other than :data:`_CHANGE` of its
     label (the arc sampled too coarsely, or a window too wide).
     """
-    count_of = dict(zip(faces.keep, counts))
+    count_of = dict(zip(faces.keep, counts, strict=True))
     index_of = {f: n for n, f in enumerate(faces.keep)}
     face_of, twin, half_label = faces.face_of, faces.twin, faces.half_label
     mismatches = []
