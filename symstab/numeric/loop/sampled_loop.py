@@ -168,6 +168,13 @@ class Loop(LoopModel):
             "description": self.description, "plane": self.plane, "arc": self._arc,
             "polynomial": self._closed_polynomial, "actuator": self.actuator}))
 
+    def _repr_latex_(self):
+        """Jupyter's view: :func:`~symstab.numeric.loop.display.loop_latex` of this loop."""
+        from .display import loop_latex
+
+        return loop_latex(self.plant, self.environment, self.environment_parts,
+                          self._plant_parts)
+
     def _check_units(self):
         from .quantities import check_si_units
 
