@@ -13,12 +13,13 @@ names are aliases of the fields (``alpha_max`` is ``y_max``, ``z_width`` is
 """
 
 import dataclasses
+import html
 
 import numpy as np
 
 from ..._validate import check_real
 
-__all__ = ["Limits", "Boundary", "Segment", "StabilityProbability", "RobustRegion"]
+__all__ = ["Limits", "Boundary", "Segment", "StabilityProbability", "RobustRegion", "html_table"]
 
 #: The paper's dimensionless plane: x = beta (damping), y = alpha (stiffness).
 PAPER_PLANE = ("beta", "alpha")
@@ -49,6 +50,32 @@ def paper_parameter(name):
     get.__name__ = name
     get.__doc__ = f"The paper's ``{name}`` (``at[{name!r}]``; the (beta, alpha) plane only)."
     return property(get)
+
+
+def html_table(caption, rows):
+    """An HTML table of ``rows`` (name, value) for Jupyter, every text escaped.
+
+    Numbers are shown to 6 significant digits, None as an empty cell.
+
+    Parameters
+    ----------
+    caption : str
+    rows : iterable of (str, object)
+
+    Returns
+    -------
+    str
+    """
+    def cell(value):
+        if value is None:
+            return ""
+        if isinstance(value, float):
+            return f"{value:.6g}"
+        return html.escape(str(value))
+
+    body = "".join(f"<tr><th style='text-align:left'>{html.escape(str(name))}</th>"
+                   f"<td>{cell(value)}</td></tr>" for name, value in rows)
+    return f"<table><caption>{html.escape(caption)}</caption>{body}</table>"
 
 
 def _head(kind, result):
@@ -151,6 +178,10 @@ class Limits:
             text = (f"{self.y}_max={self.y_max:.6g} at {self.x}={self.x_at_y_max:.6g}, "
                     f"{self.x} in [{self.x_min:.6g}, {self.x_max:.6g}], area={self.area:.6g}")
         return head + text + (f", {self.reason!r})" if self.reason else ")")
+
+    def _repr_html_(self):
+        """Jupyter's view: :meth:`as_dict` as a table."""
+        return html_table(_head("Limits", self)[:-2] + ")", self.as_dict().items())
 
     def as_dict(self):
         """The numbers, for tables and JSON (the paper's names in its plane)."""

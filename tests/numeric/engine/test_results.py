@@ -156,3 +156,17 @@ def test_a_loops_boundary_is_the_same_type_with_the_planes_names():
     # The arc starts at (beta, alpha) = (-delta, 0): the names are not swapped.
     assert (paper.beta[0], paper.alpha[0]) == (-PAPER_DEVICE.delta, 0.0)
     assert (paper.x_values[0], paper.y_values[0]) == (-PAPER_DEVICE.delta, 0.0)
+
+
+def test_limits_show_as_an_html_table_in_jupyter_with_every_text_escaped():
+    """Issue 42, item 5: a Limits in a notebook is a table of as_dict(); a reason (which may
+    name a user's parameter) is text, never markup."""
+    found = Limits("B", "K", 4.958841, 0.297, -0.0324, 0.5113, 1.804, cells=1,
+                   reason="<b>K</b> & more", at={"d": 40})
+    shown = found._repr_html_()
+    assert shown.startswith("<table><caption>Limits(B, K at d=40)</caption>")
+    assert "<tr><th style='text-align:left'>y_max</th><td>4.95884</td></tr>" in shown
+    assert "&lt;b&gt;K&lt;/b&gt; &amp; more" in shown and "<b>" not in shown
+    assert shown.count("<tr>") == len(found.as_dict())
+    empty = Limits.empty_set("B", "K", "no stable point")._repr_html_()
+    assert "<th style='text-align:left'>y_max</th><td></td>" in empty
