@@ -1,6 +1,7 @@
 """Tests of symstab._validate: one place for kind and range checks."""
 
 import fractions
+import io
 import math
 
 import numpy as np
@@ -194,3 +195,34 @@ def test_every_progress_argument_takes_true_false_none_or_a_callable(name, loop_
     assert type(results[0]) is type(results[1])
     with pytest.raises(TypeError, match="progress must be True, False, None or a callable"):
         call(1)
+
+
+class _KernelStream(io.StringIO):
+    """A stand-in for ipykernel's output stream: not a terminal, and ipykernel's by its module."""
+
+
+_KernelStream.__module__ = "ipykernel.iostream"
+
+
+def test_a_progress_bar_draws_in_a_notebook_and_not_in_a_pipe(monkeypatch):
+    """Issue 42, item 5: in Jupyter (stderr is ipykernel's stream, not a terminal) progress=True
+    drew nothing; a pipe or a log file still gets nothing."""
+    from symstab import _progress
+
+    monkeypatch.setattr(_progress, "_notebook_bar", lambda *args: None)   # without tqdm
+    notebook, pipe = _KernelStream(), io.StringIO()
+    for stream in (notebook, pipe):
+        update = _progress.progress_printer("scanning", 4, stream=stream, min_seconds=0.0)
+        for done in range(1, 5):
+            update(done)
+    assert "\rscanning [" in notebook.getvalue() and "100.0%" in notebook.getvalue()
+    assert pipe.getvalue() == ""
+
+
+def test_a_notebook_bar_is_tqdm_s_when_tqdm_is_installed(monkeypatch):
+    from symstab import _progress
+
+    calls = []
+    monkeypatch.setattr(_progress, "_notebook_bar", lambda *args: calls.append(args) or print)
+    assert _progress.progress_printer("scanning", 4, stream=_KernelStream()) is print
+    assert calls == [("scanning", 4, 2.0)]
