@@ -52,6 +52,18 @@ def test_a_signal_swallowed_in_a_callback_is_delivered_again(capsys, signum, exc
     assert capsys.readouterr().err == ""
 
 
+def _swallowed_sigterm_then_ten_seconds():
+    """A block whose SIGTERM Python swallows, then 10 s of short sleeps: whether they all ran."""
+    ran_on = False
+    with pytest.raises(Terminated):
+        with raising():
+            _signal_inside_a_weakref_callback(signal.SIGTERM)
+            for _ in range(100):
+                time.sleep(0.1)
+            ran_on = True
+    return ran_on
+
+
 def test_a_delivery_that_raised_nothing_is_repeated(monkeypatch):
     """CI: the delivery again landed just before the main thread entered ``time.sleep(30)``:
     Python's flag was set, the sleep was not interrupted, and the block ran 30 s before the
@@ -66,13 +78,7 @@ def test_a_delivery_that_raised_nothing_is_repeated(monkeypatch):
             kill(thread, signum)
 
     monkeypatch.setattr(_signals.signal, "pthread_kill", lossy_kill)
-    ran_on = False
-    with pytest.raises(Terminated):
-        with raising():
-            _signal_inside_a_weakref_callback(signal.SIGTERM)
-            for _ in range(100):   # 10 s
-                time.sleep(0.1)
-            ran_on = True
+    ran_on = _swallowed_sigterm_then_ten_seconds()
     # Sent again after the one dropped (a busy machine may send a third before it is handled).
     assert not ran_on and len(sent) >= 2 and set(sent) == {signal.SIGTERM}
 
@@ -91,13 +97,7 @@ def test_a_signal_landing_while_the_hook_delivers_again_is_not_lost(monkeypatch,
             super().start()
 
     monkeypatch.setattr(_signals.threading, "Thread", SignalledThread)
-    ran_on = False
-    with pytest.raises(Terminated):
-        with raising():
-            _signal_inside_a_weakref_callback(signal.SIGTERM)
-            for _ in range(100):   # 10 s
-                time.sleep(0.1)
-            ran_on = True
+    ran_on = _swallowed_sigterm_then_ten_seconds()
     assert not ran_on
     assert capsys.readouterr().err == ""
 
