@@ -156,7 +156,7 @@ def resolve(args, *, mass=True):
 
 
 def parse_list(text, name):
-    """The numbers of a comma-separated list; an empty item ("1,,3") is an error."""
+    """The finite numbers of a comma-separated list; an empty item ("1,,3") is an error."""
     items = [v.strip() for v in text.split(",")]
     if not any(items):
         raise ValueError(f"{name} must name at least one number")
@@ -167,6 +167,9 @@ def parse_list(text, name):
         values = [float(v) for v in items]
     except ValueError:
         raise ValueError(f"{name} must be a comma-separated list of numbers, got {text!r}") from None
+    if not all(np.isfinite(values)):
+        # Named here: a NaN passed on was refused later under the loop's name (K, not --alpha).
+        raise ValueError(f"{name} must be finite numbers, got {text!r}")
     return np.array(values)
 
 

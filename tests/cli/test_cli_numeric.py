@@ -114,6 +114,10 @@ def test_design_finds_a_gain_over_no_virtual_mass(shared_cli_run):
     (["boundary", "--n", "1"], "n must be"),
     (["classify", "--alpha", "1"], "damping"),
     (["classify", "--alpha", "1,x", "--beta", "0"], "--alpha"),
+    # A NaN was refused later as "K must be a finite real number": a name the user never typed.
+    (["classify", "--delta", "0.0025", "--alpha", "nan", "--beta", "0.5"], "--alpha"),
+    (["classify", "--delta", "0.0025", "--alpha", "0.1", "--beta", "1,inf"], "--beta"),
+    (["simulate", "--delta", "0.0025", "--alpha", "nan", "--beta", "0.5"], "--alpha"),
     (["classify", "--alpha", "1,2", "--beta", "0,1,2"], "same length"),
     (["classify", "--delta", "0.1", "--Kw", "1", "--beta", "0"], "--Kw"),
     (["limits", "--format", "xml"], "--format"),
