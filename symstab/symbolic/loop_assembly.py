@@ -30,15 +30,15 @@ import mpmath
 import numpy as np
 import sympy as sp
 
-from .._memo import method_cache
+from .._memo import SharedStores, method_cache, shared_property
 from .._validate import check_delay
 from . import model
-from .derivation_cache import DerivationCache
+from .derivation_cache import DerivationCache, cache_dir
 from .discretize import numeric_zoh, written_poles, zoh_pulse_transfer_function
 
 __all__ = ["LoopModel", "NonPhysicalPlantWarning", "parse_plant", "parse_environment", "parse_actuator", "parse_expression",
            "check_parameter_name", "check_loop_name", "check_text_line", "NAME_PATTERN",
-           "is_affine", "poly_coeffs", "shift_to_one", "PLANT_DIGITS"]
+           "is_affine", "poly_coeffs", "shift_to_one", "PLANT_DIGITS", "forget_derivations"]
 
 #: The longest plant, environment or bound expression read (a loop file's
 #: physics fits in a few hundred characters; a long chain of + or * nests
@@ -79,6 +79,23 @@ class NonPhysicalPlantWarning(UserWarning):
     (:meth:`LoopModel.plant_defect`).  A loop file bounds its physical
     parameters (``min = 0``, ``above = 0``) to refuse such a value instead.
     """
+
+
+#: The shared stores of :class:`LoopModel`, one per plant, environment, actuator and
+#: cache folder: a sweep, a design or a test that builds the same loop again derives
+#: nothing again in this process (:func:`forget_derivations` empties them).
+_SHARED = SharedStores(32)
+
+
+def forget_derivations():
+    """Forget what this process derived for its loops (the parsed text and the shared stores).
+
+    The next model of each loop reads its derivation from the cache folder,
+    or derives it, afresh: for tests of that cache, and to free memory.
+    """
+    _SHARED.clear()
+    _parsed_plant.cache_clear()
+    _parsed_rational.cache_clear()
 
 
 def shift_to_one(coefficients, dtype=None):
@@ -412,15 +429,22 @@ def parse_plant(plant):
     ValueError
         If it is not rational in ``s``, not proper, zero, or uses ``z`` or ``d``.
     """
-    if isinstance(plant, str):
-        expr = parse_expression(plant, "plant")
-    elif isinstance(plant, sp.Basic):
-        expr = sp.sympify(plant)
-    elif hasattr(plant, "num") and hasattr(plant, "den") and hasattr(plant, "dt"):
-        expr = _plant_from_control(plant)
-    else:
-        raise TypeError(f"plant must be a string, a SymPy expression or a "
-                        f"control.TransferFunction, got {type(plant).__name__}")
+    if isinstance(plant, (str, sp.Basic)):
+        return _parsed_plant(plant)
+    if hasattr(plant, "num") and hasattr(plant, "den") and hasattr(plant, "dt"):
+        return _checked_plant(_plant_from_control(plant))
+    raise TypeError(f"plant must be a string, a SymPy expression or a "
+                    f"control.TransferFunction, got {type(plant).__name__}")
+
+
+@functools.lru_cache(maxsize=128)
+def _parsed_plant(plant):
+    """:func:`parse_plant` of a string or a SymPy expression, kept: the check costs SymPy time."""
+    expr = parse_expression(plant, "plant") if isinstance(plant, str) else sp.sympify(plant)
+    return _checked_plant(expr)
+
+
+def _checked_plant(expr):
     expr = _real_symbols(_exact_decimals(expr))
     _check_rational(expr, model.s, "plant G(s)", model.z)
     return expr
@@ -485,13 +509,16 @@ def parse_environment(environment):
 
 def _rational(value, what, label, variable, other):
     """``value`` (text or SymPy) as a checked rational function of ``variable`` (:func:`_check_rational`)."""
-    if isinstance(value, str):
-        expr = parse_expression(value, what)
-    elif isinstance(value, sp.Basic):
-        expr = sp.sympify(value)
-    else:
+    if not isinstance(value, (str, sp.Basic)):
         raise TypeError(f"{what} must be a string or a SymPy expression, "
                         f"got {type(value).__name__}")
+    return _parsed_rational(value, what, label, variable, other)
+
+
+@functools.lru_cache(maxsize=128)
+def _parsed_rational(value, what, label, variable, other):
+    """:func:`_rational` of a string or a SymPy expression, kept: the check costs SymPy time."""
+    expr = parse_expression(value, what) if isinstance(value, str) else sp.sympify(value)
     expr = _real_symbols(_exact_decimals(expr))
     _check_rational(expr, variable, label, other)
     return expr
@@ -558,6 +585,10 @@ class LoopModel:
         self.plant = parse_plant(plant)
         self.environment = parse_environment(environment)
         self.actuator = parse_actuator(actuator, self.plant)
+        #: What depends only on the plant, the environment and the actuator (the
+        #: derivation, the plant at numbers): shared by every model of this loop
+        #: in this process (:mod:`symstab._memo`).
+        self.shared_memo = _SHARED((self.plant, self.environment, self.actuator, str(cache_dir())))
         self.name = check_loop_name("loop" if name is None else name)
         self.description = check_text_line("description", description)
         symbols = {str(x): x for x in self.plant.free_symbols | self.environment.free_symbols}
@@ -587,9 +618,7 @@ class LoopModel:
                 raise ValueError(f"units: {key!r} is not a parameter of this loop "
                                  f"(parameters: {', '.join(self.parameters)})")
             self.units[key] = check_text_line(f"unit of {key!r}", str(unit))
-        poles = written_poles(sp.together(self.plant / model.s))
-        numeric_plant = not (self.plant.free_symbols - {model.s})
-        self.zoh_method = "residues" if poles is not None and not numeric_plant else "matrix exponential"
+        self.zoh_method = self._zoh_method
         self.plane = None
         if plane is not None:
             plane = tuple(plane)
@@ -598,11 +627,17 @@ class LoopModel:
             self.check_plane(plane)
             self.plane = plane
 
+    @shared_property
+    def _zoh_method(self):
+        poles = written_poles(sp.together(self.plant / model.s))
+        numeric_plant = not (self.plant.free_symbols - {model.s})
+        return "residues" if poles is not None and not numeric_plant else "matrix exponential"
+
     def __repr__(self):
         return (f"Loop(plant={str(self.plant)!r}, environment={str(self.environment)!r}, "
                 f"zoh={self.zoh_method!r})")
 
-    @functools.cached_property
+    @shared_property
     def _derivation(self):
         """The loop's derivation cached on disk (:mod:`symstab.symbolic.derivation_cache`)."""
         return DerivationCache(self.plant, self.environment,
@@ -632,7 +667,7 @@ class LoopModel:
     #: and the real axis, where poles and their cancellations live).
     _CHECK_Z = complex(1.3, 0.4)
 
-    @functools.cached_property
+    @shared_property
     def _check_point(self):
         """Parameter values (none 0, 1 or equal to another) for checking cached parts."""
         point = {model.T: sp.Float("0.0213", PLANT_DIGITS)}
@@ -678,7 +713,7 @@ class LoopModel:
         return (self._close(at(parts[0]), at(ve_d) * at(p_d))
                 and self._close(at(parts[1]), at(ve_n) * at(p_n)))
 
-    @functools.cached_property
+    @shared_property
     def environment_parts(self):
         """``(Ve_n, Ve_d)``: the environment's numerator and denominator coefficients in ``z``.
 
@@ -692,7 +727,7 @@ class LoopModel:
 
         return self._derived("environment_parts", derive, self._environment_agrees)
 
-    @functools.cached_property
+    @shared_property
     def _plant_parts(self):
         """(P_n, P_d) coefficient lists in z (symbolic), or None for the numeric path."""
         if self.zoh_method != "residues":
@@ -776,7 +811,7 @@ class LoopModel:
 
         return product(ve_d, p_d), product(ve_n, p_n)
 
-    @functools.cached_property
+    @shared_property
     def _parts(self):
         """Delayed and direct coefficient lists (symbolic path only)."""
         return self._derived("parts", self._symbolic_parts, self._parts_agree)
@@ -794,7 +829,7 @@ class LoopModel:
                 out.append(name)
         return tuple(out)
 
-    @method_cache()
+    @method_cache(shared=True)
     def affine_in(self, names):
         """Whether the characteristic polynomial is affine in the parameters ``names`` jointly.
 
@@ -865,9 +900,23 @@ class LoopModel:
                              f"appears)")
 
     def _numeric_plant(self, plant_values, T):
-        return self._plant_cache(tuple(plant_values), T)
+        plant_values = tuple(plant_values)
+        self._warn_if_not_physical(plant_values, T)
+        return self._plant_cache(plant_values, T)
 
-    @functools.cached_property
+    @method_cache(maxsize=4096)
+    def _warn_if_not_physical(self, plant_values, T):
+        """A :class:`NonPhysicalPlantWarning` where :meth:`plant_defect` finds one: once per
+        point and model (the plant's numbers themselves are shared by the models of a loop)."""
+        defect = self._plant_defect(plant_values, T)
+        if defect is not None:
+            warnings.warn(defect, NonPhysicalPlantWarning, stacklevel=4)
+
+    @method_cache(maxsize=4096, shared=True)
+    def _plant_defect(self, plant_values, T):
+        return self.plant_defect(plant_values, T)
+
+    @shared_property
     def _plant_functions(self):
         """mpmath functions of (plant values..., T) giving P_n and P_d (symbolic path)."""
         num, den = self._plant_parts
@@ -944,7 +993,7 @@ class LoopModel:
                          f"cancels beyond {PLANT_MAX_DIGITS} digits: a parameter is too small "
                          f"or too large for its closed form")
 
-    @functools.cached_property
+    @shared_property
     def _pole_conditions(self):
         """``[(expression, why)]``: where an expression of the parameters vanishes, poles meet.
 
@@ -1010,7 +1059,7 @@ class LoopModel:
             f"{' or '.join(names)} another value, or write the plant as it is at {zero} "
             f"(a loop of its own)")
 
-    @functools.cached_property
+    @shared_property
     def driven_mass(self):
         """mpmath function of (plant values..., T): the actuator's and the driven mass's coefficients.
 
@@ -1031,7 +1080,7 @@ class LoopModel:
         a_num, a_den = sp.fraction(sp.cancel(sp.together(actuator)))
         return self._plant_function([poly_coeffs(p, model.s) for p in (a_num, a_den, num, den)])
 
-    @functools.cached_property
+    @shared_property
     def _plant_pole_factors(self):
         """mpmath function of (plant values..., T): coefficients of the denominator's factors in ``s``.
 
@@ -1073,7 +1122,7 @@ class LoopModel:
             total = sum(-mpmath.log10(x) for x in sizes if 0 < x < 1)
         return int(mpmath.ceil(total))
 
-    @functools.cached_property
+    @shared_property
     def _plant_fraction(self):
         """mpmath function of (plant values..., T): the plant's numerator and denominator in ``s``."""
         num, den = sp.fraction(sp.cancel(sp.together(self.plant)))
@@ -1136,19 +1185,15 @@ class LoopModel:
                 f"physical device's (a negative mass, friction or stiffness?); the results are "
                 f"those of that plant")
 
-    @method_cache(maxsize=4096)
+    @method_cache(maxsize=4096, shared=True)
     def _plant_digits(self, plant_values, T):
         """``(P_n, P_d, digits)``: the pulse transfer function's coefficients as mpmath numbers.
 
         At :data:`PLANT_DIGITS` digits, or more where the closed form needs
         them (:meth:`_closed_form_plant`); refused where it is not defined.
-        A plant that is not a physical device's at these values
-        (:meth:`plant_defect`) gives a :class:`NonPhysicalPlantWarning`,
-        once per point (the result is cached).
+        (A plant that is not a physical device's at these values is warned
+        of by :meth:`_numeric_plant` and :meth:`_exact_plant`, the entries.)
         """
-        defect = self.plant_defect(plant_values, T)
-        if defect is not None:
-            warnings.warn(defect, NonPhysicalPlantWarning, stacklevel=2)
         digits = PLANT_DIGITS
         with mpmath.workdps(PLANT_DIGITS):
             point = [mpmath.mpf(float(v)) for v in plant_values]
@@ -1214,12 +1259,14 @@ class LoopModel:
         rounded to doubles, the coefficients of a plant with a zero or a
         pole next to ``z = +-1`` lose what the arc needs there.
         """
-        p_n, p_d, digits = self._plant_digits(tuple(plant_values), T)
+        plant_values = tuple(plant_values)
+        self._warn_if_not_physical(plant_values, T)
+        p_n, p_d, digits = self._plant_digits(plant_values, T)
         with mpmath.workdps(digits):
             lead = p_d[0]
             return tuple(tuple(_fraction(c / lead) for c in part) for part in (p_n, p_d))
 
-    @method_cache(maxsize=4096)
+    @method_cache(maxsize=4096, shared=True)
     def _plant_cache(self, plant_values, T):
         """(P_n, P_d, ends, P_d in z - 1) as float arrays, monic P_d, evaluated at 30 digits.
 

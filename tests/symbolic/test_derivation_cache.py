@@ -94,12 +94,36 @@ def test_a_second_load_reads_the_derivation_and_gives_identical_numbers(zoh_call
     first = Loop(PLANT, ENVIRONMENT, plane=("B", "K"))
     fresh = numbers(first)
     assert len(zoh_calls) == 1
+    loop_assembly.forget_derivations()    # this process's shared derivation: read the disk
     again = Loop(PLANT, ENVIRONMENT, plane=("B", "K"))
     cached = numbers(again)
     assert len(zoh_calls) == 1, "derived again"
     assert_identical(fresh, cached)
     assert [sp.srepr(c) for part in again._plant_parts for c in part] == [
         sp.srepr(c) for part in first._plant_parts for c in part]
+
+
+def test_a_loop_built_again_in_the_same_process_derives_and_reads_nothing(zoh_calls, cache,
+                                                                            monkeypatch):
+    """The models of one loop share what was derived (``loop_assembly._SHARED``): a sweep or a
+    design that builds the loop again neither derives nor reads the cache folder again."""
+    from symstab.symbolic.derivation_cache import DerivationCache
+
+    first = numbers(Loop(PLANT, ENVIRONMENT, plane=("B", "K")))
+    reads = []
+    read = DerivationCache._read
+
+    def counted(self):
+        reads.append(self.path)
+        return read(self)
+
+    monkeypatch.setattr(DerivationCache, "_read", counted)
+    again = numbers(Loop(PLANT, ENVIRONMENT, plane=("B", "K")))
+    assert len(zoh_calls) == 1 and reads == []
+    assert_identical(first, again)
+    # Another plant is another derivation.
+    _ = Loop(PLANT.replace("k)", "2*k)"), ENVIRONMENT)._plant_parts
+    assert len(zoh_calls) == 2 and len(reads) == 1
 
 
 def test_the_cache_is_read_without_eval_or_exec(derived_once, cache, monkeypatch):
@@ -165,7 +189,9 @@ def test_a_damaged_or_tampered_entry_is_derived_again(damage, derived_once, zoh_
     assert len(zoh_calls) == derived, "a damaged entry was trusted"
     assert_identical(fresh, again)
     assert not (tmp_path / MARKER).exists()
-    # Rewritten: the next load reads it and derives nothing.
+    # Rewritten: the next load (in a fresh process: nothing shared) reads it and derives
+    # nothing.
+    loop_assembly.forget_derivations()
     assert_identical(fresh, numbers(Loop(PLANT, ENVIRONMENT, plane=("B", "K"))))
     assert len(zoh_calls) == derived
 

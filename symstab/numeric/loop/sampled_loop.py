@@ -44,6 +44,7 @@ import warnings
 
 import sympy as sp
 
+from ..._memo import shared_property
 from ...codegen.loop_kernels import environment_kernels, load_numpy_kernels
 from ...symbolic.loop_assembly import LoopModel, parse_environment, parse_plant
 from ..engine.results import Boundary, Limits
@@ -211,7 +212,7 @@ class Loop(LoopModel):
         """Where the loop's generated NumPy module lives (None if in memory)."""
         return self._kernels[0].__file__
 
-    @functools.cached_property
+    @shared_property
     def environment_delay(self):
         """The environment's own delay in samples: the power of ``z`` that divides ``Ve_d``.
 

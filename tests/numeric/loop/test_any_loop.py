@@ -219,6 +219,17 @@ def test_a_plant_that_is_not_a_physical_devices_warns_naming_its_values(plant, v
                                                                  **physical)
 
 
+def test_a_loop_built_again_warns_again_though_it_shares_the_plant_s_numbers():
+    """The models of one loop share its derivation and its plant at numbers (computed once
+    per process); the warning of a non-physical plant is each model's, not computed once."""
+    from symstab import NonPhysicalPlantWarning
+
+    point = dict(K=1.0, B=0.1, T=PAPER_T, d=1, m=-0.2, b=PAPER_B)
+    for _ in range(2):
+        with pytest.warns(NonPhysicalPlantWarning, match="m = -0.2"):
+            Loop("1/(m*s**2 + b*s)", "K + B*(z - 1)/(T*z)").classify(**point)
+
+
 @pytest.mark.parametrize("name", ["e", "exp"])
 def test_a_parameter_named_like_an_mpmath_name_keeps_its_value(name):
     """``e`` once shadowed Euler's number in the plant's mpmath function (K_max of a gain-49 plant for 7 e)."""
