@@ -440,19 +440,24 @@ def simulated_loop_radius(K, B, *, d, f_c=None, f_a=None, M=0.0, m=None, b=None,
 def dense_maximum(f, low, high, *, points=11, levels=7):
     """The largest ``f`` over [low, high] by nested grids (no optimiser): ``(x, f(x))``.
 
-    ``levels`` grids of ``points`` points, each spanning two steps of the one
-    before around its best point.  The optimum of a design may be a kink (a
-    stable set shrinking to a sliver and vanishing): the last grid's step,
-    ``(2 / (points - 1))**(levels - 1)`` of the first's, keeps a steep side
-    within 1e-4.  ``f`` returns ``-inf`` where there is nothing to maximise.
+    A first grid of ``points`` points over the range, then grids of five
+    points, each spanning a step of the one before on each side of its best
+    point (so halving the step), until the step is ``(2 / (points -
+    1))**(levels - 1)`` of the first's: the resolution of ``levels`` grids of
+    ``points`` points zoomed the same way.  The optimum of a design may be a
+    kink (a stable set shrinking to a sliver and vanishing): that last step
+    keeps a steep side within 1e-4.  ``f`` returns ``-inf`` where there is
+    nothing to maximise.
 
-    Each grid's ends are the points beside the best of the grid before, so
-    ``f`` (a certified answer near a kink takes seconds) is called once per
-    distinct point: the points a grid shares with the one before are
-    remembered, not evaluated again.
+    Each grid's ends and middle are points of the grid before (the best and
+    its two neighbours), so ``f`` (a certified answer near a kink takes
+    seconds) is called once per distinct point, twice per halving: 39 calls
+    for the defaults, where eleven-point grids (the same first grid and
+    resolution) took 59.
     """
     best_value, best = -math.inf, None
     ends = low, high
+    finest = (high - low) / (points - 1) * (2 / (points - 1)) ** (levels - 1)
     seen = {}
 
     def value(v):
@@ -460,12 +465,12 @@ def dense_maximum(f, low, high, *, points=11, levels=7):
             seen[v] = f(v)
         return seen[v]
 
-    for _ in range(levels):
-        grid = np.linspace(low, high, points)
+    grid = np.linspace(low, high, points)
+    while True:
         if best is not None:
             # The best point so far is the middle of this grid, up to rounding: itself.
             i = int(np.argmin(np.abs(grid - best)))
-            if abs(grid[i] - best) <= 1e-9 * (high - low):
+            if abs(grid[i] - best) <= 1e-9 * (grid[-1] - grid[0]):
                 grid[i] = best
         found = [value(float(v)) for v in grid]
         k = int(np.argmax(found))
@@ -473,12 +478,15 @@ def dense_maximum(f, low, high, *, points=11, levels=7):
             best_value, best = found[k], float(grid[k])
         if best is None:
             return None, -math.inf
+        step = grid[1] - grid[0]
+        if step <= finest * (1 + 1e-9):
+            return best, best_value
         # The next grid spans a step of this one on each side of the best point, at most
         # to the ends; a side inside this grid is its point there (evaluated already).
-        j, step = int(np.argmin(np.abs(grid - best))), grid[1] - grid[0]
+        j = int(np.argmin(np.abs(grid - best)))
         low = float(grid[j - 1]) if j > 0 else max(ends[0], best - step)
-        high = float(grid[j + 1]) if j < points - 1 else min(ends[1], best + step)
-    return best, best_value
+        high = float(grid[j + 1]) if j < len(grid) - 1 else min(ends[1], best + step)
+        grid = np.linspace(low, high, 5)
 
 
 def coulomb_friction_run(model, *, K, B, T, d, steps, x0, coulomb, stiction):
