@@ -19,7 +19,7 @@ import sys
 
 import numpy as np
 
-__all__ = ["require_matplotlib", "pyplot", "pyplot_or_none", "png_bytes", "visible",
+__all__ = ["Plot", "plot_region", "plot_limits", "plot_boundary", "require_matplotlib", "pyplot", "pyplot_or_none", "png_bytes", "visible",
            "draw_lines", "label_log_axis", "png_of", "png_or_none", "design_figure",
            "simulated_map_figure", "loop_map_figure", "probability_map_figure", "robust_figure",
            "locus_figure",
@@ -725,7 +725,7 @@ def _shade_cells(ax, decomposition, color, scale=(1.0, 1.0)):
 
     ``decomposition`` is a :class:`symstab.numeric.engine.decomposition.Decomposition`
     (x = beta, y = alpha); ``scale`` multiplies its coordinates into the
-    plotted units.
+    plotted units.  Returns the patches.
     """
     from matplotlib.patches import PathPatch
     from matplotlib.path import Path
@@ -743,11 +743,13 @@ def _shade_cells(ax, decomposition, color, scale=(1.0, 1.0)):
         codes[0], codes[-1] = Path.MOVETO, Path.CLOSEPOLY
         return vertices, codes
 
+    patches = []
     for cell in decomposition.stable:
         parts = [ring(cell.outer, False)] + [ring(h, True) for h in cell.holes]
         path = Path(np.concatenate([v for v, _ in parts]), np.concatenate([c for _, c in parts]))
-        ax.add_patch(PathPatch(path, facecolor=color, edgecolor="none", alpha=_FILL_ALPHA,
-                               zorder=1))
+        patches.append(ax.add_patch(PathPatch(path, facecolor=color, edgecolor="none",
+                                              alpha=_FILL_ALPHA, zorder=1)))
+    return patches
 
 
 def _count_text(ax, x, y, count):
@@ -1111,3 +1113,215 @@ def limits_figure(columns, suptitle):
                  fontsize=SUPTITLE_SIZE)
     _legend_below(fig, handles, ncol=4)
     return fig
+
+
+# --------------------------------------------------------------------------
+# Results that draw themselves: ``result.plot(ax=None)`` on a user's axes
+# --------------------------------------------------------------------------
+
+class Plot:
+    """What a result's ``plot()`` drew: its figure, its axes and its artists by role.
+
+    As python-control's ``ControlPlot``: keep it to restyle what was drawn
+    (``p.artists["stable"]``), to add to the axes, or to save the figure.
+
+    Attributes
+    ----------
+    figure : matplotlib.figure.Figure
+    axes : matplotlib.axes.Axes
+    artists : dict
+        ``{role: [artist, ...]}``: ``"stable"`` (the filled stable set),
+        ``"arc"`` and ``"lines"`` (the D-decomposition's curves),
+        ``"counts"`` (the root counts written in the cells), ``"marker"``
+        (a marked point), as the result drew them.
+    """
+
+    def __init__(self, figure, axes, artists):
+        self.figure = figure
+        self.axes = axes
+        self.artists = artists
+
+    def __repr__(self):
+        drawn = ", ".join(f"{role}: {len(a)}" for role, a in self.artists.items())
+        return f"Plot({drawn})"
+
+    def savefig(self, *args, **kwargs):
+        """The figure's :meth:`matplotlib.figure.Figure.savefig`."""
+        return self.figure.savefig(*args, **kwargs)
+
+
+def _axes(ax):
+    """``(figure, axes)``: ``ax`` and its figure, or a new figure's axes (pyplot's backend)."""
+    try:
+        import matplotlib.pyplot as plt
+    except ImportError:
+        raise ImportError("plot() needs matplotlib: pip install 'symstab[figures]' "
+                          "(or pip install matplotlib)") from None
+    if ax is None:
+        figure, ax = plt.subplots(figsize=(6.4, 4.8), layout="constrained")
+        return figure, ax
+    return ax.figure, ax
+
+
+#: The fill of a stable set drawn by a result's ``plot()``.
+STABLE_COLOR = "#4292c6"
+
+#: How a result's ``plot()`` draws the D-decomposition's pieces.
+_PIECE_STYLE = {"arc": {"color": "k", "lw": 1.2},
+                "z = 1": {"color": "C0", "ls": "--", "lw": 1.2},
+                "z = -1": {"color": "C3", "ls": "--", "lw": 1.2},
+                "leading": {"color": "C1", "ls": ":", "lw": 1.2}}
+_PIECE_LABEL = {"arc": r"a root at $z = e^{j\theta}$", "z = 1": "a root at $z = 1$",
+                "z = -1": "a root at $z = -1$", "leading": "a root at infinity"}
+
+
+def _pieces(ax, branches):
+    """The decomposition's pieces on ``ax``, one legend entry per kind: ``(arc, lines)``."""
+    arc, lines = [], []
+    for branch in branches:
+        style = _PIECE_STYLE.get(branch.label, _PIECE_STYLE["leading"])
+        seen = arc if branch.label == "arc" else lines
+        label = _PIECE_LABEL.get(branch.label, branch.label)
+        if any(getattr(a, "get_label", lambda: "")() == label for a in arc + lines):
+            label = "_nolegend_"
+        seen += ax.plot(branch.points[:, 0], branch.points[:, 1], label=label, zorder=3,
+                        **style)
+    return arc, lines
+
+
+def plot_region(decomposition, ax=None, *, counts=True, color=STABLE_COLOR):
+    """Draw a D-decomposition: the stable set filled, the curves, each cell's root count.
+
+    What :meth:`symstab.numeric.engine.decomposition.Decomposition.plot`
+    (and so ``loop.region(...).plot()``) draws.
+
+    Parameters
+    ----------
+    decomposition : symstab.numeric.engine.decomposition.Decomposition
+    ax : matplotlib.axes.Axes, optional
+        Where to draw (default: a new figure's axes).
+    counts : bool, optional
+        Write the number of unstable closed-loop poles in every cell with
+        room for it (default True).
+    color : str, optional
+        The stable set's fill.
+
+    Returns
+    -------
+    Plot
+        Artists ``"stable"``, ``"arc"``, ``"lines"``, ``"counts"``.
+
+    Raises
+    ------
+    ImportError
+        Without matplotlib (the ``figures`` extra).
+    """
+    figure, ax = _axes(ax)
+    from matplotlib.patches import Patch
+
+    stable = _shade_cells(ax, decomposition, color)
+    arc, lines = _pieces(ax, decomposition.branches)
+    ax.set_xlim(*decomposition.x_range)
+    ax.set_ylim(*decomposition.y_range)
+    ax.set_xlabel(decomposition.x)
+    ax.set_ylabel(decomposition.y)
+    written = []
+    if counts:
+        before = len(ax.texts)
+        _write_counts(ax, decomposition)
+        written = list(ax.texts[before:])
+    handles = [Patch(facecolor=color, alpha=_FILL_ALPHA + 0.1, label="stable (root counting)")]
+    handles += [a for a in arc + lines if not a.get_label().startswith("_")]
+    ax.legend(handles=handles, loc="best", fontsize=LEGEND_SIZE)
+    return Plot(figure, ax, {"stable": stable, "arc": arc, "lines": lines, "counts": written})
+
+
+def plot_limits(limits, ax=None, **kwargs):
+    """Draw the stable set that ``limits`` were read from, its largest ``y`` marked.
+
+    What :meth:`symstab.numeric.engine.results.Limits.plot` draws.
+
+    Parameters
+    ----------
+    limits : symstab.numeric.engine.results.Limits
+        Limits of a decomposition (:meth:`symstab.Loop.limits`,
+        :func:`symstab.limits`).
+    ax : matplotlib.axes.Axes, optional
+        Where to draw (default: a new figure's axes).
+    **kwargs
+        Handed to :func:`plot_region`.
+
+    Returns
+    -------
+    Plot
+        :func:`plot_region`'s artists, and ``"marker"``: the point
+        ``(x_at_y_max, y_max)``.
+
+    Raises
+    ------
+    ValueError
+        For limits that hold no decomposition to draw.
+    ImportError
+        Without matplotlib.
+    """
+    if limits.decomposition is None:
+        raise ValueError("these limits hold no D-decomposition to draw (they were not read "
+                         "from one)")
+    drawn = plot_region(limits.decomposition, ax, **kwargs)
+    marker = []
+    if not limits.empty and np.isfinite(limits.y_max) and np.isfinite(limits.x_at_y_max):
+        marker = drawn.axes.plot([limits.x_at_y_max], [limits.y_max], "o", color="#d62728",
+                                 zorder=6, label=f"{limits.y}_max = {limits.y_max:.6g}")
+        handles = drawn.axes.get_legend().legend_handles + marker
+        drawn.axes.legend(handles=handles, loc="best", fontsize=LEGEND_SIZE)
+    drawn.artists["marker"] = marker
+    return drawn
+
+
+def plot_boundary(boundary, ax=None, *, x_range=None, y_range=None):
+    """Draw a boundary: the arc where a root is on the unit circle, and the lines in view.
+
+    What :meth:`symstab.numeric.engine.results.Boundary.plot` draws.  A
+    loop's arc covers all of (0, pi) and may run off to very large values:
+    the default window holds its central points (from the 10th to the 90th
+    percentile in each coordinate, widened by half that span on each side).
+
+    Parameters
+    ----------
+    boundary : symstab.numeric.engine.results.Boundary
+    ax : matplotlib.axes.Axes, optional
+        Where to draw (default: a new figure's axes).
+    x_range, y_range : (float, float), optional
+        The window (default: as above).
+
+    Returns
+    -------
+    Plot
+        Artists ``"arc"`` and ``"lines"``.
+
+    Raises
+    ------
+    ImportError
+        Without matplotlib.
+    """
+    figure, ax = _axes(ax)
+    x, y = np.asarray(boundary.x_values, float), np.asarray(boundary.y_values, float)
+    arc = ax.plot(x, y, zorder=3, label=_PIECE_LABEL["arc"], **_PIECE_STYLE["arc"]) \
+        if len(x) else []
+    finite = np.isfinite(x) & np.isfinite(y)
+    for values, given, limit in ((x[finite], x_range, ax.set_xlim),
+                                 (y[finite], y_range, ax.set_ylim)):
+        if given is None and len(values):
+            lo, hi = np.percentile(values, [10, 90])
+            span = (hi - lo) or max(abs(hi), 1.0)
+            given = (lo - span / 2, hi + span / 2)
+        if given is not None:
+            limit(*given)
+    ax.set_xlabel(boundary.x)
+    ax.set_ylabel(boundary.y)
+    xs, ys = ax.get_xlim(), ax.get_ylim()
+    lines = draw_lines(ax, boundary.lines, np.linspace(*xs, 2), np.linspace(*ys, 2))
+    ax.set_xlim(*xs)
+    ax.set_ylim(*ys)
+    ax.legend(loc="best", fontsize=LEGEND_SIZE)
+    return Plot(figure, ax, {"arc": arc, "lines": lines})
