@@ -19,7 +19,8 @@ import sys
 
 import numpy as np
 
-__all__ = ["Plot", "plot_region", "plot_limits", "plot_boundary", "require_matplotlib", "pyplot", "pyplot_or_none", "png_bytes", "visible",
+__all__ = ["Plot", "plot_region", "plot_limits", "plot_boundary", "plot_robust",
+           "plot_probability", "plot_design", "require_matplotlib", "pyplot", "pyplot_or_none", "png_bytes", "visible",
            "draw_lines", "label_log_axis", "png_of", "png_or_none", "design_figure",
            "simulated_map_figure", "loop_map_figure", "probability_map_figure", "robust_figure",
            "locus_figure",
@@ -189,28 +190,39 @@ def design_figure(plt, found, labels, target_label):
     -------
     matplotlib.figure.Figure
     """
+    fig, ax = plt.subplots(figsize=(6.4, 4.4))
+    _draw_design(ax, found, labels, target_label)
+    fig.tight_layout()
+    return fig
+
+
+def _draw_design(ax, found, labels, target_label):
+    """:func:`design_figure`'s drawing on ``ax``: ``{"target", "best", "nominal", "none"}`` artists."""
+    fig = ax.figure
     samples = found.samples
     names = list(found.over)
     value = samples[:, -1]
     good = np.isfinite(value)
     none = value == -np.inf
-    fig, ax = plt.subplots(figsize=(6.4, 4.4))
+    artists = {"target": [], "none": [], "nominal": [], "best": []}
     what = "maximise " + target_label.split(" [")[0]
     if len(names) == 1:
         order = np.argsort(samples[:, 0])
         u, v = samples[order, 0], value[order]
-        ax.plot(u[np.isfinite(v)], v[np.isfinite(v)], "-o", color="C0", ms=3, lw=1.2,
-                label=f"{target_label.split(' [')[0]} ({int(good.sum())} evaluations)")
+        artists["target"] += ax.plot(
+            u[np.isfinite(v)], v[np.isfinite(v)], "-o", color="C0", ms=3, lw=1.2,
+            label=f"{target_label.split(' [')[0]} ({int(good.sum())} evaluations)")
         if none.any():
             floor = np.min(value[good]) if good.any() else 0.0
-            ax.plot(samples[none, 0], np.full(int(none.sum()), floor), "x", color="0.5",
-                    label="no stable point")
+            artists["none"] += ax.plot(samples[none, 0], np.full(int(none.sum()), floor), "x",
+                                       color="0.5", label="no stable point")
         if found.nominal:
-            ax.axvline(found.nominal[names[0]], color="C2", ls="--", lw=1,
-                       label=f"nominal {names[0]} = {found.nominal[names[0]]:.4g}")
+            artists["nominal"].append(ax.axvline(
+                found.nominal[names[0]], color="C2", ls="--", lw=1,
+                label=f"nominal {names[0]} = {found.nominal[names[0]]:.4g}"))
         if found.best is not None:
-            ax.plot([found.best[names[0]]], [found.value], "*", color="C3", ms=12,
-                    label=f"best {names[0]} = {found.best[names[0]]:.6g}")
+            artists["best"] += ax.plot([found.best[names[0]]], [found.value], "*", color="C3",
+                                       ms=12, label=f"best {names[0]} = {found.best[names[0]]:.6g}")
         ax.set_xlabel(labels[0])
         ax.set_ylabel(target_label)
     else:
@@ -218,21 +230,22 @@ def design_figure(plt, found, labels, target_label):
             dots = ax.scatter(samples[good, 0], samples[good, 1], c=value[good], s=18,
                               cmap="viridis")
             fig.colorbar(dots, ax=ax, label=target_label)
+            artists["target"].append(dots)
         if none.any():
-            ax.plot(samples[none, 0], samples[none, 1], "x", color="0.6", ms=4,
-                    label="no stable point")
+            artists["none"] += ax.plot(samples[none, 0], samples[none, 1], "x", color="0.6",
+                                       ms=4, label="no stable point")
         if found.nominal:
-            ax.plot([found.nominal[names[0]]], [found.nominal[names[1]]], "o", mfc="none",
-                    color="C2", ms=9, label="nominal")
+            artists["nominal"] += ax.plot([found.nominal[names[0]]], [found.nominal[names[1]]],
+                                          "o", mfc="none", color="C2", ms=9, label="nominal")
         if found.best is not None:
-            ax.plot([found.best[names[0]]], [found.best[names[1]]], "*", color="C3", ms=14,
-                    label="best " + ", ".join(f"{k} = {v:.4g}" for k, v in found.best.items()))
+            artists["best"] += ax.plot(
+                [found.best[names[0]]], [found.best[names[1]]], "*", color="C3", ms=14,
+                label="best " + ", ".join(f"{k} = {v:.4g}" for k, v in found.best.items()))
         ax.set_xlabel(labels[0])
         ax.set_ylabel(labels[1])
     ax.set_title(f"design: {what} over {' and '.join(names)}", fontsize=PANEL_TITLE_SIZE)
     ax.legend(fontsize=LEGEND_SIZE, loc="best")
-    fig.tight_layout()
-    return fig
+    return artists
 
 
 # --------------------------------------------------------------------------
@@ -367,18 +380,27 @@ def probability_map_figure(plt, found, curve, *, xlabel, ylabel, title):
     -------
     matplotlib.figure.Figure
     """
-    xs, ys = found.x_values, found.y_values
     fig, ax = plt.subplots(figsize=(6.4, 4.8), dpi=120)
-    mesh = ax.pcolormesh(xs, ys, found.probability, shading="nearest", vmin=0.0, vmax=1.0,
-                         cmap="Greens")
-    fig.colorbar(mesh, ax=ax, label="probability of stability")
-    handles = _loop_boundary(ax, curve, xs, ys, "nominal loop: ")
-    _map_frame(ax, xs, ys, xlabel, ylabel)
+    _draw_probability(ax, found, curve, xlabel, ylabel)
     ax.set_title(title, fontsize=8)
-    if handles:
-        ax.legend(handles=handles, loc="best", fontsize=8, framealpha=0.9)
     fig.tight_layout()
     return fig
+
+
+def _draw_probability(ax, found, curve, xlabel, ylabel):
+    """:func:`probability_map_figure`'s drawing on ``ax`` (``curve`` may be None).
+
+    Returns ``{"probability": [mesh], "colorbar": [colorbar], "boundary": [...]}``.
+    """
+    xs, ys = found.x_values, found.y_values
+    mesh = ax.pcolormesh(xs, ys, found.probability, shading="nearest", vmin=0.0, vmax=1.0,
+                         cmap="Greens")
+    bar = ax.figure.colorbar(mesh, ax=ax, label="probability of stability")
+    handles = [] if curve is None else _loop_boundary(ax, curve, xs, ys, "nominal loop: ")
+    _map_frame(ax, xs, ys, xlabel, ylabel)
+    if handles:
+        ax.legend(handles=handles, loc="best", fontsize=8, framealpha=0.9)
+    return {"probability": [mesh], "colorbar": [bar], "boundary": handles}
 
 
 # --------------------------------------------------------------------------
@@ -401,23 +423,33 @@ def robust_figure(plt, region, xlabel, ylabel):
     -------
     matplotlib.figure.Figure
     """
+    fig, ax = plt.subplots(figsize=(6.4, 4.8))
+    _draw_robust(ax, region, xlabel, ylabel)
+    fig.tight_layout()
+    return fig
+
+
+def _draw_robust(ax, region, xlabel, ylabel):
+    """:func:`robust_figure`'s drawing on ``ax``: ``{"nominal", "marginal", "robust"}`` artists."""
     from matplotlib.patches import Patch, Polygon
 
-    fig, ax = plt.subplots(figsize=(6.4, 4.8))
+    artists = {"nominal": [], "marginal": [], "robust": []}
     nominal = region.nominal
     if nominal is not None:
         for k, cell in enumerate(nominal.stable):
             ring = np.vstack([cell.outer, cell.outer[:1]])
-            ax.plot(ring[:, 0], ring[:, 1], color="0.2", lw=1.0,
-                    label="stable at the box's centre" if k == 0 else None)
+            artists["nominal"] += ax.plot(ring[:, 0], ring[:, 1], color="0.2", lw=1.0,
+                                          label="stable at the box's centre" if k == 0 else None)
     for i, bands in enumerate(region.marginal):
         x0, x1 = region.edges[i], region.edges[i + 1]
         for lo0, hi0, lo1, hi1 in bands:
-            ax.add_patch(Polygon([(x0, lo0), (x1, lo1), (x1, hi1), (x0, hi0)], closed=True,
-                                 facecolor="#f4a582", edgecolor="none"))
+            artists["marginal"].append(ax.add_patch(Polygon(
+                [(x0, lo0), (x1, lo1), (x1, hi1), (x0, hi0)], closed=True,
+                facecolor="#f4a582", edgecolor="none")))
     # The robust set's outlines (runs of strips joined: no seams between them).
     for outline in region.polygons:
-        ax.add_patch(Polygon(outline, closed=True, facecolor="#4393c3", edgecolor="none"))
+        artists["robust"].append(ax.add_patch(Polygon(outline, closed=True, facecolor="#4393c3",
+                                                      edgecolor="none")))
     handles, _ = ax.get_legend_handles_labels()
     handles += [Patch(color="#4393c3", label="stable for every value of the box"),
                 Patch(color="#f4a582", label="marginal (not certified)")]
@@ -429,8 +461,7 @@ def robust_figure(plt, region, xlabel, ylabel):
     ax.set_title(f"robust stable set: {box}", fontsize=9)
     ax.set_xlabel(xlabel)
     ax.set_ylabel(ylabel)
-    fig.tight_layout()
-    return fig
+    return artists
 
 
 # --------------------------------------------------------------------------
@@ -1325,3 +1356,89 @@ def plot_boundary(boundary, ax=None, *, x_range=None, y_range=None):
     ax.set_ylim(*ys)
     ax.legend(loc="best", fontsize=LEGEND_SIZE)
     return Plot(figure, ax, {"arc": arc, "lines": lines})
+
+
+def plot_robust(region, ax=None):
+    """Draw a robust set: certified (filled), marginal, and the nominal set's outline.
+
+    What :meth:`symstab.numeric.engine.results.RobustRegion.plot` draws (the
+    PNG of ``symstab limits --uncertain``).
+
+    Parameters
+    ----------
+    region : symstab.numeric.engine.results.RobustRegion
+    ax : matplotlib.axes.Axes, optional
+        Where to draw (default: a new figure's axes).
+
+    Returns
+    -------
+    Plot
+        Artists ``"robust"``, ``"marginal"``, ``"nominal"``.
+
+    Raises
+    ------
+    ImportError
+        Without matplotlib.
+    """
+    figure, ax = _axes(ax)
+    return Plot(figure, ax, _draw_robust(ax, region, region.x, region.y))
+
+
+def plot_probability(found, ax=None, *, boundary=None):
+    """Draw the probability of stability over its grid, a boundary over it if given.
+
+    What :meth:`symstab.numeric.engine.results.StabilityProbability.plot`
+    draws (the PNG of ``symstab map --uncertain``).
+
+    Parameters
+    ----------
+    found : symstab.numeric.engine.results.StabilityProbability
+    ax : matplotlib.axes.Axes, optional
+        Where to draw (default: a new figure's axes).
+    boundary : symstab.numeric.engine.results.Boundary, optional
+        The nominal loop's D-decomposition (:meth:`symstab.Loop.boundary`),
+        drawn over the map.
+
+    Returns
+    -------
+    Plot
+        Artists ``"probability"`` (the mesh), ``"colorbar"``, ``"boundary"``.
+
+    Raises
+    ------
+    ImportError
+        Without matplotlib.
+    """
+    figure, ax = _axes(ax)
+    return Plot(figure, ax, _draw_probability(ax, found, boundary, found.x, found.y))
+
+
+def plot_design(found, ax=None, *, target_label=None):
+    """Draw a design: its target at every value evaluated, the optimum and the nominal marked.
+
+    What :meth:`symstab.numeric.analysis.design.Design.plot` draws (the PNG
+    of ``symstab design --png``).
+
+    Parameters
+    ----------
+    found : symstab.numeric.analysis.design.Design
+    ax : matplotlib.axes.Axes, optional
+        Where to draw (default: a new figure's axes).
+    target_label : str, optional
+        The target's axis label (default: its name,
+        :attr:`~symstab.numeric.analysis.design.Design.target`).
+
+    Returns
+    -------
+    Plot
+        Artists ``"target"``, ``"best"``, ``"nominal"``, ``"none"`` (the
+        values with no stable point).
+
+    Raises
+    ------
+    ImportError
+        Without matplotlib.
+    """
+    figure, ax = _axes(ax)
+    label = found.target if target_label is None else target_label
+    return Plot(figure, ax, _draw_design(ax, found, list(found.over), label))

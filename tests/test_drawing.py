@@ -97,3 +97,52 @@ def test_without_matplotlib_plot_names_the_extra(region_d40, monkeypatch):
     monkeypatch.setitem(sys.modules, "matplotlib.pyplot", None)
     with pytest.raises(ImportError, match=r"symstab\[figures\]"):
         region_d40.plot()
+
+
+def test_a_robust_set_draws_its_certified_and_marginal_bands_and_the_nominal_outline(region_d40):
+    """Two strips with one band each (joined into one polygon) and a marginal band."""
+    from symstab.numeric.engine.results import RobustRegion
+
+    region = RobustRegion("B", "K", {"m": (0.0120, 0.0136)}, np.array([0.0, 0.1, 0.2]),
+                          (((0.0, 2.0, 0.0, 3.0),), ((0.0, 3.0, 0.0, 2.5),)),
+                          ((), ((3.0, 3.2, 2.5, 2.6),)), nominal=region_d40)
+    drawn = region.plot()
+    (robust,) = drawn.artists["robust"]
+    np.testing.assert_array_equal(robust.get_xy()[:-1], region.polygons[0])
+    (marginal,) = drawn.artists["marginal"]
+    np.testing.assert_array_equal(marginal.get_xy()[:-1],
+                                  [(0.1, 3.0), (0.2, 2.5), (0.2, 2.6), (0.1, 3.2)])
+    assert len(drawn.artists["nominal"]) == len(region_d40.stable)
+    assert "m in [0.012, 0.0136]" in drawn.axes.get_title()
+
+
+def test_a_probability_map_draws_its_grid_and_the_boundary_given():
+    from symstab.numeric.engine.results import StabilityProbability
+
+    p = np.array([[0.0, 0.5, 1.0], [0.25, 0.75, 1.0]])
+    found = StabilityProbability(np.array([0.0, 1.0]), np.array([0.0, 0.1, 0.2]), p,
+                                 np.zeros_like(p), np.zeros(p.shape, int), 100, 1,
+                                 {"m": "uniform"}, "B", "K")
+    drawn = found.plot(boundary=symstab.PAPER_LOOP.boundary(d=40))
+    (mesh,) = drawn.artists["probability"]
+    np.testing.assert_array_equal(np.asarray(mesh.get_array()).ravel(), p.ravel())
+    assert drawn.artists["colorbar"][0].ax.get_ylabel() == "probability of stability"
+    assert drawn.artists["boundary"]
+
+
+def test_a_design_marks_its_optimum_its_nominal_value_and_the_values_without_a_stable_point():
+    from symstab.numeric.analysis.design import Design
+
+    samples = np.array([[0.0, 10.0], [0.01, 14.0], [0.02, 12.0], [0.03, -np.inf]])
+    found = Design("y_max", "B", "K", {"M": (0.0, 0.03)}, {"M": 0.01}, 14.0, {"M": 0.0}, 10.0,
+                   None, samples, {"M": 0.01})
+    drawn = found.plot()
+    (best,) = drawn.artists["best"]
+    assert best.get_xydata().tolist() == [[0.01, 14.0]]
+    (line,) = drawn.artists["target"]
+    assert line.get_xydata().tolist() == [[0.0, 10.0], [0.01, 14.0], [0.02, 12.0]]
+    (none,) = drawn.artists["none"]
+    assert none.get_xydata().tolist() == [[0.03, 10.0]]
+    (nominal,) = drawn.artists["nominal"]
+    assert list(nominal.get_xdata()) == [0.0, 0.0]
+    assert drawn.axes.get_ylabel() == "y_max" and drawn.axes.get_xlabel() == "M"

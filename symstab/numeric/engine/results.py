@@ -460,6 +460,25 @@ class StabilityProbability:
     y: str
     at: dict = dataclasses.field(default_factory=dict)
 
+    def plot(self, ax=None, *, boundary=None):
+        """Draw the probability over the grid: :func:`symstab.drawing.plot_probability`.
+
+        Parameters
+        ----------
+        ax : matplotlib.axes.Axes, optional
+            Where to draw (default: a new figure's axes).
+        boundary : symstab.numeric.engine.results.Boundary, optional
+            The nominal loop's boundary, drawn over the map.
+
+        Returns
+        -------
+        symstab.drawing.Plot
+            Its ``figure``, ``axes`` and ``artists``.
+        """
+        from ...drawing import plot_probability
+
+        return plot_probability(self, ax, boundary=boundary)
+
     def __repr__(self):
         p = self.probability
         drawn = ", ".join(f"{k} ~ {v}" for k, v in self.uncertain.items())
@@ -521,6 +540,23 @@ class RobustRegion:
     examined: int = 0
     exhausted: bool = False
     unbounded: tuple = ()
+
+    def plot(self, ax=None):
+        """Draw the set: certified, marginal, and the nominal outline: :func:`symstab.drawing.plot_robust`.
+
+        Parameters
+        ----------
+        ax : matplotlib.axes.Axes, optional
+            Where to draw (default: a new figure's axes).
+
+        Returns
+        -------
+        symstab.drawing.Plot
+            Its ``figure``, ``axes`` and ``artists``.
+        """
+        from ...drawing import plot_robust
+
+        return plot_robust(self, ax)
 
     @classmethod
     def from_strips(cls, x, y, box, delays, edges, robust, marginal, nominal, at, examined=0,
