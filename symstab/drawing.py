@@ -20,7 +20,8 @@ import sys
 import numpy as np
 
 __all__ = ["Plot", "plot_region", "plot_limits", "plot_boundary", "plot_robust",
-           "plot_probability", "plot_design", "require_matplotlib", "pyplot", "pyplot_or_none", "png_bytes", "visible",
+           "plot_probability", "plot_design", "plot_passive", "plot_locus", "plot_simulation",
+           "plot_map", "require_matplotlib", "pyplot", "pyplot_or_none", "png_bytes", "visible",
            "draw_lines", "label_log_axis", "png_of", "png_or_none", "design_figure",
            "simulated_map_figure", "loop_map_figure", "probability_map_figure", "robust_figure",
            "locus_figure",
@@ -1442,3 +1443,173 @@ def plot_design(found, ax=None, *, target_label=None):
     figure, ax = _axes(ax)
     label = found.target if target_label is None else target_label
     return Plot(figure, ax, _draw_design(ax, found, list(found.over), label))
+
+
+def plot_passive(passive, ax=None, *, region=None):
+    """Draw a passive set (its polygon), the stable set beside it if given.
+
+    What :meth:`symstab.numeric.analysis.passivity.PassiveRegion.plot` draws.
+
+    Parameters
+    ----------
+    passive : symstab.numeric.analysis.passivity.PassiveRegion
+    ax : matplotlib.axes.Axes, optional
+        Where to draw (default: a new figure's axes).
+    region : symstab.numeric.engine.decomposition.Decomposition, optional
+        The stable set of the same plane (:meth:`symstab.Loop.region`),
+        drawn under it: passive points are stable, not the other way round.
+
+    Returns
+    -------
+    Plot
+        Artists ``"passive"`` and, with ``region``, :func:`plot_region`'s.
+
+    Raises
+    ------
+    ImportError
+        Without matplotlib.
+    """
+    from matplotlib.patches import Patch, Polygon
+
+    figure, ax = _axes(ax)
+    artists = plot_region(region, ax, counts=False).artists if region is not None else {}
+    handles = list(ax.get_legend().legend_handles) if ax.get_legend() else []
+    artists["passive"] = []
+    if len(passive.polygon):
+        artists["passive"].append(ax.add_patch(Polygon(
+            passive.polygon, closed=True, facecolor=PASSIVE_COLOR, edgecolor=PASSIVE_COLOR,
+            alpha=0.45, lw=1.2, zorder=2)))
+    handles.append(Patch(facecolor=PASSIVE_COLOR, alpha=0.45, label="passive"))
+    if region is None:
+        ax.set_xlim(*passive.x_range)
+        ax.set_ylim(*passive.y_range)
+        ax.set_xlabel(passive.x)
+        ax.set_ylabel(passive.y)
+    ax.legend(handles=handles, loc="best", fontsize=LEGEND_SIZE)
+    return Plot(figure, ax, artists)
+
+
+def plot_locus(locus, ax=None):
+    """Draw a root locus in the z-plane: the poles coloured by the path's value, the crossings.
+
+    What :meth:`symstab.numeric.engine.locus.Locus.plot` draws (the upper
+    left panel of ``symstab locus``'s PNG).
+
+    Parameters
+    ----------
+    locus : symstab.numeric.engine.locus.Locus
+    ax : matplotlib.axes.Axes, optional
+        Where to draw (default: a new figure's axes).
+
+    Returns
+    -------
+    Plot
+        Artists ``"poles"`` (the scatter), ``"circle"``, ``"crossings"``
+        (a marker per crossing, and its mirror for a pair) and
+        ``"colorbar"``.
+
+    Raises
+    ------
+    ImportError
+        Without matplotlib.
+    """
+    from matplotlib.colors import Normalize
+
+    figure, ax = _axes(ax)
+    values = np.asarray(locus.values, dtype=float)
+    finite = np.isfinite(locus.poles)
+    radius = float(np.max(np.abs(locus.poles[finite]))) if finite.any() else 1.0
+    limit = min(max(1.15, 1.05 * radius), _PLANE_LIMIT)
+    norm = Normalize(vmin=float(values.min()), vmax=float(values.max()))
+    before = len(ax.lines)
+    dots = _plane(ax, locus, values, locus.parameter, norm, limit)
+    lines = ax.lines[before:]
+    bar = figure.colorbar(dots, ax=ax, label=locus.parameter)
+    ax.legend(loc="best", fontsize=LEGEND_SIZE)
+    return Plot(figure, ax, {"poles": [dots], "circle": lines[:1], "crossings": lines[2:],
+                             "colorbar": [bar]})
+
+
+def plot_simulation(run, ax=None, *, T=None):
+    """Draw a recorded run: the position at each sample, one line per point simulated.
+
+    What :meth:`symstab.numeric.simulation.simulator.Simulation.plot` draws.
+
+    Parameters
+    ----------
+    run : symstab.numeric.simulation.simulator.Simulation
+        A run with its positions (``record=True``).
+    ax : matplotlib.axes.Axes, optional
+        Where to draw (default: a new figure's axes).
+    T : float, optional
+        The sample period in s: the time axis in seconds (default: in
+        samples).
+
+    Returns
+    -------
+    Plot
+        Artists ``"positions"``, one line per point.
+
+    Raises
+    ------
+    ValueError
+        For a run without its positions.
+    ImportError
+        Without matplotlib.
+    """
+    if run.positions is None:
+        raise ValueError("this run did not record its positions: simulate with record=True")
+    figure, ax = _axes(ax)
+    positions = np.asarray(run.positions, dtype=float)
+    positions = positions.reshape(len(positions), -1)
+    k = np.arange(len(positions)) * (1.0 if T is None else float(T))
+    lines = ax.plot(k, positions, lw=1.0)
+    ax.set_xlabel("sample k" if T is None else "time [s]")
+    ax.set_ylabel("position x")
+    stable = np.asarray(run.stable).ravel()
+    if len(lines) == 1:
+        ax.set_title("stable" if stable[0] else ("bounded limit cycle"
+                                                 if np.asarray(run.limit_cycle).ravel()[0]
+                                                 else "not stable"), fontsize=PANEL_TITLE_SIZE)
+    return Plot(figure, ax, {"positions": lines})
+
+
+def plot_map(found, ax=None, *, boundary=None):
+    """Draw a simulated stability map: stable cells, bounded limit cycles, a boundary over it.
+
+    What :meth:`symstab.numeric.simulation.simulator.StabilityMap.plot`
+    draws (the PNG of ``symstab map``, in the map's own plane).
+
+    Parameters
+    ----------
+    found : symstab.numeric.simulation.simulator.StabilityMap
+    ax : matplotlib.axes.Axes, optional
+        Where to draw (default: a new figure's axes).
+    boundary : symstab.numeric.engine.results.Boundary, optional
+        The loop's D-decomposition in the same plane, drawn over the map.
+
+    Returns
+    -------
+    Plot
+        Artists ``"cells"`` (the mesh) and ``"boundary"``.
+
+    Raises
+    ------
+    ImportError
+        Without matplotlib.
+    """
+    from matplotlib.colors import ListedColormap
+    from matplotlib.patches import Patch
+
+    figure, ax = _axes(ax)
+    xs, ys = np.asarray(found.x_values, float), np.asarray(found.y_values, float)
+    shade = np.where(found.stable, 1, np.where(found.limit_cycle, 2, 0))
+    mesh = ax.pcolormesh(xs, ys, shade, shading="nearest", vmin=0, vmax=2,
+                         cmap=ListedColormap(["white", "#7fc97f", LIMIT_CYCLE_COLOR]))
+    handles = [Patch(facecolor="#7fc97f", label="stable (simulated)")]
+    if np.any(found.limit_cycle):
+        handles.append(Patch(facecolor=LIMIT_CYCLE_COLOR, label=LIMIT_CYCLE_LABEL))
+    drawn = [] if boundary is None else _loop_boundary(ax, boundary, xs, ys)
+    _map_frame(ax, xs, ys, found.x, found.y)
+    ax.legend(handles=handles + drawn, loc="best", fontsize=LEGEND_SIZE, framealpha=0.9)
+    return Plot(figure, ax, {"cells": [mesh], "boundary": drawn})

@@ -146,3 +146,48 @@ def test_a_design_marks_its_optimum_its_nominal_value_and_the_values_without_a_s
     (nominal,) = drawn.artists["nominal"]
     assert list(nominal.get_xdata()) == [0.0, 0.0]
     assert drawn.axes.get_ylabel() == "y_max" and drawn.axes.get_xlabel() == "M"
+
+
+def test_a_passive_set_draws_its_polygon_over_the_stable_set(region_d40):
+    passive = symstab.PAPER_LOOP.passive_region(d=40)
+    drawn = passive.plot(region=region_d40)
+    (polygon,) = drawn.artists["passive"]
+    np.testing.assert_array_equal(polygon.get_xy()[:-1], passive.polygon)
+    assert len(drawn.artists["stable"]) == len(region_d40.stable)
+    labels = [t.get_text() for t in drawn.axes.get_legend().get_texts()]
+    assert "passive" in labels and "stable (root counting)" in labels
+
+
+def test_a_locus_draws_every_pole_and_marks_its_crossings():
+    """K along [0, 10] N m/rad at d = 40: K_max is about 4.96 there, so poles cross."""
+    found = symstab.locus(symstab.PAPER_LOOP, "K", np.linspace(0.0, 10.0, 60), B=0.3, d=40)
+    drawn = found.plot()
+    (dots,) = drawn.artists["poles"]
+    inside = np.isfinite(found.poles) & (np.abs(found.poles) <= 3.0)
+    assert len(dots.get_offsets()) == int(inside.sum())
+    marks = sum(2 if c.kind == "pair" else 1 for c in found.crossings)
+    assert found.crossings and len(drawn.artists["crossings"]) == marks
+    (circle,) = drawn.artists["circle"]
+    assert np.allclose(np.hypot(*circle.get_xydata().T), 1.0)
+
+
+def test_a_recorded_run_draws_its_positions_and_a_run_without_them_says_so():
+    values = dict(K=[1.0, 50.0], B=0.2, d=5)
+    run = symstab.PAPER_LOOP.simulate(steps=300, record=True, **values)
+    drawn = run.plot(T=1e-3)
+    assert len(drawn.artists["positions"]) == 2
+    for line, column in zip(drawn.artists["positions"], run.positions.T, strict=True):
+        np.testing.assert_array_equal(line.get_ydata(), column)
+    assert drawn.artists["positions"][0].get_xdata()[-1] == pytest.approx(0.3)
+    with pytest.raises(ValueError, match="record=True"):
+        symstab.PAPER_LOOP.simulate(steps=10, **values).plot()
+
+
+def test_a_simulated_map_draws_its_verdicts_and_the_boundary():
+    K, B = np.linspace(0.0, 8.0, 6), np.linspace(0.0, 0.5, 5)
+    found = symstab.PAPER_LOOP.stability_map(B, K, steps=400, d=40)
+    drawn = found.plot(boundary=symstab.PAPER_LOOP.boundary(d=40))
+    (mesh,) = drawn.artists["cells"]
+    np.testing.assert_array_equal(np.asarray(mesh.get_array()).reshape(found.stable.shape),
+                                  found.stable.astype(int))
+    assert drawn.artists["boundary"] and drawn.axes.get_xlabel() == found.x

@@ -140,7 +140,7 @@ class Design:
     delay: object = None
 
     def plot(self, ax=None, **kwargs):
-        """Draw the target at every value evaluated, the optimum marked: :func:`symstab.drawing.plot_design`.
+        """Draw the target at each value evaluated: :func:`symstab.drawing.plot_design`.
 
         Parameters
         ----------

@@ -542,7 +542,7 @@ class RobustRegion:
     unbounded: tuple = ()
 
     def plot(self, ax=None):
-        """Draw the set: certified, marginal, and the nominal outline: :func:`symstab.drawing.plot_robust`.
+        """Draw the certified and marginal sets: :func:`symstab.drawing.plot_robust`.
 
         Parameters
         ----------
