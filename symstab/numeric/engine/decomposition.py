@@ -237,6 +237,34 @@ class Decomposition:
     arc: object = dataclasses.field(default=None, compare=False)
     segments: tuple = ()
 
+    def plot(self, ax=None, **kwargs):
+        """Draw the decomposition: :func:`symstab.drawing.plot_region`.
+
+        The stable set filled, the arc and the lines, and each cell's number
+        of unstable closed-loop poles where it has room.
+
+        Parameters
+        ----------
+        ax : matplotlib.axes.Axes, optional
+            Where to draw (default: a new figure's axes).
+        **kwargs
+            ``counts``, ``color``: as in :func:`symstab.drawing.plot_region`.
+
+        Returns
+        -------
+        symstab.drawing.Plot
+            Its ``figure``, ``axes`` and ``artists``.
+
+        Examples
+        --------
+        >>> import symstab
+        >>> drawn = symstab.PAPER_LOOP.region(d=40).plot()      # doctest: +SKIP
+        >>> drawn.figure.savefig("region.png")                  # doctest: +SKIP
+        """
+        from ...drawing import plot_region
+
+        return plot_region(self, ax, **kwargs)
+
     @property
     def stable(self):
         """The cells with no root outside the unit circle."""
@@ -438,7 +466,7 @@ class Decomposition:
         at = {} if at is None else at
         if not self.stable:
             return Limits.empty_set(self.x, self.y, "the stable set is empty: " + self._why_empty(),
-                                    cells=0, at=at, line=line)
+                                    cells=0, at=at, line=line, decomposition=self)
         (y_max, x_at), (x_min, _), (x_max, _) = (self.extreme(*which) for which in
                                                   (("y", 1), ("x", -1), ("x", 1)))
         sides = set(self.unbounded)
@@ -447,7 +475,7 @@ class Decomposition:
         x_max = np.inf if "x_max" in sides else x_max
         area = np.inf if sides else self.area
         return Limits(self.x, self.y, float(y_max), float(x_at), float(x_min), float(x_max),
-                      float(area), cells=len(self.stable), at=at, line=line)
+                      float(area), cells=len(self.stable), at=at, line=line, decomposition=self)
 
     def _why_empty(self):
         """Why no cell is stable: the hull's proof, or what the window held."""

@@ -421,6 +421,25 @@ class Simulation:
     floor: np.ndarray
     limit_cycle: np.ndarray
 
+    def plot(self, ax=None, *, T=None):
+        """Draw the recorded positions: :func:`symstab.drawing.plot_simulation`.
+
+        Parameters
+        ----------
+        ax : matplotlib.axes.Axes, optional
+            Where to draw (default: a new figure's axes).
+        T : float, optional
+            The sample period in s: time in seconds (default: samples).
+
+        Returns
+        -------
+        symstab.drawing.Plot
+            Its ``figure``, ``axes`` and ``artists``.
+        """
+        from ...drawing import plot_simulation
+
+        return plot_simulation(self, ax, T=T)
+
     @property
     def bounded(self):
         """Stable or a limit cycle: the runs that neither grow nor diverge."""
@@ -600,6 +619,25 @@ class StabilityMap(PaperGridNames):
     x: str = PAPER_PLANE[0]
     y: str = PAPER_PLANE[1]
     at: dict = dataclasses.field(default_factory=dict)
+
+    def plot(self, ax=None, *, boundary=None):
+        """Draw the map, a boundary over it if given: :func:`symstab.drawing.plot_map`.
+
+        Parameters
+        ----------
+        ax : matplotlib.axes.Axes, optional
+            Where to draw (default: a new figure's axes).
+        boundary : symstab.numeric.engine.results.Boundary, optional
+            The loop's D-decomposition in the map's plane, drawn over it.
+
+        Returns
+        -------
+        symstab.drawing.Plot
+            Its ``figure``, ``axes`` and ``artists``.
+        """
+        from ...drawing import plot_map
+
+        return plot_map(self, ax, boundary=boundary)
 
 
 
