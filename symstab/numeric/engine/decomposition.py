@@ -46,7 +46,7 @@ import scipy.sparse.csgraph
 from ..._resources import check_memory, chunk_slices
 from .arcs import CramerArc
 from .polynomial import DelayedPolynomial
-from .results import Limits, Segment
+from .results import Limits, Segment, html_table
 from .roots import STABLE, classify_polynomials, leading_vanishes, root_counts
 from .search import bracketed_root, refit_root, zoom_max
 
@@ -541,6 +541,20 @@ class Decomposition:
             return where + "no point of the plane is stable)"
         return where + (f"{len(self.cells)} cells, counts {counts}, {len(self.stable)} stable, "
                         f"stable area {self.area:.6g})")
+
+    def _repr_html_(self):
+        """Jupyter's view: the window, the stable set's area and the cells per root count."""
+        rows = [(self.x, f"[{self.x_range[0]:.6g}, {self.x_range[1]:.6g}]"),
+                (self.y, f"[{self.y_range[0]:.6g}, {self.y_range[1]:.6g}]"),
+                ("stable area", self.area), ("stable cells", len(self.stable))]
+        counts = sorted({c.count for c in self.cells})
+        rows += [(f"cells with {n} unstable pole{'s' if n != 1 else ''}",
+                  sum(c.count == n for c in self.cells)) for n in counts]
+        if self.unbounded:
+            rows.append(("stable set reaches", ", ".join(self.unbounded)))
+        if self.hull is not None and self.hull.empty and not self.cells:
+            rows.append(("no point is stable", self.hull.reason))
+        return html_table(f"D-decomposition of the ({self.x}, {self.y}) plane", rows)
 
 
 # --------------------------------------------------------------------------

@@ -750,3 +750,18 @@ class RobustRegion:
         return (f"RobustRegion({self.x} x {self.y}, {box}: area {self.area:.6g} "
                 f"(nominal {nominal:.6g}), marginal {self.marginal_area:.3g}, "
                 f"{len(self.edges) - 1} strips{more})")
+
+    def _repr_html_(self):
+        """Jupyter's view: the box, the robust set's area beside the nominal one's, the margin."""
+        rows = [(k, f"[{lo:.6g}, {hi:.6g}]") for k, (lo, hi) in self.uncertain.items()]
+        if self.empty:
+            rows.append(("empty", self.reason))
+        else:
+            rows += [("area (stable for every value)", self.area),
+                     ("area at the box's centre",
+                      self.nominal.area if self.nominal is not None else None),
+                     ("marginal area (not certified)", self.marginal_area),
+                     ("strips", len(self.edges) - 1), ("cells examined", self.examined)]
+            if self.exhausted:
+                rows.append(("stopped", "at its budget of cells: what was open is marginal"))
+        return html_table(f"robust stable set in the ({self.x}, {self.y}) plane", rows)
