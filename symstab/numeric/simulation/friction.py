@@ -297,26 +297,20 @@ class StatePlant:
         self.substeps = substeps
         self.coulomb, self.stiction = coulomb, stiction
         self.rest = rest
-        self._rows = None
+        self._linear = None
         if not self.friction and space.phi.ndim == 2:
-            # Coefficients as arrays of the points: NumPy multiplies by an
-            # array in half the time it takes to convert a float (the same
-            # doubles); 1 as itself (an addition).
-            n_points = state.shape[1]
-            self._terms = [[(j, 1.0 if c == 1.0 else np.full(n_points, float(c)))
-                            for j, c in enumerate(row) if c != 0] for row in space.phi]
-            self._gains = {}
-            self._scratch = np.empty(n_points)
-            self._rows = list(state)
+            self._linear = _LinearStep(space.phi, space.gamma_u, state)
         else:
             self._state = state
         if self.friction:
+            # The friction's change of the state a sub-step, per direction.
+            self._friction_step = _column(space.gamma_f) * coulomb
             self._stop(self.rest)
 
     @property
     def state(self):
         """The ``(n, N)`` state (rows 0 and 1: the mass's position and velocity)."""
-        return self._state if self._rows is None else np.stack(self._rows)
+        return self._state if self._linear is None else self._linear.now.copy()
 
     @classmethod
     def from_history(cls, space, x0, v0, n_points, nonideal):
@@ -334,7 +328,9 @@ class StatePlant:
 
     def _stop(self, where):
         """Stop the mass at ``where``: the friction's impulse on the mass alone (velocity 0 exactly)."""
-        if where.any():
+        # (count_nonzero: a quarter of any()'s time on a few points, per sub-step.)
+        self._resting = bool(np.count_nonzero(where))
+        if self._resting:
             self._state -= _column(self.space.impulse) * np.where(where, self._state[1], 0.0)
 
     def step(self, force, sign=1.0, out=None):
@@ -345,10 +341,10 @@ class StatePlant:
         ``out``, which the plant may then keep as its state until the next
         period (the loop simulator's buffer row).
         """
-        if self._rows is not None:
-            for substep in range(self.substeps, 0, -1):
-                self._rows = self._linear_rows(force, sign, out if substep == 1 else None)
-            return self._rows[0]
+        if self._linear is not None:
+            for _ in range(self.substeps):
+                position = self._linear.step(force, sign)
+            return position.copy() if out is None else _copied(out, position)
         if not self.friction:
             for _ in range(self.substeps):
                 self._state = _times(self.space.phi, self._state) + (
@@ -357,26 +353,53 @@ class StatePlant:
         sp = self.space
         held = sign * force
         drive = _column(sp.gamma_u) * held
+        # The input's share of the net force is the period's (as the drive).
+        net_drive = sp.net_input * held
         for _ in range(self.substeps):
-            moving = _times(sp.phi, self._state) + drive
-            net = _dot(sp.net_state, self._state) + sp.net_input * held
-            direction = np.where(self.rest, np.sign(net), np.sign(self._state[1]))
-            moving -= _column(sp.gamma_f) * (self.coulomb * direction)
-            stuck = self.rest & (np.abs(net) <= self.stiction)
-            # A reversal within the sub-step ends at rest (friction cannot
-            # push the mass backwards); a stuck mass stays where it is.
-            reversed_ = ~self.rest & (direction != 0) & (np.sign(moving[1]) == -direction)
-            if reversed_.any():
-                moving[0] = np.where(reversed_, self._stopped_at(moving[1], net, direction),
-                                     moving[0])
-            if stuck.any():
-                kept = _times(sp.stuck_phi, self._state) + _column(sp.stuck_gamma) * held
-                kept[0] = self._state[0]
-                moving = np.where(stuck, kept, moving)
-            self._state = moving
-            self.rest = reversed_ | stuck
-            self._stop(self.rest)
+            self._friction_substep(held, drive, net_drive)
         return self._state[0].copy() if out is None else _copied(out, self._state[0])
+
+    def _friction_substep(self, held, drive, net_drive):
+        """One sub-step with friction: moving, stopped by a reversal, or held.
+
+        Where no point rests (:attr:`_resting`, known from the last
+        sub-step's stop) the direction is the velocity's and nothing sticks,
+        so the net force is computed only for a reversal: the same numbers
+        as every term computed at every point, in half the NumPy calls.
+        """
+        sp, state, rest, resting = self.space, self._state, self.rest, self._resting
+        moving = _times(sp.phi, state)
+        moving += drive
+        net = None
+        if resting:
+            net = _dot(sp.net_state, state)
+            net += net_drive
+            direction = np.where(rest, np.sign(net), np.sign(state[1]))
+        else:
+            direction = np.sign(state[1])
+        # gamma_f (F_c direction) to the bit: direction is +-1, +-0 or NaN.
+        moving -= self._friction_step * direction
+        # A reversal within the sub-step ends at rest (friction cannot
+        # push the mass backwards); a stuck mass stays where it is.
+        # (v direction < 0 is sign(v) = -direction with direction != 0.)
+        reversed_ = moving[1] * direction < 0
+        stuck = None
+        if resting:
+            reversed_ &= ~rest
+            stuck = rest & (np.abs(net) <= self.stiction)
+        if np.count_nonzero(reversed_):
+            if net is None:
+                net = _dot(sp.net_state, state)
+                net += net_drive
+            moving[0] = np.where(reversed_, self._stopped_at(moving[1], net, direction),
+                                 moving[0])
+        if stuck is not None and np.count_nonzero(stuck):
+            kept = _times(sp.stuck_phi, state) + _column(sp.stuck_gamma) * held
+            kept[0] = state[0]
+            moving = np.where(stuck, kept, moving)
+        self._state = moving
+        self.rest = reversed_ if stuck is None else reversed_ | stuck
+        self._stop(self.rest)
 
     def _stopped_at(self, velocity, net, direction):
         """Where a moving mass stops within the sub-step whose end ``velocity`` is reversed.
@@ -409,39 +432,82 @@ class StatePlant:
             travel = 0.5 * start * time
         return position + np.where(np.isfinite(travel), travel, 0.0)
 
-    def _linear_rows(self, force, sign, out=None):
-        """The rows of ``phi state + gamma_u sign force``: new arrays, summed over ``phi``'s nonzero entries."""
-        rows, tmp = self._rows, self._scratch
-        gains = self._gains.get(sign)
-        if gains is None:
-            gains = self._gains[sign] = [np.full(force.shape, sign * float(g))
-                                         for g in self.space.gamma_u]
-        new = []
-        for i, terms in enumerate(self._terms):
-            row = np.multiply(gains[i], force, out=out if i == 0 else None)
-            for j, c in terms:
-                if isinstance(c, float):      # 1
-                    row += rows[j]
-                else:
-                    np.multiply(c, rows[j], out=tmp)
-                    row += tmp
-            new.append(row)
-        return new
-
     def finite(self):
         """Per point: is every state finite?"""
-        if self._rows is None:
+        if self._linear is None:
             return np.all(np.isfinite(self._state), axis=0)
-        ok = np.isfinite(self._rows[0])
-        for row in self._rows[1:]:
+        rows = self._linear.now
+        ok = np.isfinite(rows[0])
+        for row in rows[1:]:
             ok &= np.isfinite(row)
         return ok
 
     def freeze(self, bad):
         """Zero the points ``bad`` (diverged) and hold them at rest."""
-        for row in (self._state if self._rows is None else self._rows):
+        for row in (self._state if self._linear is None else self._linear.now):
             row[bad] = 0.0
         self.rest[bad] = True
+        self._resting = bool(self.rest.any())
+
+
+class _LinearStep:
+    """A plant without friction, one matrix for every point: ``phi x + gamma_u u`` a sub-step.
+
+    The state is two buffers of rows used in turn (no array is made in a
+    period) and each row of the new one sums the gain's term and then the
+    nonzero entries of ``phi``'s row, in order, as bound NumPy calls made
+    once: the same operations in the same order as row by row, so the same
+    numbers to the last bit (the paper's device's step is seven calls a
+    period, and Python work was half of its time).
+    """
+
+    def __init__(self, phi, gamma_u, state):
+        n, n_points = state.shape
+        self._buffers = (np.array(state, dtype=float), np.empty((n, n_points)))
+        self._parity = 0
+        self._gamma_u = gamma_u
+        self._gains = {}
+        tmp = np.empty(n_points)
+        # Coefficients as arrays of the points: NumPy multiplies by an array
+        # in half the time it takes to convert a float (the same doubles); 1
+        # as itself (an addition).
+        terms = [[(j, None if c == 1.0 else np.full(n_points, float(c)))
+                  for j, c in enumerate(row) if c != 0] for row in phi]
+        old, new = self._buffers
+        self._programs = (_row_program(old, new, terms, tmp), _row_program(new, old, terms, tmp))
+
+    @property
+    def now(self):
+        """The ``(n, N)`` state (a buffer the next step overwrites)."""
+        return self._buffers[self._parity]
+
+    def step(self, force, sign):
+        """One sub-step under ``sign * force``; the new position (a view of the state)."""
+        gains = self._gains.get(sign)
+        if gains is None:
+            gains = self._gains[sign] = [np.full(force.shape, sign * float(g))
+                                         for g in self._gamma_u]
+        multiply = np.multiply
+        for gain, (row, ops) in zip(gains, self._programs[self._parity], strict=True):
+            multiply(gain, force, row)
+            for op, args in ops:
+                op(*args)
+        self._parity ^= 1
+        return self._buffers[self._parity][0]
+
+
+def _row_program(old, new, terms, tmp):
+    """``[(row, ops)]``: each row of ``new`` as ``phi``'s ``terms`` of ``old`` added to it, bound calls."""
+    program = []
+    for i, row_terms in enumerate(terms):
+        row, ops = new[i], []
+        for j, c in row_terms:
+            if c is None:
+                ops.append((np.add, (row, old[j], row)))
+            else:
+                ops += [(np.multiply, (c, old[j], tmp)), (np.add, (row, tmp, row))]
+        program.append((row, tuple(ops)))
+    return program
 
 
 def _copied(out, values):
