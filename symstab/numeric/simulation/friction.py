@@ -297,9 +297,17 @@ class StatePlant:
         self.substeps = substeps
         self.coulomb, self.stiction = coulomb, stiction
         self.rest = rest
-        self._linear = None
+        self._rows = None
         if not self.friction and space.phi.ndim == 2:
-            self._linear = _LinearStep(space.phi, space.gamma_u, state)
+            # Coefficients as arrays of the points: NumPy multiplies by an
+            # array in half the time it takes to convert a float (the same
+            # doubles); 1 as itself (an addition).
+            n_points = state.shape[1]
+            self._terms = [[(j, 1.0 if c == 1.0 else np.full(n_points, float(c)))
+                            for j, c in enumerate(row) if c != 0] for row in space.phi]
+            self._gains = {}
+            self._scratch = np.empty(n_points)
+            self._rows = list(state)
         else:
             self._state = state
         if self.friction:
@@ -310,7 +318,7 @@ class StatePlant:
     @property
     def state(self):
         """The ``(n, N)`` state (rows 0 and 1: the mass's position and velocity)."""
-        return self._state if self._linear is None else self._linear.now.copy()
+        return self._state if self._rows is None else np.stack(self._rows)
 
     @classmethod
     def from_history(cls, space, x0, v0, n_points, nonideal):
@@ -341,10 +349,10 @@ class StatePlant:
         ``out``, which the plant may then keep as its state until the next
         period (the loop simulator's buffer row).
         """
-        if self._linear is not None:
-            for _ in range(self.substeps):
-                position = self._linear.step(force, sign)
-            return position.copy() if out is None else _copied(out, position)
+        if self._rows is not None:
+            for substep in range(self.substeps, 0, -1):
+                self._rows = self._linear_rows(force, sign, out if substep == 1 else None)
+            return self._rows[0]
         if not self.friction:
             for _ in range(self.substeps):
                 self._state = _times(self.space.phi, self._state) + (
@@ -432,82 +440,41 @@ class StatePlant:
             travel = 0.5 * start * time
         return position + np.where(np.isfinite(travel), travel, 0.0)
 
+    def _linear_rows(self, force, sign, out=None):
+        """The rows of ``phi state + gamma_u sign force``: new arrays, summed over ``phi``'s nonzero entries."""
+        rows, tmp = self._rows, self._scratch
+        gains = self._gains.get(sign)
+        if gains is None:
+            gains = self._gains[sign] = [np.full(force.shape, sign * float(g))
+                                         for g in self.space.gamma_u]
+        # Positional outs (the keyword costs a fifth of a call on small arrays).
+        new, multiply, add = [], np.multiply, np.add
+        for gain, terms in zip(gains, self._terms, strict=True):
+            row = multiply(gain, force) if out is None else multiply(gain, force, out)
+            out = None
+            for j, c in terms:
+                if isinstance(c, float):      # 1
+                    add(row, rows[j], row)
+                else:
+                    add(row, multiply(c, rows[j], tmp), row)
+            new.append(row)
+        return new
+
     def finite(self):
         """Per point: is every state finite?"""
-        if self._linear is None:
+        if self._rows is None:
             return np.all(np.isfinite(self._state), axis=0)
-        rows = self._linear.now
-        ok = np.isfinite(rows[0])
-        for row in rows[1:]:
+        ok = np.isfinite(self._rows[0])
+        for row in self._rows[1:]:
             ok &= np.isfinite(row)
         return ok
 
     def freeze(self, bad):
         """Zero the points ``bad`` (diverged) and hold them at rest."""
-        for row in (self._state if self._linear is None else self._linear.now):
+        for row in (self._state if self._rows is None else self._rows):
             row[bad] = 0.0
         self.rest[bad] = True
         self._resting = bool(self.rest.any())
-
-
-class _LinearStep:
-    """A plant without friction, one matrix for every point: ``phi x + gamma_u u`` a sub-step.
-
-    The state is two buffers of rows used in turn (no array is made in a
-    period) and each row of the new one sums the gain's term and then the
-    nonzero entries of ``phi``'s row, in order, as bound NumPy calls made
-    once: the same operations in the same order as row by row, so the same
-    numbers to the last bit (the paper's device's step is seven calls a
-    period, and Python work was half of its time).
-    """
-
-    def __init__(self, phi, gamma_u, state):
-        n, n_points = state.shape
-        self._buffers = (np.array(state, dtype=float), np.empty((n, n_points)))
-        self._parity = 0
-        self._gamma_u = gamma_u
-        self._gains = {}
-        tmp = np.empty(n_points)
-        # Coefficients as arrays of the points: NumPy multiplies by an array
-        # in half the time it takes to convert a float (the same doubles); 1
-        # as itself (an addition).
-        terms = [[(j, None if c == 1.0 else np.full(n_points, float(c)))
-                  for j, c in enumerate(row) if c != 0] for row in phi]
-        old, new = self._buffers
-        self._programs = (_row_program(old, new, terms, tmp), _row_program(new, old, terms, tmp))
-
-    @property
-    def now(self):
-        """The ``(n, N)`` state (a buffer the next step overwrites)."""
-        return self._buffers[self._parity]
-
-    def step(self, force, sign):
-        """One sub-step under ``sign * force``; the new position (a view of the state)."""
-        gains = self._gains.get(sign)
-        if gains is None:
-            gains = self._gains[sign] = [np.full(force.shape, sign * float(g))
-                                         for g in self._gamma_u]
-        multiply = np.multiply
-        for gain, (row, ops) in zip(gains, self._programs[self._parity], strict=True):
-            multiply(gain, force, row)
-            for op, args in ops:
-                op(*args)
-        self._parity ^= 1
-        return self._buffers[self._parity][0]
-
-
-def _row_program(old, new, terms, tmp):
-    """``[(row, ops)]``: each row of ``new`` as ``phi``'s ``terms`` of ``old`` added to it, bound calls."""
-    program = []
-    for i, row_terms in enumerate(terms):
-        row, ops = new[i], []
-        for j, c in row_terms:
-            if c is None:
-                ops.append((np.add, (row, old[j], row)))
-            else:
-                ops += [(np.multiply, (c, old[j], tmp)), (np.add, (row, tmp, row))]
-        program.append((row, tuple(ops)))
-    return program
 
 
 def _copied(out, values):
