@@ -363,6 +363,7 @@ class StatePlant:
         drive = _column(sp.gamma_u) * held
         # The input's share of the net force is the period's (as the drive).
         net_drive = sp.net_input * held
+        self._stuck_drive = None        # the held step's input term, made when a mass sticks
         for _ in range(self.substeps):
             self._friction_substep(held, drive, net_drive)
         return self._state[0].copy() if out is None else _copied(out, self._state[0])
@@ -382,7 +383,7 @@ class StatePlant:
         if resting:
             net = _dot(sp.net_state, state)
             net += net_drive
-            direction = np.where(rest, np.sign(net), np.sign(state[1]))
+            direction = np.sign(np.where(rest, net, state[1]))
         else:
             direction = np.sign(state[1])
         # gamma_f (F_c direction) to the bit: direction is +-1, +-0 or NaN.
@@ -393,7 +394,7 @@ class StatePlant:
         reversed_ = moving[1] * direction < 0
         stuck = None
         if resting:
-            reversed_ &= ~rest
+            reversed_ = reversed_ > rest          # and not resting
             stuck = rest & (np.abs(net) <= self.stiction)
         if np.count_nonzero(reversed_):
             if net is None:
@@ -402,7 +403,9 @@ class StatePlant:
             moving[0] = np.where(reversed_, self._stopped_at(moving[1], net, direction),
                                  moving[0])
         if stuck is not None and np.count_nonzero(stuck):
-            kept = _times(sp.stuck_phi, state) + _column(sp.stuck_gamma) * held
+            if self._stuck_drive is None:
+                self._stuck_drive = _column(sp.stuck_gamma) * held
+            kept = _times(sp.stuck_phi, state) + self._stuck_drive
             kept[0] = state[0]
             moving = np.where(stuck, kept, moving)
         self._state = moving
