@@ -586,6 +586,11 @@ def test_a_moved_module_still_imports_with_a_warning(package):
             module = importlib.import_module(f"symstab.{package}.{old}")
         assert module is importlib.import_module(new)
         assert not (PACKAGE / package / f"{old}.py").exists()
+        # Still its own module: imported by the old path, it keeps its own spec, so
+        # that its relative imports resolve in its package without an ImportWarning
+        # ("__package__ != __spec__.parent": a test of warnings failed on it when the
+        # old path had been imported before).
+        assert module.__spec__.name == new and module.__spec__.parent == module.__package__
 
 
 # --------------------------------------------------------------------------
