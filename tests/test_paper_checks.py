@@ -697,3 +697,20 @@ def test_an_empty_window_is_said_in_words_and_is_empty_for_python_control(audit_
     assert all(radius(K_w, 0.6) > 1.0 for K_w in np.linspace(0.0, 40.0, 81))
     assert radius(0.5 * (k_lo + k_hi), 0.45) < 1.0
     assert radius(k_lo - 0.1, 0.45) > 1.0 and radius(k_hi + 0.1, 0.45) > 1.0
+
+
+def test_the_checks_register_in_the_one_package_they_are_installed_as():
+    """symstab.paper_checks imports its check modules by relative name: by absolute name
+    ("paper_checks.eq_model") the checkout's folder loaded a second copy of the package
+    that the audit's registry never saw, and the installed wheel found nothing at all."""
+    import re
+    import sys
+
+    from symstab.paper_checks import audit
+
+    from conftest import REPO
+
+    report = (REPO / "paper_checks" / "REPORT.md").read_text(encoding="utf-8")
+    total = int(re.search(r"\| \*\*total\*\* \| \*\*(\d+)\*\* \|", report).group(1))
+    assert len(audit.registered()) == total
+    assert not [name for name in sys.modules if name.split(".")[0] == "paper_checks"]
