@@ -22,9 +22,9 @@ import time
 
 
 def _identities():
-    from paper_checks._common import with_printed_coefficients
-    from paper_checks.printed import PRINTED_COEFFICIENTS, printed
     from symstab import boundary, coefficients
+    from symstab.paper_checks._common import with_printed_coefficients
+    from symstab.paper_checks.printed import PRINTED_COEFFICIENTS, printed
 
     return {
         "C4, eq. (27)": (PRINTED_COEFFICIENTS["C4"], coefficients()["C4"]),

@@ -41,7 +41,7 @@ TARGETS = {"audit": 20.0, "reproduce": 60.0}
 
 _SERIAL_AUDIT = """
 import pathlib, sys
-from paper_checks import audit
+from symstab.paper_checks import audit
 pathlib.Path(sys.argv[1]).write_text(audit.render_report(audit.run_audit(workers=1)), encoding="utf-8")
 """
 

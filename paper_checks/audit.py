@@ -46,14 +46,15 @@ __all__ = [
 ]
 
 
-#: Modules whose import registers checks, in report order.
+#: Modules whose import registers checks, in report order (in this package:
+#: ``symstab.paper_checks`` once installed).
 CHECK_MODULES = (
-    "paper_checks.eq_model",
-    "paper_checks.eq_boundary",
-    "paper_checks.eq_theta_max",
-    "paper_checks.eq_limits",
-    "paper_checks.claims",
-    "paper_checks.open_questions",
+    ".eq_model",
+    ".eq_boundary",
+    ".eq_theta_max",
+    ".eq_limits",
+    ".claims",
+    ".open_questions",
 )
 
 
@@ -103,7 +104,7 @@ def check(id, *, kind, where, claim):
 def registered():
     """Import every check module and return ``{id: (kind, where, claim, func)}``."""
     for name in CHECK_MODULES:
-        importlib.import_module(name)
+        importlib.import_module(name, __package__)
     return dict(_REGISTRY)
 
 

@@ -70,7 +70,13 @@ class _MovedFinder(importlib.abc.MetaPathFinder, importlib.abc.Loader):
 
     def create_module(self, spec):
         # The import system's own frames sit between the importer and here.
-        return _moved_module(spec.name, stacklevel=8)
+        module = _moved_module(spec.name, stacklevel=8)
+        spec.loader_state = module.__spec__     # this import's own, for exec_module
+        return module
 
     def exec_module(self, module):
-        pass
+        # The import system has just given the module the old path's spec;
+        # its own is put back, or its relative imports would resolve against
+        # the old package, with an ImportWarning ("__package__ !=
+        # __spec__.parent").
+        module.__spec__ = module.__spec__.loader_state

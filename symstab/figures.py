@@ -116,8 +116,7 @@ def fig5():
     """The eq. (14) boundary (d = 0, gamma = 0), printed form against the derivation."""
     import sympy as sp
 
-    from paper_checks.printed import printed
-
+    from .paper_checks.printed import printed
     from .symbolic import model
 
     curve = boundary_curve(gamma=0.0, d=0, delta=DELTA, n=400, segments=False)

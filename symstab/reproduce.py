@@ -130,9 +130,9 @@ def reproduce(out_dir, *, workers=2, log=None):
     check_workers(workers)
     require_matplotlib()
     try:
-        import paper_checks.audit  # noqa: F401
+        from .paper_checks import audit  # noqa: F401
     except ImportError as exc:  # pragma: no cover - packaging problem
-        raise ValueError(f"the paper_checks package is not installed ({exc})") from None
+        raise ValueError(f"symstab.paper_checks is not installed ({exc})") from None
     parent = out.resolve().parent
     parent.mkdir(parents=True, exist_ok=True)
     try:
@@ -153,10 +153,9 @@ def reproduce(out_dir, *, workers=2, log=None):
 
 
 def _run(out, workers, log):
-    from paper_checks import audit
-
     from . import figures
     from ._io import write_bytes
+    from .paper_checks import audit
     from .proof.derive import write
 
     total = time.perf_counter()

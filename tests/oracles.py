@@ -34,7 +34,7 @@ import mpmath
 import numpy as np
 import sympy as sp
 
-from paper_checks.regions import (  # noqa: F401
+from symstab.paper_checks.regions import (  # noqa: F401
     coefficients_at,
     stable_alpha_intervals,
     unstable_root_count,

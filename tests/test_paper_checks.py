@@ -11,7 +11,7 @@ import multiprocessing
 
 import pytest
 
-from paper_checks import audit, claims, printed
+from symstab.paper_checks import audit, claims, printed
 
 #: The verdicts as reviewed against the mathematics; update only with a reason.
 EXPECTED_VERDICTS = {
@@ -260,7 +260,7 @@ def test_report_rendering_is_deterministic():
                     reason="the workers must inherit the shortened NEWTON_DELAYS")
 def test_parallel_audit_gives_the_serial_findings(monkeypatch):
     """Two workers (with the shared theta_max of eqs. (12), (58) prefetched) = one."""
-    from paper_checks import eq_theta_max
+    from symstab.paper_checks import eq_theta_max
 
     # Two delays instead of nine keep the test short; the scheduling is the same.
     monkeypatch.setattr(eq_theta_max, "NEWTON_DELAYS", (1, 3))
@@ -282,7 +282,7 @@ def _prefetching_modules(monkeypatch, values=(int, int)):
     import sys
     import types
 
-    from paper_checks._common import Memo
+    from symstab.paper_checks._common import Memo
 
     checks, memos = {}, []
     for tag, value in zip("abc", values, strict=False):   # two or three modules
@@ -322,7 +322,7 @@ def test_a_task_s_arguments_never_change_after_they_are_handed_over(monkeypatch)
     import concurrent.futures
     import pickle
 
-    from paper_checks._common import Memo
+    from symstab.paper_checks._common import Memo
 
     class Recorder(concurrent.futures.Executor):
         _max_workers = 1
@@ -373,8 +373,8 @@ def _slow_to_compute(n):
                     reason="the workers must inherit the fake check modules")
 def test_parallel_audit_survives_slow_pickling_of_prefetched_values(monkeypatch):
     """The interleaving that broke CI: pickling in the feeder thread, filling in the main one."""
-    from paper_checks._common import Memo
     from symstab._workers import worker_pool
+    from symstab.paper_checks._common import Memo
 
     # Module a's values take 0.3 s to pickle with a check of a, while module
     # c's prefetches, slow to compute and already queued, come back.
@@ -390,7 +390,7 @@ def test_parallel_audit_survives_slow_pickling_of_prefetched_values(monkeypatch)
 
 
 def test_memo_computes_once_and_accepts_values_computed_elsewhere():
-    from paper_checks._common import Memo
+    from symstab.paper_checks._common import Memo
 
     calls = []
 
@@ -424,7 +424,7 @@ def test_gamma2_claims_do_not_hang_on_one_sample(monkeypatch, audit_run):
     nothing."""
     import dataclasses
 
-    from paper_checks import regions
+    from symstab.paper_checks import regions
 
     ids = ["claim:alpha_max_gamma2", "claim:fold_5.8", "claim:max_gamma_2_d0",
            "claim:gamma2_is_boundary"]
@@ -453,7 +453,7 @@ def test_gamma2_claims_do_not_hang_on_one_sample(monkeypatch, audit_run):
 def test_regions_refuse_delta_zero_by_name(call):
     # The 30-digit forms carry delta**2 (Gamma - 1 in the limits): at delta = 0
     # they are 0/0, which used to surface as a bare ZeroDivisionError.
-    from paper_checks import regions
+    from symstab.paper_checks import regions
 
     with pytest.raises(ValueError, match="delta must be > 0"):
         getattr(regions, call)(0.0, 0, 0.0)
@@ -482,9 +482,9 @@ def test_region_top_is_the_top_of_the_arc(gamma, d):
     """Where the region's top is the arc's top, paper_checks.regions finds it
     to 1e-12.  Its own eigenvalue scan found the gamma = 2 sliver's top only
     on its grid: 3.9571 against 4.0068."""
-    from paper_checks import regions
     from symstab.numeric.paper.curves import arc_end_angle
     from symstab.numeric.paper.device import PAPER_DEVICE
+    from symstab.paper_checks import regions
 
     delta = PAPER_DEVICE.delta
     r = regions.classify(gamma, d)
@@ -501,7 +501,7 @@ def test_regions_agree_with_the_30_digit_interval_scan(gamma, d):
     the counted intervals: a minimum stiffness at gamma = 1.5 and 1, a d = 5
     band and a tiny gamma = -1 region.  (The gamma = 2 sliver is thinner
     than the reference's grid step there: the comparison would be empty.)"""
-    from paper_checks import regions
+    from symstab.paper_checks import regions
 
     r = regions.classify(gamma, d, cross_check=True)
     check = r.library_check
@@ -515,7 +515,7 @@ def test_the_paper_device_has_one_home():
     import ast
     import pathlib
 
-    import paper_checks
+    from symstab import paper_checks
 
     typed = []
     for path in sorted(pathlib.Path(paper_checks.__file__).parent.glob("*.py")):
@@ -534,8 +534,8 @@ def test_open_question_counts_match_first_principles(gamma, d):
     import mpmath
     import numpy as np
 
-    from paper_checks import open_questions
     from symstab.numeric.paper.device import PAPER_DEVICE
+    from symstab.paper_checks import open_questions
 
     from oracles import first_principles_boundary_point, first_principles_chi_float
 
@@ -555,7 +555,7 @@ def test_open_question_counts_match_first_principles(gamma, d):
 
 
 def test_open_questions_explain_the_left_sided_curves():
-    from paper_checks import open_questions, regions
+    from symstab.paper_checks import open_questions, regions
 
     left = [c for c in regions.FIGURE_CASES if c.claimed_side == "left"]
     assert len(left) == 9
@@ -697,3 +697,20 @@ def test_an_empty_window_is_said_in_words_and_is_empty_for_python_control(audit_
     assert all(radius(K_w, 0.6) > 1.0 for K_w in np.linspace(0.0, 40.0, 81))
     assert radius(0.5 * (k_lo + k_hi), 0.45) < 1.0
     assert radius(k_lo - 0.1, 0.45) > 1.0 and radius(k_hi + 0.1, 0.45) > 1.0
+
+
+def test_the_checks_register_in_the_one_package_they_are_installed_as():
+    """symstab.paper_checks imports its check modules by relative name: by absolute name
+    ("paper_checks.eq_model") the checkout's folder loaded a second copy of the package
+    that the audit's registry never saw, and the installed wheel found nothing at all."""
+    import re
+    import sys
+
+    from symstab.paper_checks import audit
+
+    from conftest import REPO
+
+    report = (REPO / "paper_checks" / "REPORT.md").read_text(encoding="utf-8")
+    total = int(re.search(r"\| \*\*total\*\* \| \*\*(\d+)\*\* \|", report).group(1))
+    assert len(audit.registered()) == total
+    assert not [name for name in sys.modules if name.split(".")[0] == "paper_checks"]

@@ -39,9 +39,9 @@ def _report_path(args):
 def run(args):
     """Run ``symstab audit``; return the exit status (1 when a check fails inside)."""
     try:
-        from paper_checks import audit
+        from ..paper_checks import audit
     except ImportError as exc:  # pragma: no cover - packaging problem
-        raise ValueError(f"the paper_checks package is not installed ({exc})") from exc
+        raise ValueError(f"symstab.paper_checks is not installed ({exc})") from exc
     paths = check_outputs([("--report", _report_path(args), "file"), ("--json", args.json, "file")])
     start = time.perf_counter()
 

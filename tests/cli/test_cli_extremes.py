@@ -304,7 +304,7 @@ def test_map_png_folder_is_checked_before_the_simulation(capsys, tmp_path, monke
 @pytest.mark.parametrize("flag", ["--report", "--json"])
 def test_audit_refuses_a_folder_as_report_before_auditing(capsys, tmp_path, monkeypatch, flag):
     """audit --report . ran the whole audit (a minute or more), then failed on a rename."""
-    from paper_checks import audit
+    from symstab.paper_checks import audit
 
     monkeypatch.chdir(tmp_path)
     _forbid(monkeypatch, audit, "run_audit", "the audit")
@@ -315,7 +315,7 @@ def test_audit_refuses_a_folder_as_report_before_auditing(capsys, tmp_path, monk
 
 
 def test_audit_refuses_a_report_in_a_missing_folder_before_auditing(capsys, tmp_path, monkeypatch):
-    from paper_checks import audit
+    from symstab.paper_checks import audit
 
     monkeypatch.chdir(tmp_path)
     _forbid(monkeypatch, audit, "run_audit", "the audit")
