@@ -838,8 +838,14 @@ def _merged_nodes(points):
     order (the tens of thousands of chords' ends of a finely sampled arc
     would take seconds there).
     """
-    unique, first, inverse = np.unique(points, axis=0, return_index=True, return_inverse=True)
-    inverse = inverse.reshape(-1)
+    # np.unique(points, axis=0, return_index=True, return_inverse=True) by hand: a
+    # stable sort by x then y (np.unique along rows sorts a structured view, slower).
+    order = np.lexsort((points[:, 1], points[:, 0]))
+    ordered = points[order]
+    fresh = np.r_[True, (ordered[1:, 0] != ordered[:-1, 0]) | (ordered[1:, 1] != ordered[:-1, 1])]
+    unique, first = ordered[fresh], order[fresh]
+    inverse = np.empty(len(points), dtype=np.intp)
+    inverse[order] = np.cumsum(fresh) - 1
     close = _has_close_neighbour(unique)
     made = ~close        # the unique points that make a node
     merged = np.arange(len(unique))
@@ -909,7 +915,7 @@ def _candidate_pairs(lo, hi):
     thousand chords).
     """
     n = len(lo)
-    extent = np.max(hi - lo, axis=1)
+    extent = np.maximum(hi[:, 0] - lo[:, 0], hi[:, 1] - lo[:, 1])
     long_ = extent > 0.02
     short = np.flatnonzero(~long_)
     pairs = []
@@ -923,7 +929,7 @@ def _candidate_pairs(lo, hi):
                      / h).astype(np.int64)
         segment = np.tile(short, 4)
         # Sorted by cell, then segment, each (cell, segment) once.
-        order = np.lexsort((segment, y, x))
+        order = _lexicographic(x, y, segment, n)
         x, y, segment = x[order], y[order], segment[order]
         new_cell = np.r_[True, (x[1:] != x[:-1]) | (y[1:] != y[:-1])]
         fresh = new_cell | np.r_[True, segment[1:] != segment[:-1]]
@@ -952,6 +958,19 @@ def _candidate_pairs(lo, hi):
     key = key[np.r_[True, key[1:] != key[:-1]]]
     i, j = key // n, key % n
     return i[i != j], j[i != j]
+
+
+def _lexicographic(x, y, segment, n):
+    """``np.lexsort((segment, y, x))`` (``segment`` below ``n``), as one sort of one key.
+
+    Three stable sorts cost three times one; a key ``(x, y, segment)`` that
+    does not fit in 62 bits falls back to them.
+    """
+    kx, ky = x - x.min(), y - y.min()
+    rows, columns = int(kx.max()) + 1, int(ky.max()) + 1
+    if rows * columns * max(n, 1) >= 2**62:
+        return np.lexsort((segment, y, x))
+    return np.argsort((kx * columns + ky) * n + segment, kind="stable")
 
 
 def _cell_pairs(segment, after, lo, hi):
@@ -1022,11 +1041,13 @@ def _end_touches(p, q, owner, position):
     at = np.concatenate([p[first], q[last]])
     t_end = np.concatenate([np.zeros(len(first)), np.ones(len(last))])
     r = q - p
-    length2 = np.sum(r * r, axis=1)
+    length2 = r[:, 0] * r[:, 0] + r[:, 1] * r[:, 1]
     # A segment can be that close only if its box, widened by more than
-    # _MERGE and the rounding of the projection, holds the end.
+    # _MERGE and the rounding of the projection, holds the end.  (Columns
+    # compared one by one: NumPy's reductions along a row of two are slow.)
     lo, hi = np.minimum(p, q), np.maximum(p, q)
-    margin = 2 * _MERGE + 1e-12 * np.maximum(np.max(np.abs(lo), axis=1), np.max(np.abs(hi), axis=1))
+    size = np.maximum(np.abs(lo), np.abs(hi))
+    margin = 2 * _MERGE + 1e-12 * np.maximum(size[:, 0], size[:, 1])
     lo, hi = lo - margin[:, None], hi + margin[:, None]
     out = [np.zeros((0, 4))]
     for part in chunk_slices(len(ends), 16 * len(p)):
@@ -2045,9 +2066,17 @@ def _crossing_mismatches(faces, counts):
     between = np.flatnonzero(counted & counted[twin] & (half_label != "window"))
     # Each pair of cells and piece once, at its first half-edge.
     a, b = face_of[between], face_of[twin[between]]
-    _, code = np.unique(half_label[between].astype(str), return_inverse=True)
-    _, first = np.unique(np.column_stack([np.minimum(a, b), np.maximum(a, b), code.ravel()]),
-                         axis=0, return_index=True)
+    labels = half_label[between]
+    kinds = sorted(set(labels.tolist()))
+    code = np.zeros(len(labels), dtype=np.int64)
+    for n, label in enumerate(kinds):
+        code[labels == label] = n
+    # One integer per (cell, cell, label), its first half-edge by a stable sort:
+    # np.unique along rows sorts a structured view, many times slower.
+    size = int(face_of.max()) + 1 if len(face_of) else 1
+    key = (np.minimum(a, b).astype(np.int64) * size + np.maximum(a, b)) * len(kinds) + code
+    order = np.argsort(key, kind="stable")
+    first = order[np.r_[True, key[order][1:] != key[order][:-1]]]
     for h in between[np.sort(first)].tolist():
         a, b = int(face_of[h]), int(face_of[twin[h]])
         label = half_label[h]
