@@ -453,10 +453,13 @@ class Brackets:
             ratio, cosine = _multiple(self.shift, theta)
         else:
             ratio = cosine = np.zeros(theta.shape)
-        factor = np.stack([np.ones(theta.shape), ratio, cosine], axis=-1)
-        value = np.sum(value.reshape(-1, k, 3) * factor[:, None, :], axis=-1)
-        scale = np.sum(scale.reshape(-1, k, 3) * np.abs(factor)[:, None, :], axis=-1)
-        return value, scale
+        # The three forms' sum as np.sum along a row of three adds it (from 0.0,
+        # left to right: the same bits), a few times faster as columns.
+        value, scale = value.reshape(-1, k, 3), scale.reshape(-1, k, 3)
+        ratio, cosine = ratio[:, None], cosine[:, None]
+        return ((0.0 + value[:, :, 0]) + value[:, :, 1] * ratio + value[:, :, 2] * cosine,
+                (0.0 + scale[:, :, 0]) + scale[:, :, 1] * np.abs(ratio)
+                + scale[:, :, 2] * np.abs(cosine))
 
     def __call__(self, theta):
         """The brackets over sin(theta) and their rounding scales at angles in (0, pi): (M, k) each.
