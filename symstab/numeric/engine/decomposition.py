@@ -842,7 +842,8 @@ def _merged_nodes(points):
     # stable sort by x then y (np.unique along rows sorts a structured view, slower).
     order = np.lexsort((points[:, 1], points[:, 0]))
     ordered = points[order]
-    fresh = np.r_[True, (ordered[1:, 0] != ordered[:-1, 0]) | (ordered[1:, 1] != ordered[:-1, 1])]
+    fresh = np.ones(len(ordered), dtype=bool)      # (empty where there are no points)
+    fresh[1:] = (ordered[1:, 0] != ordered[:-1, 0]) | (ordered[1:, 1] != ordered[:-1, 1])
     unique, first = ordered[fresh], order[fresh]
     inverse = np.empty(len(points), dtype=np.intp)
     inverse[order] = np.cumsum(fresh) - 1
@@ -2076,7 +2077,9 @@ def _crossing_mismatches(faces, counts):
     size = int(face_of.max()) + 1 if len(face_of) else 1
     key = (np.minimum(a, b).astype(np.int64) * size + np.maximum(a, b)) * len(kinds) + code
     order = np.argsort(key, kind="stable")
-    first = order[np.r_[True, key[order][1:] != key[order][:-1]]]
+    fresh = np.ones(len(order), dtype=bool)        # (empty: no half-edge between cells)
+    fresh[1:] = key[order][1:] != key[order][:-1]
+    first = order[fresh]
     for h in between[np.sort(first)].tolist():
         a, b = int(face_of[h]), int(face_of[twin[h]])
         label = half_label[h]
