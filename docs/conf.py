@@ -159,7 +159,7 @@ def _documented(env):
                if name.startswith("symstab.")}
     if _DOCUMENTED.get("count") != len(objects):
         by_id = {}
-        for name, entry in objects.items():
+        for name in objects:
             obj = _lookup(name)
             if obj is not None:
                 by_id.setdefault(id(obj), []).append(name)
