@@ -52,6 +52,8 @@ nitpick_ignore_regex = [
 
 # --- MyST and notebooks ----------------------------------------------------
 myst_enable_extensions = ["dollarmath", "amsmath", "colon_fence", "deflist"]
+# The notebooks write display math $$...$$ inside their paragraphs, as Jupyter reads it.
+myst_dmath_double_inline = True
 myst_heading_anchors = 3
 # The notebooks are stored without outputs (tests/test_docs.py): the build
 # executes every one, and a cell that raises fails it.
