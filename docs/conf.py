@@ -109,6 +109,12 @@ plot_formats = [("png", 100)]
 plot_pre_code = "import numpy as np\nimport matplotlib.pyplot as plt\nimport symstab"
 plot_working_directory = str(REPO)
 
+# Option names (--check, --loop) keep their two hyphens: no dashes from smart quotes.
+smartquotes_action = "qe"
+# Every code fence of the pages names its language; what has none (the command
+# line's usage and its hand-laid tables) is plain text.
+highlight_language = "text"
+
 # --- HTML ---------------------------------------------------------------------
 html_theme = "pydata_sphinx_theme"
 html_title = f"symstab {release}"

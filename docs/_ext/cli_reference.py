@@ -6,7 +6,8 @@ reStructuredText.  symstab's texts are written for a terminal: a command whose
 hand (a table of quantities), and ``|x|`` is the absolute value, not a
 substitution.  :func:`build_parser` returns the parser of
 :func:`symstab.cli.commands.build_parser` with those texts made literal: a
-hand-laid description or epilog becomes a literal block, and ``|`` is escaped.
+description or epilog laid out by hand (indented lines) becomes a literal
+block, and ``|`` is escaped.
 The words are the command line's own.
 """
 
@@ -29,7 +30,8 @@ def _adapt(parser):
     for attribute in ("description", "epilog"):
         text = getattr(parser, attribute)
         if text:
-            setattr(parser, attribute, _literal(text) if raw else _escaped(text))
+            laid_out = raw and any(line.startswith(" ") for line in text.splitlines())
+            setattr(parser, attribute, _literal(text) if laid_out else _escaped(text))
     for action in parser._actions:
         if action.help and action.help is not argparse.SUPPRESS:
             action.help = _escaped(action.help)
