@@ -19,7 +19,9 @@ import sys
 
 import numpy as np
 
-__all__ = ["require_matplotlib", "pyplot", "pyplot_or_none", "png_bytes", "visible",
+__all__ = ["Plot", "plot_region", "plot_limits", "plot_boundary", "plot_robust",
+           "plot_probability", "plot_design", "plot_passive", "plot_locus", "plot_simulation",
+           "plot_map", "require_matplotlib", "pyplot", "pyplot_or_none", "png_bytes", "visible",
            "draw_lines", "label_log_axis", "png_of", "png_or_none", "design_figure",
            "simulated_map_figure", "loop_map_figure", "probability_map_figure", "robust_figure",
            "locus_figure",
@@ -189,28 +191,39 @@ def design_figure(plt, found, labels, target_label):
     -------
     matplotlib.figure.Figure
     """
+    fig, ax = plt.subplots(figsize=(6.4, 4.4))
+    _draw_design(ax, found, labels, target_label)
+    fig.tight_layout()
+    return fig
+
+
+def _draw_design(ax, found, labels, target_label):
+    """:func:`design_figure`'s drawing on ``ax``: ``{"target", "best", "nominal", "none"}`` artists."""
+    fig = ax.figure
     samples = found.samples
     names = list(found.over)
     value = samples[:, -1]
     good = np.isfinite(value)
     none = value == -np.inf
-    fig, ax = plt.subplots(figsize=(6.4, 4.4))
+    artists = {"target": [], "none": [], "nominal": [], "best": []}
     what = "maximise " + target_label.split(" [")[0]
     if len(names) == 1:
         order = np.argsort(samples[:, 0])
         u, v = samples[order, 0], value[order]
-        ax.plot(u[np.isfinite(v)], v[np.isfinite(v)], "-o", color="C0", ms=3, lw=1.2,
-                label=f"{target_label.split(' [')[0]} ({int(good.sum())} evaluations)")
+        artists["target"] += ax.plot(
+            u[np.isfinite(v)], v[np.isfinite(v)], "-o", color="C0", ms=3, lw=1.2,
+            label=f"{target_label.split(' [')[0]} ({int(good.sum())} evaluations)")
         if none.any():
             floor = np.min(value[good]) if good.any() else 0.0
-            ax.plot(samples[none, 0], np.full(int(none.sum()), floor), "x", color="0.5",
-                    label="no stable point")
+            artists["none"] += ax.plot(samples[none, 0], np.full(int(none.sum()), floor), "x",
+                                       color="0.5", label="no stable point")
         if found.nominal:
-            ax.axvline(found.nominal[names[0]], color="C2", ls="--", lw=1,
-                       label=f"nominal {names[0]} = {found.nominal[names[0]]:.4g}")
+            artists["nominal"].append(ax.axvline(
+                found.nominal[names[0]], color="C2", ls="--", lw=1,
+                label=f"nominal {names[0]} = {found.nominal[names[0]]:.4g}"))
         if found.best is not None:
-            ax.plot([found.best[names[0]]], [found.value], "*", color="C3", ms=12,
-                    label=f"best {names[0]} = {found.best[names[0]]:.6g}")
+            artists["best"] += ax.plot([found.best[names[0]]], [found.value], "*", color="C3",
+                                       ms=12, label=f"best {names[0]} = {found.best[names[0]]:.6g}")
         ax.set_xlabel(labels[0])
         ax.set_ylabel(target_label)
     else:
@@ -218,21 +231,22 @@ def design_figure(plt, found, labels, target_label):
             dots = ax.scatter(samples[good, 0], samples[good, 1], c=value[good], s=18,
                               cmap="viridis")
             fig.colorbar(dots, ax=ax, label=target_label)
+            artists["target"].append(dots)
         if none.any():
-            ax.plot(samples[none, 0], samples[none, 1], "x", color="0.6", ms=4,
-                    label="no stable point")
+            artists["none"] += ax.plot(samples[none, 0], samples[none, 1], "x", color="0.6",
+                                       ms=4, label="no stable point")
         if found.nominal:
-            ax.plot([found.nominal[names[0]]], [found.nominal[names[1]]], "o", mfc="none",
-                    color="C2", ms=9, label="nominal")
+            artists["nominal"] += ax.plot([found.nominal[names[0]]], [found.nominal[names[1]]],
+                                          "o", mfc="none", color="C2", ms=9, label="nominal")
         if found.best is not None:
-            ax.plot([found.best[names[0]]], [found.best[names[1]]], "*", color="C3", ms=14,
-                    label="best " + ", ".join(f"{k} = {v:.4g}" for k, v in found.best.items()))
+            artists["best"] += ax.plot(
+                [found.best[names[0]]], [found.best[names[1]]], "*", color="C3", ms=14,
+                label="best " + ", ".join(f"{k} = {v:.4g}" for k, v in found.best.items()))
         ax.set_xlabel(labels[0])
         ax.set_ylabel(labels[1])
     ax.set_title(f"design: {what} over {' and '.join(names)}", fontsize=PANEL_TITLE_SIZE)
     ax.legend(fontsize=LEGEND_SIZE, loc="best")
-    fig.tight_layout()
-    return fig
+    return artists
 
 
 # --------------------------------------------------------------------------
@@ -367,18 +381,27 @@ def probability_map_figure(plt, found, curve, *, xlabel, ylabel, title):
     -------
     matplotlib.figure.Figure
     """
-    xs, ys = found.x_values, found.y_values
     fig, ax = plt.subplots(figsize=(6.4, 4.8), dpi=120)
-    mesh = ax.pcolormesh(xs, ys, found.probability, shading="nearest", vmin=0.0, vmax=1.0,
-                         cmap="Greens")
-    fig.colorbar(mesh, ax=ax, label="probability of stability")
-    handles = _loop_boundary(ax, curve, xs, ys, "nominal loop: ")
-    _map_frame(ax, xs, ys, xlabel, ylabel)
+    _draw_probability(ax, found, curve, xlabel, ylabel)
     ax.set_title(title, fontsize=8)
-    if handles:
-        ax.legend(handles=handles, loc="best", fontsize=8, framealpha=0.9)
     fig.tight_layout()
     return fig
+
+
+def _draw_probability(ax, found, curve, xlabel, ylabel):
+    """:func:`probability_map_figure`'s drawing on ``ax`` (``curve`` may be None).
+
+    Returns ``{"probability": [mesh], "colorbar": [colorbar], "boundary": [...]}``.
+    """
+    xs, ys = found.x_values, found.y_values
+    mesh = ax.pcolormesh(xs, ys, found.probability, shading="nearest", vmin=0.0, vmax=1.0,
+                         cmap="Greens")
+    bar = ax.figure.colorbar(mesh, ax=ax, label="probability of stability")
+    handles = [] if curve is None else _loop_boundary(ax, curve, xs, ys, "nominal loop: ")
+    _map_frame(ax, xs, ys, xlabel, ylabel)
+    if handles:
+        ax.legend(handles=handles, loc="best", fontsize=8, framealpha=0.9)
+    return {"probability": [mesh], "colorbar": [bar], "boundary": handles}
 
 
 # --------------------------------------------------------------------------
@@ -401,23 +424,33 @@ def robust_figure(plt, region, xlabel, ylabel):
     -------
     matplotlib.figure.Figure
     """
+    fig, ax = plt.subplots(figsize=(6.4, 4.8))
+    _draw_robust(ax, region, xlabel, ylabel)
+    fig.tight_layout()
+    return fig
+
+
+def _draw_robust(ax, region, xlabel, ylabel):
+    """:func:`robust_figure`'s drawing on ``ax``: ``{"nominal", "marginal", "robust"}`` artists."""
     from matplotlib.patches import Patch, Polygon
 
-    fig, ax = plt.subplots(figsize=(6.4, 4.8))
+    artists = {"nominal": [], "marginal": [], "robust": []}
     nominal = region.nominal
     if nominal is not None:
         for k, cell in enumerate(nominal.stable):
             ring = np.vstack([cell.outer, cell.outer[:1]])
-            ax.plot(ring[:, 0], ring[:, 1], color="0.2", lw=1.0,
-                    label="stable at the box's centre" if k == 0 else None)
+            artists["nominal"] += ax.plot(ring[:, 0], ring[:, 1], color="0.2", lw=1.0,
+                                          label="stable at the box's centre" if k == 0 else None)
     for i, bands in enumerate(region.marginal):
         x0, x1 = region.edges[i], region.edges[i + 1]
         for lo0, hi0, lo1, hi1 in bands:
-            ax.add_patch(Polygon([(x0, lo0), (x1, lo1), (x1, hi1), (x0, hi0)], closed=True,
-                                 facecolor="#f4a582", edgecolor="none"))
+            artists["marginal"].append(ax.add_patch(Polygon(
+                [(x0, lo0), (x1, lo1), (x1, hi1), (x0, hi0)], closed=True,
+                facecolor="#f4a582", edgecolor="none")))
     # The robust set's outlines (runs of strips joined: no seams between them).
     for outline in region.polygons:
-        ax.add_patch(Polygon(outline, closed=True, facecolor="#4393c3", edgecolor="none"))
+        artists["robust"].append(ax.add_patch(Polygon(outline, closed=True, facecolor="#4393c3",
+                                                      edgecolor="none")))
     handles, _ = ax.get_legend_handles_labels()
     handles += [Patch(color="#4393c3", label="stable for every value of the box"),
                 Patch(color="#f4a582", label="marginal (not certified)")]
@@ -429,8 +462,7 @@ def robust_figure(plt, region, xlabel, ylabel):
     ax.set_title(f"robust stable set: {box}", fontsize=9)
     ax.set_xlabel(xlabel)
     ax.set_ylabel(ylabel)
-    fig.tight_layout()
-    return fig
+    return artists
 
 
 # --------------------------------------------------------------------------
@@ -725,7 +757,7 @@ def _shade_cells(ax, decomposition, color, scale=(1.0, 1.0)):
 
     ``decomposition`` is a :class:`symstab.numeric.engine.decomposition.Decomposition`
     (x = beta, y = alpha); ``scale`` multiplies its coordinates into the
-    plotted units.
+    plotted units.  Returns the patches.
     """
     from matplotlib.patches import PathPatch
     from matplotlib.path import Path
@@ -743,11 +775,13 @@ def _shade_cells(ax, decomposition, color, scale=(1.0, 1.0)):
         codes[0], codes[-1] = Path.MOVETO, Path.CLOSEPOLY
         return vertices, codes
 
+    patches = []
     for cell in decomposition.stable:
         parts = [ring(cell.outer, False)] + [ring(h, True) for h in cell.holes]
         path = Path(np.concatenate([v for v, _ in parts]), np.concatenate([c for _, c in parts]))
-        ax.add_patch(PathPatch(path, facecolor=color, edgecolor="none", alpha=_FILL_ALPHA,
-                               zorder=1))
+        patches.append(ax.add_patch(PathPatch(path, facecolor=color, edgecolor="none",
+                                              alpha=_FILL_ALPHA, zorder=1)))
+    return patches
 
 
 def _count_text(ax, x, y, count):
@@ -1111,3 +1145,471 @@ def limits_figure(columns, suptitle):
                  fontsize=SUPTITLE_SIZE)
     _legend_below(fig, handles, ncol=4)
     return fig
+
+
+# --------------------------------------------------------------------------
+# Results that draw themselves: ``result.plot(ax=None)`` on a user's axes
+# --------------------------------------------------------------------------
+
+class Plot:
+    """What a result's ``plot()`` drew: its figure, its axes and its artists by role.
+
+    As python-control's ``ControlPlot``: keep it to restyle what was drawn
+    (``p.artists["stable"]``), to add to the axes, or to save the figure.
+
+    Attributes
+    ----------
+    figure : matplotlib.figure.Figure
+    axes : matplotlib.axes.Axes
+    artists : dict
+        ``{role: [artist, ...]}``: ``"stable"`` (the filled stable set),
+        ``"arc"`` and ``"lines"`` (the D-decomposition's curves),
+        ``"counts"`` (the root counts written in the cells), ``"marker"``
+        (a marked point), as the result drew them.
+    """
+
+    def __init__(self, figure, axes, artists):
+        self.figure = figure
+        self.axes = axes
+        self.artists = artists
+
+    def __repr__(self):
+        drawn = ", ".join(f"{role}: {len(a)}" for role, a in self.artists.items())
+        return f"Plot({drawn})"
+
+    def savefig(self, *args, **kwargs):
+        """The figure's :meth:`matplotlib.figure.Figure.savefig`."""
+        return self.figure.savefig(*args, **kwargs)
+
+
+def _axes(ax):
+    """``(figure, axes)``: ``ax`` and its figure, or a new figure's axes (pyplot's backend)."""
+    try:
+        import matplotlib.pyplot as plt
+    except ImportError:
+        raise ImportError("plot() needs matplotlib: pip install 'symstab[figures]' "
+                          "(or pip install matplotlib)") from None
+    if ax is None:
+        figure, ax = plt.subplots(figsize=(6.4, 4.8), layout="constrained")
+        return figure, ax
+    return ax.figure, ax
+
+
+#: The fill of a stable set drawn by a result's ``plot()``.
+STABLE_COLOR = "#4292c6"
+
+#: How a result's ``plot()`` draws the D-decomposition's pieces.
+_PIECE_STYLE = {"arc": {"color": "k", "lw": 1.2},
+                "z = 1": {"color": "C0", "ls": "--", "lw": 1.2},
+                "z = -1": {"color": "C3", "ls": "--", "lw": 1.2},
+                "leading": {"color": "C1", "ls": ":", "lw": 1.2}}
+_PIECE_LABEL = {"arc": r"a root at $z = e^{j\theta}$", "z = 1": "a root at $z = 1$",
+                "z = -1": "a root at $z = -1$", "leading": "a root at infinity"}
+
+
+def _pieces(ax, branches):
+    """The decomposition's pieces on ``ax``, one legend entry per kind: ``(arc, lines)``."""
+    arc, lines = [], []
+    for branch in branches:
+        style = _PIECE_STYLE.get(branch.label, _PIECE_STYLE["leading"])
+        seen = arc if branch.label == "arc" else lines
+        label = _PIECE_LABEL.get(branch.label, branch.label)
+        if any(getattr(a, "get_label", lambda: "")() == label for a in arc + lines):
+            label = "_nolegend_"
+        seen += ax.plot(branch.points[:, 0], branch.points[:, 1], label=label, zorder=3,
+                        **style)
+    return arc, lines
+
+
+def plot_region(decomposition, ax=None, *, counts=True, color=STABLE_COLOR):
+    """Draw a D-decomposition: the stable set filled, the curves, each cell's root count.
+
+    What :meth:`symstab.numeric.engine.decomposition.Decomposition.plot`
+    (and so ``loop.region(...).plot()``) draws.
+
+    Parameters
+    ----------
+    decomposition : symstab.numeric.engine.decomposition.Decomposition
+    ax : matplotlib.axes.Axes, optional
+        Where to draw (default: a new figure's axes).
+    counts : bool, optional
+        Write the number of unstable closed-loop poles in every cell with
+        room for it (default True).
+    color : str, optional
+        The stable set's fill.
+
+    Returns
+    -------
+    Plot
+        Artists ``"stable"``, ``"arc"``, ``"lines"``, ``"counts"``.
+
+    Raises
+    ------
+    ImportError
+        Without matplotlib (the ``figures`` extra).
+    """
+    figure, ax = _axes(ax)
+    from matplotlib.patches import Patch
+
+    stable = _shade_cells(ax, decomposition, color)
+    arc, lines = _pieces(ax, decomposition.branches)
+    ax.set_xlim(*decomposition.x_range)
+    ax.set_ylim(*decomposition.y_range)
+    ax.set_xlabel(decomposition.x)
+    ax.set_ylabel(decomposition.y)
+    written = []
+    if counts:
+        before = len(ax.texts)
+        _write_counts(ax, decomposition)
+        written = list(ax.texts[before:])
+    handles = [Patch(facecolor=color, alpha=_FILL_ALPHA + 0.1, label="stable (root counting)")]
+    handles += [a for a in arc + lines if not a.get_label().startswith("_")]
+    ax.legend(handles=handles, loc="best", fontsize=LEGEND_SIZE)
+    return Plot(figure, ax, {"stable": stable, "arc": arc, "lines": lines, "counts": written})
+
+
+def plot_limits(limits, ax=None, **kwargs):
+    """Draw the stable set that ``limits`` were read from, its largest ``y`` marked.
+
+    What :meth:`symstab.numeric.engine.results.Limits.plot` draws.
+
+    Parameters
+    ----------
+    limits : symstab.numeric.engine.results.Limits
+        Limits of a decomposition (:meth:`symstab.Loop.limits`,
+        :func:`symstab.limits`).
+    ax : matplotlib.axes.Axes, optional
+        Where to draw (default: a new figure's axes).
+    **kwargs
+        Handed to :func:`plot_region`.
+
+    Returns
+    -------
+    Plot
+        :func:`plot_region`'s artists, and ``"marker"``: the point
+        ``(x_at_y_max, y_max)``.
+
+    Raises
+    ------
+    ValueError
+        For limits that hold no decomposition to draw.
+    ImportError
+        Without matplotlib.
+    """
+    if limits.decomposition is None:
+        raise ValueError("these limits hold no D-decomposition to draw (they were not read "
+                         "from one)")
+    drawn = plot_region(limits.decomposition, ax, **kwargs)
+    marker = []
+    if not limits.empty and np.isfinite(limits.y_max) and np.isfinite(limits.x_at_y_max):
+        marker = drawn.axes.plot([limits.x_at_y_max], [limits.y_max], "o", color="#d62728",
+                                 zorder=6, label=f"{limits.y}_max = {limits.y_max:.6g}")
+        handles = drawn.axes.get_legend().legend_handles + marker
+        drawn.axes.legend(handles=handles, loc="best", fontsize=LEGEND_SIZE)
+    drawn.artists["marker"] = marker
+    return drawn
+
+
+def plot_boundary(boundary, ax=None, *, x_range=None, y_range=None):
+    """Draw a boundary: the arc where a root is on the unit circle, and the lines in view.
+
+    What :meth:`symstab.numeric.engine.results.Boundary.plot` draws.  A
+    loop's arc covers all of (0, pi) and may run off to very large values:
+    the default window holds its central points (from the 10th to the 90th
+    percentile in each coordinate, widened by half that span on each side).
+
+    Parameters
+    ----------
+    boundary : symstab.numeric.engine.results.Boundary
+    ax : matplotlib.axes.Axes, optional
+        Where to draw (default: a new figure's axes).
+    x_range, y_range : (float, float), optional
+        The window (default: as above).
+
+    Returns
+    -------
+    Plot
+        Artists ``"arc"`` and ``"lines"``.
+
+    Raises
+    ------
+    ImportError
+        Without matplotlib.
+    """
+    figure, ax = _axes(ax)
+    x, y = np.asarray(boundary.x_values, float), np.asarray(boundary.y_values, float)
+    arc = ax.plot(x, y, zorder=3, label=_PIECE_LABEL["arc"], **_PIECE_STYLE["arc"]) \
+        if len(x) else []
+    finite = np.isfinite(x) & np.isfinite(y)
+    for values, given, limit in ((x[finite], x_range, ax.set_xlim),
+                                 (y[finite], y_range, ax.set_ylim)):
+        if given is None and len(values):
+            lo, hi = np.percentile(values, [10, 90])
+            span = (hi - lo) or max(abs(hi), 1.0)
+            given = (lo - span / 2, hi + span / 2)
+        if given is not None:
+            limit(*given)
+    ax.set_xlabel(boundary.x)
+    ax.set_ylabel(boundary.y)
+    xs, ys = ax.get_xlim(), ax.get_ylim()
+    lines = draw_lines(ax, boundary.lines, np.linspace(*xs, 2), np.linspace(*ys, 2))
+    ax.set_xlim(*xs)
+    ax.set_ylim(*ys)
+    ax.legend(loc="best", fontsize=LEGEND_SIZE)
+    return Plot(figure, ax, {"arc": arc, "lines": lines})
+
+
+def plot_robust(region, ax=None):
+    """Draw a robust set: certified (filled), marginal, and the nominal set's outline.
+
+    What :meth:`symstab.numeric.engine.results.RobustRegion.plot` draws (the
+    PNG of ``symstab limits --uncertain``).
+
+    Parameters
+    ----------
+    region : symstab.numeric.engine.results.RobustRegion
+    ax : matplotlib.axes.Axes, optional
+        Where to draw (default: a new figure's axes).
+
+    Returns
+    -------
+    Plot
+        Artists ``"robust"``, ``"marginal"``, ``"nominal"``.
+
+    Raises
+    ------
+    ImportError
+        Without matplotlib.
+    """
+    figure, ax = _axes(ax)
+    return Plot(figure, ax, _draw_robust(ax, region, region.x, region.y))
+
+
+def plot_probability(found, ax=None, *, boundary=None):
+    """Draw the probability of stability over its grid, a boundary over it if given.
+
+    What :meth:`symstab.numeric.engine.results.StabilityProbability.plot`
+    draws (the PNG of ``symstab map --uncertain``).
+
+    Parameters
+    ----------
+    found : symstab.numeric.engine.results.StabilityProbability
+    ax : matplotlib.axes.Axes, optional
+        Where to draw (default: a new figure's axes).
+    boundary : symstab.numeric.engine.results.Boundary, optional
+        The nominal loop's D-decomposition (:meth:`symstab.Loop.boundary`),
+        drawn over the map.
+
+    Returns
+    -------
+    Plot
+        Artists ``"probability"`` (the mesh), ``"colorbar"``, ``"boundary"``.
+
+    Raises
+    ------
+    ImportError
+        Without matplotlib.
+    """
+    figure, ax = _axes(ax)
+    return Plot(figure, ax, _draw_probability(ax, found, boundary, found.x, found.y))
+
+
+def plot_design(found, ax=None, *, target_label=None):
+    """Draw a design: its target at every value evaluated, the optimum and the nominal marked.
+
+    What :meth:`symstab.numeric.analysis.design.Design.plot` draws (the PNG
+    of ``symstab design --png``).
+
+    Parameters
+    ----------
+    found : symstab.numeric.analysis.design.Design
+    ax : matplotlib.axes.Axes, optional
+        Where to draw (default: a new figure's axes).
+    target_label : str, optional
+        The target's axis label (default: its name,
+        :attr:`~symstab.numeric.analysis.design.Design.target`).
+
+    Returns
+    -------
+    Plot
+        Artists ``"target"``, ``"best"``, ``"nominal"``, ``"none"`` (the
+        values with no stable point).
+
+    Raises
+    ------
+    ImportError
+        Without matplotlib.
+    """
+    figure, ax = _axes(ax)
+    label = found.target if target_label is None else target_label
+    return Plot(figure, ax, _draw_design(ax, found, list(found.over), label))
+
+
+def plot_passive(passive, ax=None, *, region=None):
+    """Draw a passive set (its polygon), the stable set beside it if given.
+
+    What :meth:`symstab.numeric.analysis.passivity.PassiveRegion.plot` draws.
+
+    Parameters
+    ----------
+    passive : symstab.numeric.analysis.passivity.PassiveRegion
+    ax : matplotlib.axes.Axes, optional
+        Where to draw (default: a new figure's axes).
+    region : symstab.numeric.engine.decomposition.Decomposition, optional
+        The stable set of the same plane (:meth:`symstab.Loop.region`),
+        drawn under it: passive points are stable, not the other way round.
+
+    Returns
+    -------
+    Plot
+        Artists ``"passive"`` and, with ``region``, :func:`plot_region`'s.
+
+    Raises
+    ------
+    ImportError
+        Without matplotlib.
+    """
+    from matplotlib.patches import Patch, Polygon
+
+    figure, ax = _axes(ax)
+    artists = plot_region(region, ax, counts=False).artists if region is not None else {}
+    handles = list(ax.get_legend().legend_handles) if ax.get_legend() else []
+    artists["passive"] = []
+    if len(passive.polygon):
+        artists["passive"].append(ax.add_patch(Polygon(
+            passive.polygon, closed=True, facecolor=PASSIVE_COLOR, edgecolor=PASSIVE_COLOR,
+            alpha=0.45, lw=1.2, zorder=2)))
+    handles.append(Patch(facecolor=PASSIVE_COLOR, alpha=0.45, label="passive"))
+    if region is None:
+        ax.set_xlim(*passive.x_range)
+        ax.set_ylim(*passive.y_range)
+        ax.set_xlabel(passive.x)
+        ax.set_ylabel(passive.y)
+    ax.legend(handles=handles, loc="best", fontsize=LEGEND_SIZE)
+    return Plot(figure, ax, artists)
+
+
+def plot_locus(locus, ax=None):
+    """Draw a root locus in the z-plane: the poles coloured by the path's value, the crossings.
+
+    What :meth:`symstab.numeric.engine.locus.Locus.plot` draws (the upper
+    left panel of ``symstab locus``'s PNG).
+
+    Parameters
+    ----------
+    locus : symstab.numeric.engine.locus.Locus
+    ax : matplotlib.axes.Axes, optional
+        Where to draw (default: a new figure's axes).
+
+    Returns
+    -------
+    Plot
+        Artists ``"poles"`` (the scatter), ``"circle"``, ``"crossings"``
+        (a marker per crossing, and its mirror for a pair) and
+        ``"colorbar"``.
+
+    Raises
+    ------
+    ImportError
+        Without matplotlib.
+    """
+    from matplotlib.colors import Normalize
+
+    figure, ax = _axes(ax)
+    values = np.asarray(locus.values, dtype=float)
+    finite = np.isfinite(locus.poles)
+    radius = float(np.max(np.abs(locus.poles[finite]))) if finite.any() else 1.0
+    limit = min(max(1.15, 1.05 * radius), _PLANE_LIMIT)
+    norm = Normalize(vmin=float(values.min()), vmax=float(values.max()))
+    before = len(ax.lines)
+    dots = _plane(ax, locus, values, locus.parameter, norm, limit)
+    lines = ax.lines[before:]
+    bar = figure.colorbar(dots, ax=ax, label=locus.parameter)
+    ax.legend(loc="best", fontsize=LEGEND_SIZE)
+    return Plot(figure, ax, {"poles": [dots], "circle": lines[:1], "crossings": lines[2:],
+                             "colorbar": [bar]})
+
+
+def plot_simulation(run, ax=None, *, T=None):
+    """Draw a recorded run: the position at each sample, one line per point simulated.
+
+    What :meth:`symstab.numeric.simulation.simulator.Simulation.plot` draws.
+
+    Parameters
+    ----------
+    run : symstab.numeric.simulation.simulator.Simulation
+        A run with its positions (``record=True``).
+    ax : matplotlib.axes.Axes, optional
+        Where to draw (default: a new figure's axes).
+    T : float, optional
+        The sample period in s: the time axis in seconds (default: in
+        samples).
+
+    Returns
+    -------
+    Plot
+        Artists ``"positions"``, one line per point.
+
+    Raises
+    ------
+    ValueError
+        For a run without its positions.
+    ImportError
+        Without matplotlib.
+    """
+    if run.positions is None:
+        raise ValueError("this run did not record its positions: simulate with record=True")
+    figure, ax = _axes(ax)
+    positions = np.asarray(run.positions, dtype=float)
+    positions = positions.reshape(len(positions), -1)
+    k = np.arange(len(positions)) * (1.0 if T is None else float(T))
+    lines = ax.plot(k, positions, lw=1.0)
+    ax.set_xlabel("sample k" if T is None else "time [s]")
+    ax.set_ylabel("position x")
+    stable = np.asarray(run.stable).ravel()
+    if len(lines) == 1:
+        ax.set_title("stable" if stable[0] else ("bounded limit cycle"
+                                                 if np.asarray(run.limit_cycle).ravel()[0]
+                                                 else "not stable"), fontsize=PANEL_TITLE_SIZE)
+    return Plot(figure, ax, {"positions": lines})
+
+
+def plot_map(found, ax=None, *, boundary=None):
+    """Draw a simulated stability map: stable cells, bounded limit cycles, a boundary over it.
+
+    What :meth:`symstab.numeric.simulation.simulator.StabilityMap.plot`
+    draws (the PNG of ``symstab map``, in the map's own plane).
+
+    Parameters
+    ----------
+    found : symstab.numeric.simulation.simulator.StabilityMap
+    ax : matplotlib.axes.Axes, optional
+        Where to draw (default: a new figure's axes).
+    boundary : symstab.numeric.engine.results.Boundary, optional
+        The loop's D-decomposition in the same plane, drawn over the map.
+
+    Returns
+    -------
+    Plot
+        Artists ``"cells"`` (the mesh) and ``"boundary"``.
+
+    Raises
+    ------
+    ImportError
+        Without matplotlib.
+    """
+    from matplotlib.colors import ListedColormap
+    from matplotlib.patches import Patch
+
+    figure, ax = _axes(ax)
+    xs, ys = np.asarray(found.x_values, float), np.asarray(found.y_values, float)
+    shade = np.where(found.stable, 1, np.where(found.limit_cycle, 2, 0))
+    mesh = ax.pcolormesh(xs, ys, shade, shading="nearest", vmin=0, vmax=2,
+                         cmap=ListedColormap(["white", "#7fc97f", LIMIT_CYCLE_COLOR]))
+    handles = [Patch(facecolor="#7fc97f", label="stable (simulated)")]
+    if np.any(found.limit_cycle):
+        handles.append(Patch(facecolor=LIMIT_CYCLE_COLOR, label=LIMIT_CYCLE_LABEL))
+    drawn = [] if boundary is None else _loop_boundary(ax, boundary, xs, ys)
+    _map_frame(ax, xs, ys, found.x, found.y)
+    ax.legend(handles=handles + drawn, loc="best", fontsize=LEGEND_SIZE, framealpha=0.9)
+    return Plot(figure, ax, {"cells": [mesh], "boundary": drawn})

@@ -36,9 +36,11 @@ def _tree(path):
 
 #: Rank of each layer; a module may import its own rank or lower.
 RANK = {"base": 0, "symbolic": 1, "codegen": 2, "proof": 3, "numeric": 4, "front": 5}
+#: ``drawing`` imports nothing of symstab (it draws what it is handed): the results'
+#: ``plot()`` methods, in any layer, hand themselves to it.
 _BASE = {"_io", "_lazy", "_memo", "_progress", "_project", "_resources", "_signals", "_validate", "_workers",
-         "_generated"}
-_FRONT = {"cli", "drawing", "figures", "reproduce", "__main__"}
+         "_generated", "drawing"}
+_FRONT = {"cli", "figures", "reproduce", "__main__"}
 
 
 def _layer(parts):

@@ -457,21 +457,40 @@ def test_bad_options_are_one_line(capsys, tmp_path, monkeypatch, args, needle):
     assert list((tmp_path / "work").iterdir()) == []
 
 
-def test_robust_region_and_simulated_rows_are_the_loop_s(capsys, tmp_path):
+def test_robust_region_and_simulated_rows_are_the_loop_s(capsys, tmp_path, monkeypatch):
     """Each row of the new questions is the library's answer at its values (in SI; the CSV
     keeps 12 digits).  (The robust rows at d = 10 and 20, until issue 41 at 5 and 10: the
-    robust set at d = 5 takes five times the cells.)"""
+    robust set at d = 5 takes five times the cells.)
+
+    Loop.limits is watched while the robust sweep runs (in this process), as Loop.design
+    is in the design test: each robust row is the answer of the call
+    ``loop.limits("B", "K", uncertain={"b": (0.0162, 0.0648)}, strips=4, d=d)`` on
+    paper.toml's loop, checked to be that call, rather than computed a second time."""
     loop = symstab.load_loop(LOOPS / "paper.toml")
+    calls = []
+    limits = symstab.Loop.limits
+
+    def watched(used, *args, **kwargs):
+        found = limits(used, *args, **kwargs)
+        calls.append((used, args, kwargs, found))
+        return found
+
     path = spec(tmp_path, 'question = "robust"\nchunk = 1\n[grid]\nd = [10, 20]\n[robust]\n'
                           'uncertain = { b = { range = [16.2, 64.8], unit = "mN m s/rad" } }\n'
                           'strips = 4\n', "r.toml")
-    status, text, err = run(capsys, "sweep", path, "--out", tmp_path / "r.csv", "--serial")
+    with monkeypatch.context() as patch:
+        patch.setattr(symstab.Loop, "limits", watched)
+        status, text, err = run(capsys, "sweep", path, "--out", tmp_path / "r.csv", "--serial")
     assert status == 0, err
     header, rows = read_csv(tmp_path / "r.csv")
     assert header.endswith("marginal_area [(N m s/rad)(N m/rad)],"
                            "nominal_area [(N m s/rad)(N m/rad)],reason")
-    for d, *answer in rows:
-        found = loop.limits(uncertain={"b": (0.0162, 0.0648)}, strips=4, d=int(d))
+    assert len(calls) == len(rows) == 2
+    for (d, *answer), (used, args, kwargs, found) in zip(rows, calls, strict=True):
+        # The call: paper.toml's loop, b uncertain in [0.0162, 0.0648] N m s/rad, 4 strips.
+        assert used.defaults == loop.defaults and str(used) == str(loop)
+        assert args == ("B", "K")
+        assert kwargs == {"uncertain": {"b": (0.0162, 0.0648)}, "strips": 4, "d": int(d)}
         np.testing.assert_allclose(answer, [found.y_max, found.x_at_y_max, found.x_min,
                                             found.x_max, found.area, found.region.marginal_area,
                                             found.region.nominal.area], rtol=1e-11)

@@ -91,6 +91,12 @@ def paper_folder(tmp_path_factory, cache_dir):
 
 
 @pytest.fixture(scope="module")
+def paper_compiled(tmp_path_factory, paper_folder):
+    """The C kernels of ``paper_folder``, compiled once for the module's three tests of them."""
+    return _compile(paper_folder, tmp_path_factory.mktemp("paper_c"))
+
+
+@pytest.fixture(scope="module")
 def example_derived(tmp_path_factory, cache_dir):
     """``derived(path)``: ``symstab derive --loop path`` run and its C compiled, once per file.
 
@@ -336,8 +342,8 @@ def _assemble(delayed, direct, d):
     return out
 
 
-def test_c_and_numpy_environment_kernels_agree(paper_folder, tmp_path):
-    c = _compile(paper_folder, tmp_path)
+def test_c_and_numpy_environment_kernels_agree(paper_folder, paper_compiled):
+    c = paper_compiled
     numpy_module = _numpy_module(paper_folder)
     for point in _paper_points(40, seed=11):
         args = (point["B"], point["K"], point["M"], point["T"])
@@ -348,7 +354,7 @@ def test_c_and_numpy_environment_kernels_agree(paper_folder, tmp_path):
                                        rtol=1e-15, atol=0, err_msg=name)
 
 
-def test_c_pulse_transfer_function_matches_eq4_and_python_control(paper_folder, tmp_path):
+def test_c_pulse_transfer_function_matches_eq4_and_python_control(paper_compiled):
     """The residue-path kernel against eq. (4) at 50 digits and python-control's ``c2d``.
 
     The coefficients as derived cancel about log10(4 / delta**2) digits
@@ -360,7 +366,7 @@ def test_c_pulse_transfer_function_matches_eq4_and_python_control(paper_folder, 
     import mpmath
 
     control = pytest.importorskip("control")
-    c = _compile(paper_folder, tmp_path)
+    c = paper_compiled
     rng = np.random.default_rng(3)
     for k in range(40):
         m, T = 10 ** rng.uniform(-2.5, 0), 10 ** rng.uniform(-4, -2.7)
@@ -449,14 +455,14 @@ def test_c_pulse_transfer_function_of_a_complex_pair_matches_mpmath_and_python_c
     assert compared >= 10
 
 
-def test_c_kernels_assemble_the_loops_polynomial(paper_folder, tmp_path):
+def test_c_kernels_assemble_the_loops_polynomial(paper_compiled):
     """z**d Ve_d P_d + Ve_n P_n from the C kernels equals ``Loop.coefficients``.
 
     Loop.coefficients evaluates the plant at 30 digits; the C prints its
     coefficients as derived, which cancel ~log10(4 / delta**2) digits (at
     most 6.6 here, delta >= 1e-3): 1e-8 relative leaves room for that.
     """
-    c = _compile(paper_folder, tmp_path)
+    c = paper_compiled
     loop = load_loop(PAPER_FILE)
     for k, point in enumerate(_paper_points(30, seed=7)):
         d = k % 5

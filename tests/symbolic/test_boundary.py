@@ -7,6 +7,7 @@ import numpy as np
 import pytest
 import sympy as sp
 
+from symstab import arc_end_angle
 from symstab.symbolic import model
 from symstab.symbolic.boundary import (
     ALPHA_MONOMIALS,
@@ -16,7 +17,6 @@ from symstab.symbolic.boundary import (
     boundary,
     coefficients,
 )
-from symstab.symbolic.theta_max import theta_max
 
 from conftest import PAPER_DELTA, assert_rel_close
 from oracles import (
@@ -30,14 +30,19 @@ ARGS = (model.theta, model.gamma, model.d, model.delta, model.Gamma)
 
 
 def _boundary_points(seed, n, per_arc=2):
-    """(theta, gamma, d, delta) with theta in (0, theta_max), ``per_arc`` per arc."""
+    """(theta, gamma, d, delta) with theta in (0, theta_max), ``per_arc`` per arc.
+
+    theta_max from the float kernel (:func:`symstab.arc_end_angle`): the points
+    only need to lie on the arc, and collection (in every worker) then derives
+    nothing; the exact :func:`theta_max` is the subject of test_theta_max.py.
+    """
     rng = np.random.default_rng(seed)
     out = []
     for _ in range(n):
         gamma = float(rng.uniform(-0.9, 2.5))
         d = int(rng.integers(0, 13))
         delta = float(10 ** rng.uniform(-4, 0))
-        top = theta_max(gamma=gamma, d=d, delta=delta)
+        top = arc_end_angle(gamma=gamma, d=d, delta=delta)
         out += [(float(top * rng.uniform(0.02, 0.98)), gamma, d, delta) for _ in range(per_arc)]
     return out
 

@@ -139,6 +139,25 @@ class Design:
     message: str = ""
     delay: object = None
 
+    def plot(self, ax=None, **kwargs):
+        """Draw the target at each value evaluated: :func:`symstab.drawing.plot_design`.
+
+        Parameters
+        ----------
+        ax : matplotlib.axes.Axes, optional
+            Where to draw (default: a new figure's axes).
+        **kwargs
+            ``target_label``: as in :func:`symstab.drawing.plot_design`.
+
+        Returns
+        -------
+        symstab.drawing.Plot
+            Its ``figure``, ``axes`` and ``artists``.
+        """
+        from ...drawing import plot_design
+
+        return plot_design(self, ax, **kwargs)
+
     @property
     def best_d(self):
         """The delay in samples at the optimum: ``ceil(delay / T)`` where the delay is held in seconds."""

@@ -142,6 +142,25 @@ class PassiveRegion:
     _halfplanes: np.ndarray = dataclasses.field(default=None, init=False, repr=False,
                                                 compare=False)
 
+    def plot(self, ax=None, *, region=None):
+        """Draw the passive polygon: :func:`symstab.drawing.plot_passive`.
+
+        Parameters
+        ----------
+        ax : matplotlib.axes.Axes, optional
+            Where to draw (default: a new figure's axes).
+        region : symstab.numeric.engine.decomposition.Decomposition, optional
+            The plane's stable set (:meth:`symstab.Loop.region`), drawn under it.
+
+        Returns
+        -------
+        symstab.drawing.Plot
+            Its ``figure``, ``axes`` and ``artists``.
+        """
+        from ...drawing import plot_passive
+
+        return plot_passive(self, ax, region=region)
+
     @property
     def empty(self):
         """True when no point is passive."""

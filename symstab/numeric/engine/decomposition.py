@@ -46,7 +46,7 @@ import scipy.sparse.csgraph
 from ..._resources import check_memory, chunk_slices
 from .arcs import CramerArc
 from .polynomial import DelayedPolynomial
-from .results import Limits, Segment
+from .results import Limits, Segment, html_table
 from .roots import STABLE, classify_polynomials, leading_vanishes, root_counts
 from .search import bracketed_root, refit_root, zoom_max
 
@@ -236,6 +236,34 @@ class Decomposition:
     hull: object = dataclasses.field(default=None, compare=False)
     arc: object = dataclasses.field(default=None, compare=False)
     segments: tuple = ()
+
+    def plot(self, ax=None, **kwargs):
+        """Draw the decomposition: :func:`symstab.drawing.plot_region`.
+
+        The stable set filled, the arc and the lines, and each cell's number
+        of unstable closed-loop poles where it has room.
+
+        Parameters
+        ----------
+        ax : matplotlib.axes.Axes, optional
+            Where to draw (default: a new figure's axes).
+        **kwargs
+            ``counts``, ``color``: as in :func:`symstab.drawing.plot_region`.
+
+        Returns
+        -------
+        symstab.drawing.Plot
+            Its ``figure``, ``axes`` and ``artists``.
+
+        Examples
+        --------
+        >>> import symstab
+        >>> drawn = symstab.PAPER_LOOP.region(d=40).plot()      # doctest: +SKIP
+        >>> drawn.figure.savefig("region.png")                  # doctest: +SKIP
+        """
+        from ...drawing import plot_region
+
+        return plot_region(self, ax, **kwargs)
 
     @property
     def stable(self):
@@ -438,7 +466,7 @@ class Decomposition:
         at = {} if at is None else at
         if not self.stable:
             return Limits.empty_set(self.x, self.y, "the stable set is empty: " + self._why_empty(),
-                                    cells=0, at=at, line=line)
+                                    cells=0, at=at, line=line, decomposition=self)
         (y_max, x_at), (x_min, _), (x_max, _) = (self.extreme(*which) for which in
                                                   (("y", 1), ("x", -1), ("x", 1)))
         sides = set(self.unbounded)
@@ -447,7 +475,7 @@ class Decomposition:
         x_max = np.inf if "x_max" in sides else x_max
         area = np.inf if sides else self.area
         return Limits(self.x, self.y, float(y_max), float(x_at), float(x_min), float(x_max),
-                      float(area), cells=len(self.stable), at=at, line=line)
+                      float(area), cells=len(self.stable), at=at, line=line, decomposition=self)
 
     def _why_empty(self):
         """Why no cell is stable: the hull's proof, or what the window held."""
@@ -513,6 +541,20 @@ class Decomposition:
             return where + "no point of the plane is stable)"
         return where + (f"{len(self.cells)} cells, counts {counts}, {len(self.stable)} stable, "
                         f"stable area {self.area:.6g})")
+
+    def _repr_html_(self):
+        """Jupyter's view: the window, the stable set's area and the cells per root count."""
+        rows = [(self.x, f"[{self.x_range[0]:.6g}, {self.x_range[1]:.6g}]"),
+                (self.y, f"[{self.y_range[0]:.6g}, {self.y_range[1]:.6g}]"),
+                ("stable area", self.area), ("stable cells", len(self.stable))]
+        counts = sorted({c.count for c in self.cells})
+        rows += [(f"cells with {n} unstable pole{'s' if n != 1 else ''}",
+                  sum(c.count == n for c in self.cells)) for n in counts]
+        if self.unbounded:
+            rows.append(("stable set reaches", ", ".join(self.unbounded)))
+        if self.hull is not None and self.hull.empty and not self.cells:
+            rows.append(("no point is stable", self.hull.reason))
+        return html_table(f"D-decomposition of the ({self.x}, {self.y}) plane", rows)
 
 
 # --------------------------------------------------------------------------

@@ -147,6 +147,23 @@ class Locus:
     poles: np.ndarray
     crossings: tuple
 
+    def plot(self, ax=None):
+        """Draw the poles in the z-plane: :func:`symstab.drawing.plot_locus`.
+
+        Parameters
+        ----------
+        ax : matplotlib.axes.Axes, optional
+            Where to draw (default: a new figure's axes).
+
+        Returns
+        -------
+        symstab.drawing.Plot
+            Its ``figure``, ``axes`` and ``artists``.
+        """
+        from ...drawing import plot_locus
+
+        return plot_locus(self, ax)
+
     def unstable_counts(self):
         """Number of poles outside the unit circle at each value (-1: marginal).
 

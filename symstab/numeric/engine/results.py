@@ -120,6 +120,10 @@ class Limits:
     line : callable or None
         ``line(x) -> [(lo, hi), ...]``: the stable intervals of ``y`` at
         ``x`` (:meth:`intervals_at`), where the limits came from a loop.
+    decomposition : Decomposition or None
+        The D-decomposition the numbers were read from (what :meth:`plot`
+        draws), where they were read from one.  Not pickled (its arc is
+        computed by closures): limits sent to another process draw nothing.
 
     Notes
     -----
@@ -143,6 +147,7 @@ class Limits:
     region: object = None
     at: dict = dataclasses.field(default_factory=dict)
     line: object = dataclasses.field(default=None, compare=False)
+    decomposition: object = dataclasses.field(default=None, compare=False, repr=False)
 
     alpha_max = paper_alias("alpha_max", "y_max")
     beta_at_alpha_max = paper_alias("beta_at_alpha_max", "x_at_y_max")
@@ -161,6 +166,10 @@ class Limits:
     def empty(self):
         """True when no point of the plane is stable (see :attr:`reason`)."""
         return self.y_max is None
+
+    def __getstate__(self):
+        # The decomposition's arc source is made of closures, which do not pickle.
+        return {**self.__dict__, "decomposition": None}
 
     @classmethod
     def empty_set(cls, x, y, reason, **fields):
@@ -182,6 +191,25 @@ class Limits:
     def _repr_html_(self):
         """Jupyter's view: :meth:`as_dict` as a table."""
         return html_table(_head("Limits", self)[:-2] + ")", self.as_dict().items())
+
+    def plot(self, ax=None, **kwargs):
+        """Draw the stable set, its largest ``y`` marked: :func:`symstab.drawing.plot_limits`.
+
+        Parameters
+        ----------
+        ax : matplotlib.axes.Axes, optional
+            Where to draw (default: a new figure's axes).
+        **kwargs
+            ``counts``, ``color``: as in :func:`symstab.drawing.plot_region`.
+
+        Returns
+        -------
+        symstab.drawing.Plot
+            Its ``figure``, ``axes`` and ``artists``.
+        """
+        from ...drawing import plot_limits
+
+        return plot_limits(self, ax, **kwargs)
 
     def as_dict(self):
         """The numbers, for tables and JSON (the paper's names in its plane)."""
@@ -374,6 +402,26 @@ class Boundary(PaperGridNames):
         return head + (f"{int(finite.sum())} arc points, lines "
                        f"{', '.join(self.lines) or 'none'})")
 
+    def plot(self, ax=None, **kwargs):
+        """Draw the arc and the lines in view: :func:`symstab.drawing.plot_boundary`.
+
+        Parameters
+        ----------
+        ax : matplotlib.axes.Axes, optional
+            Where to draw (default: a new figure's axes).
+        **kwargs
+            ``x_range``, ``y_range``: the window (as in
+            :func:`symstab.drawing.plot_boundary`).
+
+        Returns
+        -------
+        symstab.drawing.Plot
+            Its ``figure``, ``axes`` and ``artists``.
+        """
+        from ...drawing import plot_boundary
+
+        return plot_boundary(self, ax, **kwargs)
+
 
 @dataclasses.dataclass(frozen=True, repr=False)
 class StabilityProbability:
@@ -411,6 +459,25 @@ class StabilityProbability:
     x: str
     y: str
     at: dict = dataclasses.field(default_factory=dict)
+
+    def plot(self, ax=None, *, boundary=None):
+        """Draw the probability over the grid: :func:`symstab.drawing.plot_probability`.
+
+        Parameters
+        ----------
+        ax : matplotlib.axes.Axes, optional
+            Where to draw (default: a new figure's axes).
+        boundary : symstab.numeric.engine.results.Boundary, optional
+            The nominal loop's boundary, drawn over the map.
+
+        Returns
+        -------
+        symstab.drawing.Plot
+            Its ``figure``, ``axes`` and ``artists``.
+        """
+        from ...drawing import plot_probability
+
+        return plot_probability(self, ax, boundary=boundary)
 
     def __repr__(self):
         p = self.probability
@@ -473,6 +540,23 @@ class RobustRegion:
     examined: int = 0
     exhausted: bool = False
     unbounded: tuple = ()
+
+    def plot(self, ax=None):
+        """Draw the certified and marginal sets: :func:`symstab.drawing.plot_robust`.
+
+        Parameters
+        ----------
+        ax : matplotlib.axes.Axes, optional
+            Where to draw (default: a new figure's axes).
+
+        Returns
+        -------
+        symstab.drawing.Plot
+            Its ``figure``, ``axes`` and ``artists``.
+        """
+        from ...drawing import plot_robust
+
+        return plot_robust(self, ax)
 
     @classmethod
     def from_strips(cls, x, y, box, delays, edges, robust, marginal, nominal, at, examined=0,
@@ -666,3 +750,18 @@ class RobustRegion:
         return (f"RobustRegion({self.x} x {self.y}, {box}: area {self.area:.6g} "
                 f"(nominal {nominal:.6g}), marginal {self.marginal_area:.3g}, "
                 f"{len(self.edges) - 1} strips{more})")
+
+    def _repr_html_(self):
+        """Jupyter's view: the box, the robust set's area beside the nominal one's, the margin."""
+        rows = [(k, f"[{lo:.6g}, {hi:.6g}]") for k, (lo, hi) in self.uncertain.items()]
+        if self.empty:
+            rows.append(("empty", self.reason))
+        else:
+            rows += [("area (stable for every value)", self.area),
+                     ("area at the box's centre",
+                      self.nominal.area if self.nominal is not None else None),
+                     ("marginal area (not certified)", self.marginal_area),
+                     ("strips", len(self.edges) - 1), ("cells examined", self.examined)]
+            if self.exhausted:
+                rows.append(("stopped", "at its budget of cells: what was open is marginal"))
+        return html_table(f"robust stable set in the ({self.x}, {self.y}) plane", rows)

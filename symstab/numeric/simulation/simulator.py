@@ -278,7 +278,7 @@ def _round_into(out, values, quantum):
     np.rint(out, out=out)
     np.multiply(out, quantum, out=out)
     finite = np.isfinite(out)
-    if not finite.all():
+    if np.count_nonzero(finite) != finite.size:     # (all(): four times the time)
         np.copyto(out, values, where=~finite)
 
 
@@ -421,6 +421,25 @@ class Simulation:
     floor: np.ndarray
     limit_cycle: np.ndarray
 
+    def plot(self, ax=None, *, T=None):
+        """Draw the recorded positions: :func:`symstab.drawing.plot_simulation`.
+
+        Parameters
+        ----------
+        ax : matplotlib.axes.Axes, optional
+            Where to draw (default: a new figure's axes).
+        T : float, optional
+            The sample period in s: time in seconds (default: samples).
+
+        Returns
+        -------
+        symstab.drawing.Plot
+            Its ``figure``, ``axes`` and ``artists``.
+        """
+        from ...drawing import plot_simulation
+
+        return plot_simulation(self, ax, T=T)
+
     @property
     def bounded(self):
         """Stable or a limit cycle: the runs that neither grow nor diverge."""
@@ -521,6 +540,10 @@ def _run(run, steps, amplitude, positions, progress, report, chunk, n_chunks, to
     magnitude = np.empty(run.size) if total is not None else None
     extreme = np.empty(run.size)
     every = run.check_every
+    # A period of a run that records, sums and reports nothing is its step
+    # and its extremes only (d = 0 and 1: a period is a few microseconds).
+    plain = total is None and positions is None and progress is None
+    maximum, minimum = np.maximum, np.minimum
     # One error state for every period (run.advance() counts on it); the
     # quarters' rows as views made once, not in every period.
     with np.errstate(over="ignore", invalid="ignore"):
@@ -531,9 +554,13 @@ def _run(run, steps, amplitude, positions, progress, report, chunk, n_chunks, to
                 count = min(run.block, stop - k) if every > 1 else 1
                 run.advance(count)
                 if count == 1:
-                    block = run.x[None]
-                    np.maximum(high_q, block[0], out=high_q)
-                    np.minimum(low_q, block[0], out=low_q)
+                    x = run.x
+                    maximum(high_q, x, out=high_q)
+                    minimum(low_q, x, out=low_q)
+                    if plain:
+                        k += 1
+                        continue
+                    block = x[None]
                 else:
                     block = run.positions
                     np.maximum(high_q, np.maximum.reduce(block, axis=0, out=extreme), out=high_q)
@@ -600,6 +627,25 @@ class StabilityMap(PaperGridNames):
     x: str = PAPER_PLANE[0]
     y: str = PAPER_PLANE[1]
     at: dict = dataclasses.field(default_factory=dict)
+
+    def plot(self, ax=None, *, boundary=None):
+        """Draw the map, a boundary over it if given: :func:`symstab.drawing.plot_map`.
+
+        Parameters
+        ----------
+        ax : matplotlib.axes.Axes, optional
+            Where to draw (default: a new figure's axes).
+        boundary : symstab.numeric.engine.results.Boundary, optional
+            The loop's D-decomposition in the map's plane, drawn over it.
+
+        Returns
+        -------
+        symstab.drawing.Plot
+            Its ``figure``, ``axes`` and ``artists``.
+        """
+        from ...drawing import plot_map
+
+        return plot_map(self, ax, boundary=boundary)
 
 
 
@@ -1091,13 +1137,20 @@ class _AnyLoop:
         """
         if self.filled:
             self._shift(self.filled)
-        if count == 1:
-            self._one_period()
-        else:                   # d >= 2 (count <= d): the plant reads no command of the block
-            self._plant_block(count)
-            self._environment_block(count)
-        self.filled = count
         start, every = self.k, self.check_every
+        if count == 1:
+            # The checks below for one period, without their ranges: this
+            # runs every period at d = 0 and 1.
+            self._one_period()
+            self.filled = 1
+            self.k = start + 1
+            if (start + 1) % every == 0 and not self._calm(1, 1):
+                self.freeze_diverged(1)
+            return
+        # d >= 2 (count <= d): the plant reads no command of the block.
+        self._plant_block(count)
+        self._environment_block(count)
+        self.filled = count
         self.k += count
         checks = range(start - start % every + every, self.k + 1, every)
         if checks and not self._calm(checks[0] - start, checks[-1] - start):
@@ -1185,18 +1238,20 @@ class _AnyLoop:
         """
         if self.d:
             self._plant_one()
-        X, S, F, tmp = self._x_rows, self._s_rows, self._f_rows, self._tmp[0]
+        tmp, multiply, add = self._tmp[0], np.multiply, np.add
         ks, kf = self.keep_s, self.keep_f
+        S, F = self._s_rows, self._f_rows
         sampled, force = S[ks], F[kf]
         if self.quantum:
-            _round_into(sampled, X[self.keep_x - 1], self.quantum)
+            _round_into(sampled, self._x_rows[self.keep_x - 1], self.quantum)
         else:
-            np.copyto(sampled, X[self.keep_x - 1])
-        np.multiply(self.e0, sampled, out=force)
+            np.copyto(sampled, self._x_rows[self.keep_x - 1])
+        # Positional outs: the keyword costs a fifth of a call on small arrays.
+        multiply(self.e0, sampled, force)
         for k, coefficient in self.e:
-            np.add(force, np.multiply(coefficient, S[ks - 1 - k], out=tmp), out=force)
+            add(force, multiply(coefficient, S[ks - 1 - k], tmp), force)
         for k, coefficient in self.c:
-            np.subtract(force, np.multiply(coefficient, F[kf - 1 - k], out=tmp), out=force)
+            np.subtract(force, multiply(coefficient, F[kf - 1 - k], tmp), force)
         command = self._u_rows[self.keep_u]
         if self.compensation is not None:
             ku = self.keep_u
@@ -1216,15 +1271,15 @@ class _AnyLoop:
 
     def _plant_one(self):
         """:meth:`_plant_block` of one period on the rows."""
-        X, U, tmp = self._x_rows, self._u_rows, self._tmp[0]
+        X, U, tmp, multiply = self._x_rows, self._u_rows, self._tmp[0], np.multiply
         kx, first_u = self.keep_x, self.keep_u - self.d
         out = X[kx]
         (k, first), *rest = self.minus_b
-        np.multiply(first, U[first_u - k], out=out)
+        multiply(first, U[first_u - k], out)
         for k, coefficient in rest:
-            np.add(out, np.multiply(coefficient, U[first_u - k], out=tmp), out=out)
+            np.add(out, multiply(coefficient, U[first_u - k], tmp), out)
         for k, coefficient in self.a:
-            np.subtract(out, np.multiply(coefficient, X[kx - 1 - k], out=tmp), out=out)
+            np.subtract(out, multiply(coefficient, X[kx - 1 - k], tmp), out)
 
     def _compensated(self, command, force, sampled, count):
         """``command = force - F_c sign(v_hat)``, ``v_hat`` filtered period by period."""
@@ -1318,17 +1373,23 @@ class _StateLoop(_AnyLoop):
         for r in range(count):
             self.plant.step(self.U[first_u + r], -1.0, out=self._x_rows[self.keep_x + r])
             if (start + r + 1) % every == 0:
-                bad = ~self.plant.finite()
-                if bad.any():
-                    self._unfinite_at[r + 1] = bad
+                self._check_plant(r + 1)
 
     def _plant_one(self):
         self.plant.step(self._u_rows[self.keep_u - self.d], -1.0, out=self._x_rows[self.keep_x])
         self._unfinite_at = {}
         if (self.k + 1) % self.check_every == 0:
-            bad = ~self.plant.finite()
-            if bad.any():
-                self._unfinite_at[1] = bad
+            self._check_plant(1)
+
+    def _check_plant(self, filled):
+        """Keep the points whose plant state is not finite after ``filled`` rows of the block.
+
+        (Every period of a recorded run: count_nonzero, not any(), at a
+        quarter of its time on a few points.)
+        """
+        ok = self.plant.finite()
+        if np.count_nonzero(ok) != ok.size:
+            self._unfinite_at[filled] = ~ok
 
     def _unfinite(self, filled):
         # The plant's past is its state, whose check the block kept.

@@ -170,3 +170,25 @@ def test_limits_show_as_an_html_table_in_jupyter_with_every_text_escaped():
     assert shown.count("<tr>") == len(found.as_dict())
     empty = Limits.empty_set("B", "K", "no stable point")._repr_html_()
     assert "<th style='text-align:left'>y_max</th><td></td>" in empty
+
+
+def test_a_region_and_a_robust_set_show_as_html_tables_in_jupyter():
+    """Issue 42, item 5: the D-decomposition's table counts its cells by their number of
+    unstable poles (the counts of its cells, read independently here), and names the window;
+    a robust set's table gives its area beside the nominal one's."""
+    from symstab.numeric.engine.results import RobustRegion
+
+    region = symstab.PAPER_LOOP.region(d=5)
+    shown = region._repr_html_()
+    assert shown.startswith("<table><caption>D-decomposition of the (B, K) plane</caption>")
+    for n in {c.count for c in region.cells}:
+        cells = [c for c in region.cells if c.count == n]
+        plural = "s" if n != 1 else ""
+        assert (f"<th style='text-align:left'>cells with {n} unstable pole{plural}</th>"
+                f"<td>{len(cells)}</td>") in shown
+    assert f"<td>{region.area:.6g}</td>" in shown
+    robust = RobustRegion("B", "K", {"m<1>": (0.012, 0.0136)}, np.array([0.0, 0.1]),
+                          (((0.0, 2.0, 0.0, 3.0),),), ((),), nominal=region)
+    shown = robust._repr_html_()
+    assert "<th style='text-align:left'>m&lt;1&gt;</th><td>[0.012, 0.0136]</td>" in shown
+    assert f"<td>{robust.area:.6g}</td>" in shown and f"<td>{region.area:.6g}</td>" in shown

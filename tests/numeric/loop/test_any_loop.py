@@ -443,6 +443,9 @@ def test_unwritable_cache_compiles_in_memory(tmp_path, monkeypatch):
     ("1/(m*s**2 + b*s*z)", ENVIRONMENT, "must not contain z"),
     (PLANT, "K + B*s", "must not contain s"),
     ("0", ENVIRONMENT, "zero"),
+    # Zero only once exp's rules are applied (a quick value at a point cannot say so).
+    (PLANT, "exp(K)*exp(B) - exp(K + B)", "zero"),
+    (PLANT, "K - K*(z - 1)/(z - 1)", "zero"),
     (PLANT, "K +* B", "not a valid expression"),
     # Only arithmetic is parsed: no attribute, subscript, call or conditional.
     ("1/(m*s**2) + 0*exp.eval.__globals__['__builtins__']", ENVIRONMENT, "not allowed"),

@@ -166,8 +166,14 @@ class Example:
 
     def chi(self, K, B, d):
         """The closed loop's polynomial at one point: z**d Ve_d P_d + Ve_n P_n."""
-        ve = self.environment_tf(K, B)
-        ve_num, ve_den = np.asarray(ve.num[0][0], float), np.asarray(ve.den[0][0], float)
+        # The rows of :meth:`environment_tf` as python-control keeps them (a zero numerator
+        # over 1), without a control.tf at each of the bisections' thousands of points
+        # (most of the oracle's time); test_oracle_polynomial_is_control_feedback checks
+        # these poles against control.feedback.
+        ve_num, ve_den = (np.asarray(r, float) for r in self.oracle.environment(self.values,
+                                                                               K, B))
+        if not np.any(ve_num):
+            ve_num, ve_den = np.zeros(1), np.ones(1)
         delayed = _polymul(_polymul(ve_den, self.p_den), np.r_[1.0, np.zeros(d)])
         return np.polyadd(delayed, _polymul(ve_num, self.p_num))
 
