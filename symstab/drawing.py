@@ -907,7 +907,7 @@ def regions_figure(top, gammas, marks, n, suptitle, lower=None):
     Parameters
     ----------
     top : list of dict
-        The upper panels, one a delay (see :func:`_regions_panel`).
+        The upper panels, one a delay (see ``_regions_panel``).
     gammas : sequence of float
         The gammas drawn, in :data:`FIGURE_COLORS`' order.
     marks : dict

@@ -593,7 +593,7 @@ def make_figures(out_dir, progress=None):
     """Draw every figure into ``out_dir`` as PNG; return the FigureResults.
 
     ``progress(name, seconds)`` is called after each figure; True prints
-    ``name: seconds`` on stderr (:func:`symstab._validate.check_progress`).
+    ``name: seconds`` on stderr (``symstab._validate.check_progress``).
     """
     from ._io import write_bytes
     from ._validate import check_progress

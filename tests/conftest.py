@@ -35,6 +35,18 @@ from symstab.symbolic.loop import characteristic_polynomial
 
 REPO = pathlib.Path(__file__).resolve().parents[1]
 
+#: The manual: the README and the pages of the documentation site (docs/),
+#: whose user guide holds what the README said before it became short.
+MANUAL = (REPO / "README.md",
+          *sorted(path for path in (REPO / "docs").rglob("*.md")
+                  if not path.is_relative_to(REPO / "docs" / "_build")
+                  and not path.is_relative_to(REPO / "docs" / "derivations")))
+
+
+def manual_text():
+    """The manual's text, the README first, then the docs' pages, each whole."""
+    return "\n\n".join(path.read_text(encoding="utf-8") for path in MANUAL)
+
 # Hypothesis: the "ci" profile (the default) draws a bounded number of
 # examples, the same ones on every run (derandomized, no example database),
 # so that the suite costs the same every time; HYPOTHESIS_PROFILE=thorough

@@ -33,9 +33,10 @@ def test_citation_names_this_version_and_the_paper():
     text = (REPO / "CITATION.cff").read_text(encoding="utf-8")
     assert re.search(r'^version: "([^"]+)"$', text, re.M).group(1) == PROJECT["version"]
     assert re.search(r'^license: (\S+)$', text, re.M).group(1) == PROJECT["license"]
-    # The paper the README cites, by the same DOI.
+    # The paper the README and the docs' "How to cite" cite, by the same DOI.
     doi = re.search(r'doi: "([^"]+)"', text).group(1)
     assert doi in (REPO / "README.md").read_text(encoding="utf-8")
+    assert doi in (REPO / "docs" / "citing.md").read_text(encoding="utf-8")
 
 
 def test_the_changelog_has_a_section_for_this_version():

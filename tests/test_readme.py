@@ -1,4 +1,4 @@
-"""The README stays true: its examples run, its audit table matches the report."""
+"""The manual stays true: the examples of the README and of the docs' pages run, the audit table matches the report."""
 
 import doctest
 import importlib
@@ -6,7 +6,7 @@ import re
 
 import pytest
 
-from conftest import REPO
+from conftest import MANUAL, REPO
 
 
 def _table(text):
@@ -32,6 +32,27 @@ def test_readme_python_examples_run(monkeypatch):
     assert runner.failures == 0
 
 
+#: The docs' pages with Python examples, each run as one doctest of its own.
+EXAMPLE_PAGES = [path for path in MANUAL[1:] if ">>> " in path.read_text(encoding="utf-8")]
+
+
+def test_the_pages_moved_from_the_readme_keep_their_examples():
+    names = {path.relative_to(REPO / "docs").as_posix() for path in EXAMPLE_PAGES}
+    assert {"getting_started.md", "guide/paper.md", "guide/any_loop.md", "guide/regions.md"} <= names
+
+
+@pytest.mark.parametrize("page", EXAMPLE_PAGES, ids=lambda p: p.relative_to(REPO / "docs").as_posix())
+def test_docs_python_examples_run(page, monkeypatch, session_cache_dir):
+    """Each page's ``>>>`` examples, top to bottom in one namespace, from the repository's root."""
+    monkeypatch.chdir(REPO)
+    text = page.read_text(encoding="utf-8")
+    test = doctest.DocTestParser().get_doctest(text, {}, page.name, str(page), 0)
+    assert len(test.examples) >= 1
+    runner = doctest.DocTestRunner(optionflags=doctest.NORMALIZE_WHITESPACE)
+    runner.run(test)
+    assert runner.failures == 0
+
+
 @pytest.mark.parametrize("module", ["symstab.numeric.paper.device", "symstab.numeric.paper.curves", "symstab.numeric.paper.stability",
                                     "symstab.numeric.paper.region", "symstab.symbolic.model", "symstab.symbolic.theta_max",
                                     "symstab.numeric.loop.sampled_loop", "symstab.numeric.engine.decomposition",
@@ -48,12 +69,13 @@ def test_docstring_examples_run(module):
 
 
 def _readme_commands():
-    """The ``symstab`` command lines of the README's console and bash blocks, as argument lists."""
+    """The ``symstab`` command lines of the manual's console and bash blocks (README and docs), as argument lists."""
     import shlex
 
-    readme = (REPO / "README.md").read_text(encoding="utf-8")
     commands = []
-    for block in re.findall(r"```(?:console|bash)\n(.*?)```", readme, re.S):
+    blocks = [block for path in MANUAL
+              for block in re.findall(r"```(?:console|bash)\n(.*?)```", path.read_text(encoding="utf-8"), re.S)]
+    for block in blocks:
         for line in block.splitlines():
             for part in line.removeprefix("$ ").split("&&"):
                 words = shlex.split(part, comments=True)
@@ -63,7 +85,7 @@ def _readme_commands():
 
 
 def test_readme_console_examples_write_only_under_the_ignored_out_folder():
-    """They left map.npz, map.png, locus.png, tustin.png and operator_arm_derivation/
+    """The README's and the docs' pages' commands.  They left map.npz, map.png, locus.png, tustin.png and operator_arm_derivation/
     in the checkout (issue 18).  Every file a README command writes -- its
     ``--out``, ``--png``, ``--report``, ``--json``, the PNG that ``map`` writes beside
     its ``--out``, the folder ``derive --loop`` writes -- is under ``out/``, which
@@ -86,6 +108,6 @@ def test_readme_console_examples_write_only_under_the_ignored_out_folder():
             if path is None or (args.command == "reproduce" and path == "reproduction"):
                 continue
             written.append((" ".join(["symstab", *words]), flag, path))
-    assert len(written) >= 5
+    assert len(written) >= 12
     outside = [w for w in written if pathlib.PurePath(w[2]).parts[0] != "out"]
     assert not outside, outside

@@ -267,7 +267,7 @@ def boundary_forms():
     """Return ``(alpha, beta)`` on the boundary in the well-conditioned form.
 
     Expressions in ``theta, gamma, d, delta``, the symbols :data:`em`,
-    :data:`b1`, :data:`b0`, :data:`gap` and the multiple-angle functions
+    ``b1``, ``b0``, ``gap`` and the multiple-angle functions
     :class:`sin_multiple`, :class:`cos_multiple`.
     """
     th, d, g = model.theta, model.d, model.gamma

@@ -10,7 +10,7 @@ collects them as ``{filename: text}``; nothing here touches the disk.
 :func:`paper_loop_proofs` builds the paper's loop through the general path,
 ``Loop("1/(m*s**2 + b*s)", VE(z))``, and states the identities that make it
 today's derivation (:func:`symstab.symbolic.loop.characteristic_polynomial`,
-:func:`symstab.boundary.boundary`); :func:`symstab.proof.derive.proofs` proves them
+:func:`symstab.boundary`); :func:`symstab.proof.derive.proofs` proves them
 with the exact checker in every ``symstab derive``.
 """
 
@@ -451,7 +451,7 @@ def loop_files(loop):
     Raises
     ------
     ValueError
-        If a parameter's name cannot be printed in the kernels (:func:`check_names`).
+        If a parameter's name cannot be printed in the kernels (``_check_names``).
     """
     from .steps import render
 
@@ -547,7 +547,7 @@ def paper_loop_proofs():
       ``s_K = m / T**2`` the Table I scales of ``B`` and ``K``), so it is
       singular exactly where today's is, and today's boundary
       ``B = s_B beta(theta)``, ``K = s_K alpha(theta)`` solves it: the
-      general boundary is :func:`symstab.boundary.boundary`'s.
+      general boundary is :func:`symstab.boundary`'s.
 
     Returns
     -------

@@ -49,7 +49,7 @@ RESERVED = ("s", "z", "T", "d")
 #: Working digits of the plant's pulse transfer function (rounded once to float).
 PLANT_DIGITS = 30
 #: The most digits a plant's closed form is evaluated with (it cancels for a
-#: pole near z = 1; :meth:`LoopModel._closed_form_plant`).
+#: pole near z = 1; ``LoopModel._closed_form_plant``).
 PLANT_MAX_DIGITS = 5000
 #: Parameter names the generated NumPy and C kernels cannot take.
 _C_KEYWORDS = frozenset(
@@ -588,6 +588,16 @@ class LoopModel:
         on the driven mass (an amplifier's lag); default ``1``.  It says
         where Coulomb friction acts (:func:`parse_actuator`).
 
+    Attributes
+    ----------
+    parameters : tuple of str
+        The names of the loop's parameters: the plant's and the
+        environment's, then ``T`` and ``d``.
+    zoh_method : str
+        How the plant's pulse transfer function was derived:
+        ``'residues'`` (symbolically) or ``'matrix exponential'``
+        (numerically, at 30 digits, once the plant's values are known).
+
     Raises
     ------
     TypeError, ValueError
@@ -604,7 +614,7 @@ class LoopModel:
         self.actuator = parse_actuator(actuator, self.plant)
         #: What depends only on the plant, the environment and the actuator (the
         #: derivation, the plant at numbers): shared by every model of this loop
-        #: in this process (:mod:`symstab._memo`).
+        #: in this process (``symstab._memo``).
         self.shared_memo = _SHARED((self.plant, self.environment, self.actuator, str(cache_dir())))
         self.name = check_loop_name("loop" if name is None else name)
         self.description = check_text_line("description", description)
@@ -837,7 +847,7 @@ class LoopModel:
         """Names of the parameters in which the characteristic polynomial is affine.
 
         These can be the axes of a parameter plane (:meth:`boundary`,
-        :meth:`limits`) or the variable of :meth:`stable_intervals`.  With a
+        :meth:`limits`) or the variable of :meth:`~symstab.Loop.stable_intervals`.  With a
         plant discretised numerically only environment parameters qualify.
         """
         out = []

@@ -11,7 +11,7 @@ import re
 
 import pytest
 
-from conftest import REPO
+from conftest import REPO, manual_text
 from conftest import run_cli as run
 from conftest import run_cli_json as run_json
 
@@ -141,12 +141,12 @@ def test_locus_takes_its_set_and_its_path_in_the_files_units(capsys, tmp_path):
 
 
 def test_one_rule_for_the_units_of_the_device_options_in_the_help_and_the_readme(capsys):
-    """--m 0.2 echoed kg m^2 while the README called the device's K N/m: the rule is stated once."""
+    """--m 0.2 echoed kg m^2 while the README called the device's K N/m: the rule is stated once (the manual's command-line page)."""
     from symstab.cli.options import UNITS_RULE
 
     status, out, _ = run(capsys, "limits", "--help")
     assert status == 0 and " ".join(UNITS_RULE.split()) in " ".join(out.split())
-    readme = " ".join((REPO / "README.md").read_text(encoding="utf-8").replace("`", "").split())
+    readme = " ".join(manual_text().replace("`", "").split())
     assert ("The device options are rotary by default, as the paper's device is a paddle "
             "(m and M_w in kg m², b and B_w in N m s/rad, K_w in N m/rad); --linear reads and "
             "prints the same numbers as a sliding mass's (kg, N s/m, N/m)") in readme

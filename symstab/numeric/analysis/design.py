@@ -357,9 +357,9 @@ def maximize_pieces(f, pieces, *, include=(), rtol=1e-6, progress=None):
     seconds: ``d`` steps at each ``T = delay / k``) defeats a search of the
     whole interval: Brent's method climbs one tooth.  Here ``f`` is
     evaluated at each piece's left end (and at ``include``); the
-    :data:`_TOP_PIECES` pieces best there, and the piece of the best
+    ``_TOP_PIECES`` pieces best there, and the piece of the best
     ``include`` point, are each searched by :func:`maximize_scalar`
-    (:data:`_PIECE_POINTS` points, then Brent's method), and the best of
+    (``_PIECE_POINTS`` points, then Brent's method), and the best of
     all is taken.
 
     Parameters

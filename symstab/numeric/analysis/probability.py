@@ -132,7 +132,7 @@ def stability_probability(loop, x_values, y_values, *, x, y, uncertain, samples=
         loop's :attr:`~symstab.Loop.plane` by default).
     progress : callable, bool or None, optional
         Called with the number of draws done; True draws a bar
-        (:func:`symstab._validate.check_progress`).
+        (``symstab._validate.check_progress``).
     **values
         Single values of the other parameters (defaults for the rest).
 

@@ -28,12 +28,12 @@ box).  Over an interval of ``theta`` each part is enclosed in a disk: its
 value and slope at the middle with the interval's midpoint coefficients, a
 bound of the second derivative times ``h**2 / 2``, the coefficients' radii,
 and a bound on the rounding.  On a cell (piece x ``theta``-interval x
-sub-box) the zeros of ``chi`` are enclosed twice (:func:`_excluded`):
+sub-box) the zeros of ``chi`` are enclosed twice (``_excluded``):
 
 * in the strip: ``chi`` is within ``a + b |y|`` of ``P + y Y`` and the
-  ``y`` where it may vanish solve a quadratic inequality (:func:`_failing`),
+  ``y`` where it may vanish solve a quadratic inequality (``_failing``),
   the strip's width costing ``a`` first order in it;
-* in a *capsule* (:func:`_capsules`): the tangent segment of the curve
+* in a *capsule* (``_capsules``): the tangent segment of the curve
   where ``chi = 0`` (a 2 x 2 real solve at the middle and its derivative),
   widened by a radius second order in the ``theta``-width, where the map
   ``(x, y) -> x Ax + y Ay`` is well conditioned (not next to ``theta`` = 0
@@ -367,13 +367,13 @@ def _excluded(enclosures, shift, theta, h, box, piece):
     points where ``chi`` may vanish on the cell, both sound; what is
     returned is in both:
 
-    * the strip's (:func:`_failing`): with ``P = A0 + xc Ax`` and ``Y =
+    * the strip's (``_failing``): with ``P = A0 + xc Ax`` and ``Y =
       Ay`` at the middle of the ``theta``-interval, ``chi`` lies within ``a
       + b |y|`` of ``P + y Y`` on the cell, ``a`` and ``b`` summing what
       the ``theta``-width, the coefficients' radii, the strip's width and
       the rounding cost, so it cannot vanish where ``|P + y Y| > a + b
       |y|``; what the strip's width costs is first order in it;
-    * the capsule's (:func:`_capsules`): the zeros lie within ``rho`` of
+    * the capsule's (``_capsules``): the zeros lie within ``rho`` of
       a segment of the zero curve's tangent, ``rho`` second order in the
       ``theta``-width; it does not exist where the real map ``(x, y) ->
       x Ax + y Ay`` is nearly singular (``theta`` next to 0 or pi).
@@ -743,7 +743,7 @@ def _certify(enclosures, shift, geometry, candidates, tol, budget):
 
     Each cell (piece x theta-interval x sub-box) excludes zero for every
     ``t`` of its piece (``geometry``, :class:`_Pieces`) outside a few
-    intervals (:func:`_excluded`).  A cell whose intervals miss the piece's
+    intervals (``_excluded``).  A cell whose intervals miss the piece's
     open ``t`` (``candidates``) is done; one that meets them is halved in
     ``theta`` or the box (whichever costs more), until what the halvings
     can remove is within ``tol`` (per piece, in ``t``), or nothing is left
@@ -902,7 +902,7 @@ def robust_region(loop, x=None, y=None, *, uncertain, strips=64, rtol=1e-6, x_ra
     progress : callable, bool or None, optional
         Called with the number of delays done: 0 once the input is checked
         and the work begins, then after each delay; True draws a bar
-        (:func:`symstab._validate.check_progress`).
+        (``symstab._validate.check_progress``).
     **values
         Values of the other parameters.
 

@@ -25,7 +25,7 @@ Two arc sources share one interface, ``source(theta) -> (x, y, det)``:
 
 * :class:`CramerArc` -- the solve above, for any loop;
 * :class:`ClosedFormArc` -- a loop whose arc SymPy derived in closed form
-  (the paper's: the generated kernel :func:`symstab._generated.kernels.boundary`,
+  (the paper's: the generated kernel ``symstab._generated.kernels.boundary``,
   :func:`symstab.numeric.paper.paper_loop.paper_arc`), with the determinant's sign
   from the structured solve.
 

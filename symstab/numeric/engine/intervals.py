@@ -307,7 +307,7 @@ def family_intervals(base, across, slope, at, ends=None, *, arc=None):
         root, as the value ``v`` of its line and its position ``p`` on it,
         from a source more accurate than the coefficients (a closed form;
         NaN where it is not).  Each crossing at ``0 < theta < pi`` is then
-        re-found on it (:data:`_POLISH`).
+        re-found on it (``_POLISH``).
 
     Returns
     -------

@@ -20,7 +20,7 @@ pole crosses the unit circle.
   elsewhere the step is halved (the new points are kept for the crossings,
   not returned), and where halving does not settle it (roots that collide,
   such as a real pair breaking away into a complex one) the optimal
-  assignment of :func:`_assignment` decides.  A step is halved too when a
+  assignment of ``_assignment`` decides.  A step is halved too when a
   pole starts and ends it outside the circle but its chord dips inside:
   a crossing out and back in between two points.
 * Crossings: the points where a tracked pole changes side of the circle
@@ -73,7 +73,7 @@ _REAL = 1e-9
 _BYTES_PER_POLE = 96
 #: Bytes per pair of poles of one step of the path: the chordal distances of
 #: two consecutive points and their temporaries in :func:`_nearest` (and in
-#: :func:`_assignment`'s cost), a chunk of points at a time (generous).
+#: ``_assignment``'s cost), a chunk of points at a time (generous).
 _BYTES_PER_PAIR = 96
 #: From this degree on, the path's points take their roots by continuation
 #: (:func:`_roots_along`), with at most this many Newton steps a point.

@@ -35,7 +35,7 @@ def paper_alias(name, field):
         return getattr(self, field)
 
     get.__name__ = name
-    get.__doc__ = f"The paper's name of :attr:`{field}` (the (beta, alpha) plane only)."
+    get.__doc__ = f"The paper's name of ``{field}`` (the (beta, alpha) plane only)."
     return property(get)
 
 
@@ -360,7 +360,7 @@ class Boundary(PaperGridNames):
     Notes
     -----
     In the paper's plane ``alpha`` and ``beta`` are aliases of
-    :attr:`y_values` and :attr:`x_values`, and ``gamma``, ``d``, ``delta``
+    ``y_values`` and ``x_values``, and ``gamma``, ``d``, ``delta``
     read :attr:`at`; ``message`` is :attr:`reason` in every plane.
     """
 

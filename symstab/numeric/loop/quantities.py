@@ -10,7 +10,7 @@ its dimension is not checked.
 
 Dimensions are checked on the expression trees of the plant and the
 environment, as a linear system in the exponents of the base dimensions
-(:func:`check_dimensions`): terms that are added have one dimension, the
+(``_check_dimensions``): terms that are added have one dimension, the
 argument of ``exp`` and a symbolic exponent are dimensionless, ``s`` is
 1/time and ``z`` dimensionless, ``T`` is a time, the environment ``VE(z)``
 maps displacement to force (N/m, or N m/rad for a rotary device) and the
@@ -26,7 +26,7 @@ A parameter may also declare bounds, as data: ``min``/``max`` (closed),
 an expression of the loop's parameters in SI (built by the loop's safe
 expression parser, never evaluated as code), e.g. ``below = "1/(2*T)"``
 (the Nyquist frequency).  :func:`check_bounds` refuses a value outside with
-the wording of :func:`symstab._validate.check_real`.
+the wording of ``symstab._validate.check_real``.
 
 pint is imported, and its one :func:`unit_registry` built, on the first
 unit met: it takes about half a second, which a command without units
@@ -808,7 +808,7 @@ def check_bounds(parameters, values, *, where, skip=(), missing_ok=False):
     Raises
     ------
     ValueError
-        In the words of :func:`symstab._validate.check_real`, e.g.
+        In the words of ``symstab._validate.check_real``, e.g.
         ``f_c must be a finite real number > 0 and < 2000, got 3000.0``,
         with the unit and the bounds as the file writes them.
     """

@@ -123,6 +123,19 @@ class Loop(LoopModel):
 
     Attributes
     ----------
+    parameters : tuple of str
+        The names of the loop's parameters: the plant's and the
+        environment's, then ``T`` and ``d``.
+    zoh_method : str
+        How the plant's pulse transfer function was derived:
+        ``'residues'`` (symbolically) or ``'matrix exponential'``
+        (numerically, at 30 digits, once the plant's values are known).
+    plane : (str, str) or None
+        The default ``(x, y)`` plane.
+    defaults : dict
+        The default value of each parameter that has one.
+    units : dict
+        The SI unit of each parameter that has one, as text.
     evaluation : symstab.numeric.loop.evaluation.LoopEvaluation
         ``chi`` and its parts in floats at values of the parameters: what
         the loop's methods and the plane's questions compute on.

@@ -1,6 +1,6 @@
 """The boundary arc in floating point: theta_max, the arc's samples, the root bracketer.
 
-The generated kernel :func:`symstab._generated.kernels.boundary` evaluates
+The generated kernel ``symstab._generated.kernels.boundary`` evaluates
 alpha(theta), beta(theta) to about 1e-14 relative (tests/codegen/test_generated_kernels.py).
 Here it is used to sample the arc, and alpha's reduced numerator R to find
 where the arc ends:

@@ -47,7 +47,7 @@ def _environment():
 def closed_form_arc(x, y, values):
     """Eq. (7)'s arc in the plane ``(B, K)`` (either way round): ``theta -> (x, y)``.
 
-    The generated kernel (:func:`symstab._generated.kernels.boundary`) at
+    The generated kernel (``symstab._generated.kernels.boundary``) at
     ``gamma = M/m``, ``delta = b T/m``, scaled by ``K = alpha m/T**2``,
     ``B = beta m/T``.  It keeps its digits on the whole of (0, pi) (to
     about 2e-13 of the point's size, against the 50-digit solve of the

@@ -511,7 +511,7 @@ def boundary_curve(*, gamma, d, delta, n=1000, segments=True):
     n : int
         Number of points on the arc, ``n >= 2``; about 24 bytes each are
         kept, so ``n`` is limited by the memory limit
-        (:mod:`symstab._resources`, ``SYMSTAB_MEMORY_LIMIT``).
+        (``symstab._resources``, ``SYMSTAB_MEMORY_LIMIT``).
     segments : bool
         Also find the straight pieces (z = +-1) that bound the stable region
         (a stability scan; skip it when only the arc is wanted).

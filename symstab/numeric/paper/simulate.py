@@ -130,7 +130,7 @@ def simulate(*, alpha, beta, gamma, d, delta, steps=None, x0=1.0, v0=None, devic
         Keep every position (memory: ``steps`` times the points).
     progress : callable, bool or None
         Called with the number of steps done (every 1 % or so); True draws
-        a bar (:func:`symstab._validate.check_progress`).
+        a bar (``symstab._validate.check_progress``).
 
     Returns
     -------
@@ -141,7 +141,7 @@ def simulate(*, alpha, beta, gamma, d, delta, steps=None, x0=1.0, v0=None, devic
     TypeError, ValueError
         For a parameter of the wrong kind or out of range (the message
         names it), and when the run would need more memory than
-        ``SYMSTAB_MEMORY_LIMIT`` (see :mod:`symstab._resources`).  Without
+        ``SYMSTAB_MEMORY_LIMIT`` (see ``symstab._resources``).  Without
         ``record`` the points are simulated in chunks, so the working
         memory does not grow with their number.
     """

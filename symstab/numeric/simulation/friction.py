@@ -26,7 +26,7 @@ mass feels ``friction_coulomb sign(v)``; a sub-step that would reverse its
 velocity ends at rest, by the friction's impulse on the mass alone,
 ``x -= B_f (C_v x) / (C_v B_f)``, where the mass stopped: forward of the
 sub-step's start by ``v0 t* / 2`` at the time ``t*`` its velocity reached
-zero (:meth:`StatePlant._stopped_at`), never behind it (friction stops a
+zero (``StatePlant._stopped_at``), never behind it (friction stops a
 mass; it does not push it back): the paper's simulator's friction model,
 for any mass with any linear structure around it (the paper's device is
 one: :func:`symstab.numeric.paper.simulate.simulate` runs on :class:`StatePlant`).

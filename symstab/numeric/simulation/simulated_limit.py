@@ -7,8 +7,8 @@ largest stiffness ``y`` at which the simulated loop neither grows nor
 settles into a limit cycle above a stated amplitude?
 
 A run is *accepted* when the simulator calls it bounded (stable or a limit
-cycle: not diverged, not growing, :attr:`symstab.numeric.paper.simulate.
-Simulation.bounded`) **and** the largest ``|x|`` of its last quarter is
+cycle: not diverged, not growing, :attr:`Simulation.bounded
+<symstab.Simulation.bounded>`) **and** the largest ``|x|`` of its last quarter is
 at most ``amplitude``.  A slow decay still above ``amplitude`` at the end
 of the run is not accepted: the run is too short to call it settled.
 
@@ -130,11 +130,10 @@ def simulated_limit(loop, *, x=None, y=None, amplitude, nonideal=None, steps=Non
         quarter of a run, ``> 0``: a limit cycle above it, or a decay not
         below it by the end, is not accepted.
     nonideal : symstab.numeric.paper.simulate.Nonidealities, optional
-        Encoder quantization and force limit (:func:`~symstab.numeric.
-        simulate.simulate_loop`).
+        Encoder quantization and force limit (:func:`~symstab.numeric.simulation.simulator.simulate_loop`).
     steps, x0 : optional
         As in :meth:`symstab.Loop.simulate`; ``x0`` default 1, or 0.01 with
-        non-idealities (:func:`~symstab.numeric.paper.simulate.default_x0`, as
+        non-idealities (:func:`~symstab.numeric.simulation.simulator.default_x0`, as
         the command line), from which ``amplitude`` is reached.
     n : (int, int)
         The first grid's points in ``x`` and ``y``, each ``>= 3`` (the ``x`` of
@@ -143,7 +142,7 @@ def simulated_limit(loop, *, x=None, y=None, amplitude, nonideal=None, steps=Non
         Refinement rounds (each divides the step in ``y`` by nine), ``>= 0``.
     progress : callable, bool or None, optional
         Called with the runs done so far (one per grid or round); True draws
-        a bar (:func:`symstab._validate.check_progress`).
+        a bar (``symstab._validate.check_progress``).
     **values
         Single values of the loop's other parameters.
 

@@ -52,7 +52,7 @@ MAX_SUBSTEPS = 1000
 #: The paper's encoder: better than 3 arc seconds after quadrature and gear
 #: train (Section VI), in rad.
 PAPER_ENCODER_RESOLUTION = math.radians(3 / 3600)
-#: |x| above this is divergence: the run stops for that point.
+#: ``|x|`` above this is divergence: the run stops for that point.
 _OVERFLOW = 1e100
 #: Periods between overflow checks.
 _CHECK_EVERY = 8
@@ -65,13 +65,14 @@ _SUSTAINED = 1e-2
 #: A swing below this fraction of the amplitude is rounding, not motion: a
 #: mass settling off zero at K = 0 keeps a swing of 1e-11 of its position.
 _MOVING = 1e-8
-#: Allowed size of the initial state.  The verdict compares the largest |x|
-#: of the last two quarters and calls |x| > _OVERFLOW divergence: a start at
+#: Allowed size of the initial state.  The verdict compares the largest ``|x|``
+#: of the last two quarters and calls ``|x| > _OVERFLOW`` divergence: a start at
 #: zero never moves (0 <= 0 reads as stable), and a stable point needs room
-#: above |x0| for its transient before the overflow threshold (50 orders of
+#: above ``|x0|`` for its transient before the overflow threshold (50 orders of
 #: magnitude), as a decaying or growing run needs room below it before
 #: subnormal numbers lose the ratio (about 200 orders down to 1e-308).
 X0_MIN = 1e-100
+#: The largest allowed size of the initial state (see ``X0_MIN``).
 X0_MAX = _OVERFLOW * 1e-50
 
 
@@ -284,8 +285,7 @@ def _round_into(out, values, quantum):
 def check_friction_size(nonideal, spaces, name="nonideal.coulomb_friction", scale=1.0):
     """Refuse a Coulomb friction larger than double precision can step on the plants ``spaces``.
 
-    A sub-step adds ``-gamma_f F`` to the state (:mod:`symstab.numeric.
-    friction`); the friction is refused when its largest entry would pass
+    A sub-step adds ``-gamma_f F`` to the state (:mod:`symstab.numeric.simulation.friction`); the friction is refused when its largest entry would pass
     :data:`FRICTION_STEP_MAX`, from where adding it overflows and a held
     mass reads as diverged.  Below it any friction is stepped: a large one
     stops the mass within the sub-step where it stands.
@@ -396,7 +396,7 @@ class Simulation:
     amplitude : ndarray
         ``(4, *shape)``: the largest ``|x|`` in each quarter of the run.
     diverged : ndarray of bool
-        The state overflowed (|x| > 1e100).
+        The state overflowed (``|x| > 1e100``).
     stable : ndarray of bool
         Not diverged, not a limit cycle, and the last quarter's amplitude
         does not exceed the third's or the floor (see the module docstring).
@@ -468,7 +468,7 @@ def _run_chunks(make_run, n_points, point_bytes, *, steps, d, record, progress, 
     one chunk and its memory is checked first.  ``pulse_of(part)``, with
     a force quantum: the linear loop's response to a unit force pulse at
     the points of ``part`` it bounds (an :class:`_AnyLoop` or None), whose
-    l1 norm over the run sets their verdict's floor (:func:`_verdict`).
+    l1 norm over the run sets their verdict's floor (``_verdict``).
     """
     if record:
         check_memory(f"recording {steps} periods of {n_points} point(s) at d = {d}",
@@ -909,7 +909,7 @@ def run_loop(parts_of, n_points, *, d, steps, x0, v0, nonideal, record, progress
     linear_stable : ndarray of bool, optional
         ``(n_points,)``: the points whose linear loop is stable (a certified
         root count of 0); needed with a force quantum, whose verdict floor
-        they get (:func:`_verdict`).
+        they get (``_verdict``).
     """
     if compensation is not None:
         compensation = (compensation.coulomb, compensation.pole)

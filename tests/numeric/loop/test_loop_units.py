@@ -24,7 +24,7 @@ from symstab import Loop
 from symstab.numeric.loop.files import load_loop, parse_loop_text
 from symstab.numeric.loop.quantities import check_bounds, unit_info
 
-from conftest import REPO
+from conftest import REPO, manual_text
 from oracles import eq1_virtual_environment
 
 pytestmark = pytest.mark.usefixtures("loop_cache_dir")
@@ -294,7 +294,8 @@ def test_a_unit_pint_would_read_as_a_silent_factor_is_refused(unit, why):
 
 
 def test_every_unit_in_the_readme_is_converted_or_said_to_be_refused():
-    readme = (REPO / "README.md").read_text(encoding="utf-8")
+    """The manual's units (the loop-file format, moved from the README to docs/guide/loop_files.md)."""
+    readme = manual_text()
     units = set(re.findall(r'unit = "([^"]*)"', readme))
     assert {"ms", "g", "N/mm"} <= units
     refused = set(re.findall(r'unit = "([^"]*)"[^\n]*# refused', readme))
@@ -311,8 +312,9 @@ def test_every_unit_in_the_readme_is_converted_or_said_to_be_refused():
 
 
 def test_the_readmes_loop_file_is_read_as_its_comments_say():
-    readme = (REPO / "README.md").read_text(encoding="utf-8")
-    block = re.search(r"## Loop files.*?```toml\n(.*?)```", readme, re.S).group(1)
+    """The example of the loop-file format (docs/guide/loop_files.md, once the README's)."""
+    readme = (REPO / "docs" / "guide" / "loop_files.md").read_text(encoding="utf-8")
+    block = re.search(r"^# Loop files.*?```toml\n(.*?)```", readme, re.S | re.M).group(1)
     loop = parse_loop_text(block, source="README")
     assert loop.name == "my_paddle" and loop.plane == ("B", "K")
     assert loop.defaults == pytest.approx({"m": 0.0128, "b": 0.0324, "T": 0.00025, "d": 1,
