@@ -263,13 +263,17 @@ def audit_run(tmp_path_factory):
 
 #: Session fixtures that run a whole command.
 _SHARED_RUNS = ("audit_run", "derive_subprocess_runs")
+#: The longest of them, the docs build (a minute and more): its tests run first, so that
+#: under xdist one worker starts it at once, not the last worker at the end of the run.
+_FIRST = ("site",)
 
 
 def pytest_collection_modifyitems(config, items):
-    """Mark the tests that wait for a whole command run (audit, derive) slow."""
+    """Mark the tests that wait for a whole command run (audit, derive) slow; the docs first."""
     for item in items:
         if any(fixture in getattr(item, "fixturenames", ()) for fixture in _SHARED_RUNS):
             item.add_marker(pytest.mark.slow)
+    items.sort(key=lambda item: not any(f in getattr(item, "fixturenames", ()) for f in _FIRST))
 
 
 # --------------------------------------------------------------------------

@@ -14,6 +14,7 @@ standard library); the built pages hold them.
 
 import json
 import os
+import pathlib
 import re
 import subprocess
 import sys
@@ -22,7 +23,7 @@ import pytest
 
 import symstab
 
-from conftest import REPO
+from conftest import REPO, run_once_per_session
 
 DOCS = REPO / "docs"
 DERIVATIONS = REPO / "derivations"
@@ -109,22 +110,31 @@ def test_notebook_is_stored_clean(name):
 # The build
 
 
-@pytest.fixture(scope="module")
+@pytest.fixture(scope="session")
 def site(tmp_path_factory, session_cache_dir):
     """The site built as the README says, into a temporary folder: (exit status, log, html folder).
 
-    The ``docs`` extra (in the ``test`` extra from Python 3.11 on, as Sphinx 9
-    needs it) is the toolchain; without it the build is skipped, saying so.
+    Built once for the session, also under xdist (``conftest.run_once_per_session``):
+    two builds would cost a minute more and write the same autosummary stubs into
+    ``docs/`` at once.  Its tests are collected first (``conftest._FIRST``), so the
+    build starts with the run.  The ``docs`` extra (in the ``test`` extra from
+    Python 3.11 on, as Sphinx 9 needs it) is the toolchain; without it the build
+    is skipped, saying so.
     """
     for module in ("sphinx", "myst_nb", "numpydoc", "sphinxarg", "pydata_sphinx_theme", "ipykernel"):
         pytest.importorskip(module, reason='the docs build needs the docs extra: pip install ".[docs]"')
-    out = tmp_path_factory.mktemp("site")
-    html = out / "html"
-    command = [sys.executable, "-m", "sphinx", "-W", "--keep-going", "-n", "-b", "html",
-               "-d", str(out / "doctrees"), str(DOCS), str(html)]
-    env = {**os.environ, "SYMSTAB_CACHE_DIR": str(session_cache_dir)}
-    done = subprocess.run(command, cwd=REPO, env=env, capture_output=True, text=True, timeout=900)
-    return done.returncode, done.stdout + done.stderr, html
+
+    def build(out):
+        html = out / "html"
+        command = [sys.executable, "-m", "sphinx", "-W", "--keep-going", "-n", "-b", "html",
+                   "-d", str(out / "doctrees"), str(DOCS), str(html)]
+        env = {**os.environ, "SYMSTAB_CACHE_DIR": str(session_cache_dir)}
+        done = subprocess.run(command, cwd=REPO, env=env, capture_output=True, text=True,
+                              timeout=900)
+        return [done.returncode, done.stdout + done.stderr, str(html)]
+
+    status, log, html = run_once_per_session(tmp_path_factory, "site", build)
+    return status, log, pathlib.Path(html)
 
 
 @pytest.mark.slow
