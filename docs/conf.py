@@ -28,6 +28,8 @@ extensions = [
     "sphinx.ext.autosummary",
     "numpydoc",
     "sphinx.ext.mathjax",
+    # MathJax served from the site itself (the build and the pages need no network).
+    "sphinx-mathjax-offline",
     "sphinxarg.ext",
     "matplotlib.sphinxext.plot_directive",
     "sphinx_copybutton",

@@ -146,6 +146,10 @@ def test_the_docs_build_without_a_warning(site):
     for page in ("index", "getting_started", "guide/regions", "reference/api", "reference/cli",
                  "reference/generated/symstab.Loop", "changelog", "citing"):
         assert (html / f"{page}.html").is_file(), page
+    # The math is typeset by the site's own copy of MathJax: the pages need no network.
+    assert (html / "_static" / "mathjax" / "tex-chtml.js").is_file()
+    page = (html / "derivations" / "04_boundary_and_coefficients.html").read_text(encoding="utf-8")
+    assert "_static/mathjax/tex-chtml.js" in page and "cdn.jsdelivr" not in page
 
 
 @pytest.mark.slow
