@@ -13,7 +13,8 @@ import symstab
 
 DOCS = pathlib.Path(__file__).resolve().parent
 REPO = DOCS.parent
-# docs/_ext: the command line's parser as the CLI reference renders it.
+# docs/_ext: the command line's parser as the CLI reference renders it, and the
+# notebooks run in one shared kernel.
 sys.path.insert(0, str(DOCS / "_ext"))
 
 project = "symstab"
@@ -33,6 +34,7 @@ extensions = [
     "sphinxarg.ext",
     "matplotlib.sphinxext.plot_directive",
     "sphinx_copybutton",
+    "shared_kernel",
 ]
 
 source_suffix = {".rst": "restructuredtext", ".md": "myst-nb", ".ipynb": "myst-nb"}
@@ -56,11 +58,9 @@ myst_enable_extensions = ["dollarmath", "amsmath", "colon_fence", "deflist"]
 myst_dmath_double_inline = True
 myst_heading_anchors = 3
 # The notebooks are stored without outputs (tests/test_docs.py): the build
-# executes every one, and a cell that raises fails it.
-nb_execution_mode = "force"
-nb_execution_timeout = 600
-nb_execution_raise_on_error = True
-nb_execution_show_tb = True
+# executes every one, in one shared kernel (docs/_ext/shared_kernel.py: myst-nb
+# would start one per notebook), and a cell that raises fails it.
+nb_execution_mode = "off"
 nb_merge_streams = True
 
 # --- API reference ---------------------------------------------------------
