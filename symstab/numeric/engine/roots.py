@@ -32,7 +32,7 @@ from .polynomial import DelayedPolynomial, horner
 __all__ = [
     "STABLE", "MARGINAL", "UNSTABLE", "COEFFICIENT_ULPS",
     "root_counts", "schur_cohn", "classify_polynomials", "leading_vanishes",
-    "spectral_radius", "polish_roots",
+    "spectral_radius", "polish_roots", "circle_minimum",
 ]
 
 #: Codes of :func:`classify_polynomials`.
@@ -850,3 +850,147 @@ def _newton_in_bracket(chi, lo, hi):
         if np.all(~np.isfinite(step) | (np.abs(step) <= 4e-16 * np.abs(z))):
             break
     return z
+
+
+# --------------------------------------------------------------------------
+# The smallest |1 + L| on the circle (the modulus margin)
+
+#: Rounds of halving the arcs not yet certified, and the most open at once.
+_MINIMUM_ROUNDS = 60
+_MINIMUM_OPEN_ARCS = 4096
+
+
+def circle_minimum(chi, *, rtol=1e-9, coefficient_ulps=COEFFICIENT_ULPS):
+    """Certified smallest ``|chi / (z**s D)| = |1 + N / (z**s D)|`` on the unit circle, per polynomial.
+
+    For ``chi = z**s D + N`` the open loop is ``L = N / (z**s D)`` and
+    ``1 + L = chi / (z**s D)``; on the circle ``|z**s| = 1``, so the
+    modulus margin ``min |1 + L(exp(j theta))|`` over ``theta`` in [0, pi]
+    is ``min |chi| / |D|``.  It is certified without dividing (``D`` has a
+    root at ``z = 1`` for a plant with an integrator): ``|1 + L| >= mu``
+    everywhere if and only if ``F = |chi|**2 - mu**2 |D|**2 >= 0``
+    everywhere, and ``F`` is bounded below on each arc by its midpoint
+    value and slope and a bound on its second derivative (from the same
+    sums of the coefficients' moduli as :func:`root_counts`), with the
+    rounding of the values.  Arcs not certified are halved; their
+    midpoints lower the best value found so far, and ``mu`` follows it,
+    so the smallest value and its certificate are found together:
+    ``lower <= min |1 + L| <= upper`` with ``lower = upper (1 - rtol)``.
+
+    Parameters
+    ----------
+    chi : DelayedPolynomial
+        The polynomials (any shape).
+    rtol : float
+        The relative width of the certified bracket, in (0, 0.5).
+    coefficient_ulps : float
+        The error assumed of each coefficient, as in :func:`root_counts`.
+
+    Returns
+    -------
+    (ndarray, ndarray, ndarray)
+        ``lower``, ``upper`` and the ``theta`` (rad/sample, in [0, pi])
+        where ``upper`` is attained, each of shape ``chi.shape``.
+        ``lower`` is 0 where the minimum cannot be separated from 0 (a
+        root of ``chi`` on the circle to within rounding: a marginal
+        point) or the halving gave up.
+
+    Examples
+    --------
+    >>> # z - 1/2 = z (1 + L) with L = -1/(2 z): |1 + L| is smallest at z = 1.
+    >>> lower, upper, theta = circle_minimum(DelayedPolynomial([1.0], [-0.5], shift=1))
+    >>> round(float(upper), 12), float(theta)
+    (0.5, 0.0)
+    """
+    if not isinstance(chi, DelayedPolynomial):
+        raise TypeError(f"chi must be a DelayedPolynomial, got {type(chi).__name__}")
+    if not 0 < rtol < 0.5:
+        raise ValueError(f"rtol must be in (0, 0.5), got {rtol!r}")
+    shape = chi.shape
+    rows = chi.flat()
+    out = np.zeros((3, len(rows)))
+    for k in range(len(rows)):
+        one = rows.take(np.array([k]))
+        near_one = one.near_one
+        bounds = _chunk_bounds(one.delayed, one.direct, one.shift, coefficient_ulps, near_one)
+        out[:, k] = _row_minimum(bounds, rtol, max(64, 8 * max(rows.degree, 1)))
+    return tuple(part.reshape(shape) for part in out)
+
+
+class _MinimumArcs:
+    """The open arcs of :func:`circle_minimum`'s row: their ends and midpoint values."""
+
+    __slots__ = ("lo", "hi", "chi", "dchi", "d", "dd", "n", "dn", "e_d")
+
+    def __init__(self, bounds, lo, hi):
+        self.lo, self.hi = lo, hi
+        mid = 0.5 * (lo + hi)
+        rows = np.zeros(len(mid), dtype=np.int64)
+        s = bounds.s
+        with np.errstate(all="ignore"):
+            d_val, d_slope, self.e_d = _delayed_values(bounds.part, mid, rows)
+            n_val, n_slope = _part_values(bounds.direct, mid, rows)
+            spin = np.exp(1j * (s * mid))
+            self.chi = spin * d_val + n_val
+            self.dchi = 1j * (spin * (s * d_val + d_slope) + n_slope)
+        # d/dtheta of D(exp(j theta)) is j z D'(z).
+        self.d, self.dd, self.n, self.dn = d_val, 1j * d_slope, n_val, n_slope
+
+    def values(self):
+        """``|chi| / |D|`` at the midpoints (inf where ``D`` is 0)."""
+        with np.errstate(all="ignore"):
+            return np.abs(self.chi) / np.abs(self.d)
+
+
+def _certified(bounds, arcs, mu):
+    """Which arcs provably keep ``|chi|**2 - mu**2 |D|**2`` above 0 (second-order Taylor bound)."""
+    b, s = bounds, bounds.s
+    half = 0.5 * (arcs.hi - arcs.lo)
+    sn0 = np.sum(np.abs(b.direct), axis=1)[0]
+    with np.errstate(all="ignore"):
+        dm, e_dm = np.abs(arcs.d), arcs.e_d
+        d_max = np.minimum(b.sd0[0] + b.e_d0[0],
+                           dm + e_dm + half * (np.abs(arcs.dd) + b.e_d1[0] + 0.5 * half * b.sd2[0]))
+        d1_max = np.minimum(b.sd1[0], np.abs(arcs.dd) + b.e_d1[0] + half * b.sd2[0])
+        n_max = np.minimum(sn0 + b.e_n0[0],
+                           np.abs(arcs.n) + b.e_n0[0] + half * (np.abs(arcs.dn) + b.e_n1[0]
+                                                              + 0.5 * half * b.sn2[0]))
+        n1_max = np.minimum(b.sn1[0], np.abs(arcs.dn) + b.e_n1[0] + half * b.sn2[0])
+        c0, c1 = d_max + n_max, s * d_max + d1_max + n1_max
+        c2 = s * s * d_max + 2 * s * d1_max + b.sd2[0] + b.sn2[0]
+        second = 2 * (c1 * c1 + c0 * c2) + 2 * mu * mu * (d1_max * d1_max + d_max * b.sd2[0])
+        size, e_chi = np.abs(arcs.chi), (e_dm + b.e_n0[0] + (b.spin_error + 8 * _U) * dm
+                                         + 2 * _U * np.abs(arcs.n))
+        value = size * size - mu * mu * dm * dm
+        slope = 2 * np.real(np.conj(arcs.chi) * arcs.dchi - mu * mu * np.conj(arcs.d) * arcs.dd)
+        error = ((2 * size + e_chi) * e_chi + mu * mu * (2 * dm + e_dm) * e_dm
+                 + 32 * _U * (size * size + mu * mu * dm * dm
+                              + half * (2 * c0 * c1 + 2 * mu * mu * d_max * d1_max)))
+        low = value - np.abs(slope) * half - 0.5 * second * half * half - error
+    return np.isfinite(low) & (low > 0)
+
+
+def _row_minimum(bounds, rtol, n_arcs):
+    """``(lower, upper, theta)`` of :func:`circle_minimum` for one row's bounds."""
+    ends = np.linspace(0.0, np.pi, n_arcs + 1)
+    arcs = _MinimumArcs(bounds, ends[:-1], ends[1:])
+    # The ends of [0, pi] are candidates too (an arc's midpoint never is one).
+    edge = _MinimumArcs(bounds, np.array([0.0, np.pi]), np.array([0.0, np.pi]))
+    values = np.concatenate([arcs.values(), edge.values()])
+    angles = np.concatenate([0.5 * (arcs.lo + arcs.hi), [0.0, np.pi]])
+    best = int(np.nanargmin(values)) if np.isfinite(values).any() else 0
+    upper, theta = float(values[best]), float(angles[best])
+    for _ in range(_MINIMUM_ROUNDS):
+        ok = _certified(bounds, arcs, upper * (1 - rtol))
+        if ok.all():
+            return upper * (1 - rtol), upper, theta
+        if (~ok).sum() > _MINIMUM_OPEN_ARCS:
+            break
+        lo, hi = arcs.lo[~ok], arcs.hi[~ok]
+        mid = 0.5 * (lo + hi)
+        arcs = _MinimumArcs(bounds, np.concatenate([lo, mid]), np.concatenate([mid, hi]))
+        values = arcs.values()
+        k = int(np.nanargmin(values)) if np.isfinite(values).any() else 0
+        if values[k] < upper:
+            upper, theta = float(values[k]), float(0.5 * (arcs.lo[k] + arcs.hi[k]))
+    return 0.0, upper, theta
