@@ -36,7 +36,7 @@ from ..engine.arcs import END_ANGLE, EXACT_TERMS, ClosedFormArc, CramerArc, Exac
 from ..engine.polynomial import DelayedPolynomial
 
 __all__ = ["LoopEvaluation", "finite", "spectral_radius", "classify", "is_stable",
-           "unstable_root_counts", "difference_equations", "difference_parts"]
+           "unstable_root_counts", "difference_equations", "difference_parts", "closed_loop"]
 
 
 def _exact_product(a, b):
@@ -702,3 +702,30 @@ def difference_parts(loop, values):
         As :func:`difference_equations`.
     """
     return loop.evaluation.difference_parts(values, keep_overflow=True)
+
+
+def closed_loop(loop, **values):
+    """The closed loop of a loop from a force at the plant's input to the position.
+
+    ``P / (1 + VE z**-d P) = z**d Ve_d P_n / chi(z)``, built from the
+    polynomials (nothing cancelled), so its poles are the roots of
+    ``chi``.  Needs python-control.
+
+    Parameters
+    ----------
+    loop : symstab.Loop
+        The loop.
+    **values
+        A single value of every parameter (or its default).
+
+    Returns
+    -------
+    control.TransferFunction
+        Discrete time, ``dt = T``.
+    """
+    try:
+        import control
+    except ImportError:
+        raise ImportError("Loop.closed_loop needs python-control: pip install control") from None
+    num, chi, T = loop.evaluation.closed_loop(values)
+    return control.tf(num, chi, T)

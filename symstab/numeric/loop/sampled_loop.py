@@ -51,6 +51,7 @@ from ..engine.results import Boundary, Limits
 from .evaluation import (
     LoopEvaluation,
     classify,
+    closed_loop,
     difference_equations,
     difference_parts,
     is_stable,
@@ -458,6 +459,14 @@ class Loop(LoopModel):
         return simulated_limit(self, x=x, y=y, amplitude=amplitude, nonideal=nonideal,
                                steps=steps, x0=x0, progress=progress, **values)
 
+    def margins(self, *, parameters=None, delay_limit=None, rtol=1e-9, **values):
+        """The margins at a stable point: modulus, gain, phase, parameter and delay.
+
+        See :func:`symstab.numeric.analysis.margins.margins`."""
+        from ..analysis.margins import margins
+
+        return margins(self, parameters=parameters, delay_limit=delay_limit, rtol=rtol, **values)
+
     def passive_region(self, x=None, y=None, *, damping="b", x_range=None, y_range=None, **values):
         """The passive set of the environment behind the loop's delay, in the ``(x, y)`` plane.
 
@@ -541,28 +550,11 @@ class Loop(LoopModel):
         return friction_spaces(self, substeps, **values)
 
     def closed_loop(self, **values):
-        """The closed loop from a force at the plant's input to the position.
+        """The closed loop from a force at the plant's input to the position (python-control).
 
-        ``P / (1 + VE z**-d P) = z**d Ve_d P_n / chi(z)``, built from the
-        polynomials (nothing cancelled), so its poles are the roots of
-        ``chi``.  Needs python-control.
-
-        Parameters
-        ----------
-        **values
-            A single value of every parameter (or its default).
-
-        Returns
-        -------
-        control.TransferFunction
-            Discrete time, ``dt = T``.
+        See :func:`symstab.numeric.loop.evaluation.closed_loop`.
         """
-        try:
-            import control
-        except ImportError:
-            raise ImportError("Loop.closed_loop needs python-control: pip install control") from None
-        num, chi, T = self.evaluation.closed_loop(values)
-        return control.tf(num, chi, T)
+        return closed_loop(self, **values)
 
 
 def _rebuilt(plant, environment, options):

@@ -1,0 +1,430 @@
+"""How far from unstable: the margins of a loop at a stable point.
+
+For a point of a :class:`symstab.Loop` the characteristic polynomial is
+``chi(z) = z**s D(z) + N(z)`` (:meth:`symstab.Loop.polynomial`: ``D`` the
+environment's and the sampled plant's denominators, ``N`` their
+numerators, ``s`` the loop delay ``d``), so the loop's open loop is
+``L = VE z**-d P = N / (z**s D)`` and the closed-loop poles are the roots
+of ``1 + L``.  :func:`margins` (:meth:`symstab.Loop.margins`) gives, at one stable point:
+
+* the **modulus margin** ``min |1 + L(exp(j theta))|`` over ``theta`` in
+  [0, pi], the distance of the Nyquist curve from -1, certified
+  (:func:`symstab.numeric.engine.roots.circle_minimum`: a bracket of
+  relative width ``rtol`` proved by bounds on the circle, not a grid
+  minimum), with its frequency;
+* the **gain margins**: at every phase crossover (``L`` real and negative,
+  ``Im L = 0``) the factor ``-1 / L`` by which the loop gain can be
+  multiplied before that crossing reaches -1 (below 1 for a crossing
+  outside the unit disc: the gain may be reduced by that factor);
+* the **phase margins**: at every gain crossover (``|L| = 1``) the angle
+  ``180 deg + arg L``.  The gain crossovers are the roots of the cosine
+  polynomial ``|N|**2 - |D|**2`` (independent of the delay), found as the
+  roots of its Chebyshev series, all of them;
+* the **parameter margins**: for each parameter named, the stable interval
+  through the point along that parameter, the others fixed
+  (:meth:`symstab.Loop.stable_intervals`), as distances and as factors;
+* the **delay margin** in whole samples: the smallest number of samples
+  ``k`` added to ``d`` at which the loop is no longer stable (the certified
+  verdict of :meth:`symstab.Loop.classify` at ``d + k``, ``k = 1, 2, ...``
+  up to ``delay_limit``).  A delay between whole samples needs the
+  fractional-delay derivation, which symstab does not have yet.
+
+The phase crossovers are found by sign changes of ``Im(N conj(D) z**-s)``
+on a grid of 32 points per period of its highest harmonic, each refined
+by :func:`symstab.numeric.engine.search.bracketed_root`: two crossings
+closer together than the grid's step (a tangency of the Nyquist curve to
+the real axis) are not separated.
+"""
+
+import dataclasses
+import math
+
+import numpy as np
+
+from ..._resources import max_delay
+from ..._validate import check_count, check_real
+from ..engine.results import html_table
+from ..engine.roots import MARGINAL, STABLE, circle_minimum
+from ..engine.search import bracketed_root
+
+__all__ = ["NyquistCrossing", "ParameterMargin", "Margins", "margins"]
+
+#: Points per period of the highest harmonic of the phase-crossover scan.
+_SCAN_PER_HARMONIC = 32
+_EPS = np.finfo(float).eps
+
+
+@dataclasses.dataclass(frozen=True)
+class NyquistCrossing:
+    """A crossing of the Nyquist curve (of the real axis or the unit circle): its margin, where.
+
+    Attributes
+    ----------
+    margin : float
+        The gain factor (a gain margin) or the angle in degrees (a phase
+        margin).
+    theta : float
+        The angle on the unit circle, rad/sample, in [0, pi].
+    frequency : float
+        ``theta / (2 pi T)``, Hz.
+    """
+
+    margin: float
+    theta: float
+    frequency: float
+
+
+@dataclasses.dataclass(frozen=True)
+class ParameterMargin:
+    """The stable interval through a point along one parameter.
+
+    Attributes
+    ----------
+    name : str
+        The parameter.
+    value : float
+        Its value at the point.
+    low, high : float
+        The ends of the stable interval holding the value (``-inf``/``inf``
+        when it is unbounded); at the ends the loop is unstable or marginal.
+    """
+
+    name: str
+    value: float
+    low: float
+    high: float
+
+    @property
+    def below(self):
+        """How far the parameter can decrease: ``value - low``."""
+        return self.value - self.low
+
+    @property
+    def above(self):
+        """How far the parameter can increase: ``high - value``."""
+        return self.high - self.value
+
+    @property
+    def factors(self):
+        """``(low / value, high / value)``: the interval as factors of the value (None at 0)."""
+        if self.value == 0:
+            return None
+        ends = sorted((self.low / self.value, self.high / self.value))
+        return ends[0], ends[1]
+
+
+@dataclasses.dataclass(frozen=True)
+class Margins:
+    """The margins of a loop at a stable point (:func:`symstab.numeric.analysis.margins.margins`).
+
+    Attributes
+    ----------
+    point : dict
+        The parameters' values.
+    T : float
+        The sample period, s.
+    modulus : float
+        ``min |1 + L|`` on the circle (the value found; the true minimum is
+        in ``[modulus_lower, modulus]``).
+    modulus_lower : float
+        The certified lower bound.
+    modulus_theta, modulus_frequency : float
+        Where it is, rad/sample and Hz.
+    gain, phase : tuple of NyquistCrossing
+        Every phase crossover's gain margin and every gain crossover's
+        phase margin, by increasing frequency.
+    parameters : tuple of ParameterMargin
+        The parameter margins.
+    delay : int or None
+        The delay margin in whole samples (None: stable up to
+        ``delay_limit`` samples more).
+    delay_limit : int
+        The added delays examined, 1 to ``delay_limit``.
+    """
+
+    point: dict
+    T: float
+    modulus: float
+    modulus_lower: float
+    modulus_theta: float
+    modulus_frequency: float
+    gain: tuple
+    phase: tuple
+    parameters: tuple
+    delay: object
+    delay_limit: int
+
+    @property
+    def gain_margin(self):
+        """The gain margin: the smallest factor above 1 of :attr:`gain` (inf: none)."""
+        up = [c.margin for c in self.gain if c.margin > 1]
+        return min(up) if up else math.inf
+
+    @property
+    def phase_margin(self):
+        """The phase margin: the smallest magnitude of :attr:`phase`, degrees (inf: none)."""
+        return min((abs(c.margin) for c in self.phase), default=math.inf)
+
+    @property
+    def delay_seconds(self):
+        """The delay margin in seconds, ``delay T`` (None with :attr:`delay` None)."""
+        return None if self.delay is None else self.delay * self.T
+
+    def rows(self):
+        """``(quantity, value, where)`` rows of the margins, for tables."""
+        out = [("modulus margin min|1+L|", f"{self.modulus:.6g}",
+                f"{self.modulus_frequency:.6g} Hz ({self.modulus_theta:.6g} rad/sample); "
+                f"certified >= {self.modulus_lower:.10g}")]
+        for c in self.gain:
+            out.append(("gain margin", f"{c.margin:.6g}", f"{c.frequency:.6g} Hz"))
+        for c in self.phase:
+            out.append(("phase margin (deg)", f"{c.margin:.6g}", f"{c.frequency:.6g} Hz"))
+        for p in self.parameters:
+            out.append((f"{p.name} stable interval", f"[{p.low:.6g}, {p.high:.6g}]",
+                        f"at {p.name} = {p.value:.6g}"))
+        delay = ("none" if self.delay is None else
+                 f"{self.delay} samples ({self.delay * self.T:.6g} s)")
+        where = (f"stable up to {self.delay_limit} samples more" if self.delay is None
+                 else f"unstable at d = {self.point['d'] + self.delay}")
+        out.append(("delay margin (whole samples)", delay, where))
+        return out
+
+    def __repr__(self):
+        width = max(len(r[0]) for r in self.rows())
+        lines = [f"Margins at {_point_text(self.point)}"]
+        lines += [f"  {q:<{width}}  {v}  ({w})" for q, v, w in self.rows()]
+        return "\n".join(lines)
+
+    def _repr_html_(self):
+        return html_table(f"Margins at {_point_text(self.point)}",
+                          [(q, f"{v} ({w})") for q, v, w in self.rows()])
+
+    def as_dict(self):
+        """The margins as plain numbers (JSON-ready)."""
+        return {
+            "point": dict(self.point), "T": self.T,
+            "modulus": self.modulus, "modulus_lower": self.modulus_lower,
+            "modulus_theta": self.modulus_theta, "modulus_frequency": self.modulus_frequency,
+            "gain": [dataclasses.asdict(c) for c in self.gain],
+            "phase": [dataclasses.asdict(c) for c in self.phase],
+            "parameters": [dataclasses.asdict(p) for p in self.parameters],
+            "delay": self.delay, "delay_seconds": self.delay_seconds,
+            "delay_limit": self.delay_limit,
+        }
+
+
+def _point_text(point):
+    return ", ".join(f"{k} = {v:.6g}" if isinstance(v, float) else f"{k} = {v}"
+                     for k, v in point.items())
+
+
+def margins(loop, *, parameters=None, delay_limit=None, rtol=1e-9, **values):
+    """The margins of a loop at a stable point: modulus, gain, phase, parameter and delay.
+
+    Parameters
+    ----------
+    loop : symstab.Loop
+        The loop.
+    parameters : sequence of str, optional
+        The parameters whose stable interval through the point is given
+        (each in :meth:`symstab.Loop.affine_parameters`); default the
+        loop's :attr:`~symstab.Loop.plane`, or none without one.
+    delay_limit : int, optional
+        The most samples added to ``d`` in the search for the delay margin
+        (default ``max(100, 10 (d + 1))``, within ``SYMSTAB_MAX_DELAY``).
+    rtol : float
+        The relative width of the modulus margin's certified bracket.
+    **values
+        A single value of every parameter (or its default), ``d`` included.
+
+    Returns
+    -------
+    Margins
+
+    Raises
+    ------
+    ValueError
+        At a point that is not stable (the margins of an unstable or
+        marginal loop are not distances to instability), for an array of
+        values, or a parameter that is not affine.
+
+    Examples
+    --------
+    >>> from symstab import Loop
+    >>> loop = Loop("1/(m*s**2 + b*s)", "K + B*(z - 1)/(T*z)", plane=("B", "K"),
+    ...             values=dict(m=0.0128, b=0.0324, T=1e-3, d=0, K=100.0, B=1.0))
+    >>> found = margins(loop)
+    >>> round(found.modulus, 6), round(found.modulus_frequency, 3)
+    (0.739598, 19.022)
+    """
+    point = _stable_point(loop, values)
+    chi = loop.polynomial(**point)
+    T = float(point["T"])
+    lower, upper, theta = (float(x) for x in circle_minimum(chi, rtol=check_real(
+        "rtol", rtol, low=0.0, low_open=True, high=0.5, high_open=True)))
+    delayed, direct = chi.delayed.reshape(-1), chi.direct.reshape(-1)
+    limit = _delay_limit(point["d"], delay_limit)
+    return Margins(
+        point=point, T=T, modulus=upper, modulus_lower=lower, modulus_theta=theta,
+        modulus_frequency=theta / (2 * math.pi * T),
+        gain=_gain_crossings(delayed, direct, chi.shift, T),
+        phase=_phase_crossings(delayed, direct, chi.shift, T),
+        parameters=tuple(_parameter_margin(loop, name, point)
+                         for name in _margin_parameters(loop, parameters)),
+        delay=_delay_margin(loop, point, limit), delay_limit=limit)
+
+
+def _stable_point(loop, values):
+    """The point's values (defaults filled in, single numbers), checked to be stable."""
+    point = {**loop.defaults, **values}
+    missing = [name for name in loop.parameters if name not in point]
+    if missing:
+        raise ValueError(f"margins need a value of every parameter: give {', '.join(missing)}")
+    for name, value in point.items():
+        if np.ndim(value) != 0:
+            raise ValueError(f"margins are computed at one point: {name} must be a single "
+                             f"value, got shape {np.shape(value)}")
+    point = {name: (int(point[name]) if name == "d" else float(point[name]))
+             for name in loop.parameters}
+    code = int(loop.classify(**point))
+    if code != STABLE:
+        what = ("marginal (a pole on the unit circle)" if code == MARGINAL else
+                f"unstable ({int(loop.unstable_root_counts(**point))} poles outside the unit "
+                f"circle)")
+        raise ValueError(f"margins need a stable point: the loop is {what} there")
+    return point
+
+
+def _on_circle(c, theta):
+    """The polynomial ``c`` (highest power first) at ``exp(j theta)``."""
+    return np.polyval(c, np.exp(1j * theta))
+
+
+def _open_loop(delayed, direct, shift, theta):
+    """``L(exp(j theta)) = N / (z**s D)``."""
+    with np.errstate(all="ignore"):
+        return _on_circle(direct, theta) / (np.exp(1j * shift * theta) * _on_circle(delayed, theta))
+
+
+def _gain_crossings(delayed, direct, shift, T):
+    """Every phase crossover (``L`` real, negative) with its gain margin ``-1 / L``."""
+    harmonics = shift + max(len(delayed), len(direct))
+    grid = np.linspace(0.0, np.pi, _SCAN_PER_HARMONIC * harmonics + 1)
+
+    def imag(theta):
+        # Im L |D|**2, without the division (D vanishes at z = 1 for an integrator).
+        z = np.exp(1j * theta)
+        return np.imag(np.polyval(direct, z) * np.conj(np.polyval(delayed, z))
+                       * np.exp(-1j * shift * theta))
+
+    values = imag(grid)
+    change = np.flatnonzero(np.sign(values[:-1]) * np.sign(values[1:]) < 0)
+    exact = grid[np.flatnonzero(values == 0)]
+    theta = np.concatenate([bracketed_root(imag, grid[change], grid[change + 1]), exact])
+    theta = np.unique(np.concatenate([theta, [0.0, np.pi]]))
+    gain = _open_loop(delayed, direct, shift, theta)
+    # A pole of L on the circle (an integrator's D(1) = 0, to within rounding) is no crossing.
+    pole = np.abs(_on_circle(delayed, theta)) <= 64 * _EPS * np.sum(np.abs(delayed))
+    keep = np.isfinite(gain) & (gain.real < 0) & ~pole
+    return tuple(NyquistCrossing(float(-1.0 / gain[k].real), float(theta[k]),
+                          float(theta[k] / (2 * math.pi * T))) for k in np.flatnonzero(keep))
+
+
+def _autocorrelation(c):
+    """``r_k = sum_i c_i c_(i+k)``, k = 0 .. n: ``|c(exp(j theta))|**2 = r_0 + 2 sum r_k cos(k theta)``."""
+    c = np.asarray(c, dtype=float)
+    full = np.correlate(c, c, mode="full")
+    return full[len(c) - 1:]
+
+
+def _phase_crossings(delayed, direct, shift, T):
+    """Every gain crossover (``|L| = 1``) with its phase margin ``180 + arg L`` (degrees)."""
+    rn, rd = _autocorrelation(direct), _autocorrelation(delayed)
+    size = max(len(rn), len(rd))
+    series = np.zeros(size)
+    series[:len(rn)] += rn
+    series[:len(rd)] -= rd
+    series[1:] *= 2
+    # In x = cos(theta), cos(k theta) = T_k(x): the roots of a Chebyshev series.
+    roots = np.polynomial.chebyshev.chebroots(np.trim_zeros(series, "b")) if np.any(series) else []
+    x = np.array([r.real for r in np.atleast_1d(roots)
+                  if abs(r.imag) <= 1e-9 and -1 - 1e-9 <= r.real <= 1 + 1e-9])
+    theta = _polished(delayed, direct, np.sort(np.arccos(np.clip(x, -1.0, 1.0))))
+    gain = _open_loop(delayed, direct, shift, theta)
+    out = []
+    for k in np.flatnonzero(np.isfinite(gain)):
+        phase = math.degrees(float(np.angle(gain[k])))
+        margin = (phase + 360.0) % 360.0 - 180.0
+        out.append(NyquistCrossing(margin, float(theta[k]), float(theta[k] / (2 * math.pi * T))))
+    return tuple(out)
+
+
+def _polished(delayed, direct, theta, steps=3):
+    """Newton steps on ``|N|**2 - |D|**2`` evaluated on the circle (not in ``cos theta``).
+
+    The Chebyshev roots lose digits where ``x = cos theta`` is near 1 (a
+    crossover at low frequency: ``d theta = dx / sin theta``); a step is kept
+    only where it lowers the residual.
+    """
+    def residual(t):
+        z = np.exp(1j * t)
+        n, dn = np.polyval(direct, z), 1j * z * np.polyval(np.polyder(direct), z)
+        d, dd = np.polyval(delayed, z), 1j * z * np.polyval(np.polyder(delayed), z)
+        value = np.abs(n) ** 2 - np.abs(d) ** 2
+        return value, 2 * np.real(np.conj(n) * dn - np.conj(d) * dd)
+
+    for _ in range(steps):
+        value, slope = residual(theta)
+        with np.errstate(all="ignore"):
+            trial = np.clip(theta - value / slope, 0.0, np.pi)
+        better = np.isfinite(trial) & (np.abs(residual(trial)[0]) < np.abs(value))
+        theta = np.where(better, trial, theta)
+    return theta
+
+
+def _margin_parameters(loop, parameters):
+    """The parameters named for parameter margins (the plane's by default), checked."""
+    if parameters is None:
+        return tuple(loop.plane or ())
+    if isinstance(parameters, str):
+        parameters = (parameters,)
+    names = tuple(parameters)
+    affine = loop.affine_parameters()
+    for name in names:
+        if name not in affine:
+            raise ValueError(f"parameters: {name!r} does not enter the loop's polynomial "
+                             f"affinely; a parameter margin needs one of: "
+                             f"{', '.join(affine) or 'none'}")
+    return names
+
+
+def _parameter_margin(loop, name, point):
+    """The stable interval through ``point`` along ``name``."""
+    others = {k: v for k, v in point.items() if k != name}
+    value = point[name]
+    for low, high in loop.stable_intervals(name, **others):
+        if low <= value <= high:
+            return ParameterMargin(name, value, float(low), float(high))
+    # Stable at the point but on no interval: the line engine and the verdict disagree.
+    raise ValueError(f"the stable intervals of {name} do not hold its value {value:.6g} at a "
+                     f"point classified stable: the point is too close to the boundary to "
+                     f"resolve")
+
+
+def _delay_limit(d, delay_limit):
+    room = max_delay() - d
+    if delay_limit is None:
+        return max(0, min(max(100, 10 * (d + 1)), room))
+    limit = check_count("delay_limit", delay_limit, 1)
+    if limit > room:
+        raise ValueError(f"delay_limit must be at most {room} (SYMSTAB_MAX_DELAY - d), "
+                         f"got {limit}")
+    return limit
+
+
+def _delay_margin(loop, point, limit):
+    """The smallest whole number of samples added to ``d`` at which the loop is not stable."""
+    for k in range(1, limit + 1):
+        if int(loop.classify(**{**point, "d": point["d"] + k})) != STABLE:
+            return k
+    return None
