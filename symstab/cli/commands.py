@@ -36,7 +36,7 @@ __all__ = ["main", "build_parser", "package_version", "project_root", "COMMAND_N
 #: The commands, in the order of ``symstab --help``; each is the module of
 #: this package of the same name.
 COMMAND_NAMES = ("derive", "audit", "figures", "reproduce", "boundary", "limits", "classify",
-                 "design", "simulate", "map", "locus", "sweep")
+                 "margins", "design", "simulate", "map", "locus", "sweep")
 
 
 def command_modules():

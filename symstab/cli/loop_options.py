@@ -77,6 +77,7 @@ _REFUSED = {
     "limits": DEVICE_OPTIONS + (("--beta", "beta", "--at X (the stable y at x = X)"),
                                 ("--Bw", "Bw", "--at X (the stable y at x = X)")),
     "classify": DEVICE_OPTIONS + POINT_OPTIONS,
+    "margins": DEVICE_OPTIONS + POINT_OPTIONS,
     "design": DEVICE_OPTIONS,
     "map": DEVICE_OPTIONS + _GRID_OPTIONS + _SIMULATION_OPTIONS,
     "simulate": DEVICE_OPTIONS + POINT_OPTIONS + _SIMULATION_OPTIONS,
@@ -87,6 +88,7 @@ _LOOP_ONLY = {
     "boundary": ("set_values", "x", "y"),
     "limits": ("set_values", "x", "y", "at", "uncertain", "strips", "png"),
     "classify": ("set_values",),
+    "margins": ("set_values",),
     "design": ("set_values", "x", "y", "at", "over", "search_range", "delay"),
     "map": ("set_values", "x", "y", "x_range", "y_range", "simulate", "uncertain", "samples",
             "seed"),
@@ -128,6 +130,10 @@ _WHAT = {
                 "plant's exact ZOH step, the environment's difference equation, the delay "
                 "line; encoder quantization and force saturation in the loop's SI "
                 "units) and compares the verdict with its certified root count.",
+    "margins": "margins --loop gives, at the file's values changed by --set (a stable "
+               "point), the modulus margin min|1+L| (certified), every gain and phase "
+               "margin, the stable interval of each plane parameter through the point and "
+               "the delay margin in whole samples.",
     "map": "map --loop classifies every cell of an x-y grid by its certified root count "
            "and draws the D-decomposition over it; with --simulate it also simulates every "
            "cell and compares.",
@@ -139,6 +145,7 @@ _LOOP_EXAMPLES = {
     "classify": f"symstab classify --loop {EXAMPLE} --set K=1,3,10 --set B=0.2",
     "design": f"symstab design --loop {EXAMPLE} --set d=10",
     "simulate": f"symstab simulate --loop {EXAMPLE} --set K=3 --set B=0.2 --out trajectory.csv",
+    "margins": f"symstab margins --loop {EXAMPLE} --set K=3 --set B=0.2",
     "map": f"symstab map --loop {EXAMPLE} --x-range=-0.1,0.6,141 --y-range=0,6,121 "
            "--out map.npz",
 }
@@ -167,7 +174,7 @@ def add_loop_options(p, command):
                         "it (--set T=0.5ms, --set \"K=3 N/mm\"), of the same dimension; "
                         "converted to SI and checked against the file's bounds; repeatable; d "
                         f"is a whole number of samples{many}")
-    if command not in ("classify", "simulate"):
+    if command not in ("classify", "simulate", "margins"):
         g.add_argument("--x", metavar="NAME", help="horizontal parameter of the plane "
                                                    "(default: the file's plane)")
         g.add_argument("--y", metavar="NAME", help="vertical parameter of the plane "

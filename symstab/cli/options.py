@@ -22,7 +22,7 @@ import numpy as np
 from .output import FORMATS, quiet_when_unread
 
 __all__ = ["add_command", "Setup", "UNITS_RULE", "add_model_options", "resolve", "parse_list",
-           "stiffness_and_damping"]
+           "parse_one", "stiffness_and_damping"]
 
 
 def add_command(sub, name, *, help, description, example, func):
@@ -171,6 +171,14 @@ def parse_list(text, name):
         # Named here: a NaN passed on was refused later under the loop's name (K, not --alpha).
         raise ValueError(f"{name} must be finite numbers, got {text!r}")
     return np.array(values)
+
+
+def parse_one(text, name):
+    """One finite number (:func:`parse_list` of exactly one item)."""
+    values = parse_list(text, name)
+    if values.size != 1:
+        raise ValueError(f"{name} takes one value here, got {values.size}")
+    return float(values[0])
 
 
 def stiffness_and_damping(args, setup, parse):

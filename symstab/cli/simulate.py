@@ -22,7 +22,13 @@ import numpy as np
 
 from .._resources import check_memory
 from .loop_options import add_loop_options, resolve_loop, uses_loop, value_text
-from .options import add_command, add_model_options, parse_list, resolve, stiffness_and_damping
+from .options import (
+    add_command,
+    add_model_options,
+    parse_one,
+    resolve,
+    stiffness_and_damping,
+)
 from .output import check_files, write_output
 from .simulation import (
     add_nonideal_options,
@@ -212,13 +218,6 @@ def _check_out(out):
     check_files([("--out", out)])
 
 
-def _single(text, name):
-    values = parse_list(text, name)
-    if values.size != 1:
-        raise ValueError(f"{name} takes one value here, got {values.size}")
-    return float(values[0])
-
-
 def _point(args, setup):
-    alpha, beta = stiffness_and_damping(args, setup, _single)
+    alpha, beta = stiffness_and_damping(args, setup, parse_one)
     return float(alpha), float(beta)

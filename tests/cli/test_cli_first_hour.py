@@ -31,7 +31,7 @@ from oracles import python_control_closed_loop
 
 #: Every sub-command; a new one must be added here (and gets its --help checked).
 COMMANDS = ("derive", "audit", "figures", "reproduce", "boundary", "limits", "classify",
-            "design", "simulate", "map", "locus", "sweep")
+            "margins", "design", "simulate", "map", "locus", "sweep")
 
 
 def _main(capsys, *args):

@@ -1,0 +1,75 @@
+"""``symstab margins``: how far a stable point is from instability.
+
+At one stable point of a loop file (``--loop FILE --set NAME=VALUE``) or of
+the paper's loop (its device options and one stiffness and damping):
+the modulus margin ``min |1 + L|`` on the unit circle (certified), every
+gain and phase margin of the sampled open loop, the stable interval
+through the point of each plane parameter, and the delay margin in whole
+samples (:func:`symstab.numeric.analysis.margins.margins`).  An unstable or
+marginal point is one line and exit 2, before any work.
+"""
+
+import math
+
+from .loop_options import add_loop_options, resolve_setup
+from .options import add_command, add_model_options, parse_one, stiffness_and_damping
+from .output import emit
+
+__all__ = ["register", "run"]
+
+
+def register(subparsers):
+    """Add ``symstab margins`` to the sub-commands."""
+    p = add_command(
+        subparsers, "margins", help="how far a stable point is from instability",
+        description="At one stable point: the modulus margin min|1 + L| of the sampled open "
+                    "loop L on the unit circle (certified to a relative 1e-9), every gain "
+                    "margin (at each phase crossover) and phase margin (at each gain "
+                    "crossover), the stable interval of each plane parameter through the "
+                    "point, and the delay margin: the fewest whole samples of added delay "
+                    "at which the loop is no longer stable.",
+        example="symstab margins --Td 0.005 --Kw 100 --Bw 1", func=run)
+    add_model_options(p)
+    p.add_argument("--alpha", help="dimensionless stiffness")
+    p.add_argument("--beta", help="dimensionless damping")
+    p.add_argument("--Kw", help="virtual stiffness (physical)")
+    p.add_argument("--Bw", help="virtual damping (physical)")
+    add_loop_options(p, "margins")
+
+
+def run(args):
+    """Run ``symstab margins``: a loop file's point (``--loop``), else the paper's."""
+    setup = resolve_setup(args, plane=False)
+    values = dict(setup.values)
+    T = None
+    if setup.paper is not None:
+        alpha, beta = stiffness_and_damping(args, setup.paper, parse_one)
+        values.update(K=float(alpha), B=float(beta))
+        if setup.paper.physical:
+            T = setup.paper.device.T
+    found = setup.loop.margins(**values)
+    T = found.T if T is None and setup.paper is None else T
+    columns = ["margin", "value", "theta [rad/sample]", "frequency [Hz]", "note"]
+    rows = [("modulus min|1+L|", found.modulus, found.modulus_theta,
+             _hz(found.modulus_theta, T), f"certified >= {found.modulus_lower:.10g}")]
+    rows += [("gain", c.margin, c.theta, _hz(c.theta, T), "phase crossover") for c in found.gain]
+    rows += [("phase [deg]", c.margin, c.theta, _hz(c.theta, T), "gain crossover")
+             for c in found.phase]
+    for p in found.parameters:
+        name = setup.label(p.name)
+        rows.append((f"{name} down to", p.low, None, None, f"from {p.value:.6g}"))
+        rows.append((f"{name} up to", p.high, None, None, f"from {p.value:.6g}"))
+    d = found.point["d"]
+    note = (f"stable up to d = {d + found.delay_limit}" if found.delay is None
+            else f"unstable at d = {d + found.delay}")
+    rows.append(("delay [samples]", found.delay, None, None, note))
+    notes = ["L: the open loop VE(z) z^-d P(z), P the plant behind the zero-order hold; "
+             "the delay margin is in whole samples (a fractional delay is not derived yet)"]
+    if T is None:
+        notes.append("frequency: give the device's physical options (not --delta) for Hz")
+    emit(setup, args.format, columns, rows, notes=notes, result={"margins": found.as_dict()})
+    return 0
+
+
+def _hz(theta, T):
+    return None if T is None else theta / (2 * math.pi * T)
