@@ -4,7 +4,8 @@ Independent of symstab's derivation:
 
 * first principles -- the paper's printed eqs. (1), (2) and (4) (believed
   correct), evaluated with mpmath: :func:`eq4_pulse_transfer_function`,
-  :func:`eq1_virtual_environment`, :func:`loop_gain_parts`,
+  :func:`eq1_virtual_environment` (and :func:`eq1_virtual_environment_tf`,
+  its coefficients as a python-control transfer function), :func:`loop_gain_parts`,
   :func:`first_principles_chi` (the loop polynomial),
   :func:`first_principles_boundary_point`, :func:`first_principles_theta_max`;
 * python-control -- :func:`python_control_closed_loop`, the closed loop of
@@ -62,6 +63,23 @@ def eq4_pulse_transfer_function(z, m, b, T, exp=sp.exp):
 def eq1_virtual_environment(z, K_w, B_w, M_w, T):
     """VE(z) as printed in the paper's eq. (1)."""
     return K_w + B_w * (z - 1) / (T * z) + M_w * (z - 1) ** 2 / (T**2 * z**2)
+
+
+def eq1_virtual_environment_tf(K_w, B_w, M_w, T):
+    """VE(z) of eq. (1) as one python-control transfer function, sample period ``T``.
+
+    Eq. (1), ``K_w + B_w (z - 1)/(T z) + M_w (z - 1)^2/(T^2 z^2)``, written
+    by hand over its common denominator ``T^2 z^2``:
+    ``((K_w T^2 + B_w T + M_w) z^2 - (B_w T + 2 M_w) z + M_w) / (T^2 z^2)``.
+    One ``control.tf`` from these coefficients costs a fraction of building
+    it by python-control's transfer-function arithmetic (a few milliseconds
+    a call, thousands of calls in the suite); ``test_oracles.py`` checks it
+    equals :func:`eq1_virtual_environment` at complex ``z``.
+    """
+    import control
+
+    numerator = [K_w * T**2 + B_w * T + M_w, -(B_w * T + 2 * M_w), M_w]
+    return control.tf(numerator, [T**2, 0.0, 0.0], T)
 
 
 def loop_gain_parts(z, d, delta):
@@ -193,8 +211,7 @@ def python_control_closed_loop(*, alpha, beta, gamma, d, delta, m, T):
     b = delta * m / T
     K_w, B_w, M_w = alpha * m / T**2, beta * m / T, gamma * m
     G = control.c2d(control.tf([1], [m, b, 0]), T, "zoh")
-    z = control.tf([1, 0], [1], T)
-    VE = eq1_virtual_environment(z, K_w, B_w, M_w, T)
+    VE = eq1_virtual_environment_tf(K_w, B_w, M_w, T)
     delay = control.tf([1], [1] + [0] * d, T)
     return control.feedback(G, VE * delay)
 
