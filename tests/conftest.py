@@ -362,20 +362,25 @@ def run_cli(capsys, *args):
 
 
 @pytest.fixture(scope="session")
-def shared_cli_run():
-    """``run(*args) -> (exit status, stdout, stderr)`` of ``symstab ARGS`` in this process, once.
+def shared_cli_run(tmp_path_factory):
+    """``run(*args) -> (exit status, stdout, stderr)`` of ``symstab ARGS`` in-process, once.
 
     A command run that several tests read (a design search takes seconds)
     is run by the first test that asks for it and remembered for the
     session, keyed by its arguments; the later tests read the same output.
-    Per xdist worker, like any session fixture.
+    Once for the session, also under xdist (:func:`run_once_per_session`):
+    tests in different files that read one run may land on both workers.
     """
+    import hashlib
+
     runs = {}
 
     def run(*args):
         key = tuple(str(a) for a in args)
         if key not in runs:
-            runs[key] = _main_in_process(list(key))
+            name = "cli-run-" + hashlib.sha256("\0".join(key).encode()).hexdigest()[:16]
+            runs[key] = tuple(run_once_per_session(
+                tmp_path_factory, name, lambda folder: list(_main_in_process(list(key)))))
         return runs[key]
 
     return run
