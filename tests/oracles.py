@@ -226,18 +226,39 @@ def python_control_parts(loop, values):
     import control
 
     s, z = sp.symbols("s z")
-    subs = {symbol: values[str(symbol)] for symbol in
-            loop.plant.free_symbols | loop.environment.free_symbols if str(symbol) in values}
-    num, den = sp.fraction(sp.together(loop.plant.subs(subs)))
-    plant = control.tf([float(c) for c in sp.Poly(num, s).all_coeffs()],
-                       [float(c) for c in sp.Poly(den, s).all_coeffs()])
+    num, den = _substituted_coefficients(loop.plant, s, _values_of(loop.plant, values))
+    plant = control.tf(list(num), list(den))
     T = float(values["T"])
     sampled = control.c2d(plant, T, "zoh")
-    num, den = sp.fraction(sp.together(loop.environment.subs(subs)))
-    environment = control.tf([float(c) for c in sp.Poly(num, z).all_coeffs()],
-                             [float(c) for c in sp.Poly(den, z).all_coeffs()], T)
+    num, den = _substituted_coefficients(loop.environment, z,
+                                         _values_of(loop.environment, values))
+    environment = control.tf(list(num), list(den), T)
     delay = control.tf([1.0], [1.0] + [0.0] * int(values["d"]), T)
     return sampled, environment, delay
+
+
+def _values_of(expression, values):
+    """``(symbol, value, type)`` of the ``values`` that ``expression`` reads, in a fixed order.
+
+    The type too: ``1 == 1.0``, but SymPy substitutes the two differently.
+    """
+    return tuple(sorted(((symbol, values[str(symbol)], type(values[str(symbol)]))
+                         for symbol in expression.free_symbols if str(symbol) in values),
+                        key=lambda item: str(item[0])))
+
+
+@functools.lru_cache(maxsize=4096)
+def _substituted_coefficients(expression, variable, items):
+    """``(numerator, denominator)`` coefficients in ``variable`` of ``expression`` at ``items``.
+
+    SymPy's substitution, ``together`` and ``Poly``, remembered: a sampling
+    oracle asks again for the same plant at every cell of a draw and for the
+    same environment at every draw of a cell.
+    """
+    num, den = sp.fraction(sp.together(expression.subs({symbol: value
+                                                        for symbol, value, _ in items})))
+    return (tuple(float(c) for c in sp.Poly(num, variable).all_coeffs()),
+            tuple(float(c) for c in sp.Poly(den, variable).all_coeffs()))
 
 
 # --------------------------------------------------------------------------
