@@ -107,17 +107,24 @@ def bd():
 
 @pytest.fixture(scope="session")
 def derivation():
-    """derivation_steps(), built once (about 6 s)."""
+    """derivation_steps(), built once per xdist worker (about 4 s)."""
     from symstab.proof.derive import derivation_steps
 
     return derivation_steps()
 
 
 @pytest.fixture(scope="session")
-def rendered_files(derivation):
+def rendered_files(tmp_path_factory, request):
+    """``render(derivation_steps())``, ``{file name: text}``, computed once per session.
+
+    By :func:`run_once_per_session`: the worker that renders builds the
+    derivation; the other reads the texts and builds it only if one of its
+    tests asks for :func:`derivation` itself.
+    """
     from symstab.proof.derive import render
 
-    return render(derivation)
+    return run_once_per_session(tmp_path_factory, "rendered_files",
+                                lambda folder: render(request.getfixturevalue("derivation")))
 
 
 #: The file hand-edited for the drift tests, and the edit.
@@ -134,11 +141,12 @@ def run_symstab(*args, env_extra=None, cwd=None, timeout=300):
 
 
 @pytest.fixture(scope="session")
-def generated_code():
-    """codegen.generated_files(), built once."""
+def generated_code(tmp_path_factory):
+    """codegen.generated_files(), ``{file name: text}``, built once per session."""
     from symstab.codegen.generator import generated_files
 
-    return generated_files()
+    return run_once_per_session(tmp_path_factory, "generated_code",
+                                lambda folder: generated_files())
 
 
 #: The generated-code file hand-edited for the codegen drift test.
@@ -280,20 +288,32 @@ def pytest_collection_modifyitems(config, items):
 # The paper's best virtual mass (seconds a delay), read by test_region and test_design
 # --------------------------------------------------------------------------
 
+def _best_virtual_mass_once(tmp_path_factory, d):
+    """``best_virtual_mass(d=d)`` of the paper's device, searched once per session.
+
+    The search takes seconds: one xdist worker runs it, the other reads its
+    fields (JSON keeps a float's every bit) and rebuilds the same result.
+    """
+    import dataclasses
+
+    from symstab import BestVirtualMass, best_virtual_mass
+
+    fields = run_once_per_session(
+        tmp_path_factory, f"best_virtual_mass_d{d}",
+        lambda folder: dataclasses.asdict(best_virtual_mass(d=d, delta=PAPER_DELTA)))
+    return BestVirtualMass(**fields)
+
+
 @pytest.fixture(scope="session")
-def best_d0():
-    """``best_virtual_mass(d=0)`` of the paper's device, once per session (per xdist worker)."""
-    from symstab import best_virtual_mass
-
-    return best_virtual_mass(d=0, delta=PAPER_DELTA)
+def best_d0(tmp_path_factory):
+    """``best_virtual_mass(d=0)`` of the paper's device, once per session."""
+    return _best_virtual_mass_once(tmp_path_factory, 0)
 
 
 @pytest.fixture(scope="session")
-def best_d40():
-    """``best_virtual_mass(d=40)`` of the paper's device, once per session (per xdist worker)."""
-    from symstab import best_virtual_mass
-
-    return best_virtual_mass(d=40, delta=PAPER_DELTA)
+def best_d40(tmp_path_factory):
+    """``best_virtual_mass(d=40)`` of the paper's device, once per session."""
+    return _best_virtual_mass_once(tmp_path_factory, 40)
 
 
 # --------------------------------------------------------------------------
@@ -342,20 +362,25 @@ def run_cli(capsys, *args):
 
 
 @pytest.fixture(scope="session")
-def shared_cli_run():
-    """``run(*args) -> (exit status, stdout, stderr)`` of ``symstab ARGS`` in this process, once.
+def shared_cli_run(tmp_path_factory):
+    """``run(*args) -> (exit status, stdout, stderr)`` of ``symstab ARGS`` in-process, once.
 
     A command run that several tests read (a design search takes seconds)
     is run by the first test that asks for it and remembered for the
     session, keyed by its arguments; the later tests read the same output.
-    Per xdist worker, like any session fixture.
+    Once for the session, also under xdist (:func:`run_once_per_session`):
+    tests in different files that read one run may land on both workers.
     """
+    import hashlib
+
     runs = {}
 
     def run(*args):
         key = tuple(str(a) for a in args)
         if key not in runs:
-            runs[key] = _main_in_process(list(key))
+            name = "cli-run-" + hashlib.sha256("\0".join(key).encode()).hexdigest()[:16]
+            runs[key] = tuple(run_once_per_session(
+                tmp_path_factory, name, lambda folder: list(_main_in_process(list(key)))))
         return runs[key]
 
     return run

@@ -4,7 +4,8 @@ Independent of symstab's derivation:
 
 * first principles -- the paper's printed eqs. (1), (2) and (4) (believed
   correct), evaluated with mpmath: :func:`eq4_pulse_transfer_function`,
-  :func:`eq1_virtual_environment`, :func:`loop_gain_parts`,
+  :func:`eq1_virtual_environment` (and :func:`eq1_virtual_environment_tf`,
+  its coefficients as a python-control transfer function), :func:`loop_gain_parts`,
   :func:`first_principles_chi` (the loop polynomial),
   :func:`first_principles_boundary_point`, :func:`first_principles_theta_max`;
 * python-control -- :func:`python_control_closed_loop`, the closed loop of
@@ -62,6 +63,23 @@ def eq4_pulse_transfer_function(z, m, b, T, exp=sp.exp):
 def eq1_virtual_environment(z, K_w, B_w, M_w, T):
     """VE(z) as printed in the paper's eq. (1)."""
     return K_w + B_w * (z - 1) / (T * z) + M_w * (z - 1) ** 2 / (T**2 * z**2)
+
+
+def eq1_virtual_environment_tf(K_w, B_w, M_w, T):
+    """VE(z) of eq. (1) as one python-control transfer function, sample period ``T``.
+
+    Eq. (1), ``K_w + B_w (z - 1)/(T z) + M_w (z - 1)^2/(T^2 z^2)``, written
+    by hand over its common denominator ``T^2 z^2``:
+    ``((K_w T^2 + B_w T + M_w) z^2 - (B_w T + 2 M_w) z + M_w) / (T^2 z^2)``.
+    One ``control.tf`` from these coefficients costs a fraction of building
+    it by python-control's transfer-function arithmetic (a few milliseconds
+    a call, thousands of calls in the suite); ``test_oracles.py`` checks it
+    equals :func:`eq1_virtual_environment` at complex ``z``.
+    """
+    import control
+
+    numerator = [K_w * T**2 + B_w * T + M_w, -(B_w * T + 2 * M_w), M_w]
+    return control.tf(numerator, [T**2, 0.0, 0.0], T)
 
 
 def loop_gain_parts(z, d, delta):
@@ -193,8 +211,7 @@ def python_control_closed_loop(*, alpha, beta, gamma, d, delta, m, T):
     b = delta * m / T
     K_w, B_w, M_w = alpha * m / T**2, beta * m / T, gamma * m
     G = control.c2d(control.tf([1], [m, b, 0]), T, "zoh")
-    z = control.tf([1, 0], [1], T)
-    VE = eq1_virtual_environment(z, K_w, B_w, M_w, T)
+    VE = eq1_virtual_environment_tf(K_w, B_w, M_w, T)
     delay = control.tf([1], [1] + [0] * d, T)
     return control.feedback(G, VE * delay)
 
@@ -209,18 +226,39 @@ def python_control_parts(loop, values):
     import control
 
     s, z = sp.symbols("s z")
-    subs = {symbol: values[str(symbol)] for symbol in
-            loop.plant.free_symbols | loop.environment.free_symbols if str(symbol) in values}
-    num, den = sp.fraction(sp.together(loop.plant.subs(subs)))
-    plant = control.tf([float(c) for c in sp.Poly(num, s).all_coeffs()],
-                       [float(c) for c in sp.Poly(den, s).all_coeffs()])
+    num, den = _substituted_coefficients(loop.plant, s, _values_of(loop.plant, values))
+    plant = control.tf(list(num), list(den))
     T = float(values["T"])
     sampled = control.c2d(plant, T, "zoh")
-    num, den = sp.fraction(sp.together(loop.environment.subs(subs)))
-    environment = control.tf([float(c) for c in sp.Poly(num, z).all_coeffs()],
-                             [float(c) for c in sp.Poly(den, z).all_coeffs()], T)
+    num, den = _substituted_coefficients(loop.environment, z,
+                                         _values_of(loop.environment, values))
+    environment = control.tf(list(num), list(den), T)
     delay = control.tf([1.0], [1.0] + [0.0] * int(values["d"]), T)
     return sampled, environment, delay
+
+
+def _values_of(expression, values):
+    """``(symbol, value, type)`` of the ``values`` that ``expression`` reads, in a fixed order.
+
+    The type too: ``1 == 1.0``, but SymPy substitutes the two differently.
+    """
+    return tuple(sorted(((symbol, values[str(symbol)], type(values[str(symbol)]))
+                         for symbol in expression.free_symbols if str(symbol) in values),
+                        key=lambda item: str(item[0])))
+
+
+@functools.lru_cache(maxsize=4096)
+def _substituted_coefficients(expression, variable, items):
+    """``(numerator, denominator)`` coefficients in ``variable`` of ``expression`` at ``items``.
+
+    SymPy's substitution, ``together`` and ``Poly``, remembered: a sampling
+    oracle asks again for the same plant at every cell of a draw and for the
+    same environment at every draw of a cell.
+    """
+    num, den = sp.fraction(sp.together(expression.subs({symbol: value
+                                                        for symbol, value, _ in items})))
+    return (tuple(float(c) for c in sp.Poly(num, variable).all_coeffs()),
+            tuple(float(c) for c in sp.Poly(den, variable).all_coeffs()))
 
 
 # --------------------------------------------------------------------------

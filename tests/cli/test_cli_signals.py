@@ -17,8 +17,12 @@ import time
 
 import pytest
 
-#: The moments, after the command can first answer a signal, at which one is sent.
+#: The moments, after the command can first answer a signal, at which one is sent:
+#: SIGINT at the even ones, SIGTERM at the odd ones, so that every moment of the first
+#: second gets a signal and each signal comes every 0.1 s of it (20 runs, not 40).
 MOMENTS = [k / 19 for k in range(20)]
+RUNS = [(signal.SIGINT if k % 2 == 0 else signal.SIGTERM, moment)
+        for k, moment in enumerate(MOMENTS)]
 
 #: Minutes of simulation: only the signal ends it in time.
 LONG_MAP = ["map", "--delta", "0.0025", "--d", "10", "--alpha", "0,0.02,100",
@@ -67,7 +71,7 @@ def _interrupt(folder, signum, moment):
 @pytest.mark.slow
 @pytest.mark.skipif(not pathlib.Path("/proc/self/status").exists(), reason="needs Linux /proc")
 def test_a_signal_at_any_moment_ends_the_command_with_one_line(tmp_path):
-    runs = [(signum, moment) for signum in (signal.SIGINT, signal.SIGTERM) for moment in MOMENTS]
+    runs = RUNS
     folders = [tmp_path / f"{signum.name}-{i}" for i, (signum, _) in enumerate(runs)]
     for folder in folders:
         folder.mkdir()

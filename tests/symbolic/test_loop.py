@@ -84,7 +84,8 @@ def test_every_well_conditioned_root_matches_python_control(point):
     coeffs = _exact_coefficients(point)
     roots = np.roots(coeffs)
     poles = _control_poles(point)
-    # python-control's loop is not minimal: VE(z) carries an extra pole at z = 0.
+    # A loop that is not minimal (VE(z) over more powers of z than T^2 z^2) would
+    # carry extra poles at exactly z = 0: any pole beyond chi's roots must be one.
     extra = np.abs(poles) == 0
     assert extra.sum() == len(poles) - len(roots)
     poles = poles[~extra]

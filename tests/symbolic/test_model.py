@@ -10,7 +10,7 @@ from symstab.symbolic import model
 from symstab.symbolic.model import dimensionless_values
 
 from conftest import PAPER_B, PAPER_DELTA, PAPER_M, PAPER_T, assert_message_names, assert_rel_close
-from oracles import eq1_virtual_environment
+from oracles import eq1_virtual_environment, eq1_virtual_environment_tf
 
 # Symbols and blocks ---------------------------------------------------------
 
@@ -44,6 +44,17 @@ def test_virtual_environment_is_eq1():
     z, T = model.z, model.T
     printed = eq1_virtual_environment(z, model.K_w, model.B_w, model.M_w, T)
     assert sp.cancel(model.virtual_environment() - printed) == 0
+
+
+@pytest.mark.parametrize("K_w, B_w, M_w, T", [(300.0, 0.5, 0.002, 1e-3), (0.7, -0.3, 1.9, 1.0),
+                                             (2.0, 0.0, -0.5, 0.25), (1e4, 3.0, 0.0, 2.5e-4)])
+def test_python_control_virtual_environment_is_eq1(K_w, B_w, M_w, T):
+    """The oracle's VE(z) coefficients, written by hand, are the printed eq. (1) at complex z."""
+    environment = eq1_virtual_environment_tf(K_w, B_w, M_w, T)
+    assert environment.dt == T
+    for z in (0.3 + 0.8j, -1.7 + 0.2j, 0.99j, 2.5, np.exp(0.01j)):
+        expected = eq1_virtual_environment(z, K_w, B_w, M_w, T)
+        assert complex(environment(z)) == pytest.approx(expected, rel=1e-12), z
 
 
 def test_dimensionless_substitution_is_table_I():

@@ -101,8 +101,9 @@ def test_poles_are_python_controls_poles(alpha):
     loop = python_control_closed_loop(alpha=alpha, beta=0.0078125, gamma=0.0, d=40,
                                       delta=PAPER_DELTA, m=0.0128, T=1e-3)
     reference = control.poles(loop)
-    # Every pole of python-control's loop is one of the locus's; the locus
-    # has one more, at z = 0 (python-control's feedback cancels it).
+    # Every pole of python-control's loop is one of the locus's; a pole of
+    # the locus it lacks can only be at z = 0 (a transfer-function algebra
+    # that cancels z against z; the oracle's VE over T^2 z^2 keeps it).
     nearest = np.min(np.abs(reference[:, None] - path.poles[0][None, :]), axis=1)
     assert nearest.max() < 1e-4
     unmatched = np.min(np.abs(path.poles[0][:, None] - reference[None, :]), axis=1) > 1e-4

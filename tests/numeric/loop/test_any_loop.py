@@ -65,10 +65,9 @@ def test_characteristic_polynomial_keeps_d_symbolic(paper_loop):
     ours = np.sort_complex(np.roots([float(c) for c in poly.all_coeffs()]))
     oracle = python_control_closed_loop(alpha=alpha, beta=beta, gamma=gamma, d=d,
                                         delta=PAPER_B * PAPER_T / PAPER_M, m=PAPER_M, T=PAPER_T)
-    # python-control keeps a pole at 0 that its transfer-function algebra
-    # does not cancel against a zero at 0; chi has none.
-    theirs = oracle.poles()
-    theirs = np.sort_complex(theirs[np.abs(theirs) > 1e-12])
+    # VE(z) over its denominator T^2 z^2 (oracles.eq1_virtual_environment_tf):
+    # the closed loop's poles are chi's d + 4 roots, none added at 0.
+    theirs = np.sort_complex(oracle.poles())
     assert len(ours) == len(theirs) == d + 4
     np.testing.assert_allclose(ours, theirs, atol=1e-7)
 
@@ -351,7 +350,6 @@ def test_closed_loop_poles_are_the_characteristic_roots(paper_loop):
                                         gamma=0.002 / PAPER_M, d=3, delta=PAPER_B * PAPER_T / PAPER_M,
                                         m=PAPER_M, T=PAPER_T)
     theirs = oracle.poles()
-    theirs = theirs[np.abs(theirs) > 1e-12]      # python-control's uncancelled pole at 0
     np.testing.assert_allclose(np.sort_complex(cl.poles()), np.sort_complex(theirs), atol=1e-8)
 
 

@@ -25,7 +25,7 @@ from symstab.numeric.loop.files import load_loop, parse_loop_text
 from symstab.numeric.loop.quantities import check_bounds, unit_info
 
 from conftest import REPO, manual_text
-from oracles import eq1_virtual_environment
+from oracles import eq1_virtual_environment_tf
 
 pytestmark = pytest.mark.usefixtures("loop_cache_dir")
 
@@ -108,7 +108,7 @@ def test_milliseconds_match_python_controls_poles_at_a_quarter_millisecond():
     m, b, T, d = 0.0128, 0.0324, 2.5e-4, 1
     for K, B in ((300.0, 0.5), (3000.0, 2.0), (60000.0, 1.0)):
         G = control.c2d(control.tf([1], [m, b, 0]), T, "zoh")
-        VE = eq1_virtual_environment(control.tf([1, 0], [1], T), K, B, 0.0, T)
+        VE = eq1_virtual_environment_tf(K, B, 0.0, T)
         closed = control.feedback(G, VE * control.tf([1], [1] + [0] * d, T))
         expected = max(abs(p) for p in closed.poles())
         assert float(loop.spectral_radius(K=K, B=B, d=d)) == pytest.approx(expected, rel=1e-9)
