@@ -24,10 +24,12 @@ of ``1 + L``.  :func:`margins` (:meth:`symstab.Loop.margins`) gives, at one stab
   through the point along that parameter, the others fixed
   (:meth:`symstab.Loop.stable_intervals`), as distances and as factors;
 * the **delay margin** in whole samples: the smallest number of samples
-  ``k`` added to ``d`` at which the loop is no longer stable (the certified
-  verdict of :meth:`symstab.Loop.classify` at ``d + k``, ``k = 1, 2, ...``
-  up to ``delay_limit``).  A delay between whole samples needs the
-  fractional-delay derivation, which symstab does not have yet.
+  ``k`` added to ``d`` at which the loop is no longer stable: the certified
+  verdict of :meth:`symstab.Loop.classify` at ``d + k``, from the first
+  ``k`` at which a root can have reached the circle (a gain crossover's
+  phase margin used up by the delay's phase, ``k theta_c``) up to
+  ``delay_limit``.  A delay between whole samples needs the fractional-delay
+  derivation, which symstab does not have yet.
 
 The phase crossovers are found by sign changes of ``Im(N conj(D) z**-s)``
 on a grid of 32 points per period of its highest harmonic, each refined
@@ -264,14 +266,15 @@ def margins(loop, *, parameters=None, delay_limit=None, rtol=1e-9, **values):
         "rtol", rtol, low=0.0, low_open=True, high=0.5, high_open=True)))
     delayed, direct = chi.delayed.reshape(-1), chi.direct.reshape(-1)
     limit = _delay_limit(point["d"], delay_limit)
+    phase = _phase_crossings(delayed, direct, chi.shift, T)
     return Margins(
         point=point, T=T, modulus=upper, modulus_lower=lower, modulus_theta=theta,
         modulus_frequency=theta / (2 * math.pi * T),
         gain=_gain_crossings(delayed, direct, chi.shift, T),
-        phase=_phase_crossings(delayed, direct, chi.shift, T),
+        phase=phase,
         parameters=tuple(_parameter_margin(loop, name, point)
                          for name in _margin_parameters(loop, parameters)),
-        delay=_delay_margin(loop, point, limit), delay_limit=limit)
+        delay=_delay_margin(loop, point, limit, phase), delay_limit=limit)
 
 
 def _stable_point(loop, values):
@@ -422,9 +425,34 @@ def _delay_limit(d, delay_limit):
     return limit
 
 
-def _delay_margin(loop, point, limit):
-    """The smallest whole number of samples added to ``d`` at which the loop is not stable."""
-    for k in range(1, limit + 1):
+def _delay_margin(loop, point, limit, phase):
+    """The smallest whole number of samples added to ``d`` at which the loop is not stable.
+
+    On the circle ``|L z**-k| = |L|``, so a root reaches it at an added delay
+    only at a gain crossover ``theta_c``, when the delay's phase ``k theta_c``
+    has used up that crossover's phase margin ``phi_c`` (mod 2 pi).  Extended
+    to real ``k``, ``chi`` has no zero on the half circle before ``tau* = min
+    phi_c / theta_c``, and its argument change there, which counts the roots
+    inside at whole ``k``, cannot jump: every whole ``k < tau*`` is stable
+    (and with no gain crossover, every ``k``).  The certified verdicts are
+    taken from ``floor(tau*)`` on (one below, for the rounding of
+    ``tau*``), up to ``limit``.
+    """
+    first = _first_crossing_delay(phase)
+    if not math.isfinite(first):
+        return None
+    for k in range(max(1, math.floor(first)), limit + 1):
         if int(loop.classify(**{**point, "d": point["d"] + k})) != STABLE:
             return k
     return None
+
+
+def _first_crossing_delay(phase):
+    """``tau* = min phi_c / theta_c`` in samples over the gain crossovers (inf: none)."""
+    out = math.inf
+    for c in phase:
+        if c.theta <= 0:
+            continue
+        phi = math.radians(c.margin)
+        out = min(out, (phi if phi > 0 else phi + 2 * math.pi) / c.theta)
+    return out

@@ -204,6 +204,28 @@ def test_the_delay_margin_is_the_first_delay_python_control_calls_unstable(file,
     assert all(r < 1 for r in radii[:-1]) and radii[-1] >= 1
 
 
+def test_the_delay_margin_of_random_points_is_python_control_s_first_unstable_delay():
+    """The search starts where a gain crossover's phase margin is used up by the delay (every
+    whole delay before it is stable, by the argument principle): python-control's poles at
+    every delay up to the margin check that claim at random points (short delays, where
+    its poles are reliable)."""
+    loop = _paper()
+    rng = np.random.default_rng(7)
+    checked = 0
+    while checked < 12:
+        point = {**loop.defaults, "d": int(rng.integers(0, 3)), "M": 0.0,
+                 "K": float(rng.uniform(1.0, 400.0)), "B": float(rng.uniform(0.0, 2.0))}
+        if not loop.is_stable(**point):
+            continue
+        found = loop.margins(delay_limit=14, **point)
+        if found.delay is None:
+            continue
+        radii = [_radius(_open_loop(loop, {**point, "d": point["d"] + k}))
+                 for k in range(1, found.delay + 1)]
+        assert all(r < 1 for r in radii[:-1]) and radii[-1] > 1 - 1e-9, (point, radii)
+        checked += 1
+
+
 def test_a_long_delay_margin_is_decided_at_40_digits():
     """d = 10 with 43 samples of margin: at d + k ~ 50 python-control's poles lose the circle
     (a pole near z = 1: its radius at d = 49 came out 1.0024, 40 digits say 0.99914), so the
