@@ -338,7 +338,7 @@ class _ChunkBounds:
     ``spin_error`` that of the phase ``exp(j s theta)``.
     """
 
-    __slots__ = ("part", "direct", "s", "sd0", "sd1", "sd2", "sn1", "sn2",
+    __slots__ = ("part", "direct", "s", "sd0", "sd1", "sd2", "sn0", "sn1", "sn2",
                  "e_d0", "e_d1", "e_n0", "e_n1", "spin_error")
 
     def __init__(self, **fields):
@@ -374,8 +374,8 @@ def _chunk_bounds(delayed, direct, s, coefficient_ulps, near_one):
         e, err = near_one
         part = (delayed, (e / scale, err / scale),
                 2 * _U * (8 * (delayed.shape[1] + 1) + coefficient_ulps))
-    return _ChunkBounds(part=part, direct=direct, s=s, sd0=sd0, sd1=sd1, sd2=sd2, sn1=sn1,
-                        sn2=sn2, e_d0=e_d0, e_d1=e_d1, e_n0=e_n0, e_n1=e_n1,
+    return _ChunkBounds(part=part, direct=direct, s=s, sd0=sd0, sd1=sd1, sd2=sd2, sn0=sn0,
+                        sn1=sn1, sn2=sn2, e_d0=e_d0, e_d1=e_d1, e_n0=e_n0, e_n1=e_n1,
                         spin_error=spin_error)
 
 
@@ -890,10 +890,12 @@ def circle_minimum(chi, *, rtol=1e-9, coefficient_ulps=COEFFICIENT_ULPS):
     -------
     (ndarray, ndarray, ndarray)
         ``lower``, ``upper`` and the ``theta`` (rad/sample, in [0, pi])
-        where ``upper`` is attained, each of shape ``chi.shape``.
-        ``lower`` is 0 where the minimum cannot be separated from 0 (a
-        root of ``chi`` on the circle to within rounding: a marginal
-        point) or the halving gave up.
+        where ``upper`` is attained, each of shape ``chi.shape``.  Where
+        ``|chi|`` is too small beside its rounding for a bracket ``rtol``
+        wide (next to the boundary), the bracket proved is a thousand, a
+        million ... times wider (up to ``lower = 0.75 upper``); ``lower``
+        is 0 where the minimum cannot be separated from 0 at all (a root of
+        ``chi`` on the circle to within rounding: a marginal point).
 
     Examples
     --------
@@ -908,28 +910,40 @@ def circle_minimum(chi, *, rtol=1e-9, coefficient_ulps=COEFFICIENT_ULPS):
         raise ValueError(f"rtol must be in (0, 0.5), got {rtol!r}")
     shape = chi.shape
     rows = chi.flat()
+    n_arcs = max(64, 8 * max(rows.degree, 1))
     out = np.zeros((3, len(rows)))
-    for k in range(len(rows)):
-        one = rows.take(np.array([k]))
-        near_one = one.near_one
-        bounds = _chunk_bounds(one.delayed, one.direct, one.shift, coefficient_ulps, near_one)
-        out[:, k] = _row_minimum(bounds, rtol, max(64, 8 * max(rows.degree, 1)))
+    # Per row: the first grid's arcs (ten complex values each) and their halves.
+    per_row = 16 * 12 * (n_arcs + 2) * 2
+    todo = np.arange(len(rows))
+    # Next to the boundary |chi| is small beside the rounding of its value, and
+    # a bracket of width rtol cannot be proved: those rows are tried again
+    # with the bracket a thousand times wider, up to a quarter.
+    while todo.size:
+        for part in chunk_slices(todo.size, per_row, CHUNK_BYTES):
+            index = todo[part]
+            near_one = None if rows.near_one is None else tuple(x[index] for x in rows.near_one)
+            bounds = _chunk_bounds(rows.delayed[index], rows.direct[index], rows.shift,
+                                   coefficient_ulps, near_one)
+            out[:, index] = _chunk_minimum(bounds, len(index), rtol, n_arcs)
+        todo = todo[(out[0, todo] == 0) & (out[1, todo] > 0)]
+        if rtol >= 0.25:
+            break
+        rtol = min(0.25, 1e3 * rtol)
     return tuple(part.reshape(shape) for part in out)
 
 
 class _MinimumArcs:
-    """The open arcs of :func:`circle_minimum`'s row: their ends and midpoint values."""
+    """The open arcs of :func:`circle_minimum` (any row): their ends and midpoint values."""
 
-    __slots__ = ("lo", "hi", "chi", "dchi", "d", "dd", "n", "dn", "e_d")
+    __slots__ = ("row", "lo", "hi", "chi", "dchi", "d", "dd", "n", "dn", "e_d")
 
-    def __init__(self, bounds, lo, hi):
-        self.lo, self.hi = lo, hi
+    def __init__(self, bounds, row, lo, hi):
+        self.row, self.lo, self.hi = row, lo, hi
         mid = 0.5 * (lo + hi)
-        rows = np.zeros(len(mid), dtype=np.int64)
         s = bounds.s
         with np.errstate(all="ignore"):
-            d_val, d_slope, self.e_d = _delayed_values(bounds.part, mid, rows)
-            n_val, n_slope = _part_values(bounds.direct, mid, rows)
+            d_val, d_slope, self.e_d = _delayed_values(bounds.part, mid, row)
+            n_val, n_slope = _part_values(bounds.direct, mid, row)
             spin = np.exp(1j * (s * mid))
             self.chi = spin * d_val + n_val
             self.dchi = 1j * (spin * (s * d_val + d_slope) + n_slope)
@@ -941,26 +955,38 @@ class _MinimumArcs:
         with np.errstate(all="ignore"):
             return np.abs(self.chi) / np.abs(self.d)
 
+    def halves(self, bounds, keep):
+        """The arcs ``keep`` halved, ``[lo, mid]`` and ``[mid, hi]``, evaluated."""
+        row, lo, hi = self.row[keep], self.lo[keep], self.hi[keep]
+        mid = 0.5 * (lo + hi)
+        return _MinimumArcs(bounds, np.concatenate([row, row]), np.concatenate([lo, mid]),
+                            np.concatenate([mid, hi]))
+
 
 def _certified(bounds, arcs, mu):
-    """Which arcs provably keep ``|chi|**2 - mu**2 |D|**2`` above 0 (second-order Taylor bound)."""
-    b, s = bounds, bounds.s
+    """Which arcs provably keep ``|chi|**2 - mu**2 |D|**2`` above 0 (second-order Taylor bound).
+
+    ``mu`` is per arc.  The bounds over an arc of ``|D|``, ``|D'|``, ``|N|``,
+    ``|N'|`` are Taylor steps from the midpoint capped by the sums, as in
+    :func:`_arcs_pass`; with them ``|F''| <= 2 (|chi'|**2 + |chi| |chi''|) + 2
+    mu**2 (|D'|**2 + |D| |D''|)`` bounds ``F = |chi|**2 - mu**2 |D|**2`` below
+    by ``F(m) - |F'(m)| h - max|F''| h**2 / 2`` minus the values' rounding.
+    """
+    b, s, r = bounds, bounds.s, arcs.row
     half = 0.5 * (arcs.hi - arcs.lo)
-    sn0 = np.sum(np.abs(b.direct), axis=1)[0]
     with np.errstate(all="ignore"):
         dm, e_dm = np.abs(arcs.d), arcs.e_d
-        d_max = np.minimum(b.sd0[0] + b.e_d0[0],
-                           dm + e_dm + half * (np.abs(arcs.dd) + b.e_d1[0] + 0.5 * half * b.sd2[0]))
-        d1_max = np.minimum(b.sd1[0], np.abs(arcs.dd) + b.e_d1[0] + half * b.sd2[0])
-        n_max = np.minimum(sn0 + b.e_n0[0],
-                           np.abs(arcs.n) + b.e_n0[0] + half * (np.abs(arcs.dn) + b.e_n1[0]
-                                                              + 0.5 * half * b.sn2[0]))
-        n1_max = np.minimum(b.sn1[0], np.abs(arcs.dn) + b.e_n1[0] + half * b.sn2[0])
+        d1_at, n1_at = np.abs(arcs.dd) + b.e_d1[r], np.abs(arcs.dn) + b.e_n1[r]
+        d_max = np.minimum(b.sd0[r] + b.e_d0[r], dm + e_dm + half * (d1_at + 0.5 * half * b.sd2[r]))
+        d1_max = np.minimum(b.sd1[r], d1_at + half * b.sd2[r])
+        n_max = np.minimum(b.sn0[r] + b.e_n0[r],
+                           np.abs(arcs.n) + b.e_n0[r] + half * (n1_at + 0.5 * half * b.sn2[r]))
+        n1_max = np.minimum(b.sn1[r], n1_at + half * b.sn2[r])
         c0, c1 = d_max + n_max, s * d_max + d1_max + n1_max
-        c2 = s * s * d_max + 2 * s * d1_max + b.sd2[0] + b.sn2[0]
-        second = 2 * (c1 * c1 + c0 * c2) + 2 * mu * mu * (d1_max * d1_max + d_max * b.sd2[0])
-        size, e_chi = np.abs(arcs.chi), (e_dm + b.e_n0[0] + (b.spin_error + 8 * _U) * dm
-                                         + 2 * _U * np.abs(arcs.n))
+        c2 = s * s * d_max + 2 * s * d1_max + b.sd2[r] + b.sn2[r]
+        second = 2 * (c1 * c1 + c0 * c2) + 2 * mu * mu * (d1_max * d1_max + d_max * b.sd2[r])
+        size = np.abs(arcs.chi)
+        e_chi = e_dm + b.e_n0[r] + (b.spin_error + 8 * _U) * dm + 2 * _U * np.abs(arcs.n)
         value = size * size - mu * mu * dm * dm
         slope = 2 * np.real(np.conj(arcs.chi) * arcs.dchi - mu * mu * np.conj(arcs.d) * arcs.dd)
         error = ((2 * size + e_chi) * e_chi + mu * mu * (2 * dm + e_dm) * e_dm
@@ -970,27 +996,46 @@ def _certified(bounds, arcs, mu):
     return np.isfinite(low) & (low > 0)
 
 
-def _row_minimum(bounds, rtol, n_arcs):
-    """``(lower, upper, theta)`` of :func:`circle_minimum` for one row's bounds."""
+def _lowered(upper, theta, arcs):
+    """``upper`` and ``theta`` per row, lowered to the arcs' smallest midpoint values."""
+    values = arcs.values()
+    finite = np.isfinite(values)
+    if not finite.any():
+        return
+    row, values = arcs.row[finite], values[finite]
+    mids = 0.5 * (arcs.lo + arcs.hi)[finite]
+    order = np.lexsort((values, row))
+    first = order[np.r_[True, row[order][1:] != row[order][:-1]]]
+    better = values[first] < upper[row[first]]
+    upper[row[first[better]]] = values[first[better]]
+    theta[row[first[better]]] = mids[first[better]]
+
+
+def _chunk_minimum(bounds, n_rows, rtol, n_arcs):
+    """``(lower, upper, theta)`` of :func:`circle_minimum` for one chunk's rows."""
     ends = np.linspace(0.0, np.pi, n_arcs + 1)
-    arcs = _MinimumArcs(bounds, ends[:-1], ends[1:])
+    every = np.arange(n_rows)
+    upper, theta = np.full(n_rows, np.inf), np.zeros(n_rows)
     # The ends of [0, pi] are candidates too (an arc's midpoint never is one).
-    edge = _MinimumArcs(bounds, np.array([0.0, np.pi]), np.array([0.0, np.pi]))
-    values = np.concatenate([arcs.values(), edge.values()])
-    angles = np.concatenate([0.5 * (arcs.lo + arcs.hi), [0.0, np.pi]])
-    best = int(np.nanargmin(values)) if np.isfinite(values).any() else 0
-    upper, theta = float(values[best]), float(angles[best])
+    _lowered(upper, theta, _MinimumArcs(bounds, np.repeat(every, 2),
+                                        np.tile([0.0, np.pi], n_rows),
+                                        np.tile([0.0, np.pi], n_rows)))
+    arcs = _MinimumArcs(bounds, np.repeat(every, n_arcs), np.tile(ends[:-1], n_rows),
+                        np.tile(ends[1:], n_rows))
+    _lowered(upper, theta, arcs)
+    lower = np.zeros(n_rows)
+    open_rows = np.ones(n_rows, dtype=bool)
     for _ in range(_MINIMUM_ROUNDS):
-        ok = _certified(bounds, arcs, upper * (1 - rtol))
-        if ok.all():
-            return upper * (1 - rtol), upper, theta
-        if (~ok).sum() > _MINIMUM_OPEN_ARCS:
+        ok = _certified(bounds, arcs, upper[arcs.row] * (1 - rtol))
+        failing = np.bincount(arcs.row[~ok], minlength=n_rows)
+        done = open_rows & (failing == 0)
+        lower[done] = upper[done] * (1 - rtol)
+        # A row whose open arcs multiply has |chi| within rounding of 0 on a
+        # stretch of the circle: no positive bound can hold (lower stays 0).
+        open_rows &= (failing > 0) & (failing <= _MINIMUM_OPEN_ARCS)
+        keep = ~ok & open_rows[arcs.row]
+        if not keep.any():
             break
-        lo, hi = arcs.lo[~ok], arcs.hi[~ok]
-        mid = 0.5 * (lo + hi)
-        arcs = _MinimumArcs(bounds, np.concatenate([lo, mid]), np.concatenate([mid, hi]))
-        values = arcs.values()
-        k = int(np.nanargmin(values)) if np.isfinite(values).any() else 0
-        if values[k] < upper:
-            upper, theta = float(values[k]), float(0.5 * (arcs.lo[k] + arcs.hi[k]))
-    return 0.0, upper, theta
+        arcs = arcs.halves(bounds, keep)
+        _lowered(upper, theta, arcs)
+    return lower, upper, theta
