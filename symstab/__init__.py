@@ -55,7 +55,7 @@ _HOMES = {
     "symbolic.loop_assembly": ("NonPhysicalPlantWarning",),
     "numeric.simulation.simulator": ("Nonidealities", "Simulation", "StabilityMap"),
     "numeric.analysis.passivity": ("PassiveRegion", "passive_region"),
-    "numeric.analysis.margins": ("Margins", "NyquistCrossing", "ParameterMargin"),
+    "numeric.analysis.margins": ("MarginMap", "Margins", "NyquistCrossing", "ParameterMargin"),
     "numeric.paper.device": ("PAPER_DEVICE", "Device"),
     "numeric.paper.curves": ("BoundaryCurve", "arc_end_angle"),
     "numeric.paper.stability": ("classify", "is_stable", "spectral_radius"),
@@ -92,7 +92,7 @@ __all__ = [
     "Nonidealities", "Simulation", "simulate", "StabilityMap", "stability_map",
     "StabilityProbability",
     "RobustRegion",
-    "Margins", "NyquistCrossing", "ParameterMargin",
+    "Margins", "NyquistCrossing", "ParameterMargin", "MarginMap",
 ]
 
 

@@ -12,7 +12,7 @@ import numpy as np
 from ._resources import MAX_DELAY_ENV, max_delay
 
 __all__ = ["check_real", "check_count", "check_delay", "check_delay_samples", "check_array",
-           "check_delta", "check_loop", "check_progress", "DELTA_MAX", "PARAMETER_MAX"]
+           "check_grid", "check_delta", "check_loop", "check_progress", "DELTA_MAX", "PARAMETER_MAX"]
 
 
 def _describe_range(low, high, low_open, high_open):
@@ -230,3 +230,18 @@ def check_progress(progress, bar=None):
         return progress
     raise TypeError(f"progress must be True, False, None or a callable taking the work done so "
                     f"far, got {type(progress).__name__}")
+
+
+def check_grid(x, y, x_values, y_values, values):
+    """The grids of a map's axes ``x`` and ``y`` as 1-D float arrays, checked.
+
+    Each must be a non-empty 1-D array of finite numbers (:func:`check_array`),
+    and an axis must not also be given a single value in ``values``.
+    """
+    x_values, y_values = check_array(x, x_values), check_array(y, y_values)
+    if x_values.ndim != 1 or y_values.ndim != 1 or not x_values.size or not y_values.size:
+        raise ValueError(f"the grids of {x} and {y} must be 1-D and not empty")
+    for name in (x, y):
+        if name in values:
+            raise TypeError(f"{name} is an axis of the map: give its grid, not a value")
+    return x_values, y_values

@@ -21,7 +21,7 @@ import numpy as np
 
 __all__ = ["Plot", "plot_region", "plot_limits", "plot_boundary", "plot_robust",
            "plot_probability", "plot_design", "plot_passive", "plot_locus", "plot_simulation",
-           "plot_map", "require_matplotlib", "pyplot", "pyplot_or_none", "png_bytes", "visible",
+           "plot_map", "plot_margin_map", "require_matplotlib", "pyplot", "pyplot_or_none", "png_bytes", "visible",
            "draw_lines", "label_log_axis", "png_of", "png_or_none", "design_figure",
            "simulated_map_figure", "loop_map_figure", "probability_map_figure", "robust_figure",
            "locus_figure",
@@ -1613,3 +1613,50 @@ def plot_map(found, ax=None, *, boundary=None):
     _map_frame(ax, xs, ys, found.x, found.y)
     ax.legend(handles=handles + drawn, loc="best", fontsize=LEGEND_SIZE, framealpha=0.9)
     return Plot(figure, ax, {"cells": [mesh], "boundary": drawn})
+
+
+def plot_margin_map(found, ax=None, *, region=None, levels=None):
+    """Draw a margin map as filled contours, a decomposition over it if given.
+
+    What :meth:`symstab.numeric.analysis.margins.MarginMap.plot` draws.
+    Points that are not stable hold NaN and are left blank.
+
+    Parameters
+    ----------
+    found : symstab.numeric.analysis.margins.MarginMap
+    ax : matplotlib.axes.Axes, optional
+        Where to draw (default: a new figure's axes).
+    region : symstab.numeric.engine.decomposition.Decomposition, optional
+        The loop's decomposition in the same plane: its curves drawn over the map.
+    levels : int or sequence of float, optional
+        The contour levels (default 10).
+
+    Returns
+    -------
+    Plot
+        Artists ``"margin"`` (the filled contours), ``"colorbar"``, ``"arc"``
+        and ``"lines"``.
+
+    Raises
+    ------
+    ImportError
+        Without matplotlib.
+    """
+    figure, ax = _axes(ax)
+    xs, ys = np.asarray(found.x_values, float), np.asarray(found.y_values, float)
+    artists = {"margin": [], "colorbar": [], "arc": [], "lines": []}
+    if np.isfinite(found.values).any():
+        filled = ax.contourf(xs, ys, found.values, levels=10 if levels is None else levels,
+                             cmap="viridis")
+        bar = figure.colorbar(filled, ax=ax)
+        bar.set_label(r"modulus margin $\min_\theta |1 + L(e^{j\theta})|$")
+        artists["margin"], artists["colorbar"] = [filled], [bar]
+    if region is not None:
+        artists["arc"], artists["lines"] = _pieces(ax, region.branches)
+        ax.legend(loc="best", fontsize=LEGEND_SIZE, framealpha=0.9)
+    ax.set_xlim(xs[0], xs[-1])
+    ax.set_ylim(ys[0], ys[-1])
+    ax.set_xlabel(found.x)
+    ax.set_ylabel(found.y)
+    ax.set_title(f"{found.margin} margin (blank: not stable)")
+    return Plot(figure, ax, artists)

@@ -44,12 +44,12 @@ import math
 import numpy as np
 
 from ..._resources import max_delay
-from ..._validate import check_count, check_real
+from ..._validate import check_count, check_grid, check_real
 from ..engine.results import html_table
 from ..engine.roots import MARGINAL, STABLE, circle_minimum
 from ..engine.search import bracketed_root
 
-__all__ = ["NyquistCrossing", "ParameterMargin", "Margins", "margins"]
+__all__ = ["NyquistCrossing", "ParameterMargin", "Margins", "margins", "MarginMap", "margin_map"]
 
 #: Points per period of the highest harmonic of the phase-crossover scan.
 _SCAN_PER_HARMONIC = 32
@@ -456,3 +456,133 @@ def _first_crossing_delay(phase):
         phi = math.radians(c.margin)
         out = min(out, (phi if phi > 0 else phi + 2 * math.pi) / c.theta)
     return out
+
+
+# --------------------------------------------------------------------------
+# Margin maps
+
+#: The margins a map can hold.
+MAP_MARGINS = ("modulus",)
+
+
+@dataclasses.dataclass(frozen=True)
+class MarginMap:
+    """A margin over a grid of a plane (:func:`margin_map`): NaN where the point is not stable.
+
+    Attributes
+    ----------
+    x, y : str
+        The plane's parameters.
+    x_values, y_values : ndarray
+        The grid's values (1-D).
+    margin : str
+        Which margin (``"modulus"``: ``min |1 + L|`` on the unit circle).
+    values : ndarray
+        The margin per point, shape ``(len(y_values), len(x_values))``; NaN
+        where the point is unstable or marginal (never a number there).
+    lower : ndarray
+        Its certified lower bound per point (NaN as ``values``).
+    codes : ndarray
+        The verdicts (:data:`~symstab.numeric.engine.roots.STABLE`, ...).
+    at : dict
+        The values of the other parameters.
+    """
+
+    x: str
+    y: str
+    x_values: np.ndarray
+    y_values: np.ndarray
+    margin: str
+    values: np.ndarray
+    lower: np.ndarray
+    codes: np.ndarray
+    at: dict
+
+    def __repr__(self):
+        stable = np.isfinite(self.values)
+        best = (f", largest {np.nanmax(self.values):.4g} at {self.x} = "
+                f"{self.x_values[np.nanargmax(self.values) % len(self.x_values)]:.4g}, "
+                f"{self.y} = {self.y_values[np.nanargmax(self.values) // len(self.x_values)]:.4g}"
+                if stable.any() else "")
+        return (f"MarginMap({self.margin} margin over {len(self.x_values)} x "
+                f"{len(self.y_values)} points of ({self.x}, {self.y}): {int(stable.sum())} "
+                f"stable{best})")
+
+    def plot(self, ax=None, *, region=None, levels=None):
+        """Draw the margin as filled contours, a decomposition over it if given.
+
+        See :func:`symstab.drawing.plot_margin_map`.
+
+        Parameters
+        ----------
+        ax : matplotlib.axes.Axes, optional
+            Where to draw (default: a new figure's axes).
+        region : symstab.numeric.engine.decomposition.Decomposition, optional
+            The loop's decomposition in the same plane (:meth:`symstab.Loop.region`).
+        levels : int or sequence of float, optional
+            The contour levels (default 10 levels).
+
+        Returns
+        -------
+        symstab.drawing.Plot
+        """
+        from ...drawing import plot_margin_map
+
+        return plot_margin_map(self, ax, region=region, levels=levels)
+
+
+def margin_map(loop, x_values, y_values, *, x=None, y=None, margin="modulus", rtol=1e-9,
+               **values):
+    """A margin at every point of a grid of a loop's plane, certified per point.
+
+    Each point is classified (:meth:`symstab.Loop.classify`); at the stable
+    ones the modulus margin ``min |1 + L|`` is certified as in
+    :func:`margins` (:func:`symstab.numeric.engine.roots.circle_minimum`,
+    all points at once); elsewhere the map holds NaN.
+
+    Parameters
+    ----------
+    loop : symstab.Loop
+        The loop.
+    x_values, y_values : array_like
+        The grid's values along ``x`` and ``y`` (1-D).
+    x, y : str, optional
+        The plane (default: the loop's :attr:`~symstab.Loop.plane`).
+    margin : str
+        ``"modulus"``.
+    rtol : float
+        The relative width of each point's certified bracket (wider next to
+        the boundary, where the rounding of chi allows no narrower one).
+    **values
+        Single values of every other parameter.
+
+    Returns
+    -------
+    MarginMap
+
+    Examples
+    --------
+    >>> from symstab import Loop
+    >>> loop = Loop("1/(m*s**2 + b*s)", "K + B*(z - 1)/(T*z)", plane=("B", "K"),
+    ...             values=dict(m=0.0128, b=0.0324, T=1e-3, d=10))
+    >>> found = margin_map(loop, [0.1, 0.2], [1.0, 50.0])
+    >>> found.values.shape, bool(np.isnan(found.values[1, 0]))
+    ((2, 2), True)
+    """
+    if margin not in MAP_MARGINS:
+        raise ValueError(f"margin must be one of {', '.join(map(repr, MAP_MARGINS))}, "
+                         f"got {margin!r}")
+    x, y = loop.plane_of(x, y)
+    xs, ys = check_grid(x, y, x_values, y_values, values)
+    rtol = check_real("rtol", rtol, low=0.0, low_open=True, high=0.5, high_open=True)
+    X, Y = np.meshgrid(xs, ys)
+    codes = np.asarray(loop.classify(**{**values, x: X, y: Y}))
+    stable = codes == STABLE
+    out = np.full((2, *X.shape), np.nan)
+    if stable.any():
+        chi = loop.polynomial(**{**values, x: X[stable], y: Y[stable]})
+        lower, upper, _ = circle_minimum(chi, rtol=rtol)
+        out[0][stable], out[1][stable] = upper, lower
+    return MarginMap(x=x, y=y, x_values=xs, y_values=ys, margin=margin, values=out[0],
+                     lower=out[1], codes=codes, at=dict(values))
+

@@ -20,7 +20,7 @@ Draws outside the bounds a loop file declares are refused by name.
 import numpy as np
 
 from ..._resources import CHUNK_BYTES, check_memory
-from ..._validate import check_array, check_delay, check_progress, check_real
+from ..._validate import check_delay, check_grid, check_progress, check_real
 from ..engine.results import StabilityProbability
 from ..engine.roots import MARGINAL, STABLE
 
@@ -156,12 +156,7 @@ def stability_probability(loop, x_values, y_values, *, x, y, uncertain, samples=
     >>> found.probability.tolist(), round(float(found.standard_error[0, 0]), 3)
     ([[0.57, 1.0]], 0.035)
     """
-    x_values, y_values = check_array(x, x_values), check_array(y, y_values)
-    if x_values.ndim != 1 or y_values.ndim != 1 or not x_values.size or not y_values.size:
-        raise ValueError(f"the grids of {x} and {y} must be 1-D and not empty")
-    for name in (x, y):
-        if name in values:
-            raise TypeError(f"{name} is an axis of the map: give its grid, not a value")
+    x_values, y_values = check_grid(x, y, x_values, y_values, values)
     draws = draw_values(loop, uncertain, samples, seed, axes=(x, y))
     for name in draws:
         if name in values:

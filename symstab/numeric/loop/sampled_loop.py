@@ -467,6 +467,14 @@ class Loop(LoopModel):
 
         return margins(self, parameters=parameters, delay_limit=delay_limit, rtol=rtol, **values)
 
+    def margin_map(self, x_values, y_values, *, x=None, y=None, margin="modulus", **values):
+        """A margin over a grid of the plane, NaN where not stable.
+
+        See :func:`symstab.numeric.analysis.margins.margin_map`."""
+        from ..analysis.margins import margin_map
+
+        return margin_map(self, x_values, y_values, x=x, y=y, margin=margin, **values)
+
     def passive_region(self, x=None, y=None, *, damping="b", x_range=None, y_range=None, **values):
         """The passive set of the environment behind the loop's delay, in the ``(x, y)`` plane.
 

@@ -33,7 +33,7 @@ import numpy as np
 from ..._progress import progress_printer
 from ..._resources import MAX_STEPS_ENV, check_memory, chunk_slices
 from ..._resources import max_steps as _max_steps_setting
-from ..._validate import check_array, check_delay, check_progress, check_real
+from ..._validate import check_delay, check_grid, check_progress, check_real
 from ..engine.results import PAPER_PLANE, PaperGridNames
 from .friction import StatePlant, stacked_spaces, substeps_of
 
@@ -1436,12 +1436,7 @@ def loop_stability_map(loop, x_values, y_values, *, x=None, y=None, steps=None, 
         ``stable`` of shape ``(len(y_values), len(x_values))``.
     """
     x, y = loop.plane_of(x, y)
-    x_values, y_values = check_array(x, x_values), check_array(y, y_values)
-    if x_values.ndim != 1 or y_values.ndim != 1:
-        raise ValueError(f"the grids of {x} and {y} must be 1-D")
-    for name in (x, y):
-        if name in values:
-            raise TypeError(f"{name} is an axis of the map: give its grid, not a value")
+    x_values, y_values = check_grid(x, y, x_values, y_values, values)
     if progress is True:
         progress = progress_printer("simulating", check_steps(
             steps, check_delay(values.get("d", loop.defaults.get("d", 0)))))

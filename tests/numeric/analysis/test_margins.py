@@ -285,3 +285,48 @@ def test_the_margins_print_and_serialise():
     assert found.gain_margin == pytest.approx(23.2043, rel=1e-5)
     assert found.phase_margin == pytest.approx(43.9345, rel=1e-5)
     assert "<table" in found._repr_html_()
+
+
+# --------------------------------------------------------------------------
+# Margin maps
+
+
+def test_a_margin_map_is_python_control_s_minimum_where_stable_and_nan_elsewhere():
+    loop = _paper()
+    xs, ys = np.linspace(-0.05, 2.0, 7), np.linspace(10.0, 600.0, 6)
+    at = dict(m=0.0128, b=0.0324, T=1e-3, M=0.0, d=2)
+    found = loop.margin_map(xs, ys, **at)
+    assert found.values.shape == (6, 7) and (found.x, found.y) == ("B", "K")
+    stable = np.isfinite(found.values)
+    assert 0 < stable.sum() < stable.size
+    for i, K in enumerate(ys):
+        for j, B in enumerate(xs):
+            point = {**loop.defaults, **at, "B": float(B), "K": float(K)}
+            L = _open_loop(loop, point)
+            if _radius(L) < 1:
+                assert found.values[i, j] == pytest.approx(_refined_minimum(L)[0], rel=1e-8)
+                assert found.lower[i, j] <= found.values[i, j]
+            else:
+                assert np.isnan(found.values[i, j]) and np.isnan(found.lower[i, j])
+
+
+def test_a_margin_map_draws_its_contours_under_the_decomposition():
+    loop = _paper()
+    at = dict(d=10, M=0.0)
+    found = loop.margin_map(np.linspace(-0.05, 0.5, 30), np.linspace(0.0, 6.0, 30), **at)
+    drawn = found.plot(region=loop.region(**at), levels=8)
+    assert drawn.artists["margin"] and drawn.artists["colorbar"] and drawn.artists["arc"]
+    assert drawn.axes.get_xlabel() == "B" and "MarginMap(modulus margin" in repr(found)
+    import matplotlib.pyplot as plt
+    plt.close(drawn.figure)
+
+
+@pytest.mark.parametrize("kwargs, exception, message", [
+    (dict(margin="delay"), ValueError, "margin must be one of 'modulus'"),
+    (dict(x_values=np.ones((2, 2))), ValueError, "must be 1-D and not empty"),
+    (dict(B=0.1), TypeError, "B is an axis of the map"),
+])
+def test_bad_margin_map_input_names_the_parameter(kwargs, exception, message):
+    args = {"x_values": [0.1, 0.2], "y_values": [1.0, 2.0], **kwargs}
+    with pytest.raises(exception, match=message):
+        _paper().margin_map(args.pop("x_values"), args.pop("y_values"), **args)
