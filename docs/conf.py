@@ -13,8 +13,8 @@ import symstab
 
 DOCS = pathlib.Path(__file__).resolve().parent
 REPO = DOCS.parent
-# docs/_ext: the command line's parser as the CLI reference renders it, and the
-# notebooks run in one shared kernel.
+# docs/_ext: the command line's parser as the CLI reference renders it, the
+# notebooks run in one shared kernel, and numpydoc's template compiled once.
 sys.path.insert(0, str(DOCS / "_ext"))
 
 project = "symstab"
@@ -28,6 +28,8 @@ extensions = [
     "sphinx.ext.autodoc",
     "sphinx.ext.autosummary",
     "numpydoc",
+    # numpydoc's docstring template compiled once per build, not once per docstring.
+    "numpydoc_template",
     "sphinx.ext.mathjax",
     # MathJax served from the site itself (the build and the pages need no network).
     "sphinx-mathjax-offline",
