@@ -6,6 +6,7 @@ names of other libraries that the docstrings mention are the only ones left
 unresolved (``nitpick_ignore_regex`` below).
 """
 
+import functools
 import pathlib
 import sys
 
@@ -144,8 +145,9 @@ autosummary_ignore_module_all = False
 # matches nothing stays a warning.
 
 
+@functools.cache
 def _lookup(path):
-    """The object a dotted path names, or None."""
+    """The object a dotted path names, or None (remembered: a build does not change modules)."""
     import importlib
 
     parts = path.split(".")
@@ -168,15 +170,17 @@ _DOCUMENTED = {}
 
 def _documented(env):
     """symstab's documented objects: full name -> entry, and id(object) -> full names."""
-    objects = {name: entry for name, entry in env.get_domain("py").objects.items()
-               if name.startswith("symstab.")}
-    if _DOCUMENTED.get("count") != len(objects):
+    # Filtered again only when the domain has changed (its size): a build asks
+    # this for every unresolved name.
+    every = env.get_domain("py").objects
+    if _DOCUMENTED.get("count") != len(every):
+        objects = {name: entry for name, entry in every.items() if name.startswith("symstab.")}
         by_id = {}
         for name in objects:
             obj = _lookup(name)
             if obj is not None:
                 by_id.setdefault(id(obj), []).append(name)
-        _DOCUMENTED.update(count=len(objects), objects=objects, by_id=by_id)
+        _DOCUMENTED.update(count=len(every), objects=objects, by_id=by_id)
     return _DOCUMENTED["objects"], _DOCUMENTED["by_id"]
 
 
