@@ -173,19 +173,20 @@ _DOCUMENTED = {}
 
 
 def _documented(env):
-    """symstab's documented objects: full name -> entry, and id(object) -> full names."""
+    """symstab's documented objects: name -> entry, id(object) -> names, last part -> names."""
     # Filtered again only when the domain has changed (its size): a build asks
     # this for every unresolved name.
     every = env.get_domain("py").objects
     if _DOCUMENTED.get("count") != len(every):
         objects = {name: entry for name, entry in every.items() if name.startswith("symstab.")}
-        by_id = {}
+        by_id, by_last = {}, {}
         for name in objects:
             obj = _lookup(name)
             if obj is not None:
                 by_id.setdefault(id(obj), []).append(name)
-        _DOCUMENTED.update(count=len(every), objects=objects, by_id=by_id)
-    return _DOCUMENTED["objects"], _DOCUMENTED["by_id"]
+            by_last.setdefault(name.rsplit(".", 1)[-1], []).append(name)
+        _DOCUMENTED.update(count=len(every), objects=objects, by_id=by_id, by_last=by_last)
+    return _DOCUMENTED["objects"], _DOCUMENTED["by_id"], _DOCUMENTED["by_last"]
 
 
 def _lists(obj, attribute):
@@ -219,7 +220,7 @@ def _page_scopes(refdoc):
 
 
 def _resolve(env, target, module, cls, page=()):
-    objects, by_id = _documented(env)
+    objects, by_id, by_last = _documented(env)
     scopes = [f"{module}.{cls}." if module and cls else None, f"{module}." if module else None,
               *page, "symstab.", ""]
     candidates = [scope + target for scope in scopes if scope is not None]
@@ -232,7 +233,8 @@ def _resolve(env, target, module, cls, page=()):
                 if n.rsplit(".", 1)[-1] == target.rsplit(".", 1)[-1] or isinstance(obj, type)]
         if obj is not None and same:
             return min(same, key=len)
-    found = [name for name in objects if name.endswith("." + target)]
+    found = [name for name in by_last.get(target.rsplit(".", 1)[-1], ())
+             if name.endswith("." + target)]
     if len(found) == 1:
         return found[0]
     owner, attribute = target.rsplit(".", 1) if "." in target else (cls, target)
