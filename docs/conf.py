@@ -6,6 +6,7 @@ names of other libraries that the docstrings mention are the only ones left
 unresolved (``nitpick_ignore_regex`` below).
 """
 
+import functools
 import pathlib
 import sys
 
@@ -13,8 +14,8 @@ import symstab
 
 DOCS = pathlib.Path(__file__).resolve().parent
 REPO = DOCS.parent
-# docs/_ext: the command line's parser as the CLI reference renders it, and the
-# notebooks run in one shared kernel.
+# docs/_ext: the command line's parser as the CLI reference renders it, the
+# notebooks run in one shared kernel, and numpydoc's template compiled once.
 sys.path.insert(0, str(DOCS / "_ext"))
 
 project = "symstab"
@@ -28,6 +29,8 @@ extensions = [
     "sphinx.ext.autodoc",
     "sphinx.ext.autosummary",
     "numpydoc",
+    # numpydoc's docstring template compiled once per build, not once per docstring.
+    "numpydoc_template",
     "sphinx.ext.mathjax",
     # MathJax served from the site itself (the build and the pages need no network).
     "sphinx-mathjax-offline",
@@ -69,6 +72,10 @@ autosummary_generate = True
 numpydoc_show_class_members = False
 numpydoc_class_members_toctree = False
 numpydoc_xref_param_type = False
+# The library's signatures are annotated; it has no ``# type:`` comment for
+# autodoc to read (reading them parses the source of every function again: about
+# a second of the build).
+autodoc_use_type_comments = False
 
 
 def _not_described_here():
@@ -142,8 +149,9 @@ autosummary_ignore_module_all = False
 # matches nothing stays a warning.
 
 
+@functools.cache
 def _lookup(path):
-    """The object a dotted path names, or None."""
+    """The object a dotted path names, or None (remembered: a build does not change modules)."""
     import importlib
 
     parts = path.split(".")
@@ -165,17 +173,20 @@ _DOCUMENTED = {}
 
 
 def _documented(env):
-    """symstab's documented objects: full name -> entry, and id(object) -> full names."""
-    objects = {name: entry for name, entry in env.get_domain("py").objects.items()
-               if name.startswith("symstab.")}
-    if _DOCUMENTED.get("count") != len(objects):
-        by_id = {}
+    """symstab's documented objects: name -> entry, id(object) -> names, last part -> names."""
+    # Filtered again only when the domain has changed (its size): a build asks
+    # this for every unresolved name.
+    every = env.get_domain("py").objects
+    if _DOCUMENTED.get("count") != len(every):
+        objects = {name: entry for name, entry in every.items() if name.startswith("symstab.")}
+        by_id, by_last = {}, {}
         for name in objects:
             obj = _lookup(name)
             if obj is not None:
                 by_id.setdefault(id(obj), []).append(name)
-        _DOCUMENTED.update(count=len(objects), objects=objects, by_id=by_id)
-    return _DOCUMENTED["objects"], _DOCUMENTED["by_id"]
+            by_last.setdefault(name.rsplit(".", 1)[-1], []).append(name)
+        _DOCUMENTED.update(count=len(every), objects=objects, by_id=by_id, by_last=by_last)
+    return _DOCUMENTED["objects"], _DOCUMENTED["by_id"], _DOCUMENTED["by_last"]
 
 
 def _lists(obj, attribute):
@@ -209,7 +220,7 @@ def _page_scopes(refdoc):
 
 
 def _resolve(env, target, module, cls, page=()):
-    objects, by_id = _documented(env)
+    objects, by_id, by_last = _documented(env)
     scopes = [f"{module}.{cls}." if module and cls else None, f"{module}." if module else None,
               *page, "symstab.", ""]
     candidates = [scope + target for scope in scopes if scope is not None]
@@ -222,7 +233,8 @@ def _resolve(env, target, module, cls, page=()):
                 if n.rsplit(".", 1)[-1] == target.rsplit(".", 1)[-1] or isinstance(obj, type)]
         if obj is not None and same:
             return min(same, key=len)
-    found = [name for name in objects if name.endswith("." + target)]
+    found = [name for name in by_last.get(target.rsplit(".", 1)[-1], ())
+             if name.endswith("." + target)]
     if len(found) == 1:
         return found[0]
     owner, attribute = target.rsplit(".", 1) if "." in target else (cls, target)
