@@ -91,7 +91,7 @@ _LOOP_ONLY = {
     "margins": ("set_values",),
     "design": ("set_values", "x", "y", "at", "over", "search_range", "delay"),
     "map": ("set_values", "x", "y", "x_range", "y_range", "simulate", "uncertain", "samples",
-            "seed"),
+            "seed", "margin"),
     "simulate": ("set_values",),
 }
 
@@ -99,6 +99,7 @@ _FLAGS = {"set_values": "--set", "x": "--x", "y": "--y", "at": "--at",
           "x_range": "--x-range", "y_range": "--y-range", "over": "--over",
           "search_range": "--range", "simulate": "--simulate", "delay": "--delay",
           "uncertain": "--uncertain", "samples": "--samples", "seed": "--seed",
+          "margin": "--margin",
           "strips": "--strips", "png": "--png"}
 
 
@@ -219,6 +220,10 @@ def add_loop_options(p, command):
                             "stable when NAME is drawn uniformly from LO:HI (its SI unit, or "
                             "the unit written after HI: --uncertain \"b=0.02:0.045 N*m*s/rad\"; "
                             "d: the whole delays LO..HI); repeatable")
+        g.add_argument("--margin", choices=("modulus",),
+                       help="instead of the classification, a margin at every stable cell: "
+                            "modulus, min|1+L| on the unit circle, certified (the other "
+                            "cells hold NaN)")
         g.add_argument("--samples", type=int, metavar="N",
                        help="draws with --uncertain (default 1000)")
         g.add_argument("--seed", type=int, metavar="S",

@@ -102,8 +102,13 @@ def run(args):
         raise ValueError("map --loop needs the grid: --x-range LOW,HIGH,N and --y-range LOW,HIGH,N")
     xs, ys = _grid(args.x_range, "--x-range"), _grid(args.y_range, "--y-range")
     out, png_path = map_outputs(args)
+    if args.uncertain is not None and args.margin is not None:
+        raise ValueError("--uncertain maps the probability of stability, --margin a margin of "
+                         "the nominal loop: give one of them")
     if args.uncertain is not None:
         return _probability(args, setup, xs, ys, out, png_path)
+    if args.margin is not None:
+        return _margin(args, setup, xs, ys, out, png_path)
     return _map(_LoopMap(args, setup, xs, ys, out, png_path))
 
 
@@ -560,6 +565,62 @@ def _probability(args, setup, xs, ys, out, png_path):
           f"{int(marginal.sum())}")
     print("wrote " + ", ".join(written))
     return 0
+
+
+def _margin(args, setup, xs, ys, out, png_path):
+    """``map --loop --margin``: a margin at every stable cell (NaN elsewhere), its file and PNG."""
+    if args.simulate:
+        raise ValueError("--margin maps a margin of the linear loop; --simulate simulates it: "
+                         "give one of them")
+    for flag, dest in _LOOP_SIMULATION_OPTIONS:
+        if getattr(args, dest) not in (None, False):
+            raise ValueError(f"{flag} is an option of the simulation: drop it with --margin")
+    check_memory(f"a map of {xs.size} x {ys.size} cells", xs.size * ys.size * _MAP_CELL_BYTES
+                 + CHUNK_BYTES)
+    print(f"map --loop --margin {args.margin}: the {args.margin} margin min|1+L| of every "
+          f"stable cell, certified (NaN where not stable)")
+    for line in setup.echo:
+        print(line)
+    found = setup.loop.margin_map(xs, ys, x=setup.x, y=setup.y, margin=args.margin,
+                                  **setup.values)
+    value, lower = found.values.T, found.lower.T
+    if out.suffix == ".npz":
+        data = _loop_npz(setup, xs, ys, setup.values, margin=value, lower=lower,
+                         code=found.codes.T)
+    else:
+        X, Y = np.meshgrid(xs, ys, indexing="ij")
+        buf = io.StringIO()
+        buf.write(f"{setup.label(setup.x)},{setup.label(setup.y)},{args.margin},lower\n")
+        for row in zip(X.ravel(), Y.ravel(), value.ravel(), lower.ravel(), strict=True):
+            buf.write(",".join(f"{v:.12g}" for v in row) + "\n")
+        data = buf.getvalue()
+    image = (png_or_none(_margin_figure, setup, found, xs, ys) if png_path is not None
+             else None)
+    write_output(out, data, "--out")
+    written = [str(out)]
+    if image is not None:
+        write_output(png_path, image, "--png")
+        written.append(str(png_path))
+    stable = np.isfinite(value)
+    if stable.any():
+        print(f"{int(stable.sum())} of {value.size} cells stable; {args.margin} margin from "
+              f"{np.nanmin(value):.4g} to {np.nanmax(value):.4g}")
+    else:
+        print(f"no stable cell among the {value.size}: the map holds NaN only")
+    print("wrote " + ", ".join(written))
+    return 0
+
+
+def _margin_figure(plt, setup, found, xs, ys):
+    """The margin map's figure: filled contours under the D-decomposition of the window."""
+    region = setup.loop.region(x=setup.x, y=setup.y, x_range=(xs[0], xs[-1]),
+                               y_range=(ys[0], ys[-1]), **setup.values)
+    drawn = found.plot(region=region)
+    labels = _axis_labels(setup)
+    drawn.axes.set_xlabel(labels["xlabel"])
+    drawn.axes.set_ylabel(labels["ylabel"])
+    drawn.axes.set_title(f"loop {setup.loop.name}: {found.margin} margin (blank: not stable)")
+    return drawn.figure
 
 
 def _probability_png(setup, found, fixed, drawn):

@@ -63,3 +63,38 @@ def test_a_point_that_is_not_one_stable_point_is_one_line_and_exit_2(capsys, arg
     status, out, err = run_cli(capsys, "margins", *args)
     assert status == 2 and out == ""
     assert err.count("\n") == 1 and message in err, err
+
+
+def test_map_margin_writes_the_library_s_map_and_its_figure(capsys, tmp_path):
+    import numpy as np
+
+    out = tmp_path / "m.npz"
+    status, printed, err = run_cli(capsys, "map", "--loop", PAPER, "--set", "d=40",
+                                   "--set", "M=0.004", "--x-range=-0.05,0.6,12",
+                                   "--y-range=0,9,10", "--margin", "modulus", "--out", out)
+    assert status == 0, err
+    assert (tmp_path / "m.png").stat().st_size > 0
+    with np.load(out) as data:
+        margin, lower = data["margin"], data["lower"]
+    found = symstab.load_loop(PAPER).margin_map(np.linspace(-0.05, 0.6, 12),
+                                                np.linspace(0, 9, 10), d=40, M=0.004)
+    # The file is (x, y), as every map file; the result is (y, x).
+    assert np.array_equal(margin, found.values.T, equal_nan=True)
+    assert np.array_equal(lower, found.lower.T, equal_nan=True)
+    assert np.isnan(margin).any() and np.isfinite(margin).any()
+    assert f"{int(np.isfinite(margin).sum())} of 120 cells stable" in printed
+
+
+@pytest.mark.parametrize("extra, message", [
+    (["--simulate"], "--margin maps a margin of the linear loop"),
+    (["--uncertain", "b=0.02:0.04"], "give one of them"),
+    (["--margin", "gain"], "invalid choice: 'gain'"),
+])
+def test_map_margin_refuses_what_it_does_not_map(capsys, tmp_path, extra, message):
+    args = ["map", "--loop", PAPER, "--x-range=0,0.2,3", "--y-range=0,2,3",
+            "--out", tmp_path / "m.csv"]
+    if "--margin" not in extra:
+        args += ["--margin", "modulus"]
+    status, out, err = run_cli(capsys, *args, *extra)
+    assert status == 2 and message in err, err
+    assert not list(tmp_path.iterdir())
