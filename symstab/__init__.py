@@ -56,6 +56,7 @@ _HOMES = {
     "numeric.simulation.simulator": ("Nonidealities", "Simulation", "StabilityMap"),
     "numeric.analysis.passivity": ("PassiveRegion", "passive_region"),
     "numeric.analysis.margins": ("MarginMap", "Margins", "NyquistCrossing", "ParameterMargin"),
+    "numeric.analysis.noise": ("ForceNoise",),
     "numeric.paper.device": ("PAPER_DEVICE", "Device"),
     "numeric.paper.curves": ("BoundaryCurve", "arc_end_angle"),
     "numeric.paper.stability": ("classify", "is_stable", "spectral_radius"),
@@ -92,7 +93,7 @@ __all__ = [
     "Nonidealities", "Simulation", "simulate", "StabilityMap", "stability_map",
     "StabilityProbability",
     "RobustRegion",
-    "Margins", "NyquistCrossing", "ParameterMargin", "MarginMap",
+    "Margins", "NyquistCrossing", "ParameterMargin", "MarginMap", "ForceNoise",
 ]
 
 

@@ -259,7 +259,7 @@ def margins(loop, *, parameters=None, delay_limit=None, rtol=1e-9, **values):
     >>> round(found.modulus, 6), round(found.modulus_frequency, 3)
     (0.739598, 19.022)
     """
-    point = _stable_point(loop, values)
+    point = stable_point(loop, values)
     chi = loop.polynomial(**point)
     T = float(point["T"])
     lower, upper, theta = (float(x) for x in circle_minimum(chi, rtol=check_real(
@@ -277,24 +277,31 @@ def margins(loop, *, parameters=None, delay_limit=None, rtol=1e-9, **values):
         delay=_delay_margin(loop, point, limit, phase), delay_limit=limit)
 
 
-def _stable_point(loop, values):
-    """The point's values (defaults filled in, single numbers), checked to be stable."""
+def stable_point(loop, values, what="margins"):
+    """The point's values (defaults filled in, single numbers), checked to be stable.
+
+    The one check of the questions asked at a stable point (``what``: the
+    margins, the force noise): an unstable or marginal point is a
+    ValueError saying which.
+    """
     point = {**loop.defaults, **values}
     missing = [name for name in loop.parameters if name not in point]
     if missing:
-        raise ValueError(f"margins need a value of every parameter: give {', '.join(missing)}")
+        raise ValueError(f"{what}: give a value of every parameter (missing: "
+                         f"{', '.join(missing)})")
     for name, value in point.items():
         if np.ndim(value) != 0:
-            raise ValueError(f"margins are computed at one point: {name} must be a single "
+            raise ValueError(f"{what} at one point: {name} must be a single "
                              f"value, got shape {np.shape(value)}")
     point = {name: (int(point[name]) if name == "d" else float(point[name]))
              for name in loop.parameters}
     code = int(loop.classify(**point))
     if code != STABLE:
-        what = ("marginal (a pole on the unit circle)" if code == MARGINAL else
+        state = ("marginal (a pole on the unit circle)" if code == MARGINAL else
                 f"unstable ({int(loop.unstable_root_counts(**point))} poles outside the unit "
                 f"circle)")
-        raise ValueError(f"margins need a stable point: the loop is {what} there")
+        need = "need" if what.endswith("s") else "needs"
+        raise ValueError(f"{what} {need} a stable point: the loop is {state} there")
     return point
 
 
@@ -467,7 +474,9 @@ MAP_MARGINS = ("modulus",)
 
 @dataclasses.dataclass(frozen=True)
 class MarginMap:
-    """A margin over a grid of a plane (:func:`margin_map`): NaN where the point is not stable.
+    """A margin over a grid of a plane: NaN where the point is not stable.
+
+    Made by :func:`symstab.numeric.analysis.margins.margin_map`.
 
     Attributes
     ----------

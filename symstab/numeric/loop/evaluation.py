@@ -562,6 +562,20 @@ class LoopEvaluation:
         num = np.concatenate([_convolve(ve_d, p_n), np.zeros(d)])
         return num, chi, float(values["T"])
 
+    def noise_path(self, given):
+        """``(Ve_n P_d, chi, Ve_n, Ve_d)`` at single values: the sensor-to-force closed loop's parts.
+
+        With the sampled position read as ``x + e``, the force is
+        ``VE z**-d (x + e)`` and ``x = -P F``, so ``F = VE z**-d / (1 + L) e``,
+        whose modulus on the circle is that of ``Ve_n P_d / chi`` (dense,
+        highest power first); ``Ve_n / Ve_d`` is the environment alone.
+        """
+        values, d, shape = self.prepare(given, scalar=self.loop.parameters)
+        chi = self.chi(values, d, shape).dense()
+        p_d = self.plant_arrays(values, shape)[1]
+        ve_n, ve_d = self.environment_arrays(values, shape)
+        return _convolve(ve_n, p_d), chi, ve_n, ve_d
+
 
 def _per_point(question, loop, values, number):
     """``question`` of the loop's root polynomial at ``values``: a ``number`` at a single point."""

@@ -128,9 +128,8 @@ class Loop(LoopModel):
         The names of the loop's parameters: the plant's and the
         environment's, then ``T`` and ``d``.
     zoh_method : str
-        How the plant's pulse transfer function was derived:
-        ``'residues'`` (symbolically) or ``'matrix exponential'``
-        (numerically, at 30 digits, once the plant's values are known).
+        ``'residues'`` (the plant's pulse transfer function derived
+        symbolically) or ``'matrix exponential'`` (numerically, at 30 digits).
     plane : (str, str) or None
         The default ``(x, y)`` plane.
     defaults : dict
@@ -138,8 +137,7 @@ class Loop(LoopModel):
     units : dict
         The SI unit of each parameter that has one, as text.
     evaluation : symstab.numeric.loop.evaluation.LoopEvaluation
-        ``chi`` and its parts in floats at values of the parameters: what
-        the loop's methods and the plane's questions compute on.
+        ``chi`` and its parts in floats: what the loop's questions compute on.
 
     Raises
     ------
@@ -466,6 +464,14 @@ class Loop(LoopModel):
         from ..analysis.margins import margins
 
         return margins(self, parameters=parameters, delay_limit=delay_limit, rtol=rtol, **values)
+
+    def force_noise(self, *, encoder_resolution, **values):
+        """The force RMS of the encoder's quantization at a stable point.
+
+        See :func:`symstab.numeric.analysis.noise.force_noise`."""
+        from ..analysis.noise import force_noise
+
+        return force_noise(self, encoder_resolution=encoder_resolution, **values)
 
     def margin_map(self, x_values, y_values, *, x=None, y=None, margin="modulus", **values):
         """A margin over a grid of the plane, NaN where not stable.

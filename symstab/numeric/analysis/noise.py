@@ -1,0 +1,148 @@
+"""What a stable point costs: the force noise of the position sensor's quantization.
+
+A haptic loop reads its position through an encoder of resolution ``q``: the
+sampled position is ``x + e`` with ``e`` the rounding error, uniform on
+``[-q/2, q/2]`` and, while the device moves across many counts a sample,
+white with variance ``q**2 / 12`` (the classical quantization-noise model;
+at rest it is neither).  The force the environment renders is ``F = VE
+z**-d (x + e)`` and the device moves by ``x = -P F``, so the error reaches
+the force through the closed loop
+
+    F_e = VE z**-d / (1 + L) e,    |VE z**-d / (1 + L)| = |Ve_n P_d / chi|
+
+on the unit circle (``chi`` the loop's characteristic polynomial), and its
+RMS is ``sigma_F = (q / sqrt(12)) ||Ve_n P_d / chi||_2``.  The H2 norm is
+exact: ``sum h[k]**2 = D**2 + C P C^T`` with ``P`` the controllability
+Gramian of a state-space realisation, ``P = A P A^T + B B^T`` (a discrete
+Lyapunov equation, :func:`scipy.linalg.solve_discrete_lyapunov`), not a
+truncated impulse response.  Beside it, the environment's own ``||VE||_2``
+(what the same noise would give with the device held still: the open loop),
+infinite for an environment with a pole on the unit circle.
+
+A higher velocity-filter cut-off raises K_max (the stable set grows) and the
+force noise: :func:`force_noise` is the cost side of that trade-off.
+"""
+
+import dataclasses
+import math
+
+import numpy as np
+
+from ..._validate import check_real
+
+__all__ = ["ForceNoise", "force_noise", "h2_norm"]
+
+
+@dataclasses.dataclass(frozen=True)
+class ForceNoise:
+    """The force noise of the encoder's quantization at a stable point.
+
+    Made by :func:`symstab.numeric.analysis.noise.force_noise`.
+
+    Attributes
+    ----------
+    point : dict
+        The parameters' values.
+    encoder_resolution : float
+        ``q``, in the position's unit.
+    sensor_rms : float
+        ``q / sqrt(12)``, the RMS of the rounding error.
+    closed_loop_gain : float
+        ``||VE z**-d / (1 + L)||_2``: the force RMS per unit RMS of sensor noise.
+    open_loop_gain : float
+        ``||VE||_2`` (inf for an environment with a pole on the circle).
+    rms : float
+        The force RMS, ``sensor_rms * closed_loop_gain`` (the force's unit).
+    open_loop_rms : float
+        ``sensor_rms * open_loop_gain``.
+    """
+
+    point: dict
+    encoder_resolution: float
+    sensor_rms: float
+    closed_loop_gain: float
+    open_loop_gain: float
+    rms: float
+    open_loop_rms: float
+
+    def __repr__(self):
+        return (f"ForceNoise(rms {self.rms:.6g} with an encoder of {self.encoder_resolution:.6g} "
+                f"(closed-loop gain {self.closed_loop_gain:.6g}; the environment alone "
+                f"{self.open_loop_rms:.6g}))")
+
+
+def h2_norm(num, den):
+    """``sqrt(sum h[k]**2)`` of a stable, proper discrete transfer function ``num / den``.
+
+    Parameters
+    ----------
+    num, den : array_like
+        Coefficients, highest power first, ``len(num) <= len(den)``.
+
+    Returns
+    -------
+    float
+        Exact up to rounding (a discrete Lyapunov equation); inf where
+        ``den`` has a root on or outside the unit circle.
+
+    Examples
+    --------
+    >>> round(h2_norm([1.0, 0.0], [1.0, -0.5]), 12)   # h[k] = 0.5**k: sum 1 / (1 - 0.25)
+    1.154700538379
+    """
+    import scipy.linalg
+    import scipy.signal
+
+    num, den = np.trim_zeros(np.asarray(num, float), "f"), np.trim_zeros(np.asarray(den, float), "f")
+    if len(num) > len(den):
+        raise ValueError("h2_norm needs a proper transfer function (deg num <= deg den)")
+    if len(den) == 1:
+        return abs(float(num[-1] / den[0])) if len(num) else 0.0
+    if np.max(np.abs(np.roots(den))) >= 1:
+        return math.inf
+    A, B, C, D = scipy.signal.tf2ss(num, den)
+    gramian = scipy.linalg.solve_discrete_lyapunov(A, B @ B.T)
+    return float(math.sqrt(max(0.0, (C @ gramian @ C.T + D @ D.T).item())))
+
+
+def force_noise(loop, *, encoder_resolution, **values):
+    """The RMS force that the encoder's quantization error renders at a stable point.
+
+    Parameters
+    ----------
+    loop : symstab.Loop
+        The loop.
+    encoder_resolution : float
+        The position quantum ``q`` (the position's unit, m or rad), > 0.
+    **values
+        A single value of every parameter (or its default), ``d`` included.
+
+    Returns
+    -------
+    ForceNoise
+
+    Raises
+    ------
+    ValueError
+        At a point that is not stable, or for a resolution that is not a
+        positive number.
+
+    Examples
+    --------
+    >>> from symstab import Loop
+    >>> loop = Loop("1/(m*s**2 + b*s)", "K + B*(z - 1)/(T*z)",
+    ...             values=dict(m=0.0128, b=0.0324, T=1e-3, d=0, K=100.0, B=1.0))
+    >>> found = force_noise(loop, encoder_resolution=2 * 3.141592653589793 / 16384)
+    >>> round(found.rms, 4), round(found.open_loop_rms, 4)
+    (0.1683, 0.1646)
+    """
+    from .margins import stable_point
+
+    q = check_real("encoder_resolution", encoder_resolution, low=0.0, low_open=True)
+    point = stable_point(loop, values, "the force noise")
+    num, chi, ve_n, ve_d = loop.evaluation.noise_path(point)
+    sensor = q / math.sqrt(12.0)
+    closed, open_ = h2_norm(num, chi), h2_norm(ve_n, ve_d)
+    return ForceNoise(point=point, encoder_resolution=q, sensor_rms=sensor,
+                      closed_loop_gain=closed, open_loop_gain=open_, rms=sensor * closed,
+                      open_loop_rms=sensor * open_)
