@@ -547,18 +547,22 @@ def poly_coeffs(expr, z):
 
 
 def is_affine(coefficients, symbols):
-    """Whether every coefficient is a polynomial of total degree <= 1 in ``symbols``."""
+    """Whether every coefficient is a polynomial of total degree <= 1 in ``symbols``.
+
+    A symbol inside a function (``exp(-b*T/m)``), under a root or in a
+    denominator makes a coefficient no polynomial in it: not affine.
+    """
     for c in coefficients:
-        c = sp.expand(c)
         if not c.has(*symbols):
             continue
+        # Poly expands ``c`` itself, and its generators are exactly ``symbols``;
+        # the ground domain EX skips the search for a smaller one (half the
+        # time, spent in construct_domain) that a degree does not depend on.
         try:
-            poly = sp.Poly(c, *symbols)
+            poly = sp.Poly(c, *symbols, domain="EX")
         except sp.PolynomialError:
             return False
-        if poly.total_degree() > 1 or any(g.has(*symbols) for g in poly.gens if g not in symbols):
-            return False
-        if any(coef.has(*symbols) for coef in poly.coeffs()):
+        if poly.total_degree() > 1 or any(coef.has(*symbols) for coef in poly.coeffs()):
             return False
     return True
 
@@ -876,8 +880,11 @@ class LoopModel:
 
     def _decide_affine(self, names):
         symbols = [self.symbols[n] for n in names]
-        if self._plant_parts is None:
-            if any(n in self.plant_names or n == "T" for n in names):
+        # P_n and P_d hold the plant's parameters and T; Ve_n and Ve_d the environment's.
+        in_plant = [n in self.plant_names or n == "T" for n in names]
+        in_environment = [n in self.environment_names for n in names]
+        if self.zoh_method != "residues":
+            if any(in_plant):
                 return False
             ve_n, ve_d = self.environment_parts
             return is_affine(ve_n + ve_d, symbols)
@@ -886,9 +893,19 @@ class LoopModel:
             # One in each block: affine only if the cross terms cancel, which
             # the slopes computed block by block would miss; refuse instead.
             return False
-        delayed, direct = self._parts
         if any(n in self.plant_names and n in self.environment_names for n in names):
             return False
+        # chi's parts are Ve_d P_d and Ve_n P_n, none of them 0: a product is
+        # affine in parameters its one factor is free of exactly when its
+        # other factor is (a square's term times the other's leading
+        # coefficient survives), so the factors decide, without the product.
+        if not any(in_plant):
+            ve_n, ve_d = self.environment_parts
+            return is_affine(ve_n + ve_d, symbols)
+        if not any(in_environment):
+            p_n, p_d = self._plant_parts
+            return is_affine(p_n + p_d, symbols)
+        delayed, direct = self._parts
         return is_affine(delayed + direct, symbols)
 
     def check_plane(self, names):
