@@ -542,8 +542,41 @@ def _parsed_rational(value, what, label, variable, other):
 
 
 def poly_coeffs(expr, z):
-    """Coefficients of a polynomial ``expr`` in ``z``, highest power first."""
-    return sp.Poly(sp.expand(expr), z).all_coeffs()
+    """Coefficients of a polynomial ``expr`` in ``z``, highest power first.
+
+    As ``sp.Poly(sp.expand(expr), z).all_coeffs()`` gives them; where that
+    would hold them in SymPy's expression domain EX anyway (see
+    :func:`_in_expression_domain`), without its search for a smaller one
+    (most of the time on a loop's parts, which hold ``exp`` of the poles).
+    """
+    expanded = sp.expand(expr)
+    if _non_polynomial(expanded):
+        coefficients = sp.Poly(expanded, z, domain=sp.EX).all_coeffs()
+        if _in_expression_domain(coefficients):
+            return coefficients
+    return sp.Poly(expanded, z).all_coeffs()
+
+
+def _non_polynomial(expr):
+    """Whether ``expr`` holds a function or a power that is not an integer one (``sqrt(2)``)."""
+    return bool(expr.atoms(sp.Function)) or any(not p.exp.is_Integer for p in expr.atoms(sp.Pow))
+
+
+def _in_expression_domain(coefficients, tries=3):
+    """True when SymPy's ``construct_domain(coefficients)`` is sure to be EX; False: not known.
+
+    For coefficients with a symbol SymPy tries a polynomial ring or a
+    fraction field over generators (the bases of the factors of their
+    numerators and denominators) and falls back to EX when two generators
+    share a symbol (``exp(-b*T/m)`` and ``m``) or one is an irrational
+    algebraic number.  The generators of a list are those of its members
+    together, so a single coefficient with a symbol that already falls back
+    to EX is a witness for the whole list.  A few of the smallest candidates
+    are tried (each try costs its ``as_numer_denom``).
+    """
+    candidates = sorted((c for c in coefficients if c.free_symbols and _non_polynomial(c)),
+                        key=lambda c: len(sp.Add.make_args(c)))
+    return any(sp.construct_domain([c])[0] == sp.EX for c in candidates[:tries])
 
 
 def is_affine(coefficients, symbols):
