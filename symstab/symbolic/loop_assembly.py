@@ -29,6 +29,7 @@ import warnings
 import mpmath
 import numpy as np
 import sympy as sp
+from sympy.polys.polyerrors import CoercionFailed
 
 from .._memo import SharedStores, method_cache, shared_property
 from .._validate import check_delay
@@ -551,7 +552,10 @@ def poly_coeffs(expr, z):
     """
     expanded = sp.expand(expr)
     if _non_polynomial(expanded):
-        coefficients = sp.Poly(expanded, z, domain=sp.EX).all_coeffs()
+        try:
+            coefficients = sp.Poly(expanded, z, domain=sp.EX).all_coeffs()
+        except CoercionFailed:    # nan or zoo: not in EX, the search below says what they are
+            coefficients = []
         if _in_expression_domain(coefficients):
             return coefficients
     return sp.Poly(expanded, z).all_coeffs()
