@@ -75,6 +75,14 @@ def written_poles(F, s=model.s):
     quartic in radicals are too large to be worth carrying, and the plant
     is discretised numerically (:func:`numeric_zoh`).
     """
+    poles = _written_poles(sp.sympify(F), s)
+    return None if poles is None else dict(poles)
+
+
+@functools.lru_cache(maxsize=64)
+def _written_poles(F, s):
+    """:func:`written_poles`, kept: a loop asks when it is built (which ZOH?) and again when it
+    derives its ZOH by residues (a factorisation over the parameters each time)."""
     _, den = sp.fraction(sp.together(F))
     _, factors = sp.factor_list(sp.expand(den), s)
     poles = {}

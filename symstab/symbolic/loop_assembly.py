@@ -29,6 +29,7 @@ import warnings
 import mpmath
 import numpy as np
 import sympy as sp
+from sympy.polys.polyerrors import CoercionFailed
 
 from .._memo import SharedStores, method_cache, shared_property
 from .._validate import check_delay
@@ -542,23 +543,63 @@ def _parsed_rational(value, what, label, variable, other):
 
 
 def poly_coeffs(expr, z):
-    """Coefficients of a polynomial ``expr`` in ``z``, highest power first."""
-    return sp.Poly(sp.expand(expr), z).all_coeffs()
+    """Coefficients of a polynomial ``expr`` in ``z``, highest power first.
+
+    As ``sp.Poly(sp.expand(expr), z).all_coeffs()`` gives them; where that
+    would hold them in SymPy's expression domain EX anyway (see
+    :func:`_in_expression_domain`), without its search for a smaller one
+    (most of the time on a loop's parts, which hold ``exp`` of the poles).
+    """
+    expanded = sp.expand(expr)
+    if _non_polynomial(expanded):
+        try:
+            coefficients = sp.Poly(expanded, z, domain=sp.EX).all_coeffs()
+        except CoercionFailed:    # nan or zoo: not in EX, the search below says what they are
+            coefficients = []
+        if _in_expression_domain(coefficients):
+            return coefficients
+    return sp.Poly(expanded, z).all_coeffs()
+
+
+def _non_polynomial(expr):
+    """Whether ``expr`` holds a function or a power that is not an integer one (``sqrt(2)``)."""
+    return bool(expr.atoms(sp.Function)) or any(not p.exp.is_Integer for p in expr.atoms(sp.Pow))
+
+
+def _in_expression_domain(coefficients, tries=3):
+    """True when SymPy's ``construct_domain(coefficients)`` is sure to be EX; False: not known.
+
+    For coefficients with a symbol SymPy tries a polynomial ring or a
+    fraction field over generators (the bases of the factors of their
+    numerators and denominators) and falls back to EX when two generators
+    share a symbol (``exp(-b*T/m)`` and ``m``) or one is an irrational
+    algebraic number.  The generators of a list are those of its members
+    together, so a single coefficient with a symbol that already falls back
+    to EX is a witness for the whole list.  A few of the smallest candidates
+    are tried (each try costs its ``as_numer_denom``).
+    """
+    candidates = sorted((c for c in coefficients if c.free_symbols and _non_polynomial(c)),
+                        key=lambda c: len(sp.Add.make_args(c)))
+    return any(sp.construct_domain([c])[0] == sp.EX for c in candidates[:tries])
 
 
 def is_affine(coefficients, symbols):
-    """Whether every coefficient is a polynomial of total degree <= 1 in ``symbols``."""
+    """Whether every coefficient is a polynomial of total degree <= 1 in ``symbols``.
+
+    A symbol inside a function (``exp(-b*T/m)``), under a root or in a
+    denominator makes a coefficient no polynomial in it: not affine.
+    """
     for c in coefficients:
-        c = sp.expand(c)
         if not c.has(*symbols):
             continue
+        # Poly expands ``c`` itself, and its generators are exactly ``symbols``;
+        # the ground domain EX skips the search for a smaller one (half the
+        # time, spent in construct_domain) that a degree does not depend on.
         try:
-            poly = sp.Poly(c, *symbols)
+            poly = sp.Poly(c, *symbols, domain="EX")
         except sp.PolynomialError:
             return False
-        if poly.total_degree() > 1 or any(g.has(*symbols) for g in poly.gens if g not in symbols):
-            return False
-        if any(coef.has(*symbols) for coef in poly.coeffs()):
+        if poly.total_degree() > 1 or any(coef.has(*symbols) for coef in poly.coeffs()):
             return False
     return True
 
@@ -876,8 +917,11 @@ class LoopModel:
 
     def _decide_affine(self, names):
         symbols = [self.symbols[n] for n in names]
-        if self._plant_parts is None:
-            if any(n in self.plant_names or n == "T" for n in names):
+        # P_n and P_d hold the plant's parameters and T; Ve_n and Ve_d the environment's.
+        in_plant = [n in self.plant_names or n == "T" for n in names]
+        in_environment = [n in self.environment_names for n in names]
+        if self.zoh_method != "residues":
+            if any(in_plant):
                 return False
             ve_n, ve_d = self.environment_parts
             return is_affine(ve_n + ve_d, symbols)
@@ -886,9 +930,19 @@ class LoopModel:
             # One in each block: affine only if the cross terms cancel, which
             # the slopes computed block by block would miss; refuse instead.
             return False
-        delayed, direct = self._parts
         if any(n in self.plant_names and n in self.environment_names for n in names):
             return False
+        # chi's parts are Ve_d P_d and Ve_n P_n, none of them 0: a product is
+        # affine in parameters its one factor is free of exactly when its
+        # other factor is (a square's term times the other's leading
+        # coefficient survives), so the factors decide, without the product.
+        if not any(in_plant):
+            ve_n, ve_d = self.environment_parts
+            return is_affine(ve_n + ve_d, symbols)
+        if not any(in_environment):
+            p_n, p_d = self._plant_parts
+            return is_affine(p_n + p_d, symbols)
+        delayed, direct = self._parts
         return is_affine(delayed + direct, symbols)
 
     def check_plane(self, names):
