@@ -44,8 +44,8 @@ import numpy as np
 from ..._generated import kernels
 from .polynomial import DelayedPolynomial
 
-__all__ = ["ArcSource", "Brackets", "CramerArc", "ClosedFormArc", "ExactPolynomial", "sine_ratio",
-           "crossing_change", "SINGULAR", "END_ANGLE", "EXACT_TERMS"]
+__all__ = ["ArcSource", "Brackets", "CramerArc", "ClosedFormArc", "RememberedArc",
+           "ExactPolynomial", "sine_ratio", "crossing_change", "SINGULAR", "END_ANGLE", "EXACT_TERMS"]
 
 #: The determinant is called singular (the arc is at infinity, x and y NaN)
 #: where it is at most this fraction of the rounding scale of its sine
@@ -593,6 +593,72 @@ class ClosedFormArc(ArcSource):
         x = np.broadcast_to(np.asarray(x, dtype=float), theta.shape).copy()
         y = np.broadcast_to(np.asarray(y, dtype=float), theta.shape).copy()
         return x, y, det
+
+
+class RememberedArc(ArcSource):
+    """An arc source that evaluates each angle once, however often it is asked for.
+
+    The decompositions of one plane in several windows
+    (:func:`symstab.numeric.loop.plane.region`) sample the same arc, each
+    from the same first grid of angles and halving many of the same
+    chords: here those angles come from the values already computed.  The
+    values are the source's own, bit for bit (a source evaluates each angle
+    on its own, whatever else is in the batch).
+
+    Parameters
+    ----------
+    source : ArcSource
+        The arc.
+
+    Examples
+    --------
+    >>> cramer = CramerArc(np.array([1.0, 0.0, 0.0]), np.array([0.0, 1.0, 0.0]),
+    ...                    np.array([0.0, 0.0, 1.0]))            # z**2 + x z + y
+    >>> arc = RememberedArc(cramer)
+    >>> x, y, det = arc(np.array([np.pi / 3, np.pi / 2]))
+    >>> x, y, det = arc(np.array([np.pi / 2]))                  # remembered
+    >>> arc.evaluated
+    2
+    """
+
+    def __init__(self, source):
+        if not isinstance(source, ArcSource):
+            raise TypeError(f"source must be an ArcSource, got {type(source).__name__}")
+        self.source = source
+        # The angles evaluated (as their bits, increasing) and (x, y, det) there.
+        self._keys = np.zeros(0, dtype=np.int64)
+        self._values = np.zeros((3, 0))
+
+    @property
+    def evaluated(self):
+        """How many distinct angles the source has evaluated."""
+        return len(self._keys)
+
+    def __call__(self, theta):
+        """``(x, y, det)`` at angles ``theta``, each of ``theta``'s shape."""
+        theta = np.asarray(theta, dtype=float)
+        flat = np.ascontiguousarray(theta.ravel())
+        # Angles are told apart by their bits (0.0 from -0.0, every NaN its own).
+        keys = flat.view(np.int64)
+        at = self._find(keys)
+        missing = at < 0
+        if missing.any():
+            new_keys, first = np.unique(keys[missing], return_index=True)
+            values = np.array(self.source(flat[missing][first]), dtype=float).reshape(3, -1)
+            keys_all = np.concatenate([self._keys, new_keys])
+            order = np.argsort(keys_all, kind="stable")
+            self._keys = keys_all[order]
+            self._values = np.concatenate([self._values, values], axis=1)[:, order]
+            at = self._find(keys)
+        x, y, det = self._values[:, at]
+        return x.reshape(theta.shape), y.reshape(theta.shape), det.reshape(theta.shape)
+
+    def _find(self, keys):
+        """The index of each key among the evaluated ones, -1 where it is not."""
+        if not len(self._keys):
+            return np.full(len(keys), -1)
+        at = np.minimum(np.searchsorted(self._keys, keys), len(self._keys) - 1)
+        return np.where(self._keys[at] == keys, at, -1)
 
 
 def _part_slope(c, z):
