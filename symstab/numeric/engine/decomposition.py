@@ -864,6 +864,10 @@ def _merged_nodes(points):
     return number[merged][inverse], unique[makers]
 
 
+#: Largest table of box comparisons :func:`_pairs_with` makes (segments chosen times all).
+_MAX_PAIRS_WITH = 4_000_000
+
+
 #: Neighbours in x compared at most, before the points of a vertical run are all merged one by one.
 _MAX_SHIFTS = 64
 
@@ -961,6 +965,25 @@ def _candidate_pairs(lo, hi):
     return i[i != j], j[i != j]
 
 
+def _pairs_with(lo, hi, among):
+    """The pairs ``i < j`` of :func:`_candidate_pairs` with ``i`` or ``j`` in the mask ``among``.
+
+    Each of the few segments in ``among`` is compared with every segment's
+    box at once; many of them are left to :func:`_candidate_pairs`.
+    """
+    n = len(lo)
+    chosen = np.flatnonzero(among)
+    if len(chosen) * n > _MAX_PAIRS_WITH:
+        return _candidate_pairs(lo, hi)
+    a, b = np.nonzero(_meet(lo[chosen, None, :], hi[chosen, None, :], lo, hi))
+    i, j = chosen[a], b
+    # Sorted and deduplicated as _candidate_pairs does it.
+    key = np.sort(np.minimum(i, j) * n + np.maximum(i, j))
+    key = key[np.r_[True, key[1:] != key[:-1]]] if len(key) else key
+    i, j = key // n, key % n
+    return i[i != j], j[i != j]
+
+
 def _lexicographic(x, y, segment, n):
     """``np.lexsort((segment, y, x))`` (``segment`` below ``n``), as one sort of one key.
 
@@ -1001,12 +1024,17 @@ def _meet(lo_a, hi_a, lo_b, hi_b):
             & (lo_a[..., 1] <= hi_b[..., 1]) & (lo_b[..., 1] <= hi_a[..., 1]))
 
 
-def _intersections(p, q, owner, position):
-    """All pairs of crossing segments: (i, j, t_i, t_j)."""
+def _intersections(p, q, owner, position, among=None):
+    """All pairs of crossing segments: (i, j, t_i, t_j), or those with a segment ``among``.
+
+    ``among`` (a mask of the segments) keeps only the pairs with at least
+    one segment in it: each pair's crossing is the one all pairs give.  The
+    ends' touches (:func:`_end_touches`) are all found either way.
+    """
     r = q - p
     lo = np.minimum(p, q) - 1e-12
     hi = np.maximum(p, q) + 1e-12
-    ii, jj = _candidate_pairs(lo, hi)
+    ii, jj = _candidate_pairs(lo, hi) if among is None else _pairs_with(lo, hi, among)
     out = []
     for part in range(0, len(ii), 1_000_000):
         i, j = ii[part:part + 1_000_000], jj[part:part + 1_000_000]
@@ -1860,19 +1888,33 @@ def _trace(base, ax, ay, ends, arc, window, fine):
     curves'.  Returns ``(polylines, branches, (p, q, owner, position),
     hits)`` of the last round.
     """
-    samples = None
+    samples, known = None, None
     arc_ends = arc(np.array([0.0, np.pi]))[:2]      # the same in every round
-    for _ in range(_CROSSING_ROUNDS):
+    for round_ in range(_CROSSING_ROUNDS):
         samples = sample_arc(arc, len(base) - 1, window.to_unit, samples, fine)
         theta, xs, ys, det = samples
         sign = np.sign(det)
         polylines, branches = _pieces(base, ax, ay, ends, arc_ends, theta, xs, ys, sign,
                                       window.to_unit, window.from_unit, window.box)
         p, q, owner, position = _segments(polylines)
-        hits = _intersections(p, q, owner, position)
-        hot = _hot_angles(hits, polylines, owner, position)
+        if round_ == _CROSSING_ROUNDS - 1:
+            hits = _intersections(p, q, owner, position)
+            break
+        if known is None:
+            hits = _intersections(p, q, owner, position)
+            hot = _hot_angles(hits, polylines, owner, position)
+        else:
+            # Two chords the last round had too crossed there as they do now:
+            # had that made an angle hot, one of them would have been split.
+            # So the hot angles are those of the pairs with a new chord.
+            new = _new_chords(polylines, owner, position, np.setdiff1d(theta, known))
+            hot = _hot_angles(_intersections(p, q, owner, position, among=new), polylines,
+                              owner, position)
+            if not hot:
+                hits = _intersections(p, q, owner, position)
         if not hot:
             break
+        known = theta
         # The angles added are evaluated by the next round's sampling, the
         # others are kept.
         hot = np.setdiff1d(hot, theta)
@@ -1881,6 +1923,18 @@ def _trace(base, ax, ay, ends, arc, window, fine):
         samples = tuple(np.concatenate([a, b])[order] for a, b in
                         zip(samples, (hot, unknown, unknown, unknown), strict=True))
     return polylines, branches, (p, q, owner, position), hits
+
+
+def _new_chords(polylines, owner, position, added):
+    """Which segments are the arc's chords with an end at one of the angles ``added``."""
+    new = np.zeros(len(owner), dtype=bool)
+    for k, (_, _, th) in enumerate(polylines):
+        if th is None:
+            continue
+        fresh = np.isin(th, added)
+        mine = np.flatnonzero(owner == k)
+        new[mine] = fresh[position[mine]] | fresh[position[mine] + 1]
+    return new
 
 
 def _hot_angles(hits, polylines, owner, position):
