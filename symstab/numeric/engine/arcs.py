@@ -154,18 +154,33 @@ def _terms(parts):
     return powers[keep].astype(np.int64), coefficients[keep]
 
 
-def _laurent(a, b):
-    """``A(z) B(1/z)`` exactly, for rows ``a``, ``b`` (highest first): ``{power: Fraction}``."""
+#: A double is an integer multiple of 2**-1074 (the smallest subnormal).
+_DOUBLE_BITS = 1074
+
+
+def _scaled(x):
+    """A double ``x`` as the integer ``x * 2**1074``, exactly."""
+    numerator, denominator = float(x).as_integer_ratio()
+    return numerator << (_DOUBLE_BITS - denominator.bit_length() + 1)
+
+
+def _laurent(a, b, exact=_exact):
+    """``A(z) B(1/z)`` exactly, for rows ``a``, ``b`` (highest first): ``{power: Fraction}``.
+
+    With ``exact=_scaled`` (rows of doubles) the values are the integers
+    ``2**2148`` times those Fractions: the same sums in integers, without
+    the Fractions' reductions.
+    """
     out = {}
     pa, pb = len(a) - 1, len(b) - 1
+    b = [(j, exact(y)) for j, y in enumerate(b) if y != 0]
     for i, x in enumerate(a):
         if x == 0:
             continue
-        for j, y in enumerate(b):
-            if y == 0:
-                continue
+        x = exact(x)
+        for j, y in b:
             k = (pa - i) - (pb - j)
-            out[k] = out.get(k, 0) + _exact(x) * _exact(y)
+            out[k] = out.get(k, 0) + x * y
     return out
 
 
@@ -198,16 +213,18 @@ def _chebyshev_in_u(k):
     return tuple(t[k]), tuple(u[k])
 
 
-def _end_series(laurent, mirror):
+def _end_series(laurent, mirror, denominator=None):
     """``Re L`` and ``Im L / sin(theta)`` of a Laurent polynomial as polynomials in ``u`` (lowest first).
 
     ``u = sin(theta / 2)**2`` (``cos theta = 1 - 2u``), or with ``mirror``
     ``u = cos(theta / 2)**2`` (``cos theta = 2u - 1``), where the
-    coefficients carry ``(-1)**k``.  Exact (Fractions), rounded once.
+    coefficients carry ``(-1)**k``.  Exact (Fractions, or integers over
+    ``denominator``), rounded once (an integer quotient is correctly
+    rounded, as a Fraction's float is).
     """
     top = max([abs(k) for k in laurent] + [0])
-    real = [fractions.Fraction(0)] * (top + 1)
-    imag = [fractions.Fraction(0)] * (top + 1)
+    real = [0] * (top + 1)
+    imag = [0] * (top + 1)
     for k in range(0, top + 1):
         plus, minus = laurent.get(k, 0), laurent.get(-k, 0)
         t, u = _chebyshev_in_u(k) if k else ([1], [])
@@ -219,6 +236,9 @@ def _end_series(laurent, mirror):
             sin_k = plus - minus
             for i, c in enumerate(u):
                 imag[i] += -flip * c * sin_k if mirror else c * sin_k
+    if denominator is not None:
+        return (np.array([c / denominator for c in real], dtype=float),
+                np.array([c / denominator for c in imag], dtype=float))
     return np.array([float(c) for c in real]), np.array([float(c) for c in imag])
 
 
@@ -409,16 +429,19 @@ class Brackets:
     def _end_forms(self, p, q):
         """The three polynomials in ``u`` of a bracket, at theta = 0 and at pi."""
         (dp, np_, s), (dq, nq, _) = p, q
+        # Rows of doubles: their products summed as integers (exactly as Fractions).
+        doubles = all(r.dtype != object for r in (dp, np_, dq, nq))
+        exact, denominator = (_scaled, 1 << (2 * _DOUBLE_BITS)) if doubles else (_exact, None)
         if s == 0:
             whole = [np.polyadd(dp, np_), np.polyadd(dq, nq)]
-            l0, c = _laurent(*whole), {}
+            l0, c = _laurent(*whole, exact=exact), {}
         else:
-            l0 = _add(_laurent(dp, dq), _laurent(np_, nq))
-            c = _add(_laurent(dp, nq), _laurent(dq, np_), -1)
+            l0 = _add(_laurent(dp, dq, exact), _laurent(np_, nq, exact))
+            c = _add(_laurent(dp, nq, exact), _laurent(dq, np_, exact), -1)
         out = []
         for mirror in (False, True):
-            g = _end_series(l0, mirror)[1]
-            cr, ci = _end_series(c, mirror)
+            g = _end_series(l0, mirror, denominator)[1]
+            cr, ci = _end_series(c, mirror, denominator)
             out.append((g, cr, ci))
         return tuple(out)
 
@@ -640,25 +663,25 @@ class RememberedArc(ArcSource):
         flat = np.ascontiguousarray(theta.ravel())
         # Angles are told apart by their bits (0.0 from -0.0, every NaN its own).
         keys = flat.view(np.int64)
-        at = self._find(keys)
-        missing = at < 0
-        if missing.any():
-            new_keys, first = np.unique(keys[missing], return_index=True)
-            values = np.array(self.source(flat[missing][first]), dtype=float).reshape(3, -1)
-            keys_all = np.concatenate([self._keys, new_keys])
-            order = np.argsort(keys_all, kind="stable")
-            self._keys = keys_all[order]
+        at, known = self._find(keys)
+        if not known.all():
+            # (An angle asked for twice in one call is evaluated twice, the same.)
+            values = np.array(self.source(flat[~known]), dtype=float).reshape(3, -1)
+            # Both runs are increasing as a rule: the stable sort merges them.
+            order = np.argsort(np.concatenate([self._keys, keys[~known]]), kind="stable")
+            self._keys = np.concatenate([self._keys, keys[~known]])[order]
             self._values = np.concatenate([self._values, values], axis=1)[:, order]
-            at = self._find(keys)
+            at, _ = self._find(keys)
         x, y, det = self._values[:, at]
         return x.reshape(theta.shape), y.reshape(theta.shape), det.reshape(theta.shape)
 
     def _find(self, keys):
-        """The index of each key among the evaluated ones, -1 where it is not."""
+        """Where each key is among the evaluated ones, and whether it is there."""
         if not len(self._keys):
-            return np.full(len(keys), -1)
-        at = np.minimum(np.searchsorted(self._keys, keys), len(self._keys) - 1)
-        return np.where(self._keys[at] == keys, at, -1)
+            return np.zeros(len(keys), dtype=np.intp), np.zeros(len(keys), dtype=bool)
+        at = np.searchsorted(self._keys, keys)
+        np.minimum(at, len(self._keys) - 1, out=at)
+        return at, self._keys[at] == keys
 
 
 def _part_slope(c, z):
