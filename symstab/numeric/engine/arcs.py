@@ -154,30 +154,27 @@ def _terms(parts):
     return powers[keep].astype(np.int64), coefficients[keep]
 
 
-#: A double is an integer multiple of 2**-1074 (the smallest subnormal).
-_DOUBLE_BITS = 1074
+def _integers(rows):
+    """Rows of exact values (doubles or Fractions) as integers over one denominator.
 
-
-def _scaled(x):
-    """A double ``x`` as the integer ``x * 2**1074``, exactly."""
-    numerator, denominator = float(x).as_integer_ratio()
-    return numerator << (_DOUBLE_BITS - denominator.bit_length() + 1)
-
-
-def _laurent(a, b, exact=_exact):
-    """``A(z) B(1/z)`` exactly, for rows ``a``, ``b`` (highest first): ``{power: Fraction}``.
-
-    With ``exact=_scaled`` (rows of doubles) the values are the integers
-    ``2**2148`` times those Fractions: the same sums in integers, without
-    the Fractions' reductions.
+    Returns ``(rows, denominator)``: Python integers ``round(value *
+    denominator)``, exactly (the denominator is the least common multiple
+    of the values' own), so sums of their products are exact without the
+    reductions a Fraction makes at each step.
     """
+    ratios = [[x.as_integer_ratio() for x in row] for row in rows]
+    denominator = math.lcm(*(d for row in ratios for _, d in row))
+    return [[n * (denominator // d) for n, d in row] for row in ratios], denominator
+
+
+def _laurent(a, b):
+    """``A(z) B(1/z)`` exactly, for rows ``a``, ``b`` of integers (highest first): ``{power: int}``."""
     out = {}
     pa, pb = len(a) - 1, len(b) - 1
-    b = [(j, exact(y)) for j, y in enumerate(b) if y != 0]
+    b = [(j, y) for j, y in enumerate(b) if y != 0]
     for i, x in enumerate(a):
         if x == 0:
             continue
-        x = exact(x)
         for j, y in b:
             k = (pa - i) - (pb - j)
             out[k] = out.get(k, 0) + x * y
@@ -213,14 +210,14 @@ def _chebyshev_in_u(k):
     return tuple(t[k]), tuple(u[k])
 
 
-def _end_series(laurent, mirror, denominator=None):
+def _end_series(laurent, mirror, denominator):
     """``Re L`` and ``Im L / sin(theta)`` of a Laurent polynomial as polynomials in ``u`` (lowest first).
 
     ``u = sin(theta / 2)**2`` (``cos theta = 1 - 2u``), or with ``mirror``
     ``u = cos(theta / 2)**2`` (``cos theta = 2u - 1``), where the
-    coefficients carry ``(-1)**k``.  Exact (Fractions, or integers over
-    ``denominator``), rounded once (an integer quotient is correctly
-    rounded, as a Fraction's float is).
+    coefficients carry ``(-1)**k``.  ``laurent``'s values are integers
+    over ``denominator``: exact, rounded once (an integer quotient is
+    correctly rounded).
     """
     top = max([abs(k) for k in laurent] + [0])
     real = [0] * (top + 1)
@@ -236,10 +233,8 @@ def _end_series(laurent, mirror, denominator=None):
             sin_k = plus - minus
             for i, c in enumerate(u):
                 imag[i] += -flip * c * sin_k if mirror else c * sin_k
-    if denominator is not None:
-        return (np.array([c / denominator for c in real], dtype=float),
-                np.array([c / denominator for c in imag], dtype=float))
-    return np.array([float(c) for c in real]), np.array([float(c) for c in imag])
+    return (np.array([c / denominator for c in real], dtype=float),
+            np.array([c / denominator for c in imag], dtype=float))
 
 
 def _two_product(a, b):
@@ -263,16 +258,17 @@ def _bracket(first, second):
     """
     (pj, p), (qk, q) = first, second
     if p.dtype == object or q.dtype == object:
-        # Exact coefficients: the sums in rational arithmetic, rounded once.
+        # Exact coefficients: the sums in integers over one denominator, rounded once.
+        (p, q), scale = _integers([[_exact(a) for a in p], [_exact(b) for b in q]])
         sums = {}
         for j, a in zip(pj.tolist(), p, strict=True):
             for k, b in zip(qk.tolist(), q, strict=True):
                 if j != k:
-                    term = _exact(a) * _exact(b)
+                    term = a * b
                     sums[abs(j - k)] = sums.get(abs(j - k), 0) + (term if j > k else -term)
         frequencies = sorted(m for m, e in sums.items() if e != 0)
         return (np.array(frequencies, dtype=float),
-                np.array([float(sums[m]) for m in frequencies], dtype=float))
+                np.array([sums[m] / (scale * scale) for m in frequencies], dtype=float))
     m = np.subtract.outer(pj, qk).ravel()
     hi, lo = _two_product(np.multiply.outer(p, np.ones_like(q)).ravel(),
                           np.multiply.outer(np.ones_like(p), q).ravel())
@@ -429,19 +425,18 @@ class Brackets:
     def _end_forms(self, p, q):
         """The three polynomials in ``u`` of a bracket, at theta = 0 and at pi."""
         (dp, np_, s), (dq, nq, _) = p, q
-        # Rows of doubles: their products summed as integers (exactly as Fractions).
-        doubles = all(r.dtype != object for r in (dp, np_, dq, nq))
-        exact, denominator = (_scaled, 1 << (2 * _DOUBLE_BITS)) if doubles else (_exact, None)
+        # The products summed exactly, as integers over one denominator.
         if s == 0:
-            whole = [np.polyadd(dp, np_), np.polyadd(dq, nq)]
-            l0, c = _laurent(*whole, exact=exact), {}
+            (p_, q_), scale = _integers([np.polyadd(dp, np_), np.polyadd(dq, nq)])
+            l0, c = _laurent(p_, q_), {}
         else:
-            l0 = _add(_laurent(dp, dq, exact), _laurent(np_, nq, exact))
-            c = _add(_laurent(dp, nq, exact), _laurent(dq, np_, exact), -1)
+            (dp, np_, dq, nq), scale = _integers([dp, np_, dq, nq])
+            l0 = _add(_laurent(dp, dq), _laurent(np_, nq))
+            c = _add(_laurent(dp, nq), _laurent(dq, np_), -1)
         out = []
         for mirror in (False, True):
-            g = _end_series(l0, mirror, denominator)[1]
-            cr, ci = _end_series(c, mirror, denominator)
+            g = _end_series(l0, mirror, scale * scale)[1]
+            cr, ci = _end_series(c, mirror, scale * scale)
             out.append((g, cr, ci))
         return tuple(out)
 
