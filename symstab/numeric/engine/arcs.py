@@ -614,14 +614,14 @@ class ClosedFormArc(ArcSource):
 
 
 class RememberedArc(ArcSource):
-    """An arc source that evaluates each angle once, however often it is asked for.
+    """An arc source that answers a batch of angles asked for again from memory.
 
     The decompositions of one plane in several windows
-    (:func:`symstab.numeric.loop.plane.region`) sample the same arc, each
-    from the same first grid of angles and halving many of the same
-    chords: here those angles come from the values already computed.  The
-    values are the source's own, bit for bit (a source evaluates each angle
-    on its own, whatever else is in the batch).
+    (:func:`symstab.numeric.loop.plane.region`) each sample the arc first at
+    the same grid of angles (:func:`symstab.numeric.engine.decomposition.sample_arc`):
+    the grid is evaluated once.  A batch is remembered whole (looking up
+    single angles costs more than the few a window's halvings share with
+    another's).
 
     Parameters
     ----------
@@ -633,50 +633,30 @@ class RememberedArc(ArcSource):
     >>> cramer = CramerArc(np.array([1.0, 0.0, 0.0]), np.array([0.0, 1.0, 0.0]),
     ...                    np.array([0.0, 0.0, 1.0]))            # z**2 + x z + y
     >>> arc = RememberedArc(cramer)
-    >>> x, y, det = arc(np.array([np.pi / 3, np.pi / 2]))
-    >>> x, y, det = arc(np.array([np.pi / 2]))                  # remembered
+    >>> first = arc(np.array([np.pi / 3, np.pi / 2]))
+    >>> again = arc(np.array([np.pi / 3, np.pi / 2]))            # remembered
     >>> arc.evaluated
-    2
+    1
     """
 
     def __init__(self, source):
         if not isinstance(source, ArcSource):
             raise TypeError(f"source must be an ArcSource, got {type(source).__name__}")
         self.source = source
-        # The angles evaluated (as their bits, increasing) and (x, y, det) there.
-        self._keys = np.zeros(0, dtype=np.int64)
-        self._values = np.zeros((3, 0))
+        self._batches = {}
 
     @property
     def evaluated(self):
-        """How many distinct angles the source has evaluated."""
-        return len(self._keys)
+        """How many batches the source has evaluated."""
+        return len(self._batches)
 
     def __call__(self, theta):
-        """``(x, y, det)`` at angles ``theta``, each of ``theta``'s shape."""
+        """``(x, y, det)`` at angles ``theta``, each of ``theta``'s shape (new arrays)."""
         theta = np.asarray(theta, dtype=float)
-        flat = np.ascontiguousarray(theta.ravel())
-        # Angles are told apart by their bits (0.0 from -0.0, every NaN its own).
-        keys = flat.view(np.int64)
-        at, known = self._find(keys)
-        if not known.all():
-            # (An angle asked for twice in one call is evaluated twice, the same.)
-            values = np.array(self.source(flat[~known]), dtype=float).reshape(3, -1)
-            # Both runs are increasing as a rule: the stable sort merges them.
-            order = np.argsort(np.concatenate([self._keys, keys[~known]]), kind="stable")
-            self._keys = np.concatenate([self._keys, keys[~known]])[order]
-            self._values = np.concatenate([self._values, values], axis=1)[:, order]
-            at, _ = self._find(keys)
-        x, y, det = self._values[:, at]
-        return x.reshape(theta.shape), y.reshape(theta.shape), det.reshape(theta.shape)
-
-    def _find(self, keys):
-        """Where each key is among the evaluated ones, and whether it is there."""
-        if not len(self._keys):
-            return np.zeros(len(keys), dtype=np.intp), np.zeros(len(keys), dtype=bool)
-        at = np.searchsorted(self._keys, keys)
-        np.minimum(at, len(self._keys) - 1, out=at)
-        return at, self._keys[at] == keys
+        key = (theta.shape, theta.tobytes())
+        if key not in self._batches:
+            self._batches[key] = tuple(np.array(v, dtype=float) for v in self.source(theta))
+        return tuple(v.copy() for v in self._batches[key])
 
 
 def _part_slope(c, z):
