@@ -656,11 +656,15 @@ def sample_arc(arc, n, to_unit, samples=None, fine=1.0):
         lo_v, hi_v = np.minimum(v[1:], v[:-1]), np.maximum(v[1:], v[:-1])
         near = both & (hi_u > -0.5) & (lo_u < 1.5) & (hi_v > -0.5) & (lo_v < 1.5)
         split = near & (length > _CHORD * fine)
-        # A sharp turn between two chords near the window: refine both.
+        # A sharp turn between two chords near the window: refine both.  (The
+        # headings only of the chords near it: the arc may run far beyond it.)
+        pair = np.flatnonzero(near[1:] & near[:-1])
+        angle = np.zeros(len(du))
         with np.errstate(invalid="ignore", divide="ignore"):
-            angle = np.arctan2(dv, du)
-            turn = np.abs(np.angle(np.exp(1j * np.diff(angle))))
-        sharp = near[1:] & near[:-1] & (turn > _TURN) & (length[1:] + length[:-1] > _TURN_FLOOR * fine**2)
+            angle[near] = np.arctan2(dv[near], du[near])
+            turn = np.abs(np.angle(np.exp(1j * (angle[pair + 1] - angle[pair]))))
+        sharp = np.zeros(max(len(near) - 1, 0), dtype=bool)
+        sharp[pair] = (turn > _TURN) & (length[pair + 1] + length[pair] > _TURN_FLOOR * fine**2)
         split[1:] |= sharp
         split[:-1] |= sharp
         # Through infinity, or into a singular point: follow it closer.
