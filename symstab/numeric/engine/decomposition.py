@@ -1147,20 +1147,36 @@ def _inside(poly, x, y):
     return inside
 
 
-def _inside_intervals(sides, value, axis):
-    """The inside intervals of the line ``axis-coordinate = value`` through the rings.
+def _inside_intervals(sides, values, axis):
+    """The inside intervals of the lines ``axis-coordinate = value`` through the rings, per value.
 
-    ``sides`` holds each ring's ``(ring, ring rolled by one)``: its sides' two ends.
+    ``sides`` holds each ring's ``(ring, ring rolled by one)``: its sides' two
+    ends.  All the lines at once (each crossing computed as for one line).
     """
+    values = np.asarray(values, dtype=float)
     other = 1 - axis
-    cuts = []
+    line, cuts = [], []
     for a, b in sides:
-        crosses = (a[:, axis] > value) != (b[:, axis] > value)
-        a, b = a[crosses], b[crosses]
-        cuts.append(a[:, other] + (value - a[:, axis]) * (b[:, other] - a[:, other])
-                    / (b[:, axis] - a[:, axis]))
-    cuts = np.sort(np.concatenate(cuts)) if cuts else np.zeros(0)
-    return cuts.reshape(-1, 2) if len(cuts) % 2 == 0 else np.zeros((0, 2))
+        crosses = (a[None, :, axis] > values[:, None]) != (b[None, :, axis] > values[:, None])
+        row, side = np.nonzero(crosses)
+        a_, b_ = a[side], b[side]
+        line.append(row)
+        cuts.append(a_[:, other] + (values[row] - a_[:, axis]) * (b_[:, other] - a_[:, other])
+                    / (b_[:, axis] - a_[:, axis]))
+    line = np.concatenate(line) if line else np.zeros(0, dtype=np.intp)
+    cuts = np.concatenate(cuts) if cuts else np.zeros(0)
+    order = np.lexsort((cuts, line))
+    line, cuts = line[order], cuts[order]
+    bounds = np.searchsorted(line, np.arange(len(values) + 1))
+    out = []
+    for start, stop in zip(bounds[:-1].tolist(), bounds[1:].tolist(), strict=True):
+        mine = cuts[start:stop]
+        out.append(mine.reshape(-1, 2) if len(mine) % 2 == 0 else np.zeros((0, 2)))
+    return out
+
+
+#: The heights, as fractions of a polygon's, of the lines :func:`_interior_point` tries, in turn.
+_PROBES = (0.5, 0.25, 0.75, 0.125, 0.375, 0.625, 0.875, 0.0625, 0.9375, 0.03125, 0.96875)
 
 
 def _interior_point(rings):
@@ -1169,16 +1185,16 @@ def _interior_point(rings):
     v0, v1 = outer[:, 1].min(), outer[:, 1].max()
     best, best_width = None, -1.0
     sides = [(ring, np.roll(ring, -1, axis=0)) for ring in rings]
-    for f in (0.5, 0.25, 0.75, 0.125, 0.375, 0.625, 0.875, 0.0625, 0.9375, 0.03125, 0.96875):
-        v = v0 + f * (v1 - v0)
-        for lo, hi in _inside_intervals(sides, v, 1):
+    heights = [v0 + f * (v1 - v0) for f in _PROBES]
+    for v, intervals in zip(heights, _inside_intervals(sides, heights, 1), strict=True):
+        for lo, hi in intervals:
             if hi - lo > best_width:
                 best, best_width = (0.5 * (lo + hi), v), hi - lo
     if best is None:
         return None
     # Centre it vertically too, on the vertical line through it.
     u = best[0]
-    spans = _inside_intervals(sides, u, 0)
+    spans = _inside_intervals(sides, [u], 0)[0]
     for lo, hi in spans:
         if lo <= best[1] <= hi:
             return (u, 0.5 * (lo + hi))
