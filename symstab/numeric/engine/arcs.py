@@ -415,7 +415,7 @@ class Brackets:
             # Per end, a row per power of u: the forms' coefficients, then their
             # moduli (one Horner's scheme evaluates both).
             flat = self._ends.reshape(2, 3 * len(series), size)
-            self._horner = [np.ascontiguousarray(np.concatenate([f, np.abs(f)]).T) for f in flat]
+            self._horner = np.stack([np.concatenate([f, np.abs(f)]).T for f in flat])
 
     @property
     def frequencies(self):
@@ -453,15 +453,23 @@ class Brackets:
         return value, scale
 
     def _at_end(self, theta, mirror):
-        """The brackets by their polynomials in u, and their rounding scales: both (M, k)."""
+        """The brackets by their polynomials in u, and their rounding scales: both (M, k).
+
+        ``mirror`` (one per angle) says which end's polynomials: at ``pi``
+        rather than at 0.  Both ends are evaluated in one pass, each angle
+        with its own end's coefficients.
+        """
         k = len(self.pairs)
         half = 0.5 * np.where(mirror, (np.pi - theta) + _PI_LOW, theta)
         u = np.sin(half) ** 2
         # Horner's scheme on an (M, 6 k) array, the values and their scales
         # side by side: a matrix product this skinny costs more in BLAS's
         # threads than it computes.
-        rows = self._horner[1 if mirror else 0]
-        both = np.zeros((len(u), rows.shape[1]))
+        if mirror.all() or not mirror.any():
+            rows = self._horner[int(mirror[0])]
+        else:
+            rows = self._horner[mirror.astype(np.intp)].transpose(1, 0, 2)
+        both = np.zeros((len(u), rows.shape[-1]))
         column = u[:, None]
         for row in rows[::-1]:
             both *= column
@@ -496,14 +504,12 @@ class Brackets:
                 value[part], scale[part] = self._middle(t)
                 continue
             v, c = np.empty((len(t), k)), np.empty((len(t), k))
-            low = t < END_ANGLE
             high = t > np.pi - END_ANGLE
-            middle = ~low & ~high
-            for where, evaluate in ((low, lambda x: self._at_end(x, False)),
-                                    (high, lambda x: self._at_end(x, True)),
-                                    (middle, self._middle)):
-                if where.any():
-                    v[where], c[where] = evaluate(t[where])
+            end = (t < END_ANGLE) | high
+            if end.any():
+                v[end], c[end] = self._at_end(t[end], high[end])
+            if not end.all():
+                v[~end], c[~end] = self._middle(t[~end])
             value[part], scale[part] = v, c
         return value, scale
 
