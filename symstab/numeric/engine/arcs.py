@@ -45,7 +45,8 @@ from ..._generated import kernels
 from .polynomial import DelayedPolynomial
 
 __all__ = ["ArcSource", "Brackets", "CramerArc", "ClosedFormArc", "RememberedArc",
-           "ExactPolynomial", "sine_ratio", "crossing_change", "SINGULAR", "END_ANGLE", "EXACT_TERMS"]
+           "ExactPolynomial", "sine_ratio", "crossing_change", "SINGULAR", "END_ANGLE",
+           "EXACT_TERMS"]
 
 #: The determinant is called singular (the arc is at infinity, x and y NaN)
 #: where it is at most this fraction of the rounding scale of its sine
@@ -168,7 +169,7 @@ def _integers(rows):
 
 
 def _laurent(a, b):
-    """``A(z) B(1/z)`` exactly, for rows ``a``, ``b`` of integers (highest first): ``{power: int}``."""
+    """``A(z) B(1/z)`` exactly, for integer rows ``a``, ``b`` (highest first): ``{power: int}``."""
     out = {}
     pa, pb = len(a) - 1, len(b) - 1
     b = [(j, y) for j, y in enumerate(b) if y != 0]
