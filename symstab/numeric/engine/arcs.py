@@ -44,8 +44,9 @@ import numpy as np
 from ..._generated import kernels
 from .polynomial import DelayedPolynomial
 
-__all__ = ["ArcSource", "Brackets", "CramerArc", "ClosedFormArc", "ExactPolynomial", "sine_ratio",
-           "crossing_change", "SINGULAR", "END_ANGLE", "EXACT_TERMS"]
+__all__ = ["ArcSource", "Brackets", "CramerArc", "ClosedFormArc", "RememberedArc",
+           "ExactPolynomial", "sine_ratio", "crossing_change", "SINGULAR", "END_ANGLE",
+           "EXACT_TERMS"]
 
 #: The determinant is called singular (the arc is at infinity, x and y NaN)
 #: where it is at most this fraction of the rounding scale of its sine
@@ -154,18 +155,30 @@ def _terms(parts):
     return powers[keep].astype(np.int64), coefficients[keep]
 
 
+def _integers(rows):
+    """Rows of exact values (doubles or Fractions) as integers over one denominator.
+
+    Returns ``(rows, denominator)``: Python integers ``round(value *
+    denominator)``, exactly (the denominator is the least common multiple
+    of the values' own), so sums of their products are exact without the
+    reductions a Fraction makes at each step.
+    """
+    ratios = [[x.as_integer_ratio() for x in row] for row in rows]
+    denominator = math.lcm(*(d for row in ratios for _, d in row))
+    return [[n * (denominator // d) for n, d in row] for row in ratios], denominator
+
+
 def _laurent(a, b):
-    """``A(z) B(1/z)`` exactly, for rows ``a``, ``b`` (highest first): ``{power: Fraction}``."""
+    """``A(z) B(1/z)`` exactly, for integer rows ``a``, ``b`` (highest first): ``{power: int}``."""
     out = {}
     pa, pb = len(a) - 1, len(b) - 1
+    b = [(j, y) for j, y in enumerate(b) if y != 0]
     for i, x in enumerate(a):
         if x == 0:
             continue
-        for j, y in enumerate(b):
-            if y == 0:
-                continue
+        for j, y in b:
             k = (pa - i) - (pb - j)
-            out[k] = out.get(k, 0) + _exact(x) * _exact(y)
+            out[k] = out.get(k, 0) + x * y
     return out
 
 
@@ -198,16 +211,18 @@ def _chebyshev_in_u(k):
     return tuple(t[k]), tuple(u[k])
 
 
-def _end_series(laurent, mirror):
+def _end_series(laurent, mirror, denominator):
     """``Re L`` and ``Im L / sin(theta)`` of a Laurent polynomial as polynomials in ``u`` (lowest first).
 
     ``u = sin(theta / 2)**2`` (``cos theta = 1 - 2u``), or with ``mirror``
     ``u = cos(theta / 2)**2`` (``cos theta = 2u - 1``), where the
-    coefficients carry ``(-1)**k``.  Exact (Fractions), rounded once.
+    coefficients carry ``(-1)**k``.  ``laurent``'s values are integers
+    over ``denominator``: exact, rounded once (an integer quotient is
+    correctly rounded).
     """
     top = max([abs(k) for k in laurent] + [0])
-    real = [fractions.Fraction(0)] * (top + 1)
-    imag = [fractions.Fraction(0)] * (top + 1)
+    real = [0] * (top + 1)
+    imag = [0] * (top + 1)
     for k in range(0, top + 1):
         plus, minus = laurent.get(k, 0), laurent.get(-k, 0)
         t, u = _chebyshev_in_u(k) if k else ([1], [])
@@ -219,7 +234,8 @@ def _end_series(laurent, mirror):
             sin_k = plus - minus
             for i, c in enumerate(u):
                 imag[i] += -flip * c * sin_k if mirror else c * sin_k
-    return np.array([float(c) for c in real]), np.array([float(c) for c in imag])
+    return (np.array([c / denominator for c in real], dtype=float),
+            np.array([c / denominator for c in imag], dtype=float))
 
 
 def _two_product(a, b):
@@ -243,16 +259,17 @@ def _bracket(first, second):
     """
     (pj, p), (qk, q) = first, second
     if p.dtype == object or q.dtype == object:
-        # Exact coefficients: the sums in rational arithmetic, rounded once.
+        # Exact coefficients: the sums in integers over one denominator, rounded once.
+        (p, q), scale = _integers([[_exact(a) for a in p], [_exact(b) for b in q]])
         sums = {}
         for j, a in zip(pj.tolist(), p, strict=True):
             for k, b in zip(qk.tolist(), q, strict=True):
                 if j != k:
-                    term = _exact(a) * _exact(b)
+                    term = a * b
                     sums[abs(j - k)] = sums.get(abs(j - k), 0) + (term if j > k else -term)
         frequencies = sorted(m for m, e in sums.items() if e != 0)
         return (np.array(frequencies, dtype=float),
-                np.array([float(sums[m]) for m in frequencies], dtype=float))
+                np.array([sums[m] / (scale * scale) for m in frequencies], dtype=float))
     m = np.subtract.outer(pj, qk).ravel()
     hi, lo = _two_product(np.multiply.outer(p, np.ones_like(q)).ravel(),
                           np.multiply.outer(np.ones_like(p), q).ravel())
@@ -399,7 +416,7 @@ class Brackets:
             # Per end, a row per power of u: the forms' coefficients, then their
             # moduli (one Horner's scheme evaluates both).
             flat = self._ends.reshape(2, 3 * len(series), size)
-            self._horner = [np.ascontiguousarray(np.concatenate([f, np.abs(f)]).T) for f in flat]
+            self._horner = np.stack([np.concatenate([f, np.abs(f)]).T for f in flat])
 
     @property
     def frequencies(self):
@@ -409,16 +426,18 @@ class Brackets:
     def _end_forms(self, p, q):
         """The three polynomials in ``u`` of a bracket, at theta = 0 and at pi."""
         (dp, np_, s), (dq, nq, _) = p, q
+        # The products summed exactly, as integers over one denominator.
         if s == 0:
-            whole = [np.polyadd(dp, np_), np.polyadd(dq, nq)]
-            l0, c = _laurent(*whole), {}
+            (p_, q_), scale = _integers([np.polyadd(dp, np_), np.polyadd(dq, nq)])
+            l0, c = _laurent(p_, q_), {}
         else:
+            (dp, np_, dq, nq), scale = _integers([dp, np_, dq, nq])
             l0 = _add(_laurent(dp, dq), _laurent(np_, nq))
             c = _add(_laurent(dp, nq), _laurent(dq, np_), -1)
         out = []
         for mirror in (False, True):
-            g = _end_series(l0, mirror)[1]
-            cr, ci = _end_series(c, mirror)
+            g = _end_series(l0, mirror, scale * scale)[1]
+            cr, ci = _end_series(c, mirror, scale * scale)
             out.append((g, cr, ci))
         return tuple(out)
 
@@ -435,15 +454,23 @@ class Brackets:
         return value, scale
 
     def _at_end(self, theta, mirror):
-        """The brackets by their polynomials in u, and their rounding scales: both (M, k)."""
+        """The brackets by their polynomials in u, and their rounding scales: both (M, k).
+
+        ``mirror`` (one per angle) says which end's polynomials: at ``pi``
+        rather than at 0.  Both ends are evaluated in one pass, each angle
+        with its own end's coefficients.
+        """
         k = len(self.pairs)
         half = 0.5 * np.where(mirror, (np.pi - theta) + _PI_LOW, theta)
         u = np.sin(half) ** 2
         # Horner's scheme on an (M, 6 k) array, the values and their scales
         # side by side: a matrix product this skinny costs more in BLAS's
         # threads than it computes.
-        rows = self._horner[1 if mirror else 0]
-        both = np.zeros((len(u), rows.shape[1]))
+        if mirror.all() or not mirror.any():
+            rows = self._horner[int(mirror[0])]
+        else:
+            rows = self._horner[mirror.astype(np.intp)].transpose(1, 0, 2)
+        both = np.zeros((len(u), rows.shape[-1]))
         column = u[:, None]
         for row in rows[::-1]:
             both *= column
@@ -478,14 +505,12 @@ class Brackets:
                 value[part], scale[part] = self._middle(t)
                 continue
             v, c = np.empty((len(t), k)), np.empty((len(t), k))
-            low = t < END_ANGLE
             high = t > np.pi - END_ANGLE
-            middle = ~low & ~high
-            for where, evaluate in ((low, lambda x: self._at_end(x, False)),
-                                    (high, lambda x: self._at_end(x, True)),
-                                    (middle, self._middle)):
-                if where.any():
-                    v[where], c[where] = evaluate(t[where])
+            end = (t < END_ANGLE) | high
+            if end.any():
+                v[end], c[end] = self._at_end(t[end], high[end])
+            if not end.all():
+                v[~end], c[~end] = self._middle(t[~end])
             value[part], scale[part] = v, c
         return value, scale
 
@@ -593,6 +618,52 @@ class ClosedFormArc(ArcSource):
         x = np.broadcast_to(np.asarray(x, dtype=float), theta.shape).copy()
         y = np.broadcast_to(np.asarray(y, dtype=float), theta.shape).copy()
         return x, y, det
+
+
+class RememberedArc(ArcSource):
+    """An arc source that answers a batch of angles asked for again from memory.
+
+    The decompositions of one plane in several windows
+    (:func:`symstab.numeric.loop.plane.region`) each sample the arc first at
+    the same grid of angles (:func:`symstab.numeric.engine.decomposition.sample_arc`):
+    the grid is evaluated once.  A batch is remembered whole (looking up
+    single angles costs more than the few a window's halvings share with
+    another's).
+
+    Parameters
+    ----------
+    source : ArcSource
+        The arc.
+
+    Examples
+    --------
+    >>> cramer = CramerArc(np.array([1.0, 0.0, 0.0]), np.array([0.0, 1.0, 0.0]),
+    ...                    np.array([0.0, 0.0, 1.0]))            # z**2 + x z + y
+    >>> arc = RememberedArc(cramer)
+    >>> first = arc(np.array([np.pi / 3, np.pi / 2]))
+    >>> again = arc(np.array([np.pi / 3, np.pi / 2]))            # remembered
+    >>> arc.evaluated
+    1
+    """
+
+    def __init__(self, source):
+        if not isinstance(source, ArcSource):
+            raise TypeError(f"source must be an ArcSource, got {type(source).__name__}")
+        self.source = source
+        self._batches = {}
+
+    @property
+    def evaluated(self):
+        """How many batches the source has evaluated."""
+        return len(self._batches)
+
+    def __call__(self, theta):
+        """``(x, y, det)`` at angles ``theta``, each of ``theta``'s shape (new arrays)."""
+        theta = np.asarray(theta, dtype=float)
+        key = (theta.shape, theta.tobytes())
+        if key not in self._batches:
+            self._batches[key] = tuple(np.array(v, dtype=float) for v in self.source(theta))
+        return tuple(v.copy() for v in self._batches[key])
 
 
 def _part_slope(c, z):

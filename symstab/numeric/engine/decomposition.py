@@ -656,11 +656,15 @@ def sample_arc(arc, n, to_unit, samples=None, fine=1.0):
         lo_v, hi_v = np.minimum(v[1:], v[:-1]), np.maximum(v[1:], v[:-1])
         near = both & (hi_u > -0.5) & (lo_u < 1.5) & (hi_v > -0.5) & (lo_v < 1.5)
         split = near & (length > _CHORD * fine)
-        # A sharp turn between two chords near the window: refine both.
+        # A sharp turn between two chords near the window: refine both.  (The
+        # headings only of the chords near it: the arc may run far beyond it.)
+        pair = np.flatnonzero(near[1:] & near[:-1])
+        angle = np.zeros(len(du))
         with np.errstate(invalid="ignore", divide="ignore"):
-            angle = np.arctan2(dv, du)
-            turn = np.abs(np.angle(np.exp(1j * np.diff(angle))))
-        sharp = near[1:] & near[:-1] & (turn > _TURN) & (length[1:] + length[:-1] > _TURN_FLOOR * fine**2)
+            angle[near] = np.arctan2(dv[near], du[near])
+            turn = np.abs(np.angle(np.exp(1j * (angle[pair + 1] - angle[pair]))))
+        sharp = np.zeros(max(len(near) - 1, 0), dtype=bool)
+        sharp[pair] = (turn > _TURN) & (length[pair + 1] + length[pair] > _TURN_FLOOR * fine**2)
         split[1:] |= sharp
         split[:-1] |= sharp
         # Through infinity, or into a singular point: follow it closer.
@@ -864,6 +868,10 @@ def _merged_nodes(points):
     return number[merged][inverse], unique[makers]
 
 
+#: Largest table of box comparisons :func:`_pairs_with` makes (segments chosen times all).
+_MAX_PAIRS_WITH = 4_000_000
+
+
 #: Neighbours in x compared at most, before the points of a vertical run are all merged one by one.
 _MAX_SHIFTS = 64
 
@@ -961,6 +969,25 @@ def _candidate_pairs(lo, hi):
     return i[i != j], j[i != j]
 
 
+def _pairs_with(lo, hi, among):
+    """The pairs ``i < j`` of :func:`_candidate_pairs` with ``i`` or ``j`` in the mask ``among``.
+
+    Each of the few segments in ``among`` is compared with every segment's
+    box at once; many of them are left to :func:`_candidate_pairs`.
+    """
+    n = len(lo)
+    chosen = np.flatnonzero(among)
+    if len(chosen) * n > _MAX_PAIRS_WITH:
+        return _candidate_pairs(lo, hi)
+    a, b = np.nonzero(_meet(lo[chosen, None, :], hi[chosen, None, :], lo, hi))
+    i, j = chosen[a], b
+    # Sorted and deduplicated as _candidate_pairs does it.
+    key = np.sort(np.minimum(i, j) * n + np.maximum(i, j))
+    key = key[np.r_[True, key[1:] != key[:-1]]] if len(key) else key
+    i, j = key // n, key % n
+    return i[i != j], j[i != j]
+
+
 def _lexicographic(x, y, segment, n):
     """``np.lexsort((segment, y, x))`` (``segment`` below ``n``), as one sort of one key.
 
@@ -1001,12 +1028,17 @@ def _meet(lo_a, hi_a, lo_b, hi_b):
             & (lo_a[..., 1] <= hi_b[..., 1]) & (lo_b[..., 1] <= hi_a[..., 1]))
 
 
-def _intersections(p, q, owner, position):
-    """All pairs of crossing segments: (i, j, t_i, t_j)."""
+def _intersections(p, q, owner, position, among=None):
+    """All pairs of crossing segments: (i, j, t_i, t_j), or those with a segment ``among``.
+
+    ``among`` (a mask of the segments) keeps only the pairs with at least
+    one segment in it: each pair's crossing is the one all pairs give.  The
+    ends' touches (:func:`_end_touches`) are all found either way.
+    """
     r = q - p
     lo = np.minimum(p, q) - 1e-12
     hi = np.maximum(p, q) + 1e-12
-    ii, jj = _candidate_pairs(lo, hi)
+    ii, jj = _candidate_pairs(lo, hi) if among is None else _pairs_with(lo, hi, among)
     out = []
     for part in range(0, len(ii), 1_000_000):
         i, j = ii[part:part + 1_000_000], jj[part:part + 1_000_000]
@@ -1115,20 +1147,36 @@ def _inside(poly, x, y):
     return inside
 
 
-def _inside_intervals(sides, value, axis):
-    """The inside intervals of the line ``axis-coordinate = value`` through the rings.
+def _inside_intervals(sides, values, axis):
+    """The inside intervals of the lines ``axis-coordinate = value`` through the rings, per value.
 
-    ``sides`` holds each ring's ``(ring, ring rolled by one)``: its sides' two ends.
+    ``sides`` holds each ring's ``(ring, ring rolled by one)``: its sides' two
+    ends.  All the lines at once (each crossing computed as for one line).
     """
+    values = np.asarray(values, dtype=float)
     other = 1 - axis
-    cuts = []
+    line, cuts = [], []
     for a, b in sides:
-        crosses = (a[:, axis] > value) != (b[:, axis] > value)
-        a, b = a[crosses], b[crosses]
-        cuts.append(a[:, other] + (value - a[:, axis]) * (b[:, other] - a[:, other])
-                    / (b[:, axis] - a[:, axis]))
-    cuts = np.sort(np.concatenate(cuts)) if cuts else np.zeros(0)
-    return cuts.reshape(-1, 2) if len(cuts) % 2 == 0 else np.zeros((0, 2))
+        crosses = (a[None, :, axis] > values[:, None]) != (b[None, :, axis] > values[:, None])
+        row, side = np.nonzero(crosses)
+        a_, b_ = a[side], b[side]
+        line.append(row)
+        cuts.append(a_[:, other] + (values[row] - a_[:, axis]) * (b_[:, other] - a_[:, other])
+                    / (b_[:, axis] - a_[:, axis]))
+    line = np.concatenate(line) if line else np.zeros(0, dtype=np.intp)
+    cuts = np.concatenate(cuts) if cuts else np.zeros(0)
+    order = np.lexsort((cuts, line))
+    line, cuts = line[order], cuts[order]
+    bounds = np.searchsorted(line, np.arange(len(values) + 1))
+    out = []
+    for start, stop in zip(bounds[:-1].tolist(), bounds[1:].tolist(), strict=True):
+        mine = cuts[start:stop]
+        out.append(mine.reshape(-1, 2) if len(mine) % 2 == 0 else np.zeros((0, 2)))
+    return out
+
+
+#: The heights, as fractions of a polygon's, of the lines :func:`_interior_point` tries, in turn.
+_PROBES = (0.5, 0.25, 0.75, 0.125, 0.375, 0.625, 0.875, 0.0625, 0.9375, 0.03125, 0.96875)
 
 
 def _interior_point(rings):
@@ -1137,16 +1185,16 @@ def _interior_point(rings):
     v0, v1 = outer[:, 1].min(), outer[:, 1].max()
     best, best_width = None, -1.0
     sides = [(ring, np.roll(ring, -1, axis=0)) for ring in rings]
-    for f in (0.5, 0.25, 0.75, 0.125, 0.375, 0.625, 0.875, 0.0625, 0.9375, 0.03125, 0.96875):
-        v = v0 + f * (v1 - v0)
-        for lo, hi in _inside_intervals(sides, v, 1):
+    heights = [v0 + f * (v1 - v0) for f in _PROBES]
+    for v, intervals in zip(heights, _inside_intervals(sides, heights, 1), strict=True):
+        for lo, hi in intervals:
             if hi - lo > best_width:
                 best, best_width = (0.5 * (lo + hi), v), hi - lo
     if best is None:
         return None
     # Centre it vertically too, on the vertical line through it.
     u = best[0]
-    spans = _inside_intervals(sides, u, 0)
+    spans = _inside_intervals(sides, [u], 0)[0]
     for lo, hi in spans:
         if lo <= best[1] <= hi:
             return (u, 0.5 * (lo + hi))
@@ -1860,19 +1908,33 @@ def _trace(base, ax, ay, ends, arc, window, fine):
     curves'.  Returns ``(polylines, branches, (p, q, owner, position),
     hits)`` of the last round.
     """
-    samples = None
+    samples, known = None, None
     arc_ends = arc(np.array([0.0, np.pi]))[:2]      # the same in every round
-    for _ in range(_CROSSING_ROUNDS):
+    for round_ in range(_CROSSING_ROUNDS):
         samples = sample_arc(arc, len(base) - 1, window.to_unit, samples, fine)
         theta, xs, ys, det = samples
         sign = np.sign(det)
         polylines, branches = _pieces(base, ax, ay, ends, arc_ends, theta, xs, ys, sign,
                                       window.to_unit, window.from_unit, window.box)
         p, q, owner, position = _segments(polylines)
-        hits = _intersections(p, q, owner, position)
-        hot = _hot_angles(hits, polylines, owner, position)
+        if round_ == _CROSSING_ROUNDS - 1:
+            hits = _intersections(p, q, owner, position)
+            break
+        if known is None:
+            hits = _intersections(p, q, owner, position)
+            hot = _hot_angles(hits, polylines, owner, position)
+        else:
+            # Two chords the last round had too crossed there as they do now:
+            # had that made an angle hot, one of them would have been split.
+            # So the hot angles are those of the pairs with a new chord.
+            new = _new_chords(polylines, owner, position, np.setdiff1d(theta, known))
+            hot = _hot_angles(_intersections(p, q, owner, position, among=new), polylines,
+                              owner, position)
+            if not hot:
+                hits = _intersections(p, q, owner, position)
         if not hot:
             break
+        known = theta
         # The angles added are evaluated by the next round's sampling, the
         # others are kept.
         hot = np.setdiff1d(hot, theta)
@@ -1881,6 +1943,18 @@ def _trace(base, ax, ay, ends, arc, window, fine):
         samples = tuple(np.concatenate([a, b])[order] for a, b in
                         zip(samples, (hot, unknown, unknown, unknown), strict=True))
     return polylines, branches, (p, q, owner, position), hits
+
+
+def _new_chords(polylines, owner, position, added):
+    """Which segments are the arc's chords with an end at one of the angles ``added``."""
+    new = np.zeros(len(owner), dtype=bool)
+    for k, (_, _, th) in enumerate(polylines):
+        if th is None:
+            continue
+        fresh = np.isin(th, added)
+        mine = np.flatnonzero(owner == k)
+        new[mine] = fresh[position[mine]] | fresh[position[mine] + 1]
+    return new
 
 
 def _hot_angles(hits, polylines, owner, position):

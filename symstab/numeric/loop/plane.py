@@ -23,6 +23,7 @@ import numpy as np
 
 from ..._resources import check_memory
 from ..._validate import check_array, check_box, check_count, check_real, check_window
+from ..engine.arcs import RememberedArc
 from ..engine.decomposition import Decomposition, Unresolved, decompose, stable_hull, window_arc
 from ..engine.decomposition import lines as _lines
 from ..engine.intervals import family_intervals
@@ -265,9 +266,12 @@ def region(loop, x=None, y=None, *, x_range=None, y_range=None, **values):
                              branches=(), cells=(), mismatches=(), unbounded=(),
                              polynomial=(plane.base, plane.ax, plane.ay), hull=hull)
     enclosure = hull.box() if hull is not None else None
+    # The windows' decompositions sample one arc: each angle is evaluated once
+    # (the answer keeps the plain source, not the values remembered).
+    source, plane = plane.arc, dataclasses.replace(plane, arc=RememberedArc(plane.arc))
     found, box = _first_decomposition(plane, given, free, hull)
     found = _widened(plane, found, box, free, enclosure)
-    return dataclasses.replace(found, hull=hull)
+    return dataclasses.replace(found, hull=hull, arc=source)
 
 
 def _fitted(box, cells, free):
