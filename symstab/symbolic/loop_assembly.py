@@ -547,7 +547,7 @@ def poly_coeffs(expr, z):
 
     As ``sp.Poly(sp.expand(expr), z).all_coeffs()`` gives them; where that
     would hold them in SymPy's expression domain EX anyway (see
-    :func:`_in_expression_domain`), without its search for a smaller one
+    ``_in_expression_domain``), without its search for a smaller one
     (most of the time on a loop's parts, which hold ``exp`` of the poles).
     """
     expanded = sp.expand(expr)

@@ -6,7 +6,7 @@ sampled position is ``x + e`` with ``e`` the rounding error, uniform on
 white with variance ``q**2 / 12`` (the classical quantization-noise model;
 at rest it is neither).  The force the environment renders is ``F = VE
 z**-d (x + e)`` and the device moves by ``x = -P F``, so the error reaches
-the force through the closed loop
+the force through the closed loop::
 
     F_e = VE z**-d / (1 + L) e,    |VE z**-d / (1 + L)| = |Ve_n P_d / chi|
 
