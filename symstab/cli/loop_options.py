@@ -220,10 +220,11 @@ def add_loop_options(p, command):
                             "stable when NAME is drawn uniformly from LO:HI (its SI unit, or "
                             "the unit written after HI: --uncertain \"b=0.02:0.045 N*m*s/rad\"; "
                             "d: the whole delays LO..HI); repeatable")
-        g.add_argument("--margin", choices=("modulus",),
+        g.add_argument("--margin", choices=("modulus", "delay"),
                        help="instead of the classification, a margin at every stable cell: "
-                            "modulus, min|1+L| on the unit circle, certified (the other "
-                            "cells hold NaN)")
+                            "modulus, min|1+L| on the unit circle, certified; delay, the "
+                            "fewest whole samples of added delay that make it unstable (the "
+                            "other cells hold NaN)")
         g.add_argument("--samples", type=int, metavar="N",
                        help="draws with --uncertain (default 1000)")
         g.add_argument("--seed", type=int, metavar="S",

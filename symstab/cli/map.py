@@ -577,8 +577,10 @@ def _margin(args, setup, xs, ys, out, png_path):
             raise ValueError(f"{flag} is an option of the simulation: drop it with --margin")
     check_memory(f"a map of {xs.size} x {ys.size} cells", xs.size * ys.size * _MAP_CELL_BYTES
                  + CHUNK_BYTES)
-    print(f"map --loop --margin {args.margin}: the {args.margin} margin min|1+L| of every "
-          f"stable cell, certified (NaN where not stable)")
+    what = {"modulus": "the modulus margin min|1+L|, certified",
+            "delay": "the delay margin in whole samples (inf: stable up to the limit)"}
+    print(f"map --loop --margin {args.margin}: {what[args.margin]}, of every stable cell "
+          f"(NaN where not stable)")
     for line in setup.echo:
         print(line)
     found = setup.loop.margin_map(xs, ys, x=setup.x, y=setup.y, margin=args.margin,
@@ -601,10 +603,13 @@ def _margin(args, setup, xs, ys, out, png_path):
     if image is not None:
         write_output(png_path, image, "--png")
         written.append(str(png_path))
-    stable = np.isfinite(value)
+    stable = ~np.isnan(value)
     if stable.any():
         print(f"{int(stable.sum())} of {value.size} cells stable; {args.margin} margin from "
               f"{np.nanmin(value):.4g} to {np.nanmax(value):.4g}")
+    if args.margin == "delay" and np.isinf(value).any():
+        print(f"{int(np.isinf(value).sum())} cells stable up to {found.delay_limit} samples "
+              f"more (inf in the file)")
     else:
         print(f"no stable cell among the {value.size}: the map holds NaN only")
     print("wrote " + ", ".join(written))

@@ -89,6 +89,7 @@ def test_map_margin_writes_the_library_s_map_and_its_figure(capsys, tmp_path):
     (["--simulate"], "--margin maps a margin of the linear loop"),
     (["--uncertain", "b=0.02:0.04"], "give one of them"),
     (["--margin", "gain"], "invalid choice: 'gain'"),
+    (["--margin", "delay", "--set", "d=1.5"], "delay d must be a non-negative integer"),
 ])
 def test_map_margin_refuses_what_it_does_not_map(capsys, tmp_path, extra, message):
     args = ["map", "--loop", PAPER, "--x-range=0,0.2,3", "--y-range=0,2,3",
@@ -98,3 +99,18 @@ def test_map_margin_refuses_what_it_does_not_map(capsys, tmp_path, extra, messag
     status, out, err = run_cli(capsys, *args, *extra)
     assert status == 2 and message in err, err
     assert not list(tmp_path.iterdir())
+
+
+def test_map_margin_delay_writes_whole_samples_and_inf_beyond_the_limit(capsys, tmp_path):
+    import numpy as np
+
+    out = tmp_path / "d.csv"
+    status, printed, err = run_cli(capsys, "map", "--loop", PAPER, "--set", "d=0",
+                                   "--x-range=-0.05,2,5", "--y-range=10,600,4",
+                                   "--margin", "delay", "--out", out, "--no-png")
+    assert status == 0, err
+    rows = np.genfromtxt(out, delimiter=",", skip_header=1)
+    expected = symstab.load_loop(PAPER).margin_map(np.linspace(-0.05, 2, 5),
+                                                   np.linspace(10, 600, 4), margin="delay", d=0)
+    assert np.array_equal(rows[:, 2], expected.values.T.ravel(), equal_nan=True)
+    assert "the delay margin in whole samples" in printed

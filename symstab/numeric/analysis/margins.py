@@ -469,7 +469,7 @@ def _first_crossing_delay(phase):
 # Margin maps
 
 #: The margins a map can hold.
-MAP_MARGINS = ("modulus",)
+MAP_MARGINS = ("modulus", "delay")
 
 
 @dataclasses.dataclass(frozen=True)
@@ -485,16 +485,22 @@ class MarginMap:
     x_values, y_values : ndarray
         The grid's values (1-D).
     margin : str
-        Which margin (``"modulus"``: ``min |1 + L|`` on the unit circle).
+        Which margin: ``"modulus"`` (``min |1 + L|`` on the unit circle) or
+        ``"delay"`` (the delay margin in whole samples).
     values : ndarray
         The margin per point, shape ``(len(y_values), len(x_values))``; NaN
-        where the point is unstable or marginal (never a number there).
+        where the point is unstable or marginal (never a number there); for
+        ``"delay"``, inf where the point stays stable up to ``delay_limit``
+        samples more.
     lower : ndarray
-        Its certified lower bound per point (NaN as ``values``).
+        Its certified lower bound per point (NaN as ``values``; the delay
+        margin is exact).
     codes : ndarray
         The verdicts (:data:`~symstab.numeric.engine.roots.STABLE`, ...).
     at : dict
         The values of the other parameters.
+    delay_limit : int or None
+        ``"delay"``: the most samples added that were examined.
     """
 
     x: str
@@ -506,9 +512,10 @@ class MarginMap:
     lower: np.ndarray
     codes: np.ndarray
     at: dict
+    delay_limit: object = None
 
     def __repr__(self):
-        stable = np.isfinite(self.values)
+        stable = ~np.isnan(self.values)
         best = (f", largest {np.nanmax(self.values):.4g} at {self.x} = "
                 f"{self.x_values[np.nanargmax(self.values) % len(self.x_values)]:.4g}, "
                 f"{self.y} = {self.y_values[np.nanargmax(self.values) // len(self.x_values)]:.4g}"
@@ -541,7 +548,7 @@ class MarginMap:
 
 
 def margin_map(loop, x_values, y_values, *, x=None, y=None, margin="modulus", rtol=1e-9,
-               **values):
+               delay_limit=None, **values):
     """A margin at every point of a grid of a loop's plane, certified per point.
 
     Each point is classified (:meth:`symstab.Loop.classify`); at the stable
@@ -558,10 +565,14 @@ def margin_map(loop, x_values, y_values, *, x=None, y=None, margin="modulus", rt
     x, y : str, optional
         The plane (default: the loop's :attr:`~symstab.Loop.plane`).
     margin : str
-        ``"modulus"``.
+        ``"modulus"`` or ``"delay"`` (as :func:`margins` finds it, at every
+        stable point; points whose first candidate delay is the same are
+        classified together).
     rtol : float
         The relative width of each point's certified bracket (wider next to
         the boundary, where the rounding of chi allows no narrower one).
+    delay_limit : int, optional
+        ``"delay"``: the most samples added (as in :func:`margins`).
     **values
         Single values of every other parameter.
 
@@ -588,10 +599,43 @@ def margin_map(loop, x_values, y_values, *, x=None, y=None, margin="modulus", rt
     codes = np.asarray(loop.classify(**{**values, x: X, y: Y}))
     stable = codes == STABLE
     out = np.full((2, *X.shape), np.nan)
+    d = int(values.get("d", loop.defaults.get("d", 0)))
+    limit = _delay_limit(d, delay_limit)
     if stable.any():
         chi = loop.polynomial(**{**values, x: X[stable], y: Y[stable]})
-        lower, upper, _ = circle_minimum(chi, rtol=rtol)
+        if margin == "modulus":
+            lower, upper, _ = circle_minimum(chi, rtol=rtol)
+        else:
+            upper = lower = _delay_margins(loop, chi, {**values, "d": d}, (x, X[stable]),
+                                           (y, Y[stable]), limit)
         out[0][stable], out[1][stable] = upper, lower
     return MarginMap(x=x, y=y, x_values=xs, y_values=ys, margin=margin, values=out[0],
-                     lower=out[1], codes=codes, at=dict(values))
+                     lower=out[1], codes=codes, at=dict(values),
+                     delay_limit=limit if margin == "delay" else None)
 
+
+def _delay_margins(loop, chi, values, x, y, limit):
+    """The delay margin (whole samples, inf beyond ``limit``) of each of the points' ``chi``.
+
+    As :func:`_delay_margin` for each point, the verdicts at one added delay
+    asked for every point that waits on it at once.
+    """
+    (x, xs), (y, ys) = x, y
+    first = np.array([_first_crossing_delay(_phase_crossings(delayed, direct, chi.shift, 1.0))
+                      for delayed, direct in zip(chi.delayed.reshape(len(xs), -1),
+                                                 chi.direct.reshape(len(xs), -1), strict=True)])
+    out = np.full(len(xs), np.inf)
+    pending = np.isfinite(first)
+    k = np.where(pending, np.maximum(1, np.floor(np.where(pending, first, 0.0))), 0).astype(int)
+    while pending.any():
+        for added in np.unique(k[pending]):
+            wait = np.flatnonzero(pending & (k == added))
+            if added > limit:
+                pending[wait] = False
+                continue
+            code = loop.classify(**{**values, x: xs[wait], y: ys[wait], "d": values["d"] + added})
+            hit = np.asarray(code) != STABLE
+            out[wait[hit]] = added
+            pending[wait[hit]] = False
+            k[wait[~hit]] += 1
+    return out

@@ -310,6 +310,23 @@ def test_a_margin_map_is_python_control_s_minimum_where_stable_and_nan_elsewhere
                 assert np.isnan(found.values[i, j]) and np.isnan(found.lower[i, j])
 
 
+def test_a_delay_margin_map_is_python_control_s_first_unstable_delay_per_point():
+    loop = _paper()
+    xs, ys = np.linspace(-0.05, 2.0, 6), np.linspace(10.0, 600.0, 5)
+    at = dict(m=0.0128, b=0.0324, T=1e-3, M=0.0, d=0)
+    found = loop.margin_map(xs, ys, margin="delay", delay_limit=12, **at)
+    assert found.delay_limit == 12 and np.isnan(found.values).any()
+    for i, K in enumerate(ys):
+        for j, B in enumerate(xs):
+            point = {**loop.defaults, **at, "B": float(B), "K": float(K)}
+            if np.isnan(found.values[i, j]):
+                assert _radius(_open_loop(loop, point)) >= 1 - 1e-9
+                continue
+            radii = [_radius(_open_loop(loop, {**point, "d": k})) for k in range(1, 13)]
+            first = next((k + 1 for k, r in enumerate(radii) if r >= 1 - 1e-12), math.inf)
+            assert found.values[i, j] == first, (K, B, radii)
+
+
 def test_a_margin_map_draws_its_contours_under_the_decomposition():
     loop = _paper()
     at = dict(d=10, M=0.0)
@@ -322,7 +339,7 @@ def test_a_margin_map_draws_its_contours_under_the_decomposition():
 
 
 @pytest.mark.parametrize("kwargs, exception, message", [
-    (dict(margin="delay"), ValueError, "margin must be one of 'modulus'"),
+    (dict(margin="gain"), ValueError, "margin must be one of 'modulus', 'delay'"),
     (dict(x_values=np.ones((2, 2))), ValueError, "must be 1-D and not empty"),
     (dict(B=0.1), TypeError, "B is an axis of the map"),
 ])
