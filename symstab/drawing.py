@@ -1646,16 +1646,17 @@ def plot_margin_map(found, ax=None, *, region=None, levels=None):
     xs, ys = np.asarray(found.x_values, float), np.asarray(found.y_values, float)
     artists = {"margin": [], "colorbar": [], "arc": [], "lines": []}
     values = np.asarray(found.values, float)
-    if found.margin == "delay":
-        # Stable beyond the delays examined (inf): drawn as the top level.
+    if found.margin in ("delay", "gain"):
+        # Stable beyond the delays examined, or no gain limit (inf): drawn as the top level.
         top = np.nanmax(np.where(np.isinf(values), np.nan, values), initial=0.0) + 1
         values = np.where(np.isinf(values), top, values)
     if np.isfinite(values).any():
         filled = ax.contourf(xs, ys, values, levels=10 if levels is None else levels,
                              cmap="viridis")
         bar = figure.colorbar(filled, ax=ax)
-        bar.set_label(r"modulus margin $\min_\theta |1 + L(e^{j\theta})|$"
-                      if found.margin == "modulus" else "delay margin (whole samples added)")
+        bar.set_label({"modulus": r"modulus margin $\min_\theta |1 + L(e^{j\theta})|$",
+                       "delay": "delay margin (whole samples added)",
+                       "gain": "gain margin (factor)"}[found.margin])
         artists["margin"], artists["colorbar"] = [filled], [bar]
     if region is not None:
         artists["arc"], artists["lines"] = _pieces(ax, region.branches)

@@ -220,11 +220,12 @@ def add_loop_options(p, command):
                             "stable when NAME is drawn uniformly from LO:HI (its SI unit, or "
                             "the unit written after HI: --uncertain \"b=0.02:0.045 N*m*s/rad\"; "
                             "d: the whole delays LO..HI); repeatable")
-        g.add_argument("--margin", choices=("modulus", "delay"),
+        g.add_argument("--margin", choices=("modulus", "delay", "gain"),
                        help="instead of the classification, a margin at every stable cell: "
                             "modulus, min|1+L| on the unit circle, certified; delay, the "
-                            "fewest whole samples of added delay that make it unstable (the "
-                            "other cells hold NaN)")
+                            "fewest whole samples of added delay that make it unstable; gain, "
+                            "the smallest factor of the loop gain that does (the other cells "
+                            "hold NaN)")
         g.add_argument("--samples", type=int, metavar="N",
                        help="draws with --uncertain (default 1000)")
         g.add_argument("--seed", type=int, metavar="S",

@@ -578,7 +578,8 @@ def _margin(args, setup, xs, ys, out, png_path):
     check_memory(f"a map of {xs.size} x {ys.size} cells", xs.size * ys.size * _MAP_CELL_BYTES
                  + CHUNK_BYTES)
     what = {"modulus": "the modulus margin min|1+L|, certified",
-            "delay": "the delay margin in whole samples (inf: stable up to the limit)"}
+            "delay": "the delay margin in whole samples (inf: stable up to the limit)",
+            "gain": "the gain margin (inf: no phase crossover limits the gain)"}
     print(f"map --loop --margin {args.margin}: {what[args.margin]}, of every stable cell "
           f"(NaN where not stable)")
     for line in setup.echo:

@@ -34,6 +34,9 @@ def register(subparsers):
     p.add_argument("--beta", help="dimensionless damping")
     p.add_argument("--Kw", help="virtual stiffness (physical)")
     p.add_argument("--Bw", help="virtual damping (physical)")
+    p.add_argument("--along", metavar="NAME", action="append",
+                   help="with --loop: a parameter whose stable interval through the point is "
+                        "given (repeatable; default the file's plane)")
     add_loop_options(p, "margins")
 
 
@@ -47,7 +50,10 @@ def run(args):
         values.update(K=float(alpha), B=float(beta))
         if setup.paper.physical:
             T = setup.paper.device.T
-    found = setup.loop.margins(**values)
+    if args.along is not None and setup.paper is not None:
+        raise ValueError("--along needs a loop file: give --loop FILE (the paper's loop gives "
+                         "its damping and stiffness)")
+    found = setup.loop.margins(parameters=args.along, **values)
     T = found.T if T is None and setup.paper is None else T
     columns = ["margin", "value", "theta [rad/sample]", "frequency [Hz]", "note"]
     rows = [("modulus min|1+L|", found.modulus, found.modulus_theta,

@@ -88,7 +88,7 @@ def test_map_margin_writes_the_library_s_map_and_its_figure(capsys, tmp_path):
 @pytest.mark.parametrize("extra, message", [
     (["--simulate"], "--margin maps a margin of the linear loop"),
     (["--uncertain", "b=0.02:0.04"], "give one of them"),
-    (["--margin", "gain"], "invalid choice: 'gain'"),
+    (["--margin", "phase"], "invalid choice: 'phase'"),
     (["--margin", "delay", "--set", "d=1.5"], "delay d must be a non-negative integer"),
 ])
 def test_map_margin_refuses_what_it_does_not_map(capsys, tmp_path, extra, message):
@@ -114,3 +114,12 @@ def test_map_margin_delay_writes_whole_samples_and_inf_beyond_the_limit(capsys, 
                                                    np.linspace(10, 600, 4), margin="delay", d=0)
     assert np.array_equal(rows[:, 2], expected.values.T.ravel(), equal_nan=True)
     assert "the delay margin in whole samples" in printed
+
+
+def test_along_names_the_parameters_of_the_intervals(capsys):
+    found = run_cli_json(capsys, "margins", "--loop", PAPER, "--set", "K=3", "--set", "B=0.2",
+                         "--set", "d=10", "--along", "M")
+    (interval,) = found["margins"]["parameters"]
+    assert interval["name"] == "M" and interval["low"] < 0 < interval["high"]
+    status, out, err = run_cli(capsys, "margins", "--loop", PAPER, "--along", "b")
+    assert status == 2 and "'b' does not enter the loop's polynomial affinely" in err

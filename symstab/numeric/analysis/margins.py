@@ -43,7 +43,7 @@ import math
 
 import numpy as np
 
-from ..._resources import max_delay
+from ..._resources import chunk_slices, max_delay
 from ..._validate import check_count, check_grid, check_real
 from ..engine.results import html_table
 from ..engine.roots import MARGINAL, STABLE, circle_minimum
@@ -318,26 +318,61 @@ def _open_loop(delayed, direct, shift, theta):
 
 def _gain_crossings(delayed, direct, shift, T):
     """Every phase crossover (``L`` real, negative) with its gain margin ``-1 / L``."""
-    harmonics = shift + max(len(delayed), len(direct))
+    _, theta, gain = _phase_crossovers(delayed[None, :], direct[None, :], shift)
+    return tuple(NyquistCrossing(float(-1.0 / g.real), float(t), float(t / (2 * math.pi * T)))
+                 for t, g in zip(theta, gain, strict=True))
+
+
+def _rows_on_circle(c, rows, theta):
+    """Row ``rows[k]`` of the polynomials ``c`` (highest first) at ``exp(j theta[k])``."""
+    z = np.exp(1j * theta)
+    out = np.zeros(len(theta), dtype=complex)
+    for k in range(c.shape[1]):
+        out = out * z + c[rows, k]
+    return out
+
+
+def _phase_crossovers(delayed, direct, shift):
+    """``(row, theta, L)`` of every phase crossover (``L`` real, negative) of each row, in order.
+
+    Sign changes of ``Im(N conj(D) z**-s) = Im L |D|**2`` (no division: ``D``
+    vanishes at ``z = 1`` for an integrator) on a grid of
+    :data:`_SCAN_PER_HARMONIC` points per period of its highest harmonic,
+    refined by :func:`~symstab.numeric.engine.search.bracketed_root`, and the
+    ends ``theta = 0`` and ``pi``, where ``L`` is real; a pole of ``L`` on
+    the circle (``D`` 0 to within rounding) is no crossing.
+    """
+    n_rows = len(delayed)
+    harmonics = shift + max(delayed.shape[1], direct.shape[1])
     grid = np.linspace(0.0, np.pi, _SCAN_PER_HARMONIC * harmonics + 1)
 
-    def imag(theta):
-        # Im L |D|**2, without the division (D vanishes at z = 1 for an integrator).
-        z = np.exp(1j * theta)
-        return np.imag(np.polyval(direct, z) * np.conj(np.polyval(delayed, z))
-                       * np.exp(-1j * shift * theta))
+    def imag(theta, rows):
+        value = _rows_on_circle(direct, rows, theta) * np.conj(_rows_on_circle(delayed, rows, theta))
+        return np.imag(value * np.exp(-1j * shift * theta))
 
-    values = imag(grid)
-    change = np.flatnonzero(np.sign(values[:-1]) * np.sign(values[1:]) < 0)
-    exact = grid[np.flatnonzero(values == 0)]
-    theta = np.concatenate([bracketed_root(imag, grid[change], grid[change + 1]), exact])
-    theta = np.unique(np.concatenate([theta, [0.0, np.pi]]))
-    gain = _open_loop(delayed, direct, shift, theta)
-    # A pole of L on the circle (an integrator's D(1) = 0, to within rounding) is no crossing.
-    pole = np.abs(_on_circle(delayed, theta)) <= 64 * _EPS * np.sum(np.abs(delayed))
+    found_rows, found_theta = [np.repeat(np.arange(n_rows), 2)], [np.tile([0.0, np.pi], n_rows)]
+    for part in chunk_slices(n_rows, 16 * 4 * len(grid)):
+        rows = np.repeat(np.arange(n_rows)[part], len(grid))
+        values = imag(np.tile(grid, part.stop - part.start), rows).reshape(-1, len(grid))
+        change = np.sign(values[:, :-1]) * np.sign(values[:, 1:]) < 0
+        r, k = np.nonzero(change)
+        r = r + part.start
+        found_rows.append(r)
+        found_theta.append(bracketed_root(lambda t, i, r=r: imag(t, r[i]), grid[k], grid[k + 1],
+                                          indexed=True))
+        r0, k0 = np.nonzero(values[:, 1:-1] == 0)
+        found_rows.append(r0 + part.start)
+        found_theta.append(grid[k0 + 1])
+    rows, theta = np.concatenate(found_rows), np.concatenate(found_theta)
+    order = np.lexsort((theta, rows))
+    rows, theta = rows[order], theta[order]
+    with np.errstate(all="ignore"):
+        d_val = _rows_on_circle(delayed, rows, theta)
+        gain = (_rows_on_circle(direct, rows, theta)
+                / (np.exp(1j * shift * theta) * d_val))
+    pole = np.abs(d_val) <= 64 * _EPS * np.sum(np.abs(delayed), axis=1)[rows]
     keep = np.isfinite(gain) & (gain.real < 0) & ~pole
-    return tuple(NyquistCrossing(float(-1.0 / gain[k].real), float(theta[k]),
-                          float(theta[k] / (2 * math.pi * T))) for k in np.flatnonzero(keep))
+    return rows[keep], theta[keep], gain[keep]
 
 
 def _autocorrelation(c):
@@ -469,7 +504,7 @@ def _first_crossing_delay(phase):
 # Margin maps
 
 #: The margins a map can hold.
-MAP_MARGINS = ("modulus", "delay")
+MAP_MARGINS = ("modulus", "delay", "gain")
 
 
 @dataclasses.dataclass(frozen=True)
@@ -485,13 +520,15 @@ class MarginMap:
     x_values, y_values : ndarray
         The grid's values (1-D).
     margin : str
-        Which margin: ``"modulus"`` (``min |1 + L|`` on the unit circle) or
-        ``"delay"`` (the delay margin in whole samples).
+        Which margin: ``"modulus"`` (``min |1 + L|`` on the unit circle),
+        ``"delay"`` (the delay margin in whole samples) or ``"gain"`` (the
+        gain margin, :attr:`Margins.gain_margin`).
     values : ndarray
         The margin per point, shape ``(len(y_values), len(x_values))``; NaN
         where the point is unstable or marginal (never a number there); for
         ``"delay"``, inf where the point stays stable up to ``delay_limit``
-        samples more.
+        samples more; for ``"gain"``, inf where no phase crossover
+        limits the gain.
     lower : ndarray
         Its certified lower bound per point (NaN as ``values``; the delay
         margin is exact).
@@ -565,9 +602,10 @@ def margin_map(loop, x_values, y_values, *, x=None, y=None, margin="modulus", rt
     x, y : str, optional
         The plane (default: the loop's :attr:`~symstab.Loop.plane`).
     margin : str
-        ``"modulus"`` or ``"delay"`` (as :func:`margins` finds it, at every
-        stable point; points whose first candidate delay is the same are
-        classified together).
+        ``"modulus"``, ``"delay"`` or ``"gain"``, as :func:`margins` finds
+        each at every stable point (the modulus margins and the phase
+        crossovers of all points at once; points whose first candidate
+        delay is the same classified together).
     rtol : float
         The relative width of each point's certified bracket (wider next to
         the boundary, where the rounding of chi allows no narrower one).
@@ -605,6 +643,8 @@ def margin_map(loop, x_values, y_values, *, x=None, y=None, margin="modulus", rt
         chi = loop.polynomial(**{**values, x: X[stable], y: Y[stable]})
         if margin == "modulus":
             lower, upper, _ = circle_minimum(chi, rtol=rtol)
+        elif margin == "gain":
+            upper = lower = _gain_margins(chi)
         else:
             upper = lower = _delay_margins(loop, chi, {**values, "d": d}, (x, X[stable]),
                                            (y, Y[stable]), limit)
@@ -638,4 +678,16 @@ def _delay_margins(loop, chi, values, x, y, limit):
             out[wait[hit]] = added
             pending[wait[hit]] = False
             k[wait[~hit]] += 1
+    return out
+
+
+def _gain_margins(chi):
+    """The gain margin of each point's ``chi``: the smallest ``-1 / L > 1`` at a phase crossover."""
+    n = int(np.prod(chi.shape))
+    rows, _, gain = _phase_crossovers(chi.delayed.reshape(n, -1), chi.direct.reshape(n, -1),
+                                      chi.shift)
+    factor = -1.0 / gain.real
+    out = np.full(n, np.inf)
+    up = factor > 1
+    np.minimum.at(out, rows[up], factor[up])
     return out

@@ -327,6 +327,23 @@ def test_a_delay_margin_map_is_python_control_s_first_unstable_delay_per_point()
             assert found.values[i, j] == first, (K, B, radii)
 
 
+def test_a_gain_margin_map_is_python_control_s_gain_margin_per_point():
+    loop = _paper()
+    xs, ys = np.linspace(0.0, 2.0, 5), np.linspace(10.0, 600.0, 4)
+    at = dict(m=0.0128, b=0.0324, T=1e-3, M=0.0, d=1)
+    found = loop.margin_map(xs, ys, margin="gain", **at)
+    for i, K in enumerate(ys):
+        for j, B in enumerate(xs):
+            point = {**loop.defaults, **at, "B": float(B), "K": float(K)}
+            if np.isnan(found.values[i, j]):
+                assert _radius(_open_loop(loop, point)) >= 1 - 1e-9
+                continue
+            with warnings.catch_warnings():
+                warnings.simplefilter("ignore")
+                gm = control.stability_margins(_open_loop(loop, point))[0]
+            assert found.values[i, j] == pytest.approx(gm, rel=1e-6), (K, B)
+
+
 def test_a_margin_map_draws_its_contours_under_the_decomposition():
     loop = _paper()
     at = dict(d=10, M=0.0)
@@ -339,7 +356,7 @@ def test_a_margin_map_draws_its_contours_under_the_decomposition():
 
 
 @pytest.mark.parametrize("kwargs, exception, message", [
-    (dict(margin="gain"), ValueError, "margin must be one of 'modulus', 'delay'"),
+    (dict(margin="phase"), ValueError, "margin must be one of 'modulus', 'delay', 'gain'"),
     (dict(x_values=np.ones((2, 2))), ValueError, "must be 1-D and not empty"),
     (dict(B=0.1), TypeError, "B is an axis of the map"),
 ])
