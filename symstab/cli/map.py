@@ -605,14 +605,14 @@ def _margin(args, setup, xs, ys, out, png_path):
         write_output(png_path, image, "--png")
         written.append(str(png_path))
     stable = ~np.isnan(value)
-    if stable.any():
+    if not stable.any():
+        print(f"no stable cell among the {value.size}: the map holds NaN only")
+    else:
         print(f"{int(stable.sum())} of {value.size} cells stable; {args.margin} margin from "
               f"{np.nanmin(value):.4g} to {np.nanmax(value):.4g}")
     if args.margin == "delay" and np.isinf(value).any():
         print(f"{int(np.isinf(value).sum())} cells stable up to {found.delay_limit} samples "
               f"more (inf in the file)")
-    else:
-        print(f"no stable cell among the {value.size}: the map holds NaN only")
     print("wrote " + ", ".join(written))
     return 0
 

@@ -27,8 +27,8 @@ of ``1 + L``.  :func:`margins` (:meth:`symstab.Loop.margins`) gives, at one stab
   ``k`` added to ``d`` at which the loop is no longer stable: the certified
   verdict of :meth:`symstab.Loop.classify` at ``d + k``, from the first
   ``k`` at which a root can have reached the circle (a gain crossover's
-  phase margin used up by the delay's phase, ``k theta_c``) up to
-  ``delay_limit``.  A delay between whole samples needs the fractional-delay
+  phase margin used up by the delay's phase, ``k theta_c``; from 1 where
+  ``|L(-1)| >= 1``) up to ``delay_limit``.  A delay between whole samples needs the fractional-delay
   derivation, which symstab does not have yet.
 
 The phase crossovers are found by sign changes of ``Im(N conj(D) z**-s)``
@@ -45,6 +45,7 @@ import numpy as np
 
 from ..._resources import chunk_slices, max_delay
 from ..._validate import check_count, check_grid, check_real
+from ..engine.polynomial import horner
 from ..engine.results import html_table
 from ..engine.roots import MARGINAL, STABLE, circle_minimum
 from ..engine.search import bracketed_root
@@ -274,7 +275,8 @@ def margins(loop, *, parameters=None, delay_limit=None, rtol=1e-9, **values):
         phase=phase,
         parameters=tuple(_parameter_margin(loop, name, point)
                          for name in _margin_parameters(loop, parameters)),
-        delay=_delay_margin(loop, point, limit, phase), delay_limit=limit)
+        delay=_delay_margin(loop, point, limit, _first_delay(phase, delayed, direct)),
+        delay_limit=limit)
 
 
 def stable_point(loop, values, what="margins"):
@@ -284,17 +286,12 @@ def stable_point(loop, values, what="margins"):
     margins, the force noise): an unstable or marginal point is a
     ValueError saying which.
     """
-    point = {**loop.defaults, **values}
-    missing = [name for name in loop.parameters if name not in point]
-    if missing:
-        raise ValueError(f"{what}: give a value of every parameter (missing: "
-                         f"{', '.join(missing)})")
-    for name, value in point.items():
-        if np.ndim(value) != 0:
-            raise ValueError(f"{what} at one point: {name} must be a single "
-                             f"value, got shape {np.shape(value)}")
-    point = {name: (int(point[name]) if name == "d" else float(point[name]))
-             for name in loop.parameters}
+    # The checks of every question (unknown and missing names, d a whole
+    # number of samples, finite reals), then single values.
+    checked, d, _ = loop.evaluation.prepare(values, scalar=loop.parameters)
+    point = {name: float(checked[name]) for name in loop.symbols}
+    point["d"] = d
+    point = {name: point[name] for name in loop.parameters}
     code = int(loop.classify(**point))
     if code != STABLE:
         state = ("marginal (a pole on the unit circle)" if code == MARGINAL else
@@ -306,8 +303,9 @@ def stable_point(loop, values, what="margins"):
 
 
 def _on_circle(c, theta):
-    """The polynomial ``c`` (highest power first) at ``exp(j theta)``."""
-    return np.polyval(c, np.exp(1j * theta))
+    """The polynomial ``c`` (highest power first) at ``exp(j theta)`` (1-D ``theta``)."""
+    theta = np.asarray(theta, dtype=float)
+    return horner(np.asarray(c, dtype=float)[None, :], np.exp(1j * theta)[None, :])[0][0]
 
 
 def _open_loop(delayed, direct, shift, theta):
@@ -325,30 +323,32 @@ def _gain_crossings(delayed, direct, shift, T):
 
 def _rows_on_circle(c, rows, theta):
     """Row ``rows[k]`` of the polynomials ``c`` (highest first) at ``exp(j theta[k])``."""
-    z = np.exp(1j * theta)
-    out = np.zeros(len(theta), dtype=complex)
-    for k in range(c.shape[1]):
-        out = out * z + c[rows, k]
-    return out
+    return horner(c[rows], np.exp(1j * theta)[:, None])[0][:, 0]
 
 
 def _phase_crossovers(delayed, direct, shift):
     """``(row, theta, L)`` of every phase crossover (``L`` real, negative) of each row, in order.
 
-    Sign changes of ``Im(N conj(D) z**-s) = Im L |D|**2`` (no division: ``D``
-    vanishes at ``z = 1`` for an integrator) on a grid of
-    :data:`_SCAN_PER_HARMONIC` points per period of its highest harmonic,
-    refined by :func:`~symstab.numeric.engine.search.bracketed_root`, and the
-    ends ``theta = 0`` and ``pi``, where ``L`` is real; a pole of ``L`` on
-    the circle (``D`` 0 to within rounding) is no crossing.
+    Sign changes of ``Im(N conj(D) z**-s) / sin(theta) = Im L |D|**2 / sin(theta)``
+    (no division by ``D``, which vanishes at ``z = 1`` for an integrator) on
+    a grid of :data:`_SCAN_PER_HARMONIC` points per period of its highest
+    harmonic from a thousandth of a step off each end, refined by
+    :func:`~symstab.numeric.engine.search.bracketed_root`, and the ends
+    ``theta = 0`` and ``pi``, where ``L`` is real; a pole of ``L`` on the
+    circle (``D`` 0 to within rounding) is no crossing.  Two crossings
+    closer than the grid's step are not separated.
     """
     n_rows = len(delayed)
     harmonics = shift + max(delayed.shape[1], direct.shape[1])
     grid = np.linspace(0.0, np.pi, _SCAN_PER_HARMONIC * harmonics + 1)
+    # Im L |D|**2 is an odd function of theta, 0 at both ends: divided by
+    # sin(theta) a crossing in the first or last step is a sign change too.
+    # The ends themselves are moved in by a thousandth of a step.
+    grid[0], grid[-1] = 1e-3 * grid[1], np.pi - 1e-3 * grid[1]
 
     def imag(theta, rows):
         value = _rows_on_circle(direct, rows, theta) * np.conj(_rows_on_circle(delayed, rows, theta))
-        return np.imag(value * np.exp(-1j * shift * theta))
+        return np.imag(value * np.exp(-1j * shift * theta)) / np.sin(theta)
 
     found_rows, found_theta = [np.repeat(np.arange(n_rows), 2)], [np.tile([0.0, np.pi], n_rows)]
     for part in chunk_slices(n_rows, 16 * 4 * len(grid)):
@@ -360,12 +360,15 @@ def _phase_crossovers(delayed, direct, shift):
         found_rows.append(r)
         found_theta.append(bracketed_root(lambda t, i, r=r: imag(t, r[i]), grid[k], grid[k + 1],
                                           indexed=True))
-        r0, k0 = np.nonzero(values[:, 1:-1] == 0)
+        r0, k0 = np.nonzero(values == 0)
         found_rows.append(r0 + part.start)
-        found_theta.append(grid[k0 + 1])
+        found_theta.append(grid[k0])
     rows, theta = np.concatenate(found_rows), np.concatenate(found_theta)
     order = np.lexsort((theta, rows))
     rows, theta = rows[order], theta[order]
+    # A root bracketed next to an end is the end's crossing, added above.
+    single = np.r_[True, (np.diff(rows) != 0) | (np.diff(theta) > 1e-9)]
+    rows, theta = rows[single], theta[single]
     with np.errstate(all="ignore"):
         d_val = _rows_on_circle(delayed, rows, theta)
         gain = (_rows_on_circle(direct, rows, theta)
@@ -392,12 +395,18 @@ def _phase_crossings(delayed, direct, shift, T):
     series[1:] *= 2
     # In x = cos(theta), cos(k theta) = T_k(x): the roots of a Chebyshev series.
     roots = np.polynomial.chebyshev.chebroots(np.trim_zeros(series, "b")) if np.any(series) else []
+    # A tangency is a near-double root that rounding may make a complex pair:
+    # candidates are taken loosely, and kept where |L| = 1 once polished.
     x = np.array([r.real for r in np.atleast_1d(roots)
-                  if abs(r.imag) <= 1e-9 and -1 - 1e-9 <= r.real <= 1 + 1e-9])
-    theta = _polished(delayed, direct, np.sort(np.arccos(np.clip(x, -1.0, 1.0))))
+                  if abs(r.imag) <= 1e-6 and -1 - 1e-6 <= r.real <= 1 + 1e-6])
+    theta = _polished(delayed, direct, np.unique(np.arccos(np.clip(x, -1.0, 1.0))))
     gain = _open_loop(delayed, direct, shift, theta)
+    pole = np.abs(_on_circle(delayed, theta)) <= 64 * _EPS * np.sum(np.abs(delayed))
+    on = np.isfinite(gain) & ~pole & (np.abs(np.abs(gain) - 1) <= 1e-6)
+    theta, gain = theta[on], gain[on]
+    keep = np.r_[True, np.diff(theta) > 1e-12] if theta.size else np.zeros(0, dtype=bool)
     out = []
-    for k in np.flatnonzero(np.isfinite(gain)):
+    for k in np.flatnonzero(keep):
         phase = math.degrees(float(np.angle(gain[k])))
         margin = (phase + 360.0) % 360.0 - 180.0
         out.append(NyquistCrossing(margin, float(theta[k]), float(theta[k] / (2 * math.pi * T))))
@@ -433,7 +442,13 @@ def _margin_parameters(loop, parameters):
         return tuple(loop.plane or ())
     if isinstance(parameters, str):
         parameters = (parameters,)
-    names = tuple(parameters)
+    try:
+        names = tuple(parameters)
+    except TypeError:
+        raise TypeError(f"parameters must be parameter names (a sequence of str), got "
+                        f"{type(parameters).__name__}") from None
+    if len(set(names)) != len(names):
+        raise ValueError(f"parameters: each name once, got {', '.join(map(str, names))}")
     affine = loop.affine_parameters()
     for name in names:
         if name not in affine:
@@ -467,37 +482,46 @@ def _delay_limit(d, delay_limit):
     return limit
 
 
-def _delay_margin(loop, point, limit, phase):
+def _delay_margin(loop, point, limit, first):
     """The smallest whole number of samples added to ``d`` at which the loop is not stable.
 
-    On the circle ``|L z**-k| = |L|``, so a root reaches it at an added delay
-    only at a gain crossover ``theta_c``, when the delay's phase ``k theta_c``
-    has used up that crossover's phase margin ``phi_c`` (mod 2 pi).  Extended
-    to real ``k``, ``chi`` has no zero on the half circle before ``tau* = min
-    phi_c / theta_c``, and its argument change there, which counts the roots
-    inside at whole ``k``, cannot jump: every whole ``k < tau*`` is stable
-    (and with no gain crossover, every ``k``).  The certified verdicts are
-    taken from ``floor(tau*)`` on (one below, for the rounding of
-    ``tau*``), up to ``limit``.
+    From the added delay ``first`` (:func:`_first_delay`) on, the certified
+    verdicts at ``d + k`` up to ``limit``; None when the loop stays stable
+    (or ``first`` is inf: stable at every added delay).
     """
-    first = _first_crossing_delay(phase)
     if not math.isfinite(first):
         return None
-    for k in range(max(1, math.floor(first)), limit + 1):
+    for k in range(int(first), limit + 1):
         if int(loop.classify(**{**point, "d": point["d"] + k})) != STABLE:
             return k
     return None
 
 
-def _first_crossing_delay(phase):
-    """``tau* = min phi_c / theta_c`` in samples over the gain crossovers (inf: none)."""
+def _first_delay(phase, delayed, direct):
+    """The first whole added delay at which the loop can be unstable (inf: at none).
+
+    On the circle ``|L z**-k| = |L|``, so a root reaches it at an added delay
+    only at a gain crossover ``theta_c``, when the delay's phase ``k theta_c``
+    has used up that crossover's phase margin ``phi_c`` (mod 2 pi).  Extended
+    to real ``k``, ``chi = z**(s + k) D + N`` has no zero on the half circle
+    before ``tau* = min phi_c / theta_c``.  The argument change over the half
+    circle, which counts the roots inside at whole ``k``, then grows by
+    ``pi`` a sample, as the degree does, if and only if the end ``z = -1``
+    keeps ``|z**k D| > |N|`` there (``|L(-1)| < 1``): then every whole ``k <
+    tau*`` is stable, and with no gain crossover every ``k``.  With
+    ``|L(-1)| >= 1`` the end does not turn with ``k`` and no added delay is
+    known stable: the search starts at 1.  ``floor(tau*)``, one below, for
+    the rounding of ``tau*``.
+    """
+    if np.abs(_on_circle(direct, [np.pi])[0]) >= np.abs(_on_circle(delayed, [np.pi])[0]):
+        return 1
     out = math.inf
     for c in phase:
         if c.theta <= 0:
             continue
         phi = math.radians(c.margin)
         out = min(out, (phi if phi > 0 else phi + 2 * math.pi) / c.theta)
-    return out
+    return max(1, math.floor(out)) if math.isfinite(out) else math.inf
 
 
 # --------------------------------------------------------------------------
@@ -657,16 +681,18 @@ def margin_map(loop, x_values, y_values, *, x=None, y=None, margin="modulus", rt
 def _delay_margins(loop, chi, values, x, y, limit):
     """The delay margin (whole samples, inf beyond ``limit``) of each of the points' ``chi``.
 
-    As :func:`_delay_margin` for each point, the verdicts at one added delay
-    asked for every point that waits on it at once.
+    As :func:`_delay_margin` for each point (from :func:`_first_delay`), the
+    verdicts at one added delay asked for every point that waits on it at once.
     """
     (x, xs), (y, ys) = x, y
-    first = np.array([_first_crossing_delay(_phase_crossings(delayed, direct, chi.shift, 1.0))
+    first = np.array([_first_delay(_phase_crossings(delayed, direct, chi.shift, 1.0), delayed,
+                                   direct)
                       for delayed, direct in zip(chi.delayed.reshape(len(xs), -1),
-                                                 chi.direct.reshape(len(xs), -1), strict=True)])
+                                                 chi.direct.reshape(len(xs), -1), strict=True)],
+                     dtype=float)
     out = np.full(len(xs), np.inf)
     pending = np.isfinite(first)
-    k = np.where(pending, np.maximum(1, np.floor(np.where(pending, first, 0.0))), 0).astype(int)
+    k = np.where(pending, first, 0).astype(int)
     while pending.any():
         for added in np.unique(k[pending]):
             wait = np.flatnonzero(pending & (k == added))

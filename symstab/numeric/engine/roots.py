@@ -895,7 +895,8 @@ def circle_minimum(chi, *, rtol=1e-9, coefficient_ulps=COEFFICIENT_ULPS):
         wide (next to the boundary), the bracket proved is a thousand, a
         million ... times wider (up to ``lower = 0.75 upper``); ``lower``
         is 0 where the minimum cannot be separated from 0 at all (a root of
-        ``chi`` on the circle to within rounding: a marginal point).
+        ``chi`` on the circle to within rounding: a marginal point) or the
+        halving gave up (more open arcs than twice the first grid's).
 
     Examples
     --------
@@ -912,8 +913,10 @@ def circle_minimum(chi, *, rtol=1e-9, coefficient_ulps=COEFFICIENT_ULPS):
     rows = chi.flat()
     n_arcs = max(64, 8 * max(rows.degree, 1))
     out = np.zeros((3, len(rows)))
-    # Per row: the first grid's arcs (ten complex values each) and their halves.
-    per_row = 16 * 12 * (n_arcs + 2) * 2
+    # Per row: the first grid's arcs (ten complex values each) and their halves,
+    # up to twice as many open.
+    per_row = 16 * 12 * (n_arcs + 2) * 4
+    check_memory(f"the modulus margin at degree {rows.degree}", per_row)
     todo = np.arange(len(rows))
     # Next to the boundary |chi| is small beside the rounding of its value, and
     # a bracket of width rtol cannot be proved: those rows are tried again
@@ -970,7 +973,8 @@ def _certified(bounds, arcs, mu):
     ``|N'|`` are Taylor steps from the midpoint capped by the sums, as in
     :func:`_arcs_pass`; with them ``|F''| <= 2 (|chi'|**2 + |chi| |chi''|) + 2
     mu**2 (|D'|**2 + |D| |D''|)`` bounds ``F = |chi|**2 - mu**2 |D|**2`` below
-    by ``F(m) - |F'(m)| h - max|F''| h**2 / 2`` minus the values' rounding.
+    by ``F(m) - |F'(m)| h - max|F''| h**2 / 2`` minus the rounding of the
+    values and of the slope.
     """
     b, s, r = bounds, bounds.s, arcs.row
     half = 0.5 * (arcs.hi - arcs.lo)
@@ -989,7 +993,12 @@ def _certified(bounds, arcs, mu):
         e_chi = e_dm + b.e_n0[r] + (b.spin_error + 8 * _U) * dm + 2 * _U * np.abs(arcs.n)
         value = size * size - mu * mu * dm * dm
         slope = 2 * np.real(np.conj(arcs.chi) * arcs.dchi - mu * mu * np.conj(arcs.d) * arcs.dd)
-        error = ((2 * size + e_chi) * e_chi + mu * mu * (2 * dm + e_dm) * e_dm
+        # The rounding of chi' (as in _arcs_pass) and of D' enters through F'(m) h.
+        e_dchi = ((b.spin_error + 8 * _U) * (s * dm + np.abs(arcs.dd)) + s * e_dm + b.e_d1[r]
+                  + b.e_n1[r] + 8 * _U * np.abs(arcs.dn))
+        e_slope = 2 * (e_dchi * (size + e_chi) + np.abs(arcs.dchi) * e_chi
+                       + mu * mu * (b.e_d1[r] * (dm + e_dm) + np.abs(arcs.dd) * e_dm))
+        error = ((2 * size + e_chi) * e_chi + mu * mu * (2 * dm + e_dm) * e_dm + e_slope * half
                  + 32 * _U * (size * size + mu * mu * dm * dm
                               + half * (2 * c0 * c1 + 2 * mu * mu * d_max * d1_max)))
         low = value - np.abs(slope) * half - 0.5 * second * half * half - error
@@ -1030,9 +1039,10 @@ def _chunk_minimum(bounds, n_rows, rtol, n_arcs):
         failing = np.bincount(arcs.row[~ok], minlength=n_rows)
         done = open_rows & (failing == 0)
         lower[done] = upper[done] * (1 - rtol)
-        # A row whose open arcs multiply has |chi| within rounding of 0 on a
-        # stretch of the circle: no positive bound can hold (lower stays 0).
-        open_rows &= (failing > 0) & (failing <= _MINIMUM_OPEN_ARCS)
+        # A row whose open arcs multiply beyond its first grid has |chi| within
+        # rounding of 0 on a stretch of the circle (or many minima of one depth:
+        # a long delay's flat |L|), and the halving gives up there.
+        open_rows &= (failing > 0) & (failing <= max(_MINIMUM_OPEN_ARCS, 2 * n_arcs))
         keep = ~ok & open_rows[arcs.row]
         if not keep.any():
             break

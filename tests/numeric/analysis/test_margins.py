@@ -83,6 +83,11 @@ POINTS = [
     ("lowpass_velocity.toml", {}),
     ("operator_arm.toml", {}),
     ("two_mass.toml", {}),
+    # A phase crossover in the scan's first step (B < 0: python-control's gain margin 5.246
+    # at 1.15 rad/s), and an integrator whose |N(1)| is at the rounding of the cosine
+    # series (a root at theta = 0 that is the pole of L, not a crossing): both once missed.
+    ("lowpass_velocity.toml", dict(d=0, K=0.003242528441583091, B=-0.006174615573211431)),
+    ("paper.toml", dict(K=0.03, B=1.0, M=0.0, d=1)),
 ]
 
 
@@ -238,6 +243,30 @@ def test_a_long_delay_margin_is_decided_at_40_digits():
     assert _radius_mp(loop, {**point, "d": point["d"] + found.delay}) > 1
 
 
+def test_a_loop_with_the_nyquist_curve_outside_the_circle_at_pi_loses_stability_at_once():
+    """|L(-1)| > 1: the end z = -1 of chi = z**(d + k) D + N does not turn with k, so a
+    stable loop is unstable one sample later however far its phase margins' delay is (the
+    search once started there and said 13)."""
+    T = 1e-3
+    loop = symstab.Loop("1/(s + 1)", "c*(z - exp(-T))/(z + 0.0793)",
+                        values=dict(T=T, d=0, c=-1.0721 / (1 - math.exp(-T))))
+    found = loop.margins(delay_limit=20)
+    assert found.delay == 1
+    point = dict(loop.defaults)
+    assert _radius(_open_loop(loop, point)) < 1
+    assert _radius(_open_loop(loop, {**point, "d": 1})) > 1
+
+
+def test_a_long_delay_with_many_equal_minima_keeps_a_positive_bound():
+    """d = 8001 with a flat |1 + L| = 0.5: thousands of minima of one depth are no marginal
+    point (the halving once gave up and said lower = 0)."""
+    loop = symstab.Loop("1/(s + 1)", "c*(z - exp(-T))/z",
+                        values=dict(T=1e-3, d=8001, c=0.5 / (1 - math.exp(-1e-3))))
+    found = loop.margins(delay_limit=1)
+    assert found.modulus == pytest.approx(0.5, rel=1e-12)
+    assert 0.5 * (1 - 2e-9) <= found.modulus_lower <= 0.5
+
+
 def test_no_delay_margin_within_the_limit_is_said():
     loop, point = _loop_and_point("paper.toml", dict(WALL, K=1.0, B=0.05, d=0))
     found = loop.margins(delay_limit=2, **point)
@@ -261,6 +290,12 @@ def test_a_point_that_is_not_stable_has_no_margins(values, message):
     (dict(rtol=0.0), ValueError, "rtol"),
     (dict(delay_limit=0), ValueError, "delay_limit"),
     (dict(delay_limit=1.5), TypeError, "delay_limit"),
+    (dict(d=1.5), ValueError, "delay d must be a non-negative integer"),
+    (dict(d=True), TypeError, "delay d must be a non-negative integer"),
+    (dict(foo=1.0), TypeError, "unknown parameter"),
+    (dict(K="abc"), TypeError, "K"),
+    (dict(parameters=("K", "K")), ValueError, "each name once"),
+    (dict(parameters=5), TypeError, "parameters must be parameter names"),
 ])
 def test_bad_input_names_the_parameter(kwargs, exception, message):
     with pytest.raises(exception, match=message):

@@ -65,6 +65,9 @@ def test_h2_norm_of_a_first_order_lag_and_of_an_unstable_one():
     assert h2_norm([1.0, 0.0], [1.0, -0.9]) == pytest.approx(1 / math.sqrt(1 - 0.81), rel=1e-13)
     assert h2_norm([1.0], [1.0, -1.0]) == math.inf
     assert h2_norm([2.0], [4.0]) == 0.5
+    # Refused before its O(n**3) work: a delay of 2001 samples.
+    with pytest.raises(ValueError, match="degree 2001 is beyond 2000"):
+        h2_norm([1.0], [1.0] + [0.0] * 2001)
 
 
 def test_a_simulation_with_the_encoder_renders_the_predicted_force_noise():
