@@ -13,7 +13,13 @@ import numpy as np
 
 from .._resources import check_memory
 from .loop_options import add_loop_options, broadcast, resolve_setup
-from .options import add_command, add_model_options, parse_list, stiffness_and_damping
+from .options import (
+    add_command,
+    add_model_options,
+    add_point_options,
+    parse_list,
+    stiffness_and_damping,
+)
 from .output import emit
 from .units import physical_columns
 
@@ -35,10 +41,7 @@ def register(subparsers):
                     "number of its poles outside the unit circle.",
         example="symstab classify --Td 0.01 --Kw 1,3,10 --Bw 0.2", func=run)
     add_model_options(p)
-    p.add_argument("--alpha", help="dimensionless stiffness(es), comma-separated")
-    p.add_argument("--beta", help="dimensionless damping(s), comma-separated")
-    p.add_argument("--Kw", help="virtual stiffness(es), comma-separated (physical)")
-    p.add_argument("--Bw", help="virtual damping(s), comma-separated (physical)")
+    add_point_options(p, lists=True)
     add_loop_options(p, "classify")
 
 

@@ -12,7 +12,13 @@ marginal point is one line and exit 2, before any work.
 import math
 
 from .loop_options import add_loop_options, resolve_setup
-from .options import add_command, add_model_options, parse_one, stiffness_and_damping
+from .options import (
+    add_command,
+    add_model_options,
+    add_point_options,
+    parse_one,
+    stiffness_and_damping,
+)
 from .output import emit
 
 __all__ = ["register", "run"]
@@ -30,10 +36,7 @@ def register(subparsers):
                     "at which the loop is no longer stable.",
         example="symstab margins --Td 0.005 --Kw 100 --Bw 1", func=run)
     add_model_options(p)
-    p.add_argument("--alpha", help="dimensionless stiffness")
-    p.add_argument("--beta", help="dimensionless damping")
-    p.add_argument("--Kw", help="virtual stiffness (physical)")
-    p.add_argument("--Bw", help="virtual damping (physical)")
+    add_point_options(p)
     p.add_argument("--along", metavar="NAME", action="append",
                    help="with --loop: a parameter whose stable interval through the point is "
                         "given (repeatable; default the file's plane)")

@@ -22,7 +22,7 @@ import numpy as np
 from .output import FORMATS, quiet_when_unread
 
 __all__ = ["add_command", "Setup", "UNITS_RULE", "add_model_options", "resolve", "parse_list",
-           "parse_one", "stiffness_and_damping"]
+           "parse_one", "add_point_options", "stiffness_and_damping"]
 
 
 def add_command(sub, name, *, help, description, example, func):
@@ -179,6 +179,19 @@ def parse_one(text, name):
     if values.size != 1:
         raise ValueError(f"{name} takes one value here, got {values.size}")
     return float(values[0])
+
+
+def add_point_options(p, *, lists=False):
+    """Add ``--alpha``/``--beta`` and ``--Kw``/``--Bw``: the paper's stiffness and damping.
+
+    One value each, or with ``lists`` comma-separated lists (one point per
+    entry); :func:`stiffness_and_damping` reads them.
+    """
+    many, more = ("(es), comma-separated", "(s), comma-separated") if lists else ("", "")
+    p.add_argument("--alpha", help=f"dimensionless stiffness{many}")
+    p.add_argument("--beta", help=f"dimensionless damping{more}")
+    p.add_argument("--Kw", help=f"virtual stiffness{many} (physical)")
+    p.add_argument("--Bw", help=f"virtual damping{more} (physical)")
 
 
 def stiffness_and_damping(args, setup, parse):

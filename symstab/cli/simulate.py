@@ -25,6 +25,7 @@ from .loop_options import add_loop_options, resolve_loop, uses_loop, value_text
 from .options import (
     add_command,
     add_model_options,
+    add_point_options,
     parse_one,
     resolve,
     stiffness_and_damping,
@@ -59,10 +60,7 @@ def register(subparsers):
         func=run)
     add_model_options(p)
     add_nonideal_options(p)
-    p.add_argument("--alpha", help="dimensionless stiffness")
-    p.add_argument("--beta", help="dimensionless damping")
-    p.add_argument("--Kw", help="virtual stiffness (physical)")
-    p.add_argument("--Bw", help="virtual damping (physical)")
+    add_point_options(p)
     p.add_argument("--out", help="CSV file for the trajectory (k, t, x)")
     add_loop_options(p, "simulate")
 
