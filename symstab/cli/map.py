@@ -127,14 +127,10 @@ def _map(plan):
     simulated = plan.simulate()
     data = plan.table(code, simulated)
     image = plan.png(code, simulated) if plan.png_path is not None else None
-    write_output(plan.out, data, "--out")
-    written = [str(plan.out)]
-    if image is not None:
-        write_output(plan.png_path, image, "--png")
-        written.append(str(plan.png_path))
+    wrote = _write_map(plan.out, data, plan.png_path, image)
     for line in plan.summary(code, simulated):
         print(line)
-    print("wrote " + ", ".join(written))
+    print(wrote)
     return 0
 
 
@@ -505,6 +501,16 @@ def _loop_npz(setup, xs, ys, values, **arrays):
     return buf.getvalue()
 
 
+def _write_map(out, data, png_path, image):
+    """The map's file and its PNG (None: none) written atomically; the line that says so."""
+    write_output(out, data, "--out")
+    written = [str(out)]
+    if image is not None:
+        write_output(png_path, image, "--png")
+        written.append(str(png_path))
+    return "wrote " + ", ".join(written)
+
+
 def _probability(args, setup, xs, ys, out, png_path):
     """``map --loop --uncertain``: the probability of stability of every cell, its files and PNG."""
     from .._progress import progress_printer
@@ -552,18 +558,14 @@ def _probability(args, setup, xs, ys, out, png_path):
             buf.write(f"{row[0]:.12g},{row[1]:.12g},{row[2]:.6g},{row[3]:.3g},{int(row[4])}\n")
         data = buf.getvalue()
     image = _probability_png(setup, found, fixed, drawn) if png_path is not None else None
-    write_output(out, data, "--out")
-    written = [str(out)]
-    if image is not None:
-        write_output(png_path, image, "--png")
-        written.append(str(png_path))
+    wrote = _write_map(out, data, png_path, image)
     between = int(np.count_nonzero((p > 0) & (p < 1)))
     print(f"{samples} draws of {', '.join(drawn)} (seed {seed}): stable at every draw in "
           f"{int(np.count_nonzero(p == 1))} of {p.size} cells, at none in "
           f"{int(np.count_nonzero(p == 0))}, at some in {between} (largest standard error "
           f"{float(error.max()):.2g}); marginal draws, counted as not stable: "
           f"{int(marginal.sum())}")
-    print("wrote " + ", ".join(written))
+    print(wrote)
     return 0
 
 
@@ -599,11 +601,7 @@ def _margin(args, setup, xs, ys, out, png_path):
         data = buf.getvalue()
     image = (png_or_none(_margin_figure, setup, found, xs, ys) if png_path is not None
              else None)
-    write_output(out, data, "--out")
-    written = [str(out)]
-    if image is not None:
-        write_output(png_path, image, "--png")
-        written.append(str(png_path))
+    wrote = _write_map(out, data, png_path, image)
     stable = ~np.isnan(value)
     if not stable.any():
         print(f"no stable cell among the {value.size}: the map holds NaN only")
@@ -613,7 +611,7 @@ def _margin(args, setup, xs, ys, out, png_path):
     if args.margin == "delay" and np.isinf(value).any():
         print(f"{int(np.isinf(value).sum())} cells stable up to {found.delay_limit} samples "
               f"more (inf in the file)")
-    print("wrote " + ", ".join(written))
+    print(wrote)
     return 0
 
 

@@ -305,7 +305,8 @@ def stable_point(loop, values, what="margins"):
 def _on_circle(c, theta):
     """The polynomial ``c`` (highest power first) at ``exp(j theta)`` (1-D ``theta``)."""
     theta = np.asarray(theta, dtype=float)
-    return horner(np.asarray(c, dtype=float)[None, :], np.exp(1j * theta)[None, :])[0][0]
+    return _rows_on_circle(np.asarray(c, dtype=float)[None, :],
+                           np.zeros(theta.size, dtype=np.int64), theta)
 
 
 def _open_loop(delayed, direct, shift, theta):
