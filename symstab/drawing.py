@@ -1651,9 +1651,22 @@ def plot_margin_map(found, ax=None, *, region=None, levels=None):
         top = np.nanmax(np.where(np.isinf(values), np.nan, values), initial=0.0) + 1
         values = np.where(np.isinf(values), top, values)
     if np.isfinite(values).any():
+        style = {}
+        if found.margin == "gain" and levels is None and np.nanmin(values) > 0:
+            # A gain margin is a factor: levels evenly spaced on a log scale.
+            from matplotlib.colors import LogNorm
+
+            levels = np.geomspace(np.nanmin(values), np.nanmax(values), 11)
+            style["norm"] = LogNorm(levels[0], levels[-1])
         filled = ax.contourf(xs, ys, values, levels=10 if levels is None else levels,
-                             cmap="viridis")
+                             cmap="viridis", **style)
         bar = figure.colorbar(filled, ax=ax)
+        if "norm" in style:
+            from matplotlib.ticker import FuncFormatter, NullLocator
+
+            bar.set_ticks(levels)
+            bar.ax.yaxis.set_minor_locator(NullLocator())
+            bar.ax.yaxis.set_major_formatter(FuncFormatter(lambda v, _: f"{v:.3g}"))
         bar.set_label({"modulus": r"modulus margin $\min_\theta |1 + L(e^{j\theta})|$",
                        "delay": "delay margin (whole samples added)",
                        "gain": "gain margin (factor)"}[found.margin])

@@ -399,3 +399,18 @@ def test_bad_margin_map_input_names_the_parameter(kwargs, exception, message):
     args = {"x_values": [0.1, 0.2], "y_values": [1.0, 2.0], **kwargs}
     with pytest.raises(exception, match=message):
         _paper().margin_map(args.pop("x_values"), args.pop("y_values"), **args)
+
+
+def test_a_gain_margin_map_is_drawn_on_a_log_scale():
+    """A gain margin is a factor (1.01 to 106 over the paper's plane at d = 10): evenly spaced
+    levels put nearly all of the stable set in the lowest band."""
+    from matplotlib.colors import LogNorm
+
+    found = _paper().margin_map(np.linspace(0.0, 0.9, 12), np.linspace(0.5, 25.0, 12),
+                                margin="gain", d=10, M=0.0)
+    drawn = found.plot()
+    (filled,) = drawn.artists["margin"]
+    assert isinstance(filled.norm, LogNorm)
+    assert np.allclose(np.diff(np.log(filled.levels)), np.log(filled.levels[1] / filled.levels[0]))
+    import matplotlib.pyplot as plt
+    plt.close(drawn.figure)
