@@ -20,7 +20,8 @@ import sys
 import numpy as np
 
 __all__ = ["Plot", "plot_region", "plot_limits", "plot_boundary", "plot_robust",
-           "plot_probability", "plot_design", "plot_passive", "plot_locus", "plot_simulation",
+           "plot_probability", "plot_design", "plot_pareto", "plot_passive", "plot_locus",
+           "plot_simulation",
            "plot_map", "plot_margin_map", "require_matplotlib", "pyplot", "pyplot_or_none", "png_bytes", "visible",
            "draw_lines", "label_log_axis", "png_of", "png_or_none", "design_figure",
            "simulated_map_figure", "loop_map_figure", "probability_map_figure", "robust_figure",
@@ -169,13 +170,15 @@ def label_log_axis(ax):
         ax.yaxis.set_minor_formatter(ticker.NullFormatter())
 
 
-def design_figure(plt, found, labels, target_label):
+def design_figure(plt, found, labels, target_label, noise_label="force noise (RMS)"):
     """A :class:`~symstab.numeric.analysis.design.Design` drawn: its target against the parameter(s) searched.
 
     One parameter: the target at every value evaluated (a line through the
     scan and the refinement), the values with no stable point marked at the
     bottom, the optimum and the nominal value marked.  Two: the evaluations
-    coloured by the target, the same marks.
+    coloured by the target, the same marks.  Where the design recorded the
+    force noise (an encoder given), a second panel: the target against the
+    noise (:func:`plot_pareto`).
 
     Parameters
     ----------
@@ -186,13 +189,20 @@ def design_figure(plt, found, labels, target_label):
         The axis label of each parameter searched.
     target_label : str
         The target's label, with its unit.
+    noise_label : str
+        The force noise's label, with its unit.
 
     Returns
     -------
     matplotlib.figure.Figure
     """
-    fig, ax = plt.subplots(figsize=(6.4, 4.4))
-    _draw_design(ax, found, labels, target_label)
+    if found.noise is None:
+        fig, ax = plt.subplots(figsize=(6.4, 4.4))
+        _draw_design(ax, found, labels, target_label)
+    else:
+        fig, (ax, front) = plt.subplots(1, 2, figsize=(11.0, 4.4))
+        _draw_design(ax, found, labels, target_label)
+        _draw_pareto(front, found, target_label, noise_label)
     fig.tight_layout()
     return fig
 
@@ -224,6 +234,7 @@ def _draw_design(ax, found, labels, target_label):
         if found.best is not None:
             artists["best"] += ax.plot([found.best[names[0]]], [found.value], "*", color="C3",
                                        ms=12, label=f"best {names[0]} = {found.best[names[0]]:.6g}")
+        artists["over budget"] = _shade_over_budget(ax, found)
         ax.set_xlabel(labels[0])
         ax.set_ylabel(target_label)
     else:
@@ -245,6 +256,61 @@ def _draw_design(ax, found, labels, target_label):
         ax.set_xlabel(labels[0])
         ax.set_ylabel(labels[1])
     ax.set_title(f"design: {what} over {' and '.join(names)}", fontsize=PANEL_TITLE_SIZE)
+    ax.legend(fontsize=LEGEND_SIZE, loc="best")
+    return artists
+
+
+def _shade_over_budget(ax, found):
+    """Shade the values of the one parameter searched whose force noise is over the budget.
+
+    From the budget's scan (:attr:`~symstab.numeric.analysis.design.Design.noise_samples`,
+    whose edges are bisected): each run of values over it, to its neighbours within it.
+    """
+    if found.noise_limit is None or found.noise_samples is None:
+        return []
+    x, noise = found.noise_samples[:, 0], found.noise_samples[:, -1]
+    over = noise > found.noise_limit
+    spans, k = [], 0
+    while k < len(x):
+        if not over[k]:
+            k += 1
+            continue
+        j = k
+        while j + 1 < len(x) and over[j + 1]:
+            j += 1
+        lo, hi = x[k - 1] if k > 0 else x[k], x[j + 1] if j + 1 < len(x) else x[j]
+        spans.append(ax.axvspan(lo, hi, color="0.88", zorder=0,
+                                label=None if spans else "force noise over the budget"))
+        k = j + 1
+    (name, (low, high)), = found.over.items()
+    ax.set_xlim(low - 0.02 * (high - low), high + 0.02 * (high - low))
+    return spans
+
+
+def _draw_pareto(ax, found, target_label, noise_label):
+    """:func:`plot_pareto`'s drawing on ``ax``: ``{"samples", "front", "best", "limit"}`` artists."""
+    rows = np.column_stack([found.samples, found.noise])
+    rows = rows[np.isfinite(rows[:, -2]) & np.isfinite(rows[:, -1])]
+    front = found.pareto
+    target = target_label.split(" [")[0]
+    artists = {"samples": [], "front": [], "best": [], "limit": []}
+    artists["samples"] += ax.plot(rows[:, -1], rows[:, -2], "o", color="0.7", ms=3,
+                                  label=f"values evaluated ({len(rows)})")
+    artists["front"] += ax.plot(front[:, -1], front[:, -2], "-o", color="C0", ms=3, lw=1.2,
+                                label=f"Pareto front ({len(front)})")
+    if found.noise_limit is not None:
+        artists["limit"].append(ax.axvline(found.noise_limit, color="C3", ls="--", lw=1,
+                                           label=f"noise budget {found.noise_limit:.4g}"))
+    if found.best is not None:
+        name = next(iter(found.over))
+        artists["best"] += ax.plot([found.best_noise], [found.value], "*", color="C3", ms=12,
+                                   label=f"best {name} = {found.best[name]:.6g}"
+                                   if len(found.over) == 1 else "best")
+    ax.set_xlabel(noise_label)
+    ax.set_ylabel(target_label)
+    at = ", ".join(f"{k} = {v:.4g}" for k, v in found.noise_at.items())
+    ax.set_title(f"{target} against the encoder's force noise at {at}",
+                 fontsize=PANEL_TITLE_SIZE)
     ax.legend(fontsize=LEGEND_SIZE, loc="best")
     return artists
 
@@ -1443,6 +1509,42 @@ def plot_design(found, ax=None, *, target_label=None):
     figure, ax = _axes(ax)
     label = found.target if target_label is None else target_label
     return Plot(figure, ax, _draw_design(ax, found, list(found.over), label))
+
+
+def plot_pareto(found, ax=None, *, target_label=None, noise_label="force noise (RMS)"):
+    """Draw a design's target against the force noise: every value evaluated and the Pareto front.
+
+    What :meth:`symstab.numeric.analysis.design.Design.plot_pareto` draws
+    (the right panel of ``symstab design --png`` with an encoder): the
+    budget as a vertical line, the optimum marked.
+
+    Parameters
+    ----------
+    found : symstab.numeric.analysis.design.Design
+        A design that recorded the force noise (``encoder_resolution``).
+    ax : matplotlib.axes.Axes, optional
+        Where to draw (default: a new figure's axes).
+    target_label, noise_label : str, optional
+        The axes' labels (default: the target's name; "force noise (RMS)").
+
+    Returns
+    -------
+    Plot
+        Artists ``"samples"``, ``"front"``, ``"best"``, ``"limit"``.
+
+    Raises
+    ------
+    ValueError
+        For a design without the force noise.
+    ImportError
+        Without matplotlib.
+    """
+    if found.noise is None:
+        raise ValueError("the design recorded no force noise: give encoder_resolution to "
+                         "Loop.design")
+    figure, ax = _axes(ax)
+    label = found.target if target_label is None else target_label
+    return Plot(figure, ax, _draw_pareto(ax, found, label, noise_label))
 
 
 def plot_passive(passive, ax=None, *, region=None):

@@ -237,6 +237,29 @@ def python_control_parts(loop, values):
     return sampled, environment, delay
 
 
+def impulse_norm(num, den, dt):
+    """sqrt(sum h[k]**2) by scipy's impulse response, long enough for the tail to vanish."""
+    import scipy.signal
+
+    steps = 4096
+    while True:
+        _, (h,) = scipy.signal.dimpulse((num, den, dt), n=steps)
+        energy = np.cumsum(h.ravel() ** 2)
+        if energy[-1] == 0 or energy[-1] - energy[steps // 2] < 1e-17 * energy[-1]:
+            return math.sqrt(energy[-1])
+        steps *= 2
+
+
+def force_noise_of(loop, values, q):
+    """The force RMS of an encoder of quantum ``q`` at ``values``: python-control's closed loop
+    ``VE z**-d / (1 + VE z**-d P)`` (:func:`python_control_parts`), its impulse response summed
+    (:func:`impulse_norm`), times ``q / sqrt(12)``."""
+    plant, environment, delay = python_control_parts(loop, values)
+    closed = environment * delay / (1 + environment * delay * plant)
+    return q / math.sqrt(12.0) * impulse_norm(closed.num[0][0], closed.den[0][0],
+                                              float(values["T"]))
+
+
 def _values_of(expression, values):
     """``(symbol, value, type)`` of the ``values`` that ``expression`` reads, in a fixed order.
 

@@ -148,6 +148,37 @@ def test_a_design_marks_its_optimum_its_nominal_value_and_the_values_without_a_s
     assert drawn.axes.get_ylabel() == "y_max" and drawn.axes.get_xlabel() == "M"
 
 
+def test_a_design_with_a_budget_draws_its_front_and_shades_the_values_over_it():
+    """Values 0, 1, 2 within a budget of 0.5, 3 over it (the budget's scan: 2.5 meets it, 2.75
+    does not): the front is the three rows within it, the budget a line, and the search's
+    panel shades [2.5, 3] (to the last value within the budget)."""
+    from symstab.numeric.analysis.design import Design
+
+    samples = np.array([[0.0, 10.0], [1.0, 12.0], [2.0, 11.0], [2.5, 13.0]])
+    noise = np.array([0.1, 0.2, 0.3, 0.5])
+    scan = np.array([[0.0, 0.1], [1.0, 0.2], [2.0, 0.3], [2.5, 0.5], [2.75, 0.6], [3.0, 0.7]])
+    found = Design("y_max", "B", "K", {"f_c": (0.0, 3.0)}, {"f_c": 2.5}, 13.0, {}, None, None,
+                   samples, {"f_c": 1.0}, noise_limit=0.5, encoder_resolution=1e-6,
+                   noise_at={"B": 1.0, "K": 2.0}, noise=noise, noise_samples=scan)
+    drawn = found.plot_pareto()
+    (front,) = drawn.artists["front"]
+    assert front.get_xydata().tolist() == [[0.1, 10.0], [0.2, 12.0], [0.5, 13.0]]
+    (limit,) = drawn.artists["limit"]
+    assert list(limit.get_xdata()) == [0.5, 0.5]
+    (best,) = drawn.artists["best"]
+    assert best.get_xydata().tolist() == [[0.5, 13.0]]
+    search = found.plot()
+    (span,) = search.artists["over budget"]
+    # (A Rectangle from matplotlib 3.9, a Polygon before.)
+    xs = ([span.get_x(), span.get_x() + span.get_width()] if hasattr(span, "get_width")
+          else np.asarray(span.get_xy())[:, 0])
+    assert {round(float(x), 12) for x in xs} == {2.5, 3.0}
+    without = Design("y_max", "B", "K", {"f_c": (0.0, 3.0)}, None, None, {}, None, None,
+                     samples, {"f_c": 1.0})
+    with pytest.raises(ValueError, match="recorded no force noise"):
+        without.plot_pareto()
+
+
 def test_a_passive_set_draws_its_polygon_over_the_stable_set(region_d40):
     passive = symstab.PAPER_LOOP.passive_region(d=40)
     drawn = passive.plot(region=region_d40)

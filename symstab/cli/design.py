@@ -18,7 +18,7 @@ import dataclasses
 import math
 import sys
 
-from .loop_limits import limits_notes, named, plane_table, stable_intervals_at
+from .loop_limits import force_unit, limits_notes, named, plane_table, stable_intervals_at
 from .loop_options import (
     EXAMPLE,
     add_loop_options,
@@ -29,6 +29,7 @@ from .loop_options import (
     resolve_loop,
     split_unit,
     uses_loop,
+    value_text,
 )
 from .options import add_command, add_model_options, resolve
 from .output import check_outputs, emit, write_output
@@ -86,6 +87,15 @@ def register(subparsers):
                         "a limit cycle above it, or a decay not below it by the end, is "
                         "refused (--steps counts periods: with --delay and --over T a fixed "
                         "--steps is a shorter time at a smaller T)")
+    g.add_argument("--noise-limit", metavar="F",
+                   help="with --loop and --encoder-resolution: a noise budget, the largest RMS "
+                        "force of the encoder's quantization at the rendered point (--noise-at), "
+                        "in the loop's force unit (N or N m) or with a unit (10mN); only values "
+                        "of the one parameter searched that meet it are candidates")
+    g.add_argument("--noise-at", metavar=("X", "Y"), nargs=2,
+                   help="with --encoder-resolution: the point of the plane rendered while the "
+                        "force noise is measured, x then y, each in the file's unit or with a "
+                        "unit (default: the file's values of x and y)")
     add_nonideal_options(p, loop_only=True)
     add_loop_options(p, "design")
 
@@ -101,7 +111,9 @@ def run(args):
     """
     target = _target(args.maximize)
     # (0 is a value given: only None is "not given".)
-    given = [flag for flag, dest in _SIMULATION_FLAGS if getattr(args, dest) is not None]
+    # (--encoder-resolution is also the force noise's encoder, for every target.)
+    given = [flag for flag, dest in _SIMULATION_FLAGS if getattr(args, dest) is not None
+             and dest != "encoder_resolution"]
     if target != "simulated" and given:
         raise ValueError(f"{given[0]} is an option of the simulated target: add --maximize "
                          f"simulated (with --loop)")
@@ -140,7 +152,82 @@ def run(args):
                          f"{args.points ** len(over)} scan points, above {MAX_EVALUATIONS} (each "
                          f"is a certified region, about 0.1 to 1 s): give fewer --points")
     simulation = _simulation(args, setup.loop) if target == "simulated" else {}
-    return _search(args, setup, over, target, notes, png, delay, simulation)
+    noise = _noise(args, setup, over)
+    return _search(args, setup, over, target, notes, png, delay, simulation, noise)
+
+
+def _noise(args, setup, over):
+    """``Loop.design``'s noise arguments from --encoder-resolution, --noise-limit, --noise-at.
+
+    Checked before the search; ``{}`` without an encoder (no noise).
+    """
+    if args.encoder_resolution is None:
+        for flag, value in (("--noise-limit", args.noise_limit), ("--noise-at", args.noise_at)):
+            if value is not None:
+                raise ValueError(f"{flag} needs --encoder-resolution Q: the encoder's quantum "
+                                 f"(the loop's position unit, m or rad), whose rounding error "
+                                 f"is the force noise")
+        return {}
+    if setup.paper is not None:
+        raise ValueError(f"--encoder-resolution: the force noise of a design is a loop "
+                         f"file's (its forces in N or N m): give --loop {EXAMPLE}")
+    from .._validate import check_real
+
+    out = {"encoder_resolution": check_real("--encoder-resolution", args.encoder_resolution,
+                                            low=0.0, low_open=True)}
+    if args.noise_limit is not None:
+        if len(over) != 1:
+            raise ValueError(f"--noise-limit: a noise budget is searched over one parameter, "
+                             f"got {len(over)} (--over {' and '.join(over)})")
+        out["noise_limit"] = _noise_limit(args.noise_limit, setup)
+    x, y = setup.x, setup.y
+    if args.noise_at is not None:
+        out["noise_at"] = _noise_at(args.noise_at, setup)
+    elif x not in setup.loop.defaults or y not in setup.loop.defaults:
+        missing = [n for n in (x, y) if n not in setup.loop.defaults]
+        raise ValueError(f"--encoder-resolution: the force noise is measured at a rendered "
+                         f"point of the ({x}, {y}) plane, and {args.loop} gives no value of "
+                         f"{' and '.join(missing)}: give --noise-at X Y")
+    return out
+
+
+def _noise_limit(text, setup):
+    """``--noise-limit`` in the loop's force unit (SI): a bare number, or converted from its unit."""
+    from .._validate import check_real
+    from ..numeric.loop.quantities import dimension_name, unit_info
+    from .loop_limits import force_unit
+    from .options import parse_one
+
+    number, unit = split_unit(text.strip(), "--noise-limit")
+    value = parse_one(number, "--noise-limit")
+    if unit is not None:
+        force = force_unit(setup)
+        if force is None:
+            raise ValueError(f"--noise-limit {text}: the force's unit of this loop is not known "
+                             f"(the plane's {setup.y} has no stiffness unit in the file): give a "
+                             f"bare number in the loop's force unit")
+        try:
+            info = unit_info(unit)
+        except ValueError as exc:
+            raise ValueError(f"--noise-limit {text}: {exc}") from None
+        if info.dimensions != force.dimensions or info.angle:
+            raise ValueError(f"--noise-limit {text}: {unit!r} is {dimension_name(info.dimensions)}"
+                             f", and this loop's force is in {force.si} (its {setup.y} is in "
+                             f"{setup.unit(setup.y)})")
+        value *= float(info.factor)
+    return check_real("--noise-limit", value, low=0.0, low_open=True)
+
+
+def _noise_at(texts, setup):
+    """``--noise-at X Y``: the rendered point of the plane in SI, converted as ``--set`` values are."""
+    from .loop_options import convert_sets, parse_number
+
+    sets = {}
+    for name, text in zip((setup.x, setup.y), texts, strict=True):
+        number, unit = split_unit(text.strip(), "--noise-at")
+        sets[name] = (parse_number(name, number, "--noise-at", lists=False), unit)
+    values, _ = convert_sets(setup.loop, sets, flag="--noise-at")
+    return values
 
 
 def _simulation(args, loop):
@@ -301,15 +388,16 @@ _TARGET_ROWS = {
 }
 
 
-def _search(args, setup, over, target, notes, png, delay=None, simulation=None):
+def _search(args, setup, over, target, notes, png, delay=None, simulation=None, noise=None):
     """The values of ``over`` that maximise ``target`` in the plane of ``setup``: one design."""
     names = tuple(over)
-    found = _run_design(args, setup, over, target, delay, simulation)
+    found = _run_design(args, setup, over, target, delay, simulation, noise or {})
     at_nominal = _nominal_row(setup, found, names, target)
     if found.best is None:
         search = _search_json(setup, found, names, None)
         notes += ([found.message] + _failed_notes(found)
-                  + limits_notes(setup, _limits(setup, found.nominal, delay)))
+                  + limits_notes(setup, _limits(setup, found.nominal, delay))
+                  + _noise_notes(setup, found))
         columns, rows = plane_table(setup, [at_nominal], over=names)
         _write_png(png, setup, found, notes)
         emit(setup, args.format, columns, rows, result=_result(setup, search, None),
@@ -332,6 +420,7 @@ def _search(args, setup, over, target, notes, png, delay=None, simulation=None):
     for name in found.at_edge:
         notes.append(f"the best {setup.name(name)} is at an end of the range searched"
                      + (f": widen --over {name}=LO:HI" if setup.paper is None else ""))
+    notes += _noise_notes(setup, found)
     columns, rows = plane_table(setup, rows, over=names)
     result = _result(setup, search, lim)
     if line is not None:
@@ -341,7 +430,7 @@ def _search(args, setup, over, target, notes, png, delay=None, simulation=None):
     return 0
 
 
-def _run_design(args, setup, over, target, delay, simulation):
+def _run_design(args, setup, over, target, delay, simulation, noise):
     """Check ``--maximize`` against the plane and run the design, saying what it searches."""
     from .._progress import progress_printer
 
@@ -372,7 +461,7 @@ def _run_design(args, setup, over, target, delay, simulation):
         progress(min(k, n**len(names) + 39))
 
     found = setup.loop.design(over=over, maximize=target, x=setup.x, y=setup.y, n=n,
-                              progress=evaluated, delay=delay, **(simulation or {}),
+                              progress=evaluated, delay=delay, **(simulation or {}), **noise,
                               **{k: v for k, v in setup.values.items()
                                  if not (delay is not None and k == "d")})
     progress(n**len(names) + 40)
@@ -414,6 +503,12 @@ def _best_rows(found, names, target, lim, at_nominal):
                      "the {x} at which {y}_max is reached"))
     rows += [at_nominal, ("gain", found.gain, None, f"{label[0]} at the best over that at "
                           f"the nominal value")]
+    if found.noise is not None:
+        rows.append(("force noise at the best", found.best_noise, "force", "RMS force of the "
+                     "encoder's quantization at the rendered point, at the best "
+                     + " and ".join(f"{{{k}}}" for k in "pq"[:len(names)])))
+    if found.noise_limit is not None:
+        rows.append(("noise limit", found.noise_limit, "force", "the budget"))
     if target != "area":
         rows.append((("area at the best {p}" if len(names) == 1 else "area there", None,
                       "Z-width at the best M_w"), lim.area, "area",
@@ -502,6 +597,42 @@ def _simulation_notes(setup, found, simulation):
     return out
 
 
+def _noise_notes(setup, found):
+    """The force noise's notes: the encoder and the rendered point, whether the budget binds,
+    and the Pareto front of the target against the noise (none without an encoder)."""
+    if found.encoder_resolution is None:
+        return []
+    force = force_unit(setup)
+    unit = f" {force.si}" if force is not None else ""
+    at = ", ".join(value_text(setup, k, v) for k, v in found.noise_at.items())
+    out = [f"force noise: an encoder quantum of {found.encoder_resolution:.4g} "
+           f"{_position_unit(setup)}, uniform and white, through the closed loop at the rendered "
+           f"point {at} (exact: the H2 norm; unbounded where that point is not stable)"]
+    if found.budget_binds:
+        out.append(f"the noise budget binds: at the best value the force noise reaches "
+                   f"{found.noise_limit:.4g}{unit}; a larger budget or a finer encoder buys more")
+    front = found.pareto
+    if front is not None and len(front):
+        label = _TARGET_ROWS[found.target][0][0].format(y=setup.name(setup.y))
+        out.append(f"Pareto front: the values evaluated that no other beats on both {label} "
+                   f"and force noise")
+        heads = [setup.label(n) for n in found.over] + [label, "force noise" + (
+            f" [{force.si}]" if force is not None else "")]
+        cells = [heads] + [[f"{v:.6g}" for v in row[:-1]] + [f"{row[-1]:.4g}"] for row in front]
+        widths = [max(len(r[k]) for r in cells) for k in range(len(heads))]
+        out += ["  " + "  ".join(c.rjust(w) for c, w in zip(r, widths, strict=True))
+                for r in cells]
+    return out
+
+
+def _position_unit(setup):
+    """The loop's position unit: rad where its stiffness is per radian, else m (None: "")."""
+    force = force_unit(setup)
+    if force is None:
+        return "(the loop's position unit)"
+    return "rad" if "rad" in setup.unit(setup.y) else "m"
+
+
 def _failed_notes(found):
     """A note on the values the engine could not resolve (none when it resolved all)."""
     if not found.failed:
@@ -552,6 +683,14 @@ def _search_json(setup, found, names, lim):
                                 and found.value_nominal > -math.inf else None)
     out["y_max"] = y_max
     out["x_at_y_max"] = None if lim is None else lim.x_at_y_max
+    if found.encoder_resolution is not None:
+        front = found.pareto
+        out["noise"] = {"encoder_resolution": found.encoder_resolution,
+                        "noise_limit": found.noise_limit, "at": found.noise_at,
+                        "best": found.best_noise, "binds": found.budget_binds,
+                        "pareto": [{**{setup.name(n): v for n, v in zip(found.over, row,
+                                                                           strict=False)},
+                                    "target": row[-2], "noise": row[-1]} for row in front]}
     if found.target == "simulated":
         simulated = found.limits
         out["simulated"] = None if simulated is None else {
@@ -576,7 +715,8 @@ def _result(setup, search, lim):
 
 
 def _write_png(png, setup, found, notes):
-    """Draw the target against the searched parameter(s) into ``png`` (if given)."""
+    """Draw the target against the searched parameter(s) into ``png`` (if given); beside it,
+    with an encoder, the target against the force noise."""
     if png is None:
         return
     from ..drawing import design_figure, png_of
@@ -590,5 +730,7 @@ def _write_png(png, setup, found, notes):
         found.target, f"({setup.unit(setup.x)})({setup.unit(setup.y)})"
         if setup.unit(setup.x) and setup.unit(setup.y) else "")
     target_label = label[0].format(y=y) + (f" [{unit}]" if unit else "")
-    write_output(png, png_of(design_figure, found, labels, target_label), "--png")
+    force = force_unit(setup)
+    noise_label = "force noise (RMS)" + (f" [{force.si}]" if force is not None else "")
+    write_output(png, png_of(design_figure, found, labels, target_label, noise_label), "--png")
     notes.append(f"wrote {png}")

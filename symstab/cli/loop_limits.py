@@ -76,8 +76,29 @@ def _units(setup, physical=False, over=None):
     up, uq = (setup.unit(name) for name in _searched(over))
     if physical:
         ux, uy, up = (setup.paper.units[k] for k in ("B_w", "K_w", "M_w"))
+    force = None if setup.paper is not None else force_unit(setup)
     return {"x": ux, "y": uy, "p": up, "q": uq,
-            "area": f"({ux})({uy})" if ux and uy else (ux or uy), None: ""}
+            "area": f"({ux})({uy})" if ux and uy else (ux or uy), None: "",
+            "force": "" if force is None else force.si}
+
+
+def force_unit(setup):
+    """The :class:`~symstab.numeric.loop.quantities.UnitInfo` of a loop's force, or None.
+
+    The plane's ``y`` times the position, where ``y`` is a stiffness in the
+    file's units: ``N/m`` gives ``N``, ``N m/rad`` gives ``N m``.  None where
+    ``y`` has no unit or is not a stiffness (the force's unit is then not
+    known).
+    """
+    from ..numeric.loop.quantities import unit_info
+
+    unit = setup.unit(setup.y)
+    if not unit:
+        return None
+    position = "rad" if unit_info(unit).angle < 0 else "m"
+    force = unit_info(f"({unit}) * {position}")
+    forces = {unit_info("N").dimensions, unit_info("N m").dimensions}
+    return force if force.dimensions in forces and not force.angle else None
 
 
 def _searched(over):

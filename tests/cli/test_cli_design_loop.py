@@ -135,7 +135,20 @@ def test_the_table_names_the_optimum_the_value_there_and_at_the_nominal_value(ca
     (["--png", "/nonexistent/x.png"], "--png"),
     # The simulated target: its options only with it, with a loop file, checked first.
     (["--loop", LOOPS / "paper.toml", "--amplitude", "1e-3"], "add --maximize simulated"),
-    (["--encoder-resolution", "1e-5"], "add --maximize simulated"),
+    (["--encoder-resolution", "1e-5"], "give --loop"),
+    (["--loop", LOOPS / "lowpass_velocity.toml", "--over", "f_c=20:400", "--noise-limit",
+      "0.01"], "--noise-limit needs --encoder-resolution"),
+    (["--loop", LOOPS / "lowpass_velocity.toml", "--over", "f_c=20:400", "--noise-at", "1",
+      "2"], "--noise-at needs --encoder-resolution"),
+    (["--loop", LOOPS / "lowpass_velocity.toml", "--over", "f_c=20:400",
+      "--encoder-resolution", "1e-5", "--noise-limit", "0.01 N m"], "this loop's force is in N"),
+    (["--loop", LOOPS / "lowpass_velocity.toml", "--over", "f_c=20:400",
+      "--encoder-resolution", "1e-5", "--noise-limit", "0"], "--noise-limit must be"),
+    (["--loop", LOOPS / "lowpass_velocity.toml", "--encoder-resolution", "1e-5",
+      "--noise-limit", "0.01", "--over", "f_c=20:400", "--over", "m=0.01:0.02"],
+     "searched over one parameter"),
+    (["--loop", LOOPS / "lowpass_velocity.toml", "--over", "f_c=20:400",
+      "--encoder-resolution", "1e-5", "--noise-at", "1 kg", "2"], "--noise-at B"),
     (["--maximize", "simulated", "--amplitude", "1e-3"], "give --loop FILE"),
     (["--loop", LOOPS / "paper.toml", "--maximize", "simulated"], "needs --amplitude"),
     (["--loop", LOOPS / "paper.toml", "--maximize", "simulated", "--amplitude", "0"],
@@ -248,3 +261,29 @@ def test_a_band_of_masses_between_four_scan_points_is_found(capsys):
     assert search["best"] == pytest.approx(1.0 * PAPER_M, rel=1e-2)
     at_zero = symstab.load_loop(LOOPS / "paper.toml").limits(d=40, M=0.0).y_max
     assert search["y_max"] / at_zero == pytest.approx(4.14, abs=5e-3)
+
+
+def test_a_noise_budget_in_millinewtons_is_the_library_s_design(capsys, tmp_path):
+    """--noise-limit 30mN is 0.03 N of the loop's force (its K is in N/m): the optimum is
+    Loop.design's with that budget, the table says the budget binds and lists the Pareto
+    front, the JSON carries it, and --png draws the front beside the search."""
+    loop = symstab.load_loop(LOOPS / "lowpass_velocity.toml")
+    q = 2 * math.pi / 16384
+    args = ["design", "--loop", LOOPS / "lowpass_velocity.toml", "--set", "d=5",
+            "--over", "f_c=20:450", "--points", "9", "--encoder-resolution", str(q),
+            "--noise-at", "500 mN s/m", "5", "--noise-limit"]
+    out = run_json(capsys, *args, "30mN", "--png", tmp_path / "budget.png")
+    found = loop.design(over={"f_c": (20.0, 450.0)}, encoder_resolution=q, noise_limit=0.03,
+                        noise_at={"B": 0.5, "K": 5.0}, n=9, d=5)
+    noise = out["search"]["noise"]
+    assert noise["noise_limit"] == 0.03 and noise["at"] == {"B": 0.5, "K": 5.0}
+    assert out["search"]["best"] == found.best["f_c"] and noise["best"] == found.best_noise
+    assert noise["binds"] is True
+    assert [[row["f_c"], row["target"], row["noise"]] for row in noise["pareto"]] == \
+        found.pareto.tolist()
+    assert (tmp_path / "budget.png").stat().st_size > 0
+    status, text, _ = run(capsys, *args, "0.03")
+    assert status == 0
+    assert re.search(r"force noise at the best +0\.0\d+ +N ", text), text
+    assert "the noise budget binds: at the best value the force noise reaches 0.03 N" in text
+    assert re.search(r"f_c \[Hz\] +K_max +force noise \[N\]\n", text), text

@@ -38,6 +38,18 @@ proved to have no stable point.  Otherwise a band that holds neither a
 scan point nor the nominal value can still be missed: then the message
 says so (never a bare "none"), :attr:`Design.spacing` says the scan's
 step, and ``n`` makes it finer.
+
+A design can also count a cost: with an encoder (``encoder_resolution``)
+the force noise of its quantization at a rendered point of the plane
+(:func:`~symstab.numeric.analysis.noise.force_noise_rms`) is recorded at
+every value evaluated (:attr:`Design.pareto`, the values no other beats on
+both the target and the noise), and with a budget (``noise_limit``, one
+parameter searched) only the values whose noise fits are candidates: the
+line is scanned for the noise first, the edges where it crosses the budget
+are bisected, and the target is maximised over the pieces left
+(:func:`maximize_pieces`).  Stability has no noise criterion, so a search
+over a velocity filter's cut-off answers "the highest"; with a budget the
+answer is the highest cut-off whose noise fits.
 """
 
 import dataclasses
@@ -121,6 +133,19 @@ class Design:
     delay : float or None
         The loop delay held in seconds while ``T`` varies (``d = ceil(delay
         / T)`` at each value), or None (``d`` as given).
+    noise_limit : float or None
+        The noise budget searched within, or None.
+    encoder_resolution : float or None
+        The encoder's quantum of the force noise, or None (no noise).
+    noise_at : dict
+        The rendered ``{x: value, y: value}`` where the noise is measured.
+    noise : ndarray or None
+        The force RMS at each row of :attr:`samples` (``inf`` where the
+        rendered point is not stable), or None without an encoder.
+    noise_samples : ndarray or None
+        ``(k, len(over) + 1)``: every value where the noise was evaluated
+        (the budget's scan and the bisection of its edges, and the
+        samples), then the noise, in increasing values.
     """
 
     target: str
@@ -138,6 +163,11 @@ class Design:
     values: dict = dataclasses.field(default_factory=dict)
     message: str = ""
     delay: object = None
+    noise_limit: object = None
+    encoder_resolution: object = None
+    noise_at: dict = dataclasses.field(default_factory=dict)
+    noise: object = None
+    noise_samples: object = None
 
     def plot(self, ax=None, **kwargs):
         """Draw the target at each value evaluated: :func:`symstab.drawing.plot_design`.
@@ -158,6 +188,25 @@ class Design:
 
         return plot_design(self, ax, **kwargs)
 
+    def plot_pareto(self, ax=None, **kwargs):
+        """Draw the target against the force noise: :func:`symstab.drawing.plot_pareto`.
+
+        Parameters
+        ----------
+        ax : matplotlib.axes.Axes, optional
+            Where to draw (default: a new figure's axes).
+        **kwargs
+            ``target_label``, ``noise_label``: as in :func:`symstab.drawing.plot_pareto`.
+
+        Returns
+        -------
+        symstab.drawing.Plot
+            Its ``figure``, ``axes`` and ``artists``.
+        """
+        from ...drawing import plot_pareto
+
+        return plot_pareto(self, ax, **kwargs)
+
     @property
     def best_d(self):
         """The delay in samples at the optimum: ``ceil(delay / T)`` where the delay is held in seconds."""
@@ -176,6 +225,48 @@ class Design:
                 and self.value_nominal > 0):
             return None
         return self.value / self.value_nominal
+
+    @property
+    def best_noise(self):
+        """The force RMS at the optimum (None without an encoder or an optimum)."""
+        if self.noise is None or self.best is None:
+            return None
+        key = tuple(self.best[name] for name in self.over)
+        rows = np.flatnonzero((self.samples[:, :-1] == key).all(axis=1))
+        return float(self.noise[rows[0]])
+
+    @property
+    def budget_binds(self):
+        """Whether the optimum lies at the edge of the noise budget (its noise within 0.1 % of it).
+
+        Then a larger budget (or a finer encoder) buys a larger target.
+        """
+        best = self.best_noise
+        return (self.noise_limit is not None and best is not None
+                and best >= (1 - 1e-3) * self.noise_limit)
+
+    @property
+    def pareto(self):
+        """The values evaluated that no other beats on both counts: a higher target, less noise.
+
+        Returns
+        -------
+        ndarray or None
+            Rows ``(*values, target, noise)`` of :attr:`samples` whose
+            target is finite and higher than that of every row with no more
+            noise, in increasing noise (and target); None without an
+            encoder.
+        """
+        if self.noise is None:
+            return None
+        rows = np.column_stack([self.samples, self.noise])
+        rows = rows[np.isfinite(rows[:, -2]) & np.isfinite(rows[:, -1])]
+        rows = rows[np.lexsort((-rows[:, -2], rows[:, -1]))]
+        keep = []
+        for row in rows:
+            if not keep or row[-2] > keep[-1][-2]:
+                keep.append(row)
+        return np.array(keep, dtype=float).reshape(-1, self.samples.shape[1] + 1)
 
     @property
     def at_edge(self):
@@ -203,7 +294,10 @@ class Design:
             return f"Design({self.target} over {over}: {self.message})"
         best = ", ".join(f"{n}={v:.6g}" for n, v in self.best.items())
         gain = f", gain {self.gain:.4g}" if self.gain is not None else ""
-        return f"Design({self.target} over {over}: {best}, {self.target}={self.value:.6g}{gain})"
+        noise = "" if self.noise is None else f", force noise {self.best_noise:.4g}" + (
+            "" if self.noise_limit is None else f" within {self.noise_limit:.4g}")
+        return (f"Design({self.target} over {over}: {best}, {self.target}={self.value:.6g}"
+                f"{gain}{noise})")
 
     def as_dict(self):
         """The numbers, for tables and JSON."""
@@ -212,7 +306,9 @@ class Design:
                 "value": self.value, "nominal": self.nominal,
                 "value_nominal": self.value_nominal, "gain": self.gain,
                 "evaluations": int(self.samples.shape[0]), "spacing": self.spacing,
-                "failed": len(self.failed), "message": self.message}
+                "failed": len(self.failed), "message": self.message,
+                "noise_limit": self.noise_limit, "encoder_resolution": self.encoder_resolution,
+                "noise_at": self.noise_at or None, "best_noise": self.best_noise}
 
 
 class _Evaluations:
@@ -528,7 +624,7 @@ def _check_over(loop, over, x, y):
 
 def design(loop, *, over, maximize="y_max", x=None, y=None, n=None, rtol=None, damping="b",
            delay=None, progress=None, amplitude=None, nonideal=None, x0=None, steps=None,
-           **values):
+           noise_limit=None, encoder_resolution=None, noise_at=None, **values):
     """The value of one or two parameters that maximises K_max, the Z-width, the passive K_max
     or the simulated K_max.
 
@@ -579,6 +675,22 @@ def design(loop, *, over, maximize="y_max", x=None, y=None, n=None, rtol=None, d
         default 1, or 0.01 with non-idealities, as ``symstab design``;
         ``steps`` is periods, so with ``delay`` and ``T`` searched a
         fixed ``steps`` is a shorter time at a smaller ``T``).
+    noise_limit : float, optional
+        A noise budget: the largest force RMS accepted
+        (:func:`~symstab.numeric.analysis.noise.force_noise`, the force's
+        unit) at the rendered point ``noise_at``; values of the one
+        parameter searched whose noise exceeds it are not candidates (the
+        edges of those that meet it are bisected to ``rtol`` before the
+        search).  Needs ``encoder_resolution``.
+    encoder_resolution : float, optional
+        The encoder's quantum ``q`` (the position's unit), > 0.  Given
+        alone, the force noise is recorded at every value evaluated
+        (:attr:`Design.noise`, the front :attr:`Design.pareto`) without
+        bounding it.
+    noise_at : dict, optional
+        ``{x: value, y: value}``: the environment rendered while the noise
+        is measured (default: the loop's values of ``x`` and ``y``).  At a
+        value where it is not stable the noise is unbounded.
     **values
         Single values of the other parameters; the searched ones' values
         here (or defaults) are the nominal point the gain is measured
@@ -605,9 +717,11 @@ def design(loop, *, over, maximize="y_max", x=None, y=None, n=None, rtol=None, d
     >>> 0.006 < best.best["M"] < 0.02 and best.gain > 2
     True
     """
+    if maximize == f"{y}_max":
+        maximize = "y_max"      # K_max in the (B, K) plane
     if maximize not in TARGETS:
-        raise ValueError(f"maximize must be one of {', '.join(map(repr, TARGETS))}, "
-                         f"got {maximize!r}")
+        raise ValueError(f"maximize must be one of {', '.join(map(repr, TARGETS))} (or "
+                         f"{y}_max), got {maximize!r}")
     over = _check_over(loop, over, x, y)
     simulation = _check_simulation(maximize, amplitude, nonideal, x0, steps, loop)
     rtol = _RTOL.get(maximize, 1e-6) if rtol is None else rtol
@@ -629,56 +743,196 @@ def design(loop, *, over, maximize="y_max", x=None, y=None, n=None, rtol=None, d
             out["d"] = held_delay(delay, out.get("T", loop.defaults.get("T")))
         return out
 
+    budget = _check_budget(loop, x, y, names, noise_limit, encoder_resolution, noise_at, at)
     _check_values_once(loop, maximize, x, y, damping, over, at, simulation, steps)
-    failed = []
-    # The best answer so far is kept (not every answer: each holds its
-    # decomposition): it is the Design's limits, and near a vanishing stable
-    # set one costs a second.
-    kept = {}
-
-    def answer(point):
-        key = tuple(float(v) for v in point)
-        if key in kept:
-            return kept[key][1]
-        return _answer(loop, maximize, x, y, damping, at(key), simulation)
-
-    def target(point):
-        try:
-            found = answer(point)
-            value = _target(maximize, found)
-            if not kept or value > next(iter(kept.values()))[0]:
-                kept.clear()
-                kept[tuple(float(v) for v in point)] = (value, found)
-            return value
-        except ValueError as exc:
-            failed.append((dict(zip(names, point, strict=True)), str(exc)))
-            return math.nan
-
+    search = _Search(loop, maximize, x, y, damping, names, at, simulation)
     include = [tuple(nominal[n_] for n_ in names)] if nominal else []
     # Where a stable point can be at all: the searched box narrowed to it, or
     # proved empty (then nothing is scanned).
     bracket = _bracket(loop, maximize, x, y, names, over, at) if delay is None else over
     searched = over if bracket is None else bracket
-    best, value, seen = (None, None, []) if bracket is None else _maximize_over(
-        target, names, over, searched, delay, n, include, rtol, progress)
+    pieces = None if bracket is None else _budget_pieces(budget, searched, delay, n, rtol)
+    best, value, seen = (None, None, []) if bracket is None or pieces == [] else _maximize_over(
+        search.target, names, searched, delay, n, include, rtol, progress, pieces)
     samples = np.array([[*p, v] for p, v in seen], dtype=float).reshape(-1, len(names) + 1)
     spacing = {k: (hi - lo) / (n - 1) for k, (lo, hi) in searched.items()}
     value_nominal = None
     if nominal:
         key = tuple(nominal[k] for k in names)
         hits = [v for p, v in seen if tuple(p) == key]
-        value_nominal = hits[0] if hits else target(key)
+        value_nominal = hits[0] if hits else search.target(key)
         if value_nominal is not None and math.isnan(value_nominal):
             value_nominal = None
     common = dict(target=maximize, x=x, y=y, over=over, nominal=nominal,
                   value_nominal=value_nominal, samples=samples, spacing=spacing,
-                  failed=tuple(failed), values=dict(values), delay=delay)
+                  failed=tuple(search.failed), values=dict(values), delay=delay,
+                  **({} if budget is None else budget.fields(samples)))
     if best is None:
-        message = _not_found(maximize, simulation, x, y, over, searched, bracket, samples,
-                             spacing, failed)
+        message = (_over_budget(budget, x, y, searched) if pieces == [] else
+                   _not_found(maximize, simulation, x, y, over, searched, bracket, samples,
+                              spacing, search.failed))
         return Design(best=None, value=None, limits=None, message=message, **common)
     return Design(best=dict(zip(names, (float(v) for v in best), strict=True)), value=float(value),
-                  limits=answer(best), **common)
+                  limits=search.answer(best), **common)
+
+
+class _Search:
+    """The target at a point of the search (NaN where the engine refused, with why).
+
+    The best answer so far is kept (not every answer: each holds its
+    decomposition): it is the Design's limits, and near a vanishing stable
+    set one costs a second.
+    """
+
+    def __init__(self, loop, maximize, x, y, damping, names, at, simulation):
+        self.ask = (loop, maximize, x, y, damping)
+        self.names, self.at, self.simulation = names, at, simulation
+        self.failed, self.kept = [], {}
+
+    def answer(self, point):
+        """The answer (Limits, PassiveRegion, SimulatedLimit) at ``point``."""
+        key = tuple(float(v) for v in point)
+        if key in self.kept:
+            return self.kept[key][1]
+        return _answer(*self.ask, self.at(key), self.simulation)
+
+    def target(self, point):
+        """The target's number at ``point``; NaN (and the reason kept) where refused."""
+        try:
+            found = self.answer(point)
+            value = _target(self.ask[1], found)
+            if not self.kept or value > next(iter(self.kept.values()))[0]:
+                self.kept.clear()
+                self.kept[tuple(float(v) for v in point)] = (value, found)
+            return value
+        except ValueError as exc:
+            self.failed.append((dict(zip(self.names, point, strict=True)), str(exc)))
+            return math.nan
+
+
+def _check_budget(loop, x, y, names, noise_limit, encoder_resolution, noise_at, at):
+    """The noise budget of a design (checked), or None without an encoder.
+
+    ``encoder_resolution`` alone records the force noise at every value
+    evaluated (the Pareto front); ``noise_limit`` also bounds it.  The
+    noise is measured at the rendered point ``noise_at`` of the plane
+    (default: the loop's values of ``x`` and ``y``).
+    """
+    if encoder_resolution is None:
+        for name, given in (("noise_limit", noise_limit), ("noise_at", noise_at)):
+            if given is not None:
+                raise TypeError(f"{name} needs encoder_resolution: the encoder's quantum q (the "
+                                f"position's unit), whose rounding error is the force noise")
+        return None
+    q = check_real("encoder_resolution", encoder_resolution, low=0.0, low_open=True)
+    limit = math.inf if noise_limit is None else check_real("noise_limit", noise_limit, low=0.0,
+                                                            low_open=True)
+    if noise_limit is not None and len(names) != 1:
+        raise ValueError(f"noise_limit: a noise budget is searched over one parameter (where the "
+                         f"noise meets it is bracketed on a line), got {len(names)}: "
+                         f"{', '.join(names)}")
+    if noise_at is None:
+        missing = [name for name in (x, y) if name not in loop.defaults]
+        if missing:
+            raise TypeError(f"the force noise is measured at a rendered point of the ({x}, {y}) "
+                            f"plane, and the loop has no value of {' and '.join(missing)}: give "
+                            f"noise_at={{{x!r}: ..., {y!r}: ...}}")
+        noise_at = {x: loop.defaults[x], y: loop.defaults[y]}
+    if not isinstance(noise_at, dict) or set(noise_at) != {x, y}:
+        raise TypeError(f"noise_at must be a dict of the plane's two values, {{{x!r}: ..., "
+                        f"{y!r}: ...}}, got {noise_at!r}")
+    rendered = {name: check_real(f"noise_at[{name!r}]", noise_at[name]) for name in (x, y)}
+    return _Budget(loop, q, limit, rendered, at)
+
+
+class _Budget:
+    """The force noise at the rendered point for each value searched, against a limit.
+
+    :func:`~symstab.numeric.analysis.noise.force_noise_rms` of the loop at the
+    values of the search's point and the rendered ``(x, y)``: ``inf`` where
+    the rendered point is not stable (no budget is met there).
+    """
+
+    def __init__(self, loop, q, limit, rendered, at):
+        self.loop, self.q, self.limit, self.rendered, self.at = loop, q, limit, rendered, at
+        self.seen = {}
+
+    def __call__(self, point):
+        """The force RMS at ``point`` of the search (remembered)."""
+        from .noise import force_noise_rms
+
+        key = tuple(float(v) for v in point)
+        if key not in self.seen:
+            self.seen[key] = force_noise_rms(self.loop, self.q, {**self.at(key), **self.rendered})
+        return self.seen[key]
+
+    def meets(self, x):
+        """Whether the noise at the one parameter's value ``x`` is within the limit."""
+        return self((x,)) <= self.limit
+
+    def pieces(self, pieces, n, rtol):
+        """The parts of each piece of the line where the noise meets the limit.
+
+        Each piece is scanned at ``n`` points; where two neighbours differ,
+        the edge is bisected to ``rtol`` of the piece's width (and of
+        ``|x|``).  A part narrower than a scan step between two points over
+        the limit is not seen (the design's message says its step).
+        """
+        out = []
+        for a, b in pieces:
+            xs = np.linspace(a, b, n).tolist()
+            ok = [self.meets(x) for x in xs]
+            tol = rtol * max(abs(a), abs(b), b - a)
+            left = None
+            for k, x in enumerate(xs):
+                if ok[k] and left is None:
+                    left = a if k == 0 else self._edge(x, xs[k - 1], tol)
+                if ok[k] and (k == len(xs) - 1 or not ok[k + 1]):
+                    right = b if k == len(xs) - 1 else self._edge(x, xs[k + 1], tol)
+                    if left < right:
+                        out.append((left, right))
+                    left = None
+        return out
+
+    def _edge(self, good, bad, tol):
+        """The last value from ``good`` (within the limit) towards ``bad`` (over it) that meets it."""
+        while abs(bad - good) > tol:
+            middle = 0.5 * (good + bad)
+            good, bad = (middle, bad) if self.meets(middle) else (good, middle)
+        return good
+
+    def fields(self, samples):
+        """The :class:`Design`'s fields of the budget, its noise at each of ``samples``."""
+        scan = sorted(self.seen.items())
+        return dict(noise_limit=None if math.isinf(self.limit) else self.limit,
+                    encoder_resolution=self.q, noise_at=dict(self.rendered),
+                    noise=np.array([self(row[:-1]) for row in samples], dtype=float),
+                    noise_samples=np.array([[*p, v] for p, v in scan], dtype=float).reshape(
+                        len(scan), samples.shape[1]))
+
+
+def _budget_pieces(budget, searched, delay, n, rtol):
+    """The pieces of the line within the noise budget (``[]``: none), or None without a limit."""
+    if budget is None or math.isinf(budget.limit):
+        return None
+    (name, window), = searched.items()
+    line = delay_pieces(delay, *window) if delay is not None and name == "T" else [window]
+    return budget.pieces(line, n if len(line) == 1 else _PIECE_POINTS, rtol)
+
+
+def _over_budget(budget, x, y, searched):
+    """The message of a design whose every value scanned is over the noise budget."""
+    (name, (lo, hi)), = searched.items()
+    rendered = ", ".join(f"{k} = {v:.6g}" for k, v in budget.rendered.items())
+    (where,), least = min(budget.seen.items(), key=lambda item: item[1])
+    if math.isinf(least):
+        return (f"no value of {name} in [{lo:.6g}, {hi:.6g}] meets the noise budget: the "
+                f"rendered point {rendered} is not stable at any value scanned ({len(budget.seen)}), "
+                f"so its force noise is unbounded; render a point inside the stable set")
+    return (f"no value of {name} in [{lo:.6g}, {hi:.6g}] meets the noise budget "
+            f"{budget.limit:.6g}: the force noise at {rendered} is at least {least:.6g} (at "
+            f"{name} = {where:.6g}) of the {len(budget.seen)} values scanned (a finer encoder, a larger budget or a point "
+            f"rendered with less damping lowers it)")
 
 
 def _check_design_names(loop, maximize, x, y, damping, delay, values):
@@ -725,25 +979,29 @@ def _check_values_once(loop, maximize, x, y, damping, over, at, simulation, step
             check_steps(steps, at(tuple(corner.values())).get("d", loop.defaults.get("d", 0)))
 
 
-def _maximize_over(target, names, over, searched, delay, n, include, rtol, progress):
+def _maximize_over(target, names, searched, delay, n, include, rtol, progress, pieces=None):
     """``(best, value, seen)``: the search of ``target`` over ``searched``, points as tuples.
 
-    One parameter: :func:`maximize_scalar`, or with ``T`` and a delay held
-    in seconds :func:`maximize_pieces` over the pieces of one whole delay
-    each; two: :func:`maximize_box`.
+    One parameter: :func:`maximize_scalar`, or over ``pieces`` (the parts
+    of the range within a noise budget, or with ``T`` and a delay held in
+    seconds the pieces of one whole delay each) :func:`maximize_pieces`
+    (:func:`maximize_scalar` where one piece is left and no delay is held);
+    two: :func:`maximize_box`.
     """
-    if len(names) == 1 and delay is not None and names[0] == "T":
-        best, value, seen = maximize_pieces(lambda v: target((v,)),
-                                            delay_pieces(delay, *over["T"]),
-                                            include=[p[0] for p in include], rtol=rtol,
-                                            progress=progress)
-    elif len(names) == 1:
-        best, value, seen = maximize_scalar(lambda v: target((v,)), *searched[names[0]], n,
+    if len(names) == 2:
+        return maximize_box(target, tuple(searched[k] for k in names), n,
+                            include=include, rtol=rtol, progress=progress)
+    if pieces is None and delay is not None and names[0] == "T":
+        pieces = delay_pieces(delay, *searched["T"])
+    if pieces is None or len(pieces) == 1 and delay is None:
+        window = searched[names[0]] if pieces is None else pieces[0]
+        best, value, seen = maximize_scalar(lambda v: target((v,)), *window, n,
                                             include=[p[0] for p in include], rtol=rtol,
                                             progress=progress)
     else:
-        return maximize_box(target, tuple(searched[k] for k in names), n,
-                            include=include, rtol=rtol, progress=progress)
+        best, value, seen = maximize_pieces(lambda v: target((v,)), pieces,
+                                            include=[p[0] for p in include], rtol=rtol,
+                                            progress=progress)
     best = None if best is None else (best,)
     return best, value, [((p,), v) for p, v in seen]
 

@@ -279,6 +279,19 @@ def margins(loop, *, parameters=None, delay_limit=None, rtol=1e-9, **values):
         delay_limit=limit)
 
 
+def classified_point(loop, values):
+    """``(point, code)``: the point's values (defaults filled in, single numbers) and its verdict.
+
+    The checks of every question (unknown and missing names, ``d`` a whole
+    number of samples, finite reals), then :meth:`symstab.Loop.classify`.
+    """
+    checked, d, _ = loop.evaluation.prepare(values, scalar=loop.parameters)
+    point = {name: float(checked[name]) for name in loop.symbols}
+    point["d"] = d
+    point = {name: point[name] for name in loop.parameters}
+    return point, int(loop.classify(**point))
+
+
 def stable_point(loop, values, what="margins"):
     """The point's values (defaults filled in, single numbers), checked to be stable.
 
@@ -286,13 +299,7 @@ def stable_point(loop, values, what="margins"):
     margins, the force noise): an unstable or marginal point is a
     ValueError saying which.
     """
-    # The checks of every question (unknown and missing names, d a whole
-    # number of samples, finite reals), then single values.
-    checked, d, _ = loop.evaluation.prepare(values, scalar=loop.parameters)
-    point = {name: float(checked[name]) for name in loop.symbols}
-    point["d"] = d
-    point = {name: point[name] for name in loop.parameters}
-    code = int(loop.classify(**point))
+    point, code = classified_point(loop, values)
     if code != STABLE:
         state = ("marginal (a pole on the unit circle)" if code == MARGINAL else
                 f"unstable ({int(loop.unstable_root_counts(**point))} poles outside the unit "

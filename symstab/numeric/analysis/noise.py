@@ -31,7 +31,7 @@ import numpy as np
 from ..._resources import check_memory
 from ..._validate import check_real
 
-__all__ = ["ForceNoise", "force_noise", "h2_norm", "H2_MAX_DEGREE"]
+__all__ = ["ForceNoise", "force_noise", "force_noise_rms", "h2_norm", "H2_MAX_DEGREE"]
 
 
 @dataclasses.dataclass(frozen=True)
@@ -166,3 +166,33 @@ def force_noise(loop, *, encoder_resolution, **values):
     return ForceNoise(point=point, encoder_resolution=q, sensor_rms=sensor,
                       closed_loop_gain=closed, open_loop_gain=open_, rms=sensor * closed,
                       open_loop_rms=sensor * open_)
+
+
+def force_noise_rms(loop, encoder_resolution, values):
+    """:attr:`ForceNoise.rms` at a point, ``inf`` where the loop is not stable there.
+
+    The measure of a noise budget (:func:`symstab.numeric.analysis.design.design`
+    with ``noise_limit``): a rendered point that is unstable or marginal
+    has no bounded force noise, so it meets no budget.  Only the closed
+    loop's norm is computed.
+
+    Parameters
+    ----------
+    loop : symstab.Loop
+    encoder_resolution : float
+        ``q`` (checked by the caller), > 0.
+    values : dict
+        A single value of every parameter (or its default).
+
+    Returns
+    -------
+    float
+    """
+    from ..engine.roots import STABLE
+    from .margins import classified_point
+
+    point, code = classified_point(loop, values)
+    if code != STABLE:
+        return math.inf
+    num, chi, _, _ = loop.evaluation.noise_path(point)
+    return encoder_resolution / math.sqrt(12.0) * h2_norm(num, chi, stable=True)

@@ -89,11 +89,10 @@ class Loop(LoopModel):
         A word for reprs and generated files (ASCII letters, digits, ``_``,
         ``-``, ``.``).
     units : dict, optional
-        The SI unit of each parameter, as text (shown by the CLI), e.g.
-        ``{"K": "N/m"}``.  The loop computes with its values as given, so a
-        unit that is not SI (``"ms"``) is refused, and so are units whose
-        dimensions do not fit the loop; a loop file's units are converted
-        (:func:`symstab.load_loop`).
+        The SI unit of each parameter, as text (shown by the CLI), e.g. ``{"K": "N/m"}``.
+        The loop computes with its values as given, so a unit that is not SI (``"ms"``) is
+        refused, and so are units whose dimensions do not fit the loop; a loop file's units
+        are converted (:func:`symstab.load_loop`).
     description : str, optional
         One line on what the loop is.
     plane : (str, str), optional
@@ -528,7 +527,7 @@ class Loop(LoopModel):
 
     def design(self, *, over, maximize="y_max", x=None, y=None, n=None, rtol=None, damping="b",
                delay=None, progress=None, amplitude=None, nonideal=None, x0=None, steps=None,
-               **values):
+               noise_limit=None, encoder_resolution=None, noise_at=None, **values):
         """The value of one or two parameters that maximises a target (K_max, the Z-width, ...).
 
         See :func:`symstab.numeric.analysis.design.design`.
@@ -538,7 +537,8 @@ class Loop(LoopModel):
         x, y = self.plane_of(x, y)
         return design(self, over=over, maximize=maximize, x=x, y=y, n=n, rtol=rtol,
                       damping=damping, delay=delay, progress=progress, amplitude=amplitude,
-                      nonideal=nonideal, x0=x0, steps=steps, **values)
+                      nonideal=nonideal, x0=x0, steps=steps, noise_limit=noise_limit,
+                      encoder_resolution=encoder_resolution, noise_at=noise_at, **values)
 
     def difference_equations(self, **values):
         """The loop's difference equations per point: ``(a, b, c, e)``, ``d`` and the shape.

@@ -20,7 +20,7 @@ from symstab import Nonidealities
 from symstab.numeric.analysis.noise import h2_norm
 
 from conftest import REPO
-from oracles import python_control_parts
+from oracles import impulse_norm, python_control_parts
 
 LOOPS = REPO / "examples" / "loops"
 
@@ -28,17 +28,6 @@ pytestmark = pytest.mark.usefixtures("loop_cache_dir")
 
 #: The paper's encoder: 4096 lines, 16384 counts a turn (rad).
 Q = 2 * math.pi / 16384
-
-
-def _impulse_norm(num, den, dt):
-    """sqrt(sum h[k]**2) by scipy's impulse response, long enough for the tail to vanish."""
-    steps = 4096
-    while True:
-        _, (h,) = scipy.signal.dimpulse((num, den, dt), n=steps)
-        energy = np.cumsum(h.ravel() ** 2)
-        if energy[-1] == 0 or energy[-1] - energy[steps // 2] < 1e-17 * energy[-1]:
-            return math.sqrt(energy[-1])
-        steps *= 2
 
 
 @pytest.mark.parametrize("file, values", [
@@ -54,10 +43,10 @@ def test_the_closed_loop_gain_is_python_control_s_impulse_response_summed(file, 
     plant, environment, delay = python_control_parts(loop, point)
     H = environment * delay / (1 + environment * delay * plant)
     T = point["T"]
-    expected = _impulse_norm(H.num[0][0], H.den[0][0], T)
+    expected = impulse_norm(H.num[0][0], H.den[0][0], T)
     assert found.closed_loop_gain == pytest.approx(expected, rel=1e-7)
     assert found.open_loop_gain == pytest.approx(
-        _impulse_norm(environment.num[0][0], environment.den[0][0], T), rel=1e-9)
+        impulse_norm(environment.num[0][0], environment.den[0][0], T), rel=1e-9)
     assert found.rms == pytest.approx(Q / math.sqrt(12) * expected, rel=1e-7)
 
 
