@@ -21,8 +21,8 @@ import numpy as np
 
 __all__ = ["Plot", "plot_region", "plot_limits", "plot_boundary", "plot_robust",
            "plot_probability", "plot_design", "plot_pareto", "plot_passive", "plot_locus",
-           "plot_simulation",
-           "plot_map", "plot_margin_map", "require_matplotlib", "pyplot", "pyplot_or_none", "png_bytes", "visible",
+           "plot_simulation", "plot_map", "plot_margin_map", "require_matplotlib", "pyplot",
+           "pyplot_or_none", "png_bytes", "visible",
            "draw_lines", "label_log_axis", "png_of", "png_or_none", "design_figure",
            "simulated_map_figure", "loop_map_figure", "probability_map_figure", "robust_figure",
            "locus_figure",
@@ -268,7 +268,14 @@ def _shade_over_budget(ax, found):
     """
     if found.noise_limit is None or found.noise_samples is None:
         return []
+    (name, (low, high)), = found.over.items()
     x, noise = found.noise_samples[:, 0], found.noise_samples[:, -1]
+    # Beyond the values scanned (a bracket of Stodola's condition) no point is stable, the
+    # rendered one neither: unbounded noise.
+    if x[0] > low:
+        x, noise = np.r_[low, x], np.r_[np.inf, noise]
+    if x[-1] < high:
+        x, noise = np.r_[x, high], np.r_[noise, np.inf]
     over = noise > found.noise_limit
     spans, k = [], 0
     while k < len(x):
@@ -282,7 +289,6 @@ def _shade_over_budget(ax, found):
         spans.append(ax.axvspan(lo, hi, color="0.88", zorder=0,
                                 label=None if spans else "force noise over the budget"))
         k = j + 1
-    (name, (low, high)), = found.over.items()
     ax.set_xlim(low - 0.02 * (high - low), high + 0.02 * (high - low))
     return spans
 
@@ -301,7 +307,10 @@ def _draw_pareto(ax, found, target_label, noise_label):
     if found.noise_limit is not None:
         artists["limit"].append(ax.axvline(found.noise_limit, color="C3", ls="--", lw=1,
                                            label=f"noise budget {found.noise_limit:.4g}"))
-    if found.best is not None:
+    if not len(rows):
+        ax.text(0.5, 0.5, "the rendered point is stable at no value evaluated:\nits force noise "
+                "is unbounded", transform=ax.transAxes, ha="center", va="center")
+    if found.best is not None and math.isfinite(found.best_noise):
         name = next(iter(found.over))
         artists["best"] += ax.plot([found.best_noise], [found.value], "*", color="C3", ms=12,
                                    label=f"best {name} = {found.best[name]:.6g}"
@@ -309,8 +318,7 @@ def _draw_pareto(ax, found, target_label, noise_label):
     ax.set_xlabel(noise_label)
     ax.set_ylabel(target_label)
     at = ", ".join(f"{k} = {v:.4g}" for k, v in found.noise_at.items())
-    ax.set_title(f"{target} against the encoder's force noise at {at}",
-                 fontsize=PANEL_TITLE_SIZE)
+    ax.set_title(f"{target} against the force noise at {at}", fontsize=PANEL_TITLE_SIZE)
     ax.legend(fontsize=LEGEND_SIZE, loc="best")
     return artists
 

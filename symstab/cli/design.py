@@ -168,6 +168,8 @@ def _noise(args, setup, over):
                                  f"(the loop's position unit, m or rad), whose rounding error "
                                  f"is the force noise")
         return {}
+    if args.maximize in ("simulated",) and args.noise_limit is None and args.noise_at is None:
+        return {}       # the simulator's quantizer only: the noise on asking for it
     if setup.paper is not None:
         raise ValueError(f"--encoder-resolution: the force noise of a design is a loop "
                          f"file's (its forces in N or N m): give --loop {EXAMPLE}")
@@ -194,8 +196,7 @@ def _noise(args, setup, over):
 def _noise_limit(text, setup):
     """``--noise-limit`` in the loop's force unit (SI): a bare number, or converted from its unit."""
     from .._validate import check_real
-    from ..numeric.loop.quantities import dimension_name, unit_info
-    from .loop_limits import force_unit
+    from ..numeric.loop.quantities import unit_info
     from .options import parse_one
 
     number, unit = split_unit(text.strip(), "--noise-limit")
@@ -204,16 +205,16 @@ def _noise_limit(text, setup):
         force = force_unit(setup)
         if force is None:
             raise ValueError(f"--noise-limit {text}: the force's unit of this loop is not known "
-                             f"(the plane's {setup.y} has no stiffness unit in the file): give a "
-                             f"bare number in the loop's force unit")
+                             f"(neither {setup.x} nor {setup.y} has a stiffness unit in the "
+                             f"file): give a bare number in the loop's force unit")
         try:
             info = unit_info(unit)
         except ValueError as exc:
             raise ValueError(f"--noise-limit {text}: {exc}") from None
         if info.dimensions != force.dimensions or info.angle:
-            raise ValueError(f"--noise-limit {text}: {unit!r} is {dimension_name(info.dimensions)}"
-                             f", and this loop's force is in {force.si} (its {setup.y} is in "
-                             f"{setup.unit(setup.y)})")
+            raise ValueError(f"--noise-limit {text}: {unit!r} is not a unit of this loop's "
+                             f"force, which is in {force.si} (its stiffness in "
+                             f"{force.stiffness})")
         value *= float(info.factor)
     return check_real("--noise-limit", value, low=0.0, low_open=True)
 
@@ -504,7 +505,8 @@ def _best_rows(found, names, target, lim, at_nominal):
     rows += [at_nominal, ("gain", found.gain, None, f"{label[0]} at the best over that at "
                           f"the nominal value")]
     if found.noise is not None:
-        rows.append(("force noise at the best", found.best_noise, "force", "RMS force of the "
+        bounded = found.best_noise if math.isfinite(found.best_noise) else None
+        rows.append(("force noise at the best", bounded, "force", "RMS force of the "
                      "encoder's quantization at the rendered point, at the best "
                      + " and ".join(f"{{{k}}}" for k in "pq"[:len(names)])))
     if found.noise_limit is not None:
@@ -608,6 +610,9 @@ def _noise_notes(setup, found):
     out = [f"force noise: an encoder quantum of {found.encoder_resolution:.4g} "
            f"{_position_unit(setup)}, uniform and white, through the closed loop at the rendered "
            f"point {at} (exact: the H2 norm; unbounded where that point is not stable)"]
+    if found.best is not None and math.isinf(found.best_noise):
+        out.append(f"the rendered point {at} is not stable at the best value: its force noise "
+                   f"is unbounded there (give --noise-at X Y inside the stable set)")
     if found.budget_binds:
         out.append(f"the noise budget binds: at the best value the force noise reaches "
                    f"{found.noise_limit:.4g}{unit}; a larger budget or a finer encoder buys more")
@@ -687,7 +692,9 @@ def _search_json(setup, found, names, lim):
         front = found.pareto
         out["noise"] = {"encoder_resolution": found.encoder_resolution,
                         "noise_limit": found.noise_limit, "at": found.noise_at,
-                        "best": found.best_noise, "binds": found.budget_binds,
+                        "best": (found.best_noise if found.best_noise is None
+                                 or math.isfinite(found.best_noise) else None),
+                        "binds": found.budget_binds,
                         "pareto": [{**{setup.name(n): v for n, v in zip(found.over, row,
                                                                            strict=False)},
                                     "target": row[-2], "noise": row[-1]} for row in front]}

@@ -83,22 +83,34 @@ def _units(setup, physical=False, over=None):
 
 
 def force_unit(setup):
-    """The :class:`~symstab.numeric.loop.quantities.UnitInfo` of a loop's force, or None.
+    """The loop's force unit, from a stiffness of its plane: a ``ForceUnit``, or None.
 
-    The plane's ``y`` times the position, where ``y`` is a stiffness in the
-    file's units: ``N/m`` gives ``N``, ``N m/rad`` gives ``N m``.  None where
-    ``y`` has no unit or is not a stiffness (the force's unit is then not
-    known).
+    The plane's ``y`` (else ``x``) times the position, where it is a
+    stiffness in the file's units: ``N/m`` gives ``N``, ``N m/rad`` gives
+    ``N m``.  None where neither has a stiffness unit (the force's unit is
+    then not known).
     """
     from ..numeric.loop.quantities import unit_info
 
-    unit = setup.unit(setup.y)
-    if not unit:
-        return None
-    position = "rad" if unit_info(unit).angle < 0 else "m"
-    force = unit_info(f"({unit}) * {position}")
     forces = {unit_info("N").dimensions, unit_info("N m").dimensions}
-    return force if force.dimensions in forces and not force.angle else None
+    for name in (setup.y, setup.x):
+        unit = setup.unit(name)
+        if not unit:
+            continue
+        position = "rad" if unit_info(unit).angle < 0 else "m"
+        force = unit_info(f"({unit}) * {position}")
+        if force.dimensions in forces and not force.angle:
+            return ForceUnit(force.si, force.dimensions, unit)
+    return None
+
+
+@dataclasses.dataclass(frozen=True)
+class ForceUnit:
+    """A loop's force unit: its SI name, its dimension, and the stiffness unit it comes from."""
+
+    si: str
+    dimensions: tuple
+    stiffness: str
 
 
 def _searched(over):

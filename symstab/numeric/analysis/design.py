@@ -751,7 +751,8 @@ def design(loop, *, over, maximize="y_max", x=None, y=None, n=None, rtol=None, d
     # proved empty (then nothing is scanned).
     bracket = _bracket(loop, maximize, x, y, names, over, at) if delay is None else over
     searched = over if bracket is None else bracket
-    pieces = None if bracket is None else _budget_pieces(budget, searched, delay, n, rtol)
+    pieces = None if bracket is None else _budget_pieces(budget, searched, delay, n, rtol,
+                                                         include)
     best, value, seen = (None, None, []) if bracket is None or pieces == [] else _maximize_over(
         search.target, names, searched, delay, n, include, rtol, progress, pieces)
     samples = np.array([[*p, v] for p, v in seen], dtype=float).reshape(-1, len(names) + 1)
@@ -855,7 +856,7 @@ class _Budget:
 
     def __init__(self, loop, q, limit, rendered, at):
         self.loop, self.q, self.limit, self.rendered, self.at = loop, q, limit, rendered, at
-        self.seen = {}
+        self.seen, self.step = {}, 0.0
 
     def __call__(self, point):
         """The force RMS at ``point`` of the search (remembered)."""
@@ -870,17 +871,21 @@ class _Budget:
         """Whether the noise at the one parameter's value ``x`` is within the limit."""
         return self((x,)) <= self.limit
 
-    def pieces(self, pieces, n, rtol):
+    def pieces(self, pieces, n, rtol, include=()):
         """The parts of each piece of the line where the noise meets the limit.
 
-        Each piece is scanned at ``n`` points; where two neighbours differ,
-        the edge is bisected to ``rtol`` of the piece's width (and of
-        ``|x|``).  A part narrower than a scan step between two points over
-        the limit is not seen (the design's message says its step).
+        Each piece is scanned at ``n`` points and at the values ``include``
+        inside it (the nominal value); where two neighbours differ, the
+        edge is bisected to ``rtol`` of the piece's width (and of ``|x|``).
+        A part narrower than that is the one value ``(a, a)``.  A part
+        narrower than a scan step between two points over the limit is not
+        seen: :attr:`step` is the scan's, for the message.
         """
         out = []
         for a, b in pieces:
-            xs = np.linspace(a, b, n).tolist()
+            xs = sorted(set(np.linspace(a, b, n).tolist())
+                        | {float(v) for v in include if a <= v <= b})
+            self.step = max(self.step, (b - a) / (n - 1))
             ok = [self.meets(x) for x in xs]
             tol = rtol * max(abs(a), abs(b), b - a)
             left = None
@@ -889,8 +894,7 @@ class _Budget:
                     left = a if k == 0 else self._edge(x, xs[k - 1], tol)
                 if ok[k] and (k == len(xs) - 1 or not ok[k + 1]):
                     right = b if k == len(xs) - 1 else self._edge(x, xs[k + 1], tol)
-                    if left < right:
-                        out.append((left, right))
+                    out.append((left, right))
                     left = None
         return out
 
@@ -911,28 +915,31 @@ class _Budget:
                         len(scan), samples.shape[1]))
 
 
-def _budget_pieces(budget, searched, delay, n, rtol):
+def _budget_pieces(budget, searched, delay, n, rtol, include):
     """The pieces of the line within the noise budget (``[]``: none), or None without a limit."""
     if budget is None or math.isinf(budget.limit):
         return None
     (name, window), = searched.items()
     line = delay_pieces(delay, *window) if delay is not None and name == "T" else [window]
-    return budget.pieces(line, n if len(line) == 1 else _PIECE_POINTS, rtol)
+    return budget.pieces(line, n if len(line) == 1 else _PIECE_POINTS, rtol,
+                         [p[0] for p in include])
 
 
 def _over_budget(budget, x, y, searched):
-    """The message of a design whose every value scanned is over the noise budget."""
+    """The message of a design none of whose values scanned meets the noise budget."""
     (name, (lo, hi)), = searched.items()
     rendered = ", ".join(f"{k} = {v:.6g}" for k, v in budget.rendered.items())
     (where,), least = min(budget.seen.items(), key=lambda item: item[1])
+    between = (f"; between them (steps of {budget.step:.3g}) the range was not examined: a band "
+               f"narrower than a step may meet it (give a finer n)")
     if math.isinf(least):
         return (f"no value of {name} in [{lo:.6g}, {hi:.6g}] meets the noise budget: the "
-                f"rendered point {rendered} is not stable at any value scanned ({len(budget.seen)}), "
-                f"so its force noise is unbounded; render a point inside the stable set")
-    return (f"no value of {name} in [{lo:.6g}, {hi:.6g}] meets the noise budget "
-            f"{budget.limit:.6g}: the force noise at {rendered} is at least {least:.6g} (at "
-            f"{name} = {where:.6g}) of the {len(budget.seen)} values scanned (a finer encoder, a larger budget or a point "
-            f"rendered with less damping lowers it)")
+                f"rendered point {rendered} is not stable at any of the {len(budget.seen)} "
+                f"values evaluated, so its force noise is unbounded there{between}")
+    return (f"no value of {name} in [{lo:.6g}, {hi:.6g}] evaluated meets the noise budget "
+            f"{budget.limit:.6g}: the least force noise at {rendered} of the "
+            f"{len(budget.seen)} values evaluated is {least:.6g} (at {name} = {where:.6g})"
+            f"{between}")
 
 
 def _check_design_names(loop, maximize, x, y, damping, delay, values):
@@ -982,28 +989,63 @@ def _check_values_once(loop, maximize, x, y, damping, over, at, simulation, step
 def _maximize_over(target, names, searched, delay, n, include, rtol, progress, pieces=None):
     """``(best, value, seen)``: the search of ``target`` over ``searched``, points as tuples.
 
-    One parameter: :func:`maximize_scalar`, or over ``pieces`` (the parts
-    of the range within a noise budget, or with ``T`` and a delay held in
-    seconds the pieces of one whole delay each) :func:`maximize_pieces`
-    (:func:`maximize_scalar` where one piece is left and no delay is held);
-    two: :func:`maximize_box`.
+    Two parameters: :func:`maximize_box`.  One: :func:`maximize_scalar`
+    over the range, or over ``pieces`` (the parts of the range within a
+    noise budget) :func:`_maximize_line`; with ``T`` searched and a delay
+    held in seconds, the pieces of one whole delay each (or the budget's
+    parts of them) by :func:`maximize_pieces`.
     """
     if len(names) == 2:
         return maximize_box(target, tuple(searched[k] for k in names), n,
                             include=include, rtol=rtol, progress=progress)
-    if pieces is None and delay is not None and names[0] == "T":
+    sawtooth = delay is not None and names[0] == "T"
+    if pieces is None and sawtooth:
         pieces = delay_pieces(delay, *searched["T"])
-    if pieces is None or len(pieces) == 1 and delay is None:
-        window = searched[names[0]] if pieces is None else pieces[0]
-        best, value, seen = maximize_scalar(lambda v: target((v,)), *window, n,
+    if pieces is None:
+        best, value, seen = maximize_scalar(lambda v: target((v,)), *searched[names[0]], n,
                                             include=[p[0] for p in include], rtol=rtol,
                                             progress=progress)
     else:
-        best, value, seen = maximize_pieces(lambda v: target((v,)), pieces,
-                                            include=[p[0] for p in include], rtol=rtol,
-                                            progress=progress)
+        best, value, seen = _maximize_line(lambda v: target((v,)), pieces, n,
+                                           [p[0] for p in include], rtol, progress, sawtooth)
     best = None if best is None else (best,)
     return best, value, [((p,), v) for p, v in seen]
+
+
+def _maximize_line(f, pieces, n, include, rtol, progress, sawtooth):
+    """The best ``f`` over closed pieces of a line (a piece ``(a, a)`` is the one value ``a``).
+
+    ``sawtooth``: ``f`` jumps between the pieces (a delay held in seconds),
+    searched by :func:`maximize_pieces`; else ``f`` is one continuous
+    function cut into parts (by a noise budget), each searched by
+    :func:`maximize_scalar` with ``n`` points (``_PIECE_POINTS`` at least
+    each when there are several).  A one-value piece is evaluated.
+    """
+    seen = {}
+
+    def counted(x):
+        if x not in seen:
+            seen[x] = f(x)
+            if progress is not None:
+                progress(len(seen))
+        return seen[x]
+
+    wide = [(a, b) for a, b in pieces if a < b]
+    for a, b in pieces:
+        if a == b:
+            counted(a)
+    if sawtooth and wide:
+        maximize_pieces(counted, wide, include=include, rtol=rtol)
+    else:
+        points = n if len(wide) == 1 else max(_PIECE_POINTS, n // max(len(wide), 1))
+        for a, b in wide:
+            maximize_scalar(counted, a, b, points,
+                            include=[v for v in include if a <= v <= b], rtol=rtol)
+    found = [(v, x) for x, v in seen.items() if not math.isnan(v) and v > -math.inf]
+    if not found:
+        return None, None, list(seen.items())
+    value, best = max(found)
+    return best, value, list(seen.items())
 
 
 def _not_found(maximize, simulation, x, y, over, searched, bracket, samples, spacing, failed):

@@ -284,6 +284,18 @@ def classified_point(loop, values):
 
     The checks of every question (unknown and missing names, ``d`` a whole
     number of samples, finite reals), then :meth:`symstab.Loop.classify`.
+
+    Parameters
+    ----------
+    loop : symstab.Loop
+    values : dict
+        A single value of every parameter (or its default).
+
+    Returns
+    -------
+    (dict, int)
+        ``{name: value}`` in the loop's parameters' order, and ``STABLE``,
+        ``MARGINAL`` or ``UNSTABLE``.
     """
     checked, d, _ = loop.evaluation.prepare(values, scalar=loop.parameters)
     point = {name: float(checked[name]) for name in loop.symbols}
