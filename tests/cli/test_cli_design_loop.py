@@ -235,6 +235,9 @@ def test_the_simulated_target_names_what_it_simulated(capsys, tmp_path):
                      "--maximize", "simulated", "--amplitude", "1e-3", "--steps", "2000",
                      "--encoder-resolution", "1e-5")
     assert found["search"]["maximize"] == "simulated"
+    # The encoder is the simulator's quantizer here: no force noise unless asked for
+    # (--noise-limit or --noise-at).
+    assert "noise" not in found["search"] and "force noise" not in out
     assert found["search"]["value"] == pytest.approx(simulated, rel=1e-9)
     assert found["search"]["simulated"]["steps"] == 2000
     # With non-idealities the runs start at 0.01, as simulate and map --simulate do, and
