@@ -1056,7 +1056,8 @@ class _AnyLoop:
     few calls (the paper's loop at d >= 8: four), not twenty.
     """
 
-    def __init__(self, parts, d, x0, v0, nonideal, compensation=None, pulse=None):
+    def __init__(self, parts, d, x0, v0, nonideal, compensation=None, pulse=None,
+                 positions_unread=False):
         a, b, c, e = parts
         n_points = a.shape[0]
         # Each sum keeps its nonzero terms only (a backward difference's Ve_d
@@ -1080,6 +1081,15 @@ class _AnyLoop:
         # forces of the last m periods (one sample at least: the velocity
         # estimate's).
         self.past = (n + 1, d + n, max(m, 1), m)
+        # A plant that does not read its past positions (``positions_unread``:
+        # one on its state space) and no encoder: the samples are the
+        # positions, one buffer (the sample of a period is the position
+        # before it), whose past is the samples' (and the check's x[k-n]),
+        # all at x0; the copy of each period's sample is saved.
+        self.aliased = positions_unread and not self.quantum
+        if self.aliased:
+            past = max(n + 1, max(m, 1) + 1)
+            self.past = (past, d + n, past - 1, m)
         # keep_x, ...: the row of each buffer where the block starts; the
         # blocks follow one another in the spare rows, which are moved back
         # to the start (the past only) when they run out.
@@ -1087,18 +1097,26 @@ class _AnyLoop:
         self.spare = _spare_rows(rows)
         self.X = np.empty((self.keep_x + self.spare, n_points))
         self.U = np.zeros((self.keep_u + self.spare, n_points))
-        self.S = np.empty((self.keep_s + self.spare, n_points))
+        self.S = self.X if self.aliased else np.empty((self.keep_s + self.spare, n_points))
         self.F = np.empty((self.keep_f + self.spare, n_points))
-        # x[k] = x0; x[k-i] = x0 - i v0 before the start; no force applied yet.
-        self.X[n] = float(x0)
-        for i in range(1, n + 1):
-            self.X[n - i] = x0 - i * v0
-        sampled = self._sample(self.X[n])
+        # The buffers each with its past, moved back by _shift.
+        self._moved = [(buffer, keep) for buffer, keep, own in zip(
+            (self.X, self.U, self.S, self.F), self.past, (True, True, not self.aliased, True),
+            strict=True) if keep and own]
+        if self.aliased:
+            self.X[:self.keep_x] = float(x0)
+        else:
+            # x[k] = x0; x[k-i] = x0 - i v0 before the start; no force applied yet.
+            self.X[n] = float(x0)
+            for i in range(1, n + 1):
+                self.X[n - i] = x0 - i * v0
+        sampled = self._sample(self.X[self.keep_x - 1])
         # The environment at rest at the sampled x0: its force Ve(1) x_s
         # (none where Ve has a pole at z = 1, an integrator's).
         with np.errstate(all="ignore"):
             dc_gain = np.where(1 + c.sum(axis=1) != 0, e.sum(axis=1) / (1 + c.sum(axis=1)), 0.0)
-        self.S[:self.keep_s] = sampled
+        if not self.aliased:
+            self.S[:self.keep_s] = sampled
         self.F[:m] = dc_gain * sampled
         # Friction compensation: (F_c, filter pole) on the velocity
         # estimate, the filtered backward difference of the sampled position.
@@ -1201,9 +1219,8 @@ class _AnyLoop:
             self.keep_s += count
             self.keep_f += count
             return
-        for buffer, keep in zip((self.X, self.U, self.S, self.F), self.past, strict=True):
-            if keep:
-                buffer[:keep] = buffer[moved:moved + keep]
+        for buffer, keep in self._moved:
+            buffer[:keep] = buffer[moved:moved + keep]
         self.keep_x, self.keep_u, self.keep_s, self.keep_f = self.past
 
     def _combine(self, out, terms, buffer, first_row, sign):
@@ -1241,7 +1258,7 @@ class _AnyLoop:
         sampled = self.S[ks:ks + count]
         if q:
             _round_into(sampled, positions, q)
-        else:
+        elif not self.aliased:
             np.copyto(sampled, positions)
         force = self.F[kf:kf + count]
         np.multiply(self.e0, sampled, out=force)
@@ -1278,7 +1295,7 @@ class _AnyLoop:
         sampled, force = S[ks], F[kf]
         if self.quantum:
             _round_into(sampled, self._x_rows[self.keep_x - 1], self.quantum)
-        else:
+        elif not self.aliased:
             np.copyto(sampled, self._x_rows[self.keep_x - 1])
         # Positional outs: the keyword costs a fifth of a call on small arrays.
         multiply(self.e0, sampled, force)
@@ -1385,7 +1402,8 @@ class _StateLoop(_AnyLoop):
     """
 
     def __init__(self, parts, d, x0, v0, nonideal, space, state=None, compensation=None):
-        super().__init__(parts, d, x0, v0, nonideal, compensation=compensation)
+        super().__init__(parts, d, x0, v0, nonideal, compensation=compensation,
+                         positions_unread=True)
         coulomb = nonideal.coulomb_friction
         stiction = nonideal.stiction if nonideal.stiction is not None else coulomb
         self._unfinite_at = {}
