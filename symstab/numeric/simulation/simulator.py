@@ -1076,51 +1076,12 @@ class _AnyLoop:
         self.size = n_points
         self.block = _block_rows(d, n_points)
         rows = self.block
-        # The past each buffer keeps before its block: x[k-n] .. x[k] (the
-        # overflow check reads x[k-n]), u[k-d-n] .. u[k-1], the samples and
-        # forces of the last m periods (one sample at least: the velocity
-        # estimate's).
-        self.past = (n + 1, d + n, max(m, 1), m)
-        # A plant that does not read its past positions (``positions_unread``:
-        # one on its state space) and no encoder: the samples are the
-        # positions, one buffer (the sample of a period is the position
-        # before it), whose past is the samples' (and the check's x[k-n]),
-        # all at x0; the copy of each period's sample is saved.
-        self.aliased = positions_unread and not self.quantum
-        if self.aliased:
-            past = max(n + 1, max(m, 1) + 1)
-            self.past = (past, d + n, past - 1, m)
-        # keep_x, ...: the row of each buffer where the block starts; the
-        # blocks follow one another in the spare rows, which are moved back
-        # to the start (the past only) when they run out.
-        self.keep_x, self.keep_u, self.keep_s, self.keep_f = self.past
-        self.spare = _spare_rows(rows)
-        self.X = np.empty((self.keep_x + self.spare, n_points))
-        self.U = np.zeros((self.keep_u + self.spare, n_points))
-        self.S = self.X if self.aliased else np.empty((self.keep_s + self.spare, n_points))
-        self.F = np.empty((self.keep_f + self.spare, n_points))
-        # The buffers each with its past, moved back by _shift.
-        self._moved = [(buffer, keep) for buffer, keep, own in zip(
-            (self.X, self.U, self.S, self.F), self.past, (True, True, not self.aliased, True),
-            strict=True) if keep and own]
-        if self.aliased:
-            self.X[:self.keep_x] = float(x0)
-        else:
-            # x[k] = x0; x[k-i] = x0 - i v0 before the start; no force applied yet.
-            self.X[n] = float(x0)
-            for i in range(1, n + 1):
-                self.X[n - i] = x0 - i * v0
-        sampled = self._sample(self.X[self.keep_x - 1])
-        # The environment at rest at the sampled x0: its force Ve(1) x_s
-        # (none where Ve has a pole at z = 1, an integrator's).
-        with np.errstate(all="ignore"):
-            dc_gain = np.where(1 + c.sum(axis=1) != 0, e.sum(axis=1) / (1 + c.sum(axis=1)), 0.0)
-        if not self.aliased:
-            self.S[:self.keep_s] = sampled
-        self.F[:m] = dc_gain * sampled
+        self.compensation = compensation
+        # A force added to the first command only (the pulse response).
+        self.pulse = pulse
+        self._make_buffers(x0, v0, c, e, positions_unread)
         # Friction compensation: (F_c, filter pole) on the velocity
         # estimate, the filtered backward difference of the sampled position.
-        self.compensation = compensation
         self.v_hat = np.zeros(n_points)
         self._tmp = np.empty((rows, n_points))
         self._more = np.empty((rows, n_points)) if compensation is not None else None
@@ -1132,8 +1093,67 @@ class _AnyLoop:
         self.k = 0
         self.diverged = np.zeros(n_points, dtype=bool)
         self.check_every = _CHECK_EVERY
-        # A force added to the first command only (the pulse response).
-        self.pulse = pulse
+
+    def _make_buffers(self, x0, v0, c, e, positions_unread):
+        """The buffers of the signals in time, at the run's start; which of them are one.
+
+        Two signals share a buffer where they are equal and nothing reads
+        their difference, which saves a copy a period: the samples are the
+        positions where the plant does not read its past positions
+        (``positions_unread``: on its state space) and there is no encoder
+        (:attr:`samples_are_positions`); the commands are the forces where
+        no non-ideality or pulse changes the command, the environment does
+        not read its past forces (``Ve_d = z**m``) and the forces at rest at
+        the start are finite (what the overflow checks would read of them
+        before the run's own; :attr:`commands_are_forces`).
+        """
+        n, m, d, n_points = self.n, self.m, self.d, self.size
+        start = np.full(n_points, float(x0))
+        sampled = self._sample(start)
+        # The environment at rest at the sampled x0: its force Ve(1) x_s
+        # (none where Ve has a pole at z = 1, an integrator's).
+        with np.errstate(all="ignore"):
+            dc_gain = np.where(1 + c.sum(axis=1) != 0, e.sum(axis=1) / (1 + c.sum(axis=1)), 0.0)
+        resting_force = dc_gain * sampled
+        self.samples_are_positions = positions_unread and not self.quantum
+        self.commands_are_forces = (
+            not self.c and self.compensation is None and self.pulse is None
+            and self.force_quantum is None and self.force_limit is None
+            and bool(np.isfinite(resting_force).all()))
+        # The past each buffer keeps before its block: x[k-n] .. x[k] (the
+        # overflow check reads x[k-n]), u[k-d-n] .. u[k-1], the samples and
+        # forces of the last m periods (one sample at least: the velocity
+        # estimate's); a shared buffer keeps the longer past.
+        past_x = max(n + 1, max(m, 1) + 1) if self.samples_are_positions else n + 1
+        past_u = max(d + n, m) if self.commands_are_forces else d + n
+        self.past = (past_x, past_u, past_x - 1 if self.samples_are_positions else max(m, 1),
+                     past_u if self.commands_are_forces else m)
+        # keep_x, ...: the row of each buffer where the block starts; the
+        # blocks follow one another in the spare rows, which are moved back
+        # to the start (the past only) when they run out.
+        self.keep_x, self.keep_u, self.keep_s, self.keep_f = self.past
+        self.spare = _spare_rows(self.block)
+        self.X = np.empty((self.keep_x + self.spare, n_points))
+        self.U = np.zeros((self.keep_u + self.spare, n_points))
+        self.S = self.X if self.samples_are_positions else np.empty(
+            (self.keep_s + self.spare, n_points))
+        self.F = self.U if self.commands_are_forces else np.empty(
+            (self.keep_f + self.spare, n_points))
+        # The buffers each with its past, moved back by _shift.
+        own = (True, True, not self.samples_are_positions, not self.commands_are_forces)
+        self._moved = [(buffer, keep) for buffer, keep, mine in zip(
+            (self.X, self.U, self.S, self.F), self.past, own, strict=True) if keep and mine]
+        if self.samples_are_positions:
+            # The sampled history at x0, of which the newest is the position.
+            self.X[:self.keep_x] = start
+        else:
+            # x[k] = x0; x[k-i] = x0 - i v0 before the start; no force applied yet.
+            self.X[n] = start
+            for i in range(1, n + 1):
+                self.X[n - i] = x0 - i * v0
+            self.S[:self.keep_s] = sampled
+        if not self.commands_are_forces:
+            self.F[:m] = resting_force
 
     def _sample(self, x):
         q = self.quantum
@@ -1258,7 +1278,7 @@ class _AnyLoop:
         sampled = self.S[ks:ks + count]
         if q:
             _round_into(sampled, positions, q)
-        elif not self.aliased:
+        elif not self.samples_are_positions:
             np.copyto(sampled, positions)
         force = self.F[kf:kf + count]
         np.multiply(self.e0, sampled, out=force)
@@ -1269,7 +1289,8 @@ class _AnyLoop:
             self._compensated(command, force, sampled, count)
             self.pulse = None
         else:
-            np.copyto(command, force)
+            if not self.commands_are_forces:
+                np.copyto(command, force)
             if self.pulse is not None:
                 command[0] = force[0] + self.pulse
                 self.pulse = None
@@ -1295,7 +1316,7 @@ class _AnyLoop:
         sampled, force = S[ks], F[kf]
         if self.quantum:
             _round_into(sampled, self._x_rows[self.keep_x - 1], self.quantum)
-        elif not self.aliased:
+        elif not self.samples_are_positions:
             np.copyto(sampled, self._x_rows[self.keep_x - 1])
         # Positional outs: the keyword costs a fifth of a call on small arrays.
         multiply(self.e0, sampled, force)
@@ -1309,7 +1330,8 @@ class _AnyLoop:
             self._compensated(self.U[ku:ku + 1], self.F[kf:kf + 1], self.S[ks:ks + 1], 1)
             self.pulse = None
         else:
-            np.copyto(command, force)
+            if not self.commands_are_forces:
+                np.copyto(command, force)
             if self.pulse is not None:
                 np.add(force, self.pulse, out=command)
                 self.pulse = None
