@@ -316,7 +316,12 @@ class StatePlant:
             self._friction_step = _column(space.gamma_f) * coulomb
             self._impulse = _column(space.impulse)
             self._gamma_u = _column(space.gamma_u)
-            self._phi = space.phi if space.phi.ndim == 2 else None
+            # One plant for every point: its products inline (a call of
+            # _times or _dot costs a tenth of a sub-step's NumPy call).
+            shared = space.phi.ndim == 2
+            self._phi = space.phi if shared else None
+            self._stuck_phi = space.stuck_phi if shared else None
+            self._net_state = space.net_state if shared else None
             self._stop(self.rest)
 
     @property
@@ -386,12 +391,11 @@ class StatePlant:
         as every term computed at every point, in half the NumPy calls.
         """
         sp, state, rest, resting = self.space, self._state, self.rest, self._resting
-        # (The matrix product inline: a call of _times costs a tenth of a sub-step.)
         moving = self._phi @ state if self._phi is not None else _times(sp.phi, state)
         moving += drive
         net = None
         if resting:
-            net = _dot(sp.net_state, state)
+            net = self._net_state @ state if self._phi is not None else _dot(sp.net_state, state)
             net += net_drive
             # (np.where(rest, net, v) as a copy and a masked copy: half its time.)
             direction = state[1].copy()
@@ -422,14 +426,20 @@ class StatePlant:
             else:
                 self._resting = False     # (what _stop finds: no point to stop)
             return
-        if np.count_nonzero(stuck):
+        n_stuck = np.count_nonzero(stuck)
+        if n_stuck:
             if self._stuck_drive is None:
                 self._stuck_drive = _column(sp.stuck_gamma) * held
-            kept = _times(sp.stuck_phi, state) + self._stuck_drive
+            kept = (self._stuck_phi @ state if self._phi is not None
+                    else _times(sp.stuck_phi, state))
+            kept += self._stuck_drive
             kept[0] = state[0]
             np.copyto(moving, kept, where=stuck)
         self.rest = reversed_ | stuck
-        self._stop(self.rest)
+        if n_reversed or n_stuck:
+            self._stop(self.rest)
+        else:
+            self._resting = False     # (what _stop finds: no point to stop)
 
     def _stopped_at(self, velocity, net, direction):
         """Where a moving mass stops within the sub-step whose end ``velocity`` is reversed.
