@@ -1220,11 +1220,12 @@ class _AnyLoop:
                 self.freeze_diverged(done - start)
 
     def advance_each(self, count, high, low):
-        """``count`` blocks of one period (:meth:`advance`), each position folded into ``high``, ``low``.
+        """``count`` blocks of one period (:meth:`advance`), each position folded into the extremes.
 
-        (The extremes of :func:`_run`, in place: a run that records, sums
-        and reports nothing, its periods one at a time, d = 0 and 1 -- a
-        period is a few microseconds, a third of them the calls around it.)
+        ``high`` and ``low`` get the largest and smallest value of each
+        point, in place (:func:`_run`'s, for a run that records, sums and
+        reports nothing, its periods one at a time, d = 0 and 1: a period
+        is a few microseconds, a third of them the calls around it).
         """
         maximum, minimum, one_period = np.maximum, np.minimum, self._one_period
         every, rows, past, spare = self.check_every, self._x_rows, self.past[0], self.spare
