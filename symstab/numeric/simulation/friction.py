@@ -317,7 +317,7 @@ class StatePlant:
             self._impulse = _column(space.impulse)
             self._gamma_u = _column(space.gamma_u)
             # One plant for every point: its products inline (a call of
-            # _times or _dot costs a tenth of a sub-step's NumPy call).
+            # _times or _dot costs a sixth of one of its NumPy calls).
             shared = space.phi.ndim == 2
             self._phi = space.phi if shared else None
             self._stuck_phi = space.stuck_phi if shared else None
