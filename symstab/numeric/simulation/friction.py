@@ -311,8 +311,17 @@ class StatePlant:
         else:
             self._state = state
         if self.friction:
-            # The friction's change of the state a sub-step, per direction.
+            # The friction's change of the state a sub-step, per direction;
+            # the columns and the product a sub-step uses, made once.
             self._friction_step = _column(space.gamma_f) * coulomb
+            self._impulse = _column(space.impulse)
+            self._gamma_u = _column(space.gamma_u)
+            # One plant for every point: its products inline (a call of
+            # _times or _dot costs a sixth of one of its NumPy calls).
+            shared = space.phi.ndim == 2
+            self._phi = space.phi if shared else None
+            self._stuck_phi = space.stuck_phi if shared else None
+            self._net_state = space.net_state if shared else None
             self._stop(self.rest)
 
     @property
@@ -339,7 +348,10 @@ class StatePlant:
         # (count_nonzero: a quarter of any()'s time on a few points, per sub-step.)
         self._resting = bool(np.count_nonzero(where))
         if self._resting:
-            self._state -= _column(self.space.impulse) * np.where(where, self._state[1], 0.0)
+            # (np.where(where, v, 0.0) as a fill and a masked copy: a third of its time.)
+            velocity = np.zeros(where.shape)
+            np.copyto(velocity, self._state[1], where=where)
+            self._state -= self._impulse * velocity
 
     def step(self, force, sign=1.0, out=None):
         """Advance one period under the input ``sign * force`` (per point); the new position.
@@ -358,14 +370,16 @@ class StatePlant:
                 self._state = _times(self.space.phi, self._state) + (
                     _column(sign * self.space.gamma_u) * force)
             return self._state[0] if out is None else _copied(out, self._state[0])
-        sp = self.space
         held = sign * force
-        drive = _column(sp.gamma_u) * held
+        drive = self._gamma_u * held
         # The input's share of the net force is the period's (as the drive).
-        net_drive = sp.net_input * held
+        net_drive = self.space.net_input * held
         self._stuck_drive = None        # the held step's input term, made when a mass sticks
-        for _ in range(self.substeps):
-            self._friction_substep(held, drive, net_drive)
+        # A stop's time divides by its rate (:meth:`_stopped_at`): one error
+        # state for the period's sub-steps, not one for each stop.
+        with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
+            for _ in range(self.substeps):
+                self._friction_substep(held, drive, net_drive)
         return self._state[0].copy() if out is None else _copied(out, self._state[0])
 
     def _friction_substep(self, held, drive, net_drive):
@@ -377,13 +391,16 @@ class StatePlant:
         as every term computed at every point, in half the NumPy calls.
         """
         sp, state, rest, resting = self.space, self._state, self.rest, self._resting
-        moving = _times(sp.phi, state)
+        moving = self._phi @ state if self._phi is not None else _times(sp.phi, state)
         moving += drive
         net = None
         if resting:
-            net = _dot(sp.net_state, state)
+            net = self._net_state @ state if self._phi is not None else _dot(sp.net_state, state)
             net += net_drive
-            direction = np.sign(np.where(rest, net, state[1]))
+            # (np.where(rest, net, v) as a copy and a masked copy: half its time.)
+            direction = state[1].copy()
+            np.copyto(direction, net, where=rest)
+            np.sign(direction, out=direction)
         else:
             direction = np.sign(state[1])
         # gamma_f (F_c direction) to the bit: direction is +-1, +-0 or NaN.
@@ -392,25 +409,37 @@ class StatePlant:
         # push the mass backwards); a stuck mass stays where it is.
         # (v direction < 0 is sign(v) = -direction with direction != 0.)
         reversed_ = moving[1] * direction < 0
-        stuck = None
         if resting:
             reversed_ = reversed_ > rest          # and not resting
             stuck = rest & (np.abs(net) <= self.stiction)
-        if np.count_nonzero(reversed_):
+        n_reversed = np.count_nonzero(reversed_)
+        if n_reversed:
             if net is None:
                 net = _dot(sp.net_state, state)
                 net += net_drive
-            moving[0] = np.where(reversed_, self._stopped_at(moving[1], net, direction),
-                                 moving[0])
-        if stuck is not None and np.count_nonzero(stuck):
+            np.copyto(moving[0], self._stopped_at(moving[1], net, direction), where=reversed_)
+        self._state = moving
+        if not resting:
+            self.rest = reversed_
+            if n_reversed:
+                self._stop(reversed_)
+            else:
+                self._resting = False     # (what _stop finds: no point to stop)
+            return
+        n_stuck = np.count_nonzero(stuck)
+        if n_stuck:
             if self._stuck_drive is None:
                 self._stuck_drive = _column(sp.stuck_gamma) * held
-            kept = _times(sp.stuck_phi, state) + self._stuck_drive
+            kept = (self._stuck_phi @ state if self._phi is not None
+                    else _times(sp.stuck_phi, state))
+            kept += self._stuck_drive
             kept[0] = state[0]
-            moving = np.where(stuck, kept, moving)
-        self._state = moving
-        self.rest = reversed_ if stuck is None else reversed_ | stuck
-        self._stop(self.rest)
+            np.copyto(moving, kept, where=stuck)
+        self.rest = reversed_ | stuck
+        if n_reversed or n_stuck:
+            self._stop(self.rest)
+        else:
+            self._resting = False     # (what _stop finds: no point to stop)
 
     def _stopped_at(self, velocity, net, direction):
         """Where a moving mass stops within the sub-step whose end ``velocity`` is reversed.
@@ -435,13 +464,14 @@ class StatePlant:
         """
         sp = self.space
         position, start = self._state[0], self._state[1]
-        with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
-            rate = sp.per_mass * (self.coulomb - direction * net)
-            at_start = np.abs(start) / rate
-            mean = sp.substep * start / (start - velocity)
-            time = np.where((rate > 0) & (at_start <= sp.substep), at_start, mean)
-            travel = 0.5 * start * time
-        return position + np.where(np.isfinite(travel), travel, 0.0)
+        # (Divisions by zero and overflows are ignored by the caller, step().)
+        rate = sp.per_mass * (self.coulomb - direction * net)
+        at_start = np.abs(start) / rate
+        time = sp.substep * start / (start - velocity)      # the mean rate's
+        np.copyto(time, at_start, where=(rate > 0) & (at_start <= sp.substep))
+        travel = 0.5 * start * time
+        np.copyto(travel, 0.0, where=~np.isfinite(travel))
+        return position + travel
 
     def _linear_rows(self, force, sign, out=None):
         """The rows of ``phi state + gamma_u sign force``: new arrays, summed over ``phi``'s nonzero entries."""

@@ -26,6 +26,7 @@ neither stable nor unstable; its theory is its own root count.
 """
 
 import dataclasses
+import functools
 import math
 
 import numpy as np
@@ -549,6 +550,9 @@ def _run(run, steps, amplitude, positions, progress, report, chunk, n_chunks, to
     with np.errstate(over="ignore", invalid="ignore"):
         for q, (start, stop) in enumerate(_quarters(steps)):
             high_q, low_q = high[q], low[q]
+            if plain and run.block == 1:
+                run.advance_each(stop - start, high_q, low_q)
+                continue
             k = start
             while k < stop:
                 count = min(run.block, stop - k) if every > 1 else 1
@@ -1053,13 +1057,16 @@ class _AnyLoop:
     few calls (the paper's loop at d >= 8: four), not twenty.
     """
 
-    def __init__(self, parts, d, x0, v0, nonideal, compensation=None, pulse=None):
+    def __init__(self, parts, d, x0, v0, nonideal, compensation=None, pulse=None,
+                 positions_unread=False):
         a, b, c, e = parts
         n_points = a.shape[0]
         # Each sum keeps its nonzero terms only (a backward difference's Ve_d
         # is z**k: no force feedback at all).
         self.a, self.c = _terms(a), _terms(c)
         self.minus_b = _terms(-b)
+        # (Its newest term apart, made once: unpacking it took a tenth of a period.)
+        self._b_first, self._b_rest = self.minus_b[0], self.minus_b[1:]
         self.e0, self.e = np.ascontiguousarray(e[:, 0]), _terms(e[:, 1:])
         self.d = d
         self.quantum = nonideal.encoder_resolution
@@ -1070,47 +1077,102 @@ class _AnyLoop:
         self.size = n_points
         self.block = _block_rows(d, n_points)
         rows = self.block
-        # The past each buffer keeps before its block: x[k-n] .. x[k] (the
-        # overflow check reads x[k-n]), u[k-d-n] .. u[k-1], the samples and
-        # forces of the last m periods (one sample at least: the velocity
-        # estimate's).
-        self.past = (n + 1, d + n, max(m, 1), m)
-        # keep_x, ...: the row of each buffer where the block starts; the
-        # blocks follow one another in the spare rows, which are moved back
-        # to the start (the past only) when they run out.
-        self.keep_x, self.keep_u, self.keep_s, self.keep_f = self.past
-        self.spare = _spare_rows(rows)
-        self.X = np.empty((self.keep_x + self.spare, n_points))
-        self.U = np.zeros((self.keep_u + self.spare, n_points))
-        self.S = np.empty((self.keep_s + self.spare, n_points))
-        self.F = np.empty((self.keep_f + self.spare, n_points))
-        # x[k] = x0; x[k-i] = x0 - i v0 before the start; no force applied yet.
-        self.X[n] = float(x0)
-        for i in range(1, n + 1):
-            self.X[n - i] = x0 - i * v0
-        sampled = self._sample(self.X[n])
-        # The environment at rest at the sampled x0: its force Ve(1) x_s
-        # (none where Ve has a pole at z = 1, an integrator's).
-        with np.errstate(all="ignore"):
-            dc_gain = np.where(1 + c.sum(axis=1) != 0, e.sum(axis=1) / (1 + c.sum(axis=1)), 0.0)
-        self.S[:self.keep_s] = sampled
-        self.F[:m] = dc_gain * sampled
+        self.compensation = compensation
+        # A force added to the first command only (the pulse response).
+        self.pulse = pulse
+        self._make_buffers(x0, v0, c, e, positions_unread)
         # Friction compensation: (F_c, filter pole) on the velocity
         # estimate, the filtered backward difference of the sampled position.
-        self.compensation = compensation
         self.v_hat = np.zeros(n_points)
         self._tmp = np.empty((rows, n_points))
         self._more = np.empty((rows, n_points)) if compensation is not None else None
         # The filter's pole at every point: an array multiplies faster than a float.
         self._pole = None if compensation is None else np.full(n_points, compensation[1])
-        self._x_rows, self._f_rows = list(self.X), list(self.F)
-        self._u_rows, self._s_rows = list(self.U), list(self.S)
         self.filled = 0          # rows of the last block, not yet shifted into the past
         self.k = 0
         self.diverged = np.zeros(n_points, dtype=bool)
         self.check_every = _CHECK_EVERY
-        # A force added to the first command only (the pulse response).
-        self.pulse = pulse
+
+    def _make_buffers(self, x0, v0, c, e, positions_unread):
+        """The buffers of the signals in time, at the run's start; which of them are one.
+
+        Two signals share a buffer where they are equal and nothing reads
+        their difference, which saves a copy a period: the samples are the
+        positions where the plant does not read its past positions
+        (``positions_unread``: on its state space) and there is no encoder
+        (:attr:`samples_are_positions`); the commands are the forces where
+        no non-ideality or pulse changes the command, the environment does
+        not read its past forces (``Ve_d = z**m``) and the forces at rest at
+        the start are finite (what the overflow checks would read of them
+        before the run's own; :attr:`commands_are_forces`).
+        """
+        n, m, d, n_points = self.n, self.m, self.d, self.size
+        start = np.full(n_points, float(x0))
+        sampled = self._sample(start)
+        # The environment at rest at the sampled x0: its force Ve(1) x_s
+        # (none where Ve has a pole at z = 1, an integrator's).
+        with np.errstate(all="ignore"):
+            dc_gain = np.where(1 + c.sum(axis=1) != 0, e.sum(axis=1) / (1 + c.sum(axis=1)), 0.0)
+        resting_force = dc_gain * sampled
+        self.samples_are_positions = positions_unread and not self.quantum
+        self.commands_are_forces = (
+            not self.c and self.compensation is None and self.pulse is None
+            and self.force_quantum is None and self.force_limit is None
+            and bool(np.isfinite(resting_force).all()))
+        # The past each buffer keeps before its block: x[k-n] .. x[k] (the
+        # overflow check reads x[k-n]), u[k-d-n] .. u[k-1], the samples and
+        # forces of the last m periods (one sample at least: the velocity
+        # estimate's); a shared buffer keeps the longer past.
+        past_x = max(n + 1, max(m, 1) + 1) if self.samples_are_positions else n + 1
+        past_u = max(d + n, m) if self.commands_are_forces else d + n
+        self.past = (past_x, past_u, past_x - 1 if self.samples_are_positions else max(m, 1),
+                     past_u if self.commands_are_forces else m)
+        # keep_x, ...: the row of each buffer where the block starts; the
+        # blocks follow one another in the spare rows, which are moved back
+        # to the start (the past only) when they run out.
+        self.keep_x, self.keep_u, self.keep_s, self.keep_f = self.past
+        self.spare = _spare_rows(self.block)
+        self.X = np.empty((self.keep_x + self.spare, n_points))
+        self.U = np.zeros((self.keep_u + self.spare, n_points))
+        self.S = self.X if self.samples_are_positions else np.empty(
+            (self.keep_s + self.spare, n_points))
+        self.F = self.U if self.commands_are_forces else np.empty(
+            (self.keep_f + self.spare, n_points))
+        # The buffers each with its past, moved back by _shift.
+        own = (True, True, not self.samples_are_positions, not self.commands_are_forces)
+        self._moved = [(buffer, keep) for buffer, keep, mine in zip(
+            (self.X, self.U, self.S, self.F), self.past, own, strict=True) if keep and mine]
+        if self.samples_are_positions:
+            # The sampled history at x0, of which the newest is the position.
+            self.X[:self.keep_x] = start
+        else:
+            # x[k] = x0; x[k-i] = x0 - i v0 before the start; no force applied yet.
+            self.X[n] = start
+            for i in range(1, n + 1):
+                self.X[n - i] = x0 - i * v0
+            self.S[:self.keep_s] = sampled
+        if not self.commands_are_forces:
+            self.F[:m] = resting_force
+
+    # The buffers' rows as lists of views, made when first used (a run in
+    # blocks uses one or two; a chunk made every view, which in a run of
+    # many small chunks took as long as the run): indexing a list takes a
+    # fifth of the time of making a view.
+    @functools.cached_property
+    def _x_rows(self):
+        return list(self.X)
+
+    @functools.cached_property
+    def _u_rows(self):
+        return list(self.U)
+
+    @functools.cached_property
+    def _s_rows(self):
+        return self._x_rows if self.S is self.X else list(self.S)
+
+    @functools.cached_property
+    def _f_rows(self):
+        return self._u_rows if self.F is self.U else list(self.F)
 
     def _sample(self, x):
         q = self.quantum
@@ -1157,6 +1219,36 @@ class _AnyLoop:
             for done in checks:
                 self.freeze_diverged(done - start)
 
+    def advance_each(self, count, high, low):
+        """``count`` blocks of one period (:meth:`advance`), each position folded into the extremes.
+
+        ``high`` and ``low`` get the largest and smallest value of each
+        point, in place (:func:`_run`'s, for a run that records, sums and
+        reports nothing, its periods one at a time, d = 0 and 1: a period
+        is a few microseconds, a third of them the calls around it).
+        """
+        maximum, minimum, one_period = np.maximum, np.minimum, self._one_period
+        every, rows, past, spare = self.check_every, self._x_rows, self.past[0], self.spare
+        for _ in range(count):
+            if self.filled:
+                # _shift(1) where the rows do not run out.
+                if self.keep_x + 1 - past + self.block <= spare:
+                    self.filled = 0
+                    self.keep_x += 1
+                    self.keep_u += 1
+                    self.keep_s += 1
+                    self.keep_f += 1
+                else:
+                    self._shift(1)
+            one_period()
+            self.filled = 1
+            self.k += 1
+            if self.k % every == 0 and not self._calm(1, 1):
+                self.freeze_diverged(1)
+            x = rows[self.keep_x]
+            maximum(high, x, out=high)     # (positional: deprecated for these two, slow)
+            minimum(low, x, out=low)
+
     def _shift(self, count):
         """The last block's rows join the past; back to the buffers' start when the rows run out."""
         self.filled = 0
@@ -1167,9 +1259,8 @@ class _AnyLoop:
             self.keep_s += count
             self.keep_f += count
             return
-        for buffer, keep in zip((self.X, self.U, self.S, self.F), self.past, strict=True):
-            if keep:
-                buffer[:keep] = buffer[moved:moved + keep]
+        for buffer, keep in self._moved:
+            buffer[:keep] = buffer[moved:moved + keep]
         self.keep_x, self.keep_u, self.keep_s, self.keep_f = self.past
 
     def _combine(self, out, terms, buffer, first_row, sign):
@@ -1207,18 +1298,20 @@ class _AnyLoop:
         sampled = self.S[ks:ks + count]
         if q:
             _round_into(sampled, positions, q)
-        else:
+        elif not self.samples_are_positions:
             np.copyto(sampled, positions)
         force = self.F[kf:kf + count]
         np.multiply(self.e0, sampled, out=force)
         self._combine(force, self.e, self.S, ks - 1, 1)
-        self._recur(self._f_rows, self.c, kf, count)
+        if self.c:
+            self._recur(self._f_rows, self.c, kf, count)
         command = self.U[ku:ku + count]
         if self.compensation is not None:
             self._compensated(command, force, sampled, count)
             self.pulse = None
         else:
-            np.copyto(command, force)
+            if not self.commands_are_forces:
+                np.copyto(command, force)
             if self.pulse is not None:
                 command[0] = force[0] + self.pulse
                 self.pulse = None
@@ -1244,7 +1337,7 @@ class _AnyLoop:
         sampled, force = S[ks], F[kf]
         if self.quantum:
             _round_into(sampled, self._x_rows[self.keep_x - 1], self.quantum)
-        else:
+        elif not self.samples_are_positions:
             np.copyto(sampled, self._x_rows[self.keep_x - 1])
         # Positional outs: the keyword costs a fifth of a call on small arrays.
         multiply(self.e0, sampled, force)
@@ -1258,7 +1351,8 @@ class _AnyLoop:
             self._compensated(self.U[ku:ku + 1], self.F[kf:kf + 1], self.S[ks:ks + 1], 1)
             self.pulse = None
         else:
-            np.copyto(command, force)
+            if not self.commands_are_forces:
+                np.copyto(command, force)
             if self.pulse is not None:
                 np.add(force, self.pulse, out=command)
                 self.pulse = None
@@ -1274,9 +1368,9 @@ class _AnyLoop:
         X, U, tmp, multiply = self._x_rows, self._u_rows, self._tmp[0], np.multiply
         kx, first_u = self.keep_x, self.keep_u - self.d
         out = X[kx]
-        (k, first), *rest = self.minus_b
+        k, first = self._b_first
         multiply(first, U[first_u - k], out)
-        for k, coefficient in rest:
+        for k, coefficient in self._b_rest:
             np.add(out, multiply(coefficient, U[first_u - k], tmp), out)
         for k, coefficient in self.a:
             np.subtract(out, multiply(coefficient, X[kx - 1 - k], tmp), out)
@@ -1351,7 +1445,8 @@ class _StateLoop(_AnyLoop):
     """
 
     def __init__(self, parts, d, x0, v0, nonideal, space, state=None, compensation=None):
-        super().__init__(parts, d, x0, v0, nonideal, compensation=compensation)
+        super().__init__(parts, d, x0, v0, nonideal, compensation=compensation,
+                         positions_unread=True)
         coulomb = nonideal.coulomb_friction
         stiction = nonideal.stiction if nonideal.stiction is not None else coulomb
         self._unfinite_at = {}
