@@ -1006,14 +1006,18 @@ class LoopModel:
     def _plant_function(self, exprs):
         """An mpmath function of (plant values..., T) giving ``exprs``.
 
-        The arguments are dummies: a parameter named like an mpmath name
-        (``e``, ``exp``) would otherwise shadow it in the generated function
-        (``e`` for Euler's number), and ``T`` in the plant would be an
-        argument twice.  The plant's own ``T``, when it has one, is given
-        the same value by the caller as the last argument.
+        The arguments are renamed ``_plant0``, ``_plant1``, ...: a parameter
+        named like an mpmath name (``e``, ``exp``) would otherwise shadow it
+        in the generated function (``e`` for Euler's number), and ``T`` in
+        the plant would be an argument twice.  Plain symbols, not dummies:
+        lambdify replaces dummy arguments once more, one tree walk per
+        argument over the whole closed form (most of its time), and prints
+        the terms in an order that follows the dummies' counter.  The
+        plant's own ``T``, when it has one, is given the same value by the
+        caller as the last argument.
         """
         names = [self.symbols[n] for n in self.plant_names]
-        args = [sp.Dummy(n) for n in self.plant_names] + [sp.Dummy("T")]
+        args = [sp.Symbol(f"_plant{i}") for i in range(len(self.plant_names) + 1)]
         rename = dict(zip(names, args, strict=False))
         rename.setdefault(model.T, args[-1])
         exprs = [[sp.sympify(c).xreplace(rename) for c in part] for part in exprs]
