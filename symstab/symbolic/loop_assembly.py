@@ -36,6 +36,7 @@ from .._validate import check_delay
 from . import model
 from .derivation_cache import DerivationCache, cache_dir
 from .discretize import numeric_zoh, written_poles, zoh_pulse_transfer_function
+from .forms import NO_DOCSTRING
 
 __all__ = ["LoopModel", "NonPhysicalPlantWarning", "parse_plant", "parse_environment", "parse_actuator", "parse_expression",
            "check_parameter_name", "check_loop_name", "check_text_line", "NAME_PATTERN",
@@ -1021,7 +1022,7 @@ class LoopModel:
         rename = dict(zip(names, args, strict=False))
         rename.setdefault(model.T, args[-1])
         exprs = [[sp.sympify(c).xreplace(rename) for c in part] for part in exprs]
-        return sp.lambdify(args, exprs, modules="mpmath")
+        return sp.lambdify(args, exprs, modules="mpmath", **NO_DOCSTRING)
 
     def _closed_form_plant(self, point, T):
         """P_n, P_d of the derived closed form at ``point``, to :data:`PLANT_DIGITS` digits.
