@@ -38,7 +38,7 @@ from .numeric.paper.region import (
     limits,
     vanishing_gamma,
 )
-from .numeric.paper.simulate import stability_map
+from .numeric.paper.simulate import simulate
 from .numeric.simulation.simulator import PAPER_ENCODER_RESOLUTION, Nonidealities
 
 __all__ = ["FigureResult", "FIGURES", "make_figures"]
@@ -200,13 +200,32 @@ def figure_horizon(d):
     return 4000 + 400 * d
 
 
-def _simulated(gamma, d, window, n):
-    """Simulate an ``n`` x ``n`` grid of the window's alpha >= 0 part: ``(beta, alpha, map)``."""
+def _stable_maps(gammas, grids, d, **run):
+    """``stability_map(alpha=alpha, beta=beta, gamma=g, d=d, **run).stable`` for each gamma.
+
+    ``grids`` holds each gamma's ``(alpha, beta)``, all of one size.  In one
+    run of the simulator (:func:`symstab.numeric.paper.simulate.simulate`,
+    the run of :func:`~symstab.numeric.paper.simulate.stability_map`): it
+    steps every point of every gamma together, one Python loop over the
+    periods instead of one per gamma, which is most of a small grid's time.
+    Each point is stepped alone all the same (its own ``K, B, M``), so its
+    verdict is the one it has in its own map.
+    """
+    planes = [np.meshgrid(alpha, beta, indexing="ij") for alpha, beta in grids]
+    A, B = (np.stack([plane[k] for plane in planes]) for k in (0, 1))
+    G = np.asarray(gammas, dtype=float)[:, None, None]
+    return list(simulate(alpha=A, beta=B, gamma=G, d=d, **run).stable)
+
+
+def _simulated(gammas, d, window, n):
+    """Simulate an ``n`` x ``n`` grid of the window's alpha >= 0 part at each of ``gammas``.
+
+    Returns ``(beta, alpha, [stable map of each gamma])``.
+    """
     (b0, b1), (a0, a1) = window
     alpha, beta = np.linspace(max(a0, 0.0), a1, n), np.linspace(b0, b1, n)
-    result = stability_map(alpha=alpha, beta=beta, gamma=gamma, d=d, delta=DELTA,
-                           steps=figure_horizon(d))
-    return beta, alpha, result
+    return beta, alpha, _stable_maps(gammas, [(alpha, beta)] * len(gammas), d, delta=DELTA,
+                                     steps=figure_horizon(d))
 
 
 def _regions_panel(gammas, d, window, n, verdicts, beyond=True, colors=_COLORS, title=None):
@@ -215,14 +234,16 @@ def _regions_panel(gammas, d, window, n, verdicts, beyond=True, colors=_COLORS, 
     The panel of :func:`symstab.drawing.regions_figure`; each simulated
     gamma's verdict is appended to ``verdicts``.
     """
+    drawn = [g for g, _ in zip(gammas, colors, strict=False)]
+    if n:
+        beta, alpha, maps = _simulated(drawn, d, window, n)
     layers = []
-    for g, color in zip(gammas, colors, strict=False):
+    for k, (g, color) in enumerate(zip(drawn, colors, strict=False)):
         decomposition = _decomposition(g, d, window)
         simulated = None
         if n:
-            beta, alpha, result = _simulated(g, d, window, n)
-            simulated = (beta, alpha, result.stable)
-            verdicts.append((g, d, "S" if result.stable.any() else "U", int(result.stable.sum()),
+            simulated = (beta, alpha, maps[k])
+            verdicts.append((g, d, "S" if maps[k].any() else "U", int(maps[k].sum()),
                              bool(decomposition.stable)))
         layers.append((color, decomposition, simulated,
                        arc_polylines(gamma=g, d=d, delta=DELTA, window=window)))
@@ -386,8 +407,13 @@ def fig10(n=40):
     qf = Nonidealities(encoder_resolution=PAPER_ENCODER_RESOLUTION, velocity_cutoff=50.0)
     found, panels, passive_k = [], [], {}
     gammas = (-0.5, 0.0, 0.5, 1.0)
-    for g in gammas:
-        row, panel, passive_k[g] = _fig10_panel(g, n, qf)
+    windows = [_fig10_window(g) for g in gammas]
+    grids = [(np.linspace(0.0, a1, n), np.linspace(b0, b1, n)) for (b0, b1), (_, a1) in windows]
+    ideal = _stable_maps(gammas, grids, 40, delta=DELTA)
+    quant = _stable_maps(gammas, grids, 40, delta=None, device=PAPER_DEVICE, nonideal=qf, x0=0.01)
+    for g, window, grid, maps in zip(gammas, windows, grids, zip(ideal, quant, strict=True),
+                                     strict=True):
+        row, panel, passive_k[g] = _fig10_panel(g, window, grid, maps)
         found.append(row)
         panels.append(panel)
     fig, written = drawing.physical_figure(panels)
@@ -399,9 +425,19 @@ def fig10(n=40):
         _fig10_finding(found, counted, passive_k, n))
 
 
-def _fig10_panel(g, n, qf):
+def _fig10_window(g):
+    """Fig. 10's ``((beta0, beta1), (alpha0, alpha1))`` window at ``gamma = g``: the arc, padded."""
+    curve = boundary_curve(gamma=g, d=40, delta=DELTA, n=1000, segments=False)
+    top = 1.12 * float(curve.alpha.max())
+    pad = 0.06 * float(curve.beta.max() - curve.beta.min())
+    return (float(curve.beta.min()) - pad, float(curve.beta.max()) + pad), (-0.05 * top, top)
+
+
+def _fig10_panel(g, window, grid, maps):
     """One panel of Fig. 10 at ``gamma = g``: the exact set, the two simulations, passivity.
 
+    ``grid`` is the simulated ``(alpha, beta)`` of ``window``, ``maps`` the
+    stable cells of the ideal and the quantized + filtered runs there.
     Returns ``((g, K_max theory, K_max ideal sim, K_max QF sim, B_max ideal sim,
     B_max QF sim), the panel to draw, the passive K_max or None)``.
     """
@@ -409,21 +445,13 @@ def _fig10_panel(g, n, qf):
     # K_w and B_w are alpha and beta times constants: the plane is only rescaled.
     scale = (float(dev.damping(1.0)), float(dev.stiffness(1.0)))
     lim = limits(gamma=g, d=d, delta=DELTA)
-    curve = boundary_curve(gamma=g, d=d, delta=DELTA, n=1000, segments=False)
-    top = 1.12 * float(curve.alpha.max())
-    pad = 0.06 * float(curve.beta.max() - curve.beta.min())
-    window = ((float(curve.beta.min()) - pad, float(curve.beta.max()) + pad), (-0.05 * top, top))
-    (b0, b1), (a0, a1) = window
     decomposition = _decomposition(g, d, window)
-    alpha, beta = np.linspace(0.0, a1, n), np.linspace(b0, b1, n)
-    ideal = stability_map(alpha=alpha, beta=beta, gamma=g, d=d, delta=DELTA)
-    quant = stability_map(alpha=alpha, beta=beta, gamma=g, d=d, delta=None, device=dev,
-                          nonideal=qf, x0=0.01)
+    (alpha, beta), (ideal, quant) = grid, maps
     passive = paper_passive_region(gamma=g, d=d, delta=DELTA)
     panel = {"window": window, "scale": scale, "decomposition": decomposition,
              "arc": arc_polylines(gamma=g, d=d, delta=DELTA, window=window),
-             "grid": (dev.stiffness(alpha), dev.damping(beta)), "ideal": ideal.stable,
-             "quantized": quant.stable,
+             "grid": (dev.stiffness(alpha), dev.damping(beta)), "ideal": ideal,
+             "quantized": quant,
              "passive": None if passive.empty else
              np.vstack([passive.polygon, passive.polygon[:1]]) * scale,
              "title": fr"${_mass_label(g)}$ ($\gamma = {g:g}$)"
@@ -434,7 +462,7 @@ def _fig10_panel(g, n, qf):
     def top_of(mask):
         return (dev.stiffness(A[mask].max()), dev.damping(Bm[mask].max())) if mask.any() else (0.0, 0.0)
 
-    (ki, bi), (kq, bq) = top_of(ideal.stable), top_of(quant.stable)
+    (ki, bi), (kq, bq) = top_of(ideal), top_of(quant)
     return (g, float(dev.stiffness(lim.alpha_max)), ki, kq, bi, bq), panel, passive_k
 
 

@@ -33,7 +33,6 @@ is reported with the point that shows it.
 import collections
 import dataclasses
 import functools
-import inspect
 import random
 
 import mpmath
@@ -45,6 +44,7 @@ from sympy.polys.rings import ring
 
 from ..symbolic import model
 from ..symbolic.forms import (
+    NO_DOCSTRING,
     E,
     UnsupportedExpression,
     conjugate_on_circle,
@@ -163,10 +163,6 @@ class _Fraction:
         return self
 
 
-#: lambdify prints the whole expression into the function's docstring too
-#: (a quarter of its time here); SymPy >= 1.13 can leave it out.
-_NO_DOCSTRING = ({"docstring_limit": 0}
-                 if "docstring_limit" in inspect.signature(sp.lambdify).parameters else {})
 
 
 def _sample_point(symbols, rng):
@@ -210,7 +206,7 @@ def numeric_difference(lhs, rhs, *, samples=12, dps=40, seed=0):
     # change the size by rounding only, and cost more than the evaluation.
     magnitude = sp.Add(*[sp.Abs(t, evaluate=False)
                          for t in sp.Add.make_args(lhs) + sp.Add.make_args(rhs)])
-    f = sp.lambdify(symbols, [lhs, rhs, magnitude], modules="mpmath", **_NO_DOCSTRING)
+    f = sp.lambdify(symbols, [lhs, rhs, magnitude], modules="mpmath", **NO_DOCSTRING)
     rng = random.Random(seed)
     worst, worst_point = 0.0, {}
     done = tries = 0

@@ -13,6 +13,8 @@ sines.  The derivation uses these forms to write the boundary and theta_max;
 the exact identity checker (:mod:`symstab.proof.identity`) proves with them.
 """
 
+import inspect
+
 import sympy as sp
 
 from . import model
@@ -26,6 +28,12 @@ w = sp.Symbol("w")
 E = sp.Symbol("E")
 
 _TRIG = (sp.sin, sp.cos, sp.tan, sp.cot, sp.sec, sp.csc)
+
+#: Keyword arguments for ``sympy.lambdify`` that leave the whole expression out
+#: of the generated function's docstring: printing it is a quarter to three
+#: quarters of lambdify's time on the long closed forms (SymPy >= 1.13).
+NO_DOCSTRING = ({"docstring_limit": 0}
+                if "docstring_limit" in inspect.signature(sp.lambdify).parameters else {})
 
 
 class _exp_atom(sp.Function):

@@ -23,6 +23,7 @@ import sympy as sp
 from .._validate import check_delay, check_real
 from . import model
 from .discretize import dimensionless_pulse_transfer_function
+from .forms import NO_DOCSTRING
 
 __all__ = ["LoopPolynomial", "characteristic_polynomial", "dimensionless_environment"]
 
@@ -92,8 +93,8 @@ class LoopPolynomial:
     def _numeric(self):
         args = (model.alpha, model.beta, model.gamma, model.delta)
         sub = {model.Gamma: sp.exp(model.delta)}
-        return (sp.lambdify(args, [c.subs(sub) for c in self.delayed.all_coeffs()], modules="mpmath"),
-                sp.lambdify(args, [c.subs(sub) for c in self.direct.all_coeffs()], modules="mpmath"))
+        return tuple(sp.lambdify(args, [c.subs(sub) for c in part.all_coeffs()], modules="mpmath",
+                                 **NO_DOCSTRING) for part in (self.delayed, self.direct))
 
     def numeric_coeffs(self, *, alpha, beta, gamma, d, delta):
         """Return the coefficients (floats, highest first) at a parameter point.

@@ -36,6 +36,7 @@ from .._validate import check_delay
 from . import model
 from .derivation_cache import DerivationCache, cache_dir
 from .discretize import numeric_zoh, written_poles, zoh_pulse_transfer_function
+from .forms import NO_DOCSTRING
 
 __all__ = ["LoopModel", "NonPhysicalPlantWarning", "parse_plant", "parse_environment", "parse_actuator", "parse_expression",
            "check_parameter_name", "check_loop_name", "check_text_line", "NAME_PATTERN",
@@ -1006,18 +1007,22 @@ class LoopModel:
     def _plant_function(self, exprs):
         """An mpmath function of (plant values..., T) giving ``exprs``.
 
-        The arguments are dummies: a parameter named like an mpmath name
-        (``e``, ``exp``) would otherwise shadow it in the generated function
-        (``e`` for Euler's number), and ``T`` in the plant would be an
-        argument twice.  The plant's own ``T``, when it has one, is given
-        the same value by the caller as the last argument.
+        The arguments are renamed ``_plant0``, ``_plant1``, ...: a parameter
+        named like an mpmath name (``e``, ``exp``) would otherwise shadow it
+        in the generated function (``e`` for Euler's number), and ``T`` in
+        the plant would be an argument twice.  Plain symbols, not dummies:
+        lambdify replaces dummy arguments once more, one tree walk per
+        argument over the whole closed form (most of its time), and prints
+        the terms in an order that follows the dummies' counter.  The
+        plant's own ``T``, when it has one, is given the same value by the
+        caller as the last argument.
         """
         names = [self.symbols[n] for n in self.plant_names]
-        args = [sp.Dummy(n) for n in self.plant_names] + [sp.Dummy("T")]
+        args = [sp.Symbol(f"_plant{i}") for i in range(len(self.plant_names) + 1)]
         rename = dict(zip(names, args, strict=False))
         rename.setdefault(model.T, args[-1])
         exprs = [[sp.sympify(c).xreplace(rename) for c in part] for part in exprs]
-        return sp.lambdify(args, exprs, modules="mpmath")
+        return sp.lambdify(args, exprs, modules="mpmath", **NO_DOCSTRING)
 
     def _closed_form_plant(self, point, T):
         """P_n, P_d of the derived closed form at ``point``, to :data:`PLANT_DIGITS` digits.

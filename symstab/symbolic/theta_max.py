@@ -38,7 +38,7 @@ import sympy as sp
 from .._validate import check_loop
 from . import model
 from .boundary import boundary
-from .forms import E, exponential_form, trig_form, w
+from .forms import NO_DOCSTRING, E, exponential_form, trig_form, w
 from .small_theta import taylor_coefficients
 
 __all__ = [
@@ -150,7 +150,8 @@ def _alpha_numerator_gamma():
     # (the sines, the powers of Gamma) evaluated once: five times faster
     # than the plain form, which recomputes exp(delta) in every term.
     args = (model.theta, model.gamma, model.d, model.delta, model.Gamma)
-    return sp.lambdify(args, boundary().alpha_numerator, modules="mpmath", cse=True)
+    return sp.lambdify(args, boundary().alpha_numerator, modules="mpmath", cse=True,
+                       **NO_DOCSTRING)
 
 
 @functools.lru_cache(maxsize=None)
@@ -291,7 +292,7 @@ def theta_max_newton(*, d, delta):
 @functools.lru_cache(maxsize=None)
 def _newton_function():
     return sp.lambdify((model.d, model.delta, model.Gamma), newton_form_gamma0().theta_newton,
-                       modules="mpmath")
+                       modules="mpmath", **NO_DOCSTRING)
 
 
 # -- The reduced equation: theta_max in the general case -------------------
@@ -514,7 +515,8 @@ def reduced_qr_functions():
     """
     eq = reduced_equation()
     args = (model.delta, model.Gamma)
-    return (sp.lambdify(args, eq.q, modules="mpmath"), sp.lambdify(args, eq.r, modules="mpmath"))
+    return tuple(sp.lambdify(args, part, modules="mpmath", **NO_DOCSTRING)
+                 for part in (eq.q, eq.r))
 
 
 def reduced_value_slope(t, gamma, rate, delta, q, r, *, sin, cos, eps=None):

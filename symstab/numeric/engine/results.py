@@ -13,6 +13,7 @@ names are aliases of the fields (``alpha_max`` is ``y_max``, ``z_width`` is
 """
 
 import dataclasses
+import functools
 import html
 
 import numpy as np
@@ -628,6 +629,14 @@ class RobustRegion:
                for i, bands in enumerate(which) for band in bands]
         return np.array(out, dtype=float).reshape(-1, 6)
 
+    @functools.cached_property
+    def _robust_bands(self):
+        """``_bands(self.intervals)``, built once (read-only): a Python loop over thousands of
+        strips that every ``contains`` and ``intervals_at`` read."""
+        rows = self._bands(self.intervals)
+        rows.flags.writeable = False
+        return rows
+
     @staticmethod
     def _areas(r):
         return (r[:, 1] - r[:, 0]) * 0.5 * ((r[:, 3] - r[:, 2]) + (r[:, 5] - r[:, 4]))
@@ -635,7 +644,7 @@ class RobustRegion:
     @property
     def area(self):
         """Area of the robust set (the trapezoids' sum)."""
-        return float(np.sum(self._areas(self._bands(self.intervals))))
+        return float(np.sum(self._areas(self._robust_bands)))
 
     @property
     def marginal_area(self):
@@ -675,7 +684,7 @@ class RobustRegion:
 
     def _ends_at(self, x):
         """Per band: its strip holds ``x`` (mask) and its ``(lo, hi)`` there."""
-        r = self._bands(self.intervals)
+        r = self._robust_bands
         x = np.asarray(x, dtype=float)[..., None]
         width = r[:, 1] - r[:, 0]
         with np.errstate(invalid="ignore", divide="ignore"):
@@ -728,7 +737,7 @@ class RobustRegion:
         if self.empty:
             return Limits.empty_set(self.x, self.y, self.reason, cells=0, region=self,
                                     at=self.at, line=self.intervals_at)
-        r = self._bands(self.intervals)
+        r = self._robust_bands
         # The highest end is at a strip's edge.
         band, side = np.unravel_index(int(np.argmax(r[:, [3, 5]])), (len(r), 2))
         sides = set(self.unbounded)

@@ -265,7 +265,11 @@ def _refinement_grid(environment_terms, T, d, n):
 
 def refined_worst_margin(environment_terms, point, damping, T, d, n=2000):
     """``max_theta RHS - damping`` at 30 digits: the sweep, then a golden-section search
-    around its three best local maxima (an end point counts as one)."""
+    around its three best local maxima (an end point counts as one).
+
+    Each step keeps one of its two inner points and its value (the golden ratio puts it
+    where the next step's other point goes): one evaluation a step, not two (until issue 41).
+    """
     def rhs(theta):
         z = mpmath.expj(theta)
         u = _one_minus_inverse(theta)
@@ -286,12 +290,17 @@ def refined_worst_margin(environment_terms, point, damping, T, d, n=2000):
         for k in peaks[:3]:
             a = grid[k - 1] if k else mpmath.mpf(10) ** -12
             b = grid[k + 1] if k < n - 1 else mpmath.pi
+            x1, x2 = b - ratio * (b - a), a + ratio * (b - a)
+            f1, f2 = rhs(x1), rhs(x2)
             for _ in range(90):
-                x1, x2 = b - ratio * (b - a), a + ratio * (b - a)
-                if rhs(x1) < rhs(x2):
-                    a = x1
+                if f1 < f2:
+                    a, x1, f1 = x1, x2, f2
+                    x2 = a + ratio * (b - a)
+                    f2 = rhs(x2)
                 else:
-                    b = x2
+                    b, x2, f2 = x2, x1, f1
+                    x1 = b - ratio * (b - a)
+                    f1 = rhs(x1)
             best = max(best, rhs((a + b) / 2))
         return float(best - damping)
 
