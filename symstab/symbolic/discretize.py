@@ -14,7 +14,8 @@ import sympy as sp
 from . import model
 
 __all__ = [
-    "z_transform_by_residues", "written_poles", "zoh_pulse_transfer_function", "numeric_zoh",
+    "z_transform_by_residues", "written_poles", "zoh_pulse_transfer_function",
+    "fractional_zoh_pulse_transfer_function", "fractional_delay_identities", "numeric_zoh",
     "interval_zoh", "interval_product",
     "pulse_transfer_function",
     "dimensionless_pulse_transfer_function",
@@ -119,6 +120,70 @@ def zoh_pulse_transfer_function(G, *, s=model.s, z=model.z, T=model.T):
         If ``G`` is not proper, or its denominator has a factor of degree 3
         or more in ``s`` (then use :func:`numeric_zoh`).
     """
+    return sp.cancel(sp.together((1 - 1 / z) * _step_transform(G, 0, s, z, T)))
+
+
+def fractional_zoh_pulse_transfer_function(G, eps, *, s=model.s, z=model.z, T=model.T):
+    """Z[ZOH G(s)] with the hold's output delayed by ``eps`` of a period: the modified z-transform.
+
+    The plant's input is the held command delayed by ``eps T``, ``0 <= eps
+    < 1`` (a loop delay of ``(d + eps) T`` is this times ``z**-d``).  With
+    ``f`` the step response of ``G`` (``f(0) = 0`` for a strictly proper
+    ``G``), the sampled output is ``(1 - 1/z) sum_k f((k - eps) T) z**-k``,
+    and ``sum_k f((k - eps) T) z**-k = z**-1 sum_j f((j + 1 - eps) T) z**-j``
+    is the modified z-transform of ``F = G / s`` at ``m = 1 - eps``: the sum
+    over the poles ``p`` of ``F`` of the residues of ``F(s) exp((1 - eps) s
+    T) z / (z - exp(s T))`` (Jury; Åström and Wittenmark, *Computer-Controlled
+    Systems*, sec. 2.3 write the same with the state-space Γ₀ and Γ₁).  So::
+
+        P_eps(z) = (z - 1) / z**2 * sum_p Res(F(s) exp((1 - eps) s T) z / (z - exp(s T)), p)
+
+    ``eps = 0`` is :func:`zoh_pulse_transfer_function` (the residues' sum at
+    ``m = 1`` is ``z (Z[F] - f(0))``) and ``eps -> 1`` is it times ``1 / z``,
+    one more sample of delay: :func:`fractional_delay_identities` proves both.
+
+    Parameters
+    ----------
+    G : sympy.Expr
+        A strictly proper rational ``G(s)`` whose poles SymPy writes
+        (:func:`written_poles`).
+    eps : sympy.Symbol or number
+        The fraction of a period, ``0 <= eps < 1``.
+
+    Returns
+    -------
+    sympy.Expr
+        A rational function of ``z`` (``cancel``-ed) whose coefficients hold
+        ``exp(p T)`` and ``exp((1 - eps) p T)``.
+
+    Raises
+    ------
+    ValueError
+        If ``G`` is not strictly proper (a direct feedthrough makes the
+        output jump at ``eps T``, inside the period), or its poles are not
+        written (a factor of degree 3 or more).
+
+    Examples
+    --------
+    >>> m, b, T, eps, s, z = sp.symbols("m b T epsilon s z", positive=True)
+    >>> P = fractional_zoh_pulse_transfer_function(1 / (m * s**2), eps, s=s, z=z, T=T)
+    >>> sp.factor(P)
+    T**2*(epsilon**2*z**2 - 2*epsilon**2*z + epsilon**2 - 2*epsilon*z**2 + 2*epsilon*z + z**2 + z)/(2*m*z*(z - 1)**2)
+    """
+    num, den = sp.fraction(sp.together(G))
+    if sp.degree(num, s) >= sp.degree(den, s):
+        raise ValueError("G(s) must be strictly proper for a fractional delay: a direct "
+                         "feedthrough makes the output jump inside the period")
+    return sp.cancel(sp.together((z - 1) / z**2 * _step_transform(G, 1 - eps, s, z, T)))
+
+
+def _step_transform(G, shift, s, z, T):
+    """``sum_p Res(G(s) / s * exp(shift s T) * z / (z - exp(s T)), p)`` over the poles of ``G / s``.
+
+    ``shift = 0``: the z-transform of the sampled step response; ``shift = 1
+    - eps``: its modified z-transform.  A simple pole's residue is written
+    directly, a repeated one's is SymPy's ``residue``.
+    """
     F = sp.together(G / s)
     poles = written_poles(F, s)
     if poles is None:
@@ -128,14 +193,38 @@ def zoh_pulse_transfer_function(G, *, s=model.s, z=model.z, T=model.T):
     if sp.degree(num, s) >= sp.degree(den, s):
         raise ValueError("G(s) must be proper")
     slope = sp.diff(den, s)
-    kernel = F * z / (z - sp.exp(s * T))
+    kernel = F * sp.exp(shift * s * T) * z / (z - sp.exp(s * T))
     terms = []
     for pole, multiplicity in poles.items():
         if multiplicity == 1:
-            terms.append(num.subs(s, pole) / slope.subs(s, pole) * z / (z - sp.exp(pole * T)))
+            terms.append(num.subs(s, pole) / slope.subs(s, pole) * sp.exp(shift * pole * T)
+                         * z / (z - sp.exp(pole * T)))
         else:
             terms.append(sp.residue(kernel, s, pole))
-    return sp.cancel(sp.together((1 - 1 / z) * sp.Add(*terms)))
+    return sp.Add(*terms)
+
+
+def fractional_delay_identities(G, *, s=model.s, z=model.z, T=model.T):
+    """The two limits of a fractional delay, proved: ``(P_0 - P, P_1 - P / z)``, both exactly 0.
+
+    ``P`` is :func:`zoh_pulse_transfer_function` of ``G`` and ``P_eps``
+    :func:`fractional_zoh_pulse_transfer_function`: no fraction is today's
+    integer-delay plant, and a whole period of it is one more sample of
+    delay.  Each difference is ``cancel``-ed with the exponentials of the
+    poles as independent generators (a rational identity in them holds for
+    their values), so a zero here is a proof.
+
+    Returns
+    -------
+    (sympy.Expr, sympy.Expr)
+    """
+    eps = sp.Dummy("epsilon")
+    plant = zoh_pulse_transfer_function(G, s=s, z=z, T=T)
+    fractional = fractional_zoh_pulse_transfer_function(G, eps, s=s, z=z, T=T)
+    # exp((1 - eps) p T) is exp(p T) at eps = 0 and 1 at eps = 1, written as SymPy writes them
+    # in the integer-delay plant: cancel() takes them as the same generators.
+    return (sp.cancel(sp.together(fractional.subs(eps, 0) - plant)),
+            sp.cancel(sp.together(fractional.subs(eps, 1) - plant / z)))
 
 
 def _charpoly(A):
