@@ -662,9 +662,9 @@ def sample_arc(arc, n, to_unit, samples=None, fine=1.0):
         angle = np.zeros(len(du))
         with np.errstate(invalid="ignore", divide="ignore"):
             angle[near] = np.arctan2(dv[near], du[near])
-            turn = np.abs(np.angle(np.exp(1j * (angle[pair + 1] - angle[pair]))))
         sharp = np.zeros(max(len(near) - 1, 0), dtype=bool)
-        sharp[pair] = (turn > _TURN) & (length[pair + 1] + length[pair] > _TURN_FLOOR * fine**2)
+        sharp[pair] = (_turns_over(angle[pair + 1] - angle[pair], _TURN)
+                       & (length[pair + 1] + length[pair] > _TURN_FLOOR * fine**2))
         split[1:] |= sharp
         split[:-1] |= sharp
         # Through infinity, or into a singular point: follow it closer.
@@ -681,6 +681,23 @@ def sample_arc(arc, n, to_unit, samples=None, fine=1.0):
                               for a, b in zip((theta, xs, ys, det), (mids, *arc(mids)),
                                               strict=True))
     return theta, xs, ys, det
+
+
+def _turns_over(change, limit):
+    """Whether the turns ``change`` (differences of headings in [-pi, pi]) exceed ``limit`` (< 1).
+
+    ``abs(angle(exp(1j change))) > limit``, the turn taken the short way
+    round, decided bit for bit as that expression decides it: computed so
+    only where ``|change|`` is within 1e-6 of ``limit`` or of ``2 pi -
+    limit`` (elsewhere the rounding of the complex exponential cannot
+    move it across ``limit``), at a fraction of its cost.
+    """
+    size = np.abs(change)
+    over = (size > limit) & (size < 2 * np.pi - limit)
+    close = (np.abs(size - limit) < 1e-6) | (np.abs(size - (2 * np.pi - limit)) < 1e-6)
+    if close.any():
+        over[close] = np.abs(np.angle(np.exp(1j * change[close]))) > limit
+    return over
 
 
 def window_arc(arc, n, x_range, y_range, *, angles=()):
@@ -1927,7 +1944,7 @@ def _trace(base, ax, ay, ends, arc, window, fine):
             # Two chords the last round had too crossed there as they do now:
             # had that made an angle hot, one of them would have been split.
             # So the hot angles are those of the pairs with a new chord.
-            new = _new_chords(polylines, owner, position, np.setdiff1d(theta, known))
+            new = _new_chords(polylines, owner, position, _sorted_difference(theta, known))
             hot = _hot_angles(_intersections(p, q, owner, position, among=new), polylines,
                               owner, position)
             if not hot:
@@ -1937,7 +1954,8 @@ def _trace(base, ax, ay, ends, arc, window, fine):
         known = theta
         # The angles added are evaluated by the next round's sampling, the
         # others are kept.
-        hot = np.setdiff1d(hot, theta)
+        hot = np.unique(np.asarray(hot, dtype=float))
+        hot = hot[~_members(theta, hot)]
         order = np.argsort(np.concatenate([theta, hot]), kind="stable")
         unknown = np.full(len(hot), np.nan)
         samples = tuple(np.concatenate([a, b])[order] for a, b in
@@ -1951,10 +1969,26 @@ def _new_chords(polylines, owner, position, added):
     for k, (_, _, th) in enumerate(polylines):
         if th is None:
             continue
-        fresh = np.isin(th, added)
+        fresh = _members(added, th)
         mine = np.flatnonzero(owner == k)
         new[mine] = fresh[position[mine]] | fresh[position[mine] + 1]
     return new
+
+
+def _members(sorted_values, x):
+    """``np.isin(x, sorted_values)`` for ``sorted_values`` sorted: a binary search, not a sort."""
+    x = np.asarray(x, dtype=float)
+    if not len(sorted_values):
+        return np.zeros(x.shape, dtype=bool)
+    index = np.minimum(np.searchsorted(sorted_values, x), len(sorted_values) - 1)
+    return sorted_values[index] == x
+
+
+def _sorted_difference(a, b):
+    """``np.setdiff1d(a, b)`` for ``b`` sorted, without sorting an ``a`` already increasing."""
+    if len(a) > 1 and not (a[1:] > a[:-1]).all():
+        return np.setdiff1d(a, b)
+    return a[~_members(b, a)]
 
 
 def _hot_angles(hits, polylines, owner, position):
