@@ -220,7 +220,13 @@ class Decomposition:
         changes, so the other side is unstable), joined where they meet,
         each end where the arc meets the line re-found on the arc.  An end
         on a side of the window in :attr:`unbounded` is where the window
-        cuts the piece, not where it ends.
+        cuts the piece, not where it ends.  Empty in a decomposition made
+        with ``segments=False`` (:func:`decompose`) until
+        :meth:`with_segments`.
+    _pending : tuple
+        Private: what :meth:`with_segments` makes the segments of (each
+        line's ``(c0, cx, cy)`` and the ``(label, ends)`` of the stable
+        cells' pieces on z = +-1), empty once they are made.
     """
 
     x: str
@@ -236,6 +242,7 @@ class Decomposition:
     hull: object = dataclasses.field(default=None, compare=False)
     arc: object = dataclasses.field(default=None, compare=False)
     segments: tuple = ()
+    _pending: tuple = dataclasses.field(default=(), compare=False, repr=False)
 
     def plot(self, ax=None, **kwargs):
         """Draw the decomposition: :func:`symstab.drawing.plot_region`.
@@ -491,6 +498,24 @@ class Decomposition:
                     f"necessary condition of the roots inside the unit circle, has a root "
                     f"outside it{_UNRESOLVED}")
         return f"every cell of the window {where} has a root outside the unit circle{_UNRESOLVED}"
+
+    def with_segments(self):
+        """This decomposition with its :attr:`segments` made, where ``decompose`` left them.
+
+        Re-finding their ends on the arc costs a root search each: a caller
+        that decomposes several windows and keeps one (:meth:`symstab.Loop.region`)
+        makes them for that one only.
+
+        Returns
+        -------
+        Decomposition
+        """
+        if not self._pending:
+            return self
+        lines, pieces = self._pending
+        segments = [self._segment(label, lines, ends) for label, ends in pieces]
+        segments.sort(key=lambda g: (g.root != "z=1", g.x0))
+        return dataclasses.replace(self, segments=tuple(segments), _pending=())
 
     def renamed(self, x, y):
         """The same decomposition with the plane's parameters called ``x`` and ``y``.
@@ -1751,7 +1776,7 @@ class Unresolved(ValueError):
 
 
 def decompose(base, ax, ay, ends, *, x_range, y_range, names=("x", "y"), arc=None, family=None,
-              refine=True):
+              refine=True, segments=True):
     """The D-decomposition of ``chi = base + x ax + y ay`` inside a window.
 
     Parameters
@@ -1782,6 +1807,9 @@ def decompose(base, ax, ay, ends, *, x_range, y_range, names=("x", "y"), arc=Non
         raises :class:`Unresolved` at once there: a caller that only looks
         for where the stable set is (to narrow its window) saves the finer
         pass, which may take up to 64 times the chords.
+    segments : bool
+        Make the :attr:`Decomposition.segments` (default); False leaves
+        them to :meth:`Decomposition.with_segments`.
 
     Returns
     -------
@@ -1833,7 +1861,7 @@ def decompose(base, ax, ay, ends, *, x_range, y_range, names=("x", "y"), arc=Non
             f"the {label} piece the counts of two neighbouring cells ({found.cells[i].count}, "
             f"{found.cells[j].count}) differ by {abs(change)}, not {_CHANGE[label]}; narrow "
             f"the window around the region of interest", coarse or found)
-    return found
+    return found.with_segments() if segments else found
 
 
 def _decompose(base, ax, ay, ends, *, x_range, y_range, names, fine, arc, family=None):
@@ -1881,11 +1909,9 @@ def _decompose(base, ax, ay, ends, *, x_range, y_range, names, fine, arc, family
                           y_range=(window.y0, window.y1), branches=tuple(branches),
                           cells=tuple(cells), mismatches=tuple(mismatches), unbounded=unbounded,
                           polynomial=(base, ax, ay), resolution=resolution, arc=arc)
-    coefficients = lines(base, ax, ay, ends)
-    segments = [found._segment(label, coefficients, window.from_unit(xy[[a, b]]))
-                for label, a, b in sides]
-    segments.sort(key=lambda g: (g.root != "z=1", g.x0))
-    return dataclasses.replace(found, segments=tuple(segments))
+    # The segments are made by Decomposition.with_segments, for the passes kept.
+    pieces = tuple((label, window.from_unit(xy[[a, b]])) for label, a, b in sides)
+    return dataclasses.replace(found, _pending=(lines(base, ax, ay, ends), pieces))
 
 
 class _Window:

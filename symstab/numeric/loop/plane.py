@@ -148,7 +148,11 @@ class _PlaneParts:
         return cls(x, y, base, ax, ay, ends, arc, (structured, *slopes))
 
     def decompose(self, box, refine=True):
-        """:func:`~symstab.numeric.engine.decomposition.decompose` in the window ``box``."""
+        """:func:`~symstab.numeric.engine.decomposition.decompose` in the window ``box``.
+
+        Without its segments (:meth:`Decomposition.with_segments` makes them
+        for the window kept).
+        """
         if not all(abs(v) <= LARGEST_COORDINATE for v in box):
             x, y = self.x, self.y
             raise ValueError(
@@ -158,7 +162,7 @@ class _PlaneParts:
                 f"units that keep the plane's numbers smaller")
         return decompose(self.base, self.ax, self.ay, self.ends, x_range=box[:2],
                          y_range=box[2:], names=(self.x, self.y), arc=self.arc,
-                         family=self.family, refine=refine)
+                         family=self.family, refine=refine, segments=False)
 
 
 def boundary(loop, x=None, y=None, n=1000, *, window=None, segments=False, **values):
@@ -270,7 +274,7 @@ def region(loop, x=None, y=None, *, x_range=None, y_range=None, **values):
     # (the answer keeps the plain source, not the values remembered).
     source, plane = plane.arc, dataclasses.replace(plane, arc=RememberedArc(plane.arc))
     found, box = _first_decomposition(plane, given, free, hull)
-    found = _widened(plane, found, box, free, enclosure)
+    found = _widened(plane, found, box, free, enclosure).with_segments()
     return dataclasses.replace(found, hull=hull, arc=source)
 
 
