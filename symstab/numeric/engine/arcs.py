@@ -289,13 +289,14 @@ def _bracket(first, second):
     return frequencies[keep].astype(float), e[keep]
 
 
-def _multiple(m, theta):
+def _multiple(m, theta, cosine=True):
     """``sin(m theta) / sin(theta)`` and ``cos(m theta)``, accurate at both ends of (0, pi).
 
     ``m theta`` is carried exactly by the generated helpers
     (:func:`symstab._generated.kernels.sin_multiple`, ``cos_multiple``), so
     ``sin(m theta)`` keeps its relative accuracy next to ``pi`` as
     ``sin(theta)`` does; at ``theta = 0`` the ratio is its limit ``m``.
+    Without ``cosine``, the ratio alone (the cosine is None).
     """
     m = np.asarray(m, dtype=float)
     theta = np.asarray(theta, dtype=float)
@@ -303,7 +304,7 @@ def _multiple(m, theta):
     denominator = np.sin(theta)
     with np.errstate(invalid="ignore", divide="ignore"):
         ratio = np.where(denominator == 0, m, numerator / denominator)
-    return ratio, kernels.cos_multiple(m, theta)
+    return ratio, kernels.cos_multiple(m, theta) if cosine else None
 
 
 def sine_ratio(m, theta):
@@ -334,7 +335,7 @@ def sine_ratio(m, theta):
     >>> float(sine_ratio(5, 0.0))                # the limit
     5.0
     """
-    return _multiple(m, theta)[0]
+    return _multiple(m, theta, cosine=False)[0]
 
 
 class ArcSource:
