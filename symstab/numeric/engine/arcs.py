@@ -300,11 +300,19 @@ def _multiple(m, theta, cosine=True):
     """
     m = np.asarray(m, dtype=float)
     theta = np.asarray(theta, dtype=float)
-    numerator = kernels.sin_multiple(m, theta)
+    other = None
+    if cosine:
+        # The generated helpers' two sums of one exact product (Dekker's, as
+        # they make it) and of one sine and cosine of it.
+        hi, lo = _two_product(m, theta)
+        sin_hi, cos_hi = np.sin(hi), np.cos(hi)
+        numerator, other = sin_hi + lo * cos_hi, cos_hi - lo * sin_hi
+    else:
+        numerator = kernels.sin_multiple(m, theta)
     denominator = np.sin(theta)
     with np.errstate(invalid="ignore", divide="ignore"):
         ratio = np.where(denominator == 0, m, numerator / denominator)
-    return ratio, kernels.cos_multiple(m, theta) if cosine else None
+    return ratio, other
 
 
 def sine_ratio(m, theta):
