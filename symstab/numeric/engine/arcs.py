@@ -289,21 +289,30 @@ def _bracket(first, second):
     return frequencies[keep].astype(float), e[keep]
 
 
-def _multiple(m, theta):
+def _multiple(m, theta, cosine=True):
     """``sin(m theta) / sin(theta)`` and ``cos(m theta)``, accurate at both ends of (0, pi).
 
     ``m theta`` is carried exactly by the generated helpers
     (:func:`symstab._generated.kernels.sin_multiple`, ``cos_multiple``), so
     ``sin(m theta)`` keeps its relative accuracy next to ``pi`` as
     ``sin(theta)`` does; at ``theta = 0`` the ratio is its limit ``m``.
+    Without ``cosine``, the ratio alone (the cosine is None).
     """
     m = np.asarray(m, dtype=float)
     theta = np.asarray(theta, dtype=float)
-    numerator = kernels.sin_multiple(m, theta)
+    other = None
+    if cosine:
+        # The generated helpers' two sums of one exact product (Dekker's, as
+        # they make it) and of one sine and cosine of it.
+        hi, lo = _two_product(m, theta)
+        sin_hi, cos_hi = np.sin(hi), np.cos(hi)
+        numerator, other = sin_hi + lo * cos_hi, cos_hi - lo * sin_hi
+    else:
+        numerator = kernels.sin_multiple(m, theta)
     denominator = np.sin(theta)
     with np.errstate(invalid="ignore", divide="ignore"):
         ratio = np.where(denominator == 0, m, numerator / denominator)
-    return ratio, kernels.cos_multiple(m, theta)
+    return ratio, other
 
 
 def sine_ratio(m, theta):
@@ -334,7 +343,7 @@ def sine_ratio(m, theta):
     >>> float(sine_ratio(5, 0.0))                # the limit
     5.0
     """
-    return _multiple(m, theta)[0]
+    return _multiple(m, theta, cosine=False)[0]
 
 
 class ArcSource:

@@ -220,7 +220,13 @@ class Decomposition:
         changes, so the other side is unstable), joined where they meet,
         each end where the arc meets the line re-found on the arc.  An end
         on a side of the window in :attr:`unbounded` is where the window
-        cuts the piece, not where it ends.
+        cuts the piece, not where it ends.  Empty in a decomposition made
+        with ``segments=False`` (:func:`decompose`) until
+        :meth:`with_segments`.
+    _pending : tuple
+        Private: what :meth:`with_segments` makes the segments of (each
+        line's ``(c0, cx, cy)`` and the ``(label, ends)`` of the stable
+        cells' pieces on z = +-1), empty once they are made.
     """
 
     x: str
@@ -236,6 +242,7 @@ class Decomposition:
     hull: object = dataclasses.field(default=None, compare=False)
     arc: object = dataclasses.field(default=None, compare=False)
     segments: tuple = ()
+    _pending: tuple = dataclasses.field(default=(), compare=False, repr=False)
 
     def plot(self, ax=None, **kwargs):
         """Draw the decomposition: :func:`symstab.drawing.plot_region`.
@@ -492,6 +499,24 @@ class Decomposition:
                     f"outside it{_UNRESOLVED}")
         return f"every cell of the window {where} has a root outside the unit circle{_UNRESOLVED}"
 
+    def with_segments(self):
+        """This decomposition with its :attr:`segments` made, where ``decompose`` left them.
+
+        Re-finding their ends on the arc costs a root search each: a caller
+        that decomposes several windows and keeps one (:meth:`symstab.Loop.region`)
+        makes them for that one only.
+
+        Returns
+        -------
+        Decomposition
+        """
+        if not self._pending:
+            return self
+        lines, pieces = self._pending
+        segments = [self._segment(label, lines, ends) for label, ends in pieces]
+        segments.sort(key=lambda g: (g.root != "z=1", g.x0))
+        return dataclasses.replace(self, segments=tuple(segments), _pending=())
+
     def renamed(self, x, y):
         """The same decomposition with the plane's parameters called ``x`` and ``y``.
 
@@ -662,9 +687,9 @@ def sample_arc(arc, n, to_unit, samples=None, fine=1.0):
         angle = np.zeros(len(du))
         with np.errstate(invalid="ignore", divide="ignore"):
             angle[near] = np.arctan2(dv[near], du[near])
-            turn = np.abs(np.angle(np.exp(1j * (angle[pair + 1] - angle[pair]))))
         sharp = np.zeros(max(len(near) - 1, 0), dtype=bool)
-        sharp[pair] = (turn > _TURN) & (length[pair + 1] + length[pair] > _TURN_FLOOR * fine**2)
+        sharp[pair] = (_turns_over(angle[pair + 1] - angle[pair], _TURN)
+                       & (length[pair + 1] + length[pair] > _TURN_FLOOR * fine**2))
         split[1:] |= sharp
         split[:-1] |= sharp
         # Through infinity, or into a singular point: follow it closer.
@@ -681,6 +706,23 @@ def sample_arc(arc, n, to_unit, samples=None, fine=1.0):
                               for a, b in zip((theta, xs, ys, det), (mids, *arc(mids)),
                                               strict=True))
     return theta, xs, ys, det
+
+
+def _turns_over(change, limit):
+    """Whether the turns ``change`` (differences of headings in [-pi, pi]) exceed ``limit`` (< 1).
+
+    ``abs(angle(exp(1j change))) > limit``, the turn taken the short way
+    round, decided bit for bit as that expression decides it: computed so
+    only where ``|change|`` is within 1e-6 of ``limit`` or of ``2 pi -
+    limit`` (elsewhere the rounding of the complex exponential cannot
+    move it across ``limit``), at a fraction of its cost.
+    """
+    size = np.abs(change)
+    over = (size > limit) & (size < 2 * np.pi - limit)
+    close = (np.abs(size - limit) < 1e-6) | (np.abs(size - (2 * np.pi - limit)) < 1e-6)
+    if close.any():
+        over[close] = np.abs(np.angle(np.exp(1j * change[close]))) > limit
+    return over
 
 
 def window_arc(arc, n, x_range, y_range, *, angles=()):
@@ -1734,7 +1776,7 @@ class Unresolved(ValueError):
 
 
 def decompose(base, ax, ay, ends, *, x_range, y_range, names=("x", "y"), arc=None, family=None,
-              refine=True):
+              refine=True, segments=True):
     """The D-decomposition of ``chi = base + x ax + y ay`` inside a window.
 
     Parameters
@@ -1765,6 +1807,9 @@ def decompose(base, ax, ay, ends, *, x_range, y_range, names=("x", "y"), arc=Non
         raises :class:`Unresolved` at once there: a caller that only looks
         for where the stable set is (to narrow its window) saves the finer
         pass, which may take up to 64 times the chords.
+    segments : bool
+        Make the :attr:`Decomposition.segments` (default); False leaves
+        them to :meth:`Decomposition.with_segments`.
 
     Returns
     -------
@@ -1816,7 +1861,7 @@ def decompose(base, ax, ay, ends, *, x_range, y_range, names=("x", "y"), arc=Non
             f"the {label} piece the counts of two neighbouring cells ({found.cells[i].count}, "
             f"{found.cells[j].count}) differ by {abs(change)}, not {_CHANGE[label]}; narrow "
             f"the window around the region of interest", coarse or found)
-    return found
+    return found.with_segments() if segments else found
 
 
 def _decompose(base, ax, ay, ends, *, x_range, y_range, names, fine, arc, family=None):
@@ -1864,11 +1909,9 @@ def _decompose(base, ax, ay, ends, *, x_range, y_range, names, fine, arc, family
                           y_range=(window.y0, window.y1), branches=tuple(branches),
                           cells=tuple(cells), mismatches=tuple(mismatches), unbounded=unbounded,
                           polynomial=(base, ax, ay), resolution=resolution, arc=arc)
-    coefficients = lines(base, ax, ay, ends)
-    segments = [found._segment(label, coefficients, window.from_unit(xy[[a, b]]))
-                for label, a, b in sides]
-    segments.sort(key=lambda g: (g.root != "z=1", g.x0))
-    return dataclasses.replace(found, segments=tuple(segments))
+    # The segments are made by Decomposition.with_segments, for the passes kept.
+    pieces = tuple((label, window.from_unit(xy[[a, b]])) for label, a, b in sides)
+    return dataclasses.replace(found, _pending=(lines(base, ax, ay, ends), pieces))
 
 
 class _Window:
@@ -1927,7 +1970,7 @@ def _trace(base, ax, ay, ends, arc, window, fine):
             # Two chords the last round had too crossed there as they do now:
             # had that made an angle hot, one of them would have been split.
             # So the hot angles are those of the pairs with a new chord.
-            new = _new_chords(polylines, owner, position, np.setdiff1d(theta, known))
+            new = _new_chords(polylines, owner, position, _sorted_difference(theta, known))
             hot = _hot_angles(_intersections(p, q, owner, position, among=new), polylines,
                               owner, position)
             if not hot:
@@ -1937,7 +1980,8 @@ def _trace(base, ax, ay, ends, arc, window, fine):
         known = theta
         # The angles added are evaluated by the next round's sampling, the
         # others are kept.
-        hot = np.setdiff1d(hot, theta)
+        hot = np.unique(np.asarray(hot, dtype=float))
+        hot = hot[~_members(theta, hot)]
         order = np.argsort(np.concatenate([theta, hot]), kind="stable")
         unknown = np.full(len(hot), np.nan)
         samples = tuple(np.concatenate([a, b])[order] for a, b in
@@ -1951,10 +1995,26 @@ def _new_chords(polylines, owner, position, added):
     for k, (_, _, th) in enumerate(polylines):
         if th is None:
             continue
-        fresh = np.isin(th, added)
+        fresh = _members(added, th)
         mine = np.flatnonzero(owner == k)
         new[mine] = fresh[position[mine]] | fresh[position[mine] + 1]
     return new
+
+
+def _members(sorted_values, x):
+    """``np.isin(x, sorted_values)`` for ``sorted_values`` sorted: a binary search, not a sort."""
+    x = np.asarray(x, dtype=float)
+    if not len(sorted_values):
+        return np.zeros(x.shape, dtype=bool)
+    index = np.minimum(np.searchsorted(sorted_values, x), len(sorted_values) - 1)
+    return sorted_values[index] == x
+
+
+def _sorted_difference(a, b):
+    """``np.setdiff1d(a, b)`` for ``b`` sorted, without sorting an ``a`` already increasing."""
+    if len(a) > 1 and not (a[1:] > a[:-1]).all():
+        return np.setdiff1d(a, b)
+    return a[~_members(b, a)]
 
 
 def _hot_angles(hits, polylines, owner, position):

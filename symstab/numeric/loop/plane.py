@@ -148,7 +148,11 @@ class _PlaneParts:
         return cls(x, y, base, ax, ay, ends, arc, (structured, *slopes))
 
     def decompose(self, box, refine=True):
-        """:func:`~symstab.numeric.engine.decomposition.decompose` in the window ``box``."""
+        """:func:`~symstab.numeric.engine.decomposition.decompose` in the window ``box``.
+
+        Without its segments (:meth:`Decomposition.with_segments` makes them
+        for the window kept).
+        """
         if not all(abs(v) <= LARGEST_COORDINATE for v in box):
             x, y = self.x, self.y
             raise ValueError(
@@ -158,7 +162,7 @@ class _PlaneParts:
                 f"units that keep the plane's numbers smaller")
         return decompose(self.base, self.ax, self.ay, self.ends, x_range=box[:2],
                          y_range=box[2:], names=(self.x, self.y), arc=self.arc,
-                         family=self.family, refine=refine)
+                         family=self.family, refine=refine, segments=False)
 
 
 def boundary(loop, x=None, y=None, n=1000, *, window=None, segments=False, **values):
@@ -270,7 +274,7 @@ def region(loop, x=None, y=None, *, x_range=None, y_range=None, **values):
     # (the answer keeps the plain source, not the values remembered).
     source, plane = plane.arc, dataclasses.replace(plane, arc=RememberedArc(plane.arc))
     found, box = _first_decomposition(plane, given, free, hull)
-    found = _widened(plane, found, box, free, enclosure)
+    found = _widened(plane, found, box, free, enclosure).with_segments()
     return dataclasses.replace(found, hull=hull, arc=source)
 
 
@@ -488,15 +492,41 @@ def _start_windows(plane, hull=None):
         if hull is not None:
             held = hull.holds(px, py)
             px, py = px[held], py[held]
-        family = plane.family
-        codes = classify_polynomials(family[0].combine((px, py), family[1:]), refine=False)
-        candidates.append((px[codes == STABLE], py[codes == STABLE], 0.0))
+        candidates.append((*_stable_extent(plane, px, py), 0.0))
     out = _extent_windows(candidates, enclosure)
     if enclosure is not None:
         out.append(tuple(enclosure))
     else:
         out += [w for w in _curve_windows(plane) if w not in out]
     return out or [((-1.0, 1.0), (-1.0, 1.0))]
+
+
+def _stable_extent(plane, px, py):
+    """The points of ``(px, py)`` that are stable, or fewer with the same extremes in x and y.
+
+    A point strictly inside the box of stable points already found cannot
+    move the box: a quarter of the points (every fourth) is classified
+    first, then only those of the rest on or outside that box.
+    """
+    family = plane.family
+
+    def stable(index):
+        if not len(index):
+            return index
+        codes = classify_polynomials(family[0].combine((px[index], py[index]), family[1:]),
+                                     refine=False)
+        return index[codes == STABLE]
+
+    everything = np.arange(len(px))
+    first = stable(everything[::4])
+    rest = np.setdiff1d(everything, everything[::4])
+    if len(first):
+        x, y = px[first], py[first]
+        outside = ((px[rest] <= x.min()) | (px[rest] >= x.max())
+                   | (py[rest] <= y.min()) | (py[rest] >= y.max()))
+        rest = rest[outside]
+    found = np.sort(np.concatenate([first, stable(rest)]))
+    return px[found], py[found]
 
 
 def _curve_windows(plane):
