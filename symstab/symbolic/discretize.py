@@ -16,6 +16,7 @@ from . import model
 __all__ = [
     "z_transform_by_residues", "written_poles", "zoh_pulse_transfer_function",
     "fractional_zoh_pulse_transfer_function", "fractional_delay_identities", "numeric_zoh",
+    "numeric_fractional_zoh",
     "interval_zoh", "interval_product",
     "pulse_transfer_function",
     "dimensionless_pulse_transfer_function",
@@ -267,36 +268,105 @@ def numeric_zoh(numerator, denominator, T, *, dps=30):
     import mpmath
 
     with mpmath.workdps(dps):
-        den = [mpmath.mpf(c) for c in denominator]
-        num = [mpmath.mpf(c) for c in numerator]
-        while den and den[0] == 0:
-            den.pop(0)
-        n = len(den) - 1
-        if n < 1:
-            raise ValueError("the plant must have at least one pole")
-        num = [c / den[0] for c in num]
-        den = [c / den[0] for c in den]
-        if len(num) > n + 1:
-            if any(c != 0 for c in num[: len(num) - n - 1]):
-                raise ValueError("the plant must be proper (degree of numerator <= degree of denominator)")
-            num = num[len(num) - n - 1:]
-        num = [mpmath.mpf(0)] * (n + 1 - len(num)) + num
-        direct = num[0]
-        rest = [num[k] - direct * den[k] for k in range(1, n + 1)]
-        A = mpmath.zeros(n + 1, n + 1)
-        for j in range(n):
-            A[0, j] = -den[j + 1]
-        for i in range(1, n):
-            A[i, i - 1] = 1
-        A[0, n] = 1
-        E = mpmath.expm(A * T)
-        Phi = E[:n, :n]
-        Gamma = E[:n, n]
-        C = mpmath.matrix([rest])
+        augmented, C, direct, n = _realisation(numerator, denominator)
+        E = mpmath.expm(augmented * T)
+        Phi, Gamma = E[:n, :n], E[:n, n]
         open_loop = _charpoly(Phi)
         shifted = _charpoly(Phi - Gamma * C)
         numerator = [shifted[k] - open_loop[k] + direct * open_loop[k] for k in range(n + 1)]
         return numerator, open_loop
+
+
+def numeric_fractional_zoh(numerator, denominator, T, eps, *, dps=30):
+    """:func:`fractional_zoh_pulse_transfer_function` of a numeric ``G(s)``, by the matrix exponential.
+
+    The hold's output delayed by ``eps T`` inside the period (Åström and
+    Wittenmark, sec. 2.3): ``x[k+1] = Phi x[k] + Gamma0 u[k] + Gamma1 u[k-1]``
+    with ``Gamma0 = int_0^((1 - eps) T) exp(A s) ds B`` and ``Gamma1 = exp(A
+    (1 - eps) T) int_0^(eps T) exp(A s) ds B`` (each from the exponential of
+    the augmented matrix, as :func:`numeric_zoh`), so::
+
+        P_eps(z) = C (z I - Phi)^-1 (Gamma0 + Gamma1 / z)
+                 = (z L0(z) + L1(z)) / (z det(z I - Phi)),
+        Lk(z) = det(z I - Phi + Gammak C) - det(z I - Phi)
+
+    by the matrix determinant lemma, at ``dps`` digits.
+
+    Parameters
+    ----------
+    numerator, denominator : sequence of float
+        ``G(s)``, highest power first, strictly proper.
+    T : float
+        The sample period, > 0.
+    eps : float
+        The fraction of a period, ``0 <= eps < 1``.
+
+    Returns
+    -------
+    (list of mpmath.mpf, list of mpmath.mpf)
+        Numerator and denominator in ``z``, highest power first, both of
+        the plant's order plus one; the denominator is ``z`` times
+        :func:`numeric_zoh`'s.
+
+    Raises
+    ------
+    ValueError
+        For a plant with a direct feedthrough, or ``eps`` outside ``[0, 1)``.
+    """
+    import mpmath
+
+    if not 0 <= eps < 1:
+        raise ValueError(f"eps must be a fraction of a period, 0 <= eps < 1, got {eps!r}")
+    with mpmath.workdps(dps):
+        augmented, C, direct, n = _realisation(numerator, denominator)
+        if direct != 0:
+            raise ValueError("G(s) must be strictly proper for a fractional delay: a direct "
+                             "feedthrough makes the output jump inside the period")
+        late = mpmath.expm(augmented * ((1 - mpmath.mpf(eps)) * T))
+        early = mpmath.expm(augmented * (mpmath.mpf(eps) * T))
+        Phi = mpmath.expm(augmented[:n, :n] * T)
+        gamma0, gamma1 = late[:n, n], late[:n, :n] * early[:n, n]
+        open_loop = _charpoly(Phi)
+        first, second = (_charpoly(Phi - gamma * C) for gamma in (gamma0, gamma1))
+        numerator = [mpmath.mpf(0)] * (n + 2)
+        for k in range(n + 1):
+            numerator[k] += first[k] - open_loop[k]         # z L0(z)
+            numerator[k + 1] += second[k] - open_loop[k]    # L1(z)
+        return numerator, open_loop + [mpmath.mpf(0)]
+
+
+def _realisation(numerator, denominator):
+    """``(augmented, C, D, n)``: ``G(s)`` in controllable canonical form, at the working precision.
+
+    ``augmented = [[A, B], [0, 0]]`` (its exponential times ``t`` holds
+    ``exp(A t)`` and ``int_0^t exp(A s) ds B``), ``C`` a row, ``D`` the
+    direct term, ``n`` the order.
+    """
+    import mpmath
+
+    den = [mpmath.mpf(c) for c in denominator]
+    num = [mpmath.mpf(c) for c in numerator]
+    while den and den[0] == 0:
+        den.pop(0)
+    n = len(den) - 1
+    if n < 1:
+        raise ValueError("the plant must have at least one pole")
+    num = [c / den[0] for c in num]
+    den = [c / den[0] for c in den]
+    if len(num) > n + 1:
+        if any(c != 0 for c in num[: len(num) - n - 1]):
+            raise ValueError("the plant must be proper (degree of numerator <= degree of denominator)")
+        num = num[len(num) - n - 1:]
+    num = [mpmath.mpf(0)] * (n + 1 - len(num)) + num
+    direct = num[0]
+    rest = [num[k] - direct * den[k] for k in range(1, n + 1)]
+    A = mpmath.zeros(n + 1, n + 1)
+    for j in range(n):
+        A[0, j] = -den[j + 1]
+    for i in range(1, n):
+        A[i, i - 1] = 1
+    A[0, n] = 1
+    return A, mpmath.matrix([rest]), direct, n
 
 
 def _interval_expm1(M, n):

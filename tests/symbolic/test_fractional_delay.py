@@ -20,6 +20,8 @@ import sympy as sp
 from symstab.symbolic.discretize import (
     fractional_delay_identities,
     fractional_zoh_pulse_transfer_function,
+    numeric_fractional_zoh,
+    numeric_zoh,
 )
 
 m, b, k, tau, T, eps, s, z = sp.symbols("m b k tau T epsilon s z", positive=True)
@@ -106,3 +108,37 @@ def test_a_broken_fraction_is_caught_by_both_oracles():
 def test_a_plant_with_a_direct_feedthrough_is_refused():
     with pytest.raises(ValueError, match="strictly proper"):
         fractional_zoh_pulse_transfer_function((s + 1) / (s + 2), eps, s=s, z=z, T=T)
+
+
+#: A plant whose poles SymPy does not write (an irreducible cubic): the numeric path.
+CUBIC = (1 / (m * s**3 + b * s**2 + k * s + 1), {m: 1e-4, b: 0.02, k: 3.0})
+
+
+@pytest.mark.parametrize("name", [*PLANTS, "cubic"])
+@pytest.mark.parametrize("fraction", [0.0, 0.5, 0.999])
+def test_the_matrix_exponential_path_is_the_state_space_one(name, fraction):
+    G, values = CUBIC if name == "cubic" else PLANTS[name]
+    num, den = sp.fraction(sp.together(G.subs(values)))
+    num, den = ([float(c) for c in sp.Poly(p, s).all_coeffs()] for p in (num, den))
+    top, bottom = numeric_fractional_zoh(num, den, 1e-3, fraction)
+    points = [np.exp(1j * theta) for theta in (0.01, 0.3, 1.0, 2.5, np.pi)] + [1.7, -0.4 + 0.2j]
+    found = np.array([complex(np.polyval([complex(c) for c in top], p)
+                              / np.polyval([complex(c) for c in bottom], p)) for p in points])
+    expected = state_space_pulse(G, values, 1e-3, fraction, points)
+    np.testing.assert_allclose(found, expected, rtol=1e-9, atol=1e-13 * abs(expected).max())
+
+
+def test_no_fraction_on_the_numeric_path_is_the_integer_plant_times_z_over_z():
+    top, bottom = numeric_fractional_zoh([1.0], [0.0128, 0.0324, 0.0], 1e-3, 0.0)
+    num, den = numeric_zoh([1.0], [0.0128, 0.0324, 0.0], 1e-3)
+    assert top == [*num, 0] and bottom == [*den, 0]
+
+
+@pytest.mark.parametrize("num, den, fraction, needle", [
+    ([1.0, 1.0], [1.0, 2.0], 0.5, "strictly proper"),
+    ([1.0], [1.0, 2.0, 0.0], 1.0, "0 <= eps < 1"),
+    ([1.0], [1.0, 2.0, 0.0], -0.1, "0 <= eps < 1"),
+])
+def test_bad_numeric_fractional_plants_are_refused(num, den, fraction, needle):
+    with pytest.raises(ValueError, match=needle):
+        numeric_fractional_zoh(num, den, 1e-3, fraction)
