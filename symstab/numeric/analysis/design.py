@@ -644,7 +644,8 @@ def design(loop, *, over, maximize="y_max", x=None, y=None, n=None, rtol=None, d
         ``{name: (low, high)}``, one or two parameters outside the plane
         (not ``d``), e.g. ``{"M": (0.0, 0.04)}``.
     maximize : str
-        ``"y_max"`` (the largest stable ``y``, K_max), ``"area"`` (the
+        ``"y_max"`` (the largest stable ``y``, K_max; also the plane's
+        ``y`` by name, ``"K_max"`` in the ``(B, K)`` plane), ``"area"`` (the
         Z-width), ``"passive"`` (the passive K_max) or ``"simulated"``
         (the largest ``y`` whose simulated run neither grows nor ends
         above ``amplitude``).
