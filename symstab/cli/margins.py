@@ -68,10 +68,7 @@ def run(args):
         name = setup.label(p.name)
         rows.append((f"{name} down to", p.low, None, None, f"from {p.value:.6g}"))
         rows.append((f"{name} up to", p.high, None, None, f"from {p.value:.6g}"))
-    d = found.point["d"]
-    note = (f"stable up to d = {d + found.delay_limit}" if found.delay is None
-            else f"unstable at d = {d + found.delay}")
-    rows.append(("delay [samples]", found.delay, None, None, note))
+    rows.append(("delay [samples]", found.delay, None, None, found.delay_note))
     notes = ["L: the open loop VE(z) z^-d P(z), P the plant behind the zero-order hold; "
              "the delay margin is in whole samples (a fractional delay is not derived yet)"]
     if T is None:

@@ -187,10 +187,21 @@ class Margins:
                         f"at {p.name} = {p.value:.6g}"))
         delay = ("none" if self.delay is None else
                  f"{self.delay} samples ({self.delay * self.T:.6g} s)")
-        where = (f"stable up to {self.delay_limit} samples more" if self.delay is None
-                 else f"unstable at d = {self.point['d'] + self.delay}")
-        out.append(("delay margin (whole samples)", delay, where))
+        if self.delay is None and self.delay_limit == 0:
+            delay = "not examined"
+        out.append(("delay margin (whole samples)", delay, self.delay_note))
         return out
+
+    @property
+    def delay_note(self):
+        """What the delay margin says: unstable at which ``d``, or stable up to where examined."""
+        if self.delay is not None:
+            return f"unstable at d = {self.point['d'] + self.delay}"
+        if self.delay_limit == 0:
+            # d is SYMSTAB_MAX_DELAY already: no longer delay is evaluated.
+            return "not examined: d is the largest delay accepted (SYMSTAB_MAX_DELAY)"
+        return (f"stable up to {self.delay_limit} samples more (d = "
+                f"{self.point['d'] + self.delay_limit})")
 
     def __repr__(self):
         width = max(len(r[0]) for r in self.rows())

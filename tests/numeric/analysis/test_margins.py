@@ -271,7 +271,19 @@ def test_no_delay_margin_within_the_limit_is_said():
     loop, point = _loop_and_point("paper.toml", dict(WALL, K=1.0, B=0.05, d=0))
     found = loop.margins(delay_limit=2, **point)
     assert found.delay is None and found.delay_limit == 2
-    assert "stable up to 2 samples more" in repr(found)
+    assert "stable up to 2 samples more (d = 2)" in repr(found)
+
+
+def test_at_the_largest_delay_accepted_the_delay_margin_is_not_examined(monkeypatch):
+    """At d = SYMSTAB_MAX_DELAY no longer delay is evaluated: "stable up to 0 samples more"
+    read as a margin of none; it says the margin was not examined, and why."""
+    monkeypatch.setenv("SYMSTAB_MAX_DELAY", "3")
+    loop, point = _loop_and_point("paper.toml", dict(WALL, K=1.0, B=0.05, d=3))
+    found = loop.margins(**point)
+    assert found.delay is None and found.delay_limit == 0
+    assert found.delay_note == ("not examined: d is the largest delay accepted "
+                                "(SYMSTAB_MAX_DELAY)")
+    assert "not examined" in repr(found)
 
 
 @pytest.mark.parametrize("values, message", [
