@@ -363,15 +363,10 @@ def test_a_delay_margin_map_is_python_control_s_first_unstable_delay_per_point()
     at = dict(m=0.0128, b=0.0324, T=1e-3, M=0.0, d=0)
     found = loop.margin_map(xs, ys, margin="delay", delay_limit=12, **at)
     assert found.delay_limit == 12 and np.isnan(found.values).any()
-    for i, K in enumerate(ys):
-        for j, B in enumerate(xs):
-            point = {**loop.defaults, **at, "B": float(B), "K": float(K)}
-            if np.isnan(found.values[i, j]):
-                assert _radius(_open_loop(loop, point)) >= 1 - 1e-9
-                continue
-            radii = [_radius(_open_loop(loop, {**point, "d": k})) for k in range(1, 13)]
-            first = next((k + 1 for k, r in enumerate(radii) if r >= 1 - 1e-12), math.inf)
-            assert found.values[i, j] == first, (K, B, radii)
+    for i, j, point in _numbered_cells(loop, found, at):
+        radii = [_radius(_open_loop(loop, {**point, "d": k})) for k in range(1, 13)]
+        first = next((k + 1 for k, r in enumerate(radii) if r >= 1 - 1e-12), math.inf)
+        assert found.values[i, j] == first, (point, radii)
 
 
 def test_a_gain_margin_map_is_python_control_s_gain_margin_per_point():
@@ -379,16 +374,23 @@ def test_a_gain_margin_map_is_python_control_s_gain_margin_per_point():
     xs, ys = np.linspace(0.0, 2.0, 5), np.linspace(10.0, 600.0, 4)
     at = dict(m=0.0128, b=0.0324, T=1e-3, M=0.0, d=1)
     found = loop.margin_map(xs, ys, margin="gain", **at)
-    for i, K in enumerate(ys):
-        for j, B in enumerate(xs):
+    for i, j, point in _numbered_cells(loop, found, at):
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            gm = control.stability_margins(_open_loop(loop, point))[0]
+        assert found.values[i, j] == pytest.approx(gm, rel=1e-6), point
+
+
+def _numbered_cells(loop, found, at):
+    """``(i, j, point)`` of each cell of a (B, K) margin map that holds a number; a NaN cell
+    is checked not stable by python-control's closed-loop poles on the way."""
+    for i, K in enumerate(found.y_values):
+        for j, B in enumerate(found.x_values):
             point = {**loop.defaults, **at, "B": float(B), "K": float(K)}
             if np.isnan(found.values[i, j]):
                 assert _radius(_open_loop(loop, point)) >= 1 - 1e-9
                 continue
-            with warnings.catch_warnings():
-                warnings.simplefilter("ignore")
-                gm = control.stability_margins(_open_loop(loop, point))[0]
-            assert found.values[i, j] == pytest.approx(gm, rel=1e-6), (K, B)
+            yield i, j, point
 
 
 def test_a_margin_map_draws_its_contours_under_the_decomposition():
