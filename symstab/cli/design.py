@@ -631,11 +631,12 @@ def _noise_notes(setup, found):
 
 
 def _position_unit(setup):
-    """The loop's position unit: rad where its stiffness is per radian, else m (None: "")."""
+    """The loop's position unit: rad where its stiffness (:func:`force_unit`'s) is per radian,
+    else m; where the force's unit is not known, words saying so."""
     force = force_unit(setup)
     if force is None:
         return "(the loop's position unit)"
-    return "rad" if "rad" in setup.unit(setup.y) else "m"
+    return "rad" if "rad" in force.stiffness else "m"
 
 
 def _failed_notes(found):
