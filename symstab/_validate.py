@@ -11,7 +11,7 @@ import numpy as np
 
 from ._resources import MAX_DELAY_ENV, max_delay
 
-__all__ = ["check_real", "check_count", "check_delay", "check_delay_samples", "check_array",
+__all__ = ["check_real", "check_count", "check_delay", "check_delay_samples", "split_delay", "check_array",
            "check_grid", "check_delta", "check_loop", "check_progress", "DELTA_MAX", "PARAMETER_MAX"]
 
 
@@ -104,6 +104,52 @@ def check_delay_samples(ratio, *, name="Td / T", rtol=1e-9):
             f"{name} must be a non-negative whole number of samples, got {ratio!r}"
         )
     return check_delay(int(k), name=name)
+
+
+#: A delay within this relative distance of a whole number of samples is that
+#: number (``40e-3 / 1e-3`` is 40.00000000000001): the ratio of two floats.
+DELAY_RTOL = 1e-9
+
+
+def split_delay(samples, *, name="d"):
+    """A delay in samples, ``d + eps``, split: ``(d, eps)`` with a whole ``d`` and ``0 <= eps < 1``.
+
+    Parameters
+    ----------
+    samples : float or array_like
+        The delay in samples (``Td / T``), non-negative; arrays must share
+        their whole part.  Within :data:`DELAY_RTOL` of a whole number it
+        is that number.
+    name : str
+        The delay's name in messages (``d``, ``Td / T``).
+
+    Returns
+    -------
+    (int, ndarray or None)
+        The whole samples (at most ``SYMSTAB_MAX_DELAY``) and the fraction
+        of a period per point, None where every point is whole.
+
+    Raises
+    ------
+    TypeError, ValueError
+        Not a real number, negative, not finite, beyond the limit, or
+        points with different whole parts.
+    """
+    x = check_array(name, samples, low=0.0)
+    near = np.round(x)
+    x = np.where(np.abs(x - near) <= DELAY_RTOL * np.maximum(1.0, x), near, x)
+    whole = np.floor(x)
+    if whole.size and np.any(whole != whole.flat[0]):
+        raise ValueError(f"the delay {name} must have one whole number of samples over the points, "
+                         f"got {int(whole.min())} to {int(whole.max())}; ask each whole part "
+                         f"apart")
+    limit = max_delay()
+    d = int(whole.flat[0]) if whole.size else 0
+    if x.size and float(x.max()) > limit:
+        raise ValueError(f"delay {name} must be from 0 to {limit} samples, got "
+                         f"{float(x.max())!r} (raise the limit with {MAX_DELAY_ENV})")
+    eps = x - whole
+    return d, (eps if np.any(eps != 0) else None)
 
 
 def check_array(name, value, *, low=None, low_open=False, high=None):

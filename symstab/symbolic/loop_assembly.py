@@ -35,7 +35,13 @@ from .._memo import SharedStores, method_cache, shared_property
 from .._validate import check_delay
 from . import model
 from .derivation_cache import DerivationCache, cache_dir
-from .discretize import numeric_zoh, written_poles, zoh_pulse_transfer_function
+from .discretize import (
+    fractional_zoh_pulse_transfer_function,
+    numeric_fractional_zoh,
+    numeric_zoh,
+    written_poles,
+    zoh_pulse_transfer_function,
+)
 from .forms import NO_DOCSTRING
 
 __all__ = ["LoopModel", "NonPhysicalPlantWarning", "parse_plant", "parse_environment", "parse_actuator", "parse_expression",
@@ -50,6 +56,9 @@ MAX_EXPRESSION_LENGTH = 2000
 RESERVED = ("s", "z", "T", "d")
 #: Working digits of the plant's pulse transfer function (rounded once to float).
 PLANT_DIGITS = 30
+#: The fraction ``eps`` of a period in a fractional delay ``(d + eps) T``, in the
+#: derivation of the plant that carries it (no parameter's name starts with ``_``).
+FRACTION = sp.Symbol("_eps")
 #: The most digits a plant's closed form is evaluated with (it cancels for a
 #: pole near z = 1; ``LoopModel._closed_form_plant``).
 PLANT_MAX_DIGITS = 5000
@@ -677,10 +686,12 @@ class LoopModel:
         self.parameters = tuple(self.symbols) + ("d",)
         self.defaults = {}
         for key, value in (values or {}).items():
-            if key not in self.parameters:
+            if key not in self.parameters and key != "Td":
                 raise ValueError(f"values: {key!r} is not a parameter of this loop "
-                                 f"(parameters: {', '.join(self.parameters)})")
+                                 f"(parameters: {', '.join(self.parameters)}, or Td for d)")
             self.defaults[key] = value
+        if "d" in self.defaults and "Td" in self.defaults:
+            raise ValueError("values: give the delay once, d (in samples) or Td (in seconds)")
         self.units = {}
         for key, unit in (units or {}).items():
             if key not in self.parameters:
@@ -710,7 +721,7 @@ class LoopModel:
     def _derivation(self):
         """The loop's derivation cached on disk (:mod:`symstab.symbolic.derivation_cache`)."""
         return DerivationCache(self.plant, self.environment,
-                               dict(self.symbols, s=model.s, z=model.z))
+                               dict(self.symbols, s=model.s, z=model.z, _eps=FRACTION))
 
     def _derived(self, name, derive, agrees=None):
         """``derive()``, or what an earlier derivation of this loop stored under ``name``.
@@ -808,6 +819,55 @@ class LoopModel:
             return poly_coeffs(num, model.z), poly_coeffs(den, model.z)
 
         return self._derived("plant_parts", derive, self._pulse_agrees)
+
+    @shared_property
+    def _fractional_plant_parts(self):
+        """``(N_eps, z P_d)``: the plant with a fraction ``eps`` of a period of delay, or None.
+
+        Coefficient lists in ``z`` (symbolic, highest power first) of the
+        modified z-transform
+        (:func:`~symstab.symbolic.discretize.fractional_zoh_pulse_transfer_function`)
+        over the denominator of :attr:`_plant_parts` times ``z``, with
+        :data:`FRACTION` for ``eps``: ``P_eps = N_eps / (z P_d)``, so that a
+        loop delay of ``(d + eps) T`` has ``chi = z**d (z P_d) Ve_d + N_eps
+        Ve_n``, the integer-delay form of this plant.  None for the numeric
+        path (:func:`~symstab.symbolic.discretize.numeric_fractional_zoh`
+        gives the same at numbers).
+        """
+        if self._plant_parts is None:
+            return None
+
+        def derive():
+            z = model.z
+            den = list(self._plant_parts[1]) + [sp.Integer(0)]
+            pulse = fractional_zoh_pulse_transfer_function(self.plant, FRACTION)
+            num = sp.cancel(pulse * sp.Add(*[c * z**k for k, c in enumerate(reversed(den))]))
+            if not num.is_polynomial(z):
+                raise ValueError(f"the fractional delay's pulse transfer function of {self.plant} "
+                                 f"does not share the denominator of its integer-delay one")
+            return poly_coeffs(num, z), den
+
+        return self._derived("fractional_plant_parts", derive, self._fractional_agrees)
+
+    def _fractional_agrees(self, parts):
+        """Whether ``(N_eps, z P_d)`` give the matrix exponential's ``P_eps`` at the check point."""
+        point = {**self._check_point, FRACTION: sp.Float("0.3183098861837907", PLANT_DIGITS)}
+        num, den = sp.fraction(sp.together(self.plant.xreplace(point)))
+        with mpmath.workdps(PLANT_DIGITS):
+            num, den = ([mpmath.mpf(sp.Float(c, PLANT_DIGITS)) for c in sp.Poly(p, model.s).all_coeffs()]
+                        for p in (num, den))
+            p_n, p_d = numeric_fractional_zoh(num, den, mpmath.mpf(point[model.T]),
+                                              mpmath.mpf(point[FRACTION]), dps=PLANT_DIGITS)
+            z0 = mpmath.mpc(self._CHECK_Z.real, self._CHECK_Z.imag)
+            expected = complex(mpmath.polyval(p_n, z0) / mpmath.polyval(p_d, z0))
+
+        def at(coefficients):
+            total = 0j
+            for c in coefficients:
+                total = total * self._CHECK_Z + complex(sp.N(c.xreplace(point), PLANT_DIGITS))
+            return total
+
+        return self._close(at(parts[0]) / at(parts[1]), expected)
 
     def pulse_transfer_function(self):
         """``Z[ZOH G](z)`` as a SymPy rational function of ``z``.
@@ -981,10 +1041,10 @@ class LoopModel:
                              f"characteristic polynomial jointly affinely (a product of the two "
                              f"appears)")
 
-    def _numeric_plant(self, plant_values, T):
+    def _numeric_plant(self, plant_values, T, eps=0.0):
         plant_values = tuple(plant_values)
         self._warn_if_not_physical(plant_values, T)
-        return self._plant_cache(plant_values, T)
+        return self._plant_cache(plant_values, T, float(eps))
 
     @method_cache(maxsize=4096)
     def _warn_if_not_physical(self, plant_values, T):
@@ -1004,8 +1064,14 @@ class LoopModel:
         num, den = self._plant_parts
         return self._plant_function([list(num), list(den)])
 
-    def _plant_function(self, exprs):
-        """An mpmath function of (plant values..., T) giving ``exprs``.
+    @shared_property
+    def _fractional_plant_functions(self):
+        """mpmath function of (plant values..., T, eps) giving N_eps and z P_d (symbolic path)."""
+        num, den = self._fractional_plant_parts
+        return self._plant_function([list(num), list(den)], fraction=True)
+
+    def _plant_function(self, exprs, fraction=False):
+        """An mpmath function of (plant values..., T) giving ``exprs`` (``..., T, eps)`` with ``fraction``).
 
         The arguments are renamed ``_plant0``, ``_plant1``, ...: a parameter
         named like an mpmath name (``e``, ``exp``) would otherwise shadow it
@@ -1018,14 +1084,19 @@ class LoopModel:
         caller as the last argument.
         """
         names = [self.symbols[n] for n in self.plant_names]
-        args = [sp.Symbol(f"_plant{i}") for i in range(len(self.plant_names) + 1)]
+        args = [sp.Symbol(f"_plant{i}") for i in range(len(self.plant_names) + 1 + fraction)]
         rename = dict(zip(names, args, strict=False))
-        rename.setdefault(model.T, args[-1])
+        rename.setdefault(model.T, args[len(names)])
+        if fraction:
+            rename[FRACTION] = args[-1]
         exprs = [[sp.sympify(c).xreplace(rename) for c in part] for part in exprs]
         return sp.lambdify(args, exprs, modules="mpmath", **NO_DOCSTRING)
 
-    def _closed_form_plant(self, point, T):
+    def _closed_form_plant(self, point, T, eps=None):
         """P_n, P_d of the derived closed form at ``point``, to :data:`PLANT_DIGITS` digits.
+
+        With a fraction ``eps`` of a period of delay, ``N_eps`` and ``z P_d``
+        of :attr:`_fractional_plant_parts` instead, the same way.
 
         The closed form cancels: ``1/(m s**2 + b s)`` has ``(exp(-b T/m) - 1
         + b T/m) m / b**2``, whose leading terms' difference loses ``2
@@ -1053,7 +1124,8 @@ class LoopModel:
         while digits <= PLANT_MAX_DIGITS:
             with mpmath.workdps(digits):
                 try:
-                    parts = self._plant_functions(*point, T)
+                    parts = (self._plant_functions(*point, T) if eps is None else
+                             self._fractional_plant_functions(*point, T, mpmath.mpf(eps)))
                 except ZeroDivisionError:
                     return [mpmath.nan], [mpmath.mpf(0)], digits
                 parts = [[mpmath.mpmathify(c) for c in part] for part in parts]
@@ -1272,15 +1344,20 @@ class LoopModel:
                 f"those of that plant")
 
     @method_cache(maxsize=4096, shared=True)
-    def _plant_digits(self, plant_values, T):
+    def _plant_digits(self, plant_values, T, eps=0.0):
         """``(P_n, P_d, digits)``: the pulse transfer function's coefficients as mpmath numbers.
 
         At :data:`PLANT_DIGITS` digits, or more where the closed form needs
         them (:meth:`_closed_form_plant`); refused where it is not defined.
         (A plant that is not a physical device's at these values is warned
         of by :meth:`_numeric_plant` and :meth:`_exact_plant`, the entries.)
+        With a fraction ``0 < eps < 1`` of a period of delay, ``(N_eps, z
+        P_d)`` of the modified z-transform instead
+        (:attr:`_fractional_plant_parts`, or :func:`numeric_fractional_zoh`):
+        the loop's ``chi`` is then that plant's with the whole samples ``d``.
         """
         digits = PLANT_DIGITS
+        fraction = None if eps == 0 else eps
         with mpmath.workdps(PLANT_DIGITS):
             point = [mpmath.mpf(float(v)) for v in plant_values]
             if self._plant_parts is None:
@@ -1289,14 +1366,18 @@ class LoopModel:
                 num, den = sp.fraction(sp.together(self.plant.subs(sub)))
                 num = [mpmath.mpf(sp.Float(c, PLANT_DIGITS)) for c in sp.Poly(num, model.s).all_coeffs()]
                 den = [mpmath.mpf(sp.Float(c, PLANT_DIGITS)) for c in sp.Poly(den, model.s).all_coeffs()]
-                p_n, p_d = numeric_zoh(num, den, mpmath.mpf(float(T)), dps=PLANT_DIGITS)
+                if fraction is None:
+                    p_n, p_d = numeric_zoh(num, den, mpmath.mpf(float(T)), dps=PLANT_DIGITS)
+                else:
+                    p_n, p_d = numeric_fractional_zoh(num, den, mpmath.mpf(float(T)), fraction,
+                                                      dps=PLANT_DIGITS)
             else:
-                p_n, p_d, digits = self._closed_form_plant(point, mpmath.mpf(float(T)))
+                p_n, p_d, digits = self._closed_form_plant(point, mpmath.mpf(float(T)), fraction)
                 if not _defined(p_n, p_d):
                     # The closed form divides by a parameter at 0 (b = 0 in
                     # 1/(m s**2 + b s)) or poles meet: the realisation is its limit.
                     digits = PLANT_DIGITS
-                    p_n, p_d = self._realised_plant(plant_values, T)
+                    p_n, p_d = self._realised_plant(plant_values, T, fraction)
         with mpmath.workdps(digits):
             if not _defined(p_n, p_d):
                 if self._plant_parts is not None:
@@ -1308,8 +1389,11 @@ class LoopModel:
                                  f"vanishes there, or a value is not finite)")
         return p_n, p_d, digits
 
-    def _realised_plant(self, plant_values, T):
+    def _realised_plant(self, plant_values, T, eps=None):
         """P_n, P_d of the plant at ``plant_values`` by :func:`numeric_zoh` (its realisation).
+
+        With a fraction ``eps`` of a period of delay, ``(N_eps, z P_d)`` by
+        :func:`numeric_fractional_zoh` (and the closed form's lengths of those).
 
         From the plant as SymPy cancels it (:attr:`_plant_fraction`, the
         form the closed form is derived from), so a factor written on both
@@ -1327,19 +1411,27 @@ class LoopModel:
                 return undefined
             while len(num) > 1 and num[0] == 0:
                 num.pop(0)
-            p_n, p_d = numeric_zoh(num, den, mpmath.mpf(float(T)), dps=PLANT_DIGITS)
+            if eps is None:
+                p_n, p_d = numeric_zoh(num, den, mpmath.mpf(float(T)), dps=PLANT_DIGITS)
+            else:
+                p_n, p_d = numeric_fractional_zoh(num, den, mpmath.mpf(float(T)), eps,
+                                                  dps=PLANT_DIGITS)
             if self._plant_parts is not None:
-                length = len(self._plant_parts[0])
+                parts = self._plant_parts if eps is None else self._fractional_plant_parts
+                length = len(parts[0])
                 scale = max(abs(c) for c in p_n)
                 while len(p_n) > length and abs(p_n[0]) <= mpmath.mpf(10) ** -PLANT_DIGITS * scale:
                     p_n = p_n[1:]
                 p_n = [mpmath.mpf(0)] * (length - len(p_n)) + list(p_n)
-                if len(p_n) != length or len(p_d) != len(self._plant_parts[1]):
+                if len(p_n) != length or len(p_d) != len(parts[1]):
                     return undefined
             return list(p_n), list(p_d)
 
-    def _exact_plant(self, plant_values, T):
+    def _exact_plant(self, plant_values, T, eps=0.0):
         """``(P_n, P_d)`` with monic ``P_d``, as exact Fractions of their 30-digit values.
+
+        With a fraction ``eps`` of a period of delay, ``(N_eps, z P_d)``
+        (:meth:`_plant_digits`).
 
         For the arc's brackets (:class:`symstab.numeric.engine.arcs.CramerArc`):
         rounded to doubles, the coefficients of a plant with a zero or a
@@ -1347,13 +1439,13 @@ class LoopModel:
         """
         plant_values = tuple(plant_values)
         self._warn_if_not_physical(plant_values, T)
-        p_n, p_d, digits = self._plant_digits(plant_values, T)
+        p_n, p_d, digits = self._plant_digits(plant_values, T, float(eps))
         with mpmath.workdps(digits):
             lead = p_d[0]
             return tuple(tuple(_fraction(c / lead) for c in part) for part in (p_n, p_d))
 
     @method_cache(maxsize=4096, shared=True)
-    def _plant_cache(self, plant_values, T):
+    def _plant_cache(self, plant_values, T, eps=0.0):
         """(P_n, P_d, ends, P_d in z - 1) as float arrays, monic P_d, evaluated at 30 digits.
 
         ``ends`` is ``(P_n(1), P_d(1), P_n(-1), P_d(-1))``, summed at 30
@@ -1366,7 +1458,7 @@ class LoopModel:
         needed more digits (:meth:`_closed_form_plant`), all of this is done
         at those: a pole ``exp(-1e-30)`` keeps its ``1e-30`` after the shift.
         """
-        p_n, p_d, digits = self._plant_digits(tuple(plant_values), T)
+        p_n, p_d, digits = self._plant_digits(tuple(plant_values), T, eps)
         with mpmath.workdps(digits):
             lead = p_d[0]
             ends = [sum(c * sign**k for k, c in enumerate(reversed(part)))

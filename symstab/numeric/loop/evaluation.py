@@ -29,14 +29,21 @@ import sympy as sp
 
 from ..._memo import method_cache
 from ..._resources import check_memory
-from ..._validate import check_array, check_delay
+from ..._validate import check_array, split_delay
+from ...symbolic.loop_assembly import FRACTION as FRACTION_SYMBOL
 from ...symbolic.loop_assembly import PLANT_DIGITS, shift_to_one
 from ..engine import roots
 from ..engine.arcs import END_ANGLE, EXACT_TERMS, ClosedFormArc, CramerArc, ExactPolynomial
 from ..engine.polynomial import DelayedPolynomial
 
-__all__ = ["LoopEvaluation", "finite", "spectral_radius", "classify", "is_stable",
+__all__ = ["LoopEvaluation", "FRACTION", "finite", "spectral_radius", "classify", "is_stable",
            "unstable_root_counts", "difference_equations", "difference_parts", "closed_loop"]
+
+
+#: The key of :meth:`LoopEvaluation.prepare`'s values that holds the fraction
+#: ``eps`` of a period of a fractional delay ``(d + eps) T`` (no parameter's name:
+#: those are ASCII).  The plant carries it: ``P_eps = N_eps / (z P_d)``.
+FRACTION = "ε"
 
 
 def _exact_product(a, b):
@@ -122,13 +129,15 @@ class LoopEvaluation:
     loop : symstab.Loop
         The loop (its public parameters, symbols and names).
     plant : callable
-        ``plant(plant_values, T)``: ``(P_n, P_d, ends, P_d in z - 1)`` as
-        float arrays, monic ``P_d``, evaluated at 30 digits.
+        ``plant(plant_values, T, eps)``: ``(P_n, P_d, ends, P_d in z - 1)`` as
+        float arrays, monic ``P_d``, evaluated at 30 digits; with a fraction
+        ``eps > 0`` of a period of delay, ``(N_eps, z P_d, ...)``.
     exact_plant : callable
-        ``exact_plant(plant_values, T)``: ``(P_n, P_d)`` as exact Fractions.
+        ``exact_plant(plant_values, T, eps)``: ``(P_n, P_d)`` as exact Fractions.
     plant_parts : callable
-        ``plant_parts()``: the symbolic coefficients of ``P_n`` and ``P_d``
-        (not normalised).
+        ``plant_parts(fraction)``: the symbolic coefficients of ``P_n`` and
+        ``P_d`` (not normalised), or with ``fraction`` of ``N_eps`` and ``z
+        P_d`` in ``FRACTION``'s symbol.
     kernels : callable
         ``kernels()``: ``(module, names, n_num, n_den)`` of the loop's
         generated NumPy module.
@@ -141,7 +150,7 @@ class LoopEvaluation:
     def __init__(self, loop, *, plant, exact_plant, plant_parts, kernels, closed_polynomial=None,
                  closed_arc=None):
         self.loop = loop
-        self._plant = plant
+        self._plant_at = plant
         self._exact_plant = exact_plant
         self._plant_parts = plant_parts
         self._kernels = kernels
@@ -150,16 +159,24 @@ class LoopEvaluation:
 
     def _values(self, given, *, scalar=(), drop=()):
         loop = self.loop
-        unknown = set(given) - set(loop.parameters)
+        unknown = set(given) - set(loop.parameters) - {"Td", FRACTION}
         if unknown:
             raise TypeError(f"unknown parameter(s) {', '.join(sorted(unknown))}; "
-                            f"parameters of this loop: {', '.join(loop.parameters)}")
+                            f"parameters of this loop: {', '.join(loop.parameters)} (or Td "
+                            f"for d)")
+        if "Td" in given and "d" in given:
+            raise TypeError("give the delay once: d (in samples) or Td (in seconds), not both")
         values = dict(loop.defaults)
         values.update(given)
-        missing = [n for n in loop.parameters if n not in values and n not in drop]
+        # The delay given wins over the default's other form.
+        seconds = values.pop("Td", None) if "d" not in given else None
+        if "Td" in given or seconds is not None:
+            values.pop("d", None)
+        values.pop("Td", None)
+        missing = [n for n in loop.parameters if n not in values and n not in drop
+                   and not (n == "d" and seconds is not None)]
         if missing:
             raise TypeError(f"missing value(s) for {', '.join(missing)}")
-        d = check_delay(values.pop("d"))
         out = {}
         for name in loop.symbols:
             if name in drop:
@@ -171,7 +188,33 @@ class LoopEvaluation:
             if name in scalar and out[name].ndim:
                 raise ValueError(f"{name} must be a single value here, got an array of "
                                  f"shape {out[name].shape}")
+        d, eps = self._delay(values, seconds, out, drop)
+        if eps is not None:
+            if "d" in scalar and eps.ndim:
+                raise ValueError(f"the delay must be a single value here, got an array of "
+                                 f"shape {eps.shape}")
+            out[FRACTION] = eps
         return out, d
+
+    @staticmethod
+    def _delay(values, seconds, out, drop):
+        """``(d, eps)``: the delay's whole samples and fraction (None: whole) of a call's values."""
+        if seconds is None:
+            d, eps = split_delay(values.pop("d"), name="d")
+            if FRACTION in values:
+                # Passed on by this class's callers with the whole d: the fraction as it was.
+                if eps is not None:
+                    raise ValueError("a whole d is needed with a fraction given apart")
+                eps = check_array("the delay's fraction", values.pop(FRACTION), low=0.0,
+                                  high=1.0)
+                eps = eps if np.any(eps != 0) else None
+            return d, eps
+        if "T" in drop:
+            raise ValueError("Td (seconds) needs the sample period's value: with T on an axis, "
+                             "give the delay in samples, d")
+        with np.errstate(all="ignore"):
+            samples = check_array("Td", seconds, low=0.0) / out["T"]
+        return split_delay(samples, name="Td / T")
 
     def prepare(self, given, scalar=(), drop=()):
         """The values of a call checked: ``(values, d, shape)``.
@@ -198,9 +241,19 @@ class LoopEvaluation:
             raise ValueError(f"parameter arrays must broadcast together: {exc}") from None
         return values, d, shape
 
+    def _plant_names(self, values):
+        """The names of a point's plant: its parameters, ``T`` and the delay's fraction if it has one."""
+        return self.loop.plant_names + ("T",) + ((FRACTION,) if FRACTION in values else ())
+
+    def _plant(self, row, values):
+        """:meth:`plant_arrays` of one point's plant (a row in the order of :meth:`_plant_names`)."""
+        n = len(self.loop.plant_names)
+        eps = float(row[n + 1]) if FRACTION in values else 0.0
+        return self._plant_at(tuple(float(v) for v in row[:n]), float(row[n]), eps)
+
     def _plant_rows(self, values, shape):
-        """The distinct rows of the plant's values and ``T``, and each point's row."""
-        names = self.loop.plant_names + ("T",)
+        """The distinct rows of the plant's values and ``T`` (and ``eps``), and each point's row."""
+        names = self._plant_names(values)
         columns = np.stack([np.broadcast_to(values[n], shape).ravel() for n in names], axis=-1)
         return np.unique(columns, axis=0, return_inverse=True)
 
@@ -213,13 +266,13 @@ class LoopEvaluation:
         -------
         tuple of ndarray
         """
-        names = self.loop.plant_names + ("T",)
+        names = self._plant_names(values)
         if all(np.ndim(values[n]) == 0 for n in names):
             # One plant for every point: the common case of a plane sweep.
-            parts = self._plant(tuple(float(values[n]) for n in names[:-1]), float(values["T"]))
+            parts = self._plant([values[n] for n in names], values)
             return tuple(np.broadcast_to(part, shape + part.shape) for part in parts)
         unique, inverse = self._plant_rows(values, shape)
-        parts = [self._plant(tuple(row[:-1]), float(row[-1])) for row in unique]
+        parts = [self._plant(row, values) for row in unique]
         out = []
         for k in range(4):
             part = np.array([p[k] for p in parts])[inverse.ravel()]
@@ -312,17 +365,19 @@ class LoopEvaluation:
         # affine dependence rational; so differentiate the unnormalised
         # coefficients, scaled by the same leading coefficient (constant in
         # ``name`` when the loop is affine in it, checked by _check_plane).
-        num, den = self._plant_parts()
+        fraction = FRACTION in values
+        num, den = self._plant_parts(fraction)
         symbols = self.loop.symbols
         symbol = symbols[name]
         if sp.diff(den[0], symbol) != 0:
             raise ValueError(f"parameter {name!r} scales the plant's denominator; use it as a "
                              f"fixed value")
-        names = self.loop.plant_names + ("T",)
+        names = self._plant_names(values)
         unique, inverse = self._plant_rows(values, shape)
         rows = []
         for row in unique:
-            sub = {symbols[n]: sp.Float(repr(float(v)), PLANT_DIGITS)
+            sub = {(FRACTION_SYMBOL if n == FRACTION else symbols[n]): sp.Float(repr(float(v)),
+                                                                                 PLANT_DIGITS)
                    for n, v in zip(names, row, strict=True)}
             lead = den[0].subs(sub).evalf(PLANT_DIGITS)
             rows.append(([float(sp.diff(c, symbol).subs(sub).evalf(PLANT_DIGITS) / lead) for c in num],
@@ -356,6 +411,9 @@ class LoopEvaluation:
         if self._closed_polynomial is None:
             return self.polynomial(given)
         values, d, shape = self.prepare(given)
+        if FRACTION in values:
+            # The closed form is the integer-delay loop's.
+            return self.polynomial(given)
         check_memory("the loop's polynomial", 8 * int(np.prod(shape)) * 64)
         # As given (a single value stays one): the closed form broadcasts.
         return self._closed_polynomial(values, d)
@@ -391,6 +449,8 @@ class LoopEvaluation:
         """
         if self._closed_arc is None or x is None:
             return None
+        if FRACTION in self.prepare(values, drop=(x, y))[0]:
+            return None     # the closed form is the integer-delay loop's
         return self._closed_arc(x, y, {**self.loop.defaults, **values})
 
     def arc_source(self, x, y, values, parts):
@@ -461,7 +521,7 @@ class LoopEvaluation:
         for name in names:
             values[name] = np.asarray(0.0)
         p_n, p_d = self._exact_plant(tuple(float(values[n]) for n in loop.plant_names),
-                                     float(values["T"]))
+                                     float(values["T"]), float(values.get(FRACTION, 0.0)))
         k = loop.environment_delay
         out = []
         for slope in (None, *names):
@@ -531,6 +591,9 @@ class LoopEvaluation:
             The spaces and each point's index into them.
         """
         values, _, shape = self.prepare(given)
+        if FRACTION in values:
+            raise ValueError("Coulomb friction and start='state' are simulated with a whole "
+                             "number of samples of delay only: give d a whole number")
         unique, inverse = self._plant_rows(values, shape)
         spaces = [self._friction_space(tuple(float(v) for v in row[:-1]), float(row[-1]), substeps,
                                        build, digits)

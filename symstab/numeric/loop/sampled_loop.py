@@ -167,7 +167,8 @@ class Loop(LoopModel):
         self._closed_polynomial = polynomial
         self.evaluation = LoopEvaluation(
             self, plant=self._numeric_plant, exact_plant=self._exact_plant,
-            plant_parts=lambda: self._plant_parts, kernels=lambda: self._kernels,
+            plant_parts=lambda fraction=False: (self._fractional_plant_parts if fraction
+                                                else self._plant_parts), kernels=lambda: self._kernels,
             closed_polynomial=polynomial, closed_arc=arc)
         if self.units:
             self._check_units()

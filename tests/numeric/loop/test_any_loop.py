@@ -525,8 +525,10 @@ def test_bad_calls_name_the_parameter(paper_loop):
         paper_loop.classify(K=1.0, B=0.1, M=0.0, Q=1.0, d=0, **DEVICE)
     with pytest.raises(ValueError, match="T must be"):
         paper_loop.classify(K=1.0, B=0.1, M=0.0, d=0, m=PAPER_M, b=PAPER_B, T=-1.0)
-    with pytest.raises(ValueError, match="delay d"):
-        paper_loop.classify(K=1.0, B=0.1, M=0.0, d=1.5, **DEVICE)
+    with pytest.raises(ValueError, match="d must be"):
+        paper_loop.classify(K=1.0, B=0.1, M=0.0, d=-1.5, **DEVICE)
+    with pytest.raises(TypeError, match="delay once"):
+        paper_loop.classify(K=1.0, B=0.1, M=0.0, d=1, Td=1e-3, **DEVICE)
     with pytest.raises(ValueError, match="'m' does not enter .* affinely"):
         paper_loop.stable_intervals("m", K=1.0, B=0.1, M=0.0, d=0, b=PAPER_B, T=PAPER_T)
     with pytest.raises(ValueError, match="'m' does not enter .* affinely"):
