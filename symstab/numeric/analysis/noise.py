@@ -12,10 +12,8 @@ the force through the closed loop::
 
 on the unit circle (``chi`` the loop's characteristic polynomial), and its
 RMS is ``sigma_F = (q / sqrt(12)) ||Ve_n P_d / chi||_2``.  The H2 norm is
-exact: ``sum h[k]**2 = D**2 + C P C^T`` with ``P`` the controllability
-Gramian of a state-space realisation, ``P = A P A^T + B B^T`` (a discrete
-Lyapunov equation, :func:`scipy.linalg.solve_discrete_lyapunov`), not a
-truncated impulse response.  Beside it, the environment's own ``||VE||_2``
+exact, not a truncated impulse response: ``sum h[k]**2`` by Åström's
+recursion on the coefficients (:func:`h2_norm`).  Beside it, the environment's own ``||VE||_2``
 (what the same noise would give with the device held still: the open loop),
 infinite for an environment with a pole on the unit circle.
 
@@ -80,6 +78,18 @@ H2_MAX_DEGREE = 2000
 def h2_norm(num, den, *, stable=False):
     """``sqrt(sum h[k]**2)`` of a stable, proper discrete transfer function ``num / den``.
 
+    By Åström's recursion for the integral of ``|num / den|**2`` on the unit
+    circle (K. J. Åström, E. I. Jury and R. G. Agniel, "A numerical method
+    for the evaluation of complex integrals", IEEE Trans. Automatic Control
+    15(4), 1970; Åström, *Introduction to Stochastic Control Theory*, 1970,
+    ch. 5): the Schur-Cohn reduction of ``den`` carries ``num`` along, and
+    the sum of squares is ``sum_k beta_k b_k / a_0`` over its steps.  It
+    works on the coefficients themselves, in O(n**2): a Lyapunov equation on
+    the companion form of a loop's ``chi``, whose roots crowd next to
+    ``z = 1``, lost seven digits where this loses none (the lowpass loop's
+    closed-loop gain: 1e-7 against mpmath's 40-digit impulse response, this
+    1e-13).
+
     Parameters
     ----------
     num, den : array_like
@@ -91,8 +101,8 @@ def h2_norm(num, den, *, stable=False):
     Returns
     -------
     float
-        Exact up to rounding (a discrete Lyapunov equation); inf where
-        ``den`` has a root on or outside the unit circle.
+        Exact up to rounding; inf where ``den`` has a root on or outside the
+        unit circle.
 
     Raises
     ------
@@ -105,9 +115,6 @@ def h2_norm(num, den, *, stable=False):
     >>> round(h2_norm([1.0, 0.0], [1.0, -0.5]), 12)   # h[k] = 0.5**k: sum 1 / (1 - 0.25)
     1.154700538379
     """
-    import scipy.linalg
-    import scipy.signal
-
     num, den = np.trim_zeros(np.asarray(num, float), "f"), np.trim_zeros(np.asarray(den, float), "f")
     if len(num) > len(den):
         raise ValueError("h2_norm needs a proper transfer function (deg num <= deg den)")
@@ -115,14 +122,23 @@ def h2_norm(num, den, *, stable=False):
         return abs(float(num[-1] / den[0])) if len(num) else 0.0
     if len(den) - 1 > H2_MAX_DEGREE:
         raise ValueError(f"the H2 norm of degree {len(den) - 1} is beyond {H2_MAX_DEGREE} (its "
-                         f"Lyapunov equation is O(n**3): minutes and gigabytes): use a shorter "
-                         f"delay")
-    check_memory(f"the H2 norm of degree {len(den) - 1}", 64 * (len(den) - 1) ** 2)
+                         f"recursion is O(n**2) in Python steps of O(n)): use a shorter delay")
+    check_memory(f"the H2 norm of degree {len(den) - 1}", 64 * len(den))
     if not stable and np.max(np.abs(np.roots(den))) >= 1:
         return math.inf
-    A, B, C, D = scipy.signal.tf2ss(num, den)
-    gramian = scipy.linalg.solve_discrete_lyapunov(A, B @ B.T)
-    return float(math.sqrt(max(0.0, (C @ gramian @ C.T + D @ D.T).item())))
+    a = den / den[0]
+    b = np.concatenate([np.zeros(len(a) - len(num)), num / den[0]])
+    total = 0.0
+    for k in range(len(a) - 1, 0, -1):
+        alpha, beta = a[k] / a[0], b[k] / a[0]
+        total += beta * b[k]
+        reflected = a[k:0:-1]
+        a, b = a[:k] - alpha * reflected, b[:k] - beta * reflected
+        if not a[0] > 0:
+            # The Schur-Cohn test fails: a root on or outside the circle after all.
+            return math.inf
+    total += b[0] * b[0] / a[0]
+    return float(math.sqrt(max(0.0, total)))
 
 
 def force_noise(loop, *, encoder_resolution, **values):
