@@ -23,13 +23,17 @@ of ``1 + L``.  :func:`margins` (:meth:`symstab.Loop.margins`) gives, at one stab
 * the **parameter margins**: for each parameter named, the stable interval
   through the point along that parameter, the others fixed
   (:meth:`symstab.Loop.stable_intervals`), as distances and as factors;
+* the **delay margin**, exact: the smallest added delay, in samples
+  (fractional), at which a root reaches the circle, with that crossing's
+  frequency (:func:`symstab.numeric.analysis.delays.delay_margin`, from
+  the fractional-delay derivation);
 * the **delay margin** in whole samples: the smallest number of samples
   ``k`` added to ``d`` at which the loop is no longer stable: the certified
   verdict of :meth:`symstab.Loop.classify` at ``d + k``, from the first
   ``k`` at which a root can have reached the circle (a gain crossover's
   phase margin used up by the delay's phase, ``k theta_c``; from 1 where
-  ``|L(-1)| >= 1``) up to ``delay_limit``.  A delay between whole samples needs the fractional-delay
-  derivation, which symstab does not have yet.
+  ``|L(-1)| >= 1``) up to ``delay_limit``: what a controller that adds
+  whole samples of computation can afford.
 
 The phase crossovers are found by sign changes of ``Im(N conj(D) z**-s)``
 on a grid of 32 points per period of its highest harmonic, each refined
@@ -49,6 +53,7 @@ from ..engine.polynomial import horner
 from ..engine.results import html_table
 from ..engine.roots import MARGINAL, STABLE, circle_minimum
 from ..engine.search import bracketed_root
+from ..loop.evaluation import FRACTION
 
 __all__ = ["NyquistCrossing", "ParameterMargin", "Margins", "margins", "MarginMap", "margin_map"]
 
@@ -143,6 +148,9 @@ class Margins:
         ``delay_limit`` samples more).
     delay_limit : int
         The added delays examined, 1 to ``delay_limit``.
+    exact_delay : symstab.numeric.analysis.delays.DelayMargin or None
+        The exact delay margin (its first switch) and its crossing
+        frequency, up to ``delay_limit`` samples more.
     """
 
     point: dict
@@ -156,6 +164,7 @@ class Margins:
     parameters: tuple
     delay: object
     delay_limit: int
+    exact_delay: object = None
 
     @property
     def gain_margin(self):
@@ -190,6 +199,12 @@ class Margins:
         if self.delay is None and self.delay_limit == 0:
             delay = "not examined"
         out.append(("delay margin (whole samples)", delay, self.delay_note))
+        if self.exact_delay is not None and self.exact_delay.margin is not None:
+            found = self.exact_delay.switches[0]
+            out.append(("delay margin (exact)",
+                        f"{found.added:.9g} samples ({found.added_seconds:.6g} s)",
+                        f"a root on the circle at d = {found.samples:.9g}, "
+                        f"{found.frequency:.6g} Hz"))
         return out
 
     @property
@@ -224,6 +239,7 @@ class Margins:
             "parameters": [dataclasses.asdict(p) for p in self.parameters],
             "delay": self.delay, "delay_seconds": self.delay_seconds,
             "delay_limit": self.delay_limit,
+            "exact_delay": None if self.exact_delay is None else self.exact_delay.as_dict(),
         }
 
 
@@ -271,13 +287,15 @@ def margins(loop, *, parameters=None, delay_limit=None, rtol=1e-9, **values):
     >>> round(found.modulus, 6), round(found.modulus_frequency, 3)
     (0.739598, 19.022)
     """
+    from .delays import delay_margin  # it asks this module's questions in turn
+
     point = stable_point(loop, values)
     chi = loop.polynomial(**point)
     T = float(point["T"])
     lower, upper, theta = (float(x) for x in circle_minimum(chi, rtol=check_real(
         "rtol", rtol, low=0.0, low_open=True, high=0.5, high_open=True)))
     delayed, direct = chi.delayed.reshape(-1), chi.direct.reshape(-1)
-    limit = _delay_limit(point["d"], delay_limit)
+    limit = delay_limit_of(point["d"], delay_limit)
     phase = _phase_crossings(delayed, direct, chi.shift, T)
     return Margins(
         point=point, T=T, modulus=upper, modulus_lower=lower, modulus_theta=theta,
@@ -287,7 +305,8 @@ def margins(loop, *, parameters=None, delay_limit=None, rtol=1e-9, **values):
         parameters=tuple(_parameter_margin(loop, name, point)
                          for name in _margin_parameters(loop, parameters)),
         delay=_delay_margin(loop, point, limit, _first_delay(phase, delayed, direct)),
-        delay_limit=limit)
+        delay_limit=limit,
+        exact_delay=delay_margin(loop, limit=limit, every=False, **point) if limit else None)
 
 
 def classified_point(loop, values):
@@ -310,7 +329,8 @@ def classified_point(loop, values):
     """
     checked, d, _ = loop.evaluation.prepare(values, scalar=loop.parameters)
     point = {name: float(checked[name]) for name in loop.symbols}
-    point["d"] = d
+    # The delay in samples: whole, or with its fraction (Td read as d).
+    point["d"] = d if FRACTION not in checked else d + float(checked[FRACTION])
     point = {name: point[name] for name in loop.parameters}
     return point, int(loop.classify(**point))
 
@@ -444,7 +464,7 @@ def _phase_crossings(delayed, direct, shift, T):
     return tuple(out)
 
 
-def _polished(delayed, direct, theta, steps=3):
+def _polished(delayed, direct, theta, steps=8):
     """Newton steps on ``|N|**2 - |D|**2`` evaluated on the circle (not in ``cos theta``).
 
     The Chebyshev roots lose digits where ``x = cos theta`` is near 1 (a
@@ -502,14 +522,24 @@ def _parameter_margin(loop, name, point):
                      f"resolve")
 
 
-def _delay_limit(d, delay_limit):
+def delay_limit_of(d, delay_limit, *, name="delay_limit", whole=True):
+    """The samples to examine beyond the delay ``d``: ``delay_limit``, or the default.
+
+    The default is ``max(100, 10 (d + 1))``; either within
+    ``SYMSTAB_MAX_DELAY`` (0 where ``d`` is there already).  ``whole``: a
+    whole number of samples (the whole-sample margin's), else any positive
+    number (the exact margin's).
+    """
     room = max_delay() - d
+    if whole:
+        room = math.floor(room + 1e-9)
     if delay_limit is None:
-        return max(0, min(max(100, 10 * (d + 1)), room))
-    limit = check_count("delay_limit", delay_limit, 1)
+        return max(0, min(max(100, 10 * (math.floor(d) + 1)), room))
+    limit = (check_count(name, delay_limit, 1) if whole else
+             check_real(name, delay_limit, low=0.0, low_open=True))
     if limit > room:
-        raise ValueError(f"delay_limit must be at most {room} (SYMSTAB_MAX_DELAY - d), "
-                         f"got {limit}")
+        raise ValueError(f"{name} must be at most {room:g} (SYMSTAB_MAX_DELAY - d), "
+                         f"got {limit:g}")
     return limit
 
 
@@ -692,8 +722,10 @@ def margin_map(loop, x_values, y_values, *, x=None, y=None, margin="modulus", rt
     codes = np.asarray(loop.classify(**{**values, x: X, y: Y}))
     stable = codes == STABLE
     out = np.full((2, *X.shape), np.nan)
-    d = int(values.get("d", loop.defaults.get("d", 0)))
-    limit = _delay_limit(d, delay_limit)
+    checked, d, _ = loop.evaluation.prepare(values, drop=(x, y))
+    if FRACTION in checked:
+        d = d + float(checked[FRACTION])
+    limit = delay_limit_of(d, delay_limit)
     if stable.any():
         chi = loop.polynomial(**{**values, x: X[stable], y: Y[stable]})
         if margin == "modulus":
@@ -701,7 +733,8 @@ def margin_map(loop, x_values, y_values, *, x=None, y=None, margin="modulus", rt
         elif margin == "gain":
             upper = lower = _gain_margins(chi)
         else:
-            upper = lower = _delay_margins(loop, chi, {**values, "d": d}, (x, X[stable]),
+            given = {k: v for k, v in values.items() if k != "Td"}
+            upper = lower = _delay_margins(loop, chi, {**given, "d": d}, (x, X[stable]),
                                            (y, Y[stable]), limit)
         out[0][stable], out[1][stable] = upper, lower
     return MarginMap(x=x, y=y, x_values=xs, y_values=ys, margin=margin, values=out[0],
