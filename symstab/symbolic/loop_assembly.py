@@ -841,13 +841,18 @@ class LoopModel:
             z = model.z
             den = list(self._plant_parts[1]) + [sp.Integer(0)]
             pulse = fractional_zoh_pulse_transfer_function(self.plant, FRACTION)
-            num = sp.cancel(pulse * sp.Add(*[c * z**k for k, c in enumerate(reversed(den))]))
-            if not num.is_polynomial(z):
-                raise ValueError(f"the fractional delay's pulse transfer function of {self.plant} "
-                                 f"does not share the denominator of its integer-delay one")
-            return poly_coeffs(num, z), den
+            num, scale = sp.fraction(sp.cancel(
+                pulse * sp.Add(*[c * z**k for k, c in enumerate(reversed(den))])))
+            # A factor free of z may stay below (exp(eps p T) of a complex pair's poles).
+            if scale.has(z) or not num.is_polynomial(z):
+                # SymPy did not cancel the integer-delay denominator out of it (the
+                # exponentials of a complex pair as unrelated generators): the numeric path.
+                return [], []
+            return [c / scale for c in poly_coeffs(num, z)], den
 
-        return self._derived("fractional_plant_parts", derive, self._fractional_agrees)
+        parts = self._derived("fractional_plant_parts", derive,
+                              lambda parts: not parts[0] or self._fractional_agrees(parts))
+        return parts if parts[0] else None
 
     def _fractional_agrees(self, parts):
         """Whether ``(N_eps, z P_d)`` give the matrix exponential's ``P_eps`` at the check point."""
@@ -1041,10 +1046,10 @@ class LoopModel:
                              f"characteristic polynomial jointly affinely (a product of the two "
                              f"appears)")
 
-    def _numeric_plant(self, plant_values, T, eps=0.0):
+    def _numeric_plant(self, plant_values, T, eps=None):
         plant_values = tuple(plant_values)
         self._warn_if_not_physical(plant_values, T)
-        return self._plant_cache(plant_values, T, float(eps))
+        return self._plant_cache(plant_values, T, None if eps is None else float(eps))
 
     @method_cache(maxsize=4096)
     def _warn_if_not_physical(self, plant_values, T):
@@ -1344,20 +1349,20 @@ class LoopModel:
                 f"those of that plant")
 
     @method_cache(maxsize=4096, shared=True)
-    def _plant_digits(self, plant_values, T, eps=0.0):
+    def _plant_digits(self, plant_values, T, eps=None):
         """``(P_n, P_d, digits)``: the pulse transfer function's coefficients as mpmath numbers.
 
         At :data:`PLANT_DIGITS` digits, or more where the closed form needs
         them (:meth:`_closed_form_plant`); refused where it is not defined.
         (A plant that is not a physical device's at these values is warned
         of by :meth:`_numeric_plant` and :meth:`_exact_plant`, the entries.)
-        With a fraction ``0 < eps < 1`` of a period of delay, ``(N_eps, z
-        P_d)`` of the modified z-transform instead
+        With a fraction ``0 <= eps < 1`` of a period of delay (not None),
+        ``(N_eps, z P_d)`` of the modified z-transform instead
         (:attr:`_fractional_plant_parts`, or :func:`numeric_fractional_zoh`):
         the loop's ``chi`` is then that plant's with the whole samples ``d``.
         """
         digits = PLANT_DIGITS
-        fraction = None if eps == 0 else eps
+        fraction = eps
         with mpmath.workdps(PLANT_DIGITS):
             point = [mpmath.mpf(float(v)) for v in plant_values]
             if self._plant_parts is None:
@@ -1371,6 +1376,8 @@ class LoopModel:
                 else:
                     p_n, p_d = numeric_fractional_zoh(num, den, mpmath.mpf(float(T)), fraction,
                                                       dps=PLANT_DIGITS)
+            elif fraction is not None and self._fractional_plant_parts is None:
+                p_n, p_d = self._realised_plant(plant_values, T, fraction)
             else:
                 p_n, p_d, digits = self._closed_form_plant(point, mpmath.mpf(float(T)), fraction)
                 if not _defined(p_n, p_d):
@@ -1418,6 +1425,9 @@ class LoopModel:
                                                   dps=PLANT_DIGITS)
             if self._plant_parts is not None:
                 parts = self._plant_parts if eps is None else self._fractional_plant_parts
+                if parts is None:
+                    # The numeric path's own: n + 1 coefficients over z P_d's n + 2.
+                    parts = (p_n[1:], p_d)
                 length = len(parts[0])
                 scale = max(abs(c) for c in p_n)
                 while len(p_n) > length and abs(p_n[0]) <= mpmath.mpf(10) ** -PLANT_DIGITS * scale:
@@ -1427,7 +1437,7 @@ class LoopModel:
                     return undefined
             return list(p_n), list(p_d)
 
-    def _exact_plant(self, plant_values, T, eps=0.0):
+    def _exact_plant(self, plant_values, T, eps=None):
         """``(P_n, P_d)`` with monic ``P_d``, as exact Fractions of their 30-digit values.
 
         With a fraction ``eps`` of a period of delay, ``(N_eps, z P_d)``
@@ -1439,13 +1449,13 @@ class LoopModel:
         """
         plant_values = tuple(plant_values)
         self._warn_if_not_physical(plant_values, T)
-        p_n, p_d, digits = self._plant_digits(plant_values, T, float(eps))
+        p_n, p_d, digits = self._plant_digits(plant_values, T, None if eps is None else float(eps))
         with mpmath.workdps(digits):
             lead = p_d[0]
             return tuple(tuple(_fraction(c / lead) for c in part) for part in (p_n, p_d))
 
     @method_cache(maxsize=4096, shared=True)
-    def _plant_cache(self, plant_values, T, eps=0.0):
+    def _plant_cache(self, plant_values, T, eps=None):
         """(P_n, P_d, ends, P_d in z - 1) as float arrays, monic P_d, evaluated at 30 digits.
 
         ``ends`` is ``(P_n(1), P_d(1), P_n(-1), P_d(-1))``, summed at 30

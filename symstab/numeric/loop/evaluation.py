@@ -248,7 +248,7 @@ class LoopEvaluation:
     def _plant(self, row, values):
         """:meth:`plant_arrays` of one point's plant (a row in the order of :meth:`_plant_names`)."""
         n = len(self.loop.plant_names)
-        eps = float(row[n + 1]) if FRACTION in values else 0.0
+        eps = float(row[n + 1]) if FRACTION in values else None
         return self._plant_at(tuple(float(v) for v in row[:n]), float(row[n]), eps)
 
     def _plant_rows(self, values, shape):
@@ -366,7 +366,12 @@ class LoopEvaluation:
         # coefficients, scaled by the same leading coefficient (constant in
         # ``name`` when the loop is affine in it, checked by _check_plane).
         fraction = FRACTION in values
-        num, den = self._plant_parts(fraction)
+        parts = self._plant_parts(fraction)
+        if parts is None:
+            raise ValueError(f"parameter {name!r} is the plant's, and this plant's fractional "
+                             f"delay is computed numerically (SymPy did not derive it): a plane "
+                             f"or line along it needs a whole number of samples of delay")
+        num, den = parts
         symbols = self.loop.symbols
         symbol = symbols[name]
         if sp.diff(den[0], symbol) != 0:
@@ -521,7 +526,8 @@ class LoopEvaluation:
         for name in names:
             values[name] = np.asarray(0.0)
         p_n, p_d = self._exact_plant(tuple(float(values[n]) for n in loop.plant_names),
-                                     float(values["T"]), float(values.get(FRACTION, 0.0)))
+                                     float(values["T"]),
+                                     float(values[FRACTION]) if FRACTION in values else None)
         k = loop.environment_delay
         out = []
         for slope in (None, *names):

@@ -465,6 +465,14 @@ class Loop(LoopModel):
 
         return margins(self, parameters=parameters, delay_limit=delay_limit, rtol=rtol, **values)
 
+    def delay_margin(self, *, limit=None, step=None, every=None, **values):
+        """The exact delay margin at a stable point, and where stability switches back and forth.
+
+        See :func:`symstab.numeric.analysis.delays.delay_margin`."""
+        from ..analysis.delays import delay_margin
+
+        return delay_margin(self, limit=limit, step=step, every=every, **values)
+
     def force_noise(self, *, encoder_resolution, **values):
         """The force RMS of the encoder's quantization at a stable point.
 
