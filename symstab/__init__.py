@@ -57,6 +57,7 @@ _HOMES = {
     "numeric.analysis.passivity": ("PassiveRegion", "passive_region"),
     "numeric.analysis.margins": ("MarginMap", "Margins", "NyquistCrossing", "ParameterMargin"),
     "numeric.analysis.noise": ("ForceNoise",),
+    "numeric.analysis.delays": ("DelayMargin", "DelaySwitch"),
     "numeric.paper.device": ("PAPER_DEVICE", "Device"),
     "numeric.paper.curves": ("BoundaryCurve", "arc_end_angle"),
     "numeric.paper.stability": ("classify", "is_stable", "spectral_radius"),
@@ -94,6 +95,7 @@ __all__ = [
     "StabilityProbability",
     "RobustRegion",
     "Margins", "NyquistCrossing", "ParameterMargin", "MarginMap", "ForceNoise",
+    "DelayMargin", "DelaySwitch",
 ]
 
 

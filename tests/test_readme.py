@@ -62,7 +62,7 @@ def test_docs_python_examples_run(page, monkeypatch, session_cache_dir):
                                     "symstab.numeric.analysis.probability",
                                     "symstab.numeric.simulation.simulator",
                                     "symstab.numeric.simulation.simulated_limit",
-                                    "symstab.symbolic.discretize"])
+                                    "symstab.symbolic.discretize", "symstab.numeric.analysis.delays"])
 def test_docstring_examples_run(module):
     mod = importlib.import_module(module)
     failures, tried = doctest.testmod(mod, optionflags=doctest.NORMALIZE_WHITESPACE)

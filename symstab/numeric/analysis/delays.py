@@ -36,7 +36,7 @@ import numpy as np
 
 from ..._validate import check_real, split_delay
 from ..engine.results import html_table
-from ..engine.roots import STABLE
+from ..engine.roots import STABLE, circle_minimum
 from ..engine.search import bracketed_root
 from ..loop.evaluation import FRACTION
 from .margins import _phase_crossings, delay_limit_of, stable_point
@@ -265,10 +265,28 @@ def _switch(loop, point, low, high, stable_after, T):
 
     # The radius is continuous in the delay; at the ends it is on either side of 1.
     samples = float(bracketed_root(excess, [low], [high])[0])
-    # The root on the circle is at a gain crossover (|L| = 1) whose phase margin is 0 there.
-    chi = loop.polynomial(**base, d=samples)
-    crossings = _phase_crossings(chi.delayed.reshape(-1), chi.direct.reshape(-1), chi.shift, T)
-    theta = min(crossings, key=lambda c: abs((c.margin + 180.0) % 360.0 - 180.0)).theta
-    return DelaySwitch(samples=samples, added=samples - float(point["d"]), T=T, theta=theta,
+    return DelaySwitch(samples=samples, added=samples - float(point["d"]), T=T,
+                       theta=_crossing_angle(loop.polynomial(**base, d=samples), T),
                        stable_after=stable_after)
+
+
+def _crossing_angle(chi, T):
+    """The angle of ``chi``'s root on the unit circle, ``chi`` taken at a switch.
+
+    A root on the circle is at a gain crossover (``|L| = 1``) or at ``z =
+    +-1``, where ``L`` may have a pole (a Tustin damper's ``z = -1``: the
+    plant's sampling zero crosses it); the candidate where ``|chi|`` is
+    smallest beside its coefficients' sizes, or the certified minimum of
+    ``|1 + L|`` where no candidate is a root to 1e-8 of them.
+    """
+    delayed, direct = chi.delayed.reshape(-1), chi.direct.reshape(-1)
+    candidates = [c.theta for c in _phase_crossings(delayed, direct, chi.shift, T)]
+    candidates = np.array(candidates + [0.0, math.pi])
+    dense = chi.dense().reshape(-1)
+    residual = (np.abs(np.polyval(dense, np.exp(1j * candidates)))
+                / np.sum(np.abs(dense)))
+    best = int(np.argmin(residual))
+    if residual[best] <= 1e-8:
+        return float(candidates[best])
+    return float(circle_minimum(chi)[2])
 
