@@ -237,6 +237,115 @@ def python_control_parts(loop, values):
     return sampled, environment, delay
 
 
+# --------------------------------------------------------------------------
+# State-space oracle of a fractional loop delay (d + eps) T
+# --------------------------------------------------------------------------
+
+def _held_input_integral(A, B, t):
+    """``(e^{A t}, int_0^t e^{A s} ds B)`` by Van Loan's block exponential of ``[[A, B], [0, 0]] t``."""
+    import scipy.linalg
+
+    n, m = B.shape
+    block = np.zeros((n + m, n + m))
+    block[:n, :n], block[:n, n:] = A, B
+    exponential = scipy.linalg.expm(block * t)
+    return exponential[:n, :n], exponential[:n, n:]
+
+
+def _realisation(num, den):
+    """``(A, B, C, D)`` of ``num / den`` (coefficients highest first, proper): the controllable form.
+
+    ``A``'s first row is ``-den[1:] / den[0]``, ones below its diagonal; ``B``
+    the first unit vector; ``C`` the numerator's remainder after the direct
+    term ``D`` (as ``scipy.signal.tf2ss``, whose import costs 1.7 s).
+    """
+    den = np.trim_zeros(np.asarray(den, float), "f")
+    num = np.trim_zeros(np.asarray(num, float), "f")
+    if num.size > den.size:
+        raise ValueError("the transfer function must be proper")
+    a = den / den[0]
+    b = np.concatenate([np.zeros(den.size - num.size), num]) / den[0]
+    n = den.size - 1
+    A, B = np.zeros((n, n)), np.zeros((n, 1))
+    if n:
+        A[0], B[0, 0] = -a[1:], 1.0
+        A[1:, :-1] = np.eye(n - 1)
+    C = (b[1:] - b[0] * a[1:])[None, :]
+    return A, B, C, np.array([[b[0]]])
+
+
+def fractional_delay_closed_loop(plant_num, plant_den, env_num, env_den, T, d, eps):
+    """The closed loop's state matrix of a loop whose command waits ``(d + eps) T``.
+
+    Built from the physics, independently of symstab's modified z-transform:
+    the plant ``G(s) = plant_num / plant_den`` (s-coefficients, highest first,
+    strictly proper) realised (:func:`_realisation`) as ``x' = A x + B u``,
+    ``y = C x``; the command held over a period reaches it ``eps T`` late
+    inside the period, so over ``[kT, (k+1)T)`` the input is ``u[k-d-1]`` for
+    the first ``eps T`` and ``u[k-d]`` after::
+
+        x[k+1] = Phi x[k] + Gamma0 u[k-d] + Gamma1 u[k-d-1],
+        Phi = e^{A T},  Gamma0 = int_0^{(1-eps)T} e^{A s} ds B,
+        Gamma1 = e^{A (1-eps) T} int_0^{eps T} e^{A s} ds B.
+
+    The environment ``VE(z) = env_num / env_den`` (z-coefficients, proper) is
+    a discrete state space fed with the sampled position ``y[k] = C x[k]``,
+    its force ``f[k]``; the command is ``u[k] = -f[k]``, and the register
+    ``(f[k-1], ..., f[k-d-1])`` holds the whole samples of delay.
+
+    Returns
+    -------
+    ndarray
+        The square state matrix of ``(x, x_VE, register)``: its eigenvalues
+        are the closed loop's poles (with one more at 0 when ``eps = 0``,
+        the register's last, unused, entry).
+    """
+    A, B, C, D = _realisation(plant_num, plant_den)
+    if np.any(D != 0):
+        raise ValueError("the plant must be strictly proper (y[k] = C x[k])")
+    Ae, Be, Ce, De = _realisation(env_num, env_den)
+    Phi, _ = _held_input_integral(A, B, T)
+    Phi_late, gamma0 = _held_input_integral(A, B, (1 - eps) * T)
+    gamma1 = Phi_late @ _held_input_integral(A, B, eps * T)[1]
+    n, ne = A.shape[0], Ae.shape[0]
+    size = n + ne + d + 1
+    x, e, first = slice(0, n), slice(n, n + ne), n + ne
+    unit = np.eye(size)
+    # The force f[k] = Ce x_VE[k] + De C x[k], a row over the state.
+    force = np.zeros(size)
+    force[x], force[e] = (De @ C).ravel(), Ce.ravel()
+    # u[k-d] = -f[k-d]: the force now (d = 0) or the register's entry d - 1;
+    # u[k-d-1] = -f[k-d-1]: its entry d.
+    recent = force if d == 0 else unit[first + d - 1]
+    M = np.zeros((size, size))
+    M[x, x] = Phi
+    M[x] -= np.outer(gamma0.ravel(), recent) + np.outer(gamma1.ravel(), unit[first + d])
+    M[e, e], M[e, x] = Ae, Be @ C
+    M[first] = force
+    M[first + 1:, first:size - 1] = np.eye(d)
+    return M
+
+
+def fractional_delay_radius(plant_num, plant_den, env_num, env_den, T, d, eps):
+    """Largest modulus of the eigenvalues of :func:`fractional_delay_closed_loop`."""
+    matrix = fractional_delay_closed_loop(plant_num, plant_den, env_num, env_den, T, d, eps)
+    return float(np.max(np.abs(np.linalg.eigvals(matrix))))
+
+
+def loop_coefficients(loop, values):
+    """``(plant_num, plant_den, env_num, env_den)`` of a :class:`symstab.Loop` at ``values``.
+
+    The plant's s-coefficients and the environment's z-coefficients, highest
+    first, from the loop's expressions with ``values`` substituted by SymPy
+    (as :func:`python_control_parts` reads them).
+    """
+    s, z = sp.symbols("s z")
+    plant = _substituted_coefficients(loop.plant, s, _values_of(loop.plant, values))
+    environment = _substituted_coefficients(loop.environment, z,
+                                            _values_of(loop.environment, values))
+    return (*plant, *environment)
+
+
 def impulse_norm(num, den, dt):
     """sqrt(sum h[k]**2) by scipy's impulse response, long enough for the tail to vanish."""
     import scipy.signal
