@@ -51,15 +51,6 @@ POINTS = {"default": (1.0, 1.0), "stable": (0.5, 0.5), "unstable": (1.0, 30.0)}
 RADIUS_RTOL = 1e-9
 #: Radii this close to 1 are left to the certified classification.
 BOUNDARY_BAND = 1e-6
-#: A plant with a complex pair of poles written with a square root has no
-#: fractional pulse transfer function yet: symstab raises "does not share the
-#: denominator of its integer-delay one" (and spends some 2 s deriving again on
-#: each call).  operator_arm is checked by test_complex_pole_plant, a strict
-#: xfail: when it passes, move operator_arm back into FRACTIONAL_LOOPS.
-NO_FRACTION = ("operator_arm",)
-FRACTIONAL_LOOPS = tuple(name for name in LOOPS if name not in NO_FRACTION)
-
-
 @pytest.fixture(scope="session")
 def loops():
     """Every loop checked: the paper's and the examples', loaded once."""
@@ -103,18 +94,10 @@ def _radius_differences(loop, kind):
 
 
 @pytest.mark.parametrize("kind", POINTS)
-@pytest.mark.parametrize("name", FRACTIONAL_LOOPS)
+@pytest.mark.parametrize("name", LOOPS)
 def test_radius_matches_state_space_oracle(loops, name, kind):
     wrong = _radius_differences(loops[name], kind)
     assert not wrong, f"{name} at {kind}: (delay, symstab, oracle) {wrong}"
-
-
-@pytest.mark.xfail(raises=ValueError, strict=True,
-                   reason="no fractional pulse transfer function of a complex pair of poles")
-@pytest.mark.parametrize("name", NO_FRACTION)
-def test_complex_pole_plant(loops, name):
-    wrong = _radius_differences(loops[name], "default")
-    assert not wrong, f"{name}: (delay, symstab, oracle) {wrong}"
 
 
 @pytest.mark.parametrize("name", LOOPS)
@@ -148,7 +131,7 @@ def test_oracle_is_continuous_across_a_whole_sample(loops):
         assert abs(late - _oracle_radius(loop, values, d + 1, 0.0)) <= 1e-7 * late, d
 
 
-@pytest.mark.parametrize("name", FRACTIONAL_LOOPS)
+@pytest.mark.parametrize("name", LOOPS)
 def test_classification_agrees_with_oracle(loops, name):
     loop = loops[name]
     wrong, decided = [], 0
