@@ -702,7 +702,10 @@ def paper_setup(paper, *, plane=True):
     """
     from ..numeric.paper.paper_loop import paper_point
 
-    loop, values = paper_point(gamma=paper.gamma, d=paper.d, delta=paper.delta)
+    loop, values = paper_point(gamma=paper.gamma, d=math.floor(paper.d), delta=paper.delta)
+    # A fractional delay is in samples, so the same at m = T = 1: the loop's
+    # engine takes it (its closed forms, eq. (5) and (7), are for whole d).
+    values["d"] = paper.d
     x, y = ("B", "K") if plane else (None, None)
     return LoopSetup("", loop, values, (), x, y, echo=paper.echo, paper=paper)
 
