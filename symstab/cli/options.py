@@ -144,14 +144,16 @@ def delay_text(d, T=None):
 
 
 def whole_delay(setup, command, reason="its computation takes whole samples only"):
-    """Refuse a fractional delay (:attr:`Setup.fractional`) where ``command`` cannot take one.
+    """Refuse a fractional delay where ``command`` cannot take one, before any work.
 
-    One line naming the command and the delay, said before any work.
+    ``setup`` is a :class:`Setup` or a :class:`symstab.cli.loop_options.LoopSetup`
+    (both have ``d`` and ``fractional``); the one line names the command,
+    the delay and why.
     """
     if setup.fractional:
         raise ValueError(f"{command} does not take a fractional delay yet ({reason}), got "
-                         f"{delay_text(setup.d)}; give --Td a whole number of periods, or ask "
-                         f"boundary, limits, classify, design or locus")
+                         f"{delay_text(setup.d)}; give a whole number of samples (boundary, "
+                         f"limits, classify, design and locus take a fractional one)")
 
 
 def resolve(args, *, mass=True):
