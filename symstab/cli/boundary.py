@@ -49,26 +49,9 @@ def run(args):
     n = check_count("n", args.n, 2)
     check_memory(f"--n {n} boundary points", n * BYTES_PER_ROW)
     paper = setup.paper
-    if paper is None:
-        # The stable set's straight pieces: its D-decomposition (seconds at long delays).
-        print(f"finding the ({setup.x}, {setup.y}) plane's stable set for the segments that "
-              f"close it ...", file=sys.stderr, flush=True)
-        try:
-            curve = setup.loop.boundary(x=setup.x, y=setup.y, n=n, segments=True, **setup.values)
-        except ValueError as exc:
-            curve = setup.loop.boundary(x=setup.x, y=setup.y, n=n, **setup.values)
-            notes = [f"the segments that close the stable set were not found: {exc}"]
-        else:
-            notes = []
-        columns = ["theta [rad]", setup.label(setup.x), setup.label(setup.y)]
-        rows = list(zip(curve.theta, curve.x_values, curve.y_values, strict=True))
-        notes.insert(0, f"D-decomposition: z = exp(j theta) is a closed-loop pole at ({setup.x}, "
-                        f"{setup.y}) (nan: the 2 x 2 system is singular at that theta)")
-        notes += [_line_text(setup, label, line) for label, line in curve.lines.items()]
-        if not curve.lines:
-            notes.append("no real-root or leading-coefficient line crosses this plane")
-        result = {"lines": {label: dict(zip(("c0", "cx", "cy"), line, strict=True))
-                            for label, line in curve.lines.items()}}
+    if paper is None or paper.fractional:
+        # Eq. (7) is for a whole delay: a fractional one is the paper's loop's D-decomposition.
+        curve, columns, rows, notes, result = _decomposition(setup, n)
     else:
         curve = boundary_curve(gamma=paper.gamma, d=paper.d, delta=paper.delta, n=n)
         columns = ["theta [rad]", "alpha", "beta"]
@@ -89,6 +72,40 @@ def run(args):
     return 0
 
 
+def _decomposition(setup, n):
+    """The D-decomposition's arc, lines and segments of the plane: (curve, columns, rows, notes, json).
+
+    A loop file's, or the paper's loop's at a fractional delay (in Table
+    I's names, with the device's units beside them where it is physical).
+    """
+    x, y = setup.name(setup.x), setup.name(setup.y)
+    # The stable set's straight pieces: its D-decomposition (seconds at long delays).
+    print(f"finding the ({x}, {y}) plane's stable set for the segments that close it ...",
+          file=sys.stderr, flush=True)
+    try:
+        curve = setup.loop.boundary(x=setup.x, y=setup.y, n=n, segments=True, **setup.values)
+    except ValueError as exc:
+        curve = setup.loop.boundary(x=setup.x, y=setup.y, n=n, **setup.values)
+        notes = [f"the segments that close the stable set were not found: {exc}"]
+    else:
+        notes = []
+    columns = ["theta [rad]", setup.label(setup.x), setup.label(setup.y)]
+    rows = list(zip(curve.theta, curve.x_values, curve.y_values, strict=True))
+    paper = setup.paper
+    if paper is not None and paper.physical:
+        columns += physical_columns(paper, ["B_w", "K_w"])
+        rows = [r + (float(paper.device.damping(r[1])), float(paper.device.stiffness(r[2])))
+                for r in rows]
+    notes.insert(0, f"D-decomposition: z = exp(j theta) is a closed-loop pole at ({x}, {y}) "
+                    f"(nan: the 2 x 2 system is singular at that theta)")
+    notes += [_line_text(setup, label, line) for label, line in curve.lines.items()]
+    if not curve.lines:
+        notes.append("no real-root or leading-coefficient line crosses this plane")
+    result = {"lines": {label: dict(zip(("c0", "cx", "cy"), line, strict=True))
+                        for label, line in curve.lines.items()}}
+    return curve, columns, rows, notes, result
+
+
 def _signed(terms):
     """``"a + b x - c y"`` from ``[(a, ""), (b, "x"), (c, "y")]`` (the first term keeps its sign).
 
@@ -106,7 +123,7 @@ def _signed(terms):
 def _line_text(setup, label, line):
     """``z = 1: c0 + cx x + cy y = 0``, and solved for y (or x) when it can be."""
     c0, cx, cy = line
-    x, y = setup.x, setup.y
+    x, y = setup.name(setup.x), setup.name(setup.y)
     text = f"line {label}: {_signed([(c0, ''), (cx, x), (cy, y)])} = 0"
     if cy != 0:
         text += f", i.e. {y} = {_signed([(-c0 / cy + 0.0, ''), (-cx / cy + 0.0, x)])}"

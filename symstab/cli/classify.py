@@ -52,7 +52,7 @@ def run(args):
     setup = resolve_setup(args, plane=False, lists=True)
     if setup.paper is None:
         values = broadcast(setup.values)
-        names = [n for n in (setup.given or setup.loop.plane or ()) if n != "d"]
+        names = [n for n in (setup.given or setup.loop.plane or ()) if n not in ("d", "Td")]
     else:
         # --alpha/--Kw and --beta/--Bw: K and B of the paper's loop in Table I's variables.
         alpha, beta = (np.atleast_1d(x) for x in stiffness_and_damping(args, setup.paper, parse_list))

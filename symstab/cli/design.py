@@ -31,7 +31,7 @@ from .loop_options import (
     uses_loop,
     value_text,
 )
-from .options import add_command, add_model_options, resolve
+from .options import add_command, add_model_options, resolve, whole_delay
 from .output import check_outputs, emit, write_output
 from .simulation import add_nonideal_options, loop_nonideal_text, resolve_nonideal
 
@@ -138,6 +138,9 @@ def run(args):
         d, delta = setup.paper.d, setup.paper.delta
         over = {"M": (-1.0 - (d + 1) * delta + 1e-3, 3.0)}    # best_virtual_mass's range
         notes = []
+    if target == "passive":
+        whole_delay(setup, "design --maximize passive", "the passive set is derived for whole "
+                                                        "samples")
     if target == "passive" and setup.paper is not None and setup.paper.delta == 0:
         raise ValueError("--maximize passive: the device has no damping (delta = 0), so no "
                          "point is passive")

@@ -463,7 +463,7 @@ def _title(view):
         fixed = ", ".join(f"{n} = {v:g}" + (f" {setup.unit(n)}" if setup.unit(n) else "")
                           for n, v in setup.values.items() if n != "d")
         return (f"root locus of the loop {setup.loop.name} along {view.name}: {fixed}, "
-                f"d = {setup.values['d']}")
+                f"d = {setup.values['d']:.10g}")
     paper = setup.paper
     other, fixed = view.fixed
     if paper.physical:
@@ -472,9 +472,9 @@ def _title(view):
             where = f"$B_w$ = {float(dev.damping(fixed)):g} {units['B_w']}"
         else:
             where = f"$K_w$ = {float(dev.stiffness(fixed)):g} {units['K_w']}"
-        return (f"root locus at {where}, $T_d$ = {dev.delay(paper.d) * 1e3:g} ms "
-                f"($d$ = {paper.d}), $M_w$ = {float(dev.mass(paper.gamma)):g} "
+        return (f"root locus at {where}, $T_d$ = {paper.d * dev.T * 1e3:g} ms "
+                f"($d$ = {paper.d:.10g}), $M_w$ = {float(dev.mass(paper.gamma)):g} "
                 f"{tex_unit(units['M_w'])}")
     symbol = r"\beta" if other == "beta" else r"\alpha"
-    return (f"root locus at ${symbol}$ = {fixed:g}, $\\gamma$ = {paper.gamma:g}, $d$ = {paper.d}, "
+    return (f"root locus at ${symbol}$ = {fixed:g}, $\\gamma$ = {paper.gamma:g}, $d$ = {paper.d:.10g}, "
             f"$\\delta$ = {paper.delta:g}")

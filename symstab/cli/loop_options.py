@@ -44,7 +44,8 @@ __all__ = ["uncertain_box", "DEVICE_OPTIONS", "POINT_OPTIONS", "EXAMPLE", "LINEA
 #: that replaces each under ``--loop`` (None: nothing does, as for the simulation options).
 DEVICE_OPTIONS = (
     ("--m", "m", "--set m=..."), ("--b", "b", "--set b=..."), ("--T", "T", "--set T=..."),
-    ("--Td", "Td", "--set d=... (the delay in samples)"),
+    ("--Td", "Td", "--set Td=... (the delay in time, e.g. --set Td=40.5ms) or --set d=... "
+                   "(in samples)"),
     ("--delta", "delta", "--set with the loop's own parameters"),
     ("--gamma", "gamma", "--set with the loop's virtual mass, e.g. --set M=..."),
     ("--Mw", "Mw", "--set with the loop's virtual mass, e.g. --set M=..."),
@@ -173,8 +174,9 @@ def add_loop_options(p, command):
                    help="set a parameter of the loop: VALUE is in the unit the file gives NAME "
                         "(SI where the file gives a bare number), or in the unit written after "
                         "it (--set T=0.5ms, --set \"K=3 N/mm\"), of the same dimension; "
-                        "converted to SI and checked against the file's bounds; repeatable; d "
-                        f"is a whole number of samples{many}")
+                        "converted to SI and checked against the file's bounds; repeatable; "
+                        "the delay is d in samples (40.5: a fraction of a period more) or Td in "
+                        f"time (--set Td=40.5ms), one value{many}")
     if command not in ("classify", "simulate", "margins"):
         g.add_argument("--x", metavar="NAME", help="horizontal parameter of the plane "
                                                    "(default: the file's plane)")
@@ -319,17 +321,25 @@ def parse_number(name, text, flag, *, lists, written=None):
             shown = item if len(items) > 1 or written is None else written.strip()
             raise ValueError(f"{flag}: {name} must be a finite number, got {shown!r}")
         if name == "d":
-            from .._validate import check_delay
-            try:
-                value = check_delay(value)
-            except ValueError:
-                shown = (written if written is not None else text).strip()
-                raise ValueError(f"{flag}: delay d must be a non-negative integer, a number of "
-                                 f"samples (unit \"samples\", or none), got {shown!r}") from None
+            value = _samples(value, flag, (written if written is not None else text).strip())
         values.append(value)
-    if name == "d" and len(values) > 1:
-        raise ValueError(f"{flag}: d takes one value (run classify once per delay)")
+    if name in ("d", "Td") and len(values) > 1:
+        raise ValueError(f"{flag}: {name} takes one value (run classify once per delay)")
     return values if len(values) > 1 else values[0]
+
+
+def _samples(value, flag, shown):
+    """``--set d=VALUE``: an int when whole, else the float (40.5); refused outside 0 to the limit."""
+    from .._validate import split_delay
+
+    try:
+        whole, fraction = split_delay(value, name="d")
+    except ValueError:
+        from .._resources import max_delay
+        raise ValueError(f"{flag}: delay d must be a number of samples from 0 to {max_delay()} "
+                         f"(unit \"samples\", or none; 40.5 is a fraction of a period more), "
+                         f"got {shown!r}") from None
+    return whole if fraction is None else whole + float(fraction)
 
 
 def _parse_sets(texts, *, lists):
@@ -414,6 +424,16 @@ class LoopSetup:
     def unit(self, name):
         return "" if self.paper is not None else self.loop.units.get(name, "")
 
+    @property
+    def d(self):
+        """The delay in samples (an int, or a float for a fractional delay)."""
+        return self.values.get("d")
+
+    @property
+    def fractional(self):
+        """Whether the delay is not a whole number of samples (``d = 40.5``)."""
+        return self.d is not None and not float(self.d).is_integer()
+
     def name(self, name):
         """A parameter's name as printed: Table I's for the paper's device options."""
         return TABLE_ONE.get(name, name) if self.paper is not None else name
@@ -438,7 +458,7 @@ class LoopSetup:
             out["plane"] = {"x": self.x, "y": self.y}
         out["units"] = {k: loop.units[k] for k in loop.parameters if k in loop.units}
         written = {k: {"value": v, "unit": u} for k, (v, u, _) in self.written.items()
-                   if k in self.values}
+                   if k in self.values or k == "Td"}
         if written:
             out["as_written"] = written   # converted to "values", in "units"
         return out
@@ -521,6 +541,10 @@ def value_text(setup, name, value):
     if unit == "samples" and value == 1:
         unit = "sample"
     text = _quantity_text(name, value) + (f" {unit}" if unit else "")
+    if name == "d" and "Td" in setup.written:
+        # Given in time: "Td = 40.5 ms (d = 40.5 samples)".
+        given, given_unit, _ = setup.written["Td"]
+        return f"{_quantity_text('Td', given)} {given_unit} ({text})"
     if name in setup.written and name != "d":
         given, given_unit, _ = setup.written[name]
         shown = _quantity_text(name, given) + f" {given_unit}"
@@ -534,7 +558,8 @@ def loop_echo(setup):
     loop = setup.loop
     lines = [f"loop {loop.name} ({setup.path}): G(s) = {loop.plant}, VE(z) = {loop.environment}"
              f"; ZOH by {loop.zoh_method}"]
-    parts = [value_text(setup, n, setup.values[n]) + (" (--set)" if n in setup.given else "")
+    given = set(setup.given) | ({"d"} if "Td" in setup.given else set())
+    parts = [value_text(setup, n, setup.values[n]) + (" (--set)" if n in given else "")
              for n in loop.parameters if n in setup.values]
     lines.append("values: " + ", ".join(parts))
     if setup.x is not None:
@@ -572,8 +597,14 @@ def add_delay(args, sets):
 
 
 def check_names(args, loop, names):
-    """Refuse the first of ``names`` (given with ``--set``) that is not a parameter of ``loop``."""
-    unknown = [n for n in names if n not in loop.parameters]
+    """Refuse the first of ``names`` (given with ``--set``) that is not a parameter of ``loop``.
+
+    ``Td`` is the delay ``d`` in time.
+    """
+    if "Td" in names and "d" in names:
+        raise ValueError("give the delay once: --set Td=... (in time) or --set d=... / --d "
+                         "(in samples)")
+    unknown = [n for n in names if n not in loop.parameters and n != "Td"]
     if unknown:
         raise ValueError(f"--set {unknown[0]}: {unknown[0]!r} is not a parameter of the loop in "
                          f"{args.loop} (parameters: {', '.join(loop.parameters)})")
@@ -589,7 +620,12 @@ def loop_values(args, loop, sets, written_sets, *, skip=()):
     (:attr:`LoopSetup.written`).
     """
     values = {n: v for n, v in loop.defaults.items() if n not in skip}
+    if {"d", "Td"} & set(sets):
+        # The delay given replaces the file's, in whichever form the file gave it.
+        values.pop("d", None)
+        values.pop("Td", None)
     values.update(sets)
+    seconds = _delay_in_time(args, loop, values, sets, written_sets, skip)
     missing = [n for n in loop.parameters if n not in values and n not in skip]
     if missing:
         raise ValueError(f"no value for {', '.join(missing)}: the loop file {args.loop} gives "
@@ -606,7 +642,42 @@ def loop_values(args, loop, sets, written_sets, *, skip=()):
         check_bounds(known, values, skip=skip, where=lambda names: (
             ", ".join(f"--set {n}=..." for n in sets if n in names) or str(args.loop)))
     written.update(written_sets)
+    written.pop("Td", None)     # the file's Td, where --set d=... replaced it
+    if seconds is not None:
+        written["Td"] = seconds
     return values, written
+
+
+def _delay_in_time(args, loop, values, sets, written_sets, skip):
+    """Turn a delay in time (``Td``, the file's or ``--set``'s) into ``values["d"]``, in samples.
+
+    The commands count in samples (``Td / T``, 40.5 where it is not whole,
+    as :meth:`symstab.Loop.classify` reads ``Td``), so ``T`` must be one
+    value.  Returns ``(Td as written, its unit, "s")`` for the echo, or
+    None where the delay is given in samples.
+    """
+    if "Td" not in values:
+        return None
+    Td = values.pop("Td")
+    where = "--set Td" if "Td" in sets else f"the loop file {args.loop}'s Td"
+    if "T" in skip or isinstance(values.get("T"), list) or "T" not in values:
+        raise ValueError(f"{where}: a delay in time needs one sample period T (here T is "
+                         f"{'an axis of the plane' if 'T' in skip else 'not one value'}): "
+                         f"give the delay in samples, --set d=...")
+    from .._validate import check_real, split_delay
+
+    Td = check_real("Td", Td, low=0.0)
+    try:
+        whole, fraction = split_delay(Td / values["T"], name="Td / T")
+    except ValueError as exc:
+        raise ValueError(f"{where}: {exc}") from None
+    values["d"] = whole if fraction is None else whole + float(fraction)
+    if "Td" in written_sets:
+        given, unit, _ = written_sets.pop("Td")
+        return given, unit or "s", "s"
+    entry = getattr(loop, "file_parameters", None)
+    entry = entry.values.get("Td") if entry is not None and "Td" not in sets else None
+    return (Td, "s", "s") if entry is None else (entry.value, entry.unit or "s", "s")
 
 
 def _report_plant(args, caught):
@@ -702,7 +773,10 @@ def paper_setup(paper, *, plane=True):
     """
     from ..numeric.paper.paper_loop import paper_point
 
-    loop, values = paper_point(gamma=paper.gamma, d=paper.d, delta=paper.delta)
+    loop, values = paper_point(gamma=paper.gamma, d=math.floor(paper.d), delta=paper.delta)
+    # A fractional delay is in samples, so the same at m = T = 1: the loop's
+    # engine takes it (its closed forms, eq. (5) and (7), are for whole d).
+    values["d"] = paper.d
     x, y = ("B", "K") if plane else (None, None)
     return LoopSetup("", loop, values, (), x, y, echo=paper.echo, paper=paper)
 

@@ -12,6 +12,7 @@ checked before the work and the files written atomically.
 """
 
 import io
+import math
 import pathlib
 import textwrap
 
@@ -27,7 +28,7 @@ from ..drawing import (
     simulated_map_figure,
 )
 from .loop_options import add_loop_options, resolve_loop, uncertain_box, uses_loop, value_text
-from .options import add_command, add_model_options, resolve, stiffness_and_damping
+from .options import add_command, add_model_options, resolve, stiffness_and_damping, whole_delay
 from .output import check_files, write_output
 from .simulation import (
     add_nonideal_options,
@@ -108,6 +109,9 @@ def run(args):
     if args.uncertain is not None:
         return _probability(args, setup, xs, ys, out, png_path)
     if args.margin is not None:
+        if args.margin == "delay":
+            whole_delay(setup, "map --margin delay", "the delay margin counts whole samples "
+                                                     "added to a whole delay")
         return _margin(args, setup, xs, ys, out, png_path)
     return _map(_LoopMap(args, setup, xs, ys, out, png_path))
 
@@ -200,6 +204,8 @@ class _PaperMap:
 
         self.args = args
         setup = self.setup = resolve(args)
+        whole_delay(setup, "map", "the paper's device simulator and its theory count whole "
+                              "samples; map --loop examples/loops/paper.toml --set Td=40.5ms classifies the plane")
         self.nonideal, self.x0 = resolve_nonideal(args, setup)
         given = self.given = {}  # the grids as the user gave them, by flag: the PNG's units
 
@@ -461,7 +467,8 @@ def _loop_simulation(args, setup, xs, ys):
                 raise ValueError(f"{flag} is an option of the simulation: add --simulate")
         return None, None, None
     nonideal, x0 = resolve_nonideal(args, None, loop)
-    steps = check_steps(args.steps, values["d"])
+    # A fractional delay's horizon: that of the next whole delay.
+    steps = check_steps(args.steps, math.ceil(values["d"]))
     # The difference equations at one cell: a plant they cannot step is refused now.
     loop.difference_equations(**{setup.x: xs[0], setup.y: ys[0]}, **values)
     X, Y = np.meshgrid(xs, ys, indexing="ij")

@@ -18,6 +18,7 @@ from .options import (
     add_point_options,
     parse_one,
     stiffness_and_damping,
+    whole_delay,
 )
 from .output import emit
 
@@ -46,6 +47,8 @@ def register(subparsers):
 def run(args):
     """Run ``symstab margins``: a loop file's point (``--loop``), else the paper's."""
     setup = resolve_setup(args, plane=False)
+    # symstab.Loop.margins asks its questions at the delay's whole samples.
+    whole_delay(setup, "margins", "the margins are computed at the delay's whole samples")
     values = dict(setup.values)
     T = None
     if setup.paper is not None:

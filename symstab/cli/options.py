@@ -5,7 +5,10 @@
 --b --T``, default the paper's device, and ``--Td``) or dimensionless
 (``--delta --d``), the virtual mass as ``--Mw`` (physical) or ``--gamma``,
 and ``--format``; :func:`resolve` turns them into a :class:`Setup`, whose
-echo is printed with the output (results in both unit systems).
+echo is printed with the output (results in both unit systems).  ``--Td``
+may be a fractional number of periods (``Td / T = 40.5``): the commands
+that answer on the paper's loop as a :class:`symstab.Loop` take it, the
+others refuse it in one line (:func:`whole_delay`); ``--d`` is whole.
 Validation happens in the library; the caller
 (:func:`symstab.cli.commands.main`) turns ``ValueError``/``TypeError`` into one
 line on stderr and exit status 2.  A loop file's options are in
@@ -22,7 +25,7 @@ import numpy as np
 from .output import FORMATS, quiet_when_unread
 
 __all__ = ["add_command", "Setup", "UNITS_RULE", "add_model_options", "resolve", "parse_list",
-           "parse_one", "add_point_options", "stiffness_and_damping"]
+           "parse_one", "add_point_options", "stiffness_and_damping", "delay_text", "whole_delay"]
 
 
 def add_command(sub, name, *, help, description, example, func):
@@ -45,7 +48,7 @@ class Setup:
 
     device: object  # symstab.numeric.paper.device.Device or None (dimensionless input)
     gamma: float
-    d: int
+    d: object  # int, or a float for a fractional delay (--Td not a whole number of periods)
     delta: float
     units: dict
     echo: tuple  # lines describing the inputs
@@ -55,12 +58,17 @@ class Setup:
     def physical(self):
         return self.device is not None
 
+    @property
+    def fractional(self):
+        """Whether the delay is not a whole number of samples (``Td / T = 40.5``)."""
+        return not isinstance(self.d, int)
+
     def as_dict(self):
         out = {"gamma": self.gamma} if self.mass else {}
         out.update(d=self.d, delta=self.delta)
         if self.physical:
             out.update(m=self.device.m, b=self.device.b, T=self.device.T,
-                       Td=self.device.delay(self.d))
+                       Td=self.d * self.device.T)
             if self.mass:
                 out.update(M_w=self.device.mass(self.gamma))
             out.update(units=self.units)
@@ -85,11 +93,14 @@ def add_model_options(p):
     g.add_argument("--b", type=float, help="viscous friction, N m s/rad (N s/m with --linear), "
                                            ">= 0 (default 0.0324)")
     g.add_argument("--T", type=float, help="sample period, s, > 0 (default 0.001)")
-    g.add_argument("--Td", type=float, help="loop delay, s, a whole number of periods (default 0)")
+    g.add_argument("--Td", type=float, help="loop delay, s, >= 0 (default 0); a fraction of a "
+                                            "period (Td / T = 40.5) is taken by boundary, limits, "
+                                            "classify, design and locus")
     g = p.add_argument_group("device and delay (dimensionless, instead of --m --b --T --Td)")
     g.add_argument("--delta", type=float, help="b T / m, from 0 (frictionless) to 1e6")
     g.add_argument("--d", type=_integer, help="delay in samples, an integer >= 0 (also allowed "
-                                               "with the physical options instead of --Td)")
+                                               "with the physical options instead of --Td, which "
+                                               "takes a fractional delay)")
     g = p.add_argument_group("virtual mass")
     x = g.add_mutually_exclusive_group()
     x.add_argument("--gamma", type=float, help="M_w / m (default 0)")
@@ -106,9 +117,43 @@ def _integer(text):
         value = float(text)
     except ValueError:
         value = math.nan
+    if math.isfinite(value) and value >= 0 and not value.is_integer():
+        raise argparse.ArgumentTypeError(
+            f"delay d must be a whole number of samples, got {text!r}: give a fractional delay "
+            f"in seconds with --Td (e.g. --Td 0.0405 at T = 0.001 s), or with --loop as "
+            f"--set d={text}")
     if not (math.isfinite(value) and value.is_integer() and value >= 0):
         raise argparse.ArgumentTypeError(f"delay d must be a non-negative integer, got {text!r}")
     return int(value)
+
+
+def delay_text(d, T=None):
+    """The delay as printed: ``"d = 40"``; a fractional one ``"d = 40.5 samples"``.
+
+    With the period ``T`` (s), the delay in time first: ``"Td = 0.04 s (d =
+    40)"``, ``"Td = 40.5 ms (d = 40.5 samples)"`` (ms where Td is below a
+    second and the delay fractional, as a reader writes it).
+    """
+    samples = f"d = {d}" if isinstance(d, int) else f"d = {d:.10g} samples"
+    if T is None:
+        return samples
+    Td = d * T
+    if not isinstance(d, int) and 0 < Td < 1:
+        return f"Td = {Td * 1e3:.10g} ms ({samples})"
+    return f"Td = {Td:g} s ({samples})"
+
+
+def whole_delay(setup, command, reason="its computation takes whole samples only"):
+    """Refuse a fractional delay where ``command`` cannot take one, before any work.
+
+    ``setup`` is a :class:`Setup` or a :class:`symstab.cli.loop_options.LoopSetup`
+    (both have ``d`` and ``fractional``); the one line names the command,
+    the delay and why.
+    """
+    if setup.fractional:
+        raise ValueError(f"{command} does not take a fractional delay yet ({reason}), got "
+                         f"{delay_text(setup.d)}; give a whole number of samples (boundary, "
+                         f"limits, classify, design and locus take a fractional one)")
 
 
 def resolve(args, *, mass=True):
@@ -129,7 +174,7 @@ def resolve(args, *, mass=True):
         from .._validate import check_loop
         gamma, d, delta = check_loop(0.0 if args.gamma is None else args.gamma,
                                      0 if args.d is None else args.d, args.delta)
-        echo = (f"dimensionless: delta = {delta:.6g}, d = {d}"
+        echo = (f"dimensionless: delta = {delta:.6g}, {delay_text(d)}"
                 + (f", gamma = {gamma:.6g}" if mass else ""),)
         return Setup(None, gamma, d, delta, {}, echo, mass)
     if args.Td is not None and args.d is not None:
@@ -141,18 +186,31 @@ def resolve(args, *, mass=True):
         from .._validate import check_delay
         d = check_delay(args.d)
     else:
-        d = device.delay_samples(0.0 if args.Td is None else args.Td)
+        d = _delay_samples(0.0 if args.Td is None else args.Td, device.T)
     gamma = device.gamma(args.Mw) if args.Mw is not None else (0.0 if args.gamma is None else args.gamma)
     from .._validate import check_real
     gamma = check_real("gamma", gamma)
     units = device.units(rotary=not args.linear)
     mass_unit = units["M_w"]
     echo = (f"device: m = {device.m:g} {mass_unit}, b = {device.b:g} {units['B_w']}, "
-            f"T = {device.T:g} s; delay Td = {device.delay(d):g} s (d = {d})"
+            f"T = {device.T:g} s; delay {delay_text(d, device.T)}"
             + (f"; virtual mass M_w = {device.mass(gamma):g} {mass_unit} (gamma = {gamma:g})"
                if mass else ""),
             f"dimensionless: delta = b T / m = {device.delta:.6g}")
     return Setup(device, gamma, d, device.delta, units, echo, mass)
+
+
+def _delay_samples(Td, T):
+    """``Td / T`` in samples: an int when whole (to rounding), else the float (``40.5``).
+
+    Refused in one line: ``Td`` negative or not finite, ``Td / T`` beyond
+    ``SYMSTAB_MAX_DELAY``.
+    """
+    from .._validate import check_real, split_delay
+
+    Td = check_real("Td", Td, low=0.0)
+    whole, fraction = split_delay(Td / T, name="Td / T")
+    return whole if fraction is None else whole + float(fraction)
 
 
 def parse_list(text, name):

@@ -17,6 +17,7 @@ a failed or interrupted run leaves nothing behind.
 
 import dataclasses
 import io
+import math
 
 import numpy as np
 
@@ -29,6 +30,7 @@ from .options import (
     parse_one,
     resolve,
     stiffness_and_damping,
+    whole_delay,
 )
 from .output import check_files, write_output
 from .simulation import (
@@ -103,6 +105,9 @@ def _paper_plan(args):
     from ..numeric.simulation.simulator import check_steps
 
     setup = resolve(args)
+    whole_delay(setup, "simulate", "the paper's device simulator counts whole samples; "
+                                   "simulate --loop examples/loops/paper.toml --set Td=40.5ms "
+                                   "simulates the loop")
     alpha, beta = _point(args, setup)
     nonideal, x0 = resolve_nonideal(args, setup)
     _check_out(args.out)
@@ -147,7 +152,8 @@ def _loop_plan(args):
     loop, values = setup.loop, setup.values
     nonideal, x0 = resolve_nonideal(args, None, loop)
     _check_out(args.out)
-    steps = check_steps(args.steps, values["d"])
+    # A fractional delay's horizon: that of the next whole delay.
+    steps = check_steps(args.steps, math.ceil(values["d"]))
     # One point: its trajectory is kept (the verdict tells a mass held by
     # friction from a limit cycle by it).
     check_memory(f"the trajectory of {steps} periods", (steps + 1) * _TRAJECTORY_ROW_BYTES)

@@ -111,7 +111,7 @@ def test_png_is_written_and_deterministic(capsys, tmp_path):
     (["--Bw", "x", "--Kw", "0:30"], "--Bw must be a number"),
     (["--delta", "0.1", "--Bw", "0.1", "--alpha", "0:1"], "--Bw needs a physical device"),
     (["--Bw", "0.1", "--Kw", "0:30", "--set", "K=1"], "--set needs a loop file"),
-    (["--Bw", "0.1", "--Kw", "0:30", "--Td", "0.0405"], "whole number"),
+    (["--Bw", "0.1", "--Kw", "0:30", "--d", "40.5"], "give a fractional delay in seconds with --Td"),
     (["--loop", PAPER, "--Kw", "0:30"], "--Kw is an option of the paper's device"),
     (["--loop", PAPER, "--set", "K=1"], "give the path"),
     (["--loop", PAPER, "--set", "K=0:1", "--set", "B=0:1"], "already"),

@@ -277,7 +277,7 @@ MAP = ["--x-range=0,1,3", "--y-range=0,1,3", "--out", "m.npz"]
 
 
 @pytest.mark.parametrize("args, needle", [
-    (["limits", *L, "--Td", "0.04"], "--Td is an option of the paper's device; with --loop use --set d="),
+    (["limits", *L, "--Td", "0.04"], "--Td is an option of the paper's device; with --loop use --set Td=... (the delay in time"),
     (["limits", *L, "--gamma", "1"], "--set M="),
     (["limits", *L, "--m", "0.1"], "--set m="),
     (["limits", *L, "--linear"], "units of the loop file"),
@@ -294,7 +294,7 @@ MAP = ["--x-range=0,1,3", "--y-range=0,1,3", "--out", "m.npz"]
     (["limits", *L, "--set", "m="], "must be a number"),
     (["limits", *L, "--set", "m=nan"], "finite"),
     (["limits", *L, "--set", "m=inf"], "finite"),
-    (["limits", *L, "--set", "d=2.5"], "delay d"),
+    (["limits", *L, "--set", "d=2.5 s"], "the delay d is a number of samples"),
     (["limits", *L, "--set", "d=-1"], "delay d"),
     (["limits", *L, "--set", "T=-1"], "T must be"),
     (["limits", *L, "--set", "T=0"], "T must be"),

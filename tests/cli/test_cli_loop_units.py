@@ -202,8 +202,7 @@ def test_set_with_an_angle_to_the_parameters_power_is_converted(capsys, unit, fa
 
 
 @pytest.mark.parametrize("setting, shown", [
-    ("d=5.1 ms", "'5.1 ms'"), ("d=5.1", "'5.1'"), ("d=-1 samples", "'-1 samples'"),
-    ("K=1e999 N m/rad", "'1e999 N m/rad'"),
+    ("d=-1 samples", "'-1 samples'"), ("d=1e6", "'1e6'"), ("K=1e999 N m/rad", "'1e999 N m/rad'"),
 ])
 def test_a_refused_set_value_is_shown_as_written(capsys, setting, shown):
     """issue 40 item 16: --set "d=5.1 ms" said 'got 5.1', dropping the unit."""
@@ -211,3 +210,95 @@ def test_a_refused_set_value_is_shown_as_written(capsys, setting, shown):
     assert status == 2 and out == "" and err.count("\n") == 1, err
     assert err.startswith(f"symstab classify: error: --set {setting}: ") and err.endswith(
         f", got {shown}\n"), err
+
+
+# --------------------------------------------------------------------------
+# A fractional delay (issue 43): d = 40.5 samples, or Td in a unit of time
+
+
+def _paper_with(tmp_path, delay):
+    """The paper's loop file with its ``d = ...`` line replaced by ``delay``."""
+    text = PAPER.read_text(encoding="utf-8")
+    old = 'd = { value = 40, unit = "samples" }'
+    assert old in text
+    path = tmp_path / "paper_delay.toml"
+    path.write_text(text.replace(old, delay), encoding="utf-8")
+    return str(path)
+
+
+@pytest.fixture(scope="module")
+def k_max_at_40_5():
+    """The library's PAPER_LOOP at Td = 40.5 ms: the cross-check of the CLI's plumbing."""
+    import symstab
+
+    return symstab.PAPER_LOOP.limits("B", "K", Td=0.0405).y_max
+
+
+@pytest.mark.parametrize("delay, written", [
+    ('d = { value = 40.5, unit = "samples" }', None),
+    ("d = 40.5", None),
+    ('Td = { value = 40.5, unit = "ms" }', {"value": 40.5, "unit": "ms"}),
+    ("Td = 0.0405", {"value": 0.0405, "unit": "s"}),
+])
+def test_a_loop_file_takes_a_fractional_delay_in_samples_or_in_time(capsys, tmp_path,
+                                                                     k_max_at_40_5, delay, written):
+    out = run_json(capsys, "limits", "--loop", _paper_with(tmp_path, delay))
+    assert out["limits"]["y_max"] == pytest.approx(k_max_at_40_5, rel=1e-12)
+    assert out["inputs"]["values"]["d"] == 40.5        # a number in the JSON, in samples
+    assert out["inputs"].get("as_written", {}).get("Td") == written
+
+
+@pytest.mark.parametrize("setting", ["Td=40.5ms", "Td=0.0405 s", "d=40.5"])
+def test_set_takes_a_fractional_delay_in_samples_or_in_time(capsys, k_max_at_40_5, setting):
+    out = run_json(capsys, "limits", "--loop", PAPER, "--set", setting)
+    assert out["limits"]["y_max"] == pytest.approx(k_max_at_40_5, rel=1e-12)
+    assert out["inputs"]["values"]["d"] == 40.5 and "Td" not in out["inputs"]["values"]
+
+
+def test_the_echo_shows_a_delay_in_time_and_in_samples(capsys, tmp_path):
+    status, out, err = run(capsys, "classify", "--loop", PAPER, "--set", "Td=40.5ms")
+    assert status == 0, err
+    assert "Td = 40.5 ms (d = 40.5 samples) (--set)" in out
+    # --set d replaces the file's Td: the echo no longer names it.
+    path = _paper_with(tmp_path, 'Td = { value = 40.5, unit = "ms" }')
+    status, out, err = run(capsys, "classify", "--loop", path, "--set", "d=40")
+    assert status == 0, err
+    assert "d = 40 samples (--set)" in out and "Td" not in out
+
+
+@pytest.mark.parametrize("args, message", [
+    (["--set", "Td=40.5ms", "--set", "d=40"], "give the delay once"),
+    (["--set", "Td=40.5 kg"], "--set Td: parameter 'Td' has unit 'kg': Td is the loop delay"),
+    (["--set", "d=5.1 ms"], "the delay d is a number of samples"),
+    # Without a unit Td is in the file's unit for it, SI here: 40.5 s.
+    (["--set", "Td=40.5"], "--set Td: delay Td / T must be from 0 to 10000 samples"),
+    (["--set", "Td=-1ms"], "Td must be a finite real number >= 0"),
+    (["--set", "Td=40.5ms", "--set", "T=1e-3,2e-3"], "a delay in time needs one sample period T"),
+    (["--set", "d=nan"], "d must be a finite number"),
+    (["--d", "40.5"], "give a fractional delay in seconds with --Td"),
+])
+def test_a_bad_delay_is_refused_in_one_line(capsys, args, message):
+    status, out, err = run(capsys, "classify", "--loop", PAPER, *args)
+    assert status == 2 and out == "" and err.count("\n") == 1, err
+    assert err.startswith("symstab classify: error: ") and message in err, err
+
+
+def test_a_loop_file_with_both_d_and_td_is_refused(capsys, tmp_path):
+    path = _paper_with(tmp_path, 'd = 40\nTd = { value = 40.5, unit = "ms" }')
+    status, out, err = run(capsys, "limits", "--loop", path)
+    assert status == 2 and out == "" and err.count("\n") == 1, err
+    assert "give the delay once, d (in samples) or Td (in seconds)" in err
+
+
+@pytest.mark.parametrize("command, args, message", [
+    ("margins", ["--set", "K=1", "--set", "B=0.1"], "margins does not take a fractional delay"),
+    ("map", ["--x-range=0,0.5,3", "--y-range=0,5,3", "--out", "m.npz", "--margin", "delay"],
+     "map --margin delay does not take a fractional delay"),
+])
+def test_a_command_without_a_fractional_delay_says_so(capsys, tmp_path, monkeypatch, command,
+                                                      args, message):
+    monkeypatch.chdir(tmp_path)
+    status, out, err = run(capsys, command, "--loop", PAPER, "--set", "Td=40.5ms", *args)
+    assert status == 2 and out == "" and err.count("\n") == 1, err
+    assert err.startswith(f"symstab {command}: error: {message}"), err
+    assert list(tmp_path.iterdir()) == []

@@ -89,7 +89,7 @@ def test_map_margin_writes_the_library_s_map_and_its_figure(capsys, tmp_path):
     (["--simulate"], "--margin maps a margin of the linear loop"),
     (["--uncertain", "b=0.02:0.04"], "give one of them"),
     (["--margin", "phase"], "invalid choice: 'phase'"),
-    (["--margin", "delay", "--set", "d=1.5"], "delay d must be a non-negative integer"),
+    (["--margin", "delay", "--set", "d=1.5"], "map --margin delay does not take a fractional delay"),
 ])
 def test_map_margin_refuses_what_it_does_not_map(capsys, tmp_path, extra, message):
     args = ["map", "--loop", PAPER, "--x-range=0,0.2,3", "--y-range=0,2,3",

@@ -17,7 +17,7 @@ import symstab
 
 from conftest import PAPER_B, PAPER_DELTA, PAPER_M, PAPER_T
 from conftest import run_cli as run
-from oracles import python_control_closed_loop
+from oracles import fractional_delay_radius, python_control_closed_loop
 
 
 def test_limits_physical_echoes_units_and_matches_the_library(capsys):
@@ -33,6 +33,45 @@ def test_limits_physical_echoes_units_and_matches_the_library(capsys):
     k_max = lim.alpha_max * PAPER_M / PAPER_T**2
     line = next(line for line in out.splitlines() if "K_max" in line)
     assert f"{k_max:.10g}" in line and "N m/rad" in line
+
+
+def test_a_fractional_Td_gives_the_paper_loops_limits_at_that_delay(capsys):
+    """Issue 43: --Td 0.0405 (40.5 samples) was refused; it is the paper's loop at Td = 40.5 ms.
+
+    The cross-check of the plumbing is the library's PAPER_LOOP at Td = 0.0405 s.
+    """
+    data = json.loads(run(capsys, "limits", "--Td", "0.0405", "--format", "json")[1])
+    assert data["inputs"]["d"] == 40.5 and data["inputs"]["Td"] == pytest.approx(0.0405)
+    k_max = symstab.PAPER_LOOP.limits("B", "K", Td=0.0405).y_max
+    assert data["limits"]["alpha_max"] * PAPER_M / PAPER_T**2 == pytest.approx(k_max, rel=1e-12)
+    status, out, err = run(capsys, "limits", "--Td", "0.0405")
+    assert status == 0, err
+    assert "delay Td = 40.5 ms (d = 40.5 samples)" in out
+    assert "passive set (Colgate-Schenkel): not computed at a fractional delay" in out
+    line = next(line for line in out.splitlines() if "K_max" in line)
+    assert f"{k_max:.10g}" in line
+
+
+def test_classify_at_a_fractional_Td_agrees_with_the_sampled_state_space(capsys):
+    """The radius of the paper's loop at Td = 40.5 ms against an expm of the continuous plant."""
+    data = json.loads(run(capsys, "classify", "--Td", "0.0405", "--Kw", "1.28,3.84",
+                          "--Bw", "0.064", "--format", "json")[1])
+    radii = [fractional_delay_radius(K=K, B=0.064, M=0.0, m=PAPER_M, b=PAPER_B, T=PAPER_T,
+                                     delay=40.5) for K in (1.28, 3.84)]
+    assert [r["spectral radius"] for r in data["rows"]] == pytest.approx(radii, rel=1e-12)
+    assert [r["verdict"] for r in data["rows"]] == ["stable", "unstable"]
+    assert data["inputs"]["d"] == 40.5
+
+
+def test_boundary_at_a_fractional_Td_is_the_paper_loops_decomposition(capsys):
+    """Eq. (7) is for whole d: at Td / T = 40.5 the rows are PAPER_LOOP's D-decomposition."""
+    data = json.loads(run(capsys, "boundary", "--Td", "0.0405", "--n", "3", "--format",
+                          "json")[1])
+    curve = symstab.PAPER_LOOP.boundary(x="B", y="K", n=3, Td=0.0405)
+    assert [r["K_w [N m/rad]"] for r in data["rows"]] == pytest.approx(curve.y_values, rel=1e-9)
+    assert [r["alpha"] for r in data["rows"]] == pytest.approx(
+        np.asarray(curve.y_values) * PAPER_T**2 / PAPER_M, rel=1e-9)
+    assert data["inputs"]["d"] == 40.5
 
 
 def test_linear_units(capsys):
@@ -102,7 +141,20 @@ def test_design_finds_a_gain_over_no_virtual_mass(shared_cli_run):
     (["limits", "--m", "-1"], "m must be"),
     (["limits", "--T", "0"], "T must be"),
     (["limits", "--b", "nan"], "b must be"),
-    (["limits", "--Td", "0.0105"], "Td / T"),
+    (["limits", "--Td", "-0.001"], "Td must be a finite real number >= 0"),
+    (["limits", "--Td", "nan"], "Td must be a finite real number >= 0"),
+    (["limits", "--Td", "1e3"], "delay Td / T must be from 0 to 10000 samples"),
+    (["limits", "--d", "40.5"], "whole number of samples, got '40.5': give a fractional delay "
+                                "in seconds with --Td"),
+    # Issue 43: where the paper's loop cannot take a fractional delay, one line naming the command.
+    (["margins", "--Td", "0.0405", "--alpha", "1e-4", "--beta", "0.005"],
+     "margins does not take a fractional delay yet"),
+    (["simulate", "--Td", "0.0405", "--alpha", "1e-4", "--beta", "0.005"],
+     "simulate does not take a fractional delay yet"),
+    (["map", "--Td", "0.0405", "--alpha", "0:1e-3,3", "--beta", "0:0.01,3", "--out", "m.npz"],
+     "map does not take a fractional delay yet"),
+    (["design", "--Td", "0.0405", "--maximize", "passive"],
+     "design --maximize passive does not take a fractional delay yet"),
     (["limits", "--d", "2.5"], "delay d"),
     (["limits", "--d", "-1"], "delay d"),
     (["limits", "--gamma", "nan"], "gamma"),

@@ -14,7 +14,8 @@
     m = { value = 0.0128, unit = "kg" }
     b = { value = 0.0324, unit = "N s/m" }
     T = { value = 1, unit = "ms" }  # converted: T = 0.001 s
-    d = { value = 0, unit = "samples" }
+    d = { value = 0, unit = "samples" }  # 40.5: a fraction of a period more
+    # or the delay in time instead: Td = { value = 40.5, unit = "ms" }
     K = 300.0                       # a bare number: taken in SI, unchecked
     B = { value = 0.5, unit = "N s/m", min = 0 }   # a bound, checked
 
@@ -95,6 +96,9 @@ def parse_loop_text(text, *, source="<loop file>"):
     # Every value in SI, each unit read by pint (symstab.numeric.loop.quantities).
     values, units, file_values, bounds = read_parameters(data.get("parameters", {}),
                                                          source=source)
+    # Td is in seconds by definition (Loop takes no unit for it): its unit
+    # was checked to be a time and converted; the echo keeps it.
+    units.pop("Td", None)
     plane = data.get("plane")
     if plane is not None and not (isinstance(plane, list) and len(plane) == 2
                                   and all(isinstance(p, str) for p in plane)):

@@ -46,7 +46,8 @@ __all__ = ["unit_registry", "check_si_units", "ALLOWED_UNITS", "UnitInfo", "unit
            "read_parameters", "check_loop_units", "convert", "check_bounds", "SAMPLE_UNITS",
            "parameter_angle", "check_angle"]
 
-#: The only units of the delay ``d``, a whole number of samples.
+#: The only units of the delay ``d``, a number of samples (40 or 40.5); the
+#: delay in time is ``Td``, in a unit of time (``Td = { value = 40.5, unit = "ms" }``).
 SAMPLE_UNITS = ("samples", "sample")
 #: Keys of a parameter's table in a loop file.
 ENTRY_KEYS = ("value", "unit", "min", "max", "above", "below")
@@ -289,7 +290,8 @@ def _check_number(source, name, value):
 def convert(name, value, unit, *, where):
     """``value`` given in ``unit`` for the parameter ``name``: a :class:`FileValue` in SI.
 
-    ``T`` must be a time and ``d`` a number of samples; a frequency written
+    ``T`` and ``Td`` (the delay in time, instead of ``d``) must be times and
+    ``d`` a number of samples (whole or not); a frequency written
     with an angle (rad/s, rpm) is refused (the loop's expressions take a
     frequency in Hz = 1/s, and SI would read 1 rad/s as 1 Hz).  The
     dimension of any other parameter is checked against the loop by
@@ -318,25 +320,28 @@ def convert(name, value, unit, *, where):
     from ...symbolic.loop_assembly import check_text_line
 
     if unit is None:
-        return FileValue(name, value, None, value, "samples" if name == "d" else "")
+        return FileValue(name, value, None, value, {"d": "samples", "Td": "s"}.get(name, ""))
     try:
         check_text_line(f"unit of {name!r}", unit)
     except (TypeError, ValueError) as exc:
         raise ValueError(f"{where}: {exc}") from None
     if name == "d":
         if unit not in SAMPLE_UNITS:
-            raise ValueError(f"{where}: parameter 'd' has unit {unit!r}: the delay d is a whole "
-                             f"number of samples (unit \"samples\", or none)")
+            raise ValueError(f"{where}: parameter 'd' has unit {unit!r}: the delay d is a "
+                             f"number of samples (unit \"samples\", or none; 40.5 is a fraction "
+                             f"of a period more); give a delay in time as Td (Td = {{ value = "
+                             f"40.5, unit = \"ms\" }})")
         return FileValue(name, value, unit, value, "samples")
     try:
         info = unit_info(unit)
     except ValueError as exc:
         raise ValueError(f"{where}: parameter {name!r}: {exc}") from None
-    if name == "T" and info.dimensions != _vector({"[time]": 1}):
+    if name in ("T", "Td") and info.dimensions != _vector({"[time]": 1}):
         named = dimension_name(info.dimensions)
-        raise ValueError(f"{where}: parameter 'T' has unit {unit!r}"
+        what = "the sample period" if name == "T" else "the loop delay (in samples: d)"
+        raise ValueError(f"{where}: parameter {name!r} has unit {unit!r}"
                          + ("" if named == unit else f" ({named})")
-                         + ": T is the sample period, a time (s, ms, us)")
+                         + f": {name} is {what}, a time (s, ms, us)")
     # A rotary stiffness or damping in N m/deg^2: the dimension fits, the angle does not.
     check_angle(name, info, parameter_angle(info.dimensions), where=where)
     if info.dimensions == _vector({"[time]": -1}) and info.angle:
