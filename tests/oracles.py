@@ -218,54 +218,6 @@ def python_control_closed_loop(*, alpha, beta, gamma, d, delta, m, T):
     return control.feedback(G, VE * delay)
 
 
-def fractional_delay_radius(*, K, B, M, m, b, T, delay):
-    """The spectral radius of the paper's loop with a delay of ``delay`` samples, whole or not.
-
-    From the continuous state space, not from a z-transform: the mass
-    ``m p'' + b p' = u`` sampled every ``T``; the command ``u[k] = -VE p``
-    (eq. (1)'s backward differences of the sampled position) is held for a
-    period and reaches the mass ``delay * T`` later, so with ``delay = d +
-    eps`` the period ``[kT, (k+1)T)`` sees ``u[k-d-1]`` for ``eps T`` and then
-    ``u[k-d]``.  Each piece is ``expm`` of the augmented matrix ``[[A, b], [0,
-    0]]`` (scipy); the state ``(p, p', p[k-1], p[k-2], u[k-1] ... u[k-d-1])``
-    steps by one matrix, whose largest eigenvalue modulus is returned.
-    """
-    from scipy.linalg import expm
-
-    d = int(math.floor(delay))
-    eps = delay - d
-    A = np.array([[0.0, 1.0], [0.0, -b / m]])
-    Bu = np.array([0.0, 1.0 / m])
-
-    def held(t):
-        """``(exp(A t), integral_0^t exp(A s) ds Bu)``."""
-        big = np.zeros((3, 3))
-        big[:2, :2], big[:2, 2] = A * t, Bu * t
-        E = expm(big)
-        return E[:2, :2], E[:2, 2]
-
-    Phi, _ = held(T)
-    late, gamma_late = held((1.0 - eps) * T)
-    _, gamma_early = held(eps * T)
-    gamma_early = late @ gamma_early        # u[k-d-1], for the first eps T of the period
-    n = 4 + d + 1
-    # u[k] = -(K p + B (p - p1)/T + M (p - 2 p1 + p2)/T^2) in the state's coordinates.
-    u_now = np.zeros(n)
-    u_now[0] = -(K + B / T + M / T**2)
-    u_now[2] = B / T + 2 * M / T**2
-    u_now[3] = -M / T**2
-    step = np.zeros((n, n))
-    newest = u_now if d == 0 else np.eye(n)[4 + d - 1]        # u[k-d]
-    oldest = np.eye(n)[4 + d]                                  # u[k-d-1]
-    step[:2] = Phi @ np.eye(n)[:2] + np.outer(gamma_late, newest) + np.outer(gamma_early, oldest)
-    step[2, 0] = 1.0          # p[k] becomes p[k-1]
-    step[3, 2] = 1.0          # p[k-1] becomes p[k-2]
-    step[4] = u_now           # u[k] becomes u[k-1]
-    for k in range(5, n):
-        step[k, k - 1] = 1.0
-    return float(np.max(np.abs(np.linalg.eigvals(step))))
-
-
 def python_control_parts(loop, values):
     """python-control's ``(P(z), VE(z), z**-d)`` of a :class:`symstab.Loop` at ``values``.
 

@@ -109,9 +109,6 @@ def run(args):
     if args.uncertain is not None:
         return _probability(args, setup, xs, ys, out, png_path)
     if args.margin is not None:
-        if args.margin == "delay":
-            whole_delay(setup, "map --margin delay", "the delay margin counts whole samples "
-                                                     "added to a whole delay")
         return _margin(args, setup, xs, ys, out, png_path)
     return _map(_LoopMap(args, setup, xs, ys, out, png_path))
 

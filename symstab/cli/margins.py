@@ -18,7 +18,6 @@ from .options import (
     add_point_options,
     parse_one,
     stiffness_and_damping,
-    whole_delay,
 )
 from .output import emit
 
@@ -33,8 +32,10 @@ def register(subparsers):
                     "loop L on the unit circle (certified to a relative 1e-9), every gain "
                     "margin (at each phase crossover) and phase margin (at each gain "
                     "crossover), the stable interval of each plane parameter through the "
-                    "point, and the delay margin: the fewest whole samples of added delay "
-                    "at which the loop is no longer stable.",
+                    "point, and the delay margin: the smallest added delay (exact, from the "
+                    "fractional-delay derivation) at which a root reaches the unit circle, "
+                    "and the fewest whole samples of added delay at which the loop is no "
+                    "longer stable.",
         example="symstab margins --Td 0.005 --Kw 100 --Bw 1", func=run)
     add_model_options(p)
     add_point_options(p)
@@ -47,8 +48,6 @@ def register(subparsers):
 def run(args):
     """Run ``symstab margins``: a loop file's point (``--loop``), else the paper's."""
     setup = resolve_setup(args, plane=False)
-    # symstab.Loop.margins asks its questions at the delay's whole samples.
-    whole_delay(setup, "margins", "the margins are computed at the delay's whole samples")
     values = dict(setup.values)
     T = None
     if setup.paper is not None:
@@ -71,9 +70,16 @@ def run(args):
         name = setup.label(p.name)
         rows.append((f"{name} down to", p.low, None, None, f"from {p.value:.6g}"))
         rows.append((f"{name} up to", p.high, None, None, f"from {p.value:.6g}"))
-    rows.append(("delay [samples]", found.delay, None, None, found.delay_note))
-    notes = ["L: the open loop VE(z) z^-d P(z), P the plant behind the zero-order hold; "
-             "the delay margin is in whole samples (a fractional delay is not derived yet)"]
+    exact = found.exact_delay
+    if exact is not None and exact.margin is not None:
+        first = exact.switches[0]
+        rows.append(("delay [samples]", first.added, first.theta, _hz(first.theta, T),
+                     f"exact: a root on the unit circle at d = {first.samples:.9g}"))
+    rows.append(("delay, whole [samples]", found.delay, None, None, found.delay_note))
+    notes = ["L: the open loop VE(z) z^-d P(z), P the plant behind the zero-order hold "
+             "(delayed by a fraction of a period where d is not whole); the exact delay "
+             "margin is the fractional-delay derivation's, the whole one what added whole "
+             "samples of computation can afford"]
     if T is None:
         notes.append("frequency: give the device's physical options (not --delta) for Hz")
     emit(setup, args.format, columns, rows, notes=notes, result={"margins": found.as_dict()})

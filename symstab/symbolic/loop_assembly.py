@@ -854,6 +854,10 @@ class LoopModel:
                               lambda parts: not parts[0] or self._fractional_agrees(parts))
         return parts if parts[0] else None
 
+    def plant_parts_of(self, fraction=False):
+        """The symbolic plant's ``(P_n, P_d)``, or with ``fraction`` ``(N_eps, z P_d)`` (or None)."""
+        return self._fractional_plant_parts if fraction else self._plant_parts
+
     def _fractional_agrees(self, parts):
         """Whether ``(N_eps, z P_d)`` give the matrix exponential's ``P_eps`` at the check point."""
         point = {**self._check_point, FRACTION: sp.Float("0.3183098861837907", PLANT_DIGITS)}

@@ -11,6 +11,8 @@ import re
 
 import pytest
 
+import symstab
+
 from conftest import REPO, manual_text
 from conftest import run_cli as run
 from conftest import run_cli_json as run_json
@@ -290,15 +292,12 @@ def test_a_loop_file_with_both_d_and_td_is_refused(capsys, tmp_path):
     assert "give the delay once, d (in samples) or Td (in seconds)" in err
 
 
-@pytest.mark.parametrize("command, args, message", [
-    ("margins", ["--set", "K=1", "--set", "B=0.1"], "margins does not take a fractional delay"),
-    ("map", ["--x-range=0,0.5,3", "--y-range=0,5,3", "--out", "m.npz", "--margin", "delay"],
-     "map --margin delay does not take a fractional delay"),
-])
-def test_a_command_without_a_fractional_delay_says_so(capsys, tmp_path, monkeypatch, command,
-                                                      args, message):
-    monkeypatch.chdir(tmp_path)
-    status, out, err = run(capsys, command, "--loop", PAPER, "--set", "Td=40.5ms", *args)
-    assert status == 2 and out == "" and err.count("\n") == 1, err
-    assert err.startswith(f"symstab {command}: error: {message}"), err
-    assert list(tmp_path.iterdir()) == []
+def test_margins_at_a_fractional_delay_are_the_loops(capsys):
+    """--set Td=40.5ms: the exact delay margin and the whole one, both the library's at 40.5."""
+    found = symstab.load_loop(PAPER).margins(K=1.0, B=0.1, d=40.5)
+    margins = run_json(capsys, "margins", "--loop", PAPER, "--set", "Td=40.5ms", "--set", "K=1",
+                       "--set", "B=0.1")["margins"]
+    assert margins["point"]["d"] == 40.5
+    assert margins["modulus"] == pytest.approx(found.modulus, rel=1e-12)
+    assert margins["exact_delay"]["margin"] == pytest.approx(found.exact_delay.margin, rel=1e-12)
+    assert margins["delay"] == found.delay

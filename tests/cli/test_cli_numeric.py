@@ -56,8 +56,10 @@ def test_classify_at_a_fractional_Td_agrees_with_the_sampled_state_space(capsys)
     """The radius of the paper's loop at Td = 40.5 ms against an expm of the continuous plant."""
     data = json.loads(run(capsys, "classify", "--Td", "0.0405", "--Kw", "1.28,3.84",
                           "--Bw", "0.064", "--format", "json")[1])
-    radii = [fractional_delay_radius(K=K, B=0.064, M=0.0, m=PAPER_M, b=PAPER_B, T=PAPER_T,
-                                     delay=40.5) for K in (1.28, 3.84)]
+    # The paper's mass and K + B (z - 1) / (T z), written out: ((K T + B) z - B) / (T z).
+    radii = [fractional_delay_radius([1.0], [PAPER_M, PAPER_B, 0.0],
+                                     [K * PAPER_T + 0.064, -0.064], [PAPER_T, 0.0], PAPER_T,
+                                     40, 0.5) for K in (1.28, 3.84)]
     assert [r["spectral radius"] for r in data["rows"]] == pytest.approx(radii, rel=1e-12)
     assert [r["verdict"] for r in data["rows"]] == ["stable", "unstable"]
     assert data["inputs"]["d"] == 40.5

@@ -39,7 +39,7 @@ from ..engine.results import html_table
 from ..engine.roots import STABLE, circle_minimum
 from ..engine.search import bracketed_root
 from ..loop.evaluation import FRACTION
-from .margins import _phase_crossings, delay_limit_of, stable_point
+from .margins import phase_crossings, delay_limit_of, stable_point
 
 __all__ = ["DelaySwitch", "DelayMargin", "delay_margin"]
 
@@ -280,7 +280,7 @@ def _crossing_angle(chi, T):
     ``|1 + L|`` where no candidate is a root to 1e-8 of them.
     """
     delayed, direct = chi.delayed.reshape(-1), chi.direct.reshape(-1)
-    candidates = [c.theta for c in _phase_crossings(delayed, direct, chi.shift, T)]
+    candidates = [c.theta for c in phase_crossings(delayed, direct, chi.shift, T)]
     candidates = np.array(candidates + [0.0, math.pi])
     dense = chi.dense().reshape(-1)
     residual = (np.abs(np.polyval(dense, np.exp(1j * candidates)))

@@ -287,8 +287,6 @@ def margins(loop, *, parameters=None, delay_limit=None, rtol=1e-9, **values):
     >>> round(found.modulus, 6), round(found.modulus_frequency, 3)
     (0.739598, 19.022)
     """
-    from .delays import delay_margin  # it asks this module's questions in turn
-
     point = stable_point(loop, values)
     chi = loop.polynomial(**point)
     T = float(point["T"])
@@ -296,7 +294,7 @@ def margins(loop, *, parameters=None, delay_limit=None, rtol=1e-9, **values):
         "rtol", rtol, low=0.0, low_open=True, high=0.5, high_open=True)))
     delayed, direct = chi.delayed.reshape(-1), chi.direct.reshape(-1)
     limit = delay_limit_of(point["d"], delay_limit)
-    phase = _phase_crossings(delayed, direct, chi.shift, T)
+    phase = phase_crossings(delayed, direct, chi.shift, T)
     return Margins(
         point=point, T=T, modulus=upper, modulus_lower=lower, modulus_theta=theta,
         modulus_frequency=theta / (2 * math.pi * T),
@@ -306,7 +304,8 @@ def margins(loop, *, parameters=None, delay_limit=None, rtol=1e-9, **values):
                          for name in _margin_parameters(loop, parameters)),
         delay=_delay_margin(loop, point, limit, _first_delay(phase, delayed, direct)),
         delay_limit=limit,
-        exact_delay=delay_margin(loop, limit=limit, every=False, **point) if limit else None)
+        # The loop's own question (symstab.numeric.analysis.delays), which asks this module's.
+        exact_delay=loop.delay_margin(limit=limit, every=False, **point) if limit else None)
 
 
 def classified_point(loop, values):
@@ -436,8 +435,12 @@ def _autocorrelation(c):
     return full[len(c) - 1:]
 
 
-def _phase_crossings(delayed, direct, shift, T):
-    """Every gain crossover (``|L| = 1``) with its phase margin ``180 + arg L`` (degrees)."""
+def phase_crossings(delayed, direct, shift, T):
+    """Every gain crossover (``|L| = 1``) with its phase margin ``180 + arg L`` (degrees).
+
+    ``chi = z**shift delayed + direct`` (rows highest first); ``T`` the
+    sample period (for the frequencies).  A tuple of :class:`NyquistCrossing`.
+    """
     rn, rd = _autocorrelation(direct), _autocorrelation(delayed)
     size = max(len(rn), len(rd))
     series = np.zeros(size)
@@ -749,7 +752,7 @@ def _delay_margins(loop, chi, values, x, y, limit):
     verdicts at one added delay asked for every point that waits on it at once.
     """
     (x, xs), (y, ys) = x, y
-    first = np.array([_first_delay(_phase_crossings(delayed, direct, chi.shift, 1.0), delayed,
+    first = np.array([_first_delay(phase_crossings(delayed, direct, chi.shift, 1.0), delayed,
                                    direct)
                       for delayed, direct in zip(chi.delayed.reshape(len(xs), -1),
                                                  chi.direct.reshape(len(xs), -1), strict=True)],

@@ -86,34 +86,28 @@ class Loop(LoopModel):
     values : dict, optional
         Default values of parameters (used where a call does not give one).
     name : str, optional
-        A word for reprs and generated files (ASCII letters, digits, ``_``,
-        ``-``, ``.``).
+        A word for reprs and generated files (ASCII letters, digits, ``_-.``).
     units : dict, optional
-        The SI unit of each parameter, as text (shown by the CLI), e.g. ``{"K": "N/m"}``.
-        The loop computes with its values as given, so a unit that is not SI (``"ms"``) is
-        refused, and so are units whose dimensions do not fit the loop; a loop file's units
-        are converted (:func:`symstab.load_loop`).
+        The SI unit of each parameter, as text, e.g. ``{"K": "N/m"}``: a unit not SI
+        (``"ms"``) or whose dimensions do not fit is refused (a loop file's are converted,
+        :func:`symstab.load_loop`).
     description : str, optional
         One line on what the loop is.
     plane : (str, str), optional
         The default ``(x, y)`` plane of :meth:`boundary` and :meth:`limits`
         (for example ``("B", "K")``); checked to be jointly affine.
     arc : callable, optional
-        The loop's arc in closed form, where SymPy derived one:
-        ``arc(x, y, values)`` gives ``theta -> (x, y)``, the point of the
-        ``(x, y)`` plane where ``exp(j theta)`` is a root at the other
-        ``values`` (NaN where the closed form does not keep its digits), or
-        None for a plane it does not cover.  The line engine refines its
-        crossings on it (the paper's loop: eq. (7)'s kernel).
+        The loop's arc in closed form, where SymPy derived one (whole delays):
+        ``arc(x, y, values)`` gives ``theta -> (x, y)``, the point of the plane
+        where ``exp(j theta)`` is a root (NaN where the form loses its digits),
+        or None for a plane it does not cover (the paper's loop: eq. (7)).
     polynomial : callable, optional
-        The loop's characteristic polynomial in closed form, where SymPy
-        derived one: ``polynomial(values, d)`` gives a
-        :class:`~symstab.numeric.engine.polynomial.DelayedPolynomial` with the
-        roots of ``chi`` (any nonzero scale) at ``values`` (arrays that
-        broadcast together, ``d`` apart), of their broadcast shape.  :meth:`classify`,
-        :meth:`unstable_root_counts` and :meth:`spectral_radius` count its
-        roots (the paper's loop: eq. (5)'s kernel, exact next to ``z = 1``
-        and from ``b T/m = 0`` to 1e6); :meth:`polynomial` stays the loop's own.
+        ``chi`` in closed form, where SymPy derived one (whole delays):
+        ``polynomial(values, d)`` gives a
+        :class:`~symstab.numeric.engine.polynomial.DelayedPolynomial` with its
+        roots at ``values`` (arrays that broadcast), whose roots
+        :meth:`classify` and the root counts count (the paper's loop: eq. (5),
+        exact next to ``z = 1``); :meth:`polynomial` stays the loop's own.
     actuator : str or sympy.Expr, optional
         ``A(s)``, the factor of the plant from the force command to the
         force on the driven mass (an amplifier's lag, ``"1/(tau*s + 1)"``);
@@ -125,7 +119,8 @@ class Loop(LoopModel):
     ----------
     parameters : tuple of str
         The names of the loop's parameters: the plant's and the
-        environment's, then ``T`` and ``d``.
+        environment's, then ``T`` and ``d``, the delay in samples (whole or
+        not; every question also takes ``Td``, the delay in seconds, instead).
     zoh_method : str
         ``'residues'`` (the plant's pulse transfer function derived
         symbolically) or ``'matrix exponential'`` (numerically, at 30 digits).
@@ -167,8 +162,7 @@ class Loop(LoopModel):
         self._closed_polynomial = polynomial
         self.evaluation = LoopEvaluation(
             self, plant=self._numeric_plant, exact_plant=self._exact_plant,
-            plant_parts=lambda fraction=False: (self._fractional_plant_parts if fraction
-                                                else self._plant_parts), kernels=lambda: self._kernels,
+            plant_parts=self.plant_parts_of, kernels=lambda: self._kernels,
             closed_polynomial=polynomial, closed_arc=arc)
         if self.units:
             self._check_units()
@@ -466,9 +460,7 @@ class Loop(LoopModel):
         return margins(self, parameters=parameters, delay_limit=delay_limit, rtol=rtol, **values)
 
     def delay_margin(self, *, limit=None, step=None, every=None, **values):
-        """The exact delay margin at a stable point, and where stability switches back and forth.
-
-        See :func:`symstab.numeric.analysis.delays.delay_margin`."""
+        """The exact delay margin: :func:`symstab.numeric.analysis.delays.delay_margin`."""
         from ..analysis.delays import delay_margin
 
         return delay_margin(self, limit=limit, step=step, every=every, **values)
