@@ -39,7 +39,7 @@ from ..engine.results import html_table
 from ..engine.roots import STABLE, circle_minimum
 from ..engine.search import bracketed_root
 from ..loop.evaluation import FRACTION
-from .margins import phase_crossings, delay_limit_of, stable_point
+from .margins import delay_limit_of, phase_crossings, stable_point
 
 __all__ = ["DelaySwitch", "DelayMargin", "delay_margin"]
 
