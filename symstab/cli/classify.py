@@ -28,6 +28,8 @@ __all__ = ["register", "run"]
 #: From this many points times the degree on, the radius takes seconds
 #: (0.3 s a point at d = 5000): ``classify`` says on stderr what runs.
 _ANNOUNCE_WORK = 100_000
+#: The most stable points whose delay margin is given (each is a search of its own).
+MAX_DELAY_MARGINS = 100
 
 
 def register(subparsers):
@@ -38,7 +40,9 @@ def register(subparsers):
                     "circle (Schur-Cohn, or a certified count by the argument principle where "
                     "that is not decisive) whether each stiffness-damping point is stable, "
                     "unstable or marginal, and give the spectral radius of the loop and the "
-                    "number of its poles outside the unit circle.",
+                    "number of its poles outside the unit circle; at a stable point, the "
+                    "delay margin: the smallest delay added (in samples, exact, fractional) "
+                    "at which a root reaches the unit circle.",
         example="symstab classify --Td 0.01 --Kw 1,3,10 --Bw 0.2", func=run)
     add_model_options(p)
     add_point_options(p, lists=True)
@@ -79,15 +83,35 @@ def run(args):
         device = setup.paper.device
         columns += physical_columns(setup.paper, ["K_w", "B_w"])
         rows = [r + (float(device.stiffness(r[0])), float(device.damping(r[1]))) for r in rows]
-    columns += ["spectral radius", "unstable poles", "verdict"]
+    columns += ["spectral radius", "unstable poles", "verdict", "delay margin [samples]"]
+    margins, note = _delay_margins(loop, values, code == STABLE)
     for k in range(n):
         verdict = "stable" if code[k] == STABLE else "marginal" if code[k] == MARGINAL else "unstable"
         # A marginal verdict (a pole on the circle, or at infinity: the leading
         # coefficient lost in rounding) has no count to trust.
         poles = None if counts[k] < 0 or code[k] == MARGINAL else int(counts[k])
-        rows[k] += (float(radius[k]), poles, verdict)
+        rows[k] += (float(radius[k]), poles, verdict, margins[k])
     notes = ["unstable poles: closed-loop poles outside the unit circle, a certified count "
              "(empty where marginal: a pole on the circle to within rounding, or at "
-             "infinity where the leading coefficient vanishes)"]
+             "infinity where the leading coefficient vanishes)", note]
     emit(setup, args.format, columns, rows, notes=notes)
     return 0
+
+
+def _delay_margins(loop, values, stable):
+    """The exact delay margin at each stable point (None elsewhere), and the table's note on it."""
+    from ..numeric.analysis.margins import delay_limit_of
+
+    n = len(stable)
+    out = [None] * n
+    if np.count_nonzero(stable) > MAX_DELAY_MARGINS:
+        return out, (f"delay margin: left out, more than {MAX_DELAY_MARGINS} stable points (each "
+                     f"is a search of its own; symstab margins gives one point's)")
+    limit = delay_limit_of(float(values["d"]), None, whole=False)
+    for k in np.flatnonzero(stable):
+        point = {name: (v if name == "d" else float(v[k])) for name, v in values.items()}
+        found = loop.delay_margin(**point)
+        out[k] = found.margin
+    return out, (f"delay margin: the smallest added delay at which a root reaches the unit "
+                 f"circle (Loop.delay_margin), empty where none is found up to {limit:g} "
+                 f"samples more or the point is not stable")
