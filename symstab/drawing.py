@@ -21,7 +21,7 @@ import numpy as np
 
 __all__ = ["Plot", "plot_region", "plot_limits", "plot_boundary", "plot_robust",
            "plot_probability", "plot_design", "plot_pareto", "plot_passive", "plot_locus",
-           "plot_simulation", "plot_map", "plot_margin_map", "require_matplotlib", "pyplot",
+           "plot_simulation", "plot_map", "plot_margin_map", "plot_delay_range_map", "require_matplotlib", "pyplot",
            "pyplot_or_none", "png_bytes", "visible",
            "draw_lines", "label_log_axis", "png_of", "png_or_none", "design_figure",
            "simulated_map_figure", "loop_map_figure", "probability_map_figure", "robust_figure",
@@ -1789,4 +1789,54 @@ def plot_margin_map(found, ax=None, *, region=None, levels=None):
     ax.set_xlabel(found.x)
     ax.set_ylabel(found.y)
     ax.set_title(f"{found.margin} margin (blank: not stable)")
+    return Plot(figure, ax, artists)
+
+
+def plot_delay_range_map(found, ax=None):
+    """Draw the two sets of a delay range over a grid: every constant delay, every varying one.
+
+    What :meth:`symstab.numeric.analysis.delay_range.DelayRangeMap.plot`
+    draws: the points stable for every constant delay of the range shaded
+    light, those the small-gain criterion shows stable for every varying
+    sequence shaded dark over them (none where it is not derived).
+
+    Parameters
+    ----------
+    found : symstab.numeric.analysis.delay_range.DelayRangeMap
+    ax : matplotlib.axes.Axes, optional
+        Where to draw (default: a new figure's axes).
+
+    Returns
+    -------
+    Plot
+        Artists ``"constant"`` and ``"varying"`` (filled contours).
+
+    Raises
+    ------
+    ImportError
+        Without matplotlib.
+    """
+    from matplotlib.patches import Patch
+
+    figure, ax = _axes(ax)
+    xs, ys = np.asarray(found.x_values, float), np.asarray(found.y_values, float)
+    artists = {"constant": [], "varying": []}
+    low, high = found.samples
+    handles = []
+    for key, mask, color, label in (
+            ("constant", found.constant, "#9ecae1", "every constant delay"),
+            ("varying", found.varying, "#08519c", "every varying delay (small gain)")):
+        if mask is None or not np.any(mask):
+            continue
+        artists[key] = [ax.contourf(xs, ys, np.asarray(mask, float), levels=[0.5, 1.5],
+                                    colors=[color])]
+        handles.append(Patch(color=color, label=label))
+    if handles:
+        ax.legend(handles=handles, loc="best", fontsize=LEGEND_SIZE, framealpha=0.9)
+    ax.set_xlim(xs[0], xs[-1])
+    ax.set_ylim(ys[0], ys[-1])
+    ax.set_xlabel(found.x)
+    ax.set_ylabel(found.y)
+    varying = "" if found.varying is not None else " (varying: not derived)"
+    ax.set_title(f"stable for delays of {low:g} to {high:g} samples{varying}")
     return Plot(figure, ax, artists)

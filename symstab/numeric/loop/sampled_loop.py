@@ -235,13 +235,8 @@ class Loop(LoopModel):
         """Coefficients of ``chi(z)`` (highest power first), divided by ``P_d``'s leading one.
 
         Dense: for short delays and for comparisons; the loop's own
-        computations keep ``chi`` structured (:meth:`polynomial`).
-
-        Parameters
-        ----------
-        **values
-            Every parameter (:attr:`parameters`), or its default; arrays
-            broadcast; ``d`` is an integer.
+        computations keep ``chi`` structured (:meth:`polynomial`).  ``**values``:
+        as :meth:`polynomial`'s.
 
         Returns
         -------
@@ -256,13 +251,9 @@ class Loop(LoopModel):
         ``D = Ve_d P_d`` and ``N = Ve_n P_n``, divided by ``P_d``'s leading
         coefficient, one polynomial per point; what :meth:`classify`,
         :meth:`unstable_root_counts` and :meth:`spectral_radius` work on, in
-        O(d) per point.
-
-        Parameters
-        ----------
-        **values
-            Every parameter (:attr:`parameters`), or its default; arrays
-            broadcast; ``d`` is an integer.
+        O(d) per point.  ``**values``: every parameter (:attr:`parameters`) or its
+        default, arrays broadcast; ``d`` in samples, whole or not, or ``Td`` in
+        seconds (a fraction of a period is carried by the plant: ``P_eps = N_eps / (z P_d)``).
         """
         return self.evaluation.polynomial(values)
 
@@ -464,6 +455,12 @@ class Loop(LoopModel):
         from ..analysis.delays import delay_margin
 
         return delay_margin(self, limit=limit, step=step, every=every, **values)
+
+    def delay_range(self, *, delay_range, rtol=1e-6, **values):
+        """Every delay of a range: :func:`symstab.numeric.analysis.delay_range.delay_range`."""
+        from ..analysis.delay_range import delay_range as check
+
+        return check(self, delay_range=delay_range, rtol=rtol, **values)
 
     def force_noise(self, *, encoder_resolution, **values):
         """The force RMS of the encoder's quantization at a stable point.

@@ -1,0 +1,104 @@
+"""Delays in a range (:mod:`symstab.numeric.analysis.delay_range`) against python-control and the oracle.
+
+The small-gain bound ``min |1 + L| / (N |z - 1| |L|)`` is recomputed from
+python-control's open loop on a fine grid of the circle, refined by SciPy;
+the constant set from the state-space oracle's spectral radius at delays
+across the range (:func:`oracles.fractional_delay_radius`).
+"""
+
+import numpy as np
+import pytest
+import scipy.optimize
+
+import symstab
+from conftest import REPO
+from oracles import fractional_delay_radius, loop_coefficients, python_control_parts
+
+PAPER = REPO / "examples" / "loops" / "paper.toml"
+
+
+@pytest.fixture(scope="module")
+def loop():
+    return symstab.load_loop(PAPER)
+
+
+def _small_gain_bound(loop, point, n_samples):
+    """min over theta of |1 + L| / (N |e^{j theta} - 1| |L|), L python-control's at d_min."""
+    plant, environment, delay = python_control_parts(loop, point)
+    L = environment * delay * plant
+
+    def ratio(theta):
+        z = np.exp(1j * theta)
+        value = L(z)
+        return np.abs(1 + value) / (n_samples * np.abs(z - 1) * np.abs(value))
+
+    grid = np.linspace(1e-6, np.pi, 20001)
+    values = ratio(grid)
+    step = grid[1] - grid[0]
+    best = []
+    for k in np.argsort(values)[:5]:
+        lo, hi = max(grid[k] - step, 1e-9), min(grid[k] + step, np.pi)
+        found = scipy.optimize.minimize_scalar(lambda t: float(ratio(t)), bounds=(lo, hi),
+                                               method="bounded", options={"xatol": 1e-13})
+        best.append(found.fun)
+    return min(best)
+
+
+@pytest.mark.parametrize("values, delays", [
+    (dict(K=20.0, B=0.5, M=0.0), (0.002, 0.004)),
+    (dict(K=2.0, B=0.1, M=0.0), (0.040, 0.045)),
+    (dict(K=2.0, B=0.1, M=0.0), (0.040, 0.060)),
+    (dict(K=500.0, B=3.0, M=0.0), (0.0, 0.002)),
+])
+def test_the_small_gain_bound_is_python_control_s(loop, values, delays):
+    found = loop.delay_range(delay_range=delays, **values)
+    point = {**loop.defaults, **values, "d": round(delays[0] / loop.defaults["T"])}
+    expected = _small_gain_bound(loop, point, round((delays[1] - delays[0]) / point["T"]))
+    # The certified lower bound is within its bracket (rtol 1e-6) of the true minimum.
+    assert found.gain_margin == pytest.approx(expected, rel=2e-6)
+    assert found.gain_margin <= expected * (1 + 1e-9)
+    assert found.varying == (found.gain_margin > 1)
+
+
+def test_the_constant_set_is_the_oracles(loop):
+    """Stable across 40 to 45 ms (the oracle's radius below 1 at every 1/8 sample); across 40
+    to 60 ms unstable from the exact margin on (the oracle's radius past 1 just after it)."""
+    values = dict(K=2.0, B=0.1, M=0.0)
+    point = {**loop.defaults, **values}
+    coefficients = loop_coefficients(loop, point)
+    T = point["T"]
+
+    def radius(tau):
+        d = int(np.floor(tau))
+        return fractional_delay_radius(*coefficients, T, d, tau - d)
+
+    inside = loop.delay_range(delay_range=(0.040, 0.045), **values)
+    assert inside.constant and inside.margin is None
+    assert max(radius(tau) for tau in np.arange(40.0, 45.0 + 1e-9, 0.125)) < 1
+    beyond = loop.delay_range(delay_range=(0.040, 0.060), **values)
+    assert not beyond.constant
+    end = 40 + beyond.margin
+    assert radius(end - 1e-6) < 1 < radius(end + 1e-6)
+
+
+def test_ends_between_whole_samples_give_the_constant_set_only(loop):
+    found = loop.delay_range(delay_range=(0.040, 0.0405), K=2.0, B=0.1, M=0.0)
+    assert found.samples == (40.0, 40.5) and found.constant
+    assert found.varying is None and "whole samples" in found.why
+    assert "not derived" in repr(found)
+
+
+def test_unstable_at_the_lower_end_is_in_neither_set(loop):
+    found = loop.delay_range(delay_range=(0.040, 0.041), K=20.0, B=0.1, M=0.0)
+    assert not found.constant and found.varying is False
+
+
+@pytest.mark.parametrize("delay_range, error, message", [
+    (0.04, TypeError, "delay_range must be"),
+    ((0.041, 0.040), ValueError, "Td_min <= Td_max"),
+    ((-0.001, 0.040), ValueError, "Td_min"),
+    ((0.0, float("nan")), ValueError, "Td_max"),
+])
+def test_bad_ranges_are_refused(loop, delay_range, error, message):
+    with pytest.raises(error, match=message):
+        loop.delay_range(delay_range=delay_range, K=2.0, B=0.1, M=0.0)
