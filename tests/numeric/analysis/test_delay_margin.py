@@ -14,6 +14,7 @@ import numpy as np
 import pytest
 
 import symstab
+
 from conftest import REPO
 from oracles import fractional_delay_closed_loop, loop_coefficients
 

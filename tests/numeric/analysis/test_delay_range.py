@@ -11,6 +11,7 @@ import pytest
 import scipy.optimize
 
 import symstab
+
 from conftest import REPO
 from oracles import fractional_delay_radius, loop_coefficients, python_control_parts
 
