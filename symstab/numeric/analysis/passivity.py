@@ -83,7 +83,7 @@ import math
 import numpy as np
 import sympy as sp
 
-from ..._validate import check_delay, check_real
+from ..._validate import check_real, split_delay
 from ..engine.search import zoom_max
 
 __all__ = ["PassiveRegion", "passive_region"]
@@ -850,12 +850,17 @@ def _passive_values(loop, parameters, x, y, damping, env_names, symbols, env_sym
     """
     from ...symbolic import model
 
-    unknown = set(values) - set(parameters)
+    unknown = set(values) - set(parameters) - {"Td"}
     if unknown:
         raise TypeError(f"unknown parameter(s) {', '.join(sorted(unknown))}; parameters of this "
                         f"loop: {', '.join(parameters)}")
+    if "Td" in values and "d" in values:
+        raise TypeError("give the delay once: d (in samples) or Td (in seconds), not both")
     given = dict(getattr(loop, "defaults", {}))
     given.update(values)
+    if "Td" in given and "d" not in values:
+        T = check_real("T", given.get("T"), low=0.0, low_open=True)
+        given["d"] = check_real("Td", given.pop("Td"), low=0.0) / T
     for axis in (x, y):
         given.pop(axis, None)
     for name in (x, y):
@@ -867,7 +872,11 @@ def _passive_values(loop, parameters, x, y, damping, env_names, symbols, env_sym
     missing = [n for n in need if n not in given]
     if missing:
         raise TypeError(f"missing value(s) for {', '.join(missing)}")
-    d = check_delay(given["d"])
+    d, fraction = split_delay(given["d"], name="d")
+    if fraction is not None:
+        raise ValueError(f"Colgate and Schenkel's condition is derived for a delay of whole "
+                         f"samples (a hold whose output waits a fraction of a period is not a "
+                         f"pulse transfer function H(z)), got d = {float(given['d']):g}")
     T = check_real("T", given["T"], low=0.0, low_open=True)
     b = None
     if damping not in (x, y):
