@@ -686,7 +686,7 @@ def classify(loop, **values):
         The loop.
     **values
         Every parameter (:attr:`~symstab.Loop.parameters`) or its default;
-        arrays broadcast; ``d`` is an integer.
+        arrays broadcast; ``d`` in samples, whole or not, or ``Td`` in seconds.
 
     Returns
     -------
