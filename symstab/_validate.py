@@ -11,8 +11,8 @@ import numpy as np
 
 from ._resources import MAX_DELAY_ENV, max_delay
 
-__all__ = ["check_real", "check_count", "check_delay", "check_delay_samples", "split_delay", "check_array",
-           "check_grid", "check_delta", "check_loop", "check_progress", "DELTA_MAX", "PARAMETER_MAX"]
+__all__ = ["check_real", "check_count", "check_delay", "check_delay_samples", "split_delay",
+           "snap_delay", "check_array", "check_grid", "check_delta", "check_loop", "check_progress", "DELTA_MAX", "PARAMETER_MAX"]
 
 
 def _describe_range(low, high, low_open, high_open):
@@ -111,6 +111,17 @@ def check_delay_samples(ratio, *, name="Td / T", rtol=1e-9):
 DELAY_RTOL = 1e-9
 
 
+def snap_delay(samples):
+    """A delay in samples (a float array), each within :data:`DELAY_RTOL` of a whole number that number.
+
+    ``floor`` of it is the whole part :func:`split_delay` takes: callers
+    that group delays by their whole part (one whole ``d`` a call) use it.
+    """
+    x = np.asarray(samples, dtype=float)
+    near = np.round(x)
+    return np.where(np.abs(x - near) <= DELAY_RTOL * np.maximum(1.0, x), near, x)
+
+
 def split_delay(samples, *, name="d"):
     """A delay in samples, ``d + eps``, split: ``(d, eps)`` with a whole ``d`` and ``0 <= eps < 1``.
 
@@ -135,9 +146,7 @@ def split_delay(samples, *, name="d"):
         Not a real number, negative, not finite, beyond the limit, or
         points with different whole parts.
     """
-    x = check_array(name, samples, low=0.0)
-    near = np.round(x)
-    x = np.where(np.abs(x - near) <= DELAY_RTOL * np.maximum(1.0, x), near, x)
+    x = snap_delay(check_array(name, samples, low=0.0))
     whole = np.floor(x)
     if whole.size and np.any(whole != whole.flat[0]):
         raise ValueError(f"the delay {name} must have one whole number of samples over the points, "

@@ -78,9 +78,10 @@ def register(subparsers):
                                                  "searched as PNG")
     g.add_argument("--delay", metavar="TIME",
                    help="with --loop: hold the loop delay at TIME (s, or with a unit: 5ms) "
-                        "while the sample period is searched (--over T=...): d = ceil(TIME / "
-                        "T) samples at each T, the whole samples that cover it, instead of the "
-                        "file's d")
+                        "while the sample period is searched (--over T=...): d = TIME / T "
+                        "samples at each T, a fraction of a period included, instead of the "
+                        "file's d (a delay given in time, --set Td=... or the file's Td, is "
+                        "held so without it)")
     g.add_argument("--amplitude", metavar="X", type=float,
                    help="with --maximize simulated: the largest |x| accepted in the last "
                         "quarter of a run, in the loop's position unit (m or rad), from --x0; "
@@ -124,7 +125,12 @@ def run(args):
     if uses_loop(args):
         setup = resolve_loop(args)
         over = _search_over(args, setup)
-        delay = _delay(args, setup)
+        delay = _delay(args, setup, over)
+        if delay is not None and target == "passive":
+            raise ValueError("--maximize passive takes a whole number of samples (the passive "
+                             "set is derived for whole samples), and a delay held in time as T "
+                             "is searched is fractional; give --set d=N instead of --delay or "
+                             "--set Td")
         notes = []
     elif target == "simulated":
         raise ValueError(f"--maximize simulated simulates a loop file: give --loop FILE (the "
@@ -249,12 +255,21 @@ def _simulation(args, loop):
             "steps": args.steps}
 
 
-def _delay(args, setup):
-    """``--delay`` in seconds (converted as a ``--set T=...`` value is), or None."""
+def _delay(args, setup, over):
+    """The delay held in seconds as ``T`` is searched, or None (``d`` held in samples).
+
+    ``--delay`` (converted as a ``--set T=...`` value is); without it, a
+    delay given in time (``--set Td=...``, the file's ``Td``) while ``T``
+    is searched: it is ``Td / T`` samples at every ``T``, as the library
+    reads ``Td``.
+    """
     if args.delay is None:
+        if "T" in over and "Td" in setup.written:
+            return setup.values["d"] * setup.values["T"]
         return None
-    if "d" in setup.given:
-        raise ValueError("--delay holds the delay in seconds as T varies: drop --d / --set d")
+    if {"d", "Td"} & set(setup.given):
+        raise ValueError("--delay holds the delay in seconds as T varies: drop --d / --set d / "
+                         "--set Td")
     from .loop_options import convert_sets, parse_number
 
     text, unit = split_unit(args.delay.strip(), "--delay")
@@ -534,9 +549,8 @@ def _at_the_best(args, setup, found, target, lim, delay, rows, notes):
     at_best = dataclasses.replace(setup, values=_at(setup, found.best, delay))
     if delay is not None:
         T = at_best.values["T"]
-        notes.append(f"the delay is held at {delay:.6g} s: d = ceil({delay:.6g} s / T) "
-                     f"samples; at the best T = {T:.6g} s, d = {found.best_d} "
-                     f"({found.best_d * T:.6g} s)")
+        notes.append(f"the delay is held at {delay:.6g} s: d = {delay:.6g} s / T samples; at "
+                     f"the best T = {T:.6g} s, d = {found.best_d:.6g}")
     at = args.at
     if at is None and not lim.empty and math.isfinite(lim.x_at_y_max):
         at = lim.x_at_y_max
@@ -655,11 +669,9 @@ def _failed_notes(found):
 
 def _at(setup, point, delay):
     """The values at ``point`` of the searched parameters (``d`` held by ``delay`` if given)."""
-    from ..numeric.analysis.design import held_delay
-
     values = {**setup.values, **point}
     if delay is not None:
-        values["d"] = held_delay(delay, values["T"])
+        values["d"] = delay / values["T"]
     return values
 
 
@@ -687,6 +699,9 @@ def _search_json(setup, found, names, lim):
            "value": found.value, "gain": found.gain,
            "evaluations": int(found.samples.shape[0]),
            "spacing": found.spacing[names[0]] if one else found.spacing}
+    if found.delay is not None:
+        # Held in seconds as T varies: d = delay / T samples, fractional.
+        out.update(delay=found.delay, best_d=found.best_d)
     if found.target == "y_max":
         out["y_max_nominal"] = (found.value_nominal if found.value_nominal is not None
                                 and found.value_nominal > -math.inf else None)

@@ -515,8 +515,12 @@ def check_corners(loop, values, x, y, box, where):
 
     known = getattr(loop, "file_parameters", None) or FileParameters({})
     for corner in box_corners(box):
-        corner = {n: int(v) if n == "d" else float(v) for n, v in corner.items()}
-        at_corner = {**values, **corner}
+        corner = {n: int(v) if n == "d" and float(v).is_integer() else float(v)
+                  for n, v in corner.items()}
+        # The corner's delay replaces the other form's (d in samples, Td in time).
+        other = {"d": "Td", "Td": "d"}
+        at_corner = {**{k: v for k, v in values.items()
+                        if not (k in other and other[k] in corner)}, **corner}
         check_bounds(known, at_corner, skip=(x, y), where=lambda names: where)
         try:
             loop.polynomial(**{**at_corner, x: 0.0, y: 0.0})

@@ -12,8 +12,11 @@ largest y a simulated run accepts), optionally the plane, the rows per chunk, an
 either ``[grid]``, every combination of the values given for each parameter
 (a list, or ``{from = LO, to = HI, points = N}``; ``unit = "..."`` converts
 them, else they are in the loop file's unit), or ``[random]``, ``samples``
-rows drawn uniformly from ``NAME = [LO, HI]`` (whole delays for ``d``) with
-``seed``.  Every row's inputs and answers go to one table (CSV or NPZ, the
+rows drawn uniformly from ``NAME = [LO, HI]`` (whole delays for ``d`` with
+whole ends) with ``seed``.  The delay is ``d`` in samples (40.5: a fraction
+of a period more) or ``Td`` in time (``unit = "ms"``; ``Td / T`` samples at
+each row, so a grid of ``T`` with the loop file's ``Td`` holds the delay in
+seconds), not both.  Every row's inputs and answers go to one table (CSV or NPZ, the
 units in the header); the chunks are evaluated on a Dask cluster (a
 ``LocalCluster`` on this machine's cores, or ``--scheduler ADDRESS``) or,
 with ``--serial``, here, and saved as they finish in ``OUT.parts/``: run
@@ -380,7 +383,7 @@ def read_spec(path):
     box = {n: (rows[:, k].min(), rows[:, k].max()) for k, n in enumerate(names)}
     box.update({name: (low, high) for name, low, high in over})
     if "d" in box:
-        box["d"] = tuple(int(v) for v in box["d"])
+        box["d"] = tuple(int(v) if float(v).is_integer() else float(v) for v in box["d"])
     check_corners(loop, loop.defaults, x, y, box, where)
     return {"loop": loop, "loop_text": loop_text, "question": question,
             "names": tuple(names), "rows": rows, "chunk": chunk, "how": how}
@@ -457,6 +460,8 @@ def _points(where, loop, spec, question):
         names, rows, how = _random(where, loop, x, y, table)
     if not names:
         raise ValueError(f"{where}: sweep at least one parameter")
+    if "d" in names and "Td" in names:
+        raise ValueError(f"{where}: give the delay once: d (in samples) or Td (in time)")
     searched = [name for name, _, _ in question.over if name in names]
     if searched:
         what, section = (("uncertain", "[robust] uncertain") if question.kind == "robust"
@@ -574,7 +579,7 @@ def _ranges(where, section, loop, x, y, table, *, strict):
 
 
 def _check_name(where, loop, x, y, name):
-    if name not in loop.parameters:
+    if name not in loop.parameters and name != "Td":
         raise ValueError(f"{where}: {name!r} is not a parameter of the loop (its parameters: "
                          f"{', '.join(loop.parameters)})")
     if name in (x, y):
@@ -587,9 +592,10 @@ def _si(where, loop, name, values, unit):
     if not all(isinstance(v, (int, float)) and not isinstance(v, bool) for v in values):
         raise ValueError(f"{where}: {name} must be numbers, got {values!r}")
     if name == "d":
-        if unit not in (None, "samples") or not all(float(v).is_integer() and v >= 0
+        if unit not in (None, "samples") or not all(math.isfinite(v) and v >= 0
                                                     for v in values):
-            raise ValueError(f"{where}: d counts whole samples, >= 0, got {values!r}")
+            raise ValueError(f"{where}: d counts samples (a fraction of a period included), "
+                             f">= 0, got {values!r}")
         return [float(v) for v in values]
     if unit is not None and not isinstance(unit, str):
         raise ValueError(f"{where}: the unit of {name} must be text, got {unit!r}")
@@ -631,13 +637,8 @@ def _grid(where, loop, x, y, table):
                                      f"{MAX_ROWS}")
                 spec = list(np.linspace(low, high, n))
                 if name == "d":
-                    whole = [round(v) for v in spec]
-                    if any(abs(v - w) > 1e-9 for v, w in zip(spec, whole, strict=True)):
-                        raise ValueError(
-                            f"{where}: [grid] d = {{from = {low}, to = {high}, points = {n}}} "
-                            f"gives delays that are not whole samples ({spec[1]:.6g}, ...): "
-                            f"choose points so that the step is whole, or list the delays")
-                    spec = whole
+                    # A whole step gives whole delays (40, not 40.00000000000001).
+                    spec = [round(v) if abs(v - round(v)) <= 1e-9 else v for v in spec]
         if not isinstance(spec, list) or not spec:
             raise ValueError(f"{where}: [grid] {name} must be a non-empty list of values or "
                              f"{{from, to, points}}")
@@ -659,7 +660,8 @@ def _random(where, loop, x, y, table):
     if isinstance(seed, bool) or not isinstance(seed, int) or seed < 0:
         raise ValueError(f"{where}: [random] seed must be a non-negative integer, got {seed!r}")
     named = {k: v for k, v in table.items() if k not in ("samples", "seed")}
-    ranges = {name: (int(low), int(high)) if name == "d" else (low, high)
+    ranges = {name: (int(low), int(high)) if name == "d" and float(low).is_integer()
+              and float(high).is_integer() else (low, high)
               for name, low, high in _ranges(where, "[random]", loop, x, y, named, strict=True)}
     if not ranges:
         return [], np.empty((0, 0)), ""
@@ -681,6 +683,8 @@ def _table(plan, values, reasons, suffix):
     def unit_of(name):
         if name == "d":
             return "samples"
+        if name == "Td":
+            return "s"
         if name == "area":
             ux, uy = units.get(question.x, ""), units.get(question.y, "")
             return f"({ux})({uy})" if ux and uy else ""

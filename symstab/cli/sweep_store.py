@@ -153,7 +153,7 @@ def evaluate_rows(loop, question, names, rows):
     names : tuple of str
         The swept parameters, the columns of ``rows``.
     rows : ndarray, shape (n, len(names))
-        Their values in SI (``d`` a whole number).
+        Their values in SI (``d`` in samples, ``Td`` in seconds).
 
     Returns
     -------
@@ -164,7 +164,8 @@ def evaluate_rows(loop, question, names, rows):
     out = np.full((len(rows), len(question.columns())), np.nan)
     reasons = []
     for i, row in enumerate(rows):
-        values = {n: int(v) if n == "d" else float(v) for n, v in zip(names, row, strict=True)}
+        values = {n: int(v) if n == "d" and float(v).is_integer() else float(v)
+                  for n, v in zip(names, row, strict=True)}
         out[i], reason = question.answer(loop, values)
         reasons.append(reason)
     return out, reasons
@@ -278,10 +279,11 @@ def run_sweep(loop, question, names, rows, *, chunk, store, client=None, progres
         from dask.distributed import as_completed
 
         shared = client.scatter(loop, broadcast=True)
-        if "d" in names:
+        delay = next((n for n in ("d", "Td") if n in names), None)
+        if delay is not None:
             # A row's cost grows with its delay: the longest go first, so that no long chunk
             # is left to run alone at the end while the other workers wait.
-            column = list(names).index("d")
+            column = list(names).index(delay)
             todo.sort(key=lambda i: -rows[slices[i], column].max())
         futures = {client.submit(evaluate_rows, shared, question, names, rows[slices[i]],
                                  pure=False): i for i in todo}

@@ -132,6 +132,10 @@ def test_the_table_names_the_optimum_the_value_there_and_at_the_nominal_value(ca
     (["--loop", LOOPS / "paper.toml", "--over", "T=0.2:4 ms", "--delay", "10ms", "--d", "3"],
      "drop --d"),
     (["--delay", "10ms"], "--delay needs a loop file"),
+    (["--loop", LOOPS / "paper.toml", "--over", "T=0.2:4 ms", "--delay", "10ms", "--set",
+      "Td=3ms"], "drop --d / --set d / --set Td"),
+    (["--loop", LOOPS / "paper.toml", "--over", "T=0.5:1 ms", "--delay", "10ms", "--maximize",
+      "passive"], "--maximize passive takes a whole number of samples"),
     (["--png", "/nonexistent/x.png"], "--png"),
     # The simulated target: its options only with it, with a loop file, checked first.
     (["--loop", LOOPS / "paper.toml", "--amplitude", "1e-3"], "add --maximize simulated"),
@@ -190,6 +194,24 @@ def test_a_wide_range_finds_the_narrow_band_of_stable_masses(capsys):
     assert wide["search"]["best"] is not None, wide.get("notes")
     assert wide["search"]["y_max"] == pytest.approx(default["search"]["y_max"], rel=1e-4)
     assert wide["search"]["best"] == pytest.approx(default["search"]["best"], rel=1e-4)
+
+
+def test_a_delay_held_in_time_is_fractional_samples_of_each_T(capsys):
+    """--delay 2ms and --set Td=2ms with --over T both hold the delay in seconds: d = 2 ms / T
+    samples at each T (0.70 at the best, where the former ceil took 1).  Oracle: the
+    engine's K_max at the best T with the delay given as Td; the table's note says d."""
+    common = ["design", "--loop", LOOPS / "two_mass.toml", "--over", "T=2.5:3.2 ms",
+              "--points", "5"]
+    held = run_json(capsys, *common, "--delay", "2ms")["search"]
+    loop = symstab.load_loop(LOOPS / "two_mass.toml")
+    best = held["best"]
+    assert held["delay"] == pytest.approx(0.002, rel=1e-12)
+    assert held["best_d"] == pytest.approx(0.002 / best, rel=1e-12) and held["best_d"] < 1
+    assert held["value"] == pytest.approx(loop.limits(T=best, Td=0.002).y_max, rel=1e-9)
+    status, out, err = run(capsys, *common, "--set", "Td=2ms")
+    assert status == 0, err
+    assert f"d = 0.002 s / T samples; at the best T = {best:.6g} s, d = " \
+           f"{held['best_d']:.6g}" in out
 
 
 def test_over_takes_a_range_with_a_unit_and_two_parameters(capsys, tmp_path):

@@ -9,6 +9,7 @@ before any work, and nothing is written.
 
 import contextlib
 import os
+import re
 import signal
 import socket
 import subprocess
@@ -57,6 +58,35 @@ def test_each_row_is_the_loop_s_limits_at_its_values_in_si(capsys, tmp_path):
         np.testing.assert_allclose([y_max, x_at, x_min, x_max, area],
                                    [found.y_max, found.x_at_y_max, found.x_min, found.x_max,
                                     found.area], rtol=1e-11)
+
+
+def test_a_grid_of_delays_in_time_or_fractional_samples(capsys, tmp_path):
+    """Issue 43: [grid] Td in ms (Td / T samples, 10.5 ms a fraction more) and d = 10.5 samples
+    are the loop's limits there; a spec whose loop file gives its delay as Td holds it in
+    seconds along a grid of T.  Oracle: Loop.limits at each row's values in SI."""
+    loop = symstab.load_loop(LOOPS / "paper.toml")
+    path = spec(tmp_path, '[grid]\nTd = { values = [10.0, 10.5], unit = "ms" }\n')
+    status, text, err = run(capsys, "sweep", path, "--out", tmp_path / "t.csv", "--serial")
+    assert status == 0, err
+    header, rows = read_csv(tmp_path / "t.csv")
+    assert header.startswith("Td [s],K_max [N m/rad],")
+    np.testing.assert_allclose(rows[:, 0], [0.010, 0.0105], rtol=1e-12)
+    for row in rows:
+        assert row[1] == pytest.approx(loop.limits(Td=row[0]).y_max, rel=1e-11)
+    path = spec(tmp_path, '[grid]\nd = [10.5]\n', name="d.toml")
+    assert run(capsys, "sweep", path, "--out", tmp_path / "d.csv", "--serial")[0] == 0
+    assert read_csv(tmp_path / "d.csv")[1][0, 1] == pytest.approx(rows[1, 1], rel=1e-11)
+    text = (LOOPS / "paper.toml").read_text(encoding="utf-8")
+    held = tmp_path / "held.toml"
+    held.write_text(re.sub(r"(?m)^d = .*$", 'Td = { value = 10.5, unit = "ms" }', text),
+                    encoding="utf-8")
+    path = tmp_path / "T.toml"
+    path.write_text(f'loop = "{held.as_posix()}"\n[grid]\nT = {{ values = [0.5, 1.0], '
+                    f'unit = "ms" }}\n', encoding="utf-8")
+    status, text, err = run(capsys, "sweep", path, "--out", tmp_path / "T.csv", "--serial")
+    assert status == 0, err
+    for T, y_max in read_csv(tmp_path / "T.csv")[1][:, :2]:
+        assert y_max == pytest.approx(loop.limits(T=T, d=0.0105 / T).y_max, rel=1e-11)
 
 
 def test_a_design_sweep_finds_the_best_virtual_mass_at_each_delay(capsys, tmp_path, monkeypatch):
@@ -289,8 +319,8 @@ def test_without_dask_the_message_says_what_to_install(capsys, tmp_path, monkeyp
     ('[grid]\nd = [3]\n[random]\nsamples = 3\n', "one of them"),
     ('[grid]\nK = [1, 2]\n', "K is an axis"),
     ('[grid]\nq = [1, 2]\n', "'q' is not a parameter"),
-    ('[grid]\nd = [1.5]\n', "d counts whole samples"),
-    ('[grid]\nd = { from = 0, to = 10, points = 4 }\n', "not whole samples"),
+    ('[grid]\nd = [-1.5]\n', "d counts samples (a fraction of a period included), >= 0"),
+    ('[grid]\nd = [3]\nTd = { values = [3], unit = "ms" }\n', "give the delay once"),
     ('[grid]\nb = { values = [1], unit = "Hz" }\n', "Hz"),
     ('[grid]\nb = []\n', "non-empty list"),
     ('[grid]\nb = ["x"]\n', "must be numbers"),

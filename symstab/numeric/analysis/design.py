@@ -39,6 +39,11 @@ scan point nor the nominal value can still be missed: then the message
 says so (never a bare "none"), :attr:`Design.spacing` says the scan's
 step, and ``n`` makes it finer.
 
+A delay held in seconds while the sample period is searched (``delay``)
+is ``d = delay / T`` samples at each ``T``, a fraction of a period
+included (the modified z-transform carries it): the target is continuous
+in ``T`` and searched as any other parameter.
+
 A design can also count a cost: with an encoder (``encoder_resolution``)
 the force noise of its quantization at a rendered point of the plane
 (:func:`~symstab.numeric.analysis.noise.force_noise_rms`) is recorded at
@@ -46,8 +51,8 @@ every value evaluated (:attr:`Design.pareto`, the values no other beats on
 both the target and the noise), and with a budget (``noise_limit``, one
 parameter searched) only the values whose noise fits are candidates: the
 line is scanned for the noise first, the edges where it crosses the budget
-are bisected, and the target is maximised over the pieces left
-(:func:`maximize_pieces`).  Stability has no noise criterion, so a search
+are bisected, and the target is maximised over the pieces left (each by
+:func:`maximize_scalar`).  Stability has no noise criterion, so a search
 over a velocity filter's cut-off answers "the highest"; with a budget the
 answer is the highest cut-off whose noise fits.
 """
@@ -59,8 +64,7 @@ import numpy as np
 
 from ..._validate import check_count, check_progress, check_real, check_window
 
-__all__ = ["TARGETS", "Design", "design", "maximize_scalar", "maximize_pieces", "maximize_box",
-           "held_delay", "delay_pieces", "box_corners"]
+__all__ = ["TARGETS", "Design", "design", "maximize_scalar", "maximize_box", "box_corners"]
 
 #: What a design maximises, with what it is.
 TARGETS = {
@@ -78,12 +82,8 @@ _MIN_RUN = 5
 _MAX_ZOOMS = 8
 #: Evaluations of the local refinement at most.
 _MAX_REFINE = 200
-#: The pieces of a piecewise search refined, the best first by their left ends.
-_TOP_PIECES = 3
-#: Scan points of each piece refined.
+#: Scan points of each part of a line cut by a noise budget, at least.
 _PIECE_POINTS = 5
-#: Whole-sample pieces of a sample period's range at most (one evaluation each at least).
-MAX_PIECES = 400
 
 
 @dataclasses.dataclass(frozen=True)
@@ -131,8 +131,9 @@ class Design:
     message : str
         Why there is no optimum; else empty.
     delay : float or None
-        The loop delay held in seconds while ``T`` varies (``d = ceil(delay
-        / T)`` at each value), or None (``d`` as given).
+        The loop delay held in seconds while ``T`` varies (``d = delay /
+        T`` samples at each value, a fraction of a period included), or
+        None (``d`` as given).
     noise_limit : float or None
         The noise budget searched within, or None.
     encoder_resolution : float or None
@@ -209,12 +210,12 @@ class Design:
 
     @property
     def best_d(self):
-        """The delay in samples at the optimum: ``ceil(delay / T)`` where the delay is held in seconds."""
+        """The delay in samples at the optimum: ``delay / T`` (fractional) where it is held in seconds."""
         if self.best is None:
             return None
         if self.delay is None:
             return self.values.get("d")
-        return held_delay(self.delay, self.best.get("T", self.values.get("T")))
+        return self.delay / self.best.get("T", self.values.get("T"))
 
     @property
     def gain(self):
@@ -270,21 +271,12 @@ class Design:
 
     @property
     def at_edge(self):
-        """The searched parameters whose optimum lies within 1e-3 of the range's width of an end.
-
-        (With the delay held in seconds, of the width of the end's own whole-sample piece of ``T``.)
-        """
+        """The searched parameters whose optimum lies within 1e-3 of the range's width of an end."""
         if self.best is None:
             return ()
         out = []
         for name, (lo, hi) in self.over.items():
-            width = hi - lo
-            if self.delay is not None and name == "T":
-                # The delay held in seconds: the scale is the end's own piece
-                # (an optimum at the left end of the next piece is not the range's end).
-                pieces = delay_pieces(self.delay, lo, hi)
-                width = min(pieces[0][1] - pieces[0][0], pieces[-1][1] - pieces[-1][0])
-            if min(self.best[name] - lo, hi - self.best[name]) < 1e-3 * width:
+            if min(self.best[name] - lo, hi - self.best[name]) < 1e-3 * (hi - lo):
                 out.append(name)
         return tuple(out)
 
@@ -294,10 +286,12 @@ class Design:
             return f"Design({self.target} over {over}: {self.message})"
         best = ", ".join(f"{n}={v:.6g}" for n, v in self.best.items())
         gain = f", gain {self.gain:.4g}" if self.gain is not None else ""
+        held = ("" if self.delay is None else
+                f", delay {self.delay:.6g} s = {self.best_d:.6g} samples")
         noise = "" if self.noise is None else f", force noise {self.best_noise:.4g}" + (
             "" if self.noise_limit is None else f" within {self.noise_limit:.4g}")
         return (f"Design({self.target} over {over}: {best}, {self.target}={self.value:.6g}"
-                f"{gain}{noise})")
+                f"{held}{gain}{noise})")
 
     def as_dict(self):
         """The numbers, for tables and JSON."""
@@ -306,8 +300,8 @@ class Design:
                 "value": self.value, "nominal": self.nominal,
                 "value_nominal": self.value_nominal, "gain": self.gain,
                 "evaluations": int(self.samples.shape[0]), "spacing": self.spacing,
-                "failed": len(self.failed), "message": self.message,
-                "noise_limit": self.noise_limit, "encoder_resolution": self.encoder_resolution,
+                "failed": len(self.failed), "message": self.message, "delay": self.delay,
+                "best_d": self.best_d, "noise_limit": self.noise_limit, "encoder_resolution": self.encoder_resolution,
                 "noise_at": self.noise_at or None, "best_noise": self.best_noise}
 
 
@@ -444,73 +438,6 @@ def _rising_to_end(evaluate, x_best, value, low, high, a, b):
         return False
     inside = x_best + (1e-3 if x_best == low else -1e-3) * (b - a)
     return evaluate(inside) < value
-
-
-def maximize_pieces(f, pieces, *, include=(), rtol=1e-6, progress=None):
-    """The x that maximises ``f``, continuous on each piece but jumping between them.
-
-    A sawtooth (the target against the sample period with the delay held in
-    seconds: ``d`` steps at each ``T = delay / k``) defeats a search of the
-    whole interval: Brent's method climbs one tooth.  Here ``f`` is
-    evaluated at each piece's left end (and at ``include``); the
-    ``_TOP_PIECES`` pieces best there, and the piece of the best
-    ``include`` point, are each searched by :func:`maximize_scalar`
-    (``_PIECE_POINTS`` points, then Brent's method), and the best of
-    all is taken.
-
-    Parameters
-    ----------
-    f : callable
-        ``f(x) -> float``, as for :func:`maximize_scalar`.
-    pieces : sequence of (float, float)
-        Closed intervals, in increasing order, ``a < b``, on each of which
-        ``f`` is continuous.
-    include, rtol, progress : optional
-        As for :func:`maximize_scalar`.
-
-    Returns
-    -------
-    (float, float, list) or (None, None, list)
-        As :func:`maximize_scalar`.
-
-    Examples
-    --------
-    A sawtooth rising to 1 / k at the left end of each piece [1 / k, 1 / (k - 1)]:
-
-    >>> pieces = [(1 / k, 1 / (k - 1) - 1e-9) for k in range(9, 1, -1)]
-    >>> def f(x):
-    ...     k = next(k for k in range(9, 1, -1) if 1 / k <= x < 1 / (k - 1))
-    ...     return k - x * k * k / 2
-    >>> x, value, _ = maximize_pieces(f, pieces)
-    >>> round(x, 6), round(value, 6)
-    (0.111111, 4.5)
-    """
-    pieces = [check_window("a piece", piece) for piece in pieces]
-    if not pieces:
-        raise ValueError("pieces must hold at least one interval (a, b), a < b")
-    evaluate = _Evaluations(lambda p: f(p[0]), progress)
-    for a, _ in pieces:
-        evaluate(a)
-    inside = [float(v) for v in include if any(a <= v <= b for a, b in pieces)]
-    for v in inside:
-        evaluate(v)
-
-    def rank(k):
-        value = evaluate.seen[(pieces[k][0],)]
-        return -math.inf if math.isnan(value) else value
-
-    chosen = sorted(range(len(pieces)), key=rank, reverse=True)[:_TOP_PIECES]
-    chosen += [k for k, (a, b) in enumerate(pieces) for v in inside if a <= v <= b]
-    for k in dict.fromkeys(chosen):
-        a, b = pieces[k]
-        maximize_scalar(lambda x: evaluate((x,)), a, b, _PIECE_POINTS,
-                        include=[v for v in inside if a <= v <= b], rtol=rtol)
-    found = evaluate.best()
-    seen = [(p[0], v) for p, v in evaluate.seen.items()]
-    if found is None:
-        return None, None, seen
-    (x_best,), value = found
-    return x_best, value, seen
 
 
 def maximize_box(f, box, n=9, *, include=(), rtol=1e-6, progress=None):
@@ -662,9 +589,9 @@ def design(loop, *, over, maximize="y_max", x=None, y=None, n=None, rtol=None, d
         The device's viscous friction, for ``maximize="passive"``.
     delay : float, optional
         The loop delay in seconds, held while the sample period ``T``
-        is searched: ``d = ceil(delay / T)`` at each value, the whole
-        samples that cover it (instead
-        of ``d``).
+        is searched: ``d = delay / T`` samples at each value, a
+        fraction of a period included (instead of ``d``).  Not with
+        ``maximize="passive"`` (the passive set takes whole samples).
     progress : callable, optional
         Called with the number of evaluations so far.
     amplitude : float
@@ -738,10 +665,10 @@ def design(loop, *, over, maximize="y_max", x=None, y=None, n=None, rtol=None, d
         nominal = {}
 
     def at(point):
-        """The values at a point of the search; with ``delay``, d = ceil(delay / T) there."""
+        """The values at a point of the search; with ``delay``, d = delay / T there."""
         out = {**values, **dict(zip(names, point, strict=True))}
         if delay is not None:
-            out["d"] = held_delay(delay, out.get("T", loop.defaults.get("T")))
+            out["d"] = delay / out.get("T", loop.defaults.get("T"))
         return out
 
     budget = _check_budget(loop, x, y, names, noise_limit, encoder_resolution, noise_at, at)
@@ -752,10 +679,10 @@ def design(loop, *, over, maximize="y_max", x=None, y=None, n=None, rtol=None, d
     # proved empty (then nothing is scanned).
     bracket = _bracket(loop, maximize, x, y, names, over, at) if delay is None else over
     searched = over if bracket is None else bracket
-    pieces = None if bracket is None else _budget_pieces(budget, searched, delay, n, rtol,
+    pieces = None if bracket is None else _budget_pieces(budget, searched, n, rtol,
                                                          include)
     best, value, seen = (None, None, []) if bracket is None or pieces == [] else _maximize_over(
-        search.target, names, searched, delay, n, include, rtol, progress, pieces)
+        search.target, names, searched, n, include, rtol, progress, pieces)
     samples = np.array([[*p, v] for p, v in seen], dtype=float).reshape(-1, len(names) + 1)
     spacing = {k: (hi - lo) / (n - 1) for k, (lo, hi) in searched.items()}
     value_nominal = None
@@ -916,14 +843,12 @@ class _Budget:
                         len(scan), samples.shape[1]))
 
 
-def _budget_pieces(budget, searched, delay, n, rtol, include):
+def _budget_pieces(budget, searched, n, rtol, include):
     """The pieces of the line within the noise budget (``[]``: none), or None without a limit."""
     if budget is None or math.isinf(budget.limit):
         return None
     (name, window), = searched.items()
-    line = delay_pieces(delay, *window) if delay is not None and name == "T" else [window]
-    return budget.pieces(line, n if len(line) == 1 else _PIECE_POINTS, rtol,
-                         [p[0] for p in include])
+    return budget.pieces([window], n, rtol, [p[0] for p in include])
 
 
 def _over_budget(budget, x, y, searched):
@@ -947,7 +872,11 @@ def _check_design_names(loop, maximize, x, y, damping, delay, values):
     """The delay in seconds (checked, or None): the plane's and the damping's names are the loop's.
 
     A step of :func:`design`'s input checks: the axes take no value, and a
-    delay is given in seconds or in samples, not both.
+    delay is given in seconds (``delay``, or the loop's ``Td`` among
+    ``values``, taken out of them here, or the loop's default ``Td``) or
+    in samples, once.  The passive
+    set takes whole samples, so ``maximize="passive"`` holds no delay in
+    seconds (``delay / T`` is fractional almost everywhere).
     """
     for axis, name in (("x", x), ("y", y)) + ((("damping", damping),) if maximize == "passive"
                                                  else ()):
@@ -959,10 +888,20 @@ def _check_design_names(loop, maximize, x, y, damping, delay, values):
     for name in (x, y):
         if name in values:
             raise TypeError(f"{name} is an axis of the ({x}, {y}) plane: it takes no value here")
+    if "Td" in values:
+        if delay is not None:
+            raise TypeError("give the delay in seconds once: delay or Td, not both")
+        delay = values.pop("Td")
+    if delay is None and "d" not in values and "Td" in loop.defaults:
+        delay = loop.defaults["Td"]     # the loop's own delay is in seconds
     if delay is not None:
         delay = check_real("delay", delay, low=0.0)
         if "d" in values:
             raise TypeError("give the delay in seconds (delay) or in samples (d), not both")
+        if maximize == "passive":
+            raise ValueError("delay: maximize='passive' takes a whole number of samples d (the "
+                             "passive set is derived for whole samples), and a delay held in "
+                             "seconds is delay / T samples, fractional; give d")
     return delay
 
 
@@ -984,43 +923,38 @@ def _check_values_once(loop, maximize, x, y, damping, over, at, simulation, step
         from ..simulation.simulator import check_steps
 
         for corner in box_corners(over):
-            check_steps(steps, at(tuple(corner.values())).get("d", loop.defaults.get("d", 0)))
+            held = at(tuple(corner.values())).get("d", loop.defaults.get("d", 0))
+            check_steps(steps, math.ceil(held))
 
 
-def _maximize_over(target, names, searched, delay, n, include, rtol, progress, pieces=None):
+def _maximize_over(target, names, searched, n, include, rtol, progress, pieces=None):
     """``(best, value, seen)``: the search of ``target`` over ``searched``, points as tuples.
 
     Two parameters: :func:`maximize_box`.  One: :func:`maximize_scalar`
     over the range, or over ``pieces`` (the parts of the range within a
-    noise budget) :func:`_maximize_line`; with ``T`` searched and a delay
-    held in seconds, the pieces of one whole delay each (or the budget's
-    parts of them) by :func:`maximize_pieces`.
+    noise budget) :func:`_maximize_line`.
     """
     if len(names) == 2:
         return maximize_box(target, tuple(searched[k] for k in names), n,
                             include=include, rtol=rtol, progress=progress)
-    sawtooth = delay is not None and names[0] == "T"
-    if pieces is None and sawtooth:
-        pieces = delay_pieces(delay, *searched["T"])
     if pieces is None:
         best, value, seen = maximize_scalar(lambda v: target((v,)), *searched[names[0]], n,
                                             include=[p[0] for p in include], rtol=rtol,
                                             progress=progress)
     else:
         best, value, seen = _maximize_line(lambda v: target((v,)), pieces, n,
-                                           [p[0] for p in include], rtol, progress, sawtooth)
+                                           [p[0] for p in include], rtol, progress)
     best = None if best is None else (best,)
     return best, value, [((p,), v) for p, v in seen]
 
 
-def _maximize_line(f, pieces, n, include, rtol, progress, sawtooth):
+def _maximize_line(f, pieces, n, include, rtol, progress):
     """The best ``f`` over closed pieces of a line (a piece ``(a, a)`` is the one value ``a``).
 
-    ``sawtooth``: ``f`` jumps between the pieces (a delay held in seconds),
-    searched by :func:`maximize_pieces`; else ``f`` is one continuous
-    function cut into parts (by a noise budget), each searched by
-    :func:`maximize_scalar` with ``n`` points (``_PIECE_POINTS`` at least
-    each when there are several).  A one-value piece is evaluated.
+    ``f`` is one continuous function cut into parts (by a noise budget),
+    each searched by :func:`maximize_scalar` with ``n`` points
+    (``_PIECE_POINTS`` at least each when there are several).  A one-value
+    piece is evaluated.
     """
     seen = {}
 
@@ -1035,13 +969,10 @@ def _maximize_line(f, pieces, n, include, rtol, progress, sawtooth):
     for a, b in pieces:
         if a == b:
             counted(a)
-    if sawtooth and wide:
-        maximize_pieces(counted, wide, include=include, rtol=rtol)
-    else:
-        points = n if len(wide) == 1 else max(_PIECE_POINTS, n // max(len(wide), 1))
-        for a, b in wide:
-            maximize_scalar(counted, a, b, points,
-                            include=[v for v in include if a <= v <= b], rtol=rtol)
+    points = n if len(wide) == 1 else max(_PIECE_POINTS, n // max(len(wide), 1))
+    for a, b in wide:
+        maximize_scalar(counted, a, b, points,
+                        include=[v for v in include if a <= v <= b], rtol=rtol)
     found = [(v, x) for x, v in seen.items() if not math.isnan(v) and v > -math.inf]
     if not found:
         return None, None, list(seen.items())
@@ -1117,53 +1048,6 @@ def _bracket(loop, maximize, x, y, names, over, at):
         lo, hi = max(low, lo - pad), min(high, hi + pad)
         out[name] = (lo, hi) if lo < hi else (low, high)
     return out
-
-
-def delay_pieces(delay, low, high):
-    """The intervals of ``T`` in ``[low, high]`` on each of which ``held_delay(delay, T)`` is one ``d``.
-
-    ``d = ceil(delay / T)`` is ``d`` for ``T`` in ``[delay / d, delay / (d -
-    1))``: each piece is that interval cut to the range, its open right end
-    taken 1e-8 inside (where ``d`` is still the piece's), in increasing
-    ``T``.  With no delay, the range itself.
-
-    Raises
-    ------
-    ValueError
-        If the range spans more than :data:`MAX_PIECES` whole delays.
-
-    Examples
-    --------
-    >>> [(round(a * 1e3, 4), round(b * 1e3, 4)) for a, b in delay_pieces(0.01, 2e-3, 4e-3)]
-    [(2.0, 2.5), (2.5, 3.3333), (3.3333, 4.0)]
-    """
-    if delay == 0:
-        return [(low, high)]
-    first, last = held_delay(delay, high), held_delay(delay, low)
-    if last - first + 1 > MAX_PIECES:
-        raise ValueError(f"over['T'] in [{low:.6g}, {high:.6g}] with the delay held at "
-                         f"{delay:.6g} s spans {last - first + 1} whole-sample delays (d from "
-                         f"{first} to {last}), above {MAX_PIECES}: each is searched; narrow the "
-                         f"range of T")
-    pieces = []
-    for d in range(last, first - 1, -1):
-        a = max(low, delay / d)
-        b = high if d <= 1 or delay / (d - 1) > high else delay / (d - 1) * (1 - 1e-8)
-        if a < b:
-            pieces.append((a, b))
-    return pieces
-
-
-def held_delay(delay, T):
-    """``d = ceil(delay / T)``: a delay held in seconds, in the whole samples of ``T`` that cover it.
-
-    A force can only be applied at a sample, so a delay of 2.5 periods acts
-    as 3 (rounding down would render a shorter delay than the device has).
-    A quotient within 1e-9 of a whole number is that number.
-    """
-    quotient = delay / float(T)
-    return int(round(quotient)) if abs(quotient - round(quotient)) <= 1e-9 * max(1.0, quotient) \
-        else math.ceil(quotient)
 
 
 def _check_simulation(maximize, amplitude, nonideal, x0, steps, loop=None):

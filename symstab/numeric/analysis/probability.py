@@ -11,16 +11,24 @@ unit circle to within rounding, counts as not stable and is counted
 apart), with the Monte Carlo standard error ``sqrt(p (1 - p) / samples)``.
 
 Distributions: ``(low, high)`` is uniform on that interval (for the delay
-``d``, the integers from ``low`` to ``high``); any object with SciPy's
+``d`` with whole ends, the integers from ``low`` to ``high``; with a
+fractional end, or ``Td`` in seconds, every delay between, fractions of a
+period included); any object with SciPy's
 ``rvs(size=..., random_state=...)`` (a frozen :mod:`scipy.stats`
 distribution, e.g. ``scipy.stats.norm(0.0324, 0.003)``) is drawn from.
 Draws outside the bounds a loop file declares are refused by name.
+
+A delay drawn in fractions of a period (``d`` fractional, ``Td`` in
+seconds, or a delay held in seconds while ``T`` is drawn) is ``Td / T``
+samples per draw; the draws are classified in groups of one whole part
+(a call of :meth:`symstab.Loop.classify` takes one whole ``d`` and each
+draw's fraction).
 """
 
 import numpy as np
 
-from ..._resources import CHUNK_BYTES, check_memory
-from ..._validate import check_delay, check_grid, check_progress, check_real
+from ..._resources import CHUNK_BYTES, check_memory, max_delay
+from ..._validate import check_delay, check_grid, check_progress, check_real, snap_delay
 from ..engine.results import StabilityProbability
 from ..engine.roots import MARGINAL, STABLE
 
@@ -41,9 +49,10 @@ def draw_values(loop, uncertain, samples, seed, *, axes=()):
     ----------
     loop : symstab.Loop
     uncertain : dict
-        ``{name: (low, high)}`` (uniform; ``d``: integers ``low .. high``)
-        or ``{name: distribution}`` (an object with ``rvs(size=...,
-        random_state=...)``).
+        ``{name: (low, high)}`` (uniform; ``d`` with whole ends: integers
+        ``low .. high``) or ``{name: distribution}`` (an object with
+        ``rvs(size=..., random_state=...)``); the delay as ``d`` (samples)
+        or ``Td`` (seconds), not both.
     samples : int
         Draws, 1 to :data:`MAX_SAMPLES`.
     seed : int
@@ -55,8 +64,9 @@ def draw_values(loop, uncertain, samples, seed, *, axes=()):
     ------
     TypeError, ValueError
         Naming the parameter: not the loop's, an axis, a range that is not
-        two finite numbers with ``low < high`` (``low <= high`` for ``d``,
-        integers), a distribution without ``rvs``, a draw that is not finite.
+        two finite numbers with ``low < high`` (``low <= high`` for ``d``
+        with whole ends), a distribution without ``rvs``, a draw that is
+        not finite, a delay drawn below 0 or beyond the limit.
     """
     if not isinstance(uncertain, dict) or not uncertain:
         raise TypeError(f"uncertain must be a non-empty dict {{name: (low, high) or distribution}}, "
@@ -68,8 +78,10 @@ def draw_values(loop, uncertain, samples, seed, *, axes=()):
         raise ValueError(f"seed must be a non-negative integer, got {seed!r}")
     rng = np.random.default_rng(int(seed))
     draws = {}
+    if "d" in uncertain and "Td" in uncertain:
+        raise TypeError("uncertain: give the delay once, d (in samples) or Td (in seconds)")
     for name, spec in uncertain.items():
-        if name not in loop.parameters:
+        if name not in loop.parameters and name != "Td":
             raise ValueError(f"uncertain: {name!r} is not a parameter of the loop "
                              f"(its parameters: {', '.join(loop.parameters)})")
         if name in axes:
@@ -80,12 +92,9 @@ def draw_values(loop, uncertain, samples, seed, *, axes=()):
             values = np.asarray(spec.rvs(size=int(samples), random_state=rng), dtype=float)
             if values.shape != (samples,) or not np.all(np.isfinite(values)):
                 raise ValueError(f"{where}: the distribution must draw {samples} finite numbers")
-            if name == "d" and not np.all(values == np.round(values)):
-                raise ValueError(f"{where}: the delay is a whole number of samples; its "
-                                 f"distribution drew {values[values != np.round(values)][0]!r}")
         elif isinstance(spec, (tuple, list)) and len(spec) == 2:
             low, high = (check_real(f"{where} bounds", v) for v in spec)
-            if name == "d":
+            if name == "d" and float(low).is_integer() and float(high).is_integer():
                 low, high = check_delay(spec[0]), check_delay(spec[1])
                 if low > high:
                     raise ValueError(f"{where}: (low, high) must have low <= high, got {spec!r}")
@@ -99,10 +108,36 @@ def draw_values(loop, uncertain, samples, seed, *, axes=()):
             raise TypeError(f"{where} must be (low, high) or a distribution with rvs(size=..., "
                             f"random_state=...), got {spec!r}")
         draws[name] = values
-    if "d" in draws:
-        for d in np.unique(draws["d"]):
-            check_delay(int(d))
+    for name in ("d", "Td"):
+        if name in draws and draws[name].min() < 0:
+            raise ValueError(f"uncertain[{name!r}]: a delay is >= 0, a draw is "
+                             f"{draws[name].min()!r}")
+    if "d" in draws and draws["d"].max() > max_delay():
+        check_delay(int(np.ceil(draws["d"].max())))     # names the limit and how to raise it
     return draws
+
+
+def _delay_draws(loop, draws, values):
+    """Each draw's delay in samples (``Td / T``, fractional), or None where it is one ``d``.
+
+    The delay varies over the draws when ``d`` or ``Td`` is drawn, or when
+    ``T`` is drawn and the delay is held in seconds (``Td`` given or the
+    loop's own).
+    """
+    if "d" in draws:
+        return draws["d"]
+    seconds = draws.get("Td")
+    if seconds is None and "T" in draws:
+        if "Td" in values:
+            seconds = values["Td"]
+        elif "d" not in values and "Td" in loop.defaults:
+            seconds = loop.defaults["Td"]
+    if seconds is None:
+        return None
+    period = draws.get("T", values.get("T", loop.defaults.get("T")))
+    if period is None:
+        raise TypeError("uncertain: a delay in seconds (Td) needs the sample period T's value")
+    return snap_delay(seconds / np.asarray(period, dtype=float))
 
 
 def stability_probability(loop, x_values, y_values, *, x, y, uncertain, samples=1000, seed=0,
@@ -119,8 +154,9 @@ def stability_probability(loop, x_values, y_values, *, x, y, uncertain, samples=
         As in :func:`symstab.numeric.simulation.simulator.loop_stability_map`,
         which maps the same grid by simulation.
     uncertain : dict
-        ``{name: (low, high)}`` (uniform; ``d``: the integers from
-        ``low`` to ``high``) or ``{name: distribution}`` (a frozen
+        ``{name: (low, high)}`` (uniform; ``d`` with whole ends: the
+        integers from ``low`` to ``high``; ``d`` with a fractional end or
+        ``Td`` in seconds: continuous) or ``{name: distribution}`` (a frozen
         :mod:`scipy.stats` distribution, or any object with
         ``rvs(size=..., random_state=...)``); :func:`draw_values`.
     samples : int
@@ -159,8 +195,9 @@ def stability_probability(loop, x_values, y_values, *, x, y, uncertain, samples=
     x_values, y_values = check_grid(x, y, x_values, y_values, values)
     draws = draw_values(loop, uncertain, samples, seed, axes=(x, y))
     for name in draws:
-        if name in values:
-            raise TypeError(f"{name} is uncertain: give its distribution, not a value")
+        if name in values or (name in ("d", "Td") and {"d", "Td"} & set(values)):
+            raise TypeError(f"{name} is uncertain: give its distribution, not a value "
+                            f"(of the delay: neither d nor Td)")
     from ..._progress import progress_printer
 
     progress = check_progress(progress, lambda: progress_printer("drawing", samples))
@@ -177,18 +214,21 @@ def stability_probability(loop, x_values, y_values, *, x, y, uncertain, samples=
     Y, X = np.meshgrid(y_values, x_values, indexing="ij")
     stable = np.zeros(Y.shape, dtype=np.int64)
     marginal = np.zeros(Y.shape, dtype=np.int64)
-    # Draws of one delay are classified together (the delay is one integer a call).
-    delays = draws["d"].astype(int) if "d" in draws else None
+    # Draws of one whole delay are classified together (a call takes one whole d, and each
+    # draw's fraction of a period).
+    delays = _delay_draws(loop, draws, values)
+    wholes = None if delays is None else np.floor(delays)
     groups = ([np.arange(samples)] if delays is None
-              else [np.flatnonzero(delays == d) for d in np.unique(delays)])
+              else [np.flatnonzero(wholes == d) for d in np.unique(wholes)])
     done = 0
     for group in groups:
-        fixed = dict(values)
-        if delays is not None:
-            fixed["d"] = int(delays[group[0]])
+        fixed = {k: v for k, v in values.items() if delays is None or k not in ("d", "Td")}
         for start in range(0, group.size, per_chunk):
             part = group[start:start + per_chunk]
-            drawn = {name: v[part][:, None, None] for name, v in draws.items() if name != "d"}
+            drawn = {name: v[part][:, None, None] for name, v in draws.items()
+                     if name not in ("d", "Td")}
+            if delays is not None:
+                drawn["d"] = delays[part][:, None, None]
             codes = np.asarray(loop.classify(**{x: X[None], y: Y[None]}, **drawn, **fixed))
             codes = np.broadcast_to(codes, (part.size,) + Y.shape)
             stable += np.count_nonzero(codes == STABLE, axis=0)
@@ -197,7 +237,9 @@ def stability_probability(loop, x_values, y_values, *, x, y, uncertain, samples=
             if progress is not None:
                 progress(done)
     probability = stable / samples
-    at = {k: v for k, v in {**loop.defaults, **values}.items() if k not in (x, y) and k not in draws}
+    varied = set(draws) | ({"d", "Td"} if delays is not None else set())
+    at = {k: v for k, v in {**loop.defaults, **values}.items() if k not in (x, y)
+          and k not in varied}
     return StabilityProbability(
         y_values=y_values, x_values=x_values, probability=probability,
         standard_error=np.sqrt(probability * (1 - probability) / samples), marginal=marginal,
@@ -214,6 +256,6 @@ def _describe(name, spec):
         args = ", ".join(f"{a:g}" for a in getattr(spec, "args", ()))
         kwds = ", ".join(f"{k}={v:g}" for k, v in getattr(spec, "kwds", {}).items())
         return f"{name}({', '.join(p for p in (args, kwds) if p)})"
-    if name == "d":
+    if name == "d" and float(spec[0]).is_integer() and float(spec[1]).is_integer():
         return f"the integers {int(spec[0])} to {int(spec[1])}, equally likely"
     return f"uniform({float(spec[0]):g}, {float(spec[1]):g})"

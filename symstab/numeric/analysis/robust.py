@@ -835,6 +835,45 @@ def _grid(box):
     return [dict(zip(box, point, strict=True)) for point in itertools.product(*axes)]
 
 
+#: Why a delay range in seconds or in fractions of a period is refused.
+_FRACTIONAL_RANGE = ("{where} = {spec!r}: robust regions take a delay range in whole samples, "
+                     "uncertain={{'d': (low, high)}} with whole ends (each whole delay in it is "
+                     "certified); a range in seconds or with a fractional end holds a continuum "
+                     "of fractional delays, which the zero exclusion does not cover")
+
+
+def _whole(value):
+    """Whether ``value`` is a real number with no fraction (its checks come later)."""
+    try:
+        return float(value).is_integer()
+    except (TypeError, ValueError):
+        return True
+
+
+def _whole_delay(loop, values, box, delays):
+    """``values`` with the delay in whole samples ``d`` (a ``Td`` given, or the loop's, turned
+    into ``d``); a fractional one refused: the plant's interval enclosures are of whole-sample
+    pulse transfer functions."""
+    shown = values if {"d", "Td"} & set(values) else loop.defaults
+    if delays is not None or "d" in shown or "Td" not in shown:
+        d = shown.get("d", 0)
+        if delays is None and not _whole(d):
+            raise ValueError(f"robust regions take a whole delay d (samples), got d = {d!r}: "
+                             f"give d = N, or a range of whole delays in uncertain")
+        return {k: v for k, v in values.items() if k != "Td"}
+    period = box.get("T") or values.get("T", loop.defaults.get("T"))
+    if isinstance(period, tuple):
+        raise ValueError(f"robust regions take a whole delay d (samples): a delay Td = "
+                         f"{shown['Td']!r} s over an uncertain T is fractional; give d = N")
+    samples = check_real("Td", shown["Td"], low=0.0) / check_real("T", period, low=0.0,
+                                                                   low_open=True)
+    if abs(samples - round(samples)) > 1e-9 * max(1.0, samples):
+        raise ValueError(f"robust regions take a whole delay d (samples), got Td = "
+                         f"{shown['Td']!r} s = {samples:.6g} samples: give d = N, or a range "
+                         f"of whole delays in uncertain")
+    return {**{k: v for k, v in values.items() if k != "Td"}, "d": int(round(samples))}
+
+
 def _check_uncertain(loop, uncertain, axes):
     """``(box, delays)``: the continuous parameters' (lo, hi) and the delays, checked."""
     if not isinstance(uncertain, dict) or not uncertain:
@@ -843,6 +882,9 @@ def _check_uncertain(loop, uncertain, axes):
     box, delays = {}, None
     for name, spec in uncertain.items():
         where = f"uncertain[{name!r}]"
+        if name == "Td" or (name == "d" and isinstance(spec, (tuple, list)) and len(spec) == 2
+                            and not all(_whole(v) for v in spec)):
+            raise ValueError(_FRACTIONAL_RANGE.format(where=where, spec=spec))
         if name not in loop.parameters:
             raise ValueError(f"uncertain: {name!r} is not a parameter of the loop (its "
                              f"parameters: {', '.join(loop.parameters)})")
@@ -885,7 +927,9 @@ def robust_region(loop, x=None, y=None, *, uncertain, strips=64, rtol=1e-6, x_ra
         (default: the loop's :attr:`~symstab.Loop.plane`).
     uncertain : dict
         ``{name: (low, high)}``: the box of the plant's and environment's
-        parameters (``T`` included), and ``d`` a range of whole delays.
+        parameters (``T`` included), and ``d`` a range of whole delays
+        (a range in seconds, ``Td``, or with a fractional end is refused:
+        the zero exclusion covers each whole delay, not a continuum).
     strips : int
         Vertical strips across the window (1 to 100 000); those where the
         set has a corner or an end are halved (at most ``4 strips`` more).
@@ -981,6 +1025,7 @@ def _check_robust_values(loop, x, y, uncertain, values):
             raise ValueError(f"robust regions take a plane of the environment's parameters; "
                              f"{name} is not one")
     box, delays = _check_uncertain(loop, uncertain, (x, y))
+    values = _whole_delay(loop, values, box, delays)
     unknown = set(values) - set(loop.parameters)
     if unknown:
         raise TypeError(f"unknown parameter(s) {', '.join(sorted(unknown))}; parameters of "

@@ -186,31 +186,61 @@ def test_bad_design_input_names_the_parameter(kwargs, error, name):
 
 
 def test_the_sample_period_with_the_delay_held_in_seconds():
-    """T searched with a 10 ms delay: d = ceil(10 ms / T) at each T (the whole samples that
-    cover the delay), against a dense scan that holds it the same way.  (T from 0.5 ms: d
-    from 3 to 20, not to 50; the best d, 20, is not the file's 40.)"""
+    """T searched with a 10 ms delay: d = 10 ms / T samples at each T, a fraction of a period
+    included (was ceil(10 ms / T), the whole samples that cover it), against a dense scan of
+    the engine's K_max with the delay given as Td.  K_max rises as T falls (the sawtooth of
+    the whole-sample delay is gone): the best T is the range's low end, d = 20 there."""
     loop = symstab.load_loop(LOOPS / "paper.toml")
     delay, window = 0.01, (5e-4, 4e-3)
     found = loop.design(over={"T": window}, delay=delay, n=9, M=0.0)
-
-    def f(T):
-        d = math.ceil(delay / T - 1e-9)
-        return loop.limits(T=T, d=d, M=0.0).y_max
-
-    at, value = dense_maximum(f, *window, points=9, levels=4)
+    at, value = dense_maximum(lambda T: loop.limits(T=T, Td=delay, M=0.0).y_max, *window,
+                              points=9, levels=2)
     assert found.value == pytest.approx(value, rel=1e-4)
-    assert found.best_d == math.ceil(delay / found.best["T"] - 1e-9)
-    assert found.best_d * found.best["T"] >= delay * (1 - 1e-12)
+    assert found.best_d == pytest.approx(delay / found.best["T"], rel=1e-12)
+    assert found.at_edge == ("T",) and found.best_d == pytest.approx(20.0)
     with pytest.raises(TypeError, match="not both"):
         loop.design(over={"T": window}, delay=delay, d=3)
 
 
-@pytest.mark.parametrize("delay, T, d", [(0.01, 0.001, 10), (0.01, 0.0003, 34), (0.003, 0.001, 3),
-                                         (0.0, 0.001, 0), (0.0025, 0.001, 3)])
-def test_a_held_delay_is_the_whole_samples_that_cover_it(delay, T, d):
-    from symstab.numeric.analysis.design import held_delay
+def test_an_interior_optimum_of_the_sample_period_with_the_delay_held():
+    """two_mass (a 150 Hz transmission resonance) with the delay held at 2 ms: K_max against
+    T peaks inside the range (385 N/m near T = 2.86 ms, d = 0.70 samples), where the whole
+    samples that cover the delay (d = 1 there, the former ceil) give 257.  Oracle: a dense
+    scan of the engine's K_max at Td = 2 ms.  The loop's Td among the values is the same
+    held delay as ``delay``."""
+    loop = symstab.load_loop(LOOPS / "two_mass.toml")
+    delay, window = 0.002, (1.5e-3, 4e-3)
+    found = loop.design(over={"T": window}, delay=delay, n=9)
+    at, value = dense_maximum(lambda T: loop.limits(T=T, Td=delay).y_max, *window, points=9,
+                              levels=6)
+    assert found.value == pytest.approx(value, rel=1e-4)
+    assert found.best["T"] == pytest.approx(at, rel=1e-3) and not found.at_edge
+    assert 0 < found.best_d < 1 and found.delay == delay
+    assert f"delay 0.002 s = {found.best_d:.6g} samples" in repr(found)
+    assert found.as_dict()["delay"] == delay and found.as_dict()["best_d"] == found.best_d
+    near = {"T": (found.best["T"] * 0.999, found.best["T"] * 1.001)}
+    again = loop.design(over=near, Td=delay, n=3, rtol=1e-2)
+    assert again.delay == delay and again.value == pytest.approx(found.value, rel=1e-5)
 
-    assert held_delay(delay, T) == d
+
+def test_a_held_delay_is_continuous_across_a_whole_sample():
+    """Why no whole-sample pieces are searched: at T = 5 ms / 16 the delay is 16 samples, and
+    just above it 15 samples and a fraction near 1; K_max is the same there (the modified
+    z-transform at eps -> 1 is one more whole sample)."""
+    loop = symstab.load_loop(LOOPS / "paper.toml")
+    T = 0.005 / 16
+    at = loop.limits(T=T, Td=0.005, M=0.0).y_max
+    above = loop.limits(T=T * (1 + 1e-8), Td=0.005, M=0.0).y_max
+    assert above == pytest.approx(at, rel=1e-6)
+
+
+def test_the_passive_target_holds_no_delay_in_seconds():
+    """The passive set is derived for whole samples: a delay held in seconds (fractional
+    d = delay / T) is refused before any work, naming what is taken."""
+    loop = symstab.load_loop(LOOPS / "paper.toml")
+    with pytest.raises(ValueError, match="whole number of samples d") as excinfo:
+        loop.design(over={"T": (5e-4, 1e-3)}, maximize="passive", delay=0.01)
+    assert_message_names(excinfo, "delay")
 
 
 def test_a_band_between_two_scan_points_is_bracketed_not_called_empty():
@@ -234,24 +264,6 @@ def test_no_stable_value_is_said_with_its_proof():
     assert found.best is None and "proved" in found.message
     for M in np.linspace(0.5, 1.0, 5):
         assert loop.limits(d=40, M=M).y_max is None
-
-
-def test_the_sample_period_search_takes_the_best_whole_sample_piece():
-    """Issue 40, item 2: with the delay held at 5 ms, K_max against T is a sawtooth (d =
-    ceil(5 ms / T) steps at each T = 5 ms / k); Brent's method over the whole range climbed
-    one tooth (T = 1/3 ms, d = 15, K_max 253.375) while d = 16 is better.  Oracle: K_max of
-    the engine at four values of T in each whole-sample piece, d fixed per piece."""
-    loop = symstab.load_loop(LOOPS / "paper.toml")
-    delay, window = 0.005, (3e-4, 8e-4)
-    found = loop.design(over={"T": window}, delay=delay, n=9, M=0.0)
-    scan = []
-    for d in range(math.ceil(delay / window[1]), math.ceil(delay / window[0]) + 1):
-        low, high = max(window[0], delay / d), min(window[1], delay / (d - 1))
-        scan += [(loop.limits(T=float(T), d=d, M=0.0).y_max, d)
-                 for T in np.linspace(low, high, 5)[:-1]]
-    value, d = max(scan)
-    assert found.best_d == d == 16
-    assert found.value == pytest.approx(value, rel=1e-6)
 
 
 def test_nothing_found_unproved_says_what_was_not_examined():

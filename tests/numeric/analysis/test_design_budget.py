@@ -122,10 +122,9 @@ def test_a_budget_met_in_two_bands_searches_both():
         return 10 * x if x <= 1 else 10 - 0.01 * (x - 1)
 
     best, value, _ = design._maximize_line(f, [(0.0, 1.0), (2.0, 3.0), (3.5, 4.0), (5.0, 6.0),
-                                               (7.0, 7.0)], 17, [], 1e-9, None, False)
+                                               (7.0, 7.0)], 17, [], 1e-9, None)
     assert best == 1.0 and value == 10.0
-    best, value, _ = design._maximize_line(f, [(7.5, 7.5), (2.0, 3.0)], 17, [], 1e-9, None,
-                                           False)
+    best, value, _ = design._maximize_line(f, [(7.5, 7.5), (2.0, 3.0)], 17, [], 1e-9, None)
     assert best == 2.0 and value == pytest.approx(9.99, rel=1e-12)
 
 

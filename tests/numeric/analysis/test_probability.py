@@ -14,7 +14,7 @@ import scipy.stats
 import symstab
 
 from conftest import REPO, assert_message_names
-from oracles import python_control_parts
+from oracles import fractional_delay_radius, loop_coefficients, python_control_parts
 
 LOOPS = REPO / "examples" / "loops"
 
@@ -111,8 +111,11 @@ def test_a_certain_parameter_gives_probabilities_0_or_1_equal_to_the_root_counts
     ({"uncertain": {"b": (0.02, 0.01)}}, "uncertain['b']"),
     ({"uncertain": {"b": (0.02, float("nan"))}}, "uncertain['b']"),
     ({"uncertain": {"b": "wide"}}, "uncertain['b']"),
-    ({"uncertain": {"d": (1.5, 3)}}, "d"),
-    ({"uncertain": {"d": scipy.stats.norm(10, 2)}}, "uncertain['d']"),
+    ({"uncertain": {"d": (3, 1.5)}}, "uncertain['d']"),
+    ({"uncertain": {"d": scipy.stats.norm(1, 2)}}, "uncertain['d']"),
+    ({"uncertain": {"Td": (0.002, 0.001)}}, "uncertain['Td']"),
+    ({"uncertain": {"d": (1, 2), "Td": (0.001, 0.002)}}, "Td"),
+    ({"uncertain": {"Td": (0.001, 0.002)}, "d": 3}, "Td"),
     ({"uncertain": {"b": (0.01, 0.02)}, "samples": 0}, "samples"),
     ({"uncertain": {"b": (0.01, 0.02)}, "samples": 2.5}, "samples"),
     ({"uncertain": {"b": (0.01, 0.02)}, "seed": -1}, "seed"),
@@ -133,3 +136,36 @@ def test_a_draw_outside_the_file_s_bounds_is_refused_by_name():
         loop.stability_probability([0.0, 0.1], [1.0, 2.0], uncertain={"f_c": (100.0, 600.0)},
                                    samples=50)
     assert_message_names(excinfo, "f_c")
+
+
+def test_a_delay_uncertain_in_seconds_is_drawn_continuously():
+    """Issue 43: the delay uniform in [5.2, 6.8] ms at T = 1 ms, fractions of a period
+    included; the draws straddle two whole delays (5 and 6), classified in two groups.
+    Oracle: a Monte Carlo written here, its own generator, each draw decided by the
+    spectral radius of the state-space loop whose command waits (d + eps) T
+    (``oracles.fractional_delay_radius``, Van Loan's exponential, nothing of symstab's
+    modified z-transform).  The same range in fractional samples is the same law: with
+    the same seed, the same map."""
+    loop = symstab.load_loop(LOOPS / "paper.toml")
+    cells = [(1.0, 110.0), (1.0, 130.0), (1.8, 160.0)]
+    xs, ys = np.array([1.0, 1.8]), np.array([110.0, 130.0, 160.0])
+    found = loop.stability_probability(xs, ys, uncertain={"Td": (0.0052, 0.0068)},
+                                       samples=400, seed=2, M=0.0)
+    assert found.uncertain == {"Td": "uniform(0.0052, 0.0068)"} and "d" not in found.at
+    ours = np.array([found.probability[list(ys).index(k), list(xs).index(b)] for b, k in cells])
+    error = np.array([found.standard_error[list(ys).index(k), list(xs).index(b)]
+                      for b, k in cells])
+    rng, n = np.random.default_rng(54321), 200
+    delays = rng.uniform(5.2, 6.8, n)
+    theirs = np.zeros(len(cells))
+    for k, (B, K) in enumerate(cells):
+        parts = loop_coefficients(loop, {**loop.defaults, "M": 0.0, "B": B, "K": K})
+        theirs[k] = np.mean([fractional_delay_radius(*parts, 1e-3, int(v), v - int(v)) < 1
+                             for v in delays])
+    their_error = np.sqrt(theirs * (1 - theirs) / n)
+    assert np.all((ours > 0.05) & (ours < 0.95)), ours
+    assert np.all(np.abs(ours - theirs) <= 3 * np.hypot(error, their_error) + 1e-12), (ours, theirs)
+    in_samples = loop.stability_probability(xs, ys, uncertain={"d": (5.2, 6.8)}, samples=400,
+                                            seed=2, M=0.0)
+    np.testing.assert_array_equal(in_samples.probability, found.probability)
+    assert in_samples.uncertain == {"d": "uniform(5.2, 6.8)"}

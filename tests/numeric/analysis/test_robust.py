@@ -491,3 +491,29 @@ def test_every_zero_of_a_cell_is_in_its_set(path, box, d, h, narrow_width):
     # Not vacuous: many cells exclude all but a band a few trapezoids wide of the t in [-100,
     # 100] (with a narrow box and theta-interval, locate the zero to a few per cent of one).
     assert checked > 300 and narrow > checked / 4
+
+
+@pytest.mark.parametrize("uncertain, values, match", [
+    ({"Td": (0.010, 0.011)}, {}, r"uncertain\['Td'\] = \(0.01, 0.011\): robust regions take a "
+                                 r"delay range in whole samples"),
+    ({"d": (10, 10.5)}, {}, r"uncertain\['d'\] = \(10, 10.5\): .* whole ends"),
+    ({"b": (0.03, 0.0325)}, {"d": 10.5}, "whole delay d .* got d = 10.5"),
+    ({"b": (0.03, 0.0325)}, {"Td": 0.0105}, "got Td = 0.0105 s = 10.5 samples"),
+])
+def test_a_fractional_delay_is_refused_with_what_is_supported(paper, uncertain, values, match):
+    """Issue 43: the zero exclusion certifies each whole delay of a range (the plant's
+    interval enclosures are whole-sample pulse transfer functions), not a continuum of
+    fractional delays: a range in seconds or with a fractional end, or a fractional
+    nominal delay, is one error saying what is taken, never a region that looks certified."""
+    with pytest.raises(ValueError, match=match):
+        paper.robust_region("B", "K", uncertain=uncertain, strips=2, **values)
+    with pytest.raises(ValueError, match=match):
+        paper.limits("B", "K", uncertain=uncertain, strips=2, **values)
+
+
+def test_a_delay_in_seconds_of_whole_samples_is_that_delay(paper):
+    """Td = 10 ms at T = 1 ms is d = 10: the same robust set."""
+    box = {"b": (0.03, 0.0325)}
+    seconds = paper.robust_region("B", "K", uncertain=box, strips=2, Td=0.010, M=0.0)
+    samples = paper.robust_region("B", "K", uncertain=box, strips=2, d=10, M=0.0)
+    assert seconds.intervals == samples.intervals and seconds.area == samples.area
