@@ -48,17 +48,13 @@ import math
 
 import numpy as np
 
-from ..._validate import check_real
+from ..._validate import check_real, snap_delay
 from ..engine.polynomial import DelayedPolynomial
 from ..engine.results import html_table
 from ..engine.roots import STABLE, circle_minimum
 from .margins import classified_point
 
 __all__ = ["DelayRange", "delay_range", "DelayRangeMap", "delay_range_map"]
-
-#: A delay in samples within this of a whole number is that number (Td / T of two floats).
-_WHOLE = 1e-9
-
 
 @dataclasses.dataclass(frozen=True)
 class DelayRange:
@@ -135,10 +131,8 @@ def _range_samples(delay_range, T):
     high = check_real("delay_range's Td_max", high, low=0.0)
     if high < low:
         raise ValueError(f"delay_range must have Td_min <= Td_max, got ({low:g}, {high:g})")
-    low, high = low / T, high / T
-    ends = [round(x) if abs(x - round(x)) <= _WHOLE * max(1.0, x) else x for x in (low, high)]
-    whole = all(float(x).is_integer() for x in ends)
-    return float(ends[0]), float(ends[1]), whole
+    low, high = (float(x) for x in snap_delay([low / T, high / T]))
+    return low, high, low.is_integer() and high.is_integer()
 
 
 def _gain_bracket(chi, n_samples, rtol):

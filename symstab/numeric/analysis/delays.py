@@ -34,7 +34,7 @@ import math
 
 import numpy as np
 
-from ..._validate import check_real, split_delay
+from ..._validate import check_real, snap_delay, split_delay
 from ..engine.results import html_table
 from ..engine.roots import STABLE, circle_minimum
 from ..engine.search import bracketed_root
@@ -228,7 +228,7 @@ def _switches(loop, point, grid, *, first_only):
 
     With ``first_only``, the scan stops at the first switch (the margin).
     """
-    wholes = np.floor(grid + 1e-12)
+    wholes = np.floor(snap_delay(grid))
     out, before, last = [], True, grid[0]
     for whole in np.unique(wholes):
         where = np.flatnonzero(wholes == whole)
