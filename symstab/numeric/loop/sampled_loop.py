@@ -251,9 +251,8 @@ class Loop(LoopModel):
         ``D = Ve_d P_d`` and ``N = Ve_n P_n``, divided by ``P_d``'s leading
         coefficient, one polynomial per point; what :meth:`classify`,
         :meth:`unstable_root_counts` and :meth:`spectral_radius` work on, in
-        O(d) per point.  ``**values``: every parameter (:attr:`parameters`) or its
-        default, arrays broadcast; ``d`` in samples, whole or not, or ``Td`` in
-        seconds (a fraction of a period is carried by the plant: ``P_eps = N_eps / (z P_d)``).
+        O(d) per point.  ``**values``: every parameter (:attr:`parameters`) or its default,
+        arrays broadcast; ``d`` in samples, whole or not (``P_eps = N_eps / (z P_d)``), or ``Td``.
         """
         return self.evaluation.polynomial(values)
 
@@ -456,11 +455,15 @@ class Loop(LoopModel):
 
         return delay_margin(self, limit=limit, step=step, every=every, **values)
 
-    def delay_range(self, *, delay_range, rtol=1e-6, **values):
-        """Every delay of a range: :func:`symstab.numeric.analysis.delay_range.delay_range`."""
-        from ..analysis.delay_range import delay_range as check
+    def delay_range(self, x_values=None, y_values=None, *, delay_range, **values):
+        """Every delay of a range, at a point or (given ``x_values, y_values``) a grid's.
 
-        return check(self, delay_range=delay_range, rtol=rtol, **values)
+        See :mod:`symstab.numeric.analysis.delay_range`."""
+        from ..analysis import delay_range as rooms
+
+        if x_values is None and y_values is None:
+            return rooms.delay_range(self, delay_range=delay_range, **values)
+        return rooms.delay_range_map(self, x_values, y_values, delay_range=delay_range, **values)
 
     def force_noise(self, *, encoder_resolution, **values):
         """The force RMS of the encoder's quantization at a stable point.
