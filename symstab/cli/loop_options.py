@@ -93,14 +93,14 @@ _LOOP_ONLY = {
     "design": ("set_values", "x", "y", "at", "over", "search_range", "delay"),
     "map": ("set_values", "x", "y", "x_range", "y_range", "simulate", "uncertain", "samples",
             "seed", "margin"),
-    "simulate": ("set_values",),
+    "simulate": ("set_values", "delays", "seed"),
 }
 
 _FLAGS = {"set_values": "--set", "x": "--x", "y": "--y", "at": "--at",
           "x_range": "--x-range", "y_range": "--y-range", "over": "--over",
           "search_range": "--range", "simulate": "--simulate", "delay": "--delay",
           "uncertain": "--uncertain", "samples": "--samples", "seed": "--seed",
-          "margin": "--margin",
+          "margin": "--margin", "delays": "--delays",
           "strips": "--strips", "png": "--png"}
 
 
@@ -210,6 +210,13 @@ def add_loop_options(p, command):
                             "to 3, times the device's mass: the sum of the plant's parameters "
                             "in the unit of the mass term, with delta = b T / mass where the "
                             "loop has a damping b, else 0)")
+    if command == "simulate":
+        g.add_argument("--delays", metavar="uniform:DMIN:DMAX",
+                       help="a delay that varies from period to period: each period's delay "
+                            "drawn uniformly from the whole samples DMIN..DMAX (instead of d; "
+                            "Loop.simulate's delays)")
+        g.add_argument("--seed", type=int, metavar="S",
+                       help="seed of the --delays draws (default 0: the same run every time)")
     if command == "map":
         g.add_argument("--simulate", action="store_true", default=None,
                        help="also simulate every cell (the plant's exact ZOH step, the "

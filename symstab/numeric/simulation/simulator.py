@@ -422,10 +422,10 @@ def delay_sequence(delays, steps=None, seed=None):
         if delays[0] not in DELAY_LAWS or len(delays) != 3:
             raise ValueError(f"delays must be ('uniform', d_min, d_max) or an array of whole "
                              f"samples, got {delays!r}")
-        d_min, d_max = (check_delay(bound, name=f"delays' {name}")
+        d_min, d_max = (check_delay(bound, name=f"{name} of delays")
                         for name, bound in zip(("d_min", "d_max"), delays[1:], strict=True))
         if d_min > d_max:
-            raise ValueError(f"delays' d_min must be at most d_max, got {d_min} > {d_max}")
+            raise ValueError(f"delays: d_min must be at most d_max, got {d_min} > {d_max}")
         steps = check_steps(steps, d_max)
         seed = 0 if seed is None else check_count("seed", seed, 0)
         check_memory(f"the delays of {steps} periods", 8 * steps)
