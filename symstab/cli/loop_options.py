@@ -210,13 +210,6 @@ def add_loop_options(p, command):
                             "to 3, times the device's mass: the sum of the plant's parameters "
                             "in the unit of the mass term, with delta = b T / mass where the "
                             "loop has a damping b, else 0)")
-    if command == "simulate":
-        g.add_argument("--delays", metavar="uniform:DMIN:DMAX",
-                       help="a delay that varies from period to period: each period's delay "
-                            "drawn uniformly from the whole samples DMIN..DMAX (instead of d; "
-                            "Loop.simulate's delays)")
-        g.add_argument("--seed", type=int, metavar="S",
-                       help="seed of the --delays draws (default 0: the same run every time)")
     if command == "map":
         g.add_argument("--simulate", action="store_true", default=None,
                        help="also simulate every cell (the plant's exact ZOH step, the "

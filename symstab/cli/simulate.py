@@ -65,6 +65,12 @@ def register(subparsers):
     add_nonideal_options(p)
     add_point_options(p)
     p.add_argument("--out", help="CSV file for the trajectory (k, t, x)")
+    g = p.add_argument_group("a delay that varies from period to period (with --loop)")
+    g.add_argument("--delays", metavar="uniform:DMIN:DMAX",
+                   help="each period's delay drawn uniformly from the whole samples DMIN..DMAX, "
+                        "instead of the loop's d (Loop.simulate's delays)")
+    g.add_argument("--seed", type=int, metavar="S",
+                   help="seed of the --delays draws (default 0: the same run every time)")
     add_loop_options(p, "simulate")
 
 

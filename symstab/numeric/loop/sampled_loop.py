@@ -492,9 +492,8 @@ class Loop(LoopModel):
                               **values)
 
     def simulate(self, *, steps=None, x0=1.0, v0=None, nonideal=None, record=False,
-                 progress=None, compensation=None, start="samples", overflow="raise",
-                 delays=None, seed=None, **values):
-        """Run the loop in time for every parameter point at once (a fixed or varying delay).
+                 progress=None, compensation=None, start="samples", overflow="raise", **values):
+        """Run the loop in time for every parameter point at once (``delays=``: a varying delay).
 
         See :func:`symstab.numeric.simulation.simulator.simulate_loop`.
         """
@@ -502,7 +501,7 @@ class Loop(LoopModel):
 
         return simulate_loop(self, steps=steps, x0=x0, v0=v0, nonideal=nonideal, record=record,
                              progress=progress, compensation=compensation, start=start,
-                             overflow=overflow, delays=delays, seed=seed, **values)
+                             overflow=overflow, **values)
 
     def stability_map(self, x_values, y_values, *, x=None, y=None, steps=None, x0=1.0, v0=None,
                       nonideal=None, progress=None, **values):
