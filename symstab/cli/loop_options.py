@@ -93,14 +93,14 @@ _LOOP_ONLY = {
     "design": ("set_values", "x", "y", "at", "over", "search_range", "delay"),
     "map": ("set_values", "x", "y", "x_range", "y_range", "simulate", "uncertain", "samples",
             "seed", "margin"),
-    "simulate": ("set_values",),
+    "simulate": ("set_values", "delays", "seed"),
 }
 
 _FLAGS = {"set_values": "--set", "x": "--x", "y": "--y", "at": "--at",
           "x_range": "--x-range", "y_range": "--y-range", "over": "--over",
           "search_range": "--range", "simulate": "--simulate", "delay": "--delay",
           "uncertain": "--uncertain", "samples": "--samples", "seed": "--seed",
-          "margin": "--margin",
+          "margin": "--margin", "delays": "--delays",
           "strips": "--strips", "png": "--png"}
 
 

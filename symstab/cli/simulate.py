@@ -18,11 +18,12 @@ a failed or interrupted run leaves nothing behind.
 import dataclasses
 import io
 import math
+import re
 
 import numpy as np
 
 from .._resources import check_memory
-from .loop_options import add_loop_options, resolve_loop, uses_loop, value_text
+from .loop_options import add_loop_options, loop_echo, resolve_loop, uses_loop, value_text
 from .options import (
     add_command,
     add_model_options,
@@ -64,6 +65,12 @@ def register(subparsers):
     add_nonideal_options(p)
     add_point_options(p)
     p.add_argument("--out", help="CSV file for the trajectory (k, t, x)")
+    g = p.add_argument_group("a delay that varies from period to period (with --loop)")
+    g.add_argument("--delays", metavar="uniform:DMIN:DMAX",
+                   help="each period's delay drawn uniformly from the whole samples DMIN..DMAX, "
+                        "instead of the loop's d (Loop.simulate's delays)")
+    g.add_argument("--seed", type=int, metavar="S",
+                   help="seed of the --delays draws (default 0: the same run every time)")
     add_loop_options(p, "simulate")
 
 
@@ -149,6 +156,7 @@ def _loop_plan(args):
     from ..numeric.simulation.simulator import check_steps
 
     setup = resolve_loop(args, plane=False)
+    delays, setup = _varying_delays(args, setup)
     loop, values = setup.loop, setup.values
     nonideal, x0 = resolve_nonideal(args, None, loop)
     _check_out(args.out)
@@ -161,15 +169,58 @@ def _loop_plan(args):
     check_loop_friction(nonideal, loop, values)
     code = int(loop.classify(**values))
     radius = float(loop.spectral_radius(**values))
+    theory, conditions = "the loop's certified root count", loop_nonideal_text(nonideal)
+    varying = {}
+    if delays is not None:
+        # The run's delay is the sequence's; the theory that of its longest fixed delay.
+        varying = {"delays": delays, "seed": args.seed}
+        values = {name: value for name, value in values.items() if name != "d"}
+        if nonideal.force_resolution is not None:
+            raise ValueError("--force-resolution with --delays: the verdict's floor for a force "
+                             "quantum is the fixed-delay loop's pulse response; drop one")
+        theory += f" at the longest delay, a fixed d = {delays[2]}; a varying delay has none"
+        conditions += (f"; delay uniform on {delays[1]}..{delays[2]} samples, drawn with seed "
+                       f"{0 if args.seed is None else args.seed}")
 
     def run_file():
         return loop.simulate(steps=steps, x0=x0, nonideal=nonideal, record=True,
-                             progress=progress_printer("simulating", steps), **values)
+                             progress=progress_printer("simulating", steps), **varying, **values)
 
-    return _Plan(run_file, x0, nonideal, code, radius, "the loop's certified root count",
-                 setup.echo, conditions=f" ({loop_nonideal_text(nonideal)})",
+    return _Plan(run_file, x0, nonideal, code, radius, theory,
+                 setup.echo, conditions=f" ({conditions})",
                  csv_header=f"k,t [s],x (SI; {value_text(setup, 'T', values['T'])})",
                  period=float(values["T"]), record=True)
+
+
+def _varying_delays(args, setup):
+    """``(delays, setup)``: ``--delays uniform:DMIN:DMAX`` as ``("uniform", DMIN, DMAX)`` (or None).
+
+    With it the setup's ``d`` is the longest delay (its horizon, its
+    theory and the checks of its plant) and its echo leaves ``d`` out.
+    """
+    from ..numeric.simulation.simulator import delay_sequence
+
+    if args.delays is None:
+        if args.seed is not None:
+            raise ValueError("--seed draws the delays of --delays uniform:DMIN:DMAX: give "
+                             "--delays, or drop --seed")
+        return None, setup
+    law, *bounds = args.delays.split(":")
+    if law != "uniform" or len(bounds) != 2 or not all(b.strip().isdigit() for b in bounds):
+        raise ValueError(f"--delays must be uniform:DMIN:DMAX with whole samples "
+                         f"0 <= DMIN <= DMAX, got {args.delays!r}")
+    delays = ("uniform", int(bounds[0]), int(bounds[1]))
+    given = [name for name in ("d", "Td") if name in setup.given]
+    if given:
+        raise ValueError(f"--delays is the delay: drop --set {given[0]}=... (or --d)")
+    try:
+        delay_sequence(delays, 8, args.seed)    # checked before anything runs
+    except (TypeError, ValueError) as exc:
+        raise ValueError(re.sub(r"(?<![\w-])(delays|seed)\b", r"--\1", str(exc))) from None
+    setup = dataclasses.replace(setup, values={**setup.values, "d": delays[2]})
+    echo = loop_echo(dataclasses.replace(setup, values={
+        name: value for name, value in setup.values.items() if name != "d"}))
+    return delays, dataclasses.replace(setup, echo=echo)
 
 
 def _simulate(args, plan):

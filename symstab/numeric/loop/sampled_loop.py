@@ -493,7 +493,7 @@ class Loop(LoopModel):
 
     def simulate(self, *, steps=None, x0=1.0, v0=None, nonideal=None, record=False,
                  progress=None, compensation=None, start="samples", overflow="raise", **values):
-        """Run the loop in time for every parameter point at once.
+        """Run the loop in time for every parameter point at once (``delays=``: a varying delay).
 
         See :func:`symstab.numeric.simulation.simulator.simulate_loop`.
         """

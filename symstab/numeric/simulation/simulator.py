@@ -32,9 +32,17 @@ import math
 import numpy as np
 
 from ..._progress import progress_printer
-from ..._resources import MAX_STEPS_ENV, check_memory, chunk_slices
+from ..._resources import MAX_DELAY_ENV, MAX_STEPS_ENV, check_memory, chunk_slices
+from ..._resources import max_delay as _max_delay
 from ..._resources import max_steps as _max_steps_setting
-from ..._validate import check_delay, check_grid, check_progress, check_real
+from ..._validate import (
+    check_array,
+    check_count,
+    check_delay,
+    check_grid,
+    check_progress,
+    check_real,
+)
 from ..engine.results import PAPER_PLANE, PaperGridNames
 from .friction import StatePlant, stacked_spaces, substeps_of
 
@@ -42,7 +50,8 @@ __all__ = ["Nonidealities", "FrictionCompensation", "Simulation", "StabilityMap"
            "default_horizon", "check_steps", "check_x0", "max_steps", "progress_printer",
            "PAPER_ENCODER_RESOLUTION", "MAX_STEPS_ENV", "run_loop", "simulate_loop",
            "loop_stability_map", "check_loop_nonideal", "default_x0", "MAX_SUBSTEPS", "X0_MIN",
-           "X0_MAX", "check_friction_size", "QUANTUM_MIN", "FRICTION_STEP_MAX"]
+           "X0_MAX", "check_friction_size", "QUANTUM_MIN", "FRICTION_STEP_MAX",
+           "delay_sequence", "DELAY_LAWS"]
 
 
 #: The most sub-steps per period: each multiplies the simulation's time (a
@@ -377,6 +386,73 @@ def check_steps(steps, d):
     return steps
 
 
+#: The random laws of a varying delay (:func:`delay_sequence`).
+DELAY_LAWS = ("uniform",)
+
+
+def delay_sequence(delays, steps=None, seed=None):
+    """The delay of every period of a run whose delay varies, checked: ``(sequence, steps)``.
+
+    Parameters
+    ----------
+    delays : array_like of int or tuple
+        The delay of each period in whole samples, a 1-D array of ``steps``
+        entries from 0 to ``SYMSTAB_MAX_DELAY``; or ``("uniform", d_min,
+        d_max)``: each period's delay drawn independently, uniform on the
+        whole samples ``d_min .. d_max`` (both included), by
+        ``numpy.random.default_rng(seed)``.
+    steps : int, optional
+        Periods (default: the array's length, or :func:`default_horizon`
+        of ``d_max`` for a random sequence).
+    seed : int, optional
+        The random sequence's seed, >= 0 (default 0: the same run each
+        time); only with a random sequence.
+
+    Returns
+    -------
+    (ndarray of int64, int)
+        The ``(steps,)`` delays and ``steps``.
+
+    Raises
+    ------
+    TypeError, ValueError
+        Naming ``delays``, ``steps`` or ``seed`` and the allowed values.
+    """
+    if isinstance(delays, tuple) and delays and isinstance(delays[0], str):
+        if delays[0] not in DELAY_LAWS or len(delays) != 3:
+            raise ValueError(f"delays must be ('uniform', d_min, d_max) or an array of whole "
+                             f"samples, got {delays!r}")
+        d_min, d_max = (check_delay(bound, name=f"{name} of delays")
+                        for name, bound in zip(("d_min", "d_max"), delays[1:], strict=True))
+        if d_min > d_max:
+            raise ValueError(f"delays: d_min must be at most d_max, got {d_min} > {d_max}")
+        steps = check_steps(steps, d_max)
+        seed = 0 if seed is None else check_count("seed", seed, 0)
+        check_memory(f"the delays of {steps} periods", 8 * steps)
+        return np.random.default_rng(seed).integers(d_min, d_max + 1, size=steps), steps
+    if seed is not None:
+        raise ValueError("seed draws a random delay sequence: give delays=('uniform', d_min, "
+                         "d_max), or drop seed")
+    if isinstance(delays, (str, bytes, dict)):
+        raise TypeError(f"delays must be an array of whole samples or ('uniform', d_min, d_max), "
+                        f"got {type(delays).__name__}")
+    sequence = check_array("delays", delays, low=0.0)
+    if sequence.ndim != 1 or sequence.size < 8:
+        raise ValueError(f"delays must be a 1-D array of at least 8 delays, one a period, got "
+                         f"shape {sequence.shape}")
+    whole = np.floor(sequence) == sequence
+    limit = _max_delay()
+    if not whole.all() or sequence.max() > limit:
+        first = int(np.flatnonzero(~whole | (sequence > limit))[0])
+        raise ValueError(f"delays must be whole samples from 0 to {limit} (raise the limit with "
+                         f"{MAX_DELAY_ENV}), got {sequence[first]!r} (entry {first})")
+    steps = check_steps(sequence.size if steps is None else steps, int(sequence.max()))
+    if steps != sequence.size:
+        raise ValueError(f"delays must have one delay a period: steps = {steps} periods, got "
+                         f"{sequence.size} delays")
+    return sequence.astype(np.int64), steps
+
+
 def max_steps(d):
     """The largest ``steps`` accepted at delay ``d``.
 
@@ -412,6 +488,10 @@ class Simulation:
         growing, above the floor: a bounded limit cycle (a saturated
         unstable loop's), neither stable nor unstable.  Never set for the
         ideal loop, which is linear.
+    delays : ndarray of int or None
+        ``(steps,)``: the delay of every period in samples where it varied
+        (:func:`simulate_loop`'s ``delays``; the drawn sequence where it was
+        random); None for a fixed delay.
     """
 
     positions: object
@@ -421,6 +501,7 @@ class Simulation:
     steps: int
     floor: np.ndarray
     limit_cycle: np.ndarray
+    delays: object = None
 
     def plot(self, ax=None, *, T=None):
         """Draw the recorded positions: :func:`symstab.drawing.plot_simulation`.
@@ -454,6 +535,9 @@ class Simulation:
         if stable.ndim > 1:
             size += " (" + " x ".join(map(str, stable.shape)) + ")"
         recorded = ", positions recorded" if self.positions is not None else ""
+        if self.delays is not None:
+            recorded += (f", delay per period from {int(np.min(self.delays))} to "
+                         f"{int(np.max(self.delays))} samples")
         cycles = f"{n_cycles} limit cycle{'s' if n_cycles != 1 else ''}, " if n_cycles else ""
         n_unstable = stable.size - n_stable - n_cycles
         return (f"Simulation({size}, {self.steps} steps: {n_stable} stable, {cycles}"
@@ -685,7 +769,8 @@ def _block_rows(d, n_points=1):
 
 
 def simulate_loop(loop, *, steps=None, x0=1.0, v0=None, nonideal=None, record=False,
-                  progress=None, compensation=None, start="samples", overflow="raise", **values):
+                  progress=None, compensation=None, start="samples", overflow="raise",
+                  delays=None, seed=None, **values):
     """Run a :class:`symstab.Loop` in time for every parameter point at once.
 
     The plant's exact ZOH step on the samples, the environment's difference
@@ -726,6 +811,19 @@ def simulate_loop(loop, *, steps=None, x0=1.0, v0=None, nonideal=None, record=Fa
     unless ``compensation`` is given.  A velocity filter or an actuator lag
     is part of a loop's own environment or plant.
 
+    The delay may vary from period to period by whole samples
+    (``delays``): the plant's input at period ``k`` is then ``-f[k -
+    delta_k]``, the force computed ``delta_k`` periods earlier (one of the
+    last ``d_max + 1``), run one period at a time.  The sequence is the
+    delay: ``d`` and ``Td`` are not given (the loop's default is unused),
+    and a fractional delay that varies is not modelled.  A random sequence
+    is drawn once for the run and every point runs it, so that the points
+    of a map differ by their parameters only, not by their draws (and the
+    sequence is the result's :attr:`Simulation.delays`; for independent
+    draws, run each point with its own ``seed``).  Non-idealities are
+    those of a fixed delay but the force quantum, whose verdict floor is
+    the fixed-delay loop's pulse response.
+
     Parameters
     ----------
     loop : symstab.Loop
@@ -760,9 +858,19 @@ def simulate_loop(loop, *, steps=None, x0=1.0, v0=None, nonideal=None, record=Fa
         A point whose difference equations overflow double precision (``K
         = 1e308``) is refused before the run (default), or run as a point
         that diverges at once (the paper's simulator).
+    delays : array_like of int or tuple, optional
+        A delay that varies (see above): the delay of every period in whole
+        samples, a 1-D array of ``steps`` entries (the same for every
+        point); or ``("uniform", d_min, d_max)``, each period's delay
+        uniform on the whole samples ``d_min .. d_max``
+        (:func:`delay_sequence`).  Default None: the fixed delay ``d``.
+    seed : int, optional
+        The random sequence's seed (default 0); only with ``("uniform",
+        ...)``.
     **values
         The loop's parameters (or their defaults); arrays broadcast, ``d``
-        one integer.
+        one number of samples (whole or not) or ``Td`` seconds, neither
+        with ``delays``.
 
     Returns
     -------
@@ -793,6 +901,11 @@ def simulate_loop(loop, *, steps=None, x0=1.0, v0=None, nonideal=None, record=Fa
     if overflow not in ("raise", "diverge"):
         raise ValueError(f"overflow must be 'raise' or 'diverge', got {overflow!r}")
     check_progress(progress)   # a wrong kind is refused before the work
+    if delays is not None:
+        delays, steps, values = _varying_delay(delays, steps, seed, nonideal, values)
+    elif seed is not None:
+        raise ValueError("seed draws a random delay sequence: give delays=('uniform', d_min, "
+                         "d_max), or drop seed")
     parts_of, d, shape, parts_floats, period = _parts_by_chunk(loop, values, overflow)
     steps = check_steps(steps, d)
     progress = check_progress(progress, lambda: progress_printer("simulating", steps))
@@ -812,8 +925,26 @@ def simulate_loop(loop, *, steps=None, x0=1.0, v0=None, nonideal=None, record=Fa
     return run_loop(parts_of, int(np.prod(shape)), d=d, steps=steps, x0=x0, v0=v0,
                     nonideal=nonideal, record=record, progress=progress, shape=shape,
                     spaces=spaces, state=state, parts_floats=parts_floats,
-                    compensation=compensation,
+                    compensation=compensation, delays=delays,
                     linear_stable=linearly_stable(loop, nonideal, values, shape))
+
+
+def _varying_delay(delays, steps, seed, nonideal, values):
+    """``(sequence, steps, values)`` of a run whose delay varies; the values with ``d = d_max``.
+
+    The whole ``d_max`` sizes the buffers and leaves the plant without a
+    fraction.
+    """
+    given = [name for name in ("d", "Td") if name in values]
+    if given:
+        raise TypeError(f"give the delay once: {given[0]} (a fixed delay) or delays (one a "
+                        f"period), not both; a fractional delay that varies is not modelled")
+    if nonideal.force_resolution is not None:
+        raise ValueError("nonideal.force_resolution with delays: the verdict's floor for a force "
+                         "quantum is the fixed-delay loop's pulse response; simulate a varying "
+                         "delay without it")
+    sequence, steps = delay_sequence(delays, steps, seed)
+    return sequence, steps, {**values, "d": int(sequence.max())}
 
 
 def _compensation_of(nonideal, compensation):
@@ -885,7 +1016,8 @@ def linearly_stable(loop, nonideal, values, shape):
 
 
 def run_loop(parts_of, n_points, *, d, steps, x0, v0, nonideal, record, progress, shape,
-             spaces=None, state=None, compensation=None, parts_floats=64, linear_stable=None):
+             spaces=None, state=None, compensation=None, parts_floats=64, linear_stable=None,
+             delays=None):
     """Run ``n_points`` of a loop a chunk at a time: the one engine; the :class:`Simulation`.
 
     Parameters
@@ -914,9 +1046,16 @@ def run_loop(parts_of, n_points, *, d, steps, x0, v0, nonideal, record, progress
         ``(n_points,)``: the points whose linear loop is stable (a certified
         root count of 0); needed with a force quantum, whose verdict floor
         they get (``_verdict``).
+    delays : ndarray of int, optional
+        ``(steps,)``: the delay of every period (:func:`delay_sequence`),
+        at most ``d``, which is then the longest; run one period at a time.
+        Default: the fixed delay ``d``.
     """
     if compensation is not None:
         compensation = (compensation.coulomb, compensation.pole)
+    if delays is not None and (nonideal.force_resolution is not None
+                               or np.shape(delays) != (steps,)):
+        raise ValueError("a varying delay needs one delay a period and no force quantum")
 
     def pulse(part):
         # The linear loop's response to a unit force pulse, at its stable points only.
@@ -932,9 +1071,15 @@ def run_loop(parts_of, n_points, *, d, steps, x0, v0, nonideal, record, progress
     pulse_of = None if nonideal.force_resolution is None else pulse
     point_bytes = 8 * (d + 1 + parts_floats + _ANY_LOOP_FLOATS + 2 * _block_rows(d)
                        + _BUFFERS * _spare_rows(_block_rows(d)))
-    if spaces is None:
+    if delays is not None:
+        point_bytes = 8 * (d + 1 + parts_floats + _ANY_LOOP_FLOATS + 2 + _BUFFERS * _spare_rows(1))
+    if spaces is None and delays is None:
         def make_run(part):
             return _AnyLoop(parts_of(part), d, x0, v0, nonideal, compensation=compensation)
+    elif spaces is None:
+        def make_run(part):
+            return _VaryingLoop(parts_of(part), d, x0, v0, nonideal, delays,
+                                compensation=compensation)
     else:
         spaces, inverse = spaces
         n = spaces[0].phi.shape[0]
@@ -942,11 +1087,15 @@ def run_loop(parts_of, n_points, *, d, steps, x0, v0, nonideal, record, progress
         point_bytes += 8 * (6 * n + 4 + (0 if len(spaces) == 1 else 2 * n * n + 10 * n))
 
         def make_run(part):
-            return _StateLoop(parts_of(part), d, x0, v0, nonideal,
-                                 stacked_spaces(spaces, inverse[part]), state=state,
-                                 compensation=compensation)
-    return _run_chunks(make_run, n_points, point_bytes, steps=steps, d=d, record=record,
-                       progress=progress, nonideal=nonideal, shape=shape, pulse_of=pulse_of)
+            space = stacked_spaces(spaces, inverse[part])
+            if delays is not None:
+                return _VaryingStateLoop(parts_of(part), d, x0, v0, nonideal, space, delays,
+                                         state=state, compensation=compensation)
+            return _StateLoop(parts_of(part), d, x0, v0, nonideal, space, state=state,
+                              compensation=compensation)
+    run = _run_chunks(make_run, n_points, point_bytes, steps=steps, d=d, record=record,
+                      progress=progress, nonideal=nonideal, shape=shape, pulse_of=pulse_of)
+    return run if delays is None else dataclasses.replace(run, delays=delays)
 
 
 def check_loop_nonideal(nonideal, loop=None, friction_name="nonideal.coulomb_friction"):
@@ -1057,6 +1206,10 @@ class _AnyLoop:
     few calls (the paper's loop at d >= 8: four), not twenty.
     """
 
+    #: A delay that varies from period to period (:class:`_VaryingLoop`):
+    #: blocks of one period, the plant stepped after the environment.
+    varying = False
+
     def __init__(self, parts, d, x0, v0, nonideal, compensation=None, pulse=None,
                  positions_unread=False):
         a, b, c, e = parts
@@ -1075,7 +1228,10 @@ class _AnyLoop:
         n, m = a.shape[1], c.shape[1]
         self.n, self.m = n, m
         self.size = n_points
-        self.block = _block_rows(d, n_points)
+        self.block = 1 if self.varying else _block_rows(d, n_points)
+        # The plant steps first where it reads no command of this period (a
+        # fixed d >= 1); a varying delay may be 0 in any period.
+        self._plant_first = bool(d) and not self.varying
         rows = self.block
         self.compensation = compensation
         # A force added to the first command only (the pulse response).
@@ -1329,7 +1485,7 @@ class _AnyLoop:
         on one row (d = 0 or 1, or a recorded run: blocks of one period,
         where making the views of a block took as long as the arithmetic).
         """
-        if self.d:
+        if self._plant_first:
             self._plant_one()
         tmp, multiply, add = self._tmp[0], np.multiply, np.add
         ks, kf = self.keep_s, self.keep_f
@@ -1360,7 +1516,7 @@ class _AnyLoop:
             _round_into(command, command.copy(), self.force_quantum)
         if self.force_limit is not None:
             np.clip(command, -self.force_limit, self.force_limit, out=command)
-        if not self.d:
+        if not self._plant_first:
             self._plant_one()
 
     def _plant_one(self):
@@ -1471,7 +1627,11 @@ class _StateLoop(_AnyLoop):
                 self._check_plant(r + 1)
 
     def _plant_one(self):
-        self.plant.step(self._u_rows[self.keep_u - self.d], -1.0, out=self._x_rows[self.keep_x])
+        self._step_plant(self.keep_u - self.d)
+
+    def _step_plant(self, command_row):
+        """One period of the plant driven by the command in row ``command_row`` of the buffer."""
+        self.plant.step(self._u_rows[command_row], -1.0, out=self._x_rows[self.keep_x])
         self._unfinite_at = {}
         if (self.k + 1) % self.check_every == 0:
             self._check_plant(1)
@@ -1503,6 +1663,61 @@ class _StateLoop(_AnyLoop):
 
     def _freeze_plant(self, bad):
         self.plant.freeze(bad)
+
+
+def _lags(delays, n, d_max):
+    """The delay of each period ``k`` at index ``k + n`` (``d_max`` before the start), for indexing.
+
+    A memoryview: its items are Python ints (a NumPy scalar index costs
+    more than the row it picks); before the start the commands read are
+    the empty delay line's zeros whatever the delay.
+    """
+    lags = np.concatenate([np.full(n, d_max, dtype=np.int64), np.asarray(delays, dtype=np.int64)])
+    return memoryview(lags)
+
+
+class _VaryingLoop(_AnyLoop):
+    """A loop whose delay varies by whole samples from period to period, one period at a time.
+
+    ``d`` is the longest delay, the commands the buffers keep; ``delays``
+    the delay ``delta_k`` of every period: the plant's input at period
+    ``k`` is ``-u[k - delta_k]``, ``u`` the commands (a period's, and those
+    of the periods before it its plant still reads, each with its own
+    delay).  Each product is :meth:`_AnyLoop._plant_one`'s in the same
+    order: at a constant delay the run is the fixed delay's to the last bit.
+    """
+
+    varying = True
+
+    def __init__(self, parts, d, x0, v0, nonideal, delays, compensation=None):
+        super().__init__(parts, d, x0, v0, nonideal, compensation=compensation)
+        self._lags = _lags(delays, self.n, d)
+
+    def _plant_one(self):
+        X, U, tmp, multiply = self._x_rows, self._u_rows, self._tmp[0], np.multiply
+        kx, ku, lags, now = self.keep_x, self.keep_u, self._lags, self.k + self.n
+        out = X[kx]
+        # The input of period k - i is the command of period k - i - delta_{k-i}.
+        i, first = self._b_first
+        multiply(first, U[ku - i - lags[now - i]], out)
+        for i, coefficient in self._b_rest:
+            np.add(out, multiply(coefficient, U[ku - i - lags[now - i]], tmp), out)
+        for i, coefficient in self.a:
+            np.subtract(out, multiply(coefficient, X[kx - 1 - i], tmp), out)
+
+
+class _VaryingStateLoop(_StateLoop):
+    """:class:`_VaryingLoop` with the plant on its state space (friction, a start from a state)."""
+
+    varying = True
+
+    def __init__(self, parts, d, x0, v0, nonideal, space, delays, state=None, compensation=None):
+        super().__init__(parts, d, x0, v0, nonideal, space, state=state,
+                         compensation=compensation)
+        self._lags = _lags(delays, self.n, d)
+
+    def _plant_one(self):
+        self._step_plant(self.keep_u - self._lags[self.k + self.n])
 
 
 def loop_stability_map(loop, x_values, y_values, *, x=None, y=None, steps=None, x0=1.0, v0=None,
