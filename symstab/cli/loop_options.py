@@ -225,7 +225,8 @@ def add_loop_options(p, command):
         g.add_argument("--margin", choices=("modulus", "delay", "gain"),
                        help="instead of the classification, a margin at every stable cell: "
                             "modulus, min|1+L| on the unit circle, certified; delay, the "
-                            "fewest whole samples of added delay that make it unstable; gain, "
+                            "exact delay margin: the smallest added delay, in samples "
+                            "(fractional), at which a root reaches the unit circle; gain, "
                             "the smallest factor of the loop gain that does (the other cells "
                             "hold NaN)")
         g.add_argument("--samples", type=int, metavar="N",
