@@ -13,7 +13,11 @@ circle, and :func:`delay_margin` finds those delays:
    added delays, ``step`` of a sample apart (16 points a sample by
    default), from the point's delay up to ``limit`` samples more; the
    plant at each fraction of the grid is derived once and shared by every
-   whole part;
+   whole part; once the grid's first sample is stable, each fraction's
+   points before the phase argument's first whole delay at that fraction
+   are known stable and skipped (:mod:`.delay_scan`, which
+   :func:`symstab.numeric.analysis.margins.margin_map` searches every
+   point of a map with);
 2. each change of verdict (stable to not, or back) bracketed by two
    neighbours of the grid, refined by the one root bracketer
    (:func:`symstab.numeric.engine.search.bracketed_root`) on the spectral
@@ -200,7 +204,7 @@ def delay_margin(loop, *, limit=None, step=None, every=None, **values):
     >>> from symstab import PAPER_LOOP
     >>> found = PAPER_LOOP.delay_margin(K=2.0, B=0.1, d=40, limit=20)
     >>> round(found.margin, 6), round(found.frequency, 4)
-    (9.640327, 11.6962)
+    (16.615744, 2.1744)
     """
     point = stable_point(loop, values, "the delay margin")
     T = float(point["T"])
