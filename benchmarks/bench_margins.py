@@ -122,6 +122,7 @@ def whole_sample_delay_map(loop, xs, ys, at, limit):
     from symstab.numeric.analysis.margins import first_whole_delays
     from symstab.numeric.engine.roots import STABLE
 
+    at = {k: v for k, v in at.items() if k not in ("B", "K")}
     X, Y = np.meshgrid(xs, ys)
     out = np.full(X.shape, np.nan)
     stable = np.asarray(loop.classify(**at, B=X, K=Y)) == STABLE
@@ -154,13 +155,15 @@ def delay_map_benchmark(loop, n):
     at = {"d": 40, "M": 0.004}
     xs, ys = np.linspace(0.0, 0.25, n), np.linspace(0.0, 4.0, n)
     # One run each: the exact map takes minutes.
+    point = {**loop.defaults, **at}
+    wholes = whole_sample_delay_map(loop, xs, ys, point, 410)
+    whole = statistics.median(timed_runs(
+        lambda: whole_sample_delay_map(loop, xs, ys, point, 410), 3))
+    print(f"  whole-sample map: {fmt(whole)}", flush=True)
     start = time.perf_counter()
     found = loop.margin_map(xs, ys, margin="delay", **at)
     exact = time.perf_counter() - start
-    whole = statistics.median(timed_runs(
-        lambda: whole_sample_delay_map(loop, xs, ys, {**loop.defaults, **at}, found.delay_limit),
-        3))
-    wholes = whole_sample_delay_map(loop, xs, ys, {**loop.defaults, **at}, found.delay_limit)
+    print(f"  exact map: {fmt(exact)}", flush=True)
     subset = [(i, j) for i in range(0, n, 5) for j in range(0, n, 5)
               if np.isfinite(found.values[i, j])]
     start = time.perf_counter()
