@@ -15,7 +15,11 @@ Prints the medians, their ratio and both stability margins.  Then a modulus-marg
 map of the plane at d = 40 (``Loop.margin_map``, 100 x 100 points, every stable
 point certified) against python-control's stability margin point by point (on a
 10 x 10 grid of the same window: the per-point time is what a user's loop would
-cost at 100 x 100).
+cost at 100 x 100).  Then the exact delay-margin map (``margin="delay"``, 30 x
+30 points at d = 40, ``--delay-map N`` for N x N) against the whole-sample map
+it replaced (kept here only, as the comparison: from each point's first
+possible whole delay, one verdict a whole sample) and against
+``Loop.delay_margin`` point by point (on every fifth point of each axis).
 """
 
 import argparse
@@ -48,6 +52,8 @@ def python_control_open_loop(values):
 def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--runs", type=int, default=7)
+    parser.add_argument("--delay-map", type=int, default=30, metavar="N",
+                        help="points per axis of the delay-margin map (0: skip it)")
     args = parser.parse_args()
     loop = symstab.load_loop(ROOT / "examples" / "loops" / "paper.toml")
     for d, point in POINTS.items():
@@ -72,6 +78,8 @@ def main():
               f"{modulus / theirs:.2f} (modulus)")
 
     map_benchmark(loop, args.runs)
+    if args.delay_map:
+        delay_map_benchmark(loop, args.delay_map)
 
 
 def map_benchmark(loop, runs):
@@ -100,6 +108,83 @@ def map_benchmark(loop, runs):
     print(f"  python-control stability_margins   {fmt(theirs):>9} a stable point "
           f"({len(coarse)} points of a 10 x 10 grid): {fmt(theirs * stable)} for the map")
     print(f"  ratio symstab / python-control: {ours / (theirs * stable):.3f}")
+
+
+def whole_sample_delay_map(loop, xs, ys, at, limit):
+    """The delay margin in whole samples per point of the (B, K) grid: the map before the exact one.
+
+    From each stable point's first whole delay that can be unstable
+    (``first_whole_delays``), the verdicts at ``d + k`` of every point waiting
+    on the same ``k`` in one call.
+    """
+    import numpy as np
+
+    from symstab.numeric.analysis.margins import first_whole_delays
+    from symstab.numeric.engine.roots import STABLE
+
+    at = {k: v for k, v in at.items() if k not in ("B", "K")}
+    X, Y = np.meshgrid(xs, ys)
+    out = np.full(X.shape, np.nan)
+    stable = np.asarray(loop.classify(**at, B=X, K=Y)) == STABLE
+    bs, ks = X[stable], Y[stable]
+    first = first_whole_delays(loop.polynomial(**at, B=bs, K=ks))
+    found = np.full(bs.size, np.inf)
+    pending = np.isfinite(first)
+    k = np.where(pending, first, 0).astype(int)
+    while pending.any():
+        for added in np.unique(k[pending]):
+            wait = np.flatnonzero(pending & (k == added))
+            if added > limit:
+                pending[wait] = False
+                continue
+            code = loop.classify(**{**at, "d": at["d"] + added}, B=bs[wait], K=ks[wait])
+            hit = np.asarray(code) != STABLE
+            found[wait[hit]] = added
+            pending[wait[hit]] = False
+            k[wait[~hit]] += 1
+    out[stable] = found
+    return out
+
+
+def delay_map_benchmark(loop, n):
+    """The exact delay-margin map, n x n at d = 40, against the whole-sample one and point by point."""
+    import time
+
+    import numpy as np
+
+    at = {"d": 40, "M": 0.004}
+    xs, ys = np.linspace(0.0, 0.25, n), np.linspace(0.0, 4.0, n)
+    # One run each: the exact map takes minutes.
+    point = {**loop.defaults, **at}
+    wholes = whole_sample_delay_map(loop, xs, ys, point, 410)
+    whole = statistics.median(timed_runs(
+        lambda: whole_sample_delay_map(loop, xs, ys, point, 410), 3))
+    print(f"  whole-sample map: {fmt(whole)}", flush=True)
+    start = time.perf_counter()
+    found = loop.margin_map(xs, ys, margin="delay", **at)
+    exact = time.perf_counter() - start
+    print(f"  exact map: {fmt(exact)}", flush=True)
+    subset = [(i, j) for i in range(0, n, 5) for j in range(0, n, 5)
+              if np.isfinite(found.values[i, j])]
+    start = time.perf_counter()
+    for i, j in subset:
+        margin = loop.delay_margin(**at, B=xs[j], K=ys[i]).margin
+        assert margin == found.values[i, j] or abs(margin / found.values[i, j] - 1) < 1e-9
+    single = (time.perf_counter() - start) / max(1, len(subset))
+    stable = int(np.sum(~np.isnan(found.values)))
+    finite = np.isfinite(found.values) & np.isfinite(wholes)
+    print(f"delay-margin map, d = 40, {n} x {n} points ({stable} stable, margins "
+          f"{np.nanmin(found.values):.4g} to {np.max(found.values[finite]):.4g} samples, "
+          f"limit {found.delay_limit:g}):")
+    print(f"  symstab exact map (fractional)     {fmt(exact):>9}  ({fmt(exact / stable)} a "
+          f"stable point)")
+    print(f"  whole-sample map (the old one)     {fmt(whole):>9}  ratio exact / whole "
+          f"{exact / whole:.0f}; ceil(exact) == whole at "
+          f"{int(np.sum(np.ceil(found.values[finite]) == wholes[finite]))} of "
+          f"{int(finite.sum())}")
+    print(f"  Loop.delay_margin point by point   {fmt(single):>9} a stable point ({len(subset)} "
+          f"points): {fmt(single * stable)} for the map; ratio map / point by point "
+          f"{exact / (single * stable):.2f}")
 
 
 if __name__ == "__main__":

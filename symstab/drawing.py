@@ -1778,7 +1778,7 @@ def plot_margin_map(found, ax=None, *, region=None, levels=None):
             bar.ax.yaxis.set_minor_locator(NullLocator())
             bar.ax.yaxis.set_major_formatter(FuncFormatter(lambda v, _: f"{v:.3g}"))
         bar.set_label({"modulus": r"modulus margin $\min_\theta |1 + L(e^{j\theta})|$",
-                       "delay": "delay margin (whole samples added)",
+                       "delay": "delay margin (samples added, exact)",
                        "gain": "gain margin (factor)"}[found.margin])
         artists["margin"], artists["colorbar"] = [filled], [bar]
     if region is not None:

@@ -348,6 +348,41 @@ def loop_coefficients(loop, values):
     return (*plant, *environment)
 
 
+def fractional_delay_oracle(loop, values):
+    """``tau -> (spectral radius, angle of the largest root)`` of ``loop`` at a delay of ``tau`` samples.
+
+    From :func:`fractional_delay_closed_loop` (the state-space discretisation,
+    nothing of symstab's derivation) at ``values`` with the delay replaced.
+    """
+    coefficients = loop_coefficients(loop, values)
+    T = float(values["T"])
+
+    def at(tau):
+        d = int(math.floor(tau))
+        roots = np.linalg.eigvals(fractional_delay_closed_loop(*coefficients, T, d, tau - d))
+        k = int(np.argmax(np.abs(roots)))
+        return float(abs(roots[k])), float(abs(np.angle(roots[k])))
+
+    return at
+
+
+def first_crossing(at, start, step=1 / 32, stop=None):
+    """The first delay from ``start`` at which ``at(tau)[0]`` (a radius) reaches 1, to 1e-12 of a sample.
+
+    A grid of ``step`` then bisection; ``stop``: the delay past which no
+    crossing is an error.
+    """
+    low = start
+    while at(low + step)[0] < 1:
+        low += step
+        assert stop is None or low < stop, "no crossing found"
+    high = low + step
+    while high - low > 1e-12 * max(1.0, high):
+        middle = (low + high) / 2
+        low, high = (middle, high) if at(middle)[0] < 1 else (low, middle)
+    return (low + high) / 2
+
+
 def impulse_norm(num, den, dt):
     """sqrt(sum h[k]**2) by scipy's impulse response, long enough for the tail to vanish."""
     import scipy.signal

@@ -224,10 +224,10 @@ def add_loop_options(p, command):
                             "d: the whole delays LO..HI); repeatable")
         g.add_argument("--margin", choices=("modulus", "delay", "gain"),
                        help="instead of the classification, a margin at every stable cell: "
-                            "modulus, min|1+L| on the unit circle, certified; delay, the "
-                            "fewest whole samples of added delay that make it unstable; gain, "
-                            "the smallest factor of the loop gain that does (the other cells "
-                            "hold NaN)")
+                            "modulus, min|1+L| on the unit circle, certified; delay, the exact "
+                            "delay margin (the smallest added delay, samples, at which a root "
+                            "reaches the circle); gain, the smallest factor of the loop gain "
+                            "that does (the other cells hold NaN)")
         g.add_argument("--samples", type=int, metavar="N",
                        help="draws with --uncertain (default 1000)")
         g.add_argument("--seed", type=int, metavar="S",

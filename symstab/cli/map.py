@@ -584,7 +584,8 @@ def _margin(args, setup, xs, ys, out, png_path):
     check_memory(f"a map of {xs.size} x {ys.size} cells", xs.size * ys.size * _MAP_CELL_BYTES
                  + CHUNK_BYTES)
     what = {"modulus": "the modulus margin min|1+L|, certified",
-            "delay": "the delay margin in whole samples (inf: stable up to the limit)",
+            "delay": "the exact delay margin in samples, fractional (inf: stable up to the "
+                     "limit)",
             "gain": "the gain margin (inf: no phase crossover limits the gain)"}
     print(f"map --loop --margin {args.margin}: {what[args.margin]}, of every stable cell "
           f"(NaN where not stable)")
@@ -610,10 +611,18 @@ def _margin(args, setup, xs, ys, out, png_path):
     if not stable.any():
         print(f"no stable cell among the {value.size}: the map holds NaN only")
     else:
+        low, high, unit = np.nanmin(value), np.nanmax(value), ""
+        finite = value[np.isfinite(value)]
+        if args.margin == "delay" and finite.size:
+            low, high, unit = finite.min(), finite.max(), " samples"
+            # In ms too where the sample period is one value (not an axis of the map).
+            period = {**setup.loop.defaults, **setup.values}.get("T")
+            if period is not None and "T" not in (setup.x, setup.y):
+                unit += f" ({low * period * 1e3:.4g} to {high * period * 1e3:.4g} ms)"
         print(f"{int(stable.sum())} of {value.size} cells stable; {args.margin} margin from "
-              f"{np.nanmin(value):.4g} to {np.nanmax(value):.4g}")
+              f"{low:.4g} to {high:.4g}{unit}")
     if args.margin == "delay" and np.isinf(value).any():
-        print(f"{int(np.isinf(value).sum())} cells stable up to {found.delay_limit} samples "
+        print(f"{int(np.isinf(value).sum())} cells stable up to {found.delay_limit:g} samples "
               f"more (inf in the file)")
     print(wrote)
     return 0

@@ -89,7 +89,6 @@ def test_map_margin_writes_the_library_s_map_and_its_figure(capsys, tmp_path):
     (["--simulate"], "--margin maps a margin of the linear loop"),
     (["--uncertain", "b=0.02:0.04"], "give one of them"),
     (["--margin", "phase"], "invalid choice: 'phase'"),
-    (["--margin", "delay", "--set", "d=1.5"], "map --margin delay does not take a fractional delay"),
 ])
 def test_map_margin_refuses_what_it_does_not_map(capsys, tmp_path, extra, message):
     args = ["map", "--loop", PAPER, "--x-range=0,0.2,3", "--y-range=0,2,3",
@@ -101,19 +100,24 @@ def test_map_margin_refuses_what_it_does_not_map(capsys, tmp_path, extra, messag
     assert not list(tmp_path.iterdir())
 
 
-def test_map_margin_delay_writes_whole_samples_and_inf_beyond_the_limit(capsys, tmp_path):
+def test_map_margin_delay_writes_the_exact_margins_at_a_fractional_delay(capsys, tmp_path):
     import numpy as np
 
     out = tmp_path / "d.csv"
-    status, printed, err = run_cli(capsys, "map", "--loop", PAPER, "--set", "d=0",
+    status, printed, err = run_cli(capsys, "map", "--loop", PAPER, "--set", "d=0.5",
                                    "--x-range=-0.05,2,5", "--y-range=10,600,4",
                                    "--margin", "delay", "--out", out, "--no-png")
     assert status == 0, err
     rows = np.genfromtxt(out, delimiter=",", skip_header=1)
     expected = symstab.load_loop(PAPER).margin_map(np.linspace(-0.05, 2, 5),
-                                                   np.linspace(10, 600, 4), margin="delay", d=0)
-    assert np.array_equal(rows[:, 2], expected.values.T.ravel(), equal_nan=True)
-    assert "the delay margin in whole samples" in printed and "no stable cell" not in printed
+                                                   np.linspace(10, 600, 4), margin="delay",
+                                                   d=0.5)
+    # The file's 12 digits of the library's margins.
+    assert np.allclose(rows[:, 2], expected.values.T.ravel(), rtol=1e-11, equal_nan=True)
+    finite = expected.values[np.isfinite(expected.values)]
+    assert "the exact delay margin in samples" in printed and "no stable cell" not in printed
+    assert (f"delay margin from {finite.min():.4g} to {finite.max():.4g} samples "
+            f"({finite.min():.4g} to {finite.max():.4g} ms)") in printed
 
 
 def test_along_names_the_parameters_of_the_intervals(capsys):

@@ -13,7 +13,11 @@ circle, and :func:`delay_margin` finds those delays:
    added delays, ``step`` of a sample apart (16 points a sample by
    default), from the point's delay up to ``limit`` samples more; the
    plant at each fraction of the grid is derived once and shared by every
-   whole part;
+   whole part; once the grid's first sample is stable, each fraction's
+   points before the phase argument's first whole delay at that fraction
+   are known stable and skipped (:mod:`.delay_scan`, which
+   :func:`symstab.numeric.analysis.margins.margin_map` searches every
+   point of a map with);
 2. each change of verdict (stable to not, or back) bracketed by two
    neighbours of the grid, refined by the one root bracketer
    (:func:`symstab.numeric.engine.search.bracketed_root`) on the spectral
@@ -34,18 +38,13 @@ import math
 
 import numpy as np
 
-from ..._validate import check_real, snap_delay, split_delay
+from ..._validate import check_real
 from ..engine.results import html_table
-from ..engine.roots import STABLE, circle_minimum
-from ..engine.search import bracketed_root
-from ..loop.evaluation import FRACTION
-from .margins import delay_limit_of, phase_crossings, stable_point
+from ..engine.roots import circle_minimum
+from .delay_scan import STEPS_PER_SAMPLE, crossing_delays, delay_grid, verdict_changes
+from .margins import delay_limit_of, first_whole_delays, phase_crossings, stable_point
 
 __all__ = ["DelaySwitch", "DelayMargin", "delay_margin"]
-
-#: Points of the grid per sample of delay (the default ``step`` is its inverse).
-STEPS_PER_SAMPLE = 16
-
 
 @dataclasses.dataclass(frozen=True)
 class DelaySwitch:
@@ -205,7 +204,7 @@ def delay_margin(loop, *, limit=None, step=None, every=None, **values):
     >>> from symstab import PAPER_LOOP
     >>> found = PAPER_LOOP.delay_margin(K=2.0, B=0.1, d=40, limit=20)
     >>> round(found.margin, 6), round(found.frequency, 4)
-    (9.640327, 11.6962)
+    (16.615744, 2.1744)
     """
     point = stable_point(loop, values, "the delay margin")
     T = float(point["T"])
@@ -216,58 +215,17 @@ def delay_margin(loop, *, limit=None, step=None, every=None, **values):
     limit = float(delay_limit_of(start, limit, name="limit", whole=False))
     if limit == 0:
         return DelayMargin(point, T, (), 0.0, step)
-    n = int(math.ceil(limit / step - 1e-9))
-    grid = start + step * np.arange(n + 1)
-    grid[-1] = min(grid[-1], start + limit)
-    switches, end = _switches(loop, point, grid, first_only=not every)
-    return DelayMargin(point, T, tuple(switches), float(end - start), step)
-
-
-def _switches(loop, point, grid, *, first_only):
-    """The switches along ``grid`` (one whole sample of it at a time), and the last delay examined.
-
-    With ``first_only``, the scan stops at the first switch (the margin).
-    """
-    wholes = np.floor(snap_delay(grid))
-    out, before, last = [], True, grid[0]
-    for whole in np.unique(wholes):
-        where = np.flatnonzero(wholes == whole)
-        stable = _stable_on(loop, point, grid[where])
-        # The neighbour before each point: the last of the previous sample for the first.
-        previous = np.concatenate([[before], stable[:-1]])
-        for k in np.flatnonzero(stable != previous):
-            i = where[k]
-            out.append(_switch(loop, point, grid[i - 1], grid[i], bool(stable[k]),
-                               float(point["T"])))
-            if first_only:
-                return out, grid[i]
-        before, last = stable[-1], grid[where[-1]]
-    return out, last
-
-
-def _stable_on(loop, point, delays):
-    """Whether the loop is stable at each of ``delays`` (samples, one whole part): one call."""
-    d, eps = split_delay(delays, name="d")
-    given = {**{k: v for k, v in point.items() if k != "d"}, "d": d}
-    if eps is not None:
-        # The fractions as they are, the plant at each derived once for every whole part.
-        given[FRACTION] = eps
-    return np.broadcast_to(loop.classify(**given), delays.shape) == STABLE
-
-
-def _switch(loop, point, low, high, stable_after, T):
-    """The :class:`DelaySwitch` between two delays of the grid whose verdicts differ."""
     base = {k: v for k, v in point.items() if k != "d"}
-
-    def excess(x):
-        return np.array([float(loop.spectral_radius(**base, d=float(t))) - 1.0
-                         for t in np.ravel(x)]).reshape(np.shape(x))
-
-    # The radius is continuous in the delay; at the ends it is on either side of 1.
-    samples = float(bracketed_root(excess, [low], [high])[0])
-    return DelaySwitch(samples=samples, added=samples - float(point["d"]), T=T,
-                       theta=_crossing_angle(loop.polynomial(**base, d=samples), T),
-                       stable_after=stable_after)
+    grid = delay_grid(start, limit, step)
+    rows, index, after, examined = verdict_changes(loop, base, {}, grid, first_only=not every,
+                                                   first_whole=first_whole_delays)
+    samples = crossing_delays(loop, base, {}, rows, grid[index - 1], grid[index])
+    switches = tuple(
+        DelaySwitch(samples=float(s), added=float(s) - start, T=T,
+                    theta=_crossing_angle(loop.polynomial(**base, d=float(s)), T),
+                    stable_after=bool(a))
+        for s, a in zip(samples, after, strict=True))
+    return DelayMargin(point, T, switches, float(grid[examined[0]] - start), step)
 
 
 def _crossing_angle(chi, T):

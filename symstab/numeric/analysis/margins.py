@@ -54,8 +54,10 @@ from ..engine.results import html_table
 from ..engine.roots import MARGINAL, STABLE, circle_minimum
 from ..engine.search import bracketed_root
 from ..loop.evaluation import FRACTION
+from .delay_scan import STEPS_PER_SAMPLE, first_crossings
 
-__all__ = ["NyquistCrossing", "ParameterMargin", "Margins", "margins", "MarginMap", "margin_map"]
+__all__ = ["NyquistCrossing", "ParameterMargin", "Margins", "margins", "MarginMap", "margin_map",
+           "first_whole_delays"]
 
 #: Points per period of the highest harmonic of the phase-crossover scan.
 _SCAN_PER_HARMONIC = 32
@@ -588,6 +590,21 @@ def _first_delay(phase, delayed, direct):
     return max(1, math.floor(out)) if math.isfinite(out) else math.inf
 
 
+def first_whole_delays(chi):
+    """:func:`_first_delay` of each of ``chi``'s points (flat, stable ones): inf where at none.
+
+    The bound of the delay-margin scan
+    (:func:`symstab.numeric.analysis.delay_scan.verdict_changes`) per
+    fraction of its grid.
+    """
+    n = int(np.prod(chi.shape))
+    return np.array([_first_delay(phase_crossings(delayed, direct, chi.shift, 1.0), delayed,
+                                  direct)
+                     for delayed, direct in zip(chi.delayed.reshape(n, -1),
+                                                chi.direct.reshape(n, -1), strict=True)],
+                    dtype=float)
+
+
 # --------------------------------------------------------------------------
 # Margin maps
 
@@ -609,8 +626,10 @@ class MarginMap:
         The grid's values (1-D).
     margin : str
         Which margin: ``"modulus"`` (``min |1 + L|`` on the unit circle),
-        ``"delay"`` (the delay margin in whole samples) or ``"gain"`` (the
-        gain margin, :attr:`Margins.gain_margin`).
+        ``"delay"`` (the exact delay margin: the smallest delay added, in
+        samples, fractional, at which a root reaches the unit circle, as
+        :meth:`symstab.Loop.delay_margin` finds it) or ``"gain"`` (the gain
+        margin, :attr:`Margins.gain_margin`).
     values : ndarray
         The margin per point, shape ``(len(y_values), len(x_values))``; NaN
         where the point is unstable or marginal (never a number there); for
@@ -618,14 +637,19 @@ class MarginMap:
         samples more; for ``"gain"``, inf where no phase crossover
         limits the gain.
     lower : ndarray
-        Its certified lower bound per point (NaN as ``values``; the delay
-        margin is exact).
+        Its certified lower bound per point (NaN as ``values``); for
+        ``"delay"`` equal to ``values`` (the crossing's delay, to a few ulps;
+        what the grid of ``delay_step`` cannot see is a window of
+        instability shorter than a step, entered and left between two of
+        its points).
     codes : ndarray
         The verdicts (:data:`~symstab.numeric.engine.roots.STABLE`, ...).
     at : dict
         The values of the other parameters.
-    delay_limit : int or None
+    delay_limit : float or None
         ``"delay"``: the most samples added that were examined.
+    delay_step : float or None
+        ``"delay"``: the step of the grid of added delays, samples.
     """
 
     x: str
@@ -638,6 +662,7 @@ class MarginMap:
     codes: np.ndarray
     at: dict
     delay_limit: object = None
+    delay_step: object = None
 
     def __repr__(self):
         stable = ~np.isnan(self.values)
@@ -673,7 +698,7 @@ class MarginMap:
 
 
 def margin_map(loop, x_values, y_values, *, x=None, y=None, margin="modulus", rtol=1e-9,
-               delay_limit=None, **values):
+               delay_limit=None, delay_step=None, **values):
     """A margin at every point of a grid of a loop's plane, certified per point.
 
     Each point is classified (:meth:`symstab.Loop.classify`); at the stable
@@ -690,15 +715,23 @@ def margin_map(loop, x_values, y_values, *, x=None, y=None, margin="modulus", rt
     x, y : str, optional
         The plane (default: the loop's :attr:`~symstab.Loop.plane`).
     margin : str
-        ``"modulus"``, ``"delay"`` or ``"gain"``, as :func:`margins` finds
-        each at every stable point (the modulus margins and the phase
-        crossovers of all points at once; points whose first candidate
-        delay is the same classified together).
+        ``"modulus"`` or ``"gain"``, as :func:`margins` finds each at every
+        stable point (the modulus margins and the phase crossovers of all
+        points at once), or ``"delay"``, the exact delay margin as
+        :meth:`symstab.Loop.delay_margin` finds it, every point at once
+        (:mod:`symstab.numeric.analysis.delay_scan`: the certified verdicts
+        of the points still stable at each whole sample of the grid in one
+        call, the grid's fractions an array; every point's first change
+        refined together).
     rtol : float
         The relative width of each point's certified bracket (wider next to
         the boundary, where the rounding of chi allows no narrower one).
-    delay_limit : int, optional
-        ``"delay"``: the most samples added (as in :func:`margins`).
+    delay_limit : float, optional
+        ``"delay"``: the most samples added (default ``max(100, 10 (d +
+        1))``, within ``SYMSTAB_MAX_DELAY``); a point stable up to there
+        holds inf.
+    delay_step : float, optional
+        ``"delay"``: the grid's step in samples, in (0, 1] (default 1/16).
     **values
         Single values of every other parameter.
 
@@ -728,50 +761,26 @@ def margin_map(loop, x_values, y_values, *, x=None, y=None, margin="modulus", rt
     checked, d, _ = loop.evaluation.prepare(values, drop=(x, y))
     if FRACTION in checked:
         d = d + float(checked[FRACTION])
-    limit = delay_limit_of(d, delay_limit)
+    if margin == "delay":
+        limit = float(delay_limit_of(d, delay_limit, whole=False))
+        delay_step = 1.0 / STEPS_PER_SAMPLE if delay_step is None else check_real(
+            "delay_step", delay_step, low=0.0, low_open=True, high=1.0)
     if stable.any():
-        chi = loop.polynomial(**{**values, x: X[stable], y: Y[stable]})
-        if margin == "modulus":
-            lower, upper, _ = circle_minimum(chi, rtol=rtol)
-        elif margin == "gain":
-            upper = lower = _gain_margins(chi)
+        if margin == "delay":
+            given = {k: v for k, v in values.items() if k not in ("d", "Td")}
+            upper = lower = first_crossings(loop, given, {x: X[stable], y: Y[stable]}, d, limit,
+                                            delay_step, first_whole_delays)
+        elif margin == "modulus":
+            lower, upper, _ = circle_minimum(
+                loop.polynomial(**{**values, x: X[stable], y: Y[stable]}), rtol=rtol)
         else:
-            given = {k: v for k, v in values.items() if k != "Td"}
-            upper = lower = _delay_margins(loop, chi, {**given, "d": d}, (x, X[stable]),
-                                           (y, Y[stable]), limit)
+            upper = lower = _gain_margins(loop.polynomial(**{**values, x: X[stable],
+                                                             y: Y[stable]}))
         out[0][stable], out[1][stable] = upper, lower
     return MarginMap(x=x, y=y, x_values=xs, y_values=ys, margin=margin, values=out[0],
                      lower=out[1], codes=codes, at=dict(values),
-                     delay_limit=limit if margin == "delay" else None)
-
-
-def _delay_margins(loop, chi, values, x, y, limit):
-    """The delay margin (whole samples, inf beyond ``limit``) of each of the points' ``chi``.
-
-    As :func:`_delay_margin` for each point (from :func:`_first_delay`), the
-    verdicts at one added delay asked for every point that waits on it at once.
-    """
-    (x, xs), (y, ys) = x, y
-    first = np.array([_first_delay(phase_crossings(delayed, direct, chi.shift, 1.0), delayed,
-                                   direct)
-                      for delayed, direct in zip(chi.delayed.reshape(len(xs), -1),
-                                                 chi.direct.reshape(len(xs), -1), strict=True)],
-                     dtype=float)
-    out = np.full(len(xs), np.inf)
-    pending = np.isfinite(first)
-    k = np.where(pending, first, 0).astype(int)
-    while pending.any():
-        for added in np.unique(k[pending]):
-            wait = np.flatnonzero(pending & (k == added))
-            if added > limit:
-                pending[wait] = False
-                continue
-            code = loop.classify(**{**values, x: xs[wait], y: ys[wait], "d": values["d"] + added})
-            hit = np.asarray(code) != STABLE
-            out[wait[hit]] = added
-            pending[wait[hit]] = False
-            k[wait[~hit]] += 1
-    return out
+                     delay_limit=limit if margin == "delay" else None,
+                     delay_step=delay_step if margin == "delay" else None)
 
 
 def _gain_margins(chi):

@@ -2,9 +2,9 @@
 
 The oracle is the loop's spectral radius at a fractional delay from a
 state-space discretisation with Van Loan's block exponential
-(:func:`oracles.fractional_delay_radius`, SciPy, nothing of symstab's
+(:func:`oracles.fractional_delay_oracle`, SciPy, nothing of symstab's
 derivation): its first crossing of 1 along the delay, found on a grid of the
-delay and bisected, is the margin; each switch's side is checked just before
+delay and bisected (:func:`oracles.first_crossing`), is the margin; each switch's side is checked just before
 and after it.
 """
 
@@ -16,36 +16,9 @@ import pytest
 import symstab
 
 from conftest import REPO
-from oracles import fractional_delay_closed_loop, loop_coefficients
+from oracles import first_crossing, fractional_delay_oracle
 
 LOOPS = REPO / "examples" / "loops"
-
-
-def _oracle(loop, values):
-    """``tau -> (spectral radius, angle of the largest root)`` at a delay of ``tau`` samples."""
-    coefficients = loop_coefficients(loop, values)
-    T = float(values["T"])
-
-    def at(tau):
-        d = int(math.floor(tau))
-        roots = np.linalg.eigvals(fractional_delay_closed_loop(*coefficients, T, d, tau - d))
-        k = int(np.argmax(np.abs(roots)))
-        return float(abs(roots[k])), float(abs(np.angle(roots[k])))
-
-    return at
-
-
-def _first_crossing(at, start, step=1 / 32, stop=None):
-    """The first delay from ``start`` at which the oracle's radius reaches 1, to 1e-12 of a sample."""
-    low = start
-    while at(low + step)[0] < 1:
-        low += step
-        assert stop is None or low < stop, "no crossing found"
-    high = low + step
-    while high - low > 1e-12 * max(1.0, high):
-        middle = (low + high) / 2
-        low, high = (middle, high) if at(middle)[0] < 1 else (low, middle)
-    return (low + high) / 2
 
 
 @pytest.mark.parametrize("file, values", [
@@ -58,8 +31,8 @@ def test_the_delay_margin_is_the_oracles_first_crossing(file, values):
     loop = symstab.load_loop(LOOPS / file)
     point = {**loop.defaults, **values}
     found = loop.delay_margin(**point)
-    at = _oracle(loop, point)
-    expected = _first_crossing(at, float(point["d"]), stop=float(point["d"]) + 200)
+    at = fractional_delay_oracle(loop, point)
+    expected = first_crossing(at, float(point["d"]), stop=float(point["d"]) + 200)
     assert found.switches[0].samples == pytest.approx(expected, rel=1e-6)
     assert found.margin == pytest.approx(expected - point["d"], rel=1e-6)
     assert found.seconds == pytest.approx(found.margin * point["T"], rel=1e-15)
@@ -74,14 +47,14 @@ def test_the_tustin_dampers_stability_switches_back_and_forth():
     loop = symstab.load_loop(LOOPS / "tustin_damper.toml")
     point = dict(loop.defaults)
     found = loop.delay_margin(limit=3, **point)
-    at = _oracle(loop, point)
+    at = fractional_delay_oracle(loop, point)
     assert [s.stable_after for s in found.switches] == [False, True, False]
     for switch in found.switches:
         before, after = at(switch.samples - 1e-6)[0], at(switch.samples + 1e-6)[0]
         assert (before < 1 < after) if not switch.stable_after else (after < 1 < before)
         assert switch.theta == pytest.approx(math.pi, rel=1e-12)
         assert switch.frequency == pytest.approx(1 / (2 * point["T"]), rel=1e-12)
-    expected = _first_crossing(at, 1.0, step=1e-5, stop=1.001)
+    expected = first_crossing(at, 1.0, step=1e-5, stop=1.001)
     assert found.switches[0].samples == pytest.approx(expected, rel=1e-6)
 
 

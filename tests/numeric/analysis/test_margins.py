@@ -22,7 +22,7 @@ from symstab.numeric.engine.polynomial import DelayedPolynomial
 from symstab.numeric.engine.roots import circle_minimum
 
 from conftest import REPO
-from oracles import polyroots, python_control_parts
+from oracles import first_crossing, fractional_delay_oracle, polyroots, python_control_parts
 
 LOOPS = REPO / "examples" / "loops"
 
@@ -357,16 +357,29 @@ def test_a_margin_map_is_python_control_s_minimum_where_stable_and_nan_elsewhere
                 assert np.isnan(found.values[i, j]) and np.isnan(found.lower[i, j])
 
 
-def test_a_delay_margin_map_is_python_control_s_first_unstable_delay_per_point():
+def test_a_delay_margin_map_is_the_exact_delay_margin_per_point():
+    """Every stable cell holds ``Loop.delay_margin``'s margin (the map's vectorised search is the
+    point's), inf where none is found up to the limit; at three cells the state-space oracle's
+    first crossing (independent of symstab's fractional derivation) to 1e-6."""
     loop = _paper()
     xs, ys = np.linspace(-0.05, 2.0, 6), np.linspace(10.0, 600.0, 5)
-    at = dict(m=0.0128, b=0.0324, T=1e-3, M=0.0, d=0)
+    at = dict(m=0.0128, b=0.0324, T=1e-3, M=0.0, d=0.5)
     found = loop.margin_map(xs, ys, margin="delay", delay_limit=12, **at)
-    assert found.delay_limit == 12 and np.isnan(found.values).any()
-    for i, j, point in _numbered_cells(loop, found, at):
-        radii = [_radius(_open_loop(loop, {**point, "d": k})) for k in range(1, 13)]
-        first = next((k + 1 for k, r in enumerate(radii) if r >= 1 - 1e-12), math.inf)
-        assert found.values[i, j] == first, (point, radii)
+    assert found.delay_limit == 12 and found.delay_step == 1 / 16
+    assert np.isnan(found.values).any() and np.array_equal(found.lower, found.values,
+                                                           equal_nan=True)
+    cells = list(_numbered_cells(loop, found, at, lambda point: fractional_delay_oracle(
+        loop, point)(point["d"])[0]))
+    for i, j, point in cells:
+        margin = loop.delay_margin(limit=12, every=False, **point).margin
+        expected = math.inf if margin is None else margin
+        assert found.values[i, j] == pytest.approx(expected, rel=1e-12), point
+    finite = [cell for cell in cells if np.isfinite(found.values[cell[0], cell[1]])]
+    assert len(finite) >= 3
+    for i, j, point in finite[:: max(1, len(finite) // 3)][:3]:
+        crossing = first_crossing(fractional_delay_oracle(loop, point), point["d"],
+                                  stop=point["d"] + 13)
+        assert found.values[i, j] == pytest.approx(crossing - point["d"], rel=1e-6), point
 
 
 def test_a_gain_margin_map_is_python_control_s_gain_margin_per_point():
@@ -381,14 +394,16 @@ def test_a_gain_margin_map_is_python_control_s_gain_margin_per_point():
         assert found.values[i, j] == pytest.approx(gm, rel=1e-6), point
 
 
-def _numbered_cells(loop, found, at):
+def _numbered_cells(loop, found, at, radius=None):
     """``(i, j, point)`` of each cell of a (B, K) margin map that holds a number; a NaN cell
-    is checked not stable by python-control's closed-loop poles on the way."""
+    is checked not stable on the way by python-control's closed-loop poles (or by
+    ``radius(point)``: a fractional delay's)."""
+    radius = radius or (lambda point: _radius(_open_loop(loop, point)))
     for i, K in enumerate(found.y_values):
         for j, B in enumerate(found.x_values):
             point = {**loop.defaults, **at, "B": float(B), "K": float(K)}
             if np.isnan(found.values[i, j]):
-                assert _radius(_open_loop(loop, point)) >= 1 - 1e-9
+                assert radius(point) >= 1 - 1e-9
                 continue
             yield i, j, point
 
