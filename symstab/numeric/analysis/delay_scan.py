@@ -8,8 +8,13 @@ and shared by every point: the plant does not hold a plane's parameters, and
 when it does each row is derived once still).  Each change of verdict is a
 bracket of two neighbours of the grid, refined by the one root bracketer
 (:func:`symstab.numeric.engine.search.bracketed_root`, every bracket at
-once) on the spectral radius less 1, which is continuous in the delay (also
-across whole samples).
+once) on the spectral radius less 1, continuous in the delay (also across
+whole samples), while ``chi``'s degree allows companion eigenvalues (128:
+a few evaluations close the bracket); above, where each radius is a
+bisection of certified counts of its own (some fifty times a verdict's cost
+at a few hundred samples of delay), on the certified verdict itself
+(``+-1/2``: not stable or stable), which narrows each bracket an evaluation
+down to a few ulps of the delay.
 
 :func:`symstab.numeric.analysis.delays.delay_margin` (one point, every
 switch or the first) and the delay-margin map
@@ -21,7 +26,7 @@ import math
 
 import numpy as np
 
-from ..engine.roots import STABLE
+from ..engine.roots import EIGENVALUES_UP_TO_DEGREE, STABLE
 from ..engine.search import bracketed_root
 from ..loop.evaluation import FRACTION
 
@@ -141,27 +146,38 @@ def _known_stable(loop, values, points, bases, rows, first_whole):
 
 
 def crossing_delays(loop, values, points, rows, low, high):
-    """The delay at which the spectral radius of point ``rows[i]`` crosses 1 in ``[low[i], high[i]]``.
+    """The delay at which point ``rows[i]``'s verdict changes in ``[low[i], high[i]]``.
 
     Every bracket at once (:func:`~symstab.numeric.engine.search.bracketed_root`
-    with ``indexed``); each evaluation one call of
-    :meth:`symstab.Loop.spectral_radius` per whole part of the delays asked
-    (the fractions an array).  Returns the delays, samples, to a few ulps.
+    with ``indexed``), on the spectral radius less 1 up to degree
+    :data:`~symstab.numeric.engine.roots.EIGENVALUES_UP_TO_DEGREE`, else on
+    ``+1/2`` where not stable and ``-1/2`` where stable (the module's
+    docstring says why); each evaluation one call of the loop per whole part
+    of the delays asked (the fractions an array).  Returns the delays,
+    samples, to a few ulps: where a root is on the circle to within the
+    rounding of the radius, or of the verdict.
     """
     rows = np.asarray(rows, dtype=np.int64)
+    if rows.size == 0:
+        return np.zeros(0)
+    top = float(np.max(high))
+    degree = loop.polynomial(**_given(values, {n: v[rows[:1]] for n, v in points.items()},
+                                      int(np.floor(top)), np.array([top % 1.0]), (-1,))).degree
+    by_radius = degree <= EIGENVALUES_UP_TO_DEGREE
 
     def excess(x, index):
         out = np.empty(x.size)
         wholes = np.floor(x)
         for whole in np.unique(wholes):
             k = np.flatnonzero(wholes == whole)
-            # The radius is continuous in the delay; at the ends it is on either side of 1.
-            out[k] = _radius(loop, values, {n: v[rows[index[k]]] for n, v in points.items()},
-                             int(whole), x[k] - whole) - 1.0
+            at = ({n: v[rows[index[k]]] for n, v in points.items()}, int(whole), x[k] - whole)
+            if by_radius:
+                # Continuous in the delay; at the ends on either side of 1.
+                out[k] = _radius(loop, values, *at) - 1.0
+            else:
+                out[k] = np.where(_stable_at(loop, values, *at, k.size, paired=True), -0.5, 0.5)
         return out
 
-    if rows.size == 0:
-        return np.zeros(0)
     return bracketed_root(excess, low, high, indexed=True)
 
 
@@ -198,10 +214,14 @@ def _given(values, points, whole, fractions, shape):
     return given
 
 
-def _stable_at(loop, values, points, whole, fractions, n):
-    """Whether each of ``n`` points is stable at each delay ``whole + fractions``: ``(n, m)``."""
-    code = loop.classify(**_given(values, points, whole, fractions, (-1, 1)))
-    return np.broadcast_to(np.asarray(code) == STABLE, (n, fractions.size))
+def _stable_at(loop, values, points, whole, fractions, n, *, paired=False):
+    """Whether each of ``n`` points is stable at each delay ``whole + fractions``: ``(n, m)``.
+
+    ``paired``: point ``i`` at ``whole + fractions[i]`` only, 1-D.
+    """
+    shape = (-1,) if paired else (-1, 1)
+    code = loop.classify(**_given(values, points, whole, fractions, shape))
+    return np.broadcast_to(np.asarray(code) == STABLE, (n,) if paired else (n, fractions.size))
 
 
 def _radius(loop, values, points, whole, fractions):

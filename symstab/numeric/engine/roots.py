@@ -32,7 +32,7 @@ from .polynomial import DelayedPolynomial, horner
 __all__ = [
     "STABLE", "MARGINAL", "UNSTABLE", "COEFFICIENT_ULPS",
     "root_counts", "schur_cohn", "classify_polynomials", "leading_vanishes",
-    "spectral_radius", "polish_roots", "circle_minimum",
+    "spectral_radius", "polish_roots", "circle_minimum", "EIGENVALUES_UP_TO_DEGREE",
 ]
 
 #: Codes of :func:`classify_polynomials`.
@@ -62,7 +62,7 @@ _TABLE_BYTES = 8 * 2**20
 _DIRECT_TERMS = 2**16
 #: Up to this degree the spectral radius comes from companion eigenvalues
 #: (O(n**3)); above it from certified counts on circles (O(n) each).
-_EIGENVALUES_UP_TO_DEGREE = 128
+EIGENVALUES_UP_TO_DEGREE = 128
 #: Rows of companion matrices handed to LAPACK at once (bytes).
 _EIG_BATCH_BYTES = 64 * 2**20
 
@@ -719,7 +719,7 @@ def spectral_radius(chi):
     out = np.empty(len(rows))
     if n == 0:
         out[:] = 0.0
-    elif n <= _EIGENVALUES_UP_TO_DEGREE:
+    elif n <= EIGENVALUES_UP_TO_DEGREE:
         check_memory(f"the spectral radius of degree {n}", 4 * 8 * n * n)
         for part in chunk_slices(len(rows), 8 * (n + 1)):
             dense = rows.take(part).dense()
