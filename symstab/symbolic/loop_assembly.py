@@ -854,6 +854,19 @@ class LoopModel:
                               lambda parts: not parts[0] or self._fractional_agrees(parts))
         return parts if parts[0] else None
 
+    @shared_property
+    def environment_delay(self):
+        """The environment's own delay in samples: the power of ``z`` that divides ``Ve_d``.
+
+        How many trailing coefficients of the symbolic ``Ve_d`` are 0 (a
+        ``z**-k`` in the environment), beside the loop's delay ``d``.
+        """
+        ve_d = self.environment_parts[1]
+        k = 0
+        while k < len(ve_d) - 1 and sp.simplify(ve_d[len(ve_d) - 1 - k]) == 0:
+            k += 1
+        return k
+
     def plant_parts_of(self, fraction=False):
         """The symbolic plant's ``(P_n, P_d)``, or with ``fraction`` ``(N_eps, z P_d)`` (or None)."""
         return self._fractional_plant_parts if fraction else self._plant_parts

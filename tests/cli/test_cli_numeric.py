@@ -149,8 +149,6 @@ def test_design_finds_a_gain_over_no_virtual_mass(shared_cli_run):
     (["limits", "--d", "40.5"], "whole number of samples, got '40.5': give a fractional delay "
                                 "in seconds with --Td"),
     # Issue 43: where the paper's loop cannot take a fractional delay, one line naming the command.
-    (["margins", "--Td", "0.0405", "--alpha", "1e-4", "--beta", "0.005"],
-     "margins does not take a fractional delay yet"),
     (["simulate", "--Td", "0.0405", "--alpha", "1e-4", "--beta", "0.005"],
      "simulate does not take a fractional delay yet"),
     (["map", "--Td", "0.0405", "--alpha", "0:1e-3,3", "--beta", "0:0.01,3", "--out", "m.npz"],
@@ -252,3 +250,14 @@ def test_simulation_bad_input_exits_2_and_writes_nothing(capsys, tmp_path, monke
     assert status == 2, err
     assert needle in err.strip().splitlines()[-1]
     assert list(tmp_path.iterdir()) == []
+
+
+def test_margins_at_a_fractional_td_are_the_paper_loops(capsys):
+    """--Td 0.0405: the paper's options give PAPER_LOOP's margins at 40.5 samples."""
+    data = json.loads(run(capsys, "margins", "--Td", "0.0405", "--Kw", "1.28", "--Bw", "0.064",
+                          "--format", "json")[1])
+    expected = symstab.PAPER_LOOP.margins(K=1.28, B=0.064, Td=0.0405)
+    assert data["margins"]["point"]["d"] == 40.5
+    assert data["margins"]["modulus"] == pytest.approx(expected.modulus, rel=1e-12)
+    assert data["margins"]["exact_delay"]["margin"] == pytest.approx(
+        expected.exact_delay.margin, rel=1e-12)

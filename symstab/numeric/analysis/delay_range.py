@@ -16,7 +16,7 @@ A networked or loaded loop's delay is not one number but a range
   delays", *Automatica* 40(8), 2004; its sampled-data use is the *jitter
   margin* of A. Cervin, B. Lincoln, J. Eker, K.-E. Årzén and G. Buttazzo,
   2004).  With ``N = d_max - d_min`` and ``L = N_chi / (z**s D)`` the loop
-  at ``d_min``,
+  at ``d_min``::
 
       f[k - delta_k] - f[k - d_min] = -sum of at most N differences f[j] - f[j-1],
 
@@ -25,7 +25,7 @@ A networked or loaded loop's delay is not one number but a range
   Cauchy-Schwarz), around the nominal loop whose map from that
   perturbation to the differences is ``(1 - z**-1) L / (1 + L)``.  By the
   small-gain theorem the loop is stable for every such sequence if it is
-  stable at ``d_min`` and
+  stable at ``d_min`` and::
 
       N |exp(j theta) - 1| |L / (1 + L)| < 1   for every theta,
 
@@ -58,7 +58,7 @@ __all__ = ["DelayRange", "delay_range", "DelayRangeMap", "delay_range_map"]
 
 @dataclasses.dataclass(frozen=True)
 class DelayRange:
-    """A point's stability over a range of delays (:func:`delay_range`).
+    """A point's stability over a range of delays (:func:`symstab.numeric.analysis.delay_range.delay_range`).
 
     Attributes
     ----------
@@ -203,7 +203,7 @@ def delay_range(loop, *, delay_range, rtol=1e-6, **values):
 
 @dataclasses.dataclass(frozen=True)
 class DelayRangeMap:
-    """The two sets of :func:`delay_range` over a grid of a plane (:func:`delay_range_map`).
+    """The two sets of a delay range over a grid of a plane (:func:`symstab.numeric.analysis.delay_range.delay_range_map`).
 
     Attributes
     ----------
@@ -241,7 +241,17 @@ class DelayRangeMap:
                 f"{varying})")
 
     def plot(self, ax=None):
-        """Draw the two sets over the grid: :func:`symstab.drawing.plot_delay_range_map`."""
+        """Draw the two sets over the grid: :func:`symstab.drawing.plot_delay_range_map`.
+
+        Parameters
+        ----------
+        ax : matplotlib.axes.Axes, optional
+            Where to draw (default: a new figure's axes).
+
+        Returns
+        -------
+        symstab.drawing.Plot
+        """
         from ...drawing import plot_delay_range_map
 
         return plot_delay_range_map(self, ax)
@@ -249,7 +259,7 @@ class DelayRangeMap:
 
 def delay_range_map(loop, x_values, y_values, *, delay_range, x=None, y=None, rtol=1e-6,
                     **values):
-    """:func:`delay_range`'s two sets at every point of a grid of a loop's plane.
+    """The two sets of :func:`symstab.numeric.analysis.delay_range.delay_range` at every point of a grid.
 
     The constant set from the exact delay margin map
     (:meth:`symstab.Loop.margin_map` with ``margin="delay"``) at the range's

@@ -551,7 +551,7 @@ def delay_limit_of(d, delay_limit, *, name="delay_limit", whole=True):
 def _delay_margin(loop, point, limit, first):
     """The smallest whole number of samples added to ``d`` at which the loop is not stable.
 
-    From the added delay ``first`` (:func:`_first_delay`) on, the certified
+    From the added delay ``first`` (``_first_delay``) on, the certified
     verdicts at ``d + k`` up to ``limit``; None when the loop stays stable
     (or ``first`` is inf: stable at every added delay).
     """
@@ -591,7 +591,7 @@ def _first_delay(phase, delayed, direct):
 
 
 def first_whole_delays(chi):
-    """:func:`_first_delay` of each of ``chi``'s points (flat, stable ones): inf where at none.
+    """``_first_delay`` of each of ``chi``'s points (flat, stable ones): inf where at none.
 
     The bound of the delay-margin scan
     (:func:`symstab.numeric.analysis.delay_scan.verdict_changes`) per

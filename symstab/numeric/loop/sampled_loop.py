@@ -44,7 +44,6 @@ import warnings
 
 import sympy as sp
 
-from ..._memo import shared_property
 from ...codegen.loop_kernels import environment_kernels, load_numpy_kernels
 from ...symbolic.loop_assembly import LoopModel, parse_environment, parse_plant
 from ..engine.results import Boundary, Limits
@@ -218,25 +217,16 @@ class Loop(LoopModel):
         """Where the loop's generated NumPy module lives (None if in memory)."""
         return self._kernels[0].__file__
 
-    @shared_property
-    def environment_delay(self):
-        """The environment's own delay in samples: the power of ``z`` that divides ``Ve_d``.
-
-        How many trailing coefficients of the symbolic ``Ve_d`` are 0 (a
-        ``z**-k`` in the environment), beside the loop's delay ``d``.
-        """
-        ve_d = self.environment_parts[1]
-        k = 0
-        while k < len(ve_d) - 1 and sp.simplify(ve_d[len(ve_d) - 1 - k]) == 0:
-            k += 1
-        return k
-
     def coefficients(self, **values):
         """Coefficients of ``chi(z)`` (highest power first), divided by ``P_d``'s leading one.
 
         Dense: for short delays and for comparisons; the loop's own
-        computations keep ``chi`` structured (:meth:`polynomial`).  ``**values``:
-        as :meth:`polynomial`'s.
+        computations keep ``chi`` structured (:meth:`polynomial`).
+
+        Parameters
+        ----------
+        **values
+            As :meth:`polynomial`'s.
 
         Returns
         -------
@@ -251,8 +241,13 @@ class Loop(LoopModel):
         ``D = Ve_d P_d`` and ``N = Ve_n P_n``, divided by ``P_d``'s leading
         coefficient, one polynomial per point; what :meth:`classify`,
         :meth:`unstable_root_counts` and :meth:`spectral_radius` work on, in
-        O(d) per point.  ``**values``: every parameter (:attr:`parameters`) or its default,
-        arrays broadcast; ``d`` in samples, whole or not (``P_eps = N_eps / (z P_d)``), or ``Td``.
+        O(d) per point.
+
+        Parameters
+        ----------
+        **values
+            Every parameter (:attr:`parameters`) or its default, arrays broadcast;
+            ``d`` in samples, whole or not (``P_eps = N_eps / (z P_d)``), or ``Td``.
         """
         return self.evaluation.polynomial(values)
 
@@ -450,7 +445,9 @@ class Loop(LoopModel):
         return margins(self, parameters=parameters, delay_limit=delay_limit, rtol=rtol, **values)
 
     def delay_margin(self, *, limit=None, step=None, every=None, **values):
-        """The exact delay margin: :func:`symstab.numeric.analysis.delays.delay_margin`."""
+        """The exact delay margin at a stable point, and where stability switches.
+
+        See :func:`symstab.numeric.analysis.delays.delay_margin`."""
         from ..analysis.delays import delay_margin
 
         return delay_margin(self, limit=limit, step=step, every=every, **values)
@@ -458,7 +455,7 @@ class Loop(LoopModel):
     def delay_range(self, x_values=None, y_values=None, *, delay_range, **values):
         """Every delay of a range, at a point or (given ``x_values, y_values``) a grid's.
 
-        See :mod:`symstab.numeric.analysis.delay_range`."""
+        See :func:`symstab.numeric.analysis.delay_range.delay_range_map` (a point: ``delay_range``)."""
         from ..analysis import delay_range as rooms
 
         if x_values is None and y_values is None:
