@@ -160,10 +160,10 @@ def crossing_delays(loop, values, points, rows, low, high):
     rows = np.asarray(rows, dtype=np.int64)
     if rows.size == 0:
         return np.zeros(0)
-    top = float(np.max(high))
-    degree = loop.polynomial(**_given(values, {n: v[rows[:1]] for n, v in points.items()},
-                                      int(np.floor(top)), np.array([top % 1.0]), (-1,))).degree
-    by_radius = degree <= EIGENVALUES_UP_TO_DEGREE
+    # chi's degree less its whole delay: the method is chosen per whole part (the same for
+    # a point alone and in a grid).
+    base = loop.polynomial(**_given(values, {n: v[rows[:1]] for n, v in points.items()}, 0,
+                                    np.array([0.5]), (-1,))).degree
 
     def excess(x, index):
         out = np.empty(x.size)
@@ -171,7 +171,7 @@ def crossing_delays(loop, values, points, rows, low, high):
         for whole in np.unique(wholes):
             k = np.flatnonzero(wholes == whole)
             at = ({n: v[rows[index[k]]] for n, v in points.items()}, int(whole), x[k] - whole)
-            if by_radius:
+            if whole + base <= EIGENVALUES_UP_TO_DEGREE:
                 # Continuous in the delay; at the ends on either side of 1.
                 out[k] = _radius(loop, values, *at) - 1.0
             else:
