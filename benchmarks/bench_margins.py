@@ -20,6 +20,11 @@ cost at 100 x 100).  Then the exact delay-margin map (``margin="delay"``, 30 x
 it replaced (kept here only, as the comparison: from each point's first
 possible whole delay, one verdict a whole sample) and against
 ``Loop.delay_margin`` point by point (on every fifth point of each axis).
+
+Measured 2026-12-07 (2 CPUs, quiet), the delay map: 30 x 30 at d = 40, 734
+stable points with margins 0.2 to 406.5 samples: the exact map 61.8 s (84 ms
+a stable point), the whole-sample map 1.21 s (ceil of the exact margin equal
+to it at all 730 finite points), delay_margin point by point 110 ms a point.
 """
 
 import argparse
