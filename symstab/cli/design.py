@@ -270,14 +270,9 @@ def _delay(args, setup, over):
     if {"d", "Td"} & set(setup.given):
         raise ValueError("--delay holds the delay in seconds as T varies: drop --d / --set d / "
                          "--set Td")
-    from .loop_options import convert_sets, parse_number
+    from .loop_options import time_value
 
-    text, unit = split_unit(args.delay.strip(), "--delay")
-    value = parse_number("T", text, "--delay", lists=False)
-    values, _ = convert_sets(setup.loop, {"T": (value, unit)}, flag="--delay")
-    from .._validate import check_real
-
-    return check_real("--delay", values["T"], low=0.0)
+    return time_value(setup.loop, args.delay, "--delay")
 
 
 def _target(word):

@@ -299,6 +299,20 @@ def split_unit(text, flag):
     return head + comma + number.group(), unit
 
 
+def time_value(loop, text, flag):
+    """A time given on the command line (``"2ms"``, ``"0.002"``: seconds without a unit), in s.
+
+    Converted as a ``--set T=...`` value is (the loop file's unit of ``T``
+    where it has one); not negative.
+    """
+    from .._validate import check_real
+
+    text, unit = split_unit(text.strip(), flag)
+    value = parse_number("T", text, flag, lists=False)
+    values, _ = convert_sets(loop, {"T": (value, unit)}, flag=flag)
+    return check_real(flag, values["T"], low=0.0)
+
+
 def parse_number(name, text, flag, *, lists, written=None):
     """The value(s) of one ``--set``: a float, d an integer; a list where allowed.
 

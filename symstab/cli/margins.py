@@ -4,8 +4,11 @@ At one stable point of a loop file (``--loop FILE --set NAME=VALUE``) or of
 the paper's loop (its device options and one stiffness and damping):
 the modulus margin ``min |1 + L|`` on the unit circle (certified), every
 gain and phase margin of the sampled open loop, the stable interval
-through the point of each plane parameter, and the delay margin in whole
-samples (:func:`symstab.numeric.analysis.margins.margins`).  An unstable or
+through the point of each plane parameter, and the delay margin, exact and
+in whole samples (:func:`symstab.numeric.analysis.margins.margins`).  With
+``--delay-range TMIN TMAX``, whether the point is stable for every constant
+delay of the range and for every delay that varies in it by whole samples
+(:func:`symstab.numeric.analysis.delay_range.delay_range`).  An unstable or
 marginal point is one line and exit 2, before any work.
 """
 
@@ -42,6 +45,10 @@ def register(subparsers):
     p.add_argument("--along", metavar="NAME", action="append",
                    help="with --loop: a parameter whose stable interval through the point is "
                         "given (repeatable; default the file's plane)")
+    p.add_argument("--delay-range", nargs=2, metavar=("TMIN", "TMAX"),
+                   help="a range of loop delays (a time: 40ms, or seconds): stable for every "
+                        "constant delay of it, and for every delay varying in it by whole "
+                        "samples (a small-gain bound, sufficient only)")
     add_loop_options(p, "margins")
 
 
@@ -58,6 +65,14 @@ def run(args):
     if args.along is not None and setup.paper is not None:
         raise ValueError("--along needs a loop file: give --loop FILE (the paper's loop gives "
                          "its damping and stiffness)")
+    delays = None
+    if args.delay_range is not None:
+        from .loop_options import time_value
+
+        delays = tuple(time_value(setup.loop, text, "--delay-range") for text in args.delay_range)
+        from .._validate import check_real
+
+        check_real("--delay-range's TMAX", delays[1], low=delays[0])
     found = setup.loop.margins(parameters=args.along, **values)
     T = found.T if T is None and setup.paper is None else T
     columns = ["margin", "value", "theta [rad/sample]", "frequency [Hz]", "note"]
@@ -82,7 +97,15 @@ def run(args):
              "samples of computation can afford"]
     if T is None:
         notes.append("frequency: give the device's physical options (not --delta) for Hz")
-    emit(setup, args.format, columns, rows, notes=notes, result={"margins": found.as_dict()})
+    result = {"margins": found.as_dict()}
+    if delays is not None:
+        ranged = setup.loop.delay_range(delay_range=delays,
+                                        **{k: v for k, v in values.items() if k != "d"})
+        rows += [(quantity, value, None, None, note) for quantity, value, note in ranged.rows()]
+        result["delay_range"] = ranged.as_dict()
+        notes.append("every varying delay: the discrete-time Kao-Lincoln small-gain bound "
+                     "(sufficient, not necessary), for delays varying by whole samples")
+    emit(setup, args.format, columns, rows, notes=notes, result=result)
     return 0
 
 

@@ -127,3 +127,20 @@ def test_along_names_the_parameters_of_the_intervals(capsys):
     assert interval["name"] == "M" and interval["low"] < 0 < interval["high"]
     status, out, err = run_cli(capsys, "margins", "--loop", PAPER, "--along", "b")
     assert status == 2 and "'b' does not enter the loop's polynomial affinely" in err
+
+
+def test_a_delay_range_gives_the_librarys_two_sets(capsys):
+    data = run_cli_json(capsys, "margins", "--loop", PAPER, "--set", "K=2", "--set", "B=0.1",
+                        "--delay-range", "40ms", "0.045")
+    expected = symstab.load_loop(PAPER).delay_range(delay_range=(0.040, 0.045), K=2.0, B=0.1)
+    found = data["delay_range"]
+    assert found["samples"] == [40.0, 45.0]
+    assert found["constant"] is True and found["varying"] is True
+    assert found["gain_margin"] == pytest.approx(expected.gain_margin, rel=1e-12)
+
+
+def test_a_reversed_delay_range_is_one_line(capsys):
+    status, out, err = run_cli(capsys, "margins", "--loop", PAPER, "--delay-range", "45ms",
+                               "40ms")
+    assert status == 2 and out == "" and err.count("\n") == 1, err
+    assert "--delay-range's TMAX must be" in err

@@ -102,6 +102,12 @@ class DelayRange:
         return [("every constant delay", constant, f"{low:.9g} to {high:.9g} samples"),
                 ("every varying delay", varying, self.why)]
 
+    def as_dict(self):
+        """The sets as plain values (JSON-ready)."""
+        return {"point": dict(self.point), "T": self.T, "samples": list(self.samples),
+                "constant": self.constant, "margin": self.margin, "varying": self.varying,
+                "gain_margin": self.gain_margin, "why": self.why}
+
     def __repr__(self):
         low, high = self.samples
         lines = [f"DelayRange({low:.6g} to {high:.6g} samples, T = {self.T:g} s)"]
