@@ -756,11 +756,15 @@ class LoopModel:
             point[self.symbols[name]] = sp.Float(repr(1 + 0.3183098861837907 * (k + 1)), PLANT_DIGITS)
         return point
 
-    def _at_check_point(self, coefficients):
+    #: The fraction of a period the fractional plant is checked at (:meth:`_fractional_agrees`).
+    _CHECK_FRACTION = sp.Float("0.3183098861837907", PLANT_DIGITS)
+
+    def _at_check_point(self, coefficients, point=None):
         """A polynomial (coefficients highest first) at :attr:`_CHECK_Z` and :meth:`_check_point`."""
+        point = self._check_point if point is None else point
         total = 0j
         for c in coefficients:
-            total = total * self._CHECK_Z + complex(sp.N(c.xreplace(self._check_point), PLANT_DIGITS))
+            total = total * self._CHECK_Z + complex(sp.N(c.xreplace(point), PLANT_DIGITS))
         return total
 
     @staticmethod
@@ -773,18 +777,27 @@ class LoopModel:
         return self._close(self._at_check_point(parts[0]) / self._at_check_point(parts[1]),
                            expected)
 
-    def _pulse_agrees(self, parts):
-        """Whether (P_n, P_d) give the matrix exponential's Z[ZOH G] at the check point."""
-        point = self._check_point
+    def _pulse_agrees(self, parts, fraction=None):
+        """Whether (P_n, P_d) give the matrix exponential's Z[ZOH G] at the check point.
+
+        With a ``fraction`` of a period of delay, whether ``(N_eps, z P_d)`` in
+        :data:`FRACTION` give :func:`numeric_fractional_zoh`'s ``P_eps`` there.
+        """
+        point = dict(self._check_point)
+        if fraction is not None:
+            point[FRACTION] = fraction
         num, den = sp.fraction(sp.together(self.plant.xreplace(point)))
         with mpmath.workdps(PLANT_DIGITS):
             num, den = ([mpmath.mpf(sp.Float(c, PLANT_DIGITS)) for c in sp.Poly(p, model.s).all_coeffs()]
                         for p in (num, den))
-            p_n, p_d = numeric_zoh(num, den, mpmath.mpf(point[model.T]), dps=PLANT_DIGITS)
+            T = mpmath.mpf(point[model.T])
+            p_n, p_d = (numeric_zoh(num, den, T, dps=PLANT_DIGITS) if fraction is None else
+                        numeric_fractional_zoh(num, den, T, mpmath.mpf(fraction),
+                                               dps=PLANT_DIGITS))
             z0 = mpmath.mpc(self._CHECK_Z.real, self._CHECK_Z.imag)
             expected = complex(mpmath.polyval(p_n, z0) / mpmath.polyval(p_d, z0))
-        return self._close(self._at_check_point(parts[0]) / self._at_check_point(parts[1]),
-                           expected)
+        return self._close(self._at_check_point(parts[0], point)
+                           / self._at_check_point(parts[1], point), expected)
 
     def _parts_agree(self, parts):
         """Whether the delayed and direct parts are Ve_d P_d and Ve_n P_n at the check point."""
@@ -872,24 +885,8 @@ class LoopModel:
         return self._fractional_plant_parts if fraction else self._plant_parts
 
     def _fractional_agrees(self, parts):
-        """Whether ``(N_eps, z P_d)`` give the matrix exponential's ``P_eps`` at the check point."""
-        point = {**self._check_point, FRACTION: sp.Float("0.3183098861837907", PLANT_DIGITS)}
-        num, den = sp.fraction(sp.together(self.plant.xreplace(point)))
-        with mpmath.workdps(PLANT_DIGITS):
-            num, den = ([mpmath.mpf(sp.Float(c, PLANT_DIGITS)) for c in sp.Poly(p, model.s).all_coeffs()]
-                        for p in (num, den))
-            p_n, p_d = numeric_fractional_zoh(num, den, mpmath.mpf(point[model.T]),
-                                              mpmath.mpf(point[FRACTION]), dps=PLANT_DIGITS)
-            z0 = mpmath.mpc(self._CHECK_Z.real, self._CHECK_Z.imag)
-            expected = complex(mpmath.polyval(p_n, z0) / mpmath.polyval(p_d, z0))
-
-        def at(coefficients):
-            total = 0j
-            for c in coefficients:
-                total = total * self._CHECK_Z + complex(sp.N(c.xreplace(point), PLANT_DIGITS))
-            return total
-
-        return self._close(at(parts[0]) / at(parts[1]), expected)
+        """:meth:`_pulse_agrees` of ``(N_eps, z P_d)`` at :attr:`_CHECK_FRACTION`."""
+        return self._pulse_agrees(parts, self._CHECK_FRACTION)
 
     def pulse_transfer_function(self):
         """``Z[ZOH G](z)`` as a SymPy rational function of ``z``.
