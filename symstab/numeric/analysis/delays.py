@@ -42,7 +42,13 @@ from ..._validate import check_real
 from ..engine.results import html_table
 from ..engine.roots import circle_minimum
 from .delay_scan import STEPS_PER_SAMPLE, crossing_delays, delay_grid, verdict_changes
-from .margins import delay_limit_of, first_whole_delays, phase_crossings, stable_point
+from .margins import (
+    delay_limit_of,
+    first_whole_delays,
+    phase_crossings,
+    point_text,
+    stable_point,
+)
 
 __all__ = ["DelaySwitch", "DelayMargin", "delay_margin"]
 
@@ -145,12 +151,12 @@ class DelayMargin:
 
     def __repr__(self):
         width = max(len(r[0]) for r in self.rows())
-        lines = [f"DelayMargin at {_point_text(self.point)} (up to {self.limit:g} samples more)"]
+        lines = [f"DelayMargin at {point_text(self.point)} (up to {self.limit:g} samples more)"]
         lines += [f"  {q:<{width}}  {v}  ({w})" for q, v, w in self.rows()]
         return "\n".join(lines)
 
     def _repr_html_(self):
-        return html_table(f"Delay margin at {_point_text(self.point)}",
+        return html_table(f"Delay margin at {point_text(self.point)}",
                           [(q, f"{v} ({w})") for q, v, w in self.rows()])
 
     def as_dict(self):
@@ -160,10 +166,6 @@ class DelayMargin:
                 "switches": [dict(dataclasses.asdict(s), seconds=s.seconds,
                                   frequency=s.frequency) for s in self.switches]}
 
-
-def _point_text(point):
-    return ", ".join(f"{k} = {v:.6g}" if isinstance(v, float) else f"{k} = {v}"
-                     for k, v in point.items())
 
 
 def delay_margin(loop, *, limit=None, step=None, every=None, **values):

@@ -222,12 +222,12 @@ class Margins:
 
     def __repr__(self):
         width = max(len(r[0]) for r in self.rows())
-        lines = [f"Margins at {_point_text(self.point)}"]
+        lines = [f"Margins at {point_text(self.point)}"]
         lines += [f"  {q:<{width}}  {v}  ({w})" for q, v, w in self.rows()]
         return "\n".join(lines)
 
     def _repr_html_(self):
-        return html_table(f"Margins at {_point_text(self.point)}",
+        return html_table(f"Margins at {point_text(self.point)}",
                           [(q, f"{v} ({w})") for q, v, w in self.rows()])
 
     def as_dict(self):
@@ -245,7 +245,8 @@ class Margins:
         }
 
 
-def _point_text(point):
+def point_text(point):
+    """A point's values in one line (``K = 2, d = 40``), for the reprs of margins."""
     return ", ".join(f"{k} = {v:.6g}" if isinstance(v, float) else f"{k} = {v}"
                      for k, v in point.items())
 
