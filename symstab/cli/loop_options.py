@@ -92,7 +92,7 @@ _LOOP_ONLY = {
     "margins": ("set_values",),
     "design": ("set_values", "x", "y", "at", "over", "search_range", "delay"),
     "map": ("set_values", "x", "y", "x_range", "y_range", "simulate", "uncertain", "samples",
-            "seed", "margin"),
+            "seed", "margin", "delay_range"),
     "simulate": ("set_values", "delays", "seed"),
 }
 
@@ -100,7 +100,7 @@ _FLAGS = {"set_values": "--set", "x": "--x", "y": "--y", "at": "--at",
           "x_range": "--x-range", "y_range": "--y-range", "over": "--over",
           "search_range": "--range", "simulate": "--simulate", "delay": "--delay",
           "uncertain": "--uncertain", "samples": "--samples", "seed": "--seed",
-          "margin": "--margin", "delays": "--delays",
+          "margin": "--margin", "delays": "--delays", "delay_range": "--delay-range",
           "strips": "--strips", "png": "--png"}
 
 
@@ -228,6 +228,11 @@ def add_loop_options(p, command):
                             "delay margin (the smallest added delay, samples, at which a root "
                             "reaches the circle); gain, the smallest factor of the loop gain "
                             "that does (the other cells hold NaN)")
+        g.add_argument("--delay-range", nargs=2, metavar=("TMIN", "TMAX"),
+                       help="instead of the classification, the cells stable for every "
+                            "constant loop delay from TMIN to TMAX (a time: 40ms, or seconds; "
+                            "the exact delay margin) and for every delay varying in it by whole "
+                            "samples (a small-gain bound, sufficient only)")
         g.add_argument("--samples", type=int, metavar="N",
                        help="draws with --uncertain (default 1000)")
         g.add_argument("--seed", type=int, metavar="S",

@@ -103,13 +103,18 @@ def run(args):
         raise ValueError("map --loop needs the grid: --x-range LOW,HIGH,N and --y-range LOW,HIGH,N")
     xs, ys = _grid(args.x_range, "--x-range"), _grid(args.y_range, "--y-range")
     out, png_path = map_outputs(args)
-    if args.uncertain is not None and args.margin is not None:
-        raise ValueError("--uncertain maps the probability of stability, --margin a margin of "
-                         "the nominal loop: give one of them")
+    given = [flag for flag, dest in (("--uncertain", "uncertain"), ("--margin", "margin"),
+                                     ("--delay-range", "delay_range"))
+             if getattr(args, dest) is not None]
+    if len(given) > 1:
+        raise ValueError(f"{' and '.join(given)} each map something else (the probability of "
+                         f"stability, a margin, the sets of a delay range): give one of them")
     if args.uncertain is not None:
         return _probability(args, setup, xs, ys, out, png_path)
     if args.margin is not None:
         return _margin(args, setup, xs, ys, out, png_path)
+    if args.delay_range is not None:
+        return _delay_range(args, setup, xs, ys, out, png_path)
     return _map(_LoopMap(args, setup, xs, ys, out, png_path))
 
 
@@ -575,12 +580,7 @@ def _probability(args, setup, xs, ys, out, png_path):
 
 def _margin(args, setup, xs, ys, out, png_path):
     """``map --loop --margin``: a margin at every stable cell (NaN elsewhere), its file and PNG."""
-    if args.simulate:
-        raise ValueError("--margin maps a margin of the linear loop; --simulate simulates it: "
-                         "give one of them")
-    for flag, dest in _LOOP_SIMULATION_OPTIONS:
-        if getattr(args, dest) not in (None, False):
-            raise ValueError(f"{flag} is an option of the simulation: drop it with --margin")
+    _only_linear(args, "--margin", "a margin")
     check_memory(f"a map of {xs.size} x {ys.size} cells", xs.size * ys.size * _MAP_CELL_BYTES
                  + CHUNK_BYTES)
     what = {"modulus": "the modulus margin min|1+L|, certified",
@@ -626,6 +626,72 @@ def _margin(args, setup, xs, ys, out, png_path):
               f"more (inf in the file)")
     print(wrote)
     return 0
+
+
+def _delay_range(args, setup, xs, ys, out, png_path):
+    """``map --loop --delay-range``: the cells stable for every constant and every varying delay."""
+    from .._validate import check_real
+    from .loop_options import time_value
+
+    _only_linear(args, "--delay-range", "the sets of a delay range")
+    delays = tuple(time_value(setup.loop, text, "--delay-range") for text in args.delay_range)
+    check_real("--delay-range's TMAX", delays[1], low=delays[0])
+    check_memory(f"a map of {xs.size} x {ys.size} cells", xs.size * ys.size * _MAP_CELL_BYTES
+                 + CHUNK_BYTES)
+    print(f"map --loop --delay-range: the cells stable for every constant delay from "
+          f"{delays[0] * 1e3:.6g} to {delays[1] * 1e3:.6g} ms (the exact delay margin) and for "
+          f"every delay varying in it by whole samples (small-gain bound, sufficient only)")
+    for line in setup.echo:
+        print(line)
+    values = {k: v for k, v in setup.values.items() if k not in ("d", "Td")}
+    found = setup.loop.delay_range(xs, ys, x=setup.x, y=setup.y, delay_range=delays, **values)
+    constant = found.constant.T
+    varying = None if found.varying is None else found.varying.T
+    if out.suffix == ".npz":
+        extra = {} if varying is None else {"varying": varying}
+        data = _loop_npz(setup, xs, ys, setup.values, constant=constant,
+                         samples=np.array(found.samples), **extra)
+    else:
+        X, Y = np.meshgrid(xs, ys, indexing="ij")
+        column = (varying if varying is not None else np.full(constant.shape, -1)).ravel()
+        buf = io.StringIO()
+        buf.write(f"{setup.label(setup.x)},{setup.label(setup.y)},constant,varying\n")
+        for xv, yv, c, v in zip(X.ravel(), Y.ravel(), constant.ravel(), column, strict=True):
+            buf.write(f"{xv:.12g},{yv:.12g},{int(c)},{int(v)}\n")
+        data = buf.getvalue()
+    image = (png_or_none(_delay_range_figure, setup, found) if png_path is not None else None)
+    wrote = _write_map(out, data, png_path, image)
+    low, high = found.samples
+    print(f"{int(constant.sum())} of {constant.size} cells stable for every constant delay of "
+          f"{low:.6g} to {high:.6g} samples")
+    print(f"{int(varying.sum())} of {varying.size} cells stable for every delay varying by whole "
+          f"samples" if varying is not None else
+          "every varying delay: not derived (the range's ends are not whole samples; the "
+          "varying column holds -1)")
+    print(wrote)
+    return 0
+
+
+def _only_linear(args, flag, what):
+    """Refuse the simulation's options beside ``flag``, a map of ``what`` of the linear loop."""
+    if args.simulate:
+        raise ValueError(f"{flag} maps {what} of the linear loop; --simulate simulates it: give "
+                         f"one of them")
+    for option, dest in _LOOP_SIMULATION_OPTIONS:
+        if getattr(args, dest) not in (None, False):
+            raise ValueError(f"{option} is an option of the simulation: drop it with {flag}")
+
+
+def _delay_range_figure(plt, setup, found):
+    """The delay-range map's figure: the two sets, labelled in the loop's units."""
+    drawn = found.plot()
+    labels = _axis_labels(setup)
+    drawn.axes.set_xlabel(labels["xlabel"])
+    drawn.axes.set_ylabel(labels["ylabel"])
+    low, high = found.samples
+    drawn.axes.set_title(f"loop {setup.loop.name}: stable for delays of {low:.6g} to "
+                         f"{high:.6g} samples")
+    return drawn.figure
 
 
 def _margin_figure(plt, setup, found, xs, ys):

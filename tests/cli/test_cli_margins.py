@@ -144,3 +144,36 @@ def test_a_reversed_delay_range_is_one_line(capsys):
                                "40ms")
     assert status == 2 and out == "" and err.count("\n") == 1, err
     assert "--delay-range's TMAX must be" in err
+
+
+def test_map_delay_range_writes_the_librarys_two_sets(capsys, tmp_path):
+    import numpy as np
+
+    out = tmp_path / "r.csv"
+    status, printed, err = run_cli(capsys, "map", "--loop", PAPER, "--x-range=0.2,1,3",
+                                   "--y-range=10,200,4", "--delay-range", "2ms", "0.004",
+                                   "--out", out, "--no-png")
+    assert status == 0, err
+    rows = np.genfromtxt(out, delimiter=",", skip_header=1)
+    expected = symstab.load_loop(PAPER).delay_range(np.linspace(0.2, 1, 3),
+                                                    np.linspace(10, 200, 4),
+                                                    delay_range=(0.002, 0.004))
+    # The file is (x, y), the result (y, x).
+    assert np.array_equal(rows[:, 2], expected.constant.T.ravel())
+    assert np.array_equal(rows[:, 3], expected.varying.T.ravel())
+    assert rows[:, 2].any() and not rows[:, 2].all()
+    assert (f"{int(expected.constant.sum())} of 12 cells stable for every constant delay of 2 "
+            f"to 4 samples") in printed
+
+
+@pytest.mark.parametrize("extra, message", [
+    (["--margin", "delay"], "give one of them"),
+    (["--simulate"], "--delay-range maps the sets of a delay range of the linear loop"),
+    (["--steps", "100"], "--steps is an option of the simulation"),
+])
+def test_map_delay_range_refuses_what_it_does_not_map(capsys, tmp_path, extra, message):
+    status, out, err = run_cli(capsys, "map", "--loop", PAPER, "--x-range=0,0.2,3",
+                               "--y-range=0,2,3", "--delay-range", "2ms", "4ms",
+                               "--out", tmp_path / "m.csv", *extra)
+    assert status == 2 and message in err and err.count("\n") == 1, err
+    assert not list(tmp_path.iterdir())
