@@ -272,7 +272,7 @@ def _delay(args, setup, over):
                          "--set Td")
     from .loop_options import time_value
 
-    return time_value(setup.loop, args.delay, "--delay")
+    return time_value(args.delay, "--delay")
 
 
 def _target(word):

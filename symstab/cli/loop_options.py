@@ -304,18 +304,32 @@ def split_unit(text, flag):
     return head + comma + number.group(), unit
 
 
-def time_value(loop, text, flag):
-    """A time given on the command line (``"2ms"``, ``"0.002"``: seconds without a unit), in s.
+def time_value(text, flag):
+    """A delay given on the command line (``"2ms"``, ``"0.002"``: seconds without a unit), in s.
 
-    Converted as a ``--set T=...`` value is (the loop file's unit of ``T``
-    where it has one); not negative.
+    Converted as a loop delay ``Td`` is: a unit must be a time; not negative.
     """
     from .._validate import check_real
+    from ..numeric.loop.quantities import convert
 
     text, unit = split_unit(text.strip(), flag)
-    value = parse_number("T", text, flag, lists=False)
-    values, _ = convert_sets(loop, {"T": (value, unit)}, flag=flag)
-    return check_real(flag, values["T"], low=0.0)
+    value = parse_number("Td", text, flag, lists=False)
+    return check_real(flag, convert("Td", value, unit, where=flag).si_value, low=0.0)
+
+
+def delay_range_option(texts, loop, values):
+    """``--delay-range TMIN TMAX``: ``(Td_min, Td_max)`` in s, checked before any work.
+
+    Each a time (:func:`time_value`), ``TMIN <= TMAX``, within
+    ``SYMSTAB_MAX_DELAY`` at the period of ``values`` (or the loop's).
+    """
+    from .._validate import check_real
+    from ..numeric.analysis.delay_range import range_in_samples
+
+    delays = tuple(time_value(text, "--delay-range") for text in texts)
+    check_real("--delay-range's TMAX", delays[1], low=delays[0])
+    range_in_samples(loop, delays, **{k: v for k, v in values.items() if k not in ("d", "Td")})
+    return delays
 
 
 def parse_number(name, text, flag, *, lists, written=None):

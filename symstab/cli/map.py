@@ -630,12 +630,11 @@ def _margin(args, setup, xs, ys, out, png_path):
 
 def _delay_range(args, setup, xs, ys, out, png_path):
     """``map --loop --delay-range``: the cells stable for every constant and every varying delay."""
-    from .._validate import check_real
-    from .loop_options import time_value
+    from .loop_options import delay_range_option
 
     _only_linear(args, "--delay-range", "the sets of a delay range")
-    delays = tuple(time_value(setup.loop, text, "--delay-range") for text in args.delay_range)
-    check_real("--delay-range's TMAX", delays[1], low=delays[0])
+    delays = delay_range_option(args.delay_range, setup.loop, setup.values)
+    values = {k: v for k, v in setup.values.items() if k not in ("d", "Td")}
     check_memory(f"a map of {xs.size} x {ys.size} cells", xs.size * ys.size * _MAP_CELL_BYTES
                  + CHUNK_BYTES)
     print(f"map --loop --delay-range: the cells stable for every constant delay from "
@@ -643,7 +642,6 @@ def _delay_range(args, setup, xs, ys, out, png_path):
           f"every delay varying in it by whole samples (small-gain bound, sufficient only)")
     for line in setup.echo:
         print(line)
-    values = {k: v for k, v in setup.values.items() if k not in ("d", "Td")}
     found = setup.loop.delay_range(xs, ys, x=setup.x, y=setup.y, delay_range=delays, **values)
     constant = found.constant.T
     varying = None if found.varying is None else found.varying.T

@@ -67,12 +67,9 @@ def run(args):
                          "its damping and stiffness)")
     delays = None
     if args.delay_range is not None:
-        from .loop_options import time_value
+        from .loop_options import delay_range_option
 
-        delays = tuple(time_value(setup.loop, text, "--delay-range") for text in args.delay_range)
-        from .._validate import check_real
-
-        check_real("--delay-range's TMAX", delays[1], low=delays[0])
+        delays = delay_range_option(args.delay_range, setup.loop, values)
     found = setup.loop.margins(parameters=args.along, **values)
     T = found.T if T is None and setup.paper is None else T
     columns = ["margin", "value", "theta [rad/sample]", "frequency [Hz]", "note"]

@@ -177,3 +177,18 @@ def test_map_delay_range_refuses_what_it_does_not_map(capsys, tmp_path, extra, m
                                "--out", tmp_path / "m.csv", *extra)
     assert status == 2 and message in err and err.count("\n") == 1, err
     assert not list(tmp_path.iterdir())
+
+
+@pytest.mark.parametrize("command", ["margins", "map"])
+@pytest.mark.parametrize("ends, message", [
+    (["1kg", "2ms"], "--delay-range: parameter 'Td' has unit 'kg': Td is the loop delay"),
+    (["0", "1e9"], "at most 10000 (raise the limit with SYMSTAB_MAX_DELAY)"),
+    (["nan", "2ms"], "--delay-range: Td must be a finite number"),
+])
+def test_a_bad_delay_range_is_one_line_before_any_work(capsys, tmp_path, command, ends,
+                                                       message):
+    grid = (["--x-range=0,1,3", "--y-range=0,2,3", "--out", tmp_path / "m.csv"]
+            if command == "map" else [])
+    status, out, err = run_cli(capsys, command, "--loop", PAPER, *grid, "--delay-range", *ends)
+    assert status == 2 and out == "" and err.count("\n") == 1 and message in err, err
+    assert not list(tmp_path.iterdir())

@@ -48,6 +48,7 @@ import math
 
 import numpy as np
 
+from ..._resources import MAX_DELAY_ENV, max_delay
 from ..._validate import check_real, snap_delay
 from ..engine.polynomial import DelayedPolynomial
 from ..engine.results import html_table
@@ -137,8 +138,33 @@ def _range_samples(delay_range, T):
     high = check_real("delay_range's Td_max", high, low=0.0)
     if high < low:
         raise ValueError(f"delay_range must have Td_min <= Td_max, got ({low:g}, {high:g})")
+    if high / T > max_delay():
+        raise ValueError(f"delay_range's Td_max is {high / T:g} samples; at most "
+                         f"{max_delay():g} (raise the limit with {MAX_DELAY_ENV})")
     low, high = (float(x) for x in snap_delay([low / T, high / T]))
     return low, high, low.is_integer() and high.is_integer()
+
+
+def range_in_samples(loop, delay_range, **values):
+    """``(low, high, whole)``: a delay range in samples at the question's period, checked.
+
+    What :func:`delay_range` and :func:`delay_range_map` check first: the
+    command line calls it before it prints or computes anything.
+
+    Parameters
+    ----------
+    loop : symstab.Loop
+    delay_range : (float, float)
+        ``(Td_min, Td_max)``, seconds.
+    **values
+        The question's values (``T`` here, or the loop's).
+
+    Returns
+    -------
+    (float, float, bool)
+        The ends in samples and whether both are whole samples.
+    """
+    return _range_samples(delay_range, _period(loop, values))
 
 
 def _gain_bracket(chi, n_samples, rtol):
