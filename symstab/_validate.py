@@ -161,6 +161,25 @@ def split_delay(samples, *, name="d"):
     return d, (eps if np.any(eps != 0) else None)
 
 
+def delay_samples(samples, *, name="d"):
+    """One delay in samples, ``d + eps``: an ``int`` when whole, else the float (``40.5``).
+
+    Checked as :func:`split_delay` checks it (within :data:`DELAY_RTOL` of a
+    whole number it is that number).
+
+    Raises
+    ------
+    TypeError, ValueError
+        Not one real number, negative, not finite, or beyond
+        ``SYMSTAB_MAX_DELAY``.
+    """
+    if np.ndim(samples) != 0:
+        raise ValueError(f"delay {name} must be one number of samples, got an array of shape "
+                         f"{np.shape(samples)}")
+    whole, fraction = split_delay(check_real(f"delay {name}", samples, low=0.0), name=name)
+    return whole if fraction is None else whole + float(fraction)
+
+
 def check_array(name, value, *, low=None, low_open=False, high=None):
     """Return ``value`` as a float ndarray after checking every entry.
 

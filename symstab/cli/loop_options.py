@@ -363,16 +363,15 @@ def parse_number(name, text, flag, *, lists, written=None):
 
 def _samples(value, flag, shown):
     """``--set d=VALUE``: an int when whole, else the float (40.5); refused outside 0 to the limit."""
-    from .._validate import split_delay
+    from .._validate import delay_samples
 
     try:
-        whole, fraction = split_delay(value, name="d")
+        return delay_samples(value, name="d")
     except ValueError:
         from .._resources import max_delay
         raise ValueError(f"{flag}: delay d must be a number of samples from 0 to {max_delay()} "
                          f"(unit \"samples\", or none; 40.5 is a fraction of a period more), "
                          f"got {shown!r}") from None
-    return whole if fraction is None else whole + float(fraction)
 
 
 def _parse_sets(texts, *, lists):

@@ -28,7 +28,7 @@ from ..drawing import (
     simulated_map_figure,
 )
 from .loop_options import add_loop_options, resolve_loop, uncertain_box, uses_loop, value_text
-from .options import add_command, add_model_options, resolve, stiffness_and_damping, whole_delay
+from .options import add_command, add_model_options, resolve, stiffness_and_damping
 from .output import check_files, write_output
 from .simulation import (
     add_nonideal_options,
@@ -206,8 +206,6 @@ class _PaperMap:
 
         self.args = args
         setup = self.setup = resolve(args)
-        whole_delay(setup, "map", "the paper's device simulator and its theory count whole "
-                              "samples; map --loop examples/loops/paper.toml --set Td=40.5ms classifies the plane")
         self.nonideal, self.x0 = resolve_nonideal(args, setup)
         given = self.given = {}  # the grids as the user gave them, by flag: the PNG's units
 
@@ -220,7 +218,8 @@ class _PaperMap:
         self.out, self.png_path = map_outputs(args)
         check_memory(f"a map of {alpha.size} x {beta.size} cells",
                      alpha.size * beta.size * _MAP_CELL_BYTES)
-        self.steps = check_steps(args.steps, setup.d)
+        # A fractional delay's horizon: that of the next whole delay.
+        self.steps = check_steps(args.steps, math.ceil(setup.d))
         # The loop simulated, classified by its roots before the simulation (a
         # refusal then costs no run): its linear part, filter and lag included.
         self.theory = simulated_theory(setup, self.nonideal)

@@ -206,11 +206,9 @@ def _delay_samples(Td, T):
     Refused in one line: ``Td`` negative or not finite, ``Td / T`` beyond
     ``SYMSTAB_MAX_DELAY``.
     """
-    from .._validate import check_real, split_delay
+    from .._validate import check_real, delay_samples
 
-    Td = check_real("Td", Td, low=0.0)
-    whole, fraction = split_delay(Td / T, name="Td / T")
-    return whole if fraction is None else whole + float(fraction)
+    return delay_samples(check_real("Td", Td, low=0.0) / T, name="Td / T")
 
 
 def parse_list(text, name):

@@ -31,7 +31,6 @@ from .options import (
     parse_one,
     resolve,
     stiffness_and_damping,
-    whole_delay,
 )
 from .output import check_files, write_output
 from .simulation import (
@@ -112,13 +111,11 @@ def _paper_plan(args):
     from ..numeric.simulation.simulator import check_steps
 
     setup = resolve(args)
-    whole_delay(setup, "simulate", "the paper's device simulator counts whole samples; "
-                                   "simulate --loop examples/loops/paper.toml --set Td=40.5ms "
-                                   "simulates the loop")
     alpha, beta = _point(args, setup)
     nonideal, x0 = resolve_nonideal(args, setup)
     _check_out(args.out)
-    steps = check_steps(args.steps, setup.d)
+    # A fractional delay's horizon: that of the next whole delay.
+    steps = check_steps(args.steps, math.ceil(setup.d))
     record = args.out is not None
     if record:
         check_memory(f"the --out trajectory of {steps} periods", (steps + 1) * _TRAJECTORY_ROW_BYTES)

@@ -147,8 +147,12 @@ def simulated_theory(setup, nonideal):
     """The :class:`symstab.numeric.paper.simulate_theory.LinearTheory` of the loop simulated."""
     from ..numeric.paper.simulate_theory import linear_theory
 
-    return linear_theory(gamma=setup.gamma, d=setup.d, delta=setup.delta,
-                         device=setup.device, nonideal=nonideal)
+    try:
+        return linear_theory(gamma=setup.gamma, d=setup.d, delta=setup.delta,
+                             device=setup.device, nonideal=nonideal)
+    except (TypeError, ValueError) as exc:
+        # Its refusals before a run (Coulomb friction at a fractional delay) name the options.
+        raise with_option_names(exc) from None
 
 
 def nonideal_text(nonideal, args):

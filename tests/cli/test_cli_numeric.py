@@ -149,10 +149,10 @@ def test_design_finds_a_gain_over_no_virtual_mass(shared_cli_run):
     (["limits", "--d", "40.5"], "whole number of samples, got '40.5': give a fractional delay "
                                 "in seconds with --Td"),
     # Issue 43: where the paper's loop cannot take a fractional delay, one line naming the command.
-    (["simulate", "--Td", "0.0405", "--alpha", "1e-4", "--beta", "0.005"],
-     "simulate does not take a fractional delay yet"),
-    (["map", "--Td", "0.0405", "--alpha", "0:1e-3,3", "--beta", "0:0.01,3", "--out", "m.npz"],
-     "map does not take a fractional delay yet"),
+    (["simulate", "--Td", "0.0405", "--alpha", "1e-4", "--beta", "0.005", "--coulomb", "1e-3"],
+     "--coulomb is simulated at a whole delay only"),
+    (["map", "--Td", "0.0405", "--alpha", "0,1e-3,3", "--beta", "0,0.01,3", "--out", "m.npz",
+      "--coulomb", "1e-3"], "--coulomb is simulated at a whole delay only"),
     (["design", "--Td", "0.0405", "--maximize", "passive"],
      "design --maximize passive does not take a fractional delay yet"),
     (["limits", "--d", "2.5"], "delay d"),

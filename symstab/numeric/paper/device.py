@@ -14,7 +14,13 @@ import dataclasses
 
 import numpy as np
 
-from ..._validate import check_array, check_delay, check_delay_samples, check_delta, check_real
+from ..._validate import (
+    check_array,
+    check_delay_samples,
+    check_delta,
+    check_real,
+    delay_samples,
+)
 
 __all__ = ["Device", "PAPER_DEVICE"]
 
@@ -117,10 +123,10 @@ class Device:
 
         Parameters
         ----------
-        d : int
-            Delay in samples.
+        d : int or float
+            Delay in samples (a fraction of a period too: ``40.5``).
         """
-        return check_delay(d) * self.T
+        return delay_samples(d) * self.T
 
     def stiffness(self, alpha):
         """``K_w = alpha m / T**2``.

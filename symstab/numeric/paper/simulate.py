@@ -74,7 +74,7 @@ import math
 
 import numpy as np
 
-from ..._validate import check_array, check_delay, check_loop, check_progress, check_real
+from ..._validate import check_array, check_loop, check_progress, check_real, delay_samples
 from ..simulation.friction import substeps_of
 from ..simulation.simulator import (
     QUANTUM_MIN,
@@ -90,7 +90,7 @@ from ..simulation.simulator import (
 )
 from .simulate_theory import paper_simulated_loop
 
-__all__ = ["simulate", "stability_map", "check_device_nonideal"]
+__all__ = ["simulate", "stability_map", "check_device_nonideal", "fractional_start"]
 
 
 def simulate(*, alpha, beta, gamma, d, delta, steps=None, x0=1.0, v0=None, device=None,
@@ -105,8 +105,9 @@ def simulate(*, alpha, beta, gamma, d, delta, steps=None, x0=1.0, v0=None, devic
     ----------
     alpha, beta, gamma : float or array_like
         Dimensionless stiffness, damping, virtual mass (broadcast together).
-    d : int
-        Delay in samples, ``d >= 0``.
+    d : int or float
+        Delay in samples, ``d >= 0``; a fraction of a period (``40.5``) is
+        carried by the loop's fractional plant (see :func:`fractional_start`).
     delta : float
         ``b T / m``; with a ``device`` it must equal ``device.delta``
         (pass ``None`` to take it from the device).
@@ -154,8 +155,10 @@ def simulate(*, alpha, beta, gamma, d, delta, steps=None, x0=1.0, v0=None, devic
                         f"got {type(nonideal).__name__}")
     if device is not None and not isinstance(device, Device):
         raise TypeError(f"device must be a symstab.Device or None, got {type(device).__name__}")
+    d = delay_samples(d)
+    fractional_start(d, nonideal)
     progress = check_progress(progress, lambda: progress_printer(
-        "simulating", default_horizon(check_delay(d)) if steps is None else steps))
+        "simulating", default_horizon(math.ceil(d)) if steps is None else steps))
     if device is not None:
         nonideal.check(device.T)
         if delta is None:
@@ -172,8 +175,9 @@ def simulate(*, alpha, beta, gamma, d, delta, steps=None, x0=1.0, v0=None, devic
                                  check_array("gamma", gamma))
     if delta is None:
         raise TypeError("delta must be a real number (or None with a device), got None")
-    _, d, delta = check_loop(0.0, d, delta)
-    steps = check_steps(steps, d)
+    delta = check_loop(0.0, math.floor(d), delta)[2]
+    # A fractional delay's horizon: that of the next whole delay.
+    steps = check_steps(steps, math.ceil(d))
     x0 = check_x0(x0)
     v0 = x0 / 100 if v0 is None else check_real("v0", v0, low=-X0_MAX, high=X0_MAX)
     loop, fixed, run_nonideal = _device_run(nonideal, device, delta, d)
@@ -186,8 +190,32 @@ def simulate(*, alpha, beta, gamma, d, delta, steps=None, x0=1.0, v0=None, devic
     # The device on its state space from (x0, v0 / T) (T = 1 here); a point
     # whose equations overflow (alpha = 1e308) diverges at once, as it always has.
     return loop.simulate(steps=steps, x0=x0, v0=v0, nonideal=run_nonideal, record=record,
-                         progress=progress, compensation=compensation, start="state",
-                         overflow="diverge", **fixed, K=arrays[0], B=arrays[1], M=arrays[2])
+                         progress=progress, compensation=compensation,
+                         start=fractional_start(d, nonideal), overflow="diverge", **fixed,
+                         K=arrays[0], B=arrays[1], M=arrays[2])
+
+
+def fractional_start(d, nonideal):
+    """Where a run of the paper's loop at the delay ``d`` starts: ``"state"``, or ``"samples"``.
+
+    At a whole delay the device starts on its state space from ``(x0, v0 /
+    T)``.  A fractional one (``d = 40.5``) is carried by the loop's
+    fractional plant, whose difference equations start from the sampled
+    history ``x0 - k v0`` (:meth:`symstab.Loop.simulate`'s ``start``): the
+    same position and velocity, seen by the samples; Coulomb friction,
+    which needs the state space, is refused there.
+
+    Raises
+    ------
+    ValueError
+        For Coulomb friction at a fractional delay.
+    """
+    if isinstance(d, int):
+        return "state"
+    if nonideal is not None and nonideal.coulomb_friction is not None:
+        raise ValueError(f"nonideal.coulomb_friction is simulated at a whole delay only (the "
+                         f"device on its state space), got d = {d!r} samples")
+    return "samples"
 
 
 def _device_run(nonideal, device, delta, d):
@@ -225,7 +253,9 @@ def _device_run(nonideal, device, delta, d):
         nonideal, velocity_cutoff=None, actuator_bandwidth=None,
         **{name: None if getattr(nonideal, name) is None else getattr(nonideal, name) * scale
            for name in ("coulomb_friction", "stiction", "force_limit", "force_resolution")})
-    spaces, _ = loop.friction_spaces(substeps_of(run_nonideal), **dict(values, K=0.0, B=0.0, M=0.0))
+    # The plant's spaces do not hold the delay (a fractional one is refused there).
+    spaces, _ = loop.friction_spaces(substeps_of(run_nonideal),
+                                     **dict(values, K=0.0, B=0.0, M=0.0, d=math.floor(d)))
     check_friction_size(run_nonideal, spaces, name="nonideal.coulomb_friction", scale=scale)
     return loop, values, run_nonideal
 
@@ -279,8 +309,8 @@ def stability_map(*, alpha, beta, gamma, d, delta, steps=None, x0=1.0, v0=None, 
     if alpha.ndim != 1 or beta.ndim != 1:
         raise ValueError("alpha and beta must be 1-D grids")
     gamma = check_real("gamma", gamma)
-    d = check_delay(d)
-    total = default_horizon(d) if steps is None else steps
+    d = delay_samples(d)
+    total = default_horizon(math.ceil(d)) if steps is None else steps
     progress = check_progress(progress, lambda: progress_printer("simulating", total))
     A, B = np.meshgrid(alpha, beta, indexing="ij")
     run = simulate(alpha=A, beta=B, gamma=gamma, d=d, delta=delta, steps=steps, x0=x0, v0=v0,

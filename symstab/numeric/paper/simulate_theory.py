@@ -15,7 +15,7 @@ import math
 import numpy as np
 
 from ..._resources import chunk_slices
-from ..._validate import check_array, check_box, check_delay, check_loop, check_real
+from ..._validate import check_array, check_box, check_loop, check_real, delay_samples
 from ..simulation.simulator import Nonidealities
 
 __all__ = ["LinearTheory", "linear_theory", "paper_simulated_loop"]
@@ -45,11 +45,14 @@ class LinearTheory:
 
     Built by :func:`linear_theory`.  Points are given as the simulator takes
     them (``alpha``, ``beta``; ``gamma`` and ``d`` are fixed here).  Without
-    a velocity filter or an actuator lag the linear part is the paper's loop
-    and the paper's functions answer (:func:`symstab.numeric.paper.stability.classify`,
-    the boundary of :func:`~symstab.numeric.paper.paper_loop.paper_point`'s loop); with either, a
-    :class:`symstab.Loop` of the paper's plant (with the lag) and the
-    environment on the filtered velocity, in the device's physical units.
+    a velocity filter or an actuator lag, at a whole delay, the linear part
+    is the paper's loop and the paper's functions answer
+    (:func:`symstab.numeric.paper.stability.classify`, the boundary of
+    :func:`~symstab.numeric.paper.paper_loop.paper_point`'s loop); with
+    either, or at a fractional delay, a :class:`symstab.Loop` of the paper's
+    plant (with the lag) and the environment on the filtered velocity, in
+    the device's physical units (Table I's, ``m = T = 1``, without a
+    device).
 
     Attributes
     ----------
@@ -59,7 +62,8 @@ class LinearTheory:
         The loop's values besides its plane ``(B, K)`` (physical units).
     device : symstab.numeric.paper.device.Device or None
     gamma, d, delta
-        The point's virtual mass ratio, delay and ``b T / m``.
+        The point's virtual mass ratio, delay (samples: an int, or a float
+        with a fraction of a period) and ``b T / m``.
     label : str
         What the theory is of, e.g. "linear loop with the 100 Hz velocity filter".
     left_out : tuple of str
@@ -71,7 +75,7 @@ class LinearTheory:
     values: dict
     device: object
     gamma: float
-    d: int
+    d: object
     delta: float
     label: str
     left_out: tuple
@@ -115,7 +119,7 @@ class LinearTheory:
         flat_alpha, flat_beta = alpha.ravel(), beta.ravel()
         out = np.empty(flat_alpha.size, dtype=np.int8)
         # A chunk at a time: a point's coefficients take 8 (d + 16) bytes.
-        for part in chunk_slices(flat_alpha.size, 64 * (self.d + 16)):
+        for part in chunk_slices(flat_alpha.size, 64 * (math.ceil(self.d) + 16)):
             out[part] = self.loop.classify(**self._physical(flat_alpha[part], flat_beta[part]),
                                            **self.values)
         return out.reshape(alpha.shape)
@@ -215,16 +219,19 @@ def linear_theory(*, gamma, d, delta=None, device=None, nonideal=None):
                         f"got {type(nonideal).__name__}")
     if device is not None and not isinstance(device, Device):
         raise TypeError(f"device must be a symstab.Device or None, got {type(device).__name__}")
+    from .simulate import fractional_start
+
     gamma = check_real("gamma", gamma)
+    d = delay_samples(d)
+    fractional_start(d, nonideal)
     if device is None:
         if not nonideal.ideal:
             raise ValueError("nonideal needs a device (physical units)")
         if delta is None:
             raise TypeError("delta must be a real number (or None with a device), got None")
-        gamma, d, delta = check_loop(gamma, d, delta)
+        gamma, _, delta = check_loop(gamma, math.floor(d), delta)
     else:
         nonideal.check(device.T)
-        d = check_delay(d)
         delta = device.delta
     left_out = tuple(name for name, on in (
         ("encoder quantization", nonideal.encoder_resolution is not None),
@@ -234,8 +241,11 @@ def linear_theory(*, gamma, d, delta=None, device=None, nonideal=None):
         ("friction compensation", nonideal.friction_compensation)) if on)
     filtered = nonideal.velocity_cutoff is not None
     lagged = nonideal.actuator_bandwidth is not None
-    if not (filtered or lagged):
+    if not (filtered or lagged) and isinstance(d, int):
         return LinearTheory(None, {}, device, gamma, d, delta, "ideal loop", left_out)
+    if device is None:
+        # Table I's units: the loop's K, B, M are alpha, beta, gamma.
+        device = Device(m=1.0, b=delta, T=1.0)
     parts = []
     if filtered:
         parts.append(f"the {nonideal.velocity_cutoff:g} Hz velocity filter")
@@ -250,7 +260,8 @@ def linear_theory(*, gamma, d, delta=None, device=None, nonideal=None):
         values["tau"] = 1.0 / (2 * math.pi * nonideal.actuator_bandwidth)
     loop = paper_simulated_loop(filtered, lagged, device.b == 0)
     return LinearTheory(loop, values, device, gamma, d, delta,
-                        "linear loop with " + " and ".join(parts), left_out)
+                        "linear loop with " + " and ".join(parts) if parts else "ideal loop",
+                        left_out)
 
 
 @functools.lru_cache(maxsize=None)

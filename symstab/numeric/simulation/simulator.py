@@ -1747,9 +1747,6 @@ def loop_stability_map(loop, x_values, y_values, *, x=None, y=None, steps=None, 
     """
     x, y = loop.plane_of(x, y)
     x_values, y_values = check_grid(x, y, x_values, y_values, values)
-    if progress is True:
-        progress = progress_printer("simulating", check_steps(
-            steps, check_delay(values.get("d", loop.defaults.get("d", 0)))))
     Y, X = np.meshgrid(y_values, x_values, indexing="ij")
     run = simulate_loop(loop, steps=steps, x0=x0, v0=v0, nonideal=nonideal, progress=progress,
                         **{x: X, y: Y}, **values)

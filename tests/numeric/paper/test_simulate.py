@@ -790,7 +790,10 @@ BAD_CALLS = [
     ("beta", dict(beta=float("inf"))),
     ("gamma", dict(gamma="0.5")),
     ("d", dict(d=-1)),
-    ("d", dict(d=1.5)),
+    ("d", dict(d=float("nan"))),
+    # Issue 43: a fraction of a period is simulated, but not with Coulomb friction.
+    ("coulomb_friction", dict(d=1.5, device=PAPER_DEVICE, delta=None,
+                              nonideal=Nonidealities(coulomb_friction=1e-3))),
 ]
 
 
@@ -1003,3 +1006,35 @@ def test_simulation_prints_its_verdicts_not_its_arrays():
     assert "array(" not in text
     assert text == (f"Simulation(2 points (1 x 2), {run.steps} steps: 1 stable, "
                     "1 unstable of which 1 diverged)")
+
+
+def test_a_fractional_delay_is_simulated_as_the_oracles_loop():
+    """Issue 43: the paper's simulator takes ``d = 10.5``; its verdicts are those of the
+    state-space oracle's spectral radius (Van Loan's block exponential, nothing of symstab),
+    on the points of a grid whose radius is not within 1e-3 of 1."""
+    from oracles import fractional_delay_radius
+
+    alpha = np.linspace(0.0, 3e-3, 7)
+    beta = np.linspace(-0.002, 0.03, 7)
+    found = stability_map(alpha=alpha, beta=beta, gamma=0.0, d=10.5, delta=PAPER_DELTA)
+    checked = 0
+    for i, a in enumerate(alpha):
+        for j, b in enumerate(beta):
+            # Table I's units: m = T = 1, b = delta; VE = K + B (1 - 1/z).
+            radius = fractional_delay_radius([1.0], [1.0, PAPER_DELTA, 0.0], [a + b, -b],
+                                             [1.0, 0.0], 1.0, 10, 0.5)
+            if abs(radius - 1) > 1e-3:
+                assert found.stable[i, j] == (radius < 1), (a, b, radius)
+                checked += 1
+    assert checked > 30 and found.stable.any() and not found.stable.all()
+
+
+def test_a_fraction_next_to_a_whole_delay_gives_its_verdicts():
+    """A fraction of a period just above a whole sample (1e-7) runs from the sampled history
+    (the loop's fractional plant), the whole delay from the device's state: different starts
+    of the same motion, and the same verdicts on a stable and an unstable point."""
+    alpha, beta = np.array([1e-3, 4e-3]), np.array([0.01, 0.01])
+    whole = simulate(alpha=alpha, beta=beta, gamma=0.0, d=3, delta=PAPER_DELTA, steps=4000)
+    near = simulate(alpha=alpha, beta=beta, gamma=0.0, d=3 + 1e-7, delta=PAPER_DELTA,
+                    steps=4000)
+    assert list(whole.stable) == list(near.stable) == [True, False]
