@@ -56,6 +56,52 @@ Two consequences, checked by the tests:
   damper as well the ``theta = 0`` bound is ``K T (2 d + 1)/2 - B``: with a
   delay, positive virtual damping raises the passive stiffness.
 
+A fractional delay ``Td = (d + eps) T``, ``0 < eps < 1``.  The force ``f_k =
+(H x)_k`` (``H = VE z**-d``, ``x_k = x(kT)``) is then held on ``[(k + eps) T,
+(k + 1 + eps) T)``: not a pulse transfer function of the samples, so the
+condition is derived again from the port's energy ``int (b v**2 + f v) dt``,
+which passivity asks to be ``>= 0`` (from rest) for every velocity.  Split
+each period at ``(k + eps) T``: ``a_k = x((k + eps) T) - x(kT)``, ``c_k =
+x((k + 1) T) - x((k + eps) T)``.  The force depends on the samples only, and
+``f_k`` works ``f_k (c_k + a_{k+1})``; for given ``a_k, c_k`` the least
+``int v**2`` over the period is ``a_k**2/(eps T) + c_k**2/((1 - eps) T)``
+(Cauchy-Schwarz; equality for ``x`` piecewise linear).  So passivity is
+
+    sum_k [b a_k**2/(eps T) + b c_k**2/((1 - eps) T) + f_k (c_k + a_{k+1})] >= 0
+
+for all sequences.  With ``x_{k+1} - x_k = a_k + c_k``, ``F = G (A + C)``, ``G
+= H/(z - 1)``, and Parseval, this holds if and only if for every ``theta``
+the Hermitian matrix
+
+    M(theta) = diag(b/(eps T), b/((1 - eps) T)) + Herm(conj(G) [[z, 1], [z, 1]])
+
+is positive semidefinite (``v = (A, C)``, ``Herm(P) = (P + P^H)/2``).  With
+``R = Re G`` (bounded on the circle: ``-T R`` is the whole delay's bound
+above, evaluated by its Dirichlet kernels) and ``h = H / z`` (one more
+sample of delay),
+
+    M = [[b/(eps T) + R - Re h, R - h/2], [R - conj(h)/2, b/((1 - eps) T) + R]],
+
+since ``conj(G) z = conj(G / z)`` and ``G / z = G - h``.  Scaled by
+``sqrt(eps T)`` and ``sqrt((1 - eps) T)``, with ``r = -T R``, it is ``M' =
+[[b - eps (r + T Re h), -s (r + T h/2)], [.., b - (1 - eps) r]]``, ``s =
+sqrt(eps (1 - eps))``, affine in ``b`` and in the plane's parameters.  The
+least passive damping at ``theta``, ``b*(theta)``, is the larger root of
+
+    (b - eps (r + T Re h)) (b - (1 - eps) r) = eps (1 - eps) |r + T h/2|**2,
+
+which makes both diagonal entries ``>= 0`` as well.  Checks: ``eps -> 0``
+forces ``a = 0`` and gives ``b >= r`` (Colgate and Schenkel at ``d``);
+``eps -> 1`` forces ``c = 0`` and gives ``b >= r + T Re h``, their bound at
+``d + 1``; the velocity constant over the period (``v = (sqrt(eps),
+sqrt(1 - eps))``) gives ``b >= r + eps T Re h``, the two bounds interpolated,
+a necessary condition only.  A spring ``K`` behind half a sample (``d = 0``,
+``eps = 1/2``) at ``theta = 0``: ``r = K T/2``, ``T h = K T``, ``(b - 3 K T/4)
+(b - K T/4) = (K T/2)**2``, ``b* = (1 + sqrt(5)/2) K T/2 = 1.0590 K T``, more
+than the ``K T`` halfway between ``K T/2`` (``d = 0``) and ``3 K T/2`` (``d =
+1``).  The tests compare ``b*`` with an independent lifting (each period cut
+into ``N`` pieces, an ``N x N`` eigenvalue).
+
 One condition the frequency inequality does not contain is added: a static
 stiffness ``H(1) < 0`` is not passive (pulled slowly from 0 to ``x`` the device
 returns ``|H(1)| x**2 / 2`` of energy while the friction takes ``b x**2 /
@@ -63,8 +109,9 @@ duration``, which vanishes), so the passive set also requires ``H(1) >= 0``
 (``K >= 0`` for the paper's environment).
 
 The region.  The plane's parameters enter ``H`` affinely (the denominator
-must not depend on them), so each ``theta`` gives a half-plane and the passive
-set is their intersection: a convex set.  It is computed as a polygon by
+must not depend on them), so each ``theta`` gives a half-plane (a whole
+delay) or a convex set ``M'(theta) >= 0`` (a spectrahedron, a fractional
+one), and the passive set is their intersection: a convex set.  It is computed as a polygon by
 cutting planes: the half-planes of a grid of ``theta`` (16 points per period
 of the highest harmonic, at least 1024) cut a large box; then, at every
 vertex, the worst ``theta`` is found (the grid, then a zooming-grid search
@@ -74,7 +121,13 @@ fails, every vertex satisfies the condition with ``b (1 + 1e-6)``, so by
 convexity the polygon lies between the passive sets of the damping ``b`` and
 ``b (1 + 1e-6)`` (the worst ``theta`` being found by a refined search, not
 certified).  A curved part of the boundary (where the worst ``theta`` moves
-along it) becomes many short edges.
+along it) becomes many short edges.  With a fractional delay the grid's
+half-planes are three necessary ones per angle (``v^H M' v >= 0`` for ``v =
+(1, 0)``, ``(0, 1)`` and the constant velocity's), the failure at a vertex
+is ``b*(theta) - b`` and its cut is ``v^H M'(theta*, p) v >= 0`` with ``v``
+the eigenvector of the least eigenvalue of ``M'(theta*, p0)`` at the failing
+vertex ``p0``: linear in the point ``p``, met by every passive point, failed
+by ``p0``.
 """
 
 import dataclasses
@@ -826,7 +879,10 @@ def passive_region(loop, x=None, y=None, *, damping="b", x_range=None, y_range=N
 
         b > T / (2 (1 - cos theta)) Re{(1 - e^{-j theta}) H(e^{j theta})}
 
-    for ``theta = w T`` in [0, pi], and ``H(1) >= 0``.
+    for ``theta = w T`` in [0, pi], and ``H(1) >= 0``.  A delay of ``d + eps``
+    samples (``0 < eps < 1``, the force held from ``(k + eps) T``) asks a 2x2
+    matrix per angle to be positive semidefinite instead (module docstring):
+    exact, not an interpolation between the whole delays.
 
     Parameters
     ----------
@@ -846,7 +902,9 @@ def passive_region(loop, x=None, y=None, *, damping="b", x_range=None, y_range=N
         (an unbounded set: its finite vertices' box grown by its own size).
     **values
         Values of the other parameters (``d``, ``T``, the damping, the
-        environment's parameters), else the loop's defaults.  Other plant
+        environment's parameters), else the loop's defaults; the delay as
+        ``d`` in samples (a fraction of a period included) or ``Td`` in
+        seconds.  Other plant
         parameters (the mass) do not enter the condition and may be given.
 
     Returns
@@ -869,6 +927,13 @@ def passive_region(loop, x=None, y=None, *, damping="b", x_range=None, y_range=N
     >>> r = passive_region(loop, m=0.0128, b=0.0324, T=1e-3, d=0)
     >>> round(r.y_max, 9)          # K T / 2 + |B| < b: K_max = 2 b / T at B = 0
     64.8
+
+    A spring behind half a sample needs ``b > (1 + sqrt(5)/2) K T / 2``:
+
+    >>> spring = Loop("1/(m*s**2 + b*s)", "K")
+    >>> cone = passive_region(spring, "b", "K", m=1.0, T=1.0, d=0.5)
+    >>> cone.contains(1.0, [0.9442, 0.9443]).tolist()    # 1 / 1.05902 = 0.94427
+    [True, False]
     """
     parameters, x, y = _check_passive_plane(loop, x, y, damping)
     x_range, y_range = _windows(x_range, y_range)
