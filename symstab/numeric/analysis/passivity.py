@@ -88,7 +88,7 @@ since ``conj(G) z = conj(G / z)`` and ``G / z = G - h``.  Scaled by
 sqrt(eps (1 - eps))``, affine in ``b`` and in the plane's parameters.  The
 least passive damping at ``theta``, ``b*(theta)``, is the larger root of
 
-    (b - eps (r + T Re h)) (b - (1 - eps) r) = eps (1 - eps) |r + T h/2|**2,
+    (b - eps (r + T Re h)) (b - (1 - eps) r) = eps (1 - eps) abs(r + T h/2)**2,
 
 which makes both diagonal entries ``>= 0`` as well.  Checks: ``eps -> 0``
 forces ``a = 0`` and gives ``b >= r`` (Colgate and Schenkel at ``d``);
