@@ -12,6 +12,8 @@ Independent of symstab's derivation:
   Fig. 2 from ``control.c2d`` and ``control.feedback``;
 * the sampled state space -- :func:`fractional_delay_radius`, the paper's
   loop with a delay of a fraction of a period, from ``scipy.linalg.expm``;
+* the lifted quadratic form of passivity with a fractional delay, an
+  ``N x N`` eigenvalue per frequency (:func:`lifted_least_damping`);
 * the seeded parameter points they are compared on (:func:`random_loop_points`);
 * ``mpmath.polyroots`` started from numpy's roots (:func:`polyroots`).
 
@@ -364,6 +366,52 @@ def fractional_delay_oracle(loop, values):
         return float(abs(roots[k])), float(abs(np.angle(roots[k])))
 
     return at
+
+
+# --------------------------------------------------------------------------
+# Passivity with a fractional loop delay: the lifted quadratic form
+# --------------------------------------------------------------------------
+
+def lifted_least_damping(H, theta, T, m, N):
+    """The least passive damping at ``theta`` of a force held from ``(k + m/N) T``, by lifting.
+
+    Independent of symstab's 2x2 reduction.  The force ``f_k = (H x)_k``
+    (``H`` the environment behind its whole samples of delay, ``x_k =
+    x(kT)``) is held on ``[(k + m/N) T, (k + 1 + m/N) T)``.  Each period is
+    cut into ``N`` sub-intervals of ``T/N`` with the position's increments
+    ``u_{k,i}`` on them; the velocity is free inside each, so the least
+    friction work ``b int v**2`` for given increments is ``b sum u**2 / (T/N)``
+    (Cauchy-Schwarz), and ``f_k`` works on the sub-intervals ``i >= m`` of
+    period ``k`` and ``i < m`` of period ``k + 1``.  With ``x_{k+1} - x_k =
+    sum_i u_{k,i}``, ``F = G 1^T U``, ``G = H/(z - 1)``, Parseval turns the
+    port's energy into ``(b N/T) |U|**2 + U^H P U`` per frequency with ``P =
+    conj(G) 1 w^T`` (``w_i = z`` for ``i < m``, 1 after): passive at ``theta``
+    if and only if ``b >= -(T/N) lambda_min((P + P^H)/2)``.
+
+    Parameters
+    ----------
+    H : complex or ndarray
+        ``H(e^{j theta})`` at each angle (from the environment's own
+        coefficients or python-control), away from ``theta = 0``.
+    theta : float or ndarray
+        The angles, in (0, pi].
+    T : float
+        The sample period.
+    m, N : int
+        The fraction ``eps = m / N``; ``m = 0`` is Colgate and Schenkel's bound.
+
+    Returns
+    -------
+    ndarray
+        The least passive damping at each angle.
+    """
+    theta = np.atleast_1d(np.asarray(theta, dtype=float))
+    z = np.exp(1j * theta)
+    G = np.broadcast_to(np.asarray(H, dtype=complex), theta.shape) / (z - 1)
+    w = np.where(np.arange(N)[None, :] < m, z[:, None], 1.0)          # (angles, N)
+    P = np.conj(G)[:, None, None] * np.ones((1, N, 1)) * w[:, None, :]
+    hermitian = 0.5 * (P + np.conj(np.swapaxes(P, 1, 2)))
+    return -(T / N) * np.linalg.eigvalsh(hermitian)[:, 0]
 
 
 def first_crossing(at, start, step=1 / 32, stop=None):

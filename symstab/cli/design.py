@@ -31,7 +31,7 @@ from .loop_options import (
     uses_loop,
     value_text,
 )
-from .options import add_command, add_model_options, resolve, whole_delay
+from .options import add_command, add_model_options, resolve
 from .output import check_outputs, emit, write_output
 from .simulation import add_nonideal_options, loop_nonideal_text, resolve_nonideal
 
@@ -126,11 +126,6 @@ def run(args):
         setup = resolve_loop(args)
         over = _search_over(args, setup)
         delay = _delay(args, setup, over)
-        if delay is not None and target == "passive":
-            raise ValueError("--maximize passive takes a whole number of samples (the passive "
-                             "set is derived for whole samples), and a delay held in time as T "
-                             "is searched is fractional; give --set d=N instead of --delay or "
-                             "--set Td")
         notes = []
     elif target == "simulated":
         raise ValueError(f"--maximize simulated simulates a loop file: give --loop FILE (the "
@@ -144,9 +139,6 @@ def run(args):
         d, delta = setup.paper.d, setup.paper.delta
         over = {"M": (-1.0 - (d + 1) * delta + 1e-3, 3.0)}    # best_virtual_mass's range
         notes = []
-    if target == "passive":
-        whole_delay(setup, "design --maximize passive", "the passive set is derived for whole "
-                                                        "samples")
     if target == "passive" and setup.paper is not None and setup.paper.delta == 0:
         raise ValueError("--maximize passive: the device has no damping (delta = 0), so no "
                          "point is passive")

@@ -210,10 +210,6 @@ def passive_notes(setup, lim):
                "alpha_max": None, "beta_at_alpha_max": None}
         return ["passive set (Colgate-Schenkel): none, the device has no damping "
                 "(delta = 0)"], out
-    if setup.fractional:
-        why = (f"not computed at a fractional delay (d = {setup.d:.10g} samples): the "
-               f"condition is derived for whole samples")
-        return [f"passive set (Colgate-Schenkel): {why}"], {"error": why}
     try:
         region = passive_region(setup.loop, x=setup.x, y=setup.y, **setup.values).renamed(x, y)
     except (ValueError, TypeError, ArithmeticError) as exc:

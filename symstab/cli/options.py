@@ -6,9 +6,8 @@
 (``--delta --d``), the virtual mass as ``--Mw`` (physical) or ``--gamma``,
 and ``--format``; :func:`resolve` turns them into a :class:`Setup`, whose
 echo is printed with the output (results in both unit systems).  ``--Td``
-may be a fractional number of periods (``Td / T = 40.5``): the commands
-that answer on the paper's loop as a :class:`symstab.Loop` take it, the
-others refuse it in one line (:func:`whole_delay`); ``--d`` is whole.
+may be a fractional number of periods (``Td / T = 40.5``): every command
+takes it; ``--d`` is whole.
 Validation happens in the library; the caller
 (:func:`symstab.cli.commands.main`) turns ``ValueError``/``TypeError`` into one
 line on stderr and exit status 2.  A loop file's options are in
@@ -25,7 +24,7 @@ import numpy as np
 from .output import FORMATS, quiet_when_unread
 
 __all__ = ["add_command", "Setup", "UNITS_RULE", "add_model_options", "resolve", "parse_list",
-           "parse_one", "add_point_options", "stiffness_and_damping", "delay_text", "whole_delay"]
+           "parse_one", "add_point_options", "stiffness_and_damping", "delay_text"]
 
 
 def add_command(sub, name, *, help, description, example, func):
@@ -141,19 +140,6 @@ def delay_text(d, T=None):
     if not isinstance(d, int) and 0 < Td < 1:
         return f"Td = {Td * 1e3:.10g} ms ({samples})"
     return f"Td = {Td:g} s ({samples})"
-
-
-def whole_delay(setup, command, reason="its computation takes whole samples only"):
-    """Refuse a fractional delay where ``command`` cannot take one, before any work.
-
-    ``setup`` is a :class:`Setup` or a :class:`symstab.cli.loop_options.LoopSetup`
-    (both have ``d`` and ``fractional``); the one line names the command,
-    the delay and why.
-    """
-    if setup.fractional:
-        raise ValueError(f"{command} does not take a fractional delay yet ({reason}), got "
-                         f"{delay_text(setup.d)}; give a whole number of samples (boundary, "
-                         f"limits, classify, design and locus take a fractional one)")
 
 
 def resolve(args, *, mass=True):

@@ -134,8 +134,6 @@ def test_the_table_names_the_optimum_the_value_there_and_at_the_nominal_value(ca
     (["--delay", "10ms"], "--delay needs a loop file"),
     (["--loop", LOOPS / "paper.toml", "--over", "T=0.2:4 ms", "--delay", "10ms", "--set",
       "Td=3ms"], "drop --d / --set d / --set Td"),
-    (["--loop", LOOPS / "paper.toml", "--over", "T=0.5:1 ms", "--delay", "10ms", "--maximize",
-      "passive"], "--maximize passive takes a whole number of samples"),
     (["--png", "/nonexistent/x.png"], "--png"),
     # The simulated target: its options only with it, with a loop file, checked first.
     (["--loop", LOOPS / "paper.toml", "--amplitude", "1e-3"], "add --maximize simulated"),
@@ -212,6 +210,21 @@ def test_a_delay_held_in_time_is_fractional_samples_of_each_T(capsys):
     assert status == 0, err
     assert f"d = 0.002 s / T samples; at the best T = {best:.6g} s, d = " \
            f"{held['best_d']:.6g}" in out
+
+
+def test_the_passive_target_holds_a_delay_in_time(capsys):
+    """--maximize passive with --delay 1.5ms: d = 1.5 ms / T samples at each T, fractional
+    between the whole ones (it was refused).  Oracle: the engine's passive K_max at the best T
+    with the delay given as Td, and at a T where the delay is 2.5 samples, below it."""
+    held = run_json(capsys, "design", "--loop", LOOPS / "paper.toml", "--over", "T=0.5:1 ms",
+                    "--delay", "1.5ms", "--maximize", "passive", "--set", "M=0", "--points",
+                    "3")["search"]
+    loop = symstab.load_loop(LOOPS / "paper.toml")
+    best = held["best"]
+    assert held["best_d"] == pytest.approx(0.0015 / best, rel=1e-12)
+    assert held["value"] == pytest.approx(loop.passive_region(T=best, Td=0.0015, M=0.0).y_max,
+                                          rel=1e-9)
+    assert held["value"] > loop.passive_region(T=0.0006, Td=0.0015, M=0.0).y_max
 
 
 def test_over_takes_a_range_with_a_unit_and_two_parameters(capsys, tmp_path):

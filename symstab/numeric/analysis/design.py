@@ -41,8 +41,9 @@ step, and ``n`` makes it finer.
 
 A delay held in seconds while the sample period is searched (``delay``)
 is ``d = delay / T`` samples at each ``T``, a fraction of a period
-included (the modified z-transform carries it): the target is continuous
-in ``T`` and searched as any other parameter.
+included (the modified z-transform carries it, and the passive set's
+condition for a fractional delay): the target is continuous in ``T`` and
+searched as any other parameter.
 
 A design can also count a cost: with an encoder (``encoder_resolution``)
 the force noise of its quantization at a rendered point of the plane
@@ -590,8 +591,7 @@ def design(loop, *, over, maximize="y_max", x=None, y=None, n=None, rtol=None, d
     delay : float, optional
         The loop delay in seconds, held while the sample period ``T``
         is searched: ``d = delay / T`` samples at each value, a
-        fraction of a period included (instead of ``d``).  Not with
-        ``maximize="passive"`` (the passive set takes whole samples).
+        fraction of a period included (instead of ``d``).
     progress : callable, optional
         Called with the number of evaluations so far.
     amplitude : float
@@ -874,9 +874,7 @@ def _check_design_names(loop, maximize, x, y, damping, delay, values):
     A step of :func:`design`'s input checks: the axes take no value, and a
     delay is given in seconds (``delay``, or the loop's ``Td`` among
     ``values``, taken out of them here, or the loop's default ``Td``) or
-    in samples, once.  The passive
-    set takes whole samples, so ``maximize="passive"`` holds no delay in
-    seconds (``delay / T`` is fractional almost everywhere).
+    in samples, once.
     """
     for axis, name in (("x", x), ("y", y)) + ((("damping", damping),) if maximize == "passive"
                                                  else ()):
@@ -898,10 +896,6 @@ def _check_design_names(loop, maximize, x, y, damping, delay, values):
         delay = check_real("delay", delay, low=0.0)
         if "d" in values:
             raise TypeError("give the delay in seconds (delay) or in samples (d), not both")
-        if maximize == "passive":
-            raise ValueError("delay: maximize='passive' takes a whole number of samples d (the "
-                             "passive set is derived for whole samples), and a delay held in "
-                             "seconds is delay / T samples, fractional; give d")
     return delay
 
 

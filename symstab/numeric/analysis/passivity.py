@@ -56,6 +56,52 @@ Two consequences, checked by the tests:
   damper as well the ``theta = 0`` bound is ``K T (2 d + 1)/2 - B``: with a
   delay, positive virtual damping raises the passive stiffness.
 
+A fractional delay ``Td = (d + eps) T``, ``0 < eps < 1``.  The force ``f_k =
+(H x)_k`` (``H = VE z**-d``, ``x_k = x(kT)``) is then held on ``[(k + eps) T,
+(k + 1 + eps) T)``: not a pulse transfer function of the samples, so the
+condition is derived again from the port's energy ``int (b v**2 + f v) dt``,
+which passivity asks to be ``>= 0`` (from rest) for every velocity.  Split
+each period at ``(k + eps) T``: ``a_k = x((k + eps) T) - x(kT)``, ``c_k =
+x((k + 1) T) - x((k + eps) T)``.  The force depends on the samples only, and
+``f_k`` works ``f_k (c_k + a_{k+1})``; for given ``a_k, c_k`` the least
+``int v**2`` over the period is ``a_k**2/(eps T) + c_k**2/((1 - eps) T)``
+(Cauchy-Schwarz; equality for ``x`` piecewise linear).  So passivity is
+
+    sum_k [b a_k**2/(eps T) + b c_k**2/((1 - eps) T) + f_k (c_k + a_{k+1})] >= 0
+
+for all sequences.  With ``x_{k+1} - x_k = a_k + c_k``, ``F = G (A + C)``, ``G
+= H/(z - 1)``, and Parseval, this holds if and only if for every ``theta``
+the Hermitian matrix
+
+    M(theta) = diag(b/(eps T), b/((1 - eps) T)) + Herm(conj(G) [[z, 1], [z, 1]])
+
+is positive semidefinite (``v = (A, C)``, ``Herm(P) = (P + P^H)/2``).  With
+``R = Re G`` (bounded on the circle: ``-T R`` is the whole delay's bound
+above, evaluated by its Dirichlet kernels) and ``h = H / z`` (one more
+sample of delay),
+
+    M = [[b/(eps T) + R - Re h, R - h/2], [R - conj(h)/2, b/((1 - eps) T) + R]],
+
+since ``conj(G) z = conj(G / z)`` and ``G / z = G - h``.  Scaled by
+``sqrt(eps T)`` and ``sqrt((1 - eps) T)``, with ``r = -T R``, it is ``M' =
+[[b - eps (r + T Re h), -s (r + T h/2)], [.., b - (1 - eps) r]]``, ``s =
+sqrt(eps (1 - eps))``, affine in ``b`` and in the plane's parameters.  The
+least passive damping at ``theta``, ``b*(theta)``, is the larger root of
+
+    (b - eps (r + T Re h)) (b - (1 - eps) r) = eps (1 - eps) abs(r + T h/2)**2,
+
+which makes both diagonal entries ``>= 0`` as well.  Checks: ``eps -> 0``
+forces ``a = 0`` and gives ``b >= r`` (Colgate and Schenkel at ``d``);
+``eps -> 1`` forces ``c = 0`` and gives ``b >= r + T Re h``, their bound at
+``d + 1``; the velocity constant over the period (``v = (sqrt(eps),
+sqrt(1 - eps))``) gives ``b >= r + eps T Re h``, the two bounds interpolated,
+a necessary condition only.  A spring ``K`` behind half a sample (``d = 0``,
+``eps = 1/2``) at ``theta = 0``: ``r = K T/2``, ``T h = K T``, ``(b - 3 K T/4)
+(b - K T/4) = (K T/2)**2``, ``b* = (1 + sqrt(5)/2) K T/2 = 1.0590 K T``, more
+than the ``K T`` halfway between ``K T/2`` (``d = 0``) and ``3 K T/2`` (``d =
+1``).  The tests compare ``b*`` with an independent lifting (each period cut
+into ``N`` pieces, an ``N x N`` eigenvalue).
+
 One condition the frequency inequality does not contain is added: a static
 stiffness ``H(1) < 0`` is not passive (pulled slowly from 0 to ``x`` the device
 returns ``|H(1)| x**2 / 2`` of energy while the friction takes ``b x**2 /
@@ -63,8 +109,9 @@ duration``, which vanishes), so the passive set also requires ``H(1) >= 0``
 (``K >= 0`` for the paper's environment).
 
 The region.  The plane's parameters enter ``H`` affinely (the denominator
-must not depend on them), so each ``theta`` gives a half-plane and the passive
-set is their intersection: a convex set.  It is computed as a polygon by
+must not depend on them), so each ``theta`` gives a half-plane (a whole
+delay) or a convex set ``M'(theta) >= 0`` (a spectrahedron, a fractional
+one), and the passive set is their intersection: a convex set.  It is computed as a polygon by
 cutting planes: the half-planes of a grid of ``theta`` (16 points per period
 of the highest harmonic, at least 1024) cut a large box; then, at every
 vertex, the worst ``theta`` is found (the grid, then a zooming-grid search
@@ -74,7 +121,13 @@ fails, every vertex satisfies the condition with ``b (1 + 1e-6)``, so by
 convexity the polygon lies between the passive sets of the damping ``b`` and
 ``b (1 + 1e-6)`` (the worst ``theta`` being found by a refined search, not
 certified).  A curved part of the boundary (where the worst ``theta`` moves
-along it) becomes many short edges.
+along it) becomes many short edges.  With a fractional delay the grid's
+half-planes are three necessary ones per angle (``v^H M' v >= 0`` for ``v =
+(1, 0)``, ``(0, 1)`` and the constant velocity's), the failure at a vertex
+is ``b*(theta) - b`` and its cut is ``v^H M'(theta*, p) v >= 0`` with ``v``
+the eigenvector of the least eigenvalue of ``M'(theta*, p0)`` at the failing
+vertex ``p0``: linear in the point ``p``, met by every passive point, failed
+by ``p0``.
 """
 
 import dataclasses
@@ -288,20 +341,129 @@ class _Plane:
             a[1 + self.damping_axis] = a[1 + self.damping_axis] - 1.0
         return a
 
+    def value(self, terms, vx, vy):
+        """The condition's failure in damping units from :meth:`terms`, at the scaled points.
+
+        ``terms[i]`` broadcasts against ``vx`` and ``vy``; here it is ``a``.
+        """
+        return terms[0] + vx * self.sx * terms[1] + vy * self.sy * terms[2]
+
     def at(self, theta, vx, vy):
-        """``a`` at angle ``theta[i]`` and the (scaled) point ``(vx[i], vy[i])``."""
-        a0, ax, ay = self.terms(theta)
-        return a0 + vx * self.sx * ax + vy * self.sy * ay
+        """The failure at angle ``theta[i]`` and the (scaled) point ``(vx[i], vy[i])``."""
+        return self.value(self.terms(theta), vx, vy)
 
     def rows(self, theta):
         """Half-planes ``c0 + cx x' + cy y' <= 0`` in the scaled plane, normalised."""
-        a0, ax, ay = self.terms(np.atleast_1d(theta))
+        a0, ax, ay = self.terms(np.atleast_1d(theta))[:3]
         rows = np.stack([a0, ax * self.sx, ay * self.sy], axis=-1)
         return _normalise(rows)
+
+    def cuts(self, theta, vx, vy):
+        """The half-planes that cut off the failing scaled points ``(vx, vy)`` at their worst ``theta``.
+
+        A whole delay's condition is one half-plane per angle, whatever the point.
+        """
+        return self.rows(np.unique(theta))
 
     def static_row(self):
         h0, hx, hy = self.static
         return _normalise(np.array([[-h0, -hx * self.sx, -hy * self.sy]]))
+
+
+@dataclasses.dataclass
+class _FractionalPlane(_Plane):
+    """The condition of a delay ``(d + eps) T`` with ``0 < eps < 1``: a 2x2 matrix per angle.
+
+    ``M'(theta) = [[b - eps (r + T Re h), -s (r + T h/2)], [-s (r + T
+    conj(h)/2), b - (1 - eps) r]]`` must be positive semidefinite, with ``s
+    = sqrt(eps (1 - eps))``, ``r = -T R`` the whole delay's bound
+    (:class:`_Plane`'s ``a + b``) and ``h = H(z)/z`` (module docstring).
+    :meth:`terms` adds the rows ``T Re h`` and ``T Im h`` of the three
+    numerators to the whole delay's three; :meth:`value` is the least
+    passive damping ``b*(theta)`` less the damping.  ``num`` holds the three
+    numerators (highest power first, one length), ``d`` the whole samples.
+    """
+
+    eps: float = 0.0
+    period: float = 0.0
+    num: np.ndarray = None
+    d: int = 0
+
+    @property
+    def harmonic(self):
+        """One more than the whole delay's: ``h`` carries one more sample of delay."""
+        return super().harmonic + 1
+
+    def terms(self, theta):
+        """``(a0, ax, ay, T Re h0, .., T Im h0, ..)``: nine rows at the angles ``theta``."""
+        theta = np.asarray(theta, dtype=float)
+        z = np.exp(1j * theta)
+        shift = self.period * np.exp(-1j * (self.d + 1) * theta) / np.polyval(self.den, z)
+        h = np.stack([np.polyval(c, z) * shift for c in self.num])
+        return np.concatenate([super().terms(theta), h.real, h.imag])
+
+    def _damping(self, vx, vy):
+        """The damping at the scaled points: the constant, or the axis that is it."""
+        if self.damping_axis is None:
+            return self.damping
+        return vx * self.sx if self.damping_axis == 0 else vy * self.sy
+
+    def _parts(self, terms, vx, vy):
+        """``(b, r, T Re h, T Im h)`` at the scaled points (``terms`` broadcast as in :meth:`value`)."""
+        b = self._damping(vx, vy)
+        r = super().value(terms[:3], vx, vy) + b
+        return (b, r, super().value(terms[3:6], vx, vy), super().value(terms[6:], vx, vy))
+
+    def value(self, terms, vx, vy):
+        """``b*(theta) - b``: the larger root of ``det M' = 0`` less the damping."""
+        b, r, hr, hi = self._parts(terms, vx, vy)
+        e = self.eps
+        alpha, beta = e * (r + hr), (1 - e) * r
+        gamma = e * (1 - e) * ((r + 0.5 * hr)**2 + (0.5 * hi)**2)
+        return 0.5 * (alpha + beta) + np.sqrt((0.5 * (alpha - beta))**2 + gamma) - b
+
+    def _form(self, terms, v1, v2):
+        """``(c0, cx, cy)`` of ``-v^H M' v`` (unscaled axes) for unit vectors ``v = (v1, v2)``."""
+        e, s = self.eps, math.sqrt(self.eps * (1 - self.eps))
+        unit = np.eye(3)
+        b = unit[0] * self.damping if self.damping_axis is None else unit[1 + self.damping_axis]
+        r = terms[:3] + b[:, None]
+        hr, hi = terms[3:6], terms[6:]
+        w1, w2 = np.abs(v1)**2, np.abs(v2)**2
+        cross = np.conj(v1) * v2
+        mixed = cross.real * (r + 0.5 * hr) - cross.imag * (0.5 * hi)
+        return w1 * e * (r + hr) + w2 * (1 - e) * r + 2 * s * mixed - b[:, None]
+
+    def _scaled_rows(self, form):
+        c0, cx, cy = form
+        return _normalise(np.stack([c0, cx * self.sx, cy * self.sy], axis=-1))
+
+    def rows(self, theta):
+        """Three necessary half-planes per angle: ``v = (1, 0)``, ``(0, 1)`` and
+        ``(sqrt(eps), sqrt(1 - eps))`` (a velocity constant over the period:
+        Colgate's bound interpolated, ``b >= r + eps T Re h``)."""
+        terms = self.terms(np.atleast_1d(theta))
+        e = self.eps
+        return np.concatenate([self._scaled_rows(self._form(terms, v1, v2))
+                               for v1, v2 in ((1.0, 0.0), (0.0, 1.0),
+                                              (math.sqrt(e), math.sqrt(1 - e)))])
+
+    def cuts(self, theta, vx, vy):
+        """At each failing point, ``v^H M'(theta, p) v >= 0`` with ``v`` the least eigenvector there.
+
+        Linear in the point, met by every passive point, failed by the point
+        (where ``M'`` has a negative eigenvalue).
+        """
+        terms = self.terms(theta)
+        b, r, hr, hi = self._parts(terms, vx, vy)
+        e, s = self.eps, math.sqrt(self.eps * (1 - self.eps))
+        matrix = np.empty((len(theta), 2, 2), dtype=complex)
+        matrix[:, 0, 0] = b - e * (r + hr)
+        matrix[:, 1, 1] = b - (1 - e) * r
+        matrix[:, 0, 1] = -s * (r + 0.5 * (hr + 1j * hi))
+        matrix[:, 1, 0] = np.conj(matrix[:, 0, 1])
+        vectors = np.linalg.eigh(matrix)[1][:, :, 0]
+        return np.unique(self._scaled_rows(self._form(terms, vectors[:, 0], vectors[:, 1])), axis=0)
 
 
 def _normalise(rows):
@@ -457,7 +619,6 @@ def _worst(plane, grid, table, vx, vy):
     maxima, and a zooming-grid search (:func:`~symstab.numeric.engine.search.zoom_max`)
     between each one's neighbours refines them.
     """
-    a0, ax, ay = table
     best = np.empty(len(vx))
     where = np.empty(len(vx))
     # Chunks of vertices keep each (vertices x grid) table to 8 MB (a few
@@ -465,8 +626,7 @@ def _worst(plane, grid, table, vx, vy):
     rows_per_chunk = max(1, 2**20 // len(grid))
     for start in range(0, len(vx), rows_per_chunk):
         sl = slice(start, start + rows_per_chunk)
-        values = a0[None, :] + (vx[sl, None] * plane.sx) * ax[None, :] + (
-            vy[sl, None] * plane.sy) * ay[None, :]
+        values = plane.value(table[:, None, :], vx[sl, None], vy[sl, None])
         padded = np.pad(values, ((0, 0), (1, 1)), constant_values=-np.inf)
         peak = (padded[:, 1:-1] >= padded[:, :-2]) & (padded[:, 1:-1] >= padded[:, 2:])
         ranked = np.where(peak, values, -np.inf)
@@ -559,7 +719,7 @@ def _cut(plane, grid, table, tolerance, polygon, rows):
         failing = value > tolerance
         if not failing.any():
             return polygon, rows
-        new = plane.rows(np.unique(theta[failing]))
+        new = plane.cuts(theta[failing], polygon[failing, 0], polygon[failing, 1])
         rows = np.concatenate([rows, new])
         polygon = _clip_all(polygon, new)
         if len(polygon) > _MAX_VERTICES:
@@ -687,7 +847,8 @@ def _check_stable_denominator(den, what):
                          f"Colgate and Schenkel's condition needs a stable H(z)")
 
 
-def _prepare_plane(base, slope_x, slope_y, den, d, scale, damping, damping_axis):
+def _prepare_plane(base, slope_x, slope_y, den, d, period, damping, damping_axis, eps=0.0):
+    """The :class:`_Plane` of a whole delay ``d`` (``eps = 0``), else the :class:`_FractionalPlane`."""
     length = max(len(base), len(slope_x), len(slope_y))
     pad = [np.pad(np.asarray(c, dtype=float), (length - len(c), 0)) for c in (base, slope_x, slope_y)]
     terms = [_laurent(c, den, d) for c in pad]     # one length and lowest power for the three
@@ -698,8 +859,11 @@ def _prepare_plane(base, slope_x, slope_y, den, d, scale, damping, damping_axis)
     weights = np.where(powers <= 0, 1.0, -1.0)[:, None] * p
     at_one = float(np.sum(den))
     static = tuple(float(np.sum(c)) / at_one for c in pad)
-    return _Plane(weights, orders.astype(float), np.asarray(den, dtype=float), scale,
-                  0.0 if damping_axis is not None else damping, damping_axis, static)
+    parts = (weights, orders.astype(float), np.asarray(den, dtype=float), period / 2,
+             0.0 if damping_axis is not None else damping, damping_axis, static)
+    if not eps:
+        return _Plane(*parts)
+    return _FractionalPlane(*parts, eps=eps, period=period, num=np.stack(pad), d=d)
 
 
 # --------------------------------------------------------------------------
@@ -715,7 +879,10 @@ def passive_region(loop, x=None, y=None, *, damping="b", x_range=None, y_range=N
 
         b > T / (2 (1 - cos theta)) Re{(1 - e^{-j theta}) H(e^{j theta})}
 
-    for ``theta = w T`` in [0, pi], and ``H(1) >= 0``.
+    for ``theta = w T`` in [0, pi], and ``H(1) >= 0``.  A delay of ``d + eps``
+    samples (``0 < eps < 1``, the force held from ``(k + eps) T``) asks a 2x2
+    matrix per angle to be positive semidefinite instead (module docstring):
+    exact, not an interpolation between the whole delays.
 
     Parameters
     ----------
@@ -735,7 +902,9 @@ def passive_region(loop, x=None, y=None, *, damping="b", x_range=None, y_range=N
         (an unbounded set: its finite vertices' box grown by its own size).
     **values
         Values of the other parameters (``d``, ``T``, the damping, the
-        environment's parameters), else the loop's defaults.  Other plant
+        environment's parameters), else the loop's defaults; the delay as
+        ``d`` in samples (a fraction of a period included) or ``Td`` in
+        seconds.  Other plant
         parameters (the mass) do not enter the condition and may be given.
 
     Returns
@@ -758,6 +927,13 @@ def passive_region(loop, x=None, y=None, *, damping="b", x_range=None, y_range=N
     >>> r = passive_region(loop, m=0.0128, b=0.0324, T=1e-3, d=0)
     >>> round(r.y_max, 9)          # K T / 2 + |B| < b: K_max = 2 b / T at B = 0
     64.8
+
+    A spring behind half a sample needs ``b > (1 + sqrt(5)/2) K T / 2``:
+
+    >>> spring = Loop("1/(m*s**2 + b*s)", "K")
+    >>> cone = passive_region(spring, "b", "K", m=1.0, T=1.0, d=0.5)
+    >>> cone.contains(1.0, [0.9442, 0.9443]).tolist()    # 1 / 1.05902 = 0.94427
+    [True, False]
     """
     parameters, x, y = _check_passive_plane(loop, x, y, damping)
     x_range, y_range = _windows(x_range, y_range)
@@ -770,7 +946,7 @@ def passive_region(loop, x=None, y=None, *, damping="b", x_range=None, y_range=N
     symbols.update(plant_symbols)
     _check_device(loop, damping, symbols[damping])
     env_names = [n for n in parameters if n in env_symbols and n != "T"]
-    d, T, b, numbers = _passive_values(loop, parameters, x, y, damping, env_names, symbols,
+    d, eps, T, b, numbers = _passive_values(loop, parameters, x, y, damping, env_names, symbols,
                                        env_symbols, values)
     num, den = _environment_coefficients(environment, symbols, x, y, damping)
 
@@ -789,7 +965,7 @@ def passive_region(loop, x=None, y=None, *, damping="b", x_range=None, y_range=N
         raise ValueError("the environment is not finite at these values")
     _check_stable_denominator(den_values, f"the environment VE(z) = {environment}")
     damping_axis = (0 if x == damping else 1) if damping in (x, y) else None
-    plane = _prepare_plane(base, slopes[0], slopes[1], den_values, d, T / 2, b, damping_axis)
+    plane = _prepare_plane(base, slopes[0], slopes[1], den_values, d, T, b, damping_axis, eps)
     defaults = getattr(loop, "defaults", {})
     hints = tuple(abs(float(defaults[n])) if isinstance(defaults.get(n), (int, float)) else 0.0
                   for n in (x, y))
@@ -841,7 +1017,7 @@ def _check_device(loop, damping, b_symbol):
 
 
 def _passive_values(loop, parameters, x, y, damping, env_names, symbols, env_symbols, values):
-    """``(d, T, b, numbers)``: the values the condition needs, checked (``b`` None on an axis).
+    """``(d, eps, T, b, numbers)``: the values the condition needs, checked (``b`` None on an axis).
 
     ``numbers`` maps the environment's symbols off the plane (and ``T``)
     to 30-digit floats.  Only the environment's parameters and the damping
@@ -873,10 +1049,6 @@ def _passive_values(loop, parameters, x, y, damping, env_names, symbols, env_sym
     if missing:
         raise TypeError(f"missing value(s) for {', '.join(missing)}")
     d, fraction = split_delay(given["d"], name="d")
-    if fraction is not None:
-        raise ValueError(f"Colgate and Schenkel's condition is derived for a delay of whole "
-                         f"samples (a hold whose output waits a fraction of a period is not a "
-                         f"pulse transfer function H(z)), got d = {float(given['d']):g}")
     T = check_real("T", given["T"], low=0.0, low_open=True)
     b = None
     if damping not in (x, y):
@@ -886,7 +1058,7 @@ def _passive_values(loop, parameters, x, y, damping, env_names, symbols, env_sym
     numbers[model.T] = sp.Float(repr(T), 30)
     if "T" in env_symbols:
         numbers[env_symbols["T"]] = sp.Float(repr(T), 30)
-    return d, T, b, numbers
+    return d, 0.0 if fraction is None else float(fraction), T, b, numbers
 
 
 def _environment_coefficients(environment, symbols, x, y, damping):

@@ -234,13 +234,17 @@ def test_a_held_delay_is_continuous_across_a_whole_sample():
     assert above == pytest.approx(at, rel=1e-6)
 
 
-def test_the_passive_target_holds_no_delay_in_seconds():
-    """The passive set is derived for whole samples: a delay held in seconds (fractional
-    d = delay / T) is refused before any work, naming what is taken."""
+def test_the_passive_target_holds_a_delay_in_seconds():
+    """A delay held in seconds is d = delay / T samples, fractional between whole ones: the
+    passive set takes it (it was refused).  Oracle: the passive K_max at the best T with the
+    delay given as Td, and at a T where it is 2.5 samples (below: a longer T, a longer
+    delay's share)."""
     loop = symstab.load_loop(LOOPS / "paper.toml")
-    with pytest.raises(ValueError, match="whole number of samples d") as excinfo:
-        loop.design(over={"T": (5e-4, 1e-3)}, maximize="passive", delay=0.01)
-    assert_message_names(excinfo, "delay")
+    found = loop.design(over={"T": (5e-4, 1e-3)}, maximize="passive", delay=1.5e-3, n=3, M=0.0)
+    best = found.best["T"]
+    assert found.value == pytest.approx(loop.passive_region(T=best, Td=1.5e-3, M=0.0).y_max,
+                                        rel=1e-9)
+    assert found.value > loop.passive_region(T=6e-4, Td=1.5e-3, M=0.0).y_max
 
 
 def test_a_band_between_two_scan_points_is_bracketed_not_called_empty():
