@@ -330,6 +330,23 @@ def fractional_delay_closed_loop(plant_num, plant_den, env_num, env_den, T, d, e
     return M
 
 
+def fractional_plant_response(plant_num, plant_den, T, eps, z):
+    """``P_eps(z)``, the plant whose held command arrives ``eps T`` late, from the state space.
+
+    With :func:`fractional_delay_closed_loop`'s ``Phi``, ``Gamma0`` and
+    ``Gamma1`` (Van Loan's block exponential, SciPy), the sampled output
+    over the held command is ``C (z I - Phi)^-1 (Gamma0 + Gamma1 / z)``.
+    """
+    A, B, C, D = _realisation(plant_num, plant_den)
+    if np.any(D != 0):
+        raise ValueError("the plant must be strictly proper (y[k] = C x[k])")
+    Phi, _ = _held_input_integral(A, B, T)
+    Phi_late, gamma0 = _held_input_integral(A, B, (1 - eps) * T)
+    gamma1 = Phi_late @ _held_input_integral(A, B, eps * T)[1]
+    resolvent = np.linalg.solve(z * np.eye(A.shape[0]) - Phi, gamma0 + gamma1 / z)
+    return complex((C @ resolvent).item())
+
+
 def fractional_delay_radius(plant_num, plant_den, env_num, env_den, T, d, eps):
     """Largest modulus of the eigenvalues of :func:`fractional_delay_closed_loop`."""
     matrix = fractional_delay_closed_loop(plant_num, plant_den, env_num, env_den, T, d, eps)

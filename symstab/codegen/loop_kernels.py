@@ -25,6 +25,7 @@ is kept (the module's ``__file__`` is None).
 import hashlib
 import os
 import pathlib
+import re
 import sys
 import tempfile
 
@@ -113,8 +114,9 @@ def c_source(kernels, *, title, prefix, command):
     complex_h = ["#include <complex.h>"] if any(k.complex_arithmetic for k in kernels) else []
     lines = header("c", title, command) + ["#include <math.h>"] + complex_h + [""]
     for kernel in kernels:
-        text = c_function(kernel, printer)
-        lines += [text.replace(" symstab_", f" {prefix}"), ""]
+        # Every symstab_ name, the calls of a kernel's helpers included.
+        text = re.sub(r"\bsymstab_", prefix, c_function(kernel, printer))
+        lines += [text, ""]
     return "\n".join(lines).rstrip("\n") + "\n"
 
 

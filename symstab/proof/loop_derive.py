@@ -14,17 +14,22 @@ today's derivation (:func:`symstab.symbolic.loop.characteristic_polynomial`,
 with the exact checker in every ``symstab derive``.
 """
 
+import dataclasses
 import functools
 import re
 
 import sympy as sp
 
+from ..codegen import residue_forms
 from ..codegen.generator import RealPart, c_comment, c_signature, comment_text
 from ..codegen.loop_kernels import c_source, header, kernel, numpy_source
 from ..symbolic import model
+from ..symbolic.loop_assembly import FRACTION
+from .identity import check_identity
 
 __all__ = ["COMMAND", "OWNED", "MARKER", "PAPER_PLANT", "PAPER_ENVIRONMENT", "delay_parts", "step_source", "step_orders",
-           "plant_kernel", "c_name",
+           "plant_kernel", "fraction_symbol", "FractionalPlant", "fractional_plant",
+           "fractional_plant_kernel", "c_name",
            "derivation_steps", "kernel_files", "file_names", "loop_files", "is_generated",
            "unit_circle_system", "paper_loop_proofs"]
 
@@ -133,6 +138,147 @@ def plant_kernel(loop):
                   f"(such as a small b T / m) cancel digits in double precision; "
                   f"symstab.Loop evaluates them at 30 digits instead.",
                   complex_arithmetic=roots)
+
+
+def fraction_symbol(loop, name):
+    """The symbol of the delay's fraction of a period: ``name``, or ``name_`` ... if a parameter has it.
+
+    The derivation writes ``epsilon`` (printed ε), the kernels take ``eps``
+    (as :func:`symstab.symbolic.discretize.numeric_fractional_zoh` does); a
+    loop whose parameter already has that name gets ``_`` appended until it
+    is free.
+
+    Parameters
+    ----------
+    loop : symstab.Loop
+    name : str
+
+    Returns
+    -------
+    sympy.Symbol
+    """
+    while name in loop.parameters:
+        name += "_"
+    return sp.Symbol(name)
+
+
+@dataclasses.dataclass(frozen=True)
+class FractionalPlant:
+    """The plant with a fraction ``epsilon`` of a period of delay, as ``derive --loop`` writes it.
+
+    Attributes
+    ----------
+    numerator, denominator : tuple of sympy.Expr or None
+        Coefficients (highest power of ``z`` first) of ``N_eps`` and ``z
+        P_d`` in ``P_eps = N_eps / (z P_d)``, in :attr:`symbol`; None where
+        they are not derived in closed form (:attr:`why`).
+    forms : tuple of sympy.Expr or None
+        ``N_eps``'s coefficients as the kernel computes them
+        (:func:`symstab.codegen.residue_forms.float_safe`).
+    symbol : sympy.Symbol
+        ``epsilon`` (:func:`fraction_symbol`).
+    why : str
+        Without a closed form: how ``P_eps`` is computed instead.
+    """
+
+    numerator: tuple
+    denominator: tuple
+    forms: tuple
+    symbol: sp.Symbol
+    why: str = ""
+
+
+def fractional_plant(loop, name="epsilon"):
+    """The loop's :class:`FractionalPlant`, with the fraction's symbol named ``name``.
+
+    From :meth:`symstab.Loop.plant_parts_of` (the parts the loop runs on, at
+    30 digits): ``chi = z**d (z P_d) Ve_d + N_eps Ve_n`` for a loop delay of
+    ``(d + eps) T``.  The float-safe forms use ``exprel_k`` with ``k`` the
+    number of poles of ``G(s) / s`` (the degree of ``z P_d``).
+
+    Parameters
+    ----------
+    loop : symstab.Loop
+    name : str, optional
+
+    Returns
+    -------
+    FractionalPlant
+    """
+    symbol = fraction_symbol(loop, name)
+    numeric = ("P_eps = N_eps / (z P_d) is computed numerically, by the matrix exponential at "
+               "30 digits (symstab.symbolic.discretize.numeric_fractional_zoh), once the "
+               "plant's values are given")
+    if loop.zoh_method != "residues":
+        return FractionalPlant(None, None, None, symbol, f"the plant's Z[ZOH G] is not derived "
+                               f"by residues: {numeric}")
+    parts = loop.plant_parts_of(fraction=True)
+    if parts is None:
+        return FractionalPlant(None, None, None, symbol, f"SymPy does not cancel P_d out of the "
+                               f"residues of P_eps (the exponentials of a complex pair): {numeric}")
+    num, den = ([sp.sympify(c).xreplace({FRACTION: symbol}) for c in part] for part in parts)
+    if any(not p.exp.is_integer for c in num + den for p in sp.sympify(c).atoms(sp.Pow)):
+        return FractionalPlant(tuple(num), tuple(den), None, symbol, "the poles are written with "
+                               "square roots: no float kernel is generated (it would need "
+                               "complex arithmetic)")
+    forms = tuple(residue_forms.float_safe(c, len(den) - 1) for c in num)
+    return FractionalPlant(tuple(num), tuple(den), forms, symbol)
+
+
+def fractional_plant_kernel(loop):
+    """The kernel ``fractional_plant(<plant parameters>, T, eps)``, and the helpers it calls.
+
+    It returns the coefficients of ``N_eps`` (``pn0``, ...) and of ``z P_d``
+    (``pd0``, ...; the last is 0), highest power of ``z`` first, on one
+    common scale, so that ``chi = z**d (z P_d) Ve_d + N_eps Ve_n`` for a
+    loop delay of ``(d + eps) T``, ``0 <= eps < 1``: ``eps = 0`` gives the
+    whole-sample plant over ``z P_d``.  ``N_eps`` is computed from its
+    float-safe forms (:func:`symstab.codegen.residue_forms.float_safe`, proved
+    equal to the derivation in step ``05_kernel_forms``), ``z P_d`` as
+    derived.
+
+    Parameters
+    ----------
+    loop : symstab.Loop
+
+    Returns
+    -------
+    (Kernel or None, list of Kernel, str)
+        The kernel (None without a closed form), the ``exprel_k`` helpers
+        (printed before it), and why there is no kernel.
+
+    Raises
+    ------
+    ValueError
+        If a plant parameter has a helper's name (it would hide the helper).
+    """
+    plant = fractional_plant(loop, "eps")
+    if plant.forms is None:
+        return None, [], plant.why
+    helpers = residue_forms.helper_kernels(plant.forms)
+    clash = sorted({h.name for h in helpers} & set(loop.parameters))
+    if clash:
+        raise ValueError(f"parameter {clash[0]!r} has the name of a generated helper of the "
+                         f"fractional plant's kernel: rename it")
+    args = [(x, f"parameter {x}") for x in _parameter_symbols(loop, loop.plant) if x != model.T]
+    args += [(model.T, "sample period T"),
+             (plant.symbol, "fraction of a period of the loop delay (d + eps) T, 0 <= eps < 1")]
+    num, den = plant.forms, plant.denominator
+    outputs = ([(f"pn{k}", c, f"coefficient of z^{len(num) - 1 - k} of N_eps")
+                for k, c in enumerate(num)]
+               + [(f"pd{k}", c, f"coefficient of z^{len(den) - 1 - k} of z P_d")
+                  for k, c in enumerate(den)])
+    return kernel("fractional_plant", args, outputs,
+                  f"Numerator N_eps and denominator z P_d of the plant G(s) = {loop.plant} with "
+                  f"the hold's output eps T late, P_eps(z) = N_eps(z) / (z P_d(z)) (the modified "
+                  f"z-transform, by residues), highest power of z first, one common scale: the "
+                  f"loop delay (d + eps) T has chi = z^d (z P_d) Ve_d + N_eps Ve_n. N_eps is "
+                  f"computed with each exp(u) written as its Taylor polynomial plus u^k "
+                  f"exprel_k(u) (proved equal to the derivation in 05_kernel_forms), so that "
+                  f"small poles times T cancel no digits; exp(p T) must not overflow "
+                  f"(p T < 709). Digits are still lost where two poles meet, and in N_eps's "
+                  f"leading coefficient as eps -> 1 (it tends to 0); the accuracy measured "
+                  f"against mpmath is in docs/guide/c_kernels.md."), helpers, ""
 
 
 def step_orders(loop):
@@ -246,9 +392,12 @@ def kernel_files(loop):
     """``{filename: text}`` of the loop's NumPy module and C99 source and header.
 
     The NumPy module holds :meth:`symstab.Loop.kernels` (what the loop runs
-    on); the C files add :func:`plant_kernel` on the residue path and the
-    loop's step on its samples (:func:`step_source`) for every loop.  C
-    symbols are ``symstab_<name>_<kernel>``.
+    on) and, where the plant with a fractional delay has a closed form,
+    :func:`fractional_plant_kernel` with its helpers (the loop itself
+    evaluates the plant at 30 digits, not with this kernel); the C files
+    add :func:`plant_kernel` on the residue path and the loop's step on its
+    samples (:func:`step_source`) for every loop.  C symbols are
+    ``symstab_<name>_<kernel>``.
 
     Parameters
     ----------
@@ -270,16 +419,24 @@ def kernel_files(loop):
     stem = c_name(loop)
     environment = loop.kernels()
     plant = plant_kernel(loop)
-    c_kernels = environment + ([plant] if plant is not None else [])
+    fractional, helpers, why = fractional_plant_kernel(loop)
+    numpy_kernels = environment + (helpers + [fractional] if fractional is not None else [])
+    c_kernels = (environment + ([plant] if plant is not None else [])
+                 + numpy_kernels[len(environment):])
     prefix = f"symstab_{stem}_"
     needs = ("<math.h> and <complex.h>" if plant is not None and plant.complex_arithmetic
              else "<math.h>")
+    eps = fractional.args[-1][0] if fractional is not None else None
+    fraction_text = (f" fractional_plant: N_eps and z P_d of the plant with a fraction {eps} of "
+                     f"a period of delay, {eps} an argument." if fractional is not None else
+                     f" No kernel of the plant with a fractional delay: {why}.")
     c_title = (f"C99 kernels of the loop {loop.name} (need only {needs}, link with -lm): "
                f"VE(z) = {loop.environment}"
                + (f", and Z[ZOH G] of G(s) = {loop.plant}"
                   + (" (in complex arithmetic)." if plant.complex_arithmetic
                      else ".") if plant is not None else
-                  "; the plant's pulse transfer function is computed numerically."))
+                  "; the plant's pulse transfer function is computed numerically.")
+               + fraction_text)
     steps, step_prototypes = step_source(loop, prefix)
     c_title += " The loop's step on its samples (any plant: coefficients as arguments)."
     source = c_source(c_kernels, title=c_title, prefix=prefix, command=COMMAND) + "\n" + steps
@@ -290,7 +447,8 @@ def kernel_files(loop):
     source = source.replace("#include <math.h>\n",
                             f'#include <math.h>\n#include "{stem}_kernels.h"\n{pi}', 1)
     return {
-        f"{stem}_kernels.py": numpy_source(environment, title=loop.kernel_title(),
+        f"{stem}_kernels.py": numpy_source(numpy_kernels,
+                                           title=loop.kernel_title() + fraction_text,
                                            command=COMMAND),
         f"{stem}_kernels.c": source,
         f"{stem}_kernels.h": _c_header(c_kernels, title=c_title, prefix=prefix,
@@ -330,6 +488,80 @@ def _poly_expr(coefficients, z=model.z):
     return sp.Add(*[c * z**k for k, c in enumerate(reversed(list(coefficients)))])
 
 
+def _proved(name, statement, lhs, rhs):
+    """``(name, statement [proved: ...], 0)``: ``lhs - rhs`` is 0, proved by the exact checker."""
+    result = check_identity(lhs, rhs)
+    if result.equal is not True:
+        raise AssertionError(f"derivation identity {name} not proved: {result.note}")
+    return name, f"{statement} [proved: {result.note}]", sp.S.Zero
+
+
+def _fractional_zoh_objects(loop, plant):
+    """Step 02's objects of the delay's fraction: ``P_eps``, its parts and its two limits, proved."""
+    eps, z = plant.symbol, model.z
+    if plant.numerator is None:
+        return (("fractional_pulse_transfer_function", comment_text(
+            f"P_eps(z) = N_eps(z) / (z P_d(z)), the plant with the hold's output {eps} T late "
+            f"(loop delay (d + {eps}) T): {plant.why}", "latex"), "matrix exponential"),)
+    num, den = _poly_expr(plant.numerator), _poly_expr(plant.denominator)
+    pulse = loop.pulse_transfer_function()
+    return (
+        ("fractional_pulse_transfer_function",
+         f"P_eps(z) = N_eps(z) / (z P_d(z)): Z[ZOH G] with the hold's output {eps} T late "
+         f"(the modified z-transform, by residues), for a loop delay (d + {eps}) T, "
+         f"0 <= {eps} < 1", sp.Mul(num, sp.Pow(den, -1, evaluate=False), evaluate=False)),
+        ("fractional_numerator", "N_eps(z): coefficients, highest power first",
+         sp.Tuple(*plant.numerator)),
+        ("fractional_denominator", "z P_d(z): coefficients, highest power first",
+         sp.Tuple(*plant.denominator)),
+        _proved("fractional_at_zero", f"P_eps(z) at {eps} = 0 minus Z[ZOH G](z): no fraction "
+                f"is the whole-sample plant", (num / den).xreplace({eps: 0}), pulse),
+        _proved("fractional_at_one", f"P_eps(z) at {eps} = 1 minus Z[ZOH G](z) / z: a whole "
+                f"period is one sample more", (num / den).xreplace({eps: 1}), pulse / z),
+    )
+
+
+def _fractional_chi_objects(loop, plant, ve_n, ve_d):
+    """Step 03's objects of the delay's fraction: chi with symbolic ``d`` and ``epsilon``."""
+    z, d, eps = model.z, model.d, plant.symbol
+    note = (f"chi(z) = z^d (z P_d(z)) Ve_d(z) + N_eps(z) Ve_n(z) for the loop delay "
+            f"(d + {eps}) T, symbolic d and {eps}")
+    if plant.numerator is None:
+        N, P_d = sp.Function("N_epsilon")(z), sp.Function("P_d")(z)
+        return (("chi_fractional", f"{note}, with the numeric N_eps / (z P_d)",
+                 z**d * ve_d * z * P_d + ve_n * N),)
+    delayed = sp.Poly(_poly_expr(plant.denominator) * ve_d, z)
+    direct = sp.Poly(_poly_expr(plant.numerator) * ve_n, z)
+    return (
+        ("chi_fractional", note, z**d * delayed.as_expr() + direct.as_expr()),
+        ("fractional_delayed_part", "(z P_d(z)) Ve_d(z), multiplied by z^d: coefficients, "
+         "highest power first", sp.Tuple(*delayed.all_coeffs())),
+        ("fractional_direct_part", "N_eps(z) Ve_n(z): coefficients, highest power first",
+         sp.Tuple(*direct.all_coeffs())),
+    )
+
+
+def _kernel_forms_step(plant):
+    """Step 05: N_eps's coefficients as the kernel computes them, each proved equal to the derivation."""
+    from .steps import Step
+
+    title = "Forms the fractional plant's kernel computes, proved equal to the derivation"
+    if plant.forms is None:
+        return Step("05_kernel_forms", title, (
+            ("fractional_plant_kernel", comment_text(f"no kernel of the fractional plant: "
+                                                     f"{plant.why}", "latex"), "none"),))
+    n = len(plant.forms)
+    k = len(plant.denominator) - 1
+    objects = [(f"fractional_numerator_form_{i}",
+                f"coefficient of z^{n - 1 - i} of N_eps, each exp(u) written sum_(j < {k}) "
+                f"u^j / j! + u^{k} exprel_{k}(u)", form) for i, form in enumerate(plant.forms)]
+    pairs = [(f"fractional_numerator_form_{i}_proof", f"the form of coefficient "
+              f"z^{n - 1 - i} of N_eps = the derived coefficient", form, derived)
+             for i, (form, derived) in enumerate(zip(plant.forms, plant.numerator, strict=True))]
+    objects += [_proved(*p) for p in residue_forms.proofs(pairs)]
+    return Step("05_kernel_forms", title, tuple(objects))
+
+
 def derivation_steps(loop):
     """The derivation of ``loop`` as :class:`symstab.proof.derive.Step` objects (no I/O).
 
@@ -337,7 +569,18 @@ def derivation_steps(loop):
     ``02_zoh`` the ZOH pulse transfer function (or how it is computed);
     ``03_characteristic_polynomial`` chi(z) with the symbolic delay ``d``,
     split into its delayed and direct parts; ``04_affine_parameters`` the
-    parameters that can span a plane.
+    parameters that can span a plane; ``05_kernel_forms`` the forms the
+    fractional plant's kernel computes, each proved equal to the derivation.
+
+    The fractional delay ``(d + epsilon) T`` is always derived, whatever
+    the file's ``d``: the delay is a value, not a structure (``--set d=``,
+    ``Td=`` and every :class:`symstab.Loop` question take a fractional one
+    from the same derivation).  ``02_zoh`` holds ``P_eps = N_eps / (z
+    P_d)`` with ``epsilon`` a symbol and its two limits proved exactly
+    (``epsilon = 0`` the whole-sample plant, ``epsilon = 1`` one sample
+    more), ``03`` chi with symbolic ``d`` and ``epsilon``; a plant without
+    a closed form of ``P_eps`` says how it is computed (the matrix
+    exponential at 30 digits).
 
     Parameters
     ----------
@@ -381,7 +624,9 @@ def derivation_steps(loop):
         chi = z**d * ve_d * P_d + ve_n * P_n
         chi_note = ("chi(z) = z^d Ve_d(z) P_d(z) + Ve_n(z) P_n(z), symbolic delay d, "
                     "with the numeric P_n / P_d = Z[ZOH G]")
-    steps.append(Step("02_zoh", "Zero-order-hold pulse transfer function", zoh))
+    plant = fractional_plant(loop)
+    steps.append(Step("02_zoh", "Zero-order-hold pulse transfer function",
+                      zoh + _fractional_zoh_objects(loop, plant)))
     objects = [("chi", chi_note, chi)]
     if loop.zoh_method != "residues":
         given = {n: loop.defaults[n] for n in plant_names + ["T"] if n in loop.defaults}
@@ -400,6 +645,7 @@ def derivation_steps(loop):
             ("direct_part", "Ve_n(z) P_n(z): coefficients, highest power first",
              sp.Tuple(*direct.all_coeffs())),
         ]
+    objects += _fractional_chi_objects(loop, plant, ve_n, ve_d)
     steps.append(Step("03_characteristic_polynomial", "Closed-loop characteristic polynomial",
                       tuple(objects)))
     by_name = {str(x): x for x in _symbols(loop)}
@@ -410,6 +656,7 @@ def derivation_steps(loop):
         objects.append(("plane", "the loop file's default plane (x, y)",
                         sp.Tuple(*[by_name[n] for n in loop.plane])))
     steps.append(Step("04_affine_parameters", "Parameters that can span a plane", tuple(objects)))
+    steps.append(_kernel_forms_step(plant))
     return steps
 
 
@@ -430,7 +677,8 @@ def file_names(loop):
         Sorted.
     """
     stem = c_name(loop)
-    steps = ("01_loop", "02_zoh", "03_characteristic_polynomial", "04_affine_parameters")
+    steps = ("01_loop", "02_zoh", "03_characteristic_polynomial", "04_affine_parameters",
+             "05_kernel_forms")
     return sorted([f"{s}.{ext}" for s in steps for ext in ("json", "tex")]
                   + [f"{stem}_kernels.{ext}" for ext in ("py", "c", "h")])
 
