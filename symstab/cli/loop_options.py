@@ -211,38 +211,43 @@ def add_loop_options(p, command):
                             "in the unit of the mass term, with delta = b T / mass where the "
                             "loop has a damping b, else 0)")
     if command == "map":
-        g.add_argument("--simulate", action="store_true", default=None,
-                       help="also simulate every cell (the plant's exact ZOH step, the "
-                            "environment's difference equation, the delay line; with "
-                            "--steps, --x0, --encoder-resolution, --force-limit, "
-                            "--force-resolution in the "
-                            "loop's SI units)")
-        g.add_argument("--uncertain", metavar="NAME=LO:HI", action="append",
-                       help="instead of one classification, the probability that each cell is "
-                            "stable when NAME is drawn uniformly from LO:HI (its SI unit, or "
-                            "the unit written after HI: --uncertain \"b=0.02:0.045 N*m*s/rad\"; "
-                            "d: the whole delays LO..HI); repeatable")
-        g.add_argument("--margin", choices=("modulus", "delay", "gain"),
-                       help="instead of the classification, a margin at every stable cell: "
-                            "modulus, min|1+L| on the unit circle, certified; delay, the exact "
-                            "delay margin (the smallest added delay, samples, at which a root "
-                            "reaches the circle); gain, the smallest factor of the loop gain "
-                            "that does (the other cells hold NaN)")
-        g.add_argument("--delay-range", nargs=2, metavar=("TMIN", "TMAX"),
-                       help="instead of the classification, the cells stable for every "
-                            "constant loop delay from TMIN to TMAX (a time: 40ms, or seconds; "
-                            "the exact delay margin) and for every delay varying in it by whole "
-                            "samples (a small-gain bound, sufficient only)")
-        g.add_argument("--samples", type=int, metavar="N",
-                       help="draws with --uncertain (default 1000)")
-        g.add_argument("--seed", type=int, metavar="S",
-                       help="seed of the draws with --uncertain (default 0: the same map every "
-                            "run)")
-        g.add_argument("--x-range", metavar="LOW,HIGH,N", help="grid of x (--x-range=-0.1,0.6,200)")
-        g.add_argument("--y-range", metavar="LOW,HIGH,N", help="grid of y (--y-range=0,6,200)")
+        _add_map_options(g)
     refused = tuple((flag, dest, p.get_default(dest), instead)
                     for flag, dest, instead in _REFUSED[command])
     p.set_defaults(loop_command=command, loop_refused=refused)
+
+
+def _add_map_options(g):
+    """``map --loop``'s own options: what it maps (a classification by default) and its grid."""
+    g.add_argument("--simulate", action="store_true", default=None,
+                   help="also simulate every cell (the plant's exact ZOH step, the "
+                        "environment's difference equation, the delay line; with "
+                        "--steps, --x0, --encoder-resolution, --force-limit, "
+                        "--force-resolution in the "
+                        "loop's SI units)")
+    g.add_argument("--uncertain", metavar="NAME=LO:HI", action="append",
+                   help="instead of one classification, the probability that each cell is "
+                        "stable when NAME is drawn uniformly from LO:HI (its SI unit, or "
+                        "the unit written after HI: --uncertain \"b=0.02:0.045 N*m*s/rad\"; "
+                        "d: the whole delays LO..HI); repeatable")
+    g.add_argument("--margin", choices=("modulus", "delay", "gain"),
+                   help="instead of the classification, a margin at every stable cell: "
+                        "modulus, min|1+L| on the unit circle, certified; delay, the exact "
+                        "delay margin (the smallest added delay, samples, at which a root "
+                        "reaches the circle); gain, the smallest factor of the loop gain "
+                        "that does (the other cells hold NaN)")
+    g.add_argument("--delay-range", nargs=2, metavar=("TMIN", "TMAX"),
+                   help="instead of the classification, the cells stable for every "
+                        "constant loop delay from TMIN to TMAX (a time: 40ms, or seconds; "
+                        "the exact delay margin) and for every delay varying in it by whole "
+                        "samples (a small-gain bound, sufficient only)")
+    g.add_argument("--samples", type=int, metavar="N",
+                   help="draws with --uncertain (default 1000)")
+    g.add_argument("--seed", type=int, metavar="S",
+                   help="seed of the draws with --uncertain (default 0: the same map every "
+                        "run)")
+    g.add_argument("--x-range", metavar="LOW,HIGH,N", help="grid of x (--x-range=-0.1,0.6,200)")
+    g.add_argument("--y-range", metavar="LOW,HIGH,N", help="grid of y (--y-range=0,6,200)")
 
 
 def uses_loop(args):

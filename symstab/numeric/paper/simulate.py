@@ -88,9 +88,9 @@ from ..simulation.simulator import (
     default_horizon,
     progress_printer,
 )
-from .simulate_theory import paper_simulated_loop
+from .simulate_theory import fractional_start, paper_simulated_loop
 
-__all__ = ["simulate", "stability_map", "check_device_nonideal", "fractional_start"]
+__all__ = ["simulate", "stability_map", "check_device_nonideal"]
 
 
 def simulate(*, alpha, beta, gamma, d, delta, steps=None, x0=1.0, v0=None, device=None,
@@ -107,7 +107,8 @@ def simulate(*, alpha, beta, gamma, d, delta, steps=None, x0=1.0, v0=None, devic
         Dimensionless stiffness, damping, virtual mass (broadcast together).
     d : int or float
         Delay in samples, ``d >= 0``; a fraction of a period (``40.5``) is
-        carried by the loop's fractional plant (see :func:`fractional_start`).
+        carried by the loop's fractional plant (see
+        :func:`~symstab.numeric.paper.simulate_theory.fractional_start`).
     delta : float
         ``b T / m``; with a ``device`` it must equal ``device.delta``
         (pass ``None`` to take it from the device).
@@ -193,29 +194,6 @@ def simulate(*, alpha, beta, gamma, d, delta, steps=None, x0=1.0, v0=None, devic
                          progress=progress, compensation=compensation,
                          start=fractional_start(d, nonideal), overflow="diverge", **fixed,
                          K=arrays[0], B=arrays[1], M=arrays[2])
-
-
-def fractional_start(d, nonideal):
-    """Where a run of the paper's loop at the delay ``d`` starts: ``"state"``, or ``"samples"``.
-
-    At a whole delay the device starts on its state space from ``(x0, v0 /
-    T)``.  A fractional one (``d = 40.5``) is carried by the loop's
-    fractional plant, whose difference equations start from the sampled
-    history ``x0 - k v0`` (:meth:`symstab.Loop.simulate`'s ``start``): the
-    same position and velocity, seen by the samples; Coulomb friction,
-    which needs the state space, is refused there.
-
-    Raises
-    ------
-    ValueError
-        For Coulomb friction at a fractional delay.
-    """
-    if isinstance(d, int):
-        return "state"
-    if nonideal is not None and nonideal.coulomb_friction is not None:
-        raise ValueError(f"nonideal.coulomb_friction is simulated at a whole delay only (the "
-                         f"device on its state space), got d = {d!r} samples")
-    return "samples"
 
 
 def _device_run(nonideal, device, delta, d):

@@ -18,7 +18,7 @@ from ..._resources import chunk_slices
 from ..._validate import check_array, check_box, check_loop, check_real, delay_samples
 from ..simulation.simulator import Nonidealities
 
-__all__ = ["LinearTheory", "linear_theory", "paper_simulated_loop"]
+__all__ = ["LinearTheory", "linear_theory", "paper_simulated_loop", "fractional_start"]
 
 
 #: The simulated loop's linear part as loop expressions, in physical units;
@@ -219,8 +219,6 @@ def linear_theory(*, gamma, d, delta=None, device=None, nonideal=None):
                         f"got {type(nonideal).__name__}")
     if device is not None and not isinstance(device, Device):
         raise TypeError(f"device must be a symstab.Device or None, got {type(device).__name__}")
-    from .simulate import fractional_start
-
     gamma = check_real("gamma", gamma)
     d = delay_samples(d)
     fractional_start(d, nonideal)
@@ -262,6 +260,31 @@ def linear_theory(*, gamma, d, delta=None, device=None, nonideal=None):
     return LinearTheory(loop, values, device, gamma, d, delta,
                         "linear loop with " + " and ".join(parts) if parts else "ideal loop",
                         left_out)
+
+
+def fractional_start(d, nonideal):
+    """Where a run of the paper's loop at the delay ``d`` starts: ``"state"``, or ``"samples"``.
+
+    At a whole delay the device starts on its state space from ``(x0, v0 /
+    T)``.  A fractional one (``d = 40.5``) is carried by the loop's
+    fractional plant, whose difference equations start from the sampled
+    history ``x0 - k v0`` (:meth:`symstab.Loop.simulate`'s ``start``): the
+    same position and velocity, seen by the samples; Coulomb friction,
+    which needs the state space, is refused there.
+
+    Raises
+    ------
+    ValueError
+        For Coulomb friction at a fractional delay.
+    """
+    if isinstance(d, int):
+        return "state"
+    if nonideal is not None and nonideal.coulomb_friction is not None:
+        raise ValueError(f"nonideal.coulomb_friction is simulated at a whole delay only (the "
+                         f"device on its state space), got d = {d!r} samples")
+    return "samples"
+
+
 
 
 @functools.lru_cache(maxsize=None)
