@@ -21,7 +21,8 @@ import numpy as np
 
 __all__ = ["Plot", "plot_region", "plot_limits", "plot_boundary", "plot_robust",
            "plot_probability", "plot_design", "plot_pareto", "plot_passive", "plot_locus",
-           "plot_simulation", "plot_map", "plot_margin_map", "plot_delay_range_map", "require_matplotlib", "pyplot",
+           "plot_simulation", "plot_map", "plot_margin_map", "plot_delay_range_map", "plot_delay_range_region",
+           "require_matplotlib", "pyplot",
            "pyplot_or_none", "png_bytes", "visible",
            "draw_lines", "label_log_axis", "png_of", "png_or_none", "design_figure",
            "simulated_map_figure", "loop_map_figure", "probability_map_figure", "robust_figure",
@@ -1457,6 +1458,51 @@ def plot_robust(region, ax=None):
     """
     figure, ax = _axes(ax)
     return Plot(figure, ax, _draw_robust(ax, region, region.x, region.y))
+
+
+def plot_delay_range_region(found, ax=None):
+    """Draw a delay range's two sets in a plane: the certified constant set, the varying grid over it.
+
+    What :meth:`symstab.numeric.analysis.delay_range.DelayRangeRegion.plot`
+    draws: the robust region of every constant delay of the range
+    (:func:`plot_robust`'s drawing) and, hatched over it, the grid's points
+    the small-gain criterion shows stable for every varying sequence.
+
+    Parameters
+    ----------
+    found : symstab.numeric.analysis.delay_range.DelayRangeRegion
+    ax : matplotlib.axes.Axes, optional
+        Where to draw (default: a new figure's axes).
+
+    Returns
+    -------
+    Plot
+        Artists ``"robust"``, ``"marginal"``, ``"nominal"`` and ``"varying"``.
+
+    Raises
+    ------
+    ImportError
+        Without matplotlib.
+    """
+    from matplotlib.patches import Patch
+
+    figure, ax = _axes(ax)
+    artists = _draw_robust(ax, found.constant, found.constant.x, found.constant.y)
+    grid = found.grid
+    artists["varying"] = []
+    handles, _ = ax.get_legend_handles_labels()
+    if grid.varying is not None and np.any(grid.varying):
+        artists["varying"] = [ax.contourf(grid.x_values, grid.y_values,
+                                          np.asarray(grid.varying, float), levels=[0.5, 1.5],
+                                          colors="none", hatches=["////"])]
+        handles.append(Patch(facecolor="none", hatch="////",
+                             label="every varying delay (small gain, on a grid)"))
+    handles += [Patch(color="#4393c3", label="every constant delay (certified)"),
+                Patch(color="#f4a582", label="marginal (not certified)")]
+    ax.legend(handles=handles, loc="best", fontsize=LEGEND_SIZE, framealpha=0.9)
+    low, high = grid.samples
+    ax.set_title(f"stable for delays of {low:.6g} to {high:.6g} samples", fontsize=9)
+    return Plot(figure, ax, artists)
 
 
 def plot_probability(found, ax=None, *, boundary=None):

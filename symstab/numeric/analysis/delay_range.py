@@ -55,7 +55,8 @@ from ..engine.results import html_table
 from ..engine.roots import STABLE, circle_minimum
 from .margins import classified_point
 
-__all__ = ["DelayRange", "delay_range", "DelayRangeMap", "delay_range_map"]
+__all__ = ["DelayRange", "delay_range", "DelayRangeMap", "delay_range_map",
+           "DelayRangeRegion", "delay_range_region"]
 
 @dataclasses.dataclass(frozen=True)
 class DelayRange:
@@ -324,13 +325,130 @@ def delay_range_map(loop, x_values, y_values, *, delay_range, x=None, y=None, rt
                             delay_limit=max(high - low, 1e-9), **given, d=low)
     stable = ~np.isnan(found.values)
     constant = stable & (found.values > high - low)
-    varying = None
-    if whole:
-        varying = stable.copy()
-        if high > low and stable.any():
-            X, Y = np.meshgrid(found.x_values, found.y_values)
-            chi = loop.polynomial(**given, d=low, **{x: X[stable], y: Y[stable]})
-            lower, _ = _gain_bracket(chi, high - low, rtol)
-            varying[stable] = np.asarray(lower) > 1
+    varying = (_varying_set(loop, (x, found.x_values), (y, found.y_values), given, (low, high),
+                            rtol, stable) if whole else None)
     return DelayRangeMap(x, y, found.x_values, found.y_values, (low, high), constant, varying,
                          dict(given))
+
+
+def _varying_set(loop, x, y, given, samples, rtol, stable=None):
+    """Where the small-gain criterion holds over a grid: ``(len(y), len(x))`` of bool.
+
+    ``x``, ``y`` are ``(name, values)``; ``samples`` the range's whole ends;
+    ``stable``, the grid's stability at the lower end where known (else
+    classified here).
+    """
+    (x, xs), (y, ys), (low, high) = x, y, samples
+    X, Y = np.meshgrid(xs, ys)
+    if stable is None:
+        stable = loop.classify(**given, d=low, **{x: X, y: Y}) == STABLE
+    varying = np.array(stable, dtype=bool)
+    if high > low and varying.any():
+        chi = loop.polynomial(**given, d=low, **{x: X[varying], y: Y[varying]})
+        lower, _ = _gain_bracket(chi, high - low, rtol)
+        varying[varying] = np.asarray(lower) > 1
+    return varying
+
+
+@dataclasses.dataclass(frozen=True)
+class DelayRangeRegion:
+    """The two sets of a delay range in a plane (:func:`delay_range_region`, :meth:`symstab.Loop.region`).
+
+    Attributes
+    ----------
+    constant : symstab.numeric.engine.results.RobustRegion
+        The points stable for every constant delay of the range, certified
+        for the continuum of delays (zero exclusion with the fraction of a
+        period as a side of the box): an inner approximation, as every
+        robust region.
+    grid : DelayRangeMap
+        Both sets on a grid of the region's window: ``constant`` the
+        certified region's points, ``varying`` those of the small-gain
+        criterion for delays varying by whole samples (None where the
+        range's ends are not whole samples).
+    """
+
+    constant: object
+    grid: DelayRangeMap
+
+    def __repr__(self):
+        low, high = self.grid.samples
+        varying = ("not derived" if self.grid.varying is None else
+                   f"{int(np.count_nonzero(self.grid.varying))} of its "
+                   f"{self.grid.varying.size} points")
+        state = "empty" if self.constant.empty else "certified"
+        return (f"DelayRangeRegion({low:.6g} to {high:.6g} samples in ({self.grid.x}, "
+                f"{self.grid.y}): every constant delay {state}; every varying delay on a "
+                f"{len(self.grid.x_values)} x {len(self.grid.y_values)} grid, {varying})")
+
+    def plot(self, ax=None):
+        """Draw the certified constant set, the varying one's grid over it.
+
+        Parameters
+        ----------
+        ax : matplotlib.axes.Axes, optional
+            Where to draw (default: a new figure's axes).
+
+        Returns
+        -------
+        symstab.drawing.Plot
+            The robust region's drawing, with artists ``"varying"`` added.
+        """
+        from ...drawing import plot_delay_range_region
+
+        return plot_delay_range_region(self, ax)
+
+
+def delay_range_region(loop, x=None, y=None, *, delay_range, x_range=None, y_range=None, n=61,
+                       strips=64, rtol=1e-6, progress=None, **values):
+    """Every constant delay of a range as a certified region of a plane, every varying one on a grid.
+
+    The constant set is :func:`symstab.numeric.analysis.robust.robust_region`'s
+    with ``uncertain={"Td": delay_range}`` (with the other parameters'
+    ranges of ``uncertain`` given too): certified for every delay of the
+    range, the fraction of a period one more side of the box.  The varying
+    set is the small-gain criterion of :func:`delay_range` (whole-sample
+    ends only) at the points of an ``n x n`` grid of the region's window
+    stable at the lower end.
+
+    Parameters
+    ----------
+    loop : symstab.Loop
+    x, y : str, optional
+        The plane (default the loop's).
+    delay_range : (float, float)
+        ``(Td_min, Td_max)``, seconds.
+    x_range, y_range, strips, progress
+        As :func:`~symstab.numeric.analysis.robust.robust_region`.
+    n : int
+        Points of the grid per side (default 61).
+    rtol : float
+        The robust region's and the small-gain bracket's (as theirs).
+    **values
+        Single values of the other parameters (a delay is the range's).
+
+    Returns
+    -------
+    DelayRangeRegion
+    """
+    from ..._validate import check_count
+    from .robust import robust_region
+
+    n = check_count("n", n, 2)
+    given = {k: v for k, v in values.items() if k not in ("d", "Td")}
+    T = _period(loop, given)
+    low, high, whole = _range_samples(delay_range, T)
+    if "uncertain" in given:
+        raise TypeError("delay_range is the region's uncertain delay: use robust_region with "
+                        "uncertain={'Td': ..., ...} for a box of other parameters as well")
+    region = robust_region(loop, x, y, uncertain={"Td": tuple(delay_range)}, strips=strips,
+                           rtol=rtol, x_range=x_range, y_range=y_range, progress=progress,
+                           **given)
+    xs = np.linspace(*region.nominal.x_range, n)
+    ys = np.linspace(*region.nominal.y_range, n)
+    X, Y = np.meshgrid(xs, ys)
+    constant = np.asarray(region.contains(X, Y), dtype=bool)
+    varying = (_varying_set(loop, (region.x, xs), (region.y, ys), given, (low, high),
+                            min(rtol, 0.25)) if whole else None)
+    grid = DelayRangeMap(region.x, region.y, xs, ys, (low, high), constant, varying, dict(given))
+    return DelayRangeRegion(region, grid)

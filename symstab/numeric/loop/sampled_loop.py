@@ -384,25 +384,24 @@ class Loop(LoopModel):
         return boundary(self, x, y, n, window=window, segments=segments, **values)
 
     def region(self, x=None, y=None, *, x_range=None, y_range=None, uncertain=None, strips=64,
-               rtol=1e-6, progress=None, **values):
+               rtol=1e-6, progress=None, delay_range=None, **values):
         """The complete D-decomposition of the ``(x, y)`` plane: cells, root counts, stable set.
 
         See :func:`symstab.numeric.loop.plane.region`.
 
         Parameters
         ----------
-        uncertain, strips, rtol, progress : optional
+        delay_range : (float, float), optional
+            ``(Td_min, Td_max)``, seconds: instead, the two sets of the range,
+            :func:`symstab.numeric.analysis.delay_range.delay_range_region`.
+        strips, rtol, progress : optional
+            Of the robust region of ``delay_range`` (or of ``uncertain``).
+        uncertain : dict, optional
             Deprecated: the robust region is :meth:`robust_region`'s, which
             ``uncertain`` calls with a DeprecationWarning.
         """
-        if uncertain is not None:
-            warnings.warn("Loop.region(uncertain=...) is deprecated: use Loop.robust_region "
-                          "(or symstab.numeric.analysis.robust.robust_region)",
-                          DeprecationWarning, stacklevel=2)
-            return self.robust_region(x, y, uncertain=uncertain, strips=strips, rtol=rtol,
-                                      x_range=x_range, y_range=y_range, progress=progress,
-                                      **values)
-        return region(self, x, y, x_range=x_range, y_range=y_range, **values)
+        return _region(self, x, y, x_range, y_range, delay_range, (uncertain, strips, rtol,
+                                                                    progress), values)
 
     def robust_region(self, x=None, y=None, *, uncertain, strips=64, rtol=1e-6, x_range=None,
                       y_range=None, progress=None, **values):
@@ -584,3 +583,21 @@ def _rebuilt(plant, environment, options):
 
 #: The loops rebuilt in this process from pickles, by definition.
 _REBUILT = {}
+
+
+def _region(loop, x, y, x_range, y_range, delay_range, robust, values):
+    """:meth:`Loop.region`: the decomposition, a delay range's sets, or (deprecated) a robust region."""
+    uncertain, strips, rtol, progress = robust
+    if delay_range is not None:
+        from ..analysis.delay_range import delay_range_region
+
+        return delay_range_region(loop, x, y, delay_range=delay_range, x_range=x_range,
+                                  y_range=y_range, strips=strips, rtol=rtol, progress=progress,
+                                  **values)
+    if uncertain is not None:
+        warnings.warn("Loop.region(uncertain=...) is deprecated: use Loop.robust_region "
+                      "(or symstab.numeric.analysis.robust.robust_region)",
+                      DeprecationWarning, stacklevel=3)
+        return loop.robust_region(x, y, uncertain=uncertain, strips=strips, rtol=rtol,
+                                  x_range=x_range, y_range=y_range, progress=progress, **values)
+    return region(loop, x, y, x_range=x_range, y_range=y_range, **values)
