@@ -591,6 +591,8 @@ def _region(loop, x, y, x_range, y_range, delay_range, robust, values):
     if delay_range is not None:
         from ..analysis.delay_range import delay_range_region
 
+        if uncertain is not None:
+            values = {**values, "uncertain": uncertain}     # refused there, with what to do
         return delay_range_region(loop, x, y, delay_range=delay_range, x_range=x_range,
                                   y_range=y_range, strips=strips, rtol=rtol, progress=progress,
                                   **values)
