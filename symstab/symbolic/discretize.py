@@ -17,7 +17,7 @@ __all__ = [
     "z_transform_by_residues", "written_poles", "zoh_pulse_transfer_function",
     "fractional_zoh_pulse_transfer_function", "fractional_delay_identities", "numeric_zoh",
     "numeric_fractional_zoh",
-    "interval_zoh", "interval_product",
+    "interval_zoh", "interval_fractional_zoh", "interval_product",
     "pulse_transfer_function",
     "dimensionless_pulse_transfer_function",
 ]
@@ -519,6 +519,84 @@ def interval_zoh(numerator, denominator, T):
         If the denominator's leading coefficient can vanish, or the plant
         is not proper.
     """
+    rest, direct, n, A = _interval_realisation(numerator, denominator)
+    X = _interval_expm1(_scaled(A, T), n + 1)
+    entries = _shifted_entries(X, n)
+    p_d = _poly_det(entries)
+    gamma = [X[j][n] for j in range(n)]
+    return _poly_add([direct * c for c in p_d], _adjugate_term(entries, rest, gamma)), p_d
+
+
+def interval_fractional_zoh(numerator, denominator, T, eps):
+    """Enclosures of the fractional-delay plant's ``(N_eps, z P_d)`` in ``w = z - 1`` over intervals.
+
+    The interval counterpart of :func:`numeric_fractional_zoh` and the
+    fractional one of :func:`interval_zoh` (same realisation): ``eps`` is an
+    interval of the fraction of a period, ``0 <= eps <= 1``, and the
+    enclosures hold for every ``eps`` in it.  ``Gamma0 = int_0^((1 - eps)
+    T) exp(A s) ds B`` and ``Gamma1 = exp(A (1 - eps) T) int_0^(eps T)
+    exp(A s) ds B`` come from the Taylor enclosures of the augmented
+    exponential at the interval times ``(1 - eps) T`` and ``eps T``;
+    ``P_eps = C (z I - Phi)^-1 (Gamma0 + Gamma1 / z) = N_eps / (z P_d)``
+    with ``N_eps = z L0 + L1``, ``Lk = C adj(w I - (Phi - I)) Gammak`` by
+    cofactors, as :func:`interval_zoh`'s numerator.  ``P_d`` does not depend
+    on ``eps`` and is :func:`interval_zoh`'s: an integrator's pole ``z = 1``
+    stays exact however wide ``eps``.  At ``eps = 1`` (``Gamma0 = 0``,
+    ``Gamma1 = Gamma``) ``N_eps`` is ``P_n``: the plant of one more whole
+    sample, so that the pieces of a delay range meet.
+
+    Parameters
+    ----------
+    numerator, denominator : list of mpmath.iv.mpf
+        ``G``'s numerator and denominator coefficients in ``s``, highest
+        power first; ``G`` strictly proper.
+    T : mpmath.iv.mpf
+        The sample period.
+    eps : mpmath.iv.mpf
+        The fraction of a period, within ``[0, 1]``.
+
+    Returns
+    -------
+    (list of mpmath.iv.mpf, list of mpmath.iv.mpf)
+        ``N_eps`` (degree the plant's order) and ``z P_d`` (of the plant's
+        order plus one, monic) in powers of ``w = z - 1``, highest first.
+
+    Raises
+    ------
+    ValueError
+        As :func:`interval_zoh`; and for a direct feedthrough, or ``eps``
+        not within ``[0, 1]``.
+    """
+    from mpmath import iv
+
+    if not (eps.a >= 0 and eps.b <= 1):
+        raise ValueError(f"eps must be within [0, 1] (a fraction of a period), got {eps}")
+    rest, direct, n, A = _interval_realisation(numerator, denominator)
+    if not (direct.a == 0 and direct.b == 0):
+        raise ValueError("G(s) must be strictly proper for a fractional delay: a direct "
+                         "feedthrough makes the output jump inside the period")
+    X = _interval_expm1(_scaled(A, T), n + 1)
+    late = _interval_expm1(_scaled(A, (1 - eps) * T), n + 1)
+    early = _interval_expm1(_scaled(A, eps * T), n + 1)
+    gamma0 = [late[i][n] for i in range(n)]
+    # exp(A (1 - eps) T) = I + late's block, times int_0^(eps T) exp(A s) ds B.
+    gamma1 = [early[i][n] + sum((late[i][k] * early[k][n] for k in range(n)), iv.mpf(0))
+              for i in range(n)]
+    entries = _shifted_entries(X, n)
+    p_d = _poly_det(entries)
+    l0, l1 = (_adjugate_term(entries, rest, gamma) for gamma in (gamma0, gamma1))
+    # z L0 = (w + 1) L0: L0 and L1 have degree n - 1 (their first of n + 1 terms is an
+    # exact 0), so w L0 is L0's terms moved up by one, within n + 1 terms.
+    n_eps = _poly_add(l0[1:] + [iv.mpf(0)], _poly_add(l0, l1))
+    return n_eps, _poly_add(p_d + [iv.mpf(0)], p_d)
+
+
+def _interval_realisation(numerator, denominator):
+    """``(rest, direct, n, A)``: :func:`_realisation` of interval coefficients, before the period.
+
+    ``A`` is the augmented ``[[A, B], [0, 0]]`` as a list of rows (exact
+    zeros where the companion form has them), ``rest`` the row ``C``.
+    """
     from mpmath import iv
 
     den = list(denominator)
@@ -542,31 +620,49 @@ def interval_zoh(numerator, denominator, T):
     num = [iv.mpf(0)] * (n + 1 - len(num)) + num
     direct = num[0]
     rest = [num[k] - direct * den[k] for k in range(1, n + 1)]
-    A = [[iv.mpf(0)] * (n + 1) for _ in range(n + 1)]
+    A = [[None] * (n + 1) for _ in range(n + 1)]
     for j in range(n):
-        A[0][j] = -den[j + 1] * T
+        A[0][j] = -den[j + 1]
     for i in range(1, n):
-        A[i][i - 1] = T
-    A[0][n] = T
-    X = _interval_expm1(A, n + 1)
-    # w I - Psi as a matrix of polynomials in w; its determinant and
-    # adjugate by cofactors, so that an exact zero of Psi (an integrator's
-    # column) stays an exact zero of P_d(1).
-    entries = [[[iv.mpf(1), -X[i][j]] if i == j else [-X[i][j]] for j in range(n)]
-               for i in range(n)]
-    p_d = _poly_det(entries)
-    p_n = [direct * c for c in p_d]
+        A[i][i - 1] = iv.mpf(1)
+    A[0][n] = iv.mpf(1)
+    return rest, direct, n, A
+
+
+def _scaled(A, t):
+    """``A t`` (exact zeros, None in ``A``, kept exact)."""
+    from mpmath import iv
+
+    return [[iv.mpf(0) if c is None else c * t for c in row] for row in A]
+
+
+def _shifted_entries(X, n):
+    """``w I - Psi`` (``Psi`` the top-left ``n x n`` block of ``X``) as a matrix of polynomials in
+    ``w``: its determinant and adjugate by cofactors keep an exact zero column of ``Psi`` (an
+    integrator's) an exact zero of ``P_d(1)``."""
+    from mpmath import iv
+
+    return [[[iv.mpf(1), -X[i][j]] if i == j else [-X[i][j]] for j in range(n)]
+            for i in range(n)]
+
+
+def _adjugate_term(entries, rest, gamma):
+    """``C adj(w I - Psi) Gamma`` (``entries``: :func:`_shifted_entries`), ``n + 1`` terms in ``w``."""
+    from mpmath import iv
+
+    n = len(entries)
+    out = [iv.mpf(0)] * (n + 1)
     for i in range(n):
         for j in range(n):
-            weight = rest[i] * X[j][n]
+            weight = rest[i] * gamma[j]
             if weight.a == 0 and weight.b == 0:
                 continue
             minor = [[entries[r][c] for c in range(n) if c != i] for r in range(n) if r != j]
             cofactor = _poly_det(minor) if minor else [iv.mpf(1)]
             sign = -1 if (i + j) % 2 else 1
             for k, c in enumerate(reversed(cofactor)):
-                p_n[n - k] += sign * weight * c
-    return p_n, p_d
+                out[n - k] += sign * weight * c
+    return out
 
 
 #: The largest plant order :func:`interval_zoh` takes (its determinants are
