@@ -524,26 +524,32 @@ def interval_zoh(numerator, denominator, T):
     entries = _shifted_entries(X, n)
     p_d = _poly_det(entries)
     gamma = [X[j][n] for j in range(n)]
-    return _poly_add([direct * c for c in p_d], _adjugate_term(entries, rest, gamma)), p_d
+    term = _adjugate_term(_cofactors(entries, rest), rest, gamma)
+    return _poly_add([direct * c for c in p_d], term), p_d
 
 
-def interval_fractional_zoh(numerator, denominator, T, eps):
-    """Enclosures of the fractional-delay plant's ``(N_eps, z P_d)`` in ``w = z - 1`` over intervals.
+def interval_fractional_zoh(numerator, denominator, T):
+    """Enclosures of the fractional-delay plant's ``(N_eps, z P_d)`` in ``w = z - 1``, per interval of ``eps``.
 
     The interval counterpart of :func:`numeric_fractional_zoh` and the
-    fractional one of :func:`interval_zoh` (same realisation): ``eps`` is an
-    interval of the fraction of a period, ``0 <= eps <= 1``, and the
-    enclosures hold for every ``eps`` in it.  ``Gamma0 = int_0^((1 - eps)
-    T) exp(A s) ds B`` and ``Gamma1 = exp(A (1 - eps) T) int_0^(eps T)
-    exp(A s) ds B`` come from the Taylor enclosures of the augmented
-    exponential at the interval times ``(1 - eps) T`` and ``eps T``;
-    ``P_eps = C (z I - Phi)^-1 (Gamma0 + Gamma1 / z) = N_eps / (z P_d)``
-    with ``N_eps = z L0 + L1``, ``Lk = C adj(w I - (Phi - I)) Gammak`` by
-    cofactors, as :func:`interval_zoh`'s numerator.  ``P_d`` does not depend
-    on ``eps`` and is :func:`interval_zoh`'s: an integrator's pole ``z = 1``
-    stays exact however wide ``eps``.  At ``eps = 1`` (``Gamma0 = 0``,
-    ``Gamma1 = Gamma``) ``N_eps`` is ``P_n``: the plant of one more whole
-    sample, so that the pieces of a delay range meet.
+    fractional one of :func:`interval_zoh` (same realisation): returns a
+    function of an interval ``eps`` of the fraction of a period (within
+    [0, 1]) whose enclosures hold for every ``eps`` in it.  With ``Gamma0 =
+    int_0^((1 - eps) T) exp(A s) ds B`` and ``Gamma = Gamma0 + Gamma1`` (the
+    whole period's; ``Gamma1 = exp(A (1 - eps) T) int_0^(eps T) exp(A s) ds B``
+    is the rest of the integral), ``P_eps = C (z I - Phi)^-1 (Gamma0 +
+    Gamma1 / z) = N_eps / (z P_d)`` with::
+
+        N_eps = z L0 + (P_n - L0) = w L0 + P_n,   L0 = C adj(w I - (Phi - I)) Gamma0,
+
+    ``P_n, P_d`` :func:`interval_zoh`'s and ``L0`` by the same cofactors.
+    Only ``Gamma0`` depends on ``eps``, and only through ``w L0``: the
+    integrator's pole ``z = 1`` is kept as by :func:`interval_zoh`,
+    ``N_eps(1) = P_n(1)`` whatever the width of ``eps``, and what does not depend on ``eps`` (``Phi``, ``P_n``,
+    ``z P_d``, the cofactors) is computed once, here.  At ``eps = 1``
+    (``Gamma0 = 0``) ``N_eps`` is ``P_n``: the plant of one more whole
+    sample, so that the pieces of a delay range meet; at ``eps = 0`` it is
+    ``z P_n``.
 
     Parameters
     ----------
@@ -552,43 +558,54 @@ def interval_fractional_zoh(numerator, denominator, T, eps):
         power first; ``G`` strictly proper.
     T : mpmath.iv.mpf
         The sample period.
-    eps : mpmath.iv.mpf
-        The fraction of a period, within ``[0, 1]``.
 
     Returns
     -------
-    (list of mpmath.iv.mpf, list of mpmath.iv.mpf)
-        ``N_eps`` (degree the plant's order) and ``z P_d`` (of the plant's
-        order plus one, monic) in powers of ``w = z - 1``, highest first.
+    callable
+        ``eps -> (N_eps, z P_d)``, ``eps`` an :class:`mpmath.iv.mpf` within
+        [0, 1]: ``N_eps`` (of the plant's order) and ``z P_d`` (monic, of the
+        order plus one) in powers of ``w = z - 1``, highest first, lists of
+        :class:`mpmath.iv.mpf` at the precision of the call.
 
     Raises
     ------
     ValueError
-        As :func:`interval_zoh`; and for a direct feedthrough, or ``eps``
-        not within ``[0, 1]``.
+        As :func:`interval_zoh`; and for a direct feedthrough (here), or an
+        ``eps`` not within [0, 1] (by the function).
+
+    Examples
+    --------
+    >>> from mpmath import iv
+    >>> at = interval_fractional_zoh([iv.mpf(1)], [iv.mpf(1), iv.mpf(0)], iv.mpf(1))
+    >>> n_eps, z_p_d = at(iv.mpf([0.25, 0.5]))       # G = 1/s: ((1 - eps) z + eps) / (z (z - 1))
+    >>> [(round(float(c.a), 9), round(float(c.b), 9)) for c in n_eps]
+    [(0.5, 0.75), (1.0, 1.0)]
+    >>> [(round(float(c.a), 9), round(float(c.b), 9)) for c in z_p_d[:2]], float(z_p_d[2].b) < 1e-40
+    ([(1.0, 1.0), (1.0, 1.0)], True)
     """
     from mpmath import iv
 
-    if not (eps.a >= 0 and eps.b <= 1):
-        raise ValueError(f"eps must be within [0, 1] (a fraction of a period), got {eps}")
     rest, direct, n, A = _interval_realisation(numerator, denominator)
     if not (direct.a == 0 and direct.b == 0):
         raise ValueError("G(s) must be strictly proper for a fractional delay: a direct "
                          "feedthrough makes the output jump inside the period")
     X = _interval_expm1(_scaled(A, T), n + 1)
-    late = _interval_expm1(_scaled(A, (1 - eps) * T), n + 1)
-    early = _interval_expm1(_scaled(A, eps * T), n + 1)
-    gamma0 = [late[i][n] for i in range(n)]
-    # exp(A (1 - eps) T) = I + late's block, times int_0^(eps T) exp(A s) ds B.
-    gamma1 = [early[i][n] + sum((late[i][k] * early[k][n] for k in range(n)), iv.mpf(0))
-              for i in range(n)]
     entries = _shifted_entries(X, n)
     p_d = _poly_det(entries)
-    l0, l1 = (_adjugate_term(entries, rest, gamma) for gamma in (gamma0, gamma1))
-    # z L0 = (w + 1) L0: L0 and L1 have degree n - 1 (their first of n + 1 terms is an
-    # exact 0), so w L0 is L0's terms moved up by one, within n + 1 terms.
-    n_eps = _poly_add(l0[1:] + [iv.mpf(0)], _poly_add(l0, l1))
-    return n_eps, _poly_add(p_d + [iv.mpf(0)], p_d)
+    cofactors = _cofactors(entries, rest)
+    p_n = _adjugate_term(cofactors, rest, [X[j][n] for j in range(n)])
+    z_p_d = _poly_add(p_d + [iv.mpf(0)], p_d)
+
+    def at(eps):
+        if not (eps.a >= 0 and eps.b <= 1):
+            raise ValueError(f"eps must be within [0, 1] (a fraction of a period), got {eps}")
+        late = _interval_expm1(_scaled(A, (1 - eps) * T), n + 1)
+        l0 = _adjugate_term(cofactors, rest, [late[j][n] for j in range(n)])
+        # L0 has degree n - 1 (its first of n + 1 terms is an exact 0): w L0 is its
+        # terms moved up by one, within n + 1 terms.
+        return _poly_add(l0[1:] + [iv.mpf(0)], p_n), list(z_p_d)
+
+    return at
 
 
 def _interval_realisation(numerator, denominator):
@@ -646,22 +663,36 @@ def _shifted_entries(X, n):
             for i in range(n)]
 
 
-def _adjugate_term(entries, rest, gamma):
-    """``C adj(w I - Psi) Gamma`` (``entries``: :func:`_shifted_entries`), ``n + 1`` terms in ``w``."""
+def _cofactors(entries, rest):
+    """``{(i, j): (-1)**(i + j) det(minor without row j, column i)}`` of ``entries``
+    (:func:`_shifted_entries`), for the ``i`` where ``C`` (``rest``) is not an exact 0: the
+    adjugate's entries that ``C adj(w I - Psi)`` reads."""
     from mpmath import iv
 
     n = len(entries)
-    out = [iv.mpf(0)] * (n + 1)
+    out = {}
     for i in range(n):
+        if rest[i].a == 0 and rest[i].b == 0:
+            continue
         for j in range(n):
-            weight = rest[i] * gamma[j]
-            if weight.a == 0 and weight.b == 0:
-                continue
             minor = [[entries[r][c] for c in range(n) if c != i] for r in range(n) if r != j]
             cofactor = _poly_det(minor) if minor else [iv.mpf(1)]
-            sign = -1 if (i + j) % 2 else 1
-            for k, c in enumerate(reversed(cofactor)):
-                out[n - k] += sign * weight * c
+            out[i, j] = [-c for c in cofactor] if (i + j) % 2 else cofactor
+    return out
+
+
+def _adjugate_term(cofactors, rest, gamma):
+    """``C adj(w I - Psi) Gamma`` from :func:`_cofactors`, ``n + 1`` terms in ``w``."""
+    from mpmath import iv
+
+    n = len(rest)
+    out = [iv.mpf(0)] * (n + 1)
+    for (i, j), cofactor in cofactors.items():
+        weight = rest[i] * gamma[j]
+        if weight.a == 0 and weight.b == 0:
+            continue
+        for k, c in enumerate(reversed(cofactor)):
+            out[n - k] += weight * c
     return out
 
 
