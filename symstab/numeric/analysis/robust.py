@@ -219,7 +219,8 @@ class _Enclosures:
         self.plant = (poly_coeffs(num, model.s), poly_coeffs(den, model.s))
         sides = [box[n] for n in self.names] + ([fraction] if self.fractional else [])
         self.boxes = [np.array(sides, dtype=float).reshape(-1, 2)]
-        self.depth = [0]
+        # A box of no width (one value, one fraction of a period) is never halved.
+        self.depth = [0 if np.any(self.boxes[0][:, 1] > self.boxes[0][:, 0]) else BOX_DEPTH]
         self._children = {}
         self.mid, self.rad = [], []
         self._stacked = None
@@ -235,7 +236,7 @@ class _Enclosures:
             values = {n: iv.mpf(float(v)) for n, v in self.fixed.items()}
             sides = [iv.mpf([float(lo), float(hi)]) for lo, hi in self.boxes[index]]
             values.update(zip(self.names, sides, strict=False))
-            p_n, p_d = self._plant(index, values, sides[-1])
+            p_n, p_d = self._plant(index, values, sides[-1] if self.fractional else None)
             mids, rads = [], []
             for ve_d, ve_n in self.environment:
                 parts = (interval_product([_bound(c, values) for c in ve_d], p_d),
@@ -437,7 +438,9 @@ def _excluded(enclosures, shift, theta, h, box, piece):
     round_a = rounding[:, 0] + (ax + hx) * rounding[:, 1]
     round_b = rounding[:, 2]
     strip_y = _failing(P, Y, theta_a + box_a + strip_a + round_a, theta_b + box_b + round_b)
-    fixed_y = _failing(P, Y, strip_a + round_a, round_b)
+    # What no halving removes: the strip's width times |Ax| at the cell's middle (its
+    # theta-width and radii are the halvings' to remove), and the rounding.
+    fixed_y = _failing(P, Y, hx * np.abs(value[:, 1]) + round_a, round_b)
     strip = [piece.to_t(lo, hi) for lo, hi in strip_y]
     y_lo = np.minimum(piece.lo0, piece.lo1)
     y_hi = np.maximum(piece.hi0, piece.hi1)
