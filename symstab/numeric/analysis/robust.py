@@ -88,10 +88,13 @@ from ...symbolic.discretize import interval_fractional_zoh, interval_product, in
 from ...symbolic.loop_assembly import poly_coeffs
 from ..engine.results import RobustRegion
 
-__all__ = ["robust_region", "BOX_DEPTH", "MAX_CELLS"]
+__all__ = ["robust_region", "BOX_DEPTH", "FRACTION_DEPTH", "MAX_CELLS"]
 
 #: Most halvings of the uncertain box along one branch of the search.
 BOX_DEPTH = 10
+#: More halvings along a branch when the box has a fraction of a period as a side
+#: (a range of delays): a side more to halve.
+FRACTION_DEPTH = 4
 #: Most cells (strip x y x theta x sub-box) examined in one robust region;
 #: what is left then is marginal.
 MAX_CELLS = 20_000_000
@@ -220,7 +223,8 @@ class _Enclosures:
         sides = [box[n] for n in self.names] + ([fraction] if self.fractional else [])
         self.boxes = [np.array(sides, dtype=float).reshape(-1, 2)]
         # A box of no width (one value, one fraction of a period) is never halved.
-        self.depth = [0 if np.any(self.boxes[0][:, 1] > self.boxes[0][:, 0]) else BOX_DEPTH]
+        self.most_depth = BOX_DEPTH + (FRACTION_DEPTH if self.fractional else 0)
+        self.depth = [0 if np.any(self.boxes[0][:, 1] > self.boxes[0][:, 0]) else self.most_depth]
         self._children = {}
         self.mid, self.rad = [], []
         self._stacked = None
@@ -834,7 +838,7 @@ def _certify(enclosures, shift, geometry, candidates, tol, budget):
         reducible = reducible[meets]
         parts = [(lo[meets], hi[meets]) for lo, hi in parts]
         can_theta = (c.t1 - c.t0) > _THETA_WIDTH
-        can_box = np.array(enclosures.depth)[c.box] < BOX_DEPTH
+        can_box = np.array(enclosures.depth)[c.box] < enclosures.most_depth
         # Done when what is left open, or what halving could still remove,
         # is within the resolution, or the width that costs more cannot be
         # halved again (halving the other would not close the cell).
