@@ -596,16 +596,40 @@ def interval_fractional_zoh(numerator, denominator, T):
     p_n = _adjugate_term(cofactors, rest, [X[j][n] for j in range(n)])
     z_p_d = _poly_add(p_d + [iv.mpf(0)], p_d)
 
+    starts = {}
+
     def at(eps):
         if not (eps.a >= 0 and eps.b <= 1):
             raise ValueError(f"eps must be within [0, 1] (a fraction of a period), got {eps}")
-        late = _interval_expm1(_scaled(A, (1 - eps) * T), n + 1)
-        l0 = _adjugate_term(cofactors, rest, [late[j][n] for j in range(n)])
+        l0 = _adjugate_term(cofactors, rest, _late_integral(A, n, (1 - eps) * T, starts))
         # L0 has degree n - 1 (its first of n + 1 terms is an exact 0): w L0 is its
         # terms moved up by one, within n + 1 terms.
         return _poly_add(l0[1:] + [iv.mpf(0)], p_n), list(z_p_d)
 
     return at
+
+
+def _late_integral(A, n, tau, starts):
+    """``Gamma0 = int_0^tau exp(A s) ds B`` over an interval ``tau = [t0, t1]``, enclosed as
+    ``Gamma0(t0) + exp(A t0) Gamma0([0, t1 - t0])``.
+
+    The exponential at the point ``t0`` (kept in ``starts``: the halves of an
+    interval share an end) is as narrow as the working precision; the one over
+    the interval starts at 0 and is as wide as the interval, whose Taylor terms
+    then hardly overestimate -- unlike ``exp(A tau)`` with ``tau`` wide, whose
+    squarings multiply the interval's width (an actuator's fast pole: a hundred
+    times the true spread of ``N_eps``).
+    """
+    from mpmath import iv
+
+    start = iv.mpf(tau.a)
+    key = start._mpi_
+    if key not in starts:
+        starts[key] = _interval_expm1(_scaled(A, start), n + 1)
+    head = starts[key]
+    tail = _interval_expm1(_scaled(A, tau - start), n + 1)
+    return [head[j][n] + tail[j][n] + sum((head[j][k] * tail[k][n] for k in range(n)), iv.mpf(0))
+            for j in range(n)]
 
 
 def _interval_realisation(numerator, denominator):
