@@ -613,12 +613,12 @@ def test_robust_over_a_continuum_of_delays(path, uncertain, window, paper, over_
     oracle); just above the set at each strip's edges some delay of the range is unstable."""
     loop = paper if path == PAPER else symstab.load_loop(path)
     region = over_delays if path == PAPER else loop.robust_region(
-        uncertain=uncertain, strips=8, rtol=1e-4)
+        uncertain=uncertain, strips=4, rtol=1e-4)
     assert region.uncertain == uncertain and "d" not in region.at
     values = {**loop.defaults, **region.at}
     delays = np.linspace(*window, 201)
     rng = np.random.default_rng(5)
-    x, y = _points_in(region, 24, rng)
+    x, y = _points_in(region, 16, rng)
     assert _radii(loop, values, zip(x, y, strict=True), delays).max() < 1.0
     # Outside: at a strip's left edge, 0.2 % above the highest robust or marginal band.
     above = []
@@ -626,7 +626,7 @@ def test_robust_over_a_continuum_of_delays(path, uncertain, window, paper, over_
         tops = [band[1] for band in region.intervals[i] + region.marginal[i]]
         if tops and max(tops) > 0:
             above.append((region.edges[i], max(tops) * 1.002))
-    assert len(above) >= 4
+    assert len(above) >= 3
     assert (_radii(loop, values, above, delays).max(axis=1) >= 1.0).all()
 
 
