@@ -15,6 +15,21 @@ The piece of the plane, the box and [0, pi] are connected, so by 2 and 3 the
 number of roots outside the circle is the same everywhere on it, and by 1 it
 is 0.
 
+Delays.  A range of whole delays (``uncertain={"d": (8, 12)}``) is each of
+them.  A range in seconds (``Td``) or with a fractional end (``d = (1.5,
+2.25)``) is every delay of the continuum ``(d + eps) T``: it is split by
+whole part ``d``, ``eps`` in ``[eps0, eps1]`` within [0, 1] for each (``eps =
+1`` is ``d + 1`` samples), and ``eps`` is one more side of the box, halved
+like the others (:data:`FRACTION_DEPTH` more times).  The plant then carries
+the fraction (the modified z-transform, ``chi = z**d (z P_d) Ve_d + N_eps
+Ve_n``), enclosed over an interval of ``eps`` by
+:func:`symstab.symbolic.discretize.interval_fractional_zoh` (``N_eps = w L0 +
+P_n``: only ``w L0`` depends on ``eps``, so ``z = 1`` stays the integrator's
+pole however wide the interval).  Each piece of delays is connected and 1 is
+checked at a delay of each, so the guarantee holds for every delay of the
+range, not a sample of them.  A fractional nominal delay is a piece of no
+width.
+
 How zero exclusion is proved.  The plane is cut into vertical strips ``x``
 in ``[x0, x1]``; each strip holds *pieces*, trapezoids whose bottom and top
 run straight from an interval of ``y`` at ``x0`` to one at ``x1``; a point
@@ -1006,9 +1021,10 @@ def robust_region(loop, x=None, y=None, *, uncertain, strips=64, rtol=1e-6, x_ra
         (default: the loop's :attr:`~symstab.Loop.plane`).
     uncertain : dict
         ``{name: (low, high)}``: the box of the plant's and environment's
-        parameters (``T`` included), and ``d`` a range of whole delays
-        (a range in seconds, ``Td``, or with a fractional end is refused:
-        the zero exclusion covers each whole delay, not a continuum).
+        parameters (``T`` included), and the delay: ``d`` with whole ends,
+        each whole delay of the range; ``Td`` (seconds, over a fixed ``T``)
+        or ``d`` with a fractional end, every delay of the range, a
+        continuum (the module's "Delays").
     strips : int
         Vertical strips across the window (1 to 100 000); those where the
         set has a corner or an end are halved (at most ``4 strips`` more).
@@ -1041,6 +1057,13 @@ def robust_region(loop, x=None, y=None, *, uncertain, strips=64, rtol=1e-6, x_ra
     >>> robust = robust_region(loop, "B", "K", uncertain={"b": (0.0162, 0.0648)}, strips=16)
     >>> 0 < robust.area < robust.nominal.area
     True
+
+    Every delay from 1.5 to 2.5 ms (at B = 1 the set at 2.5 ms ends at K =
+    301.1, the one at 1.5 ms at 465.4):
+
+    >>> delays = robust_region(loop, "B", "K", uncertain={"Td": (0.0015, 0.0025)}, strips=8)
+    >>> bool(delays.contains(1.0, 250.0)), bool(delays.contains(1.0, 320.0))
+    (True, False)
     """
     x, y = loop.plane_of(x, y)
     strips = check_count("strips", strips, 1)
