@@ -131,9 +131,33 @@ def _delay_pieces(setup, box):
     return max(1, math.ceil(high) - math.floor(low))
 
 
+def _announcer(setup, box, strips):
+    """The robust region's ``progress``: what runs, said once the library has accepted the box
+    (a refusal stays one line), then a bar over its delays.
+
+    Seconds to minutes: a plant of higher order, a box of several parameters
+    and many strips or delays cost more (README).
+    """
+    from .._progress import progress_printer
+
+    delays = _delay_pieces(setup, box)
+    continuum = "Td" in box or ("d" in box and not isinstance(box["d"][0], int))
+    bar = progress_printer("delays", delays)
+
+    def progress(done):
+        if done == 0:
+            print(f"certifying the ({setup.name(setup.x)}, {setup.name(setup.y)}) plane for "
+                  f"every value of the box ({strips} strips, {delays} "
+                  f"{'piece(s) of a continuum of delays' if continuum else 'delay(s)'}, "
+                  f"{len([k for k in box if k not in ('d', 'Td')])} continuous parameter(s)) ...",
+                  file=sys.stderr, flush=True)
+        bar(done)
+
+    return progress
+
+
 def _robust(args, setup, at):
     """``limits --loop --uncertain``: the robust set's limits, certified; its PNG with --png."""
-    from .._progress import progress_printer
     from ..drawing import png_of, require_matplotlib, robust_figure
     from .output import check_files, write_output
 
@@ -151,22 +175,7 @@ def _robust(args, setup, at):
     delay = {"d", "Td"} & set(box)
     values = {k: v for k, v in setup.values.items() if k not in box and not (delay and k in
                                                                             ("d", "Td"))}
-    delays = _delay_pieces(setup, box)
-    continuum = "Td" in box or ("d" in box and not isinstance(box["d"][0], int))
-    # Seconds to minutes: a plant of higher order, a box of several
-    # parameters and many strips or delays cost more (README): say what runs,
-    # once the library has accepted the box (a refusal stays one line).
-    bar = progress_printer("delays", delays)
-
-    def progress(done):
-        if done == 0:
-            print(f"certifying the ({setup.name(setup.x)}, {setup.name(setup.y)}) plane for "
-                  f"every value of the box ({strips} strips, {delays} "
-                  f"{'piece(s) of a continuum of delays' if continuum else 'delay(s)'}, "
-                  f"{len([k for k in box if k not in ('d', 'Td')])} continuous parameter(s)) ...",
-                  file=sys.stderr, flush=True)
-        bar(done)
-
+    progress = _announcer(setup, box, strips)
     try:
         lim = setup.loop.limits(x=setup.x, y=setup.y, uncertain=box, strips=strips,
                                 progress=progress, **values)

@@ -188,12 +188,11 @@ def add_loop_options(p, command):
                             + (" (default: the x of the largest y)" if command == "design" else ""))
     if command == "limits":
         g.add_argument("--uncertain", metavar="NAME=LO:HI", action="append",
-                       help="the robust limits instead: of the points stable for every value "
-                            "of NAME in LO:HI (its SI unit, or the unit written after HI: "
-                            "--uncertain \"b=0.02:0.045 N*m*s/rad\"; d: the whole delays "
-                            "LO..HI, or every delay where an end is fractional; Td=LO:HI: "
-                            "every delay, in time, 1.5ms:2.5ms), certified by zero exclusion; "
-                            "repeatable for a box")
+                       help="the robust limits instead: of the points stable for every value of "
+                            "NAME in LO:HI (its SI unit, or the unit written after HI: --uncertain "
+                            "\"b=0.02:0.045 N*m*s/rad\"; d: the whole delays LO..HI, or every "
+                            "delay where an end is fractional; Td=LO:HI: every delay, in time, "
+                            "1.5ms:2.5ms), certified by zero exclusion; repeatable for a box")
         g.add_argument("--strips", type=int, metavar="N",
                        help="with --uncertain: vertical strips across the plane (default 64; "
                             "more strips, a larger certified set and a longer run)")
