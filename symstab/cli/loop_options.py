@@ -868,7 +868,7 @@ def uncertain_box(args, setup, *, point=False):
                              f"{setup.y}) plane; give another parameter (candidates: "
                              f"{', '.join(others)})")
         if name == "Td":
-            box[name] = _time_range(loop, window, point=point)
+            box[name] = _time_range(window, point=point)
             continue
         low, high, unit = range_text(window, f"--uncertain {name}", point=point)
         if name == "d":
@@ -884,7 +884,7 @@ def uncertain_box(args, setup, *, point=False):
     return box
 
 
-def _time_range(loop, window, *, point):
+def _time_range(window, *, point):
     """``(low, high)`` in seconds of ``--uncertain Td=LO:HI``: each end a time (``1.5ms``), or
     the unit after HI for both, seconds without one (:func:`time_value`)."""
     flag = "--uncertain Td"
@@ -895,7 +895,7 @@ def _time_range(loop, window, *, point):
     _, unit = split_unit(tail.strip(), flag)
     _, head_unit = split_unit(head.strip(), flag)
     head = head.strip() if head_unit or not unit else f"{head.strip()} {unit}"
-    low, high = time_value(loop, head, flag), time_value(loop, tail.strip(), flag)
+    low, high = time_value(head, flag), time_value(tail.strip(), flag)
     if not (low <= high if point else low < high):
         raise ValueError(f"{flag}: LO:HI must have LO {'<=' if point else '<'} HI, got "
                          f"{window!r}")
