@@ -64,7 +64,8 @@ never counted stable.
 
 Where to look.  A strip's pieces join, in order, the intervals of ``y`` its
 two edges hold in common over a grid of values of the box (its corners,
-centre and midpoints) and every delay (the one line engine,
+centre and midpoints) and every whole delay, or the ends and middle of each
+piece of a continuum of delays (the one line engine,
 :meth:`symstab.Loop.stable_intervals`): a point of an edge outside them is
 unstable at one of those values.  Where the edges hold different numbers
 of intervals (a corner, an end of the set) the strip is halved, down to
