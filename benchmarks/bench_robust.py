@@ -10,8 +10,10 @@ intervals at ``samples`` values of the box on the same strips' edges (the
 line engine at each value: what a user would do by hand, and not a
 guarantee between the values).  Prints the medians, their ratio, the areas
 (the sampled set is an outer estimate, the certified one an inner set),
-the marginal area, how the certified area grows with the strips, and, for a
-box of zero width, how close it comes to the nominal set's area.
+the marginal area, how the certified area grows with the strips, for a
+box of zero width, how close it comes to the nominal set's area, and the
+cost of a continuum of delays (every Td from 1.5 to 2.5 ms) against its
+whole delays.
 """
 
 import argparse
@@ -92,6 +94,19 @@ def main():
                                     **values)
         print(f"  {strips:>4} strips, rtol {rtol:g}  {fmt(statistics.median(times)):>9}  area "
               f"{region.area:.10g}, short by {(nominal - region.area) / nominal:.2e} of it")
+    delay_range_case(loop, args.strips, args.runs)
+
+
+def delay_range_case(loop, strips, runs):
+    """A continuum of delays (every Td from 1.5 to 2.5 ms) against its whole delays 2 and 3."""
+    print(f"every delay from 1.5 to 2.5 ms (M = 0, {strips} strips, median of {runs}):")
+    for words, uncertain in (("Td in [1.5, 2.5] ms, a continuum", {"Td": (0.0015, 0.0025)}),
+                             ("d in {2, 3}, whole delays", {"d": (2, 3)})):
+        times = timed_runs(lambda u=uncertain: loop.robust_region(
+            "B", "K", uncertain=u, strips=strips, M=0.0), runs)
+        region = loop.robust_region("B", "K", uncertain=uncertain, strips=strips, M=0.0)
+        print(f"  {words:<34} {fmt(statistics.median(times)):>9}  area {region.area:.6g}, "
+              f"marginal {region.marginal_area:.3g}, {region.examined} cells examined")
 
 
 def nominal_area(loop, values):

@@ -114,9 +114,50 @@ def _line(args, setup):
 _MAX_STRIPS = 100_000
 
 
+def _delay_pieces(setup, box):
+    """How many delays the robust region certifies one after the other (its progress): each
+    whole delay of a whole range, else one piece per whole part of the continuum."""
+    import math
+
+    from .._validate import snap_delay
+
+    if "d" in box and isinstance(box["d"][0], int):
+        return box["d"][1] - box["d"][0] + 1
+    if "d" not in box and "Td" not in box:
+        return 1
+    low, high = box["d"] if "d" in box else (
+        v / {**setup.loop.defaults, **setup.values}["T"] for v in box["Td"])
+    low, high = (float(v) for v in snap_delay([low, high]))
+    return max(1, math.ceil(high) - math.floor(low))
+
+
+def _announcer(setup, box, strips):
+    """The robust region's ``progress``: what runs, said once the library has accepted the box
+    (a refusal stays one line), then a bar over its delays.
+
+    Seconds to minutes: a plant of higher order, a box of several parameters
+    and many strips or delays cost more (README).
+    """
+    from .._progress import progress_printer
+
+    delays = _delay_pieces(setup, box)
+    continuum = "Td" in box or ("d" in box and not isinstance(box["d"][0], int))
+    bar = progress_printer("delays", delays)
+
+    def progress(done):
+        if done == 0:
+            print(f"certifying the ({setup.name(setup.x)}, {setup.name(setup.y)}) plane for "
+                  f"every value of the box ({strips} strips, {delays} "
+                  f"{'piece(s) of a continuum of delays' if continuum else 'delay(s)'}, "
+                  f"{len([k for k in box if k not in ('d', 'Td')])} continuous parameter(s)) ...",
+                  file=sys.stderr, flush=True)
+        bar(done)
+
+    return progress
+
+
 def _robust(args, setup, at):
     """``limits --loop --uncertain``: the robust set's limits, certified; its PNG with --png."""
-    from .._progress import progress_printer
     from ..drawing import png_of, require_matplotlib, robust_figure
     from .output import check_files, write_output
 
@@ -131,21 +172,10 @@ def _robust(args, setup, at):
         require_matplotlib()      # matplotlib is there before the work starts
     # A box of zero width is the nominal set, certified the robust way.
     box = uncertain_box(args, setup, point=True)
-    values = {k: v for k, v in setup.values.items() if k not in box}
-    delays = box["d"][1] - box["d"][0] + 1 if "d" in box else 1
-    # Seconds to minutes: a plant of higher order, a box of several
-    # parameters and many strips or delays cost more (README): say what runs,
-    # once the library has accepted the box (a refusal stays one line).
-    bar = progress_printer("delays", delays)
-
-    def progress(done):
-        if done == 0:
-            print(f"certifying the ({setup.name(setup.x)}, {setup.name(setup.y)}) plane for "
-                  f"every value of the box ({strips} strips, {delays} delay(s), "
-                  f"{len([k for k in box if k != 'd'])} continuous parameter(s)) ...",
-                  file=sys.stderr, flush=True)
-        bar(done)
-
+    delay = {"d", "Td"} & set(box)
+    values = {k: v for k, v in setup.values.items() if k not in box and not (delay and k in
+                                                                            ("d", "Td"))}
+    progress = _announcer(setup, box, strips)
     try:
         lim = setup.loop.limits(x=setup.x, y=setup.y, uncertain=box, strips=strips,
                                 progress=progress, **values)
@@ -158,8 +188,8 @@ def _robust(args, setup, at):
     columns, rows = limits_table(setup, lim)
     x, y = setup.name(setup.x), setup.name(setup.y)
     box_text = ", ".join(
-        f"{name} in [{lo:.6g}, {hi:.6g}]" + ("" if name == "d" or not setup.unit(name)
-                                            else f" {setup.unit(name)}")
+        f"{name} in [{lo:.6g}, {hi:.6g}]" + (" s" if name == "Td" else "" if name == "d" or
+                                            not setup.unit(name) else f" {setup.unit(name)}")
         for name, (lo, hi) in box.items())
     nominal = region.nominal
     used = len(region.edges) - 1 if len(region.edges) else strips

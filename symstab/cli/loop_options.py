@@ -188,10 +188,11 @@ def add_loop_options(p, command):
                             + (" (default: the x of the largest y)" if command == "design" else ""))
     if command == "limits":
         g.add_argument("--uncertain", metavar="NAME=LO:HI", action="append",
-                       help="the robust limits instead: of the points stable for every value "
-                            "of NAME in LO:HI (its SI unit, or the unit written after HI: "
-                            "--uncertain \"b=0.02:0.045 N*m*s/rad\"; d: the whole delays "
-                            "LO..HI), certified by zero exclusion; repeatable for a box")
+                       help="the robust limits instead: of the points stable for every value of "
+                            "NAME in LO:HI (its SI unit, or the unit written after HI: --uncertain "
+                            "\"b=0.02:0.045 N*m*s/rad\"; d: the whole delays LO..HI, or every "
+                            "delay where an end is fractional; Td=LO:HI: every delay, in time, "
+                            "1.5ms:2.5ms), certified by zero exclusion; repeatable for a box")
         g.add_argument("--strips", type=int, metavar="N",
                        help="with --uncertain: vertical strips across the plane (default 64; "
                             "more strips, a larger certified set and a longer run)")
@@ -229,7 +230,8 @@ def _add_map_options(g):
                    help="instead of one classification, the probability that each cell is "
                         "stable when NAME is drawn uniformly from LO:HI (its SI unit, or "
                         "the unit written after HI: --uncertain \"b=0.02:0.045 N*m*s/rad\"; "
-                        "d: the whole delays LO..HI); repeatable")
+                        "d: the whole delays LO..HI, drawn continuously where an end is "
+                        "fractional; Td=LO:HI in time, 1.5ms:2.5ms); repeatable")
     g.add_argument("--margin", choices=("modulus", "delay", "gain"),
                    help="instead of the classification, a margin at every stable cell: "
                         "modulus, min|1+L| on the unit circle, certified; delay, the exact "
@@ -838,11 +840,14 @@ def broadcast(values):
 
 def uncertain_box(args, setup, *, point=False):
     """``{name: (low, high)}`` of the ``--uncertain`` options, in SI, checked against the file
-    (``point``: a range of zero width allowed)."""
-    from .._validate import check_delay
+    (``point``: a range of zero width allowed).
 
+    The delay as ``d=LO:HI`` in samples (whole ends: whole delays; a
+    fractional end: a continuum) or ``Td=LO:HI`` in time (``1.5ms:2.5ms``, or
+    a unit after HI, seconds without one), once, within ``SYMSTAB_MAX_DELAY``.
+    """
     loop = setup.loop
-    others = [n for n in loop.parameters if n not in (setup.x, setup.y)]
+    others = [n for n in loop.parameters if n not in (setup.x, setup.y)] + ["Td"]
     given = {text.partition("=")[0].strip() for text in (args.set_values or [])}
     box = {}
     for text in args.uncertain:
@@ -855,23 +860,67 @@ def uncertain_box(args, setup, *, point=False):
             raise ValueError(f"--uncertain {name} is given twice; give each parameter once")
         if name in given:
             raise ValueError(f"--uncertain {name}: {name} is also given by --set; give it once")
-        if name not in loop.parameters:
+        if name not in loop.parameters and name != "Td":
             raise ValueError(f"--uncertain {name}: not a parameter of the loop in {args.loop} "
                              f"(candidates: {', '.join(others)})")
         if name in (setup.x, setup.y):
             raise ValueError(f"--uncertain {name}: {name} is an axis of the ({setup.x}, "
                              f"{setup.y}) plane; give another parameter (candidates: "
                              f"{', '.join(others)})")
+        if name == "Td":
+            box[name] = _time_range(window, point=point)
+            continue
         low, high, unit = range_text(window, f"--uncertain {name}", point=point)
         if name == "d":
-            if unit is not None or low != int(low) or high != int(high):
-                raise ValueError(f"--uncertain d: the delay is a whole number of samples: give "
-                                 f"d=LO:HI in samples, got {window!r}")
-            try:
-                box[name] = (check_delay(int(low)), check_delay(int(high)))
-            except ValueError as exc:
-                raise ValueError(f"--uncertain d: {exc}") from None
+            if unit not in (None, "samples") or low < 0:
+                raise ValueError(f"--uncertain d: the delay in samples, >= 0 (a fraction of a "
+                                 f"period included; Td=LO:HI in time), got {window!r}")
+            whole = low.is_integer() and high.is_integer()
+            box[name] = (int(low), int(high)) if whole else (low, high)
         else:
             box[name] = converted_range(setup, name, low, high, unit, flag="--uncertain")
+    _check_uncertain_delay(setup, box, given)
     check_box(setup, {k: v for k, v in box.items() if k != "d"}, "--uncertain")
     return box
+
+
+def _time_range(window, *, point):
+    """``(low, high)`` in seconds of ``--uncertain Td=LO:HI``: each end a time (``1.5ms``), or
+    the unit after HI for both, seconds without one (:func:`time_value`)."""
+    flag = "--uncertain Td"
+    head, colon, tail = window.partition(":")
+    if not colon or not head.strip() or not tail.strip():
+        raise ValueError(f"{flag} must be LO:HI, two times (1.5ms:2.5ms, or 1.5:2.5 ms), got "
+                         f"{window!r}")
+    _, unit = split_unit(tail.strip(), flag)
+    _, head_unit = split_unit(head.strip(), flag)
+    head = head.strip() if head_unit or not unit else f"{head.strip()} {unit}"
+    low, high = time_value(head, flag), time_value(tail.strip(), flag)
+    if not (low <= high if point else low < high):
+        raise ValueError(f"{flag}: LO:HI must have LO {'<=' if point else '<'} HI, got "
+                         f"{window!r}")
+    return low, high
+
+
+def _check_uncertain_delay(setup, box, given):
+    """The delay of ``--uncertain`` given once (not with ``--set``'s) and within
+    ``SYMSTAB_MAX_DELAY``; in time, over a fixed ``T``."""
+    from .._validate import split_delay
+
+    delays = [n for n in ("d", "Td") if n in box]
+    if not delays:
+        return
+    if len(delays) > 1 or {"d", "Td"} & given:
+        raise ValueError(f"--uncertain {delays[0]}: give the delay once (--uncertain d=LO:HI "
+                         f"in samples or Td=LO:HI in time, not with the other or --set)")
+    low, high = box[delays[0]]
+    if delays[0] == "Td":
+        if "T" in box:
+            raise ValueError("--uncertain Td: a delay in time over an uncertain T varies in "
+                             "samples over the box; give --uncertain d=LO:HI in samples")
+        period = {**setup.loop.defaults, **setup.values}.get("T")
+        low, high = low / period, high / period
+    try:
+        split_delay(high, name=f"--uncertain {delays[0]}" + (" / T" if delays[0] == "Td" else ""))
+    except ValueError as exc:
+        raise ValueError(str(exc)) from None

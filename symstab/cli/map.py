@@ -541,7 +541,9 @@ def _probability(args, setup, xs, ys, out, png_path):
         raise ValueError(f"--seed must be a non-negative integer, got {seed}")
     # Checked now (the counts, the seed, a delay's range), before anything is printed.
     draw_values(loop, box, samples, seed, axes=(x, y))
-    fixed = {k: v for k, v in setup.values.items() if k not in box}
+    # The delay drawn (d or Td) replaces the file's, in either form.
+    delay = {"d", "Td"} if {"d", "Td"} & set(box) else set()
+    fixed = {k: v for k, v in setup.values.items() if k not in box and k not in delay}
     check_memory(f"a map of {xs.size} x {ys.size} cells", xs.size * ys.size * _MAP_CELL_BYTES
                  + CHUNK_BYTES)
     print(LOOP_PROBABILITY_HEADLINE)

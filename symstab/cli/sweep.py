@@ -5,7 +5,9 @@ The spec (TOML) names the loop file (relative to the spec), the question
 HI]}``, one or two parameters, and ``maximize``, K_max, the Z-width or the
 passive K_max; ``region``, the D-decomposition's cells, stable pieces and
 area; ``robust`` with ``[robust] uncertain = {NAME = [LO, HI]}`` and
-``strips``, the limits of the set stable over the box; ``simulated`` with
+``strips``, the limits of the set stable over the box, the delay in it as
+``d`` or ``Td`` (every delay of the range where it is in seconds or an end
+is fractional; not swept as well); ``simulated`` with
 ``[simulated] amplitude`` and optionally ``steps``, ``x0``,
 ``encoder_resolution``, ``force_limit``, ``force_resolution`` in SI, the
 largest y a simulated run accepts), optionally the plane, the rows per chunk, and the points:
@@ -462,6 +464,8 @@ def _points(where, loop, spec, question):
         raise ValueError(f"{where}: sweep at least one parameter")
     if "d" in names and "Td" in names:
         raise ValueError(f"{where}: give the delay once: d (in samples) or Td (in time)")
+    if question.kind == "robust":
+        _check_robust_delay(where, loop, names, question.over)
     searched = [name for name, _, _ in question.over if name in names]
     if searched:
         what, section = (("uncertain", "[robust] uncertain") if question.kind == "robust"
@@ -469,6 +473,26 @@ def _points(where, loop, spec, question):
         raise ValueError(f"{where}: {searched[0]} is swept and {what}: give it in [grid] or "
                          f"[random], or in {section}, not both")
     return names, rows, how
+
+
+def _check_robust_delay(where, loop, names, over):
+    """A robust sweep's delay, given once and, in seconds, over a fixed period (as the robust
+    region takes it: :func:`symstab.numeric.analysis.robust.robust_region`), checked when the
+    spec is read, not at each row."""
+    uncertain = [name for name, _, _ in over]
+    delays = [name for name in uncertain if name in ("d", "Td")]
+    if len(delays) > 1:
+        raise ValueError(f"{where}: [robust] uncertain: give the delay range once, as d "
+                         f"(samples) or Td (seconds)")
+    swept = [name for name in names if name in ("d", "Td")]
+    if delays and swept:
+        raise ValueError(f"{where}: the delay is swept ({swept[0]}) and uncertain "
+                         f"([robust] uncertain {delays[0]}): give it in one of them")
+    given = delays or swept or [n for n in ("d", "Td") if n in loop.defaults][:1]
+    if "T" in uncertain and given == ["Td"]:
+        raise ValueError(f"{where}: [robust] uncertain T with the delay in seconds (Td): its "
+                         f"fraction of a period would vary over the box; give the delay in "
+                         f"samples, d")
 
 
 def _design(where, loop, x, y, table):

@@ -53,7 +53,8 @@ class Question:
         The plane.
     over : tuple of (str, float, float)
         ``design``: the parameters searched and their ranges (SI);
-        ``robust``: the box (``d``: whole delays).
+        ``robust``: the box (``d``: the delays in samples, whole ends each whole
+        delay, a fractional end every delay; ``Td``: every delay, in seconds).
     maximize : str
         ``design``: ``"y_max"``, ``"area"`` or ``"passive"``.
     strips : int

@@ -17,7 +17,7 @@ __all__ = [
     "z_transform_by_residues", "written_poles", "zoh_pulse_transfer_function",
     "fractional_zoh_pulse_transfer_function", "fractional_delay_identities", "numeric_zoh",
     "numeric_fractional_zoh",
-    "interval_zoh", "interval_product",
+    "interval_zoh", "interval_fractional_zoh", "interval_product",
     "pulse_transfer_function",
     "dimensionless_pulse_transfer_function",
 ]
@@ -519,6 +519,125 @@ def interval_zoh(numerator, denominator, T):
         If the denominator's leading coefficient can vanish, or the plant
         is not proper.
     """
+    rest, direct, n, A = _interval_realisation(numerator, denominator)
+    X = _interval_expm1(_scaled(A, T), n + 1)
+    entries = _shifted_entries(X, n)
+    p_d = _poly_det(entries)
+    gamma = [X[j][n] for j in range(n)]
+    term = _adjugate_term(_cofactors(entries, rest), rest, gamma)
+    return _poly_add([direct * c for c in p_d], term), p_d
+
+
+def interval_fractional_zoh(numerator, denominator, T):
+    """Enclosures of the fractional-delay plant's ``(N_eps, z P_d)`` in ``w = z - 1``, per interval of ``eps``.
+
+    The interval counterpart of :func:`numeric_fractional_zoh` and the
+    fractional one of :func:`interval_zoh` (same realisation): returns a
+    function of an interval ``eps`` of the fraction of a period (within
+    [0, 1]) whose enclosures hold for every ``eps`` in it.  With ``Gamma0 =
+    int_0^((1 - eps) T) exp(A s) ds B`` and ``Gamma = Gamma0 + Gamma1`` (the
+    whole period's; ``Gamma1 = exp(A (1 - eps) T) int_0^(eps T) exp(A s) ds B``
+    is the rest of the integral), ``P_eps = C (z I - Phi)^-1 (Gamma0 +
+    Gamma1 / z) = N_eps / (z P_d)`` with::
+
+        N_eps = z L0 + (P_n - L0) = w L0 + P_n,   L0 = C adj(w I - (Phi - I)) Gamma0,
+
+    ``P_n, P_d`` :func:`interval_zoh`'s and ``L0`` by the same cofactors.
+    Only ``Gamma0`` depends on ``eps``, and only through ``w L0``: the
+    integrator's pole ``z = 1`` is kept as by :func:`interval_zoh`,
+    ``N_eps(1) = P_n(1)`` whatever the width of ``eps``, and what does not depend on ``eps`` (``Phi``, ``P_n``,
+    ``z P_d``, the cofactors) is computed once, here.  At ``eps = 1``
+    (``Gamma0 = 0``) ``N_eps`` is ``P_n``: the plant of one more whole
+    sample, so that the pieces of a delay range meet; at ``eps = 0`` it is
+    ``z P_n``.
+
+    Parameters
+    ----------
+    numerator, denominator : list of mpmath.iv.mpf
+        ``G``'s numerator and denominator coefficients in ``s``, highest
+        power first; ``G`` strictly proper.
+    T : mpmath.iv.mpf
+        The sample period.
+
+    Returns
+    -------
+    callable
+        ``eps -> (N_eps, z P_d)``, ``eps`` an :class:`mpmath.iv.mpf` within
+        [0, 1]: ``N_eps`` (of the plant's order) and ``z P_d`` (monic, of the
+        order plus one) in powers of ``w = z - 1``, highest first, lists of
+        :class:`mpmath.iv.mpf` at the precision of the call.
+
+    Raises
+    ------
+    ValueError
+        As :func:`interval_zoh`; and for a direct feedthrough (here), or an
+        ``eps`` not within [0, 1] (by the function).
+
+    Examples
+    --------
+    >>> from mpmath import iv
+    >>> at = interval_fractional_zoh([iv.mpf(1)], [iv.mpf(1), iv.mpf(0)], iv.mpf(1))
+    >>> n_eps, z_p_d = at(iv.mpf([0.25, 0.5]))       # G = 1/s: ((1 - eps) z + eps) / (z (z - 1))
+    >>> [(round(float(c.a), 9), round(float(c.b), 9)) for c in n_eps]
+    [(0.5, 0.75), (1.0, 1.0)]
+    >>> [(round(float(c.a), 9), round(float(c.b), 9)) for c in z_p_d[:2]], float(z_p_d[2].b) < 1e-40
+    ([(1.0, 1.0), (1.0, 1.0)], True)
+    """
+    from mpmath import iv
+
+    rest, direct, n, A = _interval_realisation(numerator, denominator)
+    if not (direct.a == 0 and direct.b == 0):
+        raise ValueError("G(s) must be strictly proper for a fractional delay: a direct "
+                         "feedthrough makes the output jump inside the period")
+    X = _interval_expm1(_scaled(A, T), n + 1)
+    entries = _shifted_entries(X, n)
+    p_d = _poly_det(entries)
+    cofactors = _cofactors(entries, rest)
+    p_n = _adjugate_term(cofactors, rest, [X[j][n] for j in range(n)])
+    z_p_d = _poly_add(p_d + [iv.mpf(0)], p_d)
+
+    starts = {}
+
+    def at(eps):
+        if not (eps.a >= 0 and eps.b <= 1):
+            raise ValueError(f"eps must be within [0, 1] (a fraction of a period), got {eps}")
+        l0 = _adjugate_term(cofactors, rest, _late_integral(A, n, (1 - eps) * T, starts))
+        # L0 has degree n - 1 (its first of n + 1 terms is an exact 0): w L0 is its
+        # terms moved up by one, within n + 1 terms.
+        return _poly_add(l0[1:] + [iv.mpf(0)], p_n), list(z_p_d)
+
+    return at
+
+
+def _late_integral(A, n, tau, starts):
+    """``Gamma0 = int_0^tau exp(A s) ds B`` over an interval ``tau = [t0, t1]``, enclosed as
+    ``Gamma0(t0) + exp(A t0) Gamma0([0, t1 - t0])``.
+
+    The exponential at the point ``t0`` (kept in ``starts``: the halves of an
+    interval share an end) is as narrow as the working precision; the one over
+    the interval starts at 0 and is as wide as the interval, whose Taylor terms
+    then hardly overestimate -- unlike ``exp(A tau)`` with ``tau`` wide, whose
+    squarings multiply the interval's width (an actuator's fast pole: a hundred
+    times the true spread of ``N_eps``).
+    """
+    from mpmath import iv
+
+    start = iv.mpf(tau.a)
+    key = start._mpi_
+    if key not in starts:
+        starts[key] = _interval_expm1(_scaled(A, start), n + 1)
+    head = starts[key]
+    tail = _interval_expm1(_scaled(A, tau - start), n + 1)
+    return [head[j][n] + tail[j][n] + sum((head[j][k] * tail[k][n] for k in range(n)), iv.mpf(0))
+            for j in range(n)]
+
+
+def _interval_realisation(numerator, denominator):
+    """``(rest, direct, n, A)``: :func:`_realisation` of interval coefficients, before the period.
+
+    ``A`` is the augmented ``[[A, B], [0, 0]]`` as a list of rows (exact
+    zeros where the companion form has them), ``rest`` the row ``C``.
+    """
     from mpmath import iv
 
     den = list(denominator)
@@ -542,31 +661,63 @@ def interval_zoh(numerator, denominator, T):
     num = [iv.mpf(0)] * (n + 1 - len(num)) + num
     direct = num[0]
     rest = [num[k] - direct * den[k] for k in range(1, n + 1)]
-    A = [[iv.mpf(0)] * (n + 1) for _ in range(n + 1)]
+    A = [[None] * (n + 1) for _ in range(n + 1)]
     for j in range(n):
-        A[0][j] = -den[j + 1] * T
+        A[0][j] = -den[j + 1]
     for i in range(1, n):
-        A[i][i - 1] = T
-    A[0][n] = T
-    X = _interval_expm1(A, n + 1)
-    # w I - Psi as a matrix of polynomials in w; its determinant and
-    # adjugate by cofactors, so that an exact zero of Psi (an integrator's
-    # column) stays an exact zero of P_d(1).
-    entries = [[[iv.mpf(1), -X[i][j]] if i == j else [-X[i][j]] for j in range(n)]
-               for i in range(n)]
-    p_d = _poly_det(entries)
-    p_n = [direct * c for c in p_d]
+        A[i][i - 1] = iv.mpf(1)
+    A[0][n] = iv.mpf(1)
+    return rest, direct, n, A
+
+
+def _scaled(A, t):
+    """``A t`` (exact zeros, None in ``A``, kept exact)."""
+    from mpmath import iv
+
+    return [[iv.mpf(0) if c is None else c * t for c in row] for row in A]
+
+
+def _shifted_entries(X, n):
+    """``w I - Psi`` (``Psi`` the top-left ``n x n`` block of ``X``) as a matrix of polynomials in
+    ``w``: its determinant and adjugate by cofactors keep an exact zero column of ``Psi`` (an
+    integrator's) an exact zero of ``P_d(1)``."""
+    from mpmath import iv
+
+    return [[[iv.mpf(1), -X[i][j]] if i == j else [-X[i][j]] for j in range(n)]
+            for i in range(n)]
+
+
+def _cofactors(entries, rest):
+    """``{(i, j): (-1)**(i + j) det(minor without row j, column i)}`` of ``entries``
+    (:func:`_shifted_entries`), for the ``i`` where ``C`` (``rest``) is not an exact 0: the
+    adjugate's entries that ``C adj(w I - Psi)`` reads."""
+    from mpmath import iv
+
+    n = len(entries)
+    out = {}
     for i in range(n):
+        if rest[i].a == 0 and rest[i].b == 0:
+            continue
         for j in range(n):
-            weight = rest[i] * X[j][n]
-            if weight.a == 0 and weight.b == 0:
-                continue
             minor = [[entries[r][c] for c in range(n) if c != i] for r in range(n) if r != j]
             cofactor = _poly_det(minor) if minor else [iv.mpf(1)]
-            sign = -1 if (i + j) % 2 else 1
-            for k, c in enumerate(reversed(cofactor)):
-                p_n[n - k] += sign * weight * c
-    return p_n, p_d
+            out[i, j] = [-c for c in cofactor] if (i + j) % 2 else cofactor
+    return out
+
+
+def _adjugate_term(cofactors, rest, gamma):
+    """``C adj(w I - Psi) Gamma`` from :func:`_cofactors`, ``n + 1`` terms in ``w``."""
+    from mpmath import iv
+
+    n = len(rest)
+    out = [iv.mpf(0)] * (n + 1)
+    for (i, j), cofactor in cofactors.items():
+        weight = rest[i] * gamma[j]
+        if weight.a == 0 and weight.b == 0:
+            continue
+        for k, c in enumerate(reversed(cofactor)):
+            out[n - k] += weight * c
+    return out
 
 
 #: The largest plant order :func:`interval_zoh` takes (its determinants are

@@ -65,6 +65,22 @@ def test_a_delay_drawn_and_the_csv(capsys, tmp_path):
         assert abs(p - expected) <= 3 * np.sqrt(expected * (1 - expected) / 100) + 1e-12
 
 
+def test_a_delay_in_time_drawn_is_the_library_s(capsys, tmp_path):
+    """``--uncertain Td=5ms:15ms`` draws the delay in time (the file's d = 40 not kept beside
+    it): the library's map with ``uncertain={"Td": (0.005, 0.015)}``."""
+    out = tmp_path / "p.npz"
+    status, text, err = run(capsys, "map", "--loop", PAPER, "--uncertain", "Td=5ms:15ms",
+                            "--samples", "40", "--x-range=0.75,1.5,2", "--y-range=25,40,2",
+                            "--out", out, "--no-png")
+    assert status == 0, err
+    found = symstab.load_loop(PAPER).stability_probability(
+        np.linspace(0.75, 1.5, 2), np.linspace(25, 40, 2), uncertain={"Td": (0.005, 0.015)},
+        samples=40, seed=0)
+    with np.load(out) as f:
+        np.testing.assert_array_equal(f["probability"], found.probability.T)
+    assert np.count_nonzero((found.probability > 0) & (found.probability < 1)) >= 1
+
+
 @pytest.mark.parametrize("args, needle", [
     (["--uncertain", "b=0.01:0.02"], "--uncertain needs a loop file"),
     (["--loop", PAPER, *GRID, "--uncertain", "K=1:2"], "K is an axis"),
@@ -73,7 +89,8 @@ def test_a_delay_drawn_and_the_csv(capsys, tmp_path):
     (["--loop", PAPER, *GRID, "--uncertain", "b=0.05:0.01"], "LO < HI"),
     (["--loop", PAPER, *GRID, "--uncertain", "b=0.01:nan"], "--uncertain b must be LO:HI"),
     (["--loop", PAPER, *GRID, "--uncertain", "b=1:2 Hz"], "Hz"),
-    (["--loop", PAPER, *GRID, "--uncertain", "d=1.5:3"], "whole number"),
+    (["--loop", PAPER, *GRID, "--uncertain", "d=-1:3"], "--uncertain d: the delay in samples, >= 0"),
+    (["--loop", PAPER, *GRID, "--uncertain", "Td=3ms:2ms"], "--uncertain Td: LO:HI must have LO < HI"),
     (["--loop", PAPER, *GRID, "--uncertain", "b=0.01:0.02", "--uncertain", "b=0.01:0.03"],
      "given twice"),
     (["--loop", PAPER, *GRID, "--uncertain", "b=0.01:0.02", "--samples", "0"], "samples"),

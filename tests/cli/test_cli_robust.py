@@ -49,6 +49,26 @@ def test_robust_limits_over_delays_and_the_empty_set(capsys):
     assert "the robust set is empty" in text and "no common point" in text
 
 
+def test_robust_limits_over_a_continuum_of_delays(capsys):
+    """``--uncertain Td=1.5ms:2.5ms`` (or a unit after HI, or ``d=1.5:2.5`` in samples) is the
+    library's robust set for every delay of the range."""
+    lim = symstab.load_loop(PAPER).limits("B", "K", uncertain={"Td": (0.0015, 0.0025)},
+                                          strips=4, M=0.0)
+    for option in ("Td=1.5ms:2.5ms", "Td=1.5:2.5 ms", "d=1.5:2.5"):
+        status, text, err = run(capsys, "limits", "--loop", PAPER, "--set", "M=0",
+                                "--uncertain", option, "--strips", "4", "--format", "json")
+        assert status == 0, err
+        found = json.loads(text)
+        assert found["limits"]["y_max"] == pytest.approx(lim.y_max, rel=1e-12)
+        assert found["limits"]["area"] == pytest.approx(lim.area, rel=1e-12)
+    assert found["robust"]["uncertain"] == {"d": [1.5, 2.5]}
+    status, text, err = run(capsys, "limits", "--loop", PAPER, "--set", "M=0",
+                            "--uncertain", "Td=1.5ms:2.5ms", "--strips", "4")
+    assert status == 0, err
+    assert "stable for every Td in [0.0015, 0.0025] s" in text
+    assert "2 piece(s) of a continuum of delays" in err
+
+
 def test_a_box_ending_at_zero_is_certified_and_the_strip_count_explained(capsys):
     """b in [0, 0.0324]: refused as "not defined at b = 0" (a box holding 0 inside worked).
 
@@ -102,7 +122,18 @@ def test_a_box_of_zero_width_is_the_nominal_set(capsys):
     (("--uncertain", "b=0.01:0.05", "--png", "x.txt"), "--png"),
     (("--strips", "8"), "--uncertain"),
     (("--png", "x.png"), "--uncertain"),
-    (("--uncertain", "d=1.5:3"), "whole number"),
+    (("--uncertain", "d=-1.5:3"), "--uncertain d: the delay in samples, >= 0"),
+    (("--uncertain", "d=1:2 ms"), "--uncertain d: the delay in samples"),
+    (("--uncertain", "Td=-1ms:2ms"), "--uncertain Td must be a finite real number >= 0"),
+    (("--uncertain", "Td=nan:2ms"), "--uncertain Td: 'nan ms' is not a number"),
+    (("--uncertain", "Td=3ms:2ms"), "--uncertain Td: LO:HI must have LO <= HI"),
+    (("--uncertain", "Td=2ms"), "--uncertain Td must be LO:HI"),
+    (("--uncertain", "Td=1ms:1e6ms"), "SYMSTAB_MAX_DELAY"),
+    (("--uncertain", "d=1.5:1e9"), "SYMSTAB_MAX_DELAY"),
+    (("--uncertain", "Td=1:2 kg"), "--uncertain Td"),
+    (("--uncertain", "Td=1ms:2ms", "--uncertain", "T=0.0009:0.0011"), "over an uncertain T"),
+    (("--uncertain", "Td=1ms:2ms", "--uncertain", "d=1:2"), "give the delay once"),
+    (("--set", "d=10", "--uncertain", "Td=1ms:2ms"), "give the delay once"),
     (("--set", "b=0.03", "--uncertain", "b=0.01:0.05"), "also given by --set"),
     (("--set", "d=10", "--uncertain", "d=8:12"), "also given by --set"),
     # Refused by the library, before any work: still one line, naming the option.
@@ -110,7 +141,7 @@ def test_a_box_of_zero_width_is_the_nominal_set(capsys):
 ])
 def test_bad_options_are_one_line(capsys, tmp_path, args, message):
     args = [a.replace("x.png", str(tmp_path / "x.png")) for a in args]
-    delay = () if any(a.startswith("d=") for a in args) else ("--set", "d=10")
+    delay = () if any(a.startswith(("d=", "Td=")) for a in args) else ("--set", "d=10")
     status, text, err = run(capsys, "limits", "--loop", PAPER, *delay, *args)
     assert status == 2
     assert message in err and len(err.strip().splitlines()) == 1

@@ -368,6 +368,13 @@ def test_without_dask_the_message_says_what_to_install(capsys, tmp_path, monkeyp
      "swept and uncertain"),
     ('question = "robust"\n[grid]\nd = [3]\n[robust]\nuncertain = { K = [1, 2] }\n',
      "K is an axis"),
+    ('question = "robust"\n[grid]\nd = [3]\n[robust]\n'
+     'uncertain = { Td = { range = [1, 2], unit = "ms" } }\n',
+     "the delay is swept (d) and uncertain ([robust] uncertain Td)"),
+    ('question = "robust"\n[grid]\nb = [0.03]\n[robust]\n'
+     'uncertain = { d = [1, 2], Td = [0.001, 0.002] }\n', "give the delay range once"),
+    ('question = "robust"\n[grid]\nTd = { values = [2.5], unit = "ms" }\n[robust]\n'
+     'uncertain = { T = [0.0009, 0.0011] }\n', "its fraction of a period would vary"),
     ('question = "simulated"\n[grid]\nd = [3]\n[simulated]\nsteps = 100\n',
      "amplitude"),
     ('question = "simulated"\n[grid]\nd = [3]\n[simulated]\namplitude = -1\n',
@@ -485,6 +492,27 @@ def test_bad_options_are_one_line(capsys, tmp_path, monkeypatch, args, needle):
     status, out, err = run(capsys, "sweep", path, *args)
     assert status == 2 and needle in err.strip().splitlines()[-1], err
     assert list((tmp_path / "work").iterdir()) == []
+
+
+def test_a_robust_sweep_over_a_continuum_of_delays(capsys, tmp_path):
+    """[robust] uncertain Td in ms is every delay of the range, and a fractional d in [grid]
+    is that delay: each row is Loop.limits with them (the spec read, not refused)."""
+    loop = symstab.load_loop(LOOPS / "paper.toml")
+    path = spec(tmp_path, 'question = "robust"\n[grid]\nb = [0.0324]\n[robust]\n'
+                          'uncertain = { Td = { range = [1.5, 2.5], unit = "ms" } }\n'
+                          'strips = 4\n', "t.toml")
+    status, text, err = run(capsys, "sweep", path, "--out", tmp_path / "t.csv", "--serial")
+    assert status == 0, err
+    _, rows = read_csv(tmp_path / "t.csv")
+    found = loop.limits("B", "K", uncertain={"Td": (0.0015, 0.0025)}, strips=4, b=0.0324)
+    assert rows[0][1] == pytest.approx(found.y_max, rel=1e-11) and found.y_max > 0
+    path = spec(tmp_path, 'question = "robust"\n[grid]\nd = [2.5]\n[robust]\n'
+                          'uncertain = { b = [0.03, 0.035] }\nstrips = 4\n', "f.toml")
+    status, text, err = run(capsys, "sweep", path, "--out", tmp_path / "f.csv", "--serial")
+    assert status == 0, err
+    _, rows = read_csv(tmp_path / "f.csv")
+    found = loop.limits("B", "K", uncertain={"b": (0.03, 0.035)}, strips=4, d=2.5)
+    assert rows[0][1] == pytest.approx(found.y_max, rel=1e-11) and found.y_max > 0
 
 
 def test_robust_region_and_simulated_rows_are_the_loop_s(capsys, tmp_path, monkeypatch):

@@ -15,6 +15,21 @@ The piece of the plane, the box and [0, pi] are connected, so by 2 and 3 the
 number of roots outside the circle is the same everywhere on it, and by 1 it
 is 0.
 
+Delays.  A range of whole delays (``uncertain={"d": (8, 12)}``) is each of
+them.  A range in seconds (``Td``) or with a fractional end (``d = (1.5,
+2.25)``) is every delay of the continuum ``(d + eps) T``: it is split by
+whole part ``d``, ``eps`` in ``[eps0, eps1]`` within [0, 1] for each (``eps =
+1`` is ``d + 1`` samples), and ``eps`` is one more side of the box, halved
+like the others (:data:`FRACTION_DEPTH` more times).  The plant then carries
+the fraction (the modified z-transform, ``chi = z**d (z P_d) Ve_d + N_eps
+Ve_n``), enclosed over an interval of ``eps`` by
+:func:`symstab.symbolic.discretize.interval_fractional_zoh` (``N_eps = w L0 +
+P_n``: only ``w L0`` depends on ``eps``, so ``z = 1`` stays the integrator's
+pole however wide the interval).  Each piece of delays is connected and 1 is
+checked at a delay of each, so the guarantee holds for every delay of the
+range, not a sample of them.  A fractional nominal delay is a piece of no
+width.
+
 How zero exclusion is proved.  The plane is cut into vertical strips ``x``
 in ``[x0, x1]``; each strip holds *pieces*, trapezoids whose bottom and top
 run straight from an interval of ``y`` at ``x0`` to one at ``x1``; a point
@@ -49,7 +64,8 @@ never counted stable.
 
 Where to look.  A strip's pieces join, in order, the intervals of ``y`` its
 two edges hold in common over a grid of values of the box (its corners,
-centre and midpoints) and every delay (the one line engine,
+centre and midpoints) and every whole delay, or the ends and middle of each
+piece of a continuum of delays (the one line engine,
 :meth:`symstab.Loop.stable_intervals`): a point of an edge outside them is
 unstable at one of those values.  Where the edges hold different numbers
 of intervals (a corner, an end of the set) the strip is halved, down to
@@ -74,16 +90,27 @@ import sympy as sp
 from mpmath.libmp import to_float
 
 from ..._resources import chunk_slices
-from ..._validate import check_count, check_delay, check_progress, check_real, check_window
+from ..._validate import (
+    check_count,
+    check_delay,
+    check_progress,
+    check_real,
+    check_window,
+    snap_delay,
+    split_delay,
+)
 from ...symbolic import model
-from ...symbolic.discretize import interval_product, interval_zoh
+from ...symbolic.discretize import interval_fractional_zoh, interval_product, interval_zoh
 from ...symbolic.loop_assembly import poly_coeffs
 from ..engine.results import RobustRegion
 
-__all__ = ["robust_region", "BOX_DEPTH", "MAX_CELLS"]
+__all__ = ["robust_region", "BOX_DEPTH", "FRACTION_DEPTH", "MAX_CELLS"]
 
 #: Most halvings of the uncertain box along one branch of the search.
 BOX_DEPTH = 10
+#: More halvings along a branch when the box has a fraction of a period as a side
+#: (a range of delays): a side more to halve.
+FRACTION_DEPTH = 4
 #: Most cells (strip x y x theta x sub-box) examined in one robust region;
 #: what is left then is marginal.
 MAX_CELLS = 20_000_000
@@ -181,11 +208,16 @@ class _Enclosures:
     each.  ``mid`` and ``rad`` hold, per sub-box, ``(3 parts, 2 kinds,
     terms)``: the parts ``A0, Ax, Ay``, the kinds the delayed ``Ve_d P_d``
     and direct ``Ve_n P_n`` polynomials, highest power of ``w`` first.
+    With a ``fraction`` ``(eps0, eps1)`` of a period, the box has one more
+    side, ``eps``, and the kinds are ``Ve_d (z P_d)`` and ``Ve_n N_eps``
+    (:func:`~symstab.symbolic.discretize.interval_fractional_zoh`): ``chi``
+    over the delays ``(d + eps) T`` for the ``d`` of the shift.
     """
 
-    def __init__(self, loop, x, y, box, fixed):
+    def __init__(self, loop, x, y, box, fixed, fraction=None):
         self.names = tuple(box)
         self.fixed = fixed
+        self.fractional = fraction is not None
         symbols = {str(s): s for s in loop.symbols.values()}
         ve_n, ve_d = loop.environment_parts
         k = loop.environment_delay
@@ -204,11 +236,15 @@ class _Enclosures:
         self.environment = [(in_w(ve_d, slope), in_w(ve_n, slope)) for slope in (None, x, y)]
         num, den = sp.fraction(sp.cancel(sp.together(loop.plant)))
         self.plant = (poly_coeffs(num, model.s), poly_coeffs(den, model.s))
-        self.boxes = [np.array([box[n] for n in self.names], dtype=float).reshape(-1, 2)]
-        self.depth = [0]
+        sides = [box[n] for n in self.names] + ([fraction] if self.fractional else [])
+        self.boxes = [np.array(sides, dtype=float).reshape(-1, 2)]
+        # A box of no width (one value, one fraction of a period) is never halved.
+        self.most_depth = BOX_DEPTH + (FRACTION_DEPTH if self.fractional else 0)
+        self.depth = [0 if np.any(self.boxes[0][:, 1] > self.boxes[0][:, 0]) else self.most_depth]
         self._children = {}
         self.mid, self.rad = [], []
         self._stacked = None
+        self._fractions = {}
         with _LOCK:
             self._enclose(0)
 
@@ -218,10 +254,9 @@ class _Enclosures:
         iv.dps = _DIGITS
         try:
             values = {n: iv.mpf(float(v)) for n, v in self.fixed.items()}
-            for name, (lo, hi) in zip(self.names, self.boxes[index], strict=True):
-                values[name] = iv.mpf([float(lo), float(hi)])
-            plant = [[_bound(c, values) for c in part] for part in self.plant]
-            p_n, p_d = interval_zoh(*plant, values["T"])
+            sides = [iv.mpf([float(lo), float(hi)]) for lo, hi in self.boxes[index]]
+            values.update(zip(self.names, sides, strict=False))
+            p_n, p_d = self._plant(index, values, sides[-1] if self.fractional else None)
             mids, rads = [], []
             for ve_d, ve_n in self.environment:
                 parts = (interval_product([_bound(c, values) for c in ve_d], p_d),
@@ -243,6 +278,19 @@ class _Enclosures:
         self.rad.append(rad)
         self.sizes = (n_d, n_n)
 
+    def _plant(self, index, values, eps):
+        """The plant's interval parts over sub-box ``index`` (``values``: its sides'):
+        ``(P_n, P_d)``, or ``(N_eps, z P_d)`` over ``eps`` when fractional, the part free
+        of ``eps`` kept per box of the other sides (halving ``eps`` alone reuses it)."""
+        if not self.fractional:
+            return interval_zoh(*[[_bound(c, values) for c in part] for part in self.plant],
+                                values["T"])
+        key = self.boxes[index][:-1].tobytes()
+        if key not in self._fractions:
+            self._fractions[key] = interval_fractional_zoh(
+                *[[_bound(c, values) for c in part] for part in self.plant], values["T"])
+        return self._fractions[key](eps)
+
     def stacked(self):
         """``(mid, rad)`` of every sub-box enclosed so far, as two arrays (stacked again only
         when sub-boxes were added)."""
@@ -258,7 +306,10 @@ class _Enclosures:
     def _halves(self, index):
         if index not in self._children:
             box = self.boxes[index]
-            width = (box[:, 1] - box[:, 0]) / np.maximum(np.abs(box).max(axis=1), 1e-300)
+            scale = np.maximum(np.abs(box).max(axis=1), 1e-300)
+            if self.fractional:
+                scale[-1] = 1.0         # eps: in periods (its own size would halve it first)
+            width = (box[:, 1] - box[:, 0]) / scale
             side = int(np.argmax(width))
             middle = 0.5 * (box[side, 0] + box[side, 1])
             pair = []
@@ -290,18 +341,19 @@ class _Enclosures:
         return lead_mid, lead_rad
 
 
-def _enclosures_of(loop, x, y, box, fixed):
+def _enclosures_of(loop, x, y, box, fixed, fraction=None):
     """The loop's :class:`_Enclosures` over ``box``, kept (:data:`_KEPT_ENCLOSURES`) by what
     they are made of -- the plant, the environment, the plane and the values, not the loop
     object -- with the sub-boxes enclosed so far (each is enclosed the same way whenever it
-    is asked for, so a kept one gives the same region)."""
+    is asked for, so a kept one gives the same region); ``fraction`` as :class:`_Enclosures`."""
     key = (sp.srepr(loop.plant), sp.srepr(tuple(loop.environment_parts)),
-           loop.environment_delay, x, y, tuple(box.items()), tuple(sorted(fixed.items())))
+           loop.environment_delay, x, y, tuple(box.items()), tuple(sorted(fixed.items())),
+           fraction)
     with _LOCK:
         if key in _ENCLOSURES:
             _ENCLOSURES.move_to_end(key)
             return _ENCLOSURES[key]
-        enclosures = _Enclosures(loop, x, y, box, fixed)
+        enclosures = _Enclosures(loop, x, y, box, fixed, fraction)
         _ENCLOSURES[key] = enclosures
         while len(_ENCLOSURES) > _KEPT_ENCLOSURES:
             _ENCLOSURES.popitem(last=False)
@@ -406,7 +458,9 @@ def _excluded(enclosures, shift, theta, h, box, piece):
     round_a = rounding[:, 0] + (ax + hx) * rounding[:, 1]
     round_b = rounding[:, 2]
     strip_y = _failing(P, Y, theta_a + box_a + strip_a + round_a, theta_b + box_b + round_b)
-    fixed_y = _failing(P, Y, strip_a + round_a, round_b)
+    # What no halving removes: the strip's width times |Ax| at the cell's middle (its
+    # theta-width and radii are the halvings' to remove), and the rounding.
+    fixed_y = _failing(P, Y, hx * np.abs(value[:, 1]) + round_a, round_b)
     strip = [piece.to_t(lo, hi) for lo, hi in strip_y]
     y_lo = np.minimum(piece.lo0, piece.lo1)
     y_hi = np.maximum(piece.hi0, piece.hi1)
@@ -800,7 +854,7 @@ def _certify(enclosures, shift, geometry, candidates, tol, budget):
         reducible = reducible[meets]
         parts = [(lo[meets], hi[meets]) for lo, hi in parts]
         can_theta = (c.t1 - c.t0) > _THETA_WIDTH
-        can_box = np.array(enclosures.depth)[c.box] < BOX_DEPTH
+        can_box = np.array(enclosures.depth)[c.box] < enclosures.most_depth
         # Done when what is left open, or what halving could still remove,
         # is within the resolution, or the width that costs more cannot be
         # halved again (halving the other would not close the cell).
@@ -835,68 +889,74 @@ def _grid(box):
     return [dict(zip(box, point, strict=True)) for point in itertools.product(*axes)]
 
 
-#: Why a delay range in seconds or in fractions of a period is refused.
-_FRACTIONAL_RANGE = ("{where} = {spec!r}: robust regions take a delay range in whole samples, "
-                     "uncertain={{'d': (low, high)}} with whole ends (each whole delay in it is "
-                     "certified); a range in seconds or with a fractional end holds a continuum "
-                     "of fractional delays, which the zero exclusion does not cover")
+@dataclasses.dataclass(frozen=True)
+class _DelayPiece:
+    """The delays ``(d + eps) T`` of one whole part ``d``, ``eps`` in ``fraction = (eps0, eps1)``
+    (``0 <= eps0 <= eps1 <= 1``; ``eps = 1`` is ``d + 1`` samples), every one of them; or, with
+    ``fraction`` None, the whole delay ``d`` alone."""
+
+    d: int
+    fraction: tuple = None
+
+    @property
+    def samples(self):
+        """The delays in samples the candidates are found at: ``d``, or the ends and middle."""
+        if self.fraction is None:
+            return (self.d,)
+        low, high = self.fraction
+        return tuple(sorted({self.d + low, self.d + 0.5 * (low + high), self.d + high}))
+
+    @property
+    def middle(self):
+        """The delay in samples the root counts are taken at."""
+        return self.samples[len(self.samples) // 2]
 
 
-def _whole(value):
-    """Whether ``value`` is a real number with no fraction (its checks come later)."""
-    try:
-        return float(value).is_integer()
-    except (TypeError, ValueError):
-        return True
+def _delay_pieces(low, high, name):
+    """Every delay from ``low`` to ``high`` samples, as :class:`_DelayPiece` (one per whole part).
 
-
-def _whole_delay(loop, values, box, delays):
-    """``values`` with the delay in whole samples ``d`` (a ``Td`` given, or the loop's, turned
-    into ``d``); a fractional one refused: the plant's interval enclosures are of whole-sample
-    pulse transfer functions."""
-    shown = values if {"d", "Td"} & set(values) else loop.defaults
-    if delays is not None or "d" in shown or "Td" not in shown:
-        d = shown.get("d", 0)
-        if delays is None and not _whole(d):
-            raise ValueError(f"robust regions take a whole delay d (samples), got d = {d!r}: "
-                             f"give d = N, or a range of whole delays in uncertain")
-        return {k: v for k, v in values.items() if k != "Td"}
-    period = box.get("T") or values.get("T", loop.defaults.get("T"))
-    if isinstance(period, tuple):
-        raise ValueError(f"robust regions take a whole delay d (samples): a delay Td = "
-                         f"{shown['Td']!r} s over an uncertain T is fractional; give d = N")
-    samples = check_real("Td", shown["Td"], low=0.0) / check_real("T", period, low=0.0,
-                                                                   low_open=True)
-    if abs(samples - round(samples)) > 1e-9 * max(1.0, samples):
-        raise ValueError(f"robust regions take a whole delay d (samples), got Td = "
-                         f"{shown['Td']!r} s = {samples:.6g} samples: give d = N, or a range "
-                         f"of whole delays in uncertain")
-    return {**{k: v for k, v in values.items() if k != "Td"}, "d": int(round(samples))}
+    The ends are first taken as :func:`~symstab._validate.snap_delay` does
+    (within 1e-9 of a whole number, that number); an end that is not whole is
+    then moved out by a few units of rounding (the ratio ``Td / T`` of two
+    floats), so that the pieces hold the range given.
+    """
+    low, high = (float(v) for v in snap_delay([low, high]))
+    split_delay(high, name=name)        # within SYMSTAB_MAX_DELAY
+    if low == high:
+        d, eps = split_delay(low, name=name)
+        return (_DelayPiece(d, None if eps is None else (float(eps), float(eps))),)
+    low = low if low.is_integer() else max(low - 4 * _EPS * low, np.floor(low))
+    high = high if high.is_integer() else min(high + 4 * _EPS * high, np.ceil(high))
+    return tuple(_DelayPiece(d, (max(low - d, 0.0), min(high - d, 1.0)))
+                 for d in range(int(np.floor(low)), int(np.ceil(high))))
 
 
 def _check_uncertain(loop, uncertain, axes):
-    """``(box, delays)``: the continuous parameters' (lo, hi) and the delays, checked."""
+    """``(box, delay)``: the continuous parameters' (lo, hi), and the delay range as given,
+    ``("d" or "Td", (lo, hi))`` (None: none), checked."""
     if not isinstance(uncertain, dict) or not uncertain:
         raise TypeError(f"uncertain must be a non-empty dict {{name: (low, high)}}, got "
                         f"{uncertain!r}")
-    box, delays = {}, None
+    box, delay = {}, None
     for name, spec in uncertain.items():
         where = f"uncertain[{name!r}]"
-        if name == "Td" or (name == "d" and isinstance(spec, (tuple, list)) and len(spec) == 2
-                            and not all(_whole(v) for v in spec)):
-            raise ValueError(_FRACTIONAL_RANGE.format(where=where, spec=spec))
-        if name not in loop.parameters:
+        if name not in loop.parameters and name != "Td":
             raise ValueError(f"uncertain: {name!r} is not a parameter of the loop (its "
-                             f"parameters: {', '.join(loop.parameters)})")
+                             f"parameters: {', '.join(loop.parameters)}; Td: the delay in "
+                             f"seconds)")
         if name in axes:
             raise ValueError(f"uncertain: {name} is an axis of the ({axes[0]}, {axes[1]}) plane")
         if not isinstance(spec, (tuple, list)) or len(spec) != 2:
             raise TypeError(f"{where} must be (low, high), got {spec!r}")
-        if name == "d":
-            low, high = check_delay(spec[0]), check_delay(spec[1])
-            if low > high:
+        if name in ("d", "Td"):
+            if delay is not None:
+                raise ValueError("uncertain: give the delay range once, as d (samples) or Td "
+                                 "(seconds)")
+            low, high = (check_real(f"{where} bounds", v, low=0.0) for v in spec)
+            if not low <= high:
                 raise ValueError(f"{where}: (low, high) must have low <= high, got {spec!r}")
-            delays = list(range(low, high + 1))
+            whole = name == "d" and low.is_integer() and high.is_integer()
+            delay = (name, (int(low), int(high)) if whole else (low, high))
             continue
         low, high = (check_real(f"{where} bounds", v) for v in spec)
         if not low <= high:
@@ -904,7 +964,42 @@ def _check_uncertain(loop, uncertain, axes):
         if name == "T" and low <= 0:
             raise ValueError(f"{where}: the period must be positive, got {spec!r}")
         box[name] = (float(low), float(high))
-    return box, delays
+    return box, delay
+
+
+def _delays(loop, values, box, delay):
+    """``(values, pieces)``: ``values`` without the delay, and the delays to certify.
+
+    A range ``delay`` (:func:`_check_uncertain`): ``d`` with whole ends,
+    each whole delay in it; ``d`` with a fractional end, or ``Td`` (seconds,
+    over the period), every delay in it (:func:`_delay_pieces`).  Else the one
+    delay given (``d``, else ``Td``) or the loop's.  A delay in seconds over an
+    uncertain period is refused: its fraction of a period would vary over the box.
+    """
+    values = dict(values)
+    given = {k: values.pop(k) for k in ("d", "Td") if k in values}
+    shown = given or {k: v for k, v in loop.defaults.items() if k in ("d", "Td")}
+    if delay is not None:
+        name, (low, high) = delay
+        if name == "d" and isinstance(low, int):
+            check_delay(high, name="uncertain['d']'s high end")
+            return values, tuple(_DelayPiece(d) for d in range(low, high + 1))
+    elif "d" in shown:
+        name, low = "d", check_real("d", shown["d"], low=0.0)
+        high = low
+    elif "Td" in shown:
+        name, low = "Td", check_real("Td", shown["Td"], low=0.0)
+        high = low
+    else:
+        raise TypeError("missing value for d")
+    if name == "d":
+        return values, _delay_pieces(low, high, "d")
+    if "T" in box:
+        raise ValueError(f"robust regions take a delay Td in seconds over a fixed period: with T "
+                         f"uncertain its fraction of a period varies; give the delay in samples, "
+                         f"d (got Td = {low!r}" + ("" if high == low else f" to {high!r}") + " s)")
+    T = check_real("T", {**loop.defaults, **values}.get("T", np.nan), low=0.0, low_open=True)
+    return values, _delay_pieces(low / T, high / T, "Td / T")
 
 
 def robust_region(loop, x=None, y=None, *, uncertain, strips=64, rtol=1e-6, x_range=None,
@@ -927,9 +1022,10 @@ def robust_region(loop, x=None, y=None, *, uncertain, strips=64, rtol=1e-6, x_ra
         (default: the loop's :attr:`~symstab.Loop.plane`).
     uncertain : dict
         ``{name: (low, high)}``: the box of the plant's and environment's
-        parameters (``T`` included), and ``d`` a range of whole delays
-        (a range in seconds, ``Td``, or with a fractional end is refused:
-        the zero exclusion covers each whole delay, not a continuum).
+        parameters (``T`` included), and the delay: ``d`` with whole ends,
+        each whole delay of the range; ``Td`` (seconds, over a fixed ``T``)
+        or ``d`` with a fractional end, every delay of the range, a
+        continuum (the module's "Delays").
     strips : int
         Vertical strips across the window (1 to 100 000); those where the
         set has a corner or an end are halved (at most ``4 strips`` more).
@@ -962,6 +1058,13 @@ def robust_region(loop, x=None, y=None, *, uncertain, strips=64, rtol=1e-6, x_ra
     >>> robust = robust_region(loop, "B", "K", uncertain={"b": (0.0162, 0.0648)}, strips=16)
     >>> 0 < robust.area < robust.nominal.area
     True
+
+    Every delay from 1.5 to 2.5 ms (at B = 1 the set at 2.5 ms ends at K =
+    301.1, the one at 1.5 ms at 465.4):
+
+    >>> delays = robust_region(loop, "B", "K", uncertain={"Td": (0.0015, 0.0025)}, strips=8)
+    >>> bool(delays.contains(1.0, 250.0)), bool(delays.contains(1.0, 320.0))
+    (True, False)
     """
     x, y = loop.plane_of(x, y)
     strips = check_count("strips", strips, 1)
@@ -970,9 +1073,9 @@ def robust_region(loop, x=None, y=None, *, uncertain, strips=64, rtol=1e-6, x_ra
     rtol = check_real("rtol", rtol)
     if not 1e-12 <= rtol <= 1e-2:
         raise ValueError(f"rtol must be from 1e-12 to 1e-2, got {rtol!r}")
-    box, delays, fixed = _check_robust_values(loop, x, y, uncertain, values)
+    box, delay, pieces, fixed = _check_robust_values(loop, x, y, uncertain, values)
     centre = {n: 0.5 * (lo + hi) for n, (lo, hi) in box.items()}
-    centre_d = delays[len(delays) // 2]
+    centre_d = pieces[len(pieces) // 2].middle
     # Every corner of the box is asked of the loop (its domain: a pole that
     # cancels, a period that is not positive) before any work.
     for corner in itertools.product(*box.values()):
@@ -981,41 +1084,44 @@ def robust_region(loop, x=None, y=None, *, uncertain, strips=64, rtol=1e-6, x_ra
 
     from ..._progress import progress_printer
 
-    progress = check_progress(progress, lambda: progress_printer("delays", len(delays)))
+    progress = check_progress(progress, lambda: progress_printer("delays", len(pieces)))
     given_x, y_range = _check_robust_window(x_range, y_range)
     line = given_x is not None and given_x[0] == given_x[1]
     try:
-        enclosures = _enclosures_of(loop, x, y, box, fixed)
+        enclosures = {p.fraction: _enclosures_of(loop, x, y, box, fixed, p.fraction)
+                      for p in pieces}
     except (ValueError, ZeroDivisionError, OverflowError) as exc:
         words = ", ".join(f"{k} in [{lo:g}, {hi:g}]" for k, (lo, hi) in box.items())
-        raise ValueError(f"uncertain: {words}: {exc}") from None
+        raise ValueError(f"uncertain: {words or 'the delays'}: {exc}") from None
+    at = dict(fixed) if delay is not None else {**fixed, "d": centre_d}
     nominal = loop.region(x, y, x_range=None if line else given_x, y_range=y_range, **fixed,
                           **centre, d=centre_d)
     if not nominal.stable:
-        return RobustRegion.empty_set(x, y, box, delays, nominal, fixed,
-                                  "the stable set at the box's centre is empty")
+        return RobustRegion.empty_set(x, y, box, delay, nominal, at,
+                                      "the stable set at the box's centre is empty")
     points = np.vstack([cell.outer for cell in nominal.stable])
     x_lo, x_hi = given_x or (float(points[:, 0].min()), float(points[:, 0].max()))
     y_lo, y_hi = y_range or (float(points[:, 1].min()), float(points[:, 1].max()))
     window = (x_lo, x_hi, y_lo, y_hi)
-    edges, geometry, owner = _strip_geometry(loop, x, y, fixed, box, delays, window, strips,
+    samples = sorted({s for p in pieces for s in p.samples})
+    edges, geometry, owner = _strip_geometry(loop, x, y, fixed, box, samples, window, strips,
                                              rtol)
     tol = np.full(len(owner), rtol * (y_hi - y_lo) / 4) / np.maximum(geometry.height, 1e-300)
     marked, examined, exhausted = _certify_delays(enclosures, loop.environment_delay, geometry,
-                                                  len(owner), delays, tol, budget, progress)
-    pieces, status = _piece_status(loop, x, y, enclosures, geometry, marked, delays,
-                                   {**fixed, **centre})
-    robust, marginal = _strip_intervals(pieces, status, marked, geometry, owner, len(edges) - 1)
-    at = dict(fixed) if len(delays) > 1 else {**fixed, "d": delays[0]}
+                                                  len(owner), pieces, tol, budget, progress)
+    found, status = _piece_status(loop, x, y, enclosures, geometry, marked, pieces,
+                                  {**fixed, **centre})
+    robust, marginal = _strip_intervals(found, status, marked, geometry, owner, len(edges) - 1)
     touched = tuple(side for side in nominal.unbounded if _touches(side, edges, robust, window))
-    return RobustRegion.from_strips(x, y, box, delays, edges, robust, marginal, nominal, at,
+    return RobustRegion.from_strips(x, y, box, delay, edges, robust, marginal, nominal, at,
                                     examined=examined, exhausted=exhausted, unbounded=touched)
 
 
 def _check_robust_values(loop, x, y, uncertain, values):
-    """``(box, delays, fixed)``: :func:`robust_region`'s parameters, checked, in three kinds.
+    """``(box, delay, pieces, fixed)``: :func:`robust_region`'s parameters, checked.
 
-    The box of the uncertain continuous parameters, the delays (the
+    The box of the uncertain continuous parameters, the delay range as given
+    (None: one delay), the delays to certify (:class:`_DelayPiece`: the
     uncertain range, else the one given), and the values of every other
     parameter but the plane's, as floats.  A step of its own: every
     question about the input is asked here, before any work.
@@ -1024,20 +1130,17 @@ def _check_robust_values(loop, x, y, uncertain, values):
         if name not in loop.environment_names or name in loop.plant_names or name == "T":
             raise ValueError(f"robust regions take a plane of the environment's parameters; "
                              f"{name} is not one")
-    box, delays = _check_uncertain(loop, uncertain, (x, y))
-    values = _whole_delay(loop, values, box, delays)
+    box, delay = _check_uncertain(loop, uncertain, (x, y))
+    values, pieces = _delays(loop, values, box, delay)
+    if delay is not None and delay[1][0] == delay[1][1]:
+        delay = None                    # a range of one delay: that delay
     unknown = set(values) - set(loop.parameters)
     if unknown:
         raise TypeError(f"unknown parameter(s) {', '.join(sorted(unknown))}; parameters of "
                         f"this loop: {', '.join(loop.parameters)}")
     fixed = {**loop.defaults, **values}
-    for name in list(box) + ([] if delays is None else ["d"]):
+    for name in list(box) + ["d", "Td"]:
         fixed.pop(name, None)
-    if delays is None:
-        if "d" not in fixed:
-            raise TypeError("missing value for d")
-        delays = [check_delay(fixed["d"])]
-    fixed.pop("d", None)
     fixed.pop(x, None)
     fixed.pop(y, None)
     missing = [n for n in loop.symbols if n not in fixed and n not in box and n not in (x, y)]
@@ -1045,7 +1148,7 @@ def _check_robust_values(loop, x, y, uncertain, values):
         raise TypeError(f"missing value(s) for {', '.join(missing)}")
     for name, v in fixed.items():
         fixed[name] = check_real(name, v)
-    return box, delays, fixed
+    return box, delay, pieces, fixed
 
 
 def _check_robust_window(x_range, y_range):
@@ -1065,7 +1168,9 @@ def _strip_geometry(loop, x, y, fixed, box, delays, window, strips, rtol):
     """``(edges, geometry, owner)``: the strips of the window and the pieces where to look.
 
     The first step of the work: on each strip's edges, the intervals of
-    ``y`` stable at every delay and grid value of the box; strips whose
+    ``y`` stable at every delay of ``delays`` (in samples: the whole delays,
+    or the ends and middles of a continuum's pieces) and grid value of the
+    box; strips whose
     edges see different numbers of them are halved (:func:`_split`), and
     each strip's intervals are joined into trapezoids
     (:func:`_trapezoids`: ``geometry``, and ``owner``, each one's strip).
@@ -1092,26 +1197,26 @@ def _certify_delays(enclosures, environment_delay, geometry, n_pieces, delays, t
                     progress):
     """``(marked, examined, exhausted)``: the pieces' spans not certified, at every delay.
 
-    The second step: zero exclusion (:func:`_certify`) delay by delay,
-    each delay looking only where the delays before certified; ``marked``
-    holds, per piece, the spans of ``t`` left open.  ``progress`` is
-    called with 0, then with the number of delays done.
+    The second step: zero exclusion (:func:`_certify`) piece of delays by
+    piece (:class:`_DelayPiece`, with ``enclosures`` per fraction of a
+    period), each looking only where the pieces before certified;
+    ``marked`` holds, per piece of the plane, the spans of ``t`` left open.
+    ``progress`` is called with 0, then with the number of delay pieces done.
     """
     marked = {p: [] for p in range(n_pieces)}
     examined, exhausted = 0, False
     if progress is not None:
         progress(0)
-    for d in delays:
-        shift = d + environment_delay
-        found, n, out = _certify(enclosures, shift, geometry,
-                                 {p: _subtract([(0.0, 1.0)], marked[p]) for p in marked},
+    for done, delay in enumerate(delays, 1):
+        found, n, out = _certify(enclosures[delay.fraction], delay.d + environment_delay,
+                                 geometry, {p: _subtract([(0.0, 1.0)], marked[p]) for p in marked},
                                  tol, budget - examined)
         examined += n
         exhausted |= out
         for p in marked:
             marked[p] = _merge(marked[p] + found[p])
         if progress is not None:
-            progress(delays.index(d) + 1)
+            progress(done)
     return marked, examined, exhausted
 
 
@@ -1119,9 +1224,11 @@ def _piece_status(loop, x, y, enclosures, geometry, marked, delays, at_centre):
     """``(pieces, status)``: the certified pieces, each robust (0), marginal (1) or unstable (2).
 
     The third step: each certified piece's root count at one point (the
-    box's centre, ``at_centre``) at every delay, and its leading
-    coefficient; a count of -1 (undecided) or a leading coefficient that
-    may vanish leave it marginal, a count above 0 unstable (not robust).
+    box's centre, ``at_centre``) at a delay of every piece of delays (a
+    whole delay, or the middle of a continuum: zero exclusion holds over
+    all of it, so one count is its count), and its leading coefficient; a
+    count of -1 (undecided) or a leading coefficient that may vanish leave
+    it marginal, a count above 0 unstable (not robust).
     """
     pieces = [(p, a, b) for p in marked for a, b in _subtract([(0.0, 1.0)], marked[p])]
     where = np.array([p for p, _, _ in pieces], dtype=np.int64)
@@ -1131,10 +1238,11 @@ def _piece_status(loop, x, y, enclosures, geometry, marked, delays, at_centre):
     py = 0.5 * (inner.lo0 + inner.lo1) + middle * 0.5 * (inner.hi0 - inner.lo0 + inner.hi1
                                                          - inner.lo1)
     status = np.zeros(len(pieces), dtype=int)      # 0 robust, 1 marginal, 2 unstable
-    for d in delays:
-        counts = np.atleast_1d(loop.unstable_root_counts(**at_centre, d=d, **{x: px, y: py})) \
+    for delay in delays:
+        counts = np.atleast_1d(loop.unstable_root_counts(**at_centre, d=delay.middle,
+                                                         **{x: px, y: py})) \
             if pieces else np.zeros(0, dtype=int)
-        lead_mid, lead_rad = enclosures.leading(d + loop.environment_delay)
+        lead_mid, lead_rad = enclosures[delay.fraction].leading(delay.d + loop.environment_delay)
         for k, (p, a, b) in enumerate(pieces):
             ends = geometry.ends(p, a, b)
             if counts[k] > 0:

@@ -504,7 +504,9 @@ class RobustRegion:
     x, y : str
         The plane.
     uncertain : dict
-        ``{name: (low, high)}``: the box (``d``: the first and last delay).
+        ``{name: (low, high)}``: the box and the delay range as given
+        (``d``: the first and last delay in samples, whole or not; ``Td``:
+        in seconds).
     edges : ndarray
         The strips' edges in ``x`` (two equal edges: one line).
     intervals : tuple of tuple
@@ -560,7 +562,7 @@ class RobustRegion:
         return plot_robust(self, ax)
 
     @classmethod
-    def from_strips(cls, x, y, box, delays, edges, robust, marginal, nominal, at, examined=0,
+    def from_strips(cls, x, y, box, delay, edges, robust, marginal, nominal, at, examined=0,
                     exhausted=False, unbounded=()):
         """The region from each strip's intervals (the reason said when it is empty).
 
@@ -570,8 +572,10 @@ class RobustRegion:
             The plane.
         box : dict
             ``{name: (low, high)}`` of the continuous parameters.
-        delays : list of int
-            The delays (one, or the range's).
+        delay : (str, (float, float)) or None
+            The uncertain delay, ``("d", (low, high))`` in samples or
+            ``("Td", (low, high))`` in seconds, as given; None for one
+            delay (in ``at``).
         edges : array_like
             The strips' edges.
         robust, marginal : list of list of (float, float, float, float)
@@ -584,9 +588,7 @@ class RobustRegion:
         examined, exhausted, unbounded :
             As the attributes.
         """
-        uncertain = dict(box)
-        if len(delays) > 1:
-            uncertain["d"] = (delays[0], delays[-1])
+        uncertain = dict(box) if delay is None else {**box, delay[0]: delay[1]}
         region = cls(x, y, uncertain, np.asarray(edges, dtype=float),
                      tuple(tuple(r) for r in robust), tuple(tuple(m) for m in marginal),
                      nominal, dict(at), examined=examined, exhausted=exhausted,
@@ -603,19 +605,17 @@ class RobustRegion:
         return dataclasses.replace(region, reason=why)
 
     @classmethod
-    def empty_set(cls, x, y, box, delays, nominal, at, reason):
+    def empty_set(cls, x, y, box, delay, nominal, at, reason):
         """An empty region, with why.
 
         Parameters
         ----------
-        x, y, box, delays, nominal, at :
+        x, y, box, delay, nominal, at :
             As :meth:`from_strips`.
         reason : str
             Why it is empty.
         """
-        uncertain = dict(box)
-        if len(delays) > 1:
-            uncertain["d"] = (delays[0], delays[-1])
+        uncertain = dict(box) if delay is None else {**box, delay[0]: delay[1]}
         return cls(x, y, uncertain, np.zeros(0), (), (), nominal, dict(at), reason=reason)
 
     @property

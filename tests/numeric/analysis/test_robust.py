@@ -494,21 +494,166 @@ def test_every_zero_of_a_cell_is_in_its_set(path, box, d, h, narrow_width):
 
 
 @pytest.mark.parametrize("uncertain, values, match", [
-    ({"Td": (0.010, 0.011)}, {}, r"uncertain\['Td'\] = \(0.01, 0.011\): robust regions take a "
-                                 r"delay range in whole samples"),
-    ({"d": (10, 10.5)}, {}, r"uncertain\['d'\] = \(10, 10.5\): .* whole ends"),
-    ({"b": (0.03, 0.0325)}, {"d": 10.5}, "whole delay d .* got d = 10.5"),
-    ({"b": (0.03, 0.0325)}, {"Td": 0.0105}, "got Td = 0.0105 s = 10.5 samples"),
+    ({"Td": (-0.001, 0.002)}, {}, r"uncertain\['Td'\] bounds must be .* >= 0"),
+    ({"Td": (0.003, 0.002)}, {}, r"uncertain\['Td'\]: \(low, high\) must have low <= high"),
+    ({"Td": (float("nan"), 0.002)}, {}, r"uncertain\['Td'\] bounds"),
+    ({"Td": (0.001, 1e6)}, {}, "SYMSTAB_MAX_DELAY"),
+    ({"d": (1.5, 1e9)}, {}, "SYMSTAB_MAX_DELAY"),
+    ({"d": (1, 2), "Td": (0.001, 0.002)}, {}, "give the delay range once"),
+    ({"Td": (0.001, 0.002), "T": (0.9e-3, 1.1e-3)}, {}, "over a fixed period"),
+    ({"T": (0.9e-3, 1.1e-3)}, {"Td": 0.0025}, "over a fixed period"),
 ])
-def test_a_fractional_delay_is_refused_with_what_is_supported(paper, uncertain, values, match):
-    """Issue 43: the zero exclusion certifies each whole delay of a range (the plant's
-    interval enclosures are whole-sample pulse transfer functions), not a continuum of
-    fractional delays: a range in seconds or with a fractional end, or a fractional
-    nominal delay, is one error saying what is taken, never a region that looks certified."""
+def test_a_bad_delay_range_is_refused_by_name(paper, uncertain, values, match):
+    """A delay range (seconds or samples) is checked before any work: negative, NaN, reversed,
+    beyond the delay limit, given twice, or in seconds over an uncertain period (its fraction
+    of a period would vary over the box)."""
     with pytest.raises(ValueError, match=match):
         paper.robust_region("B", "K", uncertain=uncertain, strips=2, **values)
-    with pytest.raises(ValueError, match=match):
-        paper.limits("B", "K", uncertain=uncertain, strips=2, **values)
+
+
+def _n_eps_oracle(num, den, T, eps, z):
+    """``N_eps(z) = P_eps(z) z det(z I - Phi)`` from the state space (tests/oracles.py's
+    realisation and Van Loan's block exponential), not symstab's cofactors."""
+    from oracles import _held_input_integral, _realisation
+
+    A, B, C, _ = _realisation(num, den)
+    Phi, _ = _held_input_integral(A, B, T)
+    late, gamma0 = _held_input_integral(A, B, (1 - eps) * T)
+    gamma1 = late @ _held_input_integral(A, B, eps * T)[1]
+    n = len(A)
+    out = []
+    for zk in z:
+        resolvent = np.linalg.solve(zk * np.eye(n) - Phi, gamma0 + gamma1 / zk)
+        out.append((C @ resolvent).item() * zk * np.linalg.det(zk * np.eye(n) - Phi))
+    return np.array(out)
+
+
+@pytest.mark.parametrize("num, den", [
+    ([1.0], [0.0128, 0.0324, 0.0]),                                    # the paper's plant
+    ([1.0], [0.0128, 0.0324, 40.0]),                                   # complex poles
+    ([1.0], list(np.polymul([0.0128, 0.0324, 0.0], [0.00016, 1.0]))),  # an actuator lag
+])
+def test_interval_fractional_zoh_encloses_the_state_space(num, den):
+    """Over an interval of eps, N_eps's enclosure holds the state-space N_eps at every eps of it
+    (on the unit circle, off its integrator's z = 1, and at 1 +- 0.5), and z P_d is interval_zoh's P_d times z."""
+    from mpmath import iv
+
+    from symstab.symbolic.discretize import interval_fractional_zoh
+
+    T = 1e-3
+    z = np.concatenate([np.exp(1j * np.linspace(0.05, np.pi, 9)), [0.5, 1.5]])
+    w = z - 1.0
+    iv.dps = 30
+    try:
+        at = interval_fractional_zoh([iv.mpf(c) for c in num], [iv.mpf(c) for c in den],
+                                     iv.mpf(T))
+        p_n, p_d = interval_zoh([iv.mpf(c) for c in num], [iv.mpf(c) for c in den], iv.mpf(T))
+        checked = 0
+        for lo, hi in ((0.0, 1.0), (0.2, 0.3), (0.7, 0.7001), (0.999, 1.0)):
+            n_eps, z_p_d = at(iv.mpf([lo, hi]))
+            mid = np.array([float(c.mid) for c in n_eps])
+            rad = np.array([float(c.delta) / 2 for c in n_eps])
+            powers = np.abs(w)[:, None] ** np.arange(len(mid) - 1, -1, -1)
+            reach = powers @ rad
+            for eps in np.linspace(lo, hi, 5):
+                true = _n_eps_oracle(num, den, T, eps, z)
+                error = np.abs(np.polyval(mid, w) - true)
+                assert (error <= reach + 1e-9 * np.abs(true).max()).all(), (lo, hi, eps)
+                checked += 1
+            # Not vacuous: over a narrow interval each coefficient's radius is within a few
+            # times its spread over the interval (the oracle's coefficients in w, by solving
+            # at four real w; the cofactors' sums add the radii of terms that move together).
+            if hi - lo <= 0.1:
+                nodes = np.array([-0.5, 0.5, 1.0, 2.0])[:len(mid)]
+                vandermonde = nodes[:, None] ** np.arange(len(mid) - 1, -1, -1)
+                coefficients = np.array([np.linalg.solve(vandermonde, _n_eps_oracle(
+                    num, den, T, e, nodes + 1.0).real) for e in np.linspace(lo, hi, 9)])
+                spread = np.ptp(coefficients, axis=0) / 2
+                assert (rad <= 8 * spread + 1e-9 * np.abs(mid).max()).all(), rad / spread
+            shifted = [iv.mpf(0)] * 1 + list(p_d)
+            for a, b in zip(z_p_d, [x + y for x, y in zip(list(p_d) + [iv.mpf(0)], shifted,
+                                                           strict=True)], strict=True):
+                assert abs(float(a.mid) - float(b.mid)) <= 1e-25
+        # eps = 1 is one more whole sample: N_1 = P_n.
+        n_one, _ = at(iv.mpf(1))
+        assert all(abs(float(a.mid) - float(b.mid)) <= 1e-25 for a, b in zip(
+            n_one, p_n, strict=True))
+    finally:
+        iv.dps = 15
+    assert checked == 20
+
+
+@pytest.fixture(scope="module")
+def over_delays(paper):
+    """The paper's loop robust over Td in [1.5, 2.5] ms (a continuum: two fractional pieces)."""
+    return paper.robust_region("B", "K", uncertain={"Td": (0.0015, 0.0025)}, strips=8,
+                               rtol=1e-4, M=0.0)
+
+
+def _radii(loop, values, points, delays):
+    """The spectral radius at each point and delay (samples): tests/oracles.py's state-space
+    closed loop with the fraction of a period inside the period (Van Loan's exponential)."""
+    from oracles import fractional_delay_oracle
+
+    x, y = loop.plane
+    points = list(points)
+    out = np.zeros((len(points), len(delays)))
+    for i, (px, py) in enumerate(points):
+        at = fractional_delay_oracle(loop, {**values, x: px, y: py})
+        out[i] = [at(tau)[0] for tau in delays]
+    return out
+
+
+@pytest.mark.parametrize("path, uncertain, window", [
+    (PAPER, {"Td": (0.0015, 0.0025)}, (1.5, 2.5)),
+    ("examples/loops/lowpass_velocity.toml", {"d": (1.25, 2.5)}, (1.25, 2.5)),
+])
+def test_robust_over_a_continuum_of_delays(path, uncertain, window, paper, over_delays):
+    """Every robust point is stable at 201 delays of the range, ends included (the state-space
+    oracle); just above the set at each strip's edges some delay of the range is unstable."""
+    loop = paper if path == PAPER else symstab.load_loop(path)
+    region = over_delays if path == PAPER else loop.robust_region(
+        uncertain=uncertain, strips=4, rtol=1e-4)
+    assert region.uncertain == uncertain and "d" not in region.at
+    values = {**loop.defaults, **region.at}
+    delays = np.linspace(*window, 201)
+    rng = np.random.default_rng(5)
+    x, y = _points_in(region, 16, rng)
+    assert _radii(loop, values, zip(x, y, strict=True), delays).max() < 1.0
+    # Outside: at a strip's left edge, 0.2 % above the highest robust or marginal band.
+    above = []
+    for i in range(len(region.edges) - 1):
+        tops = [band[1] for band in region.intervals[i] + region.marginal[i]]
+        if tops and max(tops) > 0:
+            above.append((region.edges[i], max(tops) * 1.002))
+    assert len(above) >= 3
+    assert (_radii(loop, values, above, delays).max(axis=1) >= 1.0).all()
+
+
+def test_robust_over_delays_is_inside_the_delay_range_set(paper, over_delays):
+    """An inner approximation: at robust points, Loop.delay_range's constant set (stable at
+    Td_min with an exact delay margin beyond the width) holds too; and the set is smaller than
+    the stable set at the range's ends and at its whole delay."""
+    x, y = _points_in(over_delays, 6, np.random.default_rng(7))
+    for px, py in zip(x, y, strict=True):
+        assert paper.delay_range(delay_range=(0.0015, 0.0025), B=px, K=py, M=0.0).constant
+    for d in (1.5, 2, 2.5):
+        assert over_delays.area < paper.region("B", "K", d=d, M=0.0).area
+
+
+def test_a_fractional_delay_is_one_piece_of_zero_width(paper):
+    """A fractional nominal delay (d = 2.5, or Td = 2.5 ms) is certified as itself; a range of
+    one delay is that delay."""
+    box = {"b": (0.03, 0.0325)}
+    samples = paper.robust_region("B", "K", uncertain=box, strips=2, d=2.5, M=0.0)
+    seconds = paper.robust_region("B", "K", uncertain=box, strips=2, Td=0.0025, M=0.0)
+    ranged = paper.robust_region("B", "K", uncertain={**box, "d": (2.5, 2.5)}, strips=2, M=0.0)
+    assert samples.intervals == seconds.intervals == ranged.intervals
+    assert samples.at["d"] == 2.5 and "d" not in samples.uncertain
+    x, y = _points_in(samples, 20, np.random.default_rng(3))
+    for b in box["b"]:
+        assert _radii(paper, {**paper.defaults, "M": 0.0, "b": b}, zip(x, y, strict=True),
+                      [2.5]).max() < 1.0
 
 
 def test_a_delay_in_seconds_of_whole_samples_is_that_delay(paper):
