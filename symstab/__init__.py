@@ -58,7 +58,7 @@ _HOMES = {
     "numeric.analysis.margins": ("MarginMap", "Margins", "NyquistCrossing", "ParameterMargin"),
     "numeric.analysis.noise": ("ForceNoise",),
     "numeric.analysis.delays": ("DelayMargin", "DelaySwitch"),
-    "numeric.analysis.delay_range": ("DelayRange", "DelayRangeMap"),
+    "numeric.analysis.delay_range": ("DelayRange", "DelayRangeMap", "DelayRangeRegion"),
     "numeric.paper.device": ("PAPER_DEVICE", "Device"),
     "numeric.paper.curves": ("BoundaryCurve", "arc_end_angle"),
     "numeric.paper.stability": ("classify", "is_stable", "spectral_radius"),
@@ -96,7 +96,7 @@ __all__ = [
     "StabilityProbability",
     "RobustRegion",
     "Margins", "NyquistCrossing", "ParameterMargin", "MarginMap", "ForceNoise",
-    "DelayMargin", "DelaySwitch", "DelayRange", "DelayRangeMap",
+    "DelayMargin", "DelaySwitch", "DelayRange", "DelayRangeMap", "DelayRangeRegion",
 ]
 
 
