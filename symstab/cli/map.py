@@ -665,7 +665,7 @@ def _delay_range(args, setup, xs, ys, out, png_path):
           f"{low:.6g} to {high:.6g} samples")
     print(f"{int(varying.sum())} of {varying.size} cells stable for every delay varying by whole "
           f"samples" if varying is not None else
-          "every varying delay: not derived (the range's ends are not whole samples; the "
+          "every varying delay: not derived (the range's ends do not differ by whole samples; the "
           "varying column holds -1)")
     print(wrote)
     return 0

@@ -10,7 +10,8 @@ A networked or loaded loop's delay is not one number but a range
   beyond ``Td_max - Td_min``.  The ends may be fractional samples.
 * **every delay sequence in the range**, changing from sample to sample by
   whole samples (``u[k] = -f[k - delta_k]``, ``delta_k`` any of ``d_min ...
-  d_max``): a sufficient small-gain criterion, the discrete-time form of
+  d_max``; around a fixed fraction of a period, the plant's, where the ends
+  share one: 2.5 to 4.5 samples): a sufficient small-gain criterion, the discrete-time form of
   Kao and Lincoln's bound for time-varying delays (C.-Y. Kao and B.
   Lincoln, "Simple stability criteria for systems with time-varying
   delays", *Automatica* 40(8), 2004; its sampled-data use is the *jitter
@@ -37,10 +38,12 @@ A networked or loaded loop's delay is not one number but a range
 sequence, also the worst one, and bounds a norm by a product of norms; a
 point outside the varying set may well be stable for the sequences a real
 network makes, and the constant set always holds the varying one.  It is
-derived for delays that vary by whole samples: a delay that varies inside a
-sample moves the hold's switching instant, which this operator does not
-describe, so a range whose ends are not whole samples gets the constant set
-only (the varying one is None, and says why).
+derived for delays that vary by whole samples, around a fraction of a period
+that does not vary (the plant with the fraction, the modified z-transform, in
+``L``): a delay that varies inside a sample moves the hold's switching
+instant from period to period, which this operator does not describe, so a
+range whose ends do not differ by whole samples (2.5 to 4.25) gets the
+constant set only (the varying one is None, and says why).
 """
 
 import dataclasses
@@ -49,7 +52,7 @@ import math
 import numpy as np
 
 from ..._resources import MAX_DELAY_ENV, max_delay
-from ..._validate import check_real, snap_delay
+from ..._validate import DELAY_RTOL, check_real, snap_delay
 from ..engine.polynomial import DelayedPolynomial
 from ..engine.results import html_table
 from ..engine.roots import STABLE, circle_minimum
@@ -78,7 +81,7 @@ class DelayRange:
     varying : bool or None
         Stable for every sequence of whole-sample delays in the range, by
         the small-gain criterion (a sufficient one); None where it is not
-        derived (ends that are not whole samples: :attr:`why`).
+        derived (ends that do not differ by whole samples: :attr:`why`).
     gain_margin : float or None
         ``min |chi| / (N |(z - 1) N_chi|)`` on the circle (the criterion
         holds above 1): its certified lower bound.
@@ -129,7 +132,11 @@ def _period(loop, given):
 
 
 def _range_samples(delay_range, T):
-    """``(low, high, whole)``: the range in samples, and whether both ends are whole samples."""
+    """``(low, high, shared)``: the range in samples, and whether its ends share a fraction of a period.
+
+    ``shared``: ``high - low`` is a whole number of samples (within
+    :data:`~symstab._validate.DELAY_RTOL`), whole ends included.
+    """
     try:
         low, high = delay_range
     except (TypeError, ValueError):
@@ -143,11 +150,12 @@ def _range_samples(delay_range, T):
         raise ValueError(f"delay_range's Td_max is {high / T:g} samples; at most "
                          f"{max_delay():g} (raise the limit with {MAX_DELAY_ENV})")
     low, high = (float(x) for x in snap_delay([low / T, high / T]))
-    return low, high, low.is_integer() and high.is_integer()
+    width = high - low
+    return low, high, abs(width - round(width)) <= DELAY_RTOL * max(1.0, high)
 
 
 def range_in_samples(loop, delay_range, **values):
-    """``(low, high, whole)``: a delay range in samples at the question's period, checked.
+    """``(low, high, shared)``: a delay range in samples at the question's period, checked.
 
     What :func:`delay_range` and :func:`delay_range_map` check first: the
     command line calls it before it prints or computes anything.
@@ -163,7 +171,8 @@ def range_in_samples(loop, delay_range, **values):
     Returns
     -------
     (float, float, bool)
-        The ends in samples and whether both are whole samples.
+        The ends in samples and whether they share a fraction of a period
+        (the varying set is derived).
     """
     return _range_samples(delay_range, _period(loop, values))
 
@@ -212,21 +221,21 @@ def delay_range(loop, *, delay_range, rtol=1e-6, **values):
     """
     given = {k: v for k, v in values.items() if k not in ("d", "Td")}
     T = _period(loop, given)
-    low, high, whole = _range_samples(delay_range, T)
+    low, high, shared = _range_samples(delay_range, T)
     point, code = classified_point(loop, {**given, "d": low})
     if code != STABLE:
-        return DelayRange(point, T, (low, high), False, 0.0, False if whole else None, None,
+        return DelayRange(point, T, (low, high), False, 0.0, False if shared else None, None,
                           "not stable at the range's lower end")
     found = loop.delay_margin(limit=high - low, every=False, **point) if high > low else None
     margin = None if found is None else found.margin
-    if not whole:
+    if not shared:
         return DelayRange(point, T, (low, high), margin is None, margin, None, None,
-                          "derived for delays that vary by whole samples; the range's ends are "
-                          "not whole samples")
+                          "derived for delays that vary by whole samples; the range's ends do "
+                          "not differ by whole samples")
     if high == low:
         return DelayRange(point, T, (low, high), True, None, True, math.inf,
                           "a range of one delay")
-    lower, _ = _gain_bracket(loop.polynomial(**point), high - low,
+    lower, _ = _gain_bracket(loop.polynomial(**point), round(high - low),
                              check_real("rtol", rtol, low=0.0, low_open=True, high=0.5,
                                         high_open=True))
     lower = float(lower)
@@ -249,8 +258,9 @@ class DelayRangeMap:
     constant : ndarray of bool
         Stable for every constant delay of the range, shape ``(len(y_values), len(x_values))``.
     varying : ndarray of bool or None
-        Stable for every whole-sample delay sequence (the small-gain
-        criterion); None where the ends are not whole samples.
+        Stable for every delay sequence varying by whole samples (the
+        small-gain criterion); None where the ends do not differ by whole
+        samples.
     at : dict
         The other parameters' values.
     """
@@ -320,13 +330,13 @@ def delay_range_map(loop, x_values, y_values, *, delay_range, x=None, y=None, rt
     x, y = loop.plane_of(x, y)
     given = {k: v for k, v in values.items() if k not in ("d", "Td")}
     T = _period(loop, given)
-    low, high, whole = _range_samples(delay_range, T)
+    low, high, shared = _range_samples(delay_range, T)
     found = loop.margin_map(x_values, y_values, x=x, y=y, margin="delay",
                             delay_limit=max(high - low, 1e-9), **given, d=low)
     stable = ~np.isnan(found.values)
     constant = stable & (found.values > high - low)
     varying = (_varying_set(loop, (x, found.x_values), (y, found.y_values), given, (low, high),
-                            rtol, stable) if whole else None)
+                            rtol, stable) if shared else None)
     return DelayRangeMap(x, y, found.x_values, found.y_values, (low, high), constant, varying,
                          dict(given))
 
@@ -334,7 +344,8 @@ def delay_range_map(loop, x_values, y_values, *, delay_range, x=None, y=None, rt
 def _varying_set(loop, x, y, given, samples, rtol, stable=None):
     """Where the small-gain criterion holds over a grid: ``(len(y), len(x))`` of bool.
 
-    ``x``, ``y`` are ``(name, values)``; ``samples`` the range's whole ends;
+    ``x``, ``y`` are ``(name, values)``; ``samples`` the range's ends, a whole number of
+    samples apart;
     ``stable``, the grid's stability at the lower end where known (else
     classified here).
     """
@@ -345,7 +356,7 @@ def _varying_set(loop, x, y, given, samples, rtol, stable=None):
     varying = np.array(stable, dtype=bool)
     if high > low and varying.any():
         chi = loop.polynomial(**given, d=low, **{x: X[varying], y: Y[varying]})
-        lower, _ = _gain_bracket(chi, high - low, rtol)
+        lower, _ = _gain_bracket(chi, round(high - low), rtol)
         varying[varying] = np.asarray(lower) > 1
     return varying
 
@@ -365,7 +376,7 @@ class DelayRangeRegion:
         Both sets on a grid of the region's window: ``constant`` the
         certified region's points, ``varying`` those of the small-gain
         criterion for delays varying by whole samples (None where the
-        range's ends are not whole samples).
+        range's ends do not differ by whole samples).
     """
 
     constant: object
@@ -407,7 +418,7 @@ def delay_range_region(loop, x=None, y=None, *, delay_range, x_range=None, y_ran
     with ``uncertain={"Td": delay_range}`` (with the other parameters'
     ranges of ``uncertain`` given too): certified for every delay of the
     range, the fraction of a period one more side of the box.  The varying
-    set is the small-gain criterion of :func:`delay_range` (whole-sample
+    set is the small-gain criterion of :func:`delay_range` (ends a whole number of samples apart,
     ends only) at the points of an ``n x n`` grid of the region's window
     stable at the lower end.
 
@@ -437,7 +448,7 @@ def delay_range_region(loop, x=None, y=None, *, delay_range, x_range=None, y_ran
     n = check_count("n", n, 2)
     given = {k: v for k, v in values.items() if k not in ("d", "Td")}
     T = _period(loop, given)
-    low, high, whole = _range_samples(delay_range, T)
+    low, high, shared = _range_samples(delay_range, T)
     if "uncertain" in given:
         raise TypeError("delay_range is the region's uncertain delay: use robust_region with "
                         "uncertain={'Td': ..., ...} for a box of other parameters as well")
@@ -449,6 +460,6 @@ def delay_range_region(loop, x=None, y=None, *, delay_range, x_range=None, y_ran
     X, Y = np.meshgrid(xs, ys)
     constant = np.asarray(region.contains(X, Y), dtype=bool)
     varying = (_varying_set(loop, (region.x, xs), (region.y, ys), given, (low, high),
-                            min(rtol, 0.25)) if whole else None)
+                            min(rtol, 0.25)) if shared else None)
     grid = DelayRangeMap(region.x, region.y, xs, ys, (low, high), constant, varying, dict(given))
     return DelayRangeRegion(region, grid)

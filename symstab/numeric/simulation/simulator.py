@@ -36,12 +36,14 @@ from ..._resources import MAX_DELAY_ENV, MAX_STEPS_ENV, check_memory, chunk_slic
 from ..._resources import max_delay as _max_delay
 from ..._resources import max_steps as _max_steps_setting
 from ..._validate import (
+    DELAY_RTOL,
     check_array,
     check_count,
     check_delay,
     check_grid,
     check_progress,
     check_real,
+    snap_delay,
 )
 from ..engine.results import PAPER_PLANE, PaperGridNames
 from .friction import StatePlant, stacked_spaces, substeps_of
@@ -51,7 +53,7 @@ __all__ = ["Nonidealities", "FrictionCompensation", "Simulation", "StabilityMap"
            "PAPER_ENCODER_RESOLUTION", "MAX_STEPS_ENV", "run_loop", "simulate_loop",
            "loop_stability_map", "check_loop_nonideal", "default_x0", "MAX_SUBSTEPS", "X0_MIN",
            "X0_MAX", "check_friction_size", "QUANTUM_MIN", "FRICTION_STEP_MAX",
-           "delay_sequence", "DELAY_LAWS"]
+           "delay_sequence", "DELAY_LAWS", "shared_fraction"]
 
 
 #: The most sub-steps per period: each multiplies the simulation's time (a
@@ -488,10 +490,11 @@ class Simulation:
         growing, above the floor: a bounded limit cycle (a saturated
         unstable loop's), neither stable nor unstable.  Never set for the
         ideal loop, which is linear.
-    delays : ndarray of int or None
+    delays : ndarray of int or float, or None
         ``(steps,)``: the delay of every period in samples where it varied
         (:func:`simulate_loop`'s ``delays``; the drawn sequence where it was
-        random); None for a fixed delay.
+        random; floats with their shared fraction of a period); None for a
+        fixed delay.
     """
 
     positions: object
@@ -815,8 +818,10 @@ def simulate_loop(loop, *, steps=None, x0=1.0, v0=None, nonideal=None, record=Fa
     (``delays``): the plant's input at period ``k`` is then ``-f[k -
     delta_k]``, the force computed ``delta_k`` periods earlier (one of the
     last ``d_max + 1``), run one period at a time.  The sequence is the
-    delay: ``d`` and ``Td`` are not given (the loop's default is unused),
-    and a fractional delay that varies is not modelled.  A random sequence
+    delay: ``d`` and ``Td`` are not given (the loop's default is unused);
+    a fraction of a period all its delays share is the plant's (the
+    modified z-transform, as a fixed fractional delay's), and a delay that
+    varies inside a sample is not modelled.  A random sequence
     is drawn once for the run and every point runs it, so that the points
     of a map differ by their parameters only, not by their draws (and the
     sequence is the result's :attr:`Simulation.delays`; for independent
@@ -863,7 +868,9 @@ def simulate_loop(loop, *, steps=None, x0=1.0, v0=None, nonideal=None, record=Fa
         samples, a 1-D array of ``steps`` entries (the same for every
         point); or ``("uniform", d_min, d_max)``, each period's delay
         uniform on the whole samples ``d_min .. d_max``
-        (:func:`delay_sequence`).  Default None: the fixed delay ``d``.
+        (:func:`delay_sequence`).  Each may share a fraction of a period
+        (``("uniform", 2.5, 4.5)``, :func:`shared_fraction`): carried by the
+        plant, as a fixed delay's.  Default None: the fixed delay ``d``.
     seed : int, optional
         The random sequence's seed (default 0); only with ``("uniform",
         ...)``.
@@ -901,8 +908,9 @@ def simulate_loop(loop, *, steps=None, x0=1.0, v0=None, nonideal=None, record=Fa
     if overflow not in ("raise", "diverge"):
         raise ValueError(f"overflow must be 'raise' or 'diverge', got {overflow!r}")
     check_progress(progress)   # a wrong kind is refused before the work
+    fraction = 0.0
     if delays is not None:
-        delays, steps, values = _varying_delay(delays, steps, seed, nonideal, values)
+        delays, steps, values, fraction = _varying_delay(delays, steps, seed, nonideal, values)
     elif seed is not None:
         raise ValueError("seed draws a random delay sequence: give delays=('uniform', d_min, "
                          "d_max), or drop seed")
@@ -922,29 +930,75 @@ def simulate_loop(loop, *, steps=None, x0=1.0, v0=None, nonideal=None, record=Fa
         spaces, inverse = loop.friction_spaces(substeps_of(nonideal), **values)
         check_friction_size(nonideal, spaces)
         spaces = (spaces, inverse.ravel())
-    return run_loop(parts_of, int(np.prod(shape)), d=d, steps=steps, x0=x0, v0=v0,
-                    nonideal=nonideal, record=record, progress=progress, shape=shape,
-                    spaces=spaces, state=state, parts_floats=parts_floats,
-                    compensation=compensation, delays=delays,
-                    linear_stable=linearly_stable(loop, nonideal, values, shape))
+    run = run_loop(parts_of, int(np.prod(shape)), d=d, steps=steps, x0=x0, v0=v0,
+                   nonideal=nonideal, record=record, progress=progress, shape=shape,
+                   spaces=spaces, state=state, parts_floats=parts_floats,
+                   compensation=compensation, delays=delays,
+                   linear_stable=linearly_stable(loop, nonideal, values, shape))
+    return run if not fraction else dataclasses.replace(run, delays=run.delays + fraction)
 
 
 def _varying_delay(delays, steps, seed, nonideal, values):
-    """``(sequence, steps, values)`` of a run whose delay varies; the values with ``d = d_max``.
+    """``(sequence, steps, values, fraction)`` of a run whose delay varies.
 
-    The whole ``d_max`` sizes the buffers and leaves the plant without a
-    fraction.
+    The sequence in whole samples; the values with ``d = d_max`` plus the
+    fraction of a period every delay shares (:func:`shared_fraction`): the
+    whole ``d_max`` sizes the buffers, the fraction is the plant's, as a
+    fixed delay's is.
     """
     given = [name for name in ("d", "Td") if name in values]
     if given:
         raise TypeError(f"give the delay once: {given[0]} (a fixed delay) or delays (one a "
-                        f"period), not both; a fractional delay that varies is not modelled")
+                        f"period, a fraction of a period in each: 2.5, 3.5, ...), not both")
     if nonideal.force_resolution is not None:
         raise ValueError("nonideal.force_resolution with delays: the verdict's floor for a force "
                          "quantum is the fixed-delay loop's pulse response; simulate a varying "
                          "delay without it")
+    delays, fraction = shared_fraction(delays)
     sequence, steps = delay_sequence(delays, steps, seed)
-    return sequence, steps, {**values, "d": int(sequence.max())}
+    d_max = int(sequence.max())
+    return sequence, steps, {**values, "d": d_max + fraction if fraction else d_max}, fraction
+
+
+def shared_fraction(delays):
+    """``(delays, fraction)``: delays that share a fraction of a period, in whole samples, and it.
+
+    A delay that varies by whole samples around a fixed fraction of a
+    period (a computation and an amplifier that take half a sample, a
+    network that adds whole ones): ``("uniform", 2.5, 4.5)`` or ``[2.5,
+    3.5, ...]`` is ``("uniform", 2, 4)`` or ``[2, 3, ...]`` and 0.5, the
+    fraction carried by the plant (the modified z-transform) as a fixed
+    delay's.  Whole delays give themselves and 0.0; what is not a law or
+    an array of numbers is given back for :func:`delay_sequence` to refuse.
+
+    Raises
+    ------
+    ValueError
+        Delays with different fractions of a period (within
+        :data:`~symstab._validate.DELAY_RTOL`): a delay that varies inside
+        a sample moves the hold's switching instant from period to period,
+        which is not modelled.
+    """
+    law = isinstance(delays, tuple) and bool(delays) and isinstance(delays[0], str)
+    if isinstance(delays, (str, bytes, dict)) or (law and len(delays) != 3):
+        return delays, 0.0
+    try:
+        x = snap_delay(np.asarray(delays[1:] if law else delays, dtype=float))
+    except (TypeError, ValueError):
+        return delays, 0.0
+    if x.ndim != 1 or not x.size or not np.all(np.isfinite(x)) or np.any(x < 0):
+        return delays, 0.0
+    whole = np.floor(x)
+    fractions = x - whole
+    if not np.any(fractions):
+        return delays, 0.0
+    if np.ptp(fractions) > DELAY_RTOL * max(1.0, float(x.max())):
+        raise ValueError(f"delays that vary must share one fraction of a period (whole samples "
+                         f"around a fixed part: 2.5, 3.5, 4.5), got fractions from "
+                         f"{fractions.min():.6g} to {fractions.max():.6g}; a delay that varies "
+                         f"inside a sample is not modelled")
+    whole = whole.astype(np.int64)
+    return ((delays[0], int(whole[0]), int(whole[1])) if law else whole), float(fractions[0])
 
 
 def _compensation_of(nonideal, compensation):

@@ -13,7 +13,12 @@ import scipy.optimize
 import symstab
 
 from conftest import REPO
-from oracles import fractional_delay_radius, loop_coefficients, python_control_parts
+from oracles import (
+    fractional_delay_radius,
+    fractional_plant_response,
+    loop_coefficients,
+    python_control_parts,
+)
 
 PAPER = REPO / "examples" / "loops" / "paper.toml"
 
@@ -59,6 +64,34 @@ def test_the_small_gain_bound_is_python_control_s(loop, values, delays):
     assert found.gain_margin == pytest.approx(expected, rel=2e-6)
     assert found.gain_margin <= expected * (1 + 1e-9)
     assert found.varying == (found.gain_margin > 1)
+
+
+def test_the_bound_around_a_fixed_fraction_is_the_state_space_s(loop):
+    """2.5 to 4.5 samples: whole samples varying around half a sample, the half the plant's.
+    The bound from the state space's plant (Van Loan, SciPy) on a fine grid of the circle,
+    refined by SciPy; the sequences of the range simulated at the point do not grow."""
+    values = dict(K=20.0, B=0.5, M=0.0)
+    found = loop.delay_range(delay_range=(0.0025, 0.0045), **values)
+    assert found.samples == pytest.approx((2.5, 4.5), rel=1e-12) and found.varying
+    point = {**loop.defaults, **values}
+    plant_num, plant_den, env_num, env_den = loop_coefficients(loop, point)
+
+    def ratio(theta):
+        z = np.exp(1j * theta)
+        L = (np.polyval(env_num, z) / np.polyval(env_den, z) * z**-2
+             * fractional_plant_response(plant_num, plant_den, point["T"], 0.5, z))
+        return abs(1 + L) / (2 * abs(z - 1) * abs(L))
+
+    grid = np.linspace(1e-4, np.pi, 4001)
+    values_ = np.array([ratio(t) for t in grid])
+    step = grid[1] - grid[0]
+    best = min(scipy.optimize.minimize_scalar(
+        ratio, bounds=(max(grid[k] - step, 1e-9), min(grid[k] + step, np.pi)),
+        method="bounded", options={"xatol": 1e-13}).fun for k in np.argsort(values_)[:5])
+    assert found.gain_margin == pytest.approx(best, rel=2e-6)
+    assert found.gain_margin <= best * (1 + 1e-9)
+    run = loop.simulate(delays=("uniform", 2.5, 4.5), seed=0, **values)
+    assert run.stable and set(np.unique(run.delays)) == {2.5, 3.5, 4.5}
 
 
 def test_the_constant_set_is_the_oracles(loop):

@@ -62,10 +62,10 @@ def test_the_varying_grid_is_the_point_criterion(loop, found):
         assert grid.varying[i, j] == bool(at.varying), (i, j, at)
 
 
-def test_a_fractional_range_has_no_varying_set(loop):
-    found = loop.region(delay_range=(0.0025, 0.0035), x_range=(0.0, 1.5), y_range=(0.0, 300.0),
-                        n=5, strips=8)
-    assert found.grid.samples == (2.5, 3.5) and found.grid.varying is None
+def test_ends_not_a_whole_number_of_samples_apart_have_no_varying_set(loop):
+    found = loop.region(delay_range=(0.0025, 0.00375), x_range=(0.0, 1.5),
+                        y_range=(0.0, 300.0), n=5, strips=8)
+    assert found.grid.samples == pytest.approx((2.5, 3.75)) and found.grid.varying is None
     assert "not derived" in repr(found)
 
 

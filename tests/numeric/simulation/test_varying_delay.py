@@ -8,7 +8,10 @@ Oracles:
 * the closed loop written out here in plain NumPy from python-control's
   coefficients (``control.c2d`` of ``G(s)``, ``VE(z)``), ``u[k] = -f[k -
   delta_k]``, with the run's initial conditions: equal to 1e-12 of the
-  trajectory's size.
+  trajectory's size;
+* with a fraction of a period every delay shares, the same loop by hand on
+  the plant of the state space (Van Loan's block exponential, SciPy: the
+  command held over a period arrives ``eps T`` late inside it).
 """
 
 import numpy as np
@@ -18,7 +21,7 @@ import symstab
 from symstab.numeric.simulation.simulator import Nonidealities
 
 from conftest import REPO, assert_message_names, run_cli
-from oracles import python_control_parts
+from oracles import _held_input_integral, _realisation, loop_coefficients, python_control_parts
 
 LOOPS = REPO / "examples" / "loops"
 
@@ -122,6 +125,54 @@ def test_the_run_is_the_closed_loop_written_out_by_hand(file, point, source):
     assert np.max(np.abs(fixed.positions - expected)) > 1e-6 * np.max(np.abs(expected))
 
 
+def state_space_coefficients(loop, values, eps):
+    """``(N_eps, z P_d, Ve_n, Ve_d)``: the plant whose command arrives ``eps T`` late, by hand.
+
+    ``x[k+1] = Phi x[k] + Gamma0 w[k] + Gamma1 w[k-1]`` (tests/oracles.py's
+    realisation and exponentials), so ``P = C adj(zI - Phi) (Gamma0 z +
+    Gamma1) / (z det(zI - Phi))``, with ``adj(zI - Phi) = sum_k z**(n-1-k)
+    B_k``, ``B_0 = I``, ``B_k = Phi B_{k-1} + c_k I`` (``c_k`` the
+    characteristic polynomial's: Faddeev-LeVerrier), so that ``C B_k g`` is
+    computed from ``C`` and ``g`` themselves, with no difference of
+    determinants (which would cost the digits of a small ``C g``).
+    """
+    plant_num, plant_den, env_num, env_den = loop_coefficients(loop, values)
+    A, B, C, _ = _realisation(plant_num, plant_den)
+    T = float(values["T"])
+    Phi, _ = _held_input_integral(A, B, T)
+    late, gamma0 = _held_input_integral(A, B, (1 - eps) * T)
+    gamma1 = late @ _held_input_integral(A, B, eps * T)[1]
+    char = np.poly(Phi)
+    adjugate, term = [], np.eye(len(Phi))
+    for c in char[1:]:
+        adjugate.append(term)
+        term = Phi @ term + c * np.eye(len(Phi))
+    n0, n1 = (np.array([(C @ b @ g).item() for b in adjugate]) for g in (gamma0, gamma1))
+    numerator = np.concatenate([n0, [0.0]]) + np.concatenate([[0.0], n1])
+    return (numerator, np.concatenate([char, [0.0]]), np.asarray(env_num, float),
+            np.asarray(env_den, float))
+
+
+@pytest.mark.parametrize("file, point", [
+    ("paper.toml", {"K": 3.0, "B": 0.05, "M": 0.002}),
+    ("tustin_damper.toml", {}),
+])
+def test_a_shared_fraction_is_the_state_space_loop_by_hand(file, point):
+    """Delays 0.5 to 5.5 samples (a fixed half sample, whole ones varying): the plant carries
+    the half, as a fixed delay's; the run is the loop by hand on the state space's plant."""
+    loop = symstab.load_loop(LOOPS / file)
+    values = {**{k: v for k, v in loop.defaults.items() if k != "d"}, **point}
+    delays = np.random.default_rng(5).integers(0, 6, size=90) + 0.5
+    run = loop.simulate(delays=delays, record=True, x0=0.3, v0=0.01, **values)
+    expected = closed_loop_by_hand(state_space_coefficients(loop, values, 0.5),
+                                   delays.astype(int), 0.3, 0.01)
+    np.testing.assert_allclose(run.positions, expected, rtol=0,
+                               atol=1e-12 * np.max(np.abs(expected)))
+    assert np.array_equal(run.delays, delays)
+    law = loop.simulate(delays=("uniform", 0.5, 5.5), steps=90, seed=2, **values)
+    assert np.all(law.delays % 1 == 0.5) and law.delays.min() >= 0.5 and law.delays.max() <= 5.5
+
+
 def test_a_uniform_sequence_is_numpy_s_draw_from_its_seed_the_same_for_every_point(paper):
     run = paper.simulate(delays=("uniform", 3, 6), seed=11, steps=400, K=[1.0, 2.0], B=0.05)
     assert np.array_equal(run.delays, np.random.default_rng(11).integers(3, 7, size=400))
@@ -144,6 +195,7 @@ def test_a_uniform_sequence_is_numpy_s_draw_from_its_seed_the_same_for_every_poi
     ({"delays": ("uniform", 5, 2)}, ValueError, "delays"),
     ({"delays": ("normal", 1, 2)}, ValueError, "delays"),
     ({"delays": ("uniform", 1, 2.5)}, ValueError, "delays"),
+    ({"delays": [1.5, 2.25] * 5}, ValueError, "delays"),
     ({"delays": ("uniform", 1, 2), "seed": -1}, ValueError, "seed"),
     ({"delays": [1, 2] * 5, "seed": 3}, ValueError, "seed"),
     ({"seed": 3}, ValueError, "seed"),
