@@ -67,7 +67,8 @@ def register(subparsers):
     g = p.add_argument_group("a delay that varies from period to period (with --loop)")
     g.add_argument("--delays", metavar="uniform:DMIN:DMAX",
                    help="each period's delay drawn uniformly from the whole samples DMIN..DMAX, "
-                        "instead of the loop's d (Loop.simulate's delays)")
+                        "instead of the loop's d (Loop.simulate's delays); both may share a "
+                        "fraction of a period, the plant's (uniform:2.5:4.5)")
     g.add_argument("--seed", type=int, metavar="S",
                    help="seed of the --delays draws (default 0: the same run every time)")
     add_loop_options(p, "simulate")
@@ -195,7 +196,7 @@ def _varying_delays(args, setup):
     With it the setup's ``d`` is the longest delay (its horizon, its
     theory and the checks of its plant) and its echo leaves ``d`` out.
     """
-    from ..numeric.simulation.simulator import delay_sequence
+    from ..numeric.simulation.simulator import delay_sequence, shared_fraction
 
     if args.delays is None:
         if args.seed is not None:
@@ -203,18 +204,25 @@ def _varying_delays(args, setup):
                              "--delays, or drop --seed")
         return None, setup
     law, *bounds = args.delays.split(":")
-    if law != "uniform" or len(bounds) != 2 or not all(b.strip().isdigit() for b in bounds):
-        raise ValueError(f"--delays must be uniform:DMIN:DMAX with whole samples "
-                         f"0 <= DMIN <= DMAX, got {args.delays!r}")
-    delays = ("uniform", int(bounds[0]), int(bounds[1]))
+    try:
+        ends = [float(b) if "." in b else int(b) for b in bounds]
+    except ValueError:
+        ends = None
+    if law != "uniform" or len(bounds) != 2 or ends is None:
+        raise ValueError(f"--delays must be uniform:DMIN:DMAX with samples 0 <= DMIN <= DMAX "
+                         f"(whole, or sharing a fraction: uniform:2.5:4.5), got {args.delays!r}")
+    delays = ("uniform", *ends)
     given = [name for name in ("d", "Td") if name in setup.given]
     if given:
         raise ValueError(f"--delays is the delay: drop --set {given[0]}=... (or --d)")
     try:
-        delay_sequence(delays, 8, args.seed)    # checked before anything runs
+        # Checked before anything runs.
+        whole, fraction = shared_fraction(delays)
+        delay_sequence(whole, 8, args.seed)
     except (TypeError, ValueError) as exc:
         raise ValueError(re.sub(r"(?<![\w-])(delays|seed)\b", r"--\1", str(exc))) from None
-    setup = dataclasses.replace(setup, values={**setup.values, "d": delays[2]})
+    longest = whole[2] + fraction if fraction else whole[2]
+    setup = dataclasses.replace(setup, values={**setup.values, "d": longest})
     echo = loop_echo(dataclasses.replace(setup, values={
         name: value for name, value in setup.values.items() if name != "d"}))
     return delays, dataclasses.replace(setup, echo=echo)

@@ -135,7 +135,7 @@ def _range_samples(delay_range, T):
     """``(low, high, shared)``: the range in samples, and whether its ends share a fraction of a period.
 
     ``shared``: ``high - low`` is a whole number of samples (within
-    :data:`~symstab._validate.DELAY_RTOL`), whole ends included.
+    ``DELAY_RTOL``), whole ends included.
     """
     try:
         low, high = delay_range

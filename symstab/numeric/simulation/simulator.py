@@ -975,7 +975,7 @@ def shared_fraction(delays):
     ------
     ValueError
         Delays with different fractions of a period (within
-        :data:`~symstab._validate.DELAY_RTOL`): a delay that varies inside
+        ``DELAY_RTOL``): a delay that varies inside
         a sample moves the hold's switching instant from period to period,
         which is not modelled.
     """

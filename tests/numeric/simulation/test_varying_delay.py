@@ -228,7 +228,15 @@ def test_the_cli_simulates_a_uniform_delay_and_refuses_bad_ones_in_one_line(caps
     run = symstab.load_loop(LOOPS / "paper.toml").simulate(
         delays=("uniform", 2, 5), seed=4, steps=400, record=True)
     assert np.array_equal(np.loadtxt(out, delimiter=",", skiprows=1)[:, 2], run.positions)
+    status, text, _ = run_cli(capsys, *args, "--delays", "uniform:2.5:4.5", "--seed", 4,
+                              "--out", out)
+    assert status == 0 and "delay uniform on 2.5..4.5 samples, drawn with seed 4" in text
+    run = symstab.load_loop(LOOPS / "paper.toml").simulate(
+        delays=("uniform", 2.5, 4.5), seed=4, steps=400, record=True)
+    assert np.array_equal(np.loadtxt(out, delimiter=",", skiprows=1)[:, 2], run.positions)
     for bad, named in ((("--delays", "uniform:5:2"), "--delays"), (("--delays", "u:1:2"), "--delays"),
+                       (("--delays", "uniform:1.5:2.25"), "--delays"),
+                       (("--delays", "uniform:1:x"), "--delays"),
                        (("--seed", 3), "--seed"), (("--delays", "uniform:1:2", "--d", 3), "--delays")):
         status, text, err = run_cli(capsys, *args, *bad)
         assert status == 2 and text == "" and len(err.strip().splitlines()) == 1 and named in err
