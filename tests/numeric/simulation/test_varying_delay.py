@@ -222,18 +222,14 @@ def test_a_delay_beyond_the_limit_is_refused_naming_it(paper, monkeypatch):
 def test_the_cli_simulates_a_uniform_delay_and_refuses_bad_ones_in_one_line(capsys, tmp_path):
     out = tmp_path / "x.csv"
     args = ("simulate", "--loop", LOOPS / "paper.toml", "--steps", 400)
-    status, text, _ = run_cli(capsys, *args, "--delays", "uniform:2:5", "--seed", 4,
-                              "--out", out)
-    assert status == 0 and "delay uniform on 2..5 samples, drawn with seed 4" in text
-    run = symstab.load_loop(LOOPS / "paper.toml").simulate(
-        delays=("uniform", 2, 5), seed=4, steps=400, record=True)
-    assert np.array_equal(np.loadtxt(out, delimiter=",", skiprows=1)[:, 2], run.positions)
-    status, text, _ = run_cli(capsys, *args, "--delays", "uniform:2.5:4.5", "--seed", 4,
-                              "--out", out)
-    assert status == 0 and "delay uniform on 2.5..4.5 samples, drawn with seed 4" in text
-    run = symstab.load_loop(LOOPS / "paper.toml").simulate(
-        delays=("uniform", 2.5, 4.5), seed=4, steps=400, record=True)
-    assert np.array_equal(np.loadtxt(out, delimiter=",", skiprows=1)[:, 2], run.positions)
+    # Whole samples, and whole samples around a fixed half sample (the plant's).
+    for low, high in ((2, 5), (2.5, 4.5)):
+        status, text, _ = run_cli(capsys, *args, "--delays", f"uniform:{low}:{high}", "--seed",
+                                  4, "--out", out)
+        assert status == 0 and f"delay uniform on {low}..{high} samples, drawn with seed 4" in text
+        run = symstab.load_loop(LOOPS / "paper.toml").simulate(
+            delays=("uniform", low, high), seed=4, steps=400, record=True)
+        assert np.array_equal(np.loadtxt(out, delimiter=",", skiprows=1)[:, 2], run.positions)
     for bad, named in ((("--delays", "uniform:5:2"), "--delays"), (("--delays", "u:1:2"), "--delays"),
                        (("--delays", "uniform:1.5:2.25"), "--delays"),
                        (("--delays", "uniform:1:x"), "--delays"),
